@@ -1,0 +1,57 @@
+"""surfmod: the surface-modeling toolbox of CAD/CAM on OpenCASCADE, checked by NumPy.
+
+>>> import surfmod as sm
+>>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
+>>> sm.crosscheck(s).passed
+True
+
+Public names are resolved lazily so that ``import surfmod`` stays fast; OCP and
+build123d load on the first call that needs the kernel.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from .errors import KernelError, SurfmodError
+
+__version__ = "0.1.0"
+
+# public name -> module that defines it (relative to this package)
+_EXPORTS = {
+    "Surface": ".surface",
+    "Curve": ".curve",
+    "Curvatures": ".eval.differential",
+    "BSplineSurface": ".nets.bspline",
+    "BSplineCurve": ".nets.bspline",
+    "BezierSurface": ".nets.bezier",
+    "BezierCurve": ".nets.bezier",
+    "HermiteBicubic": ".nets.hermite",
+    "plane": ".build.plane",
+    "PlaneSurface": ".build.plane",
+    "Line": ".build.curves",
+    "from_face": ".build.from_face",
+    "from_edge": ".build.from_face",
+    "crosscheck": ".check",
+    "CrossCheck": ".check",
+    "mesh": ".mesh.grid",
+    "Mesh": ".mesh.grid",
+    "export_step": ".io.step",
+    "import_step": ".io.step",
+    "export_stl": ".io.stl",
+}
+
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'surfmod' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return __all__

@@ -1,0 +1,1 @@
+"""Constructors: each lecture entity -> a surfmod Surface (or Curve)."""

@@ -1,0 +1,179 @@
+"""Cross-checking a surfmod object against its OCCT twin.
+
+``parametric`` mode (the construct is exact in OCCT): positions, first and second
+derivatives, normals and curvatures from the NumPy evaluator are compared with OCCT's
+``D2`` and ``GeomLProp_SLProps`` at the same parameters, on a grid that contains the
+domain ends, every knot and any seam.
+
+``geometric`` mode (OCCT only approximates the construct: sweeps, lofts, fits): the
+distance from every NumPy point to the OCCT face is measured.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from . import checks, tolerances
+from .curve import Curve
+from .surface import Surface
+
+
+class _CrossCheckFields(NamedTuple):
+    max_deviation: float
+    mode: str
+    samples: int
+    passed: bool
+
+
+class CrossCheck(_CrossCheckFields):
+    """Result of :func:`crosscheck`: ``(max_deviation, mode, samples, passed)``.
+
+    ``max_deviation`` is the largest position deviation in model units; ``details``
+    (an attribute, not a field) holds the per-quantity figures.
+    """
+
+    details: dict
+
+    def __repr__(self):
+        state = "passed" if self.passed else "FAILED"
+        return f"CrossCheck({self.mode}, {self.samples} samples, max deviation {self.max_deviation:.3g}, {state})"
+
+
+def _result(max_dev, mode, samples, passed, details):
+    out = CrossCheck(float(max_dev), mode, int(samples), bool(passed))
+    out.details = details
+    return out
+
+
+def sample_parameters(lo: float, hi: float, count: int, extra=()) -> np.ndarray:
+    """``count`` equally spaced values plus the given extra values (knots, seams), sorted."""
+    base = np.linspace(lo, hi, count)
+    extra = np.asarray([x for x in extra if lo <= x <= hi], dtype=float)
+    return np.unique(np.concatenate([base, extra]))
+
+
+def _knots_in(obj, direction):
+    knots = getattr(obj, "knots", None)
+    if knots is None:
+        return ()
+    return knots[direction] if isinstance(knots, tuple) else knots
+
+
+def _rel(a, b, scale):
+    return float(np.nanmax(np.abs(a - b)) / scale) if a.size else 0.0
+
+
+def crosscheck(obj, samples: int = 64, tolerance: float | None = None) -> CrossCheck:
+    """Compare ``obj`` with OCCT; works on surfmod surfaces and curves, and on build123d /
+    OCP faces (read back with :func:`surfmod.from_face`).
+
+    >>> import surfmod as sm
+    >>> r = sm.crosscheck(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), samples=8)
+    >>> r.mode, r.passed
+    ('parametric', True)
+    """
+    samples = checks.count(samples, "samples", minimum=2)
+    if isinstance(obj, Curve):
+        return _check_curve(obj, samples)
+    if not isinstance(obj, Surface):
+        from .build.from_face import from_face
+
+        obj = from_face(obj)
+    if obj.exact_in_occt:
+        return _check_parametric(obj, samples)
+    return _check_geometric(obj, samples, tolerance)
+
+
+def _check_parametric(s: Surface, samples: int) -> CrossCheck:
+    from .occ.sample import surface_d2, surface_props
+
+    (u0, u1), (v0, v1) = s.domain
+    us = sample_parameters(u0, u1, samples, _knots_in(s, 0))
+    vs = sample_parameters(v0, v1, samples, _knots_in(s, 1))
+    uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
+    mine = s._derivatives(uu, vv, 2)
+    occ = surface_d2(s.geom(), uu, vv)
+
+    pos_scale = max(float(np.abs(mine[:, 0, 0]).max()), 1.0)
+    d1_scale = max(float(np.abs(mine[:, [1, 0], [0, 1]]).max()), 1e-300)
+    d2_scale = max(float(np.abs(mine[:, [2, 1, 0], [0, 1, 2]]).max()), 1e-300)
+    pos_dev = float(np.abs(mine[:, 0, 0] - occ[:, 0, 0]).max())
+    d1_rel = _rel(mine[:, [1, 0], [0, 1]], occ[:, [1, 0], [0, 1]], d1_scale)
+    d2_rel = _rel(mine[:, [2, 1, 0], [0, 1, 2]], occ[:, [2, 1, 0], [0, 1, 2]], d2_scale)
+
+    # normals and curvature where both sides call them defined (off degenerate points)
+    sub = slice(None, None, max(1, len(uu) // 1024))  # GeomLProp is slow; a dense subset
+    n_occ, k_occ = surface_props(s.geom(), uu[sub], vv[sub])
+    n_mine = s.normals(uu[sub], vv[sub])
+    ok = np.all(np.isfinite(n_occ), axis=1)
+    normal_dev = float(np.abs(n_mine[ok] - n_occ[ok]).max()) if ok.any() else 0.0
+    c = s.curvatures(uu[sub], vv[sub])
+    mine_k = np.stack([c.gaussian, c.mean, c.k1, c.k2], axis=1)
+    okk = np.all(np.isfinite(k_occ), axis=1) & ok
+    k_scale = max(float(np.abs(k_occ[okk]).max()) if okk.any() else 0.0, 1.0 / pos_scale)
+    # Gaussian curvature has units 1/L^2: compare it against k_scale^2
+    k_dev = 0.0
+    if okk.any():
+        diff = np.abs(mine_k[okk] - k_occ[okk])
+        k_dev = float(max(diff[:, 0].max() / k_scale**2, diff[:, 1:].max() / k_scale))
+
+    details = {
+        "position": pos_dev,
+        "position_rel": pos_dev / pos_scale,
+        "d1_rel": d1_rel,
+        "d2_rel": d2_rel,
+        "normal": normal_dev,
+        "curvature_rel": k_dev,
+    }
+    passed = (
+        pos_dev <= tolerances.EXACT_RTOL * pos_scale * 10
+        and d1_rel <= tolerances.DERIVATIVE_RTOL
+        and d2_rel <= tolerances.DERIVATIVE_RTOL
+        and normal_dev <= 1e-8
+        and k_dev <= 1e-7
+    )
+    return _result(pos_dev, "parametric", uu.size, passed, details)
+
+
+def _check_geometric(s: Surface, samples: int, tolerance: float | None) -> CrossCheck:
+    from .occ.sample import distances_to_surface
+
+    tol = tolerance if tolerance is not None else getattr(s, "tolerance", None) or tolerances.GEOMETRIC_TOL
+    (u0, u1), (v0, v1) = s.domain
+    us = np.linspace(u0, u1, samples)
+    vs = np.linspace(v0, v1, samples)
+    pts = s.grid(us, vs).reshape(-1, 3)
+    geom = s.geom()
+    bounds = _geom_bounds(s, geom)
+    dist = distances_to_surface(geom, pts, bounds)
+    if np.any(np.isnan(dist)):
+        from .occ.sample import distances_to_face
+
+        miss = np.isnan(dist)
+        dist[miss] = distances_to_face(s.face().wrapped, pts[miss])
+    max_dev = float(dist.max())
+    return _result(max_dev, "geometric", len(pts), max_dev <= tol, {"tolerance": tol, "mean": float(dist.mean())})
+
+
+def _geom_bounds(s, geom):
+    bounds = getattr(s, "occ_bounds", None)
+    if bounds is not None:
+        return bounds
+    return geom.Bounds()
+
+
+def _check_curve(c: Curve, samples: int) -> CrossCheck:
+    from .occ.sample import curve_d2
+
+    t0, t1 = c.domain
+    knots = getattr(c, "knots", ())
+    t = sample_parameters(t0, t1, samples, knots)
+    mine = c._derivatives(t, 2)
+    occ = curve_d2(c.geom(), t)
+    scale = max(float(np.abs(mine[:, 0]).max()), 1.0)
+    pos_dev = float(np.abs(mine[:, 0] - occ[:, 0]).max())
+    d_rel = _rel(mine[:, 1:], occ[:, 1:], max(float(np.abs(mine[:, 1:]).max()), 1e-300))
+    passed = pos_dev <= tolerances.EXACT_RTOL * scale * 10 and d_rel <= tolerances.DERIVATIVE_RTOL
+    return _result(pos_dev, "parametric", t.size, passed, {"position": pos_dev, "derivatives_rel": d_rel})

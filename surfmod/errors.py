@@ -1,0 +1,25 @@
+"""Exceptions raised by surfmod.
+
+Every problem with user input is a :class:`SurfmodError` (a ``ValueError``) whose
+message names the offending argument.  Failures inside OpenCASCADE are re-raised as
+:class:`KernelError` (a subclass, so ``except SurfmodError`` catches both) carrying the
+operation that failed, never as a raw ``Standard_Failure``.
+"""
+
+from __future__ import annotations
+
+
+class SurfmodError(ValueError):
+    """Bad input to a surfmod call; the message names the argument.
+
+    >>> import surfmod as sm
+    >>> try:
+    ...     sm.plane((0, 0, 0), (1, 0, 0), (2, 0, 0))
+    ... except sm.SurfmodError as exc:
+    ...     print("p2" in str(exc))
+    True
+    """
+
+
+class KernelError(SurfmodError):
+    """OpenCASCADE refused or failed an operation; the message says which one."""

@@ -1,0 +1,96 @@
+"""B-spline and Bernstein basis functions with derivatives, vectorized over parameters.
+
+The loops run over the degree and the derivative order only (Piegl & Tiller, *The NURBS
+Book*, algorithms A2.1 and A2.3, with every scalar replaced by an array over the
+parameters).  A Bézier basis of degree n is the B-spline basis on the clamped knot vector
+``[0]*(n+1) + [1]*(n+1)``, so both share this code.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def find_spans(knots: np.ndarray, degree: int, n_ctrl: int, t: np.ndarray) -> np.ndarray:
+    """Index ``i`` with ``knots[i] <= t < knots[i+1]`` for each t, inside ``[degree, n_ctrl-1]``.
+
+    The right end of the domain belongs to the last non-empty span, as in OCCT.
+    """
+    spans = np.searchsorted(knots, t, side="right") - 1
+    return np.clip(spans, degree, n_ctrl - 1)
+
+
+def basis_derivatives(knots: np.ndarray, degree: int, spans: np.ndarray, t: np.ndarray, order: int) -> np.ndarray:
+    """Non-zero basis functions and their derivatives.
+
+    Returns ``ders`` of shape ``(len(t), order + 1, degree + 1)`` where ``ders[a, k, r]`` is the
+    k-th derivative of ``N_{spans[a] - degree + r, degree}`` at ``t[a]``.  Derivatives above
+    the degree are zero.
+    """
+    p = degree
+    t = np.asarray(t, dtype=float).ravel()
+    n_pts = t.size
+    ndu = np.zeros((n_pts, p + 1, p + 1))
+    ndu[:, 0, 0] = 1.0
+    left = np.zeros((n_pts, p + 1))
+    right = np.zeros((n_pts, p + 1))
+    for j in range(1, p + 1):
+        left[:, j] = t - knots[spans + 1 - j]
+        right[:, j] = knots[spans + j] - t
+        saved = np.zeros(n_pts)
+        for r in range(j):
+            ndu[:, j, r] = right[:, r + 1] + left[:, j - r]
+            temp = ndu[:, r, j - 1] / ndu[:, j, r]
+            ndu[:, r, j] = saved + right[:, r + 1] * temp
+            saved = left[:, j - r] * temp
+        ndu[:, j, j] = saved
+
+    ders = np.zeros((n_pts, order + 1, p + 1))
+    ders[:, 0, :] = ndu[:, :, p]
+    top = min(order, p)
+    for r in range(p + 1):
+        a = np.zeros((2, n_pts, p + 1))
+        a[0, :, 0] = 1.0
+        s1, s2 = 0, 1
+        for k in range(1, top + 1):
+            d = np.zeros(n_pts)
+            rk, pk = r - k, p - k
+            if r >= k:
+                a[s2, :, 0] = a[s1, :, 0] / ndu[:, pk + 1, rk]
+                d += a[s2, :, 0] * ndu[:, rk, pk]
+            j1 = 1 if rk >= -1 else -rk
+            j2 = k - 1 if r - 1 <= pk else p - r
+            for j in range(j1, j2 + 1):
+                a[s2, :, j] = (a[s1, :, j] - a[s1, :, j - 1]) / ndu[:, pk + 1, rk + j]
+                d += a[s2, :, j] * ndu[:, rk + j, pk]
+            if r <= pk:
+                a[s2, :, k] = -a[s1, :, k - 1] / ndu[:, pk + 1, r]
+                d += a[s2, :, k] * ndu[:, r, pk]
+            ders[:, k, r] = d
+            s1, s2 = s2, s1
+    factor = float(p)
+    for k in range(1, top + 1):
+        ders[:, k, :] *= factor
+        factor *= p - k
+    return ders
+
+
+def clamped_bezier_knots(degree: int) -> np.ndarray:
+    """The knot vector on which the B-spline basis of ``degree`` is the Bernstein basis."""
+    return np.concatenate([np.zeros(degree + 1), np.ones(degree + 1)])
+
+
+def basis_matrix(knots: np.ndarray, degree: int, n_ctrl: int, t: np.ndarray, order: int = 0) -> np.ndarray:
+    """Dense basis matrices ``B[k, a, i] = d^k N_i(t_a)``, shape ``(order+1, len(t), n_ctrl)``.
+
+    Used for grid evaluation, where two BLAS products beat any gather.
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    spans = find_spans(knots, degree, n_ctrl, t)
+    ders = basis_derivatives(knots, degree, spans, t, order)
+    mat = np.zeros((order + 1, t.size, n_ctrl))
+    rows = np.arange(t.size)[:, None]
+    cols = spans[:, None] - degree + np.arange(degree + 1)[None, :]
+    for k in range(order + 1):
+        mat[k, rows, cols] = ders[:, k, :]
+    return mat

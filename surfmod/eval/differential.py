@@ -1,0 +1,61 @@
+"""Normals and curvatures from first and second partial derivatives (fundamental forms).
+
+Sign convention: the unit normal is ``Su x Sv / |Su x Sv|`` (as OCCT's ``GeomLProp``),
+and the second fundamental form is taken against that normal, so a sphere whose normal
+points outwards has mean curvature ``-1/R``.  ``k1 >= k2``.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+class Curvatures(NamedTuple):
+    """Gaussian and mean curvature and the principal curvatures ``k1 >= k2``."""
+
+    gaussian: np.ndarray
+    mean: np.ndarray
+    k1: np.ndarray
+    k2: np.ndarray
+
+
+def raw_normals(ders: np.ndarray) -> np.ndarray:
+    """``Su x Sv`` (not normalised) from a ``(..., K, K, 3)`` derivative array."""
+    return np.cross(ders[..., 1, 0, :], ders[..., 0, 1, :])
+
+
+def degenerate_mask(ders: np.ndarray, rel: float) -> np.ndarray:
+    """True where ``|Su x Sv|`` is negligible against ``|Su| |Sv|`` (or both vanish)."""
+    su = np.linalg.norm(ders[..., 1, 0, :], axis=-1)
+    sv = np.linalg.norm(ders[..., 0, 1, :], axis=-1)
+    cross = np.linalg.norm(raw_normals(ders), axis=-1)
+    scale = np.maximum(su * sv, np.finfo(float).tiny)
+    return (cross <= rel * scale) | (su * sv == 0.0)
+
+
+def unit_normals(ders: np.ndarray) -> np.ndarray:
+    """Unit normals; callers replace degenerate points beforehand."""
+    n = raw_normals(ders)
+    norm = np.linalg.norm(n, axis=-1, keepdims=True)
+    return n / np.where(norm > 0.0, norm, 1.0)
+
+
+def curvatures(ders: np.ndarray) -> Curvatures:
+    """Curvatures from a derivative array of order >= 2 (``(..., 3, 3, 3)`` or larger)."""
+    su, sv = ders[..., 1, 0, :], ders[..., 0, 1, :]
+    suu, suv, svv = ders[..., 2, 0, :], ders[..., 1, 1, :], ders[..., 0, 2, :]
+    n = unit_normals(ders)
+    e = np.einsum("...i,...i->...", su, su)
+    f = np.einsum("...i,...i->...", su, sv)
+    g = np.einsum("...i,...i->...", sv, sv)
+    l_ = np.einsum("...i,...i->...", suu, n)
+    m_ = np.einsum("...i,...i->...", suv, n)
+    n_ = np.einsum("...i,...i->...", svv, n)
+    det = e * g - f * f
+    det = np.where(det > 0.0, det, np.finfo(float).tiny)
+    gauss = (l_ * n_ - m_ * m_) / det
+    mean = (e * n_ - 2.0 * f * m_ + g * l_) / (2.0 * det)
+    disc = np.sqrt(np.maximum(mean * mean - gauss, 0.0))
+    return Curvatures(gauss, mean, mean + disc, mean - disc)

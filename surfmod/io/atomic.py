@@ -1,0 +1,45 @@
+"""Atomic file writes: write a temporary file beside the target, fsync, then rename.
+
+A failure at any point removes the temporary file and leaves an existing target as it
+was, so no reader ever sees a half-written file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+from ..errors import SurfmodError
+
+
+def target_path(path, name: str = "path", suffixes: tuple[str, ...] = ()) -> Path:
+    """Validate an output path: parent folder exists, suffix as expected."""
+    try:
+        p = Path(os.fspath(path))
+    except TypeError:
+        raise SurfmodError(f"{name}: expected a file path, got {type(path).__name__}") from None
+    if p.is_dir():
+        raise SurfmodError(f"{name}: {p} is a directory")
+    if not p.parent.exists():
+        raise SurfmodError(f"{name}: folder {p.parent} does not exist")
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise SurfmodError(f"{name}: expected a file ending in {' or '.join(suffixes)}, got {p.name}")
+    return p
+
+
+@contextlib.contextmanager
+def atomic_path(path: Path):
+    """Yield a temporary path in the target's folder; on success it replaces ``path``."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.remove(tmp)
+        raise

@@ -1,0 +1,36 @@
+"""The lecture's m x n parameter mesh: m values of u, n of v, equal divisions."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import checks
+from ..surface import Surface
+from .polymesh import Mesh
+
+
+def grid_faces(m: int, n: int, quads: bool = False) -> np.ndarray:
+    """Faces of an ``m x n`` vertex grid (row-major, vertex ``i*n + j``), counter-clockwise
+    in (u, v) so that they face along ``Su x Sv``."""
+    i, j = np.meshgrid(np.arange(m - 1), np.arange(n - 1), indexing="ij")
+    a = (i * n + j).ravel()
+    b, c, d = a + n, a + n + 1, a + 1
+    if quads:
+        return np.stack([a, b, c, d], axis=1)
+    return np.concatenate([np.stack([a, b, c], axis=1), np.stack([a, c, d], axis=1)])
+
+
+def mesh(s: Surface, m: int, n: int, *, quads: bool = False) -> Mesh:
+    """The m x n grid mesh of ``s``: vertices ``S(u_i, v_j)`` with ``m`` equally spaced
+    values of u and ``n`` of v; faces are triangles (``quads=True`` keeps the quads).
+
+    >>> import surfmod as sm
+    >>> msh = sm.mesh(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), 3, 4)
+    >>> msh.vertices.shape, msh.faces.shape
+    ((12, 3), (12, 3))
+    """
+    m = checks.count(m, "m", minimum=2)
+    n = checks.count(n, "n", minimum=2)
+    (u0, u1), (v0, v1) = s.domain
+    pts = s.grid(np.linspace(u0, u1, m), np.linspace(v0, v1, n))
+    return Mesh(pts.reshape(-1, 3), grid_faces(m, n, quads), {"kind": "grid", "m": m, "n": n})

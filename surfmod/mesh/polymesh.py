@@ -1,0 +1,64 @@
+"""``Mesh``: the plain vertex/face container shared by meshing, subdivision and export."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Vertices ``(V, 3)`` float and faces ``(F, k)`` int (triangles k=3 or quads k=4).
+
+    ``info`` carries measured facts about how the mesh was made (e.g. the measured
+    chordal deviation of a tessellation).
+
+    >>> import surfmod as sm
+    >>> m = sm.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    >>> float(m.area)
+    0.5
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    info: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self):
+        v = checks.finite_array(self.vertices, "vertices", ndim=2, last=3)
+        try:
+            f = np.asarray(self.faces)
+        except (TypeError, ValueError):
+            raise SurfmodError("faces: expected an integer array (F, 3) or (F, 4)") from None
+        if f.ndim != 2 or f.shape[1] not in (3, 4) or (f.size and not np.issubdtype(f.dtype, np.integer)):
+            raise SurfmodError(f"faces: expected an integer array (F, 3) or (F, 4), got shape {f.shape}")
+        if f.size and (f.min() < 0 or f.max() >= len(v)):
+            raise SurfmodError(f"faces: vertex index out of range 0..{len(v) - 1}")
+        object.__setattr__(self, "vertices", checks.frozen(v))
+        fi = np.array(f, dtype=np.int64, copy=True)
+        fi.setflags(write=False)
+        object.__setattr__(self, "faces", fi)
+
+    def triangles(self) -> np.ndarray:
+        """Faces as triangles (quads split along their 0-2 diagonal)."""
+        if self.faces.shape[1] == 3:
+            return self.faces
+        f = self.faces
+        return np.concatenate([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
+
+    def triangulated(self) -> "Mesh":
+        return Mesh(self.vertices, self.triangles(), dict(self.info))
+
+    @property
+    def area(self) -> float:
+        t = self.vertices[self.triangles()]
+        return float(np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum() / 2)
+
+    def to_trimesh(self):
+        """A ``trimesh.Trimesh`` (no processing, so vertex order is kept)."""
+        import trimesh
+
+        return trimesh.Trimesh(self.vertices, self.triangles(), process=False)

@@ -1,0 +1,1 @@
+"""Control-net surfaces and curves: Bézier, B-spline/NURBS, Hermite (frozen values)."""

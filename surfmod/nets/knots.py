@@ -1,0 +1,75 @@
+"""Knot-vector algorithms on homogeneous control arrays: insertion, segmentation,
+Bézier extraction.  Control arrays have the control index first; any trailing axes
+(other net direction, coordinates) ride along, so one routine serves curves and both
+directions of a surface (the net is transposed by the caller).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def multiplicity(knots: np.ndarray, t: float) -> int:
+    """How many times ``t`` occurs in ``knots`` (exact comparison)."""
+    return int(np.count_nonzero(knots == t))
+
+
+def insert_knot(knots: np.ndarray, degree: int, ctrl: np.ndarray, t: float, times: int):
+    """Boehm insertion of ``t`` ``times`` times (Piegl & Tiller A5.1), vectorized over
+    the trailing axes of ``ctrl``.  Returns ``(new_knots, new_ctrl)``; the shape of the
+    spline is unchanged."""
+    p = degree
+    n = ctrl.shape[0]
+    if times <= 0:
+        return knots, ctrl
+    k = int(np.clip(np.searchsorted(knots, t, side="right") - 1, p, n - 1))
+    s = multiplicity(knots, t)
+    r = times
+    new_knots = np.concatenate([knots[: k + 1], np.full(r, t), knots[k + 1 :]])
+    q = np.empty((n + r,) + ctrl.shape[1:])
+    q[: k - p + 1] = ctrl[: k - p + 1]
+    q[k - s + r :] = ctrl[k - s :]
+    rr = ctrl[k - p : k - s + 1].copy()
+    last = k - p
+    for j in range(1, r + 1):
+        last = k - p + j
+        for i in range(p - j - s + 1):
+            alpha = (t - knots[last + i]) / (knots[i + k + 1] - knots[last + i])
+            rr[i] = alpha * rr[i + 1] + (1.0 - alpha) * rr[i]
+        q[last] = rr[0]
+        q[k + r - j - s] = rr[p - j - s]
+    for i in range(last + 1, k - s):
+        q[i] = rr[i - last]
+    return new_knots, q
+
+
+def raise_multiplicity(knots, degree, ctrl, t, target):
+    """Insert ``t`` until its multiplicity is at least ``target``."""
+    return insert_knot(knots, degree, ctrl, t, target - multiplicity(knots, t))
+
+
+def segment(knots: np.ndarray, degree: int, ctrl: np.ndarray, a: float, b: float):
+    """The exact piece of the spline over ``[a, b]`` as a clamped spline."""
+    p = degree
+    knots, ctrl = raise_multiplicity(knots, p, ctrl, a, p)
+    knots, ctrl = raise_multiplicity(knots, p, ctrl, b, p)
+    s = int(np.searchsorted(knots, a, side="right")) - p
+    e = int(np.searchsorted(knots, b, side="left"))
+    sub_knots = np.concatenate([[a], knots[s : e + p], [b]])
+    return sub_knots, ctrl[s - 1 : e].copy()
+
+
+def bezier_pieces(knots: np.ndarray, degree: int, ctrl: np.ndarray):
+    """Split into Bézier pieces: list of ``((t0, t1), ctrl_piece)`` with ``degree+1`` points."""
+    n = ctrl.shape[0]
+    breaks = np.unique(knots[degree : n + 1])
+    pieces = []
+    for t0, t1 in zip(breaks[:-1], breaks[1:]):
+        _, piece = segment(knots, degree, ctrl, t0, t1)
+        pieces.append(((float(t0), float(t1)), piece))
+    return pieces
+
+
+def breakpoints(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
+    """Distinct knots inside the domain, ends included."""
+    return np.unique(knots[degree : n_ctrl + 1])

@@ -1,0 +1,93 @@
+"""NumPy <-> OCCT container conversions (TColgp / TColStd arrays, knots + multiplicities)."""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.gp import gp_Pnt, gp_Vec
+from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
+from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
+
+
+def pnt(p) -> gp_Pnt:
+    return gp_Pnt(float(p[0]), float(p[1]), float(p[2]))
+
+
+def vec(p) -> gp_Vec:
+    return gp_Vec(float(p[0]), float(p[1]), float(p[2]))
+
+
+def xyz(p) -> np.ndarray:
+    """A gp_Pnt/gp_Vec/gp_Dir as a NumPy array."""
+    return np.array([p.X(), p.Y(), p.Z()])
+
+
+def points_1d(points: np.ndarray) -> TColgp_Array1OfPnt:
+    arr = TColgp_Array1OfPnt(1, len(points))
+    for i, p in enumerate(points, start=1):
+        arr.SetValue(i, pnt(p))
+    return arr
+
+
+def points_2d(net: np.ndarray) -> TColgp_Array2OfPnt:
+    n, m = net.shape[:2]
+    arr = TColgp_Array2OfPnt(1, n, 1, m)
+    for i in range(n):
+        for j in range(m):
+            arr.SetValue(i + 1, j + 1, pnt(net[i, j]))
+    return arr
+
+
+def reals_1d(values) -> TColStd_Array1OfReal:
+    values = np.asarray(values, dtype=float)
+    arr = TColStd_Array1OfReal(1, len(values))
+    for i, x in enumerate(values, start=1):
+        arr.SetValue(i, float(x))
+    return arr
+
+
+def ints_1d(values) -> TColStd_Array1OfInteger:
+    arr = TColStd_Array1OfInteger(1, len(values))
+    for i, x in enumerate(values, start=1):
+        arr.SetValue(i, int(x))
+    return arr
+
+
+def reals_2d(values: np.ndarray) -> TColStd_Array2OfReal:
+    n, m = values.shape
+    arr = TColStd_Array2OfReal(1, n, 1, m)
+    for i in range(n):
+        for j in range(m):
+            arr.SetValue(i + 1, j + 1, float(values[i, j]))
+    return arr
+
+
+def knots_and_mults(flat_knots: np.ndarray):
+    """A full knot vector -> OCCT's (distinct knots, multiplicities) pair."""
+    values, counts = np.unique(np.asarray(flat_knots, dtype=float), return_counts=True)
+    return reals_1d(values), ints_1d(counts)
+
+
+def to_numpy_1d(arr) -> np.ndarray:
+    return np.array([arr.Value(i) for i in range(arr.Lower(), arr.Upper() + 1)], dtype=float)
+
+
+def pnts_to_numpy_1d(arr) -> np.ndarray:
+    return np.array([xyz(arr.Value(i)) for i in range(arr.Lower(), arr.Upper() + 1)])
+
+
+def pnts_to_numpy_2d(arr) -> np.ndarray:
+    return np.array(
+        [
+            [xyz(arr.Value(i, j)) for j in range(arr.LowerCol(), arr.UpperCol() + 1)]
+            for i in range(arr.LowerRow(), arr.UpperRow() + 1)
+        ]
+    )
+
+
+def reals_to_numpy_2d(arr) -> np.ndarray:
+    return np.array(
+        [
+            [arr.Value(i, j) for j in range(arr.LowerCol(), arr.UpperCol() + 1)]
+            for i in range(arr.LowerRow(), arr.UpperRow() + 1)
+        ]
+    )

@@ -1,0 +1,143 @@
+"""Build OCCT ``Geom_*`` curves and surfaces from surfmod data, and read them back."""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface
+
+from . import arrays
+from .guard import kernel
+
+
+def bspline_surface(net, degree, knots, weights=None) -> Geom_BSplineSurface:
+    """``Geom_BSplineSurface`` with the same poles, weights, flat knots and degrees."""
+    (p, q), (ku, kv) = degree, knots
+    uk, um = arrays.knots_and_mults(ku)
+    vk, vm = arrays.knots_and_mults(kv)
+    poles = arrays.points_2d(net)
+    with kernel("Geom_BSplineSurface"):
+        if weights is None:
+            return Geom_BSplineSurface(poles, uk, vk, um, vm, p, q, False, False)
+        return Geom_BSplineSurface(poles, arrays.reals_2d(weights), uk, vk, um, vm, p, q, False, False)
+
+
+def bezier_surface(net, weights=None) -> Geom_BezierSurface:
+    poles = arrays.points_2d(net)
+    with kernel("Geom_BezierSurface"):
+        if weights is None:
+            return Geom_BezierSurface(poles)
+        return Geom_BezierSurface(poles, arrays.reals_2d(weights))
+
+
+def bspline_curve(points, degree, knots, weights=None) -> Geom_BSplineCurve:
+    k, mults = arrays.knots_and_mults(knots)
+    poles = arrays.points_1d(points)
+    with kernel("Geom_BSplineCurve"):
+        if weights is None:
+            return Geom_BSplineCurve(poles, k, mults, degree, False)
+        return Geom_BSplineCurve(poles, arrays.reals_1d(weights), k, mults, degree, False)
+
+
+def bezier_curve(points, weights=None) -> Geom_BezierCurve:
+    poles = arrays.points_1d(points)
+    with kernel("Geom_BezierCurve"):
+        if weights is None:
+            return Geom_BezierCurve(poles)
+        return Geom_BezierCurve(poles, arrays.reals_1d(weights))
+
+
+def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
+    """Poles, weights (None if polynomial), flat knots and degrees of a B-spline surface.
+
+    Periodic surfaces are read through a non-periodic copy (same shape, OCCT converts)."""
+    with kernel("reading Geom_BSplineSurface"):
+        if surf.IsUPeriodic() or surf.IsVPeriodic():
+            surf = Geom_BSplineSurface.DownCast(surf.Copy())
+            if surf.IsUPeriodic():
+                surf.SetUNotPeriodic()
+            if surf.IsVPeriodic():
+                surf.SetVNotPeriodic()
+        n, m = surf.NbUPoles(), surf.NbVPoles()
+        from OCP.TColgp import TColgp_Array2OfPnt
+        from OCP.TColStd import TColStd_Array1OfReal, TColStd_Array2OfReal
+
+        poles = TColgp_Array2OfPnt(1, n, 1, m)
+        surf.Poles(poles)
+        net = arrays.pnts_to_numpy_2d(poles)
+        weights = None
+        if surf.IsURational() or surf.IsVRational():
+            w = TColStd_Array2OfReal(1, n, 1, m)
+            surf.Weights(w)
+            weights = arrays.reals_to_numpy_2d(w)
+        p, q = surf.UDegree(), surf.VDegree()
+        ku = TColStd_Array1OfReal(1, n + p + 1)
+        surf.UKnotSequence(ku)
+        kv = TColStd_Array1OfReal(1, m + q + 1)
+        surf.VKnotSequence(kv)
+    return {
+        "control_points": net,
+        "weights": weights,
+        "knots": (arrays.to_numpy_1d(ku), arrays.to_numpy_1d(kv)),
+        "degree": (p, q),
+    }
+
+
+def read_bezier_surface(surf: Geom_BezierSurface) -> dict:
+    with kernel("reading Geom_BezierSurface"):
+        from OCP.TColgp import TColgp_Array2OfPnt
+        from OCP.TColStd import TColStd_Array2OfReal
+
+        n, m = surf.NbUPoles(), surf.NbVPoles()
+        poles = TColgp_Array2OfPnt(1, n, 1, m)
+        surf.Poles(poles)
+        weights = None
+        if surf.IsURational() or surf.IsVRational():
+            w = TColStd_Array2OfReal(1, n, 1, m)
+            surf.Weights(w)
+            weights = arrays.reals_to_numpy_2d(w)
+    return {"control_points": arrays.pnts_to_numpy_2d(poles), "weights": weights}
+
+
+def read_bspline_curve(curve: Geom_BSplineCurve) -> dict:
+    with kernel("reading Geom_BSplineCurve"):
+        from OCP.TColgp import TColgp_Array1OfPnt
+        from OCP.TColStd import TColStd_Array1OfReal
+
+        if curve.IsPeriodic():
+            curve = Geom_BSplineCurve.DownCast(curve.Copy())
+            curve.SetNotPeriodic()
+        n, p = curve.NbPoles(), curve.Degree()
+        poles = TColgp_Array1OfPnt(1, n)
+        curve.Poles(poles)
+        weights = None
+        if curve.IsRational():
+            w = TColStd_Array1OfReal(1, n)
+            curve.Weights(w)
+            weights = arrays.to_numpy_1d(w)
+        k = TColStd_Array1OfReal(1, n + p + 1)
+        curve.KnotSequence(k)
+    return {"points": arrays.pnts_to_numpy_1d(poles), "weights": weights, "knots": arrays.to_numpy_1d(k), "degree": p}
+
+
+def surface_type(surf) -> str:
+    """OCCT dynamic type name of a Geom_Surface handle, e.g. ``Geom_BSplineSurface``."""
+    return surf.DynamicType().Name()
+
+
+def downcast_surface(surf):
+    """The most derived Python wrapper of a ``Geom_Surface`` handle."""
+    import OCP.Geom as G
+
+    cls = getattr(G, surface_type(surf), None)
+    if cls is None or not hasattr(cls, "DownCast"):
+        return surf
+    down = cls.DownCast(surf)
+    return down if down is not None else surf
+
+
+def as_bspline_surface(surf) -> np.ndarray:
+    """Exact conversion of any analytic/Bézier surface to B-spline (GeomConvert)."""
+    from OCP.GeomConvert import GeomConvert
+
+    with kernel("GeomConvert.SurfaceToBSplineSurface_s"):
+        return GeomConvert.SurfaceToBSplineSurface_s(surf)

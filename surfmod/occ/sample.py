@@ -1,0 +1,92 @@
+"""Per-point sampling of OCCT geometry: the cross-check's independent side.
+
+These are deliberately plain loops over OCCT calls (``D0``/``D1``/``D2``, ``GeomLProp``);
+they are the reference, not an evaluation path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.gp import gp_Pnt, gp_Vec
+from OCP.GeomLProp import GeomLProp_SLProps
+
+from .arrays import xyz
+from .guard import kernel
+
+
+def surface_d2(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``(N, 3, 3, 3)`` derivative squares from ``D2`` (entries with k+l > 2 are NaN)."""
+    out = np.full((len(u), 3, 3, 3), np.nan)
+    p = gp_Pnt()
+    d1u, d1v, d2u, d2v, d2uv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
+    with kernel("Geom_Surface.D2"):
+        for a, (uu, vv) in enumerate(zip(u, v)):
+            surf.D2(float(uu), float(vv), p, d1u, d1v, d2u, d2v, d2uv)
+            out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d1u), xyz(d1v)
+            out[a, 2, 0], out[a, 0, 2], out[a, 1, 1] = xyz(d2u), xyz(d2v), xyz(d2uv)
+    return out
+
+
+def surface_d0(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``(N, 3)`` positions from ``Value``."""
+    with kernel("Geom_Surface.Value"):
+        return np.array([xyz(surf.Value(float(uu), float(vv))) for uu, vv in zip(u, v)])
+
+
+def surface_props(surf, u: np.ndarray, v: np.ndarray, resolution: float = 1e-9):
+    """Normals ``(N, 3)`` (NaN where undefined) and curvatures ``(N, 4)`` = (K, H, max, min)
+    from ``GeomLProp_SLProps`` (NaN where undefined)."""
+    normals = np.full((len(u), 3), np.nan)
+    curv = np.full((len(u), 4), np.nan)
+    with kernel("GeomLProp_SLProps"):
+        props = GeomLProp_SLProps(surf, 2, resolution)
+        for a, (uu, vv) in enumerate(zip(u, v)):
+            props.SetParameters(float(uu), float(vv))
+            if props.IsNormalDefined():
+                normals[a] = xyz(props.Normal())
+            if props.IsCurvatureDefined():
+                curv[a] = (props.GaussianCurvature(), props.MeanCurvature(), props.MaxCurvature(), props.MinCurvature())
+    return normals, curv
+
+
+def curve_d2(curve, t: np.ndarray) -> np.ndarray:
+    """``(N, 3, 3)`` position, first and second derivative from ``D2``."""
+    out = np.empty((len(t), 3, 3))
+    p, d1, d2 = gp_Pnt(), gp_Vec(), gp_Vec()
+    with kernel("Geom_Curve.D2"):
+        for a, tt in enumerate(t):
+            curve.D2(float(tt), p, d1, d2)
+            out[a] = (xyz(p), xyz(d1), xyz(d2))
+    return out
+
+
+def distances_to_face(face_shape, points: np.ndarray) -> np.ndarray:
+    """Distance from each point to a TopoDS face (``BRepExtrema_DistShapeShape``)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+
+    out = np.empty(len(points))
+    with kernel("BRepExtrema_DistShapeShape"):
+        dist = BRepExtrema_DistShapeShape()
+        dist.LoadS1(face_shape)
+        for a, q in enumerate(points):
+            vertex = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, q))).Vertex()
+            dist.LoadS2(vertex)
+            dist.Perform()
+            out[a] = dist.Value() if dist.IsDone() else np.inf
+    return out
+
+
+def distances_to_surface(surf, points: np.ndarray, bounds) -> np.ndarray:
+    """Distance from each point to a bounded ``Geom_Surface`` (``GeomAPI_ProjectPointOnSurf``),
+    falling back to the face distance when projection finds no extremum (e.g. at borders)."""
+    from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+
+    u0, u1, v0, v1 = bounds
+    out = np.empty(len(points))
+    with kernel("GeomAPI_ProjectPointOnSurf"):
+        proj = GeomAPI_ProjectPointOnSurf()
+        for a, q in enumerate(points):
+            proj.Init(gp_Pnt(*map(float, q)), surf, u0, u1, v0, v1)
+            out[a] = proj.LowerDistance() if proj.NbPoints() > 0 else np.nan
+    return out

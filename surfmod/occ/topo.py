@@ -1,0 +1,115 @@
+"""Faces, edges and shapes: from ``Geom_*`` objects to build123d topology and back."""
+
+from __future__ import annotations
+
+from OCP.BRep import BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace
+from OCP.TopoDS import TopoDS
+
+from ..errors import SurfmodError
+from .guard import check_done, kernel
+
+FACE_TOLERANCE = 1e-7
+
+
+def face_from_surface(surf, u0, u1, v0, v1):
+    """A build123d ``Face`` bounded by the parameter rectangle."""
+    import build123d as bd
+
+    with kernel("BRepBuilderAPI_MakeFace"):
+        maker = BRepBuilderAPI_MakeFace(surf, u0, u1, v0, v1, FACE_TOLERANCE)
+        check_done(maker, "BRepBuilderAPI_MakeFace")
+        return bd.Face(maker.Face())
+
+
+def edge_from_curve(curve, t0, t1):
+    """A build123d ``Edge`` over ``[t0, t1]``."""
+    import build123d as bd
+
+    with kernel("BRepBuilderAPI_MakeEdge"):
+        maker = BRepBuilderAPI_MakeEdge(curve, t0, t1)
+        check_done(maker, "BRepBuilderAPI_MakeEdge")
+        return bd.Edge(maker.Edge())
+
+
+def wrapped(obj):
+    """The ``TopoDS_Shape`` inside a build123d object (or the shape itself)."""
+    return getattr(obj, "wrapped", obj)
+
+
+def face_surface(face):
+    """``(Geom_Surface, (u0, u1, v0, v1), reversed)`` of a build123d or OCP face."""
+    from OCP.BRepTools import BRepTools
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
+
+    shape = wrapped(face)
+    if shape is None or shape.IsNull() or shape.ShapeType() != TopAbs_FACE:
+        raise SurfmodError(f"face: expected a build123d Face or TopoDS_Face, got {type(face).__name__}")
+    with kernel("BRep_Tool.Surface_s"):
+        f = TopoDS.Face_s(shape)
+        surf = BRep_Tool.Surface_s(f)
+        u0, u1, v0, v1 = BRepTools.UVBounds_s(f)
+        return surf, (u0, u1, v0, v1), f.Orientation() == TopAbs_REVERSED
+
+
+def curve_of_edge(edge):
+    """``(Geom_Curve, t0, t1)`` of a build123d or OCP edge."""
+    from OCP.TopAbs import TopAbs_EDGE
+
+    shape = wrapped(edge)
+    if shape is None or shape.IsNull() or shape.ShapeType() != TopAbs_EDGE:
+        raise SurfmodError(f"edge: expected a build123d Edge or TopoDS_Edge, got {type(edge).__name__}")
+    with kernel("BRep_Tool.Curve_s"):
+        e = TopoDS.Edge_s(shape)
+        curve, t0, t1 = BRep_Tool.Curve_s(e, 0.0, 0.0)
+        if curve is None:
+            raise SurfmodError("edge: has no 3-D curve")
+        return curve, t0, t1
+
+
+def faces_of(shape):
+    """All faces of a shape (build123d object or TopoDS_Shape), in exploration order."""
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+
+    out = []
+    explorer = TopExp_Explorer(wrapped(shape), TopAbs_FACE)
+    while explorer.More():
+        out.append(TopoDS.Face_s(explorer.Current()))
+        explorer.Next()
+    return out
+
+
+def shape_bspline(shape):
+    """The exact B-spline form of an edge's or a wire's 3-D curve (wires are joined
+    edge by edge with ``GeomConvert_CompCurveToBSplineCurve``)."""
+    from OCP.Geom import Geom_TrimmedCurve
+    from OCP.GeomConvert import GeomConvert, GeomConvert_CompCurveToBSplineCurve
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_WIRE
+    from OCP.BRepTools import BRepTools_WireExplorer
+
+    s = wrapped(shape)
+    if s is None or s.IsNull() or s.ShapeType() not in (TopAbs_EDGE, TopAbs_WIRE):
+        raise SurfmodError(f"expected a build123d Edge or Wire, got {type(shape).__name__}")
+    if s.ShapeType() == TopAbs_EDGE:
+        edges = [TopoDS.Edge_s(s)]
+    else:
+        edges = []
+        explorer = BRepTools_WireExplorer(TopoDS.Wire_s(s))
+        while explorer.More():
+            edges.append(explorer.Current())
+            explorer.Next()
+    with kernel("GeomConvert (edge to B-spline)"):
+        joined = None
+        for e in edges:
+            curve, t0, t1 = curve_of_edge(e)
+            piece = GeomConvert.CurveToBSplineCurve_s(Geom_TrimmedCurve(curve, t0, t1))
+            from OCP.TopAbs import TopAbs_REVERSED
+
+            if e.Orientation() == TopAbs_REVERSED:
+                piece.Reverse()
+            if joined is None:
+                joined = GeomConvert_CompCurveToBSplineCurve(piece)
+            elif not joined.Add(piece, 1e-6, True):
+                raise SurfmodError("wire: edges are not connected end to end")
+        return joined.BSplineCurve()

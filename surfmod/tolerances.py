@@ -1,0 +1,24 @@
+"""The few named tolerances of surfmod, documented once.
+
+``EXACT_RTOL``
+    Relative agreement expected between the NumPy evaluator and OCCT for constructs
+    that OCCT represents exactly (relative to the size of the control net).
+``DERIVATIVE_RTOL``
+    The same for first and second derivatives, which lose a few digits to cancellation
+    in the de Boor recurrences of both implementations.
+``DEGENERATE_NORMAL``
+    ``|Su x Sv|`` below this fraction of ``|Su| |Sv|`` (or of the net size squared)
+    marks a degenerate point (collapsed edge, pole) whose normal is taken as the limit
+    from the inside of the domain.
+``GEOMETRIC_TOL``
+    Default pass threshold of the geometric cross-check for constructs OCCT only
+    approximates (sweeps, lofts, fits), in model units.
+``LINEAR``
+    Default modelling tolerance handed to OCCT builders (sewing, pipe shells).
+"""
+
+EXACT_RTOL = 1e-12
+DERIVATIVE_RTOL = 1e-10
+DEGENERATE_NORMAL = 1e-10
+GEOMETRIC_TOL = 1e-4
+LINEAR = 1e-7
