@@ -9,6 +9,17 @@ from .arrays import xyz
 from .guard import kernel
 
 
+def _quiet_messages() -> None:
+    """OCCT's STEP translator prints statistics banners to stdout; keep only failures."""
+    from OCP.Message import Message, Message_Gravity
+
+    for printer in Message.DefaultMessenger_s().Printers():
+        printer.SetTraceLevel(Message_Gravity.Message_Fail)
+
+
+_quiet_messages()
+
+
 def compound(shapes):
     """One TopoDS_Compound of the given TopoDS shapes."""
     from OCP.BRep import BRep_Builder

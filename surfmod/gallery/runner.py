@@ -1,0 +1,76 @@
+"""Run the gallery: build, cross-check, export STEP + STL (+ PNG when rendering exists)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import SurfmodError
+from . import Entry, entries
+
+
+@dataclass
+class Row:
+    name: str
+    entity: str
+    construct: str
+    mode: str
+    max_deviation: float
+    passed: bool
+    note: str = ""
+
+
+def run_entry(e: Entry, outdir: Path) -> Row:
+    from .. import io
+    from ..check import crosscheck
+    from ..io.step import export_step
+    from ..io.stl import export_stl
+    from ..surface import Surface
+
+    del io
+    try:
+        obj = e.build()
+        if isinstance(obj, Surface):
+            result = crosscheck(obj)
+            construct = obj.occt_construct
+            mode, dev, ok = result.mode, result.max_deviation, result.passed
+        else:  # a build123d shape (solids from subdivision, parts): checked face by face
+            results = [crosscheck(f) for f in obj.faces()]
+            construct = type(obj).__name__
+            mode = "per-face"
+            dev = max(r.max_deviation for r in results)
+            ok = all(r.passed for r in results)
+        export_step(obj, outdir / f"{e.name}.step")
+        export_stl(obj, outdir / f"{e.name}.stl", tolerance=0.01)
+        _render(obj, outdir / f"{e.name}.png")
+        return Row(e.name, e.entity, construct, mode, dev, ok)
+    except SurfmodError as exc:
+        return Row(e.name, e.entity, "-", "error", float("nan"), False, str(exc))
+
+
+def _render(obj, path: Path) -> None:
+    try:
+        from ..mesh.render import render
+    except ImportError:  # rendering is provided by surfmod.mesh.render when installed
+        return
+    render([obj], path)
+
+
+def run_gallery(outdir, *, progress: bool = True) -> list[Row]:
+    from tqdm import tqdm
+
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    items = entries()
+    return [run_entry(e, out) for e in tqdm(items, desc="gallery", unit="entity", disable=not progress)]
+
+
+def format_table(rows: list[Row]) -> str:
+    head = f"{'entity':<34} {'OCCT construct':<42} {'mode':<10} {'max dev':>10}  pass"
+    lines = [head, "-" * len(head)]
+    for r in rows:
+        lines.append(
+            f"{r.entity:<34.34} {r.construct:<42.42} {r.mode:<10} {r.max_deviation:>10.2e}  {'yes' if r.passed else 'NO'}"
+            + (f"  ({r.note})" if r.note else "")
+        )
+    return "\n".join(lines)
