@@ -1,0 +1,111 @@
+"""Textbook evaluators written plainly, one point at a time: the yardstick for the fast code.
+
+Nothing here is vectorized or clever; each function follows the formula as printed in
+the lecture / The NURBS Book so that a disagreement points at the fast path.
+"""
+
+from __future__ import annotations
+
+from math import comb
+
+import numpy as np
+
+
+def bernstein(i: int, n: int, t: float) -> float:
+    """B_{i,n}(t) = C(n, i) t^i (1 - t)^(n - i)."""
+    return comb(n, i) * t**i * (1.0 - t) ** (n - i)
+
+
+def bezier_point(net, s: float, t: float, weights=None) -> np.ndarray:
+    """Sum_i Sum_j B_i(s) B_j(t) w_ij P_ij / Sum w B B."""
+    net = np.asarray(net, dtype=float)
+    n, m = net.shape[0] - 1, net.shape[1] - 1
+    w = np.ones(net.shape[:2]) if weights is None else np.asarray(weights, dtype=float)
+    num, den = np.zeros(3), 0.0
+    for i in range(n + 1):
+        for j in range(m + 1):
+            b = bernstein(i, n, s) * bernstein(j, m, t) * w[i, j]
+            num += b * net[i, j]
+            den += b
+    return num / den
+
+
+def cox_de_boor(i: int, p: int, knots, t: float) -> float:
+    """Recursive N_{i,p}(t) on half-open spans [k_i, k_{i+1}) (0/0 taken as 0)."""
+    if p == 0:
+        return 1.0 if knots[i] <= t < knots[i + 1] else 0.0
+    out = 0.0
+    d1 = knots[i + p] - knots[i]
+    if d1 > 0:
+        out += (t - knots[i]) / d1 * cox_de_boor(i, p - 1, knots, t)
+    d2 = knots[i + p + 1] - knots[i + 1]
+    if d2 > 0:
+        out += (knots[i + p + 1] - t) / d2 * cox_de_boor(i + 1, p - 1, knots, t)
+    return out
+
+
+def bspline_basis(knots, p: int, n_ctrl: int, t: float) -> np.ndarray:
+    """All N_{i,p}(t), i < n_ctrl, with t = domain end handled as the limit from the left."""
+    knots = list(map(float, knots))
+    end = knots[n_ctrl]
+    if t >= end:
+        # limit from the left: evaluate a hair inside and snap (basis is polynomial per span)
+        return _left_limit(knots, p, n_ctrl, end)
+    return np.array([cox_de_boor(i, p, knots, t) for i in range(n_ctrl)])
+
+
+def _left_limit(knots, p, n_ctrl, end):
+    start = max(k for k in knots[: n_ctrl] if k < end)
+    # the basis restricted to the last span is a polynomial of degree p: fit it exactly
+    ts = np.linspace(start, end, p + 2)[:-1]
+    vals = np.array([[cox_de_boor(i, p, knots, t) for i in range(n_ctrl)] for t in ts])
+    coeffs = np.polynomial.polynomial.polyfit(ts - end, vals, p)
+    return coeffs[0]
+
+
+def bspline_surface_point(net, p, q, ku, kv, u, v, weights=None) -> np.ndarray:
+    net = np.asarray(net, dtype=float)
+    n, m = net.shape[:2]
+    w = np.ones((n, m)) if weights is None else np.asarray(weights, dtype=float)
+    bu = bspline_basis(ku, p, n, u)
+    bv = bspline_basis(kv, q, m, v)
+    coef = np.outer(bu, bv) * w
+    return np.einsum("ij,ijk->k", coef, net) / coef.sum()
+
+
+#: The lecture's uniform cubic B-spline matrix (times 1/6), rows for [t^3 t^2 t 1].
+UNIFORM_CUBIC_M = np.array([[-1.0, 3.0, -3.0, 1.0], [3.0, -6.0, 3.0, 0.0], [-3.0, 0.0, 3.0, 0.0], [1.0, 4.0, 1.0, 0.0]]) / 6.0
+
+#: The lecture's Hermite matrix, rows for [t^3 t^2 t 1].
+HERMITE_M = np.array([[2.0, -2.0, 1.0, 1.0], [-3.0, 3.0, -2.0, -1.0], [0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 0.0, 0.0]])
+
+
+def uniform_cubic_point(net, u: float, v: float) -> np.ndarray:
+    """Lecture matrix form on patch (i, j) = (floor u, floor v):
+    [s^3 s^2 s 1] M P_ij M^T [t^3 t^2 t 1]^T with P_ij the 4x4 neighbourhood."""
+    net = np.asarray(net, dtype=float)
+    n, m = net.shape[:2]
+    i = min(int(np.floor(u)), n - 4)
+    j = min(int(np.floor(v)), m - 4)
+    s, t = u - i, v - j
+    S = np.array([s**3, s**2, s, 1.0])
+    T = np.array([t**3, t**2, t, 1.0])
+    P = net[i : i + 4, j : j + 4]
+    return np.einsum("a,ab,bck,dc,d->k", S, UNIFORM_CUBIC_M, P, UNIFORM_CUBIC_M, T)
+
+
+def hermite_point(corners, du, dv, twist, s: float, t: float) -> np.ndarray:
+    """Lecture form S(s, t) = S M B M^T T^T with the 4x4 geometry matrix B."""
+    B = np.empty((4, 4, 3))
+    B[0, 0], B[0, 1], B[1, 0], B[1, 1] = corners[0, 0], corners[0, 1], corners[1, 0], corners[1, 1]
+    B[0, 2], B[0, 3], B[1, 2], B[1, 3] = dv[0, 0], dv[0, 1], dv[1, 0], dv[1, 1]
+    B[2, 0], B[2, 1], B[3, 0], B[3, 1] = du[0, 0], du[0, 1], du[1, 0], du[1, 1]
+    B[2, 2], B[2, 3], B[3, 2], B[3, 3] = twist[0, 0], twist[0, 1], twist[1, 0], twist[1, 1]
+    S = np.array([s**3, s**2, s, 1.0])
+    T = np.array([t**3, t**2, t, 1.0])
+    return np.einsum("a,ab,bck,dc,d->k", S, HERMITE_M, B, HERMITE_M, T)
+
+
+def finite_difference(fn, x: float, h: float = 1e-6) -> np.ndarray:
+    """Central difference of a vector function of one variable."""
+    return (np.asarray(fn(x + h)) - np.asarray(fn(x - h))) / (2 * h)
