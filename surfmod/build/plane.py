@@ -28,6 +28,13 @@ class PlaneSurface(BSplineSurface):
         n = np.cross(self.control_points[1, 0] - self.origin, self.control_points[0, 1] - self.origin)
         return n / np.linalg.norm(n)
 
+    def transformed(self, matrix) -> "PlaneSurface":
+        """An affine image of a plane is a plane: same class, mapped control points."""
+        out = BSplineSurface.transformed(self, matrix)
+        obj = PlaneSurface.__new__(PlaneSurface)
+        BSplineSurface._set(obj, out.control_points, out.degree, out.knots, None)
+        return obj
+
     def implicit(self, xyz) -> np.ndarray:
         """Signed distance ``F(x) = n . (x - P0)``; zero on the plane."""
         return (np.asarray(xyz, dtype=float) - self.origin) @ self.normal
