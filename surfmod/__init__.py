@@ -34,14 +34,18 @@ _EXPORTS = {
     "from_edge": ".build.from_face",
     "crosscheck": ".check",
     "CrossCheck": ".check",
-    "mesh": ".mesh.grid",
     "Mesh": ".mesh.grid",
     "export_step": ".io.step",
     "import_step": ".io.step",
     "export_stl": ".io.stl",
 }
 
-__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])
+
+# ``surfmod.mesh`` is both the subpackage with the meshing code and the public function
+# ``sm.mesh(s, m, n)``.  Importing the subpackage sets the package attribute, so the
+# function is bound right after it (pure NumPy, cheap) and stays the public name.
+from .mesh.grid import mesh  # noqa: E402
 
 
 def __getattr__(name: str):
