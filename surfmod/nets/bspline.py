@@ -281,6 +281,7 @@ class BSplineSurface(Surface):
     def split(self, u: float | None = None, v: float | None = None) -> list["BSplineSurface"]:
         """Split at ``u`` and/or ``v`` into 2 or 4 exact pieces (u-major order)."""
         (u0, u1), (v0, v1) = self.domain
+        u, v = (None if t is None else _interior(t, name, rng) for t, name, rng in ((u, "u", (u0, u1)), (v, "v", (v0, v1))))
         us = [(u0, u1)] if u is None else [(u0, float(u)), (float(u), u1)]
         vs = [(v0, v1)] if v is None else [(v0, float(v)), (float(v), v1)]
         return [self.segment(ur, vr) for ur in us for vr in vs]
@@ -312,6 +313,17 @@ class BSplineSurface(Surface):
         pts, w = cartesian(h, self.rational)
         other = 1 - direction
         return BSplineCurve._trusted(pts, self.degree[other], self.knots[other], w)
+
+
+def _interior(value, name, domain):
+    """A single parameter strictly inside ``domain`` (a split position)."""
+    t = checks.parameters(value, name, domain)
+    if t.size != 1:
+        raise SurfmodError(f"{name}: expected one split parameter, got shape {t.shape}")
+    t = float(t.item())
+    if not domain[0] < t < domain[1]:
+        raise SurfmodError(f"{name}: split parameter {t:g} must lie strictly inside ({domain[0]:g}, {domain[1]:g})")
+    return t
 
 
 def _pair(value, name):
