@@ -33,8 +33,11 @@ def edge_from_curve(curve, t0, t1):
 
 
 def wrapped(obj):
-    """The ``TopoDS_Shape`` inside a build123d object (or the shape itself)."""
-    return getattr(obj, "wrapped", obj)
+    """The ``TopoDS_Shape`` inside a build123d object, the shape itself, or None."""
+    from OCP.TopoDS import TopoDS_Shape
+
+    shape = getattr(obj, "wrapped", obj)
+    return shape if isinstance(shape, TopoDS_Shape) else None
 
 
 def face_surface(face):
@@ -61,9 +64,10 @@ def curve_of_edge(edge):
         raise SurfmodError(f"edge: expected a build123d Edge or TopoDS_Edge, got {type(edge).__name__}")
     with kernel("BRep_Tool.Curve_s"):
         e = TopoDS.Edge_s(shape)
-        curve, t0, t1 = BRep_Tool.Curve_s(e, 0.0, 0.0)
+        curve = BRep_Tool.Curve_s(e, 0.0, 0.0)  # located copy; OCP returns only the curve
         if curve is None:
             raise SurfmodError("edge: has no 3-D curve")
+        t0, t1 = BRep_Tool.Range_s(e)
         return curve, t0, t1
 
 
@@ -72,8 +76,11 @@ def faces_of(shape):
     from OCP.TopAbs import TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
 
+    shp = wrapped(shape)
+    if shp is None:
+        raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
     out = []
-    explorer = TopExp_Explorer(wrapped(shape), TopAbs_FACE)
+    explorer = TopExp_Explorer(shp, TopAbs_FACE)
     while explorer.More():
         out.append(TopoDS.Face_s(explorer.Current()))
         explorer.Next()
