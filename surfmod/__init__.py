@@ -38,6 +38,13 @@ _EXPORTS = {
     "export_step": ".io.step",
     "import_step": ".io.step",
     "export_stl": ".io.stl",
+    "catmull_clark": ".subdiv.catmull_clark",
+    "loop_subdivide": ".subdiv.loop",
+    "catmull_clark_limit": ".subdiv.masks",
+    "loop_limit": ".subdiv.masks",
+    "LimitPoints": ".subdiv.masks",
+    "limit_surface": ".subdiv.limit",
+    "LimitSurface": ".subdiv.limit",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])

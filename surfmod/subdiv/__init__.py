@@ -1,0 +1,1 @@
+"""Subdivision surfaces: Catmull–Clark, Loop, limit masks and limit-surface patches."""
