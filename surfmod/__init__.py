@@ -38,6 +38,8 @@ _EXPORTS = {
     "export_step": ".io.step",
     "import_step": ".io.step",
     "export_stl": ".io.stl",
+    "trim": ".ops.trim",
+    "trimmed_area": ".ops.trim",
     "catmull_clark": ".subdiv.catmull_clark",
     "loop_subdivide": ".subdiv.loop",
     "catmull_clark_limit": ".subdiv.masks",
@@ -45,6 +47,8 @@ _EXPORTS = {
     "LimitPoints": ".subdiv.masks",
     "limit_surface": ".subdiv.limit",
     "LimitSurface": ".subdiv.limit",
+    "mass_properties": ".uses.mass",
+    "MassProperties": ".uses.mass",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])

@@ -1,0 +1,2 @@
+"""Surface manipulation: trimming, intersection, projection and shadows (NumPy first,
+cross-checked against OCCT in the tests)."""
