@@ -1,0 +1,425 @@
+"""OCCT side of the "uses" of surface models: solids, mass properties (``BRepGProp``),
+booleans (``BRepAlgoAPI``), distances (``BRepExtrema``), planar sections, BREP/STEP I/O
+for gmsh, and the per-face data the NumPy quadrature needs.
+
+Everything here returns plain Python/NumPy data; the NumPy work lives in
+``surfmod/uses``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.BRep import BRep_Tool
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+
+from ..errors import SurfmodError
+from .arrays import xyz
+from .guard import check_done, kernel
+
+SEW_TOLERANCE = 1e-6
+
+
+def _explore(shape, kind):
+    out = []
+    explorer = TopExp_Explorer(shape, kind)
+    while explorer.More():
+        out.append(explorer.Current())
+        explorer.Next()
+    return out
+
+
+def solids_of(shape):
+    return [TopoDS.Solid_s(s) for s in _explore(shape, TopAbs_SOLID)]
+
+
+def shells_of(shape):
+    return [TopoDS.Shell_s(s) for s in _explore(shape, TopAbs_SHELL)]
+
+
+def count_faces(shape) -> int:
+    return len(_explore(shape, TopAbs_FACE))
+
+
+def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
+    """Sew faces into a closed shell and make an outward-oriented solid.
+
+    Raises ``SurfmodError`` when the faces do not close up.
+    """
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+    from OCP.BRepLib import BRepLib
+
+    with kernel("BRepBuilderAPI_Sewing"):
+        sewing = BRepBuilderAPI_Sewing(tolerance)
+        for f in face_shapes:
+            sewing.Add(f)
+        sewing.Perform()
+        sewed = sewing.SewedShape()
+    shells = shells_of(sewed)
+    if len(shells) != 1 or not BRep_Tool.IsClosed_s(shells[0]):
+        raise SurfmodError(
+            f"obj: the {len(face_shapes)} faces do not sew into one closed shell "
+            f"(got {len(shells)} shell(s), free edges remain): volume needs a closed boundary"
+        )
+    with kernel("BRepBuilderAPI_MakeSolid"):
+        maker = BRepBuilderAPI_MakeSolid(shells[0])
+        check_done(maker, "BRepBuilderAPI_MakeSolid")
+        solid = maker.Solid()
+        BRepLib.OrientClosedSolid_s(solid)
+    return solid
+
+
+def closed_solid(shape):
+    """A closed solid (or compound of them) for volume work; open shells are refused."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
+    from OCP.BRepLib import BRepLib
+
+    from .exchange import compound
+
+    solids = solids_of(shape)
+    if solids:
+        for i, s in enumerate(solids):
+            for sh in shells_of(s):
+                if not BRep_Tool.IsClosed_s(sh):
+                    raise SurfmodError(f"obj: solid {i} has an open shell (free edges): volume needs a closed boundary")
+        return solids[0] if len(solids) == 1 else compound(solids)
+    shells = shells_of(shape)
+    if shells:
+        out = []
+        for i, sh in enumerate(shells):
+            if not BRep_Tool.IsClosed_s(sh):
+                raise SurfmodError(f"obj: shell {i} is not closed (free edges): volume needs a closed boundary")
+            with kernel("BRepBuilderAPI_MakeSolid"):
+                solid = BRepBuilderAPI_MakeSolid(sh).Solid()
+                BRepLib.OrientClosedSolid_s(solid)
+            out.append(solid)
+        return out[0] if len(out) == 1 else compound(out)
+    faces = _explore(shape, TopAbs_FACE)
+    if not faces:
+        raise SurfmodError("obj: has no faces")
+    return sew_solid(faces)
+
+
+def gprops(shape, eps: float = 1e-9) -> dict:
+    """``BRepGProp`` volume and surface properties at relative tolerance ``eps``.
+
+    Returns volume, area, centroid and the inertia matrix about the centroid
+    (OCCT's ``MatrixOfInertia``: diagonal ``∫(y²+z²)``, off-diagonal ``−∫xy``).
+    """
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    with kernel("BRepGProp.VolumeProperties_s"):
+        vp = GProp_GProps()
+        verr = BRepGProp.VolumeProperties_s(shape, vp, float(eps), False, False)
+        sp = GProp_GProps()
+        serr = BRepGProp.SurfaceProperties_s(shape, sp, float(eps), False)
+        c = vp.CentreOfMass()
+        m = vp.MatrixOfInertia()
+        inertia = np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)])
+    return {
+        "volume": vp.Mass(),
+        "area": sp.Mass(),
+        "centroid": xyz(c),
+        "inertia": inertia,
+        "volume_error": verr,
+        "area_error": serr,
+    }
+
+
+def bounding_box(shape) -> np.ndarray:
+    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` (optimal box)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    with kernel("BRepBndLib.AddOptimal_s"):
+        box = Bnd_Box()
+        BRepBndLib.AddOptimal_s(shape, box, False, False)
+        return np.array(box.Get()).reshape(2, 3)
+
+
+# -- per-face data for the NumPy quadrature ---------------------------------------------
+def _elementary(surf, name):
+    """Frame and radii of an OCCT elementary surface, or None."""
+    import OCP.Geom as G
+
+    cls = getattr(G, name, None)
+    s = cls.DownCast(surf) if cls is not None and hasattr(cls, "DownCast") else surf
+    if name not in ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface",
+                    "Geom_SphericalSurface", "Geom_ToroidalSurface"):
+        return None
+    ax = s.Position()
+    data = {
+        "origin": xyz(ax.Location()),
+        "x": xyz(ax.XDirection()),
+        "y": xyz(ax.YDirection()),
+        "z": xyz(ax.Direction()),
+    }
+    if name == "Geom_CylindricalSurface":
+        data["radius"] = s.Radius()
+    elif name == "Geom_SphericalSurface":
+        data["radius"] = s.Radius()
+    elif name == "Geom_ConicalSurface":
+        data["radius"], data["angle"] = s.RefRadius(), s.SemiAngle()
+    elif name == "Geom_ToroidalSurface":
+        data["major"], data["minor"] = s.MajorRadius(), s.MinorRadius()
+    return data
+
+
+def _is_rectangle(face, bounds) -> bool:
+    """True when every edge's p-curve lies on the border of the face's UV box (one wire)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+
+    if len(_explore(face, TopAbs_WIRE)) != 1:
+        return False
+    u0, u1, v0, v1 = bounds
+    tu, tv = 1e-7 * max(1.0, u1 - u0), 1e-7 * max(1.0, v1 - v0)
+    for e in _explore(face, TopAbs_EDGE):
+        edge = TopoDS.Edge_s(e)
+        pc = BRepAdaptor_Curve2d(edge, face)
+        f, l = pc.FirstParameter(), pc.LastParameter()
+        for t in f + (l - f) * np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0]):
+            p = pc.Value(float(t))
+            u, v = p.X(), p.Y()
+            on = min(abs(u - u0), abs(u - u1)) <= tu or min(abs(v - v0), abs(v - v1)) <= tv
+            if not on:
+                return False
+    return True
+
+
+def face_records(shape) -> list[dict]:
+    """One record per face: OCCT surface (unwrapped from rectangular trims), its type,
+    UV bounds, orientation, whether the face is its full UV rectangle, B-spline knots
+    and elementary-surface data."""
+    import OCP.Geom as G
+    from OCP.BRepTools import BRepTools
+
+    from .geom import downcast_surface, surface_type
+
+    out = []
+    for i, f in enumerate(_explore(shape, TopAbs_FACE)):
+        face = TopoDS.Face_s(f)
+        with kernel("face data"):
+            surf = BRep_Tool.Surface_s(face)
+            while surface_type(surf) == "Geom_RectangularTrimmedSurface":
+                surf = G.Geom_RectangularTrimmedSurface.DownCast(surf).BasisSurface()
+            name = surface_type(surf)
+            bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
+            rec = {
+                "index": i,
+                "face": face,
+                "geom": downcast_surface(surf),
+                "kind": name,
+                "bounds": bounds,
+                "reversed": face.Orientation() == TopAbs_REVERSED,
+                "natural": _is_rectangle(face, bounds),
+                "elementary": _elementary(surf, name),
+                "knots": None,
+            }
+            if name in ("Geom_BSplineSurface", "Geom_BezierSurface"):
+                g = rec["geom"]
+                if name == "Geom_BSplineSurface":
+                    uk = [g.UKnot(k) for k in range(1, g.NbUKnots() + 1)]
+                    vk = [g.VKnot(k) for k in range(1, g.NbVKnots() + 1)]
+                    rec["knots"] = (np.array(uk), np.array(vk))
+                    rec["degree"] = (g.UDegree(), g.VDegree())
+                    rec["rational"] = g.IsURational() or g.IsVRational()
+                else:
+                    rec["knots"] = (np.array([0.0, 1.0]), np.array([0.0, 1.0]))
+                    rec["degree"] = (g.UDegree(), g.VDegree())
+                    rec["rational"] = g.IsURational() or g.IsVRational()
+        out.append(rec)
+    return out
+
+
+def face_uv_triangles(face, deflection: float, angular: float = 0.1):
+    """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
+    face (the face's trimmed parameter region as a polygonal patchwork)."""
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.BRepTools import BRepTools
+    from OCP.TopLoc import TopLoc_Location
+
+    with kernel("BRepMesh_IncrementalMesh (face)"):
+        BRepTools.Clean_s(face)
+        BRepMesh_IncrementalMesh(face, float(deflection), False, float(angular), True)
+        tri = BRep_Tool.Triangulation_s(face, TopLoc_Location())
+        if tri is None or not tri.HasUVNodes():
+            raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
+        uv = np.array([[p.X(), p.Y()] for p in (tri.UVNode(i) for i in range(1, tri.NbNodes() + 1))])
+        idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
+    return uv, idx
+
+
+def face_boundary_nodes(face, order: int, pieces: int = 4):
+    """Gauss nodes on the p-curves of a face's boundary, for Green's theorem in (u, v).
+
+    Returns ``(u, v, w)`` with ``w = weight · dv/dt`` signed by the edge's orientation
+    in the face, so that ``Σ w G(u, v) = ∮ G dv`` over the whole boundary (outer wire
+    and holes).  Each p-curve is split at its C2 breaks and into at least ``pieces``
+    parts.
+    """
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.GeomAbs import GeomAbs_C2
+    from OCP.gp import gp_Pnt2d, gp_Vec2d
+    from OCP.TColStd import TColStd_Array1OfReal
+
+    x, w = np.polynomial.legendre.leggauss(order)
+    us, vs, ws = [], [], []
+    p, d = gp_Pnt2d(), gp_Vec2d()
+    with kernel("BRepAdaptor_Curve2d (face boundary)"):
+        for e in _explore(face, TopAbs_EDGE):
+            edge = TopoDS.Edge_s(e)
+            pc = BRepAdaptor_Curve2d(edge, face)
+            f, l = pc.FirstParameter(), pc.LastParameter()
+            n = pc.NbIntervals(GeomAbs_C2)
+            arr = TColStd_Array1OfReal(1, n + 1)
+            pc.Intervals(arr, GeomAbs_C2)
+            br = np.unique(np.concatenate([[arr.Value(i) for i in range(1, n + 2)], np.linspace(f, l, pieces + 1)]))
+            br = br[(br >= f) & (br <= l)]
+            a, b = br[:-1, None], br[1:, None]
+            t = ((a + b) / 2 + (b - a) / 2 * x).ravel()
+            wt = ((b - a) / 2 * w).ravel()
+            sign = -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0
+            for ti, wi in zip(t, wt):
+                pc.D1(float(ti), p, d)
+                us.append(p.X())
+                vs.append(p.Y())
+                ws.append(sign * wi * d.Y())
+    return np.array(us), np.array(vs), np.array(ws)
+
+
+def surface_derivatives(geom, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
+    """OCCT ``D0``/``D1``/``D2`` as ``(N, order+1, order+1, 3)`` (the fallback evaluator
+    for surface types without a NumPy twin; a plain loop over OCCT calls)."""
+    from OCP.gp import gp_Pnt, gp_Vec
+
+    n = len(u)
+    out = np.zeros((n, order + 1, order + 1, 3))
+    p = gp_Pnt()
+    d = [gp_Vec() for _ in range(5)]
+    with kernel("Geom_Surface.D2"):
+        for a in range(n):
+            uu, vv = float(u[a]), float(v[a])
+            if order == 0:
+                geom.D0(uu, vv, p)
+                out[a, 0, 0] = xyz(p)
+            elif order == 1:
+                geom.D1(uu, vv, p, d[0], d[1])
+                out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d[0]), xyz(d[1])
+            else:
+                geom.D2(uu, vv, p, d[0], d[1], d[2], d[3], d[4])
+                out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d[0]), xyz(d[1])
+                out[a, 2, 0], out[a, 0, 2], out[a, 1, 1] = xyz(d[2]), xyz(d[3]), xyz(d[4])
+    return out
+
+
+# -- interference -----------------------------------------------------------------------
+def common_volume(a, b, eps: float = 1e-9) -> float:
+    """Volume of ``BRepAlgoAPI_Common(a, b)`` (0 when the parts do not overlap)."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+
+    with kernel("BRepAlgoAPI_Common"):
+        op = BRepAlgoAPI_Common(a, b)
+        if not op.IsDone() or op.HasErrors():
+            raise SurfmodError("a, b: OCCT boolean common failed on these parts")
+        result = op.Shape()
+    if result is None or result.IsNull() or not solids_of(result):
+        return 0.0
+    return float(gprops(result, eps)["volume"])
+
+
+def min_distance(a, b):
+    """``(distance, point_on_a, point_on_b, inner)`` from ``BRepExtrema_DistShapeShape``."""
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+
+    with kernel("BRepExtrema_DistShapeShape"):
+        d = BRepExtrema_DistShapeShape(a, b)
+        if not d.IsDone() or d.NbSolution() == 0:
+            raise SurfmodError("a, b: OCCT could not compute the minimum distance")
+        return float(d.Value()), xyz(d.PointOnShape1(1)), xyz(d.PointOnShape2(1)), bool(d.InnerSolution())
+
+
+# -- sections ---------------------------------------------------------------------------
+def planar_faces_in(shape, origin, normal, tol: float):
+    """Indices of planar faces lying in the plane (origin, normal)."""
+    out = []
+    for rec in face_records(shape):
+        e = rec["elementary"]
+        if rec["kind"] != "Geom_Plane":
+            continue
+        if abs(abs(float(np.dot(e["z"], normal))) - 1.0) < 1e-9 and abs(float(np.dot(e["origin"] - origin, normal))) < tol:
+            out.append(rec["index"])
+    return out
+
+
+def section_edges(shape, origin, normal):
+    """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
+    end to end with ``ShapeAnalysis_FreeBounds``)."""
+    import build123d as bd
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
+    from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+    from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
+    from OCP.TopTools import TopTools_HSequenceOfShape
+
+    with kernel("BRepAlgoAPI_Section"):
+        pln = gp_Pln(gp_Pnt(*map(float, origin)), gp_Dir(*map(float, normal)))
+        op = BRepAlgoAPI_Section(shape, pln, False)
+        op.Approximation(False)
+        op.ComputePCurveOn1(False)
+        op.Build()
+        if not op.IsDone() or op.HasErrors():
+            raise SurfmodError("obj: OCCT could not section this shape")
+        edges = _explore(op.Shape(), TopAbs_EDGE)
+        if not edges:
+            return []
+        seq = TopTools_HSequenceOfShape()
+        for e in edges:
+            seq.Append(e)
+        wires = TopTools_HSequenceOfShape()
+        ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(seq, 1e-6, False, wires)
+        return [bd.Wire(TopoDS.Wire_s(wires.Value(i))) for i in range(1, wires.Length() + 1)]
+
+
+def wire_edges(wire):
+    """The edges of a wire in connection order."""
+    from OCP.BRepTools import BRepTools_WireExplorer
+
+    out = []
+    ex = BRepTools_WireExplorer(TopoDS.Wire_s(getattr(wire, "wrapped", wire)))
+    while ex.More():
+        out.append(ex.Current())
+        ex.Next()
+    return out
+
+
+def edge_polyline(edge, n: int) -> np.ndarray:
+    """``n`` points along an edge in its orientation (OCCT ``BRepAdaptor_Curve``)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    with kernel("BRepAdaptor_Curve"):
+        c = BRepAdaptor_Curve(edge)
+        t = np.linspace(c.FirstParameter(), c.LastParameter(), n)
+        if edge.Orientation() == TopAbs_REVERSED:
+            t = t[::-1]
+        return np.array([xyz(c.Value(float(x))) for x in t])
+
+
+# -- files ------------------------------------------------------------------------------
+def write_brep(shape, path) -> None:
+    from OCP.BRepTools import BRepTools
+
+    with kernel("BRepTools.Write_s"):
+        if not BRepTools.Write_s(shape, str(path)):
+            raise SurfmodError(f"path: could not write BREP {path}")
+
+
+def is_solid_like(shape) -> bool:
+    return bool(solids_of(shape))
+
+
+__all__ = [
+    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_polyline", "face_records",
+    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_solid_like", "min_distance", "planar_faces_in", "section_edges",
+    "sew_solid", "shells_of", "solids_of", "surface_derivatives", "wire_edges", "write_brep",
+]

@@ -1,0 +1,73 @@
+"""Turn whatever the user hands to a "use" into an OCCT shape.
+
+Accepted: a surfmod ``Surface`` (its face), a list/tuple of surfaces or faces (sewn into
+a closed solid when ``solid=True``), any build123d shape, an OCP ``TopoDS_Shape``, or the
+path of a STEP file.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import SurfmodError
+
+
+def load_step(path, name: str = "obj"):
+    """The TopoDS shape in a STEP file; unreadable files raise ``SurfmodError``."""
+    from ..occ.exchange import read_step
+
+    p = Path(os.fspath(path))
+    if not p.is_file():
+        raise SurfmodError(f"{name}: no such file {p}")
+    with open(p, "rb") as fh:
+        head = fh.read(256)
+    if b"ISO-10303-21" not in head:
+        raise SurfmodError(f"{name}: {p} is not a readable STEP file (no ISO-10303-21 header)")
+    try:
+        return read_step(p)
+    except SurfmodError as exc:
+        raise SurfmodError(f"{name}: {exc}") from None
+
+
+def _single(item, name):
+    from ..surface import Surface
+
+    if isinstance(item, Surface):
+        return item.face().wrapped
+    shape = getattr(item, "wrapped", item)
+    if type(shape).__module__.startswith("OCP") and hasattr(shape, "IsNull"):
+        if shape.IsNull():
+            raise SurfmodError(f"{name}: is an empty shape")
+        return shape
+    raise SurfmodError(
+        f"{name}: expected a surfmod surface, a list of them, a build123d shape or a STEP path, "
+        f"got {type(item).__name__}"
+    )
+
+
+def to_shape(obj, name: str = "obj", *, solid: bool = False):
+    """The OCCT shape for ``obj``; with ``solid=True`` a closed, outward-oriented solid
+    (open shells raise ``SurfmodError``)."""
+    from ..occ import uses as occ
+
+    if isinstance(obj, (str, os.PathLike)):
+        shape = load_step(obj, name)
+    elif isinstance(obj, (list, tuple)):
+        if not obj:
+            raise SurfmodError(f"{name}: empty list of surfaces")
+        faces = [_single(o, name) for o in obj]
+        if solid:
+            return occ.sew_solid(faces)
+        from ..occ.exchange import compound
+
+        shape = compound(faces)
+    else:
+        shape = _single(obj, name)
+    if solid:
+        try:
+            return occ.closed_solid(shape)
+        except SurfmodError as exc:
+            msg = str(exc)
+            raise SurfmodError(msg if msg.startswith(name) else f"{name}: {msg}") from None
+    return shape
