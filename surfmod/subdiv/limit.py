@@ -217,7 +217,10 @@ def _build(v, topo, levels, tangent_plane):
         ):
             i, j = _rot(ij, k)
             bnets[:, i, j] = v[vert]
-    nets[rf] = np.einsum("ai,nijk,bj->nabk", _BSPLINE_TO_BEZIER, bnets, _BSPLINE_TO_BEZIER)
+    exact = np.einsum("ai,nijk,bj->nabk", _BSPLINE_TO_BEZIER, bnets, _BSPLINE_TO_BEZIER)
+    # the ACC rules must reproduce the exact Bézier points on regular faces (watertightness)
+    acc_mismatch = float(np.abs(nets[rf] - exact).max()) if len(rf) else 0.0
+    nets[rf] = exact
 
     patches = [None] * nf
     for idx, f in enumerate(rf):
@@ -227,6 +230,7 @@ def _build(v, topo, levels, tangent_plane):
     nets.setflags(write=False)
     mesh = Mesh(v, quads, {"levels": levels, "scheme": "catmull-clark"})
     errors = _measure(v, topo, twin, nets, regular)
+    errors["acc_regular_mismatch"] = acc_mismatch
     return LimitSurface(mesh, patches, checks.frozen(regular).astype(bool), nets, levels, errors)
 
 
