@@ -97,3 +97,6 @@ def as_curve(value, name: str):
         except SurfmodError as exc:
             raise SurfmodError(f"{name}: {exc}") from None
     raise SurfmodError(f"{name}: expected a surfmod curve or a build123d Edge/Wire, got {type(value).__name__}")
+
+
+from . import readers_elementary  # noqa: E402,F401  (registers the analytic surface readers)

@@ -1,0 +1,266 @@
+"""Conics as curve inputs: ``Circle``, ``Arc``, ``Ellipse`` (OCCT's angle parametrization)
+and ``LineCurve`` (``Geom_Line``'s ``O + t D`` over a parameter range).
+
+A conic with centre ``C``, frame ``(X, Y = N x X)`` and semi-axes ``a, b`` is
+``C + a cos t X + b sin t Y`` with ``t`` in radians, exactly ``Geom_Circle`` /
+``Geom_Ellipse`` on ``gp_Ax2(C, N, X)``; when ``X`` is not given it is chosen by OCCT's
+own ``gp_Ax2(C, N)`` rule.  ``to_bspline()`` is the exact rational quadratic NURBS
+(at most 90 degrees per Bézier segment, middle weights ``cos(delta/2)``) on the same
+parameter interval; its parametrization differs from the angle (same points as a set).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import checks, transforms
+from ..curve import Curve
+from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve
+from .elementary import cos_d, frame_transformed, make_frame, sin_d
+
+TWO_PI = 2.0 * math.pi
+
+
+def arc_bspline(center, x_axis, y_axis, t0: float, t1: float) -> BSplineCurve:
+    """Exact rational quadratic B-spline of ``center + cos t x_axis + sin t y_axis`` for
+    ``t`` in ``[t0, t1]`` (axes carry the semi-axis lengths); knots on ``[t0, t1]``."""
+    span = t1 - t0
+    nseg = max(1, int(math.ceil(abs(span) / (math.pi / 2) - 1e-9)))
+    delta = span / nseg
+    half = math.cos(delta / 2.0)
+    theta = t0 + np.arange(2 * nseg + 1) * (delta / 2.0)
+    scale = np.where(np.arange(2 * nseg + 1) % 2 == 1, 1.0 / half, 1.0)
+    pts = center + (np.cos(theta) * scale)[:, None] * x_axis + (np.sin(theta) * scale)[:, None] * y_axis
+    w = np.where(np.arange(2 * nseg + 1) % 2 == 1, half, 1.0)
+    inner = np.repeat(t0 + delta * np.arange(1, nseg), 2)
+    knots = np.concatenate([[t0] * 3, inner, [t1] * 3])
+    knots[-3:] = t1
+    return BSplineCurve._trusted(pts, 2, knots, w)
+
+
+class Conic(Curve):
+    """``C + a cos t X + b sin t Y`` over a range of ``t`` (radians); base of Circle/Arc/Ellipse."""
+
+    def _init(self, center, normal, x_dir, a, b, t_range):
+        self.center = checks.frozen(center)
+        self.normal = checks.frozen(normal)
+        self.x_dir = checks.frozen(x_dir)
+        self.y_dir = checks.frozen(np.cross(normal, x_dir))
+        self.a, self.b = float(a), float(b)
+        self._domain = (float(t_range[0]), float(t_range[1]))
+
+    @classmethod
+    def _from_radians(cls, center, normal, x_dir, a, b, t_range):
+        """Trusted constructor (readers, surfaces): a circle arc when ``a == b``."""
+        target = Arc if (cls is Conic and a == b) else (Ellipse if cls is Conic else cls)
+        obj = target.__new__(target)
+        Conic._init(obj, np.asarray(center, float), np.asarray(normal, float), np.asarray(x_dir, float), a, b, t_range)
+        return obj
+
+    @property
+    def domain(self):
+        return self._domain
+
+    @property
+    def is_full(self) -> bool:
+        t0, t1 = self._domain
+        return abs(t0) < 1e-15 and abs(t1 - TWO_PI) < 1e-12
+
+    def _derivatives(self, t, order):
+        out = np.empty((t.size, order + 1, 3))
+        for k in range(order + 1):
+            out[:, k] = (self.a * cos_d(t, k))[:, None] * self.x_dir + (self.b * sin_d(t, k))[:, None] * self.y_dir
+        out[:, 0] += self.center
+        return out
+
+    def _basis_geom(self):
+        from ..occ.analytic import circle, ellipse
+
+        if self.a == self.b:
+            return circle(self.center, self.normal, self.x_dir, self.a)
+        if self.a >= self.b:
+            return ellipse(self.center, self.normal, self.x_dir, self.a, self.b)
+        raise SurfmodError("ellipse: OCCT needs the major radius along X (a >= b)")
+
+    def geom(self):
+        """``Geom_Circle``/``Geom_Ellipse`` (full) or its ``Geom_TrimmedCurve``."""
+        from ..occ.analytic import trimmed
+
+        basis = self._basis_geom()
+        return basis if self.is_full else trimmed(basis, *self._domain)
+
+    def to_bspline(self) -> BSplineCurve:
+        """Exact rational quadratic NURBS over the same parameter interval.
+
+        >>> import numpy as np, surfmod as sm
+        >>> c = sm.Circle((0, 0, 0), (0, 0, 1), 2.0).to_bspline()
+        >>> bool(np.allclose(np.linalg.norm(c.points(np.linspace(0, 6.2, 7)), axis=1), 2.0))
+        True
+        """
+        t0, t1 = self._domain
+        return arc_bspline(self.center, self.a * self.x_dir, self.b * self.y_dir, t0, t1)
+
+    def transformed(self, matrix):
+        """Similarity maps keep the conic (frame moved, radii scaled); other affine maps
+        return the mapped exact NURBS."""
+        m = transforms.affine(matrix)
+        if not transforms.is_similarity(m):
+            return self.to_bspline().transformed(m)
+        (c, x, y, _), s = frame_transformed((self.center, self.x_dir, self.y_dir, self.normal), m)
+        return type(self)._from_radians(c, np.cross(x, y), x, self.a * s, self.b * s, self._domain)
+
+    def implicit(self, xyz) -> np.ndarray:
+        """``(x/a)^2 + (y/b)^2 - 1`` in the conic's plane frame (in-plane test only)."""
+        d = np.asarray(xyz, dtype=float) - self.center
+        return (d @ self.x_dir / self.a) ** 2 + (d @ self.y_dir / self.b) ** 2 - 1.0
+
+
+class Circle(Conic):
+    """Full circle ``C + r (cos t X + sin t Y)``, ``t`` in ``[0, 2 pi]`` (``Geom_Circle``).
+
+    >>> import surfmod as sm
+    >>> c = sm.Circle((0, 0, 0), (0, 0, 1), 2.0)
+    >>> c.points(0.0), c.domain
+    (array([2., 0., 0.]), (0.0, 6.283185307179586))
+    """
+
+    occt_construct = "Geom_Circle"
+
+    def __init__(self, center, normal, radius, x_dir=None):
+        c, x, _, n = make_frame(center, normal, x_dir, axis_name="normal")
+        r = checks.positive(radius, "radius")
+        self._init(c, n, x, r, r, (0.0, TWO_PI))
+
+    @property
+    def radius(self) -> float:
+        return self.a
+
+
+class Arc(Conic):
+    """Circular arc from ``start_angle`` to ``end_angle`` (degrees, measured from ``x_dir``
+    about ``normal``), parametrized by the angle in radians like ``Geom_TrimmedCurve`` of a
+    ``Geom_Circle``: the domain starts at ``start_angle`` brought into ``[0, 360)``.
+
+    >>> import surfmod as sm
+    >>> a = sm.Arc((0, 0, 0), (0, 0, 1), 1.0, 0, 90)
+    >>> a.points(a.domain[1]).round(12)
+    array([0., 1., 0.])
+    """
+
+    occt_construct = "Geom_TrimmedCurve(Geom_Circle)"
+
+    def __init__(self, center, normal, radius, start_angle, end_angle, x_dir=None):
+        c, x, _, n = make_frame(center, normal, x_dir, axis_name="normal")
+        r = checks.positive(radius, "radius")
+        a0 = float(checks.finite_array(start_angle, "start_angle"))
+        a1 = float(checks.finite_array(end_angle, "end_angle"))
+        span = math.radians(a1 - a0)
+        if not 0.0 < span <= TWO_PI + 1e-12:
+            raise SurfmodError(f"end_angle: must exceed start_angle by (0, 360] degrees, got {a0:g} -> {a1:g}")
+        t0 = math.radians(a0) % TWO_PI
+        self._init(c, n, x, r, r, (t0, t0 + min(span, TWO_PI)))
+
+    @property
+    def radius(self) -> float:
+        return self.a
+
+    @classmethod
+    def through(cls, p0, p1, p2) -> "Arc":
+        """The arc from ``p0`` through ``p1`` to ``p2``.
+
+        >>> import surfmod as sm
+        >>> a = sm.Arc.through((1, 0, 0), (0, 1, 0), (-1, 0, 0))
+        >>> round(a.radius, 12), a.center.round(12).tolist()
+        (1.0, [0.0, 0.0, 0.0])
+        """
+        a, b, c = checks.point(p0, "p0"), checks.point(p1, "p1"), checks.point(p2, "p2")
+        ab, ac = b - a, c - a
+        n = np.cross(ab, ac)
+        scale = max(np.linalg.norm(ab), np.linalg.norm(ac))
+        if np.linalg.norm(ab) <= 1e-12 * max(scale, 1.0):
+            raise SurfmodError("p1: coincides with p0")
+        if np.linalg.norm(n) <= 1e-12 * scale * scale:
+            raise SurfmodError("p2: collinear with p0 and p1, no arc passes through them")
+        # circumcentre
+        nn = float(np.dot(n, n))
+        center = a + (np.dot(ac, ac) * np.cross(n, ab) + np.dot(ab, ab) * np.cross(ac, n)) / (2.0 * nn)
+        normal = n / np.sqrt(nn)
+        x = (a - center) / np.linalg.norm(a - center)
+        y = np.cross(normal, x)
+        end = math.atan2(float((c - center) @ y), float((c - center) @ x)) % TWO_PI
+        r = float(np.linalg.norm(a - center))
+        return cls._from_radians(center, normal, x, r, r, (0.0, end))
+
+
+class Ellipse(Conic):
+    """Full ellipse ``C + a cos t X + b sin t Y`` (``Geom_Ellipse``, ``a >= b``).
+
+    >>> import surfmod as sm
+    >>> sm.Ellipse((0, 0, 0), (0, 0, 1), 3.0, 1.0).points(0.0)
+    array([3., 0., 0.])
+    """
+
+    occt_construct = "Geom_Ellipse"
+
+    def __init__(self, center, normal, major, minor, x_dir=None):
+        c, x, _, n = make_frame(center, normal, x_dir, axis_name="normal")
+        a, b = checks.positive(major, "major"), checks.positive(minor, "minor")
+        if b > a:
+            raise SurfmodError(f"minor: must not exceed major ({a:g}), got {b:g}")
+        self._init(c, n, x, a, b, (0.0, TWO_PI))
+
+
+class LineCurve(Curve):
+    """``Geom_Line``'s parametrization ``O + t D`` (``D`` unit) over ``t_range``.
+
+    >>> import surfmod as sm
+    >>> sm.LineCurve((0, 0, 0), (1, 0, 0), (-1, 2)).points(-1.0)
+    array([-1.,  0.,  0.])
+    """
+
+    occt_construct = "Geom_TrimmedCurve(Geom_Line)"
+
+    def __init__(self, origin, direction, t_range=(0.0, 1.0)):
+        self.origin = checks.frozen(checks.point(origin, "origin"))
+        self.direction = checks.frozen(checks.direction(direction, "direction"))
+        try:
+            t0, t1 = (float(t) for t in t_range)
+        except (TypeError, ValueError):
+            raise SurfmodError(f"t_range: expected two numbers, got {t_range!r}") from None
+        if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
+            raise SurfmodError(f"t_range: need finite start < end, got {t_range!r}")
+        self._domain = (t0, t1)
+
+    @property
+    def domain(self):
+        return self._domain
+
+    def _derivatives(self, t, order):
+        out = np.zeros((t.size, order + 1, 3))
+        out[:, 0] = self.origin + t[:, None] * self.direction
+        if order >= 1:
+            out[:, 1] = self.direction
+        return out
+
+    def geom(self):
+        from ..occ.analytic import infinite_line, trimmed
+
+        return trimmed(infinite_line(self.origin, self.direction), *self._domain)
+
+    def to_bspline(self) -> BSplineCurve:
+        """Degree-1 B-spline with the same parametrization."""
+        t0, t1 = self._domain
+        pts = np.array([self.origin + t0 * self.direction, self.origin + t1 * self.direction])
+        return BSplineCurve._trusted(pts, 1, np.array([t0, t0, t1, t1]))
+
+    def transformed(self, matrix):
+        m = transforms.affine(matrix)
+        if not transforms.is_similarity(m):
+            return self.to_bspline().transformed(m)
+        d = transforms.apply_vectors(m, self.direction)
+        s = float(np.linalg.norm(d))
+        t0, t1 = self._domain
+        return LineCurve(transforms.apply(m, self.origin), d / s, (t0 * s, t1 * s))

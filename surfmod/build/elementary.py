@@ -1,0 +1,467 @@
+"""OCCT's elementary surfaces with their own frames and parametrizations.
+
+Every surface here carries a frame ``(origin, x_dir, y_dir, z_dir)`` (an OCCT ``gp_Ax3``;
+indirect frames, e.g. after a mirror, are kept as they are) and is evaluated exactly as
+OCCT evaluates it:
+
+===========================  ==============================================================
+``AnalyticPlane``            ``O + u X + v Y``                          (``Geom_Plane``)
+``CylindricalSurface``       ``O + R (cos u X + sin u Y) + v Z``        (``Geom_CylindricalSurface``)
+``ConicalSurface``           ``O + (R + v sin a)(cos u X + sin u Y) + v cos a Z``
+``SphericalSurface``         ``O + R cos v (cos u X + sin u Y) + R sin v Z``
+``ToroidalSurface``          ``O + (R + r cos v)(cos u X + sin u Y) + r sin v Z``
+===========================  ==============================================================
+
+Similarity transforms keep the analytic type (the frame moves, radii and the linear
+parameter ranges scale by ``|s|``, exactly like ``Geom_Surface::Transform``); any other
+affine map goes through the exact rational B-spline form (``to_nurbs``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import checks, transforms
+from ..errors import SurfmodError
+from ..surface import Surface
+
+TWO_PI = 2.0 * math.pi
+
+
+# -- frames ----------------------------------------------------------------------------------
+def default_x_dir(normal) -> np.ndarray:
+    """The X direction OCCT's ``gp_Ax2(P, N)`` chooses for the main direction ``N``.
+
+    >>> default_x_dir((0, 0, 1))
+    array([1., 0., 0.])
+    """
+    a, b, c = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
+    aa, ab, ac = abs(a), abs(b), abs(c)
+    if ab <= aa and ab <= ac:
+        d = (-c, 0.0, a) if aa > ac else (c, 0.0, -a)
+    elif aa <= ab and aa <= ac:
+        d = (0.0, -c, b) if ab > ac else (0.0, c, -b)
+    else:
+        d = (-b, a, 0.0) if aa > ab else (b, -a, 0.0)
+    d = np.array(d, dtype=float) + 0.0
+    return d / np.linalg.norm(d)
+
+
+def make_frame(origin, axis, x_dir=None, *, origin_name="center", axis_name="axis", x_name="x_dir"):
+    """A direct orthonormal frame ``(o, x, y, z)`` from an origin, a main direction and an
+    optional X direction (default: OCCT's ``gp_Ax2`` rule); ``x_dir`` must not be parallel
+    to the axis (its component along the axis is removed)."""
+    o = checks.point(origin, origin_name)
+    z = checks.direction(axis, axis_name)
+    if x_dir is None:
+        x = default_x_dir(z)
+    else:
+        x = checks.direction(x_dir, x_name)
+        x = x - np.dot(x, z) * z
+        if np.linalg.norm(x) < 1e-9:
+            raise SurfmodError(f"{x_name}: parallel to {axis_name}, cannot define the X direction")
+        x /= np.linalg.norm(x)
+    return o, x, np.cross(z, x), z
+
+
+def frame_transformed(frame, matrix):
+    """``(frame', s)``: the frame moved by a similarity matrix and its scale ``|s|``."""
+    o, x, y, z = frame
+    lin = matrix[:3, :3]
+    s = float(abs(np.linalg.det(lin)) ** (1.0 / 3.0))
+    return (transforms.apply(matrix, o), lin @ x / s, lin @ y / s, lin @ z / s), s
+
+
+def _range(value, name, default):
+    if value is None:
+        return default
+    try:
+        a, b = (float(t) for t in value)
+    except (TypeError, ValueError):
+        raise SurfmodError(f"{name}: expected two numbers (start, end), got {value!r}") from None
+    if not (np.isfinite(a) and np.isfinite(b)) or not b > a:
+        raise SurfmodError(f"{name}: need finite start < end, got ({a:g}, {b:g})")
+    return a, b
+
+
+def cos_d(t, k):
+    """k-th derivative of cos at t."""
+    return np.cos(t + k * math.pi / 2.0)
+
+
+def sin_d(t, k):
+    """k-th derivative of sin at t."""
+    return np.sin(t + k * math.pi / 2.0)
+
+
+# -- base ----------------------------------------------------------------------------------------
+class ElementarySurface(Surface):
+    """Common frame handling of the OCCT elementary surfaces (not built directly)."""
+
+    _linear_u = False  # u is a length (scales under similarity)
+    _linear_v = False
+
+    def _init_frame(self, frame, u_range, v_range):
+        self.origin, self.x_dir, self.y_dir, self.z_dir = (checks.frozen(a) for a in frame)
+        self._domain = ((float(u_range[0]), float(u_range[1])), (float(v_range[0]), float(v_range[1])))
+        self._occ = None
+
+    @classmethod
+    def _trusted(cls, frame, params, u_range, v_range):
+        obj = cls.__new__(cls)
+        obj._init_frame(frame, u_range, v_range)
+        obj._set_params(*params)
+        return obj
+
+    @property
+    def frame(self):
+        """``(origin, x_dir, y_dir, z_dir)``."""
+        return self.origin, self.x_dir, self.y_dir, self.z_dir
+
+    @property
+    def domain(self):
+        return self._domain
+
+    @property
+    def _spin_axis(self) -> np.ndarray:
+        """``X ^ Y``: the axis about which increasing ``u`` turns (``-Z`` if indirect)."""
+        return np.cross(self.x_dir, self.y_dir)
+
+    def _local(self, p) -> np.ndarray:
+        d = np.asarray(p, dtype=float) - self.origin
+        return np.stack([d @ self.x_dir, d @ self.y_dir, d @ self.z_dir], axis=-1)
+
+    def _coefficients(self, u, v, order):
+        """``(fx, fy, fz)`` arrays ``(N, K, K)``: partials of the X, Y, Z coordinates."""
+        raise NotImplementedError
+
+    def _derivatives(self, u, v, order):
+        fx, fy, fz = self._coefficients(u, v, order)
+        out = fx[..., None] * self.x_dir + fy[..., None] * self.y_dir + fz[..., None] * self.z_dir
+        out[:, 0, 0] += self.origin
+        return out
+
+    def geom(self):
+        if self._occ is None:
+            self._occ = self._build_geom()
+        return self._occ
+
+    def transformed(self, matrix):
+        """Similarity: same analytic type with a moved frame; otherwise the exact NURBS form
+        with mapped control points."""
+        m = transforms.affine(matrix)
+        if not transforms.is_similarity(m):
+            return self.to_nurbs().transformed(m)
+        frame, s = frame_transformed(self.frame, m)
+        (u0, u1), (v0, v1) = self._domain
+        ur = (u0 * s, u1 * s) if self._linear_u else (u0, u1)
+        vr = (v0 * s, v1 * s) if self._linear_v else (v0, v1)
+        return type(self)._trusted(frame, self._scaled_params(s), ur, vr)
+
+
+def _zeros(n, order):
+    k = order + 1
+    return np.zeros((n, k, k)), np.zeros((n, k, k)), np.zeros((n, k, k))
+
+
+class AnalyticPlane(ElementarySurface):
+    """OCCT's ``Geom_Plane``: ``S(u, v) = O + u X + v Y`` over ``u_range x v_range``.
+
+    >>> import surfmod as sm
+    >>> p = sm.AnalyticPlane((0, 0, 1), normal=(0, 0, 1), u_range=(0, 2), v_range=(0, 1))
+    >>> p.points(1.0, 0.5)
+    array([1. , 0.5, 1. ])
+    """
+
+    occt_construct = "Geom_Plane"
+    _linear_u = _linear_v = True
+
+    def __init__(self, origin=(0, 0, 0), normal=(0, 0, 1), x_dir=None, *, u_range=(0.0, 1.0), v_range=(0.0, 1.0)):
+        frame = make_frame(origin, normal, x_dir, origin_name="origin", axis_name="normal")
+        self._init_frame(frame, _range(u_range, "u_range", None), _range(v_range, "v_range", None))
+        self._set_params()
+
+    def _set_params(self):
+        pass
+
+    def _scaled_params(self, s):
+        return ()
+
+    def _coefficients(self, u, v, order):
+        fx, fy, fz = _zeros(u.size, order)
+        fx[:, 0, 0], fy[:, 0, 0] = u, v
+        if order >= 1:
+            fx[:, 1, 0] = 1.0
+            fy[:, 0, 1] = 1.0
+        return fx, fy, fz
+
+    def _build_geom(self):
+        from ..occ.analytic import plane
+
+        return plane(self.frame)
+
+    def implicit(self, xyz) -> np.ndarray:
+        """Signed distance ``(x - O) . Z``."""
+        return self._local(xyz)[..., 2]
+
+    def to_nurbs(self):
+        """The same plane as a degree-1 B-spline with the same parametrization."""
+        from ..nets.bspline import BSplineSurface
+
+        (u0, u1), (v0, v1) = self._domain
+        net = np.array([[self.points(u0, v0), self.points(u0, v1)], [self.points(u1, v0), self.points(u1, v1)]])
+        return BSplineSurface._trusted(net, (1, 1), (np.array([u0, u0, u1, u1]), np.array([v0, v0, v1, v1])))
+
+
+class CylindricalSurface(ElementarySurface):
+    """OCCT's ``Geom_CylindricalSurface``: ``O + R (cos u X + sin u Y) + v Z``.
+
+    >>> import surfmod as sm
+    >>> c = sm.CylindricalSurface(2.0, (0, 0, 0), (0, 0, 1), v_range=(0, 5))
+    >>> c.points(0.0, 1.0)
+    array([2., 0., 1.])
+    """
+
+    occt_construct = "Geom_CylindricalSurface"
+    _linear_v = True
+
+    def __init__(self, radius, origin=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *, u_range=None, v_range=(0.0, 1.0)):
+        r = checks.positive(radius, "radius")
+        frame = make_frame(origin, axis, x_dir, origin_name="origin")
+        self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), _range(v_range, "v_range", None))
+        self._set_params(r)
+
+    def _set_params(self, radius):
+        self.radius = float(radius)
+
+    def _scaled_params(self, s):
+        return (self.radius * s,)
+
+    def _coefficients(self, u, v, order):
+        fx, fy, fz = _zeros(u.size, order)
+        for k in range(order + 1):
+            fx[:, k, 0] = self.radius * cos_d(u, k)
+            fy[:, k, 0] = self.radius * sin_d(u, k)
+        fz[:, 0, 0] = v
+        if order >= 1:
+            fz[:, 0, 1] = 1.0
+        return fx, fy, fz
+
+    def _build_geom(self):
+        from ..occ.analytic import cylinder
+
+        return cylinder(self.frame, self.radius)
+
+    def implicit(self, xyz) -> np.ndarray:
+        """``x^2 + y^2 - R^2`` in the frame."""
+        p = self._local(xyz)
+        return p[..., 0] ** 2 + p[..., 1] ** 2 - self.radius**2
+
+    def to_nurbs(self):
+        """Exact rational B-spline (a revolved line)."""
+        from .revolution import revolve_nurbs
+        from .conics import LineCurve
+
+        (u0, u1), (v0, v1) = self._domain
+        line = LineCurve(self.origin + self.radius * self.x_dir, self.z_dir, (v0, v1))
+        return revolve_nurbs(line.to_bspline(), self.origin, self._spin_axis, (u0, u1))
+
+
+class ConicalSurface(ElementarySurface):
+    """OCCT's ``Geom_ConicalSurface``: ``O + (R + v sin a)(cos u X + sin u Y) + v cos a Z``
+    (``R`` = reference radius at ``v = 0``, ``a`` = semi-angle in radians, ``v`` measured
+    along the generatrix).
+
+    >>> import math, surfmod as sm
+    >>> c = sm.ConicalSurface(math.radians(45), 1.0, v_range=(0, 1))
+    >>> bool(abs(c.implicit(c.points(0.3, 0.7))) < 1e-12)
+    True
+    """
+
+    occt_construct = "Geom_ConicalSurface"
+    _linear_v = True
+
+    def __init__(self, semi_angle, ref_radius=0.0, origin=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *,
+                 u_range=None, v_range=(0.0, 1.0)):
+        a = float(checks.finite_array(semi_angle, "semi_angle"))
+        if not 1e-12 < abs(a) < math.pi / 2 - 1e-12:
+            raise SurfmodError(f"semi_angle: must lie in (-pi/2, pi/2) and not be 0, got {a:g}")
+        r = float(checks.finite_array(ref_radius, "ref_radius"))
+        if r < 0:
+            raise SurfmodError(f"ref_radius: must be >= 0, got {r:g}")
+        frame = make_frame(origin, axis, x_dir, origin_name="origin")
+        self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), _range(v_range, "v_range", None))
+        self._set_params(r, a)
+
+    def _set_params(self, radius, semi_angle):
+        self.radius, self.semi_angle = float(radius), float(semi_angle)
+
+    def _scaled_params(self, s):
+        return (self.radius * s, self.semi_angle)
+
+    @property
+    def apex(self) -> np.ndarray:
+        return self.origin - self.radius / math.tan(self.semi_angle) * self.z_dir
+
+    def _coefficients(self, u, v, order):
+        fx, fy, fz = _zeros(u.size, order)
+        sa, ca = math.sin(self.semi_angle), math.cos(self.semi_angle)
+        rho = [self.radius + v * sa, np.full(u.size, sa)]
+        for k in range(order + 1):
+            for l in range(min(order, 1) + 1):
+                fx[:, k, l] = cos_d(u, k) * rho[l]
+                fy[:, k, l] = sin_d(u, k) * rho[l]
+        fz[:, 0, 0] = v * ca
+        if order >= 1:
+            fz[:, 0, 1] = ca
+        return fx, fy, fz
+
+    def _build_geom(self):
+        from ..occ.analytic import cone
+
+        return cone(self.frame, self.semi_angle, self.radius)
+
+    def implicit(self, xyz) -> np.ndarray:
+        """``x^2 + y^2 - (R + z tan a)^2`` in the frame."""
+        p = self._local(xyz)
+        return p[..., 0] ** 2 + p[..., 1] ** 2 - (self.radius + p[..., 2] * math.tan(self.semi_angle)) ** 2
+
+    def to_nurbs(self):
+        """Exact rational B-spline (a revolved line)."""
+        from .conics import LineCurve
+        from .revolution import revolve_nurbs
+
+        (u0, u1), (v0, v1) = self._domain
+        sa, ca = math.sin(self.semi_angle), math.cos(self.semi_angle)
+        line = LineCurve(self.origin + self.radius * self.x_dir, sa * self.x_dir + ca * self.z_dir, (v0, v1))
+        return revolve_nurbs(line.to_bspline(), self.origin, self._spin_axis, (u0, u1))
+
+
+class SphericalSurface(ElementarySurface):
+    """OCCT's ``Geom_SphericalSurface``: ``O + R cos v (cos u X + sin u Y) + R sin v Z``,
+    ``u`` in ``[0, 2 pi]`` (longitude), ``v`` in ``[-pi/2, pi/2]`` (latitude).
+
+    >>> import surfmod as sm
+    >>> s = sm.SphericalSurface(2.0)
+    >>> s.points(0.0, 0.0), s.domain[1]
+    (array([2., 0., 0.]), (-1.5707963267948966, 1.5707963267948966))
+    """
+
+    occt_construct = "Geom_SphericalSurface"
+
+    def __init__(self, radius, center=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *, u_range=None, v_range=None):
+        r = checks.positive(radius, "radius")
+        frame = make_frame(center, axis, x_dir)
+        vr = _range(v_range, "v_range", (-math.pi / 2, math.pi / 2))
+        if vr[0] < -math.pi / 2 - 1e-12 or vr[1] > math.pi / 2 + 1e-12:
+            raise SurfmodError(f"v_range: latitude must stay within [-pi/2, pi/2], got {vr}")
+        self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), vr)
+        self._set_params(r)
+
+    def _set_params(self, radius):
+        self.radius = float(radius)
+
+    def _scaled_params(self, s):
+        return (self.radius * s,)
+
+    @property
+    def center(self) -> np.ndarray:
+        return self.origin
+
+    def _coefficients(self, u, v, order):
+        fx, fy, fz = _zeros(u.size, order)
+        r = self.radius
+        for k in range(order + 1):
+            cu, su = cos_d(u, k), sin_d(u, k)
+            for l in range(order + 1):
+                cv = cos_d(v, l)
+                fx[:, k, l] = r * cu * cv
+                fy[:, k, l] = r * su * cv
+        for l in range(order + 1):
+            fz[:, 0, l] = r * sin_d(v, l)
+        return fx, fy, fz
+
+    def _build_geom(self):
+        from ..occ.analytic import sphere
+
+        return sphere(self.frame, self.radius)
+
+    def implicit(self, xyz) -> np.ndarray:
+        """``|x - C|^2 - R^2``."""
+        p = self._local(xyz)
+        return np.sum(p * p, axis=-1) - self.radius**2
+
+    def to_nurbs(self):
+        """Exact rational B-spline (degree 2 x 2): a revolved circular arc."""
+        from .conics import Arc
+        from .revolution import revolve_nurbs
+
+        (u0, u1), (v0, v1) = self._domain
+        arc = Arc._from_radians(self.origin, np.cross(self.x_dir, self.z_dir), self.x_dir, self.radius, self.radius, (v0, v1))
+        return revolve_nurbs(arc.to_bspline(), self.origin, self._spin_axis, (u0, u1))
+
+
+class ToroidalSurface(ElementarySurface):
+    """OCCT's ``Geom_ToroidalSurface``: ``O + (R + r cos v)(cos u X + sin u Y) + r sin v Z``.
+
+    >>> import surfmod as sm
+    >>> t = sm.ToroidalSurface(3.0, 1.0)
+    >>> t.points(0.0, 0.0)
+    array([4., 0., 0.])
+    """
+
+    occt_construct = "Geom_ToroidalSurface"
+
+    def __init__(self, major, minor, center=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *, u_range=None, v_range=None):
+        big = checks.positive(major, "major")
+        small = checks.positive(minor, "minor")
+        if small >= big:
+            raise SurfmodError(f"minor: must be smaller than major ({big:g}) for a ring torus, got {small:g}")
+        frame = make_frame(center, axis, x_dir)
+        self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), _range(v_range, "v_range", (0.0, TWO_PI)))
+        self._set_params(big, small)
+
+    def _set_params(self, major, minor):
+        self.major, self.minor = float(major), float(minor)
+
+    def _scaled_params(self, s):
+        return (self.major * s, self.minor * s)
+
+    @property
+    def center(self) -> np.ndarray:
+        return self.origin
+
+    def _coefficients(self, u, v, order):
+        fx, fy, fz = _zeros(u.size, order)
+        rho = [self.major + self.minor * np.cos(v)] + [self.minor * cos_d(v, l) for l in range(1, order + 1)]
+        for k in range(order + 1):
+            cu, su = cos_d(u, k), sin_d(u, k)
+            for l in range(order + 1):
+                fx[:, k, l] = cu * rho[l]
+                fy[:, k, l] = su * rho[l]
+        for l in range(order + 1):
+            fz[:, 0, l] = self.minor * sin_d(v, l)
+        return fx, fy, fz
+
+    def _build_geom(self):
+        from ..occ.analytic import torus
+
+        return torus(self.frame, self.major, self.minor)
+
+    def implicit(self, xyz) -> np.ndarray:
+        """``(|p|^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + y^2)`` in the frame."""
+        p = self._local(xyz)
+        big, small = self.major, self.minor
+        return (np.sum(p * p, axis=-1) + big**2 - small**2) ** 2 - 4 * big**2 * (p[..., 0] ** 2 + p[..., 1] ** 2)
+
+    def to_nurbs(self):
+        """Exact rational B-spline (degree 2 x 2): a revolved circle."""
+        from .conics import Arc
+        from .revolution import revolve_nurbs
+
+        (u0, u1), (v0, v1) = self._domain
+        center = self.origin + self.major * self.x_dir
+        arc = Arc._from_radians(center, np.cross(self.x_dir, self.z_dir), self.x_dir, self.minor, self.minor, (v0, v1))
+        return revolve_nurbs(arc.to_bspline(), self.origin, self._spin_axis, (u0, u1))

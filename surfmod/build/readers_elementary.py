@@ -1,0 +1,247 @@
+"""``from_face`` readers for OCCT's analytic surface types, and the offset surface.
+
+Registered with :func:`surfmod.build.from_face.reader`: ``Geom_Plane``,
+``Geom_CylindricalSurface``, ``Geom_ConicalSurface``, ``Geom_SphericalSurface``,
+``Geom_ToroidalSurface``, ``Geom_SurfaceOfRevolution``, ``Geom_SurfaceOfLinearExtrusion``,
+``Geom_RectangularTrimmedSurface`` and ``Geom_OffsetSurface``.  Every reader keeps OCCT's
+parametrization (basis curves of swept surfaces are read natively: lines, circles,
+ellipses, B-splines, Béziers), restricts the domain to the face's parameter bounds and
+keeps the OCCT surface it read as ``geom()``, so ``crosscheck`` compares the NumPy
+evaluation with the very surface of the file.
+"""
+
+from __future__ import annotations
+
+from math import comb, factorial
+
+import numpy as np
+
+from .. import tolerances, transforms
+from ..errors import SurfmodError
+from ..eval.differential import degenerate_mask
+from ..surface import Surface
+from .from_face import READERS, reader
+
+
+# -- offset surface ------------------------------------------------------------------------------
+def _jet_product(a, b, op=None):
+    """Truncated product of two bivariate Taylor jets ``(N, K, K, ...)``."""
+    k_max = a.shape[1]
+    shape = np.broadcast_shapes(a.shape[3:], b.shape[3:]) if op is None else (3,)
+    out = np.zeros((a.shape[0], k_max, k_max) + tuple(shape))
+    for i in range(k_max):
+        for j in range(k_max):
+            for k in range(i, k_max):
+                for l in range(j, k_max):
+                    x, y = a[:, i, j], b[:, k - i, l - j]
+                    out[:, k, l] += op(x, y) if op is not None else x * y
+    return out
+
+
+def _factorials(k_max):
+    f = np.array([factorial(k) for k in range(k_max)], dtype=float)
+    return np.outer(f, f)
+
+
+def offset_derivatives(base_ders: np.ndarray, distance: float, order: int) -> np.ndarray:
+    """Partials ``(N, order+1, order+1, 3)`` of ``S + d N`` from the base surface's partials
+    of order ``order + 1`` (``(N, order+2, order+2, 3)``), by exact jet (truncated
+    Taylor series) arithmetic: ``n = Su x Sv``, ``N = n (n.n)^(-1/2)``."""
+    k_max = order + 1
+    fac = _factorials(k_max + 1)
+    taylor = base_ders / fac[None, :, :, None]
+    fk = _factorials(k_max)
+    su = base_ders[:, 1 : k_max + 1, :k_max] / fk[None, :, :, None]
+    sv = base_ders[:, :k_max, 1 : k_max + 1] / fk[None, :, :, None]
+    n = _jet_product(su, sv, np.cross)
+    f = _jet_product(n, n, lambda x, y: np.sum(x * y, axis=-1, keepdims=True))[..., :1]
+    f0 = f[:, 0, 0, 0]
+    delta = f.copy()
+    delta[:, 0, 0] = 0.0
+    g = np.zeros_like(f)
+    power = np.zeros_like(f)
+    power[:, 0, 0] = 1.0
+    for m in range(2 * order + 1):
+        coef = comb_half(m) * f0 ** (-0.5 - m)
+        g += coef[:, None, None, None] * power
+        power = _jet_product(power, delta)
+    normal = _jet_product(n, g)
+    out = taylor[:, :k_max, :k_max] + distance * normal
+    return out * fk[None, :, :, None]
+
+
+def comb_half(m: int) -> float:
+    """Generalized binomial coefficient ``binom(-1/2, m)``."""
+    c = 1.0
+    for i in range(m):
+        c *= (-0.5 - i) / (i + 1)
+    return c
+
+
+class OffsetSurface(Surface):
+    """``S(u, v) + d N(u, v)`` with ``N`` the unit normal ``Su x Sv / |Su x Sv|`` of the base
+    surface: OCCT's ``Geom_OffsetSurface``.  Positions, normals and derivatives (up to
+    any order) come from exact jet arithmetic on the base surface's partials; at
+    degenerate points of the base the position uses the limit normal.
+
+    >>> import surfmod as sm
+    >>> s = sm.OffsetSurface(sm.sphere(2.0), 0.5)
+    >>> s.points(0.0, 0.0).round(12)
+    array([2.5, 0. , 0. ])
+    """
+
+    occt_construct = "Geom_OffsetSurface"
+
+    def __init__(self, base: Surface, distance: float):
+        if not isinstance(base, Surface):
+            raise SurfmodError(f"base: expected a surfmod surface, got {type(base).__name__}")
+        d = float(distance)
+        if not np.isfinite(d):
+            raise SurfmodError(f"distance: must be finite, got {distance!r}")
+        self.base, self.distance = base, d
+        self._occ = None
+
+    @property
+    def domain(self):
+        return self.base.domain
+
+    def _derivatives(self, u, v, order):
+        ders = self.base._derivatives(u, v, order + 1)
+        bad = degenerate_mask(ders, tolerances.DEGENERATE_NORMAL)
+        if np.any(bad):
+            (u0, u1), (v0, v1) = self.domain
+            un = u[bad] + 1e-7 * ((u0 + u1) / 2 - u[bad])
+            vn = v[bad] + 1e-7 * ((v0 + v1) / 2 - v[bad])
+            ders[bad] = self.base._derivatives(un, vn, order + 1)
+        out = offset_derivatives(ders, self.distance, order)
+        if np.any(bad):
+            limit = self.base.normals(u[bad], v[bad])
+            out[bad, 0, 0] = self.base._derivatives(u[bad], v[bad], 0)[:, 0, 0] + self.distance * limit
+        return out
+
+    def geom(self):
+        if self._occ is None:
+            from ..occ.analytic import offset_surface
+
+            self._occ = offset_surface(self.base.geom(), self.distance)
+        return self._occ
+
+    def transformed(self, matrix):
+        """Similarity maps only (an offset is not affine-invariant): the base is mapped and
+        the distance scaled by ``|s|`` (sign flips with a mirror, as the normal does)."""
+        m = transforms.affine(matrix)
+        if not transforms.is_similarity(m):
+            raise SurfmodError("matrix: an offset surface can only be moved by a similarity (rotation, mirror, uniform scale)")
+        det = float(np.linalg.det(m[:3, :3]))
+        s = abs(det) ** (1.0 / 3.0)
+        return OffsetSurface(self.base.transformed(m), self.distance * s * np.sign(det))
+
+
+# -- curve readers ----------------------------------------------------------------------------------
+def curve_from_occ(curve, t_range):
+    """A surfmod curve in OCCT's own parametrization of ``curve`` over ``t_range``."""
+    from ..nets.bezier import BezierCurve
+    from ..nets.bspline import BSplineCurve
+    from ..occ.analytic import read_curve
+    from .conics import Conic, LineCurve
+
+    t0, t1 = (float(t) for t in t_range)
+    d = read_curve(curve)
+    kind = d["kind"]
+    if kind == "line":
+        return LineCurve(d["origin"], d["direction"], (t0, t1))
+    if kind in ("circle", "ellipse"):
+        o, x, _, z = d["frame"]
+        a, b = (d["radius"], d["radius"]) if kind == "circle" else (d["major"], d["minor"])
+        return Conic._from_radians(o, z, x, a, b, (t0, t1))
+    if kind == "bspline":
+        c = BSplineCurve(d["points"], d["degree"], d["knots"], d["weights"])
+    else:
+        c = BezierCurve(d["points"], d["weights"])
+    lo, hi = c.domain
+    tol = 1e-9 * max(1.0, hi - lo)
+    if t0 > lo + tol or t1 < hi - tol:
+        c = c.segment(max(t0, lo), min(t1, hi))
+    return c
+
+
+# -- surface readers ---------------------------------------------------------------------------------
+def _elementary(cls, params):
+    def read(surf, bounds):
+        from ..occ.analytic import read_elementary
+
+        data = read_elementary(surf)
+        u0, u1, v0, v1 = bounds
+        obj = cls._trusted(data["frame"], params(data), (u0, u1), (v0, v1))
+        obj._occ = surf
+        return obj
+
+    return read
+
+
+def _register_elementary():
+    from .elementary import AnalyticPlane, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
+
+    reader("Geom_Plane")(_elementary(AnalyticPlane, lambda d: ()))
+    reader("Geom_CylindricalSurface")(_elementary(CylindricalSurface, lambda d: (d["radius"],)))
+    reader("Geom_ConicalSurface")(_elementary(ConicalSurface, lambda d: (d["radius"], d["semi_angle"])))
+    reader("Geom_SphericalSurface")(_elementary(SphericalSurface, lambda d: (d["radius"],)))
+    reader("Geom_ToroidalSurface")(_elementary(ToroidalSurface, lambda d: (d["major"], d["minor"])))
+
+
+_register_elementary()
+
+
+@reader("Geom_SurfaceOfRevolution")
+def _revolution(surf, bounds):
+    from ..occ.analytic import read_revolution
+    from .revolution import RevolutionSurface
+
+    data = read_revolution(surf)
+    u0, u1, v0, v1 = bounds
+    obj = RevolutionSurface._trusted(curve_from_occ(data["basis"], (v0, v1)), data["origin"], data["direction"], (u0, u1))
+    obj._occ = surf
+    return obj
+
+
+@reader("Geom_SurfaceOfLinearExtrusion")
+def _extrusion(surf, bounds):
+    from ..occ.analytic import read_extrusion
+    from .extrusion import TabulatedCylinder
+
+    data = read_extrusion(surf)
+    u0, u1, v0, v1 = bounds
+    obj = TabulatedCylinder._trusted(curve_from_occ(data["basis"], (u0, u1)), data["direction"], (v0, v1))
+    obj._occ = surf
+    return obj
+
+
+def _read_basis(basis, bounds):
+    from ..occ.geom import downcast_surface, surface_type
+
+    name = surface_type(basis)
+    read = READERS.get(name)
+    if read is None:
+        raise SurfmodError(f"face: unsupported OCCT basis surface type {name}")
+    return read(downcast_surface(basis), bounds)
+
+
+@reader("Geom_RectangularTrimmedSurface")
+def _trimmed(surf, bounds):
+    from ..occ.analytic import read_trimmed_surface
+
+    data = read_trimmed_surface(surf)
+    tu0, tu1, tv0, tv1 = data["bounds"]
+    u0, u1, v0, v1 = bounds
+    return _read_basis(data["basis"], (max(u0, tu0), min(u1, tu1), max(v0, tv0), min(v1, tv1)))
+
+
+@reader("Geom_OffsetSurface")
+def _offset(surf, bounds):
+    from ..occ.analytic import read_offset
+
+    data = read_offset(surf)
+    obj = OffsetSurface(_read_basis(data["basis"], bounds), data["distance"])
+    obj._occ = surf
+    return obj
+

@@ -1,0 +1,234 @@
+"""OCCT analytic curves and surfaces (conics, elementary surfaces, swept analytic
+surfaces, offset and trimmed surfaces, GeomFill ruled surfaces): builders from surfmod
+data and readers back to plain NumPy data.
+
+Frames are passed as ``(origin, x_dir, y_dir, z_dir)`` NumPy arrays; an indirect frame
+(``x ^ y = -z``, e.g. after a mirror) becomes an indirect ``gp_Ax3``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Trsf
+
+from ..errors import SurfmodError
+from .arrays import pnt, xyz
+from .guard import kernel
+
+
+def _dir(v) -> gp_Dir:
+    return gp_Dir(float(v[0]), float(v[1]), float(v[2]))
+
+
+def ax3(frame) -> gp_Ax3:
+    """``gp_Ax3`` from ``(origin, x, y, z)``; indirect when ``x ^ y`` opposes ``z``."""
+    o, x, y, z = frame
+    with kernel("gp_Ax3"):
+        a = gp_Ax3(pnt(o), _dir(z), _dir(x))
+        if float(np.dot(np.cross(z, x), y)) < 0.0:
+            a.YReverse()
+        return a
+
+
+def ax2(origin, normal, x_dir) -> gp_Ax2:
+    with kernel("gp_Ax2"):
+        return gp_Ax2(pnt(origin), _dir(normal), _dir(x_dir))
+
+
+def default_x_dir(normal) -> np.ndarray:
+    """The X direction ``gp_Ax2(P, N)`` picks for a main direction ``N``."""
+    with kernel("gp_Ax2"):
+        return xyz(gp_Ax2(pnt((0.0, 0.0, 0.0)), _dir(normal)).XDirection())
+
+
+def read_ax3(pos) -> tuple:
+    """``(origin, x, y, z)`` of a ``gp_Ax3`` / ``gp_Ax2``."""
+    return xyz(pos.Location()), xyz(pos.XDirection()), xyz(pos.YDirection()), xyz(pos.Direction())
+
+
+# -- curves ---------------------------------------------------------------------------------
+def circle(origin, normal, x_dir, radius):
+    from OCP.Geom import Geom_Circle
+    from OCP.gp import gp_Circ
+
+    with kernel("Geom_Circle"):
+        return Geom_Circle(gp_Circ(ax2(origin, normal, x_dir), float(radius)))
+
+
+def ellipse(origin, normal, x_dir, major, minor):
+    from OCP.Geom import Geom_Ellipse
+    from OCP.gp import gp_Elips
+
+    with kernel("Geom_Ellipse"):
+        return Geom_Ellipse(gp_Elips(ax2(origin, normal, x_dir), float(major), float(minor)))
+
+
+def infinite_line(origin, direction):
+    from OCP.Geom import Geom_Line
+    from OCP.gp import gp_Lin
+
+    with kernel("Geom_Line"):
+        return Geom_Line(gp_Lin(pnt(origin), _dir(direction)))
+
+
+def trimmed(curve, t0, t1):
+    from OCP.Geom import Geom_TrimmedCurve
+
+    with kernel("Geom_TrimmedCurve"):
+        return Geom_TrimmedCurve(curve, float(t0), float(t1))
+
+
+def curve_type(curve) -> str:
+    return curve.DynamicType().Name()
+
+
+def read_curve(curve) -> dict:
+    """Plain data of an OCCT curve in its own parametrization.
+
+    ``kind`` is one of ``line``, ``circle``, ``ellipse``, ``bspline``, ``bezier``;
+    trimmed curves are unwrapped (the caller keeps the parameter range).
+    """
+
+    from .geom import read_bspline_curve
+
+    name = curve_type(curve)
+    with kernel(f"reading {name}"):
+        if name == "Geom_TrimmedCurve":
+            return read_curve(curve.BasisCurve())
+        if name == "Geom_Line":
+            lin = curve.Lin()
+            return {"kind": "line", "origin": xyz(lin.Location()), "direction": xyz(lin.Direction())}
+        if name == "Geom_Circle":
+            c = curve
+            return {"kind": "circle", "frame": read_ax3(c.Position()), "radius": c.Radius()}
+        if name == "Geom_Ellipse":
+            e = curve
+            return {"kind": "ellipse", "frame": read_ax3(e.Position()), "major": e.MajorRadius(), "minor": e.MinorRadius()}
+        if name == "Geom_BSplineCurve":
+            data = read_bspline_curve(curve)
+            return {"kind": "bspline", **data}
+        if name == "Geom_BezierCurve":
+            b = curve
+            pts = np.array([xyz(b.Pole(i)) for i in range(1, b.NbPoles() + 1)])
+            w = np.array([b.Weight(i) for i in range(1, b.NbPoles() + 1)]) if b.IsRational() else None
+            return {"kind": "bezier", "points": pts, "weights": w}
+    raise SurfmodError(f"curve: unsupported OCCT curve type {name}")
+
+
+# -- elementary surfaces ----------------------------------------------------------------------
+def plane(frame):
+    from OCP.Geom import Geom_Plane
+
+    with kernel("Geom_Plane"):
+        return Geom_Plane(ax3(frame))
+
+
+def cylinder(frame, radius):
+    from OCP.Geom import Geom_CylindricalSurface
+
+    with kernel("Geom_CylindricalSurface"):
+        return Geom_CylindricalSurface(ax3(frame), float(radius))
+
+
+def cone(frame, semi_angle, ref_radius):
+    from OCP.Geom import Geom_ConicalSurface
+
+    with kernel("Geom_ConicalSurface"):
+        return Geom_ConicalSurface(ax3(frame), float(semi_angle), float(ref_radius))
+
+
+def sphere(frame, radius):
+    from OCP.Geom import Geom_SphericalSurface
+
+    with kernel("Geom_SphericalSurface"):
+        return Geom_SphericalSurface(ax3(frame), float(radius))
+
+
+def torus(frame, major, minor):
+    from OCP.Geom import Geom_ToroidalSurface
+
+    with kernel("Geom_ToroidalSurface"):
+        return Geom_ToroidalSurface(ax3(frame), float(major), float(minor))
+
+
+def read_elementary(surf) -> dict:
+    """Frame and radii of a downcast Geom_Plane / Cylindrical / Conical / Spherical / Toroidal surface."""
+    name = surf.DynamicType().Name()
+    with kernel(f"reading {name}"):
+        out = {"kind": name, "frame": read_ax3(surf.Position())}
+        if name == "Geom_CylindricalSurface":
+            out["radius"] = surf.Radius()
+        elif name == "Geom_ConicalSurface":
+            out["radius"], out["semi_angle"] = surf.RefRadius(), surf.SemiAngle()
+        elif name == "Geom_SphericalSurface":
+            out["radius"] = surf.Radius()
+        elif name == "Geom_ToroidalSurface":
+            out["major"], out["minor"] = surf.MajorRadius(), surf.MinorRadius()
+    return out
+
+
+# -- swept analytic surfaces --------------------------------------------------------------------
+def revolution(basis_curve, origin, direction):
+    from OCP.Geom import Geom_SurfaceOfRevolution
+
+    with kernel("Geom_SurfaceOfRevolution"):
+        return Geom_SurfaceOfRevolution(basis_curve, gp_Ax1(pnt(origin), _dir(direction)))
+
+
+def extrusion(basis_curve, direction):
+    from OCP.Geom import Geom_SurfaceOfLinearExtrusion
+
+    with kernel("Geom_SurfaceOfLinearExtrusion"):
+        return Geom_SurfaceOfLinearExtrusion(basis_curve, _dir(direction))
+
+
+def read_revolution(surf) -> dict:
+    with kernel("reading Geom_SurfaceOfRevolution"):
+        axis = surf.Axis()
+        return {"basis": surf.BasisCurve(), "origin": xyz(axis.Location()), "direction": xyz(axis.Direction())}
+
+
+def read_extrusion(surf) -> dict:
+    with kernel("reading Geom_SurfaceOfLinearExtrusion"):
+        return {"basis": surf.BasisCurve(), "direction": xyz(surf.Direction())}
+
+
+def offset_surface(basis, distance):
+    from OCP.Geom import Geom_OffsetSurface
+
+    with kernel("Geom_OffsetSurface"):
+        return Geom_OffsetSurface(basis, float(distance))
+
+
+def read_offset(surf) -> dict:
+    with kernel("reading Geom_OffsetSurface"):
+        return {"basis": surf.BasisSurface(), "distance": surf.Offset()}
+
+
+def read_trimmed_surface(surf) -> dict:
+    with kernel("reading Geom_RectangularTrimmedSurface"):
+        return {"basis": surf.BasisSurface(), "bounds": tuple(surf.Bounds())}
+
+
+def ruled(curve1, curve2):
+    """OCCT's ruled surface between two curves (``GeomFill::Surface``)."""
+    from OCP.GeomFill import GeomFill
+
+    with kernel("GeomFill::Surface"):
+        return GeomFill.Surface_s(curve1, curve2)
+
+
+# -- transforms ------------------------------------------------------------------------------
+def trsf(matrix) -> gp_Trsf:
+    """``gp_Trsf`` of a 4x4 similarity matrix (rotation/mirror times uniform scale)."""
+    m = np.asarray(matrix, dtype=float)
+    t = gp_Trsf()
+    with kernel("gp_Trsf.SetValues"):
+        t.SetValues(*(float(x) for x in m[:3, :4].ravel()))
+    return t
+
+
+def transformed(geom, matrix):
+    """``geom.Transformed(gp_Trsf(matrix))`` for a similarity matrix."""
+    with kernel("Geom_Geometry.Transformed"):
+        return geom.Transformed(trsf(matrix))
