@@ -86,7 +86,7 @@ class OffsetSurface(Surface):
 
     >>> import surfmod as sm
     >>> s = sm.OffsetSurface(sm.sphere(2.0), 0.5)
-    >>> s.points(0.0, 0.0).round(12)
+    >>> s.points(0.0, 0.0).round(12) + 0.0
     array([2.5, 0. , 0. ])
     """
 
