@@ -321,7 +321,7 @@ def common_volume(a, b, eps: float = 1e-9) -> float:
 
     with kernel("BRepAlgoAPI_Common"):
         op = BRepAlgoAPI_Common(a, b)
-        if not op.IsDone() or op.HasErrors():
+        if not op.IsDone():
             raise SurfmodError("a, b: OCCT boolean common failed on these parts")
         result = op.Shape()
     if result is None or result.IsNull() or not solids_of(result):
@@ -368,7 +368,7 @@ def section_edges(shape, origin, normal):
         op.Approximation(False)
         op.ComputePCurveOn1(False)
         op.Build()
-        if not op.IsDone() or op.HasErrors():
+        if not op.IsDone():
             raise SurfmodError("obj: OCCT could not section this shape")
         edges = _explore(op.Shape(), TopAbs_EDGE)
         if not edges:
