@@ -69,6 +69,8 @@ _EXPORTS = {
     "LimitSurface": ".subdiv.limit",
     "mass_properties": ".uses.mass",
     "MassProperties": ".uses.mass",
+    "interference": ".uses.interference",
+    "Interference": ".uses.interference",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])
