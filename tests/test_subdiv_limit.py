@@ -1,0 +1,151 @@
+"""Catmull–Clark limit surfaces as CAD patches: exactness, measured continuity, OCCT solid."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import reference as ref
+import surfmod as sm
+from surfmod.subdiv.limit import bezier_eval
+from test_subdiv import CUBE_F, CUBE_V, pentagonal_prism, torus_cage
+
+
+@pytest.fixture(scope="module")
+def cube_limit():
+    return sm.limit_surface(CUBE_V, CUBE_F)
+
+
+@pytest.fixture(scope="module")
+def cube_solid(cube_limit):
+    return cube_limit.solid()
+
+
+def test_regular_patches_are_the_uniform_cubic_bspline():
+    """A torus cage is all regular: every patch is the lecture's matrix-form uniform
+    cubic B-spline of its 4 x 4 neighbourhood, to 1e-12."""
+    n, m = 6, 5
+    net, faces = torus_cage(n, m, jitter=0.15, seed=2)
+    lim = sm.limit_surface(net.reshape(-1, 3), faces, levels=0)
+    assert lim.regular.all() and len(lim.patches) == n * m
+    a = np.linspace(0, 1, 5)
+    for f in (0, 7, 29):
+        p, q = divmod(f, m)
+        net4 = net[np.ix_(np.arange(p - 1, p + 3) % n, np.arange(q - 1, q + 3) % m)]
+        patch = lim.patches[f]
+        assert isinstance(patch, sm.BSplineSurface) and patch.domain == ((0.0, 1.0), (0.0, 1.0))
+        np.testing.assert_array_equal(patch.control_points, net4)
+        expected = np.array([[ref.uniform_cubic_point(net4, u, v) for v in a] for u in a])
+        np.testing.assert_allclose(patch.grid(a, a), expected, atol=1e-12)
+        # the Bézier form kept for measuring is the exact conversion
+        uu, vv = (x.ravel() for x in np.meshgrid(a, a, indexing="ij"))
+        bp, _ = bezier_eval(np.repeat(lim.bezier_nets[f][None], uu.size, 0), uu, vv)
+        np.testing.assert_allclose(bp, expected.reshape(-1, 3), atol=1e-12)
+    e = lim.errors
+    assert e["max_gap"] < 1e-12 and e["max_normal_angle_deg"] < 1e-9
+    assert e["max_limit_deviation"] < 1e-12 and e["max_limit_normal_deg"] < 1e-9
+
+
+def test_acc_rules_reproduce_regular_patches(cube_limit):
+    """On regular faces the extraordinary-patch rules give the B-spline's own Bézier
+    points, so exact and approximate patches meet without a gap."""
+    e = cube_limit.errors
+    assert e["acc_regular_mismatch"] < 1e-14
+    assert e["max_gap"] < 1e-12
+    assert e["max_normal_angle_regular_deg"] < 1e-9
+    assert e["max_limit_deviation_regular"] < 1e-12
+
+
+def test_cube_limit_counts_and_corner_interpolation(cube_limit):
+    lim = cube_limit
+    assert len(lim.patches) == 96 and int(lim.regular.sum()) == 72 and lim.levels == 2
+    assert all(isinstance(p, sm.BezierSurface) for p, r in zip(lim.patches, lim.regular) if not r)
+    # patch corners are the exact limit points of the mesh vertices, with the exact
+    # limit normal at the extraordinary vertices (tangent-plane projection)
+    masks = sm.catmull_clark_limit(lim.mesh.vertices, lim.mesh.faces)
+    quads = lim.mesh.faces
+    uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    f = np.repeat(np.arange(len(quads)), 4)
+    k = np.tile(np.arange(4), len(quads))
+    p, nrm = bezier_eval(lim.bezier_nets[f], uv[k, 0], uv[k, 1])
+    np.testing.assert_allclose(p, masks.positions[quads.ravel()], atol=1e-14)
+    np.testing.assert_allclose(nrm, masks.normals[quads.ravel()], atol=1e-12)
+
+
+def test_measured_errors_are_stated_and_shrink_with_levels():
+    rng = np.random.default_rng(5)
+    cage = CUBE_V + 0.1 * rng.standard_normal(CUBE_V.shape)
+    errs = [sm.limit_surface(cage, CUBE_F, levels=k).errors for k in (1, 2, 3)]
+    for e in errs:
+        assert e["max_gap"] < 1e-12  # watertight by construction
+        assert e["max_limit_deviation_regular"] < 1e-12
+    dev = [e["max_limit_deviation_rel"] for e in errs]
+    ang = [e["max_normal_angle_deg"] for e in errs]
+    assert dev[2] < dev[1] < dev[0] < 0.01
+    assert ang[2] < ang[1] < ang[0] < 4.0
+
+
+def test_cube_solid_is_valid_closed_and_has_the_limit_volume(cube_solid):
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    assert BRepCheck_Analyzer(cube_solid.wrapped).IsValid()
+    assert len(cube_solid.faces()) == 96
+    # volume of the polyhedron through exact limit points of a fine mesh (inscribed,
+    # converges from below): the solid's volume must be just above it
+    fine = sm.catmull_clark(CUBE_V, CUBE_F, 5)
+    lim = sm.catmull_clark_limit(fine.vertices, fine.faces)
+    poly = sm.Mesh(lim.positions, fine.faces).to_trimesh().volume
+    assert poly < cube_solid.volume < poly * 1.002
+    assert cube_solid.volume == pytest.approx(0.3275437, abs=2e-6)
+
+
+def test_step_round_trip_faces_cross_check(cube_solid, tmp_path):
+    path = tmp_path / "cube.step"
+    sm.export_step(cube_solid, path)
+    back = sm.import_step(path)
+    faces = back.faces()
+    assert len(back.solids()) == 1 and len(faces) == 96
+    results = [sm.crosscheck(f, samples=6) for f in faces[::7]]
+    assert all(r.passed and r.mode == "parametric" for r in results)
+    assert max(r.max_deviation for r in results) < 1e-12
+
+
+def test_patches_cross_check_against_occt(cube_limit):
+    irregular = int(np.flatnonzero(~cube_limit.regular)[0])
+    regular = int(np.flatnonzero(cube_limit.regular)[0])
+    for f in (irregular, regular):
+        r = sm.crosscheck(cube_limit.patches[f], samples=12)
+        assert r.passed and r.mode == "parametric", r.details
+
+
+def test_mixed_polygon_cage_becomes_a_solid():
+    v, faces = pentagonal_prism()
+    lim = sm.limit_surface(v, faces, levels=1)
+    assert len(lim.patches) == 30 and lim.errors["max_gap"] < 1e-12
+    shell = lim.shell()
+    assert len(shell.faces()) == 30
+    solid = lim.solid()
+    assert solid.is_valid and solid.volume > 0
+    fine = sm.catmull_clark(v, faces, 5)
+    assert solid.volume == pytest.approx(sm.Mesh(fine.vertices, fine.faces).to_trimesh().volume, rel=0.02)
+
+
+BAD = [
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F[:5]), "quads.*closed cage"),
+    (lambda: sm.limit_surface(CUBE_V, [CUBE_F[0][::-1]] + CUBE_F[1:]), "quads.*consistently oriented"),
+    (lambda: sm.limit_surface(*pentagonal_prism(), levels=0), "quads.*levels=0"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=9), "levels"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=40), "levels.*limit"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F, tangent_plane="yes"), "tangent_plane"),
+    (lambda: sm.limit_surface(CUBE_V, []), "quads.*empty"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F + [(0, 1, 5, 4)]), "quads.*non-manifold"),
+    (lambda: sm.limit_surface(np.full((8, 3), np.nan), CUBE_F), "vertices.*NaN"),
+    (lambda: sm.limit_surface(CUBE_V, [(0, 3, 2, 2)] + CUBE_F[1:]), "quads.*repeats"),
+    (lambda: sm.limit_surface(CUBE_V, [(0, 3, 2, 10)] + CUBE_F[1:]), "quads.*out of range"),
+]
+
+
+@pytest.mark.parametrize("call, message", BAD, ids=[m for _, m in BAD])
+def test_limit_surface_bad_input(call, message):
+    with pytest.raises(sm.SurfmodError, match=message):
+        call()
