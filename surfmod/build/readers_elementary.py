@@ -78,6 +78,47 @@ def comb_half(m: int) -> float:
     return c
 
 
+def _degenerate(ders):
+    """``|Su x Sv|`` negligible against ``max(|Su|, |Sv|)^2`` (poles where one partial is
+    round-off small but not zero, e.g. ``cos(pi/2)``)."""
+    su = np.linalg.norm(ders[:, 1, 0], axis=-1)
+    sv = np.linalg.norm(ders[:, 0, 1], axis=-1)
+    cross = np.linalg.norm(np.cross(ders[:, 1, 0], ders[:, 0, 1]), axis=-1)
+    return (cross <= 1e-9 * np.maximum(su, sv) ** 2) | degenerate_mask(ders, tolerances.DEGENERATE_NORMAL)
+
+
+def _equivalent(base, d):
+    """The elementary surface an offset of a plane, cylinder, sphere or torus is (same
+    parametrization, like OCCT's equivalent surface), or None."""
+    from .elementary import AnalyticPlane, CylindricalSurface, SphericalSurface, ToroidalSurface
+
+    if not isinstance(base, (AnalyticPlane, CylindricalSurface, SphericalSurface, ToroidalSurface)):
+        return None
+    o, x, y, z = base.frame
+    if isinstance(base, AnalyticPlane):
+        return AnalyticPlane._trusted((o + d * np.cross(x, y), x, y, z), (), *base.domain)
+    (u0, u1), (v0, v1) = base.domain
+    um, vm = 0.5 * (u0 + u1), 0.5 * (v0 + v1)
+    if isinstance(base, SphericalSurface):
+        vm = 0.0 if v0 < 0.0 < v1 else vm
+    p, n = base.points(um, vm), base.normals(um, vm)
+    rel = p - o
+    if isinstance(base, SphericalSurface):
+        radial = rel
+    else:
+        radial = rel - (rel @ z) * z
+        if isinstance(base, ToroidalSurface):
+            radial = rel - base.major * radial / np.linalg.norm(radial)
+    sign = 1.0 if float(n @ radial) > 0 else -1.0
+    if isinstance(base, ToroidalSurface):
+        minor = base.minor + sign * d
+        return ToroidalSurface._trusted(base.frame, (base.major, minor), *base.domain) if minor > 0 else None
+    radius = base.radius + sign * d
+    if radius <= 0:
+        return None
+    return type(base)._trusted(base.frame, (radius,), *base.domain)
+
+
 class OffsetSurface(Surface):
     """``S(u, v) + d N(u, v)`` with ``N`` the unit normal ``Su x Sv / |Su x Sv|`` of the base
     surface: OCCT's ``Geom_OffsetSurface``.  Positions, normals and derivatives (up to
@@ -100,14 +141,17 @@ class OffsetSurface(Surface):
             raise SurfmodError(f"distance: must be finite, got {distance!r}")
         self.base, self.distance = base, d
         self._occ = None
+        self._equivalent = _equivalent(base, d)
 
     @property
     def domain(self):
         return self.base.domain
 
     def _derivatives(self, u, v, order):
+        if self._equivalent is not None:
+            return self._equivalent._derivatives(u, v, order)
         ders = self.base._derivatives(u, v, order + 1)
-        bad = degenerate_mask(ders, tolerances.DEGENERATE_NORMAL)
+        bad = _degenerate(ders)
         if np.any(bad):
             (u0, u1), (v0, v1) = self.domain
             un = u[bad] + 1e-7 * ((u0 + u1) / 2 - u[bad])

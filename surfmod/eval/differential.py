@@ -27,11 +27,13 @@ def raw_normals(ders: np.ndarray) -> np.ndarray:
 
 
 def degenerate_mask(ders: np.ndarray, rel: float) -> np.ndarray:
-    """True where ``|Su x Sv|`` is negligible against ``|Su| |Sv|`` (or both vanish)."""
+    """True where ``|Su x Sv|`` is negligible against ``max(|Su|, |Sv|)^2`` (or a partial
+    vanishes).  The larger partial sets the scale so that a pole where one partial is
+    only round-off (``cos(pi/2)``, rational quotients) still counts as degenerate."""
     su = np.linalg.norm(ders[..., 1, 0, :], axis=-1)
     sv = np.linalg.norm(ders[..., 0, 1, :], axis=-1)
     cross = np.linalg.norm(raw_normals(ders), axis=-1)
-    scale = np.maximum(su * sv, np.finfo(float).tiny)
+    scale = np.maximum(np.maximum(su, sv) ** 2, np.finfo(float).tiny)
     return (cross <= rel * scale) | (su * sv == 0.0)
 
 
