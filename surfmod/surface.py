@@ -72,7 +72,16 @@ class Surface(abc.ABC):
         return self._derivatives(uf, vf, 0)[:, 0, 0, :].reshape(*shape, 3)
 
     def derivatives(self, u, v, order: int = 1) -> np.ndarray:
-        """Partials ``[..., k, l, :] = d^(k+l) S / du^k dv^l`` for ``k, l <= order``."""
+        """Partials ``[..., k, l, :] = d^(k+l) S / du^k dv^l`` for ``k, l <= order``.
+
+        At an interior knot where a derivative jumps (multiplicity above degree minus
+        the order) the right-hand derivative is returned; at the end of the domain the
+        left-hand one.
+
+        >>> import surfmod as sm
+        >>> sm.plane((0, 0, 0), (2, 0, 0), (0, 3, 0)).derivatives(0.5, 0.5)[1, 0]
+        array([2., 0., 0.])
+        """
         order = checks.count(order, "order", minimum=0)
         shape, uf, vf = self._params(u, v)
         out = self._derivatives(uf, vf, order)
@@ -81,6 +90,24 @@ class Surface(abc.ABC):
     def grid(self, us, vs) -> np.ndarray:
         """Positions on the tensor grid ``us x vs``: ``(len(us), len(vs), 3)``."""
         return self.grid_derivatives(us, vs, 0)[:, :, 0, 0, :]
+
+    def grid_chunks(self, us, vs, max_points: int = 1 << 21):
+        """Evaluate a huge grid block by block with bounded memory.
+
+        Yields ``(i0, block)`` where ``block = grid(us[i0:i1], vs)``; each block holds at
+        most about ``max_points`` points (at least one row of u).
+
+        >>> import surfmod as sm, numpy as np
+        >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
+        >>> [(i0, b.shape) for i0, b in s.grid_chunks(np.linspace(0, 1, 5), np.linspace(0, 1, 4), 8)]
+        [(0, (2, 4, 3)), (2, (2, 4, 3)), (4, (1, 4, 3))]
+        """
+        us = np.atleast_1d(np.asarray(us, dtype=float)).ravel()
+        vs = np.atleast_1d(np.asarray(vs, dtype=float)).ravel()
+        max_points = checks.count(max_points, "max_points")
+        rows = max(1, max_points // max(1, vs.size))
+        for i0 in range(0, us.size, rows):
+            yield i0, self.grid(us[i0 : i0 + rows], vs)
 
     def grid_derivatives(self, us, vs, order: int = 1) -> np.ndarray:
         """Partials on the tensor grid: ``(len(us), len(vs), order+1, order+1, 3)``."""

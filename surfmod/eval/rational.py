@@ -44,3 +44,24 @@ def surface_quotient(hders: np.ndarray) -> np.ndarray:
                     acc -= comb(k, i) * comb(l, j) * w[..., i, j, None] * out[..., k - i, l - j, :]
             out[..., k, l, :] = acc / w0
     return out
+
+
+def planes_quotient(planes: dict, order: int) -> dict:
+    """The quotient rule on grid planes ``{(k, l): (nu, nv, 4)}`` -> ``(nu, nv, 3)``.
+
+    Same formula as :func:`surface_quotient`, laid out for the grid fast path.
+    """
+    out = {}
+    w0 = planes[0, 0][..., 3:4]
+    for k in range(order + 1):
+        for l in range(order + 1):
+            acc = planes[k, l][..., :3].copy()
+            for j in range(1, l + 1):
+                acc -= comb(l, j) * planes[0, j][..., 3:4] * out[k, l - j]
+            for i in range(1, k + 1):
+                acc -= comb(k, i) * planes[i, 0][..., 3:4] * out[k - i, l]
+                for j in range(1, l + 1):
+                    acc -= comb(k, i) * comb(l, j) * planes[i, j][..., 3:4] * out[k - i, l - j]
+            acc /= w0
+            out[k, l] = acc
+    return out

@@ -41,18 +41,32 @@ def surface_derivatives(knots_u, p, knots_v, q, ctrl, u, v, order):
     return np.einsum("nkjd,nlj->nkld", tmp, nv)
 
 
-def surface_grid_derivatives(knots_u, p, knots_v, q, ctrl, us, vs, order):
-    """Mixed partials on the tensor grid ``us x vs``: ``(len(us), len(vs), order+1, order+1, dim)``.
+def surface_grid_planes(knots_u, p, knots_v, q, ctrl, us, vs, order):
+    """Mixed partials on the grid ``us x vs``: ``{(k, l): array (len(us), len(vs), dim)}``.
 
-    Two dense matrix products per derivative pair (BLAS), the fast path for meshes.
+    ``L_k = Bu_k @ P`` per coordinate, then one batched product ``Bv_l @ L_k`` whose
+    output is already laid out point-major: BLAS does all the work, no gather, no
+    per-point Python, and no copy for plain positions.
     """
-    n, m, dim = ctrl.shape
+    n, m, _ = ctrl.shape
     bu = basis_matrix(knots_u, p, n, us, order)  # (K, nu, n)
     bv = basis_matrix(knots_v, q, m, vs, order)  # (K, nv, m)
-    out = np.empty((bu.shape[1], bv.shape[1], order + 1, order + 1, dim))
+    ctrl_d = np.ascontiguousarray(np.moveaxis(ctrl, -1, 0))  # (dim, n, m)
+    planes = {}
     for k in range(order + 1):
-        tmp = np.tensordot(bu[k], ctrl, axes=(1, 0))  # (nu, m, dim)
-        tmp = np.ascontiguousarray(tmp.transpose(0, 2, 1))  # (nu, dim, m)
+        left = np.matmul(bu[k], ctrl_d).transpose(1, 2, 0)  # (nu, m, dim)
         for l in range(order + 1):
-            out[:, :, k, l, :] = (tmp @ bv[l].T).transpose(0, 2, 1)
+            planes[k, l] = np.matmul(bv[l], left)  # (nu, nv, dim)
+    return planes
+
+
+def planes_to_array(planes, order, dim=3):
+    """Assemble ``{(k, l): (nu, nv, dim)}`` into ``(nu, nv, order+1, order+1, dim)``
+    (a view, without copying, for positions only)."""
+    if order == 0:
+        return planes[0, 0][:, :, None, None, :dim]
+    first = planes[0, 0]
+    out = np.empty((first.shape[0], first.shape[1], order + 1, order + 1, dim))
+    for (k, l), plane in planes.items():
+        out[:, :, k, l, :] = plane[..., :dim]
     return out

@@ -14,8 +14,8 @@ import numpy as np
 from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..eval.rational import curve_quotient, surface_quotient
-from ..eval.tensor import curve_derivatives, surface_derivatives, surface_grid_derivatives
+from ..eval.rational import curve_quotient, planes_quotient, surface_quotient
+from ..eval.tensor import curve_derivatives, planes_to_array, surface_derivatives, surface_grid_planes
 from ..surface import Surface
 from . import knots as kn
 
@@ -209,6 +209,13 @@ class BSplineSurface(Surface):
     def rational(self) -> bool:
         return self.weights is not None
 
+    def __repr__(self):
+        n, m = self.control_points.shape[:2]
+        kind = "NURBS" if self.rational else "B-spline"
+        return (f"{type(self).__name__}({kind}, {n}x{m} net, degree={self.degree}, "
+                f"knots=({np.array2string(self.knots[0], precision=17, separator=',')}, "
+                f"{np.array2string(self.knots[1], precision=17, separator=',')}))")
+
     @property
     def domain(self):
         (p, q), (ku, kv) = self.degree, self.knots
@@ -222,8 +229,10 @@ class BSplineSurface(Surface):
 
     def _grid_derivatives(self, us, vs, order):
         (p, q), (ku, kv) = self.degree, self.knots
-        h = surface_grid_derivatives(ku, p, kv, q, self._h, us, vs, order)
-        return surface_quotient(h) if self.rational else h
+        planes = surface_grid_planes(ku, p, kv, q, self._h, us, vs, order)
+        if self.rational:
+            planes = planes_quotient(planes, order)
+        return planes_to_array(planes, order)
 
     def geom(self):
         from ..occ.geom import bspline_surface
