@@ -1,0 +1,146 @@
+"""Cross-section views: planar sections of a part as curves, in 3-D and in the plane's frame."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+
+
+def plane_frame(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal in-plane axes ``(x, y)`` with ``x × y = normal``.
+
+    Without ``x_axis`` the x axis is the projection of the global X axis (or of Y when
+    the normal is close to X): a plane with normal +Z gets the global X/Y axes.
+    """
+    if x_axis is None:
+        helper = np.array([1.0, 0, 0]) if abs(normal[0]) < 0.9 else np.array([0, 1.0, 0])
+    else:
+        helper = checks.direction(x_axis, "x_axis")
+    x = helper - np.dot(helper, normal) * normal
+    if np.linalg.norm(x) < 1e-9:
+        raise SurfmodError("x_axis: must not be parallel to plane_normal")
+    x /= np.linalg.norm(x)
+    return x, np.cross(normal, x)
+
+
+@dataclass(frozen=True)
+class Section:
+    """Section curves of a part by a plane.
+
+    ``wires`` are build123d ``Wire``s (OCCT's section edges chained end to end);
+    ``polylines`` the same curves sampled by the NumPy evaluator (each edge read back
+    exactly with :func:`surfmod.from_edge`), one ``(N, 3)`` array per wire;
+    ``closed`` says which wires close up.  The plane frame is ``origin`` with axes
+    ``x_axis``, ``y_axis`` and ``normal``; :meth:`polylines_2d` gives the curves in it.
+    An empty section (the plane misses the part) has no wires.
+    """
+
+    origin: np.ndarray
+    normal: np.ndarray
+    x_axis: np.ndarray
+    y_axis: np.ndarray
+    wires: list = field(repr=False)
+    polylines: list = field(repr=False)
+    closed: list
+
+    @property
+    def empty(self) -> bool:
+        return not self.wires
+
+    @property
+    def length(self) -> float:
+        """Total length of the section curves (OCCT edge lengths)."""
+        return float(sum(w.length for w in self.wires))
+
+    def polylines_2d(self) -> list[np.ndarray]:
+        """The polylines in the plane frame, ``(N, 2)`` each."""
+        axes = np.stack([self.x_axis, self.y_axis], axis=1)
+        return [(p - self.origin) @ axes for p in self.polylines]
+
+    def areas(self) -> np.ndarray:
+        """Signed areas (shoelace, in the plane frame) of the closed curves; 0 for open ones."""
+        out = []
+        for q, c in zip(self.polylines_2d(), self.closed):
+            out.append(0.5 * float(np.sum(q[:-1, 0] * q[1:, 1] - q[1:, 0] * q[:-1, 1])) if c else 0.0)
+        return np.array(out)
+
+    def preview(self, path, *, dpi: int = 120) -> None:
+        """A PNG drawing of the section in the plane frame (matplotlib, atomic write)."""
+        from ..io.atomic import atomic_path, target_path
+
+        target = target_path(path, "path", (".png",))
+        try:
+            import matplotlib
+
+            matplotlib.use("Agg", force=False)
+            import matplotlib.pyplot as plt
+        except ImportError:  # pragma: no cover
+            raise SurfmodError("path: PNG previews need matplotlib (pip install matplotlib)") from None
+        fig, ax = plt.subplots(figsize=(5, 5))
+        try:
+            for q in self.polylines_2d():
+                ax.plot(q[:, 0], q[:, 1], "-", lw=1.2, color="tab:blue")
+            ax.set_aspect("equal")
+            ax.set_xlabel("plane x")
+            ax.set_ylabel("plane y")
+            o, n = self.origin, self.normal
+            ax.set_title(f"section at ({o[0]:.4g}, {o[1]:.4g}, {o[2]:.4g}) n=({n[0]:.3g}, {n[1]:.3g}, {n[2]:.3g})", fontsize=9)
+            ax.grid(True, lw=0.3)
+            with atomic_path(target) as tmp:
+                fig.savefig(tmp, format="png", dpi=dpi)
+        finally:
+            plt.close(fig)
+
+    def __str__(self) -> str:
+        if self.empty:
+            return "section: empty (the plane misses the part)"
+        return f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}"
+
+
+def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) -> Section:
+    """Planar section of a part (or of surfaces): curves where the plane cuts it.
+
+    ``obj``: a build123d shape, surfmod surface(s) or a STEP path.  A plane that misses
+    the part gives an empty :class:`Section`; a plane lying on a planar face of the
+    part is ambiguous (the "section" would be the face) and raises ``SurfmodError``.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> s = sm.section(bd.Sphere(2), (0, 0, 1), (0, 0, 1))
+    >>> len(s.wires), s.closed, round(s.length, 12) == round(2 * 3.141592653589793 * 3 ** 0.5, 12)
+    (1, [True], True)
+    """
+    from ..build.from_face import from_edge
+    from ..occ import uses as occ
+    from .inputs import to_shape
+
+    origin = checks.point(plane_origin, "plane_origin")
+    normal = checks.direction(plane_normal, "plane_normal")
+    samples = checks.count(samples, "samples", minimum=2)
+    xa, ya = plane_frame(normal, x_axis)
+    shape = to_shape(obj, "obj")
+    box = occ.bounding_box(shape)
+    tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
+    on = occ.planar_faces_in(shape, origin, normal, tol)
+    if on:
+        raise SurfmodError(
+            f"plane_normal: the section plane is parallel to planar face(s) {on} of obj and lies on them; "
+            "move plane_origin off the face or tilt the plane"
+        )
+    wires = occ.section_edges(shape, origin, normal)
+    polylines, closed = [], []
+    for w in wires:
+        pts = []
+        for e in occ.wire_edges(w):
+            curve = from_edge(e)
+            (t0, t1) = curve.domain
+            p = curve.points(np.linspace(t0, t1, samples))  # from_edge follows the edge's orientation
+            pts.append(p if not pts else p[1:])
+        poly = np.concatenate(pts)
+        polylines.append(checks.frozen(poly))
+        closed.append(bool(w.is_closed) if hasattr(w, "is_closed") else bool(np.allclose(poly[0], poly[-1])))
+    return Section(checks.frozen(origin), checks.frozen(normal), checks.frozen(xa), checks.frozen(ya),
+                   wires, polylines, closed)
