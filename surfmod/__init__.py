@@ -71,6 +71,10 @@ _EXPORTS = {
     "MassProperties": ".uses.mass",
     "interference": ".uses.interference",
     "Interference": ".uses.interference",
+    "section": ".uses.section",
+    "Section": ".uses.section",
+    "export_dxf": ".io.dxf",
+    "export_svg": ".io.svg",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])
