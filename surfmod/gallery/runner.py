@@ -21,13 +21,11 @@ class Row:
 
 
 def run_entry(e: Entry, outdir: Path) -> Row:
-    from .. import io
     from ..check import crosscheck
     from ..io.step import export_step
     from ..io.stl import export_stl
     from ..surface import Surface
 
-    del io
     try:
         obj = e.build()
         if isinstance(obj, Surface):
@@ -56,12 +54,18 @@ def _render(obj, path: Path) -> None:
     render([obj], path)
 
 
-def run_gallery(outdir, *, progress: bool = True) -> list[Row]:
+def run_gallery(outdir, *, progress: bool = True, only=None) -> list[Row]:
+    """Build, check and export every entry (or the named ones); one row each."""
     from tqdm import tqdm
 
+    items = entries()
+    if only:
+        unknown = sorted(set(only) - {e.name for e in items})
+        if unknown:
+            raise SurfmodError(f"only: unknown entities {', '.join(unknown)}")
+        items = [e for e in items if e.name in only]
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
-    items = entries()
     return [run_entry(e, out) for e in tqdm(items, desc="gallery", unit="entity", disable=not progress)]
 
 

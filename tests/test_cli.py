@@ -1,0 +1,78 @@
+"""The command line: gallery and check (driven in-process and as a real console script)."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import surfmod as sm
+from surfmod.cli import main
+
+
+def test_help_lists_the_subcommands(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    for name in ("gallery", "check"):
+        assert name in out
+
+
+def test_check_reports_every_face(tmp_path, capsys):
+    import build123d as bd
+
+    rng = np.random.default_rng(0)
+    sm.export_step(sm.BSplineSurface(rng.uniform(-1, 1, (5, 5, 3)), (3, 3)), tmp_path / "a.step")
+    bd.export_step(bd.Box(1, 2, 3), str(tmp_path / "box.step"))
+    code = main(["check", str(tmp_path), "--no-progress", "--jobs", "1", "--samples", "8"])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "Geom_BSplineSurface" in out and "Geom_Plane" in out
+    assert "7 of 7 faces passed" in out
+
+
+def test_check_exits_nonzero_on_bad_files(tmp_path, capsys):
+    (tmp_path / "bad.step").write_text("ISO-10303-21;\nnonsense\n")
+    code = main(["check", str(tmp_path / "bad.step"), "--no-progress"])
+    assert code == 1
+    assert "NO" in capsys.readouterr().out
+    assert main(["check", str(tmp_path / "missing.step"), "--no-progress"]) == 2
+
+
+def test_cadquery_step_files_read_back(tmp_path, capsys):
+    cq = pytest.importorskip("cadquery")
+    part = cq.Workplane().box(4, 3, 2).edges("|Z").fillet(0.5).faces(">Z").hole(1.0)
+    cq.exporters.export(part, str(tmp_path / "cq.step"))
+    code = main(["check", str(tmp_path / "cq.step"), "--no-progress", "--samples", "8"])
+    out = capsys.readouterr().out
+    assert code == 0, out
+
+
+def _console_script():
+    beside = Path(sys.executable).parent / "surfmod"
+    return str(beside) if beside.exists() else shutil.which("surfmod")
+
+
+@pytest.mark.skipif(_console_script() is None, reason="surfmod console script not installed")
+def test_console_script_runs_the_gallery(tmp_path):
+    out = subprocess.run(
+        [_console_script(), "gallery", str(tmp_path), "--only", "bezier", "hermite", "--no-progress"],
+        capture_output=True, text=True,
+    )
+    assert out.returncode == 0, out.stderr
+    assert "2 of 2 entities passed" in out.stdout
+    for name in ("bezier", "hermite"):
+        assert (tmp_path / f"{name}.step").stat().st_size > 0
+        assert (tmp_path / f"{name}.stl").stat().st_size > 0
+        back = sm.import_step(tmp_path / f"{name}.step")
+        assert sm.crosscheck(back.faces()[0]).passed
+
+
+def test_gallery_unknown_entity(capsys):
+    assert main(["gallery", "/tmp/unused", "--only", "nope"]) == 2
+    assert "only: unknown entities nope" in capsys.readouterr().err
