@@ -232,3 +232,17 @@ def transformed(geom, matrix):
     """``geom.Transformed(gp_Trsf(matrix))`` for a similarity matrix."""
     with kernel("Geom_Geometry.Transformed"):
         return geom.Transformed(trsf(matrix))
+
+
+def rectangular_trimmed(basis, u0, u1, v0, v1):
+    """``Geom_RectangularTrimmedSurface`` of ``basis`` over ``[u0, u1] x [v0, v1]``."""
+    from OCP.Geom import Geom_RectangularTrimmedSurface
+
+    with kernel("Geom_RectangularTrimmedSurface"):
+        return Geom_RectangularTrimmedSurface(basis, float(u0), float(u1), float(v0), float(v1))
+
+
+def bezier_curve_geom(points, weights=None):
+    from .geom import bezier_curve
+
+    return bezier_curve(np.asarray(points, float), None if weights is None else np.asarray(weights, float))
