@@ -1,0 +1,86 @@
+"""FE meshes through gmsh and meshio: measures against the exact part, files read back."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import surfmod as sm
+
+bd = pytest.importorskip("build123d")
+meshio = pytest.importorskip("meshio")
+pytest.importorskip("gmsh")
+
+
+def test_box_tetra_volume_exact():
+    m = sm.fe_mesh(bd.Box(2, 3, 1), size=0.5)
+    assert m.cell_type == "tetra" and m.n_elements > 50
+    assert m.volume == pytest.approx(6.0, rel=1e-12)
+    assert 0.1 < m.quality["gamma"]["min"] <= m.quality["gamma"]["mean"] <= 1.0
+    assert m.quality["minSICN"]["min"] > 0  # no inverted element
+    assert "tetra elements" in str(m)
+
+
+def test_sphere_volume_and_area_converge():
+    exact_v, exact_a = 4 / 3 * math.pi * 8, 16 * math.pi
+    coarse = sm.fe_mesh(bd.Sphere(2), size=0.8)
+    fine = sm.fe_mesh(bd.Sphere(2), size=0.4)
+    # inscribed polyhedra: below the exact volume, and closer when finer
+    assert coarse.volume < fine.volume < exact_v
+    assert (exact_v - fine.volume) / exact_v < 0.02
+    surf = sm.fe_mesh(bd.Sphere(2), size=0.4, kind="surface")
+    assert surf.area == pytest.approx(exact_a, rel=0.02)
+    # quadratic triangles follow the sphere: gmsh's curved area is far closer
+    surf2 = sm.fe_mesh(bd.Sphere(2), size=0.4, kind="surface", order=2)
+    assert surf2.cell_type == "triangle6"
+    assert abs(surf2.quality["measure"] - exact_a) / exact_a < 1e-4
+    # every node lies on the sphere
+    assert np.abs(np.linalg.norm(surf2.points, axis=1) - 2).max() < 1e-6
+
+
+def test_holed_part_volume_vs_mass_properties(tmp_path):
+    part = bd.Box(2, 2, 2) - bd.Cylinder(0.5, 3)
+    step = tmp_path / "part.step"
+    sm.export_step(part, step)
+    m = sm.fe_mesh(str(step), size=0.25)
+    v = sm.mass_properties(part).volume
+    # the hole is an inscribed polygon prism: a little more material than the exact part
+    assert v < m.volume < v * 1.01
+
+
+@pytest.mark.parametrize("suffix, cell", [(".msh", "tetra"), (".vtu", "tetra"), (".inp", "tetra")])
+def test_files_read_back(tmp_path, suffix, cell):
+    m = sm.fe_mesh(bd.Box(1, 1, 1), size=0.5, path=tmp_path / f"m{suffix}")
+    back = meshio.read(tmp_path / f"m{suffix}")
+    cells = back.get_cells_type(cell)
+    assert len(cells) == m.n_elements
+    assert np.allclose(np.sort(back.points[np.unique(cells)], axis=0), np.sort(m.points, axis=0))
+
+
+def test_surface_of_a_surfmod_patch():
+    net = np.zeros((3, 3, 3))
+    net[..., 0], net[..., 1] = np.mgrid[0:3, 0:3]
+    m = sm.fe_mesh(sm.BezierSurface(net), size=0.5, kind="surface")
+    assert m.area == pytest.approx(4.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("kw, arg", [({"size": 0}, "size"), ({"size": -1}, "size"), ({"order": 3}, "order"),
+                                     ({"kind": "hex"}, "kind"), ({"size": 1e4}, "size")])
+def test_bad_arguments(kw, arg):
+    args = {"size": 0.5} | kw
+    with pytest.raises(sm.SurfmodError, match=arg):
+        sm.fe_mesh(bd.Box(1, 1, 1), **args)
+
+
+def test_bad_input_and_no_partial_files(tmp_path):
+    with pytest.raises(sm.SurfmodError, match="obj: .*closed"):
+        sm.fe_mesh(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), 0.2, kind="volume")
+    with pytest.raises(sm.SurfmodError, match="obj: no such file"):
+        sm.fe_mesh(tmp_path / "missing.step", 0.2)
+    with pytest.raises(sm.SurfmodError, match="path"):
+        sm.fe_mesh(bd.Box(1, 1, 1), 0.5, path=tmp_path / "m.stl")
+    with pytest.raises(sm.SurfmodError, match="mesh"):
+        sm.export_fe_mesh("not a mesh", tmp_path / "m.vtu")
+    assert list(tmp_path.iterdir()) == []
