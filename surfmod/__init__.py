@@ -75,6 +75,9 @@ _EXPORTS = {
     "Section": ".uses.section",
     "export_dxf": ".io.dxf",
     "export_svg": ".io.svg",
+    "fe_mesh": ".uses.femesh",
+    "FEMesh": ".uses.femesh",
+    "export_fe_mesh": ".uses.femesh",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])
