@@ -148,6 +148,22 @@ def test_open_boundary_follows_cubic_bspline_curve_rules():
         np.testing.assert_allclose(out.vertices[8 + e], refined[2 * i + 1], atol=1e-15)
 
 
+def test_single_face_boundary_vertices_are_corners():
+    """Corners of an open quad grid and the tips of a triangle strip stay put."""
+    quad_v = np.array([(0, 0, 0), (1, 0, 0.3), (2, 0, 0), (0, 1, 0), (1, 1, 1), (2, 1, 0)], float)
+    quad_f = [(0, 1, 4, 3), (1, 2, 5, 4)]
+    m = sm.catmull_clark(quad_v, quad_f, 3)
+    np.testing.assert_array_equal(m.vertices[[0, 2, 3, 5]], quad_v[[0, 2, 3, 5]])
+    lim = sm.catmull_clark_limit(quad_v, quad_f)
+    np.testing.assert_array_equal(lim.positions[[0, 2, 3, 5]], quad_v[[0, 2, 3, 5]])
+    # the middle boundary vertex follows the curve rule (a + 6v + b) / 8
+    np.testing.assert_allclose(sm.catmull_clark(quad_v, quad_f, 1).vertices[1], (quad_v[0] + 6 * quad_v[1] + quad_v[2]) / 8)
+    tri_f = [(0, 1, 3), (1, 4, 3), (1, 2, 4), (2, 5, 4)]
+    t = sm.loop_subdivide(quad_v, tri_f, 3)
+    np.testing.assert_array_equal(t.vertices[[0, 5]], quad_v[[0, 5]])
+    np.testing.assert_array_equal(sm.loop_limit(quad_v, tri_f).positions[[0, 5]], quad_v[[0, 5]])
+
+
 def test_all_creases_keep_the_cube():
     """Every cube edge sharp: corners stay, edges stay straight, faces stay flat."""
     edges = [(a, b) for f in CUBE_F for a, b in zip(f, f[1:] + f[:1])]

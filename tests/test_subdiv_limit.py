@@ -130,8 +130,52 @@ def test_mixed_polygon_cage_becomes_a_solid():
     assert solid.volume == pytest.approx(sm.Mesh(fine.vertices, fine.faces).to_trimesh().volume, rel=0.02)
 
 
+def open_grid(n=6, m=5):
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    z = np.sin(i * 0.9) * np.cos(j * 0.7)
+    v = np.stack([i * 1.0, j * 1.2, z], -1)
+    faces = np.array([[p * m + q, (p + 1) * m + q, (p + 1) * m + q + 1, p * m + q + 1] for p in range(n - 1) for q in range(m - 1)])
+    return v, faces
+
+
+def test_open_grid_is_exact_bspline_with_ghost_points():
+    """Boundary curve rule and interpolated corners: every face of an open quad grid is an
+    exact uniform cubic B-spline patch of the net continued by ghost points 2b - i."""
+    net, faces = open_grid()
+    lim = sm.limit_surface(net.reshape(-1, 3), faces, levels=0)
+    assert lim.regular.all() and lim.open
+    e = lim.errors
+    assert e["max_limit_deviation"] < 1e-12 and e["max_limit_normal_deg"] < 1e-9
+    assert e["max_gap"] < 1e-12 and e["max_normal_angle_deg"] < 1e-9
+    # the whole grid continued by ghost rows/columns is one uniform cubic B-spline
+    g = np.concatenate([2 * net[:1] - net[1:2], net, 2 * net[-1:] - net[-2:-1]], 0)
+    g = np.concatenate([2 * g[:, :1] - g[:, 1:2], g, 2 * g[:, -1:] - g[:, -2:-1]], 1)
+    whole = sm.BSplineSurface.uniform_cubic(g)
+    a = np.linspace(0, 1, 4)
+    m = net.shape[1]
+    for f in (0, 3, 9, len(faces) - 1):
+        p, q = divmod(f, m - 1)
+        np.testing.assert_allclose(lim.patches[f].grid(a, a), whole.grid(p + a, q + a), atol=1e-12)
+    # the corners are interpolated, the limit agrees with deep refinement
+    np.testing.assert_allclose(whole.points(0.0, 0.0), net[0, 0], atol=1e-15)
+    deep = sm.catmull_clark(net.reshape(-1, 3), faces, 6)
+    np.testing.assert_allclose(deep.vertices[0], net[0, 0], atol=0)
+    shell = lim.shell()
+    assert len(shell.faces()) == len(faces)
+
+
+def test_open_cage_with_extraordinary_vertices_gives_a_shell():
+    lim = sm.limit_surface(CUBE_V, CUBE_F[:5])  # a box without one side
+    e = lim.errors
+    assert lim.open and e["boundary_edges"] == 16
+    assert e["max_gap"] < 1e-12 and e["max_limit_deviation_regular"] < 1e-12
+    assert e["max_limit_deviation_rel"] < 0.005 and e["max_normal_angle_deg"] < 2.0
+    shell = lim.shell()
+    assert len(shell.faces()) == 80
+
+
 BAD = [
-    (lambda: sm.limit_surface(CUBE_V, CUBE_F[:5]), "quads.*closed cage"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F[:5]).solid(), "solid.*boundary"),
     (lambda: sm.limit_surface(CUBE_V, [CUBE_F[0][::-1]] + CUBE_F[1:]), "quads.*consistently oriented"),
     (lambda: sm.limit_surface(*pentagonal_prism(), levels=0), "quads.*levels=0"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=9), "levels"),

@@ -8,7 +8,9 @@ One step of the lecture's "coarse mesh & subdivision rule":
 * vertex point ``V = (Q + 2R + (n - 3) v) / n`` for a smooth vertex of valence ``n``
   (``Q`` the average of the adjacent face points, ``R`` of the adjacent edge midpoints);
   ``(a + 6 v + b) / 8`` on a boundary/crease curve (``a``, ``b`` its two sharp
-  neighbours); a vertex with three or more sharp edges is a corner and stays put.
+  neighbours); a vertex with three or more sharp edges is a corner and stays put, and so
+  does a boundary vertex used by a single face (OpenSubdiv's "edge and corner" boundary
+  interpolation: the corners of an open quad grid are interpolated).
 
 Every polygon with ``k`` corners becomes ``k`` quads ``[v_j, e_j, f, e_(j-1)]``, so after
 one step the mesh is all quads: ``V' = V + E + F``, ``F' = sum(k)``, ``E' = 2E + sum(k)``.
@@ -91,6 +93,7 @@ def step(v: np.ndarray, topo: tp.Topology, crease: np.ndarray):
     vp = (q + 2.0 * r + (valence - 3.0)[:, None] * v) / valence[:, None]
 
     n_sharp, se = _vertex_sharpness(topo, sharp)
+    n_sharp[topo.faces_at() == 1] = 3  # a boundary vertex of a single face is a corner
     other = np.zeros((nv, 3))
     np.add.at(other, se[:, 0], v[se[:, 1]])
     np.add.at(other, se[:, 1], v[se[:, 0]])

@@ -1,13 +1,16 @@
 """Catmull–Clark limit surfaces as CAD patches (``sm.limit_surface``).
 
-The cage is first subdivided ``levels`` times (default 2), which makes it all quads and
-isolates the extraordinary vertices (valence != 4): after two steps each face touches at
-most one of them.  Then one patch per quad face, parametrized ``u`` along corner 0 -> 1
+The cage (closed or with boundaries) is first subdivided ``levels`` times (default 2),
+which makes it all quads and isolates the extraordinary vertices (valence != 4): after two
+steps each face touches at most one of them.  Then one patch per quad face, parametrized ``u`` along corner 0 -> 1
 and ``v`` along corner 0 -> 3 on ``[0, 1]^2`` (so ``Su x Sv`` follows the face winding):
 
 * **regular faces** (all four vertices of valence 4): the limit surface is *exactly* the
   bicubic uniform B-spline of the face's 4 x 4 neighbourhood; the patch is
-  ``BSplineSurface.uniform_cubic(net4x4)``;
+  ``BSplineSurface.uniform_cubic(net4x4)``.  On a boundary a vertex with two faces (the
+  cubic B-spline curve rule) or one face (a corner) is regular too: the neighbourhood is
+  continued by ghost points ``2 b - i`` (b on the boundary, i its inner neighbour), which
+  is exactly what the boundary rules compute;
 * **faces at an extraordinary vertex**: a bicubic Bézier patch built with the rules of
   Loop & Schaefer's approximation (ACC, 2008): interior points
   ``(n v + 2 (e_prev + e_next) + d) / (n + 5)``, edge points the average of the two interior
@@ -16,7 +19,8 @@ and ``v`` along corner 0 -> 3 on ``[0, 1]^2`` (so ``Su x Sv`` follows the face w
   projected into the exact limit tangent plane (limit masks), so every patch meeting there
   has the exact limit normal.  On regular faces these rules reproduce the B-spline's
   Bézier points, so the patches are watertight (C0) everywhere; across edges near an
-  extraordinary vertex the normal is only approximately continuous.
+  extraordinary vertex the normal is only approximately continuous.  Boundary edges take
+  the Bézier points of the cubic B-spline boundary curve, which is the exact limit there.
 
 Both the approximation and the continuity are *measured* on construction (``errors``):
 the gap and the normal angle across every shared patch edge, and the distance and
@@ -74,7 +78,7 @@ def _angle_deg(n1, n2):
 
 
 class LimitSurface:
-    """The Catmull–Clark limit of a closed quad/polygon cage as surfmod patches.
+    """The Catmull–Clark limit of a quad/polygon cage as surfmod patches.
 
     Attributes: ``patches`` (list of surfmod surfaces, one per face of ``mesh``),
     ``regular`` (bool array: exact uniform cubic B-spline patch), ``mesh`` (the
@@ -104,6 +108,11 @@ class LimitSurface:
             f"max gap {e['max_gap']:.2g}, max normal jump {e['max_normal_angle_deg']:.3g} deg)"
         )
 
+    @property
+    def open(self) -> bool:
+        """True when the cage has boundary edges (the limit is a shell, not a solid)."""
+        return bool(self.errors.get("boundary_edges", 0))
+
     def faces(self):
         """One build123d ``Face`` per patch."""
         return [p.face() for p in self.patches]
@@ -119,14 +128,18 @@ class LimitSurface:
         return shell(self.faces(), self._tolerance())[0]
 
     def solid(self):
-        """The closed, outward-oriented build123d ``Solid`` bounded by the patches."""
+        """The closed, outward-oriented build123d ``Solid`` bounded by the patches (closed
+        cages only; an open cage gives a :meth:`shell`)."""
         from ..occ.subdiv import solid
+
+        if self.open:
+            raise SurfmodError("solid: the cage has boundary edges, so its limit bounds no solid; use shell()")
 
         return solid(self.faces(), self._tolerance())[0]
 
 
 def limit_surface(vertices, quads, *, levels: int = 2, tangent_plane: bool = True) -> LimitSurface:
-    """The Catmull–Clark limit surface of a closed, consistently oriented cage as patches.
+    """The Catmull–Clark limit surface of a consistently oriented cage as CAD patches.
 
     ``quads`` may hold any polygons when ``levels >= 1`` (one step makes them quads).
     Regular faces give exact bicubic uniform B-spline patches; faces at extraordinary
@@ -148,9 +161,6 @@ def limit_surface(vertices, quads, *, levels: int = 2, tangent_plane: bool = Tru
         raise SurfmodError(f"levels: {n} levels would make more than {MAX_PATCHES:,} patches")
     if not isinstance(tangent_plane, (bool, np.bool_)):
         raise SurfmodError(f"tangent_plane: expected True or False, got {tangent_plane!r}")
-    if np.any(topo.boundary):
-        a, b = topo.edges[int(np.argmax(topo.boundary))]
-        raise SurfmodError(f"quads: limit_surface needs a closed cage, edge {a}-{b} is a boundary edge")
     if n == 0 and np.any(topo.sizes != 4):
         raise SurfmodError("quads: with levels=0 every face must be a quad (use levels >= 1)")
     tp.require_oriented(topo, "quads")
@@ -169,24 +179,32 @@ def _build(v, topo, levels, tangent_plane):
     twin = topo.twin()
     nf = topo.n_faces
     valence = topo.valence()
-    regular_vertex = valence == 4
+    on_boundary = np.zeros(len(v), dtype=bool)
+    on_boundary[topo.edges[topo.boundary].ravel()] = True
+    # regular: interior of valence 4, or on a boundary with two faces (three edges), or a
+    # boundary corner of one face; the latter two are B-splines continued by ghost points
+    regular_vertex = np.where(on_boundary, topo.faces_at() <= 2, valence == 4)
     quads = corners.reshape(-1, 4)
     regular = np.all(regular_vertex[quads], axis=1)
+    limit_pos, normals, _ = _cc_limit(v, topo, np.zeros(topo.n_edges, dtype=bool))
 
-    # ACC rules
-    nval = valence[corners].astype(float)[:, None]
+    # ACC rules (boundary vertices weighted as regular ones continued by ghost points)
+    nval = np.where(on_boundary, 4, valence)[corners].astype(float)[:, None]
     interior = (
         nval * v[corners] + 2.0 * (v[corners[nxt]] + v[corners[prv]]) + v[corners[nxt[nxt]]]
     ) / (nval + 5.0)
     csum = np.zeros_like(v)
     np.add.at(csum, corners, interior)
     corner_pts = csum / topo.faces_at()[:, None]
-    near_start = 0.5 * (interior + interior[nxt[twin]])
-    near_end = 0.5 * (interior[nxt] + interior[twin])
+    corner_pts[on_boundary] = limit_pos[on_boundary]  # on the cubic B-spline boundary curve
+    inner = twin >= 0
+    tw = np.where(inner, twin, 0)
+    a, b = v[corners], v[corners[nxt]]
+    near_start = np.where(inner[:, None], 0.5 * (interior + interior[nxt[tw]]), (2.0 * a + b) / 3.0)
+    near_end = np.where(inner[:, None], 0.5 * (interior[nxt] + interior[tw]), (a + 2.0 * b) / 3.0)
     if tangent_plane:
-        _, normals, _ = _cc_limit(v, topo, np.zeros(topo.n_edges, dtype=bool))
         for pts, vert in ((near_start, corners), (near_end, corners[nxt])):
-            ev = ~regular_vertex[vert]
+            ev = ~regular_vertex[vert] & ~on_boundary[vert]
             nn = normals[vert[ev]]
             d = np.einsum("ij,ij->i", pts[ev] - corner_pts[vert[ev]], nn)
             pts[ev] -= d[:, None] * nn
@@ -202,21 +220,25 @@ def _build(v, topo, levels, tangent_plane):
         nets[:, i0, j0] = near_start[c]
         nets[:, i1, j1] = near_end[c]
 
-    # exact 4x4 B-spline nets of the regular faces
+    # exact 4x4 B-spline nets of the regular faces (ghost rows 2 b - i beyond a boundary)
     rf = np.flatnonzero(regular)
-    bnets = np.empty((len(rf), 4, 4, 3))
+    bnets = np.full((len(rf), 4, 4, 3), np.nan)
     for k in range(4):
         c = 4 * rf + k
-        g = twin[c]
+        bnets[(slice(None), *_rot((1, 1), k))] = v[corners[c]]
+        has = np.flatnonzero(twin[c] >= 0)
+        g = twin[c[has]]
+        bnets[(has, *_rot((1, 0), k))] = v[corners[nxt[nxt[g]]]]
+        bnets[(has, *_rot((2, 0), k))] = v[corners[prv[g]]]
         h = twin[nxt[g]]
-        for ij, vert in (
-            ((1, 1), corners[c]),
-            ((1, 0), corners[nxt[nxt[g]]]),
-            ((2, 0), corners[prv[g]]),
-            ((0, 0), corners[prv[h]]),
-        ):
-            i, j = _rot(ij, k)
-            bnets[:, i, j] = v[vert]
+        hh = h >= 0
+        bnets[(has[hh], *_rot((0, 0), k))] = v[corners[prv[h[hh]]]]
+    for ii in ((1, 2), (0, 3)):  # corners of a ghost row last: they may need a ghost column
+        for k in range(4):
+            ghost = np.flatnonzero(twin[4 * rf + k] < 0)
+            for i in ii:
+                out, near, far = _rot((i, 0), k), _rot((i, 1), k), _rot((i, 2), k)
+                bnets[(ghost, *out)] = 2.0 * bnets[(ghost, *near)] - bnets[(ghost, *far)]
     exact = np.einsum("ai,nijk,bj->nabk", _BSPLINE_TO_BEZIER, bnets, _BSPLINE_TO_BEZIER)
     # the ACC rules must reproduce the exact Bézier points on regular faces (watertightness)
     acc_mismatch = float(np.abs(nets[rf] - exact).max()) if len(rf) else 0.0
@@ -231,6 +253,7 @@ def _build(v, topo, levels, tangent_plane):
     mesh = Mesh(v, quads, {"levels": levels, "scheme": "catmull-clark"})
     errors = _measure(v, topo, twin, nets, regular)
     errors["acc_regular_mismatch"] = acc_mismatch
+    errors["boundary_edges"] = int(topo.boundary.sum())
     return LimitSurface(mesh, patches, checks.frozen(regular).astype(bool), nets, levels, errors)
 
 
@@ -297,7 +320,7 @@ def _measure(v, topo, twin, nets, regular, samples: int = 17, extra_levels: int 
         "max_limit_deviation": float(dev.max()),
         "max_limit_deviation_rel": float(dev.max()) / size,
         "max_limit_deviation_regular": float(dev[reg].max()) if reg.any() else 0.0,
-        "max_limit_normal_deg": float(ang.max()),
+        "max_limit_normal_deg": float(np.nanmax(ang)),
         "samples_per_edge": samples,
         "limit_samples": int(len(dev)),
         "patches": int(len(nets)),

@@ -78,7 +78,8 @@ def step(v: np.ndarray, topo: tp.Topology, beta: str = "loop"):
     np.add.at(bsum, be[:, 1], v[be[:, 0]])
     nb = np.bincount(be.ravel(), minlength=nv)
     vp = np.where((nb == 2)[:, None], 0.75 * v + 0.125 * bsum, vp)
-    vp = np.where((nb > 2)[:, None], v, vp)  # non-manifold boundary vertex: a corner
+    corner = (nb > 2) | (topo.faces_at() == 1)  # non-manifold boundary vertex or single triangle
+    vp = np.where(corner[:, None], v, vp)
 
     tri = corners.reshape(-1, 3)
     e = nv + topo.edge_of.reshape(-1, 3)  # e[:, j] is on edge tri[:, j] -> tri[:, j+1]

@@ -13,8 +13,8 @@ Loop (interior vertex, ``beta`` of the scheme)::
     tangent 1 = sum cos(2 pi i/n) e_i,   tangent 2 = sum sin(2 pi i/n) e_i
 
 On a boundary or crease curve both schemes follow the cubic B-spline curve, whose limit
-point is ``(a + 4 v + b) / 6`` with tangent ``b - a``; corners (three or more sharp edges)
-stay where they are.  The normal is ``tangent 1 x tangent 2`` normalised; it is only
+point is ``(a + 4 v + b) / 6`` with tangent ``b - a``; corners (three or more sharp edges,
+or a boundary vertex of a single face) stay where they are.  The normal is ``tangent 1 x tangent 2`` normalised; it is only
 given (not NaN) at smooth interior vertices.
 """
 
@@ -59,6 +59,7 @@ def ring_index(topo: tp.Topology, twin: np.ndarray, interior: np.ndarray) -> np.
 
 def _interior_vertices(topo, sharp_edges):
     nsharp = np.bincount(topo.edges[sharp_edges].ravel(), minlength=topo.n_vertices)
+    nsharp[topo.faces_at() == 1] = 3  # a boundary vertex of a single face is a corner
     bnd = np.bincount(topo.edges[topo.boundary].ravel(), minlength=topo.n_vertices) > 0
     return nsharp, ~bnd
 
