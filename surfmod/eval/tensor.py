@@ -44,19 +44,20 @@ def surface_derivatives(knots_u, p, knots_v, q, ctrl, u, v, order):
 def surface_grid_planes(knots_u, p, knots_v, q, ctrl, us, vs, order):
     """Mixed partials on the grid ``us x vs``: ``{(k, l): array (len(us), len(vs), dim)}``.
 
-    ``L_k = Bu_k @ P`` per coordinate, then one batched product ``Bv_l @ L_k`` whose
-    output is already laid out point-major: BLAS does all the work, no gather, no
-    per-point Python, and no copy for plain positions.
+    First the small contraction over v, ``W_l[i, b, :] = sum_j Bv_l[b, j] P[i, j, :]``
+    (size n x nv x dim), then one large GEMM ``Bu_k @ W_l`` whose output is already the
+    point-major grid: BLAS does all the work, nothing is gathered or copied afterwards.
     """
-    n, m, _ = ctrl.shape
+    n, m, dim = ctrl.shape
     bu = basis_matrix(knots_u, p, n, us, order)  # (K, nu, n)
     bv = basis_matrix(knots_v, q, m, vs, order)  # (K, nv, m)
-    ctrl_d = np.ascontiguousarray(np.moveaxis(ctrl, -1, 0))  # (dim, n, m)
+    nu, nv = bu.shape[1], bv.shape[1]
+    by_v = ctrl.transpose(1, 0, 2).reshape(m, n * dim)
     planes = {}
-    for k in range(order + 1):
-        left = np.matmul(bu[k], ctrl_d).transpose(1, 2, 0)  # (nu, m, dim)
-        for l in range(order + 1):
-            planes[k, l] = np.matmul(bv[l], left)  # (nu, nv, dim)
+    for l in range(order + 1):
+        w = (bv[l] @ by_v).reshape(nv, n, dim).transpose(1, 0, 2).reshape(n, nv * dim)
+        for k in range(order + 1):
+            planes[k, l] = (bu[k] @ w).reshape(nu, nv, dim)
     return planes
 
 
