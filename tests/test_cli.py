@@ -76,3 +76,16 @@ def test_console_script_runs_the_gallery(tmp_path):
 def test_gallery_unknown_entity(capsys):
     assert main(["gallery", "/tmp/unused", "--only", "nope"]) == 2
     assert "only: unknown entities nope" in capsys.readouterr().err
+
+
+def test_mesh_command_writes_a_watertight_stl(tmp_path, capsys):
+    import build123d as bd
+    import trimesh
+
+    part = bd.Box(20, 20, 10) - bd.Cylinder(5, 30)
+    bd.export_step(part, str(tmp_path / "part.step"))
+    assert main(["mesh", str(tmp_path / "part.step"), "--tolerance", "0.02"]) == 0
+    out = capsys.readouterr().out
+    assert "watertight True" in out
+    stl = trimesh.load(tmp_path / "part.stl")
+    assert stl.is_watertight and abs(stl.volume - part.volume) < 0.01 * part.volume
