@@ -29,7 +29,7 @@ def test_check_reports_every_face(tmp_path, capsys):
     rng = np.random.default_rng(0)
     sm.export_step(sm.BSplineSurface(rng.uniform(-1, 1, (5, 5, 3)), (3, 3)), tmp_path / "a.step")
     bd.export_step(bd.Box(1, 2, 3), str(tmp_path / "box.step"))
-    code = main(["check", str(tmp_path), "--no-progress", "--jobs", "1", "--samples", "8"])
+    code = main(["check", str(tmp_path), "--no-progress", "--jobs", "2", "--samples", "8"])  # worker processes
     out = capsys.readouterr().out
     assert code == 0, out
     assert "Geom_BSplineSurface" in out and "Geom_Plane" in out
