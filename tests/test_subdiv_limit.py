@@ -174,6 +174,48 @@ def test_open_cage_with_extraordinary_vertices_gives_a_shell():
     assert len(shell.faces()) == 80
 
 
+def test_all_creases_give_the_flat_cube_exactly():
+    edges = [(a, b) for f in CUBE_F for a, b in zip(f, f[1:] + f[:1])]
+    lim = sm.limit_surface(CUBE_V, CUBE_F, levels=0, creases=edges)
+    assert lim.regular.all() and len(lim.patches) == 6
+    assert lim.errors["max_limit_deviation"] < 1e-14 and lim.errors["max_gap"] < 1e-14
+    solid = lim.solid()
+    assert solid.volume == pytest.approx(1.0, abs=1e-12)
+    bb = solid.bounding_box()
+    np.testing.assert_allclose([*bb.min, *bb.max], [0, 0, 0, 1, 1, 1], atol=1e-6)  # box has the face tolerance
+
+
+def test_crease_through_regular_vertices_keeps_exact_patches():
+    """A crease loop around a torus cage: its vertices follow the curve rule on both sides,
+    so every patch is still an exact B-spline (continued by ghost points at the crease)."""
+    n, m = 6, 5
+    net, faces = torus_cage(n, m, jitter=0.1, seed=4)
+    ring = [(p * m, ((p + 1) % n) * m) for p in range(n)]  # the edges j = 0 all around
+    lim = sm.limit_surface(net.reshape(-1, 3), faces, levels=0, creases=ring)
+    assert lim.regular.all()
+    e = lim.errors
+    assert e["max_limit_deviation"] < 1e-12 and e["max_gap"] < 1e-12
+    assert e["max_normal_angle_deg"] < 1e-9  # smooth edges stay smooth
+    # across the crease the normal jumps: the surface has a sharp edge there
+    f0, f1 = 0, m - 1  # faces on both sides of the crease edge (0, m)
+    n0 = lim.patches[f0].normals(0.5, 0.0)
+    n1 = lim.patches[f1].normals(0.5, 1.0)
+    np.testing.assert_allclose(lim.patches[f0].points(0.5, 0.0), lim.patches[f1].points(0.5, 1.0), atol=1e-12)
+    assert np.degrees(np.arccos(np.clip(n0 @ n1, -1, 1))) > 5.0
+
+
+def test_creased_cube_ring_is_a_valid_solid():
+    ring = [(0, 1), (1, 2), (2, 3), (3, 0)]
+    lim = sm.limit_surface(CUBE_V, CUBE_F, creases=ring)
+    e = lim.errors
+    assert e["max_gap"] < 1e-12 and e["max_limit_deviation_regular"] < 1e-12
+    assert e["max_limit_deviation_rel"] < 0.005
+    solid = lim.solid()
+    assert solid.is_valid
+    fine = sm.catmull_clark(CUBE_V, CUBE_F, 5, creases=ring)
+    assert solid.volume == pytest.approx(fine.to_trimesh().volume, rel=0.01)
+
+
 BAD = [
     (lambda: sm.limit_surface(CUBE_V, CUBE_F[:5]).solid(), "solid.*boundary"),
     (lambda: sm.limit_surface(CUBE_V, [CUBE_F[0][::-1]] + CUBE_F[1:]), "quads.*consistently oriented"),
@@ -181,6 +223,7 @@ BAD = [
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=9), "levels"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=40), "levels.*limit"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, tangent_plane="yes"), "tangent_plane"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F, creases=[(0, 6)]), "creases.*not an edge"),
     (lambda: sm.limit_surface(CUBE_V, []), "quads.*empty"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F + [(0, 1, 5, 4)]), "quads.*non-manifold"),
     (lambda: sm.limit_surface(np.full((8, 3), np.nan), CUBE_F), "vertices.*NaN"),

@@ -70,7 +70,8 @@ def bezier_eval(nets, u, v):
     su = np.einsum("ni,nj,nijk->nk", du, bv, nets)
     sv = np.einsum("ni,nj,nijk->nk", bu, dv, nets)
     n = np.cross(su, sv)
-    return p, n / np.linalg.norm(n, axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):  # NaN where Su x Sv vanishes
+        return p, n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
 def _angle_deg(n1, n2):
@@ -138,10 +139,12 @@ class LimitSurface:
         return solid(self.faces(), self._tolerance())[0]
 
 
-def limit_surface(vertices, quads, *, levels: int = 2, tangent_plane: bool = True) -> LimitSurface:
+def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_plane: bool = True) -> LimitSurface:
     """The Catmull–Clark limit surface of a consistently oriented cage as CAD patches.
 
-    ``quads`` may hold any polygons when ``levels >= 1`` (one step makes them quads).
+    ``quads`` may hold any polygons when ``levels >= 1`` (one step makes them quads);
+    ``creases`` are sharp cage edges as in :func:`catmull_clark` (patches meet there with
+    a crease, C0, and a straight crease through regular vertices keeps exact patches).
     Regular faces give exact bicubic uniform B-spline patches; faces at extraordinary
     vertices give approximating bicubic Bézier patches (module docstring).  ``errors``
     holds the measured ``max_gap`` and ``max_normal_angle_deg`` across shared patch edges
@@ -164,39 +167,60 @@ def limit_surface(vertices, quads, *, levels: int = 2, tangent_plane: bool = Tru
     if n == 0 and np.any(topo.sizes != 4):
         raise SurfmodError("quads: with levels=0 every face must be a quad (use levels >= 1)")
     tp.require_oriented(topo, "quads")
-    crease = np.zeros(topo.n_edges, dtype=bool)
+    crease = tp.crease_flags(topo, creases)
     for _ in range(n):
         v, topo, crease = cc_step(v, topo, crease)
-    return _build(v, topo, n, bool(tangent_plane))
+    return _build(v, topo, n, bool(tangent_plane), crease)
 
 
-def _build(v, topo, levels, tangent_plane):
+def _regular_corners(topo, twin, nsharp):
+    """Per corner: is the limit there a B-spline (possibly continued by ghost points)?
+
+    A smooth vertex must have valence 4; a vertex on sharp (boundary/crease) edges must
+    have, in the sector of faces between its sharp edges that holds the corner, two faces
+    and exactly two sharp edges (the curve rule) or one face and be a corner."""
+    corners, nxt, prv = topo.corners, topo.nxt, topo.prv
+
+    def step(arr, idx):
+        ok = idx >= 0
+        return np.where(ok, arr[np.maximum(idx, 0)], -1)
+
+    fwd = twin[prv]  # corner at the same vertex in the face across the previous edge
+    bwd = step(nxt, twin)  # ... across the next edge
+    one = (fwd < 0) & (bwd < 0)
+    two = ((fwd >= 0) & (bwd < 0) & (step(fwd, fwd) < 0)) | ((bwd >= 0) & (fwd < 0) & (step(bwd, bwd) < 0))
+    ns = nsharp[corners]
+    sectors = (one & (ns >= 3)) | (two & (ns == 2))
+    return np.where(ns > 0, sectors, topo.valence()[corners] == 4)
+
+
+def _build(v, topo, levels, tangent_plane, crease):
     from ..mesh.polymesh import Mesh
     from ..nets.bezier import BezierSurface
     from ..nets.bspline import BSplineSurface
 
     corners, nxt, prv = topo.corners, topo.nxt, topo.prv
-    twin = topo.twin()
+    full_twin = topo.twin()
+    sharp = crease | topo.boundary
+    twin = np.where(sharp[topo.edge_of], -1, full_twin)  # patches are cut along sharp edges
     nf = topo.n_faces
     valence = topo.valence()
-    on_boundary = np.zeros(len(v), dtype=bool)
-    on_boundary[topo.edges[topo.boundary].ravel()] = True
-    # regular: interior of valence 4, or on a boundary with two faces (three edges), or a
-    # boundary corner of one face; the latter two are B-splines continued by ghost points
-    regular_vertex = np.where(on_boundary, topo.faces_at() <= 2, valence == 4)
+    nsharp = np.bincount(topo.edges[sharp].ravel(), minlength=len(v))
+    nsharp[topo.faces_at() == 1] = 3  # a boundary vertex of a single face is a corner
+    on_curve = nsharp >= 2  # boundary/crease curve vertices and corners
     quads = corners.reshape(-1, 4)
-    regular = np.all(regular_vertex[quads], axis=1)
-    limit_pos, normals, _ = _cc_limit(v, topo, np.zeros(topo.n_edges, dtype=bool))
+    regular = np.all(_regular_corners(topo, twin, nsharp).reshape(-1, 4), axis=1)
+    limit_pos, normals, _ = _cc_limit(v, topo, crease)
 
-    # ACC rules (boundary vertices weighted as regular ones continued by ghost points)
-    nval = np.where(on_boundary, 4, valence)[corners].astype(float)[:, None]
+    # ACC rules (curve vertices weighted as regular ones continued by ghost points)
+    nval = np.where(on_curve, 4, valence)[corners].astype(float)[:, None]
     interior = (
         nval * v[corners] + 2.0 * (v[corners[nxt]] + v[corners[prv]]) + v[corners[nxt[nxt]]]
     ) / (nval + 5.0)
     csum = np.zeros_like(v)
     np.add.at(csum, corners, interior)
     corner_pts = csum / topo.faces_at()[:, None]
-    corner_pts[on_boundary] = limit_pos[on_boundary]  # on the cubic B-spline boundary curve
+    corner_pts[on_curve] = limit_pos[on_curve]  # on the cubic B-spline boundary/crease curve
     inner = twin >= 0
     tw = np.where(inner, twin, 0)
     a, b = v[corners], v[corners[nxt]]
@@ -204,7 +228,7 @@ def _build(v, topo, levels, tangent_plane):
     near_end = np.where(inner[:, None], 0.5 * (interior[nxt] + interior[tw]), (a + 2.0 * b) / 3.0)
     if tangent_plane:
         for pts, vert in ((near_start, corners), (near_end, corners[nxt])):
-            ev = ~regular_vertex[vert] & ~on_boundary[vert]
+            ev = (valence[vert] != 4) & (nsharp[vert] == 0)
             nn = normals[vert[ev]]
             d = np.einsum("ij,ij->i", pts[ev] - corner_pts[vert[ev]], nn)
             pts[ev] -= d[:, None] * nn
@@ -251,7 +275,7 @@ def _build(v, topo, levels, tangent_plane):
         patches[f] = BezierSurface._trusted(nets[f])
     nets.setflags(write=False)
     mesh = Mesh(v, quads, {"levels": levels, "scheme": "catmull-clark"})
-    errors = _measure(v, topo, twin, nets, regular)
+    errors = _measure(v, topo, full_twin, nets, regular, crease)
     errors["acc_regular_mismatch"] = acc_mismatch
     errors["boundary_edges"] = int(topo.boundary.sum())
     return LimitSurface(mesh, patches, checks.frozen(regular).astype(bool), nets, levels, errors)
@@ -263,7 +287,7 @@ def _edge_uv(k, t):
     return a[:, None] * (1 - t) + b[:, None] * t
 
 
-def _measure(v, topo, twin, nets, regular, samples: int = 17, extra_levels: int = 2):
+def _measure(v, topo, twin, nets, regular, crease, samples: int = 17, extra_levels: int = 2):
     """Measured continuity and approximation figures (see :func:`limit_surface`)."""
     size = float(np.ptp(v, axis=0).max()) or 1.0
     # 1. across every shared edge: gap and normal angle
@@ -280,8 +304,10 @@ def _measure(v, topo, twin, nets, regular, samples: int = 17, extra_levels: int 
     pf, nf_ = bezier_eval(np.repeat(nets[f], samples, axis=0), uf, vf)
     pg, ng = bezier_eval(np.repeat(nets[fg], samples, axis=0), ug, vg)
     gap = float(np.linalg.norm(pf - pg, axis=1).max())
-    jump = _angle_deg(nf_, ng)
-    edge_reg = np.repeat(regular[f] & regular[fg], samples)
+    smooth = np.repeat(~crease[topo.edge_of[c]], samples)  # creases are meant to be sharp
+    jump = _angle_deg(nf_, ng)[smooth] if smooth.any() else np.zeros(1)
+    degenerate = int(np.isnan(jump).sum())
+    edge_reg = np.repeat(regular[f] & regular[fg], samples)[smooth] if smooth.any() else np.zeros(1, bool)
 
     # 2. against the exact limit: vertices of further levels, placed with the masks
     vv, tt = v, topo
@@ -289,7 +315,6 @@ def _measure(v, topo, twin, nets, regular, samples: int = 17, extra_levels: int 
     d1 = np.repeat(np.array([[1.0, 0.0]]), topo.n_faces, axis=0)
     d2 = np.repeat(np.array([[0.0, 1.0]]), topo.n_faces, axis=0)
     base = np.arange(topo.n_faces)
-    crease = np.zeros(tt.n_edges, dtype=bool)
     for _ in range(extra_levels):
         vv, new_tt, crease = cc_step(vv, tt, crease)
         j = np.tile(np.arange(4), tt.n_faces)  # child j of every parent face (corner order)
@@ -315,8 +340,9 @@ def _measure(v, topo, twin, nets, regular, samples: int = 17, extra_levels: int 
     return {
         "max_gap": gap,
         "max_gap_rel": gap / size,
-        "max_normal_angle_deg": float(jump.max()),
-        "max_normal_angle_regular_deg": float(jump[edge_reg].max()) if edge_reg.any() else 0.0,
+        "max_normal_angle_deg": float(np.nanmax(jump)),
+        "max_normal_angle_regular_deg": float(np.nanmax(jump[edge_reg])) if edge_reg.any() else 0.0,
+        "degenerate_normals": degenerate,
         "max_limit_deviation": float(dev.max()),
         "max_limit_deviation_rel": float(dev.max()) / size,
         "max_limit_deviation_regular": float(dev[reg].max()) if reg.any() else 0.0,
