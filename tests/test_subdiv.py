@@ -303,3 +303,34 @@ def test_level_guard_estimate_is_the_face_count():
     tp.levels_arg(10, 24)
     with pytest.raises(sm.SurfmodError, match="levels"):
         tp.levels_arg(11, 24)
+
+
+# ---------------------------------------------------------------------------------------
+# property: subdivision is affine invariant and its weights sum to one
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), scheme=st.sampled_from(["cc", "cc_prism", "cc_crease", "loop"]))
+def test_subdivision_commutes_with_affine_maps(seed, scheme):
+    rng = np.random.default_rng(seed)
+    if scheme == "loop":
+        v0, f = TET_V, TET_F
+    elif scheme == "cc_prism":
+        v0, f = pentagonal_prism()
+    else:
+        v0, f = CUBE_V, CUBE_F
+    v = v0 + 0.2 * rng.standard_normal(v0.shape)
+    a = rng.uniform(-2, 2, (3, 3)) + 3 * np.eye(3)
+    b = rng.uniform(-5, 5, 3)
+    creases = [(0, 1), (1, 2)] if scheme == "cc_crease" else None
+    if scheme == "loop":
+        run = lambda x: sm.loop_subdivide(x, f, 2).vertices  # noqa: E731
+        lim = lambda x: sm.loop_limit(x, f).positions  # noqa: E731
+    else:
+        run = lambda x: sm.catmull_clark(x, f, 2, creases=creases).vertices  # noqa: E731
+        lim = lambda x: sm.catmull_clark_limit(x, f, creases=creases).positions  # noqa: E731
+    scale = np.abs(v @ a.T + b).max()
+    np.testing.assert_allclose(run(v @ a.T + b), run(v) @ a.T + b, atol=1e-13 * scale)
+    np.testing.assert_allclose(lim(v @ a.T + b), lim(v) @ a.T + b, atol=1e-13 * scale)
