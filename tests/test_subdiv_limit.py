@@ -164,7 +164,7 @@ def test_open_grid_is_exact_bspline_with_ghost_points():
     assert len(shell.faces()) == len(faces)
 
 
-def test_open_cage_with_extraordinary_vertices_gives_a_shell():
+def test_open_cage_with_extraordinary_vertices_gives_a_shell(tmp_path):
     lim = sm.limit_surface(CUBE_V, CUBE_F[:5])  # a box without one side
     e = lim.errors
     assert lim.open and e["boundary_edges"] == 16
@@ -172,6 +172,10 @@ def test_open_cage_with_extraordinary_vertices_gives_a_shell():
     assert e["max_limit_deviation_rel"] < 0.005 and e["max_normal_angle_deg"] < 2.0
     shell = lim.shell()
     assert len(shell.faces()) == 80
+    assert type(lim.shape()).__name__ == "Shell"
+    path = tmp_path / "open_box.step"
+    sm.export_step(lim, path)  # a LimitSurface exports directly (its sewn shape)
+    assert len(sm.import_step(path).faces()) == 80
 
 
 def test_all_creases_give_the_flat_cube_exactly():

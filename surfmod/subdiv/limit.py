@@ -85,6 +85,8 @@ class LimitSurface:
     ``regular`` (bool array: exact uniform cubic B-spline patch), ``mesh`` (the
     subdivided control mesh), ``bezier_nets`` ``(P, 4, 4, 3)`` (every patch in Bézier
     form), ``levels`` and ``errors`` (measured figures, see :func:`limit_surface`).
+    ``shape()`` is the sewn solid (closed cage) or shell (open cage); ``wrapped`` is its
+    ``TopoDS_Shape``, so ``sm.export_step(limit, path)`` works directly.
 
     >>> import surfmod as sm
     >>> cube_v = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
@@ -135,8 +137,18 @@ class LimitSurface:
 
         if self.open:
             raise SurfmodError("solid: the cage has boundary edges, so its limit bounds no solid; use shell()")
-
         return solid(self.faces(), self._tolerance())[0]
+
+    def shape(self):
+        """:meth:`solid` for a closed cage, :meth:`shell` for an open one (built once)."""
+        if getattr(self, "_shape", None) is None:
+            self._shape = self.shell() if self.open else self.solid()
+        return self._shape
+
+    @property
+    def wrapped(self):
+        """The OCCT ``TopoDS_Shape`` of :meth:`shape` (build123d's convention)."""
+        return self.shape().wrapped
 
 
 def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_plane: bool = True) -> LimitSurface:
@@ -147,9 +159,14 @@ def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_pla
     a crease, C0, and a straight crease through regular vertices keeps exact patches).
     Regular faces give exact bicubic uniform B-spline patches; faces at extraordinary
     vertices give approximating bicubic Bézier patches (module docstring).  ``errors``
-    holds the measured ``max_gap`` and ``max_normal_angle_deg`` across shared patch edges
-    and ``max_limit_deviation`` / ``max_limit_normal_deg`` against the exact limit
-    (plus ``..._rel`` relative to the cage size).
+    holds the measured figures: ``max_gap`` and ``max_normal_angle_deg`` across shared
+    patch edges (crease edges excluded from the angle; ``..._regular_deg`` between exact
+    patches; ``degenerate_normals`` counts samples where ``Su x Sv`` vanishes, e.g. where a
+    smooth boundary curve turns through a single face), ``max_limit_deviation`` and
+    ``max_limit_normal_deg`` against the exact limit at the vertices of two further
+    subdivision levels placed with the limit masks (``..._rel`` relative to the cage
+    size, ``..._regular`` on exact patches only), ``acc_regular_mismatch`` (the Bézier
+    rules against the exact conversion on regular faces) and ``boundary_edges``.
 
     >>> import surfmod as sm
     >>> cube_v = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
