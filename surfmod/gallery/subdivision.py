@@ -54,3 +54,11 @@ def _torus():
     from ..subdiv.limit import limit_surface
 
     return limit_surface(*torus_cage(), levels=0).solid()
+
+
+@entry("subdivision_creased", "Catmull–Clark limit with a sharp crease loop", "sm.limit_surface(v, quads, creases=ring).solid()")
+def _creased():
+    from ..subdiv.limit import limit_surface
+
+    ring = [(0, 1), (1, 2), (2, 3), (3, 0)]  # the bottom square stays a sharp edge
+    return limit_surface(CUBE_VERTICES, CUBE_FACES, levels=2, creases=ring).solid()
