@@ -231,6 +231,7 @@ BAD = [
     (lambda: sm.limit_surface(CUBE_V, []), "quads.*empty"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F + [(0, 1, 5, 4)]), "quads.*non-manifold"),
     (lambda: sm.limit_surface(np.full((8, 3), np.nan), CUBE_F), "vertices.*NaN"),
+    (lambda: sm.limit_surface(np.ones((8, 3)), CUBE_F), "vertices.*coincide"),
     (lambda: sm.limit_surface(CUBE_V, [(0, 3, 2, 2)] + CUBE_F[1:]), "quads.*repeats"),
     (lambda: sm.limit_surface(CUBE_V, [(0, 3, 2, 10)] + CUBE_F[1:]), "quads.*out of range"),
 ]

@@ -74,6 +74,13 @@ def bezier_eval(nets, u, v):
         return p, n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
+def _nanmax(a) -> float:
+    """Largest non-NaN value (NaN when there is none), without NumPy's warning."""
+    a = np.asarray(a, dtype=float)
+    ok = ~np.isnan(a)
+    return float(a[ok].max()) if ok.any() else float("nan")
+
+
 def _angle_deg(n1, n2):
     return np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), np.einsum("ij,ij->i", n1, n2)))
 
@@ -176,6 +183,8 @@ def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_pla
     (96, 0.328)
     """
     v, topo = tp.polygon_mesh(vertices, quads, faces_name="quads")
+    if not np.ptp(v, axis=0).max() > 0:
+        raise SurfmodError("vertices: all cage vertices coincide, the limit surface is a point")
     n = tp.levels_arg(levels, len(topo.corners))
     if len(topo.corners) * 4.0 ** max(n - 1, 0) > MAX_PATCHES:
         raise SurfmodError(f"levels: {n} levels would make more than {MAX_PATCHES:,} patches")
@@ -245,7 +254,7 @@ def _build(v, topo, levels, tangent_plane, crease):
     near_end = np.where(inner[:, None], 0.5 * (interior[nxt] + interior[tw]), (a + 2.0 * b) / 3.0)
     if tangent_plane:
         for pts, vert in ((near_start, corners), (near_end, corners[nxt])):
-            ev = (valence[vert] != 4) & (nsharp[vert] == 0)
+            ev = (valence[vert] != 4) & (nsharp[vert] == 0) & np.isfinite(normals[vert, 0])
             nn = normals[vert[ev]]
             d = np.einsum("ij,ij->i", pts[ev] - corner_pts[vert[ev]], nn)
             pts[ev] -= d[:, None] * nn
@@ -285,6 +294,8 @@ def _build(v, topo, levels, tangent_plane, crease):
     acc_mismatch = float(np.abs(nets[rf] - exact).max()) if len(rf) else 0.0
     nets[rf] = exact
 
+    if not (np.all(np.isfinite(nets)) and np.all(np.isfinite(bnets))):
+        raise SurfmodError("vertices: degenerate cage, the limit patches are undefined (coincident points?)")
     patches = [None] * nf
     for idx, f in enumerate(rf):
         patches[f] = BSplineSurface.uniform_cubic(bnets[idx])
@@ -357,13 +368,13 @@ def _measure(v, topo, twin, nets, regular, crease, samples: int = 17, extra_leve
     return {
         "max_gap": gap,
         "max_gap_rel": gap / size,
-        "max_normal_angle_deg": float(np.nanmax(jump)),
-        "max_normal_angle_regular_deg": float(np.nanmax(jump[edge_reg])) if edge_reg.any() else 0.0,
+        "max_normal_angle_deg": _nanmax(jump),
+        "max_normal_angle_regular_deg": _nanmax(jump[edge_reg]) if edge_reg.any() else 0.0,
         "degenerate_normals": degenerate,
         "max_limit_deviation": float(dev.max()),
         "max_limit_deviation_rel": float(dev.max()) / size,
         "max_limit_deviation_regular": float(dev[reg].max()) if reg.any() else 0.0,
-        "max_limit_normal_deg": float(np.nanmax(ang)),
+        "max_limit_normal_deg": _nanmax(ang),
         "samples_per_edge": samples,
         "limit_samples": int(len(dev)),
         "patches": int(len(nets)),
