@@ -262,6 +262,7 @@ BAD = [
     (lambda: sm.catmull_clark(CUBE_V, np.zeros((0, 4), int)), "faces.*empty"),
     (lambda: sm.catmull_clark(CUBE_V, CUBE_F + [(0, 1, 2, 3)] + [(1, 0, 6, 7)]), "faces.*non-manifold"),
     (lambda: sm.catmull_clark(CUBE_V, [(0, 1, 1, 2)] + CUBE_F[1:]), "faces.*repeats vertex 1"),
+    (lambda: sm.catmull_clark(CUBE_V[:7], [(0, 1, 2, 3), (2, 4, 5, 6)]), "faces.*vertex 2 form 2 separate fans"),
     (lambda: sm.catmull_clark(CUBE_V, [(0, 3, 2, 8)] + CUBE_F[1:]), "faces.*out of range"),
     (lambda: sm.catmull_clark(CUBE_V, [(0, 3, 2, -1)] + CUBE_F[1:]), "faces.*out of range"),
     (lambda: sm.catmull_clark(CUBE_V, [(0, 1)] + CUBE_F[1:]), "faces.*at least 3"),

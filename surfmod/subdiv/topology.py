@@ -99,8 +99,8 @@ def polygon_mesh(vertices, faces, *, vertices_name="vertices", faces_name="faces
     ``faces`` is an ``(F, k)`` integer array or a list of index lists (mixed polygons).
     ``face_size`` (3 or 4) restricts every face to that many corners.  Refused with
     :class:`SurfmodError`: empty input, NaN/inf coordinates, faces with fewer than three
-    corners or repeated vertices, out-of-range indices, unused vertices and edges shared
-    by more than two faces (non-manifold).
+    corners or repeated vertices, out-of-range indices, unused vertices, and non-manifold
+    cages (an edge shared by more than two faces, or faces at a vertex forming several fans).
     """
     v = checks.finite_array(vertices, vertices_name, ndim=2, last=3)
     if len(v) == 0:
@@ -134,7 +134,38 @@ def polygon_mesh(vertices, faces, *, vertices_name="vertices", faces_name="faces
         raise SurfmodError(
             f"{faces_name}: non-manifold cage, edge {a}-{b} is shared by {topo.edge_faces[e]} faces (at most 2 allowed)"
         )
+    fans = vertex_fans(topo)
+    if np.any(fans > 1):
+        bad = int(np.argmax(fans > 1))
+        raise SurfmodError(
+            f"{faces_name}: non-manifold cage, the faces at vertex {bad} form {fans[bad]} separate fans"
+        )
     return v, topo
+
+
+def vertex_fans(topo: Topology) -> np.ndarray:
+    """Number of edge-connected fans of faces around each vertex (1 on a manifold)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    order = np.argsort(topo.edge_of, kind="stable")
+    e_sorted = topo.edge_of[order]
+    first = np.flatnonzero((np.diff(e_sorted) == 0))  # pairs (order[i], order[i+1]) share an edge
+    h1, h2 = order[first], order[first + 1]
+    links = []
+    for end in (0, 1):
+        vert = topo.edges[topo.edge_of[h1], end]
+        c1 = np.where(topo.corners[h1] == vert, h1, topo.nxt[h1])
+        c2 = np.where(topo.corners[h2] == vert, h2, topo.nxt[h2])
+        links.append((c1, c2))
+    rows = np.concatenate([a for a, _ in links])
+    cols = np.concatenate([b for _, b in links])
+    n = len(topo.corners)
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    # components never span two vertices: count distinct labels per vertex
+    pairs = np.unique(np.stack([topo.corners, label], 1), axis=0)
+    return np.bincount(pairs[:, 0], minlength=topo.n_vertices)
 
 
 def _flatten_faces(faces, name):
