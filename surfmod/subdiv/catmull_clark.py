@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import SurfmodError
 from ..mesh.polymesh import Mesh
 from . import topology as tp
 
@@ -46,8 +47,6 @@ def catmull_clark(vertices, faces, levels: int = 1, *, creases=None) -> Mesh:
     if n == 0:
         if np.all(topo.sizes == topo.sizes[0]) and topo.sizes[0] in (3, 4):
             return Mesh(v, topo.corners.reshape(-1, topo.sizes[0]), {"levels": 0})
-        from ..errors import SurfmodError
-
         raise SurfmodError("levels: 0 levels of a mixed-polygon cage cannot be returned as a Mesh; use levels >= 1")
     for _ in range(n):
         v, topo, sharp = step(v, topo, sharp)
@@ -55,7 +54,7 @@ def catmull_clark(vertices, faces, levels: int = 1, *, creases=None) -> Mesh:
 
 
 def _vertex_sharpness(topo: tp.Topology, sharp_edges: np.ndarray):
-    """Per vertex: number of sharp edges and the sum of their other end points (indices)."""
+    """Per vertex: number of sharp edges, and the sharp edges themselves."""
     e = topo.edges[sharp_edges]
     count = np.bincount(e.ravel(), minlength=topo.n_vertices)
     return count, e
