@@ -67,3 +67,59 @@ def solid(faces, tolerance: float):
     if not valid:
         raise KernelError("BRepCheck_Analyzer: the sewn limit-surface solid is not valid")
     return bd.Solid(s), info
+
+
+def edge_continuity(shape, samples: int = 17):
+    """OCCT's own view of how the faces of a sewn shape meet.
+
+    For every edge shared by two faces, at ``samples`` points of the edge: the distance
+    between the two faces' surface points (through each face's p-curve) and the angle
+    between their outward normals (face orientation applied).  Returns ``(max_gap,
+    max_angle_deg, edges)``; a per-edge loop (a check, not an evaluation path).
+    """
+    import numpy as np
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
+    from OCP.gp import gp_Pnt, gp_Vec
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    s = wrapped(shape)
+    gap, angle, count = 0.0, 0.0, 0
+    with kernel("edge continuity (BRepAdaptor_Curve2d)"):
+        amap = TopTools_IndexedDataMapOfShapeListOfShape()
+        TopExp.MapShapesAndAncestors_s(s, TopAbs_EDGE, TopAbs_FACE, amap)
+        for i in range(1, amap.Extent() + 1):
+            faces = list(amap.FindFromIndex(i))
+            if len(faces) != 2:
+                continue
+            edge = TopoDS.Edge_s(amap.FindKey(i))
+            if BRep_Tool.Degenerated_s(edge):
+                continue
+            count += 1
+            pts, nrm = [], []
+            for f in faces:
+                face = TopoDS.Face_s(f)
+                pcurve = BRepAdaptor_Curve2d(edge, face)
+                t0, t1 = pcurve.FirstParameter(), pcurve.LastParameter()
+                surf = BRepAdaptor_Surface(face, False)
+                sign = -1.0 if face.Orientation() == TopAbs_REVERSED else 1.0
+                p_f, n_f = [], []
+                for t in np.linspace(t0, t1, samples):
+                    uv = pcurve.Value(float(t))
+                    p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+                    surf.D1(uv.X(), uv.Y(), p, du, dv)
+                    n = du.Crossed(dv)
+                    p_f.append((p.X(), p.Y(), p.Z()))
+                    n_f.append((sign * n.X(), sign * n.Y(), sign * n.Z()))
+                pts.append(np.array(p_f))
+                nrm.append(np.array(n_f))
+            gap = max(gap, float(np.linalg.norm(pts[0] - pts[1], axis=1).max()))
+            n0, n1 = nrm
+            cross = np.linalg.norm(np.cross(n0, n1), axis=1)
+            dot = np.einsum("ij,ij->i", n0, n1)
+            ok = np.linalg.norm(n0, axis=1) * np.linalg.norm(n1, axis=1) > 0
+            if ok.any():
+                angle = max(angle, float(np.degrees(np.arctan2(cross[ok], dot[ok])).max()))
+    return gap, angle, count

@@ -146,6 +146,18 @@ class LimitSurface:
             raise SurfmodError("solid: the cage has boundary edges, so its limit bounds no solid; use shell()")
         return solid(self.faces(), self._tolerance())[0]
 
+    def occt_continuity(self, samples: int = 17) -> dict:
+        """The gap and normal jump across shared edges measured by OCCT on the sewn
+        :meth:`shape` (through each face's p-curve): an independent check of ``errors``.
+
+        Crease edges are included in the angle here, so compare on crease-free cages.
+        """
+        from ..occ.subdiv import edge_continuity
+
+        samples = checks.count(samples, "samples", minimum=2)
+        gap, angle, edges = edge_continuity(self.shape(), samples)
+        return {"max_gap": gap, "max_normal_angle_deg": angle, "shared_edges": edges}
+
     def shape(self):
         """:meth:`solid` for a closed cage, :meth:`shell` for an open one (built once)."""
         if getattr(self, "_shape", None) is None:
