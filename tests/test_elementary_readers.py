@@ -208,3 +208,18 @@ def test_offset_similarity_transform_matches_gp_trsf():
 def test_bad_input(call, name):
     with pytest.raises(sm.SurfmodError, match=name):
         call()
+
+
+def test_closed_nurbs_come_back_periodic_from_step_and_still_read(tmp_path):
+    """OCCT re-reads closed rational B-splines (ellipsoid, revolved NURBS) as periodic."""
+    import build123d as bd
+
+    faces = [sm.ellipsoid(3.0, 2.0, 1.0).face(), sm.revolution(sm.Circle((3, 0, 0), (0, 1, 0), 1.0)).to_nurbs().face()]
+    path = tmp_path / "closed.step"
+    sm.export_step(faces, path)
+    shape = bd.import_step(str(path))
+    assert len(shape.faces()) == 2
+    for face in shape.faces():
+        s = sm.from_face(face)
+        assert isinstance(s, sm.BSplineSurface) and s.rational
+        assert sm.crosscheck(face, samples=10).passed

@@ -52,7 +52,7 @@ def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
     Periodic surfaces are read through a non-periodic copy (same shape, OCCT converts)."""
     with kernel("reading Geom_BSplineSurface"):
         if surf.IsUPeriodic() or surf.IsVPeriodic():
-            surf = Geom_BSplineSurface.DownCast(surf.Copy())
+            surf = surf.Copy()  # OCP returns the derived type (no DownCast in OCP)
             if surf.IsUPeriodic():
                 surf.SetUNotPeriodic()
             if surf.IsVPeriodic():
@@ -104,7 +104,7 @@ def read_bspline_curve(curve: Geom_BSplineCurve) -> dict:
         from OCP.TColStd import TColStd_Array1OfReal
 
         if curve.IsPeriodic():
-            curve = Geom_BSplineCurve.DownCast(curve.Copy())
+            curve = curve.Copy()  # OCP returns the derived type (no DownCast in OCP)
             curve.SetNotPeriodic()
         n, p = curve.NbPoles(), curve.Degree()
         poles = TColgp_Array1OfPnt(1, n)
