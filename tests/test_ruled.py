@@ -149,3 +149,32 @@ def test_make_compatible_shares_degree_domain_and_knots():
 def test_bad_input(call, name):
     with pytest.raises(sm.SurfmodError, match=name):
         call()
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from strategies import clamped_knots  # noqa: E402
+
+
+@st.composite
+def bspline_curves(draw, max_degree=5):
+    p = draw(st.integers(1, max_degree))
+    n = draw(st.integers(p + 1, p + 4))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    pts = rng.uniform(-5, 5, (n, 3))
+    w = 10.0 ** rng.uniform(-0.7, 0.7, n) if draw(st.booleans()) else None
+    return sm.BSplineCurve(pts, p, draw(clamped_knots(n, p)), w)
+
+
+@settings(max_examples=25, deadline=None)
+@given(bspline_curves(), bspline_curves())
+def test_random_curves_match_geomfill(g, q):
+    s = sm.ruled(g, q)
+    _assert_matches_geomfill(s)
+    # the boundary rows are the input curves, reparametrized onto the common interval
+    (u0, u1), _ = s.domain
+    t = np.linspace(0, 1, 9)
+    for v, c in ((0.0, g), (1.0, q)):
+        c0, c1 = c.domain
+        np.testing.assert_allclose(s.points(u0 + t * (u1 - u0), v), c.points(c0 + t * (c1 - c0)), atol=1e-12)
