@@ -109,6 +109,42 @@ def test_occt_measures_the_same_gap_and_normal_jump():
     assert occ["max_normal_angle_deg"] == pytest.approx(lim.errors["max_normal_angle_deg"], abs=1e-9)
 
 
+def test_adaptive_refinement_near_extraordinary_vertices():
+    """Feature-adaptive levels: each extraordinary face becomes three exact patches and
+    one smaller approximate one; the measured errors roughly halve per level."""
+    errs = []
+    for a in (0, 1, 2, 3):
+        lim = sm.limit_surface(CUBE_V, CUBE_F, adaptive=a)
+        assert len(lim.patches) == 96 + 72 * a and int((~lim.regular).sum()) == 24
+        e = lim.errors
+        assert e["max_gap"] < 1e-12 and e["max_limit_deviation_regular"] < 1e-12
+        errs.append((e["max_normal_angle_deg"], e["max_limit_deviation_rel"], e["max_limit_normal_deg"]))
+    for coarse, fine in zip(errs, errs[1:]):
+        assert all(f < 0.7 * c for c, f in zip(coarse, fine))
+    assert errs[3][0] < 0.1 and errs[3][1] < 2e-4
+
+
+def test_adaptive_patches_sew_across_t_junctions():
+    rng = np.random.default_rng(8)
+    lim = sm.limit_surface(CUBE_V + 0.1 * rng.standard_normal(CUBE_V.shape), CUBE_F, levels=2, adaptive=2)
+    solid = lim.solid()
+    assert solid.is_valid and len(solid.faces()) == 240
+    occ = lim.occt_continuity()
+    assert occ["max_gap"] < 1e-12
+    assert occ["max_normal_angle_deg"] == pytest.approx(lim.errors["max_normal_angle_deg"], abs=1e-9)
+    # the same solid as without adaptive refinement, to the stated deviation
+    coarse = sm.limit_surface(CUBE_V + 0.1 * np.random.default_rng(8).standard_normal(CUBE_V.shape), CUBE_F).solid()
+    assert solid.volume == pytest.approx(coarse.volume, rel=2e-3)
+
+
+def test_adaptive_on_open_creased_cage():
+    lim = sm.limit_surface(CUBE_V, CUBE_F[:5], creases=[(0, 1), (1, 2)], adaptive=2)
+    e = lim.errors
+    assert lim.open and e["max_gap"] < 1e-12 and e["max_limit_deviation_regular"] < 1e-12
+    assert e["max_limit_deviation_rel"] < 0.01
+    assert len(lim.shell().faces()) == len(lim.patches)
+
+
 def test_step_round_trip_faces_cross_check(cube_solid, tmp_path):
     path = tmp_path / "cube.step"
     sm.export_step(cube_solid, path)
@@ -237,6 +273,9 @@ BAD = [
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=9), "levels"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=40), "levels.*limit"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, tangent_plane="yes"), "tangent_plane"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F, adaptive=-1), "adaptive"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F, adaptive=1.5), "adaptive"),
+    (lambda: sm.limit_surface(CUBE_V, CUBE_F, levels=3, adaptive=8), "adaptive.*too deep"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F, creases=[(0, 6)]), "creases.*not an edge"),
     (lambda: sm.limit_surface(CUBE_V, []), "quads.*empty"),
     (lambda: sm.limit_surface(CUBE_V, CUBE_F + [(0, 1, 5, 4)]), "quads.*non-manifold"),

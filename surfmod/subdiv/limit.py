@@ -22,6 +22,11 @@ and ``v`` along corner 0 -> 3 on ``[0, 1]^2`` (so ``Su x Sv`` follows the face w
   extraordinary vertex the normal is only approximately continuous.  Boundary edges take
   the Bézier points of the cubic B-spline boundary curve, which is the exact limit there.
 
+With ``adaptive = a`` the faces at extraordinary vertices are refined ``a`` more times
+(and only those): three of the four children of each are regular, so they become exact
+patches, and the approximate patches shrink towards the extraordinary vertices.  Patches
+of different levels meet in T-junctions (exact there, since both sides are exact).
+
 Both the approximation and the continuity are *measured* on construction (``errors``):
 the gap and the normal angle across every shared patch edge, and the distance and
 normal angle from the patches to the exact limit surface at the vertices of two further
@@ -40,6 +45,8 @@ from .masks import _cc_limit
 
 #: Most patches a limit surface may have (each becomes an OCCT face).
 MAX_PATCHES = 200_000
+#: Most faces of the finest mesh built to place and measure the patches.
+MAX_MEASURED_FACES = 4_000_000
 
 # uniform cubic B-spline segment -> Bézier control points (one direction)
 _BSPLINE_TO_BEZIER = np.array([[1, 4, 1, 0], [0, 4, 2, 0], [0, 2, 4, 0], [0, 1, 4, 1]], dtype=float) / 6.0
@@ -103,7 +110,8 @@ class LimitSurface:
     (96, 72, True)
     """
 
-    def __init__(self, mesh, patches, regular, bezier_nets, levels, errors):
+    def __init__(self, mesh, patches, regular, bezier_nets, levels, errors, adaptive=0):
+        self.adaptive = adaptive
         self.mesh = mesh
         self.patches = list(patches)
         self.regular = regular
@@ -170,22 +178,31 @@ class LimitSurface:
         return self.shape().wrapped
 
 
-def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_plane: bool = True) -> LimitSurface:
+def limit_surface(
+    vertices, quads, *, levels: int = 2, adaptive: int = 0, creases=None, tangent_plane: bool = True
+) -> LimitSurface:
     """The Catmull–Clark limit surface of a consistently oriented cage as CAD patches.
 
     ``quads`` may hold any polygons when ``levels >= 1`` (one step makes them quads);
     ``creases`` are sharp cage edges as in :func:`catmull_clark` (patches meet there with
     a crease, C0, and a straight crease through regular vertices keeps exact patches).
     Regular faces give exact bicubic uniform B-spline patches; faces at extraordinary
-    vertices give approximating bicubic Bézier patches (module docstring).  ``errors``
-    holds the measured figures: ``max_gap`` and ``max_normal_angle_deg`` across shared
-    patch edges (crease edges excluded from the angle; ``..._regular_deg`` between exact
-    patches; ``degenerate_normals`` counts samples where ``Su x Sv`` vanishes, e.g. where a
-    smooth boundary curve turns through a single face), ``max_limit_deviation`` and
-    ``max_limit_normal_deg`` against the exact limit at the vertices of two further
-    subdivision levels placed with the limit masks (``..._rel`` relative to the cage
-    size, ``..._regular`` on exact patches only), ``acc_regular_mismatch`` (the Bézier
-    rules against the exact conversion on regular faces) and ``boundary_edges``.
+    vertices give approximating bicubic Bézier patches (module docstring).
+    ``adaptive`` more levels refine only the faces at extraordinary vertices (feature
+    adaptive, like OpenSubdiv): each one splits into three exact patches and one smaller
+    approximate patch, so the approximation error shrinks about twofold per level while
+    the patch count grows only linearly (patches of different levels meet in T-junctions,
+    which the sewing splits).
+
+    ``errors`` holds the measured figures: ``max_gap`` and ``max_normal_angle_deg`` across
+    edges between patches (crease edges excluded from the angle; ``..._regular_deg``
+    between exact patches; ``degenerate_normals`` counts samples where ``Su x Sv``
+    vanishes, e.g. where a smooth boundary curve turns through a single face),
+    ``max_limit_deviation`` and ``max_limit_normal_deg`` against the exact limit at the
+    vertices of further subdivision levels placed with the limit masks (``..._rel``
+    relative to the cage size, ``..._regular`` on exact patches only),
+    ``acc_regular_mismatch`` (the Bézier rules against the exact conversion on regular
+    faces) and ``boundary_edges``.
 
     >>> import surfmod as sm
     >>> cube_v = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
@@ -193,6 +210,9 @@ def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_pla
     >>> solid = sm.limit_surface(cube_v, cube_f).solid()
     >>> len(solid.faces()), round(solid.volume, 3)
     (96, 0.328)
+    >>> fine = sm.limit_surface(cube_v, cube_f, adaptive=3)
+    >>> len(fine.patches), fine.errors["max_normal_angle_deg"] < 0.2
+    (312, True)
     """
     v, topo = tp.polygon_mesh(vertices, quads, faces_name="quads")
     if not np.ptp(v, axis=0).max() > 0:
@@ -200,6 +220,13 @@ def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_pla
     n = tp.levels_arg(levels, len(topo.corners))
     if len(topo.corners) * 4.0 ** max(n - 1, 0) > MAX_PATCHES:
         raise SurfmodError(f"levels: {n} levels would make more than {MAX_PATCHES:,} patches")
+    a = checks.count(adaptive, "adaptive", minimum=0)
+    extra = 2 if a == 0 else 1  # measuring levels beyond the finest
+    if np.log(len(topo.corners)) + (max(n - 1, 0) + a + extra) * np.log(4.0) > np.log(MAX_MEASURED_FACES):
+        raise SurfmodError(
+            f"adaptive: levels={n} plus adaptive={a} refine too deep to build and measure "
+            f"(more than {MAX_MEASURED_FACES:,} faces); use fewer levels"
+        )
     if not isinstance(tangent_plane, (bool, np.bool_)):
         raise SurfmodError(f"tangent_plane: expected True or False, got {tangent_plane!r}")
     if n == 0 and np.any(topo.sizes != 4):
@@ -208,7 +235,79 @@ def limit_surface(vertices, quads, *, levels: int = 2, creases=None, tangent_pla
     crease = tp.crease_flags(topo, creases)
     for _ in range(n):
         v, topo, crease = cc_step(v, topo, crease)
-    return _build(v, topo, n, bool(tangent_plane), crease)
+    return _assemble(v, topo, crease, n, a, bool(tangent_plane), extra)
+
+
+def _assemble(v, topo, crease, levels, adaptive, tangent_plane, extra):
+    """Patches of every adaptive level, the kept selection, and the measurements."""
+    from ..mesh.polymesh import Mesh
+    from ..nets.bezier import BezierSurface
+    from ..nets.bspline import BSplineSurface
+
+    mesh = Mesh(v, topo.quads(), {"levels": levels, "scheme": "catmull-clark"})
+    boundary_edges = int(topo.boundary.sum())
+    active = np.ones(topo.n_faces, dtype=bool)
+    owner = np.full(topo.n_faces, -1)
+    maps = _identity_maps(topo.n_faces)
+    patches, regular, nets, mismatch = [], [], [], 0.0
+    for j in range(adaptive + 1):
+        reg_j, nets_j, bnets_j, mism = _level_patches(v, topo, crease, tangent_plane)
+        keep = active if j == adaptive else active & reg_j
+        mismatch = max(mismatch, mism)
+        kept = np.flatnonzero(keep)
+        bpos = np.cumsum(reg_j) - 1  # row of each regular face in bnets_j
+        first = len(patches)
+        for f in kept:
+            if reg_j[f]:
+                patches.append(BSplineSurface.uniform_cubic(bnets_j[bpos[f]]))
+            else:
+                patches.append(BezierSurface._trusted(nets_j[f]))
+        regular.append(reg_j[kept])
+        nets.append(nets_j[kept])
+        # newly owned faces parametrize their patch directly
+        owner[kept] = first + np.arange(len(kept))
+        maps = _reset_maps(maps, kept)
+        if j < adaptive:
+            active = np.repeat(active & ~reg_j, 4)
+            v, topo, crease, owner, maps = _refine(v, topo, crease, owner, maps)
+    regular = np.concatenate(regular)
+    nets = np.concatenate(nets)
+    nets.setflags(write=False)
+    errors = _measure(v, topo, crease, owner, maps, nets, regular, extra)
+    errors["acc_regular_mismatch"] = mismatch
+    errors["boundary_edges"] = boundary_edges
+    return LimitSurface(mesh, patches, checks.frozen(regular).astype(bool), nets, levels, errors, adaptive)
+
+
+def _identity_maps(n):
+    """Affine maps (origin, d1, d2) from a face's own (s, t) to its patch's (u, v)."""
+    return [np.zeros((n, 2)), np.tile([1.0, 0.0], (n, 1)), np.tile([0.0, 1.0], (n, 1))]
+
+
+def _reset_maps(maps, idx):
+    ident = _identity_maps(len(idx))
+    for m, i in zip(maps, ident):
+        m[idx] = i
+    return maps
+
+
+def _refine(v, topo, crease, owner, maps):
+    """One Catmull–Clark step carrying each face's patch owner and (s, t) -> (u, v) map.
+
+    Child ``j`` of a quad is ``[c_j, e_j, f, e_(j-1)]``: its local axes run from corner j
+    halfway towards corners j+1 and j-1 of the parent."""
+    nf = topo.n_faces
+    v, topo, crease = cc_step(v, topo, crease)
+    j = np.tile(np.arange(4), nf)
+    par = np.repeat(np.arange(nf), 4)
+    origin, d1, d2 = maps
+    pj, pn, pp = _CORNER_UV[j], _CORNER_UV[(j + 1) % 4], _CORNER_UV[(j - 1) % 4]
+
+    def amap(x):
+        return d1[par] * x[:, :1] + d2[par] * x[:, 1:]
+
+    maps = [origin[par] + amap(pj), 0.5 * amap(pn - pj), 0.5 * amap(pp - pj)]
+    return v, topo, crease, owner[par], maps
 
 
 def _regular_corners(topo, twin, nsharp):
@@ -232,11 +331,9 @@ def _regular_corners(topo, twin, nsharp):
     return np.where(ns > 0, sectors, topo.valence()[corners] == 4)
 
 
-def _build(v, topo, levels, tangent_plane, crease):
-    from ..mesh.polymesh import Mesh
-    from ..nets.bezier import BezierSurface
-    from ..nets.bspline import BSplineSurface
-
+def _level_patches(v, topo, crease, tangent_plane):
+    """Regular flags, Bézier nets ``(F, 4, 4, 3)`` (exact on regular faces), 4x4 B-spline
+    nets of the regular faces and the ACC-vs-exact mismatch, for one level."""
     corners, nxt, prv = topo.corners, topo.nxt, topo.prv
     full_twin = topo.twin()
     sharp = crease | topo.boundary
@@ -246,7 +343,6 @@ def _build(v, topo, levels, tangent_plane, crease):
     nsharp = np.bincount(topo.edges[sharp].ravel(), minlength=len(v))
     nsharp[topo.faces_at() == 1] = 3  # a boundary vertex of a single face is a corner
     on_curve = nsharp >= 2  # boundary/crease curve vertices and corners
-    quads = corners.reshape(-1, 4)
     regular = np.all(_regular_corners(topo, twin, nsharp).reshape(-1, 4), axis=1)
     limit_pos, normals, _ = _cc_limit(v, topo, crease)
 
@@ -308,79 +404,67 @@ def _build(v, topo, levels, tangent_plane, crease):
 
     if not (np.all(np.isfinite(nets)) and np.all(np.isfinite(bnets))):
         raise SurfmodError("vertices: degenerate cage, the limit patches are undefined (coincident points?)")
-    patches = [None] * nf
-    for idx, f in enumerate(rf):
-        patches[f] = BSplineSurface.uniform_cubic(bnets[idx])
-    for f in np.flatnonzero(~regular):
-        patches[f] = BezierSurface._trusted(nets[f])
-    nets.setflags(write=False)
-    mesh = Mesh(v, quads, {"levels": levels, "scheme": "catmull-clark"})
-    errors = _measure(v, topo, full_twin, nets, regular, crease)
-    errors["acc_regular_mismatch"] = acc_mismatch
-    errors["boundary_edges"] = int(topo.boundary.sum())
-    return LimitSurface(mesh, patches, checks.frozen(regular).astype(bool), nets, levels, errors)
+    return regular, nets, bnets, acc_mismatch
 
 
-def _edge_uv(k, t):
-    """Parameters of edge k (corner k -> k+1) of a quad patch at fraction t."""
-    a, b = _CORNER_UV[k], _CORNER_UV[(k + 1) % 4]
-    return a[:, None] * (1 - t) + b[:, None] * t
+def _bezier_at(nets, idx, u, v, chunk: int = 1 << 16):
+    """:func:`bezier_eval` of ``nets[idx]`` in chunks (bounded memory)."""
+    out_p, out_n = np.empty((len(idx), 3)), np.empty((len(idx), 3))
+    for s in range(0, len(idx), chunk):
+        sl = slice(s, s + chunk)
+        out_p[sl], out_n[sl] = bezier_eval(nets[idx[sl]], u[sl], v[sl])
+    return out_p, out_n
 
 
-def _measure(v, topo, twin, nets, regular, crease, samples: int = 17, extra_levels: int = 2):
-    """Measured continuity and approximation figures (see :func:`limit_surface`)."""
+def _apply(maps, faces, st):
+    origin, d1, d2 = maps
+    return origin[faces] + d1[faces] * st[:, :1] + d2[faces] * st[:, 1:]
+
+
+def _measure(v, topo, crease, owner, maps, nets, regular, extra, samples: int = 17):
+    """Measured continuity and approximation figures (see :func:`limit_surface`), on the
+    finest mesh whose faces know their patch (``owner``) and place in it (``maps``)."""
     size = float(np.ptp(v, axis=0).max()) or 1.0
-    # 1. across every shared edge: gap and normal angle
+    # 1. across every edge between two different patches: gap and normal angle
+    twin = topo.twin()
     c = np.flatnonzero(np.arange(len(twin)) < twin)
-    f, k = c // 4, c % 4
+    c = c[owner[c // 4] != owner[twin[c] // 4]]
     g = twin[c]
-    fg, l = g // 4, g % 4
     t = np.linspace(0.0, 1.0, samples)
-    uv_f = np.stack([_edge_uv(kk, t) for kk in range(4)])  # (4, 2, S)
-    uf = uv_f[k][:, 0].ravel()
-    vf = uv_f[k][:, 1].ravel()
-    ug = uv_f[l][:, 0, ::-1].ravel()
-    vg = uv_f[l][:, 1, ::-1].ravel()
-    pf, nf_ = bezier_eval(np.repeat(nets[f], samples, axis=0), uf, vf)
-    pg, ng = bezier_eval(np.repeat(nets[fg], samples, axis=0), ug, vg)
-    gap = float(np.linalg.norm(pf - pg, axis=1).max())
+    k, l = np.repeat(c % 4, samples), np.repeat(g % 4, samples)
+    tt = np.tile(t, len(c))[:, None]
+    st_f = _CORNER_UV[k] * (1 - tt) + _CORNER_UV[(k + 1) % 4] * tt
+    st_g = _CORNER_UV[l] * tt + _CORNER_UV[(l + 1) % 4] * (1 - tt)
+    ff, fg = np.repeat(c // 4, samples), np.repeat(g // 4, samples)
+    uv_f, uv_g = _apply(maps, ff, st_f), _apply(maps, fg, st_g)
+    pf, nf_ = _bezier_at(nets, owner[ff], uv_f[:, 0], uv_f[:, 1])
+    pg, ng = _bezier_at(nets, owner[fg], uv_g[:, 0], uv_g[:, 1])
+    gap = float(np.linalg.norm(pf - pg, axis=1).max()) if len(c) else 0.0
     smooth = np.repeat(~crease[topo.edge_of[c]], samples)  # creases are meant to be sharp
-    jump = _angle_deg(nf_, ng)[smooth] if smooth.any() else np.zeros(1)
+    jump = _angle_deg(nf_, ng)[smooth]
     degenerate = int(np.isnan(jump).sum())
-    edge_reg = np.repeat(regular[f] & regular[fg], samples)[smooth] if smooth.any() else np.zeros(1, bool)
+    edge_reg = (regular[owner[ff]] & regular[owner[fg]])[smooth]
 
     # 2. against the exact limit: vertices of further levels, placed with the masks
-    vv, tt = v, topo
-    origin = np.repeat(np.zeros((1, 2)), topo.n_faces, axis=0)
-    d1 = np.repeat(np.array([[1.0, 0.0]]), topo.n_faces, axis=0)
-    d2 = np.repeat(np.array([[0.0, 1.0]]), topo.n_faces, axis=0)
-    base = np.arange(topo.n_faces)
-    for _ in range(extra_levels):
-        vv, new_tt, crease = cc_step(vv, tt, crease)
-        j = np.tile(np.arange(4), tt.n_faces)  # child j of every parent face (corner order)
-        par = np.repeat(np.arange(tt.n_faces), 4)
-        pj, pn, pp = _CORNER_UV[j], _CORNER_UV[(j + 1) % 4], _CORNER_UV[(j - 1) % 4]
-
-        def amap(x, par=par):
-            return d1[par] * x[:, :1] + d2[par] * x[:, 1:]
-
-        origin, d1, d2 = origin[par] + amap(pj), 0.5 * amap(pn - pj), 0.5 * amap(pp - pj)
-        base = base[par]
-        tt = new_tt
-    pos, nrm, _ = _cc_limit(vv, tt, crease)
-    kk = np.tile(np.arange(4), tt.n_faces)
-    ff = np.repeat(np.arange(tt.n_faces), 4)
-    uv = origin[ff] + d1[ff] * _CORNER_UV[kk][:, :1] + d2[ff] * _CORNER_UV[kk][:, 1:]
-    bp = base[ff]
-    p, nn = bezier_eval(nets[bp], uv[:, 0], uv[:, 1])
-    vert = tt.corners
+    vv, tp_, cr, own, mp = v, topo, crease, owner, maps
+    for _ in range(extra):
+        vv, tp_, cr, own, mp = _refine(vv, tp_, cr, own, mp)
+    pos, nrm, _ = _cc_limit(vv, tp_, cr)
+    faces = np.repeat(np.arange(tp_.n_faces), 4)
+    corner = np.tile(np.arange(4), tp_.n_faces)
+    vert = tp_.corners
+    # one sample per (vertex, patch): vertices on patch borders are checked on each side
+    _, first = np.unique(vert * len(nets) + own[faces], return_index=True)
+    faces, corner, vert = faces[first], corner[first], vert[first]
+    uv = _apply(mp, faces, _CORNER_UV[corner])
+    p, nn = _bezier_at(nets, own[faces], uv[:, 0], uv[:, 1])
     dev = np.linalg.norm(p - pos[vert], axis=1)
     ang = _angle_deg(nn, nrm[vert])
-    reg = regular[bp]
+    reg = regular[own[faces]]
     return {
         "max_gap": gap,
         "max_gap_rel": gap / size,
-        "max_normal_angle_deg": _nanmax(jump),
+        "max_normal_angle_deg": _nanmax(jump) if jump.size else 0.0,
         "max_normal_angle_regular_deg": _nanmax(jump[edge_reg]) if edge_reg.any() else 0.0,
         "degenerate_normals": degenerate,
         "max_limit_deviation": float(dev.max()),
