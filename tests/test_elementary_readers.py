@@ -223,3 +223,12 @@ def test_closed_nurbs_come_back_periodic_from_step_and_still_read(tmp_path):
         s = sm.from_face(face)
         assert isinstance(s, sm.BSplineSurface) and s.rational
         assert sm.crosscheck(face, samples=10).passed
+
+
+def test_offset_grid_fast_path_equals_scattered_evaluation():
+    rng = np.random.default_rng(3)
+    s = sm.OffsetSurface(sm.BSplineSurface(rng.uniform(0, 1, (5, 4, 3)), (3, 2)), 0.2)
+    us, vs = np.linspace(0, 1, 7), np.linspace(0, 1, 5)
+    uu, vv = np.meshgrid(us, vs, indexing="ij")
+    for order in (0, 2):
+        np.testing.assert_allclose(s.grid_derivatives(us, vs, order), s.derivatives(uu, vv, order), atol=1e-12)

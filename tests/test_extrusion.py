@@ -102,3 +102,10 @@ def test_non_uniform_scale_goes_through_the_bspline_form():
 def test_bad_input(call, name):
     with pytest.raises(sm.SurfmodError, match=name):
         call()
+
+
+def test_grid_fast_path_equals_scattered_evaluation():
+    s = sm.tabulated_cylinder(SPLINE, (0, 1, 2), 3.0)
+    us, vs = np.linspace(0, 2, 7), np.linspace(0, 3, 5)
+    uu, vv = np.meshgrid(us, vs, indexing="ij")
+    np.testing.assert_allclose(s.grid_derivatives(us, vs, 2), s.derivatives(uu, vv, 2), atol=1e-14)

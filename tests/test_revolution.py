@@ -149,3 +149,11 @@ SPLINE_XZ = sm.BSplineCurve([(1, 0, 0), (2, 0, 1), (1.5, 0, 2)], 2)
 def test_bad_input(call, name):
     with pytest.raises(sm.SurfmodError, match=name):
         call()
+
+
+def test_grid_fast_path_equals_scattered_evaluation():
+    s = sm.revolution(sm.BSplineCurve([(1, 0, 0), (2, 0, 1), (1.5, 0, 2)], 2), (0, 0, 0), (0, 0, 1), 200)
+    (u0, u1), (v0, v1) = s.domain
+    us, vs = np.linspace(u0, u1, 7), np.linspace(v0, v1, 5)
+    uu, vv = np.meshgrid(us, vs, indexing="ij")
+    np.testing.assert_allclose(s.grid_derivatives(us, vs, 2), s.derivatives(uu, vv, 2), atol=1e-14)

@@ -62,6 +62,15 @@ class TabulatedCylinder(Surface):
             out[:, 0, 1] = self.direction
         return out
 
+    def _grid_derivatives(self, us, vs, order):
+        """Tensor grid: the curve is evaluated once per u."""
+        out = np.zeros((us.size, vs.size, order + 1, order + 1, 3))
+        out[:, :, :, 0] = self.curve._derivatives(us, order)[:, None]
+        out[:, :, 0, 0] += vs[None, :, None] * self.direction
+        if order >= 1:
+            out[:, :, 0, 1] = self.direction
+        return out
+
     def geom(self):
         if self._occ is None:
             from ..occ.analytic import extrusion

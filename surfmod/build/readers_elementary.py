@@ -147,17 +147,33 @@ class OffsetSurface(Surface):
     def domain(self):
         return self.base.domain
 
+    def _grid_derivatives(self, us, vs, order):
+        if self._equivalent is not None:
+            return self._equivalent._grid_derivatives(us, vs, order)
+        ders = self.base._grid_derivatives(us, vs, order + 1)
+        flat = ders.reshape(-1, *ders.shape[2:])
+        uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
+        out = self._from_base(uu, vv, flat, order)
+        return out.reshape(us.size, vs.size, *out.shape[1:])
+
     def _derivatives(self, u, v, order):
         if self._equivalent is not None:
             return self._equivalent._derivatives(u, v, order)
-        ders = self.base._derivatives(u, v, order + 1)
+        return self._from_base(u, v, self.base._derivatives(u, v, order + 1), order)
+
+    def _from_base(self, u, v, ders, order):
         bad = _degenerate(ders)
         if np.any(bad):
             (u0, u1), (v0, v1) = self.domain
             un = u[bad] + 1e-7 * ((u0 + u1) / 2 - u[bad])
             vn = v[bad] + 1e-7 * ((v0 + v1) / 2 - v[bad])
             ders[bad] = self.base._derivatives(un, vn, order + 1)
-        out = offset_derivatives(ders, self.distance, order)
+        if order == 0:  # positions only: S + d (Su x Sv)/|Su x Sv|
+            n = np.cross(ders[:, 1, 0], ders[:, 0, 1])
+            norm = np.linalg.norm(n, axis=-1, keepdims=True)
+            out = (ders[:, 0, 0] + self.distance * n / np.where(norm > 0, norm, 1.0))[:, None, None]
+        else:
+            out = offset_derivatives(ders, self.distance, order)
         if np.any(bad):
             limit = self.base.normals(u[bad], v[bad])
             out[bad, 0, 0] = self.base._derivatives(u[bad], v[bad], 0)[:, 0, 0] + self.distance * limit

@@ -115,6 +115,22 @@ class RevolutionSurface(Surface):
         out[:, 0, 0] += o
         return out
 
+    def _grid_derivatives(self, us, vs, order):
+        """Tensor grid: the profile is evaluated once per v, the rotation once per u."""
+        a, o = self.axis_direction, self.axis_origin
+        c = self.profile._derivatives(vs, order)  # (nv, K, 3)
+        c[:, 0] -= o
+        along = np.einsum("nkd,d->nk", c, a)[..., None] * a
+        radial = c - along
+        cross = np.cross(a, radial)
+        out = np.empty((us.size, vs.size, order + 1, order + 1, 3))
+        for k in range(order + 1):
+            ck, sk = cos_d(us, k)[:, None, None, None], sin_d(us, k)[:, None, None, None]
+            out[:, :, k] = ck * radial[None] + sk * cross[None]
+        out[:, :, 0] += along[None]
+        out[:, :, 0, 0] += o
+        return out
+
     def geom(self):
         if self._occ is None:
             from ..occ.analytic import revolution as occ_revolution
