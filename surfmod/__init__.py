@@ -68,6 +68,8 @@ _EXPORTS = {
     "implicit": ".build.forms",
     "ImplicitSurface": ".build.forms",
     "to_implicit": ".build.forms",
+    "sweep": ".build.sweep",
+    "SweptSurface": ".build.sweep",
     "trim": ".ops.trim",
     "trimmed_area": ".ops.trim",
     "catmull_clark": ".subdiv.catmull_clark",

@@ -1,0 +1,88 @@
+"""OCCT's swept and lofted shells: ``BRepOffsetAPI_MakePipeShell`` and
+``BRepOffsetAPI_ThruSections``, built from OCCT curves (``Geom_Curve`` + range)."""
+
+from __future__ import annotations
+
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell, BRepOffsetAPI_ThruSections
+from OCP.TopExp import TopExp
+from OCP.TopoDS import TopoDS
+
+from ..errors import KernelError
+from .guard import check_done, kernel
+from .topo import faces_of
+
+
+def _wire(curve, t0, t1):
+    edge = BRepBuilderAPI_MakeEdge(curve, float(t0), float(t1))
+    check_done(edge, "BRepBuilderAPI_MakeEdge")
+    wire = BRepBuilderAPI_MakeWire(edge.Edge())
+    check_done(wire, "BRepBuilderAPI_MakeWire")
+    return wire.Wire()
+
+
+def pipe_shell(profiles, path, *, mode: str = "frenet", auxiliary=None, contact: bool = False,
+               tolerance: float = 1e-6, max_degree: int = 11, max_segments: int = 200):
+    """A pipe shell: ``profiles`` is one ``(curve, t0, t1)`` (placed at the path start) or
+    two (start and end of the path); ``path`` is ``(curve, t0, t1)``.
+
+    ``mode``: ``"frenet"`` / ``"corrected_frenet"`` (OCCT's trihedron laws) or
+    ``"auxiliary"`` with ``auxiliary=(curve, t0, t1)``: the normal points at the
+    auxiliary spine (found in the normal plane of the spine, no curvilinear
+    equivalence); ``contact`` keeps the profile touching it (scaled).  Returns the shell
+    (``TopoDS_Shape``) and its faces.
+    """
+    from OCP.BRepFill import BRepFill_TypeOfContact
+
+    with kernel("BRepOffsetAPI_MakePipeShell"):
+        spine = _wire(*path)
+        first, last = TopoDS.Vertex_s(TopExp.FirstVertex_s(_edge_of(spine))), TopoDS.Vertex_s(
+            TopExp.LastVertex_s(_edge_of(spine))
+        )
+        maker = BRepOffsetAPI_MakePipeShell(spine)
+        if mode == "frenet":
+            maker.SetMode(True)
+        elif mode == "corrected_frenet":
+            maker.SetMode(False)
+        elif mode == "auxiliary":
+            kind = BRepFill_TypeOfContact.BRepFill_ContactOnBorder if contact else BRepFill_TypeOfContact.BRepFill_NoContact
+            maker.SetMode(_wire(*auxiliary), False, kind)
+        else:  # pragma: no cover - callers validate
+            raise KernelError(f"pipe_shell: unknown mode {mode!r}")
+        maker.SetTolerance(float(tolerance), float(tolerance), 1e-4)
+        maker.SetMaxDegree(int(max_degree))
+        maker.SetMaxSegments(int(max_segments))
+        for k, prof in enumerate(profiles):
+            maker.Add(_wire(*prof), first if k == 0 else last, False, False)
+        maker.Build()
+        check_done(maker, "BRepOffsetAPI_MakePipeShell")
+        shape = maker.Shape()
+    faces = faces_of(shape)
+    if not faces:
+        raise KernelError("BRepOffsetAPI_MakePipeShell: the result has no face")
+    return shape, faces
+
+
+def thru_sections(sections, *, ruled: bool, tolerance: float = 1e-6):
+    """``BRepOffsetAPI_ThruSections`` through ``[(curve, t0, t1), ...]`` (a shell, not a
+    solid); returns ``(shape, faces)``."""
+    with kernel("BRepOffsetAPI_ThruSections"):
+        maker = BRepOffsetAPI_ThruSections(False, bool(ruled), float(tolerance))
+        maker.CheckCompatibility(False)
+        for sec in sections:
+            maker.AddWire(_wire(*sec))
+        maker.Build()
+        check_done(maker, "BRepOffsetAPI_ThruSections")
+        shape = maker.Shape()
+    faces = faces_of(shape)
+    if not faces:
+        raise KernelError("BRepOffsetAPI_ThruSections: the result has no face")
+    return shape, faces
+
+
+def _edge_of(wire):
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+
+    explorer = TopExp_Explorer(wire, TopAbs_EDGE)
+    return TopoDS.Edge_s(explorer.Current())
