@@ -221,7 +221,7 @@ def limit_surface(
     if len(topo.corners) * 4.0 ** max(n - 1, 0) > MAX_PATCHES:
         raise SurfmodError(f"levels: {n} levels would make more than {MAX_PATCHES:,} patches")
     a = checks.count(adaptive, "adaptive", minimum=0)
-    extra = 2 if a == 0 else 1  # measuring levels beyond the finest
+    extra = 2  # measuring levels beyond the finest (samples on a 5 x 5 grid per finest face)
     if np.log(len(topo.corners)) + (max(n - 1, 0) + a + extra) * np.log(4.0) > np.log(MAX_MEASURED_FACES):
         raise SurfmodError(
             f"adaptive: levels={n} plus adaptive={a} refine too deep to build and measure "
