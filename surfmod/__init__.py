@@ -34,6 +34,8 @@ _EXPORTS = {
     "Arc": ".build.conics",
     "Ellipse": ".build.conics",
     "LineCurve": ".build.conics",
+    "Parabola": ".build.conics",
+    "Hyperbola": ".build.conics",
     "ruled": ".build.ruled",
     "RuledSurface": ".build.ruled",
     "tabulated_cylinder": ".build.extrusion",

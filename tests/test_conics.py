@@ -108,6 +108,30 @@ def test_line_curve_matches_geom_line():
     np.testing.assert_allclose(b.points(np.linspace(-2, 3, 9)), c.points(np.linspace(-2, 3, 9)), atol=1e-14)
 
 
+@pytest.mark.parametrize(
+    "curve",
+    [sm.Parabola((1, 2, 3), (0, 1, 1), 0.7, (-2, 3)), sm.Hyperbola((1, 2, 3), (0, 1, 1), 2.0, 1.0, (-1.5, 2))],
+    ids=["parabola", "hyperbola"],
+)
+def test_parabola_and_hyperbola(curve):
+    assert sm.crosscheck(curve).passed
+    b = curve.to_bspline()
+    assert b.degree == 2 and sm.crosscheck(b).passed
+    t = np.linspace(*b.domain, 301)
+    d = b.points(t) - curve.center
+    x, y = d @ curve.x_dir, d @ curve.y_dir
+    np.testing.assert_allclose(d @ curve.normal, 0.0, atol=1e-14)
+    if isinstance(curve, sm.Parabola):  # polynomial: even the parametrization is the same
+        np.testing.assert_allclose(b.points(t), curve.points(t), atol=1e-14)
+        np.testing.assert_allclose(x, y * y / (4 * curve.focal), atol=1e-13)
+    else:
+        np.testing.assert_allclose((x / curve.a) ** 2 - (y / curve.b) ** 2, 1.0, atol=1e-13)
+    for m in SIMILARITIES.values():
+        out = curve.transformed(m)
+        tt = np.linspace(*out.domain, 9)
+        np.testing.assert_allclose(out.derivatives(tt, 2), curve_d2(occ_transformed(curve.geom(), m), tt), atol=1e-12)
+
+
 @pytest.mark.parametrize("name", sorted(SIMILARITIES))
 @pytest.mark.parametrize(
     "curve",
@@ -144,6 +168,8 @@ def test_non_uniform_scale_gives_exact_nurbs_ellipse():
         (lambda: sm.Ellipse((0, 0, 0), (0, 0, 1), 1.0, 2.0), "minor"),
         (lambda: sm.LineCurve((0, 0, 0), (0, 0, 0)), "direction"),
         (lambda: sm.LineCurve((0, 0, 0), (1, 0, 0), (2, 1)), "t_range"),
+        (lambda: sm.Parabola((0, 0, 0), (0, 0, 1), 0.0, (0, 1)), "focal"),
+        (lambda: sm.Hyperbola((0, 0, 0), (0, 0, 1), 1.0, 1.0, (1, 1)), "t_range"),
     ],
 )
 def test_bad_input(call, name):

@@ -118,6 +118,8 @@ def _basis_curves():
         "line": (occ.infinite_line((1, 0, -1), (0.3, 0, 1)), (-1.0, 2.0)),
         "circle": (occ.circle((3, 0, 0), (0, 1, 0), (1, 0, 0), 1.0), (-1.0, 4.0)),
         "ellipse": (occ.ellipse((3, 0, 0), (0, 1, 0), (0, 0, 1), 1.0, 0.5), (0.5, 6.0)),
+        "parabola": (occ.parabola((3, 0, 0), (0, 1, 0), (0, 0, 1), 0.5), (-1.0, 1.5)),
+        "hyperbola": (occ.hyperbola((1, 0, 0), (0, 1, 0), (1, 0, 0), 1.0, 0.5), (-1.0, 1.2)),
         "bspline": (spline.geom(), (0.2, 0.9)),
         "bezier": (occ.bezier_curve_geom([(1, 0, 0), (2, 0, 1), (1, 0, 3)], [1, 3, 1]), (0.0, 1.0)),
         "trimmed": (occ.trimmed(occ.circle((3, 0, 0), (0, 1, 0), (1, 0, 0), 1.0), -1.0, 2.0), (-1.0, 2.0)),

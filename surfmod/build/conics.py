@@ -264,3 +264,132 @@ class LineCurve(Curve):
         s = float(np.linalg.norm(d))
         t0, t1 = self._domain
         return LineCurve(transforms.apply(m, self.origin), d / s, (t0 * s, t1 * s))
+
+
+class _FramedCurve(Curve):
+    """Shared frame handling of Parabola and Hyperbola (planar, ``Y = N x X``)."""
+
+    def _init(self, center, normal, x_dir, params, t_range):
+        self.center = checks.frozen(center)
+        self.normal = checks.frozen(normal)
+        self.x_dir = checks.frozen(x_dir)
+        self.y_dir = checks.frozen(np.cross(normal, x_dir))
+        self._set_params(*params)
+        t0, t1 = (float(t) for t in t_range)
+        if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
+            raise SurfmodError(f"t_range: need finite start < end, got {t_range!r}")
+        self._domain = (t0, t1)
+
+    @classmethod
+    def _make(cls, center, normal, x_dir, params, t_range):
+        obj = cls.__new__(cls)
+        obj._init(*(np.asarray(a, float) for a in (center, normal, x_dir)), params, t_range)
+        return obj
+
+    @property
+    def domain(self):
+        return self._domain
+
+    def _derivatives(self, t, order):
+        fx, fy = self._coefficients(t, order)
+        out = fx[..., None] * self.x_dir + fy[..., None] * self.y_dir
+        out[:, 0] += self.center
+        return out
+
+    def geom(self):
+        from ..occ.analytic import trimmed
+
+        return trimmed(self._basis_geom(), *self._domain)
+
+    def transformed(self, matrix):
+        m = transforms.affine(matrix)
+        if not transforms.is_similarity(m):
+            return self.to_bspline().transformed(m)
+        (c, x, y, _), s = frame_transformed((self.center, self.x_dir, self.y_dir, self.normal), m)
+        params, t_scale = self._scaled(s)
+        t0, t1 = self._domain
+        return type(self)._make(c, np.cross(x, y), x, params, (t0 * t_scale, t1 * t_scale))
+
+
+class Parabola(_FramedCurve):
+    """``Geom_Parabola``: ``C + t^2 / (4 f) X + t Y`` over ``t_range`` (``f`` focal length).
+
+    >>> import surfmod as sm
+    >>> sm.Parabola((0, 0, 0), (0, 0, 1), 0.25, (-1, 1)).points(1.0)
+    array([1., 1., 0.])
+    """
+
+    occt_construct = "Geom_TrimmedCurve(Geom_Parabola)"
+
+    def __init__(self, center, normal, focal, t_range, x_dir=None):
+        c, x, _, n = make_frame(center, normal, x_dir, axis_name="normal")
+        self._init(c, n, x, (checks.positive(focal, "focal"),), t_range)
+
+    def _set_params(self, focal):
+        self.focal = float(focal)
+
+    def _scaled(self, s):
+        return (self.focal * s,), s
+
+    def _coefficients(self, t, order):
+        fx, fy = np.zeros((t.size, order + 1)), np.zeros((t.size, order + 1))
+        fx[:, 0], fy[:, 0] = t * t / (4 * self.focal), t
+        if order >= 1:
+            fx[:, 1], fy[:, 1] = t / (2 * self.focal), 1.0
+        if order >= 2:
+            fx[:, 2] = 1.0 / (2 * self.focal)
+        return fx, fy
+
+    def _basis_geom(self):
+        from ..occ.analytic import parabola
+
+        return parabola(self.center, self.normal, self.x_dir, self.focal)
+
+    def to_bspline(self) -> BSplineCurve:
+        """The exact quadratic Bézier (same parametrization: the parabola is polynomial)."""
+        t0, t1 = self._domain
+        d = self._derivatives(np.array([t0, t1]), 1)
+        pts = np.array([d[0, 0], d[0, 0] + 0.5 * (t1 - t0) * d[0, 1], d[1, 0]])
+        return BSplineCurve._trusted(pts, 2, np.array([t0, t0, t0, t1, t1, t1]))
+
+
+class Hyperbola(_FramedCurve):
+    """``Geom_Hyperbola``: ``C + a cosh t X + b sinh t Y`` over ``t_range``.
+
+    >>> import surfmod as sm
+    >>> sm.Hyperbola((0, 0, 0), (0, 0, 1), 2.0, 1.0, (-1, 1)).points(0.0)
+    array([2., 0., 0.])
+    """
+
+    occt_construct = "Geom_TrimmedCurve(Geom_Hyperbola)"
+
+    def __init__(self, center, normal, major, minor, t_range, x_dir=None):
+        c, x, _, n = make_frame(center, normal, x_dir, axis_name="normal")
+        self._init(c, n, x, (checks.positive(major, "major"), checks.positive(minor, "minor")), t_range)
+
+    def _set_params(self, major, minor):
+        self.a, self.b = float(major), float(minor)
+
+    def _scaled(self, s):
+        return (self.a * s, self.b * s), 1.0
+
+    def _coefficients(self, t, order):
+        fx, fy = np.empty((t.size, order + 1)), np.empty((t.size, order + 1))
+        ch, sh = np.cosh(t), np.sinh(t)
+        for k in range(order + 1):
+            fx[:, k] = self.a * (ch if k % 2 == 0 else sh)
+            fy[:, k] = self.b * (sh if k % 2 == 0 else ch)
+        return fx, fy
+
+    def _basis_geom(self):
+        from ..occ.analytic import hyperbola
+
+        return hyperbola(self.center, self.normal, self.x_dir, self.a, self.b)
+
+    def to_bspline(self) -> BSplineCurve:
+        """Exact rational quadratic (one segment, middle weight ``cosh((t1 - t0) / 2)``)."""
+        t0, t1 = self._domain
+        tm, w = 0.5 * (t0 + t1), math.cosh(0.5 * (t1 - t0))
+        mid = self.center + (self.a * math.cosh(tm) * self.x_dir + self.b * math.sinh(tm) * self.y_dir) / w
+        ends = self.points(np.array([t0, t1]))
+        return BSplineCurve._trusted(np.array([ends[0], mid, ends[1]]), 2, np.array([t0, t0, t0, t1, t1, t1]), np.array([1.0, w, 1.0]))

@@ -5,7 +5,7 @@ Registered with :func:`surfmod.build.from_face.reader`: ``Geom_Plane``,
 ``Geom_ToroidalSurface``, ``Geom_SurfaceOfRevolution``, ``Geom_SurfaceOfLinearExtrusion``,
 ``Geom_RectangularTrimmedSurface`` and ``Geom_OffsetSurface``.  Every reader keeps OCCT's
 parametrization (basis curves of swept surfaces are read natively: lines, circles,
-ellipses, B-splines, Béziers), restricts the domain to the face's parameter bounds and
+ellipses, parabolas, hyperbolas, B-splines, Béziers), restricts the domain to the face's parameter bounds and
 keeps the OCCT surface it read as ``geom()``, so ``crosscheck`` compares the NumPy
 evaluation with the very surface of the file.
 """
@@ -203,7 +203,7 @@ def curve_from_occ(curve, t_range):
     from ..nets.bezier import BezierCurve
     from ..nets.bspline import BSplineCurve
     from ..occ.analytic import read_curve
-    from .conics import Conic, LineCurve
+    from .conics import Conic, Hyperbola, LineCurve, Parabola
 
     t0, t1 = (float(t) for t in t_range)
     d = read_curve(curve)
@@ -214,6 +214,12 @@ def curve_from_occ(curve, t_range):
         o, x, _, z = d["frame"]
         a, b = (d["radius"], d["radius"]) if kind == "circle" else (d["major"], d["minor"])
         return Conic._from_radians(o, z, x, a, b, (t0, t1))
+    if kind == "parabola":
+        o, x, _, z = d["frame"]
+        return Parabola._make(o, z, x, (d["focal"],), (t0, t1))
+    if kind == "hyperbola":
+        o, x, _, z = d["frame"]
+        return Hyperbola._make(o, z, x, (d["major"], d["minor"]), (t0, t1))
     if kind == "bspline":
         c = BSplineCurve(d["points"], d["degree"], d["knots"], d["weights"])
     else:

@@ -63,6 +63,22 @@ def ellipse(origin, normal, x_dir, major, minor):
         return Geom_Ellipse(gp_Elips(ax2(origin, normal, x_dir), float(major), float(minor)))
 
 
+def parabola(origin, normal, x_dir, focal):
+    from OCP.Geom import Geom_Parabola
+    from OCP.gp import gp_Parab
+
+    with kernel("Geom_Parabola"):
+        return Geom_Parabola(gp_Parab(ax2(origin, normal, x_dir), float(focal)))
+
+
+def hyperbola(origin, normal, x_dir, major, minor):
+    from OCP.Geom import Geom_Hyperbola
+    from OCP.gp import gp_Hypr
+
+    with kernel("Geom_Hyperbola"):
+        return Geom_Hyperbola(gp_Hypr(ax2(origin, normal, x_dir), float(major), float(minor)))
+
+
 def infinite_line(origin, direction):
     from OCP.Geom import Geom_Line
     from OCP.gp import gp_Lin
@@ -85,7 +101,8 @@ def curve_type(curve) -> str:
 def read_curve(curve) -> dict:
     """Plain data of an OCCT curve in its own parametrization.
 
-    ``kind`` is one of ``line``, ``circle``, ``ellipse``, ``bspline``, ``bezier``;
+    ``kind`` is one of ``line``, ``circle``, ``ellipse``, ``parabola``, ``hyperbola``,
+    ``bspline``, ``bezier``;
     trimmed curves are unwrapped (the caller keeps the parameter range).
     """
 
@@ -104,6 +121,10 @@ def read_curve(curve) -> dict:
         if name == "Geom_Ellipse":
             e = curve
             return {"kind": "ellipse", "frame": read_ax3(e.Position()), "major": e.MajorRadius(), "minor": e.MinorRadius()}
+        if name == "Geom_Parabola":
+            return {"kind": "parabola", "frame": read_ax3(curve.Position()), "focal": curve.Focal()}
+        if name == "Geom_Hyperbola":
+            return {"kind": "hyperbola", "frame": read_ax3(curve.Position()), "major": curve.MajorRadius(), "minor": curve.MinorRadius()}
         if name == "Geom_BSplineCurve":
             data = read_bspline_curve(curve)
             return {"kind": "bspline", **data}
