@@ -276,7 +276,9 @@ def _assemble(v, topo, crease, levels, adaptive, tangent_plane, extra):
     errors = _measure(v, topo, crease, owner, maps, nets, regular, extra)
     errors["acc_regular_mismatch"] = mismatch
     errors["boundary_edges"] = boundary_edges
-    return LimitSurface(mesh, patches, checks.frozen(regular).astype(bool), nets, levels, errors, adaptive)
+    regular = np.array(regular, dtype=bool)
+    regular.setflags(write=False)
+    return LimitSurface(mesh, patches, regular, nets, levels, errors, adaptive)
 
 
 def _identity_maps(n):
