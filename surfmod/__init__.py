@@ -72,6 +72,8 @@ _EXPORTS = {
     "to_implicit": ".build.forms",
     "sweep": ".build.sweep",
     "SweptSurface": ".build.sweep",
+    "loft": ".build.loft",
+    "LoftSurface": ".build.loft",
     "trim": ".ops.trim",
     "trimmed_area": ".ops.trim",
     "catmull_clark": ".subdiv.catmull_clark",
