@@ -198,3 +198,38 @@ def test_default_frame_follows_gp_ax2():
 def test_bad_input(call, name):
     with pytest.raises(sm.SurfmodError, match=name):
         call()
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_vec = st.tuples(*[st.floats(-1, 1, allow_nan=False)] * 3).filter(lambda v: np.linalg.norm(v) > 0.1)
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    kind=st.sampled_from(["cylinder", "cone", "sphere", "torus", "plane"]),
+    center=st.tuples(*[st.floats(-10, 10, allow_nan=False)] * 3),
+    axis=_vec,
+    xref=_vec,
+    r=st.floats(0.5, 5.0),
+    mirror=st.booleans(),
+)
+def test_random_frames_match_occt(kind, center, axis, xref, r, mirror):
+    if np.linalg.norm(np.cross(axis, xref)) < 0.05 * np.linalg.norm(axis) * np.linalg.norm(xref):
+        xref = None
+    s = {
+        "cylinder": lambda: sm.CylindricalSurface(r, center, axis, xref, v_range=(-1, 2)),
+        "cone": lambda: sm.ConicalSurface(-0.4, r, center, axis, xref, v_range=(-0.5, 2)),
+        "sphere": lambda: sm.SphericalSurface(r, center, axis, xref),
+        "torus": lambda: sm.ToroidalSurface(r + 1.0, r * 0.5, center, axis, xref),
+        "plane": lambda: sm.AnalyticPlane(center, axis, xref, u_range=(-r, r), v_range=(0, r)),
+    }[kind]()
+    if mirror:  # an indirect frame
+        s = s.mirrored(center, xref if xref is not None else (1, 0, 0))
+    uu, vv = _grid(s.domain, 6, 6)
+    idx = ([0, 1, 0, 2, 1, 0], [0, 0, 1, 0, 1, 2])
+    mine = s.derivatives(uu, vv, 2)[:, idx[0], idx[1]]
+    occ = surface_d2(s.geom(), uu, vv)[:, idx[0], idx[1]]
+    np.testing.assert_allclose(mine, occ, atol=1e-13 * max(1.0, np.abs(mine).max()))
+    np.testing.assert_allclose(s.implicit(s.points(uu, vv)), 0.0, atol=1e-11 * max(1.0, r) ** 4)
