@@ -45,22 +45,14 @@ def cox_de_boor(i: int, p: int, knots, t: float) -> float:
 
 
 def bspline_basis(knots, p: int, n_ctrl: int, t: float) -> np.ndarray:
-    """All N_{i,p}(t), i < n_ctrl, with t = domain end handled as the limit from the left."""
-    knots = list(map(float, knots))
-    end = knots[n_ctrl]
-    if t >= end:
-        # limit from the left: evaluate a hair inside and snap (basis is polynomial per span)
-        return _left_limit(knots, p, n_ctrl, end)
+    """All N_{i,p}(t), i < n_ctrl.  At the right end of the domain the half-open spans
+    give nothing, so the limit from the left is taken by mirroring: N_i(t) on knots k
+    is N_{n-1-i}(-t) on the reversed, negated knots, where -t is the domain start."""
+    knots = [float(k) for k in knots]
+    if t >= knots[n_ctrl]:
+        mirrored = [-k for k in reversed(knots)]
+        return np.array([cox_de_boor(i, p, mirrored, -t) for i in range(n_ctrl)])[::-1]
     return np.array([cox_de_boor(i, p, knots, t) for i in range(n_ctrl)])
-
-
-def _left_limit(knots, p, n_ctrl, end):
-    start = max(k for k in knots[: n_ctrl] if k < end)
-    # the basis restricted to the last span is a polynomial of degree p: fit it exactly
-    ts = np.linspace(start, end, p + 2)[:-1]
-    vals = np.array([[cox_de_boor(i, p, knots, t) for i in range(n_ctrl)] for t in ts])
-    coeffs = np.polynomial.polynomial.polyfit(ts - end, vals, p)
-    return coeffs[0]
 
 
 def bspline_surface_point(net, p, q, ku, kv, u, v, weights=None) -> np.ndarray:

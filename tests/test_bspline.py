@@ -15,7 +15,12 @@ from surfmod.occ.sample import curve_d2, surface_d2, surface_props
 
 
 def _scale(s):
-    return max(1.0, float(np.abs(s.control_points).max()))
+    """Net size times the conditioning of the rational quotient (sqrt of the weight ratio):
+    both evaluators round the homogeneous sums, OCCT and we differ by that much."""
+    size = max(1.0, float(np.abs(s.control_points).max()))
+    if s.weights is None:
+        return size
+    return size * float(np.sqrt(s.weights.max() / s.weights.min()))
 
 
 @settings(max_examples=60, deadline=None)
