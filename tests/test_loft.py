@@ -79,3 +79,17 @@ def test_bad_inputs():
         sm.loft([A, A])
     with pytest.raises(sm.SurfmodError, match=r"sections\[0\]"):
         sm.loft(["A", B])
+
+
+def test_rational_sections_of_different_shape_match_occt():
+    import build123d as bd
+
+    duct = [
+        bd.Edge.make_circle(10),
+        bd.Edge.make_ellipse(16, 8, bd.Plane.XY.offset(25)),
+        bd.Edge.make_circle(6, bd.Plane.XY.offset(50)),
+    ]
+    s = sm.loft(duct)
+    assert s.rational
+    r = sm.crosscheck(s, samples=12)
+    assert r.passed and r.max_deviation < 1e-9

@@ -143,3 +143,13 @@ def test_bad_inputs():
     assert sweep(PROFILE, inflect, mode="corrected_frenet").points(0.5, 0.5).shape == (3,)
     with pytest.raises(sm.SurfmodError, match="order"):
         sweep(PROFILE, PATH).derivatives(0.5, 0.5, order=3)
+
+
+def test_coiled_path_and_short_guide():
+    helix, ellipse = _helix()
+    s = sweep(ellipse, helix, mode="corrected_frenet", twist=30.0)
+    r = sm.crosscheck(s, samples=10)
+    assert r.passed and r.max_deviation < 1e-5
+    short = GUIDE.segment(0.0, 0.6)
+    with pytest.raises(sm.SurfmodError, match="guide: does not cross the normal plane"):
+        sweep(PROFILE, PATH, guide=short)

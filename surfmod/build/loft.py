@@ -4,7 +4,8 @@ The sections are made compatible (same degree, parameter interval and knot vecto
 :func:`surfmod.nets.elevate.make_compatible`, OCCT's ``GeomFill_Profiler`` steps), then
 corresponding control points are interpolated across the sections (P&T 10.3,
 skinning): in homogeneous coordinates for rational sections, with section parameters
-``v_k`` by chord length between the sections' whole control polygons (as OCCT), knots by
+``v_k`` by chord length between the sections' whole (homogeneous) control polygons (as
+OCCT), knots by
 averaging, degree ``K - 1`` for up to 9 sections (one polynomial piece, as OCCT) and 3
 beyond - or degree 1 (``ruled=True``: straight rulings between consecutive sections).
 The result is a B-spline surface through every section exactly (``S(u, v_k) = C_k(u)``).
@@ -154,10 +155,9 @@ def loft(sections, *, ruled: bool = False) -> LoftSurface:
         [homogeneous(c.control_points, c.weights if c.weights is not None else (np.ones(len(c.control_points)) if rational else None)) for c in compat]
     )  # (K, n, dim)
     k_sec = hs.shape[0]
-    pts = np.stack([c.control_points for c in compat])
-    # chord length between whole control polygons (Frobenius norm), as OCCT's
-    # ThruSections (GeomFill_AppSurf, Approx_ChordLength) parametrizes the sections
-    d = np.sqrt(np.sum(np.diff(pts, axis=0) ** 2, axis=(1, 2)))  # (K-1,)
+    # chord length between whole (homogeneous) control polygons, Frobenius norm: how
+    # OCCT's ThruSections (GeomFill_AppSurf, Approx_ChordLength) parametrizes sections
+    d = np.sqrt(np.sum(np.diff(hs, axis=0) ** 2, axis=(1, 2)))  # (K-1,)
     if np.any(d <= 1e-12 * max(size, 1.0)):
         k = int(np.argmax(d <= 1e-12 * max(size, 1.0))) + 1
         raise SurfmodError(f"sections[{k}]: coincides with sections[{k - 1}]")

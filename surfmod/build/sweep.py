@@ -142,6 +142,12 @@ class SweptSurface(Surface):
             if np.max(np.abs(step)) <= 1e-14 * (g1 - g0):
                 break
         q = self.guide._derivatives(s, 0)[:, 0]
+        miss = np.abs(np.sum((q - p) * t, axis=-1)) > 1e-9 * self._size
+        if np.any(miss):
+            raise SurfmodError(
+                f"guide: does not cross the normal plane of the path at t = {v[np.argmax(miss)]:g} "
+                "(extend the guide so that it spans the whole path)"
+            )
         off = q - p
         off = off - np.sum(off * t, axis=-1, keepdims=True) * t
         norm = np.linalg.norm(off, axis=-1)
@@ -275,8 +281,19 @@ class SweptSurface(Surface):
         else:
             # OCCT's own CorrectedFrenet law is a coarse approximation of the
             # rotation-minimizing frame (about ten angle samples, then smoothed); the
-            # auxiliary spine traced from our frame makes OCCT sweep *our* definition
-            shape, faces = pipe_shell(profiles, occ(self.path), mode="auxiliary", auxiliary=occ(self._frame_rail()))
+            # auxiliary spine traced from our frame makes OCCT sweep *our* definition.
+            # OCCT finds the rail point in the normal plane: a rail close to the path
+            # keeps that intersection unique (coiled paths), so shrink it on failure.
+            from ..errors import KernelError
+
+            for offset in (0.05, 0.01, 0.002):
+                try:
+                    rail = occ(self._frame_rail(offset))
+                    shape, faces = pipe_shell(profiles, occ(self.path), mode="auxiliary", auxiliary=rail)
+                    break
+                except KernelError:
+                    if offset == 0.002:
+                        raise
         if len(faces) != 1:
             raise SurfmodError(f"profile: the pipe shell has {len(faces)} faces, expected one")
         self._pipe_cache = (shape, faces[0])
@@ -297,7 +314,7 @@ class SweptSurface(Surface):
         profiles = [occ(self.profile)] + ([occ(self.end_profile)] if self.end_profile is not None else [])
         return bd.Face(pipe_shell(profiles, occ(self.path), mode=self.mode)[1][0])
 
-    def _frame_rail(self):
+    def _frame_rail(self, offset=0.05):
         """An auxiliary spine for OCCT: the path offset along our (twisted) normal,
         traced densely and interpolated, so that OCCT's 'normal towards the auxiliary
         spine' is our frame's normal."""
@@ -309,7 +326,7 @@ class SweptSurface(Surface):
         vs = np.linspace(v0, v1, 201)
         p = self.path._derivatives(vs, 0)[:, 0]
         r = self._frames(vs)
-        pts = p + 0.25 * self._size * r[:, :, 1]
+        pts = p + offset * self._size * r[:, :, 1]
         t = (vs - v0) / (v1 - v0)
         k = averaging_knots(t, 3)
         ctrl = np.linalg.solve(basis_matrix(k, 3, t.size, t)[0], pts)
