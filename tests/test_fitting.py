@@ -105,3 +105,29 @@ def test_bad_inputs_named():
         sm.interpolate(pts)
     with pytest.raises(sm.SurfmodError, match="points"):
         sm.interpolate(np.full((5, 5, 3), np.nan))
+
+
+from hypothesis import given, settings, strategies as st
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    p=st.integers(1, 5),
+    q=st.integers(1, 5),
+    n_extra=st.integers(0, 6),
+    m_extra=st.integers(0, 6),
+    method=st.sampled_from(["chord", "centripetal", "uniform"]),
+    seed=st.integers(0, 2**16),
+)
+def test_interpolation_property(p, q, n_extra, m_extra, method, seed):
+    rng = np.random.default_rng(seed)
+    n, m = p + 1 + n_extra, q + 1 + m_extra
+    x, y = np.meshgrid(np.cumsum(rng.uniform(0.2, 1, n)), np.cumsum(rng.uniform(0.2, 1, m)), indexing="ij")
+    pts = np.stack([x, y, rng.normal(size=(n, m))], axis=-1)
+    s = sm.interpolate(pts, degree=(p, q), method=method)
+    assert s.degree == (p, q) and s.control_points.shape == (n, m, 3)
+    scale = np.abs(pts).max()
+    assert s.max_error <= 1e-9 * scale
+    # the approximation with the full control count is the interpolation
+    a = sm.approximate(pts, degree=(p, q), n_ctrl=(n, m), method=method)
+    assert np.abs(a.control_points - s.control_points).max() <= 1e-7 * np.abs(s.control_points).max()

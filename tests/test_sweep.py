@@ -153,3 +153,28 @@ def test_coiled_path_and_short_guide():
     short = GUIDE.segment(0.0, 0.6)
     with pytest.raises(sm.SurfmodError, match="guide: does not cross the normal plane"):
         sweep(PROFILE, PATH, guide=short)
+
+
+def test_similarity_transform_moves_the_sweep():
+    s = sweep(PROFILE, PATH, mode="corrected_frenet", twist=60.0)
+    moved = s.rotated((1, 2, 3), (0.3, -1, 0.5), 40.0).scaled(2.0)
+    u = np.linspace(0, 1, 5)[:, None]
+    v = np.linspace(0, 1, 6)[None, :]
+    from surfmod.transforms import rotation_matrix, scale_matrix
+
+    m = scale_matrix(2.0) @ rotation_matrix((1, 2, 3), (0.3, -1, 0.5), 40.0)
+    expect = s.points(u, v) @ m[:3, :3].T + m[:3, 3]
+    assert np.abs(moved.points(u, v) - expect).max() < 1e-9
+    with pytest.raises(sm.SurfmodError, match="matrix: a swept surface"):
+        s.scaled((1.0, 2.0, 1.0))
+
+
+def test_rotation_minimizing_table_has_no_spin():
+    # along the RMF the normal's derivative has no binormal component: r' . b = 0
+    s = sweep(PROFILE, PATH, mode="corrected_frenet")
+    v = np.linspace(0.05, 0.95, 19)
+    h = 1e-5
+    r0, r1 = s.frames(v - h), s.frames(v + h)
+    dr = (r1[:, :, 1] - r0[:, :, 1]) / (2 * h)
+    b = s.frames(v)[:, :, 2]
+    assert np.abs(np.sum(dr * b, axis=1)).max() < 1e-6
