@@ -81,3 +81,14 @@ def test_implicit_bad_inputs():
         cone.normals((0.0, 0.0, 0.0))
     with pytest.raises(sm.SurfmodError, match="surface: no implicit form"):
         sm.to_implicit(sm.BSplineSurface(np.random.default_rng(0).normal(size=(4, 4, 3))))
+
+
+def test_quadric_parametric_to_implicit():
+    s = sm.sphere(2.0)
+    F = sm.to_implicit(s)
+    (u0, u1), (v0, v1) = s.domain
+    u, v = np.meshgrid(np.linspace(u0, u1, 9), np.linspace(v0 + 0.1, v1 - 0.1, 7))
+    p = s.points(u, v)
+    assert np.abs(F.value(p)).max() < 1e-12
+    n_imp, n_par = F.normals(p), s.normals(u, v)
+    assert np.abs(np.abs(np.sum(n_imp * n_par, axis=-1)) - 1).max() < 1e-8

@@ -37,6 +37,12 @@ class FittedSurface(BSplineSurface):
     at which the data are matched), ``max_error`` (largest ``|S(u_k, v_l) - Q_kl|``),
     ``tolerance`` (the requested bound for approximations, ``None`` for interpolation)
     and ``kind`` (``"interpolation"`` or ``"approximation"``).
+
+    >>> import numpy as np, surfmod as sm
+    >>> x, y = np.meshgrid(np.linspace(0, 1, 4), np.linspace(0, 1, 4), indexing="ij")
+    >>> s = sm.interpolate(np.stack([x, y, x * y], axis=-1))
+    >>> s.kind, [p.tolist() for p in s.parameters][0]
+    ('interpolation', [0.0, 0.3333333333333333, 0.6666666666666666, 1.0])
     """
 
     occt_construct = "Geom_BSplineSurface (fitted; cf. GeomAPI_PointsToBSplineSurface)"

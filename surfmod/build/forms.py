@@ -139,6 +139,11 @@ class ExplicitSurface(FittedSurface):
     Attributes: ``f``, ``x_range``, ``y_range``, ``tolerance`` (requested), ``max_error``
     (measured ``max |z_spline - f|`` on a grid three times finer than the samples) and
     ``samples``.
+
+    >>> import surfmod as sm
+    >>> s = sm.explicit(lambda x, y: x * y, (0, 1), (0, 1))
+    >>> float(s.height(0.5, 0.5)), s.parametric(1.0, 2.0).tolist()
+    (0.25, [1.0, 2.0, 2.0])
     """
 
     occt_construct = "Geom_BSplineSurface (bicubic fit of z = f(x, y))"

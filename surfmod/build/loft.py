@@ -41,6 +41,11 @@ class LoftSurface(BSplineSurface):
     (smooth lofts, two-section ruled lofts); a ruled loft through more sections is
     compared with OCCT's multi-face shell by :meth:`occt_deviation`, and its ``geom()``
     is its exact spline twin.
+
+    >>> import surfmod as sm
+    >>> s = sm.loft([sm.Line((0, 0, 0), (1, 0, 0)), sm.Line((0, 1, 1), (1, 1, 1))], ruled=True)
+    >>> s.degree, s.points(0.5, 0.5).tolist()
+    ((1, 1), [0.5, 0.5, 0.5])
     """
 
     occt_construct = "BRepOffsetAPI_ThruSections"

@@ -139,6 +139,11 @@ class Superellipsoid(FittedSurface):
     Methods: :meth:`parametric` (analytic points at angles), :meth:`analytic_points`
     (analytic points at the spline's ``(u, v)``), :meth:`implicit` (F at points) and
     :meth:`implicit_surface` (an :class:`~surfmod.build.forms.ImplicitSurface`).
+
+    >>> import surfmod as sm
+    >>> s = sm.superellipsoid(1, 1, 1, 0.5, 0.5)
+    >>> s.parametric(0.0, 0.0).tolist(), float(s.implicit((1.0, 0.0, 0.0)))
+    ([1.0, 0.0, 0.0], 0.0)
     """
 
     occt_construct = "Geom_BSplineSurface (bicubic fit of the superellipsoid)"

@@ -53,6 +53,11 @@ class SweptSurface(Surface):
     Attributes: ``profile``, ``path``, ``end_profile``, ``guide`` (surfmod curves),
     ``twist`` (degrees), ``mode``; ``tolerance`` is the pass threshold of the geometric
     cross-check (``1e-4`` times the size of the surface).
+
+    >>> import surfmod as sm
+    >>> s = sm.sweep(sm.Line((-1, 0, 0), (1, 0, 0)), sm.Line((0, 0, 0), (0, 0, 5)), twist=90)
+    >>> (s.points(0.0, 5.0).round(12) + 0.0).tolist()   # the blade turned a quarter at the top
+    [0.0, -1.0, 5.0]
     """
 
     exact_in_occt = False
