@@ -141,6 +141,10 @@ def test_bad_inputs():
         sweep(PROFILE, inflect, mode="frenet")
     # the corrected (rotation-minimizing) frame handles the inflection
     assert sweep(PROFILE, inflect, mode="corrected_frenet").points(0.5, 0.5).shape == (3,)
+    # a copy of the profile merely translated to the path end is turned round in the
+    # end frame here: refused (OCCT would silently flip it)
+    with pytest.raises(sm.SurfmodError, match="end_profile: runs opposite to profile"):
+        sweep(PROFILE, PATH, end_profile=PROFILE.translated(PATH.points(1.0)))
     with pytest.raises(sm.SurfmodError, match="order"):
         sweep(PROFILE, PATH).derivatives(0.5, 0.5, order=3)
 

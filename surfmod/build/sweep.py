@@ -120,7 +120,24 @@ class SweptSurface(Surface):
         p = self.path._derivatives(np.array([v0, v1]), 0)[:, 0]
         r = self._frames(np.array([v0, v1]))
         self._p0, self._r0, self._p1, self._r1 = p[0], r[0], p[1], r[1]
+        if self.end_profile is not None:
+            self._check_end_orientation()
         self._tolerance = tolerances.GEOMETRIC_TOL * max(1.0, self._extent())
+
+    def _check_end_orientation(self):
+        """The end section must run the same way as the start section, seen in the
+        path's frame (else the blend would turn inside out; OCCT flips it silently)."""
+        u = np.linspace(*self.profile.domain, 65)
+        la, lb = (x[:, 0] for x in self._local(u, 0))
+        closed = np.linalg.norm(la[-1] - la[0]) <= 1e-9 * self._size
+        if closed:
+            area = lambda q: np.sum(np.cross(q[:-1] - q.mean(0), q[1:] - q.mean(0)), axis=0)  # noqa: E731
+            opposite = float(area(la) @ area(lb)) < 0.0
+        else:
+            same = np.linalg.norm(la[0] - lb[0]) + np.linalg.norm(la[-1] - lb[-1])
+            opposite = np.linalg.norm(la[0] - lb[-1]) + np.linalg.norm(la[-1] - lb[0]) < same
+        if opposite:
+            raise SurfmodError("end_profile: runs opposite to profile in the path's frame (reverse it)")
 
     def _extent(self):
         (u0, u1) = self.profile.domain
