@@ -527,6 +527,12 @@ def _weld(vertices: np.ndarray, triangles: np.ndarray):
     return unique, tri[keep]
 
 
+def _face_tolerance(face) -> float:
+    from ..occ.mesh import max_tolerance
+
+    return max_tolerance(face)
+
+
 def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES, angular: float = 0.5) -> Mesh:
     """Watertight BRepMesh triangulation of a build123d/OCP shape whose *measured*
     deviation is within ``tolerance`` (the deflection is tightened until it is)."""
@@ -545,11 +551,21 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
             f"max_triangles={max_triangles:,}"
         )
     deflection = tolerance
+    previous = np.inf
     for attempt in range(1, 9):
         fms = brepmesh(shape, deflection, angular)
-        dev = float(measure_face_meshes(fms, DENSE).max())
+        per_face = measure_face_meshes(fms, DENSE)
+        dev = float(per_face.max())
         if dev <= tolerance:
             break
+        if dev > 0.9 * previous:  # a finer deflection does not help: the model itself is off
+            worst = int(np.argmax(per_face))
+            raise SurfmodError(
+                f"tolerance: {tolerance:g} cannot be met: face {worst} of the shape deviates {dev:.3g} from its "
+                f"surface whatever the deflection (its own modelling tolerance is "
+                f"{_face_tolerance(fms[worst].face):.3g}); use a tolerance above that"
+            )
+        previous = dev
         deflection *= max(0.25, 0.9 * tolerance / dev)
     else:
         raise SurfmodError(f"tolerance: BRepMesh could not reach {tolerance:g} (measured {dev:g})")

@@ -189,3 +189,14 @@ def shape_figures(shape, samples: int = 9):
                         vals.append(np.sqrt(max(k1, floor) * max(k2, floor)))
             figures.append((area, float(np.mean(vals)) if vals else floor))
     return figures, diag
+
+
+def max_tolerance(shape) -> float:
+    """Largest vertex/edge/face tolerance stored in a shape (how far OCCT allows its
+    topology to stray from the geometry)."""
+    from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
+
+    from .topo import wrapped
+
+    with kernel("ShapeAnalysis_ShapeTolerance"):
+        return float(ShapeAnalysis_ShapeTolerance().Tolerance(wrapped(shape), 1))

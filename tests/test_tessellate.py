@@ -1,0 +1,194 @@
+"""Adaptive tessellation: the measured deviation is a guarantee (checked independently
+against OCCT), refinement follows curvature, closed surfaces and solids are watertight,
+absurd tolerances are refused before allocating."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+import surfmod as sm
+from surfmod.gallery.synthetic import wavy_net
+from surfmod.mesh.tessellate import _barycentric
+
+
+def _independent_max_distance(s, mesh, per_triangle=3, limit=1500, seed=0):
+    """Distance of random points on the triangles to the OCCT surface, measured by
+    ``GeomAPI_ProjectPointOnSurf`` (not our Gauss-Newton)."""
+    from surfmod.occ.sample import distances_to_surface
+
+    rng = np.random.default_rng(seed)
+    tri = mesh.vertices[mesh.triangles()]
+    pick = rng.choice(len(tri), size=min(limit, len(tri)), replace=False)
+    b = rng.dirichlet(np.ones(3), size=(len(pick), per_triangle))
+    pts = np.einsum("tkj,tjd->tkd", b, tri[pick]).reshape(-1, 3)
+    (u0, u1), (v0, v1) = s.domain
+    d = distances_to_surface(s.geom(), pts, (u0, u1, v0, v1))
+    return float(np.nanmax(d))
+
+
+def _bspline():
+    ku = [0, 0, 0, 0, 0.2, 0.5, 0.5, 1, 1, 1, 1]
+    kv = [0, 0, 0, 0.3, 0.6, 1, 1, 1]
+    return sm.BSplineSurface(wavy_net(7, 5), (3, 2), (ku, kv))
+
+
+@pytest.mark.parametrize("tol", [0.05, 0.01])
+def test_measured_deviation_is_within_tolerance_and_confirmed_by_occt(tol):
+    s = _bspline()
+    m = sm.tessellate(s, tol)
+    assert m.info["kind"] == "adaptive"
+    assert 0 < m.info["max_deviation"] <= tol
+    assert m.info["triangles"] == len(m.faces)
+    # independent: OCCT's projection of random triangle points
+    assert _independent_max_distance(s, m) <= tol * (1 + 1e-6)
+    # vertices lie on the surface exactly (they are surface points)
+    uv = m.info["uv"]
+    np.testing.assert_allclose(m.vertices, s.points(uv[:, 0], uv[:, 1]), atol=1e-12)
+
+
+def test_deviation_is_not_slack():
+    """The reported maximum is a real maximum: close to the tolerance, not far below."""
+    m = sm.tessellate(sm.BezierSurface(wavy_net(6, 5)), 0.01)
+    assert 0.5 * 0.01 < m.info["max_deviation"] <= 0.01
+
+
+def test_refinement_follows_curvature_cylinder_is_split_only_around():
+    """A NURBS quarter-cylinder is straight along v: no cell is ever split along v."""
+    w = np.sqrt(0.5)
+    ring = np.array([[1, 0], [1, 1], [0, 1]], float) * 3.0
+    net = np.array([[[x, y, 0.0], [x, y, 10.0]] for x, y in ring])
+    s = sm.BSplineSurface(net, (2, 1), weights=np.array([[1, 1], [w, w], [1, 1]]))
+    m = sm.tessellate(s, 1e-3)
+    assert set(np.round(m.vertices[:, 2], 12)) == {0.0, 10.0}
+    # sagitta of n equal chords of a quarter circle r=3: 3(1 - cos(pi/(4n))) <= 1e-3 -> n >= 31
+    n_seg = len(np.unique(np.round(m.vertices[m.vertices[:, 2] == 0][:, :2], 9), axis=0)) - 1
+    assert 31 <= n_seg <= 1.25 * 31
+    assert m.info["max_deviation"] <= 1e-3
+
+
+def test_refinement_is_local_where_curvature_is_high():
+    """A flat net with one sharp bump: triangles crowd around the bump."""
+    net = wavy_net(9, 9, amplitude=0.0)
+    net[6, 6, 2] = 4.0
+    s = sm.BSplineSurface(net, (3, 3))
+    m = sm.tessellate(s, 0.005)
+    c = m.vertices[m.triangles()].mean(axis=1)
+    near = np.linalg.norm(c[:, :2] - net[6, 6, :2], axis=1) < 2.5
+    area_near = np.pi * 2.5**2
+    area_far = 80.0 - area_near
+    assert near.sum() / area_near > 5 * (~near).sum() / area_far
+
+
+def test_plane_needs_two_triangles():
+    m = sm.tessellate(sm.plane((0, 0, 0), (3, 0, 0), (0, 2, 1)), 1e-6)
+    assert len(m.faces) == 2 and m.info["max_deviation"] < 1e-12
+
+
+def test_fewer_triangles_than_brepmesh_at_equal_tolerance():
+    from surfmod.mesh.tessellate import DENSE, measure_face_meshes
+    from surfmod.occ.mesh import brepmesh
+
+    s = sm.BezierSurface(wavy_net(6, 5))
+    ours = sm.tessellate(s, 0.01)
+    fms = brepmesh(s.face(), 0.01)
+    theirs = sum(len(f.triangles) for f in fms)
+    assert len(ours.faces) <= theirs
+    assert ours.info["max_deviation"] <= 0.01
+    assert measure_face_meshes(fms, DENSE).max() > 0.005  # BRepMesh measured the same way
+
+
+def test_sphere_surface_is_watertight_with_volume_bounds():
+    r, tol = 2.0, 0.01
+    m = sm.tessellate(sm.sphere(r), tol)
+    tm = m.to_trimesh()
+    assert tm.is_watertight and tm.is_winding_consistent
+    # inscribed polyhedron: all vertices on the sphere, all facets within tol of it
+    np.testing.assert_allclose(np.linalg.norm(m.vertices, axis=1), r, rtol=1e-13)
+    assert 4 / 3 * np.pi * (r - tol) ** 3 <= tm.volume < 4 / 3 * np.pi * r**3
+    assert m.info["max_deviation"] <= tol
+
+
+def test_torus_closed_both_ways_is_watertight():
+    m = sm.tessellate(sm.torus(3.0, 1.0), 0.02)
+    tm = m.to_trimesh()
+    assert m.info["closed"] == (True, True)
+    assert tm.is_watertight and tm.is_winding_consistent
+    assert abs(tm.volume) <= 2 * np.pi**2 * 3.0 * 1.0**2
+    assert abs(tm.volume) >= 2 * np.pi**2 * 3.0 * (1.0 - 0.02) ** 2 * 0.99
+
+
+def test_closed_solid_is_watertight_outward_and_within_tolerance():
+    import build123d as bd
+
+    from surfmod.occ.sample import distances_to_face
+    from surfmod.occ.topo import faces_of
+
+    hole = bd.Solid.make_cylinder(2, 10).moved(bd.Location((5, 5, 0)))
+    solid = bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 2) - hole
+    tol = 0.01
+    m = sm.tessellate(solid, tol)
+    tm = m.to_trimesh()
+    assert tm.is_watertight and tm.is_winding_consistent
+    assert tm.volume > 0  # outward normals
+    assert abs(tm.volume - solid.volume) < 1e-2 * solid.volume
+    assert m.info["max_deviation"] <= tol
+    # independent: distance of triangle centroids to the nearest face (BRepExtrema)
+    c = m.vertices[m.triangles()].mean(axis=1)[:: max(1, len(m.faces) // 150)]
+    d = np.min([distances_to_face(f, c) for f in faces_of(solid)], axis=0)
+    assert d.max() <= tol * (1 + 1e-6)
+
+
+def test_sample_points_exclude_corners():
+    b = _barycentric(4)
+    assert len(b) == 12 and np.allclose(b.sum(axis=1), 1) and not np.any(b == 1)
+
+
+# -- bad input ----------------------------------------------------------------------------
+@pytest.mark.parametrize("tol", [0, -1.0, float("nan"), float("inf"), "abc", None])
+def test_bad_tolerance(tol):
+    with pytest.raises(sm.SurfmodError, match="tolerance"):
+        sm.tessellate(sm.sphere(1.0), tol)
+
+
+def test_absurdly_small_tolerance_is_refused_quickly():
+    t = time.perf_counter()
+    with pytest.raises(sm.SurfmodError, match="tolerance.*triangles"):
+        sm.tessellate(sm.sphere(1.0), 1e-8)
+    with pytest.raises(sm.SurfmodError, match="tolerance.*below"):
+        sm.tessellate(sm.sphere(1.0), 1e-13)
+    import build123d as bd
+
+    with pytest.raises(sm.SurfmodError, match="tolerance.*triangles"):
+        sm.tessellate(bd.Solid.make_sphere(10), 1e-6)
+    assert time.perf_counter() - t < 5.0
+
+
+def test_max_triangles_limit():
+    with pytest.raises(sm.SurfmodError, match="max_triangles"):
+        sm.tessellate(sm.sphere(1.0), 1e-4, max_triangles=1000)
+    with pytest.raises(sm.SurfmodError, match="max_triangles"):
+        sm.tessellate(sm.sphere(1.0), 1e-2, max_triangles=0)
+
+
+@pytest.mark.parametrize("obj", ["sphere", 3.0, None])
+def test_bad_object(obj):
+    with pytest.raises(sm.SurfmodError, match="obj"):
+        sm.tessellate(obj, 0.1)
+
+
+def test_mesh_is_refused():
+    with pytest.raises(sm.SurfmodError, match="obj.*Mesh"):
+        sm.tessellate(sm.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]), 0.1)
+
+
+def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_refused():
+    """A near-tangent boolean leaves vertices with 0.056 tolerance: no deflection can
+    bring the mesh within 0.01 of the faces, and that is said instead of looping."""
+    import build123d as bd
+
+    solid = bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 2) - bd.Solid.make_cylinder(2, 10)
+    with pytest.raises(sm.SurfmodError, match="tolerance: 0.01 cannot be met.*modelling tolerance"):
+        sm.tessellate(solid, 0.01)
