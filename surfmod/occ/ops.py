@@ -234,7 +234,7 @@ def intersect_line(surf, origin, direction) -> np.ndarray:
         inter = GeomAPI_IntCS(line, surf)
         if not inter.IsDone():
             raise RuntimeError("GeomAPI_IntCS not done")
-        rows = [inter.Parameters(i, 0.0, 0.0, 0.0) for i in range(1, inter.NbPoints() + 1)]
+        rows = [inter.Parameters(i) for i in range(1, inter.NbPoints() + 1)]
     return np.array(rows, dtype=float).reshape(-1, 3)
 
 
@@ -250,7 +250,7 @@ def project_points(surf, bounds, points) -> np.ndarray:
         for a, q in enumerate(points):
             proj.Init(arrays.pnt(q), surf, u0, u1, v0, v1)
             if proj.NbPoints() > 0:
-                u, v = proj.LowerDistanceParameters(0.0, 0.0)
+                u, v = proj.LowerDistanceParameters()
                 out[a] = (u, v, proj.LowerDistance())
     return out
 
