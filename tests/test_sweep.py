@@ -182,3 +182,12 @@ def test_rotation_minimizing_table_has_no_spin():
     dr = (r1[:, :, 1] - r0[:, :, 1]) / (2 * h)
     b = s.frames(v)[:, :, 2]
     assert np.abs(np.sum(dr * b, axis=1)).max() < 1e-6
+
+
+def test_straight_path_gives_a_cylinder_like_sweep():
+    # on a straight path the Frenet frame is undefined; the frame stays fixed instead
+    s = sweep(PROFILE, sm.Line((0, 0, 0), (0, 0, 10)), mode="frenet")
+    u = np.linspace(0, 1, 7)
+    for z in (0.0, 4.0, 10.0):
+        assert np.abs(s.points(u, z) - (PROFILE.points(u) + (0, 0, z))).max() < 1e-12
+    assert sm.crosscheck(s, samples=8).max_deviation < 1e-6

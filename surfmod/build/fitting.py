@@ -137,13 +137,24 @@ def approximation_knots(params: np.ndarray, degree: int, n_ctrl: int) -> np.ndar
 
 
 def _interp_along(params, knots, p, data):
-    """Solve ``B c = data`` along axis 0 for every trailing column at once."""
+    """Solve ``B c = data`` along axis 0 for every trailing column at once.
+
+    With knots by averaging, ``B`` is banded (at most ``p`` sub- and super-diagonals,
+    P&T 9.2.1), so one banded LU (``scipy.linalg.solve_banded``) serves all columns."""
+    from scipy.linalg import solve_banded
+
     n = params.size
     b = basis_matrix(knots, p, n, params)[0]
     flat = data.reshape(n, -1)
+    rows, cols = np.nonzero(b)
+    lower = int(max(0, (rows - cols).max())) if rows.size else 0
+    upper = int(max(0, (cols - rows).max())) if rows.size else 0
+    ab = np.zeros((lower + upper + 1, n))
+    ab[upper + rows - cols, cols] = b[rows, cols]
     try:
-        sol = np.linalg.solve(b, flat)
-    except np.linalg.LinAlgError:
+        with np.errstate(all="raise"):
+            sol = solve_banded((lower, upper), ab, flat)
+    except (np.linalg.LinAlgError, FloatingPointError, ValueError):
         raise SurfmodError("points: the interpolation system is singular (repeated parameters)") from None
     return sol.reshape(data.shape)
 
