@@ -30,7 +30,12 @@ def merged(meshes: list[Mesh]) -> Mesh:
         verts.append(m.vertices)
         faces.append(m.triangles() + offset)
         offset += len(m.vertices)
-    return Mesh(np.concatenate(verts), np.concatenate(faces))
+    # keep what the tessellation measured (e.g. max_deviation) for the caller
+    info = dict(meshes[0].info) if len(meshes) == 1 else {}
+    devs = [m.info["max_deviation"] for m in meshes if "max_deviation" in m.info]
+    if devs:
+        info["max_deviation"] = max(devs)
+    return Mesh(np.concatenate(verts), np.concatenate(faces), info)
 
 
 def facet_normals(tri: np.ndarray) -> np.ndarray:

@@ -1,0 +1,115 @@
+"""STL for CAM: a closed solid exports watertight and manifold, tolerance-driven, in
+binary and ASCII; read back with trimesh and with a real STL client (Debian ``admesh``)."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import surfmod as sm
+
+
+def _solid():
+    import build123d as bd
+
+    hole = bd.Solid.make_cylinder(2, 10).moved(bd.Location((5, 5, 0)))
+    return bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 1.5) - hole
+
+
+def _load(path):
+    import trimesh
+
+    return trimesh.load(str(path), file_type="stl", process=True)
+
+
+@pytest.mark.parametrize("ascii", [False, True])
+def test_solid_stl_is_watertight_manifold_and_outward(tmp_path, ascii):
+    solid = _solid()
+    path = tmp_path / ("s_ascii.stl" if ascii else "s.stl")
+    m = sm.export_stl(solid, path, tolerance=0.01, ascii=ascii)
+    assert m.info["max_deviation"] <= 0.01
+    tm = _load(path)
+    assert tm.is_watertight and tm.is_winding_consistent
+    # manifold: every edge has exactly two faces
+    edges = np.sort(tm.edges, axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    assert np.all(counts == 2)
+    assert len(tm.faces) == len(m.faces)
+    assert tm.volume > 0 and abs(tm.volume - solid.volume) < 5e-3 * solid.volume
+    head = path.read_bytes()[:5]
+    assert (head == b"solid") == ascii
+
+
+def test_tolerance_drives_the_facet_count(tmp_path):
+    a = sm.export_stl(_solid(), tmp_path / "a.stl", tolerance=0.1)
+    b = sm.export_stl(_solid(), tmp_path / "b.stl", tolerance=0.005)
+    assert len(b.faces) > 3 * len(a.faces)
+    assert a.info["max_deviation"] <= 0.1 and b.info["max_deviation"] <= 0.005
+
+
+def test_surfmod_sphere_exports_watertight(tmp_path):
+    m = sm.export_stl(sm.sphere(3.0), tmp_path / "sphere.stl", tolerance=0.01)
+    tm = _load(tmp_path / "sphere.stl")
+    assert tm.is_watertight and tm.is_winding_consistent and tm.volume > 0
+    assert m.info["kind"] == "adaptive" and m.info["max_deviation"] <= 0.01
+
+
+def _admesh_stats(path):
+    out = subprocess.run(["admesh", str(path)], capture_output=True, timeout=60).stdout
+    out = out.decode("utf-8", errors="replace")  # admesh echoes the raw 80-byte header
+    stats = {}
+    for key in (
+        "Number of facets",
+        "Facets with 1 disconnected edge",
+        "Total disconnected facets",
+        "Number of parts",
+        "Degenerate facets",
+        "Edges fixed",
+        "Facets removed",
+        "Facets added",
+        "Facets reversed",
+        "Backwards edges",
+        "Normals fixed",
+    ):
+        match = re.search(re.escape(key) + r"\s*:\s*(\d+)", out)
+        assert match, f"admesh output lacks {key!r}:\n{out}"
+        stats[key] = int(match.group(1))
+    vol = re.search(r"Volume\s*:\s*([-0-9.eE+]+)", out)
+    stats["Volume"] = float(vol.group(1))
+    return stats
+
+
+@pytest.mark.skipif(shutil.which("admesh") is None, reason="admesh not installed (apt-get install admesh)")
+@pytest.mark.parametrize("ascii", [False, True])
+def test_admesh_finds_nothing_to_fix(tmp_path, ascii):
+    solid = _solid()
+    path = tmp_path / "part.stl"
+    m = sm.export_stl(solid, path, tolerance=0.01, ascii=ascii)
+    st = _admesh_stats(path)
+    assert st["Number of facets"] == len(m.faces)
+    for key in (
+        "Facets with 1 disconnected edge",
+        "Total disconnected facets",
+        "Degenerate facets",
+        "Edges fixed",
+        "Facets removed",
+        "Facets added",
+        "Facets reversed",
+        "Backwards edges",
+        "Normals fixed",
+    ):
+        assert st[key] == 0, (key, st)
+    assert st["Number of parts"] == 1
+    assert abs(st["Volume"] - solid.volume) < 5e-3 * solid.volume
+
+
+def test_bad_tolerance_writes_nothing(tmp_path):
+    with pytest.raises(sm.SurfmodError, match="tolerance"):
+        sm.export_stl(_solid(), tmp_path / "x.stl", tolerance=0.0)
+    with pytest.raises(sm.SurfmodError, match="tolerance"):
+        sm.export_stl(sm.sphere(1.0), tmp_path / "x.stl", tolerance=1e-9)
+    assert list(tmp_path.iterdir()) == []
