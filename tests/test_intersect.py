@@ -1,0 +1,165 @@
+"""Intersections by marching on the NumPy evaluator vs GeomAPI_IntSS / GeomAPI_IntCS and
+closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import surfmod as sm
+from surfmod.occ import ops as occ
+from surfmod.ops.marching import segment_distances
+
+
+def _nurbs():
+    rng = np.random.default_rng(0)
+    x, y = np.meshgrid(np.linspace(0, 4, 7), np.linspace(0, 3, 6), indexing="ij")
+    net = np.stack([x, y, rng.uniform(-1, 1, (7, 6))], -1)
+    return sm.BSplineSurface(net, (3, 3), None, rng.uniform(0.5, 2, (7, 6)))
+
+
+def _wavy():
+    x, y = np.meshgrid(np.linspace(-0.5, 4.5, 6), np.linspace(-0.5, 3.5, 6), indexing="ij")
+    return sm.BSplineSurface(np.stack([x, y, 0.3 * np.sin(x * 2) + 0.2 * y - 0.3], -1), (3, 3))
+
+
+def _on_surface(s, uv, pts, tol):
+    np.testing.assert_allclose(s.points(uv[:, 0], uv[:, 1]), pts, rtol=0, atol=tol)
+
+
+def _match_occt(curves, occ_curves, surfaces):
+    """Every OCCT curve has a surfmod curve of the same length whose polyline passes
+    through the OCCT points; OCCT points lie on both surfaces."""
+    for pts, length in occ_curves:
+        for s in surfaces:
+            assert sm.project(pts, s).distance.max() < 1e-6
+        mine = min(curves, key=lambda c: abs(c.length - length))
+        assert mine.length == pytest.approx(length, rel=1e-6)
+        # OCCT points to our polyline: within the polyline's chordal error
+        assert segment_distances(pts, mine.points).max() < 2e-3
+
+
+def test_surface_plane_matches_intss():
+    s = _nurbs()
+    origin, normal = np.array([2, 1.5, 0.1]), np.array([0.3, 0.2, 1.0])
+    curves = sm.intersect(s, (origin, normal))
+    theirs = occ.intersect_surfaces(s.geom(), occ.infinite_plane(origin, normal))
+    assert len(curves) == len(theirs) == 2
+    n = normal / np.linalg.norm(normal)
+    for c in curves:
+        _on_surface(s, c.uv_a, c.points, 1e-15)
+        assert np.abs((c.points - origin) @ n).max() < 1e-12  # on the plane
+        assert not c.closed
+        # ends on the patch boundary
+        ends = c.uv_a[[0, -1]]
+        assert np.all(np.min(np.abs(np.concatenate([ends, 1 - ends], 1)), axis=1) < 1e-12)
+        # uv_b are coordinates in the plane's frame
+        o, x, y, _ = sm.intersect.__globals__["plane_frame"](origin, n)
+        np.testing.assert_allclose(o + c.uv_b[:, :1] * x + c.uv_b[:, 1:] * y, c.points, atol=1e-12)
+    _match_occt(curves, theirs, [s])
+
+
+def test_surface_surface_matches_intss_and_finds_a_loop_occt_misses():
+    a, b = _nurbs(), _wavy()
+    curves = sm.intersect(a, b)
+    theirs = occ.intersect_surfaces(a.geom(), b.geom())
+    for c in curves:
+        _on_surface(a, c.uv_a, c.points, 1e-15)
+        _on_surface(b, c.uv_b, c.points, 1e-12)
+    _match_occt(curves, theirs, [a, b])
+    # a small closed loop (about 0.2 x 0.3) that GeomAPI_IntSS does not report
+    loops = [c for c in curves if c.closed]
+    assert len(curves) == 4 and len(theirs) == 3 and len(loops) == 1
+    np.testing.assert_array_equal(loops[0].points[0], loops[0].points[-1])
+    assert min(segment_distances(loops[0].points, t[0]).min() for t in theirs) > 0.5
+
+
+def test_sphere_like_closed_form_circle():
+    """A bilinear plane z = 0 cut by the plane x = 0.3: a straight segment of known length;
+    a rational quadratic cylinder patch cut by a plane z = c: an exact circular arc."""
+    p = sm.plane((0, 0, 0), (2, 0, 0), (0, 3, 0))
+    [c] = sm.intersect(p, ((0.3, 0, 0), (1, 0, 0)))
+    assert c.length == pytest.approx(3.0, rel=1e-14)
+    # quarter cylinder x^2 + y^2 = 4, z in [0, 5] as an exact NURBS
+    w = np.array([1, 2**-0.5, 1])
+    arc = np.array([[2, 0], [2, 2], [0, 2]], float)
+    net = np.stack([np.c_[arc, np.full(3, z)] for z in (0.0, 5.0)], axis=1)  # (3, 2, 3)
+    cyl = sm.BSplineSurface(net, (2, 1), ([0, 0, 0, 1, 1, 1], [0, 0, 1, 1]), np.stack([w, w], 1))
+    [arc_curve] = sm.intersect(cyl, ((0, 0, 1.7), (0, 0, 1)))
+    assert arc_curve.length == pytest.approx(np.pi, rel=2e-8)  # quarter of 2 pi * 2 (Hermite length)
+    assert np.abs(np.linalg.norm(arc_curve.points[:, :2], axis=1) - 2).max() < 1e-12
+    # two surfaces: the cylinder and a tilted plane patch through it -> a quarter ellipse
+    tilted = sm.plane((-1, -1, 1.0), (4, -1, 3.5), (-1, 4, 1.0))
+    [ell] = sm.intersect(cyl, tilted)
+    ts = np.linspace(0, np.pi / 2, 4001)
+    x, y = 2 * np.cos(ts), 2 * np.sin(ts)
+    z = 1.0 + 0.5 * (x + 1)
+    exact = np.sum(np.linalg.norm(np.diff(np.c_[x, y, z], axis=0), axis=1))
+    assert ell.length == pytest.approx(exact, rel=1e-7)
+
+
+def test_empty_intersections_are_empty():
+    s = _nurbs()
+    assert sm.intersect(s, ((0, 0, 10), (0, 0, 1))) == []
+    assert sm.intersect(s, s.translated((0, 0, 10))) == []
+    assert sm.intersect(((0, 0, 10), (0, 0, 1)), s) == []
+    assert sm.intersect_line(s, (0, 0, 10), (1, 0, 0)).shape == (0, 3)
+    assert sm.intersect_line(s, (-10, -10, 0), (-1, 0, 0)).shape == (0, 3)
+
+
+def test_plane_first_swaps_uv():
+    s = _nurbs()
+    plane = ((2, 1.5, 0.1), (0.3, 0.2, 1.0))
+    a = sm.intersect(s, plane)
+    b = sm.intersect(plane, s)
+    assert len(a) == len(b)
+    for ca, cb in zip(a, b):
+        np.testing.assert_array_equal(ca.uv_a, cb.uv_b)
+
+
+def test_intersect_line_matches_intcs():
+    s = _nurbs()
+    rng = np.random.default_rng(5)
+    hits = 0
+    for _ in range(8):
+        origin = np.r_[rng.uniform(0.5, 3.5), rng.uniform(0.5, 2.5), 3.0]
+        direction = np.r_[rng.uniform(-0.3, 0.3, 2), -1.0]
+        mine = sm.intersect_line(s, origin, direction)
+        theirs = occ.intersect_line(s.geom(), origin, direction / np.linalg.norm(direction))
+        theirs = theirs[np.argsort(theirs[:, 2])]
+        assert mine.shape == theirs.shape
+        hits += len(mine)
+        np.testing.assert_allclose(mine, theirs, atol=1e-9)
+        hit = origin + mine[:, 2:] * direction / np.linalg.norm(direction)
+        np.testing.assert_allclose(s.points(mine[:, 0], mine[:, 1]), hit, atol=1e-12)
+    assert hits >= 5
+
+
+def test_intersect_line_several_hits():
+    """A line through the wavy surface along its waves crosses it several times."""
+    w = _wavy()
+    mine = sm.intersect_line(w, (-0.4, 1.0, -0.1), (1, 0, 0.02))
+    theirs = occ.intersect_line(w.geom(), (-0.4, 1.0, -0.1), np.array([1, 0, 0.02]) / np.linalg.norm([1, 0, 0.02]))
+    assert len(mine) == len(theirs) >= 2
+    np.testing.assert_allclose(mine, theirs[np.argsort(theirs[:, 2])], atol=1e-9)
+    assert np.all(np.diff(mine[:, 2]) > 0)
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda s: sm.intersect_line(s, (0, 0, 0), (0, 0, 0)), "direction"),
+        (lambda s: sm.intersect_line(s, (0, np.nan, 0), (0, 0, 1)), "origin"),
+        (lambda s: sm.intersect_line("s", (0, 0, 0), (0, 0, 1)), "s: expected"),
+        (lambda s: sm.intersect(s, ((0, 0, 0), (0, 0, 0))), "normal"),
+        (lambda s: sm.intersect(s, ((0, 0, np.nan), (0, 0, 1))), "origin"),
+        (lambda s: sm.intersect(s, 42), "b: expected a plane"),
+        (lambda s: sm.intersect("a", s), "a: expected a surfmod Surface"),
+        (lambda s: sm.intersect(s, s, tolerance=0), "tolerance"),
+        (lambda s: sm.intersect(s, s, step=-1), "step"),
+        (lambda s: sm.intersect(s, s, max_angle=np.nan), "max_angle"),
+    ],
+)
+def test_bad_intersect_input(call, match):
+    with pytest.raises(sm.SurfmodError, match=match):
+        call(_nurbs())
