@@ -1,5 +1,6 @@
 """Swept surface steered by a guide rail: the profile's frame turns so that its normal
-points at the rail (OCCT: pipe shell with an auxiliary spine)."""
+points at the rail (OCCT: pipe shell with an auxiliary spine); with guide_scale the
+section also grows and shrinks with the rail's distance (OCCT: plus a SetLaw law)."""
 
 from pathlib import Path
 
@@ -22,6 +23,8 @@ profile = bd.Edge.make_three_point_arc(start.from_local_coords((-6, 0)), start.f
                                        start.from_local_coords((6, 0)))
 
 s = sm.sweep(profile, path, guide=rail)
-print(sm.crosscheck(s, samples=16))
-sm.export_step([s.face(), rail], OUT / "sweep_guide_rail.step")
+print("oriented by the rail:", sm.crosscheck(s, samples=16))
+scaled = sm.sweep(profile, path, guide=rail, guide_scale=True)  # also sized by the rail
+print("scaled to the rail:  ", sm.crosscheck(scaled, samples=16))
+sm.export_step([s.face(), scaled.face().translate((50, 0, 0)), rail], OUT / "sweep_guide_rail.step")
 sm.export_stl(s, OUT / "sweep_guide_rail.stl", tolerance=0.05)

@@ -191,3 +191,28 @@ def test_straight_path_gives_a_cylinder_like_sweep():
     for z in (0.0, 4.0, 10.0):
         assert np.abs(s.points(u, z) - (PROFILE.points(u) + (0, 0, z))).max() < 1e-12
     assert sm.crosscheck(s, samples=8).max_deviation < 1e-6
+
+
+def test_guide_rail_scaling():
+    s = sweep(PROFILE, PATH, guide=GUIDE, guide_scale=True)
+    r = sm.crosscheck(s, samples=12)
+    assert r.passed and r.max_deviation < 1.5e-5
+    # the section grows with the rail's distance from the path (in the normal plane)
+    v = np.linspace(0, 1, 9)
+    u = np.linspace(0, 1, 5)
+    d = PATH.derivatives(v, 1)
+    t = d[:, 1] / np.linalg.norm(d[:, 1], axis=1)[:, None]
+    q = GUIDE.points(np.linspace(0, 1, 20001))
+    dist = []
+    for k in range(9):
+        rel = q - d[k, 0]
+        j = np.argmin(np.abs(rel @ t[k]))
+        dist.append(np.linalg.norm(rel[j] - (rel[j] @ t[k]) * t[k]))
+    ratio = np.array(dist) / dist[0]
+    r0 = np.linalg.norm(PROFILE.points(u) - PATH.points(0.0), axis=1)
+    got = np.linalg.norm(s.points(u[:, None], v[None, :]) - d[None, :, 0], axis=-1)
+    assert np.abs(got - r0[:, None] * ratio[None, :]).max() < 2e-3  # sampled rail: ~1e-4
+    with pytest.raises(sm.SurfmodError, match="guide_scale: scaling to a guide rail needs guide="):
+        sweep(PROFILE, PATH, guide_scale=True)
+    with pytest.raises(sm.SurfmodError, match="guide_scale: .* cannot be combined with end_profile"):
+        sweep(PROFILE, PATH, guide=GUIDE, guide_scale=True, end_profile=_end_section("frenet"))

@@ -15,7 +15,9 @@ given), ``w(v) = (v - v0) / (v1 - v0)`` the blending law, and ``R(v)`` the movin
   pieces) - see :mod:`surfmod.eval.frames`;
 * **changing profile** (``end_profile=B``): start and end sections blended along the path;
 * **guide rail** (``guide=G``): the normal points from ``P(v)`` to the point of the guide
-  in the normal plane of the path at ``P(v)``;
+  in the normal plane of the path at ``P(v)``; with ``guide_scale=True`` the section is
+  also scaled about ``P(v)`` by the rail's distance relative to the start (OCCT: the
+  auxiliary spine plus a homothetic ``Law_Interpol`` through ``SetLaw``);
 * **twisted** (``twist=degrees``): the frame additionally turns about the tangent by
   ``twist * w(v)`` (linear law).
 
@@ -63,7 +65,8 @@ class SweptSurface(Surface):
     exact_in_occt = False
     occt_construct = "BRepOffsetAPI_MakePipeShell"
 
-    def __init__(self, profile, path, *, end_profile=None, twist: float = 0.0, mode: str = "frenet", guide=None):
+    def __init__(self, profile, path, *, end_profile=None, twist: float = 0.0, mode: str = "frenet", guide=None,
+                 guide_scale: bool = False):
         self.profile = as_curve(profile, "profile")
         self.path = as_curve(path, "path")
         self.end_profile = None if end_profile is None else as_curve(end_profile, "end_profile")
@@ -77,6 +80,11 @@ class SweptSurface(Surface):
         if mode not in MODES:
             raise SurfmodError(f"mode: expected one of {MODES}, got {mode!r}")
         self.mode = mode
+        self.guide_scale = bool(guide_scale)
+        if self.guide_scale and self.guide is None:
+            raise SurfmodError("guide_scale: scaling to a guide rail needs guide=")
+        if self.guide_scale and self.end_profile is not None:
+            raise SurfmodError("guide_scale: the guide sets the section size, it cannot be combined with end_profile")
         self._prepare()
 
     # -- construction ----------------------------------------------------------------------
@@ -98,6 +106,9 @@ class SweptSurface(Surface):
         self._straight = False
         if self.guide is not None:
             self._guide_prepare()
+            if self.guide_scale:
+                self._dist0 = 1.0
+                self._dist0 = float(self._guide_scale(np.array([float(v0)]))[0])
         elif self.mode == "frenet":
             _, kappa = frenet_frames(d[:, 1], d[:, 2])
             flat = kappa * size <= 1e-9
@@ -149,20 +160,41 @@ class SweptSurface(Surface):
     def _guide_prepare(self):
         g0, g1 = self.guide.domain
         self._g = (float(g0), float(g1))
+        self._gtab = None
+        # solve once on a table along the path; later solves start from its interpolant
+        ts = np.linspace(*self._v, 257)
+        d = self.path._derivatives(ts, 1)
+        t = d[:, 1] / np.linalg.norm(d[:, 1], axis=-1)[:, None]
+        self._gtab = (ts, self._guide_params(ts, d[:, 0], t, iterations=60))
 
-    def _guide_points(self, v, p, t):
-        """The guide point in the normal plane of the path at each ``v`` (Newton on the
-        guide parameter, vectorized; start at the same normalized parameter)."""
+    def _guide_params(self, v, p, t, iterations=30):
+        """Guide parameters of the normal-plane crossings (vectorized Newton)."""
         (v0, v1), (g0, g1) = self._v, self._g
-        s = g0 + (v - v0) / (v1 - v0) * (g1 - g0)
-        for _ in range(30):
-            gd = self.guide._derivatives(np.clip(s, g0, g1), 1)
+        if self._gtab is None:
+            s = g0 + (v - v0) / (v1 - v0) * (g1 - g0)
+        else:
+            s = np.interp(v, *self._gtab)
+        for _ in range(iterations):
+            gd = self.guide._derivatives(s, 1)
             f = np.sum((gd[:, 0] - p) * t, axis=-1)
             df = np.sum(gd[:, 1] * t, axis=-1)
             step = f / np.where(np.abs(df) > 0, df, 1.0)
             s = np.clip(s - step, g0, g1)
-            if np.max(np.abs(step)) <= 1e-14 * (g1 - g0):
+            if np.max(np.abs(f)) <= 1e-13 * self._size:
                 break
+        return s
+
+    def _guide_scale(self, v):
+        """Distance from the path to the guide in the normal plane, relative to the start."""
+        d = self.path._derivatives(v, 1)
+        t = d[:, 1] / np.linalg.norm(d[:, 1], axis=-1)[:, None]
+        return self._guide_points(v, d[:, 0], t, distances=True) / self._dist0
+
+    def _guide_points(self, v, p, t, distances=False):
+        """The guide point in the normal plane of the path at each ``v`` (Newton on the
+        guide parameter, vectorized; start at the same normalized parameter): the unit
+        normal towards it (or the distances to it)."""
+        s = self._guide_params(v, p, t)
         q = self.guide._derivatives(s, 0)[:, 0]
         miss = np.abs(np.sum((q - p) * t, axis=-1)) > 1e-9 * self._size
         if np.any(miss):
@@ -175,6 +207,8 @@ class SweptSurface(Surface):
         norm = np.linalg.norm(off, axis=-1)
         if np.any(norm <= 1e-12 * self._size):
             raise SurfmodError("guide: touches the path, the normal towards it is undefined")
+        if distances:
+            return norm
         return off / norm[:, None]
 
     # -- frames ----------------------------------------------------------------------------
@@ -248,6 +282,8 @@ class SweptSurface(Surface):
         r = self._frames(vv).reshape(offsets.shape[0], n, 3, 3)
         w = self._weight(vv).reshape(offsets.shape[0], n)
         loc = (1.0 - w)[..., None, None] * la[None] + w[..., None, None] * lb[None]  # (S, N, K, 3)
+        if self.guide_scale:
+            loc = loc * self._guide_scale(vv).reshape(offsets.shape[0], n)[..., None, None]
         g = np.einsum("snij,snkj->snki", r, loc)
         g[:, :, 0] += p
         out = np.zeros((n, order + 1, order + 1, 3))
@@ -297,7 +333,12 @@ class SweptSurface(Surface):
 
         profiles = [occ(self.profile)] + ([occ(self.end_profile)] if self.end_profile is not None else [])
         if self.guide is not None:
-            shape, faces = pipe_shell(profiles, occ(self.path), mode="auxiliary", auxiliary=occ(self.guide))
+            law = None
+            if self.guide_scale:
+                vs = np.linspace(*self._v, 201)
+                law = (vs, self._guide_scale(vs))
+            shape, faces = pipe_shell(profiles, occ(self.path), mode="auxiliary", auxiliary=occ(self.guide),
+                                      scale_law=law)
         elif self.mode == "frenet" and self.twist == 0.0 and not self._straight:
             shape, faces = pipe_shell(profiles, occ(self.path), mode="frenet")
         else:
@@ -379,15 +420,19 @@ class SweptSurface(Surface):
             twist=self.twist * np.sign(np.linalg.det(m[:3, :3])),
             mode=self.mode,
             guide=None if self.guide is None else self.guide.transformed(m),
+            guide_scale=self.guide_scale,
         )
 
 
-def sweep(profile, path, *, end_profile=None, twist: float = 0.0, mode: str = "frenet", guide=None) -> SweptSurface:
+def sweep(profile, path, *, end_profile=None, twist: float = 0.0, mode: str = "frenet", guide=None,
+          guide_scale: bool = False) -> SweptSurface:
     """The swept surface of ``profile`` along ``path`` (see :mod:`surfmod.build.sweep`).
 
     ``mode`` ``"frenet"`` or ``"corrected_frenet"`` (rotation-minimizing); ``end_profile``
     blends to a second section at the path end; ``guide`` turns the frame towards a
-    guide rail; ``twist`` (degrees) turns it linearly about the tangent.
+    guide rail (``guide_scale=True`` also scales the section, about the path, with the
+    rail's distance from the path); ``twist`` (degrees) turns it linearly about the
+    tangent.
 
     >>> import surfmod as sm, numpy as np
     >>> path = sm.BSplineCurve([(0, 0, 0), (0, 0, 4), (3, 0, 8), (8, 0, 9)], 3)
@@ -398,4 +443,5 @@ def sweep(profile, path, *, end_profile=None, twist: float = 0.0, mode: str = "f
     >>> np.round(np.linalg.norm(p, axis=-1), 12).tolist()
     [1.0, 1.0, 1.0]
     """
-    return SweptSurface(profile, path, end_profile=end_profile, twist=twist, mode=mode, guide=guide)
+    return SweptSurface(profile, path, end_profile=end_profile, twist=twist, mode=mode, guide=guide,
+                        guide_scale=guide_scale)

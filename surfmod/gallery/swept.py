@@ -64,6 +64,15 @@ def _sweep_guide():
     return sweep(_profile(), _path(), guide=rail)
 
 
+@entry("sweep_guide_scaled", "swept surface scaled to a guide rail", "sm.sweep(profile, path, guide=rail, guide_scale=True)")
+def _sweep_guide_scaled():
+    from ..build.sweep import sweep
+    from ..nets.bspline import BSplineCurve
+
+    rail = BSplineCurve([(0, 10, 0), (0, 16, 20), (15, 20, 40), (40, 6, 45), (50, 25, 60)], 3)
+    return sweep(_profile(), _path(), guide=rail, guide_scale=True)
+
+
 @entry("sweep_twisted", "twisted swept surface", "sm.sweep(profile, path, twist=180)")
 def _sweep_twisted():
     from ..build.sweep import sweep

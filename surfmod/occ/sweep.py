@@ -22,15 +22,17 @@ def _wire(curve, t0, t1):
 
 
 def pipe_shell(profiles, path, *, mode: str = "frenet", auxiliary=None, contact: bool = False,
-               tolerance: float = 1e-6, max_degree: int = 11, max_segments: int = 200):
+               tolerance: float = 1e-6, max_degree: int = 11, max_segments: int = 200, scale_law=None):
     """A pipe shell: ``profiles`` is one ``(curve, t0, t1)`` (placed at the path start) or
     two (start and end of the path); ``path`` is ``(curve, t0, t1)``.
 
     ``mode``: ``"frenet"`` / ``"corrected_frenet"`` (OCCT's trihedron laws) or
     ``"auxiliary"`` with ``auxiliary=(curve, t0, t1)``: the normal points at the
     auxiliary spine (found in the normal plane of the spine, no curvilinear
-    equivalence); ``contact`` keeps the profile touching it (scaled).  Returns the shell
-    (``TopoDS_Shape``) and its faces.
+    equivalence); ``contact`` keeps the profile touching it (scaled).  ``scale_law`` =
+    ``(spine_params, factors)`` scales the (single) profile homothetically along the
+    spine (``SetLaw`` with a ``Law_Interpol``).  Returns the shell (``TopoDS_Shape``) and
+    its faces.
     """
     from OCP.BRepFill import BRepFill_TypeOfContact
 
@@ -52,8 +54,11 @@ def pipe_shell(profiles, path, *, mode: str = "frenet", auxiliary=None, contact:
         maker.SetTolerance(float(tolerance), float(tolerance), 1e-4)
         maker.SetMaxDegree(int(max_degree))
         maker.SetMaxSegments(int(max_segments))
-        for k, prof in enumerate(profiles):
-            maker.Add(_wire(*prof), first if k == 0 else last, False, False)
+        if scale_law is not None:
+            maker.SetLaw(_wire(*profiles[0]), _interpolated_law(*scale_law), first, False, False)
+        else:
+            for k, prof in enumerate(profiles):
+                maker.Add(_wire(*prof), first if k == 0 else last, False, False)
         maker.Build()
         check_done(maker, "BRepOffsetAPI_MakePipeShell")
         shape = maker.Shape()
@@ -78,6 +83,19 @@ def thru_sections(sections, *, ruled: bool, tolerance: float = 1e-6):
     if not faces:
         raise KernelError("BRepOffsetAPI_ThruSections: the result has no face")
     return shape, faces
+
+
+def _interpolated_law(params, values):
+    from OCP.gp import gp_Pnt2d
+    from OCP.Law import Law_Interpol
+    from OCP.TColgp import TColgp_Array1OfPnt2d
+
+    arr = TColgp_Array1OfPnt2d(1, len(params))
+    for i, (a, b) in enumerate(zip(params, values), start=1):
+        arr.SetValue(i, gp_Pnt2d(float(a), float(b)))
+    law = Law_Interpol()
+    law.Set(arr, False)
+    return law
 
 
 def _edge_of(wire):
