@@ -92,3 +92,16 @@ def test_quadric_parametric_to_implicit():
     assert np.abs(F.value(p)).max() < 1e-12
     n_imp, n_par = F.normals(p), s.normals(u, v)
     assert np.abs(np.abs(np.sum(n_imp * n_par, axis=-1)) - 1).max() < 1e-8
+
+
+def test_implicit_to_explicit_where_it_exists():
+    ball = sm.implicit(lambda x, y, z: x**2 + y**2 + z**2 - 4, gradient=lambda x, y, z: (2 * x, 2 * y, 2 * z))
+    cap = ball.to_explicit((-1, 1), (-1, 1), z0=2.0, tolerance=1e-7)
+    rng = np.random.default_rng(3)
+    x, y = rng.uniform(-1, 1, 300), rng.uniform(-1, 1, 300)
+    assert np.abs(cap.points(x, y)[:, 2] - np.sqrt(4 - x**2 - y**2)).max() <= 1e-7
+    lower = ball.to_explicit((-1, 1), (-1, 1), z0=-2.0, tolerance=1e-6)
+    assert lower.points(0.0, 0.0)[2] == pytest.approx(-2.0, abs=1e-12)
+    # the equator sheet x^2 + y^2 = 4 has dF/dz = 0 at z = 0
+    with pytest.raises(sm.SurfmodError, match="z0: dF/dz vanishes"):
+        ball.to_explicit((-1, 1), (-1, 1), z0=0.0)

@@ -7,8 +7,9 @@ parametric ``S(u, v)``, and the conversions between them where they exist.
 * explicit -> implicit: ``F = z - f(x, y)`` (:meth:`ExplicitSurface.to_implicit`);
 * parametric -> implicit where the implicit equation is known (planes, quadrics,
   superellipsoids: :func:`to_implicit`);
-* implicit -> explicit/parametric: not in general (needs solving ``F = 0``), only
-  locally; :meth:`ImplicitSurface.project` moves points onto ``F = 0``.
+* implicit -> explicit: where ``∂F/∂z ≠ 0``, by solving ``F(x, y, z) = 0`` for ``z``
+  (:meth:`ImplicitSurface.to_explicit`); in general only locally, and
+  :meth:`ImplicitSurface.project` moves points onto ``F = 0``.
 """
 
 from __future__ import annotations
@@ -120,6 +121,39 @@ class ImplicitSurface:
             if np.max(np.abs(step)) <= 1e-15 * max(1.0, float(np.abs(p).max())):
                 break
         return p
+
+
+    def to_explicit(self, x_range, y_range, z0: float = 0.0, tolerance: float | None = None):
+        """The explicit form ``z = f(x, y)`` of the sheet of ``F = 0`` through the start
+        height ``z0``, where it exists (``∂F/∂z ≠ 0`` over the rectangle): ``f`` solves
+        ``F(x, y, f) = 0`` by vectorized Newton steps in ``z``, and the result is fitted
+        by :func:`explicit` within ``tolerance``.
+
+        >>> import surfmod as sm, numpy as np
+        >>> ball = sm.implicit(lambda x, y, z: x**2 + y**2 + z**2 - 4)
+        >>> cap = ball.to_explicit((-1, 1), (-1, 1), z0=2.0, tolerance=1e-6)
+        >>> round(float(cap.height(0.0, 0.0)), 12), bool(cap.max_error <= 1e-6)
+        (2.0, True)
+        """
+        z_start = float(checks.finite_array(z0, "z0"))
+
+        def height(x, y):
+            x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+            z = np.full(x.shape, z_start)
+            for _ in range(60):
+                p = np.stack([x, y, z], axis=-1)
+                fz = self.gradient(p)[..., 2]
+                if np.any(np.abs(fz) < 1e-300):
+                    raise SurfmodError("z0: dF/dz vanishes, no explicit form z = f(x, y) there")
+                step = self._value(p) / fz
+                z = z - step
+                if np.max(np.abs(step)) <= 1e-14 * max(1.0, float(np.abs(z).max())):
+                    break
+            else:
+                raise SurfmodError("z0: Newton's method for z did not converge; no explicit form from this start")
+            return z
+
+        return explicit(height, x_range, y_range, tolerance)
 
 
 def implicit(F, bounds=None, gradient=None, step: float | None = None) -> ImplicitSurface:
