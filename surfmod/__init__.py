@@ -86,6 +86,8 @@ _EXPORTS = {
     "IntersectionCurve": ".ops.intersect",
     "project": ".ops.project",
     "Projection": ".ops.project",
+    "shadow": ".ops.shadow",
+    "Shadow": ".ops.shadow",
     "catmull_clark": ".subdiv.catmull_clark",
     "loop_subdivide": ".subdiv.loop",
     "catmull_clark_limit": ".subdiv.masks",
