@@ -76,3 +76,21 @@ def test_bad_inputs():
         sm.superellipsoid(1, 1, 1, 1, 9)
     with pytest.raises(sm.SurfmodError, match="tolerance"):
         sm.superellipsoid(1, 1, 1, 1, 1, tolerance=1e-12)
+
+
+def test_unit_exponents_lie_on_the_exact_nurbs_ellipsoid():
+    e = sm.ellipsoid(3.0, 2.0, 1.0)
+    s = sm.superellipsoid(3.0, 2.0, 1.0, 1.0, 1.0, tolerance=1e-4)
+    u, v = _random_uv(1500, 5)
+    dist = sm.to_implicit(e).distance_estimate(s.points(u, v))
+    assert np.abs(dist).max() <= 1e-4
+    # OCCT's area of the fitted face equals the ellipsoid's area (Gauss-Legendre on the
+    # analytic parametrization), to the fit's accuracy
+    x, w = np.polynomial.legendre.leggauss(200)
+    eta, om = x[:, None] * np.pi / 2, x[None, :] * np.pi
+    a, b, c = 3.0, 2.0, 1.0
+    jac = np.cos(eta) * np.sqrt(
+        (b * c * np.cos(eta) * np.cos(om)) ** 2 + (a * c * np.cos(eta) * np.sin(om)) ** 2 + (a * b * np.sin(eta)) ** 2
+    )
+    exact = float(np.einsum("i,j,ij->", w, w, jac)) * (np.pi / 2) * np.pi
+    assert s.face().area == pytest.approx(exact, rel=1e-4)
