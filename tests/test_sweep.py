@@ -171,6 +171,14 @@ def test_similarity_transform_moves_the_sweep():
     assert np.abs(moved.points(u, v) - expect).max() < 1e-9
     with pytest.raises(sm.SurfmodError, match="matrix: a swept surface"):
         s.scaled((1.0, 2.0, 1.0))
+    # a mirror reverses the handedness of the frames: the twist law is mirrored too
+    from surfmod.transforms import mirror_matrix
+
+    for kw in ({"mode": "frenet", "twist": 60.0}, {"guide": GUIDE, "guide_scale": True, "twist": 30.0}):
+        t = sweep(PROFILE, PATH, **kw)
+        mm = mirror_matrix((1, 0, 2), (0.3, 1, -0.2))
+        mirrored = t.mirrored((1, 0, 2), (0.3, 1, -0.2))
+        assert np.abs(mirrored.points(u, v) - (t.points(u, v) @ mm[:3, :3].T + mm[:3, 3])).max() < 1e-9
 
 
 def test_rotation_minimizing_table_has_no_spin():
