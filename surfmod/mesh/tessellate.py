@@ -168,6 +168,40 @@ def _breaks(s, direction: int) -> np.ndarray:
     return np.linspace(lo, hi, 3)
 
 
+def _start_counts(s, tolerance: float, scale: float = 1.0, samples: int = 33) -> tuple[int, int]:
+    """Uniform start divisions ``(n_u, n_v)`` for a surface without knots (analytic
+    surfaces: sphere, torus, ...): the fewest equal chords that the most curved iso-curve
+    row needs, so that refinement does not have to round a count up to a power of two.
+
+    Along an iso-curve of curvature ``k`` a chord of length ``h`` sags ``k h^2 / 8``;
+    where the other direction is curved as much the same way (elliptic points), a
+    triangle's interior deviates about
+    twice its edges', hence ``k h^2 / 4``.  The count is a lower bound of what the
+    tolerance needs (the rows are refined further where it is not enough); ``scale``
+    divides it by ``sqrt(scale)`` (a coarser start that dyadic refinement completes).
+    """
+    (u0, u1), (v0, v1) = s.domain
+    us, vs = np.linspace(u0, u1, samples), np.linspace(v0, v1, samples)
+    d = s.grid_derivatives(us, vs, 2)
+    su, sv, suu, svv = d[:, :, 1, 0], d[:, :, 0, 1], d[:, :, 2, 0], d[:, :, 0, 2]
+    lu, lv = np.linalg.norm(su, axis=-1), np.linalg.norm(sv, axis=-1)
+    tiny = np.finfo(float).tiny
+    ku = np.linalg.norm(np.cross(su, suu), axis=-1) / np.maximum(lu, tiny) ** 3
+    kv = np.linalg.norm(np.cross(sv, svv), axis=-1) / np.maximum(lv, tiny) ** 3
+    ku, kv = np.where(lu > 0, ku, 0.0), np.where(lv > 0, kv, 0.0)
+    n = np.cross(su, sv)
+    same = np.einsum("...i,...i->...", n, suu) * np.einsum("...i,...i->...", n, svv) > 0  # elliptic point
+    cu = scale * np.where(same, 4.0 + 4.0 * (1.0 - np.minimum(1.0, kv / np.maximum(ku, tiny))), 8.0)
+    cv = scale * np.where(same, 4.0 + 4.0 * (1.0 - np.minimum(1.0, ku / np.maximum(kv, tiny))), 8.0)
+    du, dv = (u1 - u0) / (samples - 1), (v1 - v0) / (samples - 1)
+    rate_u = np.sqrt(ku / (cu * tolerance)) * lu  # chords per unit u
+    rate_v = np.sqrt(kv / (cv * tolerance)) * lv
+    nu = np.trapezoid(rate_u, dx=du, axis=0).max()  # integrate along u, worst v row
+    nv = np.trapezoid(rate_v, dx=dv, axis=1).max()
+    cap = 4096
+    return int(min(cap, max(2, np.floor(0.999 * nu) + 1))), int(min(cap, max(2, np.floor(0.999 * nv) + 1)))
+
+
 def _surface_size(s) -> float:
     (u0, u1), (v0, v1) = s.domain
     pts = s.grid(np.linspace(u0, u1, 17), np.linspace(v0, v1, 17)).reshape(-1, 3)
@@ -210,12 +244,17 @@ def estimate_triangles(s, tolerance: float, size: float) -> float:
 
 
 class _Refiner:
-    def __init__(self, s, tolerance: float, max_triangles: int):
+    def __init__(self, s, tolerance: float, max_triangles: int, start_scale: float = 1.0):
         self.s, self.tol, self.max_triangles = s, tolerance, max_triangles
         (u0, u1), (v0, v1) = s.domain
         self.bounds = (u0, u1, v0, v1)
         self.size = _surface_size(s)
-        self.lat = _Lattice(_breaks(s, 0), _breaks(s, 1))
+        ub, vb = _breaks(s, 0), _breaks(s, 1)
+        if getattr(s, "knots", None) is None:
+            nu, nv = _start_counts(s, tolerance, start_scale)
+            ub = np.linspace(ub[0], ub[-1], nu + 1)
+            vb = np.linspace(vb[0], vb[-1], nv + 1)
+        self.lat = _Lattice(ub, vb)
         self.degenerate, self.closed_u, self.closed_v = _sides(s, self.size)
         st = self.lat.step
         i, j = np.meshgrid(np.arange(len(self.lat.ub) - 1), np.arange(len(self.lat.vb) - 1), indexing="ij")
@@ -459,8 +498,16 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES) 
             f"tolerance: {tolerance:g} would need about {estimate:,.0f} triangles, above the limit "
             f"max_triangles={max_triangles:,}"
         )
-    ref = _Refiner(s, tolerance, max_triangles)
-    tris, dev, stuck = ref.run()
+    # analytic surfaces start from a uniform grid sized by curvature; whether the exact
+    # count or half of it (per direction, completed by dyadic refinement) lands closer to
+    # the need depends on the surface, so both are tried and the smaller mesh is kept
+    best = None
+    for scale in (1.0,) if getattr(s, "knots", None) is not None else (1.0, 2.0):
+        ref = _Refiner(s, tolerance, max_triangles, scale)
+        tris, dev, stuck = ref.run()
+        if best is None or len(tris) < len(best[1]):
+            best = (ref, tris, dev, stuck)
+    ref, tris, dev, stuck = best
     flat = tris.reshape(-1, 2)
     cx, cy = ref._canonical(flat[:, 0], flat[:, 1])
     keys = ref._key(cx, cy)
