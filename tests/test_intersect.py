@@ -163,3 +163,25 @@ def test_intersect_line_several_hits():
 def test_bad_intersect_input(call, match):
     with pytest.raises(sm.SurfmodError, match=match):
         call(_nurbs())
+
+
+def test_quadrics_closed_forms():
+    """Sphere and torus (analytic, periodic): plane sections are circles of known length,
+    the pole of the sphere is one line hit, not one per meridian."""
+    sphere = sm.sphere(2.0)
+    [c] = sm.intersect(sphere, ((0, 0, 1), (0, 0, 1)))  # open at the seam u = 0 / 2 pi
+    assert c.length == pytest.approx(2 * np.pi * np.sqrt(3), rel=1e-7)
+    assert np.abs(np.linalg.norm(c.points, axis=1) - 2).max() < 1e-12
+    assert np.abs(c.points[:, 2] - 1).max() < 1e-12
+    torus = sm.torus(3.0, 1.0)
+    circles = sm.intersect(torus, ((0, 0, 0), (1, 0, 0)))
+    assert len(circles) == 2 and all(k.closed for k in circles)
+    for k in circles:
+        assert k.length == pytest.approx(2 * np.pi, rel=1e-7)
+    hits = sm.intersect_line(sphere, (0, 0, 5), (0, 0, -1))
+    assert hits.shape == (2, 3)
+    np.testing.assert_allclose(hits[:, 2], [3.0, 7.0], atol=1e-12)
+    np.testing.assert_allclose(np.abs(hits[:, 1]), np.pi / 2, atol=1e-12)
+    theirs = occ.intersect_line(sphere.geom(), (0.3, 0.2, 5), np.array([0.1, 0, -1]) / np.linalg.norm([0.1, 0, -1]))
+    mine = sm.intersect_line(sphere, (0.3, 0.2, 5), (0.1, 0, -1))
+    np.testing.assert_allclose(mine, theirs[np.argsort(theirs[:, 2])], atol=1e-9)

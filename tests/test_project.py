@@ -138,3 +138,12 @@ def test_bad_project_surface_and_options():
         sm.project((0, 0, 0), s, seeds=0)
     empty = sm.project(np.empty((0, 3)), s)
     assert empty.u.shape == (0,) and empty.point.shape == (0, 3)
+
+
+def test_sphere_closed_form():
+    s = sm.sphere(2.0)
+    rng = np.random.default_rng(9)
+    pts = rng.normal(size=(200, 3)) * 3
+    pr = sm.project(pts, s)
+    np.testing.assert_allclose(pr.distance, np.abs(np.linalg.norm(pts, axis=1) - 2), atol=1e-12)
+    np.testing.assert_allclose(pr.point, 2 * pts / np.linalg.norm(pts, axis=1, keepdims=True), atol=1e-12)

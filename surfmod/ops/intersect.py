@@ -284,7 +284,10 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
         o, x, y, _ = plane_frame(origin, normal)
         uv_b_of = lambda X, P: np.stack([(P - o) @ x, (P - o) @ y], axis=1)  # noqa: E731
     h = checks.positive(step, "step") if step is not None else problem.scale / 40
-    curves = _curves(problem, marching.trace_all(problem, seeds, h, angle), uv_b_of)
+    traced = marching.trace_all(problem, seeds, h, angle)
+    # drop slivers (a seed on a seam or at a tangency traced for a vanishing length)
+    traced = [(X, c) for X, c in traced if np.ptp(problem.evaluate(X)[2], axis=0).max() > 1e-6 * problem.scale]
+    curves = _curves(problem, traced, uv_b_of)
     if swap:
         curves = [IntersectionCurve(c.points, c.uv_b, c.uv_a, c.tangents, c.closed) for c in curves]
     return curves
@@ -318,7 +321,7 @@ def intersect_line(s: Surface, origin, direction, *, tolerance: float = 1e-9) ->
     if len(X) == 0:
         return np.empty((0, 3))
     X = X[np.lexsort((X[:, 1], X[:, 0], X[:, 2]))]
+    # on a line, t fixes the point: equal t is one hit (poles and seams give several (u, v))
     dup = np.zeros(len(X), bool)
-    close = np.all(np.abs(np.diff(X, axis=0)) <= 1e-8 * problem.span, axis=1)
-    dup[1:] = close
+    dup[1:] = np.diff(X[:, 2]) <= 1e-9 * problem.scale
     return X[~dup]
