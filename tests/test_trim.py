@@ -138,3 +138,17 @@ def test_bad_trim_hole_names_its_index_and_bad_surface():
         sm.trim("surface", _ellipse(0.5, 0.5, 0.3, 0.3))
     with pytest.raises(sm.SurfmodError, match="tolerance"):
         sm.trim(s, _ellipse(0.5, 0.5, 0.3, 0.3), tolerance=-1)
+
+
+def test_sphere_patch_closed_form():
+    """An octant of the sphere of radius 2 (u in [0, pi/2], v in [0, pi/2]): area 2 pi;
+    a latitude band cut by a polygon in (u, v): r^2 (u1 - u0) (sin v1 - sin v0)."""
+    s = sm.sphere(2.0)
+    h = np.pi / 2
+    octant = [(0, 0), (h, 0), (h, h), (0, h), (0, 0)]
+    assert trimmed_area(s, octant) == pytest.approx(2 * np.pi, rel=1e-12)
+    assert face_area(sm.trim(s, octant), 1e-10) == pytest.approx(2 * np.pi, rel=1e-8)
+    band = [(0.5, 0.1), (2.5, 0.1), (2.5, 0.9), (0.5, 0.9), (0.5, 0.1)]
+    expected = 4.0 * 2.0 * (np.sin(0.9) - np.sin(0.1))
+    assert trimmed_area(s, band) == pytest.approx(expected, rel=1e-12)
+    assert face_area(sm.trim(s, band), 1e-10) == pytest.approx(expected, rel=1e-8)
