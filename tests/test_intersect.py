@@ -185,3 +185,14 @@ def test_quadrics_closed_forms():
     theirs = occ.intersect_line(sphere.geom(), (0.3, 0.2, 5), np.array([0.1, 0, -1]) / np.linalg.norm([0.1, 0, -1]))
     mine = sm.intersect_line(sphere, (0.3, 0.2, 5), (0.1, 0, -1))
     np.testing.assert_allclose(mine, theirs[np.argsort(theirs[:, 2])], atol=1e-9)
+
+
+def test_intersection_curve_as_polyline_bspline():
+    [c] = sm.intersect(sm.sphere(2.0), ((0, 0, 1), (0, 0, 1)))
+    poly = c.polyline()
+    assert poly.degree == 1 and len(poly.control_points) == len(c)
+    np.testing.assert_allclose(poly.points(np.array([0.0, 1.0])), c.points[[0, -1]], atol=1e-15)
+    # the polyline is shorter than the curve by the chordal error only
+    assert 0 < c.length - poly.length(samples=4 * len(c)) < 1e-3 * c.length
+    assert c.tangents.shape == c.points.shape
+    np.testing.assert_allclose(np.linalg.norm(c.tangents, axis=1), 1.0, atol=1e-14)
