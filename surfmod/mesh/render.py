@@ -199,11 +199,12 @@ def render(
             flat = net.reshape(-1, 3)
             ax.scatter(flat[:, 0], flat[:, 1], flat[:, 2], color=(0.85, 0.2, 0.1), s=6, depthshade=False, zorder=4)
             lo, hi = np.minimum(lo, flat.min(axis=0)), np.maximum(hi, flat.max(axis=0))
-    centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2, 1e-9)
-    ax.set_xlim(centre[0] - half, centre[0] + half)
-    ax.set_ylim(centre[1] - half, centre[1] + half)
-    ax.set_zlim(centre[2] - half, centre[2] + half)
-    ax.set_box_aspect((1, 1, 1))
+    # true proportions, but flat objects keep a third of the largest extent in height
+    centre = (lo + hi) / 2
+    extent = np.maximum(hi - lo, max(float(np.max(hi - lo)), 1e-9) / 3)
+    for axis, c, e in zip("xyz", centre, extent):
+        getattr(ax, f"set_{axis}lim")(c - e / 2, c + e / 2)
+    ax.set_box_aspect(tuple(extent), zoom=1.1)
     ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
     if title:
