@@ -1,0 +1,75 @@
+"""G-code (RS-274, ISO 6983) export of tool paths, atomic."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+from .atomic import atomic_path, target_path
+
+
+def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = None,
+               safe_height: float | None = None, spindle: float | None = None, digits: int = 4) -> str:
+    """G-code for a :class:`~surfmod.uses.toolpath.Toolpath` (millimetres, absolute)."""
+    from ..uses.toolpath import Toolpath
+
+    if not isinstance(toolpath, Toolpath):
+        raise SurfmodError(f"toolpath: expected a surfmod Toolpath, got {type(toolpath).__name__}")
+    feed = checks.positive(feed, "feed")
+    plunge = feed / 3 if plunge_feed is None else checks.positive(plunge_feed, "plunge_feed")
+    pts = toolpath.points
+    top = float(pts[:, 2].max())
+    if safe_height is None:
+        safe = top + max(5.0, toolpath.tool.radius)
+    else:
+        safe = float(checks.finite_array(safe_height, "safe_height"))
+        if safe <= top:
+            raise SurfmodError(f"safe_height: {safe:g} must be above the highest path point {top:.6g}")
+    f = f"{{:.{int(digits)}f}}"
+    t = toolpath.tool
+    lines = [
+        "%",
+        f"(surfmod drop-cutter zig-zag: {t.kind} end mill radius {t.radius:g} mm)",
+        f"(stepover {toolpath.stepover:.6g} mm, scallop {toolpath.scallop:.4g} mm, {len(pts)} points)",
+        "G21 (millimetres)",
+        "G90 (absolute)",
+        "G17 (XY plane)",
+    ]
+    if spindle is not None:
+        lines.append(f"S{checks.positive(spindle, 'spindle'):.0f} M3")
+    x0, y0, z0 = pts[0]
+    lines += [
+        f"G0 Z{f.format(safe)}",
+        f"G0 X{f.format(x0)} Y{f.format(y0)}",
+        f"G1 Z{f.format(z0)} F{plunge:g}",
+    ]
+    body = np.char.add(np.char.add(np.char.add("G1 X", np.char.mod(f"%.{int(digits)}f", pts[1:, 0])),
+                                   np.char.add(" Y", np.char.mod(f"%.{int(digits)}f", pts[1:, 1]))),
+                       np.char.add(" Z", np.char.mod(f"%.{int(digits)}f", pts[1:, 2])))
+    body = list(body)
+    if body:
+        body[0] = f"{body[0]} F{feed:g}"
+    lines += body
+    lines += [f"G0 Z{f.format(safe)}"]
+    if spindle is not None:
+        lines.append("M5")
+    lines += ["M2", "%", ""]
+    return "\n".join(lines)
+
+
+def export_gcode(toolpath, path, *, feed: float = 600.0, safe_height: float | None = None, **kw) -> None:
+    """Write a tool path as G-code: G21/G90, ``G0`` rapid to ``safe_height``, ``G1``
+    moves at ``feed`` (mm/min), retract and ``M2``.  Atomic.
+
+    >>> import surfmod as sm, tempfile, os
+    >>> tp = sm.toolpath(sm.plane((0, 0, 0), (4, 0, 0), (0, 4, 0)), sm.Tool("flat", 1.0), stepover=1.5)
+    >>> p = os.path.join(tempfile.mkdtemp(), "p.nc")
+    >>> sm.export_gcode(tp, p, feed=800, safe_height=10)
+    >>> open(p).read().splitlines()[-3:]
+    ['G0 Z10.0000', 'M2', '%']
+    """
+    target = target_path(path, "path", (".nc", ".gcode", ".ngc", ".tap", ".cnc"))
+    text = gcode_text(toolpath, feed=feed, safe_height=safe_height, **kw)
+    with atomic_path(target) as tmp:
+        tmp.write_text(text, encoding="ascii")
