@@ -106,6 +106,10 @@ _EXPORTS = {
     "fe_mesh": ".uses.femesh",
     "FEMesh": ".uses.femesh",
     "export_fe_mesh": ".uses.femesh",
+    "toolpath": ".uses.toolpath",
+    "Toolpath": ".uses.toolpath",
+    "Tool": ".uses.toolpath",
+    "export_gcode": ".io.gcode",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])
