@@ -202,7 +202,7 @@ def _heights(tool: Tool, cl: np.ndarray, p: np.ndarray) -> np.ndarray:
     r = tool.radius
     inside = d2 <= r * r * (1 + 1e-12)
     if tool.kind == "ball":
-        h = p[..., 2] + np.sqrt(np.where(inside, r * r - d2, 0.0)) - r
+        h = p[..., 2] + np.sqrt(np.where(inside, np.maximum(r * r - d2, 0.0), 0.0)) - r
     else:
         h = p[..., 2].copy()
     return np.where(inside, h, -np.inf)

@@ -1,0 +1,46 @@
+"""``surfmod section FILE.step --origin x y z --normal x y z --out file.dxf``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import SurfmodError
+
+
+def register(sub) -> None:
+    p = sub.add_parser("section", help="planar section of a STEP part to DXF / SVG (+ PNG preview)")
+    p.add_argument("path", help="STEP file")
+    p.add_argument("--origin", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"))
+    p.add_argument("--normal", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"))
+    p.add_argument("--out", required=True, help="output .dxf or .svg")
+    p.add_argument("--png", help="also write a PNG preview")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from tqdm import tqdm
+
+    from ..io.dxf import export_dxf
+    from ..io.svg import export_svg
+    from ..uses.inputs import to_shape
+    from ..uses.section import section
+
+    suffix = Path(args.out).suffix.lower()
+    if suffix not in (".dxf", ".svg"):
+        raise SurfmodError(f"out: expected a .dxf or .svg file, got {args.out}")
+    with tqdm(total=3, desc="section", unit="step", disable=args.no_progress) as bar:
+        shape = to_shape(args.path, "path")
+        bar.update()
+        s = section(shape, args.origin, args.normal)
+        bar.update()
+        if s.empty:
+            print(s)
+            return 1
+        (export_dxf if suffix == ".dxf" else export_svg)(s, args.out)
+        if args.png:
+            s.preview(args.png)
+        bar.update()
+    print(s)
+    print(f"wrote {args.out}" + (f" and {args.png}" if args.png else ""))
+    return 0
