@@ -204,7 +204,7 @@ def render(
     extent = np.maximum(hi - lo, max(float(np.max(hi - lo)), 1e-9) / 3)
     for axis, c, e in zip("xyz", centre, extent):
         getattr(ax, f"set_{axis}lim")(c - e / 2, c + e / 2)
-    ax.set_box_aspect(tuple(extent), zoom=1.1)
+    ax.set_box_aspect(tuple(extent), zoom=1.0)
     ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
     if title:
