@@ -71,3 +71,20 @@ def to_shape(obj, name: str = "obj", *, solid: bool = False):
             msg = str(exc)
             raise SurfmodError(msg if msg.startswith(name) else f"{name}: {msg}") from None
     return shape
+
+
+def make_solid(surfaces):
+    """A build123d ``Solid`` bounded by surfmod surfaces (and/or faces) that close up:
+    they are sewn (``BRepBuilderAPI_Sewing``) and oriented outwards.  Faces that leave
+    free edges raise ``SurfmodError``.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> cube = sm.make_solid(bd.Box(1, 2, 3).faces())
+    >>> round(cube.volume, 12)
+    6.0
+    """
+    import build123d as bd
+
+    if not isinstance(surfaces, (list, tuple)) or not surfaces:
+        raise SurfmodError("surfaces: expected a non-empty list of surfaces or faces")
+    return bd.Solid(to_shape(list(surfaces), "surfaces", solid=True))
