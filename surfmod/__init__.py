@@ -110,6 +110,7 @@ _EXPORTS = {
     "Toolpath": ".uses.toolpath",
     "Tool": ".uses.toolpath",
     "export_gcode": ".io.gcode",
+    "make_solid": ".uses.inputs",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "mesh"])
