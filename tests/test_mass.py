@@ -127,3 +127,15 @@ def test_unreadable_files(tmp_path):
         sm.mass_properties(bad)
     with pytest.raises(sm.SurfmodError, match="obj: expected"):
         sm.mass_properties(42)
+
+
+def test_closed_surfmod_surfaces_use_their_own_evaluator():
+    if not hasattr(sm, "sphere") or not hasattr(sm, "torus"):
+        pytest.skip("quadric constructors not available")
+    r = sm.mass_properties(sm.sphere(2))
+    assert r.evaluators == {"numpy": 1, "occt": 0}
+    assert rel(r.volume, 4 / 3 * math.pi * 8) < 1e-14 and rel(r.area, 16 * math.pi) < 1e-14
+    t = sm.mass_properties(sm.torus(3, 1))
+    v = 2 * math.pi**2 * 3
+    assert rel(t.volume, v) < 1e-14
+    assert rel(t.inertia[2, 2], v * (9 + 0.75)) < 1e-14

@@ -98,6 +98,21 @@ def closed_solid(shape):
     faces = _explore(shape, TopAbs_FACE)
     if not faces:
         raise SurfmodError("obj: has no faces")
+    # faces that already share their edges (e.g. one periodic face: a full sphere or
+    # torus closed by its own seam and poles) form a closed shell without sewing
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Shell
+
+    builder = BRep_Builder()
+    shell = TopoDS_Shell()
+    builder.MakeShell(shell)
+    for f in faces:
+        builder.Add(shell, f)
+    if BRep_Tool.IsClosed_s(shell):
+        with kernel("BRepBuilderAPI_MakeSolid"):
+            solid = BRepBuilderAPI_MakeSolid(shell).Solid()
+            BRepLib.OrientClosedSolid_s(solid)
+        return solid
     return sew_solid(faces)
 
 

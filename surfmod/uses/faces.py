@@ -150,8 +150,11 @@ def surface_patch(surf, index: int = 0) -> Patch:
     (u0, u1), (v0, v1) = surf.domain
     ku = getattr(surf, "knots", None)
     knots = ku if isinstance(ku, tuple) and len(ku) == 2 else (None, None)
+    # analytic surfaces (no knots): eight pieces per direction keep Gauss converged
+    pu = None if knots[0] is not None else (u1 - u0) / 8
+    pv = None if knots[1] is not None else (v1 - v0) / 8
     return Patch(index, type(surf).__name__, (u0, u1, v0, v1), 1.0, True,
-                 _breaks(u0, u1, knots[0], None), _breaks(v0, v1, knots[1], None),
+                 _breaks(u0, u1, knots[0], pu), _breaks(v0, v1, knots[1], pv),
                  "numpy", _surface_evaluator(surf), None)
 
 

@@ -186,7 +186,21 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str =
                               method=f"occt BRepGProp eps={eps:g}", error_estimate=float(g["volume_error"]))
     box = occ.bounding_box(solid)
     ref = box.mean(axis=0)
-    pats = patches(solid)
+    from ..surface import Surface
+
+    if isinstance(obj, Surface):
+        # one closed surface (sphere, torus, ...): integrate its own NumPy evaluator over
+        # its domain; the orientation is fixed by the sign of the enclosed volume
+        from .faces import surface_patch
+
+        pats = [surface_patch(obj)]
+        probe = patch_moments(pats[0], ref, order)
+        if probe[1] < 0:
+            from dataclasses import replace
+
+            pats = [replace(pats[0], sign=-1.0)]
+    else:
+        pats = patches(solid)
     total = np.zeros(14)
     low = np.zeros(14)
     low_order = max(2, order - 4)
