@@ -131,3 +131,20 @@ def test_bad_gcode_export_leaves_no_file(tmp_path):
     with pytest.raises(sm.SurfmodError, match="toolpath"):
         sm.export_gcode("G0", tmp_path / "a.nc")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_solid_top_faces_fillet_closed_form(tmp_path):
+    """Ball over a filleted block from STEP: on the fillet (axis x = 8, z = 0.5, radius 2)
+    the tip height is 0.5 + sqrt((2 + r)^2 - (x - 8)^2) - r; on the top face it is 2.5."""
+    from surfmod.uses.toolpath import drop_cutter
+
+    solid = bd.fillet(bd.Box(20, 20, 5).edges().group_by(bd.Axis.Z)[-1], radius=2)
+    path = tmp_path / "block.step"
+    sm.export_step(solid, path)
+    r = 1.0
+    x = np.array([0.0, 5.0, 8.0, 8.5, 9.0, 9.5])
+    z, cc = drop_cutter(str(path), sm.Tool("ball", r), np.column_stack([x, np.zeros_like(x)]))
+    expect = np.where(x <= 8, 2.5, 0.5 + np.sqrt((2 + r) ** 2 - np.maximum(x - 8, 0) ** 2) - r)
+    assert np.abs(z - expect).max() < 1e-9
+    tp = sm.toolpath(str(path), sm.Tool("ball", r), stepover=1.5, step=1.0)
+    assert tp.gouge < 1e-9 and tp.points[:, 2].max() == pytest.approx(2.5, abs=1e-12)
