@@ -192,3 +192,53 @@ def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_refused():
     solid = bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 2) - bd.Solid.make_cylinder(2, 10)
     with pytest.raises(sm.SurfmodError, match="tolerance: 0.01 cannot be met.*modelling tolerance"):
         sm.tessellate(solid, 0.01)
+
+
+def test_ear_clipping_never_collapses_onto_a_side():
+    """Regression: a cell with two hanging nodes on one side, whose greedy clipping used to
+    leave four collinear points; every triangle must keep an area and they tile the cell."""
+    from surfmod.mesh.tessellate import _ear_clip
+
+    poly = np.array([[16, 4], [20, 4], [20, 5], [20, 6], [20, 8], [16, 8]], dtype=np.int64)
+    pos = np.array(
+        [
+            [1.8356333839, 1.6011877367, -0.1847333487],
+            [2.5320718870, 1.4639773194, -0.0758561436],
+            [2.5142981986, 1.5497472086, -0.0929060905],
+            [2.5010203188, 1.6186577909, -0.1062807071],
+            [2.4769170899, 1.7568772270, -0.1245615055],
+            [1.8424589576, 2.0931728884, -0.1520255821],
+        ]
+    )
+    tris = _ear_clip(poly, pos)
+    assert tris.shape == (4, 3, 2)
+    e1, e2 = tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]
+    cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    assert np.all(cross > 0) and cross.sum() == 2 * 16
+
+
+@pytest.mark.parametrize("seed", [2, 6, 11])
+def test_random_splines_with_creases_and_collapsed_edges(seed):
+    """Random nets, degrees 1-4, interior knots up to multiplicity 2, rational or not,
+    some with a collapsed edge: measured deviation within tolerance, mesh valid."""
+    rng = np.random.default_rng(seed)
+    p, q = rng.integers(1, 5, 2)
+    n, m = p + rng.integers(1, 4), q + rng.integers(1, 4)
+    net = rng.uniform(-1, 1, (n, m, 3))
+    net[..., 0] += 2 * np.arange(n)[:, None]
+    net[..., 1] += 2 * np.arange(m)[None, :]
+
+    def kv(nc, d):
+        inner = np.sort(rng.uniform(0.1, 0.9, nc - d - 1))
+        if inner.size > 1 and d > 1:
+            inner[1] = inner[0]
+        return np.concatenate([np.zeros(d + 1), inner, np.ones(d + 1)])
+
+    if seed == 6:
+        net[0, :, :] = net[0, 0]
+    w = rng.uniform(0.3, 3, (n, m)) if seed != 2 else None
+    s = sm.BSplineSurface(net, (p, q), (kv(n, p), kv(m, q)), w)
+    m_ = sm.tessellate(s, 0.02)
+    assert m_.info["max_deviation"] <= 0.02
+    f = m_.faces
+    assert np.all((f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2]))

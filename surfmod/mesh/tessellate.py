@@ -472,6 +472,11 @@ def _ear_clip(poly: np.ndarray, pos: np.ndarray) -> np.ndarray:
             )
             if cross <= 0:
                 continue
+            # the rest must keep an area (not collapse onto the line of one side)
+            rest = poly[ids[:k] + ids[k + 1 :]]
+            area2 = np.dot(rest[:, 0], np.roll(rest[:, 1], -1)) - np.dot(rest[:, 1], np.roll(rest[:, 0], -1))
+            if area2 <= 0:
+                continue
             length = float(np.sum((pos[a] - pos[c]) ** 2))
             if length < best_len:
                 best, best_len = k, length
