@@ -37,7 +37,7 @@ def run(args) -> int:
         shape = to_shape(args.path, "path")
         bar.update()
         tp = toolpath(shape, Tool(args.tool, args.radius), args.stepover, scallop=args.scallop,
-                      step=args.step, direction=args.direction)
+                      step=args.step, direction=args.direction, progress=not args.no_progress)
         bar.update()
         export_gcode(tp, args.out, feed=args.feed, safe_height=args.safe_height)
         bar.update()

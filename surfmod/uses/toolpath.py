@@ -379,33 +379,43 @@ def _seeded(best, arg, pid_s, us, vs):
     return np.where(hit, pid_s[j], -1), np.where(hit, us[j], 0.0), np.where(hit, vs[j], 0.0)
 
 
-def drop_cutter(obj, tool: Tool, xy, *, spacing: float | None = None, _model_cache=None):
+def drop_cutter(obj, tool: Tool, xy, *, spacing: float | None = None, progress: bool = False,
+                chunk: int = 1000, _model_cache=None):
     """Tool-tip heights ``(N,)`` and contact points ``(N, 3)`` of ``tool`` dropped onto
-    ``obj`` at the (x, y) locations ``xy`` ``(N, 2)`` (NaN where the tool misses)."""
+    ``obj`` at the (x, y) locations ``xy`` ``(N, 2)`` (NaN where the tool misses).
+    CL points are processed in blocks of ``chunk`` (a tqdm bar with ``progress``)."""
     if not isinstance(tool, Tool):
         raise SurfmodError(f"tool: expected a surfmod Tool, got {type(tool).__name__}")
-    cl = checks.finite_array(xy, "xy", ndim=2, last=2)
+    cl_all = checks.finite_array(xy, "xy", ndim=2, last=2)
     model = _model_cache or _model(obj)
     spacing = tool.radius / 4 if spacing is None else checks.positive(spacing, "spacing")
     pts, pid_s, us, vs, hu, hv = _samples(model, spacing)
-    bests, args = _drop(tool, cl, pts, sectors=4)
-    best = np.full(len(cl), -np.inf)
-    pid, u, v = np.full(len(cl), -1), np.zeros(len(cl)), np.zeros(len(cl))
-    for q in range(4):  # one seed per quadrant: separate local maxima are all refined
-        sel = np.nonzero(args[:, q] >= 0)[0]
-        if not sel.size:
-            continue
-        pq, uq, vq = _seeded(bests[sel, q], args[sel, q], pid_s, us, vs)
-        bq, uq, vq = _refine(tool, model, cl[sel], bests[sel, q].copy(), pq, uq, vq, hu, hv)
-        take = bq > best[sel]
-        t = sel[take]
-        best[t], pid[t], u[t], v[t] = bq[take], pq[take], uq[take], vq[take]
-    contacts = np.full((len(cl), 3), np.nan)
-    for k, patch in enumerate(model.patches):
-        sel = np.nonzero(pid == k)[0]
-        if sel.size:
-            contacts[sel] = patch.evaluate(u[sel], v[sel], 0)[:, 0, 0]
-    z = np.where(np.isfinite(best), best, np.nan)
+    z = np.full(len(cl_all), np.nan)
+    contacts = np.full((len(cl_all), 3), np.nan)
+    starts = range(0, len(cl_all), chunk)
+    if progress:
+        from tqdm import tqdm
+
+        starts = tqdm(starts, desc="drop-cutter", unit="block")
+    for s0 in starts:
+        cl = cl_all[s0:s0 + chunk]
+        bests, args = _drop(tool, cl, pts, sectors=4)
+        best = np.full(len(cl), -np.inf)
+        pid, u, v = np.full(len(cl), -1), np.zeros(len(cl)), np.zeros(len(cl))
+        for q in range(4):  # one seed per quadrant: separate local maxima are all refined
+            sel = np.nonzero(args[:, q] >= 0)[0]
+            if not sel.size:
+                continue
+            pq, uq, vq = _seeded(bests[sel, q], args[sel, q], pid_s, us, vs)
+            bq, uq, vq = _refine(tool, model, cl[sel], bests[sel, q].copy(), pq, uq, vq, hu, hv)
+            take = bq > best[sel]
+            t = sel[take]
+            best[t], pid[t], u[t], v[t] = bq[take], pq[take], uq[take], vq[take]
+        for k, patch in enumerate(model.patches):
+            sel = np.nonzero(pid == k)[0]
+            if sel.size:
+                contacts[s0 + sel] = patch.evaluate(u[sel], v[sel], 0)[:, 0, 0]
+        z[s0:s0 + len(cl)] = np.where(np.isfinite(best), best, np.nan)
     return z, contacts
 
 
@@ -444,7 +454,8 @@ def _raster(lo, hi, stepover, step, direction):
 
 
 def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float | None = None,
-             step: float | None = None, direction: str = "x", bounds=None, check: bool = True) -> Toolpath:
+             step: float | None = None, direction: str = "x", bounds=None, check: bool = True,
+             progress: bool = False) -> Toolpath:
     """Zig-zag drop-cutter finishing path of ``tool`` over a surface or a solid's top.
 
     ``obj``: a surfmod surface (or list of them) machined from above, a build123d solid
@@ -453,6 +464,8 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     ball cutter, stepover = 2·sqrt(2rh − h²)).  ``step`` is the spacing of CL points
     along a pass (default ``radius / 4``); passes run along ``direction`` ``"x"`` or
     ``"y"`` over the part's (x, y) bounding box or ``bounds = ((xmin, ymin), (xmax, ymax))``.
+    ``check`` measures the gouge on an independent denser sample; ``progress`` shows a
+    tqdm bar over blocks of cutter locations.
 
     >>> import surfmod as sm, numpy as np
     >>> s = sm.plane((0, 0, 1), (10, 0, 1), (0, 10, 1))
@@ -488,7 +501,7 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     xy, index, across = _raster(lo, hi, stepover, step, direction)
     if len(xy) > 2_000_000:
         raise SurfmodError(f"step: {len(xy)} cutter locations is too many; use a larger step or stepover")
-    z, contacts = drop_cutter(obj, tool, xy, spacing=spacing, _model_cache=model)
+    z, contacts = drop_cutter(obj, tool, xy, spacing=spacing, progress=progress, _model_cache=model)
     if np.isnan(z).all():
         raise SurfmodError("bounds: the tool touches no surface inside these bounds")
     z = np.where(np.isnan(z), np.nanmin(z), z)  # outside the part: stay at the lowest level
