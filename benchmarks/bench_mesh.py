@@ -99,7 +99,8 @@ def solid_rows(tolerances=(0.01, 0.001)):
             dt = time.perf_counter() - t
             tm = m.to_trimesh()
             n_b, dev_b = _brep(solid, tol)
-            out.append((name, tol, len(m.faces), m.info["max_deviation"], dt, n_b, dev_b, tm.is_watertight and tm.is_winding_consistent))
+            ok = tm.is_watertight and tm.is_winding_consistent
+            out.append((name, tol, len(m.faces), m.info["max_deviation"], dt, n_b, dev_b, ok))
     return out
 
 
@@ -117,11 +118,17 @@ def main() -> None:
             f"| {n_ok:>16d} | {dev_ok:>9.3g} | {n / n_ok:>7.2f} |"
         )
     print("(!) BRepMesh's measured deviation exceeds the requested deflection\n")
-    head2 = f"| {'solid':<22} | {'tol':>6} | {'tris':>7} | {'measured dev':>12} | {'time s':>6} | {'BRepMesh(defl=tol) tris':>23} | {'its dev':>9} | watertight |"
+    head2 = (
+        f"| {'solid':<22} | {'tol':>6} | {'tris':>7} | {'measured dev':>12} | {'time s':>6} "
+        f"| {'BRepMesh(defl=tol) tris':>23} | {'its dev':>9} | watertight |"
+    )
     print(head2)
     print("|" + "|".join("-" * (len(c)) for c in head2.split("|")[1:-1]) + "|")
     for name, tol, n, dev, dt, n_b, dev_b, ok in solid_rows():
-        print(f"| {name:<22} | {tol:>6g} | {n:>7d} | {dev:>12.3g} | {dt:>6.2f} | {n_b:>23d} | {dev_b:>9.3g} | {'yes' if ok else 'NO':>10} |")
+        print(
+            f"| {name:<22} | {tol:>6g} | {n:>7d} | {dev:>12.3g} | {dt:>6.2f} | {n_b:>23d} | {dev_b:>9.3g} "
+            f"| {'yes' if ok else 'NO':>10} |"
+        )
 
 
 if __name__ == "__main__":

@@ -378,7 +378,6 @@ class _Refiner:
         """Split the given cells along u, v or both, by the chord sagitta per direction."""
         x0, x1, y0, y1 = (a[cells] for a in (self.x0, self.x1, self.y0, self.y1))
         xm, ym = (x0 + x1) // 2, (y0 + y1) // 2
-        lat = self.lat
 
         def sag(xa, ya, xb, yb, xc, yc):
             pa = self._positions(np.stack([xa, ya], 1))
@@ -386,8 +385,9 @@ class _Refiner:
             pc = self._positions(np.stack([xc, yc], 1))
             return np.linalg.norm((pa + pb) / 2 - pc, axis=1)
 
-        eu = np.maximum(sag(x0, ym, x1, ym, xm, ym), np.maximum(sag(x0, y0, x1, y0, xm, y0), sag(x0, y1, x1, y1, xm, y1)))
-        ev = np.maximum(sag(xm, y0, xm, y1, xm, ym), np.maximum(sag(x0, y0, x0, y1, x0, ym), sag(x1, y0, x1, y1, x1, ym)))
+        # sagitta of the u-chords (bottom, middle, top row) and of the v-chords
+        eu = np.maximum.reduce([sag(x0, y, x1, y, xm, y) for y in (y0, ym, y1)])
+        ev = np.maximum.reduce([sag(x, y0, x, y1, x, ym) for x in (x0, xm, x1)])
         can_u, can_v = (x1 - x0) >= 2, (y1 - y0) >= 2
         # k-d refinement: split across the direction whose chords sag more (both on a tie,
         # e.g. a twisted cell with straight edges); measured best for triangle count
@@ -395,7 +395,6 @@ class _Refiner:
         sv = (ev > eu) | (eu == ev)
         su, sv = (su & can_u) | (sv & ~can_v & can_u), (sv & can_v) | (su & ~can_u & can_v)
         stuck = ~su & ~sv
-        del lat
         keep = np.ones(self.x0.size, bool)
         keep[cells[~stuck]] = False
         new = []
