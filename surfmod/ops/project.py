@@ -29,18 +29,20 @@ class Projection(NamedTuple):
 
 
 def seed_parameters(s: Surface, direction: int, per_span: int = 4, minimum: int = 24, maximum: int = 96) -> np.ndarray:
-    """Sample parameters along one direction: every knot plus ``per_span`` per knot span."""
+    """Sample parameters along one direction: ``minimum`` equal steps over the domain
+    (so long spans are not starved when short spans hold most knots), every knot, and
+    ``per_span`` samples inside each knot span while that stays under ``maximum``."""
     lo, hi = s.domain[direction]
+    even = np.linspace(lo, hi, minimum + 1)
     knots = getattr(s, "knots", None)
     if knots is None:
-        return np.linspace(lo, hi, minimum + 1)
+        return even
     k = np.asarray(knots[direction])
     k = np.unique(np.concatenate([[lo, hi], k[(k > lo) & (k < hi)]]))
     if (len(k) - 1) * per_span > maximum:
         return np.unique(np.concatenate([np.linspace(lo, hi, maximum + 1), k]))
-    per = max(per_span, -(-minimum // (len(k) - 1)))
-    fine = [np.linspace(a, b, per, endpoint=False) for a, b in zip(k[:-1], k[1:])]
-    return np.concatenate(fine + [k[-1:]])
+    fine = [np.linspace(a, b, per_span, endpoint=False) for a, b in zip(k[:-1], k[1:])]
+    return np.unique(np.concatenate(fine + [even, k]))
 
 
 def nearest_samples(points: np.ndarray, samples: np.ndarray, count: int, chunk: int = 2_000_000) -> np.ndarray:
@@ -90,18 +92,37 @@ def nearest_triangles(points, tri_pts, count: int, chunk: int = 1_000_000):
     return idx, bary
 
 
+def crease_boxes(s: Surface, direction: int, t: np.ndarray):
+    """Per-parameter bounds ``(lo, hi)``: the piece between C0 knot lines (multiplicity
+    >= degree) that holds ``t``.  Across such a crease the distance has a kink that
+    Newton cannot settle on, so each start works in its own smooth piece and a minimum on
+    the crease becomes a constrained (boundary) minimum."""
+    lo, hi = s.domain[direction]
+    knots, degree = getattr(s, "knots", None), getattr(s, "degree", None)
+    if knots is None or degree is None:
+        return np.full(t.shape, lo), np.full(t.shape, hi)
+    values, mult = np.unique(np.asarray(knots[direction]), return_counts=True)
+    creases = values[(mult >= degree[direction]) & (values > lo) & (values < hi)]
+    breaks = np.concatenate([[lo], creases, [hi]])
+    piece = np.clip(np.searchsorted(breaks, t, side="right") - 1, 0, len(breaks) - 2)
+    return breaks[piece], breaks[piece + 1]
+
+
 def newton_closest(s: Surface, points: np.ndarray, u: np.ndarray, v: np.ndarray, iterations: int = 60):
     """Projected Newton on ``|S - P|^2 / 2`` from starts ``(u, v)`` (flat arrays, one per
-    point row of ``points``).  Returns refined ``(u, v)``."""
-    (u0, u1), (v0, v1) = s.domain
-    spanu, spanv = u1 - u0, v1 - v0
+    point row of ``points``), each kept inside its smooth piece (:func:`crease_boxes`).
+    Returns refined ``(u, v)``."""
+    (du0, du1), (dv0, dv1) = s.domain
+    spanu, spanv = du1 - du0, dv1 - dv0
     u, v = u.astype(float).copy(), v.astype(float).copy()
+    box_u, box_v = crease_boxes(s, 0, u), crease_boxes(s, 1, v)
     active = np.ones(u.shape, bool)
     for _ in range(iterations):
         idx = np.nonzero(active)[0]
         if idx.size == 0:
             break
         uu, vv, pp = u[idx], v[idx], points[idx]
+        u0, u1, v0, v1 = box_u[0][idx], box_u[1][idx], box_v[0][idx], box_v[1][idx]
         d = s._derivatives(uu, vv, 2)
         S, Su, Sv = d[:, 0, 0], d[:, 1, 0], d[:, 0, 1]
         r = S - pp
@@ -137,8 +158,8 @@ def newton_closest(s: Surface, points: np.ndarray, u: np.ndarray, v: np.ndarray,
             if trial.size == 0:
                 break
             step /= 4
-            nu[trial] = np.clip(uu[trial] + step * du[trial], u0, u1)
-            nv[trial] = np.clip(vv[trial] + step * dv[trial], v0, v1)
+            nu[trial] = np.clip(uu[trial] + step * du[trial], u0[trial], u1[trial])
+            nv[trial] = np.clip(vv[trial] + step * dv[trial], v0[trial], v1[trial])
         # no decrease even for a tiny step: converged to round-off, stay
         nu[trial], nv[trial] = uu[trial], vv[trial]
         moved = np.maximum(np.abs(nu - uu) / spanu, np.abs(nv - vv) / spanv)
