@@ -44,6 +44,23 @@ def test_failed_export_leaves_no_partial_file_and_keeps_the_old_one(tmp_path, su
     assert sorted(os.listdir(tmp_path)) == ["keep.step"]
 
 
+def test_exports_get_ordinary_file_modes(tmp_path, surface):
+    # the atomic writer's temporary file is 0600; a new export must get 0666 minus the umask
+    # and an overwritten file must keep its mode
+    umask = os.umask(0o022)
+    try:
+        new = tmp_path / "new.stl"
+        sm.export_stl(surface, new, tolerance=0.05)
+        assert new.stat().st_mode & 0o777 == 0o644
+        kept = tmp_path / "kept.step"
+        kept.write_text("old")
+        kept.chmod(0o640)
+        sm.export_step(surface, kept)
+        assert kept.stat().st_mode & 0o777 == 0o640
+    finally:
+        os.umask(umask)
+
+
 def test_export_path_errors(tmp_path, surface):
     with pytest.raises(sm.SurfmodError, match="path: folder .* does not exist"):
         sm.export_step(surface, tmp_path / "missing" / "a.step")

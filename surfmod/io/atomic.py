@@ -29,6 +29,19 @@ def target_path(path, name: str = "path", suffixes: tuple[str, ...] = ()) -> Pat
     return p
 
 
+def _final_mode(path: Path) -> int:
+    """Mode the written file should end with.
+
+    mkstemp creates 0600 files; an export must look like any other file the user writes
+    (an overwritten file keeps its mode, a new one gets 0666 minus the umask).
+    """
+    with contextlib.suppress(FileNotFoundError):
+        return path.stat().st_mode & 0o7777
+    umask = os.umask(0)  # the only portable way to read the umask is to set it
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
 @contextlib.contextmanager
 def atomic_path(path: Path):
     """Yield a temporary path in the target's folder; on success it replaces ``path``."""
@@ -38,6 +51,7 @@ def atomic_path(path: Path):
         yield Path(tmp)
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
+        os.chmod(tmp, _final_mode(path))
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
