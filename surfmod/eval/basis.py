@@ -25,54 +25,58 @@ def basis_derivatives(knots: np.ndarray, degree: int, spans: np.ndarray, t: np.n
 
     Returns ``ders`` of shape ``(len(t), order + 1, degree + 1)`` where ``ders[a, k, r]`` is the
     k-th derivative of ``N_{spans[a] - degree + r, degree}`` at ``t[a]``.  Derivatives above
-    the degree are zero.
+    the degree are zero.  The tables are kept with the points on the last axis, so every
+    step of the recurrence is one contiguous array operation; the result is a view in the
+    documented axis order.
     """
     p = degree
     t = np.asarray(t, dtype=float).ravel()
     n_pts = t.size
-    ndu = np.zeros((n_pts, p + 1, p + 1))
-    ndu[:, 0, 0] = 1.0
-    left = np.zeros((n_pts, p + 1))
-    right = np.zeros((n_pts, p + 1))
+    # ndu[j, r]: upper triangle = basis functions of rising degree, lower = knot differences
+    ndu = np.zeros((p + 1, p + 1, n_pts))
+    ndu[0, 0] = 1.0
+    left = np.zeros((p + 1, n_pts))
+    right = np.zeros((p + 1, n_pts))
     for j in range(1, p + 1):
-        left[:, j] = t - knots[spans + 1 - j]
-        right[:, j] = knots[spans + j] - t
+        left[j] = t - knots[spans + 1 - j]
+        right[j] = knots[spans + j] - t
         saved = np.zeros(n_pts)
         for r in range(j):
-            ndu[:, j, r] = right[:, r + 1] + left[:, j - r]
-            temp = ndu[:, r, j - 1] / ndu[:, j, r]
-            ndu[:, r, j] = saved + right[:, r + 1] * temp
-            saved = left[:, j - r] * temp
-        ndu[:, j, j] = saved
+            ndu[j, r] = right[r + 1] + left[j - r]
+            temp = ndu[r, j - 1] / ndu[j, r]
+            ndu[r, j] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        ndu[j, j] = saved
 
-    ders = np.zeros((n_pts, order + 1, p + 1))
-    ders[:, 0, :] = ndu[:, :, p]
+    ders = np.zeros((order + 1, p + 1, n_pts))
+    ders[0] = ndu[:, p]
     top = min(order, p)
-    for r in range(p + 1):
-        a = np.zeros((2, n_pts, p + 1))
-        a[0, :, 0] = 1.0
+    for r in range(p + 1 if top > 0 else 0):
+        a = np.zeros((2, p + 1, n_pts))
+        a[0, 0] = 1.0
         s1, s2 = 0, 1
         for k in range(1, top + 1):
             d = np.zeros(n_pts)
             rk, pk = r - k, p - k
             if r >= k:
-                a[s2, :, 0] = a[s1, :, 0] / ndu[:, pk + 1, rk]
-                d += a[s2, :, 0] * ndu[:, rk, pk]
+                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
+                d += a[s2, 0] * ndu[rk, pk]
             j1 = 1 if rk >= -1 else -rk
             j2 = k - 1 if r - 1 <= pk else p - r
-            for j in range(j1, j2 + 1):
-                a[s2, :, j] = (a[s1, :, j] - a[s1, :, j - 1]) / ndu[:, pk + 1, rk + j]
-                d += a[s2, :, j] * ndu[:, rk + j, pk]
+            if j2 >= j1:
+                js = slice(j1, j2 + 1)
+                a[s2, js] = (a[s1, js] - a[s1, j1 - 1 : j2]) / ndu[pk + 1, rk + j1 : rk + j2 + 1]
+                d += np.einsum("jn,jn->n", a[s2, js], ndu[rk + j1 : rk + j2 + 1, pk])
             if r <= pk:
-                a[s2, :, k] = -a[s1, :, k - 1] / ndu[:, pk + 1, r]
-                d += a[s2, :, k] * ndu[:, r, pk]
-            ders[:, k, r] = d
+                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
+                d += a[s2, k] * ndu[r, pk]
+            ders[k, r] = d
             s1, s2 = s2, s1
     factor = float(p)
     for k in range(1, top + 1):
-        ders[:, k, :] *= factor
+        ders[k] *= factor
         factor *= p - k
-    return ders
+    return ders.transpose(2, 0, 1)
 
 
 def clamped_bezier_knots(degree: int) -> np.ndarray:

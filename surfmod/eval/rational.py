@@ -27,41 +27,25 @@ def surface_quotient(hders: np.ndarray) -> np.ndarray:
     """``(..., K, K, 4)`` homogeneous mixed partials -> ``(..., K, K, 3)`` Cartesian ones.
 
     Every entry of the square is exact (also ``k + l > K - 1``), as the rule needs only
-    lower entries of the same square.
+    lower entries of the same square.  The work is done on planes: the derivative axes are
+    moved to the front once, so every arithmetic step runs over one contiguous array of
+    points; the result is the matching moved-axis view (same shape, planar memory).
     """
-    aders, w = hders[..., :3], hders[..., 3]
     order = hders.shape[-2] - 1
-    out = np.zeros_like(aders)
-    w0 = w[..., 0, 0, None]
+    if order == 0:  # positions only: one division, the common (and large-grid) case
+        return hders[..., :3] / hders[..., 3:4]
+    planes = np.ascontiguousarray(np.moveaxis(hders, (-3, -2, -1), (0, 1, 2)))  # (K, K, 4, ...)
+    a, w = planes[:, :, :3], planes[:, :, 3:4]
+    out = np.empty_like(a)
+    inv_w0 = 1.0 / w[0, 0]
     for k in range(order + 1):
         for l in range(order + 1):
-            acc = aders[..., k, l, :].copy()
+            acc = a[k, l].copy()
             for j in range(1, l + 1):
-                acc -= comb(l, j) * w[..., 0, j, None] * out[..., k, l - j, :]
+                acc -= comb(l, j) * w[0, j] * out[k, l - j]
             for i in range(1, k + 1):
-                acc -= comb(k, i) * w[..., i, 0, None] * out[..., k - i, l, :]
+                acc -= comb(k, i) * w[i, 0] * out[k - i, l]
                 for j in range(1, l + 1):
-                    acc -= comb(k, i) * comb(l, j) * w[..., i, j, None] * out[..., k - i, l - j, :]
-            out[..., k, l, :] = acc / w0
-    return out
-
-
-def planes_quotient(planes: dict, order: int) -> dict:
-    """The quotient rule on grid planes ``{(k, l): (nu, nv, 4)}`` -> ``(nu, nv, 3)``.
-
-    Same formula as :func:`surface_quotient`, laid out for the grid fast path.
-    """
-    out = {}
-    w0 = planes[0, 0][..., 3:4]
-    for k in range(order + 1):
-        for l in range(order + 1):
-            acc = planes[k, l][..., :3].copy()
-            for j in range(1, l + 1):
-                acc -= comb(l, j) * planes[0, j][..., 3:4] * out[k, l - j]
-            for i in range(1, k + 1):
-                acc -= comb(k, i) * planes[i, 0][..., 3:4] * out[k - i, l]
-                for j in range(1, l + 1):
-                    acc -= comb(k, i) * comb(l, j) * planes[i, j][..., 3:4] * out[k - i, l - j]
-            acc /= w0
-            out[k, l] = acc
-    return out
+                    acc -= (comb(k, i) * comb(l, j)) * w[i, j] * out[k - i, l - j]
+            np.multiply(acc, inv_w0, out=out[k, l])
+    return np.moveaxis(out, (0, 1, 2), (-3, -2, -1))

@@ -14,8 +14,8 @@ import numpy as np
 from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..eval.rational import curve_quotient, planes_quotient, surface_quotient
-from ..eval.tensor import curve_derivatives, planes_to_array, surface_derivatives, surface_grid_planes
+from ..eval.rational import curve_quotient, surface_quotient
+from ..eval.tensor import curve_derivatives, rational_grid_positions, surface_derivatives, surface_grid
 from ..surface import Surface
 from . import knots as kn
 
@@ -229,10 +229,10 @@ class BSplineSurface(Surface):
 
     def _grid_derivatives(self, us, vs, order):
         (p, q), (ku, kv) = self.degree, self.knots
-        planes = surface_grid_planes(ku, p, kv, q, self._h, us, vs, order)
-        if self.rational:
-            planes = planes_quotient(planes, order)
-        return planes_to_array(planes, order)
+        if self.rational and order == 0:
+            return rational_grid_positions(ku, p, kv, q, self._h, us, vs)[:, :, None, None, :]
+        h = surface_grid(ku, p, kv, q, self._h, us, vs, order)
+        return surface_quotient(h) if self.rational else h
 
     def geom(self):
         from ..occ.geom import bspline_surface
