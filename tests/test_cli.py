@@ -89,3 +89,13 @@ def test_mesh_command_writes_a_watertight_stl(tmp_path, capsys):
     assert "watertight True" in out
     stl = trimesh.load(tmp_path / "part.stl")
     assert stl.is_watertight and abs(stl.volume - part.volume) < 0.01 * part.volume
+
+
+def test_gallery_table_keeps_long_names_whole():
+    from surfmod.gallery.runner import Row, format_table
+
+    long = "Catmull–Clark limit of a pentagonal prism (mixed polygons)"
+    rows = [Row("a", long, "Solid", "per-face", 7.1e-15, True), Row("b", "sphere", "Geom_SphericalSurface", "parametric", 0.0, False)]
+    lines = format_table(rows).splitlines()
+    assert long in lines[2] and lines[2].endswith("yes")
+    assert lines[3].endswith("NO") and len({len(line) for line in lines[:4]}) == 1

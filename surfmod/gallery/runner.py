@@ -71,11 +71,14 @@ def run_gallery(outdir, *, progress: bool = True, only=None) -> list[Row]:
 
 
 def format_table(rows: list[Row]) -> str:
-    head = f"{'entity':<34} {'OCCT construct':<42} {'mode':<10} {'max dev':>10}  pass"
+    """Plain-text table, columns as wide as their longest entry (nothing is cut)."""
+    we = max([len("entity"), *(len(r.entity) for r in rows)])
+    wc = max([len("OCCT construct"), *(len(r.construct) for r in rows)])
+    head = f"{'entity':<{we}} {'OCCT construct':<{wc}} {'mode':<10} {'max dev':>10}  pass"
     lines = [head, "-" * len(head)]
     for r in rows:
         lines.append(
-            f"{r.entity:<34.34} {r.construct:<42.42} {r.mode:<10} {r.max_deviation:>10.2e}  {'yes' if r.passed else 'NO'}"
+            f"{r.entity:<{we}} {r.construct:<{wc}} {r.mode:<10} {r.max_deviation:>10.2e}  {'yes' if r.passed else 'NO'}"
             + (f"  ({r.note})" if r.note else "")
         )
     return "\n".join(lines)
