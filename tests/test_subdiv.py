@@ -335,3 +335,18 @@ def test_subdivision_commutes_with_affine_maps(seed, scheme):
     scale = np.abs(v @ a.T + b).max()
     np.testing.assert_allclose(run(v @ a.T + b), run(v) @ a.T + b, atol=1e-13 * scale)
     np.testing.assert_allclose(lim(v @ a.T + b), lim(v) @ a.T + b, atol=1e-13 * scale)
+
+
+def test_loop_matches_trimesh_independent_implementation():
+    # trimesh implements Loop's original rule on closed meshes: same vertex set, same count
+    import trimesh
+    from scipy.spatial import cKDTree
+    from trimesh.remesh import subdivide_loop
+
+    ico = trimesh.creation.icosphere(subdivisions=1)
+    v, f = np.asarray(ico.vertices), np.asarray(ico.faces)
+    ours = sm.loop_subdivide(v, f, levels=2)
+    theirs, their_faces = subdivide_loop(v, f, iterations=2)
+    assert ours.vertices.shape == theirs.shape and ours.faces.shape == their_faces.shape
+    assert cKDTree(theirs).query(ours.vertices)[0].max() < 1e-14
+    assert cKDTree(ours.vertices).query(theirs)[0].max() < 1e-14
