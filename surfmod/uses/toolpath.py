@@ -311,15 +311,20 @@ def _newton_ball(tool, model, cl, best, pid, u, v, iterations=8):
             su = np.where(at_u & at_v, 0.0, su)
             sv = np.where(at_u & at_v, 0.0, sv)
             uu, vv = np.clip(uu + su, u0, u1), np.clip(vv + sv, v0, v1)
-        p = patch.evaluate(uu, vv, 0)[:, 0, 0]
-        h = _heights(tool, cl[sel], p)
-        inside = model.inside[k]
-        if inside is not None:
-            h = np.where(inside(uu, vv), h, -np.inf)
-        better = h > best[sel]
-        idx = sel[better]
-        best[idx], u[idx], v[idx] = h[better], uu[better], vv[better]
+        _keep_higher(tool, model, k, cl, sel, uu, vv, best, u, v)
     return best, u, v
+
+
+def _keep_higher(tool, model, k, cl, sel, uu, vv, best, u, v) -> None:
+    """Where polished contacts ``(uu, vv)`` on patch ``k`` lift the tool higher than the
+    current ``best`` (and lie inside the patch's trim), adopt them, in place."""
+    h = _heights(tool, cl[sel], model.patches[k].evaluate(uu, vv, 0)[:, 0, 0])
+    inside = model.inside[k]
+    if inside is not None:
+        h = np.where(inside(uu, vv), h, -np.inf)
+    better = h > best[sel]
+    idx = sel[better]
+    best[idx], u[idx], v[idx] = h[better], uu[better], vv[better]
 
 
 def _newton_flat_rim(tool, model, cl, best, pid, u, v, iterations=10):
@@ -354,14 +359,7 @@ def _newton_flat_rim(tool, model, cl, best, pid, u, v, iterations=10):
             J[~good] = np.eye(3)
             step = -np.linalg.solve(J, np.where(good[:, None], F, 0.0)[..., None])[..., 0]
             uu, vv, lam = np.clip(uu + step[:, 0], u0, u1), np.clip(vv + step[:, 1], v0, v1), lam + step[:, 2]
-        p = patch.evaluate(uu, vv, 0)[:, 0, 0]
-        h = _heights(tool, cl[sel], p)
-        inside = model.inside[k]
-        if inside is not None:
-            h = np.where(inside(uu, vv), h, -np.inf)
-        better = h > best[sel]
-        idx = sel[better]
-        best[idx], u[idx], v[idx] = h[better], uu[better], vv[better]
+        _keep_higher(tool, model, k, cl, sel, uu, vv, best, u, v)
     return best, u, v
 
 
