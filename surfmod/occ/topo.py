@@ -40,14 +40,22 @@ def wrapped(obj):
     return shape if isinstance(shape, TopoDS_Shape) else None
 
 
+def _single(obj, kind: str):
+    """The ``TopoDS_Shape`` of a build123d or OCP ``kind`` ("Face", "Edge"), else SurfmodError."""
+    from OCP import TopAbs
+
+    shape = wrapped(obj)
+    if shape is None or shape.IsNull() or shape.ShapeType() != getattr(TopAbs, f"TopAbs_{kind.upper()}"):
+        raise SurfmodError(f"{kind.lower()}: expected a build123d {kind} or TopoDS_{kind}, got {type(obj).__name__}")
+    return shape
+
+
 def face_surface(face):
     """``(Geom_Surface, (u0, u1, v0, v1), reversed)`` of a build123d or OCP face."""
     from OCP.BRepTools import BRepTools
-    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
+    from OCP.TopAbs import TopAbs_REVERSED
 
-    shape = wrapped(face)
-    if shape is None or shape.IsNull() or shape.ShapeType() != TopAbs_FACE:
-        raise SurfmodError(f"face: expected a build123d Face or TopoDS_Face, got {type(face).__name__}")
+    shape = _single(face, "Face")
     with kernel("BRep_Tool.Surface_s"):
         f = TopoDS.Face_s(shape)
         surf = BRep_Tool.Surface_s(f)
@@ -57,11 +65,7 @@ def face_surface(face):
 
 def curve_of_edge(edge):
     """``(Geom_Curve, t0, t1)`` of a build123d or OCP edge."""
-    from OCP.TopAbs import TopAbs_EDGE
-
-    shape = wrapped(edge)
-    if shape is None or shape.IsNull() or shape.ShapeType() != TopAbs_EDGE:
-        raise SurfmodError(f"edge: expected a build123d Edge or TopoDS_Edge, got {type(edge).__name__}")
+    shape = _single(edge, "Edge")
     with kernel("BRep_Tool.Curve_s"):
         e = TopoDS.Edge_s(shape)
         curve = BRep_Tool.Curve_s(e, 0.0, 0.0)  # located copy; OCP returns only the curve
