@@ -62,10 +62,7 @@ def pipe_shell(profiles, path, *, mode: str = "frenet", auxiliary=None, contact:
         maker.Build()
         check_done(maker, "BRepOffsetAPI_MakePipeShell")
         shape = maker.Shape()
-    faces = faces_of(shape)
-    if not faces:
-        raise KernelError("BRepOffsetAPI_MakePipeShell: the result has no face")
-    return shape, faces
+    return shape, _faces(shape, "BRepOffsetAPI_MakePipeShell")
 
 
 def thru_sections(sections, *, ruled: bool, tolerance: float = 1e-6):
@@ -79,10 +76,15 @@ def thru_sections(sections, *, ruled: bool, tolerance: float = 1e-6):
         maker.Build()
         check_done(maker, "BRepOffsetAPI_ThruSections")
         shape = maker.Shape()
+    return shape, _faces(shape, "BRepOffsetAPI_ThruSections")
+
+
+def _faces(shape, maker: str):
+    """The faces of a maker's result; a result without any is a kernel failure."""
     faces = faces_of(shape)
     if not faces:
-        raise KernelError("BRepOffsetAPI_ThruSections: the result has no face")
-    return shape, faces
+        raise KernelError(f"{maker}: the result has no face")
+    return faces
 
 
 def _interpolated_law(params, values):
