@@ -57,3 +57,55 @@ def test_crosscheck_of_curves_and_faces(rng):
     s = sm.BezierSurface(rng.uniform(-1, 1, (3, 4, 3)))
     r = sm.crosscheck(s.face())
     assert r.passed and r.mode == "parametric"
+
+
+def _short_span_surface(rng):
+    """A degree-4 x 1 face of a trimmed STEP part (``examples/trim.py``): a span of 0.0045,
+    coordinates near 33 and control points 0.03 apart, so D2 (~50) is a difference of
+    differences over 0.0045^2 and both evaluators round it off at about 1e-8."""
+    ku = [0] * 5 + [0.004504733009621] * 4 + [0.04230871343658] * 5
+    x = np.array([33.003717, 32.972179, 32.940689, 32.909249, 32.877860, 32.614437, 32.354574, 32.098808, 31.847532])
+    y = np.array([18.660630, 18.682972, 18.705315, 18.727657, 18.75, 18.9375, 19.13125, 19.33125, 19.5375])
+    z = np.array([5.770739, 5.768235, 5.765690, 5.763104, 5.760476, 5.738430, 5.712849, 5.684185, 5.652887])
+    bottom = np.stack([x, y, z], axis=-1)
+    top = bottom + [-0.155, -0.09, 0.98]
+    net = np.stack([bottom, top], axis=1) + rng.uniform(-1e-9, 1e-9, (9, 2, 3))
+    return ku, net
+
+
+def test_short_knot_spans_are_judged_against_their_round_off(rng):
+    ku, net = _short_span_surface(rng)
+    s = sm.BSplineSurface(net, (4, 1), (ku, [0, 0, 1, 1]))
+    r = sm.crosscheck(s, samples=64)
+    assert r.passed, r.details
+
+
+class _BentD2(sm.BSplineSurface):
+    """Second u-derivative off by ``bend`` times the surface's own D2 round-off scale x 1e4."""
+
+    bend = 1e-3
+
+    def _derivatives(self, u, v, order):
+        out = np.array(super()._derivatives(u, v, order))
+        if order >= 2:
+            out[:, 2, 0, 2] += self.bend * np.abs(out[:, 2, 0]).max()
+        return out
+
+
+def test_a_wrong_second_derivative_still_fails_on_short_spans(rng):
+    ku, net = _short_span_surface(rng)
+    s = _BentD2._trusted(net, (4, 1), (ku, [0, 0, 1, 1]))
+    r = sm.crosscheck(s, samples=17)
+    assert not r.passed and r.details["d2_rel"] > 1e-6
+
+
+class _TurnedNormal(sm.BezierSurface):
+    def normals(self, u, v):
+        n = super().normals(u, v) + [1e-6, 0, 0]
+        return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def test_a_turned_normal_fails_at_regular_points(rng):
+    s = _TurnedNormal(rng.uniform(-1, 1, (4, 4, 3)))
+    r = sm.crosscheck(s, samples=9)
+    assert not r.passed and r.details["normal_conditioned"] > 1e-7
