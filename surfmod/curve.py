@@ -16,7 +16,17 @@ from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translatio
 
 
 class Curve(abc.ABC):
-    """Base of every parametric curve in surfmod."""
+    """Base of every parametric curve in surfmod.
+
+    Curves evaluate like surfaces, vectorized over the parameter:
+
+    >>> import surfmod as sm
+    >>> c = sm.BezierCurve([(0, 0, 0), (1, 2, 0), (2, 0, 0)])
+    >>> c.points([0.0, 0.5, 1.0])
+    array([[0., 0., 0.],
+           [1., 1., 0.],
+           [2., 0., 0.]])
+    """
 
     exact_in_occt: bool = True
     occt_construct: str = "Geom_Curve"

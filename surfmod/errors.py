@@ -22,4 +22,11 @@ class SurfmodError(ValueError):
 
 
 class KernelError(SurfmodError):
-    """OpenCASCADE refused or failed an operation; the message says which one."""
+    """OpenCASCADE refused or failed an operation; the message says which one.
+
+    Like :class:`SurfmodError` it is a ``ValueError``, so one ``except`` catches both:
+
+    >>> import surfmod as sm
+    >>> issubclass(sm.KernelError, sm.SurfmodError) and issubclass(sm.KernelError, ValueError)
+    True
+    """

@@ -22,6 +22,11 @@ class Surface(abc.ABC):
 
     Parameters broadcast like NumPy ufunc arguments; results carry the broadcast shape
     in front of their own trailing axes.
+
+    >>> import surfmod as sm
+    >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
+    >>> s.points([0.0, 0.5], [[0.0], [1.0]]).shape    # (2, 1) x (2,) -> (2, 2)
+    (2, 2, 3)
     """
 
     #: True when ``geom()`` is the exact OCCT counterpart with the same parametrization.

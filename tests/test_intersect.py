@@ -169,7 +169,9 @@ def test_quadrics_closed_forms():
     """Sphere and torus (analytic, periodic): plane sections are circles of known length,
     the pole of the sphere is one line hit, not one per meridian."""
     sphere = sm.sphere(2.0)
-    [c] = sm.intersect(sphere, ((0, 0, 1), (0, 0, 1)))  # open at the seam u = 0 / 2 pi
+    [c] = sm.intersect(sphere, ((0, 0, 1), (0, 0, 1)))  # leaves and re-enters through the seam
+    assert c.closed and np.linalg.norm(c.points[0] - c.points[-1]) < 1e-9
+    assert {round(c.uv_a[0, 0] % (2 * np.pi), 9), round(c.uv_a[-1, 0] % (2 * np.pi), 9)} == {0.0}
     assert c.length == pytest.approx(2 * np.pi * np.sqrt(3), rel=1e-7)
     assert np.abs(np.linalg.norm(c.points, axis=1) - 2).max() < 1e-12
     assert np.abs(c.points[:, 2] - 1).max() < 1e-12

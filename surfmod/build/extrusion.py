@@ -33,7 +33,13 @@ def curve_plane_normal(curve: Curve, name: str = "curve"):
 
 
 class TabulatedCylinder(Surface):
-    """``Geom_SurfaceOfLinearExtrusion``: ``C(u) + v D``.  Build with :func:`tabulated_cylinder`."""
+    """``Geom_SurfaceOfLinearExtrusion``: ``C(u) + v D``.  Build with :func:`tabulated_cylinder`.
+
+    >>> import surfmod as sm
+    >>> s = sm.tabulated_cylinder(sm.Circle((0, 0, 0), (0, 0, 1), 2.0), (0, 0, 1), 5.0)
+    >>> [round(float(x), 12) for x in s.points(0.0, 5.0)]
+    [2.0, 0.0, 5.0]
+    """
 
     occt_construct = "Geom_SurfaceOfLinearExtrusion"
 

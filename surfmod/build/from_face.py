@@ -76,7 +76,13 @@ def from_face(face):
 
 def from_edge(edge):
     """A surfmod curve for a build123d ``Edge``/``Wire`` or OCP edge (exact B-spline form
-    of the edge's 3-D curve over its parameter range)."""
+    of the edge's 3-D curve over its parameter range).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> c = sm.from_edge(bd.Edge.make_line((0, 0, 0), (3, 4, 0)))
+    >>> c.points(c.domain[1])
+    array([3., 4., 0.])
+    """
     from ..nets.bspline import BSplineCurve
     from ..occ.geom import read_bspline_curve
     from ..occ.topo import shape_bspline

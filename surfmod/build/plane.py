@@ -15,6 +15,11 @@ class PlaneSurface(BSplineSurface):
     OCCT's ``Geom_Plane`` is parametrized by an orthonormal frame, so it matches
     ``P0 + u(P1-P0) + v(P2-P0)`` only for orthonormal edge vectors; the degree-1
     ``Geom_BSplineSurface`` matches it for any three points.
+
+    >>> import surfmod as sm
+    >>> p = sm.plane((0, 0, 0), (2, 0, 0), (1, 1, 0))   # skewed edges: still exact
+    >>> p.points(0.5, 1.0)
+    array([2., 1., 0.])
     """
 
     occt_construct = "Geom_BSplineSurface (degree 1 x 1)"

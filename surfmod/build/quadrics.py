@@ -38,7 +38,14 @@ class Ellipsoid(BSplineSurface):
     """``(x/rx)^2 + (y/ry)^2 + (z/rz)^2 = 1`` about ``center``, as an exact rational
     B-spline (degree 2 x 2, 9 x 5 control points): the NURBS unit sphere (u around z,
     v from the south to the north pole) scaled by ``(rx, ry, rz)``.  OCCT counterpart:
-    ``Geom_BSplineSurface`` with the same poles, weights and knots."""
+    ``Geom_BSplineSurface`` with the same poles, weights and knots.
+
+    >>> import surfmod as sm, numpy as np
+    >>> e = sm.ellipsoid(3, 2, 1)
+    >>> p = e.grid(np.linspace(0, 1, 5), np.linspace(0, 1, 5))
+    >>> bool(np.allclose((p[..., 0] / 3) ** 2 + (p[..., 1] / 2) ** 2 + p[..., 2] ** 2, 1))
+    True
+    """
 
     occt_construct = "Geom_BSplineSurface (rational, exact ellipsoid)"
 

@@ -82,7 +82,14 @@ def axis_plane_check(profile: Curve, origin, axis, name="profile", samples: int 
 
 class RevolutionSurface(Surface):
     """``Geom_SurfaceOfRevolution``: u = rotation angle (radians) over ``u_range``,
-    v = the profile's own parameter.  Build with :func:`revolution`."""
+    v = the profile's own parameter.  Build with :func:`revolution`.
+
+    >>> import surfmod as sm, numpy as np
+    >>> cone = sm.revolution(sm.Line((1, 0, 0), (0, 0, 1)), (0, 0, 0), (0, 0, 1))
+    >>> v_mid = cone.domain[1][1] / 2   # the line's parameter is its arc length
+    >>> [round(float(x), 12) + 0.0 for x in cone.points(np.pi / 2, v_mid)]   # a quarter turn
+    [0.0, 0.5, 0.5]
+    """
 
     occt_construct = "Geom_SurfaceOfRevolution"
 

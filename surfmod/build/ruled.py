@@ -34,7 +34,13 @@ def _occt_weights(c: BSplineCurve):
 
 class RuledSurface(BSplineSurface):
     """A ruled B-spline surface of degree ``(p, 1)``; ``g`` and ``q`` are the two
-    compatible boundary curves (``v = 0`` and ``v = 1``).  Build with :func:`ruled`."""
+    compatible boundary curves (``v = 0`` and ``v = 1``).  Build with :func:`ruled`.
+
+    >>> import surfmod as sm
+    >>> s = sm.ruled(sm.Line((0, 0, 0), (1, 0, 0)), sm.Line((0, 1, 1), (1, 1, 1)))
+    >>> s.degree, s.points(0.5, 0.5)
+    ((1, 1), array([0.5, 0.5, 0.5]))
+    """
 
     occt_construct = "Geom_BSplineSurface (GeomFill ruled, degree p x 1)"
 

@@ -13,7 +13,13 @@ import numpy as np
 
 
 class Curvatures(NamedTuple):
-    """Gaussian and mean curvature and the principal curvatures ``k1 >= k2``."""
+    """Gaussian and mean curvature and the principal curvatures ``k1 >= k2``.
+
+    >>> import surfmod as sm
+    >>> c = sm.sphere(2.0).curvatures(0.3, 0.2)
+    >>> [round(abs(float(x)), 12) for x in c]   # sphere: K = 1/r^2, |H| = |k1| = |k2| = 1/r
+    [0.25, 0.5, 0.5, 0.5]
+    """
 
     gaussian: np.ndarray
     mean: np.ndarray

@@ -48,7 +48,14 @@ def export_step(objects, path) -> None:
 
 
 def import_step(path):
-    """Read a STEP file as a build123d shape (``Compound``/``Solid``/…)."""
+    """Read a STEP file as a build123d shape (``Compound``/``Solid``/…).
+
+    >>> import surfmod as sm, tempfile, os
+    >>> path = os.path.join(tempfile.mkdtemp(), "p.step")
+    >>> sm.export_step(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), path)
+    >>> len(sm.import_step(path).faces())
+    1
+    """
     import os
 
     import build123d as bd

@@ -80,6 +80,11 @@ class IsoCurves:
 
     ``exact`` says the curves are B-splines equal to the surface's iso-curves (B-spline
     surfaces); otherwise they are :class:`IsoCurve` objects evaluating the surface.
+
+    >>> import surfmod as sm
+    >>> iso = sm.isocurves(sm.BezierSurface([[(0, 0, 0), (0, 1, 0)], [(1, 0, 0), (1, 1, 1)]]), 3, 2)
+    >>> iso.exact, len(iso.u_curves), len(iso.v_curves)
+    (True, 3, 2)
     """
 
     surface: Surface

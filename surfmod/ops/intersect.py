@@ -98,6 +98,11 @@ class IntersectionCurve:
     coordinates in the plane's frame ``plane_frame``), unit ``tangents (N, 3)`` along the
     polyline, ``closed`` when the curve is a loop (then the last point repeats the
     first).
+
+    >>> import surfmod as sm, numpy as np
+    >>> (c,) = sm.intersect(sm.sphere(2.0), ((0, 0, 0), (0, 0, 1)))   # sphere x equator plane
+    >>> c.closed, bool(np.allclose(np.linalg.norm(c.points, axis=1), 2.0))
+    (True, True)
     """
 
     points: np.ndarray

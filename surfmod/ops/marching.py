@@ -155,7 +155,12 @@ def trace(problem, x0, h: float, max_angle: float, max_points: int = 20000):
     if closed:
         return branches[0], True
     back, fwd = branches
-    return np.concatenate([back[::-1], fwd[1:]]), False
+    X = np.concatenate([back[::-1], fwd[1:]])
+    # on a periodic surface a loop leaves through the seam and comes back through it:
+    # both ends lie on the domain boundary at one point in space
+    ends = problem.evaluate(X[[0, -1]])[2]
+    seam_loop = len(X) > 3 and np.linalg.norm(ends[0] - ends[1]) <= 10 * problem.tolerance
+    return X, bool(seam_loop)
 
 
 def segment_distances(points, polyline):

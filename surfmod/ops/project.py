@@ -20,7 +20,13 @@ from ..surface import Surface
 
 
 class Projection(NamedTuple):
-    """Closest points: parameters ``u``, ``v``, the surface ``point`` and the ``distance``."""
+    """Closest points: parameters ``u``, ``v``, the surface ``point`` and the ``distance``.
+
+    >>> import surfmod as sm
+    >>> pr = sm.project([(0, 0, 5)], sm.sphere(2.0))
+    >>> [round(float(x), 12) for x in (pr.distance[0], pr.point[0][2])]
+    [3.0, 2.0]
+    """
 
     u: np.ndarray
     v: np.ndarray

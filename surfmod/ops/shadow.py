@@ -54,6 +54,11 @@ class Shadow:
     ``area``: the shadow's area (from the outline loops); ``complete`` is False when
     some outline pieces could not be chained into closed loops (then ``outline`` and
     ``area`` are partial; this happens at grazing light on wavy surfaces).
+
+    >>> import surfmod as sm, numpy as np
+    >>> sh = sm.shadow(sm.sphere(1.0).translated((0, 0, 3)), (0, 0, -1), ((0, 0, 0), (0, 0, 1)))
+    >>> sh.complete, bool(abs(sh.area - np.pi) < 1e-3)   # a disc of radius 1
+    (True, True)
     """
 
     outline: list

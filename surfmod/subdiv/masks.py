@@ -30,7 +30,15 @@ from . import topology as tp
 class LimitPoints(NamedTuple):
     """Limit positions ``(V, 3)``, unit normals ``(V, 3)`` and the two tangent vectors
     ``(V, 2, 3)`` of every cage vertex (NaN normals/tangents where the limit surface has
-    no tangent plane given by the mask: boundary, crease and corner vertices)."""
+    no tangent plane given by the mask: boundary, crease and corner vertices).
+
+    >>> import surfmod as sm, numpy as np
+    >>> v = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    >>> quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    >>> lp = sm.catmull_clark_limit(v, quads)
+    >>> lp.positions.shape, bool(np.allclose(np.abs(lp.positions), np.abs(lp.positions[0])))   # symmetric
+    ((8, 3), True)
+    """
 
     positions: np.ndarray
     normals: np.ndarray

@@ -26,8 +26,15 @@ class FEMesh:
     ``order=2``), ``quality`` gmsh's element-quality statistics (scaled Jacobian
     ``minSJ`` (1 for every straight-sided element, informative for ``order=2``),
     signed inverse condition number ``minSICN`` and inscribed/circumscribed radius
-    ratio ``gamma``: min, mean, max each) plus ``measure``, the total volume (area for
-    surface meshes) of the elements as gmsh integrates them, curved sides included."""
+    ratio ``gamma``: min, mean, max each) plus ``quality["measure"]``, the total volume
+    (area for surface meshes) of the elements as gmsh integrates them, curved sides
+    included.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> fe = sm.fe_mesh(bd.Box(2, 2, 2), size=1.0)
+    >>> round(fe.quality["measure"], 9), fe.kind
+    (8.0, 'volume')
+    """
 
     mesh: object = field(repr=False)
     kind: str

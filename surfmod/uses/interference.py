@@ -19,6 +19,11 @@ class Interference:
     points ``point_a``/``point_b``; ``contact`` is True when the parts touch
     (distance ≤ ``tolerance``) without overlapping volume; ``interferes`` when the
     overlap volume exceeds ``tolerance`` times the smaller part's volume.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> r = sm.interference(bd.Box(2, 2, 2), bd.Pos(1.5, 0, 0) * bd.Box(2, 2, 2))
+    >>> round(r.overlap_volume, 9), r.interferes
+    (2.0, True)
     """
 
     overlap_volume: float

@@ -47,6 +47,11 @@ class MassProperties:
     ``evaluators`` says how many faces used the NumPy evaluator vs. OCCT sampling.
     ``error_estimate`` is the relative change of the volume between the requested
     quadrature order and a lower one.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> m = sm.mass_properties(bd.Box(1, 2, 3))
+    >>> round(m.volume, 12), round(m.area, 12)
+    (6.0, 22.0)
     """
 
     volume: float

@@ -37,6 +37,11 @@ class Section:
     ``closed`` says which wires close up.  The plane frame is ``origin`` with axes
     ``x_axis``, ``y_axis`` and ``normal``; :meth:`polylines_2d` gives the curves in it.
     An empty section (the plane misses the part) has no wires.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> sec = sm.section(bd.Box(2, 2, 2), (0, 0, 0), (0, 0, 1))
+    >>> len(sec.wires), sec.closed
+    (1, [True])
     """
 
     origin: np.ndarray

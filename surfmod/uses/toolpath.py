@@ -78,6 +78,12 @@ class Toolpath:
     cutter-contact points on the surface; ``pass_index`` ``(N,)``: raster pass of each
     point (-1 on links); ``gouge``: deepest penetration of the tool into an
     independent dense sample of the exact surface (≤ 0 means none found).
+
+    >>> import surfmod as sm
+    >>> flat = sm.plane((0, 0, 0), (10, 0, 0), (0, 10, 0))
+    >>> tp = sm.toolpath(flat, sm.Tool("ball", 1.0), stepover=1.0)
+    >>> float(tp.points[:, 2].min()), tp.gouge <= 0   # the ball's tip rides on z = 0
+    (0.0, True)
     """
 
     points: np.ndarray = field(repr=False)
