@@ -27,16 +27,17 @@ def surface_quotient(hders: np.ndarray) -> np.ndarray:
     """``(..., K, K, 4)`` homogeneous mixed partials -> ``(..., K, K, 3)`` Cartesian ones.
 
     Every entry of the square is exact (also ``k + l > K - 1``), as the rule needs only
-    lower entries of the same square.  The work is done on planes: the derivative axes are
-    moved to the front once, so every arithmetic step runs over one contiguous array of
-    points; the result is the matching moved-axis view (same shape, planar memory).
+    lower entries of the same square.  The work is done on planes: with the derivative
+    axes moved to the front, every arithmetic step runs over one array of points, which
+    is fast when the points are the contiguous axis (the layout of the scattered and the
+    planar grid evaluators); the result is the matching moved-axis view.
     """
     order = hders.shape[-2] - 1
     if order == 0:  # positions only: one division, the common (and large-grid) case
         return hders[..., :3] / hders[..., 3:4]
-    planes = np.ascontiguousarray(np.moveaxis(hders, (-3, -2, -1), (0, 1, 2)))  # (K, K, 4, ...)
+    planes = np.moveaxis(hders, (-3, -2, -1), (0, 1, 2))  # (K, K, 4, ...)
     a, w = planes[:, :, :3], planes[:, :, 3:4]
-    out = np.empty_like(a)
+    out = np.empty(a.shape)
     inv_w0 = 1.0 / w[0, 0]
     for k in range(order + 1):
         for l in range(order + 1):

@@ -231,8 +231,9 @@ class BSplineSurface(Surface):
         (p, q), (ku, kv) = self.degree, self.knots
         if self.rational and order == 0:
             return rational_grid_positions(ku, p, kv, q, self._h, us, vs)[:, :, None, None, :]
-        h = surface_grid(ku, p, kv, q, self._h, us, vs, order)
-        return surface_quotient(h) if self.rational else h
+        if self.rational:
+            return surface_quotient(surface_grid(ku, p, kv, q, self._h, us, vs, order, planar=True))
+        return surface_grid(ku, p, kv, q, self._h, us, vs, order)
 
     def geom(self):
         from ..occ.geom import bspline_surface
