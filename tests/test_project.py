@@ -147,3 +147,45 @@ def test_sphere_closed_form():
     pr = sm.project(pts, s)
     np.testing.assert_allclose(pr.distance, np.abs(np.linalg.norm(pts, axis=1) - 2), atol=1e-12)
     np.testing.assert_allclose(pr.point, 2 * pts / np.linalg.norm(pts, axis=1, keepdims=True), atol=1e-12)
+
+
+def _stretched_height_field(seed):
+    """A height field with random degrees, knots and weights over two decades: weights
+    stretch the parametrization, so equal parameter steps are very unequal in space."""
+    rng = np.random.default_rng(seed)
+    p, q = (int(d) for d in rng.integers(1, 5, 2))
+    n, m = p + int(rng.integers(1, 6)), q + int(rng.integers(1, 6))
+
+    def knots(count, degree):
+        return np.concatenate([[0] * (degree + 1), np.sort(rng.uniform(0, 1, count - degree - 1)), [1] * (degree + 1)])
+
+    x, y = np.meshgrid(np.linspace(0, 4, n), np.linspace(0, 3, m), indexing="ij")
+    net = np.stack([x, y, rng.uniform(-1, 1, (n, m))], -1)
+    w = 10.0 ** rng.uniform(-1, 1, (n, m)) if rng.random() < 0.8 else None
+    s = sm.BSplineSurface(net, (p, q), (knots(n, p), knots(m, q)), w)
+    uv = np.c_[rng.uniform(0, 1, 20), rng.uniform(0, 1, 20)]
+    pts = s.points(uv[:, 0], uv[:, 1]) + s.normals(uv[:, 0], uv[:, 1]) * rng.uniform(-0.3, 0.3, (20, 1))
+    return s, pts
+
+
+@pytest.mark.parametrize("seed", [518, 686, 1526, 1908, 2354])
+def test_stretched_parametrizations_find_the_global_minimum(seed):
+    # cases where seeds from an even parameter grid, or only from the nearest triangles
+    # (all in one flat valley), ended in a local minimum farther than OCCT's answer
+    s, pts = _stretched_height_field(seed)
+    pr = sm.project(pts, s)
+    theirs = occ.project_points(s.geom(), _bounds(s), pts)
+    ok = np.isfinite(theirs[:, 2])
+    assert np.all(pr.distance[ok] <= theirs[ok, 2] + 1e-12)
+
+
+def test_newton_carries_on_across_a_crease():
+    # two flat pieces meeting at a C0 crease (degree 1, knot u = 0.5): a start in the
+    # first piece reaches the foot of the perpendicular in the second
+    from surfmod.ops.project import newton_closest
+
+    net = np.array([[[0, 0, 0], [0, 1, 0]], [[1, 0, 0.5], [1, 1, 0.5]], [[2, 0, 0.5], [2, 1, 0.5]]], float)
+    s = sm.BSplineSurface(net, (1, 1), ([0, 0, 0.5, 1, 1], [0, 0, 1, 1]))
+    target = np.array([[1.6, 0.5, 1.5]])
+    u, v = newton_closest(s, target, np.array([0.2]), np.array([0.5]))
+    np.testing.assert_allclose(s.points(u, v), [[1.6, 0.5, 0.5]], atol=1e-12)

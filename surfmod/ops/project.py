@@ -1,11 +1,14 @@
 """Closest-point projection of many points (or a sampled curve) onto a surface.
 
-Vectorized over all points at once: every point starts from its few nearest samples of
-a parameter grid (a grid that resolves every knot span), then a projected Newton
-iteration on ``f(u, v) = |S(u, v) - P|^2 / 2`` runs on all starts together.  The domain
-is a box constraint: a parameter at its bound whose gradient points outward is held
-there and the other one is solved alone (the constrained step), so points whose closest
-point lies on an edge or at a corner converge too.  The best start wins.
+Vectorized over all points at once: every point starts from the nearest triangles of a
+sampled grid (resolving every knot span, evenly spaced in chord length) and from the
+valley bottoms of its sampled distance; then a projected Newton iteration on
+``f(u, v) = |S(u, v) - P|^2 / 2`` runs on all starts together.  The domain is a box
+constraint: a parameter at its bound whose gradient points outward is held there and the
+other one is solved alone (the constrained step), so points whose closest point lies on
+an edge or at a corner converge too; a start stopped on a C0 crease with the distance
+still falling across it carries on in the next piece.  The best start wins.  The
+seeding is a dense sampling, not a proof of global optimality.
 """
 
 from __future__ import annotations
@@ -65,70 +68,69 @@ def nearest_samples(points: np.ndarray, samples: np.ndarray, count: int, chunk: 
     return out
 
 
-def nearest_triangles(points, tri_pts, count: int, chunk: int = 1_000_000):
-    """For each point the ``count`` grid triangles whose (approximate) closest point is
-    nearest: ``(idx (N, count), barycentric (N, count, 3))``.  The closest point of a
-    triangle is its plane projection with barycentric coordinates clipped to the
-    triangle (exact inside, a good seed near edges)."""
-    a, b, c = tri_pts[:, 0], tri_pts[:, 1], tri_pts[:, 2]
-    e0, e1 = b - a, c - a
-    d00, d01, d11 = (np.einsum("ij,ij->i", x, y) for x, y in ((e0, e0), (e0, e1), (e1, e1)))
-    det = np.maximum(d00 * d11 - d01**2, 1e-300)
-    count = min(count, len(tri_pts))
-    idx = np.empty((len(points), count), dtype=int)
-    bary = np.empty((len(points), count, 3))
-    step = max(1, chunk // max(1, len(tri_pts)))
-    for s0 in range(0, len(points), step):  # memory chunks, not points
-        p = points[s0 : s0 + step]
-        r = p[:, None, :] - a[None]
-        r0, r1 = np.einsum("ntj,tj->nt", r, e0), np.einsum("ntj,tj->nt", r, e1)
-        beta = np.clip((d11 * r0 - d01 * r1) / det, 0, 1)
-        gamma = np.clip((d00 * r1 - d01 * r0) / det, 0, 1)
-        tot = beta + gamma
-        over = tot > 1
-        safe = np.where(over, tot, 1.0)
-        beta, gamma = beta / safe, gamma / safe
-        q = a[None] + beta[..., None] * e0[None] + gamma[..., None] * e1[None]
-        d2 = np.einsum("ntj,ntj->nt", q - p[:, None], q - p[:, None])
-        best = np.argpartition(d2, count - 1, axis=1)[:, :count] if count < d2.shape[1] else np.argsort(d2, axis=1)
-        rows = np.arange(len(p))[:, None]
-        idx[s0 : s0 + step] = best
-        bg = np.stack([beta[rows, best], gamma[rows, best]], axis=-1)
-        bary[s0 : s0 + step] = np.concatenate([1 - bg.sum(-1, keepdims=True), bg], axis=-1)
-    return idx, bary
+def crease_breaks(s: Surface, direction: int) -> np.ndarray:
+    """Domain ends and the C0 knot lines (multiplicity >= degree) between them.
 
-
-def crease_boxes(s: Surface, direction: int, t: np.ndarray):
-    """Per-parameter bounds ``(lo, hi)``: the piece between C0 knot lines (multiplicity
-    >= degree) that holds ``t``.  Across such a crease the distance has a kink that
-    Newton cannot settle on, so each start works in its own smooth piece and a minimum on
-    the crease becomes a constrained (boundary) minimum."""
+    Across such a crease the distance has a kink that Newton cannot settle on, so each
+    start works in its own smooth piece between two breaks; a minimum on the crease then
+    becomes a constrained (boundary) minimum of the piece.
+    """
     lo, hi = s.domain[direction]
     knots, degree = getattr(s, "knots", None), getattr(s, "degree", None)
     if knots is None or degree is None:
-        return np.full(t.shape, lo), np.full(t.shape, hi)
+        return np.array([lo, hi])
     values, mult = np.unique(np.asarray(knots[direction]), return_counts=True)
     creases = values[(mult >= degree[direction]) & (values > lo) & (values < hi)]
-    breaks = np.concatenate([[lo], creases, [hi]])
-    piece = np.clip(np.searchsorted(breaks, t, side="right") - 1, 0, len(breaks) - 2)
-    return breaks[piece], breaks[piece + 1]
+    return np.concatenate([[lo], creases, [hi]])
+
+
+def _piece_of(breaks: np.ndarray, t: np.ndarray) -> np.ndarray:
+    return np.clip(np.searchsorted(breaks, t, side="right") - 1, 0, len(breaks) - 2)
 
 
 def newton_closest(s: Surface, points: np.ndarray, u: np.ndarray, v: np.ndarray, iterations: int = 60):
     """Projected Newton on ``|S - P|^2 / 2`` from starts ``(u, v)`` (flat arrays, one per
-    point row of ``points``), each kept inside its smooth piece (:func:`crease_boxes`).
-    Returns refined ``(u, v)``."""
+    point row of ``points``), each kept inside its smooth piece (:func:`crease_breaks`).
+
+    A start that stops on a crease while the distance still falls across it carries on
+    in the neighbouring piece, so a minimum beyond a crease is reached and a minimum on
+    a crease is one from both sides.  Returns refined ``(u, v)``.
+    """
+    u, v = u.astype(float).copy(), v.astype(float).copy()
+    breaks_u, breaks_v = crease_breaks(s, 0), crease_breaks(s, 1)
+    piece_u, piece_v = _piece_of(breaks_u, u), _piece_of(breaks_v, v)
+    todo = np.arange(u.size)
+    for _ in range(len(breaks_u) + len(breaks_v)):  # each crossing moves one piece on
+        box = (breaks_u[piece_u[todo]], breaks_u[piece_u[todo] + 1], breaks_v[piece_v[todo]], breaks_v[piece_v[todo] + 1])
+        u[todo], v[todo] = _newton_in_boxes(s, points[todo], u[todo], v[todo], box, iterations)
+        d = s._derivatives(u[todo], v[todo], 1)
+        r = d[:, 0, 0] - points[todo]
+        gu, gv = np.einsum("ij,ij->i", r, d[:, 1, 0]), np.einsum("ij,ij->i", r, d[:, 0, 1])
+        # descent leaves the piece through an interior crease: step into the next piece
+        down_u = (u[todo] <= box[0]) & (gu > 0) & (piece_u[todo] > 0)
+        up_u = (u[todo] >= box[1]) & (gu < 0) & (piece_u[todo] < len(breaks_u) - 2)
+        down_v = (v[todo] <= box[2]) & (gv > 0) & (piece_v[todo] > 0)
+        up_v = (v[todo] >= box[3]) & (gv < 0) & (piece_v[todo] < len(breaks_v) - 2)
+        piece_u[todo] += up_u.astype(int) - down_u.astype(int)
+        piece_v[todo] += up_v.astype(int) - down_v.astype(int)
+        todo = todo[down_u | up_u | down_v | up_v]
+        if todo.size == 0:
+            break
+    return u, v
+
+
+def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
+    """The projected Newton iteration, each start confined to its box ``(u0, u1, v0, v1)``."""
     (du0, du1), (dv0, dv1) = s.domain
     spanu, spanv = du1 - du0, dv1 - dv0
-    u, v = u.astype(float).copy(), v.astype(float).copy()
-    box_u, box_v = crease_boxes(s, 0, u), crease_boxes(s, 1, v)
+    u, v = u.copy(), v.copy()
     active = np.ones(u.shape, bool)
     for _ in range(iterations):
         idx = np.nonzero(active)[0]
         if idx.size == 0:
             break
         uu, vv, pp = u[idx], v[idx], points[idx]
-        u0, u1, v0, v1 = box_u[0][idx], box_u[1][idx], box_v[0][idx], box_v[1][idx]
+        u0, u1, v0, v1 = (bound[idx] for bound in box)
         d = s._derivatives(uu, vv, 2)
         S, Su, Sv = d[:, 0, 0], d[:, 1, 0], d[:, 0, 1]
         r = S - pp
@@ -175,23 +177,112 @@ def newton_closest(s: Surface, points: np.ndarray, u: np.ndarray, v: np.ndarray,
     return u, v
 
 
-def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
-    """``(u, v, point, distance)`` flat arrays for ``(N, 3)`` points (trusted input)."""
+def _even_chords(t: np.ndarray, chords: np.ndarray) -> np.ndarray:
+    """As many parameters as ``t`` whose steps have equal cumulative chord length."""
+    arc = np.concatenate([[0.0], np.cumsum(chords)])
+    if not arc[-1] > 0:
+        return t
+    return np.interp(np.linspace(0.0, arc[-1], len(t)), arc, t)
+
+
+def seed_grid(s: Surface):
+    """Seed parameters ``(us, vs)`` and their grid points.
+
+    The knot-based samples of :func:`seed_parameters` are moved to equal steps of chord
+    length (the longest chord across the other direction) and the knots added back, so
+    that stretched regions -- strongly varying weights, long spans -- are sampled as
+    finely in space as the rest; otherwise a coarse triangle there may hide the closest
+    point.
+    """
     us, vs = seed_parameters(s, 0), seed_parameters(s, 1)
     g = s.grid(us, vs)
-    uu, vv = np.meshgrid(us, vs, indexing="ij")
-    # two triangles per grid cell, with their corner parameters
-    i, j = np.meshgrid(np.arange(len(us) - 1), np.arange(len(vs) - 1), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    ij = lambda a, b: np.stack([a, b], axis=-1)  # noqa: E731
-    corners = np.concatenate(
-        [np.stack([ij(i, j), ij(i + 1, j), ij(i + 1, j + 1)], 1), np.stack([ij(i, j), ij(i + 1, j + 1), ij(i, j + 1)], 1)], 0
-    )
-    tri_pts = g[corners[:, :, 0], corners[:, :, 1]]  # (T, 3 corners, 3)
-    tri_uv = np.stack([uu[corners[:, :, 0], corners[:, :, 1]], vv[corners[:, :, 0], corners[:, :, 1]]], -1)
-    near, bary = nearest_triangles(points, tri_pts, seeds)  # (N, K), (N, K, 3)
-    k = near.shape[1]
-    start = np.einsum("nkc,nkcd->nkd", bary, tri_uv[near])
+    chords_u = np.linalg.norm(np.diff(g, axis=0), axis=-1).max(axis=1)
+    chords_v = np.linalg.norm(np.diff(g, axis=1), axis=-1).max(axis=0)
+    us = np.unique(np.concatenate([_even_chords(us, chords_u), _knots_inside(s, 0)]))
+    vs = np.unique(np.concatenate([_even_chords(vs, chords_v), _knots_inside(s, 1)]))
+    return us, vs, s.grid(us, vs)
+
+
+def _knots_inside(s: Surface, direction: int) -> np.ndarray:
+    knots = getattr(s, "knots", None)
+    if knots is None:
+        return np.empty(0)
+    lo, hi = s.domain[direction]
+    k = np.asarray(knots[direction])
+    return k[(k >= lo) & (k <= hi)]
+
+
+def seed_starts(points, us, vs, g, seeds: int, chunk: int = 1 << 21) -> np.ndarray:
+    """Newton starts ``(N, seeds + seeds // 2, 2)`` in (u, v) for each point.
+
+    The grid ``g`` is split into two triangles per cell.  For every point and triangle the
+    closest point of the triangle's plane, its barycentric coordinates clipped to the
+    triangle (exact inside, a good seed near edges), and the squared distance to it are
+    formed from three GEMMs (``p.a``, ``p.e0``, ``p.e1``) and elementwise work, so a
+    block of points against all triangles costs a few passes over one array.  Starts:
+    the ``seeds`` nearest triangles, entered at those points; and the bottoms of the
+    deepest valleys of the sampled distance (samples no farther than their eight
+    neighbours), because in a nearly flat valley all nearest triangles sit in one basin.
+    """
+    nu, nv = g.shape[:2]
+    i, j = (x.ravel() for x in np.meshgrid(np.arange(nu - 1), np.arange(nv - 1), indexing="ij"))
+    tri_i = np.concatenate([np.stack([i, i + 1, i + 1], 1), np.stack([i, i + 1, i], 1)])
+    tri_j = np.concatenate([np.stack([j, j, j + 1], 1), np.stack([j, j + 1, j + 1], 1)])
+    a, e0, e1 = g[tri_i[:, 0], tri_j[:, 0]], g[tri_i[:, 1], tri_j[:, 1]], g[tri_i[:, 2], tri_j[:, 2]]
+    e0, e1 = e0 - a, e1 - a
+    d00, d01, d11 = (np.einsum("ij,ij->i", x, y) for x, y in ((e0, e0), (e0, e1), (e1, e1)))
+    det = np.maximum(d00 * d11 - d01**2, 1e-300)
+    ae0, ae1, aa = (np.einsum("ij,ij->i", a, x) for x in (e0, e1, a))
+    flat = g.reshape(-1, 3)
+    ss = np.einsum("ij,ij->i", flat, flat)
+    n_basins = max(2, seeds // 2)
+    k = min(seeds, len(a))
+    out = np.empty((len(points), seeds + n_basins, 2))
+    step = max(1, chunk // len(a))
+    for c0 in range(0, len(points), step):  # memory blocks, not points
+        p = points[c0 : c0 + step]
+        rows = np.arange(len(p))[:, None]
+        pp = np.einsum("ij,ij->i", p, p)[:, None]
+        r0 = p @ e0.T - ae0  # (p - a).e0
+        r1 = p @ e1.T - ae1
+        beta = np.clip((d11 * r0 - d01 * r1) / det, 0, 1)
+        gamma = np.clip((d00 * r1 - d01 * r0) / det, 0, 1)
+        over = np.maximum(beta + gamma, 1.0)
+        beta /= over
+        gamma /= over
+        # |a + beta e0 + gamma e1 - p|^2, expanded
+        dist = aa - 2 * (p @ a.T) + pp
+        dist += beta * (beta * d00 - 2 * r0) + gamma * (gamma * d11 - 2 * r1) + 2 * beta * gamma * d01
+        best = np.argpartition(dist, k - 1, axis=1)[:, :k] if k < len(a) else np.argsort(dist, axis=1)
+        b, gm = beta[rows, best], gamma[rows, best]
+        w = np.stack([1 - b - gm, b, gm], axis=-1)  # (n, k, 3) weights of the corners
+        out[c0 : c0 + step, :k, 0] = np.einsum("nkc,nkc->nk", w, us[tri_i[best]])
+        out[c0 : c0 + step, :k, 1] = np.einsum("nkc,nkc->nk", w, vs[tri_j[best]])
+        out[c0 : c0 + step, k:seeds] = out[c0 : c0 + step, :1]
+        # valley bottoms of the sampled distance
+        d2 = (ss[None, :] - 2 * p @ flat.T).reshape(len(p), nu, nv)
+        ring = np.pad(d2, ((0, 0), (1, 1), (1, 1)), constant_values=np.inf)
+        bottom = np.ones(d2.shape, dtype=bool)
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                if di or dj:
+                    bottom &= d2 <= ring[:, 1 + di : 1 + di + nu, 1 + dj : 1 + dj + nv]
+        score = np.where(bottom, d2, np.inf).reshape(len(p), -1)
+        m = min(n_basins, score.shape[1])
+        deep = np.argpartition(score, m - 1, axis=1)[:, :m] if m < score.shape[1] else np.argsort(score, axis=1)
+        nearest = np.argmin(d2.reshape(len(p), -1), axis=1)
+        deep = np.where(np.isfinite(score[rows, deep]), deep, nearest[:, None])
+        out[c0 : c0 + step, seeds : seeds + m, 0] = us[deep // nv]
+        out[c0 : c0 + step, seeds : seeds + m, 1] = vs[deep % nv]
+        out[c0 : c0 + step, seeds + m :] = out[c0 : c0 + step, seeds : seeds + 1]
+    return out
+
+
+def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
+    """``(u, v, point, distance)`` flat arrays for ``(N, 3)`` points (trusted input)."""
+    us, vs, g = seed_grid(s)
+    start = seed_starts(points, us, vs, g, seeds)
+    k = start.shape[1]
     rep = np.repeat(points, k, axis=0)
     u, v = newton_closest(s, rep, start[..., 0].ravel(), start[..., 1].ravel())
     pts = s._derivatives(u, v, 0)[:, 0, 0]
