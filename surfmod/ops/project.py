@@ -101,7 +101,8 @@ def newton_closest(s: Surface, points: np.ndarray, u: np.ndarray, v: np.ndarray,
     piece_u, piece_v = _piece_of(breaks_u, u), _piece_of(breaks_v, v)
     todo = np.arange(u.size)
     for _ in range(len(breaks_u) + len(breaks_v)):  # each crossing moves one piece on
-        box = (breaks_u[piece_u[todo]], breaks_u[piece_u[todo] + 1], breaks_v[piece_v[todo]], breaks_v[piece_v[todo] + 1])
+        pu, pv = piece_u[todo], piece_v[todo]
+        box = (breaks_u[pu], breaks_u[pu + 1], breaks_v[pv], breaks_v[pv + 1])
         u[todo], v[todo] = _newton_in_boxes(s, points[todo], u[todo], v[todo], box, iterations)
         d = s._derivatives(u[todo], v[todo], 1)
         r = d[:, 0, 0] - points[todo]
@@ -215,11 +216,10 @@ def _knots_inside(s: Surface, direction: int) -> np.ndarray:
 def seed_starts(points, us, vs, g, seeds: int, chunk: int = 1 << 21) -> np.ndarray:
     """Newton starts ``(N, seeds + seeds // 2, 2)`` in (u, v) for each point.
 
-    The grid ``g`` is split into two triangles per cell.  For every point and triangle the
-    closest point of the triangle's plane, its barycentric coordinates clipped to the
-    triangle (exact inside, a good seed near edges), and the squared distance to it are
-    formed from three GEMMs (``p.a``, ``p.e0``, ``p.e1``) and elementwise work, so a
-    block of points against all triangles costs a few passes over one array.  Starts:
+    The grid ``g`` is split into two triangles per cell.  The triangles whose bounding
+    spheres come nearest (one GEMM against all centres) are the candidates; on those the
+    closest point of the triangle's plane with its barycentric coordinates clipped to the
+    triangle (exact inside, a good seed near edges) gives each a foot point.  Starts:
     the ``seeds`` nearest triangles, entered at those points; and the bottoms of the
     deepest valleys of the sampled distance (samples no farther than their eight
     neighbours), because in a nearly flat valley all nearest triangles sit in one basin.
@@ -232,7 +232,12 @@ def seed_starts(points, us, vs, g, seeds: int, chunk: int = 1 << 21) -> np.ndarr
     e0, e1 = e0 - a, e1 - a
     d00, d01, d11 = (np.einsum("ij,ij->i", x, y) for x, y in ((e0, e0), (e0, e1), (e1, e1)))
     det = np.maximum(d00 * d11 - d01**2, 1e-300)
-    ae0, ae1, aa = (np.einsum("ij,ij->i", a, x) for x in (e0, e1, a))
+    # bounding spheres: a triangle is no nearer than |p - centre| - radius
+    centre = a + (e0 + e1) / 3
+    corners = (a - centre, a + e0 - centre, a + e1 - centre)
+    radius = np.sqrt(np.maximum.reduce([np.einsum("ij,ij->i", x, x) for x in corners]))
+    cc = np.einsum("ij,ij->i", centre, centre)
+    n_cand = min(max(8 * seeds, 64), len(a))
     flat = g.reshape(-1, 3)
     ss = np.einsum("ij,ij->i", flat, flat)
     n_basins = max(2, seeds // 2)
@@ -243,18 +248,24 @@ def seed_starts(points, us, vs, g, seeds: int, chunk: int = 1 << 21) -> np.ndarr
         p = points[c0 : c0 + step]
         rows = np.arange(len(p))[:, None]
         pp = np.einsum("ij,ij->i", p, p)[:, None]
-        r0 = p @ e0.T - ae0  # (p - a).e0
-        r1 = p @ e1.T - ae1
-        beta = np.clip((d11 * r0 - d01 * r1) / det, 0, 1)
-        gamma = np.clip((d00 * r1 - d01 * r0) / det, 0, 1)
+        # candidates: the triangles with the smallest lower bounds (one GEMM), then the
+        # exact clipped foot on those only
+        lower = np.sqrt(np.maximum(cc - 2 * (p @ centre.T) + pp, 0.0)) - radius
+        cand = np.argpartition(lower, n_cand - 1, axis=1)[:, :n_cand] if n_cand < len(a) else np.argsort(lower, axis=1)
+        ca = a[cand]
+        r0 = np.einsum("nkj,nkj->nk", p[:, None] - ca, e0[cand])  # (p - a).e0
+        r1 = np.einsum("nkj,nkj->nk", p[:, None] - ca, e1[cand])
+        c00, c01, c11, cdet = d00[cand], d01[cand], d11[cand], det[cand]
+        beta = np.clip((c11 * r0 - c01 * r1) / cdet, 0, 1)
+        gamma = np.clip((c00 * r1 - c01 * r0) / cdet, 0, 1)
         over = np.maximum(beta + gamma, 1.0)
         beta /= over
         gamma /= over
-        # |a + beta e0 + gamma e1 - p|^2, expanded
-        dist = aa - 2 * (p @ a.T) + pp
-        dist += beta * (beta * d00 - 2 * r0) + gamma * (gamma * d11 - 2 * r1) + 2 * beta * gamma * d01
-        best = np.argpartition(dist, k - 1, axis=1)[:, :k] if k < len(a) else np.argsort(dist, axis=1)
-        b, gm = beta[rows, best], gamma[rows, best]
+        foot = ca + beta[..., None] * e0[cand] + gamma[..., None] * e1[cand]
+        dist = np.einsum("nkj,nkj->nk", foot - p[:, None], foot - p[:, None])
+        pick = np.argpartition(dist, k - 1, axis=1)[:, :k] if k < n_cand else np.argsort(dist, axis=1)[:, :k]
+        best = cand[rows, pick]
+        b, gm = beta[rows, pick], gamma[rows, pick]
         w = np.stack([1 - b - gm, b, gm], axis=-1)  # (n, k, 3) weights of the corners
         out[c0 : c0 + step, :k, 0] = np.einsum("nkc,nkc->nk", w, us[tri_i[best]])
         out[c0 : c0 + step, :k, 1] = np.einsum("nkc,nkc->nk", w, vs[tri_j[best]])
