@@ -134,14 +134,19 @@ class ElementarySurface(Surface):
         return np.stack([d @ self.x_dir, d @ self.y_dir, d @ self.z_dir], axis=-1)
 
     def _coefficients(self, u, v, order):
-        """``(fx, fy, fz)`` arrays ``(N, K, K)``: partials of the X, Y, Z coordinates."""
+        """``(fx, fy, fz)`` arrays ``(..., K, K)``: partials of the X, Y, Z coordinates,
+        for ``u`` and ``v`` broadcast against each other."""
         raise NotImplementedError
 
     def _derivatives(self, u, v, order):
         fx, fy, fz = self._coefficients(u, v, order)
         out = fx[..., None] * self.x_dir + fy[..., None] * self.y_dir + fz[..., None] * self.z_dir
-        out[:, 0, 0] += self.origin
+        out[..., 0, 0, :] += self.origin
         return out
+
+    def _grid_derivatives(self, us, vs, order):
+        # separable: the trigonometry runs on the nu + nv parameters, not on nu x nv points
+        return self._derivatives(us[:, None], vs[None, :], order)
 
     def geom(self):
         if self._occ is None:
@@ -161,9 +166,9 @@ class ElementarySurface(Surface):
         return type(self)._trusted(frame, self._scaled_params(s), ur, vr)
 
 
-def _zeros(n, order):
+def _zeros(shape, order):
     k = order + 1
-    return np.zeros((n, k, k)), np.zeros((n, k, k)), np.zeros((n, k, k))
+    return np.zeros((*shape, k, k)), np.zeros((*shape, k, k)), np.zeros((*shape, k, k))
 
 
 class AnalyticPlane(ElementarySurface):
@@ -190,11 +195,11 @@ class AnalyticPlane(ElementarySurface):
         return ()
 
     def _coefficients(self, u, v, order):
-        fx, fy, fz = _zeros(u.size, order)
-        fx[:, 0, 0], fy[:, 0, 0] = u, v
+        fx, fy, fz = _zeros(np.broadcast_shapes(np.shape(u), np.shape(v)), order)
+        fx[..., 0, 0], fy[..., 0, 0] = u, v
         if order >= 1:
-            fx[:, 1, 0] = 1.0
-            fy[:, 0, 1] = 1.0
+            fx[..., 1, 0] = 1.0
+            fy[..., 0, 1] = 1.0
         return fx, fy, fz
 
     def _build_geom(self):
@@ -240,13 +245,13 @@ class CylindricalSurface(ElementarySurface):
         return (self.radius * s,)
 
     def _coefficients(self, u, v, order):
-        fx, fy, fz = _zeros(u.size, order)
+        fx, fy, fz = _zeros(np.broadcast_shapes(np.shape(u), np.shape(v)), order)
         for k in range(order + 1):
-            fx[:, k, 0] = self.radius * cos_d(u, k)
-            fy[:, k, 0] = self.radius * sin_d(u, k)
-        fz[:, 0, 0] = v
+            fx[..., k, 0] = self.radius * cos_d(u, k)
+            fy[..., k, 0] = self.radius * sin_d(u, k)
+        fz[..., 0, 0] = v
         if order >= 1:
-            fz[:, 0, 1] = 1.0
+            fz[..., 0, 1] = 1.0
         return fx, fy, fz
 
     def _build_geom(self):
@@ -306,16 +311,16 @@ class ConicalSurface(ElementarySurface):
         return self.origin - self.radius / math.tan(self.semi_angle) * self.z_dir
 
     def _coefficients(self, u, v, order):
-        fx, fy, fz = _zeros(u.size, order)
+        fx, fy, fz = _zeros(np.broadcast_shapes(np.shape(u), np.shape(v)), order)
         sa, ca = math.sin(self.semi_angle), math.cos(self.semi_angle)
-        rho = [self.radius + v * sa, np.full(u.size, sa)]
+        rho = [self.radius + v * sa, sa]
         for k in range(order + 1):
             for l in range(min(order, 1) + 1):
-                fx[:, k, l] = cos_d(u, k) * rho[l]
-                fy[:, k, l] = sin_d(u, k) * rho[l]
-        fz[:, 0, 0] = v * ca
+                fx[..., k, l] = cos_d(u, k) * rho[l]
+                fy[..., k, l] = sin_d(u, k) * rho[l]
+        fz[..., 0, 0] = v * ca
         if order >= 1:
-            fz[:, 0, 1] = ca
+            fz[..., 0, 1] = ca
         return fx, fy, fz
 
     def _build_geom(self):
@@ -371,16 +376,16 @@ class SphericalSurface(ElementarySurface):
         return self.origin
 
     def _coefficients(self, u, v, order):
-        fx, fy, fz = _zeros(u.size, order)
+        fx, fy, fz = _zeros(np.broadcast_shapes(np.shape(u), np.shape(v)), order)
         r = self.radius
         for k in range(order + 1):
             cu, su = cos_d(u, k), sin_d(u, k)
             for l in range(order + 1):
                 cv = cos_d(v, l)
-                fx[:, k, l] = r * cu * cv
-                fy[:, k, l] = r * su * cv
+                fx[..., k, l] = r * cu * cv
+                fy[..., k, l] = r * su * cv
         for l in range(order + 1):
-            fz[:, 0, l] = r * sin_d(v, l)
+            fz[..., 0, l] = r * sin_d(v, l)
         return fx, fy, fz
 
     def _build_geom(self):
@@ -434,15 +439,15 @@ class ToroidalSurface(ElementarySurface):
         return self.origin
 
     def _coefficients(self, u, v, order):
-        fx, fy, fz = _zeros(u.size, order)
+        fx, fy, fz = _zeros(np.broadcast_shapes(np.shape(u), np.shape(v)), order)
         rho = [self.major + self.minor * np.cos(v)] + [self.minor * cos_d(v, l) for l in range(1, order + 1)]
         for k in range(order + 1):
             cu, su = cos_d(u, k), sin_d(u, k)
             for l in range(order + 1):
-                fx[:, k, l] = cu * rho[l]
-                fy[:, k, l] = su * rho[l]
+                fx[..., k, l] = cu * rho[l]
+                fy[..., k, l] = su * rho[l]
         for l in range(order + 1):
-            fz[:, 0, l] = self.minor * sin_d(v, l)
+            fz[..., 0, l] = self.minor * sin_d(v, l)
         return fx, fy, fz
 
     def _build_geom(self):
