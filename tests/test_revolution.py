@@ -9,25 +9,10 @@ import numpy as np
 import pytest
 
 import surfmod as sm
+from reference import surface_area as area
 from surfmod.occ.analytic import transformed as occ_transformed
 from surfmod.occ.sample import surface_d0
 from surfmod.transforms import mirror_matrix, rotation_matrix, scale_matrix
-
-
-def area(s, n=32):
-    """Gauss-Legendre quadrature of |Su x Sv| per knot span (independent of OCCT)."""
-    x, w = np.polynomial.legendre.leggauss(n)
-    (u0, u1), (v0, v1) = s.domain
-    knots = getattr(s, "knots", None)
-    bu = np.unique(np.clip(knots[0], u0, u1)) if knots is not None else np.array([u0, u1])
-    bv = np.unique(np.clip(knots[1], v0, v1)) if knots is not None else np.array([v0, v1])
-    total = 0.0
-    for a, b in zip(bu[:-1], bu[1:]):
-        for c, d in zip(bv[:-1], bv[1:]):
-            der = s.grid_derivatives((x + 1) / 2 * (b - a) + a, (x + 1) / 2 * (d - c) + c, 1)
-            jac = np.linalg.norm(np.cross(der[:, :, 1, 0], der[:, :, 0, 1]), axis=-1)
-            total += np.einsum("i,j,ij", w, w, jac) * (b - a) * (d - c) / 4
-    return total
 
 
 def _grid(domain, n=9, m=7):
