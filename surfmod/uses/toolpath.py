@@ -277,10 +277,7 @@ def _zoom(tool, model, cl, best, pid, u, v, hu, hv, levels=14, n=5):
 def _newton_ball(tool, model, cl, best, pid, u, v, iterations=8):
     """Polish ball-cutter contacts: Newton on grad h = 0, h = z + sqrt(r² − dx² − dy²)."""
     r = tool.radius
-    for k, patch in enumerate(model.patches):
-        sel = np.nonzero((pid == k) & np.isfinite(best))[0]
-        if not sel.size:
-            continue
+    for k, patch, sel in _contacts_by_patch(model, pid, best):
         u0, u1, v0, v1 = patch.bounds
         uu, vv = u[sel].copy(), v[sel].copy()
         for _ in range(iterations):
@@ -321,6 +318,14 @@ def _newton_ball(tool, model, cl, best, pid, u, v, iterations=8):
     return best, u, v
 
 
+def _contacts_by_patch(model, pid, best):
+    """``(k, patch, indices)`` for every patch holding found contacts (finite ``best``)."""
+    for k, patch in enumerate(model.patches):
+        sel = np.nonzero((pid == k) & np.isfinite(best))[0]
+        if sel.size:
+            yield k, patch, sel
+
+
 def _keep_higher(tool, model, k, cl, sel, uu, vv, best, u, v) -> None:
     """Where polished contacts ``(uu, vv)`` on patch ``k`` lift the tool higher than the
     current ``best`` (and lie inside the patch's trim), adopt them, in place."""
@@ -337,10 +342,7 @@ def _newton_flat_rim(tool, model, cl, best, pid, u, v, iterations=10):
     """Polish flat-end-mill rim contacts: maximize S_z subject to |S_xy − cl| = r
     (Newton on the Lagrange system in (u, v, λ))."""
     r = tool.radius
-    for k, patch in enumerate(model.patches):
-        sel = np.nonzero((pid == k) & np.isfinite(best))[0]
-        if not sel.size:
-            continue
+    for k, patch, sel in _contacts_by_patch(model, pid, best):
         u0, u1, v0, v1 = patch.bounds
         uu, vv = u[sel].copy(), v[sel].copy()
         lam = None
