@@ -62,6 +62,21 @@ def positive(value, name: str) -> float:
     return x
 
 
+def interval(value, name: str) -> tuple[float, float]:
+    """A parameter or coordinate range ``(start, end)`` with finite ``start < end``.
+
+    >>> interval([0, 2.5], "x_range")
+    (0.0, 2.5)
+    """
+    try:
+        a, b = (float(t) for t in value)
+    except (TypeError, ValueError):
+        raise SurfmodError(f"{name}: expected two numbers (start, end), got {value!r}") from None
+    if not (np.isfinite(a) and np.isfinite(b)) or not b > a:
+        raise SurfmodError(f"{name}: expected finite start < end, got ({a:g}, {b:g})")
+    return a, b
+
+
 def count(value, name: str, minimum: int = 1) -> int:
     """An integer >= ``minimum``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):

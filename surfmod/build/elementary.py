@@ -75,15 +75,7 @@ def frame_transformed(frame, matrix):
 
 
 def _range(value, name, default):
-    if value is None:
-        return default
-    try:
-        a, b = (float(t) for t in value)
-    except (TypeError, ValueError):
-        raise SurfmodError(f"{name}: expected two numbers (start, end), got {value!r}") from None
-    if not (np.isfinite(a) and np.isfinite(b)) or not b > a:
-        raise SurfmodError(f"{name}: need finite start < end, got ({a:g}, {b:g})")
-    return a, b
+    return default if value is None else checks.interval(value, name)
 
 
 def cos_d(t, k):

@@ -222,16 +222,6 @@ def _call_f(f, x, y):
     return z
 
 
-def _range(value, name):
-    try:
-        a, b = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise SurfmodError(f"{name}: expected two numbers (start, end), got {value!r}") from None
-    if not (np.isfinite(a) and np.isfinite(b)) or not b > a:
-        raise SurfmodError(f"{name}: expected finite start < end, got ({a:g}, {b:g})")
-    return a, b
-
-
 def _error_grid(x, per_span=3):
     f = np.linspace(0.0, 1.0, per_span + 1)[:-1]
     return np.concatenate([(x[:-1, None] + np.diff(x)[:, None] * f).ravel(), x[-1:]])
@@ -254,7 +244,7 @@ def explicit(f, x_range, y_range, tolerance: float | None = None) -> ExplicitSur
     """
     if not callable(f):
         raise SurfmodError(f"f: expected a callable f(x, y), got {type(f).__name__}")
-    (x0, x1), (y0, y1) = _range(x_range, "x_range"), _range(y_range, "y_range")
+    (x0, x1), (y0, y1) = checks.interval(x_range, "x_range"), checks.interval(y_range, "y_range")
     nx = ny = 9
     xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
     z0 = _call_f(f, xs[:, None], ys[None, :])
