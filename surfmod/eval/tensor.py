@@ -111,7 +111,9 @@ def rational_grid_positions(knots_u, p, knots_v, q, hctrl, us, vs, rows: int = 3
     bu = basis_matrix(knots_u, p, n, us)[0]
     bv = basis_matrix(knots_v, q, m, vs)[0]
     nv = bv.shape[0]
-    by_v = np.ascontiguousarray(np.einsum("bj,ijd->idb", bv, hctrl)).reshape(n, dim * nv)
+    # W[i, d, b] = sum_j Bv[b, j] P[i, j, d]: a GEMM, then one small transposing copy
+    by_v = (bv @ hctrl.transpose(1, 0, 2).reshape(m, n * dim)).reshape(nv, n, dim)
+    by_v = np.ascontiguousarray(by_v.transpose(1, 2, 0)).reshape(n, dim * nv)
     out = np.empty((bu.shape[0], nv, dim - 1))
     for r0 in range(0, bu.shape[0], rows):
         block = (bu[r0 : r0 + rows] @ by_v).reshape(-1, dim, nv)
