@@ -23,6 +23,10 @@ def curve_quotient(hders: np.ndarray) -> np.ndarray:
     return out
 
 
+# points per block of the surface quotient rule: the temporaries stay in cache
+_BLOCK = 1 << 14
+
+
 def surface_quotient(hders: np.ndarray) -> np.ndarray:
     """``(..., K, K, 4)`` homogeneous mixed partials -> ``(..., K, K, 3)`` Cartesian ones.
 
@@ -45,8 +49,6 @@ def surface_quotient(hders: np.ndarray) -> np.ndarray:
         _quotient_planes(planes[block], out[block], order)
     return np.moveaxis(out, (0, 1, 2), (-3, -2, -1))
 
-
-_BLOCK = 1 << 14
 
 
 def _quotient_planes(planes, out, order: int) -> None:
