@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.build.fitting import approximation_knots, averaging_knots, grid_parameters
+from surfmod.construct.fitting import approximation_knots, averaging_knots, grid_parameters
 
 
 def _grid(n, m, warp=0.0):

@@ -54,7 +54,7 @@ def test_meshes_shapes_and_mixed_lists(tmp_path):
 
 def test_closed_surface_hides_back_isocurves(tmp_path):
     """On a sphere, only the iso-curves facing the viewer are drawn."""
-    from surfmod.mesh.render import _iso_lines
+    from surfmod.meshing.render import _iso_lines
 
     s = sm.sphere(1.0)
     m = sm.tessellate(s, 0.02)
@@ -64,7 +64,7 @@ def test_closed_surface_hides_back_isocurves(tmp_path):
 
 
 def test_shade_is_lambert():
-    from surfmod.mesh.render import shade
+    from surfmod.meshing.render import shade
 
     tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
     np.testing.assert_allclose(shade(tri, (1, 1, 1), (1, 0, 0))[0, :3], 0.35)

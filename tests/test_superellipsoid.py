@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.build.superellipsoid import superellipsoid_implicit, superellipsoid_points
+from surfmod.construct.superellipsoid import superellipsoid_implicit, superellipsoid_points
 
 
 def _random_uv(n=3000, seed=0):

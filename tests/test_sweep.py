@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.build.sweep import sweep
+from surfmod.construct.sweep import sweep
 
 PATH = sm.BSplineCurve([(0, 0, 0), (0, 0, 4), (3, 1, 8), (8, 0, 9), (10, 3, 12)], 3)
 # an asymmetric open profile in the plane z = 0, normal to the path at its start

@@ -10,7 +10,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.mesh.tessellate import _barycentric
+from surfmod.meshing.tessellate import _barycentric
 
 
 def _independent_max_distance(s, mesh, per_triangle=3, limit=1500, seed=0):
@@ -87,7 +87,7 @@ def test_plane_needs_two_triangles():
 
 
 def test_fewer_triangles_than_brepmesh_at_equal_tolerance():
-    from surfmod.mesh.tessellate import DENSE, measure_face_meshes
+    from surfmod.meshing.tessellate import DENSE, measure_face_meshes
     from surfmod.occ.mesh import brepmesh
 
     s = sm.BezierSurface(wavy_net(6, 5))
@@ -195,7 +195,7 @@ def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_refused():
 def test_ear_clipping_never_collapses_onto_a_side():
     """Regression: a cell with two hanging nodes on one side, whose greedy clipping used to
     leave four collinear points; every triangle must keep an area and they tile the cell."""
-    from surfmod.mesh.tessellate import _ear_clip
+    from surfmod.meshing.tessellate import _ear_clip
 
     poly = np.array([[16, 4], [20, 4], [20, 5], [20, 6], [20, 8], [16, 8]], dtype=np.int64)
     pos = np.array(

@@ -33,7 +33,7 @@ def step_files(paths) -> list[Path]:
 
 def check_file(path: Path, samples: int) -> list[tuple]:
     """``[(file, face index, surface type, max deviation, passed, note), ...]``."""
-    from ..build.from_face import from_face
+    from ..construct.from_face import from_face
     from ..check import crosscheck
     from ..io.step import import_step
     from ..occ.geom import surface_type

@@ -11,8 +11,8 @@ from . import entry
 
 @entry("ruled", "ruled surface (1-v)G(u) + vQ(u)", "sm.ruled(g, q)")
 def _ruled():
-    from ..build.conics import Arc
-    from ..build.ruled import ruled
+    from ..construct.conics import Arc
+    from ..construct.ruled import ruled
     from ..nets.bspline import BSplineCurve
 
     g = BSplineCurve([(0, 0, 0), (3, 4, 0), (6, -2, 0), (10, 2, 0)], 3)
@@ -22,7 +22,7 @@ def _ruled():
 
 @entry("tabulated_cylinder", "tabulated cylinder", "sm.tabulated_cylinder(curve, direction, length)")
 def _tabulated():
-    from ..build.extrusion import tabulated_cylinder
+    from ..construct.extrusion import tabulated_cylinder
     from ..nets.bspline import BSplineCurve
 
     c = BSplineCurve([(0, 0, 0), (3, 4, 0), (6, -2, 0), (10, 2, 0), (12, 0, 0)], 3)
@@ -31,7 +31,7 @@ def _tabulated():
 
 @entry("revolution", "surface of revolution", "sm.revolution(profile, origin, axis, 270)")
 def _revolution():
-    from ..build.revolution import revolution
+    from ..construct.revolution import revolution
     from ..nets.bspline import BSplineCurve
 
     profile = BSplineCurve([(2, 0, 0), (5, 0, 1), (3, 0, 4), (4, 0, 7), (1.5, 0, 9)], 3)
@@ -45,35 +45,35 @@ def _revolution_nurbs():
 
 @entry("sphere", "sphere (quadric)", "sm.sphere(4)")
 def _sphere():
-    from ..build.quadrics import sphere
+    from ..construct.quadrics import sphere
 
     return sphere(4.0, center=(0, 0, 4))
 
 
 @entry("ellipsoid", "ellipsoid (exact rational B-spline)", "sm.ellipsoid(6, 4, 2.5)")
 def _ellipsoid():
-    from ..build.quadrics import ellipsoid
+    from ..construct.quadrics import ellipsoid
 
     return ellipsoid(6.0, 4.0, 2.5)
 
 
 @entry("torus", "torus (quadric of revolution)", "sm.torus(6, 1.5)")
 def _torus():
-    from ..build.quadrics import torus
+    from ..construct.quadrics import torus
 
     return torus(6.0, 1.5, axis=(0, 1, 1))
 
 
 @entry("cone", "cone frustum (OCCT frame)", "sm.ConicalSurface(semi_angle, r)")
 def _cone():
-    from ..build.elementary import ConicalSurface
+    from ..construct.elementary import ConicalSurface
 
     return ConicalSurface(math.radians(20), 3.0, v_range=(0.0, 8.0))
 
 
 @entry("offset", "offset surface S + dN", "sm.OffsetSurface(surface, d)")
 def _offset():
-    from ..build.readers_elementary import OffsetSurface
+    from ..construct.readers_elementary import OffsetSurface
     from ..nets.bspline import BSplineSurface
     from .synthetic import wavy_net
 

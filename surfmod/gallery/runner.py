@@ -49,8 +49,8 @@ def run_entry(e: Entry, outdir: Path) -> Row:
 
 def _render(obj, path: Path) -> None:
     try:
-        from ..mesh.render import render
-    except ImportError:  # rendering is provided by surfmod.mesh.render when installed
+        from ..meshing.render import render
+    except ImportError:  # rendering is provided by surfmod.meshing.render when installed
         return
     render([obj], path)
 

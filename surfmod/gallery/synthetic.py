@@ -17,7 +17,7 @@ def wavy_net(n: int, m: int, amplitude: float = 0.6) -> np.ndarray:
 
 @entry("plane", "plane through three points", "sm.plane(p0, p1, p2)")
 def _plane():
-    from ..build.plane import plane
+    from ..construct.plane import plane
 
     return plane((0, 0, 0), (10, 0, 1), (2, 8, 0))
 

@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..mesh.polymesh import Mesh
+from ..meshing.polymesh import Mesh
 from .atomic import atomic_path, target_path
 
 
@@ -16,10 +16,10 @@ def _mesh_of(obj, tolerance: float) -> Mesh:
     if isinstance(obj, Mesh):
         return obj.triangulated()
     if isinstance(obj, Surface):
-        from ..mesh.tessellate import tessellate
+        from ..meshing.tessellate import tessellate
 
         return tessellate(obj, tolerance)
-    from ..mesh.tessellate import tessellate
+    from ..meshing.tessellate import tessellate
 
     return tessellate(obj, tolerance)
 

@@ -234,7 +234,7 @@ def plane_frame(origin, normal):
 def as_plane(value, name: str):
     """``(origin, unit normal)`` from ``(origin, normal)``, a build123d ``Plane`` or a
     surfmod ``PlaneSurface`` (its infinite carrier plane)."""
-    from ..build.plane import PlaneSurface
+    from ..construct.plane import PlaneSurface
 
     if isinstance(value, PlaneSurface):
         return np.array(value.origin), np.array(value.normal)

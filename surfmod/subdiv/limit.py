@@ -240,7 +240,7 @@ def limit_surface(
 
 def _assemble(v, topo, crease, levels, adaptive, tangent_plane, extra):
     """Patches of every adaptive level, the kept selection, and the measurements."""
-    from ..mesh.polymesh import Mesh
+    from ..meshing.polymesh import Mesh
     from ..nets.bezier import BezierSurface
     from ..nets.bspline import BSplineSurface
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
-from ..mesh.polymesh import Mesh
+from ..meshing.polymesh import Mesh
 from . import topology as tp
 
 

@@ -116,7 +116,7 @@ def patch_of(rec: dict) -> Patch:
         evaluate, how = elementary_evaluator(kind, rec["elementary"]), "numpy"
     elif kind in ("Geom_BSplineSurface", "Geom_BezierSurface"):
         try:
-            from ..build.from_face import from_face
+            from ..construct.from_face import from_face
 
             surf = from_face(rec["face"])
             evaluate, how = _surface_evaluator(surf), "numpy"

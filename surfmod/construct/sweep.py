@@ -426,7 +426,7 @@ class SweptSurface(Surface):
 
 def sweep(profile, path, *, end_profile=None, twist: float = 0.0, mode: str = "frenet", guide=None,
           guide_scale: bool = False) -> SweptSurface:
-    """The swept surface of ``profile`` along ``path`` (see :mod:`surfmod.build.sweep`).
+    """The swept surface of ``profile`` along ``path`` (see :mod:`surfmod.construct.sweep`).
 
     ``mode`` ``"frenet"`` or ``"corrected_frenet"`` (rotation-minimizing); ``end_profile``
     blends to a second section at the path end; ``guide`` turns the frame towards a

@@ -138,7 +138,7 @@ class Superellipsoid(FittedSurface):
     parameters, an upper bound of the geometric distance), ``samples`` (grid size).
     Methods: :meth:`parametric` (analytic points at angles), :meth:`analytic_points`
     (analytic points at the spline's ``(u, v)``), :meth:`implicit` (F at points) and
-    :meth:`implicit_surface` (an :class:`~surfmod.build.forms.ImplicitSurface`).
+    :meth:`implicit_surface` (an :class:`~surfmod.construct.forms.ImplicitSurface`).
 
     >>> import surfmod as sm
     >>> s = sm.superellipsoid(1, 1, 1, 0.5, 0.5)
@@ -169,7 +169,7 @@ class Superellipsoid(FittedSurface):
         return superellipsoid_implicit(self.rx, self.ry, self.rz, self.s1, self.s2, p[..., 0], p[..., 1], p[..., 2])
 
     def implicit_surface(self):
-        """The implicit form as an :class:`~surfmod.build.forms.ImplicitSurface`."""
+        """The implicit form as an :class:`~surfmod.construct.forms.ImplicitSurface`."""
         from .forms import ImplicitSurface
 
         rx, ry, rz, s1, s2 = self.rx, self.ry, self.rz, self.s1, self.s2

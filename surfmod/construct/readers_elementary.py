@@ -1,6 +1,6 @@
 """``from_face`` readers for OCCT's analytic surface types, and the offset surface.
 
-Registered with :func:`surfmod.build.from_face.reader`: ``Geom_Plane``,
+Registered with :func:`surfmod.construct.from_face.reader`: ``Geom_Plane``,
 ``Geom_CylindricalSurface``, ``Geom_ConicalSurface``, ``Geom_SphericalSurface``,
 ``Geom_ToroidalSurface``, ``Geom_SurfaceOfRevolution``, ``Geom_SurfaceOfLinearExtrusion``,
 ``Geom_RectangularTrimmedSurface`` and ``Geom_OffsetSurface``.  Every reader keeps OCCT's

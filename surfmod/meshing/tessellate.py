@@ -539,7 +539,7 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES) 
 def _face_evaluator(fm):
     """``(d1, bounds)`` for measuring against one face: NumPy when ``from_face`` reads the
     face's surface, else OCCT ``D1`` per point."""
-    from ..build.from_face import from_face
+    from ..construct.from_face import from_face
     from ..occ.mesh import surface_d1
 
     u0, u1, v0, v1 = fm.bounds
