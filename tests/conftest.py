@@ -8,6 +8,7 @@ with ``HYPOTHESIS_PROFILE=explore``.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,3 +22,24 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "reproducible"))
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+# The real-parts corpus (../shared/step_corpus beside the checkout).  Tests over every file
+# of it are marked ``corpus`` and run as the second command of .ci/run:
+# ``python -m pytest -q -m corpus``; the default run (``-m "not corpus"`` in pyproject)
+# keeps the quick per-file cases.
+CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "step_corpus"
+CORPUS_FILES = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
+
+
+@pytest.fixture(params=CORPUS_FILES, ids=lambda p: p.name)
+def corpus_file(request):
+    """Each STEP file of the real-parts corpus in turn."""
+    return request.param
+
+
+@pytest.fixture(scope="session")
+def corpus_dir():
+    if not CORPUS_FILES:
+        pytest.fail(f"the real-parts corpus is missing: {CORPUS} (CI clones ../shared beside main)")
+    return CORPUS
