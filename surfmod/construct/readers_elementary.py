@@ -12,7 +12,7 @@ evaluation with the very surface of the file.
 
 from __future__ import annotations
 
-from math import comb, factorial
+from math import factorial
 
 import numpy as np
 

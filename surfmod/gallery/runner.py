@@ -48,10 +48,8 @@ def run_entry(e: Entry, outdir: Path) -> Row:
 
 
 def _render(obj, path: Path) -> None:
-    try:
-        from ..meshing.render import render
-    except ImportError:  # rendering is provided by surfmod.meshing.render when installed
-        return
+    from ..meshing.render import render
+
     render([obj], path)
 
 

@@ -158,9 +158,8 @@ def render(
     >>> open(p, "rb").read(4) == b"\\x89PNG"
     True
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False) if matplotlib.get_backend().lower() != "agg" else None
+    # A local Agg canvas: the caller's pyplot backend is left alone.
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
@@ -180,6 +179,7 @@ def render(
         raise SurfmodError(f"color: expected 3 numbers in [0, 1], got {color!r}")
 
     fig = Figure(figsize=size, dpi=dpi)
+    FigureCanvasAgg(fig)
     ax = fig.add_subplot(projection="3d")
     ax.computed_zorder = False  # curves and nets are drawn over the shading
     e, a = np.radians(elev), np.radians(azim)

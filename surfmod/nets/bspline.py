@@ -84,6 +84,10 @@ class BSplineCurve(Curve):
         n = self.control_points.shape[0]
         return float(self.knots[self.degree]), float(self.knots[n])
 
+    @property
+    def breaks(self):
+        return np.unique(self.knots[self.degree : len(self.control_points) + 1])
+
     def _derivatives(self, t, order):
         h = curve_derivatives(self.knots, self.degree, self._h, t, order)
         return curve_quotient(h) if self.rational else h

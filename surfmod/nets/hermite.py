@@ -14,9 +14,6 @@ from .. import checks, transforms
 from ..errors import SurfmodError
 from .bezier import BezierSurface
 
-#: Hermite basis matrix: rows are the coefficients of [s^3, s^2, s, 1].
-HERMITE_MATRIX = np.array([[2.0, -2.0, 1.0, 1.0], [-3.0, 3.0, -2.0, -1.0], [0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 0.0, 0.0]])
-
 #: Maps the Hermite data (p0, p1, d0, d1) of a cubic to its Bézier control points.
 HERMITE_TO_BEZIER = np.array(
     [[1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 1.0 / 3.0, 0.0], [0.0, 1.0, 0.0, -1.0 / 3.0], [0.0, 1.0, 0.0, 0.0]]

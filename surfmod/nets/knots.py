@@ -70,11 +70,6 @@ def bezier_pieces(knots: np.ndarray, degree: int, ctrl: np.ndarray):
     return pieces
 
 
-def breakpoints(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
-    """Distinct knots inside the domain, ends included."""
-    return np.unique(knots[degree : n_ctrl + 1])
-
-
 def smooth_mask(knots: np.ndarray, degree: int, t: np.ndarray, order: int) -> np.ndarray:
     """False where ``t`` is an interior knot across which the ``order``-th derivative
     jumps (multiplicity > degree - order).  There the derivative is two-valued: surfmod

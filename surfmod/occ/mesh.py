@@ -143,11 +143,6 @@ def curve_points(curve, t: np.ndarray) -> np.ndarray:
         return out
 
 
-def curve_range(curve) -> tuple[float, float]:
-    with kernel("Geom_Curve.FirstParameter"):
-        return float(curve.FirstParameter()), float(curve.LastParameter())
-
-
 def shape_figures(shape, samples: int = 9):
     """Per face ``(area, mean sqrt(|k1| |k2|) with each |k| floored by 1/diagonal)`` and the
     bounding-box diagonal: enough to estimate how many triangles a chordal tolerance

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_GTrsf, gp_Lin, gp_Mat, gp_Pnt, gp_Trsf, gp_Vec, gp_XYZ
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_GTrsf, gp_Lin, gp_Mat, gp_Pnt, gp_Trsf, gp_XYZ
 
 from . import arrays
 from .geom import downcast_surface

@@ -408,10 +408,6 @@ def wire_edges(wire):
     return out
 
 
-def is_reversed(shape) -> bool:
-    return getattr(shape, "wrapped", shape).Orientation() == TopAbs_REVERSED
-
-
 def edge_polyline(edge, n: int) -> np.ndarray:
     """``n`` points along an edge in its orientation (OCCT ``BRepAdaptor_Curve``)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve
