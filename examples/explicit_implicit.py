@@ -15,7 +15,7 @@ def terrain(x, y):
 
 
 s = sm.explicit(terrain, (0, 50), (0, 40), tolerance=1e-3)
-print(f"explicit: {s.samples} samples, max |z - f| = {s.max_error:.2e} (tolerance 1e-3)")
+print(f"explicit: {s.samples} samples, max |z - f| = {s.max_deviation:.2e} (tolerance 1e-3)")
 F = sm.to_implicit(s)
 p = s.parametric(np.array([10.0, 25.0]), np.array([5.0, 20.0]))
 print("implicit F on the exact surface:", F.value(p), "normals:", F.normals(p).round(4).tolist())

@@ -12,10 +12,11 @@ import abc
 import numpy as np
 
 from . import checks
+from .immutable import Immutable
 from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
 
 
-class Curve(abc.ABC):
+class Curve(Immutable, abc.ABC):
     """Base of every parametric curve in surfmod.
 
     Curves evaluate like surfaces, vectorized over the parameter:

@@ -14,10 +14,11 @@ import numpy as np
 
 from . import checks, tolerances
 from .eval.differential import Curvatures, curvatures, degenerate_mask, unit_normals
+from .immutable import Immutable
 from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
 
 
-class Surface(abc.ABC):
+class Surface(Immutable, abc.ABC):
     """Base of every parametric surface in surfmod.
 
     Parameters broadcast like NumPy ufunc arguments; results carry the broadcast shape

@@ -20,7 +20,7 @@ def test_interpolate_passes_through_points(method):
     assert s.control_points.shape == (9, 7, 3)
     us, vs = s.parameters
     assert np.abs(s.grid(us, vs) - pts).max() < 1e-13
-    assert s.max_error < 1e-13
+    assert s.max_deviation < 1e-13
     assert sm.crosscheck(s, samples=12).passed  # the spline is its OCCT twin
 
 
@@ -54,17 +54,17 @@ def test_interpolate_matches_occt_on_the_data():
     pts = _grid(10, 8, warp=0.1)
     s = sm.interpolate(pts)
     geom, occ_err = s.occt_fit()
-    assert s.max_error < 1e-10 and occ_err < 1e-10
+    assert s.max_deviation < 1e-10 and occ_err < 1e-10
 
 
 def test_approximate_within_tolerance_and_smaller_than_interpolation():
     pts = _grid(40, 30)
     a = sm.approximate(pts, tolerance=1e-4)
-    assert a.max_error <= 1e-4
+    assert a.max_deviation <= 1e-4
     n, m = a.control_points.shape[:2]
     assert n < 40 and m < 30
     us, vs = a.parameters
-    assert np.isclose(np.linalg.norm(a.grid(us, vs) - pts, axis=-1).max(), a.max_error, rtol=1e-12)
+    assert np.isclose(np.linalg.norm(a.grid(us, vs) - pts, axis=-1).max(), a.max_deviation, rtol=1e-12)
     geom, occ_err = a.occt_fit()
     assert occ_err <= 1e-4
 
@@ -127,7 +127,7 @@ def test_interpolation_property(p, q, n_extra, m_extra, method, seed):
     s = sm.interpolate(pts, degree=(p, q), method=method)
     assert s.degree == (p, q) and s.control_points.shape == (n, m, 3)
     scale = np.abs(pts).max()
-    assert s.max_error <= 1e-9 * scale
+    assert s.max_deviation <= 1e-9 * scale
     # the approximation with the full control count is the interpolation
     a = sm.approximate(pts, degree=(p, q), n_ctrl=(n, m), method=method)
     assert np.abs(a.control_points - s.control_points).max() <= 1e-7 * np.abs(s.control_points).max()

@@ -12,7 +12,7 @@ def f_wave(x, y):
 
 def test_explicit_fit_within_tolerance_and_linear_xy():
     s = sm.explicit(f_wave, (0, 3), (-1, 2), tolerance=1e-6)
-    assert s.max_error <= 1e-6
+    assert s.max_deviation <= 1e-6
     rng = np.random.default_rng(1)
     x, y = rng.uniform(0, 3, 400), rng.uniform(-1, 2, 400)
     p = s.points(x, y)
@@ -23,7 +23,7 @@ def test_explicit_fit_within_tolerance_and_linear_xy():
 
 def test_explicit_default_tolerance_and_forms():
     s = sm.explicit(lambda x, y: np.exp(-4 * (x**2 + y**2)), (-1, 1), (-1, 1))
-    assert s.tolerance == pytest.approx(2e-3) and s.max_error <= s.tolerance
+    assert s.tolerance == pytest.approx(2e-3) and s.max_deviation <= s.tolerance
     # explicit -> parametric is exact, explicit -> implicit z - f is zero on the exact form
     xy = np.array([[0.3, -0.2], [0.0, 0.9]])
     exact = s.parametric(xy[:, 0], xy[:, 1])

@@ -56,7 +56,7 @@ class Conic(Curve):
     def _from_radians(cls, center, normal, x_dir, a, b, t_range):
         """Trusted constructor (readers, surfaces): a circle arc when ``a == b``."""
         target = Arc if (cls is Conic and a == b) else (Ellipse if cls is Conic else cls)
-        obj = target.__new__(target)
+        obj = target._construct_fast()
         Conic._init(obj, np.asarray(center, float), np.asarray(normal, float), np.asarray(x_dir, float), a, b, t_range)
         return obj
 
@@ -282,7 +282,7 @@ class _FramedCurve(Curve):
 
     @classmethod
     def _make(cls, center, normal, x_dir, params, t_range):
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         obj._init(*(np.asarray(a, float) for a in (center, normal, x_dir)), params, t_range)
         return obj
 

@@ -98,11 +98,10 @@ class ElementarySurface(Surface):
     def _init_frame(self, frame, u_range, v_range):
         self.origin, self.x_dir, self.y_dir, self.z_dir = (checks.frozen(a) for a in frame)
         self._domain = ((float(u_range[0]), float(u_range[1])), (float(v_range[0]), float(v_range[1])))
-        self._occ = None
 
     @classmethod
     def _trusted(cls, frame, params, u_range, v_range):
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         obj._init_frame(frame, u_range, v_range)
         obj._set_params(*params)
         return obj
@@ -141,9 +140,7 @@ class ElementarySurface(Surface):
         return self._derivatives(us[:, None], vs[None, :], order)
 
     def geom(self):
-        if self._occ is None:
-            self._occ = self._build_geom()
-        return self._occ
+        return self._twin(self._build_geom)
 
     def transformed(self, matrix):
         """Similarity: same analytic type with a moved frame; otherwise the exact NURBS form

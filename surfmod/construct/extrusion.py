@@ -45,11 +45,10 @@ class TabulatedCylinder(Surface):
 
     @classmethod
     def _trusted(cls, curve: Curve, direction, v_range):
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         obj.curve = curve
         obj.direction = checks.frozen(np.asarray(direction, float) / np.linalg.norm(direction))
         obj.v_range = (float(v_range[0]), float(v_range[1]))
-        obj._occ = None
         return obj
 
     @property
@@ -78,11 +77,9 @@ class TabulatedCylinder(Surface):
         return out
 
     def geom(self):
-        if self._occ is None:
-            from ..occ.analytic import extrusion
+        from ..occ.analytic import extrusion
 
-            self._occ = extrusion(self.curve.geom(), self.direction)
-        return self._occ
+        return self._twin(lambda: extrusion(self.curve.geom(), self.direction))
 
     def transformed(self, matrix):
         """Similarity maps keep the construct (v scales by ``|s|``, like OCCT); other

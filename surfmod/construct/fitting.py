@@ -13,7 +13,7 @@ The lecture contrasts two ways of making a surface from measured points:
   smallest that keeps the max error within ``tolerance``.
 
 Both return a :class:`FittedSurface` (a B-spline surface that *is* its OCCT twin
-``Geom_BSplineSurface``) with the data parameters and the measured ``max_error``;
+``Geom_BSplineSurface``) with the data parameters and the measured ``max_deviation``;
 :meth:`FittedSurface.occt_fit` builds OCCT's own fit (``GeomAPI_PointsToBSplineSurface``)
 of the same data for comparison.
 """
@@ -34,7 +34,7 @@ class FittedSurface(BSplineSurface):
     """A B-spline surface fitted to a grid of points.
 
     Extra attributes: ``data`` (the ``(n, m, 3)`` points), ``parameters`` (``(us, vs)``
-    at which the data are matched), ``max_error`` (largest ``|S(u_k, v_l) - Q_kl|``),
+    at which the data are matched), ``max_deviation`` (largest ``|S(u_k, v_l) - Q_kl|``),
     ``tolerance`` (the requested bound for approximations, ``None`` for interpolation)
     and ``kind`` (``"interpolation"`` or ``"approximation"``).
 
@@ -49,14 +49,14 @@ class FittedSurface(BSplineSurface):
 
     @classmethod
     def _make(cls, net, degree, knots, data, params, kind, tolerance=None):
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         BSplineSurface._set(obj, net, degree, knots, None)
         obj.data = checks.frozen(data)
         obj.parameters = (checks.frozen(params[0]), checks.frozen(params[1]))
         obj.kind = kind
         obj.tolerance_requested = tolerance
         fitted = obj._grid_derivatives(obj.parameters[0], obj.parameters[1], 0)[:, :, 0, 0]
-        obj.max_error = float(np.linalg.norm(fitted - data, axis=-1).max())
+        obj.max_deviation = float(np.linalg.norm(fitted - data, axis=-1).max())
         return obj
 
     @property
@@ -216,14 +216,14 @@ def interpolate(points, degree=(3, 3), method: str = "chord", parameters=None) -
     Global interpolation (P&T 9.2.5): ``method`` ``"chord"`` (chord length),
     ``"centripetal"`` or ``"uniform"`` parameters averaged over rows and columns, or
     explicit ``parameters=(us, vs)``; knots by averaging; the control net solves one
-    linear system per direction.  ``max_error`` is the residual at the data points
+    linear system per direction.  ``max_deviation`` is the residual at the data points
     (round-off only).
 
     >>> import numpy as np, surfmod as sm
     >>> x, y = np.meshgrid(np.linspace(0, 3, 5), np.linspace(0, 2, 4), indexing="ij")
     >>> pts = np.stack([x, y, np.sin(x) * np.cos(y)], axis=-1)
     >>> s = sm.interpolate(pts, degree=(3, 3))
-    >>> s.control_points.shape, bool(s.max_error < 1e-12)
+    >>> s.control_points.shape, bool(s.max_deviation < 1e-12)
     ((5, 4, 3), True)
     """
     q, p, r = _check_grid(points, degree)
@@ -276,14 +276,14 @@ def approximate(points, degree=(3, 3), tolerance: float | None = None, *, n_ctrl
     ``tolerance`` (default ``1e-3`` times the diagonal of the points' bounding box)
     bounds the max error ``|S(u_k, v_l) - Q_kl|`` at the data parameters; the number of
     control points per direction is the smallest that meets it (or fixed by
-    ``n_ctrl=(nu, nv)``, then ``max_error`` is simply reported).  Knots follow P&T
+    ``n_ctrl=(nu, nv)``, then ``max_deviation`` is simply reported).  Knots follow P&T
     eq. 9.69 so each span holds data.
 
     >>> import numpy as np, surfmod as sm
     >>> x, y = np.meshgrid(np.linspace(0, 3, 30), np.linspace(0, 2, 20), indexing="ij")
     >>> pts = np.stack([x, y, np.sin(x) * np.cos(y)], axis=-1)
     >>> s = sm.approximate(pts, tolerance=1e-3)
-    >>> bool(s.max_error <= 1e-3), s.control_points.shape[0] < 30
+    >>> bool(s.max_deviation <= 1e-3), s.control_points.shape[0] < 30
     (True, True)
     """
     q, p, r = _check_grid(points, degree)
@@ -309,7 +309,7 @@ def approximate(points, degree=(3, 3), tolerance: float | None = None, *, n_ctrl
     while True:
         net, knots = _lsq_surface(q, p, r, us, vs, nu, nv)
         fit = FittedSurface._make(net, (p, r), knots, q, (us, vs), "approximation", tol)
-        if fit.max_error <= tol or (nu >= n and nv >= m):
+        if fit.max_deviation <= tol or (nu >= n and nv >= m):
             return fit
         nu = min(n, max(nu + 1, int(nu * 1.25)))
         nv = min(m, max(nv + 1, int(nv * 1.25)))

@@ -132,7 +132,7 @@ class ImplicitSurface:
         >>> import surfmod as sm, numpy as np
         >>> ball = sm.implicit(lambda x, y, z: x**2 + y**2 + z**2 - 4)
         >>> cap = ball.to_explicit((-1, 1), (-1, 1), z0=2.0, tolerance=1e-6)
-        >>> round(float(cap.height(0.0, 0.0)), 12), bool(cap.max_error <= 1e-6)
+        >>> round(float(cap.height(0.0, 0.0)), 12), bool(cap.max_deviation <= 1e-6)
         (2.0, True)
         """
         z_start = float(checks.finite_array(z0, "z0"))
@@ -170,7 +170,7 @@ def implicit(F, bounds=None, gradient=None, step: float | None = None) -> Implic
 class ExplicitSurface(FittedSurface):
     """``z = f(x, y)`` fitted by a bicubic B-spline with parameters ``u = x``, ``v = y``.
 
-    Attributes: ``f``, ``x_range``, ``y_range``, ``tolerance`` (requested), ``max_error``
+    Attributes: ``f``, ``x_range``, ``y_range``, ``tolerance`` (requested), ``max_deviation``
     (measured ``max |z_spline - f|`` on a grid three times finer than the samples) and
     ``samples``.
 
@@ -237,7 +237,7 @@ def explicit(f, x_range, y_range, tolerance: float | None = None) -> ExplicitSur
 
     >>> import numpy as np, surfmod as sm
     >>> s = sm.explicit(lambda x, y: np.sin(x) * np.cos(y), (0, 3), (0, 2), tolerance=1e-5)
-    >>> s.max_error <= 1e-5
+    >>> s.max_deviation <= 1e-5
     True
     >>> s.points(1.0, 0.5)[:2].round(12).tolist()
     [1.0, 0.5]
@@ -269,14 +269,8 @@ def explicit(f, x_range, y_range, tolerance: float | None = None) -> ExplicitSur
             nx = min(_MAX_SAMPLES, 2 * nx - 1)
         if ev >= 0.5 * eu or nx >= _MAX_SAMPLES:
             ny = min(_MAX_SAMPLES, 2 * ny - 1)
-    obj = ExplicitSurface.__new__(ExplicitSurface)
-    obj.__dict__.update(fit.__dict__)
-    obj.f = f
-    obj.x_range, obj.y_range = (x0, x1), (y0, y1)
-    obj.tolerance_requested = tol
-    obj.max_error = max_err
-    obj.samples = (nx, ny)
-    return obj
+    fields = {**fit.__dict__, "f": f, "x_range": (x0, x1), "y_range": (y0, y1), "tolerance_requested": tol}
+    return ExplicitSurface._construct_fast(**{**fields, "max_deviation": max_err, "samples": (nx, ny)})
 
 
 def to_implicit(surface) -> ImplicitSurface:

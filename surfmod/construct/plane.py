@@ -36,7 +36,7 @@ class PlaneSurface(BSplineSurface):
     def transformed(self, matrix) -> "PlaneSurface":
         """An affine image of a plane is a plane: same class, mapped control points."""
         out = BSplineSurface.transformed(self, matrix)
-        obj = PlaneSurface.__new__(PlaneSurface)
+        obj = PlaneSurface._construct_fast()
         BSplineSurface._set(obj, out.control_points, out.degree, out.knots, None)
         return obj
 
@@ -62,6 +62,6 @@ def plane(p0, p1, p2) -> PlaneSurface:
         raise SurfmodError("p2: collinear with p0 and p1, the three points do not span a plane")
     net = np.array([[a, c], [b, b + e2]])
     k = np.array([0.0, 0.0, 1.0, 1.0])
-    obj = PlaneSurface.__new__(PlaneSurface)
+    obj = PlaneSurface._construct_fast()
     BSplineSurface._set(obj, net, (1, 1), (k, k), None)
     return obj

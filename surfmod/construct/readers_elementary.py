@@ -140,7 +140,6 @@ class OffsetSurface(Surface):
         if not np.isfinite(d):
             raise SurfmodError(f"distance: must be finite, got {distance!r}")
         self.base, self.distance = base, d
-        self._occ = None
         self._equivalent = _equivalent(base, d)
 
     @property
@@ -180,11 +179,9 @@ class OffsetSurface(Surface):
         return out
 
     def geom(self):
-        if self._occ is None:
-            from ..occ.analytic import offset_surface
+        from ..occ.analytic import offset_surface
 
-            self._occ = offset_surface(self.base.geom(), self.distance)
-        return self._occ
+        return self._twin(lambda: offset_surface(self.base.geom(), self.distance))
 
     def transformed(self, matrix):
         """Similarity maps only (an offset is not affine-invariant): the base is mapped and
@@ -239,7 +236,7 @@ def _elementary(cls, params):
         data = read_elementary(surf)
         u0, u1, v0, v1 = bounds
         obj = cls._trusted(data["frame"], params(data), (u0, u1), (v0, v1))
-        obj._occ = surf
+        obj._adopt_twin(surf)
         return obj
 
     return read
@@ -266,7 +263,7 @@ def _revolution(surf, bounds):
     data = read_revolution(surf)
     u0, u1, v0, v1 = bounds
     obj = RevolutionSurface._trusted(curve_from_occ(data["basis"], (v0, v1)), data["origin"], data["direction"], (u0, u1))
-    obj._occ = surf
+    obj._adopt_twin(surf)
     return obj
 
 
@@ -278,7 +275,7 @@ def _extrusion(surf, bounds):
     data = read_extrusion(surf)
     u0, u1, v0, v1 = bounds
     obj = TabulatedCylinder._trusted(curve_from_occ(data["basis"], (u0, u1)), data["direction"], (v0, v1))
-    obj._occ = surf
+    obj._adopt_twin(surf)
     return obj
 
 
@@ -308,6 +305,6 @@ def _offset(surf, bounds):
 
     data = read_offset(surf)
     obj = OffsetSurface(_read_basis(data["basis"], bounds), data["distance"])
-    obj._occ = surf
+    obj._adopt_twin(surf)
     return obj
 

@@ -95,12 +95,11 @@ class RevolutionSurface(Surface):
 
     @classmethod
     def _trusted(cls, profile: Curve, origin, axis, u_range):
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         obj.profile = profile
         obj.axis_origin = checks.frozen(origin)
         obj.axis_direction = checks.frozen(np.asarray(axis, float) / np.linalg.norm(axis))
         obj.u_range = (float(u_range[0]), float(u_range[1]))
-        obj._occ = None
         return obj
 
     @property
@@ -139,11 +138,9 @@ class RevolutionSurface(Surface):
         return out
 
     def geom(self):
-        if self._occ is None:
-            from ..occ.analytic import revolution as occ_revolution
+        from ..occ.analytic import revolution as occ_revolution
 
-            self._occ = occ_revolution(self.profile.geom(), self.axis_origin, self.axis_direction)
-        return self._occ
+        return self._twin(lambda: occ_revolution(self.profile.geom(), self.axis_origin, self.axis_direction))
 
     def transformed(self, matrix):
         """Similarity maps keep the construct: profile and axis are mapped, and a mirror

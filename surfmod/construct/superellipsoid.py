@@ -284,12 +284,12 @@ def superellipsoid(rx, ry, rz, s1, s2, *, tolerance: float | None = None) -> Sup
         ecs, wcs = eta_map.cos_sin(us[:, None]), omega_map.cos_sin(vs[None, :])
         pts = _points_cs(rx, ry, rz, s1, s2, ecs, wcs)
         fit = interpolate(pts, (3, 3), parameters=(us, vs))
-        obj = Superellipsoid.__new__(Superellipsoid)
-        obj.__dict__.update(fit.__dict__)
-        obj.rx, obj.ry, obj.rz, obj.s1, obj.s2 = rx, ry, rz, s1, s2
-        obj._eta_map, obj._omega_map = eta_map, omega_map
-        obj.tolerance_requested = tol
-        obj.samples = (n_u, n_v)
+        # the fit's residual at its samples gives way to the measured deviation below
+        fields = {k: v for k, v in fit.__dict__.items() if k != "max_deviation"}
+        fields.update(tolerance_requested=tol, samples=(n_u, n_v))
+        obj = Superellipsoid._construct_fast(
+            **fields, rx=rx, ry=ry, rz=rz, s1=s1, s2=s2, _eta_map=eta_map, _omega_map=omega_map
+        )
         obj.max_deviation = _deviation(obj, 4)
         if obj.max_deviation <= tol:
             return obj

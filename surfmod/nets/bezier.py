@@ -36,7 +36,7 @@ class BezierCurve(BSplineCurve):
 
     @classmethod
     def _trusted(cls, pts, w=None):
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         BSplineCurve._set(obj, pts, pts.shape[0] - 1, clamped_bezier_knots(pts.shape[0] - 1), w)
         return obj
 
@@ -82,7 +82,7 @@ class BezierSurface(BSplineSurface):
 
     @classmethod
     def _trusted(cls, net, weights=None):
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         BezierSurface._set_bezier(obj, np.asarray(net, dtype=float), weights)
         return obj
 

@@ -71,7 +71,7 @@ class BSplineCurve(Curve):
     @classmethod
     def _trusted(cls, pts, p, k, w=None):
         """Build without re-validating (data produced inside surfmod)."""
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         BSplineCurve._set(obj, pts, p, k, w)
         return obj
 
@@ -183,7 +183,7 @@ class BSplineSurface(Surface):
     @classmethod
     def _trusted(cls, net, degree, knots, weights=None):
         """Build without re-validating (data produced inside surfmod)."""
-        obj = cls.__new__(cls)
+        obj = cls._construct_fast()
         BSplineSurface._set(obj, net, degree, knots, weights)
         return obj
 

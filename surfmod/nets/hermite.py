@@ -63,7 +63,7 @@ class HermiteBicubic(BezierSurface):
     def transformed(self, matrix) -> "HermiteBicubic":
         """Corners map affinely, tangents and twists linearly: still a Hermite patch."""
         m = transforms.affine(matrix)
-        obj = HermiteBicubic.__new__(HermiteBicubic)
+        obj = HermiteBicubic._construct_fast()
         obj._set_hermite(
             transforms.apply(m, self.corners),
             transforms.apply_vectors(m, self.du),

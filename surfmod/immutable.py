@@ -1,0 +1,70 @@
+"""Immutable values: the one way surfmod surfaces and curves are built and cached.
+
+A surface or curve is a value.  Its public attributes (control net, knots, weights, frame,
+profile...) are bound once, while it is built; rebinding one afterwards would leave the
+caches derived from it (homogeneous net, OCCT twin) silently stale, so it is refused.
+Arrays are frozen separately (``checks.frozen``).  Two doors build an object:
+
+* the class's own ``__init__``, which validates user input (DESIGN.md rule 3);
+* ``cls._construct_fast(**fields)`` for data produced inside surfmod, already valid
+  (scipy's ``construct_fast`` idea): fields are bound as given, nothing is re-checked.
+
+Analytic constructs whose OCCT twin is costly to rebuild (elementary, revolution,
+extrusion, offset) cache it with :meth:`_twin`; the cached ``Geom_Surface`` is shared, so
+a caller who wants to modify it in place (``Segment``, ``Transform``) copies it first.
+Net-based surfaces build a fresh twin on every ``geom()`` call.
+"""
+
+from __future__ import annotations
+
+from .errors import SurfmodError
+
+
+class ImmutableError(SurfmodError, AttributeError):
+    """An attempt to rebind or delete an attribute of a surfmod value.
+
+    >>> import surfmod as sm
+    >>> s = sm.sphere(1.0)
+    >>> try:
+    ...     s.radius = 2.0
+    ... except AttributeError as exc:
+    ...     print(type(exc).__name__)
+    ImmutableError
+    """
+
+
+class Immutable:
+    """Base of surfmod's value objects: public attributes bind once; private caches may fill in."""
+
+    __slots__ = ()
+
+    def __setattr__(self, name: str, value) -> None:
+        if not name.startswith("_") and name in self.__dict__:
+            raise ImmutableError(
+                f"{name}: {type(self).__name__} is immutable; build a new one "
+                "(e.g. with transformed(), segment() or the constructor)"
+            )
+        object.__setattr__(self, name, value)
+
+    def __delattr__(self, name: str) -> None:
+        raise ImmutableError(f"{name}: {type(self).__name__} is immutable; its attributes cannot be deleted")
+
+    @classmethod
+    def _construct_fast(cls, **fields):
+        """An instance with ``fields`` bound as given: no validation (trusted data only)."""
+        obj = object.__new__(cls)
+        for name, value in fields.items():
+            object.__setattr__(obj, name, value)
+        return obj
+
+    def _twin(self, build):
+        """The cached OCCT counterpart, built by ``build()`` on the first call."""
+        twin = self.__dict__.get("_occt_twin")
+        if twin is None:
+            twin = build()
+            object.__setattr__(self, "_occt_twin", twin)
+        return twin
+
+    def _adopt_twin(self, twin) -> None:
+        """Seed the cache with an OCCT object the value was read from (``from_face``)."""
+        object.__setattr__(self, "_occt_twin", twin)
