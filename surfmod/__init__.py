@@ -33,7 +33,6 @@ _EXPORTS = {
     "Circle": ".construct.conics",
     "Arc": ".construct.conics",
     "Ellipse": ".construct.conics",
-    "LineCurve": ".construct.conics",
     "Parabola": ".construct.conics",
     "Hyperbola": ".construct.conics",
     "ruled": ".construct.ruled",

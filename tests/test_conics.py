@@ -1,4 +1,4 @@
-"""Circle, Arc, Ellipse, LineCurve: OCCT's parametrization, exact rational B-spline forms."""
+"""Circle, Arc, Ellipse, Line: OCCT's parametrization, exact rational B-spline forms."""
 
 from __future__ import annotations
 
@@ -101,7 +101,7 @@ def test_ellipse_matches_occt_and_implicit():
 
 
 def test_line_curve_matches_geom_line():
-    c = sm.LineCurve((1, 2, 3), (1, 1, 0), (-2, 3))
+    c = sm.Line.through((1, 2, 3), (1, 1, 0), (-2, 3))
     assert sm.crosscheck(c).passed
     np.testing.assert_allclose(c.points(-2.0), np.array([1, 2, 3]) - 2 * np.array([1, 1, 0]) / math.sqrt(2), atol=1e-14)
     b = c.to_bspline()
@@ -135,7 +135,7 @@ def test_parabola_and_hyperbola(curve):
 @pytest.mark.parametrize("name", sorted(SIMILARITIES))
 @pytest.mark.parametrize(
     "curve",
-    [sm.Circle((1, 2, 3), (1, 1, 0), 2.0), sm.Arc((0, 0, 0), (0, 0, 1), 1.0, -90, 120), sm.LineCurve((0, 0, 0), (1, 1, 0), (-1, 2))],
+    [sm.Circle((1, 2, 3), (1, 1, 0), 2.0), sm.Arc((0, 0, 0), (0, 0, 1), 1.0, -90, 120), sm.Line.through((0, 0, 0), (1, 1, 0), (-1, 2))],
 )
 def test_similarity_transforms_match_gp_trsf(curve, name):
     m = SIMILARITIES[name]
@@ -166,8 +166,8 @@ def test_non_uniform_scale_gives_exact_nurbs_ellipse():
         (lambda: sm.Arc.through((0, 0, 0), (1, 1, 1), (2, 2, 2)), "p2"),
         (lambda: sm.Arc.through((0, 0, 0), (0, 0, 0), (2, 2, 2)), "p1"),
         (lambda: sm.Ellipse((0, 0, 0), (0, 0, 1), 1.0, 2.0), "minor"),
-        (lambda: sm.LineCurve((0, 0, 0), (0, 0, 0)), "direction"),
-        (lambda: sm.LineCurve((0, 0, 0), (1, 0, 0), (2, 1)), "t_range"),
+        (lambda: sm.Line.through((0, 0, 0), (0, 0, 0)), "direction"),
+        (lambda: sm.Line.through((0, 0, 0), (1, 0, 0), (2, 1)), "t_range"),
         (lambda: sm.Parabola((0, 0, 0), (0, 0, 1), 0.0, (0, 1)), "focal"),
         (lambda: sm.Hyperbola((0, 0, 0), (0, 0, 1), 1.0, 1.0, (1, 1)), "t_range"),
     ],

@@ -1,5 +1,5 @@
-"""Conics as curve inputs: ``Circle``, ``Arc``, ``Ellipse`` (OCCT's angle parametrization)
-and ``LineCurve`` (``Geom_Line``'s ``O + t D`` over a parameter range).
+"""Conics as curve inputs: ``Circle``, ``Arc``, ``Ellipse`` (OCCT's angle parametrization),
+``Parabola`` and ``Hyperbola``; straight lines are ``construct/curves.Line``.
 
 A conic with centre ``C``, frame ``(X, Y = N x X)`` and semi-axes ``a, b`` is
 ``C + a cos t X + b sin t Y`` with ``t`` in radians, exactly ``Geom_Circle`` /
@@ -211,59 +211,6 @@ class Ellipse(Conic):
         if b > a:
             raise SurfmodError(f"minor: must not exceed major ({a:g}), got {b:g}")
         self._init(c, n, x, a, b, (0.0, TWO_PI))
-
-
-class LineCurve(Curve):
-    """``Geom_Line``'s parametrization ``O + t D`` (``D`` unit) over ``t_range``.
-
-    >>> import surfmod as sm
-    >>> sm.LineCurve((0, 0, 0), (1, 0, 0), (-1, 2)).points(-1.0)
-    array([-1.,  0.,  0.])
-    """
-
-    occt_construct = "Geom_TrimmedCurve(Geom_Line)"
-
-    def __init__(self, origin, direction, t_range=(0.0, 1.0)):
-        self.origin = checks.frozen(checks.point(origin, "origin"))
-        self.direction = checks.frozen(checks.direction(direction, "direction"))
-        try:
-            t0, t1 = (float(t) for t in t_range)
-        except (TypeError, ValueError):
-            raise SurfmodError(f"t_range: expected two numbers, got {t_range!r}") from None
-        if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
-            raise SurfmodError(f"t_range: need finite start < end, got {t_range!r}")
-        self._domain = (t0, t1)
-
-    @property
-    def domain(self):
-        return self._domain
-
-    def _derivatives(self, t, order):
-        out = np.zeros((t.size, order + 1, 3))
-        out[:, 0] = self.origin + t[:, None] * self.direction
-        if order >= 1:
-            out[:, 1] = self.direction
-        return out
-
-    def geom(self):
-        from ..occ.analytic import infinite_line, trimmed
-
-        return trimmed(infinite_line(self.origin, self.direction), *self._domain)
-
-    def to_bspline(self) -> BSplineCurve:
-        """Degree-1 B-spline with the same parametrization."""
-        t0, t1 = self._domain
-        pts = np.array([self.origin + t0 * self.direction, self.origin + t1 * self.direction])
-        return BSplineCurve._trusted(pts, 1, np.array([t0, t0, t1, t1]))
-
-    def transformed(self, matrix):
-        m = transforms.affine(matrix)
-        if not transforms.is_similarity(m):
-            return self.to_bspline().transformed(m)
-        d = transforms.apply_vectors(m, self.direction)
-        s = float(np.linalg.norm(d))
-        t0, t1 = self._domain
-        return LineCurve(transforms.apply(m, self.origin), d / s, (t0 * s, t1 * s))
 
 
 class _FramedCurve(Curve):

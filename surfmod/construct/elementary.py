@@ -256,10 +256,10 @@ class CylindricalSurface(ElementarySurface):
     def to_nurbs(self):
         """Exact rational B-spline (a revolved line)."""
         from .revolution import revolve_nurbs
-        from .conics import LineCurve
+        from .curves import Line
 
         (u0, u1), (v0, v1) = self._domain
-        line = LineCurve(self.origin + self.radius * self.x_dir, self.z_dir, (v0, v1))
+        line = Line.through(self.origin + self.radius * self.x_dir, self.z_dir, (v0, v1))
         return revolve_nurbs(line.to_bspline(), self.origin, self._spin_axis, (u0, u1))
 
 
@@ -324,12 +324,12 @@ class ConicalSurface(ElementarySurface):
 
     def to_nurbs(self):
         """Exact rational B-spline (a revolved line)."""
-        from .conics import LineCurve
+        from .curves import Line
         from .revolution import revolve_nurbs
 
         (u0, u1), (v0, v1) = self._domain
         sa, ca = math.sin(self.semi_angle), math.cos(self.semi_angle)
-        line = LineCurve(self.origin + self.radius * self.x_dir, sa * self.x_dir + ca * self.z_dir, (v0, v1))
+        line = Line.through(self.origin + self.radius * self.x_dir, sa * self.x_dir + ca * self.z_dir, (v0, v1))
         return revolve_nurbs(line.to_bspline(), self.origin, self._spin_axis, (u0, u1))
 
 

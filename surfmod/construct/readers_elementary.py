@@ -200,13 +200,14 @@ def curve_from_occ(curve, t_range):
     from ..nets.bezier import BezierCurve
     from ..nets.bspline import BSplineCurve
     from ..occ.analytic import read_curve
-    from .conics import Conic, Hyperbola, LineCurve, Parabola
+    from .conics import Conic, Hyperbola, Parabola
+    from .curves import Line
 
     t0, t1 = (float(t) for t in t_range)
     d = read_curve(curve)
     kind = d["kind"]
     if kind == "line":
-        return LineCurve(d["origin"], d["direction"], (t0, t1))
+        return Line.through(d["origin"], d["direction"], (t0, t1))
     if kind in ("circle", "ellipse"):
         o, x, _, z = d["frame"]
         a, b = (d["radius"], d["radius"]) if kind == "circle" else (d["major"], d["minor"])
