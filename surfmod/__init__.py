@@ -112,6 +112,8 @@ _EXPORTS = {
     "Tool": ".uses.toolpath",
     "export_gcode": ".io.gcode",
     "make_solid": ".uses.inputs",
+    "coons": ".construct.coons",
+    "CoonsSurface": ".construct.coons",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
