@@ -114,6 +114,8 @@ _EXPORTS = {
     "make_solid": ".uses.inputs",
     "coons": ".construct.coons",
     "CoonsSurface": ".construct.coons",
+    "gordon": ".construct.gordon",
+    "GordonSurface": ".construct.gordon",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
