@@ -116,6 +116,14 @@ _EXPORTS = {
     "CoonsSurface": ".construct.coons",
     "gordon": ".construct.gordon",
     "GordonSurface": ".construct.gordon",
+    "to_geomdl": ".interop.geomdl_io",
+    "from_geomdl": ".interop.geomdl_io",
+    "to_splipy": ".interop.splipy_io",
+    "from_splipy": ".interop.splipy_io",
+    "to_rhino": ".interop.rhino_io",
+    "from_rhino": ".interop.rhino_io",
+    "export_iges": ".io.iges",
+    "import_iges": ".io.iges",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
