@@ -124,6 +124,8 @@ _EXPORTS = {
     "from_rhino": ".interop.rhino_io",
     "export_iges": ".io.iges",
     "import_iges": ".io.iges",
+    "fit": ".construct.scattered_fit",
+    "Fit": ".construct.scattered_fit",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
