@@ -17,7 +17,7 @@ guide to cross the profiles at ``V_i``.  A network that already does (e.g. iso-c
 one B-spline surface) is used as is and the surface is exact.  Otherwise every curve is
 reparametrized by a monotone map sending its crossings to the common parameters (the
 means over the network), and re-interpolated as a cubic B-spline whose distance from
-the original curve is measured and kept below a quarter of ``tolerance``; the crossing
+the original curve is measured and kept below half of ``tolerance``; the crossing
 points themselves are hit exactly.  The three terms are then made compatible (degree
 elevation and knot merging, :mod:`surfmod.nets.elevate`) and summed control point by
 control point.
@@ -131,7 +131,7 @@ def _reparametrized_curve(curve, crossings, targets, tolerance):
     y = np.concatenate([[a], crossings, [b]])
     x, keep = np.unique(x, return_index=True)
     phi = PchipInterpolator(x, y[keep])
-    per = 8
+    per = 4
     while True:
         t = np.unique(np.concatenate([np.linspace(x0, x1, per + 1) for x0, x1 in zip(x[:-1], x[1:])]))
         pts = curve.points(np.clip(phi(t), a, b))
@@ -145,7 +145,7 @@ def _reparametrized_curve(curve, crossings, targets, tolerance):
             if err > tolerance:
                 raise SurfmodError(f"tolerance: a network curve cannot be reparametrized within {tolerance:g} (reached {err:.3g})")
             return fitted
-        per *= 2
+        per = (3 * per + 1) // 2
 
 
 # -- surface algebra ------------------------------------------------------------------------
@@ -266,8 +266,8 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
         p_curves = [reparametrized(c, 0.0, 1.0) for c in prof]
         g_curves = [reparametrized(c, 0.0, 1.0) for c in guid]
     else:
-        p_curves = [_reparametrized_curve(c, u[i], big_u, tol / 4) for i, c in enumerate(prof)]
-        g_curves = [_reparametrized_curve(c, v[:, j], big_v, tol / 4) for j, c in enumerate(guid)]
+        p_curves = [_reparametrized_curve(c, u[i], big_u, tol / 2) for i, c in enumerate(prof)]
+        g_curves = [_reparametrized_curve(c, v[:, j], big_v, tol / 2) for j, c in enumerate(guid)]
     p_curves = make_compatible(p_curves)
     g_curves = make_compatible(g_curves)
     k_p, k_g = len(p_curves), len(g_curves)
