@@ -111,3 +111,14 @@ def test_errors_name_the_curves():
     short = [_spline([(x, y, _height(x, y)) for y in np.linspace(0, 3, 7)]) for x in (0, 1, 2.5, 3.5)]
     with pytest.raises(sm.SurfmodError, match=r"profiles\[\d\]: its ends must lie on the first and last guides"):
         sm.gordon(profiles, short, 1e-3)
+
+
+def test_rational_profiles_are_reparametrized_within_tolerance():
+    import build123d as bd
+
+    profiles = [bd.Edge.make_three_point_arc((0, y, 0), (5, y, 2 + 0.2 * y), (10, y, 0)) for y in (0, 5, 10)]
+    guides = [sm.Line((0, 0, 0), (0, 10, 0)), sm.Line((10, 0, 0), (10, 10, 0)),
+              _spline([(5, y, 2 + 0.2 * y) for y in (0, 5, 10)])]
+    s = sm.gordon(profiles, guides, 1e-4)
+    assert s.reparametrized and not s.rational
+    assert s.network_deviation() <= 1e-4

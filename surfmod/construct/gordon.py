@@ -15,7 +15,7 @@ knots by averaging), and the tensor-product interpolant of the intersection poin
 This needs each profile to cross the guides at the same parameters ``U_j`` and each
 guide to cross the profiles at ``V_i``.  A network that already does (e.g. iso-curves of
 one B-spline surface) is used as is and the surface is exact.  Otherwise every curve is
-reparametrized by a monotone map sending its crossings to the common parameters (the
+reparametrized by a smooth monotone map sending its crossings to the common parameters (the
 means over the network), and re-interpolated as a cubic B-spline whose distance from
 the original curve is measured and kept below half of ``tolerance``; the crossing
 points themselves are hit exactly.  The three terms are then made compatible (degree
@@ -124,13 +124,17 @@ def _reparametrized_curve(curve, crossings, targets, tolerance):
     """``curve(phi(t))`` as a cubic B-spline on ``[0, 1]`` with ``phi(targets) = crossings``
     (monotone piecewise cubic), interpolated at samples that include every target so the
     crossing points stay exact; refined until within ``tolerance`` of the curve."""
-    from scipy.interpolate import PchipInterpolator
+    from scipy.interpolate import CubicSpline, PchipInterpolator
 
     a, b = curve.domain
     x = np.concatenate([[0.0], targets, [1.0]])
     y = np.concatenate([[a], crossings, [b]])
     x, keep = np.unique(x, return_index=True)
-    phi = PchipInterpolator(x, y[keep])
+    # a C2 map keeps curve(phi(t)) smooth, so its cubic interpolant converges fast; the
+    # monotone (C1) PCHIP map is the fallback when the C2 one would turn back
+    phi = CubicSpline(x, y[keep], bc_type="natural")
+    if np.any(phi(np.linspace(0.0, 1.0, 2049), 1) <= 0):
+        phi = PchipInterpolator(x, y[keep])
     per = 4
     while True:
         t = np.unique(np.concatenate([np.linspace(x0, x1, per + 1) for x0, x1 in zip(x[:-1], x[1:])]))
