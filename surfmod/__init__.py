@@ -111,6 +111,20 @@ _EXPORTS = {
     "Tool": ".uses.toolpath",
     "export_gcode": ".io.gcode",
     "make_solid": ".uses.inputs",
+    "coons": ".construct.coons",
+    "CoonsSurface": ".construct.coons",
+    "gordon": ".construct.gordon",
+    "GordonSurface": ".construct.gordon",
+    "to_geomdl": ".interop.geomdl_io",
+    "from_geomdl": ".interop.geomdl_io",
+    "to_splipy": ".interop.splipy_io",
+    "from_splipy": ".interop.splipy_io",
+    "to_rhino": ".interop.rhino_io",
+    "from_rhino": ".interop.rhino_io",
+    "export_iges": ".io.iges",
+    "import_iges": ".io.iges",
+    "fit": ".construct.scattered_fit",
+    "Fit": ".construct.scattered_fit",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
