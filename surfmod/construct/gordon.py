@@ -290,7 +290,7 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
         (1.0, skin_g, (pu, g_curves[0].degree), (ku, g_curves[0].knots)),
         (-1.0, tensor, (pu, qv), (ku, kv)),
     ])
-    obj = GordonSurface.__new__(GordonSurface)
+    obj = GordonSurface._construct_fast()
     BSplineSurface._set(obj, net, deg, knots, None)
     obj.profiles = tuple(prof)
     obj.guides = tuple(guid)
