@@ -1,0 +1,356 @@
+"""Compiled (numba) kernels for tensor-product evaluation with local support.
+
+Every point touches only its ``(p+1) x (q+1)`` poles, so the cost depends on the number
+of points and the degrees, never on the size of the control net.  The kernels are
+imported lazily (``import surfmod`` never imports numba) and compiled once into numba's
+on-disk cache (``cache=True``).  All arrays they write are allocated by the NumPy caller,
+so ``tracemalloc`` sees the memory and the caller decides the blocking.
+
+Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polynomial,
+4 rational ``(w x, w y, w z, w)``), C-contiguous float64.  Spans follow
+:func:`surfmod.eval.basis.find_spans`: ``knots[i] <= t < knots[i+1]`` clipped to
+``[degree, n_ctrl - 1]`` (the right end of the domain belongs to the last span).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def find_span(knots, degree, n_ctrl, t):
+    """The largest ``i`` with ``knots[i] <= t``, clipped to the domain.  A branch-free
+    binary search (the halving step compiles to a conditional move): random parameters
+    would mispredict every branch of the textbook loop."""
+    base = 0
+    size = knots.size
+    while size > 1:
+        half = size // 2
+        base = base + half if knots[base + half] <= t else base
+        size -= half
+    span = base if knots[base] <= t else base - 1
+    if span < degree:
+        return degree
+    if span > n_ctrl - 1:
+        return n_ctrl - 1
+    return span
+
+
+@njit(cache=True, inline="always")
+def basis_ders_point(knots, p, span, t, order, ndu, left, right, a, ders):
+    """Piegl & Tiller A2.3 for one parameter: ``ders[k, r]`` = k-th derivative of
+    ``N_{span-p+r}`` at ``t`` for ``k <= order`` (rows above the degree are zero).
+
+    ``ndu (p+1, p+1)``, ``left``/``right (p+1)`` and ``a (2, p+1)`` are scratch.  The
+    arithmetic is the same sequence as :func:`surfmod.eval.basis.basis_derivatives`.
+    """
+    ndu[0, 0] = 1.0
+    for j in range(1, p + 1):
+        left[j] = t - knots[span + 1 - j]
+        right[j] = knots[span + j] - t
+        saved = 0.0
+        for r in range(j):
+            ndu[j, r] = right[r + 1] + left[j - r]
+            temp = ndu[r, j - 1] / ndu[j, r]
+            ndu[r, j] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        ndu[j, j] = saved
+    for r in range(p + 1):
+        ders[0, r] = ndu[r, p]
+    for k in range(1, order + 1):
+        for r in range(p + 1):
+            ders[k, r] = 0.0
+    top = min(order, p)
+    if top == 0:
+        return
+    for r in range(p + 1):
+        s1, s2 = 0, 1
+        a[0, 0] = 1.0
+        for k in range(1, top + 1):
+            d = 0.0
+            rk, pk = r - k, p - k
+            if r >= k:
+                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
+                d = a[s2, 0] * ndu[rk, pk]
+            j1 = 1 if rk >= -1 else -rk
+            j2 = k - 1 if r - 1 <= pk else p - r
+            for j in range(j1, j2 + 1):
+                a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
+            # summed separately, in the order of the NumPy path (einsum over j)
+            acc = 0.0
+            for j in range(j1, j2 + 1):
+                acc += a[s2, j] * ndu[rk + j, pk]
+            d += acc
+            if r <= pk:
+                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
+                d += a[s2, k] * ndu[r, pk]
+            ders[k, r] = d
+            s1, s2 = s2, s1
+    factor = float(p)
+    for k in range(1, top + 1):
+        for r in range(p + 1):
+            ders[k, r] *= factor
+        factor *= p - k
+
+
+@njit(cache=True, inline="always")
+def quotient_point(h, binom, out):
+    """Rational quotient rule (A4.4) at one point: homogeneous ``h (K, K, 4)`` ->
+    Cartesian ``out (K, K, 3)``; every entry of the square is exact."""
+    kk = h.shape[0]
+    inv_w = 1.0 / h[0, 0, 3]
+    for k in range(kk):
+        for l in range(kk):
+            for d in range(3):
+                v = h[k, l, d]
+                for j in range(1, l + 1):
+                    v -= binom[l, j] * h[0, j, 3] * out[k, l - j, d]
+                for i in range(1, k + 1):
+                    v -= binom[k, i] * h[i, 0, 3] * out[k - i, l, d]
+                    v2 = 0.0
+                    for j in range(1, l + 1):
+                        v2 += binom[l, j] * h[i, j, 3] * out[k - i, l - j, d]
+                    v -= binom[k, i] * v2
+                out[k, l, d] = v * inv_w
+
+
+def reciprocal_table(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
+    """``inv[span, j, r] = 1 / (knots[span+r+1] - knots[span+r+1-j])`` for the spans of the
+    domain (other entries 0): the divisors of the Cox-de Boor triangle.  Every such
+    difference spans the non-empty knot interval ``[knots[span], knots[span+1])``."""
+    p = degree
+    inv = np.zeros((n_ctrl, p + 1, p + 1))
+    span = np.arange(p, n_ctrl)
+    for j in range(1, p + 1):
+        for r in range(j):
+            diff = knots[span + r + 1] - knots[span + r + 1 - j]
+            with np.errstate(divide="ignore"):
+                inv[p:, j, r] = np.where(diff > 0, 1.0 / np.where(diff > 0, diff, 1.0), 0.0)
+    return inv
+
+
+def binomials(order: int) -> np.ndarray:
+    """``C(k, i)`` table ``(order+1, order+1)`` for the quotient rule."""
+    kk = order + 1
+    out = np.zeros((kk, kk))
+    for k in range(kk):
+        out[k, 0] = 1.0
+        for i in range(1, k + 1):
+            out[k, i] = out[k - 1, i - 1] + (out[k - 1, i] if i < k else 0.0)
+    return out
+
+
+@njit(cache=True)
+def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, out):
+    """Mixed partials at scattered pairs into ``out (N, K, K, 3)`` (Cartesian).
+
+    ``ctrl`` is ``(n, m, 4)``: homogeneous for a rational net, the weight column unused
+    (any value) otherwise, so the innermost loop is a literal 4-vector."""
+    n, m = ctrl.shape[0], ctrl.shape[1]
+    kk = order + 1
+    ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
+    lu, ru, au = np.empty(p + 1), np.empty(p + 1), np.empty((2, p + 1))
+    lv, rv, av = np.empty(q + 1), np.empty(q + 1), np.empty((2, q + 1))
+    bu, bv = np.empty((kk, p + 1)), np.empty((kk, q + 1))
+    h = np.empty((kk, kk, 4))
+    row = np.empty((kk, 4))
+    for a in range(u.size):
+        su = find_span(ku, p, n, u[a])
+        sv = find_span(kv, q, m, v[a])
+        basis_ders_point(ku, p, su, u[a], order, ndu_u, lu, ru, au, bu)
+        basis_ders_point(kv, q, sv, v[a], order, ndu_v, lv, rv, av, bv)
+        for k in range(kk):
+            for l in range(kk):
+                for d in range(4):
+                    h[k, l, d] = 0.0
+        for i in range(p + 1):
+            ci = su - p + i
+            for l in range(kk):
+                for d in range(4):
+                    row[l, d] = 0.0
+            for j in range(q + 1):
+                cj = sv - q + j
+                for l in range(kk):
+                    c = bv[l, j]
+                    for d in range(4):
+                        row[l, d] += c * ctrl[ci, cj, d]
+            for k in range(kk):
+                c = bu[k, i]
+                for l in range(kk):
+                    for d in range(4):
+                        h[k, l, d] += c * row[l, d]
+        if rational:
+            quotient_point(h, binom, out[a])
+        else:
+            for k in range(kk):
+                for l in range(kk):
+                    for d in range(3):
+                        out[a, k, l, d] = h[k, l, d]
+
+
+@njit(cache=True)
+def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, out):
+    """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
+    :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
+    sums kept in registers."""
+    n, m = ctrl.shape[0], ctrl.shape[1]
+    nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
+    lu, ru = np.empty(p + 1), np.empty(p + 1)
+    lv, rv = np.empty(q + 1), np.empty(q + 1)
+    for a in range(u.size):
+        su = find_span(ku, p, n, u[a])
+        sv = find_span(kv, q, m, v[a])
+        _basis_funs(ku, p, su, u[a], inv_u, lu, ru, nu_)
+        _basis_funs(kv, q, sv, v[a], inv_v, lv, rv, nv_)
+        x = y = z = w = 0.0
+        for i in range(p + 1):
+            rx = ry = rz = rw = 0.0
+            ci = su - p + i
+            for j in range(q + 1):
+                c = nv_[j]
+                cj = sv - q + j
+                rx += c * ctrl[ci, cj, 0]
+                ry += c * ctrl[ci, cj, 1]
+                rz += c * ctrl[ci, cj, 2]
+                rw += c * ctrl[ci, cj, 3]
+            c = nu_[i]
+            x += c * rx
+            y += c * ry
+            z += c * rz
+            w += c * rw
+        if rational:
+            x /= w
+            y /= w
+            z /= w
+        out[a, 0] = x
+        out[a, 1] = y
+        out[a, 2] = z
+
+
+@njit(cache=True, inline="always")
+def _basis_funs(knots, p, span, t, inv, left, right, out):
+    """Piegl & Tiller A2.2: the p+1 non-zero basis functions at ``t``.  The denominators
+    ``right[r+1] + left[j-r]`` are knot differences independent of ``t``; their
+    reciprocals come from the table ``inv[span, j, r]`` (see :func:`reciprocal_table`),
+    so the triangle has no division."""
+    out[0] = 1.0
+    for j in range(1, p + 1):
+        left[j] = t - knots[span + 1 - j]
+        right[j] = knots[span + j] - t
+        saved = 0.0
+        for r in range(j):
+            temp = out[r] * inv[span, j, r]
+            out[r] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        out[j] = saved
+
+
+@njit(cache=True)
+def grid_rows(bv, sv, q, ctrl, rows, dim, out):
+    """First stage of the grid: ``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]``
+    for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
+    with the v-basis."""
+    kk = bv.shape[1]
+    for r in range(rows.size):
+        i = rows[r]
+        for b in range(sv.size):
+            s = sv[b] - q
+            for l in range(kk):
+                x = y = z = w = 0.0
+                for j in range(q + 1):
+                    c = bv[b, l, j]
+                    x += c * ctrl[i, s + j, 0]
+                    y += c * ctrl[i, s + j, 1]
+                    z += c * ctrl[i, s + j, 2]
+                    w += c * ctrl[i, s + j, 3]
+                out[r, l, 0, b] = x
+                out[r, l, 1, b] = y
+                out[r, l, 2, b] = z
+                if dim == 4:
+                    out[r, l, 3, b] = w
+
+
+@njit(cache=True, inline="always")
+def _combine_rows(bu, a, first, p, w, kk, dim, acc):
+    """``acc[k, l, d, :] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the vector axis)."""
+    r0 = first[a]
+    nv = w.shape[3]
+    for k in range(kk):
+        for l in range(kk):
+            for d in range(dim):
+                c = bu[a, k, 0]
+                for b in range(nv):
+                    acc[k, l, d, b] = c * w[r0, l, d, b]
+                for i in range(1, p + 1):
+                    c = bu[a, k, i]
+                    for b in range(nv):
+                        acc[k, l, d, b] += c * w[r0 + i, l, d, b]
+
+
+@njit(cache=True)
+def grid_positions(bu, first, p, w, rational, acc, out):
+    """Second stage for positions: ``out (n_u, n_v, 3)`` point-major, the division by the
+    weight fused into the (interleaving) store."""
+    nv = w.shape[3]
+    dim = 4 if rational else 3
+    for a in range(bu.shape[0]):
+        _combine_rows(bu, a, first, p, w, 1, dim, acc)
+        if rational:
+            for b in range(nv):
+                inv_w = 1.0 / acc[0, 0, 3, b]
+                out[a, b, 0] = acc[0, 0, 0, b] * inv_w
+                out[a, b, 1] = acc[0, 0, 1, b] * inv_w
+                out[a, b, 2] = acc[0, 0, 2, b] * inv_w
+        else:
+            for b in range(nv):
+                out[a, b, 0] = acc[0, 0, 0, b]
+                out[a, b, 1] = acc[0, 0, 1, b]
+                out[a, b, 2] = acc[0, 0, 2, b]
+
+
+@njit(cache=True)
+def grid_derivatives(bu, first, p, w, rational, binom, acc, out):
+    """Second stage for partials: for each u-point combine its p+1 rows of ``w``, apply
+    the quotient rule on the planes (rational), and write ``out (n_u, K, K, 3, n_v)``:
+    planar, every partial and coordinate a contiguous row of v."""
+    kk = bu.shape[1]
+    nv = w.shape[3]
+    dim = 4 if rational else 3
+    for a in range(bu.shape[0]):
+        if rational:
+            _combine_rows(bu, a, first, p, w, kk, dim, acc)
+            _quotient_planes(acc, binom)
+            for k in range(kk):
+                for l in range(kk):
+                    for d in range(3):
+                        for b in range(nv):
+                            out[a, k, l, d, b] = acc[k, l, d, b]
+        else:
+            _combine_rows(bu, a, first, p, w, kk, dim, out[a])
+
+
+@njit(cache=True, inline="always")
+def _quotient_planes(acc, binom):
+    """The quotient rule in place on planes ``acc (K, K, 4, n)``: coordinates 0..2 of
+    every entry become Cartesian, entry by entry in rising order (each needs only lower
+    entries, already converted, and the untouched weight planes).  Every step is a pass
+    over the contiguous last axis, so it vectorizes."""
+    kk, nv = acc.shape[0], acc.shape[3]
+    inv_w = np.empty(nv)
+    for b in range(nv):
+        inv_w[b] = 1.0 / acc[0, 0, 3, b]
+    for k in range(kk):
+        for l in range(kk):
+            for d in range(3):
+                for j in range(1, l + 1):
+                    c = binom[l, j]
+                    for b in range(nv):
+                        acc[k, l, d, b] -= c * acc[0, j, 3, b] * acc[k, l - j, d, b]
+                for i in range(1, k + 1):
+                    for j in range(l + 1):
+                        c = binom[k, i] * binom[l, j]
+                        for b in range(nv):
+                            acc[k, l, d, b] -= c * acc[i, j, 3, b] * acc[k - i, l - j, d, b]
+                for b in range(nv):
+                    acc[k, l, d, b] *= inv_w[b]

@@ -1,0 +1,126 @@
+"""Tensor-product surface evaluation with local support: each point touches only its
+``(p+1) x (q+1)`` poles, so the cost depends on the points and the degrees, not on the
+size of the control net (a 1000 x 1000 net costs what a 4 x 4 one does).
+
+Scattered pairs run one compiled loop over the points (span search, basis derivatives,
+local contraction, quotient rule).  Grids run in two stages: the net rows that the
+u-points need are contracted with the v-basis once (``W[i, l, :, b]``), then each u-point
+combines its p+1 rows with the v-points on the contiguous axis.  The u-points go in
+blocks so that the row table stays a few MiB whatever the grid or the net.
+
+The compiled kernels live in :mod:`surfmod.eval.kernels`, imported on first use (so
+``import surfmod`` does not load numba).
+
+>>> import numpy as np
+>>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+>>> knots = np.array([0, 0, 0, 0, 1, 1, 1, 1.0])
+>>> surface_points(knots, 3, knots, 3, net, np.array([0.5]), np.array([0.25]), False)
+array([[1.5 , 0.75, 0.  ]])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .basis import basis_derivatives, find_spans
+
+#: doubles in the per-block row table of the grid stage (4 MiB): fits in L2/L3
+ROW_TABLE = 1 << 19
+
+
+def _kernels():
+    from . import kernels  # numba: compiled on first use, then from its disk cache
+
+    return kernels
+
+
+def writable(t) -> np.ndarray:
+    """A flat, C-contiguous, writable float64 array (copied only when needed): one
+    array type for the compiled kernels, so they are compiled once."""
+    return np.require(np.asarray(t, dtype=float).ravel(), float, ["C", "W"])
+
+
+_as_float = writable
+
+
+def surface_points(knots_u, p, knots_v, q, ctrl, u, v, rational: bool, out=None) -> np.ndarray:
+    """Positions at scattered pairs ``(u[a], v[a])``: ``(N, 3)``, written into ``out`` when
+    given (any C-contiguous ``(N, 3)`` float array, e.g. a slice of a larger buffer)."""
+    k = _kernels()
+    u, v = _as_float(u), _as_float(v)
+    if out is None:
+        out = np.empty((u.size, 3))
+    n, m = ctrl.shape[:2]
+    inv_u, inv_v = k.reciprocal_table(knots_u, p, n), k.reciprocal_table(knots_v, q, m)
+    k.scattered_positions(knots_u, p, knots_v, q, ctrl, u, v, rational, inv_u, inv_v, out)
+    return out
+
+
+def surface_derivatives(knots_u, p, knots_v, q, ctrl, u, v, order: int, rational: bool, out=None) -> np.ndarray:
+    """Cartesian mixed partials at scattered pairs: ``(N, K, K, 3)``, ``K = order + 1``;
+    entry ``[a, k, l]`` is d^(k+l) S / du^k dv^l (the rational quotient rule included)."""
+    k = _kernels()
+    u, v = _as_float(u), _as_float(v)
+    if out is None:
+        out = np.empty((u.size, order + 1, order + 1, 3))
+    k.scattered_derivatives(knots_u, p, knots_v, q, ctrl, u, v, int(order), rational, k.binomials(order), out)
+    return out
+
+
+def _basis(knots, degree, n_ctrl, t, order):
+    spans = find_spans(knots, degree, n_ctrl, t)
+    ders = np.ascontiguousarray(basis_derivatives(knots, degree, spans, t, order))  # (N, K, deg+1)
+    return spans, ders
+
+
+def homogeneous4(ctrl: np.ndarray) -> np.ndarray:
+    """The net as ``(n, m, 4)`` float64, C-contiguous: homogeneous points stay, a
+    polynomial net gets a unit weight column (the kernels' inner loop is a 4-vector)."""
+    if ctrl.shape[-1] == 4:
+        return np.require(ctrl, float, ["C", "W"])
+    out = np.ones(ctrl.shape[:-1] + (4,))
+    out[..., :3] = ctrl
+    return out
+
+
+def _row_blocks(su, p, n, per_row):
+    """Blocks of u-points whose net rows fit the row table: ``(a0, a1, rows, first)``."""
+    max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
+    step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
+    for a0 in range(0, su.size, step):  # loop over memory blocks, not points
+        s = su[a0 : a0 + step]
+        rows = np.unique((s[:, None] - p + np.arange(p + 1)).ravel())
+        yield a0, a0 + s.size, rows, np.searchsorted(rows, s - p)
+
+
+def surface_grid(knots_u, p, knots_v, q, ctrl, us, vs, order: int, rational: bool, out=None) -> np.ndarray:
+    """Cartesian mixed partials on the grid ``us x vs``: ``(len(us), len(vs), K, K, 3)``.
+
+    ``ctrl`` is ``(n, m, 4)`` (see :func:`homogeneous4`).  Positions (``order == 0``) are
+    written point-major, into ``out (len(us), len(vs), 3)`` when given; partials are
+    written planar (every partial and coordinate a contiguous row of v) and returned as
+    the transposed view.
+    """
+    k = _kernels()
+    us, vs = _as_float(us), _as_float(vs)
+    n, m = ctrl.shape[:2]
+    kk = order + 1
+    dim = 4 if rational else 3
+    su, bu = _basis(knots_u, p, n, us, order)
+    sv, bv = _basis(knots_v, q, m, vs, order)
+    acc = np.empty((kk, kk, 4, vs.size))
+    if order == 0:
+        if out is None:
+            out = np.empty((us.size, vs.size, 3))
+        for a0, a1, rows, first in _row_blocks(su, p, n, dim * vs.size):
+            table = np.empty((rows.size, 1, dim, vs.size))
+            k.grid_rows(bv, sv, q, ctrl, rows, dim, table)
+            k.grid_positions(bu[a0:a1], first, p, table, rational, acc, out[a0:a1])
+        return out[:, :, None, None, :]
+    planar = np.empty((us.size, kk, kk, 3, vs.size))
+    binom = k.binomials(order)
+    for a0, a1, rows, first in _row_blocks(su, p, n, kk * dim * vs.size):
+        table = np.empty((rows.size, kk, dim, vs.size))
+        k.grid_rows(bv, sv, q, ctrl, rows, dim, table)
+        k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, acc, planar[a0:a1])
+    return planar.transpose(0, 4, 1, 2, 3)
