@@ -38,12 +38,44 @@ def find_span(knots, degree, n_ctrl, t):
 
 
 @njit(cache=True, inline="always")
-def basis_ders_point(knots, p, span, t, order, ndu, left, right, a, ders):
-    """Piegl & Tiller A2.3 for one parameter: ``ders[k, r]`` = k-th derivative of
-    ``N_{span-p+r}`` at ``t`` for ``k <= order`` (rows above the degree are zero).
+def find_span_bucketed(knots, degree, n_ctrl, t, t0, scale, table):
+    """:func:`find_span` in O(1): a uniform bucket grid over the domain gives a span at or
+    just before the answer (see :func:`span_buckets`), then a short, well-predicted walk.
+    The walk back guards against the rounding of the bucket index."""
+    b = int((t - t0) * scale)
+    if b < 0:
+        b = 0
+    elif b >= table.size:
+        b = table.size - 1
+    span = table[b]
+    while span < n_ctrl - 1 and knots[span + 1] <= t:
+        span += 1
+    while span > degree and knots[span] > t:
+        span -= 1
+    return span
 
-    ``ndu (p+1, p+1)``, ``left``/``right (p+1)`` and ``a (2, p+1)`` are scratch.  The
-    arithmetic is the same sequence as :func:`surfmod.eval.basis.basis_derivatives`.
+
+def span_buckets(knots: np.ndarray, degree: int, n_ctrl: int, per_span: int = 4):
+    """``(t0, scale, table)`` for :func:`find_span_bucketed`: ``per_span`` buckets per
+    knot span over ``[knots[degree], knots[n_ctrl]]``, each holding the span of its start."""
+    t0, t1 = float(knots[degree]), float(knots[n_ctrl])
+    count = max(1, per_span * (n_ctrl - degree))
+    starts = t0 + (t1 - t0) * np.arange(count) / count
+    table = np.clip(np.searchsorted(knots, starts, side="right") - 1, degree, n_ctrl - 1).astype(np.int64)
+    return t0, (count / (t1 - t0) if t1 > t0 else 0.0), table
+
+
+@njit(cache=True, inline="always")
+def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders):
+    """The p+1 non-zero basis functions at ``t`` and their derivatives: ``ders[k, r]`` is
+    the k-th derivative of ``N_{span-p+r}`` for ``k <= order`` (zero above the degree).
+
+    The Cox-de Boor triangle ``ndu[r, j] = N_{span-j+r, j}`` keeps every lower degree;
+    the k-th derivative starts from degree p-k and is raised k times by the textbook
+    rule ``N'_{i,d} = d (N_{i,d-1} / (u_{i+d} - u_i) - N_{i+1,d-1} / (u_{i+d+1} - u_{i+1}))``
+    (The NURBS Book eq. 2.9; A2.3 evaluates the same sums).  Every divisor is a knot
+    difference whose reciprocal is in ``inv`` (:func:`reciprocal_table`; 0 for an empty
+    difference, the 0/0 = 0 convention), so nothing divides.
     """
     ndu[0, 0] = 1.0
     for j in range(1, p + 1):
@@ -51,47 +83,27 @@ def basis_ders_point(knots, p, span, t, order, ndu, left, right, a, ders):
         right[j] = knots[span + j] - t
         saved = 0.0
         for r in range(j):
-            ndu[j, r] = right[r + 1] + left[j - r]
-            temp = ndu[r, j - 1] / ndu[j, r]
+            temp = ndu[r, j - 1] * inv[span, j, r]
             ndu[r, j] = saved + right[r + 1] * temp
             saved = left[j - r] * temp
         ndu[j, j] = saved
     for r in range(p + 1):
         ders[0, r] = ndu[r, p]
     for k in range(1, order + 1):
+        if k > p:
+            for r in range(p + 1):
+                ders[k, r] = 0.0
+            continue
+        for r in range(p - k + 1):
+            tmp[r] = ndu[r, p - k]
+        for d in range(p - k + 1, p + 1):
+            # in place from the top: new[r] needs old[r - 1] and old[r]
+            tmp[d] = d * (tmp[d - 1] * inv[span, d, d - 1])
+            for r in range(d - 1, 0, -1):
+                tmp[r] = d * (tmp[r - 1] * inv[span, d, r - 1] - tmp[r] * inv[span, d, r])
+            tmp[0] = -d * (tmp[0] * inv[span, d, 0])
         for r in range(p + 1):
-            ders[k, r] = 0.0
-    top = min(order, p)
-    if top == 0:
-        return
-    for r in range(p + 1):
-        s1, s2 = 0, 1
-        a[0, 0] = 1.0
-        for k in range(1, top + 1):
-            d = 0.0
-            rk, pk = r - k, p - k
-            if r >= k:
-                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
-                d = a[s2, 0] * ndu[rk, pk]
-            j1 = 1 if rk >= -1 else -rk
-            j2 = k - 1 if r - 1 <= pk else p - r
-            for j in range(j1, j2 + 1):
-                a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
-            # summed separately, in the order of the NumPy path (einsum over j)
-            acc = 0.0
-            for j in range(j1, j2 + 1):
-                acc += a[s2, j] * ndu[rk + j, pk]
-            d += acc
-            if r <= pk:
-                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
-                d += a[s2, k] * ndu[r, pk]
-            ders[k, r] = d
-            s1, s2 = s2, s1
-    factor = float(p)
-    for k in range(1, top + 1):
-        for r in range(p + 1):
-            ders[k, r] *= factor
-        factor *= p - k
+            ders[k, r] = tmp[r]
 
 
 @njit(cache=True, inline="always")
@@ -142,7 +154,7 @@ def binomials(order: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, out):
+def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
     """Mixed partials at scattered pairs into ``out (N, K, K, 3)`` (Cartesian).
 
     ``ctrl`` is ``(n, m, 4)``: homogeneous for a rational net, the weight column unused
@@ -150,16 +162,18 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, out)
     n, m = ctrl.shape[0], ctrl.shape[1]
     kk = order + 1
     ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
-    lu, ru, au = np.empty(p + 1), np.empty(p + 1), np.empty((2, p + 1))
-    lv, rv, av = np.empty(q + 1), np.empty(q + 1), np.empty((2, q + 1))
+    lu, ru, tu = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
+    lv, rv, tv = np.empty(q + 1), np.empty(q + 1), np.empty(q + 1)
     bu, bv = np.empty((kk, p + 1)), np.empty((kk, q + 1))
     h = np.empty((kk, kk, 4))
     row = np.empty((kk, 4))
+    t0u, scale_u, table_u = bucket_u
+    t0v, scale_v, table_v = bucket_v
     for a in range(u.size):
-        su = find_span(ku, p, n, u[a])
-        sv = find_span(kv, q, m, v[a])
-        basis_ders_point(ku, p, su, u[a], order, ndu_u, lu, ru, au, bu)
-        basis_ders_point(kv, q, sv, v[a], order, ndu_v, lv, rv, av, bv)
+        su = find_span_bucketed(ku, p, n, u[a], t0u, scale_u, table_u)
+        sv = find_span_bucketed(kv, q, m, v[a], t0v, scale_v, table_v)
+        basis_ders_point(ku, p, su, u[a], order, inv_u, ndu_u, lu, ru, tu, bu)
+        basis_ders_point(kv, q, sv, v[a], order, inv_v, ndu_v, lv, rv, tv, bv)
         for k in range(kk):
             for l in range(kk):
                 for d in range(4):
@@ -190,7 +204,7 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, out)
 
 
 @njit(cache=True)
-def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, out):
+def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out):
     """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
     :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
     sums kept in registers."""
@@ -198,9 +212,11 @@ def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, out):
     nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
     lu, ru = np.empty(p + 1), np.empty(p + 1)
     lv, rv = np.empty(q + 1), np.empty(q + 1)
+    t0u, scale_u, table_u = bucket_u
+    t0v, scale_v, table_v = bucket_v
     for a in range(u.size):
-        su = find_span(ku, p, n, u[a])
-        sv = find_span(kv, q, m, v[a])
+        su = find_span_bucketed(ku, p, n, u[a], t0u, scale_u, table_u)
+        sv = find_span_bucketed(kv, q, m, v[a], t0v, scale_v, table_v)
         _basis_funs(ku, p, su, u[a], inv_u, lu, ru, nu_)
         _basis_funs(kv, q, sv, v[a], inv_v, lv, rv, nv_)
         x = y = z = w = 0.0
@@ -272,8 +288,9 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
 
 
 @njit(cache=True, inline="always")
-def _combine_rows(bu, a, first, p, w, kk, dim, acc):
-    """``acc[k, l, d, :] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the vector axis)."""
+def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
+    """``acc[k, l, d, off:off+n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
+    vector axis)."""
     r0 = first[a]
     nv = w.shape[3]
     for k in range(kk):
@@ -281,53 +298,53 @@ def _combine_rows(bu, a, first, p, w, kk, dim, acc):
             for d in range(dim):
                 c = bu[a, k, 0]
                 for b in range(nv):
-                    acc[k, l, d, b] = c * w[r0, l, d, b]
+                    acc[k, l, d, off + b] = c * w[r0, l, d, b]
                 for i in range(1, p + 1):
                     c = bu[a, k, i]
                     for b in range(nv):
-                        acc[k, l, d, b] += c * w[r0 + i, l, d, b]
+                        acc[k, l, d, off + b] += c * w[r0 + i, l, d, b]
 
 
 @njit(cache=True)
-def grid_positions(bu, first, p, w, rational, acc, out):
-    """Second stage for positions: ``out (n_u, n_v, 3)`` point-major, the division by the
-    weight fused into the (interleaving) store."""
+def grid_positions(bu, first, p, w, rational, acc, b0, out):
+    """Second stage for positions: ``out[:, b0:b0+n_v]`` of ``out (n_u, N_v, 3)``
+    point-major, the division by the weight fused into the (interleaving) store."""
     nv = w.shape[3]
     dim = 4 if rational else 3
     for a in range(bu.shape[0]):
-        _combine_rows(bu, a, first, p, w, 1, dim, acc)
+        _combine_rows(bu, a, first, p, w, 1, dim, acc, 0)
         if rational:
             for b in range(nv):
                 inv_w = 1.0 / acc[0, 0, 3, b]
-                out[a, b, 0] = acc[0, 0, 0, b] * inv_w
-                out[a, b, 1] = acc[0, 0, 1, b] * inv_w
-                out[a, b, 2] = acc[0, 0, 2, b] * inv_w
+                out[a, b0 + b, 0] = acc[0, 0, 0, b] * inv_w
+                out[a, b0 + b, 1] = acc[0, 0, 1, b] * inv_w
+                out[a, b0 + b, 2] = acc[0, 0, 2, b] * inv_w
         else:
             for b in range(nv):
-                out[a, b, 0] = acc[0, 0, 0, b]
-                out[a, b, 1] = acc[0, 0, 1, b]
-                out[a, b, 2] = acc[0, 0, 2, b]
+                out[a, b0 + b, 0] = acc[0, 0, 0, b]
+                out[a, b0 + b, 1] = acc[0, 0, 1, b]
+                out[a, b0 + b, 2] = acc[0, 0, 2, b]
 
 
 @njit(cache=True)
-def grid_derivatives(bu, first, p, w, rational, binom, acc, out):
+def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
     """Second stage for partials: for each u-point combine its p+1 rows of ``w``, apply
-    the quotient rule on the planes (rational), and write ``out (n_u, K, K, 3, n_v)``:
-    planar, every partial and coordinate a contiguous row of v."""
+    the quotient rule on the planes (rational), and write ``out[..., b0:b0+n_v]`` of
+    ``out (n_u, K, K, 3, N_v)``: planar, every partial and coordinate a contiguous row."""
     kk = bu.shape[1]
     nv = w.shape[3]
     dim = 4 if rational else 3
     for a in range(bu.shape[0]):
-        if rational:
-            _combine_rows(bu, a, first, p, w, kk, dim, acc)
-            _quotient_planes(acc, binom)
-            for k in range(kk):
-                for l in range(kk):
-                    for d in range(3):
-                        for b in range(nv):
-                            out[a, k, l, d, b] = acc[k, l, d, b]
-        else:
-            _combine_rows(bu, a, first, p, w, kk, dim, out[a])
+        if not rational:  # straight into the output planes
+            _combine_rows(bu, a, first, p, w, kk, dim, out[a], b0)
+            continue
+        _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
+        _quotient_planes(acc, binom)
+        for k in range(kk):
+            for l in range(kk):
+                for d in range(3):
+                    for b in range(nv):
+                        out[a, k, l, d, b0 + b] = acc[k, l, d, b]
 
 
 @njit(cache=True, inline="always")

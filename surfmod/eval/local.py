@@ -26,6 +26,8 @@ from .basis import basis_derivatives, find_spans
 
 #: doubles in the per-block row table of the grid stage (4 MiB): fits in L2/L3
 ROW_TABLE = 1 << 19
+#: v-points per block of the grid: the rows a u-point combines stay in cache
+V_BLOCK = 1024
 
 
 def _kernels():
@@ -52,7 +54,8 @@ def surface_points(knots_u, p, knots_v, q, ctrl, u, v, rational: bool, out=None)
         out = np.empty((u.size, 3))
     n, m = ctrl.shape[:2]
     inv_u, inv_v = k.reciprocal_table(knots_u, p, n), k.reciprocal_table(knots_v, q, m)
-    k.scattered_positions(knots_u, p, knots_v, q, ctrl, u, v, rational, inv_u, inv_v, out)
+    bucket_u, bucket_v = k.span_buckets(knots_u, p, n), k.span_buckets(knots_v, q, m)
+    k.scattered_positions(knots_u, p, knots_v, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out)
     return out
 
 
@@ -63,7 +66,11 @@ def surface_derivatives(knots_u, p, knots_v, q, ctrl, u, v, order: int, rational
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
-    k.scattered_derivatives(knots_u, p, knots_v, q, ctrl, u, v, int(order), rational, k.binomials(order), out)
+    n, m = ctrl.shape[:2]
+    inv_u, inv_v = k.reciprocal_table(knots_u, p, n), k.reciprocal_table(knots_v, q, m)
+    bucket_u, bucket_v = k.span_buckets(knots_u, p, n), k.span_buckets(knots_v, q, m)
+    k.scattered_derivatives(knots_u, p, knots_v, q, ctrl, u, v, int(order), rational, k.binomials(order),
+                            inv_u, inv_v, bucket_u, bucket_v, out)
     return out
 
 
@@ -108,19 +115,23 @@ def surface_grid(knots_u, p, knots_v, q, ctrl, us, vs, order: int, rational: boo
     dim = 4 if rational else 3
     su, bu = _basis(knots_u, p, n, us, order)
     sv, bv = _basis(knots_v, q, m, vs, order)
-    acc = np.empty((kk, kk, 4, vs.size))
+    acc = np.empty((kk, kk, 4, min(V_BLOCK, vs.size)))
     if order == 0:
         if out is None:
             out = np.empty((us.size, vs.size, 3))
-        for a0, a1, rows, first in _row_blocks(su, p, n, dim * vs.size):
-            table = np.empty((rows.size, 1, dim, vs.size))
-            k.grid_rows(bv, sv, q, ctrl, rows, dim, table)
-            k.grid_positions(bu[a0:a1], first, p, table, rational, acc, out[a0:a1])
+    else:
+        planar = np.empty((us.size, kk, kk, 3, vs.size))
+        binom = k.binomials(order)
+    for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
+        svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
+        accb = acc if svb.size == acc.shape[-1] else np.empty(acc.shape[:-1] + (svb.size,))
+        for a0, a1, rows, first in _row_blocks(su, p, n, kk * dim * svb.size):
+            table = np.empty((rows.size, kk, dim, svb.size))
+            k.grid_rows(bvb, svb, q, ctrl, rows, dim, table)
+            if order == 0:
+                k.grid_positions(bu[a0:a1], first, p, table, rational, accb, b0, out[a0:a1])
+            else:
+                k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, accb, b0, planar[a0:a1])
+    if order == 0:
         return out[:, :, None, None, :]
-    planar = np.empty((us.size, kk, kk, 3, vs.size))
-    binom = k.binomials(order)
-    for a0, a1, rows, first in _row_blocks(su, p, n, kk * dim * vs.size):
-        table = np.empty((rows.size, kk, dim, vs.size))
-        k.grid_rows(bv, sv, q, ctrl, rows, dim, table)
-        k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, acc, planar[a0:a1])
     return planar.transpose(0, 4, 1, 2, 3)
