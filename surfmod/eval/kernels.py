@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def find_span(knots, degree, n_ctrl, t):
     """The largest ``i`` with ``knots[i] <= t``, clipped to the domain.  A branch-free
     binary search (the halving step compiles to a conditional move): random parameters
@@ -37,7 +37,7 @@ def find_span(knots, degree, n_ctrl, t):
     return span
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def find_span_bucketed(knots, degree, n_ctrl, t, t0, scale, table):
     """:func:`find_span` in O(1): a uniform bucket grid over the domain gives a span at or
     just before the answer (see :func:`span_buckets`), then a short, well-predicted walk.
@@ -65,7 +65,7 @@ def span_buckets(knots: np.ndarray, degree: int, n_ctrl: int, per_span: int = 4)
     return t0, (count / (t1 - t0) if t1 > t0 else 0.0), table
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders):
     """The p+1 non-zero basis functions at ``t`` and their derivatives: ``ders[k, r]`` is
     the k-th derivative of ``N_{span-p+r}`` for ``k <= order`` (zero above the degree).
@@ -106,7 +106,7 @@ def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders)
             ders[k, r] = tmp[r]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def quotient_point(h, binom, out):
     """Rational quotient rule (A4.4) at one point: homogeneous ``h (K, K, 4)`` ->
     Cartesian ``out (K, K, 3)``; every entry of the square is exact."""
@@ -153,57 +153,75 @@ def binomials(order: int) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+#: points per block of the scattered-derivative kernel (its planes stay in L1/L2)
+POINT_BLOCK = 128
+
+
+@njit(cache=True, error_model="numpy")
 def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
     """Mixed partials at scattered pairs into ``out (N, K, K, 3)`` (Cartesian).
 
     ``ctrl`` is ``(n, m, 4)``: homogeneous for a rational net, the weight column unused
-    (any value) otherwise, so the innermost loop is a literal 4-vector."""
+    otherwise.  Points go in blocks: per point the spans, the basis derivatives and a
+    gather of the local ``(p+1) x (q+1)`` net into planes; then the contraction and the
+    quotient rule run over the block with the points on the contiguous (vector) axis."""
     n, m = ctrl.shape[0], ctrl.shape[1]
     kk = order + 1
+    nb = POINT_BLOCK
+    dim = 4 if rational else 3
     ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
     lu, ru, tu = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
     lv, rv, tv = np.empty(q + 1), np.empty(q + 1), np.empty(q + 1)
-    bu, bv = np.empty((kk, p + 1)), np.empty((kk, q + 1))
-    h = np.empty((kk, kk, 4))
-    row = np.empty((kk, 4))
+    du, dv = np.empty((kk, p + 1)), np.empty((kk, q + 1))
+    bu, bv = np.empty((kk, p + 1, nb)), np.empty((kk, q + 1, nb))
+    local = np.empty((p + 1, q + 1, 4, nb))
+    row = np.empty((kk, 4, nb))
+    h = np.empty((kk, kk, 4, nb))
     t0u, scale_u, table_u = bucket_u
     t0v, scale_v, table_v = bucket_v
-    for a in range(u.size):
-        su = find_span_bucketed(ku, p, n, u[a], t0u, scale_u, table_u)
-        sv = find_span_bucketed(kv, q, m, v[a], t0v, scale_v, table_v)
-        basis_ders_point(ku, p, su, u[a], order, inv_u, ndu_u, lu, ru, tu, bu)
-        basis_ders_point(kv, q, sv, v[a], order, inv_v, ndu_v, lv, rv, tv, bv)
-        for k in range(kk):
-            for l in range(kk):
-                for d in range(4):
-                    h[k, l, d] = 0.0
-        for i in range(p + 1):
-            ci = su - p + i
-            for l in range(kk):
-                for d in range(4):
-                    row[l, d] = 0.0
-            for j in range(q + 1):
-                cj = sv - q + j
-                for l in range(kk):
-                    c = bv[l, j]
-                    for d in range(4):
-                        row[l, d] += c * ctrl[ci, cj, d]
+    for a0 in range(0, u.size, nb):
+        cnt = min(nb, u.size - a0)
+        for b in range(cnt):
+            su = find_span_bucketed(ku, p, n, u[a0 + b], t0u, scale_u, table_u)
+            sv = find_span_bucketed(kv, q, m, v[a0 + b], t0v, scale_v, table_v)
+            basis_ders_point(ku, p, su, u[a0 + b], order, inv_u, ndu_u, lu, ru, tu, du)
+            basis_ders_point(kv, q, sv, v[a0 + b], order, inv_v, ndu_v, lv, rv, tv, dv)
             for k in range(kk):
-                c = bu[k, i]
-                for l in range(kk):
+                for i in range(p + 1):
+                    bu[k, i, b] = du[k, i]
+                for j in range(q + 1):
+                    bv[k, j, b] = dv[k, j]
+            for i in range(p + 1):
+                for j in range(q + 1):
                     for d in range(4):
-                        h[k, l, d] += c * row[l, d]
+                        local[i, j, d, b] = ctrl[su - p + i, sv - q + j, d]
+        for i in range(p + 1):
+            for l in range(kk):
+                for d in range(dim):
+                    for b in range(cnt):
+                        row[l, d, b] = bv[l, 0, b] * local[i, 0, d, b]
+                    for j in range(1, q + 1):
+                        for b in range(cnt):
+                            row[l, d, b] += bv[l, j, b] * local[i, j, d, b]
+            for k in range(kk):
+                for l in range(kk):
+                    for d in range(dim):
+                        if i == 0:
+                            for b in range(cnt):
+                                h[k, l, d, b] = bu[k, 0, b] * row[l, d, b]
+                        else:
+                            for b in range(cnt):
+                                h[k, l, d, b] += bu[k, i, b] * row[l, d, b]
         if rational:
-            quotient_point(h, binom, out[a])
-        else:
+            _quotient_planes(h[..., :cnt], binom)
+        for b in range(cnt):
             for k in range(kk):
                 for l in range(kk):
                     for d in range(3):
-                        out[a, k, l, d] = h[k, l, d]
+                        out[a0 + b, k, l, d] = h[k, l, d, b]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out):
     """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
     :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
@@ -244,7 +262,7 @@ def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket
         out[a, 2] = z
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _basis_funs(knots, p, span, t, inv, left, right, out):
     """Piegl & Tiller A2.2: the p+1 non-zero basis functions at ``t``.  The denominators
     ``right[r+1] + left[j-r]`` are knot differences independent of ``t``; their
@@ -262,7 +280,7 @@ def _basis_funs(knots, p, span, t, inv, left, right, out):
         out[j] = saved
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def grid_rows(bv, sv, q, ctrl, rows, dim, out):
     """First stage of the grid: ``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]``
     for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
@@ -287,7 +305,7 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
                     out[r, l, 3, b] = w
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
     """``acc[k, l, d, off:off+n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
     vector axis)."""
@@ -305,7 +323,7 @@ def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
                         acc[k, l, d, off + b] += c * w[r0 + i, l, d, b]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def grid_positions(bu, first, p, w, rational, acc, b0, out):
     """Second stage for positions: ``out[:, b0:b0+n_v]`` of ``out (n_u, N_v, 3)``
     point-major, the division by the weight fused into the (interleaving) store."""
@@ -326,7 +344,7 @@ def grid_positions(bu, first, p, w, rational, acc, b0, out):
                 out[a, b0 + b, 2] = acc[0, 0, 2, b]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
     """Second stage for partials: for each u-point combine its p+1 rows of ``w``, apply
     the quotient rule on the planes (rational), and write ``out[..., b0:b0+n_v]`` of
@@ -347,7 +365,7 @@ def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
                         out[a, k, l, d, b0 + b] = acc[k, l, d, b]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _quotient_planes(acc, binom):
     """The quotient rule in place on planes ``acc (K, K, 4, n)``: coordinates 0..2 of
     every entry become Cartesian, entry by entry in rising order (each needs only lower
