@@ -353,11 +353,10 @@ def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
     nv = w.shape[3]
     dim = 4 if rational else 3
     for a in range(bu.shape[0]):
-        if not rational:  # straight into the output planes
-            _combine_rows(bu, a, first, p, w, kk, dim, out[a], b0)
-            continue
+        # accumulate in the cache-resident scratch, then write every output plane once
         _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
-        _quotient_planes(acc, binom)
+        if rational:
+            _quotient_planes(acc, binom)
         for k in range(kk):
             for l in range(kk):
                 for d in range(3):
@@ -370,22 +369,24 @@ def _quotient_planes(acc, binom):
     """The quotient rule in place on planes ``acc (K, K, 4, n)``: coordinates 0..2 of
     every entry become Cartesian, entry by entry in rising order (each needs only lower
     entries, already converted, and the untouched weight planes).  Every step is a pass
-    over the contiguous last axis, so it vectorizes."""
+    over the contiguous last axis through 1-D views, so it vectorizes."""
     kk, nv = acc.shape[0], acc.shape[3]
     inv_w = np.empty(nv)
+    w00 = acc[0, 0, 3]
     for b in range(nv):
-        inv_w[b] = 1.0 / acc[0, 0, 3, b]
+        inv_w[b] = 1.0 / w00[b]
     for k in range(kk):
         for l in range(kk):
             for d in range(3):
-                for j in range(1, l + 1):
-                    c = binom[l, j]
-                    for b in range(nv):
-                        acc[k, l, d, b] -= c * acc[0, j, 3, b] * acc[k, l - j, d, b]
-                for i in range(1, k + 1):
+                dst = acc[k, l, d]
+                for i in range(k + 1):
                     for j in range(l + 1):
+                        if i == 0 and j == 0:
+                            continue
                         c = binom[k, i] * binom[l, j]
+                        wij = acc[i, j, 3]
+                        src = acc[k - i, l - j, d]
                         for b in range(nv):
-                            acc[k, l, d, b] -= c * acc[i, j, 3, b] * acc[k - i, l - j, d, b]
+                            dst[b] -= c * wij[b] * src[b]
                 for b in range(nv):
-                    acc[k, l, d, b] *= inv_w[b]
+                    dst[b] *= inv_w[b]

@@ -14,13 +14,15 @@ The compiled kernels live in :mod:`surfmod.eval.kernels`, imported on first use 
 >>> import numpy as np
 >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
 >>> knots = np.array([0, 0, 0, 0, 1, 1, 1, 1.0])
->>> surface_points(knots, 3, knots, 3, net, np.array([0.5]), np.array([0.25]), False)
+>>> surface_points(prepare(knots, 3, knots, 3, net), np.array([0.5]), np.array([0.25]))
 array([[1.5 , 0.75, 0.  ]])
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from typing import NamedTuple
 
 from .basis import basis_derivatives, find_spans
 
@@ -45,32 +47,54 @@ def writable(t) -> np.ndarray:
 _as_float = writable
 
 
-def surface_points(knots_u, p, knots_v, q, ctrl, u, v, rational: bool, out=None) -> np.ndarray:
+class LocalNet(NamedTuple):
+    """A surface's data as the kernels take it, built once per surface by :func:`prepare`."""
+
+    knots_u: np.ndarray
+    p: int
+    knots_v: np.ndarray
+    q: int
+    ctrl: np.ndarray  # (n, m, 4), see homogeneous4
+    rational: bool
+    inv_u: np.ndarray  # reciprocal knot differences (kernels.reciprocal_table)
+    inv_v: np.ndarray
+    bucket_u: tuple  # span search buckets (kernels.span_buckets)
+    bucket_v: tuple
+
+
+def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
+    """Tables for the kernels from full knot vectors, degrees and the homogeneous net
+    ``(n, m, 3)`` (polynomial) or ``(n, m, 4)`` (rational)."""
+    k = _kernels()
+    ku, kv = writable(knots_u), writable(knots_v)
+    ctrl = homogeneous4(hctrl)
+    n, m = ctrl.shape[:2]
+    return LocalNet(ku, int(p), kv, int(q), ctrl, hctrl.shape[-1] == 4,
+                    k.reciprocal_table(ku, p, n), k.reciprocal_table(kv, q, m),
+                    k.span_buckets(ku, p, n), k.span_buckets(kv, q, m))
+
+
+def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
     """Positions at scattered pairs ``(u[a], v[a])``: ``(N, 3)``, written into ``out`` when
     given (any C-contiguous ``(N, 3)`` float array, e.g. a slice of a larger buffer)."""
     k = _kernels()
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, 3))
-    n, m = ctrl.shape[:2]
-    inv_u, inv_v = k.reciprocal_table(knots_u, p, n), k.reciprocal_table(knots_v, q, m)
-    bucket_u, bucket_v = k.span_buckets(knots_u, p, n), k.span_buckets(knots_v, q, m)
-    k.scattered_positions(knots_u, p, knots_v, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out)
+    k.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
+                          net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
     return out
 
 
-def surface_derivatives(knots_u, p, knots_v, q, ctrl, u, v, order: int, rational: bool, out=None) -> np.ndarray:
+def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray:
     """Cartesian mixed partials at scattered pairs: ``(N, K, K, 3)``, ``K = order + 1``;
     entry ``[a, k, l]`` is d^(k+l) S / du^k dv^l (the rational quotient rule included)."""
     k = _kernels()
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
-    n, m = ctrl.shape[:2]
-    inv_u, inv_v = k.reciprocal_table(knots_u, p, n), k.reciprocal_table(knots_v, q, m)
-    bucket_u, bucket_v = k.span_buckets(knots_u, p, n), k.span_buckets(knots_v, q, m)
-    k.scattered_derivatives(knots_u, p, knots_v, q, ctrl, u, v, int(order), rational, k.binomials(order),
-                            inv_u, inv_v, bucket_u, bucket_v, out)
+    k.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order), net.rational,
+                            k.binomials(order), net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
     return out
 
 
@@ -100,15 +124,16 @@ def _row_blocks(su, p, n, per_row):
         yield a0, a0 + s.size, rows, np.searchsorted(rows, s - p)
 
 
-def surface_grid(knots_u, p, knots_v, q, ctrl, us, vs, order: int, rational: bool, out=None) -> np.ndarray:
+def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     """Cartesian mixed partials on the grid ``us x vs``: ``(len(us), len(vs), K, K, 3)``.
 
-    ``ctrl`` is ``(n, m, 4)`` (see :func:`homogeneous4`).  Positions (``order == 0``) are
+    Positions (``order == 0``) are
     written point-major, into ``out (len(us), len(vs), 3)`` when given; partials are
     written planar (every partial and coordinate a contiguous row of v) and returned as
     the transposed view.
     """
     k = _kernels()
+    knots_u, p, knots_v, q, ctrl, rational = net[:6]
     us, vs = _as_float(us), _as_float(vs)
     n, m = ctrl.shape[:2]
     kk = order + 1

@@ -176,6 +176,7 @@ class BSplineSurface(Surface):
         self.knots = (checks.frozen(knots[0]), checks.frozen(knots[1]))
         self.weights = None if w is None else checks.frozen(w)
         self._h = homogeneous(self.control_points, self.weights)
+        self.__dict__.pop("_local", None)  # kernel tables (_local_net) follow the data
 
     @classmethod
     def _trusted(cls, net, degree, knots, weights=None):
@@ -223,23 +224,22 @@ class BSplineSurface(Surface):
         n, m = self.control_points.shape[:2]
         return (float(ku[p]), float(ku[n])), (float(kv[q]), float(kv[m]))
 
-    def _local_net(self):
-        """The net as the compiled kernels take it (``(n, m, 4)``, knots writable
-        float64), built once per surface."""
+    def _local_net(self) -> "local.LocalNet":
+        """The net and tables as the compiled kernels take them, built once per surface."""
         cached = self.__dict__.get("_local")
         if cached is None:
             (p, q), (ku, kv) = self.degree, self.knots
-            cached = self._local = (local.writable(ku), p, local.writable(kv), q, local.homogeneous4(self._h))
+            cached = self._local = local.prepare(ku, p, kv, q, self._h)
         return cached
 
     def _derivatives(self, u, v, order):
         # local support: each point touches its (p+1) x (q+1) poles only (eval/local.py)
         if order == 0:
-            return local.surface_points(*self._local_net(), u, v, self.rational)[:, None, None, :]
-        return local.surface_derivatives(*self._local_net(), u, v, order, self.rational)
+            return local.surface_points(self._local_net(), u, v)[:, None, None, :]
+        return local.surface_derivatives(self._local_net(), u, v, order)
 
     def _grid_derivatives(self, us, vs, order):
-        return local.surface_grid(*self._local_net(), us, vs, order, self.rational)
+        return local.surface_grid(self._local_net(), us, vs, order)
 
     def grid_into(self, us, vs, out) -> np.ndarray:
         """Positions on the grid ``us x vs`` written into the preallocated C-contiguous
@@ -259,7 +259,7 @@ class BSplineSurface(Surface):
                 and out.flags.writeable and out.shape == (us.size, vs.size, 3)):
             raise SurfmodError(f"out: expected a writable C-contiguous float64 array of shape "
                                f"{(us.size, vs.size, 3)}, got {getattr(out, 'shape', type(out).__name__)}")
-        local.surface_grid(*self._local_net(), us, vs, 0, self.rational, out=out)
+        local.surface_grid(self._local_net(), us, vs, 0, out=out)
         return out
 
     def geom(self):
