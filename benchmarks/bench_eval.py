@@ -1,14 +1,24 @@
-"""Evaluation speed: surfmod's vectorized grid vs OCCT per-point, splipy and geomdl.
+"""Evaluation speed (issue 12): surfmod's local-support evaluation vs OCCT per point,
+splipy and geomdl, on nets of 4 to 1000 poles per direction.
 
-Cases (issue 3): a 20x20 bicubic B-spline, a 20x20 rational bicubic NURBS and a degree-5
-Bézier patch, on 100^2, 500^2 and 1000^2 parameter grids.  OCCT per-point rates
-(``Value`` = D0, ``D2``) are measured on 100^2 points through OCP and scaled to the grid
-size (a 10^6-point Python loop over OCP would only measure the same rate for longer).
-Finally a 10^8-point grid is evaluated in chunks, reporting the peak memory.
+Every timing runs twice, in two subprocesses: *1 core* with BLAS and numba pinned to one
+thread (``OMP/OPENBLAS/MKL/NUMBA_NUM_THREADS=1``; OCCT's per-point loop is single-threaded
+anyway) and *all cores* with the machine's defaults.  Single-core times are CPU times of
+the process (``time.process_time``), best of several runs, so that other load on a shared
+machine inflates neither side; all-core times are wall times.  OCCT per-point rates
+(``Value`` = positions, ``D2`` = all partials to order 2, into preallocated ``gp_Pnt`` /
+``gp_Vec``, no conversion) are measured on 100² points through OCP and scaled to the point
+count.  The memory-write floor is the time to allocate and fill the output array.
+
+``python -m benchmarks eval``
 """
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
 import time
 import tracemalloc
 
@@ -17,27 +27,34 @@ import numpy as np
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
 
-GRIDS = (100, 500, 1000)
+NET_SIZES = (4, 20, 100, 400, 1000)
+GRID = 1000
+SCATTERED = 10**6
+THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
 
 
-def _time(fn, repeat: int = 3) -> float:
+def _clock(single: bool):
+    return time.process_time if single else time.perf_counter
+
+
+def _time(fn, single: bool, repeat: int = 3) -> float:
+    clock = _clock(single)
     best = np.inf
     for _ in range(repeat):
-        t = time.perf_counter()
+        t = clock()
         fn()
-        best = min(best, time.perf_counter() - t)
+        best = min(best, clock() - t)
     return best
 
 
-def cases():
+def nurbs(n: int, rational: bool = True, degree: int = 3) -> sm.BSplineSurface:
     rng = np.random.default_rng(7)
-    net = wavy_net(20, 20)
-    yield "20x20 bicubic B-spline", sm.BSplineSurface(net, (3, 3))
-    yield "20x20 rational NURBS", sm.BSplineSurface(net, (3, 3), weights=10 ** rng.uniform(-1, 1, (20, 20)))
-    yield "degree-5 Bezier", sm.BezierSurface(wavy_net(6, 6))
+    w = 10 ** rng.uniform(-1, 1, (n, n)) if rational else None
+    return sm.BSplineSurface(wavy_net(n, n), (min(degree, n - 1),) * 2, weights=w)
 
 
 def occt_rates(s, n: int = 100):
+    """CPU seconds per point of ``Value`` and ``D2`` through OCP."""
     from OCP.gp import gp_Pnt, gp_Vec
 
     g = s.geom()
@@ -56,7 +73,7 @@ def occt_rates(s, n: int = 100):
             for v in vs:
                 g.D2(u, v, p, *vecs)
 
-    return _time(d0) / n**2, _time(d2) / n**2
+    return _time(d0, True) / n**2, _time(d2, True) / n**2
 
 
 def splipy_fn(s):
@@ -91,65 +108,145 @@ def geomdl_fn(s):
     return lambda us, vs: surf.evaluate_list([(u, v) for u in us for v in vs])
 
 
-def _fmt(x: float, spec: str, unit: str = "") -> str:
-    return "—" if x is None or not np.isfinite(x) else f"{x:{spec}}{unit}"
+def write_floor(shape, single: bool) -> float:
+    """Allocate and fill an array of the output's shape: no evaluator can do less."""
+    return _time(lambda: np.empty(shape).fill(0.0), single, 5)
+
+
+def measure(single: bool) -> dict:
+    """Every timing of the tables, in seconds, for this process's thread setting."""
+    out = {"net": {}, "rows": {}}
+    grid = np.linspace(0, 1, GRID)
+    for n in NET_SIZES:
+        s = nurbs(n)
+        s.grid(grid[:10], grid[:10])  # compile / load the kernels outside the timing
+        entry = {"ours": _time(lambda: s.grid(grid, grid), single)}
+        sp = splipy_fn(s)
+        entry["splipy"] = _time(lambda: sp(grid, grid), single, 2) if sp else None
+        if single:
+            entry["occt_d0"], entry["occt_d2"] = occt_rates(s)
+        out["net"][n] = entry
+    rows = out["rows"]
+    s20, b20 = nurbs(20), nurbs(20, rational=False)
+    rows["grid_poly20"] = _time(lambda: b20.grid(grid, grid), single)
+    rows["floor_d0"] = write_floor((GRID, GRID, 3), single)
+    s20.grid_derivatives(grid[:4], grid[:4], 2)
+    rows["grid_d2"] = _time(lambda: s20.grid_derivatives(grid, grid, 2), single)
+    rows["grid_d2_poly"] = _time(lambda: b20.grid_derivatives(grid, grid, 2), single)
+    rows["floor_d2"] = write_floor((GRID, GRID, 3, 3, 3), single)
+    rng = np.random.default_rng(3)
+    u, v = rng.uniform(0, 1, SCATTERED), rng.uniform(0, 1, SCATTERED)
+    s20.derivatives(u[:4], v[:4], 2)
+    rows["scattered_d0"] = _time(lambda: s20.points(u, v), single)
+    rows["scattered_d2"] = _time(lambda: s20.derivatives(u, v, 2), single, 2)
+    for n in (4, 20):
+        gd = geomdl_fn(nurbs(n, rational=False))
+        small = np.linspace(0, 1, 100)
+        rows[f"geomdl{n}"] = _time(lambda: gd(small, small), single, 1) * (GRID / 100) ** 2 if gd else None
+        bn = nurbs(n, rational=False)
+        rows[f"poly{n}"] = _time(lambda: bn.grid(grid, grid), single)
+        if single:
+            rows[f"occt_poly{n}"] = occt_rates(bn)[0]
+    if single:
+        rows["memory"] = memory()
+    return out
+
+
+def memory(grid_n: int = 10_000, scattered_n: int = 10**7, chunk: int = 1 << 20) -> dict:
+    """A 10^8-point grid (``grid_chunks``) and 10^7 scattered points (in slices) of the
+    20x20 NURBS, reduced to a bounding box: time and tracemalloc peak (NumPy reports its
+    buffers to tracemalloc; the kernels allocate nothing sizeable themselves)."""
+    s = nurbs(20)
+    res = {}
+    us = vs = np.linspace(0, 1, grid_n)
+    tracemalloc.start()
+    t = time.process_time()
+    lo = np.full(3, np.inf)
+    for _, block in s.grid_chunks(us, vs, max_points=1 << 21):
+        lo = np.minimum(lo, block.reshape(-1, 3).min(axis=0))
+    res["grid"] = (grid_n**2, time.process_time() - t, tracemalloc.get_traced_memory()[1] / 2**20, grid_n**2 * 24 / 2**20)
+    tracemalloc.stop()
+    rng = np.random.default_rng(5)
+    u, v = rng.uniform(0, 1, scattered_n), rng.uniform(0, 1, scattered_n)  # the input itself: 153 MiB
+    tracemalloc.start()
+    t = time.process_time()
+    lo = np.full(3, np.inf)
+    for a in range(0, scattered_n, chunk):
+        lo = np.minimum(lo, s.points(u[a : a + chunk], v[a : a + chunk]).min(axis=0))
+    res["scattered"] = (scattered_n, time.process_time() - t, tracemalloc.get_traced_memory()[1] / 2**20,
+                        scattered_n * 24 / 2**20)
+    tracemalloc.stop()
+    return res
+
+
+def _run_worker(single: bool) -> dict:
+    env = dict(os.environ)
+    for var in THREAD_VARS:
+        if single:
+            env[var] = "1"
+        else:
+            env.pop(var, None)
+    cmd = [sys.executable, "-m", "benchmarks.bench_eval", "--worker", "single" if single else "all"]
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _f(x, spec=".4f", unit="s"):
+    return "—" if x is None else f"{x:{spec}}{unit}"
+
+
+def _x(a, b):
+    return "—" if a is None or b is None or b == 0 else f"{a / b:.1f}x"
+
+
+def report(one: dict, every: dict) -> None:
+    print(f"{GRID}² grid of positions, rational bicubic net n x n (OCCT: per-point Value x 10^6)")
+    head = (f"{'net':>6} {'surfmod 1c':>11} {'surfmod all':>12} {'OCCT':>8} {'splipy 1c':>10} {'splipy all':>11} "
+            f"{'x OCCT':>8} {'x splipy 1c':>12} {'x splipy all':>13}")
+    print(head)
+    print("-" * len(head))
+    for n in map(str, NET_SIZES):
+        a, b = one["net"][n], every["net"][n]
+        occ = a["occt_d0"] * GRID**2
+        print(f"{n + 'x' + n:>6} {_f(a['ours']):>11} {_f(b['ours']):>12} {_f(occ, '.3f'):>8} {_f(a['splipy']):>10} "
+              f"{_f(b['splipy']):>11} {_x(occ, a['ours']):>8} {_x(a['splipy'], a['ours']):>12} "
+              f"{_x(b['splipy'], b['ours']):>13}")
+    r, ra = one["rows"], every["rows"]
+    d0_20, d2_20 = one["net"]["20"]["occt_d0"], one["net"]["20"]["occt_d2"]
+    print("\ncase (20x20 bicubic unless named)          surfmod 1c  surfmod all        OCCT     x OCCT    floor  x floor")
+    print("-" * 107)
+    lines = [
+        ("1000² grid, rational NURBS", one["net"]["20"]["ours"], every["net"]["20"]["ours"], d0_20 * GRID**2, r["floor_d0"]),
+        ("1000² grid, polynomial B-spline", r["grid_poly20"], ra["grid_poly20"], r["occt_poly20"] * GRID**2, r["floor_d0"]),
+        ("1000² grid, 4x4 polynomial", r["poly4"], ra["poly4"], r["occt_poly4"] * GRID**2, r["floor_d0"]),
+        ("1000² grid, partials to 2, NURBS", r["grid_d2"], ra["grid_d2"], d2_20 * GRID**2, r["floor_d2"]),
+        ("1000² grid, partials to 2, B-spline", r["grid_d2_poly"], ra["grid_d2_poly"], d2_20 * GRID**2, r["floor_d2"]),
+        ("10⁶ scattered, NURBS positions", r["scattered_d0"], ra["scattered_d0"], d0_20 * SCATTERED, None),
+        ("10⁶ scattered, NURBS partials to 2", r["scattered_d2"], ra["scattered_d2"], d2_20 * SCATTERED, None),
+    ]
+    for name, t1, ta, occ, floor in lines:
+        print(f"{name:<40} {_f(t1):>11} {_f(ta):>12} {_f(occ, '.3f'):>11} {_x(occ, t1):>10} "
+              f"{_f(floor):>8} {_x(t1, floor):>8}")
+    print("partials to 2: OCCT D2 gives 6 vectors a point, surfmod the full 3x3 square (27 doubles);")
+    print("floor = allocate and fill the output array; x floor = surfmod / floor (1 = at the floor).")
+    print("\ngeomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
+    for n in (4, 20):
+        print(f"  {n}x{n}: geomdl {_f(r[f'geomdl{n}'], '.1f')}  surfmod {_f(r[f'poly{n}'])}  "
+              f"x geomdl {_x(r[f'geomdl{n}'], r[f'poly{n}'])}")
+    print("\nbounded memory (20x20 NURBS, reduced to a bounding box as it streams):")
+    for key, what in (("grid", "grid via grid_chunks(max_points=2^21)"), ("scattered", "scattered in slices of 2^20")):
+        count, secs, peak, whole = r["memory"][key]
+        print(f"  {count:.0e} points, {what}: {secs:.1f} s CPU (bounding box included), tracemalloc peak {peak:.0f} MiB "
+              f"(one array of the result: {whole:.0f} MiB)")
 
 
 def main() -> None:
-    rows = []
-    for name, s in cases():
-        occ_d0, occ_d2 = occt_rates(s)
-        sp, gd = splipy_fn(s), geomdl_fn(s)
-        for n in GRIDS:
-            us = np.linspace(*s.domain[0], n)
-            vs = np.linspace(*s.domain[1], n)
-            t_ours = _time(lambda: s.grid(us, vs))
-            t_ours_d2 = _time(lambda: s.grid_derivatives(us, vs, 2), 1)
-            t_sp = _time(lambda: sp(us, vs)) if sp else None
-            t_gd = _time(lambda: gd(us, vs), 1) if gd and n <= 100 else None
-            rows.append((name, f"{n}²", t_ours, t_ours_d2, occ_d0 * n * n, occ_d2 * n * n, t_sp, t_gd))
-        rows.append(scattered_row(name, s, occ_d0, occ_d2))
-    head = (f"{'case':<24} {'points':>8} {'surfmod D0':>11} {'surfmod D2':>11} {'OCCT D0':>9} {'OCCT D2':>9} "
-            f"{'x OCCT D0':>10} {'x OCCT D2':>10} {'splipy':>9} {'x splipy':>9} {'geomdl':>8}")
-    print(head)
-    print("-" * len(head))
-    for name, n, t, t2, o0, o2, tsp, tgd in rows:
-        print(f"{name:<24} {n:>8} {t:>10.4f}s {t2:>10.4f}s {o0:>8.3f}s {o2:>8.3f}s {o0 / t:>9.0f}x {o2 / t2:>9.0f}x "
-              f"{_fmt(tsp, '8.4f', 's'):>9} {_fmt(tsp and tsp / t, '8.2f', 'x'):>9} {_fmt(tgd, '7.3f', 's'):>8}")
-    print("D0 = positions, D2 = all partials up to 2 (OCCT D2: 6 vectors per point; surfmod: the")
-    print("full 3x3 square of mixed partials).  OCCT times are per-point rates measured on 100²")
-    print("points through OCP, times the point count.  x splipy > 1 means surfmod is faster;")
-    print("geomdl (pure Python) is timed on 100² only; splipy has no scattered-point evaluation.")
-    chunked()
-
-
-def scattered_row(name, s, occ_d0, occ_d2, n: int = 10**6):
-    """Random (u, v) pairs instead of a grid: the path projection and meshing use."""
-    rng = np.random.default_rng(3)
-    (u0, u1), (v0, v1) = s.domain
-    u, v = rng.uniform(u0, u1, n), rng.uniform(v0, v1, n)
-    t = _time(lambda: s.points(u, v), 2)
-    t2 = _time(lambda: s.derivatives(u, v, 2), 1)
-    return name, "1e6 rnd", t, t2, occ_d0 * n, occ_d2 * n, None, None
-
-
-def chunked(n: int = 10_000) -> None:
-    """Evaluate an n x n (10^8 point) grid block by block; report time and peak memory."""
-    s = sm.BSplineSurface(wavy_net(20, 20), (3, 3))
-    us = np.linspace(0, 1, n)
-    vs = np.linspace(0, 1, n)
-    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
-    tracemalloc.start()  # NumPy reports its buffers to tracemalloc: this is the array memory
-    t = time.perf_counter()
-    for _, block in s.grid_chunks(us, vs, max_points=1 << 21):
-        flat = block.reshape(-1, 3)
-        lo, hi = np.minimum(lo, flat.min(axis=0)), np.maximum(hi, flat.max(axis=0))
-    dt = time.perf_counter() - t
-    peak = tracemalloc.get_traced_memory()[1] / 2**20
-    tracemalloc.stop()
-    print(f"\n{n * n:.0e} points in chunks of 2^21: {dt:.1f} s, peak array memory {peak:.0f} MiB "
-          f"(a single array would need {n * n * 24 / 2**20:.0f} MiB); bbox {lo.round(3)} .. {hi.round(3)}")
+    one, every = _run_worker(True), _run_worker(False)
+    report(one, every)
 
 
 if __name__ == "__main__":
-    main()
+    if len(sys.argv) > 2 and sys.argv[1] == "--worker":
+        print(json.dumps(measure(sys.argv[2] == "single")))
+    else:
+        main()

@@ -65,6 +65,72 @@ def bspline_surface_point(net, p, q, ku, kv, u, v, weights=None) -> np.ndarray:
     return np.einsum("ij,ijk->k", coef, net) / coef.sum()
 
 
+def cox_de_boor_derivative(i: int, p: int, knots, t: float, k: int) -> float:
+    """k-th derivative of N_{i,p} by the textbook formula applied k times:
+    N'_{i,p} = p N_{i,p-1} / (u_{i+p} - u_i) - p N_{i+1,p-1} / (u_{i+p+1} - u_{i+1})
+    (terms with a zero denominator dropped; half-open spans: the right-hand derivative)."""
+    if k == 0:
+        return cox_de_boor(i, p, knots, t)
+    if k > p:
+        return 0.0
+    out = 0.0
+    d1 = knots[i + p] - knots[i]
+    if d1 > 0:
+        out += p / d1 * cox_de_boor_derivative(i, p - 1, knots, t, k - 1)
+    d2 = knots[i + p + 1] - knots[i + 1]
+    if d2 > 0:
+        out -= p / d2 * cox_de_boor_derivative(i + 1, p - 1, knots, t, k - 1)
+    return out
+
+
+def bspline_basis_derivative(knots, p: int, n_ctrl: int, t: float, k: int) -> np.ndarray:
+    """All d^k N_{i,p}(t), i < n_ctrl; at the right end of the domain the left-hand limit,
+    by mirroring as in :func:`bspline_basis` (a k-th derivative changes sign k times)."""
+    knots = [float(x) for x in knots]
+    if t >= knots[n_ctrl]:
+        mirrored = [-x for x in reversed(knots)]
+        vals = [cox_de_boor_derivative(i, p, mirrored, -t, k) for i in range(n_ctrl)]
+        return (-1) ** k * np.array(vals)[::-1]
+    return np.array([cox_de_boor_derivative(i, p, knots, t, k) for i in range(n_ctrl)])
+
+
+def bspline_surface_derivatives(net, p, q, ku, kv, u, v, order: int, weights=None) -> np.ndarray:
+    """Mixed partials ``[k, l, :]`` for k, l <= order at one point.  Polynomial: the double
+    sum of basis derivatives times the poles.  Rational: the same sums for the weighted
+    poles A and the weights W, then the quotient rule written out,
+    S^(k,l) = (A^(k,l) - sum_{(i,j) != (0,0), i<=k, j<=l} C(k,i) C(l,j) W^(i,j) S^(k-i,l-j)) / W."""
+    net = np.asarray(net, dtype=float)
+    n, m = net.shape[:2]
+    w = np.ones((n, m)) if weights is None else np.asarray(weights, dtype=float)
+    bu = [bspline_basis_derivative(ku, p, n, u, k) for k in range(order + 1)]
+    bv = [bspline_basis_derivative(kv, q, m, v, k) for k in range(order + 1)]
+    a = np.array([[np.einsum("i,j,ij,ijd->d", bu[k], bv[l], w, net) for l in range(order + 1)] for k in range(order + 1)])
+    ww = np.array([[np.einsum("i,j,ij->", bu[k], bv[l], w) for l in range(order + 1)] for k in range(order + 1)])
+    s = np.zeros_like(a)
+    for k in range(order + 1):
+        for l in range(order + 1):
+            acc = a[k, l].copy()
+            for i in range(k + 1):
+                for j in range(l + 1):
+                    if i or j:
+                        acc -= comb(k, i) * comb(l, j) * ww[i, j] * s[k - i, l - j]
+            s[k, l] = acc / ww[0, 0]
+    return s
+
+
+def curvatures_from_partials(d) -> tuple[float, float]:
+    """Gaussian and mean curvature from partials ``d[k, l]`` (k + l <= 2) by the
+    fundamental forms, normal n = Su x Sv / |Su x Sv|:
+    K = (L N - M^2) / (E G - F^2), H = (E N - 2 F M + G L) / (2 (E G - F^2))."""
+    su, sv, suu, suv, svv = d[1, 0], d[0, 1], d[2, 0], d[1, 1], d[0, 2]
+    n = np.cross(su, sv)
+    n = n / np.linalg.norm(n)
+    e, f, g = su @ su, su @ sv, sv @ sv
+    l_, m_, n_ = suu @ n, suv @ n, svv @ n
+    det = e * g - f * f
+    return (l_ * n_ - m_ * m_) / det, (e * n_ - 2 * f * m_ + g * l_) / (2 * det)
+
+
 #: The lecture's uniform cubic B-spline matrix (times 1/6), rows for [t^3 t^2 t 1].
 UNIFORM_CUBIC_M = np.array([[-1.0, 3.0, -3.0, 1.0], [3.0, -6.0, 3.0, 0.0], [-3.0, 0.0, 3.0, 0.0], [1.0, 4.0, 1.0, 0.0]]) / 6.0
 

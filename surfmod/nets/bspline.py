@@ -14,8 +14,9 @@ import numpy as np
 from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..eval.rational import curve_quotient, surface_quotient
-from ..eval.tensor import curve_derivatives, rational_grid_positions, surface_derivatives, surface_grid
+from ..eval import local
+from ..eval.rational import curve_quotient
+from ..eval.tensor import curve_derivatives
 from ..surface import Surface
 from . import knots as kn
 
@@ -179,6 +180,7 @@ class BSplineSurface(Surface):
         self.knots = (checks.frozen(knots[0]), checks.frozen(knots[1]))
         self.weights = None if w is None else checks.frozen(w)
         self._h = homogeneous(self.control_points, self.weights)
+        self.__dict__.pop("_local", None)  # kernel tables (_local_net) follow the data
 
     @classmethod
     def _trusted(cls, net, degree, knots, weights=None):
@@ -226,18 +228,43 @@ class BSplineSurface(Surface):
         n, m = self.control_points.shape[:2]
         return (float(ku[p]), float(ku[n])), (float(kv[q]), float(kv[m]))
 
+    def _local_net(self) -> "local.LocalNet":
+        """The net and tables as the compiled kernels take them, built once per surface."""
+        cached = self.__dict__.get("_local")
+        if cached is None:
+            (p, q), (ku, kv) = self.degree, self.knots
+            cached = self._local = local.prepare(ku, p, kv, q, self._h)
+        return cached
+
     def _derivatives(self, u, v, order):
-        (p, q), (ku, kv) = self.degree, self.knots
-        h = surface_derivatives(ku, p, kv, q, self._h, u, v, order)
-        return surface_quotient(h) if self.rational else h
+        # local support: each point touches its (p+1) x (q+1) poles only (eval/local.py)
+        if order == 0:
+            return local.surface_points(self._local_net(), u, v)[:, None, None, :]
+        return local.surface_derivatives(self._local_net(), u, v, order)
 
     def _grid_derivatives(self, us, vs, order):
-        (p, q), (ku, kv) = self.degree, self.knots
-        if self.rational and order == 0:
-            return rational_grid_positions(ku, p, kv, q, self._h, us, vs)[:, :, None, None, :]
-        if self.rational:
-            return surface_quotient(surface_grid(ku, p, kv, q, self._h, us, vs, order, planar=True))
-        return surface_grid(ku, p, kv, q, self._h, us, vs, order)
+        return local.surface_grid(self._local_net(), us, vs, order)
+
+    def grid_into(self, us, vs, out) -> np.ndarray:
+        """Positions on the grid ``us x vs`` written into the preallocated C-contiguous
+        float array ``out`` of shape ``(len(us), len(vs), 3)`` (no other array of that
+        size is made); returns ``out``.
+
+        >>> import numpy as np, surfmod as sm
+        >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+        >>> buf = np.empty((2, 3, 3))
+        >>> sm.BSplineSurface(net, (3, 3)).grid_into([0, 1], [0, 0.5, 1], buf)[1, 1]
+        array([3. , 1.5, 0. ])
+        """
+        (u0, u1), (v0, v1) = self.domain
+        us = checks.parameters(np.atleast_1d(us), "us", (u0, u1)).ravel()
+        vs = checks.parameters(np.atleast_1d(vs), "vs", (v0, v1)).ravel()
+        if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.flags.c_contiguous
+                and out.flags.writeable and out.shape == (us.size, vs.size, 3)):
+            raise SurfmodError(f"out: expected a writable C-contiguous float64 array of shape "
+                               f"{(us.size, vs.size, 3)}, got {getattr(out, 'shape', type(out).__name__)}")
+        local.surface_grid(self._local_net(), us, vs, 0, out=out)
+        return out
 
     def geom(self):
         from ..occ.geom import bspline_surface

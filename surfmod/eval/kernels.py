@@ -1,0 +1,392 @@
+"""Compiled (numba) kernels for tensor-product evaluation with local support.
+
+Every point touches only its ``(p+1) x (q+1)`` poles, so the cost depends on the number
+of points and the degrees, never on the size of the control net.  The kernels are
+imported lazily (``import surfmod`` never imports numba) and compiled once into numba's
+on-disk cache (``cache=True``).  All arrays they write are allocated by the NumPy caller,
+so ``tracemalloc`` sees the memory and the caller decides the blocking.
+
+Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polynomial,
+4 rational ``(w x, w y, w z, w)``), C-contiguous float64.  Spans follow
+:func:`surfmod.eval.basis.find_spans`: ``knots[i] <= t < knots[i+1]`` clipped to
+``[degree, n_ctrl - 1]`` (the right end of the domain belongs to the last span).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def find_span(knots, degree, n_ctrl, t):
+    """The largest ``i`` with ``knots[i] <= t``, clipped to the domain.  A branch-free
+    binary search (the halving step compiles to a conditional move): random parameters
+    would mispredict every branch of the textbook loop."""
+    base = 0
+    size = knots.size
+    while size > 1:
+        half = size // 2
+        base = base + half if knots[base + half] <= t else base
+        size -= half
+    span = base if knots[base] <= t else base - 1
+    if span < degree:
+        return degree
+    if span > n_ctrl - 1:
+        return n_ctrl - 1
+    return span
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def find_span_bucketed(knots, degree, n_ctrl, t, t0, scale, table):
+    """:func:`find_span` in O(1): a uniform bucket grid over the domain gives a span at or
+    just before the answer (see :func:`span_buckets`), then a short, well-predicted walk.
+    The walk back guards against the rounding of the bucket index."""
+    b = int((t - t0) * scale)
+    if b < 0:
+        b = 0
+    elif b >= table.size:
+        b = table.size - 1
+    span = table[b]
+    while span < n_ctrl - 1 and knots[span + 1] <= t:
+        span += 1
+    while span > degree and knots[span] > t:
+        span -= 1
+    return span
+
+
+def span_buckets(knots: np.ndarray, degree: int, n_ctrl: int, per_span: int = 4):
+    """``(t0, scale, table)`` for :func:`find_span_bucketed`: ``per_span`` buckets per
+    knot span over ``[knots[degree], knots[n_ctrl]]``, each holding the span of its start."""
+    t0, t1 = float(knots[degree]), float(knots[n_ctrl])
+    count = max(1, per_span * (n_ctrl - degree))
+    starts = t0 + (t1 - t0) * np.arange(count) / count
+    table = np.clip(np.searchsorted(knots, starts, side="right") - 1, degree, n_ctrl - 1).astype(np.int64)
+    return t0, (count / (t1 - t0) if t1 > t0 else 0.0), table
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders):
+    """The p+1 non-zero basis functions at ``t`` and their derivatives: ``ders[k, r]`` is
+    the k-th derivative of ``N_{span-p+r}`` for ``k <= order`` (zero above the degree).
+
+    The Cox-de Boor triangle ``ndu[r, j] = N_{span-j+r, j}`` keeps every lower degree;
+    the k-th derivative starts from degree p-k and is raised k times by the textbook
+    rule ``N'_{i,d} = d (N_{i,d-1} / (u_{i+d} - u_i) - N_{i+1,d-1} / (u_{i+d+1} - u_{i+1}))``
+    (The NURBS Book eq. 2.9; A2.3 evaluates the same sums).  Every divisor is a knot
+    difference whose reciprocal is in ``inv`` (:func:`reciprocal_table`; 0 for an empty
+    difference, the 0/0 = 0 convention), so nothing divides.
+    """
+    ndu[0, 0] = 1.0
+    for j in range(1, p + 1):
+        left[j] = t - knots[span + 1 - j]
+        right[j] = knots[span + j] - t
+        saved = 0.0
+        for r in range(j):
+            temp = ndu[r, j - 1] * inv[span, j, r]
+            ndu[r, j] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        ndu[j, j] = saved
+    for r in range(p + 1):
+        ders[0, r] = ndu[r, p]
+    for k in range(1, order + 1):
+        if k > p:
+            for r in range(p + 1):
+                ders[k, r] = 0.0
+            continue
+        for r in range(p - k + 1):
+            tmp[r] = ndu[r, p - k]
+        for d in range(p - k + 1, p + 1):
+            # in place from the top: new[r] needs old[r - 1] and old[r]
+            tmp[d] = d * (tmp[d - 1] * inv[span, d, d - 1])
+            for r in range(d - 1, 0, -1):
+                tmp[r] = d * (tmp[r - 1] * inv[span, d, r - 1] - tmp[r] * inv[span, d, r])
+            tmp[0] = -d * (tmp[0] * inv[span, d, 0])
+        for r in range(p + 1):
+            ders[k, r] = tmp[r]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def quotient_point(h, binom, out):
+    """Rational quotient rule (A4.4) at one point: homogeneous ``h (K, K, 4)`` ->
+    Cartesian ``out (K, K, 3)``; every entry of the square is exact."""
+    kk = h.shape[0]
+    inv_w = 1.0 / h[0, 0, 3]
+    for k in range(kk):
+        for l in range(kk):
+            for d in range(3):
+                v = h[k, l, d]
+                for j in range(1, l + 1):
+                    v -= binom[l, j] * h[0, j, 3] * out[k, l - j, d]
+                for i in range(1, k + 1):
+                    v -= binom[k, i] * h[i, 0, 3] * out[k - i, l, d]
+                    v2 = 0.0
+                    for j in range(1, l + 1):
+                        v2 += binom[l, j] * h[i, j, 3] * out[k - i, l - j, d]
+                    v -= binom[k, i] * v2
+                out[k, l, d] = v * inv_w
+
+
+def reciprocal_table(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
+    """``inv[span, j, r] = 1 / (knots[span+r+1] - knots[span+r+1-j])`` for the spans of the
+    domain (other entries 0): the divisors of the Cox-de Boor triangle.  Every such
+    difference spans the non-empty knot interval ``[knots[span], knots[span+1])``."""
+    p = degree
+    inv = np.zeros((n_ctrl, p + 1, p + 1))
+    span = np.arange(p, n_ctrl)
+    for j in range(1, p + 1):
+        for r in range(j):
+            diff = knots[span + r + 1] - knots[span + r + 1 - j]
+            with np.errstate(divide="ignore"):
+                inv[p:, j, r] = np.where(diff > 0, 1.0 / np.where(diff > 0, diff, 1.0), 0.0)
+    return inv
+
+
+def binomials(order: int) -> np.ndarray:
+    """``C(k, i)`` table ``(order+1, order+1)`` for the quotient rule."""
+    kk = order + 1
+    out = np.zeros((kk, kk))
+    for k in range(kk):
+        out[k, 0] = 1.0
+        for i in range(1, k + 1):
+            out[k, i] = out[k - 1, i - 1] + (out[k - 1, i] if i < k else 0.0)
+    return out
+
+
+#: points per block of the scattered-derivative kernel (its planes stay in L1/L2)
+POINT_BLOCK = 128
+
+
+@njit(cache=True, error_model="numpy")
+def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
+    """Mixed partials at scattered pairs into ``out (N, K, K, 3)`` (Cartesian).
+
+    ``ctrl`` is ``(n, m, 4)``: homogeneous for a rational net, the weight column unused
+    otherwise.  Points go in blocks: per point the spans, the basis derivatives and a
+    gather of the local ``(p+1) x (q+1)`` net into planes; then the contraction and the
+    quotient rule run over the block with the points on the contiguous (vector) axis."""
+    n, m = ctrl.shape[0], ctrl.shape[1]
+    kk = order + 1
+    nb = POINT_BLOCK
+    dim = 4 if rational else 3
+    ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
+    lu, ru, tu = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
+    lv, rv, tv = np.empty(q + 1), np.empty(q + 1), np.empty(q + 1)
+    du, dv = np.empty((kk, p + 1)), np.empty((kk, q + 1))
+    bu, bv = np.empty((kk, p + 1, nb)), np.empty((kk, q + 1, nb))
+    local = np.empty((p + 1, q + 1, 4, nb))
+    row = np.empty((kk, 4, nb))
+    h = np.empty((kk, kk, 4, nb))
+    t0u, scale_u, table_u = bucket_u
+    t0v, scale_v, table_v = bucket_v
+    for a0 in range(0, u.size, nb):
+        cnt = min(nb, u.size - a0)
+        for b in range(cnt):
+            su = find_span_bucketed(ku, p, n, u[a0 + b], t0u, scale_u, table_u)
+            sv = find_span_bucketed(kv, q, m, v[a0 + b], t0v, scale_v, table_v)
+            basis_ders_point(ku, p, su, u[a0 + b], order, inv_u, ndu_u, lu, ru, tu, du)
+            basis_ders_point(kv, q, sv, v[a0 + b], order, inv_v, ndu_v, lv, rv, tv, dv)
+            for k in range(kk):
+                for i in range(p + 1):
+                    bu[k, i, b] = du[k, i]
+                for j in range(q + 1):
+                    bv[k, j, b] = dv[k, j]
+            for i in range(p + 1):
+                for j in range(q + 1):
+                    for d in range(4):
+                        local[i, j, d, b] = ctrl[su - p + i, sv - q + j, d]
+        for i in range(p + 1):
+            for l in range(kk):
+                for d in range(dim):
+                    for b in range(cnt):
+                        row[l, d, b] = bv[l, 0, b] * local[i, 0, d, b]
+                    for j in range(1, q + 1):
+                        for b in range(cnt):
+                            row[l, d, b] += bv[l, j, b] * local[i, j, d, b]
+            for k in range(kk):
+                for l in range(kk):
+                    for d in range(dim):
+                        if i == 0:
+                            for b in range(cnt):
+                                h[k, l, d, b] = bu[k, 0, b] * row[l, d, b]
+                        else:
+                            for b in range(cnt):
+                                h[k, l, d, b] += bu[k, i, b] * row[l, d, b]
+        if rational:
+            _quotient_planes(h[..., :cnt], binom)
+        for b in range(cnt):
+            for k in range(kk):
+                for l in range(kk):
+                    for d in range(3):
+                        out[a0 + b, k, l, d] = h[k, l, d, b]
+
+
+@njit(cache=True, error_model="numpy")
+def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out):
+    """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
+    :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
+    sums kept in registers."""
+    n, m = ctrl.shape[0], ctrl.shape[1]
+    nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
+    lu, ru = np.empty(p + 1), np.empty(p + 1)
+    lv, rv = np.empty(q + 1), np.empty(q + 1)
+    t0u, scale_u, table_u = bucket_u
+    t0v, scale_v, table_v = bucket_v
+    for a in range(u.size):
+        su = find_span_bucketed(ku, p, n, u[a], t0u, scale_u, table_u)
+        sv = find_span_bucketed(kv, q, m, v[a], t0v, scale_v, table_v)
+        _basis_funs(ku, p, su, u[a], inv_u, lu, ru, nu_)
+        _basis_funs(kv, q, sv, v[a], inv_v, lv, rv, nv_)
+        x = y = z = w = 0.0
+        for i in range(p + 1):
+            rx = ry = rz = rw = 0.0
+            ci = su - p + i
+            for j in range(q + 1):
+                c = nv_[j]
+                cj = sv - q + j
+                rx += c * ctrl[ci, cj, 0]
+                ry += c * ctrl[ci, cj, 1]
+                rz += c * ctrl[ci, cj, 2]
+                rw += c * ctrl[ci, cj, 3]
+            c = nu_[i]
+            x += c * rx
+            y += c * ry
+            z += c * rz
+            w += c * rw
+        if rational:
+            x /= w
+            y /= w
+            z /= w
+        out[a, 0] = x
+        out[a, 1] = y
+        out[a, 2] = z
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _basis_funs(knots, p, span, t, inv, left, right, out):
+    """Piegl & Tiller A2.2: the p+1 non-zero basis functions at ``t``.  The denominators
+    ``right[r+1] + left[j-r]`` are knot differences independent of ``t``; their
+    reciprocals come from the table ``inv[span, j, r]`` (see :func:`reciprocal_table`),
+    so the triangle has no division."""
+    out[0] = 1.0
+    for j in range(1, p + 1):
+        left[j] = t - knots[span + 1 - j]
+        right[j] = knots[span + j] - t
+        saved = 0.0
+        for r in range(j):
+            temp = out[r] * inv[span, j, r]
+            out[r] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        out[j] = saved
+
+
+@njit(cache=True, error_model="numpy")
+def grid_rows(bv, sv, q, ctrl, rows, dim, out):
+    """First stage of the grid: ``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]``
+    for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
+    with the v-basis."""
+    kk = bv.shape[1]
+    for r in range(rows.size):
+        i = rows[r]
+        for b in range(sv.size):
+            s = sv[b] - q
+            for l in range(kk):
+                x = y = z = w = 0.0
+                for j in range(q + 1):
+                    c = bv[b, l, j]
+                    x += c * ctrl[i, s + j, 0]
+                    y += c * ctrl[i, s + j, 1]
+                    z += c * ctrl[i, s + j, 2]
+                    w += c * ctrl[i, s + j, 3]
+                out[r, l, 0, b] = x
+                out[r, l, 1, b] = y
+                out[r, l, 2, b] = z
+                if dim == 4:
+                    out[r, l, 3, b] = w
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
+    """``acc[k, l, d, off:off+n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
+    vector axis)."""
+    r0 = first[a]
+    nv = w.shape[3]
+    for k in range(kk):
+        for l in range(kk):
+            for d in range(dim):
+                c = bu[a, k, 0]
+                for b in range(nv):
+                    acc[k, l, d, off + b] = c * w[r0, l, d, b]
+                for i in range(1, p + 1):
+                    c = bu[a, k, i]
+                    for b in range(nv):
+                        acc[k, l, d, off + b] += c * w[r0 + i, l, d, b]
+
+
+@njit(cache=True, error_model="numpy")
+def grid_positions(bu, first, p, w, rational, acc, b0, out):
+    """Second stage for positions: ``out[:, b0:b0+n_v]`` of ``out (n_u, N_v, 3)``
+    point-major, the division by the weight fused into the (interleaving) store."""
+    nv = w.shape[3]
+    dim = 4 if rational else 3
+    for a in range(bu.shape[0]):
+        _combine_rows(bu, a, first, p, w, 1, dim, acc, 0)
+        if rational:
+            for b in range(nv):
+                inv_w = 1.0 / acc[0, 0, 3, b]
+                out[a, b0 + b, 0] = acc[0, 0, 0, b] * inv_w
+                out[a, b0 + b, 1] = acc[0, 0, 1, b] * inv_w
+                out[a, b0 + b, 2] = acc[0, 0, 2, b] * inv_w
+        else:
+            for b in range(nv):
+                out[a, b0 + b, 0] = acc[0, 0, 0, b]
+                out[a, b0 + b, 1] = acc[0, 0, 1, b]
+                out[a, b0 + b, 2] = acc[0, 0, 2, b]
+
+
+@njit(cache=True, error_model="numpy")
+def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
+    """Second stage for partials: for each u-point combine its p+1 rows of ``w``, apply
+    the quotient rule on the planes (rational), and write ``out[..., b0:b0+n_v]`` of
+    ``out (n_u, K, K, 3, N_v)``: planar, every partial and coordinate a contiguous row."""
+    kk = bu.shape[1]
+    nv = w.shape[3]
+    dim = 4 if rational else 3
+    for a in range(bu.shape[0]):
+        # accumulate in the cache-resident scratch, then write every output plane once
+        _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
+        if rational:
+            _quotient_planes(acc, binom)
+        for k in range(kk):
+            for l in range(kk):
+                for d in range(3):
+                    for b in range(nv):
+                        out[a, k, l, d, b0 + b] = acc[k, l, d, b]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _quotient_planes(acc, binom):
+    """The quotient rule in place on planes ``acc (K, K, 4, n)``: coordinates 0..2 of
+    every entry become Cartesian, entry by entry in rising order (each needs only lower
+    entries, already converted, and the untouched weight planes).  Every step is a pass
+    over the contiguous last axis through 1-D views, so it vectorizes."""
+    kk, nv = acc.shape[0], acc.shape[3]
+    inv_w = np.empty(nv)
+    w00 = acc[0, 0, 3]
+    for b in range(nv):
+        inv_w[b] = 1.0 / w00[b]
+    for k in range(kk):
+        for l in range(kk):
+            for d in range(3):
+                dst = acc[k, l, d]
+                for i in range(k + 1):
+                    for j in range(l + 1):
+                        if i == 0 and j == 0:
+                            continue
+                        c = binom[k, i] * binom[l, j]
+                        wij = acc[i, j, 3]
+                        src = acc[k - i, l - j, d]
+                        for b in range(nv):
+                            dst[b] -= c * wij[b] * src[b]
+                for b in range(nv):
+                    dst[b] *= inv_w[b]
