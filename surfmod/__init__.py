@@ -112,6 +112,8 @@ _EXPORTS = {
     "Tool": ".uses.toolpath",
     "export_gcode": ".io.gcode",
     "make_solid": ".uses.inputs",
+    "continuity": ".ops.continuity",
+    "Continuity": ".ops.continuity",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
