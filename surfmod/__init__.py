@@ -114,6 +114,8 @@ _EXPORTS = {
     "make_solid": ".uses.inputs",
     "continuity": ".ops.continuity",
     "Continuity": ".ops.continuity",
+    "blend": ".construct.blend",
+    "BlendSurface": ".construct.blend",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])

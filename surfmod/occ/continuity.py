@@ -17,7 +17,7 @@ from .guard import kernel
 from .topo import wrapped
 
 
-def local_analysis(geom_a, uv_a: np.ndarray, geom_b, uv_b: np.ndarray) -> np.ndarray:
+def local_analysis(geom_a, uv_a: np.ndarray, geom_b, uv_b: np.ndarray, *, reverse_b: bool = False) -> np.ndarray:
     """``(N, 3)``: OCCT's ``C0Value``, ``G1Angle`` and ``G2CurvatureGap`` at each pair of
     parameters (NaN where OCCT reports the analysis not done, e.g. undefined curvature).
 
@@ -25,10 +25,15 @@ def local_analysis(geom_a, uv_a: np.ndarray, geom_b, uv_b: np.ndarray) -> np.nda
     and the half-difference of the principal curvatures
     (``|dH| + sqrt(dZ^2 cos^2 a + Z^2 sin^2 a)``, ``Z`` the mean half-difference, ``a``
     the angle between averaged principal directions): for a plane tangent to a cylinder
-    of radius ``R`` it is ``1/(2R)``.
+    of radius ``R`` it is ``1/(2R)``.  The gap takes both curvatures against each
+    surface's own normal, so for oppositely oriented surfaces ``reverse_b=True`` hands
+    OCCT ``b``'s ``UReversed`` copy (at the mapped parameters) instead.
     """
     out = np.full((len(uv_a), 3), np.nan)
     with kernel("LocalAnalysis_SurfaceContinuity"):
+        if reverse_b:
+            uv_b = np.array([(geom_b.UReversedParameter(float(u)), v) for u, v in uv_b])
+            geom_b = geom_b.UReversed()
         for i, ((ua, va), (ub, vb)) in enumerate(zip(uv_a, uv_b)):
             la = LocalAnalysis_SurfaceContinuity(
                 geom_a, float(ua), float(va), geom_b, float(ub), float(vb), GeomAbs_G2)

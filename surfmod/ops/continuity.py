@@ -39,7 +39,8 @@ class Continuity:
 
     Maxima: ``g0`` (gap, model units), ``g1`` (normal angle, radians), ``g2`` (jump of
     the normal curvature across the boundary, 1/length) and ``g2_relative`` (``g2`` over
-    the largest ``|k|`` on either side).  Per sample: ``points``, ``gap``, ``angle``,
+    the largest ``|k|`` on either side, or over 1/(boundary length) if that is larger,
+    so that flat joins are judged on the scale of the part).  Per sample: ``points``, ``gap``, ``angle``,
     ``jump``, ``curvature_a``, ``curvature_b``, ``params_a``, ``params_b``; ``occt`` is
     OCCT's ``(C0Value, G1Angle, G2CurvatureGap)`` per sample when asked for;
     ``edges`` holds the per-edge results of a shell.
@@ -81,7 +82,11 @@ class Continuity:
     def g2_relative(self) -> float:
         if not self.jump.size:
             return 0.0
-        scale = max(float(np.nanmax(np.abs(self.curvature_a))), float(np.nanmax(np.abs(self.curvature_b))))
+        length = float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum()) if not self.edges else 0.0
+        if self.edges:
+            length = min(float(np.linalg.norm(np.diff(e.points, axis=0), axis=1).sum()) for e in self.edges)
+        scale = max(float(np.nanmax(np.abs(self.curvature_a))), float(np.nanmax(np.abs(self.curvature_b))),
+                    1.0 / length if length > 0 else 0.0)
         return self.g2 / scale if scale > 0 else self.g2
 
     def level(self, g0_tol: float = 1e-6, g1_tol: float = 1e-6, g2_tol: float = 1e-6) -> str:
@@ -131,9 +136,10 @@ def normal_curvature(ders, normal, direction):
 
 
 def measure(ders_a, inward_a, ders_b, inward_b, edge_tangent):
-    """Per-sample ``(gap, angle, jump, k_a, k_b)`` from order-2 derivative arrays
+    """Per-sample ``(gap, angle, jump, k_a, k_b, flip)`` from order-2 derivative arrays
     ``(N, 3, 3, 3)`` of both surfaces, 3-D vectors pointing into each surface and the
-    edge tangent (see the module docstring for what is compared)."""
+    edge tangent (see the module docstring for what is compared).  ``flip`` is -1 where
+    ``b``'s normal had to be reversed to be oriented like ``a``'s."""
     gap = np.linalg.norm(ders_a[:, 0, 0] - ders_b[:, 0, 0], axis=1)
     n_a = _unit(np.cross(ders_a[:, 1, 0], ders_a[:, 0, 1]))
     n_b = _unit(np.cross(ders_b[:, 1, 0], ders_b[:, 0, 1]))
@@ -153,7 +159,7 @@ def measure(ders_a, inward_a, ders_b, inward_b, edge_tangent):
     angle = np.arctan2(np.linalg.norm(np.cross(n_a, n_b), axis=1), np.einsum("ij,ij->i", n_a, n_b))
     k_a = normal_curvature(ders_a, n_a, t_a)
     k_b = normal_curvature(ders_b, n_b, t_b)
-    return gap, angle, np.abs(k_a - k_b), k_a, k_b
+    return gap, angle, np.abs(k_a - k_b), k_a, k_b, flip
 
 
 # -- boundaries of parameter rectangles -----------------------------------------------------------
@@ -190,7 +196,8 @@ def _hausdorff(p, q):
 
 def match_sides(a: Surface, b: Surface, probe: int = 41):
     """The pair of sides ``(side_a, side_b)`` closest in symmetric sampled distance
-    (degenerate sides such as poles are skipped) and that distance."""
+    (degenerate sides such as poles are skipped) and that distance, refined by exact
+    closest points on the sides."""
     size = max(np.ptp(a.grid(*(np.linspace(*d, 5) for d in a.domain)).reshape(-1, 3), axis=0).max(), 1e-300)
     best = (np.inf, None, None)
     for sa in SIDES:
@@ -202,9 +209,17 @@ def match_sides(a: Surface, b: Surface, probe: int = 41):
             d = _hausdorff(pa, pb)
             if d < best[0]:
                 best = (d, sa, sb)
-    if best[1] is None or best[0] > 0.05 * size:
+    if best[1] is None:
         raise SurfmodError("b: no side of b runs along a side of a (give edge=(side_a, side_b))")
-    return best[1], best[2], best[0]
+    _, sa, sb = best
+    _, pa = _side_points(a, sa, probe)
+    _, pb = _side_points(b, sb, 3)
+    on_b = b.points(*side_params(b, sb, _closest_on_side(b, sb, pa)))
+    on_a = a.points(*side_params(a, sa, _closest_on_side(a, sa, pb)))
+    exact = max(float(np.linalg.norm(on_b - pa, axis=1).max()), float(np.linalg.norm(on_a - pb, axis=1).max()))
+    if exact > 1e-3 * size:
+        raise SurfmodError("b: no side of b runs along a side of a (give edge=(side_a, side_b))")
+    return sa, sb, exact
 
 
 def _closest_on_side(s: Surface, side: str, points: np.ndarray, iterations: int = 30):
@@ -238,14 +253,49 @@ def _pair(a: Surface, b: Surface, side_a: str, side_b: str, samples: int, occt: 
     db = b.derivatives(ub, vb, 2)
     along_a, in_a = side_vectors(a, side_a, da)
     _, in_b = side_vectors(b, side_b, db)
-    gap, angle, jump, k_a, k_b = measure(da, in_a, db, in_b, along_a)
+    gap, angle, jump, k_a, k_b, flip = measure(da, in_a, db, in_b, along_a)
     uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
     ref = None
     if occt:
         from ..occ.continuity import local_analysis
 
-        ref = local_analysis(a.geom(), uv_a, b.geom(), uv_b)
+        ref = local_analysis(a.geom(), uv_a, b.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
     return Continuity(label, pa, gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
+
+
+def _projected(a: Surface, b: Surface, samples: int, occt: bool):
+    """Fallback when no side of ``b`` runs along a side of ``a`` (e.g. ``b`` is a trimmed
+    face such as OCCT's filling): the side of ``a`` lying on ``b`` is found by projecting
+    its samples onto ``b``; ``b`` is taken to continue ``a`` across that side."""
+    from .project import closest_points
+
+    size = max(np.ptp(a.grid(*(np.linspace(*d, 5) for d in a.domain)).reshape(-1, 3), axis=0).max(), 1e-300)
+    best = (np.inf, None)
+    for side in SIDES:
+        _, pts = _side_points(a, side, 9)
+        if np.linalg.norm(pts[-1] - pts[0]) + np.linalg.norm(pts[4] - pts[0]) < 1e-9 * size:
+            continue
+        d = float(closest_points(b, pts)[3].max())
+        if d < best[0]:
+            best = (d, side)
+    if best[1] is None or best[0] > 0.05 * size:
+        raise SurfmodError("b: no side of b runs along a side of a, nor does a side of a lie on b "
+                           "(give edge=(side_a, side_b))")
+    side_a = best[1]
+    t_a = _free_samples(a, side_a, samples)
+    ua, va = side_params(a, side_a, t_a)
+    da = a.derivatives(ua, va, 2)
+    ub, vb, _, _ = closest_points(b, da[:, 0, 0])
+    db = b.derivatives(ub, vb, 2)
+    along_a, in_a = side_vectors(a, side_a, da)
+    gap, angle, jump, k_a, k_b, flip = measure(da, in_a, db, -in_a, along_a)
+    uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
+    ref = None
+    if occt:
+        from ..occ.continuity import local_analysis
+
+        ref = local_analysis(a.geom(), uv_a, b.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
+    return Continuity(f"a.{side_a} | b (projected)", da[:, 0, 0], gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
 
 
 # -- faces and shells -----------------------------------------------------------------------------
@@ -264,13 +314,14 @@ def _edge_result(rec, surfaces, occt: bool, label: str):
     ub, vb = _clip_uv(sb, uvb)
     da, db = sa.derivatives(ua, va, 2), sb.derivatives(ub, vb, 2)
     tangent = _to_3d(da, rec["tangent"][0])
-    gap, angle, jump, k_a, k_b = measure(da, _to_3d(da, rec["inward"][0]), db, _to_3d(db, rec["inward"][1]), tangent)
+    gap, angle, jump, k_a, k_b, flip = measure(
+        da, _to_3d(da, rec["inward"][0]), db, _to_3d(db, rec["inward"][1]), tangent)
     uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
     ref = None
     if occt:
         from ..occ.continuity import local_analysis
 
-        ref = local_analysis(sa.geom(), uv_a, sb.geom(), uv_b)
+        ref = local_analysis(sa.geom(), uv_a, sb.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
     return Continuity(label, da[:, 0, 0], gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
 
 
@@ -350,7 +401,10 @@ def continuity(a, b=None, samples: int = 50, *, edge=None, occt: bool = False) -
     a = _as_surface(a, "a")
     b = _as_surface(b, "b")
     if edge is None:
-        side_a, side_b, _ = match_sides(a, b)
+        try:
+            side_a, side_b, _ = match_sides(a, b)
+        except SurfmodError:
+            return _projected(a, b, samples, occt)
     else:
         try:
             side_a, side_b = edge
