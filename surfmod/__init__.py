@@ -116,6 +116,8 @@ _EXPORTS = {
     "Continuity": ".ops.continuity",
     "blend": ".construct.blend",
     "BlendSurface": ".construct.blend",
+    "analyze": ".meshing.analyze",
+    "Analysis": ".meshing.analyze",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])

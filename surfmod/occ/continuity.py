@@ -113,3 +113,32 @@ def shared_edges(shape, samples: int) -> list[dict]:
                 rec["inward"].append(sign * perp)
             records.append(rec)
     return records
+
+
+def face_edges_uv(face, samples: int) -> list:
+    """Every non-degenerate edge of one face as ``(uv (samples, 2), tangent (samples, 2))``
+    through its p-curve on that face."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.gp import gp_Pnt2d, gp_Vec2d
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+
+    f = TopoDS.Face_s(wrapped(face))
+    out = []
+    with kernel("face edges (BRepAdaptor_Curve2d)"):
+        explorer = TopExp_Explorer(f, TopAbs_EDGE)
+        while explorer.More():
+            edge = TopoDS.Edge_s(explorer.Current())
+            explorer.Next()
+            if BRep_Tool.Degenerated_s(edge):
+                continue
+            pcurve = BRepAdaptor_Curve2d(edge, f)
+            t = np.linspace(pcurve.FirstParameter(), pcurve.LastParameter(), samples)
+            uv, tangent = np.empty((samples, 2)), np.empty((samples, 2))
+            p, d = gp_Pnt2d(), gp_Vec2d()
+            for k, tk in enumerate(t):
+                pcurve.D1(float(tk), p, d)
+                uv[k] = (p.X(), p.Y())
+                tangent[k] = (d.X(), d.Y())
+            out.append((uv, tangent))
+    return out
