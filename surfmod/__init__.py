@@ -118,6 +118,9 @@ _EXPORTS = {
     "BlendSurface": ".construct.blend",
     "analyze": ".meshing.analyze",
     "Analysis": ".meshing.analyze",
+    "offset": ".construct.offset",
+    "thicken": ".construct.offset",
+    "OffsetApproximation": ".construct.offset",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
