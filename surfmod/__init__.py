@@ -125,6 +125,15 @@ _EXPORTS = {
     "import_iges": ".io.iges",
     "fit": ".construct.scattered_fit",
     "Fit": ".construct.scattered_fit",
+    "continuity": ".ops.continuity",
+    "Continuity": ".ops.continuity",
+    "blend": ".construct.blend",
+    "BlendSurface": ".construct.blend",
+    "analyze": ".meshing.analyze",
+    "Analysis": ".meshing.analyze",
+    "offset": ".construct.offset",
+    "thicken": ".construct.offset",
+    "OffsetApproximation": ".construct.offset",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])

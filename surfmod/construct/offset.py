@@ -1,0 +1,235 @@
+"""Offsets as B-splines, with a pre-check that says where they would fail, and thickening.
+
+``offset(s, d, tolerance)`` approximates the exact offset ``S + d N`` (surfmod's
+:class:`~surfmod.construct.readers_elementary.OffsetSurface`, OCCT's
+``Geom_OffsetSurface``) by a bicubic B-spline in the base surface's own parameters:
+least squares on a tensor grid (separable, one solve per direction), then knots are
+inserted in the middle of every span whose error at the span midpoints exceeds the
+tolerance, until the fit holds everywhere sampled.
+
+The pre-check: the offset's partials are ``S_x (1 - d k)`` along principal directions
+(``k`` signed against the normal, as ``curvatures``), so the offset folds wherever
+``d k >= 1``, i.e. where ``|d|`` reaches the smallest radius of curvature on the concave
+side.  A B-spline base with a C0 knot line across which the normal jumps (a crease)
+has no offset either.  Both raise :class:`SurfmodError` naming the ``(u, v)`` region.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+from ..eval.basis import basis_matrix
+from ..nets.bspline import BSplineSurface
+from ..surface import Surface
+
+#: Margin on ``d k < 1``: closer than this the offset's partials nearly vanish.
+FOLD_MARGIN = 1e-6
+
+
+class OffsetApproximation(BSplineSurface):
+    """The bicubic B-spline made by :func:`offset`: ``base``, ``distance``, the requested
+    ``tolerance`` and ``max_error`` (largest distance to the exact offset at the
+    check samples, in the same parameters)."""
+
+    base: Surface
+    distance: float = 0.0
+    tolerance: float = 0.0
+    max_error: float = 0.0
+
+
+def _breaks(s: Surface, direction: int) -> np.ndarray:
+    """Distinct knots of a B-spline base inside its domain (ends included), else the ends."""
+    lo, hi = s.domain[direction]
+    if isinstance(s, BSplineSurface):
+        k = s.knots[direction]
+        inner = k[(k > lo) & (k < hi)]
+        return np.unique(np.concatenate([[lo], inner, [hi]]))
+    return np.array([lo, hi])
+
+
+def _samples(breaks: np.ndarray, per_span: int) -> np.ndarray:
+    t = np.linspace(0.0, 1.0, per_span + 1)[:-1]
+    pts = (breaks[:-1, None] + t[None, :] * np.diff(breaks)[:, None]).ravel()
+    return np.concatenate([pts, breaks[-1:]])
+
+
+def _region(u, v, mask) -> str:
+    return (f"u in [{u[mask].min():.6g}, {u[mask].max():.6g}], "
+            f"v in [{v[mask].min():.6g}, {v[mask].max():.6g}]")
+
+
+def precheck(s: Surface, distance: float, per_span: int = 8, minimum: int = 33) -> None:
+    """Raise ``SurfmodError`` where the offset by ``distance`` folds (``d k >= 1``) or
+    where the base has a crease (normal jump across a C0 knot line)."""
+    us = _samples(_breaks(s, 0), per_span)
+    vs = _samples(_breaks(s, 1), per_span)
+    if us.size < minimum:
+        us = np.linspace(*s.domain[0], minimum)
+    if vs.size < minimum:
+        vs = np.linspace(*s.domain[1], minimum)
+    uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
+    c = s.curvatures(uu, vv)
+    reach = distance * np.maximum(c.k1, c.k2) if distance > 0 else distance * np.minimum(c.k1, c.k2)
+    bad = reach >= 1.0 - FOLD_MARGIN
+    if np.any(bad):
+        k = np.abs(np.where(distance > 0, c.k1, c.k2)[bad]).max()
+        raise SurfmodError(
+            f"distance: |{distance:g}| reaches the smallest radius of curvature on the concave side "
+            f"({1.0 / k:.6g}) where {_region(uu, vv, bad)}: the offset would fold there")
+    if isinstance(s, BSplineSurface):
+        for direction, name in ((0, "u"), (1, "v")):
+            p, k = s.degree[direction], s.knots[direction]
+            lo, hi = s.domain[direction]
+            values, mult = np.unique(k[(k > lo) & (k < hi)], return_counts=True)
+            other = vs if direction == 0 else us
+            for t in values[mult >= p]:
+                eps = 1e-9 * max(1.0, hi - lo)
+                left, right = np.full_like(other, t - eps), np.full_like(other, t + eps)
+                args_l = (left, other) if direction == 0 else (other, left)
+                args_r = (right, other) if direction == 0 else (other, right)
+                cos = np.einsum("ij,ij->i", s.normals(*args_l), s.normals(*args_r))
+                if np.any(cos < 1.0 - 1e-10):
+                    where = other[cos < 1.0 - 1e-10]
+                    o = "v" if direction == 0 else "u"
+                    raise SurfmodError(
+                        f"s: the surface has a crease along {name} = {t:.6g} ({o} in [{where.min():.6g}, "
+                        f"{where.max():.6g}]): the offset is not defined across it; split the surface there")
+
+
+def _lsq(params, knots, p, data):
+    """Least squares along axis 0 of ``data`` for the B-spline space ``(knots, p)``."""
+    n = knots.size - p - 1
+    b = basis_matrix(knots, p, n, params)[0]
+    flat = data.reshape(data.shape[0], -1)
+    sol, *_ = np.linalg.lstsq(b, flat, rcond=None)
+    return sol.reshape((n,) + data.shape[1:])
+
+
+def _base_multiplicities(s: Surface, direction: int) -> dict:
+    """Knot multiplicity the cubic fit needs at each interior knot of a B-spline base: the
+    base is C^(p-m) there, its offset (through the normal, one derivative down)
+    C^(p-m-1), which a cubic carries with multiplicity ``4 - p + m`` (at most 3)."""
+    if not isinstance(s, BSplineSurface):
+        return {}
+    p, k = s.degree[direction], s.knots[direction]
+    lo, hi = s.domain[direction]
+    values, mult = np.unique(k[(k > lo) & (k < hi)], return_counts=True)
+    return {float(t): int(min(3, max(1, 4 - p + m))) for t, m in zip(values, mult)}
+
+
+def _knots(breaks, mults, p=3):
+    inner = np.repeat(breaks[1:-1], [mults.get(float(t), 1) for t in breaks[1:-1]])
+    return np.concatenate([np.full(p + 1, breaks[0]), inner, np.full(p + 1, breaks[-1])])
+
+
+def _fit(exact: Surface, bu, bv, mults, per_span: int = 6):
+    us, vs = _samples(bu, per_span), _samples(bv, per_span)
+    grid = exact.grid(us, vs)
+    ku, kv = _knots(bu, mults[0]), _knots(bv, mults[1])
+    net = _lsq(us, ku, 3, grid)                                   # (nu, len(vs), 3)
+    net = _lsq(vs, kv, 3, net.transpose(1, 0, 2)).transpose(1, 0, 2)
+    return BSplineSurface._trusted(net, (3, 3), (ku, kv))
+
+
+def _span_errors(fit: Surface, exact: Surface, bu, bv):
+    """Max parametric distance per (u span, v span) at interior check points."""
+    t = np.array([0.17, 0.5, 0.83])
+    us = (bu[:-1, None] + t * np.diff(bu)[:, None]).ravel()
+    vs = (bv[:-1, None] + t * np.diff(bv)[:, None]).ravel()
+    err = np.linalg.norm(fit.grid(us, vs) - exact.grid(us, vs), axis=2)
+    return err.reshape(bu.size - 1, 3, bv.size - 1, 3).max(axis=(1, 3))
+
+
+def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: int = 10) -> OffsetApproximation:
+    """A bicubic B-spline within ``tolerance`` of the offset ``S + distance * N`` (``N``
+    the unit normal ``Su x Sv``), in the parameters of ``s``.  Raises ``SurfmodError``
+    naming the ``(u, v)`` region where the offset would fold or where ``s`` has a crease.
+
+    >>> import surfmod as sm
+    >>> o = sm.offset(sm.CylindricalSurface(2.0, u_range=(0, 1.5), v_range=(0, 3)), 0.5, 1e-6)
+    >>> o.max_error < 1e-6, round(float(np.linalg.norm(o.points(0.7, 1.0)[:2])), 6)
+    (True, 2.5)
+    """
+    from .readers_elementary import OffsetSurface
+
+    if not isinstance(s, Surface):
+        raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
+    try:
+        d = float(distance)
+    except (TypeError, ValueError):
+        raise SurfmodError(f"distance: expected a number, got {distance!r}") from None
+    if not np.isfinite(d) or d == 0.0:
+        raise SurfmodError(f"distance: must be finite and non-zero, got {distance!r}")
+    tol = checks.positive(tolerance, "tolerance")
+    max_rounds = checks.count(max_rounds, "max_rounds")
+    precheck(s, d)
+    exact = OffsetSurface(s, d)
+    bu, bv = _breaks(s, 0), _breaks(s, 1)
+    if bu.size < 3:
+        bu = np.linspace(bu[0], bu[-1], 3)
+    if bv.size < 3:
+        bv = np.linspace(bv[0], bv[-1], 3)
+    mults = (_base_multiplicities(s, 0), _base_multiplicities(s, 1))
+    for _ in range(max_rounds):
+        fit = _fit(exact, bu, bv, mults)
+        err = _span_errors(fit, exact, bu, bv)
+        bad = err > tol
+        if not np.any(bad):
+            break
+        bu = np.union1d(bu, 0.5 * (bu[:-1] + bu[1:])[bad.any(axis=1)])
+        bv = np.union1d(bv, 0.5 * (bv[:-1] + bv[1:])[bad.any(axis=0)])
+    else:
+        raise SurfmodError(f"tolerance: {tol:g} not reached after {max_rounds} refinements "
+                           f"(max error {err.max():.3g}); loosen it or raise max_rounds")
+    out = OffsetApproximation._trusted(fit.control_points, (3, 3), fit.knots)
+    out.base, out.distance, out.tolerance, out.max_error = s, d, tol, float(err.max())
+    return out
+
+
+def thicken(s: Surface, thickness: float, tolerance: float = 1e-5):
+    """A closed build123d ``Solid`` between ``s`` and its offset by ``thickness`` (along
+    the normal; negative goes the other way): the two faces plus ruled walls along the
+    four sides, sewn and oriented outwards (:func:`surfmod.make_solid`).  Sides that
+    collapse to a point or close on themselves get no wall.
+
+    >>> import surfmod as sm
+    >>> slab = sm.thicken(sm.plane((0, 0, 0), (2, 0, 0), (0, 3, 0)), 0.5)
+    >>> round(slab.volume, 9)
+    3.0
+    """
+    from ..ops.continuity import SIDES, side_params
+    from ..uses.inputs import make_solid
+    from .blend import as_bspline_surface
+    from .ruled import ruled
+
+    if not isinstance(s, Surface):
+        raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
+    try:
+        t = float(thickness)
+    except (TypeError, ValueError):
+        raise SurfmodError(f"thickness: expected a number, got {thickness!r}") from None
+    if not np.isfinite(t) or t == 0.0:
+        raise SurfmodError(f"thickness: must be finite and non-zero, got {thickness!r}")
+    try:
+        far = offset(s, t, tolerance)
+    except SurfmodError as exc:
+        raise SurfmodError(str(exc).replace("distance:", "thickness:", 1)) from None
+    near = as_bspline_surface(s, "s")
+    faces = [s, far]
+    probe = np.linspace(0.0, 1.0, 7)
+    for side in SIDES:
+        fixed, end = SIDES[side]
+        lo, hi = s.domain[1 - fixed]
+        pts = s.points(*side_params(s, side, lo + probe * (hi - lo)))
+        opposite = s.points(*side_params(s, side[0] + ("1" if end == 0 else "0"), lo + probe * (hi - lo)))
+        size = np.ptp(pts, axis=0).max()
+        if size < 1e-9 or np.allclose(pts, opposite, atol=1e-9 * max(1.0, size)):
+            continue  # a pole, or a closed direction: the faces meet themselves there
+        value = {"u0": near.domain[0][0], "u1": near.domain[0][1], "v0": near.domain[1][0], "v1": near.domain[1][1]}
+        c_near = near.isocurve(**{"uv"[fixed]: value[side]})
+        far_value = far.domain[fixed][end]
+        c_far = far.isocurve(**{"uv"[fixed]: far_value})
+        faces.append(ruled(c_near, c_far))
+    return make_solid(faces)

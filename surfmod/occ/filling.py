@@ -1,0 +1,72 @@
+"""OCCT's filling constructs, used as the reference beside surfmod's blends and fills:
+``BRepOffsetAPI_MakeFilling`` (plate surface through boundary edges, optionally tangent
+to support faces), and the exact B-spline conversion of a bounded surface."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .guard import check_done, kernel
+from .topo import wrapped
+
+
+def bspline_over(geom, bounds) -> dict:
+    """Exact B-spline data of ``geom`` restricted to ``bounds = (u0, u1, v0, v1)``
+    (``GeomConvert`` on a ``Geom_RectangularTrimmedSurface``)."""
+    from OCP.Geom import Geom_RectangularTrimmedSurface
+    from OCP.GeomConvert import GeomConvert
+
+    from .geom import read_bspline_surface
+
+    u0, u1, v0, v1 = (float(x) for x in bounds)
+    with kernel("GeomConvert.SurfaceToBSplineSurface_s"):
+        trimmed = Geom_RectangularTrimmedSurface(geom, u0, u1, v0, v1)
+        return read_bspline_surface(GeomConvert.SurfaceToBSplineSurface_s(trimmed))
+
+
+def nearest_edge(face, point):
+    """The edge of ``face`` whose midpoint is closest to ``point`` (a TopoDS_Edge)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    best, best_d = None, np.inf
+    explorer = TopExp_Explorer(wrapped(face), TopAbs_EDGE)
+    with kernel("BRepAdaptor_Curve"):
+        while explorer.More():
+            e = TopoDS.Edge_s(explorer.Current())
+            c = BRepAdaptor_Curve(e)
+            p = c.Value(0.5 * (c.FirstParameter() + c.LastParameter()))
+            d = float(np.linalg.norm(np.array([p.X(), p.Y(), p.Z()]) - point))
+            if d < best_d:
+                best, best_d = e, d
+            explorer.Next()
+    return best
+
+
+def make_filling(constraints, *, degree: int = 3, points_on_curve: int = 15, iterations: int = 2,
+                 max_degree: int = 8, max_segments: int = 9):
+    """``BRepOffsetAPI_MakeFilling`` through boundary ``constraints``: a list of
+    ``(edge, support_face_or_None, order)`` with order ``"C0"``, ``"G1"`` or ``"G2"``
+    (OCCT accepts G2 as a constraint order only with a support face and then treats
+    curvature approximately).  Returns the filling face (build123d ``Face``)."""
+    import build123d as bd
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeFilling
+    from OCP.GeomAbs import GeomAbs_C0, GeomAbs_G1, GeomAbs_G2
+    from OCP.TopoDS import TopoDS
+
+    orders = {"C0": GeomAbs_C0, "G1": GeomAbs_G1, "G2": GeomAbs_G2}
+    with kernel("BRepOffsetAPI_MakeFilling"):
+        maker = BRepOffsetAPI_MakeFilling(degree, points_on_curve, iterations, False, 1e-5, 1e-5, 1e-4, 1e-2,
+                                          max_degree, max_segments)
+        for edge, face, order in constraints:
+            e = TopoDS.Edge_s(wrapped(edge))
+            if face is None:
+                maker.Add(e, orders[order], True)
+            else:
+                maker.Add(e, TopoDS.Face_s(wrapped(face)), orders[order], True)
+        maker.Build()
+        check_done(maker, "BRepOffsetAPI_MakeFilling")
+        return bd.Face(TopoDS.Face_s(maker.Shape()))
+
