@@ -145,3 +145,23 @@ def test_bad_input_is_named():
     line = np.column_stack([np.linspace(0, 1, 50), np.zeros(50), np.zeros(50)])
     with pytest.raises(sm.SurfmodError, match="points: the points do not spread"):
         sm.fit(line, 1e-3)
+
+
+def test_fit_a_fan_blade_of_a_corpus_part(corpus_dir):
+    # the BRepMesh nodes of a real B-spline face, shuffled and noisy like a scan
+    import build123d as bd
+
+    from surfmod.occ.sample import distances_to_face
+
+    part = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+    blade = max((f for f in part.faces() if f.geom_type == bd.GeomType.BSPLINE), key=lambda f: f.area)
+    vertices, _ = blade.tessellate(0.005, 0.2)
+    rng = np.random.default_rng(8)
+    pts = np.array([tuple(v) for v in vertices])
+    pts = pts[rng.permutation(len(pts))] + rng.normal(0, SIGMA, (len(pts), 3))
+    f = sm.fit(pts, 5 * SIGMA)
+    assert f.converged and f.max_deviation <= 5 * SIGMA
+    # the fitted surface over the data lies on the original blade within 3 sigma
+    sub = rng.choice(len(pts), 150, replace=False)
+    on_fit = f.surface.points(f.parameters[0][sub], f.parameters[1][sub])
+    assert distances_to_face(blade.wrapped, on_fit).max() <= 3 * SIGMA
