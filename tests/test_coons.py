@@ -113,7 +113,7 @@ def test_rational_boundaries_quarter_circles():
     d1 = sm.Line(p_end, p_end + (0, 3, 0))
     s = sm.coons(a, c1, d0, d1)
     assert s.rational
-    (u0, u1), (v0, v1) = s.domain
+    (u0, u1), (v0, _) = s.domain
     t = np.linspace(*a.domain, 9)
     assert np.abs(s.points(u0 + (t - t[0]) / (t[-1] - t[0]) * (u1 - u0), v0) - a.points(t)).max() < 1e-13
     # a cylinder: every point at v0 lies on the circle of radius 2 in the XZ plane

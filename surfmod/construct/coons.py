@@ -69,7 +69,6 @@ class CoonsSurface(BSplineSurface):
 
 def _corner_check(curves, tolerance):
     """Each of the four corners must be shared by the two curves meeting there."""
-    c0, c1, d0, d1 = curves
     ends = {name: c.points(np.array(c.domain)) for name, c in zip(NAMES, curves)}
     corners = (
         ("c0", 0, "d0", 0, "S(u0, v0)"),
@@ -111,7 +110,6 @@ def _hermite_coefficients(n):
 
 def _scaled_weights(curves):
     """Homogeneous control arrays with weights scaled so corner weights agree."""
-    c0, c1, d0, d1 = curves
     w = [c.weights if c.weights is not None else np.ones(len(c.control_points)) for c in curves]
     w0, w1, wd0, wd1 = w
     a = 1.0 / w0[0]

@@ -5,8 +5,8 @@
    *height field* over it: the in-plane coordinates of the poles are the exact linear
    map of the Greville abscissae and only the heights are unknown, so every point keeps
    its exact parameters.  With ``base=`` a surfmod surface, the parameters come from
-   :func:`surfmod.project` and all three coordinates of the poles are unknown, or any surfmod surface (``base=``, projected with
-   :func:`surfmod.project`); the parameters are scaled onto ``[0, 1]^2``.
+   :func:`surfmod.project` and all three coordinates of the poles are unknown.  The
+   parameters are scaled onto ``[0, 1]^2``.
 2. **Penalized least squares**: the control net minimizes
    ``sum_k |S(u_k, v_k) - Q_k|^2 + lambda * E(S)`` with the thin-plate energy
    ``E = integral |S_uu|^2 + 2 |S_uv|^2 + |S_vv|^2 du dv`` (membrane energy for degree 1).
@@ -282,7 +282,8 @@ def _check_max_poles(value, degree):
         a, b = value
     except (TypeError, ValueError):
         raise SurfmodError(f"max_poles: expected an integer or a pair (nu, nv), got {value!r}") from None
-    return (checks.count(a, "max_poles[0]", minimum=degree[0] + 1), checks.count(b, "max_poles[1]", minimum=degree[1] + 1))
+    return (checks.count(a, "max_poles[0]", minimum=degree[0] + 1),
+            checks.count(b, "max_poles[1]", minimum=degree[1] + 1))
 
 
 def _foot_points(surface, points, u, v):
@@ -334,7 +335,7 @@ def fit(points, tolerance: float, degree=(3, 3), *, smoothing: float = 1e-6, bas
     else:
         frame, heights = None, None
         u, v = base_parameters(q, base)
-    knots = [_clamped_uniform(min(spans, limit[0] - deg[0]), deg[0]), _clamped_uniform(min(spans, limit[1] - deg[1]), deg[1])]
+    knots = [_clamped_uniform(min(spans, limit[d] - deg[d]), deg[d]) for d in (0, 1)]
     iterations = 0
     while True:
         iterations += 1
