@@ -165,3 +165,15 @@ def test_fit_a_fan_blade_of_a_corpus_part(corpus_dir):
     sub = rng.choice(len(pts), 150, replace=False)
     on_fit = f.surface.points(f.parameters[0][sub], f.parameters[1][sub])
     assert distances_to_face(blade.wrapped, on_fit).max() <= 3 * SIGMA
+
+
+@pytest.mark.parametrize("degree", [(1, 1), (2, 2), (3, 2), (5, 5)])
+def test_every_degree_meets_the_tolerance(degree):
+    # degree 1 uses the membrane energy (second derivatives vanish inside its spans)
+    rng = np.random.default_rng(9)
+    xy = rng.uniform(-1, 1, (2500, 2))
+    pts = np.column_stack([xy, np.sin(2 * xy[:, 0]) * np.cos(xy[:, 1])])
+    f = sm.fit(pts, 1e-3, degree=degree)
+    assert f.surface.degree == degree
+    assert f.converged and f.max_deviation <= 1e-3
+    assert sm.crosscheck(f.surface, samples=8).passed
