@@ -152,8 +152,9 @@ def coons(c0, c1, d0, d1, *, blend: str = "linear", tolerance: float = 1e-7) -> 
     _corner_check(given, tolerance)
     from ..nets.elevate import make_compatible
 
+    # as OCCT's SetSameDistribution: the longer interval wins, ties go to c0 and to d1
     cu = make_compatible([given[0].to_bspline(), given[1].to_bspline()])
-    cv = make_compatible([given[2].to_bspline(), given[3].to_bspline()])
+    cv = make_compatible([given[3].to_bspline(), given[2].to_bspline()])[::-1]
     if blend == "hermite":  # OCCT's cubic blend needs at least 4 poles per direction
         cu = _at_least_cubic(cu)
         cv = _at_least_cubic(cv)
