@@ -124,6 +124,9 @@ def test_base_surface_for_points_that_are_no_height_field():
     base = sm.CylindricalSurface(2.0, (0, 0, 0), (0, 0, 1), u_range=(0, 1.5 * np.pi), v_range=(0, 4))
     f = sm.fit(pts, 1e-3, base=base)
     assert f.converged and f.max_deviation <= 1e-3
+    # over a plane these points fold: refused with a pointer to base=
+    with pytest.raises(sm.SurfmodError, match=r"points: .* no height field .*base="):
+        sm.fit(pts, 1e-3)
 
 
 def test_bad_input_is_named():

@@ -39,6 +39,11 @@ from ..nets.bspline import BSplineSurface
 
 #: points per chunk when assembling the normal equations (memory bound)
 CHUNK = 200_000
+#: a local normal this close to perpendicular to the base normal (|cos| below, 84 deg)
+#: marks a place where a height field over the base plane folds; more than
+#: STEEP_FRACTION of such points and the plane is refused as a base
+STEEP_COSINE = 0.1
+STEEP_FRACTION = 0.01
 
 
 class Fit(NamedTuple):
@@ -91,7 +96,8 @@ def mean_normal_frame(points: np.ndarray, sample: int = 20_000, neighbours: int 
     like the global PCA normal).  For a curved height field such as ``z = sin(2x)`` the
     global PCA plane tilts with the trend and folds the projection; the mean normal
     stays along the height direction.  The in-plane axes are the principal axes of the
-    points projected onto that plane.
+    points projected onto that plane.  Also returned: the fraction of local normals
+    nearly perpendicular to the plane's (where a height field over it would fold).
     """
     from scipy.spatial import cKDTree
 
@@ -110,7 +116,8 @@ def mean_normal_frame(points: np.ndarray, sample: int = 20_000, neighbours: int 
     _, _, vt = np.linalg.svd(flat[:: max(1, len(flat) // sample)], full_matrices=False)
     e1 = vt[0] - (vt[0] @ n) * n
     e1 /= np.linalg.norm(e1)
-    return c, np.array([e1, np.cross(n, e1), n])
+    steep = float(np.mean(np.abs(normals @ n) < STEEP_COSINE))
+    return c, np.array([e1, np.cross(n, e1), n]), steep
 
 
 def base_parameters(points: np.ndarray, base):
@@ -154,7 +161,13 @@ def _greville(knots, degree):
 
 def height_frame(points: np.ndarray):
     """The mean-normal plane of the points, their parameters on it and their heights."""
-    c, axes = mean_normal_frame(points)
+    c, axes, steep = mean_normal_frame(points)
+    if steep > STEEP_FRACTION:
+        raise SurfmodError(
+            f"points: {100 * steep:.0f} % of the points lie where the surface stands nearly perpendicular "
+            "to the points' mean plane, so they are no height field over it; give a base surface "
+            "(base=...) that follows their shape"
+        )
     local = (points - c) @ axes.T
     x, y, h = local[:, 0], local[:, 1], local[:, 2]
     u, v = _unit(x, "points"), _unit(y, "points")
