@@ -124,6 +124,9 @@ def test_base_surface_for_points_that_are_no_height_field():
     base = sm.CylindricalSurface(2.0, (0, 0, 0), (0, 0, 1), u_range=(0, 1.5 * np.pi), v_range=(0, 4))
     f = sm.fit(pts, 1e-3, base=base)
     assert f.converged and f.max_deviation <= 1e-3
+    # over a plane these points fold: refused with a pointer to base=
+    with pytest.raises(sm.SurfmodError, match=r"points: .* no height field .*base="):
+        sm.fit(pts, 1e-3)
 
 
 def test_bad_input_is_named():
@@ -145,3 +148,35 @@ def test_bad_input_is_named():
     line = np.column_stack([np.linspace(0, 1, 50), np.zeros(50), np.zeros(50)])
     with pytest.raises(sm.SurfmodError, match="points: the points do not spread"):
         sm.fit(line, 1e-3)
+
+
+def test_fit_a_fan_blade_of_a_corpus_part(corpus_dir):
+    # the BRepMesh nodes of a real B-spline face, shuffled and noisy like a scan
+    import build123d as bd
+
+    from surfmod.occ.sample import distances_to_face
+
+    part = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+    blade = max((f for f in part.faces() if f.geom_type == bd.GeomType.BSPLINE), key=lambda f: f.area)
+    vertices, _ = blade.tessellate(0.005, 0.2)
+    rng = np.random.default_rng(8)
+    pts = np.array([tuple(v) for v in vertices])
+    pts = pts[rng.permutation(len(pts))] + rng.normal(0, SIGMA, (len(pts), 3))
+    f = sm.fit(pts, 5 * SIGMA)
+    assert f.converged and f.max_deviation <= 5 * SIGMA
+    # the fitted surface over the data lies on the original blade within 3 sigma
+    sub = rng.choice(len(pts), 150, replace=False)
+    on_fit = f.surface.points(f.parameters[0][sub], f.parameters[1][sub])
+    assert distances_to_face(blade.wrapped, on_fit).max() <= 3 * SIGMA
+
+
+@pytest.mark.parametrize("degree", [(1, 1), (2, 2), (3, 2), (5, 5)])
+def test_every_degree_meets_the_tolerance(degree):
+    # degree 1 uses the membrane energy (second derivatives vanish inside its spans)
+    rng = np.random.default_rng(9)
+    xy = rng.uniform(-1, 1, (2500, 2))
+    pts = np.column_stack([xy, np.sin(2 * xy[:, 0]) * np.cos(xy[:, 1])])
+    f = sm.fit(pts, 1e-3, degree=degree)
+    assert f.surface.degree == degree
+    assert f.converged and f.max_deviation <= 1e-3
+    assert sm.crosscheck(f.surface, samples=8).passed

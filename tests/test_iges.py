@@ -80,3 +80,26 @@ def test_iges_errors_name_the_path(tmp_path):
         sm.import_iges(bad)
     with pytest.raises(sm.SurfmodError, match="objects: cannot export"):
         sm.export_iges(["text"], tmp_path / "x.igs")
+
+
+@pytest.mark.corpus
+def test_corpus_bspline_faces_survive_iges_and_the_libraries(corpus_file, tmp_path):
+    import build123d as bd
+
+    faces = [f for f in sm.import_step(corpus_file).faces() if f.geom_type == bd.GeomType.BSPLINE]
+    if not faces:
+        pytest.skip("no B-spline faces in this file")
+    surfaces = [sm.from_face(f) for f in faces]
+    path = tmp_path / "faces.igs"
+    sm.export_iges([s.face() for s in surfaces], path)
+    back = [sm.from_face(f) for f in sm.import_iges(path).faces()]
+    assert len(back) == len(surfaces)
+    for s, b in zip(surfaces, back):
+        (u0, u1), (v0, v1) = s.domain
+        uu, vv = np.meshgrid(np.linspace(u0, u1, 5), np.linspace(v0, v1, 5))
+        size = max(1.0, float(np.abs(s.control_points).max()))
+        assert np.abs(b.points(uu, vv) - s.points(uu, vv)).max() <= 1e-13 * size
+        for to, frm in ((sm.to_geomdl, sm.from_geomdl), (sm.to_splipy, sm.from_splipy), (sm.to_rhino, sm.from_rhino)):
+            r = frm(to(s))
+            assert r.degree == s.degree and all(np.array_equal(a, c) for a, c in zip(r.knots, s.knots))
+            assert np.abs(r.points(uu, vv) - s.points(uu, vv)).max() <= 1e-13 * size

@@ -8,6 +8,8 @@ import sys
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from strategies import bspline_surfaces, parameters_with_knots
 
 import surfmod as sm
 
@@ -165,3 +167,22 @@ def test_bad_input_is_named():
         sm.from_splipy([1, 2])
     with pytest.raises(sm.SurfmodError, match="obj: expected rhino3dm NURBS geometry"):
         sm.from_rhino(3.0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(s=bspline_surfaces())
+def test_random_surfaces_survive_every_library_and_iges(s, tmp_path_factory):
+    # degrees 1-7, repeated interior knots, weights over two decades (tests/strategies.py)
+    pytest.importorskip("geomdl"), pytest.importorskip("splipy"), pytest.importorskip("rhino3dm")
+    us, vs = parameters_with_knots(s)
+    uu, vv = np.meshgrid(us, vs)
+    ref = s.points(uu, vv)
+    for lib in LIBS:
+        to, back = CONVERT[lib]
+        b = back(to(s))
+        _assert_same(s, b)
+        assert np.abs(b.points(uu, vv) - ref).max() <= 1e-13 * max(1.0, np.abs(ref).max())
+    path = tmp_path_factory.mktemp("iges") / "s.igs"
+    sm.export_iges(s, path)
+    b = sm.from_face(sm.import_iges(path).faces()[0])
+    assert np.abs(b.points(uu, vv) - ref).max() <= 1e-13 * max(1.0, np.abs(ref).max())

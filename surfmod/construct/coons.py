@@ -69,7 +69,6 @@ class CoonsSurface(BSplineSurface):
 
 def _corner_check(curves, tolerance):
     """Each of the four corners must be shared by the two curves meeting there."""
-    c0, c1, d0, d1 = curves
     ends = {name: c.points(np.array(c.domain)) for name, c in zip(NAMES, curves)}
     corners = (
         ("c0", 0, "d0", 0, "S(u0, v0)"),
@@ -111,7 +110,6 @@ def _hermite_coefficients(n):
 
 def _scaled_weights(curves):
     """Homogeneous control arrays with weights scaled so corner weights agree."""
-    c0, c1, d0, d1 = curves
     w = [c.weights if c.weights is not None else np.ones(len(c.control_points)) for c in curves]
     w0, w1, wd0, wd1 = w
     a = 1.0 / w0[0]
@@ -154,8 +152,9 @@ def coons(c0, c1, d0, d1, *, blend: str = "linear", tolerance: float = 1e-7) -> 
     _corner_check(given, tolerance)
     from ..nets.elevate import make_compatible
 
+    # as OCCT's SetSameDistribution: the longer interval wins, ties go to c0 and to d1
     cu = make_compatible([given[0].to_bspline(), given[1].to_bspline()])
-    cv = make_compatible([given[2].to_bspline(), given[3].to_bspline()])
+    cv = make_compatible([given[3].to_bspline(), given[2].to_bspline()])[::-1]
     if blend == "hermite":  # OCCT's cubic blend needs at least 4 poles per direction
         cu = _at_least_cubic(cu)
         cv = _at_least_cubic(cv)

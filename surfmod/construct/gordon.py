@@ -147,7 +147,9 @@ def _reparametrized_curve(curve, crossings, targets, tolerance):
         err = float(np.linalg.norm(fitted.points(mid) - curve.points(np.clip(phi(mid), a, b)), axis=-1).max())
         if err <= tolerance or per >= 1024:
             if err > tolerance:
-                raise SurfmodError(f"tolerance: a network curve cannot be reparametrized within {tolerance:g} (reached {err:.3g})")
+                raise SurfmodError(
+                    f"tolerance: a network curve cannot be reparametrized within {tolerance:g} (reached {err:.3g})"
+                )
             return fitted
         per = (3 * per + 1) // 2
 
@@ -183,8 +185,10 @@ def _compatible_sum(terms):
         elevated.append((sign, net, ks))
     common = []
     for d in (0, 1):
-        fake = [BSplineCurve._trusted(np.zeros((len(k) - out_deg[d] - 1, 3)), out_deg[d], k) for _, _, ks in elevated for k in [ks[d]]]
-        common.append(merged_knots(fake, tol=0.0))
+        # merged_knots works on curves: stand-ins carrying each term's knot vector
+        stand_ins = [BSplineCurve._trusted(np.zeros((len(ks[d]) - out_deg[d] - 1, 3)), out_deg[d], ks[d])
+                     for _, _, ks in elevated]
+        common.append(merged_knots(stand_ins, tol=0.0))
     total = None
     knots_out = None
     for sign, net, ks in elevated:
@@ -244,7 +248,9 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
     u, v, gap = _crossings(prof, guid)
     if gap.max() > tol:
         i, j = np.unravel_index(int(gap.argmax()), gap.shape)
-        raise SurfmodError(f"guides[{j}]: does not cross profiles[{i}] (closest approach {gap[i, j]:.3g} > tolerance {tol:g})")
+        raise SurfmodError(
+            f"guides[{j}]: does not cross profiles[{i}] (closest approach {gap[i, j]:.3g} > tolerance {tol:g})"
+        )
     un = _normalized(u, prof, 0)  # (K, L) in [0, 1] along each profile
     vn = _normalized(v, guid, 1)
     order_g = np.argsort(un.mean(axis=0))
@@ -254,10 +260,14 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
     u, v, un, vn = (a[np.ix_(order_p, order_g)] for a in (u, v, un, vn))
     for i in range(len(prof)):
         if np.any(np.diff(un[i]) <= 0):
-            raise SurfmodError(f"profiles[{int(order_p[i])}]: crosses the guides in a different order than the other profiles")
+            raise SurfmodError(
+                f"profiles[{int(order_p[i])}]: crosses the guides in a different order than the other profiles"
+            )
     for j in range(len(guid)):
         if np.any(np.diff(vn[:, j]) <= 0):
-            raise SurfmodError(f"guides[{int(order_g[j])}]: crosses the profiles in a different order than the other guides")
+            raise SurfmodError(
+                f"guides[{int(order_g[j])}]: crosses the profiles in a different order than the other guides"
+            )
     _check_ends(prof, u, un, tol, "profiles", order_p, "guides")
     _check_ends(guid, v.T, vn.T, tol, "guides", order_g, "profiles")
     un[:, 0], un[:, -1], vn[0], vn[-1] = 0.0, 1.0, 0.0, 1.0

@@ -5,8 +5,8 @@
    *height field* over it: the in-plane coordinates of the poles are the exact linear
    map of the Greville abscissae and only the heights are unknown, so every point keeps
    its exact parameters.  With ``base=`` a surfmod surface, the parameters come from
-   :func:`surfmod.project` and all three coordinates of the poles are unknown, or any surfmod surface (``base=``, projected with
-   :func:`surfmod.project`); the parameters are scaled onto ``[0, 1]^2``.
+   :func:`surfmod.project` and all three coordinates of the poles are unknown.  The
+   parameters are scaled onto ``[0, 1]^2``.
 2. **Penalized least squares**: the control net minimizes
    ``sum_k |S(u_k, v_k) - Q_k|^2 + lambda * E(S)`` with the thin-plate energy
    ``E = integral |S_uu|^2 + 2 |S_uv|^2 + |S_vv|^2 du dv`` (membrane energy for degree 1).
@@ -39,6 +39,11 @@ from ..nets.bspline import BSplineSurface
 
 #: points per chunk when assembling the normal equations (memory bound)
 CHUNK = 200_000
+#: a local normal this close to perpendicular to the base normal (|cos| below, 84 deg)
+#: marks a place where a height field over the base plane folds; more than
+#: STEEP_FRACTION of such points and the plane is refused as a base
+STEEP_COSINE = 0.1
+STEEP_FRACTION = 0.01
 
 
 class Fit(NamedTuple):
@@ -91,7 +96,8 @@ def mean_normal_frame(points: np.ndarray, sample: int = 20_000, neighbours: int 
     like the global PCA normal).  For a curved height field such as ``z = sin(2x)`` the
     global PCA plane tilts with the trend and folds the projection; the mean normal
     stays along the height direction.  The in-plane axes are the principal axes of the
-    points projected onto that plane.
+    points projected onto that plane.  Also returned: the fraction of local normals
+    nearly perpendicular to the plane's (where a height field over it would fold).
     """
     from scipy.spatial import cKDTree
 
@@ -110,7 +116,8 @@ def mean_normal_frame(points: np.ndarray, sample: int = 20_000, neighbours: int 
     _, _, vt = np.linalg.svd(flat[:: max(1, len(flat) // sample)], full_matrices=False)
     e1 = vt[0] - (vt[0] @ n) * n
     e1 /= np.linalg.norm(e1)
-    return c, np.array([e1, np.cross(n, e1), n])
+    steep = float(np.mean(np.abs(normals @ n) < STEEP_COSINE))
+    return c, np.array([e1, np.cross(n, e1), n]), steep
 
 
 def base_parameters(points: np.ndarray, base):
@@ -154,7 +161,13 @@ def _greville(knots, degree):
 
 def height_frame(points: np.ndarray):
     """The mean-normal plane of the points, their parameters on it and their heights."""
-    c, axes = mean_normal_frame(points)
+    c, axes, steep = mean_normal_frame(points)
+    if steep > STEEP_FRACTION:
+        raise SurfmodError(
+            f"points: {100 * steep:.0f} % of the points lie where the surface stands nearly perpendicular "
+            "to the points' mean plane, so they are no height field over it; give a base surface "
+            "(base=...) that follows their shape"
+        )
     local = (points - c) @ axes.T
     x, y, h = local[:, 0], local[:, 1], local[:, 2]
     u, v = _unit(x, "points"), _unit(y, "points")
@@ -282,7 +295,8 @@ def _check_max_poles(value, degree):
         a, b = value
     except (TypeError, ValueError):
         raise SurfmodError(f"max_poles: expected an integer or a pair (nu, nv), got {value!r}") from None
-    return (checks.count(a, "max_poles[0]", minimum=degree[0] + 1), checks.count(b, "max_poles[1]", minimum=degree[1] + 1))
+    return (checks.count(a, "max_poles[0]", minimum=degree[0] + 1),
+            checks.count(b, "max_poles[1]", minimum=degree[1] + 1))
 
 
 def _foot_points(surface, points, u, v):
@@ -311,7 +325,7 @@ def fit(points, tolerance: float, degree=(3, 3), *, smoothing: float = 1e-6, bas
     >>> xy = rng.uniform(-1, 1, (2000, 2))
     >>> pts = np.column_stack([xy, np.sin(2 * xy[:, 0]) * np.cos(xy[:, 1])])
     >>> f = sm.fit(pts, 1e-3)
-    >>> bool(f.max_deviation <= 1e-3), f.surface.control_points.shape[:2] <= (20, 20)
+    >>> bool(f.max_deviation <= 1e-3), max(f.surface.control_points.shape[:2]) <= 20
     (True, True)
     """
     q = checks.finite_array(points, "points", ndim=2, last=3)
@@ -334,7 +348,7 @@ def fit(points, tolerance: float, degree=(3, 3), *, smoothing: float = 1e-6, bas
     else:
         frame, heights = None, None
         u, v = base_parameters(q, base)
-    knots = [_clamped_uniform(min(spans, limit[0] - deg[0]), deg[0]), _clamped_uniform(min(spans, limit[1] - deg[1]), deg[1])]
+    knots = [_clamped_uniform(min(spans, limit[d] - deg[d]), deg[d]) for d in (0, 1)]
     iterations = 0
     while True:
         iterations += 1

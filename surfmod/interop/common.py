@@ -50,7 +50,9 @@ def nurbs_of(obj, name: str = "obj"):
         s = BSplineSurface(data["control_points"], data["degree"], data["knots"], data["weights"])
         (u0, u1), (v0, v1) = obj.domain
         return "surface", s.segment((u0, u1), (v0, v1))
-    raise SurfmodError(f"{name}: expected a surfmod surface or curve (or a build123d Face/Edge), got {type(obj).__name__}")
+    raise SurfmodError(
+        f"{name}: expected a surfmod surface or curve (or a build123d Face/Edge), got {type(obj).__name__}"
+    )
 
 
 def from_homogeneous(h: np.ndarray, rational: bool):

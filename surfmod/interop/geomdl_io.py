@@ -3,8 +3,9 @@
 geomdl's ``BSpline.Surface``/``Curve`` hold Cartesian control points, its
 ``NURBS.Surface``/``Curve`` homogeneous ones (``ctrlptsw``); surface points are stored
 flat with ``v`` running fastest.  A polynomial surfmod object becomes a ``BSpline``
-object, a rational one a ``NURBS`` object, so the kind survives the round trip.  geomdl normalizes knot vectors to [0, 1] by
-default; the objects made here keep the knots as they are (``normalize_kv=False``).
+object, a rational one a ``NURBS`` object, so the kind survives the round trip.
+geomdl normalizes knot vectors to [0, 1] by default; the objects made here keep the
+knots as they are (``normalize_kv=False``).
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ def to_geomdl(obj):
     ((2, 3), True)
     """
     require("geomdl", "to_geomdl")
-    from geomdl import BSpline, NURBS
+    from geomdl import NURBS, BSpline
 
     kind, b = nurbs_of(obj)
     if kind == "curve":

@@ -139,6 +139,8 @@ def read_3dm(path) -> list:
         geom = item.Geometry
         if isinstance(geom, r3.Brep):
             out.extend(from_rhino(f.ToNurbsSurface()) for f in geom.Faces)
-        elif hasattr(geom, "ToNurbsSurface") or hasattr(geom, "ToNurbsCurve") or isinstance(geom, (r3.NurbsCurve, r3.NurbsSurface)):
+        elif isinstance(geom, (r3.NurbsCurve, r3.NurbsSurface)) or any(
+            hasattr(geom, attr) for attr in ("ToNurbsSurface", "ToNurbsCurve")
+        ):
             out.append(from_rhino(geom))
     return out

@@ -17,8 +17,8 @@ from .guard import kernel
 
 def project_points(surf, points: np.ndarray, u: np.ndarray, v: np.ndarray):
     """Distances ``(N,)`` and OCCT foot parameters ``(u, v)`` of ``points`` on ``surf``."""
-    from OCP.GeomAdaptor import GeomAdaptor_Surface
     from OCP.Extrema import Extrema_GenLocateExtPS
+    from OCP.GeomAdaptor import GeomAdaptor_Surface
     from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
     from OCP.gp import gp_Pnt
 
@@ -58,8 +58,7 @@ def project_points(surf, points: np.ndarray, u: np.ndarray, v: np.ndarray):
 def plate_through_points(points: np.ndarray, degree: int = 3, max_segments: int = 9, tolerance: float = 1e-3):
     """OCCT's ``GeomPlate`` surface constrained by points (``GeomPlate_BuildPlateSurface``
     with ``GeomPlate_PointConstraint``s, approximated by ``GeomPlate_MakeApprox``)."""
-    from OCP.GeomPlate import (GeomPlate_BuildPlateSurface, GeomPlate_MakeApprox,
-                               GeomPlate_PointConstraint)
+    from OCP.GeomPlate import GeomPlate_BuildPlateSurface, GeomPlate_MakeApprox, GeomPlate_PointConstraint
     from OCP.gp import gp_Pnt
 
     with kernel("GeomPlate_BuildPlateSurface"):
