@@ -79,6 +79,27 @@ def _insert(dist, key, vals, d, k, v0, v1, v2, count):
     return min(count + 1, size)
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _is_bottom(d2, i, j, d):
+    """No neighbour of sample ``(i, j)`` (of eight) is nearer than ``d``; the neighbours
+    along the row go first, as they reject most samples at once."""
+    nu, nv = d2.shape[0], d2.shape[1]
+    if j > 0 and d2[i, j - 1] < d:
+        return False
+    if j < nv - 1 and d2[i, j + 1] < d:
+        return False
+    j0, j1 = max(j - 1, 0), min(j + 1, nv - 1)
+    if i > 0:
+        for jj in range(j0, j1 + 1):
+            if d2[i - 1, jj] < d:
+                return False
+    if i < nu - 1:
+        for jj in range(j0, j1 + 1):
+            if d2[i + 1, jj] < d:
+                return False
+    return True
+
+
 @njit(cache=True, error_model="numpy")
 def seed_kernel(points, g, us, vs, e, gram, cross, diam, seeds, n_basins, out):
     """Starts ``out (N, seeds + n_basins, 2)``: the ``seeds`` nearest triangles entered at
@@ -106,16 +127,16 @@ def seed_kernel(points, g, us, vs, e, gram, cross, diam, seeds, n_basins, out):
                 for t in range(2):
                     d, beta, gamma = _foot(px, py, pz, g, ci, cj, e, gram, cross, t)
                     count = _insert(top_d, top_k, top_v, d, (ci * (nv - 1) + cj) * 2 + t, ci, beta, gamma, count)
+        worst = np.sqrt(top_d[seeds - 1]) if count == seeds else np.inf
         for ci in range(nu - 1):
             for cj in range(nv - 1):
-                if count == seeds:
-                    near = min(min(d2[ci, cj], d2[ci + 1, cj]), min(d2[ci + 1, cj + 1], d2[ci, cj + 1]))
-                    reach = np.sqrt(top_d[seeds - 1]) + diam[ci, cj]
-                    if near > reach * reach:
-                        continue
+                reach = worst + diam[ci, cj]
+                if min(min(d2[ci, cj], d2[ci + 1, cj]), min(d2[ci + 1, cj + 1], d2[ci, cj + 1])) > reach * reach:
+                    continue
                 for t in range(2):
                     d, beta, gamma = _foot(px, py, pz, g, ci, cj, e, gram, cross, t)
                     count = _insert(top_d, top_k, top_v, d, (ci * (nv - 1) + cj) * 2 + t, ci, beta, gamma, count)
+                worst = np.sqrt(top_d[seeds - 1]) if count == seeds else np.inf
         for s in range(count):
             kk = top_k[s]
             t = kk % 2
@@ -138,13 +159,10 @@ def seed_kernel(points, g, us, vs, e, gram, cross, diam, seeds, n_basins, out):
                 d = d2[i, j]
                 if nb == n_basins and d >= bot_d[n_basins - 1]:
                     continue
-                bottom = True
-                for di in range(-1, 2):
-                    for dj in range(-1, 2):
-                        ii, jj = i + di, j + dj
-                        if (di or dj) and 0 <= ii < nu and 0 <= jj < nv and d2[ii, jj] < d:
-                            bottom = False
-                if bottom:
+                # the row neighbours reject most samples: tested here, without a call
+                if (j > 0 and d2[i, j - 1] < d) or (j < nv - 1 and d2[i, j + 1] < d):
+                    continue
+                if _is_bottom(d2, i, j, d):
                     nb = _insert(bot_d, bot_k, bot_v, d, i * nv + j, i, j, 0.0, nb)
         if nb == 0:
             bot_v[0, 0], bot_v[0, 1] = bi, bj
