@@ -125,6 +125,17 @@ def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
     (du0, du1), (dv0, dv1) = s.domain
     spanu, spanv = du1 - du0, dv1 - dv0
     u, v = u.copy(), v.copy()
+    if hasattr(s, "_local_net"):  # B-spline / NURBS: the same iteration, compiled
+        from ..eval.kernels import binomials
+        from .newton import newton_boxes
+
+        net = s._local_net()
+        u, v = np.require(u, float, ["C", "W"]), np.require(v, float, ["C", "W"])
+        bounds = [np.require(b, float, ["C", "W"]) for b in box]
+        newton_boxes(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v,
+                     net.bucket_u, net.bucket_v, binomials(2), binomials(0), np.require(points, float, ["C", "W"]),
+                     u, v, *bounds, float(spanu), float(spanv), int(iterations))
+        return u, v
     active = np.ones(u.shape, bool)
     for _ in range(iterations):
         idx = np.nonzero(active)[0]
