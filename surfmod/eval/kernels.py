@@ -108,12 +108,13 @@ def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders)
 
 @njit(cache=True, inline="always", error_model="numpy")
 def quotient_point(h, binom, out):
-    """Rational quotient rule (A4.4) at one point: homogeneous ``h (K, K, 4)`` ->
-    Cartesian ``out (K, K, 3)``; every entry of the square is exact."""
+    """Rational quotient rule (A4.4) at one point for the partials with ``k + l < K``
+    (the triangle a Newton or curvature step needs): homogeneous ``h (K, K, 4)`` ->
+    Cartesian ``out (K, K, 3)``; each entry needs only lower ones of the triangle."""
     kk = h.shape[0]
     inv_w = 1.0 / h[0, 0, 3]
     for k in range(kk):
-        for l in range(kk):
+        for l in range(kk - k):
             for d in range(3):
                 v = h[k, l, d]
                 for j in range(1, l + 1):

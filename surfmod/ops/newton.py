@@ -17,7 +17,8 @@ from ..eval.kernels import basis_ders_point, find_span_bucketed, quotient_point
 
 @njit(cache=True, error_model="numpy")
 def _eval(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u, v, order, binom, sc, out):
-    """Cartesian partials ``out (K, K, 3)`` at one point; ``sc`` is a tuple of scratch."""
+    """Cartesian partials ``out[k, l]`` with ``k + l <= order`` at one point (the rest of
+    the square is left alone); ``sc`` is a tuple of scratch."""
     ndu_u, ndu_v, lu, ru, tu, lv, rv, tv, du, dv, h, row = sc
     n, m = ctrl.shape[0], ctrl.shape[1]
     kk = order + 1
@@ -40,14 +41,14 @@ def _eval(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u, v, 
                     row[l, d] += c * ctrl[su - p + i, sv - q + j, d]
         for k in range(kk):
             c = du[k, i]
-            for l in range(kk):
+            for l in range(kk - k):
                 for d in range(4):
                     h[k, l, d] += c * row[l, d]
     if rational:
         quotient_point(h[:kk, :kk], binom, out)
     else:
         for k in range(kk):
-            for l in range(kk):
+            for l in range(kk - k):
                 for d in range(3):
                     out[k, l, d] = h[k, l, d]
 
