@@ -236,14 +236,14 @@ def seed_starts(points, us, vs, g, seeds: int) -> np.ndarray:
     compiled branch and bound of :mod:`surfmod.ops.seeding` (cells whose nearest corner
     is farther than the current ``seeds``-th foot plus the cell's diameter are skipped).
     """
-    from .seeding import seed_kernel, triangle_tables  # numba, loaded on first use
+    from .seeding import row_diameters, seed_kernel, triangle_tables  # numba, loaded on first use
 
     e, gram, cross, diam = triangle_tables(g)
     n_basins = max(2, seeds // 2)
     out = np.empty((len(points), seeds + n_basins, 2))
     seed_kernel(np.require(points, float, ["C", "W"]), np.require(g, float, ["C", "W"]),
                 np.require(us, float, ["C", "W"]), np.require(vs, float, ["C", "W"]),
-                e, gram, cross, diam, int(seeds), int(n_basins), out)
+                e, gram, cross, diam, row_diameters(diam), int(seeds), int(n_basins), out)
     return out
 
 
@@ -253,7 +253,14 @@ def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
     start = seed_starts(points, us, vs, g, seeds)
     k = start.shape[1]
     rep = np.repeat(points, k, axis=0)
-    u, v = newton_closest(s, rep, start[..., 0].ravel(), start[..., 1].ravel())
+    # about half the starts of a point repeat another one exactly (a valley bottom at a
+    # triangle's corner, short lists padded): iterate each distinct start once
+    owner = np.repeat(np.arange(len(points)), k)
+    flat = start.reshape(-1, 2)
+    _, first, inverse = np.unique(np.c_[owner, flat], axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    u, v = newton_closest(s, rep[first], flat[first, 0], flat[first, 1])
+    u, v = u[inverse], v[inverse]
     pts = s._derivatives(u, v, 0)[:, 0, 0]
     dist = np.linalg.norm(pts - rep, axis=1).reshape(-1, k)
     best = np.argmin(dist, axis=1)

@@ -36,6 +36,11 @@ def triangle_tables(g: np.ndarray):
             np.sqrt(diam2))
 
 
+def row_diameters(diam: np.ndarray) -> np.ndarray:
+    """The largest cell diameter of each row of cells (prunes whole rows at once)."""
+    return np.ascontiguousarray(diam.max(axis=1))
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _foot(px, py, pz, g, i, j, e, gram, cross, t):
     """Clipped barycentric foot of the point on triangle ``t`` (0 or 1) of cell ``(i, j)``:
@@ -101,12 +106,13 @@ def _is_bottom(d2, i, j, d):
 
 
 @njit(cache=True, error_model="numpy")
-def seed_kernel(points, g, us, vs, e, gram, cross, diam, seeds, n_basins, out):
+def seed_kernel(points, g, us, vs, e, gram, cross, diam, row_diam, seeds, n_basins, out):
     """Starts ``out (N, seeds + n_basins, 2)``: the ``seeds`` nearest triangles entered at
     their clipped feet, then the ``n_basins`` deepest bottoms of the sampled distance
     (samples no farther than their eight neighbours); short lists repeat their first."""
     nu, nv = g.shape[0], g.shape[1]
     d2 = np.empty((nu, nv))
+    row_min = np.empty(nu)
     top_d, top_k, top_v = np.empty(seeds), np.empty(seeds, np.int64), np.empty((seeds, 3))
     bot_d, bot_k, bot_v = np.empty(n_basins), np.empty(n_basins, np.int64), np.empty((n_basins, 3))
     for a in range(points.shape[0]):
@@ -117,9 +123,13 @@ def seed_kernel(points, g, us, vs, e, gram, cross, diam, seeds, n_basins, out):
                 dx, dy, dz = g[i, j, 0] - px, g[i, j, 1] - py, g[i, j, 2] - pz
                 d2[i, j] = dx * dx + dy * dy + dz * dz
         for i in range(nu):
+            low = np.inf
             for j in range(nv):
-                if d2[i, j] < best:
-                    best, bi, bj = d2[i, j], i, j
+                if d2[i, j] < low:
+                    low = d2[i, j]
+                    if low < best:
+                        best, bi, bj = low, i, j
+            row_min[i] = low
         count = 0
         # the cells around the nearest sample first: a tight bound from the start
         for ci in range(max(bi - 1, 0), min(bi + 1, nu - 2) + 1):
@@ -129,6 +139,10 @@ def seed_kernel(points, g, us, vs, e, gram, cross, diam, seeds, n_basins, out):
                     count = _insert(top_d, top_k, top_v, d, (ci * (nv - 1) + cj) * 2 + t, ci, beta, gamma, count)
         worst = np.sqrt(top_d[seeds - 1]) if count == seeds else np.inf
         for ci in range(nu - 1):
+            # a whole row of cells whose nearest sample is out of reach is skipped at once
+            reach = worst + row_diam[ci]
+            if min(row_min[ci], row_min[ci + 1]) > reach * reach:
+                continue
             for cj in range(nv - 1):
                 reach = worst + diam[ci, cj]
                 if min(min(d2[ci, cj], d2[ci + 1, cj]), min(d2[ci + 1, cj + 1], d2[ci, cj + 1])) > reach * reach:
