@@ -79,6 +79,10 @@ def newton_boxes(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
             huv = b + (rx * d[1, 1, 0] + ry * d[1, 1, 1] + rz * d[1, 1, 2])
             hvv = c + (rx * d[0, 2, 0] + ry * d[0, 2, 1] + rz * d[0, 2, 2])
             tiny = 1e-300 + 1e-14 * (a + c) ** 2
+            # held at a bound, the step is one-dimensional: its own second derivative
+            # decides (the 2x2 Hessian may be indefinite through the other direction)
+            huu_1d = huu if huu > 1e-14 * (a + c) else a
+            hvv_1d = hvv if hvv > 1e-14 * (a + c) else c
             if huu <= 0 or hvv <= 0 or huu * hvv - huv**2 <= tiny:  # indefinite: Gauss-Newton
                 huu, huv, hvv = a, b, c
             huu = max(huu, 1e-300 + 1e-14 * (a + c))
@@ -91,11 +95,11 @@ def newton_boxes(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
             if fix_u:
                 du = 0.0
             elif fix_v:
-                du = -gu / huu
+                du = -gu / max(huu_1d, 1e-300)
             if fix_v:
                 dv = 0.0
             elif fix_u:
-                dv = -gv / hvv
+                dv = -gv / max(hvv_1d, 1e-300)
             du = min(max(du, -0.25 * span_u), 0.25 * span_u)
             dv = min(max(dv, -0.25 * span_v), 0.25 * span_v)
             f0 = rx * rx + ry * ry + rz * rz

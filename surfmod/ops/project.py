@@ -152,6 +152,10 @@ def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
         huv = b + np.einsum("ij,ij->i", r, d[:, 1, 1])
         hvv = c + np.einsum("ij,ij->i", r, d[:, 0, 2])
         tiny = 1e-300 + 1e-14 * (a + c) ** 2
+        # held at a bound, the step is one-dimensional: its own second derivative decides
+        # (the 2x2 Hessian may be indefinite through the other direction)
+        huu_1d = np.maximum(np.where(huu > 1e-14 * (a + c), huu, a), 1e-300)
+        hvv_1d = np.maximum(np.where(hvv > 1e-14 * (a + c), hvv, c), 1e-300)
         indefinite = (huu <= 0) | (hvv <= 0) | (huu * hvv - huv**2 <= tiny)
         huu, huv, hvv = np.where(indefinite, a, huu), np.where(indefinite, b, huv), np.where(indefinite, c, hvv)
         huu = np.maximum(huu, 1e-300 + 1e-14 * (a + c))
@@ -162,8 +166,8 @@ def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
         # constrained step: a parameter held at its bound when the descent leaves the domain
         fix_u = ((uu <= u0) & (gu > 0)) | ((uu >= u1) & (gu < 0))
         fix_v = ((vv <= v0) & (gv > 0)) | ((vv >= v1) & (gv < 0))
-        du = np.where(fix_u, 0.0, np.where(fix_v, -gu / huu, du))
-        dv = np.where(fix_v, 0.0, np.where(fix_u, -gv / hvv, dv))
+        du = np.where(fix_u, 0.0, np.where(fix_v, -gu / huu_1d, du))
+        dv = np.where(fix_v, 0.0, np.where(fix_u, -gv / hvv_1d, dv))
         # no jumps across the whole patch in one step
         du = np.clip(du, -0.25 * spanu, 0.25 * spanu)
         dv = np.clip(dv, -0.25 * spanv, 0.25 * spanv)
