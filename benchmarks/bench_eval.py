@@ -148,8 +148,27 @@ def measure(single: bool) -> dict:
         if single:
             rows[f"occt_poly{n}"] = occt_rates(bn)[0]
     if single:
+        rows["numpy"] = numpy_paths(grid, u, v)
         rows["memory"] = memory()
     return out
+
+
+def numpy_paths(grid, u, v) -> dict:
+    """The pure-NumPy evaluators of the first round (dense basis matrices and two GEMMs
+    for grids, cache-blocked gathers for scattered points, NumPy quotient rule), timed
+    on the same cases as the compiled local-support kernels that replaced them."""
+    from surfmod.eval.rational import surface_quotient
+    from surfmod.eval.tensor import rational_grid_positions, surface_derivatives
+
+    res = {}
+    for n in (20, 400):
+        s = nurbs(n)
+        (p, q), (ku, kv) = s.degree, s.knots
+        res[f"grid{n}"] = _time(lambda: rational_grid_positions(ku, p, kv, q, s._h, grid, grid), True, 2)
+    s = nurbs(20)
+    (p, q), (ku, kv) = s.degree, s.knots
+    res["scattered"] = _time(lambda: surface_quotient(surface_derivatives(ku, p, kv, q, s._h, u, v, 0)), True, 1)
+    return res
 
 
 def memory(grid_n: int = 10_000, scattered_n: int = 10**7, chunk: int = 1 << 20) -> dict:
@@ -233,6 +252,14 @@ def report(one: dict, every: dict) -> None:
     for n in (4, 20):
         print(f"  {n}x{n}: geomdl {_f(r[f'geomdl{n}'], '.1f')}  surfmod {_f(r[f'poly{n}'])}  "
               f"x geomdl {_x(r[f'geomdl{n}'], r[f'poly{n}'])}")
+    npy = r["numpy"]
+    print("\nnumba kernels vs the pure-NumPy paths they replaced (1 core, rational bicubic):")
+    print(f"  1000² grid, 20x20 net:   NumPy {_f(npy['grid20'])}  numba {_f(one['net']['20']['ours'])}  "
+          f"{_x(npy['grid20'], one['net']['20']['ours'])}")
+    print(f"  1000² grid, 400x400 net: NumPy {_f(npy['grid400'])}  numba {_f(one['net']['400']['ours'])}  "
+          f"{_x(npy['grid400'], one['net']['400']['ours'])}")
+    print(f"  10⁶ scattered, 20x20:    NumPy {_f(npy['scattered'])}  numba {_f(r['scattered_d0'])}  "
+          f"{_x(npy['scattered'], r['scattered_d0'])}")
     print("\nbounded memory (20x20 NURBS, reduced to a bounding box as it streams):")
     for key, what in (("grid", "grid via grid_chunks(max_points=2^21)"), ("scattered", "scattered in slices of 2^20")):
         count, secs, peak, whole = r["memory"][key]

@@ -210,3 +210,19 @@ def test_empty_inputs():
     s = _surface(6, 6, 3, 3, True)
     assert s.points(np.empty(0), np.empty(0)).shape == (0, 3)
     assert s.grid_derivatives(np.empty(0), [0.5], 2).shape == (0, 1, 3, 3, 3)
+
+
+@settings(max_examples=25, deadline=None)
+@given(s=bspline_surfaces())
+def test_local_kernels_equal_the_dense_blas_path(s):
+    """An independent algorithm: dense basis matrices and two GEMMs (eval/tensor.py) with
+    the NumPy quotient rule (eval/rational.py)."""
+    from surfmod.eval.rational import surface_quotient
+    from surfmod.eval.tensor import surface_grid
+
+    us, vs = parameters_with_knots(s, 6)
+    (p, q), (ku, kv) = s.degree, s.knots
+    dense = surface_grid(ku, p, kv, q, s._h, us, vs, 2, planar=s.rational)
+    if s.rational:
+        dense = surface_quotient(dense)
+    _assert_partials(s.grid_derivatives(us, vs, 2), dense, s)

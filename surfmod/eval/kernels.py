@@ -108,12 +108,13 @@ def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders)
 
 @njit(cache=True, inline="always", error_model="numpy")
 def quotient_point(h, binom, out):
-    """Rational quotient rule (A4.4) at one point: homogeneous ``h (K, K, 4)`` ->
-    Cartesian ``out (K, K, 3)``; every entry of the square is exact."""
+    """Rational quotient rule (A4.4) at one point for the partials with ``k + l < K``
+    (the triangle a Newton or curvature step needs): homogeneous ``h (K, K, 4)`` ->
+    Cartesian ``out (K, K, 3)``; each entry needs only lower ones of the triangle."""
     kk = h.shape[0]
     inv_w = 1.0 / h[0, 0, 3]
     for k in range(kk):
-        for l in range(kk):
+        for l in range(kk - k):
             for d in range(3):
                 v = h[k, l, d]
                 for j in range(1, l + 1):
@@ -176,7 +177,7 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_
     bu, bv = np.empty((kk, p + 1, nb)), np.empty((kk, q + 1, nb))
     local = np.empty((p + 1, q + 1, 4, nb))
     row = np.empty((kk, 4, nb))
-    h = np.empty((kk, kk, 4, nb))
+    h = np.ones((kk, kk, 4, nb))  # lanes past a short last block keep finite values
     t0u, scale_u, table_u = bucket_u
     t0v, scale_v, table_v = bucket_v
     for a0 in range(0, u.size, nb):
@@ -212,8 +213,8 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_
                         else:
                             for b in range(cnt):
                                 h[k, l, d, b] += bu[k, i, b] * row[l, d, b]
-        if rational:
-            _quotient_planes(h[..., :cnt], binom)
+        if rational:  # on the whole block: contiguous planes vectorize
+            _quotient_planes(h, binom)
         for b in range(cnt):
             for k in range(kk):
                 for l in range(kk):

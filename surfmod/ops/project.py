@@ -125,6 +125,17 @@ def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
     (du0, du1), (dv0, dv1) = s.domain
     spanu, spanv = du1 - du0, dv1 - dv0
     u, v = u.copy(), v.copy()
+    if hasattr(s, "_local_net"):  # B-spline / NURBS: the same iteration, compiled
+        from ..eval.kernels import binomials
+        from .newton import newton_boxes
+
+        net = s._local_net()
+        u, v = np.require(u, float, ["C", "W"]), np.require(v, float, ["C", "W"])
+        bounds = [np.require(b, float, ["C", "W"]) for b in box]
+        newton_boxes(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v,
+                     net.bucket_u, net.bucket_v, binomials(2), binomials(0), np.require(points, float, ["C", "W"]),
+                     u, v, *bounds, float(spanu), float(spanv), int(iterations))
+        return u, v
     active = np.ones(u.shape, bool)
     for _ in range(iterations):
         idx = np.nonzero(active)[0]
@@ -141,6 +152,10 @@ def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
         huv = b + np.einsum("ij,ij->i", r, d[:, 1, 1])
         hvv = c + np.einsum("ij,ij->i", r, d[:, 0, 2])
         tiny = 1e-300 + 1e-14 * (a + c) ** 2
+        # held at a bound, the step is one-dimensional: its own second derivative decides
+        # (the 2x2 Hessian may be indefinite through the other direction)
+        huu_1d = np.maximum(np.where(huu > 1e-14 * (a + c), huu, a), 1e-300)
+        hvv_1d = np.maximum(np.where(hvv > 1e-14 * (a + c), hvv, c), 1e-300)
         indefinite = (huu <= 0) | (hvv <= 0) | (huu * hvv - huv**2 <= tiny)
         huu, huv, hvv = np.where(indefinite, a, huu), np.where(indefinite, b, huv), np.where(indefinite, c, hvv)
         huu = np.maximum(huu, 1e-300 + 1e-14 * (a + c))
@@ -151,8 +166,8 @@ def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
         # constrained step: a parameter held at its bound when the descent leaves the domain
         fix_u = ((uu <= u0) & (gu > 0)) | ((uu >= u1) & (gu < 0))
         fix_v = ((vv <= v0) & (gv > 0)) | ((vv >= v1) & (gv < 0))
-        du = np.where(fix_u, 0.0, np.where(fix_v, -gu / huu, du))
-        dv = np.where(fix_v, 0.0, np.where(fix_u, -gv / hvv, dv))
+        du = np.where(fix_u, 0.0, np.where(fix_v, -gu / huu_1d, du))
+        dv = np.where(fix_v, 0.0, np.where(fix_u, -gv / hvv_1d, dv))
         # no jumps across the whole patch in one step
         du = np.clip(du, -0.25 * spanu, 0.25 * spanu)
         dv = np.clip(dv, -0.25 * spanv, 0.25 * spanv)
@@ -213,79 +228,26 @@ def _knots_inside(s: Surface, direction: int) -> np.ndarray:
     return k[(k >= lo) & (k <= hi)]
 
 
-def seed_starts(points, us, vs, g, seeds: int, chunk: int = 1 << 21) -> np.ndarray:
+def seed_starts(points, us, vs, g, seeds: int) -> np.ndarray:
     """Newton starts ``(N, seeds + seeds // 2, 2)`` in (u, v) for each point.
 
-    The grid ``g`` is split into two triangles per cell.  The triangles whose bounding
-    spheres come nearest (one GEMM against all centres) are the candidates; on those the
-    closest point of the triangle's plane with its barycentric coordinates clipped to the
-    triangle (exact inside, a good seed near edges) gives each a foot point.  Starts:
-    the ``seeds`` nearest triangles, entered at those points; and the bottoms of the
-    deepest valleys of the sampled distance (samples no farther than their eight
-    neighbours), because in a nearly flat valley all nearest triangles sit in one basin.
+    The grid ``g`` is split into two triangles per cell.  On each triangle the closest
+    point of its plane with the barycentric coordinates clipped to the triangle (exact
+    inside, a good seed near edges) is the foot.  Starts: the ``seeds`` triangles with
+    the nearest feet, entered at those points; and the bottoms of the deepest valleys of
+    the sampled distance (samples no farther than their eight neighbours), because in a
+    nearly flat valley all nearest triangles sit in one basin.  The search is the
+    compiled branch and bound of :mod:`surfmod.ops.seeding` (cells whose nearest corner
+    is farther than the current ``seeds``-th foot plus the cell's diameter are skipped).
     """
-    nu, nv = g.shape[:2]
-    i, j = (x.ravel() for x in np.meshgrid(np.arange(nu - 1), np.arange(nv - 1), indexing="ij"))
-    tri_i = np.concatenate([np.stack([i, i + 1, i + 1], 1), np.stack([i, i + 1, i], 1)])
-    tri_j = np.concatenate([np.stack([j, j, j + 1], 1), np.stack([j, j + 1, j + 1], 1)])
-    a, e0, e1 = g[tri_i[:, 0], tri_j[:, 0]], g[tri_i[:, 1], tri_j[:, 1]], g[tri_i[:, 2], tri_j[:, 2]]
-    e0, e1 = e0 - a, e1 - a
-    d00, d01, d11 = (np.einsum("ij,ij->i", x, y) for x, y in ((e0, e0), (e0, e1), (e1, e1)))
-    det = np.maximum(d00 * d11 - d01**2, 1e-300)
-    # bounding spheres: a triangle is no nearer than |p - centre| - radius
-    centre = a + (e0 + e1) / 3
-    corners = (a - centre, a + e0 - centre, a + e1 - centre)
-    radius = np.sqrt(np.maximum.reduce([np.einsum("ij,ij->i", x, x) for x in corners]))
-    cc = np.einsum("ij,ij->i", centre, centre)
-    n_cand = min(max(8 * seeds, 64), len(a))
-    flat = g.reshape(-1, 3)
-    ss = np.einsum("ij,ij->i", flat, flat)
+    from .seeding import row_diameters, seed_kernel, triangle_tables  # numba, loaded on first use
+
+    e, gram, cross, diam = triangle_tables(g)
     n_basins = max(2, seeds // 2)
-    k = min(seeds, len(a))
     out = np.empty((len(points), seeds + n_basins, 2))
-    step = max(1, chunk // len(a))
-    for c0 in range(0, len(points), step):  # memory blocks, not points
-        p = points[c0 : c0 + step]
-        rows = np.arange(len(p))[:, None]
-        pp = np.einsum("ij,ij->i", p, p)[:, None]
-        # candidates: the triangles with the smallest lower bounds (one GEMM), then the
-        # exact clipped foot on those only
-        lower = np.sqrt(np.maximum(cc - 2 * (p @ centre.T) + pp, 0.0)) - radius
-        cand = np.argpartition(lower, n_cand - 1, axis=1)[:, :n_cand] if n_cand < len(a) else np.argsort(lower, axis=1)
-        ca = a[cand]
-        r0 = np.einsum("nkj,nkj->nk", p[:, None] - ca, e0[cand])  # (p - a).e0
-        r1 = np.einsum("nkj,nkj->nk", p[:, None] - ca, e1[cand])
-        c00, c01, c11, cdet = d00[cand], d01[cand], d11[cand], det[cand]
-        beta = np.clip((c11 * r0 - c01 * r1) / cdet, 0, 1)
-        gamma = np.clip((c00 * r1 - c01 * r0) / cdet, 0, 1)
-        over = np.maximum(beta + gamma, 1.0)
-        beta /= over
-        gamma /= over
-        foot = ca + beta[..., None] * e0[cand] + gamma[..., None] * e1[cand]
-        dist = np.einsum("nkj,nkj->nk", foot - p[:, None], foot - p[:, None])
-        pick = np.argpartition(dist, k - 1, axis=1)[:, :k] if k < n_cand else np.argsort(dist, axis=1)[:, :k]
-        best = cand[rows, pick]
-        b, gm = beta[rows, pick], gamma[rows, pick]
-        w = np.stack([1 - b - gm, b, gm], axis=-1)  # (n, k, 3) weights of the corners
-        out[c0 : c0 + step, :k, 0] = np.einsum("nkc,nkc->nk", w, us[tri_i[best]])
-        out[c0 : c0 + step, :k, 1] = np.einsum("nkc,nkc->nk", w, vs[tri_j[best]])
-        out[c0 : c0 + step, k:seeds] = out[c0 : c0 + step, :1]
-        # valley bottoms of the sampled distance
-        d2 = (ss[None, :] - 2 * p @ flat.T).reshape(len(p), nu, nv)
-        ring = np.pad(d2, ((0, 0), (1, 1), (1, 1)), constant_values=np.inf)
-        bottom = np.ones(d2.shape, dtype=bool)
-        for di in (-1, 0, 1):
-            for dj in (-1, 0, 1):
-                if di or dj:
-                    bottom &= d2 <= ring[:, 1 + di : 1 + di + nu, 1 + dj : 1 + dj + nv]
-        score = np.where(bottom, d2, np.inf).reshape(len(p), -1)
-        m = min(n_basins, score.shape[1])
-        deep = np.argpartition(score, m - 1, axis=1)[:, :m] if m < score.shape[1] else np.argsort(score, axis=1)
-        nearest = np.argmin(d2.reshape(len(p), -1), axis=1)
-        deep = np.where(np.isfinite(score[rows, deep]), deep, nearest[:, None])
-        out[c0 : c0 + step, seeds : seeds + m, 0] = us[deep // nv]
-        out[c0 : c0 + step, seeds : seeds + m, 1] = vs[deep % nv]
-        out[c0 : c0 + step, seeds + m :] = out[c0 : c0 + step, seeds : seeds + 1]
+    seed_kernel(np.require(points, float, ["C", "W"]), np.require(g, float, ["C", "W"]),
+                np.require(us, float, ["C", "W"]), np.require(vs, float, ["C", "W"]),
+                e, gram, cross, diam, row_diameters(diam), int(seeds), int(n_basins), out)
     return out
 
 
@@ -295,7 +257,14 @@ def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
     start = seed_starts(points, us, vs, g, seeds)
     k = start.shape[1]
     rep = np.repeat(points, k, axis=0)
-    u, v = newton_closest(s, rep, start[..., 0].ravel(), start[..., 1].ravel())
+    # about half the starts of a point repeat another one exactly (a valley bottom at a
+    # triangle's corner, short lists padded): iterate each distinct start once
+    owner = np.repeat(np.arange(len(points)), k)
+    flat = start.reshape(-1, 2)
+    _, first, inverse = np.unique(np.c_[owner, flat], axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    u, v = newton_closest(s, rep[first], flat[first, 0], flat[first, 1])
+    u, v = u[inverse], v[inverse]
     pts = s._derivatives(u, v, 0)[:, 0, 0]
     dist = np.linalg.norm(pts - rep, axis=1).reshape(-1, k)
     best = np.argmin(dist, axis=1)
