@@ -351,8 +351,13 @@ def _shell(shape, samples: int, occt: bool, only_faces=None):
         surfaces = []
         for idx, face in zip(rec["faces"], rec["face_shapes"]):
             if idx not in cache:
-                cache[idx] = from_face(face)
+                try:
+                    cache[idx] = from_face(face)
+                except SurfmodError:  # a surface type surfmod cannot read: its edges are left out
+                    cache[idx] = None
             surfaces.append(cache[idx])
+        if any(s is None for s in surfaces):
+            continue
         fa, fb = rec["faces"]
         parts.append(_edge_result(rec, surfaces, occt, f"edge {rec['edge']}: face {fa} | face {fb}"))
     return parts
