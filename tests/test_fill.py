@@ -127,6 +127,27 @@ def test_bad_boundaries():
     with pytest.raises(sm.SurfmodError, match=r"boundary\[2\]: does not start"):
         sm.fill([boundary[0], boundary[1], (boundary[2][0].translated((0, 0, 1)), "v0"), boundary[3]])
     with pytest.raises(sm.SurfmodError, match="continuity"):
-        sm.fill(boundary, "G2")
+        sm.fill(boundary, "G3")
     with pytest.raises(sm.SurfmodError, match=r"boundary\[0\]"):
         sm.fill([42, *boundary[1:]])
+
+
+def test_g2_fill_matches_the_neighbours_curvature_along_the_sides():
+    boundary, _ = four_sided_hole()
+    g1, g2 = sm.fill(boundary, "G1"), sm.fill(boundary, "G2")
+    for nb, side in boundary:
+        c2 = sm.continuity(nb, g2[0], samples=31)
+        scale = c2.g2 / c2.g2_relative
+        assert c2.g0 < 1e-12 and c2.angle[1:-1].max() < 1e-12
+        # along the open side the 2-jets agree; the corner points are the scheme's singular points
+        assert (c2.jump[1:-1] / scale).max() < 1e-9
+        c1 = sm.continuity(nb, g1[0], samples=31)
+        assert (c1.jump[1:-1] / scale).max() > 1e-2          # the G1 fill does not
+    corner = corner_hole()
+    for patch in sm.fill(corner, "G2"):
+        for nb, _ in corner:
+            try:
+                c = sm.continuity(patch, nb, samples=21)
+            except sm.SurfmodError:
+                continue
+            assert c.g0 < 1e-12 and c.angle[1:-1].max() < 1e-12 and c.jump[1:-1].max() < 1e-9

@@ -1,4 +1,4 @@
-"""Filling 3-, 4- and 5-sided holes between surfaces with G1 (or G0) continuity.
+"""Filling 3-, 4- and 5-sided holes between surfaces with G1 or G2 (or G0) continuity.
 
 The fill is a transfinite side-blending surface over a regular n-gon domain (Kato's
 scheme): every side ``i`` carries a ribbon ``R_i(s, d) = C_i(s) + d T_i(s)``, the boundary
@@ -8,7 +8,10 @@ the distance to side ``i`` in the domain, ``s_i = d_(i-1) / (d_(i-1) + d_(i+1))`
 weights ``B_i = prod_(j != i) d_j^2 / sum_k prod_(j != k) d_j^2``.  On side ``i`` the weight
 ``B_i`` is 1 and every weight has zero derivative, so the fill reproduces ``R_i`` to first
 order there: same points, cross derivatives in the neighbour's tangent plane, i.e. G1
-along every side whatever the corners do (no twist compatibility is needed).
+along every side whatever the corners do (no twist compatibility is needed).  For G2
+the ribbons carry the second cross derivative too (``+ d^2/2 Q``, ``Q`` scaled by the
+square of the tangent scale) and the weights use cubes, flat to second order on every
+side: the fill then has the neighbour's 2-jet along each side, i.e. G2 there.
 
 A four-sided hole is one patch over the square; a 3- or 5-sided hole is split from the
 centre into n quadrilateral patches (vertex, side midpoints, centre) of the same smooth
@@ -83,6 +86,7 @@ class Ribbon:
     def __init__(self, kind, source, side=None, reverse=False, scale=1.0, centre=None):
         self.kind, self.source, self.side, self.reverse = kind, source, side, reverse
         self.scale, self.centre = scale, centre
+        self.second_order = False   # G2: the ribbon also carries the second cross derivative
 
     def _t(self, s):
         return 1.0 - s if self.reverse else s
@@ -111,12 +115,31 @@ class Ribbon:
             t = (out * d[:, 0, 1], out * d[:, 1, 1] * rate, out * d[:, 2, 1] * rate**2)
         return c + t
 
+    def second(self, s):
+        """``(Q, Q', Q'')``: the neighbour's second cross derivative along the side."""
+        sign = -1.0 if self.reverse else 1.0
+        surf, side = self.source, self.side
+        fixed, _ = SIDES[side]
+        lo, hi = surf.domain[1 - fixed]
+        u, v = side_params(surf, side, lo + self._t(s) * (hi - lo))
+        d = surf.derivatives(u, v, 4)
+        rate = sign * (hi - lo)
+        if fixed == 0:
+            return d[:, 2, 0], d[:, 2, 1] * rate, d[:, 2, 2] * rate**2
+        return d[:, 0, 2], d[:, 1, 2] * rate, d[:, 2, 2] * rate**2
+
     def jets(self, s: Jet, inradius: float):
+        """Jets of ``C``, ``T`` and (second order ribbons, else None) ``Q`` at ``s``."""
         c0, c1, c2, d0, d1, d2 = self.curve(s.v)
         if d0 is None:  # G0: the ribbon heads for the centre of the hole
             d0, d1, d2 = (self.centre - c0) / inradius, -c1 / inradius, -c2 / inradius
-            return compose(c0, c1, c2, s), compose(d0, d1, d2, s)
-        return compose(c0, c1, c2, s), compose(self.scale * d0, self.scale * d1, self.scale * d2, s)
+            return compose(c0, c1, c2, s), compose(d0, d1, d2, s), None
+        k = self.scale
+        q = None
+        if self.second_order:
+            q0, q1, q2 = self.second(s.v)
+            q = compose(k * k * q0, k * k * q1, k * k * q2, s)
+        return compose(c0, c1, c2, s), compose(k * d0, k * d1, k * d2, s), q
 
 
 # -- the n-gon domain and its side-blending surface -----------------------------------------------
@@ -131,14 +154,17 @@ def polygon(n: int):
     return verts, inward, float(np.cos(np.pi / n))
 
 
-def side_blend(ribbons, xy: np.ndarray) -> Jet:
-    """The fill and its first and second derivatives w.r.t. the domain point ``xy``."""
+def side_blend(ribbons, xy: np.ndarray, power: int = 2) -> Jet:
+    """The fill and its first and second derivatives w.r.t. the domain point ``xy``;
+    ``power`` 2 for G1 (weights flat to first order on every side), 3 for G2."""
     n = len(ribbons)
     verts, inward, r = polygon(n)
     N = len(xy)
     zero_h = np.zeros((N, 2, 2))
     dist = [Jet((xy - verts[i]) @ inward[i], np.broadcast_to(inward[i], (N, 2)).copy(), zero_h) for i in range(n)]
     sq = [mul(d, d) for d in dist]
+    if power == 3:
+        sq = [mul(d, q) for d, q in zip(dist, sq)]
     prods = []
     for i in range(n):
         p = None
@@ -154,8 +180,10 @@ def side_blend(ribbons, xy: np.ndarray) -> Jet:
     for i, rib in enumerate(ribbons):
         prev, nxt = dist[(i - 1) % n], dist[(i + 1) % n]
         s = mul(prev, reciprocal(prev + nxt))
-        c, t = rib.jets(s, r)
+        c, t, q = rib.jets(s, r)
         value = c + mul(dist[i], t)
+        if q is not None:
+            value = value + mul(mul(dist[i], dist[i]), q).scaled(0.5)
         term = mul(mul(prods[i], inv_total), value)
         out = term if out is None else out + term
     return out
@@ -168,8 +196,9 @@ class FillPatch(Surface):
     exact_in_occt = False
     occt_construct = "Geom_BSplineSurface (bicubic approximation)"
 
-    def __init__(self, ribbons, quad, tolerance, matrix=None):
+    def __init__(self, ribbons, quad, tolerance, matrix=None, power=2):
         self.ribbons, self.quad, self.tolerance = ribbons, np.asarray(quad, float), float(tolerance)
+        self.power = power
         self.matrix = np.eye(4) if matrix is None else matrix
         self._occ = None
         self._corners = [np.asarray(rb.curve(np.array([0.0]))[0][0]) for rb in ribbons]
@@ -189,7 +218,7 @@ class FillPatch(Surface):
         at_vertex = gap.min(axis=1) < 1e-9
         # the blend is 0/0 exactly at a polygon vertex: evaluate a hair inside, snap the point
         xy = np.where(at_vertex[:, None], xy * (1 - 1e-7), xy)
-        jet = side_blend(self.ribbons, xy)
+        jet = side_blend(self.ribbons, xy, self.power)
         xu = (1 - v)[:, None] * (q10 - q00) + v[:, None] * (q11 - q01)
         xv = (1 - u)[:, None] * (q01 - q00) + u[:, None] * (q11 - q10)
         xuv = np.broadcast_to(q00 - q10 - q01 + q11, xu.shape)
@@ -219,7 +248,7 @@ class FillPatch(Surface):
         return self._occ
 
     def transformed(self, matrix):
-        return FillPatch(self.ribbons, self.quad, self.tolerance, transforms.affine(matrix) @ self.matrix)
+        return FillPatch(self.ribbons, self.quad, self.tolerance, transforms.affine(matrix) @ self.matrix, self.power)
 
 
 class Fill(tuple):
@@ -250,7 +279,8 @@ def _ribbon(item, index, order):
 def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: float = 1e-4) -> Fill:
     """Fill the hole bounded by 3, 4 or 5 sides.  Each item of ``boundary`` is either
     ``(surface, side)`` (a side ``"u0"``, ``"u1"``, ``"v0"``, ``"v1"`` of a neighbour: the
-    fill meets it with ``continuity``) or a curve / build123d ``Edge`` (met with G0).
+    fill meets it with ``continuity``, ``"G0"``, ``"G1"`` or ``"G2"``) or a curve /
+    build123d ``Edge`` (met with G0).
     The sides must close up end to end in the given order (either orientation each).
     ``tension`` scales the cross-boundary tangents; ``tolerance`` is for the OCCT
     B-spline twin of each patch.
@@ -263,8 +293,8 @@ def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: f
     >>> len(f), bool(np.allclose(f[0].points(0.3, 0.6)[2], 0.0))
     (1, True)
     """
-    if continuity not in ("G0", "G1"):
-        raise SurfmodError(f"continuity: fill reaches G0 or G1 (sm.blend joins two sides with G2), got {continuity!r}")
+    if continuity not in ("G0", "G1", "G2"):
+        raise SurfmodError(f"continuity: expected G0, G1 or G2, got {continuity!r}")
     if not isinstance(boundary, (list, tuple)) or not 3 <= len(boundary) <= 5:
         raise SurfmodError("boundary: expected a list of 3, 4 or 5 sides")
     tension = checks.positive(tension, "tension")
@@ -309,7 +339,11 @@ def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: f
         mids = 0.5 * (verts + np.roll(verts, -1, axis=0))
         centre_xy = np.zeros(2)
         quads = [(verts[k], mids[k], mids[k - 1], centre_xy) for k in range(n)]
-    out = Fill(FillPatch(ribbons, q, tolerance) for q in quads)
+    if continuity == "G2":
+        for rb in ribbons:
+            rb.second_order = rb.kind == "surface"
+    power = 3 if continuity == "G2" else 2
+    out = Fill(FillPatch(ribbons, q, tolerance, power=power) for q in quads)
     out.n_sides, out.continuity = n, continuity
     return out
 
