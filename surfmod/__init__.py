@@ -134,6 +134,8 @@ _EXPORTS = {
     "offset": ".construct.offset",
     "thicken": ".construct.offset",
     "OffsetApproximation": ".construct.offset",
+    "fill": ".construct.fill",
+    "Fill": ".construct.fill",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])

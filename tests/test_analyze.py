@@ -130,3 +130,25 @@ def test_cli_analyze(tmp_path, capsys):
     assert out.read_bytes()[:4] == b"\x89PNG"
     assert "wrote" in capsys.readouterr().out
     assert main(["analyze", str(tmp_path / "missing.step"), "--out", str(out)]) == 2
+
+
+def _normals_against_occt(path):
+    from surfmod.occ.sample import surface_props
+
+    r = sm.analyze(sm.import_step(path), "isophote", resolution=12)
+    for p in r.patches:
+        pick = np.linspace(0, len(p.uv) - 1, 5).astype(int)
+        normals, _ = surface_props(p.surface.geom(), p.uv[pick, 0], p.uv[pick, 1])
+        ok = np.all(np.isfinite(normals), axis=1)
+        dots = np.abs(np.einsum("ij,ij->i", normals[ok], p.normals[pick][ok]))
+        np.testing.assert_allclose(dots, 1.0, atol=1e-9)
+    return len(r.patches)
+
+
+def test_one_corpus_file_normals(corpus_dir):
+    assert _normals_against_occt(corpus_dir / "cadquery_red_cube_blue_cylinder.step") > 0
+
+
+@pytest.mark.corpus
+def test_corpus_normals_against_occt(corpus_file):
+    _normals_against_occt(corpus_file)

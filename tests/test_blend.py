@@ -128,3 +128,9 @@ def test_occt_filling_on_the_same_case_stays_short_of_g1_and_refuses_g2(pair):
     np.testing.assert_allclose(theirs.occt[:, 1], theirs.angle, atol=1e-9)
     with pytest.raises(sm.KernelError, match="continuity"):
         occt_blend(a, "u1", b, "u0", ours, "G2")
+
+
+def test_faces_are_accepted(pair):
+    a, b = pair
+    f = sm.blend(a.face(), "u1", b.face(), "u0", "G2")
+    check_join(a, f, 1e-12, 1e-10)

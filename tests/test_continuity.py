@@ -119,3 +119,26 @@ def test_tangent_fillet_on_a_real_solid_is_g1_with_known_jump():
     assert np.isclose(jumps.max(), 2.0, rtol=1e-6)
     occt_g1 = np.concatenate([e.occt[:, 1] for e in smooth])
     assert np.nanmax(occt_g1) < 1e-6
+
+
+def _check_against_occt(path):
+    shape = sm.import_step(path)
+    c = sm.continuity(shape, samples=5, occt=True)
+    if not c.edges:
+        return 0
+    ok = np.all(np.isfinite(c.occt[:, :2]), axis=1)
+    size = np.ptp(c.points, axis=0).max()
+    np.testing.assert_allclose(c.gap[ok], c.occt[ok, 0], atol=1e-9 * max(size, 1.0))
+    folded = np.minimum(c.angle, np.pi - c.angle)          # OCCT folds the angle into [0, pi/2]
+    np.testing.assert_allclose(folded[ok], c.occt[ok, 1], atol=1e-7)
+    return len(c.edges)
+
+
+def test_one_corpus_file_against_occt(corpus_dir):
+    path = corpus_dir / "cadquery_red_cube_blue_cylinder.step"
+    assert _check_against_occt(path) > 0
+
+
+@pytest.mark.corpus
+def test_corpus_continuity_against_occt(corpus_file):
+    _check_against_occt(corpus_file)

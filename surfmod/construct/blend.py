@@ -152,6 +152,15 @@ def _normals_disagree(a: BSplineSurface, side: str, out: BSplineSurface) -> bool
     return float(np.sum(n_a * n_out)) < 0.0
 
 
+def _surface(obj, name):
+    """A surfmod surface, or the surface of a build123d / OCP face (``sm.from_face``)."""
+    if isinstance(obj, Surface):
+        return obj
+    from ..ops.continuity import _as_surface
+
+    return _as_surface(obj, name)
+
+
 def _check_side(side, name):
     if side not in SIDES:
         raise SurfmodError(f"{name}: side must be one of u0, u1, v0, v1, got {side!r}")
@@ -182,7 +191,8 @@ def _rows(ca, cb, order, n, lam_a, lam_b):
 def blend(a: Surface, side_a: str, b: Surface, side_b: str, continuity: str = "G2", *, tension=None) -> BlendSurface:
     """An exact B-spline surface joining side ``side_a`` of ``a`` to side ``side_b`` of ``b``
     with G0, G1 or G2 continuity at both (a side is ``"u0"``, ``"u1"``, ``"v0"`` or
-    ``"v1"``).  The boundaries' orientations are matched automatically; ``tension``
+    ``"v1"``); ``a`` and ``b`` may also be faces (read with ``sm.from_face``, sides of
+    their parameter rectangles).  The boundaries' orientations are matched automatically; ``tension``
     (a number or one per side, default 1) scales how far the blend carries the
     neighbours' cross-boundary tangents.  With rational neighbours a large tension can
     drive a weight of the blend to zero: the default then backs off (halving) until all
@@ -203,6 +213,7 @@ def blend(a: Surface, side_a: str, b: Surface, side_b: str, continuity: str = "G
     order = ORDERS[continuity]
     auto = tension is None
     ta, tb = _tensions(1.0 if auto else tension)
+    a, b = _surface(a, "a"), _surface(b, "b")
     sa, sb = as_bspline_surface(a, "a"), as_bspline_surface(b, "b")
     rows_a, ka, pa = side_curves(sa, side_a, order)
     rows_b, kb, pb = side_curves(sb, side_b, order)

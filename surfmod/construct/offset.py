@@ -142,6 +142,27 @@ def _span_errors(fit: Surface, exact: Surface, bu, bv):
     return err.reshape(bu.size - 1, 3, bv.size - 1, 3).max(axis=(1, 3))
 
 
+def bicubic_approximation(exact: Surface, bu, bv, tol: float, mults=({}, {}), max_rounds: int = 10):
+    """``(fit, max_error)``: a bicubic B-spline within ``tol`` of ``exact`` in its own
+    parameters, starting from the breakpoints ``bu``, ``bv`` (with the interior knot
+    multiplicities ``mults``) and halving every span whose midpoint errors exceed ``tol``."""
+    bu, bv = np.asarray(bu, float), np.asarray(bv, float)
+    if bu.size < 3:
+        bu = np.linspace(bu[0], bu[-1], 3)
+    if bv.size < 3:
+        bv = np.linspace(bv[0], bv[-1], 3)
+    for _ in range(max_rounds):
+        fit = _fit(exact, bu, bv, mults)
+        err = _span_errors(fit, exact, bu, bv)
+        bad = err > tol
+        if not np.any(bad):
+            return fit, float(err.max())
+        bu = np.union1d(bu, 0.5 * (bu[:-1] + bu[1:])[bad.any(axis=1)])
+        bv = np.union1d(bv, 0.5 * (bv[:-1] + bv[1:])[bad.any(axis=0)])
+    raise SurfmodError(f"tolerance: {tol:g} not reached after {max_rounds} refinements "
+                       f"(max error {err.max():.3g}); loosen it or raise max_rounds")
+
+
 def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: int = 10) -> OffsetApproximation:
     """A bicubic B-spline within ``tolerance`` of the offset ``S + distance * N`` (``N``
     the unit normal ``Su x Sv``), in the parameters of ``s``.  Raises ``SurfmodError``
@@ -166,25 +187,10 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
     max_rounds = checks.count(max_rounds, "max_rounds")
     precheck(s, d)
     exact = OffsetSurface(s, d)
-    bu, bv = _breaks(s, 0), _breaks(s, 1)
-    if bu.size < 3:
-        bu = np.linspace(bu[0], bu[-1], 3)
-    if bv.size < 3:
-        bv = np.linspace(bv[0], bv[-1], 3)
     mults = (_base_multiplicities(s, 0), _base_multiplicities(s, 1))
-    for _ in range(max_rounds):
-        fit = _fit(exact, bu, bv, mults)
-        err = _span_errors(fit, exact, bu, bv)
-        bad = err > tol
-        if not np.any(bad):
-            break
-        bu = np.union1d(bu, 0.5 * (bu[:-1] + bu[1:])[bad.any(axis=1)])
-        bv = np.union1d(bv, 0.5 * (bv[:-1] + bv[1:])[bad.any(axis=0)])
-    else:
-        raise SurfmodError(f"tolerance: {tol:g} not reached after {max_rounds} refinements "
-                           f"(max error {err.max():.3g}); loosen it or raise max_rounds")
+    fit, err = bicubic_approximation(exact, _breaks(s, 0), _breaks(s, 1), tol, mults, max_rounds)
     out = OffsetApproximation._trusted(fit.control_points, (3, 3), fit.knots)
-    out.base, out.distance, out.tolerance, out.max_error = s, d, tol, float(err.max())
+    out.base, out.distance, out.tolerance, out.max_error = s, d, tol, err
     return out
 
 

@@ -189,15 +189,16 @@ def _side_points(s, side, count):
     return t, s.points(*side_params(s, side, t))
 
 
-def _hausdorff(p, q):
-    d = np.linalg.norm(p[:, None, :] - q[None, :, :], axis=2)
-    return max(float(d.min(axis=1).max()), float(d.min(axis=0).max()))
+def _one_sided(p, q):
+    """Largest distance from a point of ``p`` to the nearest point of ``q``."""
+    return float(np.linalg.norm(p[:, None, :] - q[None, :, :], axis=2).min(axis=1).max())
 
 
 def match_sides(a: Surface, b: Surface, probe: int = 41):
-    """The pair of sides ``(side_a, side_b)`` closest in symmetric sampled distance
-    (degenerate sides such as poles are skipped) and that distance, refined by exact
-    closest points on the sides."""
+    """The pair of sides ``(side_a, side_b)`` such that the side of ``a`` lies closest
+    along the side of ``b`` (sampled, then refined by exact closest points; the side of
+    ``a`` may be a part of the side of ``b``; degenerate sides such as poles are skipped)
+    and that distance."""
     size = max(np.ptp(a.grid(*(np.linspace(*d, 5) for d in a.domain)).reshape(-1, 3), axis=0).max(), 1e-300)
     best = (np.inf, None, None)
     for sa in SIDES:
@@ -206,17 +207,15 @@ def match_sides(a: Surface, b: Surface, probe: int = 41):
             continue
         for sb in SIDES:
             _, pb = _side_points(b, sb, 4 * probe)
-            d = _hausdorff(pa, pb)
+            d = _one_sided(pa, pb)
             if d < best[0]:
                 best = (d, sa, sb)
     if best[1] is None:
         raise SurfmodError("b: no side of b runs along a side of a (give edge=(side_a, side_b))")
     _, sa, sb = best
     _, pa = _side_points(a, sa, probe)
-    _, pb = _side_points(b, sb, 3)
     on_b = b.points(*side_params(b, sb, _closest_on_side(b, sb, pa)))
-    on_a = a.points(*side_params(a, sa, _closest_on_side(a, sa, pb)))
-    exact = max(float(np.linalg.norm(on_b - pa, axis=1).max()), float(np.linalg.norm(on_a - pb, axis=1).max()))
+    exact = float(np.linalg.norm(on_b - pa, axis=1).max())
     if exact > 1e-3 * size:
         raise SurfmodError("b: no side of b runs along a side of a (give edge=(side_a, side_b))")
     return sa, sb, exact
@@ -352,8 +351,13 @@ def _shell(shape, samples: int, occt: bool, only_faces=None):
         surfaces = []
         for idx, face in zip(rec["faces"], rec["face_shapes"]):
             if idx not in cache:
-                cache[idx] = from_face(face)
+                try:
+                    cache[idx] = from_face(face)
+                except SurfmodError:  # a surface type surfmod cannot read: its edges are left out
+                    cache[idx] = None
             surfaces.append(cache[idx])
+        if any(s is None for s in surfaces):
+            continue
         fa, fb = rec["faces"]
         parts.append(_edge_result(rec, surfaces, occt, f"edge {rec['edge']}: face {fa} | face {fb}"))
     return parts
