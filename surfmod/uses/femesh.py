@@ -204,7 +204,7 @@ def export_fe_mesh(mesh, path) -> None:
     """
     import meshio
 
-    from ..io.atomic import atomic_path, target_path
+    from ..atomic import atomic_path, target_path
 
     target = target_path(path, "path", tuple(FORMATS))
     m = mesh.mesh if isinstance(mesh, FEMesh) else mesh
