@@ -326,18 +326,10 @@ def parameters(value, name: str, domain: tuple[float, float], slack: float = 1e-
     return np.clip(t, lo, hi)
 
 
-def nonempty_parameters(value, name: str, domain: tuple[float, float]) -> np.ndarray:
-    """:func:`parameters` that refuses an empty array."""
-    t = parameters(value, name, domain)
-    if t.size == 0:
-        raise SurfmodError(f"{name}: no parameter values (empty array)")
-    return t
-
-
 def parameter_pair(u, v, domain, names=("u", "v"), per_point: int = 1, max_points: int = MAX_POINTS):
     """``(shape, u, v)``: validated parameters broadcast together and flattened.
 
-    Refuses arrays that do not broadcast, empty arrays, and broadcasts whose result
+    Refuses arrays that do not broadcast and broadcasts whose result
     (``per_point`` vectors each) would exceed ``max_points``.
 
     >>> parameter_pair(np.zeros(2), np.zeros(3), ((0, 1), (0, 1)))
@@ -345,8 +337,8 @@ def parameter_pair(u, v, domain, names=("u", "v"), per_point: int = 1, max_point
     ...
     surfmod.errors.SurfmodError: u, v: shapes (2,) and (3,) do not broadcast together
     """
-    uu = nonempty_parameters(u, names[0], domain[0])
-    vv = nonempty_parameters(v, names[1], domain[1])
+    uu = parameters(u, names[0], domain[0])
+    vv = parameters(v, names[1], domain[1])
     try:
         shape = np.broadcast_shapes(uu.shape, vv.shape)
     except ValueError:
@@ -358,7 +350,7 @@ def parameter_pair(u, v, domain, names=("u", "v"), per_point: int = 1, max_point
 
 def parameter_grid(us, vs, domain, per_point: int = 1, max_points: int = MAX_POINTS):
     """``(us, vs)``: two flat validated parameter vectors for a tensor grid within the cap."""
-    us = nonempty_parameters(us, "us", domain[0]).ravel()
-    vs = nonempty_parameters(vs, "vs", domain[1]).ravel()
+    us = parameters(us, "us", domain[0]).ravel()
+    vs = parameters(vs, "vs", domain[1]).ravel()
     work(float(us.size) * vs.size * per_point, max_points, "max_points", f"the grid of {us.size} x {vs.size} points")
     return us, vs

@@ -62,7 +62,7 @@ class Curve(abc.ABC):
         """The exact B-spline/NURBS form (parametrization may differ for conics)."""
 
     def _params(self, t, per_point: int = 1, max_points: int = checks.MAX_POINTS):
-        tt = checks.nonempty_parameters(t, "t", self.domain)
+        tt = checks.parameters(t, "t", self.domain)
         checks.work(float(tt.size) * per_point, max_points, "max_points", f"evaluating {tt.size} parameters")
         return tt.shape, tt.ravel()
 
@@ -74,7 +74,7 @@ class Curve(abc.ABC):
         array([1., 0., 0.])
         """
         shape, tf = self._params(t, 1, max_points)
-        return _finite(self._derivatives(tf, 0)[:, 0, :], tf, "points").reshape(*shape, 3)
+        return _finite(self._evaluate(tf, 0)[:, 0, :], tf, "points").reshape(*shape, 3)
 
     def derivatives(self, t, order: int = 1, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """``[..., k, :] = d^k C / dt^k`` for ``k <= order`` (``order`` at most
@@ -87,16 +87,22 @@ class Curve(abc.ABC):
         """
         order = checks.derivative_order(order)
         shape, tf = self._params(t, order + 1, max_points)
-        return _finite(self._derivatives(tf, order), tf, "derivatives").reshape(*shape, order + 1, 3)
+        return _finite(self._evaluate(tf, order), tf, "derivatives").reshape(*shape, order + 1, 3)
 
     def tangents(self, t, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """Unit tangents ``C' / |C'|``; a parameter where the curve stops (``C' = 0``)
         raises ``SurfmodError`` instead of returning NaN."""
         shape, tf = self._params(t, 2, max_points)
-        d = self._derivatives(tf, 1)[:, 1, :]
+        d = self._evaluate(tf, 1)[:, 1, :]
         speed = np.linalg.norm(d, axis=-1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):
             return _finite(d / speed, tf, "tangents").reshape(*shape, 3)
+
+    def _evaluate(self, tf: np.ndarray, order: int) -> np.ndarray:
+        """``_derivatives`` that also takes empty arrays (subclasses need not)."""
+        if tf.size == 0:
+            return np.empty((0, order + 1, 3))
+        return self._derivatives(tf, order)
 
     def edge(self):
         """A build123d ``Edge`` over the whole domain."""

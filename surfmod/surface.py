@@ -88,7 +88,7 @@ class Surface(abc.ABC):
         array([0.5 , 0.25, 0.  ])
         """
         shape, uf, vf = self._params(u, v, max_points=max_points)
-        out = self._derivatives(uf, vf, 0)[:, 0, 0, :]
+        out = self._evaluate(uf, vf, 0)[:, 0, 0, :]
         return finite_result(out, uf, vf, "points").reshape(*shape, 3)
 
     def derivatives(self, u, v, order: int = 1, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
@@ -104,7 +104,7 @@ class Surface(abc.ABC):
         """
         order = checks.derivative_order(order)
         shape, uf, vf = self._params(u, v, (order + 1) ** 2, max_points)
-        out = finite_result(self._derivatives(uf, vf, order), uf, vf, "derivatives")
+        out = finite_result(self._evaluate(uf, vf, order), uf, vf, "derivatives")
         return out.reshape(*shape, order + 1, order + 1, 3)
 
     def grid(self, us, vs, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
@@ -130,8 +130,8 @@ class Surface(abc.ABC):
         >>> [(i0, b.shape) for i0, b in s.grid_chunks(np.linspace(0, 1, 5), np.linspace(0, 1, 4), 8)]
         [(0, (2, 4, 3)), (2, (2, 4, 3)), (4, (1, 4, 3))]
         """
-        us = checks.nonempty_parameters(us, "us", self.domain[0]).ravel()
-        vs = checks.nonempty_parameters(vs, "vs", self.domain[1]).ravel()
+        us = checks.parameters(us, "us", self.domain[0]).ravel()
+        vs = checks.parameters(vs, "vs", self.domain[1]).ravel()
         max_points = checks.count(max_points, "max_points")
         rows = max(1, max_points // max(1, vs.size))
         for i0 in range(0, us.size, rows):
@@ -141,17 +141,25 @@ class Surface(abc.ABC):
         """Partials on the tensor grid: ``(len(us), len(vs), order+1, order+1, 3)``."""
         order = checks.derivative_order(order)
         us, vs = checks.parameter_grid(us, vs, self.domain, (order + 1) ** 2, max_points)
+        if us.size == 0 or vs.size == 0:  # NumPy-style: empty in, empty out
+            return np.empty((us.size, vs.size, order + 1, order + 1, 3))
         out = self._grid_derivatives(us, vs, order)
         if not np.isfinite(out).all():
             bad = np.argwhere(~np.isfinite(out))[0]
             finite_result(out[bad[0], bad[1]][None], us[bad[:1]], vs[bad[1:2]], "grid")
         return out
 
+    def _evaluate(self, uf: np.ndarray, vf: np.ndarray, order: int) -> np.ndarray:
+        """``_derivatives`` that also takes empty arrays (subclasses need not)."""
+        if uf.size == 0:
+            return np.empty((0, order + 1, order + 1, 3))
+        return self._derivatives(uf, vf, order)
+
     # -- differential geometry -----------------------------------------------------------
     def _regular_derivatives(self, uf: np.ndarray, vf: np.ndarray, order: int) -> np.ndarray:
         """Derivatives where degenerate points (poles, collapsed edges) are replaced by
         the values a short step towards the domain centre, i.e. the limit from inside."""
-        ders = self._derivatives(uf, vf, order)
+        ders = self._evaluate(uf, vf, order)
         bad = degenerate_mask(ders, tolerances.DEGENERATE_NORMAL)
         if np.any(bad):
             (u0, u1), (v0, v1) = self.domain
