@@ -200,10 +200,15 @@ def work(estimate: float, cap: int, keyword: str, what: str) -> None:
     surfmod.errors.SurfmodError: max_points: the grid of 5000 x 10000 points needs about 50,000,000 points, above the cap 10,000,000; pass max_points= a larger value to allow it
     """
     cap = count(cap, keyword, minimum=1)
+    try:
+        estimate = float(estimate)
+    except OverflowError:  # an exact integer product beyond float range
+        estimate = math.inf
     if not estimate <= cap:
         unit = keyword.removeprefix("max_")
+        shown = f"{estimate:,.0f}" if math.isfinite(estimate) else "more than 1e308"
         raise SurfmodError(
-            f"{keyword}: {what} needs about {estimate:,.0f} {unit}, above the cap {cap:,}; "
+            f"{keyword}: {what} needs about {shown} {unit}, above the cap {cap:,}; "
             f"pass {keyword}= a larger value to allow it"
         )
 

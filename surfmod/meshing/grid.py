@@ -32,9 +32,10 @@ def mesh(s: Surface, m: int, n: int, *, quads: bool = False, max_points: int = c
     ((12, 3), (12, 3))
     """
     s = checks.surface(s, "s")
-    m = checks.count(m, "m", minimum=2)
-    n = checks.count(n, "n", minimum=2)
-    checks.work(float(m) * n, max_points, "max_points", f"the {m} x {n} grid mesh")
+    max_points = checks.count(max_points, "max_points")
+    m = checks.count(m, "m", minimum=2, maximum=max_points)
+    n = checks.count(n, "n", minimum=2, maximum=max_points)
+    checks.work(m * n, max_points, "max_points", f"the {m} x {n} grid mesh")
     (u0, u1), (v0, v1) = s.domain
     pts = s.grid(np.linspace(u0, u1, m), np.linspace(v0, v1, n), max_points=max_points)
     return Mesh(pts.reshape(-1, 3), grid_faces(m, n, quads), {"kind": "grid", "m": m, "n": n})
