@@ -308,7 +308,8 @@ def _report(failures, count, seed):
 
 
 @pytest.mark.parametrize("group, count", [("constructors", 900), ("evaluation", 900), ("operations", 260)])
-def test_api_fuzz(group, count, tmp_path):
+def test_api_fuzz(group, count, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # relative export paths land in the test's folder
     count *= SCALE
     seed = SEED + ["constructors", "evaluation", "operations"].index(group)
     make = {
