@@ -13,8 +13,9 @@ The limits, documented once (README "Errors and limits"):
 
 ``LARGEST``
     Largest magnitude accepted for any number (coordinates, lengths, angles, parameters):
-    ``1e100``.  Squares and products of three such numbers stay finite in float64, so no
-    evaluation overflows to inf; larger inputs are refused instead of giving NaN later.
+    ``1e70``.  Curvature multiplies four first derivatives (``EG - F^2``), so fourth powers
+    of such numbers, with room for sums and degree factors, stay finite in float64: no
+    evaluation overflows to inf, and larger inputs are refused instead of giving NaN later.
 ``MAX_DERIVATIVE_ORDER``
     Highest derivative order of ``derivatives``/``grid_derivatives`` (20): the result holds
     ``(order + 1)**2`` vectors per point.
@@ -34,7 +35,7 @@ import numpy as np
 
 from .errors import SurfmodError
 
-LARGEST = 1e100
+LARGEST = 1e70
 MAX_DERIVATIVE_ORDER = 20
 MAX_POINTS = 10_000_000
 MAX_PATH_COMPONENT = 255
@@ -134,7 +135,7 @@ def direction(value, name: str) -> np.ndarray:
     >>> direction((1e300, 1e300, 1e300), "axis")
     Traceback (most recent call last):
     ...
-    surfmod.errors.SurfmodError: axis: magnitude 1e+300 exceeds the limit 1e+100
+    surfmod.errors.SurfmodError: axis: magnitude 1e+300 exceeds the limit 1e+70
     """
     vec = point(value, name)
     big = float(np.abs(vec).max())
