@@ -125,14 +125,16 @@ class _Worker:
 
     def __init__(self) -> None:
         self._proc: subprocess.Popen | None = None
+        self._ready = False
         self._owner = -1
         self._lock = threading.Lock()
 
-    def _start(self, deadline: float) -> subprocess.Popen:
+    def _spawn(self) -> None:
+        """Start a worker without waiting for it (it imports OCCT meanwhile)."""
         root = str(Path(__file__).resolve().parents[2])  # the folder holding the surfmod package
         env = dict(os.environ)
         env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-        proc = subprocess.Popen(
+        self._proc = subprocess.Popen(
             [sys.executable, "-m", "surfmod.occ.isolated"],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
@@ -140,15 +142,28 @@ class _Worker:
             env=env,
             close_fds=True,
         )
+        self._ready = False
+
+    def prestart(self) -> None:
+        """Spawn the worker now if none runs, so its start overlaps the caller's own
+        imports; ``read`` waits for it."""
+        with self._lock:
+            if self._owner != os.getpid():  # a forked child must not share the parent's worker
+                self._proc, self._owner = None, os.getpid()
+            if self._proc is None or self._proc.poll() is not None:
+                self._spawn()
+
+    def _wait_ready(self) -> None:
+        proc = self._proc
         try:
-            kind, _ = _recv(proc.stdout.fileno(), deadline)
+            kind, _ = _recv(proc.stdout.fileno(), time.monotonic() + 120.0)
         except (EOFError, TimeoutError):
-            self._kill(proc)
-            raise DamagedFileError("STEP reader: the reader process did not start") from None
-        if kind != "ready":  # pragma: no cover - protocol guard
+            kind = None
+        if kind != "ready":
+            self._proc = None
             self._kill(proc)
             raise DamagedFileError("STEP reader: the reader process did not start")
-        return proc
+        self._ready = True
 
     @staticmethod
     def _kill(proc: subprocess.Popen) -> None:
@@ -175,11 +190,11 @@ class _Worker:
         with self._lock:
             if self._owner != os.getpid():  # a forked child must not share the parent's worker
                 self._proc, self._owner = None, os.getpid()
-            deadline = time.monotonic() + timeout
             if self._proc is None or self._proc.poll() is not None:
-                # starting costs the interpreter and the OCCT import; it is not charged to the file
-                self._proc = self._start(time.monotonic() + max(60.0, timeout))
-                deadline = time.monotonic() + timeout
+                self._spawn()
+            if not self._ready:  # the start is not charged to the file's time limit
+                self._wait_ready()
+            deadline = time.monotonic() + timeout
             proc = self._proc
             try:
                 _send(proc.stdin, (path, max_coordinate))
@@ -224,12 +239,14 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     readable file, and :class:`~surfmod.errors.DamagedFileError` (a ``KernelError``) naming
     the file when OCCT refuses it, crashes on it, runs past ``timeout`` seconds, or yields
     NaN or coordinates beyond ``max_coordinate``.
-    """
-    from OCP.BinTools import BinTools
-    from OCP.TopoDS import TopoDS_Shape
 
+    >>> import os, tempfile, surfmod as sm
+    >>> path = os.path.join(tempfile.mkdtemp(), "p.step")
+    >>> sm.export_step(sm.sphere(1.0), path)
+    >>> read_step_file(path).ShapeType().name
+    'TopAbs_SHELL'
+    """
     from .. import checks
-    from .guard import kernel
 
     p = checks.file_path(path, name)
     if timeout is not None:
@@ -246,6 +263,12 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
         raise SurfmodError(f"{name}: {p} is not a STEP file (not a readable STEP header: ISO-10303-21 missing)")
     if timeout is None:
         timeout = TIMEOUT_BASE + TIMEOUT_PER_MB * p.stat().st_size / 1e6
+    _WORKER.prestart()  # the worker imports OCCT while this process does the same
+    from OCP.BinTools import BinTools
+    from OCP.TopoDS import TopoDS_Shape
+
+    from .guard import kernel
+
     try:
         data = _WORKER.read(str(p), timeout, max_coordinate)
     except DamagedFileError as exc:
@@ -258,7 +281,10 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
 
 
 def stop_worker() -> None:
-    """Stop the reader process (it restarts on the next read)."""
+    """Stop the reader process (it restarts on the next read); also done at exit.
+
+    >>> stop_worker()
+    """
     _WORKER.close()
 
 
