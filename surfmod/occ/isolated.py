@@ -114,7 +114,8 @@ def _worker_main() -> None:
         try:
             _send(reply, ("ok", _read_and_check(path, max_coordinate)))
         except SurfmodError as exc:
-            _send(reply, ("error", type(exc).__name__, str(exc)))
+            msg = str(exc)  # every refusal names the file (a kernel failure names its operation)
+            _send(reply, ("error", type(exc).__name__, msg if path in msg else f"path: {path}: {msg}"))
         except Exception as exc:  # a reader fault must reach the parent as text, not kill the loop
             _send(reply, ("error", "KernelError", f"path: reading {path} failed ({type(exc).__name__}: {exc})"))
 
