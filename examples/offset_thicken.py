@@ -11,7 +11,7 @@ OUT = Path(__file__).resolve().parent.parent / "step_samples"
 skin = sm.BSplineSurface(wavy_net(7, 6, 0.5))
 outer = sm.offset(skin, 0.8, tolerance=1e-5)
 print(f"offset 0.8: {outer.control_points.shape[0]} x {outer.control_points.shape[1]} poles, "
-      f"max error {outer.max_error:.2e}")
+      f"max deviation {outer.max_deviation:.2e}")
 try:
     sm.offset(skin, -4.0, tolerance=1e-5)
 except sm.SurfmodError as exc:

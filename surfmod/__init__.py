@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import KernelError, SurfmodError
+from .errors import DamagedFileError, KernelError, SurfmodError
 
 __version__ = "0.1.0"
 
@@ -138,7 +138,7 @@ _EXPORTS = {
     "Fill": ".construct.fill",
 }
 
-__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError"])
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError"])
 
 
 def __getattr__(name: str):

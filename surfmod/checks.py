@@ -1,15 +1,45 @@
-"""Input checks done once, at the door of every public constructor.
+"""Input checks done once, at the door of every public entry.
 
-Each helper converts its argument to a float64 NumPy array (copied, read-only) and raises
-:class:`~surfmod.errors.SurfmodError` naming the argument when the value is unusable.
-Inside the package the arrays are trusted.
+One validator per kind of argument, reused everywhere: arrays of numbers
+(:func:`finite_array`), single numbers (:func:`real`, :func:`positive`, :func:`angle`),
+integers (:func:`count`, :func:`derivative_order`), points and directions, parameter
+arrays that must broadcast (:func:`parameter_pair`), file paths (:func:`file_path`),
+surfaces and curves (:func:`surface`, :func:`curve`), and the cost of a piece of work
+against its cap (:func:`work`).  Each raises :class:`~surfmod.errors.SurfmodError` whose
+message starts with the argument's name; arrays come back as float64.  Inside the package
+the values are trusted.
+
+The limits, documented once (README "Errors and limits"):
+
+``LARGEST``
+    Largest magnitude accepted for any number (coordinates, lengths, angles, parameters):
+    ``1e70``.  Curvature multiplies four first derivatives (``EG - F^2``), so fourth powers
+    of such numbers, with room for sums and degree factors, stay finite in float64: no
+    evaluation overflows to inf, and larger inputs are refused instead of giving NaN later.
+``MAX_DERIVATIVE_ORDER``
+    Highest derivative order of ``derivatives``/``grid_derivatives`` (20): the result holds
+    ``(order + 1)**2`` vectors per point.
+``MAX_POINTS``
+    Default cap on the number of points an evaluation may produce (``max_points=`` raises it).
+``MAX_PATH_COMPONENT``, ``MAX_PATH``
+    Longest file name (255 bytes) and path (4096 bytes) that POSIX file systems take.
 """
 
 from __future__ import annotations
 
+import math
+import os
+from pathlib import Path
+
 import numpy as np
 
 from .errors import SurfmodError
+
+LARGEST = 1e70
+MAX_DERIVATIVE_ORDER = 20
+MAX_POINTS = 10_000_000
+MAX_PATH_COMPONENT = 255
+MAX_PATH = 4096
 
 
 def frozen(array: np.ndarray) -> np.ndarray:
@@ -19,19 +49,75 @@ def frozen(array: np.ndarray) -> np.ndarray:
     return out
 
 
-def finite_array(value, name: str, *, ndim: int | None = None, last: int | None = None) -> np.ndarray:
-    """``value`` as a finite float array, optionally with ``ndim`` axes and last axis ``last``."""
+def _as_floats(value, name: str) -> np.ndarray:
+    """``value`` as a float64 array; text, complex numbers, ragged lists, objects that are
+    not numbers and integers beyond float range are refused."""
+    if isinstance(value, (str, bytes)):
+        raise SurfmodError(f"{name}: expected numbers, got {type(value).__name__} {value!r:.40}")
     try:
-        arr = np.asarray(value, dtype=float)
+        raw = np.asarray(value)
+        if raw.dtype.kind in "USVc" or (raw.dtype.kind == "O" and any(isinstance(x, (str, bytes, complex)) for x in raw.flat)):
+            raise TypeError(f"{raw.dtype.kind == 'c' and 'complex' or 'text'} values")
+        arr = np.asarray(raw, dtype=float)
+    except OverflowError:
+        raise SurfmodError(f"{name}: a number is too large (limit {LARGEST:g})") from None
     except (TypeError, ValueError) as exc:
-        raise SurfmodError(f"{name}: expected numbers, got {type(value).__name__} ({exc})") from None
+        kind = "ragged nested lists" if "inhomogeneous" in str(exc) or "sequence" in str(exc) else str(exc)
+        raise SurfmodError(f"{name}: expected numbers, got {type(value).__name__} ({kind})") from None
+    return arr
+
+
+def finite_array(value, name: str, *, ndim: int | None = None, last: int | None = None) -> np.ndarray:
+    """``value`` as a finite float array of magnitude at most ``LARGEST``, optionally with
+    ``ndim`` axes and last axis ``last``.
+
+    >>> finite_array([[1, 2], [3]], "u")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: u: expected numbers, got list (ragged nested lists)
+    """
+    arr = _as_floats(value, name)
     if ndim is not None and arr.ndim != ndim:
         raise SurfmodError(f"{name}: expected an array with {ndim} axes, got shape {arr.shape}")
     if last is not None and (arr.ndim == 0 or arr.shape[-1] != last):
         raise SurfmodError(f"{name}: last axis must have length {last}, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise SurfmodError(f"{name}: contains NaN or infinite values")
+    if arr.size and np.abs(arr).max() > LARGEST:
+        raise SurfmodError(f"{name}: magnitude {np.abs(arr).max():.3g} exceeds the limit {LARGEST:g}")
     return arr
+
+
+def real(value, name: str, *, low: float | None = None, high: float | None = None) -> float:
+    """One finite number (not an array) with optional inclusive bounds.
+
+    >>> real(2, "twist")
+    2.0
+    >>> real([1, 2], "twist")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: twist: expected a single number, got an array of shape (2,)
+    """
+    if isinstance(value, bool):
+        raise SurfmodError(f"{name}: expected a number, got {value!r}")
+    arr = _as_floats(value, name)
+    if arr.shape != ():
+        raise SurfmodError(f"{name}: expected a single number, got an array of shape {arr.shape}")
+    x = float(arr)
+    if not math.isfinite(x):
+        raise SurfmodError(f"{name}: must be finite, got {x}")
+    if abs(x) > LARGEST:
+        raise SurfmodError(f"{name}: {x:.3g} exceeds the limit {LARGEST:g} in magnitude")
+    if low is not None and x < low:
+        raise SurfmodError(f"{name}: must be >= {low:g}, got {x:g}")
+    if high is not None and x > high:
+        raise SurfmodError(f"{name}: must be <= {high:g}, got {x:g}")
+    return x
+
+
+def angle(value, name: str) -> float:
+    """One finite angle (a single number, never an array)."""
+    return real(value, name)
 
 
 def point(value, name: str) -> np.ndarray:
@@ -43,21 +129,26 @@ def point(value, name: str) -> np.ndarray:
 
 
 def direction(value, name: str) -> np.ndarray:
-    """A unit 3-D direction; a zero-length vector is refused."""
+    """A unit 3-D direction; a zero-length vector is refused.  The norm is taken after
+    scaling by the largest component, so huge vectors do not overflow to inf.
+
+    >>> direction((1e300, 1e300, 1e300), "axis")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: axis: magnitude 1e+300 exceeds the limit 1e+70
+    """
     vec = point(value, name)
-    norm = np.linalg.norm(vec)
-    if norm < 1e-12:
+    big = float(np.abs(vec).max())
+    if big == 0.0 or big * np.linalg.norm(vec / big) < 1e-12:
         raise SurfmodError(f"{name}: zero-length direction")
-    return vec / norm
+    scaled = vec / big
+    return scaled / np.linalg.norm(scaled)
 
 
 def positive(value, name: str) -> float:
-    """A finite float > 0."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise SurfmodError(f"{name}: expected a number, got {value!r}") from None
-    if not np.isfinite(x) or x <= 0.0:
+    """A finite number > 0 (a single number, at most ``LARGEST``)."""
+    x = real(value, name)
+    if x <= 0.0:
         raise SurfmodError(f"{name}: must be a finite number > 0, got {value!r}")
     return x
 
@@ -68,22 +159,104 @@ def interval(value, name: str) -> tuple[float, float]:
     >>> interval([0, 2.5], "x_range")
     (0.0, 2.5)
     """
-    try:
-        a, b = (float(t) for t in value)
-    except (TypeError, ValueError):
-        raise SurfmodError(f"{name}: expected two numbers (start, end), got {value!r}") from None
-    if not (np.isfinite(a) and np.isfinite(b)) or not b > a:
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 2:
+        raise SurfmodError(f"{name}: expected two numbers (start, end), got {value!r:.60}")
+    a, b = real(value[0], f"{name}[0]"), real(value[1], f"{name}[1]")
+    if not b > a:
         raise SurfmodError(f"{name}: expected finite start < end, got ({a:g}, {b:g})")
     return a, b
 
 
-def count(value, name: str, minimum: int = 1) -> int:
-    """An integer >= ``minimum``."""
+def count(value, name: str, minimum: int = 1, maximum: int | None = None) -> int:
+    """An integer in ``[minimum, maximum]``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise SurfmodError(f"{name}: expected an integer, got {value!r}")
+        raise SurfmodError(f"{name}: expected an integer, got {value!r:.60}")
     if value < minimum:
         raise SurfmodError(f"{name}: must be >= {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        shown = f"{value}" if abs(value) < 10**30 else f"about 1e{len(str(abs(value))) - 1}"
+        raise SurfmodError(f"{name}: must be <= {maximum}, got {shown}")
     return int(value)
+
+
+def derivative_order(value, name: str = "order") -> int:
+    """A derivative order ``0 <= order <= MAX_DERIVATIVE_ORDER``.
+
+    >>> derivative_order(10**20)
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: order: must be <= 20, got 100000000000000000000
+    """
+    return count(value, name, minimum=0, maximum=MAX_DERIVATIVE_ORDER)
+
+
+def work(estimate: float, cap: int, keyword: str, what: str) -> None:
+    """Refuse a piece of work whose up-front estimate exceeds its cap.
+
+    The message names the keyword that raises the cap, so the caller knows what to do.
+
+    >>> work(5e7, 10_000_000, "max_points", "the grid of 5000 x 10000 points")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: max_points: the grid of 5000 x 10000 points needs about 50,000,000 points, above the cap 10,000,000; pass max_points= a larger value to allow it
+    """
+    cap = count(cap, keyword, minimum=1)
+    try:
+        estimate = float(estimate)
+    except OverflowError:  # an exact integer product beyond float range
+        estimate = math.inf
+    if not estimate <= cap:
+        unit = keyword.removeprefix("max_")
+        shown = f"{estimate:,.0f}" if math.isfinite(estimate) else "more than 1e308"
+        raise SurfmodError(
+            f"{keyword}: {what} needs about {shown} {unit}, above the cap {cap:,}; "
+            f"pass {keyword}= a larger value to allow it"
+        )
+
+
+def surface(value, name: str = "s"):
+    """A surfmod :class:`~surfmod.surface.Surface`."""
+    from .surface import Surface
+
+    if not isinstance(value, Surface):
+        raise SurfmodError(f"{name}: expected a surfmod Surface, got {type(value).__name__}")
+    return value
+
+
+def curve(value, name: str = "curve"):
+    """A surfmod :class:`~surfmod.curve.Curve`."""
+    from .curve import Curve
+
+    if not isinstance(value, Curve):
+        raise SurfmodError(f"{name}: expected a surfmod Curve, got {type(value).__name__}")
+    return value
+
+
+def file_path(value, name: str = "path") -> Path:
+    """A file path of a usable length (no OSError "File name too long" later).
+
+    >>> file_path("a" * 300 + ".step", "path")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: path: file name of 305 bytes is longer than the limit 255
+    """
+    try:
+        p = Path(os.fspath(value))
+    except TypeError:
+        raise SurfmodError(f"{name}: expected a file path, got {type(value).__name__}") from None
+    text = str(p)
+    if not text or text == ".":
+        raise SurfmodError(f"{name}: empty file path")
+    if "\x00" in text:
+        raise SurfmodError(f"{name}: file path contains a NUL character")
+    encoded = os.fsencode(text)
+    if len(encoded) > MAX_PATH:
+        raise SurfmodError(f"{name}: path of {len(encoded)} bytes is longer than the limit {MAX_PATH}")
+    for part in p.parts:
+        size = len(os.fsencode(part))
+        if size > MAX_PATH_COMPONENT:
+            raise SurfmodError(f"{name}: file name of {size} bytes is longer than the limit {MAX_PATH_COMPONENT}")
+    return p
 
 
 def control_net(value, name: str = "control_points") -> np.ndarray:
@@ -157,3 +330,33 @@ def parameters(value, name: str, domain: tuple[float, float], slack: float = 1e-
             f"{name}: parameters must lie in [{lo:g}, {hi:g}], got range [{t.min():g}, {t.max():g}]"
         )
     return np.clip(t, lo, hi)
+
+
+def parameter_pair(u, v, domain, names=("u", "v"), per_point: int = 1, max_points: int = MAX_POINTS):
+    """``(shape, u, v)``: validated parameters broadcast together and flattened.
+
+    Refuses arrays that do not broadcast and broadcasts whose result
+    (``per_point`` vectors each) would exceed ``max_points``.
+
+    >>> parameter_pair(np.zeros(2), np.zeros(3), ((0, 1), (0, 1)))
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: u, v: shapes (2,) and (3,) do not broadcast together
+    """
+    uu = parameters(u, names[0], domain[0])
+    vv = parameters(v, names[1], domain[1])
+    try:
+        shape = np.broadcast_shapes(uu.shape, vv.shape)
+    except ValueError:
+        raise SurfmodError(f"{names[0]}, {names[1]}: shapes {uu.shape} and {vv.shape} do not broadcast together") from None
+    work(float(np.prod(shape, dtype=float)) * per_point, max_points, "max_points", f"evaluating {shape} parameters")
+    uu, vv = np.broadcast_arrays(uu, vv)
+    return shape, uu.ravel(), vv.ravel()
+
+
+def parameter_grid(us, vs, domain, per_point: int = 1, max_points: int = MAX_POINTS):
+    """``(us, vs)``: two flat validated parameter vectors for a tensor grid within the cap."""
+    us = parameters(us, "us", domain[0]).ravel()
+    vs = parameters(vs, "vs", domain[1]).ravel()
+    work(float(us.size) * vs.size * per_point, max_points, "max_points", f"the grid of {us.size} x {vs.size} points")
+    return us, vs

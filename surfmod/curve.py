@@ -12,8 +12,17 @@ import abc
 import numpy as np
 
 from . import checks
+from .errors import SurfmodError
 from .immutable import Immutable
 from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
+
+
+def _finite(out: np.ndarray, t: np.ndarray, what: str) -> np.ndarray:
+    """``out`` when finite; else a ``SurfmodError`` naming the first bad parameter."""
+    if np.isfinite(out).all():
+        return out
+    i = int(np.argmax(~np.isfinite(out.reshape(len(out), -1)).all(axis=1)))
+    raise SurfmodError(f"t: the {what} at t = {t[i]:.17g} are not finite (the curve is singular or overflows there)")
 
 
 class Curve(Immutable, abc.ABC):
@@ -53,30 +62,48 @@ class Curve(Immutable, abc.ABC):
     def to_bspline(self):
         """The exact B-spline/NURBS form (parametrization may differ for conics)."""
 
-    def _params(self, t):
+    def _params(self, t, per_point: int = 1, max_points: int = checks.MAX_POINTS):
         tt = checks.parameters(t, "t", self.domain)
+        checks.work(float(tt.size) * per_point, max_points, "max_points", f"evaluating {tt.size} parameters")
         return tt.shape, tt.ravel()
 
-    def points(self, t) -> np.ndarray:
+    def points(self, t, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """Positions, shape ``t.shape + (3,)``.
 
         >>> import surfmod as sm
         >>> sm.Line((0, 0, 0), (2, 0, 0)).points(1.0)
         array([1., 0., 0.])
         """
-        shape, tf = self._params(t)
-        return self._derivatives(tf, 0)[:, 0, :].reshape(*shape, 3)
+        shape, tf = self._params(t, 1, max_points)
+        return _finite(self._evaluate(tf, 0)[:, 0, :], tf, "points").reshape(*shape, 3)
 
-    def derivatives(self, t, order: int = 1) -> np.ndarray:
-        """``[..., k, :] = d^k C / dt^k`` for ``k <= order``."""
-        order = checks.count(order, "order", minimum=0)
-        shape, tf = self._params(t)
-        return self._derivatives(tf, order).reshape(*shape, order + 1, 3)
+    def derivatives(self, t, order: int = 1, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
+        """``[..., k, :] = d^k C / dt^k`` for ``k <= order`` (``order`` at most
+        ``checks.MAX_DERIVATIVE_ORDER``).
 
-    def tangents(self, t) -> np.ndarray:
-        """Unit tangents ``C' / |C'|``."""
-        d = self.derivatives(t, 1)[..., 1, :]
-        return d / np.linalg.norm(d, axis=-1, keepdims=True)
+        >>> import surfmod as sm
+        >>> sm.Line((0, 0, 0), (2, 0, 0)).derivatives(0.5, order=2)[1:]   # unit speed
+        array([[1., 0., 0.],
+               [0., 0., 0.]])
+        """
+        order = checks.derivative_order(order)
+        shape, tf = self._params(t, order + 1, max_points)
+        return _finite(self._evaluate(tf, order), tf, "derivatives").reshape(*shape, order + 1, 3)
+
+    def tangents(self, t, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
+        """Unit tangents ``C' / |C'|``; a parameter where the curve stops (``C' = 0``)
+        raises ``SurfmodError`` instead of returning NaN."""
+        shape, tf = self._params(t, 2, max_points)
+        d = self._evaluate(tf, 1)[:, 1, :]
+        speed = np.linalg.norm(d, axis=-1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return _finite(d / speed, tf, "tangents").reshape(*shape, 3)
+
+    def _evaluate(self, tf: np.ndarray, order: int) -> np.ndarray:
+        """``_derivatives`` that also takes empty arrays (subclasses need not)."""
+        if tf.size == 0:
+            return np.empty((0, order + 1, 3))
+        return self._derivatives(tf, order)
 
     def edge(self):
         """A build123d ``Edge`` over the whole domain."""

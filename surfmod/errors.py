@@ -30,3 +30,15 @@ class KernelError(SurfmodError):
     >>> issubclass(sm.KernelError, sm.SurfmodError) and issubclass(sm.KernelError, ValueError)
     True
     """
+
+
+class DamagedFileError(KernelError):
+    """A file exists but OCCT could not give a usable shape from it: it is truncated or
+    corrupt, its coordinates are NaN or huge, or the reader crashed or ran past its time
+    limit (it reads in a child process, so none of this takes the caller down).  The
+    message names the file.  The command line exits with status 1 on it.
+
+    >>> import surfmod as sm
+    >>> issubclass(sm.DamagedFileError, sm.KernelError)
+    True
+    """

@@ -13,9 +13,22 @@ import abc
 import numpy as np
 
 from . import checks, tolerances
+from .errors import SurfmodError
 from .eval.differential import Curvatures, curvatures, degenerate_mask, unit_normals
 from .immutable import Immutable
 from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
+
+
+def finite_result(out: np.ndarray, u: np.ndarray, v: np.ndarray, what: str) -> np.ndarray:
+    """``out`` (one row per parameter pair) when every value is finite; otherwise a
+    ``SurfmodError`` naming the first parameters where the surface has no finite value."""
+    if np.isfinite(out).all():
+        return out
+    i = int(np.argmax(~np.isfinite(out.reshape(len(out), -1)).all(axis=1)))
+    raise SurfmodError(
+        f"u, v: the {what} at (u, v) = ({u[i]:.17g}, {v[i]:.17g}) are not finite "
+        "(the surface is singular or overflows there)"
+    )
 
 
 class Surface(Immutable, abc.ABC):
@@ -60,24 +73,26 @@ class Surface(Immutable, abc.ABC):
         return out.reshape(us.size, vs.size, *out.shape[1:])
 
     # -- evaluation ----------------------------------------------------------------------
-    def _params(self, u, v):
-        (u0, u1), (v0, v1) = self.domain
-        uu = checks.parameters(u, "u", (u0, u1))
-        vv = checks.parameters(v, "v", (v0, v1))
-        uu, vv = np.broadcast_arrays(uu, vv)
-        return uu.shape, uu.ravel(), vv.ravel()
+    def _params(self, u, v, per_point: int = 1, max_points: int = checks.MAX_POINTS):
+        """``(shape, u, v)``: validated, broadcast, flat; refuses empty or non-broadcasting
+        arrays and results above ``max_points``."""
+        return checks.parameter_pair(u, v, self.domain, per_point=per_point, max_points=max_points)
 
-    def points(self, u, v) -> np.ndarray:
+    def points(self, u, v, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """Positions ``S(u, v)``, shape ``broadcast(u, v).shape + (3,)``.
+
+        ``u`` and ``v`` must broadcast together; more than ``max_points`` results are
+        refused up front (pass a larger ``max_points`` to allow them).
 
         >>> import surfmod as sm
         >>> sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)).points(0.5, 0.25)
         array([0.5 , 0.25, 0.  ])
         """
-        shape, uf, vf = self._params(u, v)
-        return self._derivatives(uf, vf, 0)[:, 0, 0, :].reshape(*shape, 3)
+        shape, uf, vf = self._params(u, v, max_points=max_points)
+        out = self._evaluate(uf, vf, 0)[:, 0, 0, :]
+        return finite_result(out, uf, vf, "points").reshape(*shape, 3)
 
-    def derivatives(self, u, v, order: int = 1) -> np.ndarray:
+    def derivatives(self, u, v, order: int = 1, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """Partials ``[..., k, l, :] = d^(k+l) S / du^k dv^l`` for ``k, l <= order``.
 
         At an interior knot where a derivative jumps (multiplicity above degree minus
@@ -88,14 +103,22 @@ class Surface(Immutable, abc.ABC):
         >>> sm.plane((0, 0, 0), (2, 0, 0), (0, 3, 0)).derivatives(0.5, 0.5)[1, 0]
         array([2., 0., 0.])
         """
-        order = checks.count(order, "order", minimum=0)
-        shape, uf, vf = self._params(u, v)
-        out = self._derivatives(uf, vf, order)
+        order = checks.derivative_order(order)
+        shape, uf, vf = self._params(u, v, (order + 1) ** 2, max_points)
+        out = finite_result(self._evaluate(uf, vf, order), uf, vf, "derivatives")
         return out.reshape(*shape, order + 1, order + 1, 3)
 
-    def grid(self, us, vs) -> np.ndarray:
-        """Positions on the tensor grid ``us x vs``: ``(len(us), len(vs), 3)``."""
-        return self.grid_derivatives(us, vs, 0)[:, :, 0, 0, :]
+    def grid(self, us, vs, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
+        """Positions on the tensor grid ``us x vs``: ``(len(us), len(vs), 3)``.
+
+        Grids of more than ``max_points`` points are refused up front (evaluate a bigger
+        one block by block with :meth:`grid_chunks`, or raise ``max_points``).
+
+        >>> import surfmod as sm
+        >>> sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)).grid([0, 1], [0, 0.5, 1]).shape
+        (2, 3, 3)
+        """
+        return self.grid_derivatives(us, vs, 0, max_points=max_points)[:, :, 0, 0, :]
 
     def grid_chunks(self, us, vs, max_points: int = 1 << 21):
         """Evaluate a huge grid block by block with bounded memory.
@@ -108,26 +131,36 @@ class Surface(Immutable, abc.ABC):
         >>> [(i0, b.shape) for i0, b in s.grid_chunks(np.linspace(0, 1, 5), np.linspace(0, 1, 4), 8)]
         [(0, (2, 4, 3)), (2, (2, 4, 3)), (4, (1, 4, 3))]
         """
-        us = np.atleast_1d(np.asarray(us, dtype=float)).ravel()
-        vs = np.atleast_1d(np.asarray(vs, dtype=float)).ravel()
+        us = checks.parameters(us, "us", self.domain[0]).ravel()
+        vs = checks.parameters(vs, "vs", self.domain[1]).ravel()
         max_points = checks.count(max_points, "max_points")
         rows = max(1, max_points // max(1, vs.size))
         for i0 in range(0, us.size, rows):
-            yield i0, self.grid(us[i0 : i0 + rows], vs)
+            yield i0, self.grid(us[i0 : i0 + rows], vs, max_points=max(max_points, vs.size))
 
-    def grid_derivatives(self, us, vs, order: int = 1) -> np.ndarray:
+    def grid_derivatives(self, us, vs, order: int = 1, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """Partials on the tensor grid: ``(len(us), len(vs), order+1, order+1, 3)``."""
-        order = checks.count(order, "order", minimum=0)
-        (u0, u1), (v0, v1) = self.domain
-        us = checks.parameters(np.atleast_1d(us), "us", (u0, u1)).ravel()
-        vs = checks.parameters(np.atleast_1d(vs), "vs", (v0, v1)).ravel()
-        return self._grid_derivatives(us, vs, order)
+        order = checks.derivative_order(order)
+        us, vs = checks.parameter_grid(us, vs, self.domain, (order + 1) ** 2, max_points)
+        if us.size == 0 or vs.size == 0:  # NumPy-style: empty in, empty out
+            return np.empty((us.size, vs.size, order + 1, order + 1, 3))
+        out = self._grid_derivatives(us, vs, order)
+        if not np.isfinite(out).all():
+            bad = np.argwhere(~np.isfinite(out))[0]
+            finite_result(out[bad[0], bad[1]][None], us[bad[:1]], vs[bad[1:2]], "grid")
+        return out
+
+    def _evaluate(self, uf: np.ndarray, vf: np.ndarray, order: int) -> np.ndarray:
+        """``_derivatives`` that also takes empty arrays (subclasses need not)."""
+        if uf.size == 0:
+            return np.empty((0, order + 1, order + 1, 3))
+        return self._derivatives(uf, vf, order)
 
     # -- differential geometry -----------------------------------------------------------
     def _regular_derivatives(self, uf: np.ndarray, vf: np.ndarray, order: int) -> np.ndarray:
         """Derivatives where degenerate points (poles, collapsed edges) are replaced by
         the values a short step towards the domain centre, i.e. the limit from inside."""
-        ders = self._derivatives(uf, vf, order)
+        ders = self._evaluate(uf, vf, order)
         bad = degenerate_mask(ders, tolerances.DEGENERATE_NORMAL)
         if np.any(bad):
             (u0, u1), (v0, v1) = self.domain
@@ -145,7 +178,7 @@ class Surface(Immutable, abc.ABC):
                 vn = vf[bad] + step * ((v0 + v1) / 2 - vf[bad])
         return ders
 
-    def normals(self, u, v) -> np.ndarray:
+    def normals(self, u, v, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """Unit normals in the direction of ``Su x Sv``, shape ``(..., 3)``.
 
         At a degenerate point (a pole of a sphere, the apex of a cone, a collapsed edge)
@@ -156,16 +189,17 @@ class Surface(Immutable, abc.ABC):
         >>> sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)).normals(0.3, 0.3)
         array([0., 0., 1.])
         """
-        shape, uf, vf = self._params(u, v)
-        return unit_normals(self._regular_derivatives(uf, vf, 1)).reshape(*shape, 3)
+        shape, uf, vf = self._params(u, v, 2, max_points)
+        return finite_result(unit_normals(self._regular_derivatives(uf, vf, 1)), uf, vf, "normals").reshape(*shape, 3)
 
-    def curvatures(self, u, v) -> Curvatures:
+    def curvatures(self, u, v, *, max_points: int = checks.MAX_POINTS) -> Curvatures:
         """Gaussian, mean and principal curvatures (``k1 >= k2``), signed against ``normals``.
 
         Degenerate points use the limit from inside the domain, as :meth:`normals` does.
         """
-        shape, uf, vf = self._params(u, v)
+        shape, uf, vf = self._params(u, v, 9, max_points)
         c = curvatures(self._regular_derivatives(uf, vf, 2))
+        finite_result(np.stack(c, axis=-1), uf, vf, "curvatures")
         return Curvatures(*(a.reshape(shape) for a in c))
 
     # -- OCCT twins ----------------------------------------------------------------------

@@ -47,7 +47,7 @@ def rotation_matrix(axis_origin, axis_direction, degrees) -> np.ndarray:
     """Rodrigues rotation about an axis through ``axis_origin``."""
     o = checks.point(axis_origin, "axis_origin")
     k = checks.direction(axis_direction, "axis_direction")
-    angle = np.radians(checks.finite_array(degrees, "degrees").item())
+    angle = np.radians(checks.angle(degrees, "degrees"))
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     rot = np.eye(3) + np.sin(angle) * kx + (1 - np.cos(angle)) * (kx @ kx)
     m = np.eye(4)

@@ -28,7 +28,7 @@ def test_offset_distance_checked_by_occt_projection(d):
     s = wavy()
     tol = 1e-5
     o = sm.offset(s, d, tol)
-    assert o.max_error <= tol and o.degree == (3, 3)
+    assert o.max_deviation <= tol and o.degree == (3, 3)
     u, v = grid_uv(o)
     pts = o.points(u, v)
     dist = distances_to_surface(s.geom(), pts, (0, 1, 0, 1))
@@ -65,7 +65,7 @@ def test_crease_precheck():
     with pytest.raises(sm.SurfmodError, match=r"crease along u = 0.5"):
         sm.offset(s, 0.05, 1e-5)
     left, right = s.split(u=0.5)
-    assert sm.offset(left, 0.05, 1e-5).max_error <= 1e-5
+    assert sm.offset(left, 0.05, 1e-5).max_deviation <= 1e-5
 
 
 def test_bad_arguments():

@@ -23,15 +23,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    from ..errors import SurfmodError
+    from ..errors import DamagedFileError, SurfmodError
 
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.run(args) or 0)
     except SurfmodError as exc:
+        # one line, no traceback: 1 when an input file is damaged, 2 for a bad argument
         print(f"surfmod {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return 1 if isinstance(exc, DamagedFileError) else 2
 
 
 if __name__ == "__main__":  # pragma: no cover

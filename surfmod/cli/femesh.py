@@ -17,7 +17,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from tqdm import tqdm
 
-    from ..io.atomic import target_path
+    from ..atomic import target_path
     from ..uses.femesh import FORMATS, fe_mesh
 
     target_path(args.out, "out", tuple(FORMATS))

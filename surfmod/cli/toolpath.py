@@ -25,7 +25,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from tqdm import tqdm
 
-    from ..io.atomic import target_path
+    from ..atomic import target_path
     from ..io.gcode import export_gcode
     from ..uses.inputs import to_shape
     from ..uses.toolpath import Tool, toolpath

@@ -155,8 +155,8 @@ class Arc(Conic):
     def __init__(self, center, normal, radius, start_angle, end_angle, x_dir=None):
         c, x, _, n = make_frame(center, normal, x_dir, axis_name="normal")
         r = checks.positive(radius, "radius")
-        a0 = float(checks.finite_array(start_angle, "start_angle"))
-        a1 = float(checks.finite_array(end_angle, "end_angle"))
+        a0 = checks.angle(start_angle, "start_angle")
+        a1 = checks.angle(end_angle, "end_angle")
         span = math.radians(a1 - a0)
         if not 0.0 < span <= TWO_PI + 1e-12:
             raise SurfmodError(f"end_angle: must exceed start_angle by (0, 360] degrees, got {a0:g} -> {a1:g}")
@@ -222,10 +222,7 @@ class _FramedCurve(Curve):
         self.x_dir = checks.frozen(x_dir)
         self.y_dir = checks.frozen(np.cross(normal, x_dir))
         self._set_params(*params)
-        t0, t1 = (float(t) for t in t_range)
-        if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
-            raise SurfmodError(f"t_range: need finite start < end, got {t_range!r}")
-        self._domain = (t0, t1)
+        self._domain = checks.interval(t_range, "t_range")
 
     @classmethod
     def _make(cls, center, normal, x_dir, params, t_range):

@@ -41,13 +41,9 @@ class Line(Curve):
         """The line ``origin + t * direction`` (direction normalized) for ``t`` in ``t_range``."""
         o = checks.point(origin, "origin")
         d = checks.direction(direction, "direction")
-        try:
-            t0, t1 = (float(t) for t in t_range)
-        except (TypeError, ValueError):
-            raise SurfmodError(f"t_range: expected two numbers, got {t_range!r}") from None
-        if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
-            raise SurfmodError(f"t_range: need finite start < end, got {t_range!r}")
-        return cls._construct_fast(origin=checks.frozen(o), direction=checks.frozen(d), _domain=(t0, t1))
+        return cls._construct_fast(
+            origin=checks.frozen(o), direction=checks.frozen(d), _domain=checks.interval(t_range, "t_range")
+        )
 
     @property
     def domain(self):

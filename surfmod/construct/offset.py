@@ -30,13 +30,13 @@ FOLD_MARGIN = 1e-6
 
 class OffsetApproximation(BSplineSurface):
     """The bicubic B-spline made by :func:`offset`: ``base``, ``distance``, the requested
-    ``tolerance`` and ``max_error`` (largest distance to the exact offset at the
+    ``tolerance`` and ``max_deviation`` (largest distance to the exact offset at the
     check samples, in the same parameters)."""
 
     base: Surface
     distance: float = 0.0
     tolerance: float = 0.0
-    max_error: float = 0.0
+    max_deviation: float = 0.0
 
 
 def _breaks(s: Surface, direction: int) -> np.ndarray:
@@ -143,7 +143,7 @@ def _span_errors(fit: Surface, exact: Surface, bu, bv):
 
 
 def bicubic_approximation(exact: Surface, bu, bv, tol: float, mults=({}, {}), max_rounds: int = 10):
-    """``(fit, max_error)``: a bicubic B-spline within ``tol`` of ``exact`` in its own
+    """``(fit, max_deviation)``: a bicubic B-spline within ``tol`` of ``exact`` in its own
     parameters, starting from the breakpoints ``bu``, ``bv`` (with the interior knot
     multiplicities ``mults``) and halving every span whose midpoint errors exceed ``tol``."""
     bu, bv = np.asarray(bu, float), np.asarray(bv, float)
@@ -170,7 +170,7 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
 
     >>> import surfmod as sm
     >>> o = sm.offset(sm.CylindricalSurface(2.0, u_range=(0, 1.5), v_range=(0, 3)), 0.5, 1e-6)
-    >>> o.max_error < 1e-6, round(float(np.linalg.norm(o.points(0.7, 1.0)[:2])), 6)
+    >>> o.max_deviation < 1e-6, round(float(np.linalg.norm(o.points(0.7, 1.0)[:2])), 6)
     (True, 2.5)
     """
     from .readers_elementary import OffsetSurface
@@ -190,7 +190,7 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
     mults = (_base_multiplicities(s, 0), _base_multiplicities(s, 1))
     fit, err = bicubic_approximation(exact, _breaks(s, 0), _breaks(s, 1), tol, mults, max_rounds)
     out = OffsetApproximation._trusted(fit.control_points, (3, 3), fit.knots)
-    out.base, out.distance, out.tolerance, out.max_error = s, d, tol, err
+    out.base, out.distance, out.tolerance, out.max_deviation = s, d, tol, err
     return out
 
 

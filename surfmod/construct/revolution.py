@@ -178,7 +178,7 @@ def revolution(profile, axis_origin=(0.0, 0.0, 0.0), axis_direction=(0.0, 0.0, 1
     curve = as_curve(profile, "profile")
     o = checks.point(axis_origin, "axis_origin")
     a = checks.direction(axis_direction, "axis_direction")
-    ang = float(checks.finite_array(angle, "angle"))
+    ang = checks.angle(angle, "angle")
     if not 0.0 < ang <= 360.0:
         raise SurfmodError(f"angle: must lie in (0, 360] degrees, got {ang:g}")
     axis_plane_check(curve, o, a)

@@ -71,13 +71,8 @@ class SweptSurface(Surface):
         self.path = as_curve(path, "path")
         self.end_profile = None if end_profile is None else as_curve(end_profile, "end_profile")
         self.guide = None if guide is None else as_curve(guide, "guide")
-        try:
-            self.twist = float(twist)
-        except (TypeError, ValueError):
-            raise SurfmodError(f"twist: expected an angle in degrees, got {twist!r}") from None
-        if not np.isfinite(self.twist):
-            raise SurfmodError("twist: must be finite")
-        if mode not in MODES:
+        self.twist = checks.angle(twist, "twist")
+        if not isinstance(mode, str) or mode not in MODES:
             raise SurfmodError(f"mode: expected one of {MODES}, got {mode!r}")
         self.mode = mode
         self.guide_scale = bool(guide_scale)

@@ -109,7 +109,7 @@ def export_3dm(objects, path) -> list:
     1
     """
     r3 = require("rhino3dm", "export_3dm")
-    from ..io.atomic import atomic_path, target_path
+    from ..atomic import atomic_path, target_path
 
     target = target_path(path, "path", (".3dm",))
     items = list(objects) if isinstance(objects, (list, tuple)) else [objects]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .atomic import atomic_path, target_path
+from ..atomic import atomic_path, target_path
 from .curves2d import polylines_of
 
 

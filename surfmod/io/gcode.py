@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from .atomic import atomic_path, target_path
+from ..atomic import atomic_path, target_path
 
 
 def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = None,

@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 
 from ..errors import SurfmodError
-from .atomic import atomic_path, target_path
+from ..atomic import atomic_path, target_path
 from .step import _as_list, to_shape
 
 SUFFIXES = (".igs", ".iges")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..errors import SurfmodError
-from .atomic import atomic_path, target_path
+from ..atomic import atomic_path, target_path
 
 
 def to_shape(obj):
@@ -47,25 +47,31 @@ def export_step(objects, path) -> None:
         write_step(shape, tmp)
 
 
-def import_step(path):
+def import_step(path, *, timeout: float | None = None, max_coordinate: float = 1e9):
     """Read a STEP file as a build123d shape (``Compound``/``Solid``/…).
+
+    The file is read in a separate, reused worker process with a time limit, so a damaged
+    file that crashes or hangs OCCT's reader raises :class:`~surfmod.errors.DamagedFileError`
+    naming the file instead of taking the caller down.  ``timeout`` (seconds) defaults to
+    30 s plus 10 s per megabyte; a shape with NaN coordinates or coordinates beyond
+    ``max_coordinate`` (model units) is refused the same way.
 
     >>> import surfmod as sm, tempfile, os
     >>> path = os.path.join(tempfile.mkdtemp(), "p.step")
     >>> sm.export_step(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), path)
     >>> len(sm.import_step(path).faces())
     1
+    >>> with open(path, "r+b") as fh:     # cut the file short
+    ...     _ = fh.truncate(600)
+    >>> try:
+    ...     sm.import_step(path)
+    ... except sm.DamagedFileError as exc:
+    ...     print("p.step" in str(exc))
+    True
     """
-    import os
-
     import build123d as bd
 
-    from ..occ.exchange import read_step
+    from ..occ.isolated import read_step_file
 
-    if not os.path.isfile(os.fspath(path)):
-        raise SurfmodError(f"path: no such file {path}")
-    with open(path, "rb") as fh:
-        head = fh.read(64)
-    if b"ISO-10303-21" not in head:
-        raise SurfmodError(f"path: {path} is not a STEP file (no ISO-10303-21 header)")
-    return bd.Compound.cast(read_step(path)) if hasattr(bd.Compound, "cast") else bd.Compound(read_step(path))
+    shape = read_step_file(path, "path", timeout=timeout, max_coordinate=max_coordinate)
+    return bd.Compound.cast(shape) if hasattr(bd.Compound, "cast") else bd.Compound(shape)

@@ -7,7 +7,7 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..meshing.polymesh import Mesh
-from .atomic import atomic_path, target_path
+from ..atomic import atomic_path, target_path
 
 
 def _mesh_of(obj, tolerance: float) -> Mesh:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks
-from .atomic import atomic_path, target_path
+from ..atomic import atomic_path, target_path
 from .curves2d import polylines_of
 
 

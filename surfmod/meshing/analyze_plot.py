@@ -44,7 +44,7 @@ def write_png(result, out, eye, *, title=None, stripes: int = 8, dpi: int = 110)
         import matplotlib.cm as cm
     except ImportError as exc:  # pragma: no cover - matplotlib is a declared dependency
         raise SurfmodError("out: writing a PNG needs matplotlib (pip install matplotlib)") from exc
-    from ..io.atomic import atomic_path, target_path
+    from ..atomic import atomic_path, target_path
 
     target = target_path(out, "out", (".png",))
     bx, by, bz = _view_basis(np.asarray(eye, float))

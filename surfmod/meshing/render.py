@@ -163,7 +163,7 @@ def render(
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from ..io.atomic import atomic_path, target_path
+    from ..atomic import atomic_path, target_path
 
     target = target_path(path, "path", (".png",))
     items = list(objects) if isinstance(objects, (list, tuple)) else [objects]

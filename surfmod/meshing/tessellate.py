@@ -638,7 +638,12 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     return Mesh(v, t, info)
 
 
-def tessellate(obj, tolerance: float, *, max_triangles: int = MAX_TRIANGLES) -> Mesh:
+#: default cap for surfmod surfaces, whose adaptive refinement runs in NumPy (about a few
+#: thousand triangles per second): a cap of 250,000 is a few minutes at most
+MAX_SURFACE_TRIANGLES = 250_000
+
+
+def tessellate(obj, tolerance: float, *, max_triangles: int | None = None) -> Mesh:
     """Triangle mesh of a surfmod surface or a build123d shape whose chordal deviation
     from the exact geometry is at most ``tolerance`` -- measured on 25 sample points per
     triangle and reported in ``info["max_deviation"]``.
@@ -646,7 +651,9 @@ def tessellate(obj, tolerance: float, *, max_triangles: int = MAX_TRIANGLES) -> 
     Surfaces are refined adaptively where curvature is high; faces of a shape share their
     boundary vertices, so a closed solid gives a watertight mesh.  A tolerance <= 0, or
     one so small that more than ``max_triangles`` triangles would be needed, raises
-    ``SurfmodError`` before anything large is allocated.
+    ``SurfmodError`` before anything large is allocated.  The default cap is
+    ``MAX_SURFACE_TRIANGLES`` (250,000) for surfmod surfaces and ``MAX_TRIANGLES``
+    (5,000,000) for shapes meshed by BRepMesh.
 
     >>> import surfmod as sm, numpy as np
     >>> net = np.zeros((3, 3, 3)); net[..., 0], net[..., 1] = np.mgrid[0:3, 0:3]
@@ -658,6 +665,8 @@ def tessellate(obj, tolerance: float, *, max_triangles: int = MAX_TRIANGLES) -> 
     from ..surface import Surface
 
     tolerance = checks.positive(tolerance, "tolerance")
+    if max_triangles is None:
+        max_triangles = MAX_SURFACE_TRIANGLES if isinstance(obj, Surface) else MAX_TRIANGLES
     max_triangles = checks.count(max_triangles, "max_triangles", minimum=2)
     if isinstance(obj, Surface):
         return tessellate_surface(obj, tolerance, max_triangles)

@@ -207,7 +207,6 @@ def face_records(shape) -> list[dict]:
     """One record per face: OCCT surface (unwrapped from rectangular trims), its type,
     UV bounds, orientation, whether the face is its full UV rectangle, B-spline knots
     and elementary-surface data."""
-    import OCP.Geom as G
     from OCP.BRepTools import BRepTools
 
     from .geom import downcast_surface, surface_type
@@ -215,10 +214,10 @@ def face_records(shape) -> list[dict]:
     out = []
     for i, f in enumerate(_explore(shape, TopAbs_FACE)):
         face = TopoDS.Face_s(f)
-        with kernel("face data"):
+        with kernel(f"obj: face {i}"):
             surf = BRep_Tool.Surface_s(face)
             while surface_type(surf) == "Geom_RectangularTrimmedSurface":
-                surf = G.Geom_RectangularTrimmedSurface.DownCast(surf).BasisSurface()
+                surf = downcast_surface(surf).BasisSurface()
             name = surface_type(surf)
             bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
             rec = {

@@ -253,7 +253,59 @@ def _is_plane_spec(value):
     return hasattr(value, "z_dir") or isinstance(value, (tuple, list))
 
 
-def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_angle: float = 4.0) -> list[IntersectionCurve]:
+#: samples per direction of the coincidence test done before tracing
+_COINCIDENCE_SAMPLES = 17
+
+
+def _coincide_over_region(s: Surface, distance, tol: float, near=None) -> bool:
+    """True when a 2 x 2 block of neighbouring samples of ``s`` all lie within ``tol`` of
+    the other object (``distance`` maps points to distances): a patch of ``s`` lies on
+    it, so the intersection is a region, not a curve.  Touching along a curve or at a
+    point never fills such a block.  ``near`` (points -> mask) is a cheap necessary
+    condition; only the corners of blocks that pass it get an exact distance."""
+    (u0, u1), (v0, v1) = s.domain
+    n = _COINCIDENCE_SAMPLES
+    pts = s.grid(np.linspace(u0, u1, n), np.linspace(v0, v1, n)).reshape(-1, 3)
+    maybe = (np.ones(n * n, bool) if near is None else near(pts)).reshape(n, n)
+    blocks = maybe[:-1, :-1] & maybe[1:, :-1] & maybe[:-1, 1:] & maybe[1:, 1:]
+    if not blocks.any():
+        return False
+    corners = np.zeros((n, n), bool)
+    for di in (0, 1):
+        for dj in (0, 1):
+            corners[di : n - 1 + di, dj : n - 1 + dj] |= blocks
+    idx = np.nonzero(corners.ravel())[0]
+    on = np.zeros(n * n, bool)
+    on[idx] = distance(pts[idx]) <= tol
+    on = on.reshape(n, n)
+    return bool(np.any(on[:-1, :-1] & on[1:, :-1] & on[:-1, 1:] & on[1:, 1:]))
+
+
+def _near_samples_of(s: Surface, tol: float):
+    """Points -> mask of those within a sample cell of ``s`` (a point on ``s`` always is)."""
+    _, _, _, _, pts, cell = _grid(s)
+    return lambda p: np.linalg.norm(p - pts[nearest_samples(p, pts, 1)[:, 0]], axis=1) <= cell + tol
+
+
+def _refuse_coincident(a, b, plane, tol: float, names) -> None:
+    from .project import closest_points
+
+    if plane is not None:
+        o, n = plane
+        hit = _coincide_over_region(a, lambda p: np.abs((p - o) @ n), tol)
+    else:
+        hit = _coincide_over_region(a, lambda p: closest_points(b, p, 2)[3], tol, _near_samples_of(b, tol)) or (
+            _coincide_over_region(b, lambda p: closest_points(a, p, 2)[3], tol, _near_samples_of(a, tol))
+        )
+    if hit:
+        raise SurfmodError(
+            f"{names[0]}, {names[1]}: the surfaces coincide over a region (within tolerance {tol:g}); "
+            "their intersection is that region, not a curve"
+        )
+
+
+def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_angle: float = 4.0,
+              max_points: int = 1_000_000) -> list[IntersectionCurve]:
     """Intersection curves of two surfaces, or of a surface and an infinite plane.
 
     ``b`` (or ``a``) may be a surfmod surface (a bounded patch, a ``PlaneSurface``
@@ -261,7 +313,10 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     Every returned point lies on both within ``tolerance`` (Newton converges to ~1e-12
     in practice); ``step`` bounds the 3-D step (default 1/40 of the model size) and
     ``max_angle`` (degrees) the turn of the tangent per step.  No intersection gives
-    ``[]``.
+    ``[]``.  Surfaces that coincide over a region (``intersect(s, s)``) raise
+    ``SurfmodError`` ("the surfaces coincide over a region") before any tracing; a
+    ``step`` so small that the curves would need more than ``max_points`` points (about
+    ten model sizes of curve) is refused up front.
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0))
@@ -272,23 +327,25 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     []
     """
     tol = checks.positive(tolerance, "tolerance")
-    angle = checks.positive(max_angle, "max_angle")
+    angle = checks.real(max_angle, "max_angle", low=1e-3, high=90.0)
     swap = _is_plane_spec(a) and isinstance(b, Surface)
     if swap:
         a, b = b, a
     if not isinstance(a, Surface):
         raise SurfmodError(f"{'b' if swap else 'a'}: expected a surfmod Surface, got {type(a).__name__}")
-    if isinstance(b, Surface):
-        problem = SurfaceSurface(a, b, tol)
+    plane = None if isinstance(b, Surface) else as_plane(b, "a" if swap else "b")
+    problem = SurfaceSurface(a, b, tol) if plane is None else SurfacePlane(a, *plane, tol)
+    h = checks.positive(step, "step") if step is not None else problem.scale / 40
+    checks.work(10.0 * problem.scale / h, max_points, "max_points", f"tracing with step {h:.3g} on a model of size {problem.scale:.3g}")
+    _refuse_coincident(a, b, plane, tol, ("b", "a") if swap else ("a", "b"))  # before any seed is solved
+    if plane is None:
         seeds = _surface_surface_seeds(problem)
         uv_b_of = lambda X, P: X[:, 2:]  # noqa: E731
     else:
-        origin, normal = as_plane(b, "a" if swap else "b")
-        problem = SurfacePlane(a, origin, normal, tol)
+        origin, normal = plane
         seeds = _implicit_seeds(problem, a)
         o, x, y, _ = plane_frame(origin, normal)
         uv_b_of = lambda X, P: np.stack([(P - o) @ x, (P - o) @ y], axis=1)  # noqa: E731
-    h = checks.positive(step, "step") if step is not None else problem.scale / 40
     traced = marching.trace_all(problem, seeds, h, angle)
     # drop slivers (a seed on a seam or at a tangency traced for a vanishing length)
     traced = [(X, c) for X, c in traced if np.ptp(problem.evaluate(X)[2], axis=0).max() > 1e-6 * problem.scale]

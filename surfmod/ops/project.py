@@ -287,7 +287,14 @@ def _as_points(points_or_curve, samples):
     return checks.finite_array(points_or_curve, "points_or_curve", last=3)
 
 
-def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8) -> Projection:
+#: default cap on the number of points of one ``project`` call (about a minute of work)
+MAX_PROJECT_POINTS = 100_000
+#: points per block; a progress bar shows from the second block on
+_BLOCK = 10_000
+
+
+def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8,
+            max_points: int = MAX_PROJECT_POINTS, progress: bool | None = None) -> Projection:
     """Closest points on ``s`` to many points at once (or to ``samples`` points of a curve).
 
     ``points_or_curve``: a point ``(3,)``, points ``(..., 3)``, a surfmod curve or a
@@ -295,21 +302,34 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8) -
     Returns ``Projection(u, v, point, distance)`` with the points' leading shape.  The
     closest point may lie on the boundary of the domain (a constrained minimum).
 
+    More than ``max_points`` points are refused before any work (raise it to allow
+    them); work of more than one block of 10,000 points shows a tqdm progress bar
+    (``progress=False`` hides it).  A distance that is not finite raises ``SurfmodError``.
+
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
     >>> pr = sm.project([(0.25, 0.5, 2.0), (3.0, 0.5, 0.0)], s)
     >>> pr.u, pr.v, pr.distance
     (array([0.25, 1.  ]), array([0.5, 0.5]), array([2., 2.]))
     """
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
-    samples = checks.count(samples, "samples", minimum=2)
-    seeds = checks.count(seeds, "seeds", minimum=1)
+    s = checks.surface(s, "s")
+    samples = checks.count(samples, "samples", minimum=2, maximum=checks.MAX_POINTS)
+    seeds = checks.count(seeds, "seeds", minimum=1, maximum=64)
     pts = _as_points(points_or_curve, samples)
     shape = pts.shape[:-1]
     flat = pts.reshape(-1, 3)
     if flat.shape[0] == 0:
         empty = np.empty(shape)
         return Projection(empty, empty.copy(), np.empty(shape + (3,)), empty.copy())
-    u, v, p, d = closest_points(s, flat, seeds)
+    checks.work(len(flat), max_points, "max_points", f"projecting {len(flat):,} points")
+    blocks = range(0, len(flat), _BLOCK)
+    if progress or (progress is None and len(blocks) > 1):
+        from tqdm import tqdm
+
+        blocks = tqdm(blocks, desc="project", unit="block")
+    parts = [closest_points(s, flat[b0 : b0 + _BLOCK], seeds) for b0 in blocks]
+    u, v, p, d = (np.concatenate(a) for a in zip(*parts))
+    if not (np.isfinite(d).all() and np.isfinite(p).all()):
+        i = int(np.argmax(~np.isfinite(d) | ~np.isfinite(p).all(axis=1)))
+        raise SurfmodError(f"points_or_curve: the closest point to point {i} is not finite (the point is too far away)")
     return Projection(u.reshape(shape), v.reshape(shape), p.reshape(shape + (3,)), d.reshape(shape))

@@ -141,13 +141,16 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int) -> dict:
                 gmsh.finalize()
 
 
-def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None) -> FEMesh:
+def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None,
+            max_elements: int = 2_000_000) -> FEMesh:
     """Triangle (``kind="surface"``) or tetrahedral (``kind="volume"``) FE mesh of a part
     with target element ``size`` (gmsh, also refined by curvature), ``order`` 1 or 2.
 
     ``obj``: a build123d shape, surfmod surface(s) or a STEP path.  The part goes to
     gmsh as a BREP file (exact geometry); the mesh comes back through meshio.  With
-    ``path`` the mesh is also written (``.msh``, ``.vtu``, ``.inp``).
+    ``path`` the mesh is also written (``.msh``, ``.vtu``, ``.inp``).  Meshes estimated
+    (from the bounding box and ``size``) above ``max_elements`` elements are refused
+    before gmsh runs; raise ``max_elements`` to allow them.
 
     >>> import surfmod as sm, build123d as bd
     >>> m = sm.fe_mesh(bd.Box(2, 2, 2), size=1.0)
@@ -172,8 +175,12 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     extent = float(np.max(box[1] - box[0]))
     if size > 10 * extent:
         raise SurfmodError(f"size: {size:g} is far larger than the part (extent {extent:.4g})")
-    if extent / size > 400:
-        raise SurfmodError(f"size: {size:g} would need more than ~{400**2 * 10:.0e} elements for a part of extent {extent:.4g}")
+    dims = np.maximum(box[1] - box[0], size)
+    if kind == "volume":  # about 6 tetrahedra per cube of the element size
+        estimate = 6.0 * float(np.prod(dims / size))
+    else:  # 2 triangles per square on the box's faces
+        estimate = 4.0 * float(dims[0] * dims[1] + dims[1] * dims[2] + dims[0] * dims[2]) / size**2
+    checks.work(estimate, max_elements, "max_elements", f"a {kind} mesh with element size {size:g} of a part of extent {extent:.4g}")
     with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp:
         brep, msh = Path(tmp) / "part.brep", Path(tmp) / "part.msh"
         occ.write_brep(shape, brep)
@@ -204,7 +211,7 @@ def export_fe_mesh(mesh, path) -> None:
     """
     import meshio
 
-    from ..io.atomic import atomic_path, target_path
+    from ..atomic import atomic_path, target_path
 
     target = target_path(path, "path", tuple(FORMATS))
     m = mesh.mesh if isinstance(mesh, FEMesh) else mesh

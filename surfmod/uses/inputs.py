@@ -8,26 +8,16 @@ path of a STEP file.
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 from ..errors import SurfmodError
 
 
 def load_step(path, name: str = "obj"):
-    """The TopoDS shape in a STEP file; unreadable files raise ``SurfmodError``."""
-    from ..occ.exchange import read_step
+    """The TopoDS shape in a STEP file, read in the isolated reader process
+    (:func:`surfmod.import_step`); unreadable or damaged files raise ``SurfmodError``."""
+    from ..occ.isolated import read_step_file
 
-    p = Path(os.fspath(path))
-    if not p.is_file():
-        raise SurfmodError(f"{name}: no such file {p}")
-    with open(p, "rb") as fh:
-        head = fh.read(256)
-    if b"ISO-10303-21" not in head:
-        raise SurfmodError(f"{name}: {p} is not a readable STEP file (no ISO-10303-21 header)")
-    try:
-        return read_step(p)
-    except SurfmodError as exc:
-        raise SurfmodError(f"{name}: {exc}") from None
+    return read_step_file(path, name)
 
 
 def _single(item, name):

@@ -75,7 +75,7 @@ class Section:
 
     def preview(self, path, *, dpi: int = 120) -> None:
         """A PNG drawing of the section in the plane frame (matplotlib, atomic write)."""
-        from ..io.atomic import atomic_path, target_path
+        from ..atomic import atomic_path, target_path
 
         target = target_path(path, "path", (".png",))
         try:

@@ -461,7 +461,7 @@ def _raster(lo, hi, stepover, step, direction):
 
 def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float | None = None,
              step: float | None = None, direction: str = "x", bounds=None, check: bool = True,
-             progress: bool = False) -> Toolpath:
+             progress: bool = False, max_points: int = 2_000_000) -> Toolpath:
     """Zig-zag drop-cutter finishing path of ``tool`` over a surface or a solid's top.
 
     ``obj``: a surfmod surface (or list of them) machined from above, a build123d solid
@@ -471,7 +471,9 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     along a pass (default ``radius / 4``); passes run along ``direction`` ``"x"`` or
     ``"y"`` over the part's (x, y) bounding box or ``bounds = ((xmin, ymin), (xmax, ymax))``.
     ``check`` measures the gouge on an independent denser sample; ``progress`` shows a
-    tqdm bar over blocks of cutter locations.
+    tqdm bar over blocks of cutter locations.  More than ``max_points`` cutter locations
+    (estimated from the bounds, stepover and step before anything is allocated) are
+    refused; raise ``max_points`` to allow them.
 
     >>> import surfmod as sm, numpy as np
     >>> s = sm.plane((0, 0, 1), (10, 0, 1), (0, 10, 1))
@@ -504,9 +506,12 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         if b.shape != (2, 2) or np.any(b[1] < b[0]):
             raise SurfmodError(f"bounds: expected ((xmin, ymin), (xmax, ymax)), got {b.tolist()}")
         lo, hi = b[0], b[1]
+    a, b = (0, 1) if direction == "x" else (1, 0)
+    passes = (float(hi[b] - lo[b]) / stepover + 2) if np.isfinite(hi[b] - lo[b]) else np.inf
+    along = (float(hi[a] - lo[a]) / step + 2) if np.isfinite(hi[a] - lo[a]) else np.inf
+    checks.work(passes * along + passes * stepover / step, max_points, "max_points",
+                f"the raster of {passes:,.0f} passes x {along:,.0f} points (use a larger step or stepover)")
     xy, index, across = _raster(lo, hi, stepover, step, direction)
-    if len(xy) > 2_000_000:
-        raise SurfmodError(f"step: {len(xy)} cutter locations is too many; use a larger step or stepover")
     z, contacts = drop_cutter(obj, tool, xy, spacing=spacing, progress=progress, _model_cache=model)
     if np.isnan(z).all():
         raise SurfmodError("bounds: the tool touches no surface inside these bounds")

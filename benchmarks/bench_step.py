@@ -1,0 +1,51 @@
+"""Cost of reading STEP files in the isolated reader process (``sm.import_step``) against
+OCCT's ``STEPControl_Reader`` in the calling process, over the real-parts corpus.
+
+The first isolated read pays the worker's start (interpreter plus OCCT import); after that
+each read adds the coordinate check, the BinTools round trip and the pipe transfer.
+
+``python -m benchmarks step``
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import surfmod as sm
+from surfmod.occ import isolated
+from surfmod.occ.exchange import read_step
+
+CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "step_corpus"
+
+
+def main() -> None:
+    files = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
+    if not files:
+        print(f"no corpus at {CORPUS}")
+        return
+    isolated.stop_worker()
+    t = time.perf_counter()
+    sm.import_step(files[0])
+    start = time.perf_counter() - t
+    print(f"{'file':<44} {'MB':>6} {'in-process':>11} {'isolated':>9} {'overhead':>9}")
+    print("-" * 83)
+    total_direct = total_isolated = 0.0
+    for f in files:
+        t = time.perf_counter()
+        read_step(str(f))
+        direct = time.perf_counter() - t
+        t = time.perf_counter()
+        sm.import_step(f)
+        iso = time.perf_counter() - t
+        total_direct += direct
+        total_isolated += iso
+        print(f"{f.name:<44.44} {f.stat().st_size / 1e6:6.2f} {direct:10.3f}s {iso:8.3f}s {iso / direct:8.2f}x")
+    print("-" * 83)
+    print(f"{'corpus':<44} {'':>6} {total_direct:10.3f}s {total_isolated:8.3f}s "
+          f"{total_isolated / total_direct:8.2f}x")
+    print(f"worker start (first read, once per process): {start:.2f}s")
+
+
+if __name__ == "__main__":
+    main()
