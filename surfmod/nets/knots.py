@@ -71,9 +71,20 @@ def bezier_pieces(knots: np.ndarray, degree: int, ctrl: np.ndarray):
 
 
 def smooth_mask(knots: np.ndarray, degree: int, t: np.ndarray, order: int) -> np.ndarray:
-    """False where ``t`` is an interior knot across which the ``order``-th derivative
-    jumps (multiplicity > degree - order).  There the derivative is two-valued: surfmod
-    returns the right-hand one, OCCT may return either, so comparisons skip them."""
+    """False where ``t`` is (within a few ulps of) an interior knot across which the
+    ``order``-th derivative jumps (multiplicity > degree - order).  There the derivative is
+    two-valued: surfmod returns the one of the span ``t`` falls in, while OCCT's span
+    search (``BSplCLib::LocateParameter``) snaps a parameter that close to the knot onto
+    it, so comparisons skip such parameters.
+
+    >>> smooth_mask(np.array([0, 0, 0.6000000000000001, 3, 3]), 1, np.array([0.3, 0.6, 0.6000000000000001]), 1)
+    array([ True, False, False])
+    """
     inner = knots[(knots > knots[degree]) & (knots < knots[-degree - 1])]
     values, mult = np.unique(inner, return_counts=True)
-    return ~np.isin(t, values[mult > degree - order])
+    jumps = values[mult > degree - order]
+    if not jumps.size:
+        return np.ones(np.shape(t), dtype=bool)
+    t = np.asarray(t, dtype=float)
+    near = np.abs(t[..., None] - jumps) <= 8 * np.finfo(float).eps * np.maximum(1.0, np.abs(jumps))
+    return ~near.any(axis=-1)
