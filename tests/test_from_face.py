@@ -14,7 +14,7 @@ def test_build123d_spline_face_reads_back():
     pts = [[(x, y, 0.2 * np.sin(x + y)) for y in range(5)] for x in range(4)]
     face = bd.Face.make_surface_from_array_of_points(pts)
     s = sm.from_face(face)
-    assert isinstance(s, sm.BSplineSurface)
+    assert isinstance(s.surface, sm.BSplineSurface)
     r = sm.crosscheck(face)
     assert r.passed, r.details
     # the surface interpolates the given points somewhere: every point is on it (checked via OCCT)

@@ -10,32 +10,15 @@ from __future__ import annotations
 
 import numpy as np
 from OCP.BRep import BRep_Tool
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS
 
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import check_done, kernel
+from .topo import explore as _explore, shells_of, solids_of
 
 SEW_TOLERANCE = 1e-6
-
-
-def _explore(shape, kind):
-    out = []
-    explorer = TopExp_Explorer(shape, kind)
-    while explorer.More():
-        out.append(explorer.Current())
-        explorer.Next()
-    return out
-
-
-def solids_of(shape):
-    return [TopoDS.Solid_s(s) for s in _explore(shape, TopAbs_SOLID)]
-
-
-def shells_of(shape):
-    return [TopoDS.Shell_s(s) for s in _explore(shape, TopAbs_SHELL)]
 
 
 def count_faces(shape) -> int:
@@ -155,34 +138,7 @@ def bounding_box(shape) -> np.ndarray:
 
 
 # -- per-face data for the NumPy quadrature ---------------------------------------------
-def _elementary(surf, name):
-    """Frame and radii of an OCCT elementary surface, or None."""
-    import OCP.Geom as G
-
-    cls = getattr(G, name, None)
-    s = cls.DownCast(surf) if cls is not None and hasattr(cls, "DownCast") else surf
-    if name not in ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface",
-                    "Geom_SphericalSurface", "Geom_ToroidalSurface"):
-        return None
-    ax = s.Position()
-    data = {
-        "origin": xyz(ax.Location()),
-        "x": xyz(ax.XDirection()),
-        "y": xyz(ax.YDirection()),
-        "z": xyz(ax.Direction()),
-    }
-    if name == "Geom_CylindricalSurface":
-        data["radius"] = s.Radius()
-    elif name == "Geom_SphericalSurface":
-        data["radius"] = s.Radius()
-    elif name == "Geom_ConicalSurface":
-        data["radius"], data["angle"] = s.RefRadius(), s.SemiAngle()
-    elif name == "Geom_ToroidalSurface":
-        data["major"], data["minor"] = s.MajorRadius(), s.MinorRadius()
-    return data
-
-
-def _is_rectangle(face, bounds) -> bool:
+def is_rectangle(face, bounds) -> bool:
     """True when every edge's p-curve lies on the border of the face's UV box (one wire)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 
@@ -201,51 +157,6 @@ def _is_rectangle(face, bounds) -> bool:
             if not on:
                 return False
     return True
-
-
-def face_records(shape) -> list[dict]:
-    """One record per face: OCCT surface (unwrapped from rectangular trims), its type,
-    UV bounds, orientation, whether the face is its full UV rectangle, B-spline knots
-    and elementary-surface data."""
-    import OCP.Geom as G
-    from OCP.BRepTools import BRepTools
-
-    from .geom import downcast_surface, surface_type
-
-    out = []
-    for i, f in enumerate(_explore(shape, TopAbs_FACE)):
-        face = TopoDS.Face_s(f)
-        with kernel("face data"):
-            surf = BRep_Tool.Surface_s(face)
-            while surface_type(surf) == "Geom_RectangularTrimmedSurface":
-                surf = G.Geom_RectangularTrimmedSurface.DownCast(surf).BasisSurface()
-            name = surface_type(surf)
-            bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
-            rec = {
-                "index": i,
-                "face": face,
-                "geom": downcast_surface(surf),
-                "kind": name,
-                "bounds": bounds,
-                "reversed": face.Orientation() == TopAbs_REVERSED,
-                "natural": _is_rectangle(face, bounds),
-                "elementary": _elementary(surf, name),
-                "knots": None,
-            }
-            if name in ("Geom_BSplineSurface", "Geom_BezierSurface"):
-                g = rec["geom"]
-                if name == "Geom_BSplineSurface":
-                    uk = [g.UKnot(k) for k in range(1, g.NbUKnots() + 1)]
-                    vk = [g.VKnot(k) for k in range(1, g.NbVKnots() + 1)]
-                    rec["knots"] = (np.array(uk), np.array(vk))
-                    rec["degree"] = (g.UDegree(), g.VDegree())
-                    rec["rational"] = g.IsURational() or g.IsVRational()
-                else:
-                    rec["knots"] = (np.array([0.0, 1.0]), np.array([0.0, 1.0]))
-                    rec["degree"] = (g.UDegree(), g.VDegree())
-                    rec["rational"] = g.IsURational() or g.IsVRational()
-        out.append(rec)
-    return out
 
 
 def face_uv_triangles(face, deflection: float, angular: float = 0.1):
@@ -304,31 +215,6 @@ def face_boundary_nodes(face, order: int, pieces: int = 4):
     return np.array(us), np.array(vs), np.array(ws)
 
 
-def surface_derivatives(geom, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
-    """OCCT ``D0``/``D1``/``D2`` as ``(N, order+1, order+1, 3)`` (the fallback evaluator
-    for surface types without a NumPy twin; a plain loop over OCCT calls)."""
-    from OCP.gp import gp_Pnt, gp_Vec
-
-    n = len(u)
-    out = np.zeros((n, order + 1, order + 1, 3))
-    p = gp_Pnt()
-    d = [gp_Vec() for _ in range(5)]
-    with kernel("Geom_Surface.D2"):
-        for a in range(n):
-            uu, vv = float(u[a]), float(v[a])
-            if order == 0:
-                geom.D0(uu, vv, p)
-                out[a, 0, 0] = xyz(p)
-            elif order == 1:
-                geom.D1(uu, vv, p, d[0], d[1])
-                out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d[0]), xyz(d[1])
-            else:
-                geom.D2(uu, vv, p, d[0], d[1], d[2], d[3], d[4])
-                out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d[0]), xyz(d[1])
-                out[a, 2, 0], out[a, 0, 2], out[a, 1, 1] = xyz(d[2]), xyz(d[3]), xyz(d[4])
-    return out
-
-
 # -- interference -----------------------------------------------------------------------
 def common_volume(a, b, eps: float = 1e-9) -> float:
     """Volume of ``BRepAlgoAPI_Common(a, b)`` (0 when the parts do not overlap)."""
@@ -356,18 +242,6 @@ def min_distance(a, b):
 
 
 # -- sections ---------------------------------------------------------------------------
-def planar_faces_in(shape, origin, normal, tol: float):
-    """Indices of planar faces lying in the plane (origin, normal)."""
-    out = []
-    for rec in face_records(shape):
-        e = rec["elementary"]
-        if rec["kind"] != "Geom_Plane":
-            continue
-        if abs(abs(float(np.dot(e["z"], normal))) - 1.0) < 1e-9 and abs(float(np.dot(e["origin"] - origin, normal))) < tol:
-            out.append(rec["index"])
-    return out
-
-
 def section_edges(shape, origin, normal):
     """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
     end to end with ``ShapeAnalysis_FreeBounds``)."""
@@ -438,7 +312,7 @@ def is_solid_like(shape) -> bool:
 
 
 __all__ = [
-    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_polyline", "face_records",
-    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_solid_like", "min_distance", "planar_faces_in", "section_edges",
-    "sew_solid", "shells_of", "solids_of", "surface_derivatives", "wire_edges", "write_brep",
+    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_polyline",
+    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "is_solid_like", "min_distance", "section_edges",
+    "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

@@ -106,6 +106,22 @@ class Section:
         return f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}"
 
 
+def planar_faces_in(shape, origin, normal, tol: float) -> list[int]:
+    """Indices of the planar faces of ``shape`` lying in the plane ``(origin, normal)``."""
+    from ..construct.elementary import AnalyticPlane
+    from ..occ.topo import faces_of
+    from ..readback import from_face
+
+    out = []
+    for i, f in enumerate(faces_of(shape)):
+        s = from_face(f).surface
+        if not isinstance(s, AnalyticPlane):
+            continue
+        if abs(abs(float(np.dot(s.z_dir, normal))) - 1.0) < 1e-9 and abs(float(np.dot(s.origin - origin, normal))) < tol:
+            out.append(i)
+    return out
+
+
 def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) -> Section:
     """Planar section of a part (or of surfaces): curves where the plane cuts it.
 
@@ -129,7 +145,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     shape = to_shape(obj, "obj")
     box = occ.bounding_box(shape)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
-    on = occ.planar_faces_in(shape, origin, normal, tol)
+    on = planar_faces_in(shape, origin, normal, tol)
     if on:
         raise SurfmodError(
             f"plane_normal: the section plane is parallel to planar face(s) {on} of obj and lies on them; "
