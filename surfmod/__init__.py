@@ -98,6 +98,7 @@ _EXPORTS = {
     "limit_surface": ".subdiv.limit",
     "LimitSurface": ".subdiv.limit",
     "mass_properties": ".uses.mass",
+    "boundary_ambiguity": ".uses.mass",
     "MassProperties": ".uses.mass",
     "interference": ".uses.interference",
     "Interference": ".uses.interference",

@@ -30,8 +30,9 @@ def main(argv=None) -> int:
     try:
         return int(args.run(args) or 0)
     except SurfmodError as exc:
-        print(f"surfmod {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        # one line, no traceback: bad input is the user's to fix, not a crash
+        print(f"surfmod {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

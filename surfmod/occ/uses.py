@@ -25,6 +25,14 @@ def count_faces(shape) -> int:
     return len(_explore(shape, TopAbs_FACE))
 
 
+def model_tolerance(shape) -> float:
+    """The largest edge tolerance of ``shape`` (what the writing system vouched for)."""
+    from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
+
+    with kernel("ShapeAnalysis_ShapeTolerance"):
+        return float(ShapeAnalysis_ShapeTolerance().Tolerance(shape, 1, TopAbs_EDGE))
+
+
 def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
     """Sew faces into a closed shell and make an outward-oriented solid.
 
@@ -42,7 +50,7 @@ def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
     shells = shells_of(sewed)
     if len(shells) != 1 or not BRep_Tool.IsClosed_s(shells[0]):
         raise SurfmodError(
-            f"obj: the {len(face_shapes)} faces do not sew into one closed shell "
+            f"obj: the {len(face_shapes)} faces do not sew into one closed shell at tolerance {tolerance:.3g} "
             f"(got {len(shells)} shell(s), free edges remain): volume needs a closed boundary"
         )
     with kernel("BRepBuilderAPI_MakeSolid"):
@@ -53,34 +61,50 @@ def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
     return solid
 
 
-def closed_solid(shape):
-    """A closed solid (or compound of them) for volume work; open shells are refused."""
+def _solid_of_shell(shell, what: str):
+    """A solid bounded by one shell; an open shell is sewn at the model's own tolerance
+    first (loose faces that OCCT sewing joins), and refused only if it stays open."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
     from OCP.BRepLib import BRepLib
 
+    if not BRep_Tool.IsClosed_s(shell):
+        tol = max(SEW_TOLERANCE, model_tolerance(shell))
+        try:
+            return sew_solid(_explore(shell, TopAbs_FACE), tol)
+        except SurfmodError:
+            raise SurfmodError(f"obj: {what} is not closed (free edges remain after sewing at the model's tolerance "
+                               f"{tol:.3g}): volume needs a closed boundary") from None
+    with kernel("BRepBuilderAPI_MakeSolid"):
+        solid = BRepBuilderAPI_MakeSolid(shell).Solid()
+        BRepLib.OrientClosedSolid_s(solid)
+    return solid
+
+
+def closed_solid(shape):
+    """A closed solid (or compound of them) for volume work; open shells are sewn at the
+    model's tolerance and refused if they stay open."""
     from .exchange import compound
 
     solids = solids_of(shape)
     if solids:
+        out = []
         for i, s in enumerate(solids):
-            for sh in shells_of(s):
-                if not BRep_Tool.IsClosed_s(sh):
-                    raise SurfmodError(f"obj: solid {i} has an open shell (free edges): volume needs a closed boundary")
-        return solids[0] if len(solids) == 1 else compound(solids)
+            shells = shells_of(s)
+            if all(BRep_Tool.IsClosed_s(sh) for sh in shells):
+                out.append(s)
+            elif len(shells) == 1:
+                out.append(_solid_of_shell(shells[0], f"solid {i}"))
+            else:
+                raise SurfmodError(f"obj: solid {i} has an open shell among {len(shells)} (free edges): "
+                                   "volume needs a closed boundary")
+        return out[0] if len(out) == 1 else compound(out)
     shells = shells_of(shape)
     if shells:
-        out = []
-        for i, sh in enumerate(shells):
-            if not BRep_Tool.IsClosed_s(sh):
-                raise SurfmodError(f"obj: shell {i} is not closed (free edges): volume needs a closed boundary")
-            with kernel("BRepBuilderAPI_MakeSolid"):
-                solid = BRepBuilderAPI_MakeSolid(sh).Solid()
-                BRepLib.OrientClosedSolid_s(solid)
-            out.append(solid)
+        out = [_solid_of_shell(sh, f"shell {i}") for i, sh in enumerate(shells)]
         return out[0] if len(out) == 1 else compound(out)
     faces = _explore(shape, TopAbs_FACE)
     if not faces:
-        raise SurfmodError("obj: has no faces")
+        raise SurfmodError("obj: has no faces, so no solid to measure")
     # faces that already share their edges (e.g. one periodic face: a full sphere or
     # torus closed by its own seam and poles) form a closed shell without sewing
     from OCP.BRep import BRep_Builder
@@ -92,11 +116,8 @@ def closed_solid(shape):
     for f in faces:
         builder.Add(shell, f)
     if BRep_Tool.IsClosed_s(shell):
-        with kernel("BRepBuilderAPI_MakeSolid"):
-            solid = BRepBuilderAPI_MakeSolid(shell).Solid()
-            BRepLib.OrientClosedSolid_s(solid)
-        return solid
-    return sew_solid(faces)
+        return _solid_of_shell(shell, "the shell of its faces")
+    return sew_solid(faces, max(SEW_TOLERANCE, model_tolerance(shape)))
 
 
 def gprops(shape, eps: float = 1e-9) -> dict:
@@ -177,42 +198,119 @@ def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     return uv, idx
 
 
-def face_boundary_nodes(face, order: int, pieces: int = 4):
+def _pcurve_d1(pc, t: np.ndarray) -> np.ndarray:
+    """``(N, 4)``: ``u, v, du/dt, dv/dt`` of a 2-D curve adaptor at parameters ``t``."""
+    from OCP.gp import gp_Pnt2d, gp_Vec2d
+
+    p, d = gp_Pnt2d(), gp_Vec2d()
+    out = np.empty((len(t), 4))
+    for i, ti in enumerate(t):
+        pc.D1(float(ti), p, d)
+        out[i] = (p.X(), p.Y(), d.X(), d.Y())
+    return out
+
+
+def _crossings(pc, cuts: np.ndarray, lines, coord: int, per_piece: int = 8) -> list:
+    """Parameters where a p-curve crosses the lines ``u = c`` (``coord`` 0) or ``v = c``
+    (``coord`` 1): sign changes on a sampling, refined by Newton steps."""
+    if not len(lines):
+        return []
+    a, b = cuts[:-1, None], cuts[1:, None]
+    t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
+    val = _pcurve_d1(pc, t)[:, coord]
+    out = []
+    for c in lines:
+        s = val - c
+        for i in np.nonzero(s[:-1] * s[1:] < 0)[0]:
+            lo, hi = t[i], t[i + 1]
+            x = lo + (hi - lo) * s[i] / (s[i] - s[i + 1])
+            for _ in range(4):
+                q = _pcurve_d1(pc, [x])[0]
+                if q[2 + coord] == 0.0:
+                    break
+                x = min(max(x - (q[coord] - c) / q[2 + coord], lo), hi)
+            out.append(x)
+    return out
+
+
+def face_boundary_nodes(face, order: int, pieces: int = 4, lines_u=(), lines_v=()):
     """Gauss nodes on the p-curves of a face's boundary, for Green's theorem in (u, v).
 
     Returns ``(u, v, w)`` with ``w = weight · dv/dt`` signed by the edge's orientation
     in the face, so that ``Σ w G(u, v) = ∮ G dv`` over the whole boundary (outer wire
-    and holes).  Each p-curve is split at its C2 breaks and into at least ``pieces``
+    and holes).  Each p-curve is split wherever Gauss would lose its exactness: at every
+    knot of the p-curve (``GeomAbs_CN`` intervals: a cubic's third derivative jumps at
+    simple knots), where it crosses the surface's own break lines ``u = lines_u[i]``,
+    ``v = lines_v[j]`` (the integrand is piecewise there), and into at least ``pieces``
     parts.
     """
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-    from OCP.GeomAbs import GeomAbs_C2
-    from OCP.gp import gp_Pnt2d, gp_Vec2d
+    from OCP.GeomAbs import GeomAbs_CN
     from OCP.TColStd import TColStd_Array1OfReal
 
     x, w = np.polynomial.legendre.leggauss(order)
     us, vs, ws = [], [], []
-    p, d = gp_Pnt2d(), gp_Vec2d()
     with kernel("BRepAdaptor_Curve2d (face boundary)"):
         for e in _explore(face, TopAbs_EDGE):
             edge = TopoDS.Edge_s(e)
             pc = BRepAdaptor_Curve2d(edge, face)
             f, l = pc.FirstParameter(), pc.LastParameter()
-            n = pc.NbIntervals(GeomAbs_C2)
+            n = pc.NbIntervals(GeomAbs_CN)
             arr = TColStd_Array1OfReal(1, n + 1)
-            pc.Intervals(arr, GeomAbs_C2)
+            pc.Intervals(arr, GeomAbs_CN)
             br = np.unique(np.concatenate([[arr.Value(i) for i in range(1, n + 2)], np.linspace(f, l, pieces + 1)]))
             br = br[(br >= f) & (br <= l)]
+            extra = _crossings(pc, br, lines_u, 0) + _crossings(pc, br, lines_v, 1)
+            if extra:
+                br = np.unique(np.concatenate([br, extra]))
+                br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
             a, b = br[:-1, None], br[1:, None]
             t = ((a + b) / 2 + (b - a) / 2 * x).ravel()
             wt = ((b - a) / 2 * w).ravel()
             sign = -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0
-            for ti, wi in zip(t, wt):
-                pc.D1(float(ti), p, d)
-                us.append(p.X())
-                vs.append(p.Y())
-                ws.append(sign * wi * d.Y())
-    return np.array(us), np.array(vs), np.array(ws)
+            q = _pcurve_d1(pc, t)
+            us.append(q[:, 0])
+            vs.append(q[:, 1])
+            ws.append(sign * wt * q[:, 3])
+    if not us:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    return np.concatenate(us), np.concatenate(vs), np.concatenate(ws)
+
+
+def edge_deviations(shape, samples: int = 23) -> np.ndarray:
+    """``(E, 2)``: per edge of ``shape`` the largest distance between its 3-D curve and the
+    image of its p-curve on each of its faces (``samples`` points, as ``BRepCheck`` does),
+    and the edge's length.  A model whose edges are off their faces this far bounds a
+    region only up to that distance."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    out = []
+    with kernel("edge deviations"):
+        emap = TopTools_IndexedDataMapOfShapeListOfShape()
+        TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, emap)
+        for k in range(1, emap.Extent() + 1):
+            edge = TopoDS.Edge_s(emap.FindKey(k))
+            if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
+                continue
+            c3 = BRepAdaptor_Curve(edge)
+            t = np.linspace(c3.FirstParameter(), c3.LastParameter(), samples)
+            p3 = np.array([xyz(c3.Value(float(x))) for x in t])
+            dev = 0.0
+            for f in emap.FindFromIndex(k):
+                face = TopoDS.Face_s(f)
+                pc = BRepAdaptor_Curve2d(edge, face)
+                surf = BRepAdaptor_Surface(face, False)
+                tp = np.linspace(pc.FirstParameter(), pc.LastParameter(), samples)
+                ps = np.array([xyz(surf.Value(q.X(), q.Y())) for q in (pc.Value(float(x)) for x in tp)])
+                dev = max(dev, float(np.linalg.norm(ps - p3, axis=1).max()))
+            props = GProp_GProps()
+            BRepGProp.LinearProperties_s(edge, props)
+            out.append((dev, props.Mass()))
+    return np.array(out).reshape(-1, 2)
 
 
 # -- interference -----------------------------------------------------------------------
@@ -312,7 +410,7 @@ def is_solid_like(shape) -> bool:
 
 
 __all__ = [
-    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_polyline",
+    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_deviations", "edge_polyline",
     "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "is_solid_like", "min_distance", "section_edges",
-    "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
+    "model_tolerance", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..construct.elementary import ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
+from ..construct.elementary import AnalyticPlane, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
 from ..construct.conics import Conic
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.offset import OffsetSurface
@@ -78,6 +78,8 @@ def direction_breaks(surface, direction: int):
         return "angular" if direction == 0 else _curve_breaks(surface.profile)
     if isinstance(surface, TabulatedCylinder):
         return _curve_breaks(surface.curve) if direction == 0 else None
+    if isinstance(surface, AnalyticPlane):
+        return None
     if isinstance(surface, (SphericalSurface, ToroidalSurface)):
         return "angular"
     if isinstance(surface, (CylindricalSurface, ConicalSurface)):

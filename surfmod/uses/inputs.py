@@ -14,20 +14,18 @@ from ..errors import SurfmodError
 
 
 def load_step(path, name: str = "obj"):
-    """The TopoDS shape in a STEP file; unreadable files raise ``SurfmodError``."""
-    from ..occ.exchange import read_step
+    """The TopoDS shape in a STEP file, read by :func:`surfmod.import_step` (the one STEP
+    reader); unreadable files raise ``SurfmodError`` naming ``name``."""
+    from ..io.step import import_step
 
     p = Path(os.fspath(path))
     if not p.is_file():
         raise SurfmodError(f"{name}: no such file {p}")
-    with open(p, "rb") as fh:
-        head = fh.read(256)
-    if b"ISO-10303-21" not in head:
-        raise SurfmodError(f"{name}: {p} is not a readable STEP file (no ISO-10303-21 header)")
     try:
-        return read_step(p)
+        return import_step(p).wrapped
     except SurfmodError as exc:
-        raise SurfmodError(f"{name}: {exc}") from None
+        msg = str(exc)
+        raise SurfmodError(msg if msg.startswith(name) else f"{name}: {msg.removeprefix('path: ')}") from None
 
 
 def _single(item, name):

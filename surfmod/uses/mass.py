@@ -123,26 +123,35 @@ def patch_moments(patch: Patch, ref: np.ndarray, order: int) -> np.ndarray:
     return _moments(*green_nodes(patch, order), patch.sign, ref)
 
 
-def green_nodes(patch: Patch, order: int):
+def green_nodes(patch: Patch, order: int, base: str = "left"):
     """Partials and weights for ``∫∫_D g du dv = ∮_∂D G dv`` with
     ``G(u, v) = ∫_{u0}^{u} g(s, v) ds``: Gauss on the exact p-curves of the trimming
     boundary, and for each boundary node Gauss in ``u`` from the left edge of the
-    face's box to the node, split at the patch's ``u`` break points."""
+    face's box to the node (``base="right"``: ``G = -∫_u^{u1} g ds`` from the right
+    edge), split at the patch's ``u`` break points.  On a closed boundary both bases give
+    the same integral; where the p-curves leave gaps (a model whose edges are off its
+    faces) they differ, which is how :func:`mass_properties` measures that ambiguity."""
     from ..occ.uses import face_boundary_nodes
 
-    ub, vb, wb = face_boundary_nodes(patch.face, order)
+    ub, vb, wb = face_boundary_nodes(patch.face, order, lines_u=patch.breaks_u[1:-1], lines_v=patch.breaks_v[1:-1])
     u0 = patch.bounds[0]
     if np.sum(wb * (ub - u0)) < 0:  # boundary traversed clockwise in (u, v): flip
         wb = -wb
     x, w = np.polynomial.legendre.leggauss(order)
     br = patch.breaks_u
-    a = np.clip(br[None, :-1], None, ub[:, None])  # (B, S) span starts clipped to node
-    b = np.clip(br[None, 1:], None, ub[:, None])
+    if base == "left":
+        a = np.clip(br[None, :-1], None, ub[:, None])  # (B, S) span starts clipped to node
+        b = np.clip(br[None, 1:], None, ub[:, None])
+        sign = 1.0
+    else:
+        a = np.clip(br[None, :-1], ub[:, None], None)
+        b = np.clip(br[None, 1:], ub[:, None], None)
+        sign = -1.0
     keep = b - a > 0
     bi, si = np.nonzero(keep)
     a, b = a[bi, si], b[bi, si]
     s = ((a + b)[:, None] / 2 + (b - a)[:, None] / 2 * x).ravel()
-    ws = ((b - a)[:, None] / 2 * w * wb[bi, None]).ravel()
+    ws = sign * ((b - a)[:, None] / 2 * w * wb[bi, None]).ravel()
     vv = np.repeat(vb[bi], order)
     return patch.evaluate(s, vv, 1), ws
 
@@ -221,3 +230,27 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str =
         evaluators={"numpy": sum(p.evaluator == "numpy" for p in pats), "occt": sum(p.evaluator == "occt" for p in pats)},
         error_estimate=float(est),
     )
+
+
+def boundary_ambiguity(obj) -> float:
+    """How far a solid's own data leaves its volume open, relative to the volume.
+
+    Each edge's 3-D curve and the images of its p-curves on its faces should coincide;
+    real files carry them apart by up to the edge tolerance (and beyond).  Moving a
+    boundary curve of length ``L`` by ``d`` across a face changes the enclosed volume by at
+    most ``d L r / 3`` (``r`` the half diagonal of the bounding box), so the bound is
+    ``Σ d_e L_e r / (3 V)``.  Two correct integrators may differ by up to this much.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> sm.boundary_ambiguity(bd.Box(1, 2, 3)) < 1e-12
+    True
+    """
+    from ..occ import uses as occ
+    from .inputs import to_shape
+
+    solid = to_shape(obj, "obj", solid=True)
+    box = occ.bounding_box(solid)
+    r = float(np.linalg.norm(box[1] - box[0])) / 2
+    volume = occ.gprops(solid, 1e-6)["volume"]
+    dev = occ.edge_deviations(solid)
+    return float(np.sum(dev[:, 0] * dev[:, 1]) * r / 3 / volume) if len(dev) else 0.0
