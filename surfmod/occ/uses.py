@@ -396,6 +396,30 @@ def edge_polyline(edge, n: int) -> np.ndarray:
         return np.array([xyz(c.Value(float(x))) for x in t])
 
 
+def edge_points(edge, deflection: float) -> np.ndarray:
+    """Points along an edge (in its orientation) whose chords stay within ``deflection``
+    of the curve (``GCPnts_QuasiUniformDeflection``)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.GCPnts import GCPnts_QuasiUniformDeflection
+
+    with kernel("GCPnts_QuasiUniformDeflection"):
+        c = BRepAdaptor_Curve(edge)
+        algo = GCPnts_QuasiUniformDeflection(c, float(deflection), c.FirstParameter(), c.LastParameter())
+        if not algo.IsDone():
+            raise SurfmodError("tolerance: OCCT could not discretize a section edge at this deflection")
+        pts = np.array([xyz(algo.Value(i)) for i in range(1, algo.NbPoints() + 1)])
+    return pts[::-1] if edge.Orientation() == TopAbs_REVERSED else pts
+
+
+def edge_length(edge) -> float:
+    """Length of an edge (``GCPnts_AbscissaPoint``, OCCT's own)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.GCPnts import GCPnts_AbscissaPoint
+
+    with kernel("GCPnts_AbscissaPoint.Length_s"):
+        return float(GCPnts_AbscissaPoint.Length_s(BRepAdaptor_Curve(edge), 1e-12))
+
+
 # -- files ------------------------------------------------------------------------------
 def write_brep(shape, path) -> None:
     from OCP.BRepTools import BRepTools
@@ -410,7 +434,7 @@ def is_solid_like(shape) -> bool:
 
 
 __all__ = [
-    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_deviations", "edge_polyline",
+    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_deviations", "edge_length", "edge_points", "edge_polyline",
     "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "is_solid_like", "min_distance", "section_edges",
     "model_tolerance", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]
