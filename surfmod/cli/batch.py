@@ -63,7 +63,7 @@ def _dask(job, files, options, address):
     except ImportError:  # pragma: no cover - the extra is declared in pyproject
         raise SurfmodError("scheduler: running on a cluster needs dask.distributed (pip install 'surfmod[cluster]')") from None
     try:
-        client = Client(address, timeout="10s", set_as_default=False)
+        client = Client(address, timeout="10s")
     except (OSError, TimeoutError) as exc:
         raise SurfmodError(f"scheduler: cannot reach the Dask scheduler at {address} ({exc})") from None
     try:
@@ -71,7 +71,7 @@ def _dask(job, files, options, address):
         futures = [client.submit(job, str(f), pure=False, **options) for f in files]
         for future in as_completed(futures):
             yield future.result()
-            future.release()
+            future.release()  # rows are in hand: let the cluster forget the task
     finally:
         client.close()
 
