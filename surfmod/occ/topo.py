@@ -152,6 +152,32 @@ def classify_uv(face, u, v, tolerance=None):
                         dtype=bool)
 
 
+def closest_on_face(face, points):
+    """``(distances (N,), points (N, 3))``: closest points on a trimmed face, boundary
+    included (``BRepExtrema_DistShapeShape``)."""
+    import numpy as np
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.gp import gp_Pnt
+
+    from .arrays import xyz
+
+    f = single_face(face)
+    dist = np.empty(len(points))
+    near = np.empty((len(points), 3))
+    with kernel("BRepExtrema_DistShapeShape"):
+        ext = BRepExtrema_DistShapeShape()
+        ext.LoadS1(f)
+        for i, q in enumerate(points):
+            ext.LoadS2(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, q))).Vertex())
+            ext.Perform()
+            if not ext.IsDone() or ext.NbSolution() == 0:
+                raise SurfmodError("s: OCCT found no closest point on the face")
+            dist[i] = ext.Value()
+            near[i] = xyz(ext.PointOnShape1(1))
+    return dist, near
+
+
 def face_wires_uv(face, samples: int):
     """The face's wires as ``(N, 2)`` arrays in ``(u, v)`` (outer wire first), each edge
     sampled at ``samples`` points of its p-curve in the wire's order."""

@@ -324,7 +324,9 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8) -
     ``points_or_curve``: a point ``(3,)``, points ``(..., 3)``, a surfmod curve or a
     build123d ``Edge``/``Wire`` (sampled at ``samples`` equally spaced parameters).
     Returns ``Projection(u, v, point, distance)`` with the points' leading shape.  The
-    closest point may lie on the boundary of the domain (a constrained minimum).
+    closest point may lie on the boundary of the domain (a constrained minimum).  ``s``
+    may be a build123d / OCP face or a face read back with :func:`surfmod.from_face`:
+    distances are then to the trimmed face, its boundary included.
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
@@ -332,8 +334,12 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8) -
     >>> pr.u, pr.v, pr.distance
     (array([0.25, 1.  ]), array([0.5, 0.5]), array([2., 2.]))
     """
+    from ..readback.clip import as_face_surface, project_on_face
+    from ..readback.trimmed import TrimmedFace
+
+    s = as_face_surface(s)  # a face is a trimmed surface: distances are to the face
     if not isinstance(s, Surface):
-        raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
+        raise SurfmodError(f"s: expected a surfmod Surface or a face, got {type(s).__name__}")
     samples = checks.count(samples, "samples", minimum=2)
     seeds = checks.count(seeds, "seeds", minimum=1)
     pts = _as_points(points_or_curve, samples)
@@ -343,4 +349,6 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8) -
         empty = np.empty(shape)
         return Projection(empty, empty.copy(), np.empty(shape + (3,)), empty.copy())
     u, v, p, d = closest_points(s, flat, seeds)
+    if isinstance(s, TrimmedFace):
+        u, v, p, d = project_on_face(s, flat, u, v, p, d)
     return Projection(u.reshape(shape), v.reshape(shape), p.reshape(shape + (3,)), d.reshape(shape))
