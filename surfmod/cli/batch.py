@@ -137,3 +137,60 @@ class RowSink:
         writer.writerows(self.rows)
         with atomic_path(self.csv_target) as tmp:
             Path(tmp).write_text(buf.getvalue(), encoding="utf-8")
+
+
+# -- plumbing shared by the commands that take many files ---------------------------------------
+def add_batch_arguments(parser) -> None:
+    """``--csv``, ``--scheduler`` and ``--jobs`` for a command taking ``PATH...``."""
+    parser.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
+    parser.add_argument("--scheduler", help="run on the Dask distributed scheduler at this address (tcp://host:8786)")
+    parser.add_argument("--csv", help="write one row per file to this CSV file instead of printing the table")
+
+
+MESH_COLUMNS = [("file", "<36.36"), ("triangles", ">10d"), ("watertight", "<10.10"), ("max dev", ">10.2e"),
+                ("stl", "<")]
+
+
+def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None) -> list[tuple]:
+    """Mesh one STEP file to an STL beside it (or in ``out_dir``) with the per-file mesh
+    function of ``surfmod mesh``; ``[(file, triangles, watertight, max deviation, stl or
+    error)]``."""
+    from ..io.step import import_step
+    from ..io.stl import export_stl
+
+    p = Path(path)
+    out = (Path(out_dir) / p.with_suffix(".stl").name) if out_dir else p.with_suffix(".stl")
+    try:
+        mesh = export_stl(import_step(p), out, tolerance=tolerance, ascii=ascii)
+    except SurfmodError as exc:
+        return [(str(p), 0, "-", float("nan"), f"error: {' '.join(str(exc).split())}")]
+    dev = mesh.info.get("max_deviation")
+    return [(str(p), len(mesh.faces), "yes" if mesh.to_trimesh().is_watertight else "NO",
+             float("nan") if dev is None else float(dev), str(out))]
+
+
+def run_mesh(args) -> int:
+    """``surfmod mesh PATH...`` over files and folders: one row per file."""
+    files = step_files(args.step)
+    out_dir = None
+    if args.out:
+        out_dir = Path(args.out)
+        if not out_dir.is_dir():
+            raise SurfmodError(f"out: with several files or folders --out must be an existing folder, got {out_dir}")
+    sink = RowSink(MESH_COLUMNS, args.csv)
+    bad = 0
+    options = {"tolerance": args.tolerance, "ascii": args.ascii, "out_dir": None if out_dir is None else str(out_dir)}
+    for chunk in run_batch(mesh_file, files, options=options, scheduler=args.scheduler, jobs=args.jobs,
+                           progress=not getattr(args, "no_progress", False), desc="mesh"):
+        for row in chunk:
+            sink.add((Path(row[0]).name if not args.csv else row[0], *row[1:]))
+            bad += row[4].startswith("error") or row[2] != "yes"
+    sink.close()
+    print(f"{len(files) - bad} of {len(files)} file(s) meshed watertight" + (f"; rows in {args.csv}" if args.csv else ""))
+    return 1 if bad else 0
+
+
+def is_batch(args) -> bool:
+    """True when ``surfmod mesh`` was given more than one file, a folder, ``--csv`` or ``--scheduler``."""
+    paths = args.step if isinstance(args.step, list) else [args.step]
+    return len(paths) > 1 or any(Path(p).is_dir() for p in paths) or bool(args.csv) or bool(args.scheduler)
