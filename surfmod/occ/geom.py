@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
 from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface
 
 from . import arrays
@@ -133,11 +132,3 @@ def downcast_surface(surf):
         return surf
     down = cls.DownCast(surf)
     return down if down is not None else surf
-
-
-def as_bspline_surface(surf) -> np.ndarray:
-    """Exact conversion of any analytic/Bézier surface to B-spline (GeomConvert)."""
-    from OCP.GeomConvert import GeomConvert
-
-    with kernel("GeomConvert.SurfaceToBSplineSurface_s"):
-        return GeomConvert.SurfaceToBSplineSurface_s(surf)

@@ -21,10 +21,6 @@ from .topo import explore as _explore, shells_of, solids_of
 SEW_TOLERANCE = 1e-6
 
 
-def count_faces(shape) -> int:
-    return len(_explore(shape, TopAbs_FACE))
-
-
 def model_tolerance(shape) -> float:
     """The largest edge tolerance of ``shape`` (what the writing system vouched for)."""
     from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
@@ -380,22 +376,6 @@ def wire_edges(wire):
     return out
 
 
-def is_reversed(shape) -> bool:
-    return getattr(shape, "wrapped", shape).Orientation() == TopAbs_REVERSED
-
-
-def edge_polyline(edge, n: int) -> np.ndarray:
-    """``n`` points along an edge in its orientation (OCCT ``BRepAdaptor_Curve``)."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve
-
-    with kernel("BRepAdaptor_Curve"):
-        c = BRepAdaptor_Curve(edge)
-        t = np.linspace(c.FirstParameter(), c.LastParameter(), n)
-        if edge.Orientation() == TopAbs_REVERSED:
-            t = t[::-1]
-        return np.array([xyz(c.Value(float(x))) for x in t])
-
-
 def edge_points(edge, deflection: float) -> np.ndarray:
     """Points along an edge (in its orientation) whose chords stay within ``deflection``
     of the curve (``GCPnts_QuasiUniformDeflection``)."""
@@ -429,12 +409,8 @@ def write_brep(shape, path) -> None:
             raise SurfmodError(f"path: could not write BREP {path}")
 
 
-def is_solid_like(shape) -> bool:
-    return bool(solids_of(shape))
-
-
 __all__ = [
-    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_deviations", "edge_length", "edge_points", "edge_polyline",
-    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "is_solid_like", "min_distance", "section_edges",
+    "bounding_box", "closed_solid", "common_volume", "edge_deviations", "edge_length", "edge_points",
+    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
     "model_tolerance", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]
