@@ -96,19 +96,24 @@ def gauss_nodes(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]
 
 def _moments(ders: np.ndarray, weights: np.ndarray, sign: float, ref: np.ndarray) -> np.ndarray:
     """[area, V, M(3), S(3,3)] contributions from partials at quadrature nodes."""
-    x = ders[:, 0, 0] - ref
-    n = sign * np.cross(ders[:, 1, 0], ders[:, 0, 1])
-    area = np.sum(weights * np.linalg.norm(n, axis=1))
-    vol = np.sum(weights * np.einsum("ij,ij->i", x, n)) / 3.0
-    first = np.einsum("i,ij->j", weights, x**2 * n) / 2.0
-    second = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            if i == j:
-                second[i, i] = np.sum(weights * x[:, i] ** 3 * n[:, i]) / 3.0
-            else:
-                # symmetric average of the two equivalent divergence forms
-                second[i, j] = np.sum(weights * (x[:, i] ** 2 * x[:, j] * n[:, i] + x[:, j] ** 2 * x[:, i] * n[:, j])) / 4.0
+    # (3, N) rows, contiguous: np.sum then reduces each row pairwise, which keeps the 1e-14
+    # of the closed forms (a reduction over axis 0 of (N, 3), or a BLAS dot, does not)
+    x = np.ascontiguousarray((ders[:, 0, 0] - ref).T)
+    su, sv = ders[:, 1, 0].T, ders[:, 0, 1].T
+    n = np.empty_like(x)  # sign * (Su x Sv), written out
+    n[0] = su[1] * sv[2] - su[2] * sv[1]
+    n[1] = su[2] * sv[0] - su[0] * sv[2]
+    n[2] = su[0] * sv[1] - su[1] * sv[0]
+    if sign < 0:
+        n = -n
+    area = float(np.sum(weights * np.sqrt(np.sum(n * n, axis=0))))
+    vol = float(np.sum(weights * np.sum(x * n, axis=0))) / 3.0
+    a = weights * x**2 * n  # w x_i^2 n_i, (3, N)
+    first = np.sum(a, axis=1) / 2.0
+    m = np.array([[np.sum(a[i] * x[j]) for j in range(3)] for i in range(3)])  # sum w x_i^2 n_i x_j
+    # off the diagonal: symmetric average of the two equivalent divergence forms
+    second = (m + m.T) / 4.0
+    second[np.diag_indices(3)] = np.sum(weights * x**3 * n, axis=1) / 3.0
     return np.concatenate([[area, vol], first, second.ravel()])
 
 
@@ -137,6 +142,9 @@ def green_nodes(patch: Patch, order: int, base: str = "left"):
     u0 = patch.bounds[0]
     if np.sum(wb * (ub - u0)) < 0:  # boundary traversed clockwise in (u, v): flip
         wb = -wb
+    # nodes on p-curves along v = const carry dv = 0: no inner integral needed there
+    moving = wb != 0.0
+    ub, vb, wb = ub[moving], vb[moving], wb[moving]
     x, w = np.polynomial.legendre.leggauss(order)
     br = patch.breaks_u
     if base == "left":
