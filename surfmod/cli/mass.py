@@ -30,7 +30,8 @@ def run(args) -> int:
     with tqdm(total=3, desc="mass", unit="step", disable=args.no_progress) as bar:
         solid = to_shape(args.path, "path", solid=True)
         bar.update()
-        r = mass_properties(solid, args.density)
+        # BRepGProp below is the independent check: the second quadrature pass is not needed
+        r = mass_properties(solid, args.density, estimate_error=False)
         bar.update()
         o = mass_properties(solid, args.density, method="occt", eps=args.eps)
         bar.update()

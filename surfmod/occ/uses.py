@@ -241,7 +241,7 @@ def face_boundary_nodes(face, order: int, pieces: int = 4, lines_u=(), lines_v=(
     parts.
     """
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-    from OCP.GeomAbs import GeomAbs_CN
+    from OCP.GeomAbs import GeomAbs_CN, GeomAbs_Line
     from OCP.TColStd import TColStd_Array1OfReal
 
     x, w = np.polynomial.legendre.leggauss(order)
@@ -254,7 +254,10 @@ def face_boundary_nodes(face, order: int, pieces: int = 4, lines_u=(), lines_v=(
             n = pc.NbIntervals(GeomAbs_CN)
             arr = TColStd_Array1OfReal(1, n + 1)
             pc.Intervals(arr, GeomAbs_CN)
-            br = np.unique(np.concatenate([[arr.Value(i) for i in range(1, n + 2)], np.linspace(f, l, pieces + 1)]))
+            # a straight p-curve carries a polynomial or trigonometric integrand that the
+            # break-line splits below already make smooth: one piece is enough
+            k = 1 if pc.GetType() == GeomAbs_Line else pieces
+            br = np.unique(np.concatenate([[arr.Value(i) for i in range(1, n + 2)], np.linspace(f, l, k + 1)]))
             br = br[(br >= f) & (br <= l)]
             extra = _crossings(pc, br, lines_u, 0) + _crossings(pc, br, lines_v, 1)
             if extra:
