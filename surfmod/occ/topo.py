@@ -153,8 +153,8 @@ def classify_uv(face, u, v, tolerance=None):
 
 
 def closest_on_face(face, points):
-    """``(distances (N,), points (N, 3))``: closest points on a trimmed face, boundary
-    included (``BRepExtrema_DistShapeShape``)."""
+    """``(distances (N,), points (N, 3))``: closest points on a trimmed face (or any
+    shape of faces: shell, compound), boundary included (``BRepExtrema_DistShapeShape``)."""
     import numpy as np
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
     from OCP.BRepExtrema import BRepExtrema_DistShapeShape
@@ -162,7 +162,9 @@ def closest_on_face(face, points):
 
     from .arrays import xyz
 
-    f = single_face(face)
+    f = wrapped(face)
+    if f is None or f.IsNull():
+        raise SurfmodError(f"face: expected a build123d shape or TopoDS_Shape, got {type(face).__name__}")
     dist = np.empty(len(points))
     near = np.empty((len(points), 3))
     with kernel("BRepExtrema_DistShapeShape"):
