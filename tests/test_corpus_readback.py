@@ -230,3 +230,11 @@ def test_section_quick_file(tmp_path):
 @pytest.mark.corpus
 def test_section_dxf_length_matches_occt(corpus_file, tmp_path):
     _sections_match(corpus_file, tmp_path)
+
+
+def test_open_shell_stays_refused_with_a_clear_error():
+    import build123d as bd
+
+    open_box = bd.Shell(bd.Box(1, 2, 3).faces()[:5])
+    with pytest.raises(sm.SurfmodError, match=r"obj: .*not closed .*sewing at the model's tolerance"):
+        sm.mass_properties(open_box)
