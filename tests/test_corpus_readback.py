@@ -160,10 +160,29 @@ def test_mass_matches_brepgprop(corpus_file):
     _mass_agrees(corpus_file)
 
 
+@pytest.mark.corpus
 def test_mass_command_says_when_the_model_is_ambiguous(capsys):
-    # occt_screw's thread edges lie up to 3e-4 off their faces: 4.4e-7 apart from BRepGProp
-    assert main(["mass", str(CORPUS / "occt_screw.step"), "--no-progress"]) == 3
+    # Ventilator's extrusion faces have edges up to 1.4e-2 off them: 2e-5 from BRepGProp
+    assert main(["mass", str(CORPUS / "pythonocc_Ventilator.stp"), "--no-progress"]) == 3
     assert "AMBIGUOUS MODEL" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("ambiguity, code, word", [(1e-5, 3, "AMBIGUOUS MODEL"), (1e-9, 4, "DISAGREEMENT")])
+def test_mass_command_never_prints_a_disagreement_with_exit_0(monkeypatch, capsys, ambiguity, code, word):
+    import dataclasses
+
+    import surfmod.uses.mass as mass
+
+    real = mass.mass_properties
+
+    def off_by_1e6(solid, density=1.0, **kw):
+        r = real(solid, density, **kw)
+        return r if kw.get("method") == "occt" else dataclasses.replace(r, volume=r.volume * (1 + 1e-6))
+
+    monkeypatch.setattr(mass, "mass_properties", off_by_1e6)
+    monkeypatch.setattr(mass, "boundary_ambiguity", lambda solid: ambiguity)
+    assert main(["mass", str(CORPUS / "cadquery_red_cube_blue_cylinder.step"), "--no-progress"]) == code
+    assert word in capsys.readouterr().out
 
 
 def test_open_shell_closed_by_sewing_at_the_model_tolerance():

@@ -143,6 +143,16 @@ def gprops(shape, eps: float = 1e-9) -> dict:
     }
 
 
+def vertex_mean(shape) -> np.ndarray:
+    """Mean of the shape's vertex points, visited with repeats as ``TopExp_Explorer`` does
+    (BRepGProp's rough barycentre, the reference point of its integrals); the bounding
+    box centre when the shape has no vertex (one periodic face: a full sphere)."""
+    from OCP.TopAbs import TopAbs_VERTEX
+
+    pts = [xyz(BRep_Tool.Pnt_s(TopoDS.Vertex_s(v))) for v in _explore(shape, TopAbs_VERTEX)]
+    return np.mean(pts, axis=0) if pts else bounding_box(shape).mean(axis=0)
+
+
 def bounding_box(shape) -> np.ndarray:
     """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` (optimal box)."""
     from OCP.Bnd import Bnd_Box
@@ -413,7 +423,7 @@ def write_brep(shape, path) -> None:
 
 
 __all__ = [
-    "bounding_box", "closed_solid", "common_volume", "edge_deviations", "edge_length", "edge_points",
+    "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
     "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
     "model_tolerance", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

@@ -21,8 +21,8 @@ domain:
   is the accuracy of the p-curves themselves (the edge tolerance of the part, about
   1e-7 for boolean results).
 
-Coordinates are shifted to the bounding-box centre before integrating to avoid
-cancellation.  The inertia tensor is about the centroid, ``I = ρ ∫ (|r|² E − r rᵀ) dV``
+Coordinates are shifted to the mean of the solid's vertices (BRepGProp's reference
+point) before integrating, which also avoids cancellation.  The inertia tensor is about the centroid, ``I = ρ ∫ (|r|² E − r rᵀ) dV``
 (``r`` from the centroid): diagonal ``Ixx = ρ∫(y²+z²)``, off-diagonal ``Ixy = −ρ∫xy``,
 the convention of OCCT's ``GProp_GProps.MatrixOfInertia``.
 """
@@ -208,8 +208,11 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str =
         g = occ.gprops(solid, eps)
         return MassProperties(g["volume"], g["area"], g["centroid"], density * g["inertia"], density,
                               method=f"occt BRepGProp eps={eps:g}", error_estimate=float(g["volume_error"]))
-    box = occ.bounding_box(solid)
-    ref = box.mean(axis=0)
+    # the reference point of the surface integrals: the mean of the vertices, as BRepGProp
+    # takes it.  On a boundary that closes exactly any point gives the same result; on a
+    # real file whose faces leave gaps (edges off their faces) the integrals depend on it
+    # by (shift . closure defect) / 3, so the same point makes the two comparable.
+    ref = occ.vertex_mean(solid)
     from ..surface import Surface
 
     if isinstance(obj, Surface):
