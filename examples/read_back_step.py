@@ -44,8 +44,8 @@ kinds, worst = Counter(), 0.0
 for face in shape.faces():
     s = sm.from_face(face)
     r = sm.crosscheck(face, samples=16)
-    assert r.passed, (type(s).__name__, r)
-    kinds[type(s).__name__] += 1
+    assert r.passed, (type(s.surface).__name__, r)
+    kinds[type(s.surface).__name__] += 1
     worst = max(worst, r.max_deviation)
 print(f"{len(shape.faces())} faces read back, max deviation {worst:.2e}")
 for name, n in sorted(kinds.items()):

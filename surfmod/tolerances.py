@@ -15,6 +15,27 @@
     approximates (sweeps, lofts, fits), in model units.
 ``LINEAR``
     Default modelling tolerance handed to OCCT builders (sewing, pipe shells).
+``CROSSCHECK_POSITION_RTOL``
+    Pass limit of the parametric cross-check on positions, relative to the size of the
+    geometry: both evaluators round at ``EXACT_RTOL``; a tenfold margin covers the
+    different summation orders (de Boor vs. power-basis cache).
+``CROSSCHECK_NORMAL_RTOL``
+    Pass limit on the normal deviation converted back into the derivative difference
+    that explains it (see ``check._normal_deviation``): derivatives agree to about
+    ``DERIVATIVE_RTOL``; the cross product and normalization lose up to two digits more.
+``CROSSCHECK_CURVATURE_RTOL``
+    Pass limit on curvatures relative to the largest curvature: curvature divides
+    second derivatives by ``|Su x Sv|`` (cubed for the Gaussian), losing about three
+    digits against the derivatives themselves.
+``MASS_AGREEMENT_RTOL``
+    Relative volume agreement ``surfmod mass`` demands between its quadrature and
+    ``BRepGProp`` at eps 1e-9; beyond it the command says whether the model's own
+    boundary ambiguity explains the difference, and exits non-zero either way.
+``SHORT_SPAN_RTOL``
+    Knot spans narrower than this fraction of the parameter domain are round-off, not
+    geometry (files from other systems carry spans ~1e-11 wide): derivatives there grow
+    like ``h^-k`` and curvature means nothing, so the cross-check judges only positions
+    on them and says how many samples it judged so.
 """
 
 EXACT_RTOL = 1e-12
@@ -22,6 +43,11 @@ DERIVATIVE_RTOL = 1e-10
 DEGENERATE_NORMAL = 1e-10
 GEOMETRIC_TOL = 1e-4
 LINEAR = 1e-7
+CROSSCHECK_POSITION_RTOL = 10 * EXACT_RTOL
+CROSSCHECK_NORMAL_RTOL = 1e-8
+CROSSCHECK_CURVATURE_RTOL = 1e-7
+SHORT_SPAN_RTOL = 1e-9
+MASS_AGREEMENT_RTOL = 1e-7
 
 
 def occt_derivative_rtol(degree: int) -> float:

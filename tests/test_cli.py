@@ -41,7 +41,7 @@ def test_check_exits_nonzero_on_bad_files(tmp_path, capsys):
     code = main(["check", str(tmp_path / "bad.step"), "--no-progress"])
     assert code == 1
     assert "NO" in capsys.readouterr().out
-    assert main(["check", str(tmp_path / "missing.step"), "--no-progress"]) == 2
+    assert main(["check", str(tmp_path / "missing.step"), "--no-progress"]) == 1
 
 
 def test_cadquery_step_files_read_back(tmp_path, capsys):
@@ -74,7 +74,7 @@ def test_console_script_runs_the_gallery(tmp_path):
 
 
 def test_gallery_unknown_entity(capsys):
-    assert main(["gallery", "/tmp/unused", "--only", "nope"]) == 2
+    assert main(["gallery", "/tmp/unused", "--only", "nope"]) == 1
     assert "only: unknown entities nope" in capsys.readouterr().err
 
 

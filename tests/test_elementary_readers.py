@@ -32,7 +32,7 @@ def _check_face(face):
     surf, bounds, _ = face_surface(face)
     s = sm.from_face(face)
     name = surface_type(surf)
-    assert isinstance(s, EXPECTED_CLASS[name]), (name, type(s))
+    assert isinstance(s.surface, EXPECTED_CLASS[name]), (name, type(s))
     assert np.ravel(s.domain) == pytest.approx(bounds, abs=1e-12)
     (u0, u1), (v0, v1) = s.domain
     uu, vv = (a.ravel() for a in np.meshgrid(np.linspace(u0, u1, 7), np.linspace(v0, v1, 7)))
@@ -140,7 +140,7 @@ def test_rectangular_trimmed_surface_is_unwrapped():
     trimmed = occ.rectangular_trimmed(cyl, 0.5, 2.5, -1.0, 3.0)
     face = face_from_surface(trimmed, 0.7, 2.0, 0.0, 2.0)
     s = sm.from_face(face)
-    assert isinstance(s, sm.CylindricalSurface)
+    assert isinstance(s.surface, sm.CylindricalSurface)
     assert s.domain == ((0.7, 2.0), (0.0, 2.0))
     assert sm.crosscheck(face).passed
 
@@ -164,7 +164,7 @@ def test_rectangular_trimmed_surface_is_unwrapped():
 def test_offset_surface(base, distance):
     face = face_from_surface(occ.offset_surface(base.geom(), distance), *np.ravel(base.domain))
     s = sm.from_face(face)
-    assert isinstance(s, sm.OffsetSurface)
+    assert isinstance(s.surface, sm.OffsetSurface)
     (u0, u1), (v0, v1) = s.domain
     uu, vv = (a.ravel() for a in np.meshgrid(np.linspace(u0, u1, 7), np.linspace(v0 + 0.05, v1 - 0.05, 7)))
     np.testing.assert_allclose(s.points(uu, vv), base.points(uu, vv) + distance * base.normals(uu, vv), atol=1e-13)
@@ -223,7 +223,7 @@ def test_closed_nurbs_come_back_periodic_from_step_and_still_read(tmp_path):
     assert len(shape.faces()) == 2
     for face in shape.faces():
         s = sm.from_face(face)
-        assert isinstance(s, sm.BSplineSurface) and s.rational
+        assert isinstance(s.surface, sm.BSplineSurface) and s.rational
         assert sm.crosscheck(face, samples=10).passed
 
 

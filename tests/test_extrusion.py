@@ -56,7 +56,7 @@ def test_same_parametrization_as_the_build123d_prism_face():
     edge = bd.Edge.make_spline([(0, 0, 0), (1, 2, 0), (3, -1, 0), (4, 1, 0)])
     face = bd.Face.extrude(edge, bd.Vector(0, 0.6, 0.8) * 2.5)  # BRepPrimAPI_MakePrism
     back = sm.from_face(face)
-    assert isinstance(back, sm.TabulatedCylinder)
+    assert isinstance(back.surface, sm.TabulatedCylinder)
     # BRepSweep stores the prism surface with the reversed direction and v in [-L, 0]
     np.testing.assert_allclose(back.direction, (0, -0.6, -0.8), atol=1e-15)
     assert back.v_range == pytest.approx((-2.5, 0.0))

@@ -73,7 +73,7 @@ def test_same_parametrization_as_build123d_revolve():
     edge = bd.Edge.make_spline([(1, 0, 0), (2, 0, 1), (1.5, 0, 2), (2.5, 0, 3)])
     face = bd.Face.revolve(edge, 200, bd.Axis.Z)  # BRepPrimAPI_MakeRevol
     back = sm.from_face(face)
-    assert isinstance(back, sm.RevolutionSurface)
+    assert isinstance(back.surface, sm.RevolutionSurface)
     s = sm.revolution(edge, (0, 0, 0), (0, 0, 1), 200)
     uu, vv = _grid(s.domain)
     np.testing.assert_allclose(s.points(uu, vv), surface_d0(back.geom(), uu, vv), atol=1e-12)

@@ -88,13 +88,14 @@ def test_dxf_svg_png_round_trip(tmp_path):
     import ezdxf
 
     s = sm.section(bd.Box(2, 3, 4) - bd.Cylinder(0.5, 5), (0, 0, 0.5), (0, 0, 1))
-    assert sm.export_dxf(s, tmp_path / "s.dxf") == 2
-    doc = ezdxf.readfile(tmp_path / "s.dxf")
-    polys = doc.modelspace().query("LWPOLYLINE")
-    assert len(polys) == 2 and all(p.closed for p in polys)
-    pts = [np.array([q[:2] for q in p.get_points()]) for p in polys]
-    box = max(pts, key=lambda a: np.ptp(a[:, 0]))
-    assert np.allclose(np.ptp(box, axis=0), (2, 3), atol=1e-12)
+    # exact entities: the box's four sides as LINEs, the hole as one CIRCLE
+    assert sm.export_dxf(s, tmp_path / "s.dxf") == 5
+    msp = ezdxf.readfile(tmp_path / "s.dxf").modelspace()
+    lines, circles = msp.query("LINE"), msp.query("CIRCLE")
+    assert len(lines) == 4 and len(circles) == 1
+    ends = np.array([[*ln.dxf.start][:2] for ln in lines] + [[*ln.dxf.end][:2] for ln in lines])
+    np.testing.assert_allclose(np.ptp(ends, axis=0), (2, 3), atol=1e-12)
+    assert circles[0].dxf.radius == 0.5 and np.allclose([*circles[0].dxf.center][:2], 0.0, atol=1e-12)
     # 3-D polylines pass through as POLYLINE entities
     assert sm.export_dxf([s.polylines[0]], tmp_path / "p3.dxf") == 1
     assert len(ezdxf.readfile(tmp_path / "p3.dxf").modelspace().query("POLYLINE")) == 1

@@ -23,16 +23,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    from ..errors import DamagedFileError, SurfmodError
+    from ..errors import SurfmodError
 
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.run(args) or 0)
     except SurfmodError as exc:
-        # one line, no traceback: 1 when an input file is damaged, 2 for a bad argument
-        print(f"surfmod {args.command}: error: {exc}", file=sys.stderr)
-        return 1 if isinstance(exc, DamagedFileError) else 2
+        # one line, no traceback: bad input is the user's to fix, not a crash
+        print(f"surfmod {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

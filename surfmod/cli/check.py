@@ -1,70 +1,75 @@
-"""``surfmod check PATH...``: read every face of STEP files back and cross-check it."""
+"""``surfmod check PATH...``: read every face of STEP files (or folders of them) back and
+cross-check it against OCCT; one row per face, streamed, or ``--csv FILE``."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..errors import SurfmodError
+from .batch import RowSink, run_batch, step_files
+
+COLUMNS = [("file", "<36.36"), ("face", ">5d"), ("surface type", "<30.30"), ("max dev", ">10.2e"),
+           ("pass", "<4.4"), ("note", "<")]
 
 
 def register(sub) -> None:
     p = sub.add_parser("check", help="cross-check every face of STEP files (or folders of them) against OCCT")
-    p.add_argument("paths", nargs="+", help="STEP files or folders")
+    p.add_argument("paths", nargs="+", help="STEP files or folders (searched recursively for .step/.stp)")
     p.add_argument("--samples", type=int, default=24, help="samples per parameter direction (default 24)")
-    p.add_argument("--jobs", type=int, default=-1, help="worker processes (default: all cores)")
+    p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
+    p.add_argument("--scheduler", help="run on the Dask distributed scheduler at this address (tcp://host:8786)")
+    p.add_argument("--csv", help="write the rows to this CSV file instead of printing the table")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(run=run)
 
 
-def step_files(paths) -> list[Path]:
-    out = []
-    for raw in paths:
-        p = Path(raw)
-        if p.is_dir():
-            out.extend(sorted(q for q in p.rglob("*") if q.suffix.lower() in (".step", ".stp")))
-        elif p.exists():
-            out.append(p)
-        else:
-            raise SurfmodError(f"paths: {p} does not exist")
-    if not out:
-        raise SurfmodError("paths: no STEP files found")
-    return out
+def _note(result) -> str:
+    """What failed, with the measured figure and its limit; what was not judged."""
+    details = result.details
+    parts = [f"{k} {v:.2e} > {lim:.1e}" for k, (v, lim) in details.get("failed", {}).items()]
+    if not result.passed and not parts and "tolerance" in details:
+        parts.append(f"deviation {result.max_deviation:.2e} > {details['tolerance']:.1e}")
+    if details.get("short_span_points"):
+        parts.append(f"{details['short_span_points']} samples on round-off-wide knot spans: position only")
+    return "; ".join(parts)
 
 
-def check_file(path: Path, samples: int) -> list[tuple]:
-    """``[(file, face index, surface type, max deviation, passed, note), ...]``."""
-    from ..construct.from_face import from_face
+def check_file(path, samples: int = 24) -> list[tuple]:
+    """``[(file, face index, surface type, max deviation, passed, note), ...]`` for one
+    STEP file; an unreadable file is one row with face index -1."""
     from ..check import crosscheck
     from ..io.step import import_step
     from ..occ.geom import surface_type
     from ..occ.topo import face_surface, faces_of
+    from ..readback import from_face
 
+    name = str(path)
     try:
         shape = import_step(path)
     except SurfmodError as exc:
-        return [(str(path), -1, "-", float("nan"), False, str(exc))]
+        return [(name, -1, "-", float("nan"), False, str(exc))]
     rows = []
     for i, face in enumerate(faces_of(shape)):
+        kind = "-"
         try:
             kind = surface_type(face_surface(face)[0])
             r = crosscheck(from_face(face), samples=samples)
-            rows.append((str(path), i, kind, r.max_deviation, r.passed, ""))
+            rows.append((name, i, kind, r.max_deviation, r.passed, _note(r)))
         except SurfmodError as exc:
-            rows.append((str(path), i, locals().get("kind", "-"), float("nan"), False, str(exc)))
+            rows.append((name, i, kind, float("nan"), False, str(exc)))
     return rows
 
 
 def run(args) -> int:
-    from joblib import Parallel, delayed
-    from tqdm import tqdm
-
     files = step_files(args.paths)
-    jobs = args.jobs if len(files) > 1 else 1
-    results = Parallel(n_jobs=jobs, return_as="generator")(delayed(check_file)(f, args.samples) for f in files)
-    rows = [row for chunk in tqdm(results, total=len(files), desc="check", unit="file", disable=args.no_progress) for row in chunk]
-    print(f"{'file':<40} {'face':>4}  {'surface type':<34} {'max dev':>10}  pass")
-    for f, i, kind, dev, ok, note in rows:
-        print(f"{Path(f).name:<40.40} {i:>4}  {kind:<34.34} {dev:>10.2e}  {'yes' if ok else 'NO'}" + (f"  ({note})" if note else ""))
-    bad = sum(1 for r in rows if not r[4])
-    print(f"\n{len(rows) - bad} of {len(rows)} faces passed")
+    sink = RowSink(COLUMNS, args.csv)
+    faces = bad = 0
+    for chunk in run_batch(check_file, files, options={"samples": args.samples}, scheduler=args.scheduler,
+                           jobs=args.jobs, progress=not args.no_progress, desc="check"):
+        for f, i, kind, dev, ok, note in chunk:
+            sink.add((Path(f).name if not args.csv else f, i, kind, dev, "yes" if ok else "NO", note))
+            faces += 1
+            bad += not ok
+    sink.close()
+    print(f"{faces - bad} of {faces} faces passed in {len(files)} file(s)" + (f"; rows in {args.csv}" if args.csv else ""))
     return 1 if bad else 0

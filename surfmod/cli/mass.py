@@ -1,6 +1,14 @@
-"""``surfmod mass FILE.step``: volume, area, centroid and inertia of a STEP solid."""
+"""``surfmod mass FILE.step``: volume, area, centroid and inertia of a STEP solid, checked
+against ``BRepGProp``; a disagreement is never printed with exit code 0."""
 
 from __future__ import annotations
+
+from .. import tolerances
+
+#: exit code when surfmod and BRepGProp differ by less than the model's own ambiguity
+EXIT_AMBIGUOUS = 3
+#: exit code when they differ by more (a real disagreement)
+EXIT_DISAGREE = 4
 
 
 def register(sub) -> None:
@@ -17,18 +25,29 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from ..uses.inputs import to_shape
-    from ..uses.mass import mass_properties
+    from ..uses.mass import boundary_ambiguity, mass_properties
 
     with tqdm(total=3, desc="mass", unit="step", disable=args.no_progress) as bar:
         solid = to_shape(args.path, "path", solid=True)
         bar.update()
-        r = mass_properties(solid, args.density)
+        # BRepGProp below is the independent check: the second quadrature pass is not needed
+        r = mass_properties(solid, args.density, estimate_error=False)
         bar.update()
         o = mass_properties(solid, args.density, method="occt", eps=args.eps)
         bar.update()
     print(r)
     scale = max(abs(o.inertia).max(), 1e-300)
-    print(f"BRepGProp (eps={args.eps:g}) relative differences: volume {abs(r.volume - o.volume) / o.volume:.2e}, "
+    dv = abs(r.volume - o.volume) / o.volume
+    print(f"BRepGProp (eps={args.eps:g}) relative differences: volume {dv:.2e}, "
           f"area {abs(r.area - o.area) / o.area:.2e}, centroid {np.abs(r.centroid - o.centroid).max():.2e}, "
           f"inertia {np.abs(r.inertia - o.inertia).max() / scale:.2e}")
-    return 0
+    if dv <= tolerances.MASS_AGREEMENT_RTOL:
+        return 0
+    amb = boundary_ambiguity(solid)
+    if amb >= dv:
+        print(f"AMBIGUOUS MODEL: the volumes differ by {dv:.2e} (more than {tolerances.MASS_AGREEMENT_RTOL:g}) and the "
+              f"model's edges lie off its faces enough to leave the volume open by up to {amb:.2e} (relative); "
+              "the file cannot settle the volume closer than that")
+        return EXIT_AMBIGUOUS
+    print(f"DISAGREEMENT: the volumes differ by {dv:.2e}, more than the model's own ambiguity {amb:.2e}")
+    return EXIT_DISAGREE

@@ -4,19 +4,27 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .batch import add_batch_arguments, is_batch, run_mesh
+
 
 def register(sub) -> None:
     p = sub.add_parser("mesh", help="tessellate a STEP file to a watertight STL within a chordal tolerance")
-    p.add_argument("step", help="input STEP file")
+    p.add_argument("step", nargs="+", help="input STEP file(s) or folders (searched recursively for .step/.stp)")
     p.add_argument("--tolerance", type=float, default=0.01, help="max chordal deviation (model units, default 0.01)")
-    p.add_argument("--out", help="output STL (default: beside the input)")
+    p.add_argument("--out", help="output STL (default: beside the input); with several files a folder")
     p.add_argument("--ascii", action="store_true", help="ASCII STL instead of binary")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    add_batch_arguments(p)
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
     from ..io.step import import_step
     from ..io.stl import export_stl
+
+    if is_batch(args):
+        return run_mesh(args)
+    args.step = args.step[0]
 
     shape = import_step(args.step)
     out = Path(args.out) if args.out else Path(args.step).with_suffix(".stl")

@@ -1,7 +1,7 @@
 """Offsets as B-splines, with a pre-check that says where they would fail, and thickening.
 
 ``offset(s, d, tolerance)`` approximates the exact offset ``S + d N`` (surfmod's
-:class:`~surfmod.construct.readers_elementary.OffsetSurface`, OCCT's
+:class:`~surfmod.construct.offset_surface.OffsetSurface`, OCCT's
 ``Geom_OffsetSurface``) by a bicubic B-spline in the base surface's own parameters:
 least squares on a tensor grid (separable, one solve per direction), then knots are
 inserted in the middle of every span whose error at the span midpoints exceeds the
@@ -173,7 +173,7 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
     >>> o.max_deviation < 1e-6, round(float(np.linalg.norm(o.points(0.7, 1.0)[:2])), 6)
     (True, 2.5)
     """
-    from .readers_elementary import OffsetSurface
+    from .offset_surface import OffsetSurface
 
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")

@@ -73,7 +73,7 @@ def _cone():
 
 @entry("offset", "offset surface S + dN", "sm.OffsetSurface(surface, d)")
 def _offset():
-    from ..construct.readers_elementary import OffsetSurface
+    from ..construct.offset_surface import OffsetSurface
     from ..nets.bspline import BSplineSurface
     from .synthetic import wavy_net
 

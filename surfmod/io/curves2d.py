@@ -1,25 +1,32 @@
-"""Gather polylines for the 2-D exporters (DXF, SVG) from sections, curves or arrays."""
+"""Gather polylines for the 2-D exporters (DXF, SVG) from sections, curves or arrays.
+
+A section is recognized by what it offers (``polylines_2d`` and ``closed``), not by its
+class, so this low-level module does not depend on ``surfmod.uses``.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
 from .. import checks
+from ..curve import Curve
 from ..errors import SurfmodError
 
 
-def polylines_of(obj, name: str = "curves", samples: int = 128) -> tuple[list[np.ndarray], list[bool]]:
-    """``(polylines, closed)``: a :class:`~surfmod.uses.section.Section` gives its curves in
-    the plane frame ``(N, 2)``; surfmod curves are sampled in 3-D; arrays ``(N, 2)`` or
-    ``(N, 3)`` pass through.  Lists may mix these."""
-    from ..curve import Curve
-    from ..uses.section import Section
+def is_section(item) -> bool:
+    """True for objects shaped like :class:`surfmod.uses.section.Section`."""
+    return hasattr(item, "polylines_2d") and hasattr(item, "closed") and hasattr(item, "wires")
 
+
+def polylines_of(obj, name: str = "curves", samples: int = 128, tolerance: float | None = None):
+    """``(polylines, closed)``: a section gives its curves in the plane frame ``(N, 2)``
+    (within ``tolerance`` of the exact edges when given); surfmod curves are sampled in
+    3-D; arrays ``(N, 2)`` or ``(N, 3)`` pass through.  Lists may mix these."""
     items = obj if isinstance(obj, (list, tuple)) else [obj]
     polys, closed = [], []
     for k, item in enumerate(items):
-        if isinstance(item, Section):
-            polys.extend(item.polylines_2d())
+        if is_section(item):
+            polys.extend(item.polylines_2d(tolerance))
             closed.extend(item.closed)
         elif isinstance(item, Curve):
             t0, t1 = item.domain

@@ -132,4 +132,3 @@ def downcast_surface(surf):
         return surf
     down = cls.DownCast(surf)
     return down if down is not None else surf
-

@@ -61,20 +61,11 @@ def curve_d2(curve, t: np.ndarray) -> np.ndarray:
 
 
 def distances_to_face(face_shape, points: np.ndarray) -> np.ndarray:
-    """Distance from each point to a TopoDS face (``BRepExtrema_DistShapeShape``)."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    """Distance from each point to a TopoDS face, boundary included
+    (``BRepExtrema_DistShapeShape``; see :func:`surfmod.occ.topo.closest_on_face`)."""
+    from .topo import closest_on_face
 
-    out = np.empty(len(points))
-    with kernel("BRepExtrema_DistShapeShape"):
-        dist = BRepExtrema_DistShapeShape()
-        dist.LoadS1(face_shape)
-        for a, q in enumerate(points):
-            vertex = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, q))).Vertex()
-            dist.LoadS2(vertex)
-            dist.Perform()
-            out[a] = dist.Value() if dist.IsDone() else np.inf
-    return out
+    return closest_on_face(face_shape, np.asarray(points, dtype=float).reshape(-1, 3))[0]
 
 
 def distances_to_surface(surf, points: np.ndarray, bounds) -> np.ndarray:

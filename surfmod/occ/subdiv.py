@@ -5,13 +5,11 @@ from __future__ import annotations
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
-from OCP.TopAbs import TopAbs_SHELL
-from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 from ..errors import KernelError
 from .guard import check_done, kernel
-from .topo import wrapped
+from .topo import shells_of, wrapped
 
 
 def sew(faces, tolerance: float):
@@ -29,15 +27,6 @@ def sew(faces, tolerance: float):
             "degenerated_shapes": sewing.NbDegeneratedShapes(),
         }
     return shape, info
-
-
-def shells_of(shape):
-    out = []
-    explorer = TopExp_Explorer(shape, TopAbs_SHELL)
-    while explorer.More():
-        out.append(TopoDS.Shell_s(explorer.Current()))
-        explorer.Next()
-    return out
 
 
 def shell(faces, tolerance: float):

@@ -50,8 +50,14 @@ def _single(obj, kind: str):
     return shape
 
 
+def single_face(face):
+    """The ``TopoDS_Face`` of a build123d or OCP face; anything else raises ``SurfmodError``."""
+    return TopoDS.Face_s(_single(face, "Face"))
+
+
 def face_surface(face):
-    """``(Geom_Surface, (u0, u1, v0, v1), reversed)`` of a build123d or OCP face."""
+    """``(Geom_Surface, (u0, u1, v0, v1), reversed)`` of a build123d or OCP face (the
+    surface with the face's location applied)."""
     from OCP.BRepTools import BRepTools
     from OCP.TopAbs import TopAbs_REVERSED
 
@@ -75,19 +81,133 @@ def curve_of_edge(edge):
         return curve, t0, t1
 
 
+def explore(shape, kind):
+    """Sub-shapes of one ``TopAbs`` kind, in exploration order (with repeats, as OCCT)."""
+    from OCP.TopExp import TopExp_Explorer
+
+    out = []
+    explorer = TopExp_Explorer(shape, kind)
+    while explorer.More():
+        out.append(explorer.Current())
+        explorer.Next()
+    return out
+
+
 def faces_of(shape):
     """All faces of a shape (build123d object or TopoDS_Shape), in exploration order."""
     from OCP.TopAbs import TopAbs_FACE
-    from OCP.TopExp import TopExp_Explorer
 
     shp = wrapped(shape)
     if shp is None:
         raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
+    return [TopoDS.Face_s(f) for f in explore(shp, TopAbs_FACE)]
+
+
+def solids_of(shape):
+    from OCP.TopAbs import TopAbs_SOLID
+
+    return [TopoDS.Solid_s(s) for s in explore(shape, TopAbs_SOLID)]
+
+
+def shells_of(shape):
+    from OCP.TopAbs import TopAbs_SHELL
+
+    return [TopoDS.Shell_s(s) for s in explore(shape, TopAbs_SHELL)]
+
+
+def transformed_face(face, matrix):
+    """A face mapped by a 4x4 affine matrix: ``BRepBuilderAPI_Transform`` for
+    similarities (the surface type is kept), ``BRepBuilderAPI_GTransform`` otherwise."""
+    import numpy as np
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_GTransform, BRepBuilderAPI_Transform
+    from OCP.gp import gp_GTrsf, gp_Mat, gp_XYZ
+
+    from .. import transforms
+    from .analytic import trsf
+
+    m = transforms.affine(matrix)
+    shape = single_face(face)
+    with kernel("BRepBuilderAPI_Transform"):
+        if transforms.is_similarity(m) and np.linalg.det(m[:3, :3]) > 0:
+            out = BRepBuilderAPI_Transform(shape, trsf(m), True).Shape()
+        else:
+            g = gp_GTrsf(gp_Mat(*map(float, m[:3, :3].ravel())), gp_XYZ(*map(float, m[:3, 3])))
+            out = BRepBuilderAPI_GTransform(shape, g, True).Shape()
+        return TopoDS.Face_s(out)
+
+
+def classify_uv(face, u, v, tolerance=None):
+    """Boolean array: ``(u[i], v[i])`` inside the face or on its boundary
+    (``BRepTopAdaptor_FClass2d`` at ``tolerance``, default the face's own tolerance)."""
+    import numpy as np
+    from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
+    from OCP.gp import gp_Pnt2d
+    from OCP.TopAbs import TopAbs_OUT
+
+    f = single_face(face)
+    with kernel("BRepTopAdaptor_FClass2d"):
+        tol = BRep_Tool.Tolerance_s(f) if tolerance is None else float(tolerance)
+        classifier = BRepTopAdaptor_FClass2d(f, tol)
+        return np.array([classifier.Perform(gp_Pnt2d(float(a), float(b)), False) != TopAbs_OUT for a, b in zip(u, v)],
+                        dtype=bool)
+
+
+def closest_on_face(face, points):
+    """``(distances (N,), points (N, 3))``: closest points on a trimmed face (or any
+    shape of faces: shell, compound), boundary included (``BRepExtrema_DistShapeShape``)."""
+    import numpy as np
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.gp import gp_Pnt
+
+    from .arrays import xyz
+
+    f = wrapped(face)
+    if f is None or f.IsNull():
+        raise SurfmodError(f"face: expected a build123d shape or TopoDS_Shape, got {type(face).__name__}")
+    dist = np.empty(len(points))
+    near = np.empty((len(points), 3))
+    with kernel("BRepExtrema_DistShapeShape"):
+        ext = BRepExtrema_DistShapeShape()
+        ext.LoadS1(f)
+        for i, q in enumerate(points):
+            ext.LoadS2(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, q))).Vertex())
+            ext.Perform()
+            if not ext.IsDone() or ext.NbSolution() == 0:
+                raise SurfmodError("s: OCCT found no closest point on the face")
+            dist[i] = ext.Value()
+            near[i] = xyz(ext.PointOnShape1(1))
+    return dist, near
+
+
+def face_wires_uv(face, samples: int):
+    """The face's wires as ``(N, 2)`` arrays in ``(u, v)`` (outer wire first), each edge
+    sampled at ``samples`` points of its p-curve in the wire's order."""
+    import numpy as np
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
+    from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
+
+    f = single_face(face)
     out = []
-    explorer = TopExp_Explorer(shp, TopAbs_FACE)
-    while explorer.More():
-        out.append(TopoDS.Face_s(explorer.Current()))
-        explorer.Next()
+    with kernel("BRepAdaptor_Curve2d (face wires)"):
+        outer = BRepTools.OuterWire_s(f)
+        wires = [TopoDS.Wire_s(w) for w in explore(f, TopAbs_WIRE)]
+        wires.sort(key=lambda w: not w.IsSame(outer))
+        for w in wires:
+            pts = []
+            ex = BRepTools_WireExplorer(w, f)
+            while ex.More():
+                edge = ex.Current()
+                pc = BRepAdaptor_Curve2d(edge, f)
+                t = np.linspace(pc.FirstParameter(), pc.LastParameter(), samples)
+                if edge.Orientation() == TopAbs_REVERSED:
+                    t = t[::-1]
+                q = np.array([(p.X(), p.Y()) for p in (pc.Value(float(x)) for x in t)])
+                pts.append(q if not pts else q[1:])
+                ex.Next()
+            if pts:
+                out.append(np.concatenate(pts))
     return out
 
 

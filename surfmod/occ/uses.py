@@ -10,36 +10,23 @@ from __future__ import annotations
 
 import numpy as np
 from OCP.BRep import BRep_Tool
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS
 
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import check_done, kernel
+from .topo import explore as _explore, shells_of, solids_of
 
 SEW_TOLERANCE = 1e-6
 
 
-def _explore(shape, kind):
-    out = []
-    explorer = TopExp_Explorer(shape, kind)
-    while explorer.More():
-        out.append(explorer.Current())
-        explorer.Next()
-    return out
+def model_tolerance(shape) -> float:
+    """The largest edge tolerance of ``shape`` (what the writing system vouched for)."""
+    from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 
-
-def solids_of(shape):
-    return [TopoDS.Solid_s(s) for s in _explore(shape, TopAbs_SOLID)]
-
-
-def shells_of(shape):
-    return [TopoDS.Shell_s(s) for s in _explore(shape, TopAbs_SHELL)]
-
-
-def count_faces(shape) -> int:
-    return len(_explore(shape, TopAbs_FACE))
+    with kernel("ShapeAnalysis_ShapeTolerance"):
+        return float(ShapeAnalysis_ShapeTolerance().Tolerance(shape, 1, TopAbs_EDGE))
 
 
 def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
@@ -59,7 +46,7 @@ def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
     shells = shells_of(sewed)
     if len(shells) != 1 or not BRep_Tool.IsClosed_s(shells[0]):
         raise SurfmodError(
-            f"obj: the {len(face_shapes)} faces do not sew into one closed shell "
+            f"obj: the {len(face_shapes)} faces do not sew into one closed shell at tolerance {tolerance:.3g} "
             f"(got {len(shells)} shell(s), free edges remain): volume needs a closed boundary"
         )
     with kernel("BRepBuilderAPI_MakeSolid"):
@@ -70,34 +57,50 @@ def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
     return solid
 
 
-def closed_solid(shape):
-    """A closed solid (or compound of them) for volume work; open shells are refused."""
+def _solid_of_shell(shell, what: str):
+    """A solid bounded by one shell; an open shell is sewn at the model's own tolerance
+    first (loose faces that OCCT sewing joins), and refused only if it stays open."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
     from OCP.BRepLib import BRepLib
 
+    if not BRep_Tool.IsClosed_s(shell):
+        tol = max(SEW_TOLERANCE, model_tolerance(shell))
+        try:
+            return sew_solid(_explore(shell, TopAbs_FACE), tol)
+        except SurfmodError:
+            raise SurfmodError(f"obj: {what} is not closed (free edges remain after sewing at the model's tolerance "
+                               f"{tol:.3g}): volume needs a closed boundary") from None
+    with kernel("BRepBuilderAPI_MakeSolid"):
+        solid = BRepBuilderAPI_MakeSolid(shell).Solid()
+        BRepLib.OrientClosedSolid_s(solid)
+    return solid
+
+
+def closed_solid(shape):
+    """A closed solid (or compound of them) for volume work; open shells are sewn at the
+    model's tolerance and refused if they stay open."""
     from .exchange import compound
 
     solids = solids_of(shape)
     if solids:
+        out = []
         for i, s in enumerate(solids):
-            for sh in shells_of(s):
-                if not BRep_Tool.IsClosed_s(sh):
-                    raise SurfmodError(f"obj: solid {i} has an open shell (free edges): volume needs a closed boundary")
-        return solids[0] if len(solids) == 1 else compound(solids)
+            shells = shells_of(s)
+            if all(BRep_Tool.IsClosed_s(sh) for sh in shells):
+                out.append(s)
+            elif len(shells) == 1:
+                out.append(_solid_of_shell(shells[0], f"solid {i}"))
+            else:
+                raise SurfmodError(f"obj: solid {i} has an open shell among {len(shells)} (free edges): "
+                                   "volume needs a closed boundary")
+        return out[0] if len(out) == 1 else compound(out)
     shells = shells_of(shape)
     if shells:
-        out = []
-        for i, sh in enumerate(shells):
-            if not BRep_Tool.IsClosed_s(sh):
-                raise SurfmodError(f"obj: shell {i} is not closed (free edges): volume needs a closed boundary")
-            with kernel("BRepBuilderAPI_MakeSolid"):
-                solid = BRepBuilderAPI_MakeSolid(sh).Solid()
-                BRepLib.OrientClosedSolid_s(solid)
-            out.append(solid)
+        out = [_solid_of_shell(sh, f"shell {i}") for i, sh in enumerate(shells)]
         return out[0] if len(out) == 1 else compound(out)
     faces = _explore(shape, TopAbs_FACE)
     if not faces:
-        raise SurfmodError("obj: has no faces")
+        raise SurfmodError("obj: has no faces, so no solid to measure")
     # faces that already share their edges (e.g. one periodic face: a full sphere or
     # torus closed by its own seam and poles) form a closed shell without sewing
     from OCP.BRep import BRep_Builder
@@ -109,11 +112,8 @@ def closed_solid(shape):
     for f in faces:
         builder.Add(shell, f)
     if BRep_Tool.IsClosed_s(shell):
-        with kernel("BRepBuilderAPI_MakeSolid"):
-            solid = BRepBuilderAPI_MakeSolid(shell).Solid()
-            BRepLib.OrientClosedSolid_s(solid)
-        return solid
-    return sew_solid(faces)
+        return _solid_of_shell(shell, "the shell of its faces")
+    return sew_solid(faces, max(SEW_TOLERANCE, model_tolerance(shape)))
 
 
 def gprops(shape, eps: float = 1e-9) -> dict:
@@ -143,6 +143,16 @@ def gprops(shape, eps: float = 1e-9) -> dict:
     }
 
 
+def vertex_mean(shape) -> np.ndarray:
+    """Mean of the shape's vertex points, visited with repeats as ``TopExp_Explorer`` does
+    (BRepGProp's rough barycentre, the reference point of its integrals); the bounding
+    box centre when the shape has no vertex (one periodic face: a full sphere)."""
+    from OCP.TopAbs import TopAbs_VERTEX
+
+    pts = [xyz(BRep_Tool.Pnt_s(TopoDS.Vertex_s(v))) for v in _explore(shape, TopAbs_VERTEX)]
+    return np.mean(pts, axis=0) if pts else bounding_box(shape).mean(axis=0)
+
+
 def bounding_box(shape) -> np.ndarray:
     """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` (optimal box)."""
     from OCP.Bnd import Bnd_Box
@@ -155,34 +165,7 @@ def bounding_box(shape) -> np.ndarray:
 
 
 # -- per-face data for the NumPy quadrature ---------------------------------------------
-def _elementary(surf, name):
-    """Frame and radii of an OCCT elementary surface, or None."""
-    import OCP.Geom as G
-
-    cls = getattr(G, name, None)
-    s = cls.DownCast(surf) if cls is not None and hasattr(cls, "DownCast") else surf
-    if name not in ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface",
-                    "Geom_SphericalSurface", "Geom_ToroidalSurface"):
-        return None
-    ax = s.Position()
-    data = {
-        "origin": xyz(ax.Location()),
-        "x": xyz(ax.XDirection()),
-        "y": xyz(ax.YDirection()),
-        "z": xyz(ax.Direction()),
-    }
-    if name == "Geom_CylindricalSurface":
-        data["radius"] = s.Radius()
-    elif name == "Geom_SphericalSurface":
-        data["radius"] = s.Radius()
-    elif name == "Geom_ConicalSurface":
-        data["radius"], data["angle"] = s.RefRadius(), s.SemiAngle()
-    elif name == "Geom_ToroidalSurface":
-        data["major"], data["minor"] = s.MajorRadius(), s.MinorRadius()
-    return data
-
-
-def _is_rectangle(face, bounds) -> bool:
+def is_rectangle(face, bounds) -> bool:
     """True when every edge's p-curve lies on the border of the face's UV box (one wire)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 
@@ -203,50 +186,6 @@ def _is_rectangle(face, bounds) -> bool:
     return True
 
 
-def face_records(shape) -> list[dict]:
-    """One record per face: OCCT surface (unwrapped from rectangular trims), its type,
-    UV bounds, orientation, whether the face is its full UV rectangle, B-spline knots
-    and elementary-surface data."""
-    from OCP.BRepTools import BRepTools
-
-    from .geom import downcast_surface, surface_type
-
-    out = []
-    for i, f in enumerate(_explore(shape, TopAbs_FACE)):
-        face = TopoDS.Face_s(f)
-        with kernel(f"obj: face {i}"):
-            surf = BRep_Tool.Surface_s(face)
-            while surface_type(surf) == "Geom_RectangularTrimmedSurface":
-                surf = downcast_surface(surf).BasisSurface()
-            name = surface_type(surf)
-            bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
-            rec = {
-                "index": i,
-                "face": face,
-                "geom": downcast_surface(surf),
-                "kind": name,
-                "bounds": bounds,
-                "reversed": face.Orientation() == TopAbs_REVERSED,
-                "natural": _is_rectangle(face, bounds),
-                "elementary": _elementary(surf, name),
-                "knots": None,
-            }
-            if name in ("Geom_BSplineSurface", "Geom_BezierSurface"):
-                g = rec["geom"]
-                if name == "Geom_BSplineSurface":
-                    uk = [g.UKnot(k) for k in range(1, g.NbUKnots() + 1)]
-                    vk = [g.VKnot(k) for k in range(1, g.NbVKnots() + 1)]
-                    rec["knots"] = (np.array(uk), np.array(vk))
-                    rec["degree"] = (g.UDegree(), g.VDegree())
-                    rec["rational"] = g.IsURational() or g.IsVRational()
-                else:
-                    rec["knots"] = (np.array([0.0, 1.0]), np.array([0.0, 1.0]))
-                    rec["degree"] = (g.UDegree(), g.VDegree())
-                    rec["rational"] = g.IsURational() or g.IsVRational()
-        out.append(rec)
-    return out
-
-
 def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
     face (the face's trimmed parameter region as a polygonal patchwork)."""
@@ -265,67 +204,122 @@ def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     return uv, idx
 
 
-def face_boundary_nodes(face, order: int, pieces: int = 4):
+def _pcurve_d1(pc, t: np.ndarray) -> np.ndarray:
+    """``(N, 4)``: ``u, v, du/dt, dv/dt`` of a 2-D curve adaptor at parameters ``t``."""
+    from OCP.gp import gp_Pnt2d, gp_Vec2d
+
+    p, d = gp_Pnt2d(), gp_Vec2d()
+    out = np.empty((len(t), 4))
+    for i, ti in enumerate(t):
+        pc.D1(float(ti), p, d)
+        out[i] = (p.X(), p.Y(), d.X(), d.Y())
+    return out
+
+
+def _crossings(pc, cuts: np.ndarray, lines, coord: int, per_piece: int = 8) -> list:
+    """Parameters where a p-curve crosses the lines ``u = c`` (``coord`` 0) or ``v = c``
+    (``coord`` 1): sign changes on a sampling, refined by Newton steps."""
+    if not len(lines):
+        return []
+    a, b = cuts[:-1, None], cuts[1:, None]
+    t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
+    val = _pcurve_d1(pc, t)[:, coord]
+    out = []
+    for c in lines:
+        s = val - c
+        for i in np.nonzero(s[:-1] * s[1:] < 0)[0]:
+            lo, hi = t[i], t[i + 1]
+            x = lo + (hi - lo) * s[i] / (s[i] - s[i + 1])
+            for _ in range(4):
+                q = _pcurve_d1(pc, [x])[0]
+                if q[2 + coord] == 0.0:
+                    break
+                x = min(max(x - (q[coord] - c) / q[2 + coord], lo), hi)
+            out.append(x)
+    return out
+
+
+def face_boundary_nodes(face, order: int, pieces: int = 4, lines_u=(), lines_v=()):
     """Gauss nodes on the p-curves of a face's boundary, for Green's theorem in (u, v).
 
     Returns ``(u, v, w)`` with ``w = weight · dv/dt`` signed by the edge's orientation
     in the face, so that ``Σ w G(u, v) = ∮ G dv`` over the whole boundary (outer wire
-    and holes).  Each p-curve is split at its C2 breaks and into at least ``pieces``
+    and holes).  Each p-curve is split wherever Gauss would lose its exactness: at every
+    knot of the p-curve (``GeomAbs_CN`` intervals: a cubic's third derivative jumps at
+    simple knots), where it crosses the surface's own break lines ``u = lines_u[i]``,
+    ``v = lines_v[j]`` (the integrand is piecewise there), and into at least ``pieces``
     parts.
     """
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-    from OCP.GeomAbs import GeomAbs_C2
-    from OCP.gp import gp_Pnt2d, gp_Vec2d
+    from OCP.GeomAbs import GeomAbs_CN, GeomAbs_Line
     from OCP.TColStd import TColStd_Array1OfReal
 
     x, w = np.polynomial.legendre.leggauss(order)
     us, vs, ws = [], [], []
-    p, d = gp_Pnt2d(), gp_Vec2d()
     with kernel("BRepAdaptor_Curve2d (face boundary)"):
         for e in _explore(face, TopAbs_EDGE):
             edge = TopoDS.Edge_s(e)
             pc = BRepAdaptor_Curve2d(edge, face)
             f, l = pc.FirstParameter(), pc.LastParameter()
-            n = pc.NbIntervals(GeomAbs_C2)
+            n = pc.NbIntervals(GeomAbs_CN)
             arr = TColStd_Array1OfReal(1, n + 1)
-            pc.Intervals(arr, GeomAbs_C2)
-            br = np.unique(np.concatenate([[arr.Value(i) for i in range(1, n + 2)], np.linspace(f, l, pieces + 1)]))
+            pc.Intervals(arr, GeomAbs_CN)
+            # a straight p-curve carries a polynomial or trigonometric integrand that the
+            # break-line splits below already make smooth: one piece is enough
+            k = 1 if pc.GetType() == GeomAbs_Line else pieces
+            br = np.unique(np.concatenate([[arr.Value(i) for i in range(1, n + 2)], np.linspace(f, l, k + 1)]))
             br = br[(br >= f) & (br <= l)]
+            extra = _crossings(pc, br, lines_u, 0) + _crossings(pc, br, lines_v, 1)
+            if extra:
+                br = np.unique(np.concatenate([br, extra]))
+                br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
             a, b = br[:-1, None], br[1:, None]
             t = ((a + b) / 2 + (b - a) / 2 * x).ravel()
             wt = ((b - a) / 2 * w).ravel()
             sign = -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0
-            for ti, wi in zip(t, wt):
-                pc.D1(float(ti), p, d)
-                us.append(p.X())
-                vs.append(p.Y())
-                ws.append(sign * wi * d.Y())
-    return np.array(us), np.array(vs), np.array(ws)
+            q = _pcurve_d1(pc, t)
+            us.append(q[:, 0])
+            vs.append(q[:, 1])
+            ws.append(sign * wt * q[:, 3])
+    if not us:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    return np.concatenate(us), np.concatenate(vs), np.concatenate(ws)
 
 
-def surface_derivatives(geom, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
-    """OCCT ``D0``/``D1``/``D2`` as ``(N, order+1, order+1, 3)`` (the fallback evaluator
-    for surface types without a NumPy twin; a plain loop over OCCT calls)."""
-    from OCP.gp import gp_Pnt, gp_Vec
+def edge_deviations(shape, samples: int = 23) -> np.ndarray:
+    """``(E, 2)``: per edge of ``shape`` the largest distance between its 3-D curve and the
+    image of its p-curve on each of its faces (``samples`` points, as ``BRepCheck`` does),
+    and the edge's length.  A model whose edges are off their faces this far bounds a
+    region only up to that distance."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
-    n = len(u)
-    out = np.zeros((n, order + 1, order + 1, 3))
-    p = gp_Pnt()
-    d = [gp_Vec() for _ in range(5)]
-    with kernel("Geom_Surface.D2"):
-        for a in range(n):
-            uu, vv = float(u[a]), float(v[a])
-            if order == 0:
-                geom.D0(uu, vv, p)
-                out[a, 0, 0] = xyz(p)
-            elif order == 1:
-                geom.D1(uu, vv, p, d[0], d[1])
-                out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d[0]), xyz(d[1])
-            else:
-                geom.D2(uu, vv, p, d[0], d[1], d[2], d[3], d[4])
-                out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d[0]), xyz(d[1])
-                out[a, 2, 0], out[a, 0, 2], out[a, 1, 1] = xyz(d[2]), xyz(d[3]), xyz(d[4])
-    return out
+    out = []
+    with kernel("edge deviations"):
+        emap = TopTools_IndexedDataMapOfShapeListOfShape()
+        TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, emap)
+        for k in range(1, emap.Extent() + 1):
+            edge = TopoDS.Edge_s(emap.FindKey(k))
+            if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
+                continue
+            c3 = BRepAdaptor_Curve(edge)
+            t = np.linspace(c3.FirstParameter(), c3.LastParameter(), samples)
+            p3 = np.array([xyz(c3.Value(float(x))) for x in t])
+            dev = 0.0
+            for f in emap.FindFromIndex(k):
+                face = TopoDS.Face_s(f)
+                pc = BRepAdaptor_Curve2d(edge, face)
+                surf = BRepAdaptor_Surface(face, False)
+                tp = np.linspace(pc.FirstParameter(), pc.LastParameter(), samples)
+                ps = np.array([xyz(surf.Value(q.X(), q.Y())) for q in (pc.Value(float(x)) for x in tp)])
+                dev = max(dev, float(np.linalg.norm(ps - p3, axis=1).max()))
+            props = GProp_GProps()
+            BRepGProp.LinearProperties_s(edge, props)
+            out.append((dev, props.Mass()))
+    return np.array(out).reshape(-1, 2)
 
 
 # -- interference -----------------------------------------------------------------------
@@ -355,18 +349,6 @@ def min_distance(a, b):
 
 
 # -- sections ---------------------------------------------------------------------------
-def planar_faces_in(shape, origin, normal, tol: float):
-    """Indices of planar faces lying in the plane (origin, normal)."""
-    out = []
-    for rec in face_records(shape):
-        e = rec["elementary"]
-        if rec["kind"] != "Geom_Plane":
-            continue
-        if abs(abs(float(np.dot(e["z"], normal))) - 1.0) < 1e-9 and abs(float(np.dot(e["origin"] - origin, normal))) < tol:
-            out.append(rec["index"])
-    return out
-
-
 def section_edges(shape, origin, normal):
     """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
     end to end with ``ShapeAnalysis_FreeBounds``)."""
@@ -407,16 +389,28 @@ def wire_edges(wire):
     return out
 
 
-def edge_polyline(edge, n: int) -> np.ndarray:
-    """``n`` points along an edge in its orientation (OCCT ``BRepAdaptor_Curve``)."""
+def edge_points(edge, deflection: float) -> np.ndarray:
+    """Points along an edge (in its orientation) whose chords stay within ``deflection``
+    of the curve (``GCPnts_QuasiUniformDeflection``)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.GCPnts import GCPnts_QuasiUniformDeflection
 
-    with kernel("BRepAdaptor_Curve"):
+    with kernel("GCPnts_QuasiUniformDeflection"):
         c = BRepAdaptor_Curve(edge)
-        t = np.linspace(c.FirstParameter(), c.LastParameter(), n)
-        if edge.Orientation() == TopAbs_REVERSED:
-            t = t[::-1]
-        return np.array([xyz(c.Value(float(x))) for x in t])
+        algo = GCPnts_QuasiUniformDeflection(c, float(deflection), c.FirstParameter(), c.LastParameter())
+        if not algo.IsDone():
+            raise SurfmodError("tolerance: OCCT could not discretize a section edge at this deflection")
+        pts = np.array([xyz(algo.Value(i)) for i in range(1, algo.NbPoints() + 1)])
+    return pts[::-1] if edge.Orientation() == TopAbs_REVERSED else pts
+
+
+def edge_length(edge) -> float:
+    """Length of an edge (``GCPnts_AbscissaPoint``, OCCT's own)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.GCPnts import GCPnts_AbscissaPoint
+
+    with kernel("GCPnts_AbscissaPoint.Length_s"):
+        return float(GCPnts_AbscissaPoint.Length_s(BRepAdaptor_Curve(edge), 1e-12))
 
 
 # -- files ------------------------------------------------------------------------------
@@ -428,12 +422,8 @@ def write_brep(shape, path) -> None:
             raise SurfmodError(f"path: could not write BREP {path}")
 
 
-def is_solid_like(shape) -> bool:
-    return bool(solids_of(shape))
-
-
 __all__ = [
-    "bounding_box", "closed_solid", "common_volume", "count_faces", "edge_polyline", "face_records",
-    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_solid_like", "min_distance", "planar_faces_in", "section_edges",
-    "sew_solid", "shells_of", "solids_of", "surface_derivatives", "wire_edges", "write_brep",
+    "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
+    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
+    "model_tolerance", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

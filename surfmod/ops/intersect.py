@@ -310,6 +310,8 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
 
     ``b`` (or ``a``) may be a surfmod surface (a bounded patch, a ``PlaneSurface``
     included) or an infinite plane given as ``(origin, normal)`` / a build123d ``Plane``.
+    A build123d / OCP face, or a face read back with :func:`surfmod.from_face`, is a
+    trimmed surface: the curves are clipped to its boundary.
     Every returned point lies on both within ``tolerance`` (Newton converges to ~1e-12
     in practice); ``step`` bounds the 3-D step (default 1/40 of the model size) and
     ``max_angle`` (degrees) the turn of the tangent per step.  No intersection gives
@@ -326,8 +328,12 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     >>> sm.intersect(s, ((0, 0, 5), (0, 0, 1)))
     []
     """
+    from ..readback.clip import as_face_surface, clip_curves
+
     tol = checks.positive(tolerance, "tolerance")
     angle = checks.real(max_angle, "max_angle", low=1e-3, high=90.0)
+    # faces (build123d / OCP / read back) are trimmed surfaces: curves end at their boundary
+    a, b = as_face_surface(a), as_face_surface(b)
     swap = _is_plane_spec(a) and isinstance(b, Surface)
     if swap:
         a, b = b, a
@@ -349,7 +355,7 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     traced = marching.trace_all(problem, seeds, h, angle)
     # drop slivers (a seed on a seam or at a tangency traced for a vanishing length)
     traced = [(X, c) for X, c in traced if np.ptp(problem.evaluate(X)[2], axis=0).max() > 1e-6 * problem.scale]
-    curves = _curves(problem, traced, uv_b_of)
+    curves = clip_curves(_curves(problem, traced, uv_b_of), a, b, IntersectionCurve)
     if swap:
         curves = [IntersectionCurve(c.points, c.uv_b, c.uv_a, c.tangents, c.closed) for c in curves]
     return curves

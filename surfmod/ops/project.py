@@ -300,7 +300,9 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8,
     ``points_or_curve``: a point ``(3,)``, points ``(..., 3)``, a surfmod curve or a
     build123d ``Edge``/``Wire`` (sampled at ``samples`` equally spaced parameters).
     Returns ``Projection(u, v, point, distance)`` with the points' leading shape.  The
-    closest point may lie on the boundary of the domain (a constrained minimum).
+    closest point may lie on the boundary of the domain (a constrained minimum).  ``s``
+    may be a build123d / OCP face or a face read back with :func:`surfmod.from_face`:
+    distances are then to the trimmed face, its boundary included.
 
     More than ``max_points`` points are refused before any work (raise it to allow
     them); work of more than one block of 10,000 points shows a tqdm progress bar
@@ -312,7 +314,10 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8,
     >>> pr.u, pr.v, pr.distance
     (array([0.25, 1.  ]), array([0.5, 0.5]), array([2., 2.]))
     """
-    s = checks.surface(s, "s")
+    from ..readback.clip import as_face_surface, project_on_face
+    from ..readback.trimmed import TrimmedFace
+
+    s = checks.surface(as_face_surface(s), "s")  # a face is a trimmed surface: distances are to the face
     samples = checks.count(samples, "samples", minimum=2, maximum=checks.MAX_POINTS)
     seeds = checks.count(seeds, "seeds", minimum=1, maximum=64)
     pts = _as_points(points_or_curve, samples)
@@ -329,6 +334,8 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8,
         blocks = tqdm(blocks, desc="project", unit="block")
     parts = [closest_points(s, flat[b0 : b0 + _BLOCK], seeds) for b0 in blocks]
     u, v, p, d = (np.concatenate(a) for a in zip(*parts))
+    if isinstance(s, TrimmedFace):
+        u, v, p, d = project_on_face(s, flat, u, v, p, d)
     if not (np.isfinite(d).all() and np.isfinite(p).all()):
         i = int(np.argmax(~np.isfinite(d) | ~np.isfinite(p).all(axis=1)))
         raise SurfmodError(f"points_or_curve: the closest point to point {i} is not finite (the point is too far away)")

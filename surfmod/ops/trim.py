@@ -223,14 +223,25 @@ def _curve_crossings(curve, ubreaks, vbreaks, per_span: int = 8, dense: int = 64
     return np.unique(base)
 
 
-def trimmed_area(s: Surface, boundary_curve_uv, order: int = 24) -> float:
+def trimmed_area(s: Surface, boundary_curve_uv=None, order: int = 24) -> float:
     """Area of the trimmed region, by NumPy quadrature (Green's theorem in (u, v)).
+
+    Without ``boundary_curve_uv``, ``s`` is a face (build123d / OCP, or read back with
+    :func:`surfmod.from_face`) and its own boundary is used.
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0))
     >>> round(trimmed_area(s, [(0, 0), (0.5, 0), (0, 0.5), (0, 0)]), 12)
     0.5
     """
+    if boundary_curve_uv is None:
+        from ..readback.clip import as_face_surface
+        from ..readback.trimmed import TrimmedFace
+
+        face = as_face_surface(s)
+        if not isinstance(face, TrimmedFace):
+            raise SurfmodError("boundary_curve_uv: needed unless s is a face (it carries its own boundary)")
+        return face.area()
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
     order = checks.count(order, "order", minimum=2)

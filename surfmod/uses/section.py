@@ -61,10 +61,36 @@ class Section:
         """Total length of the section curves (OCCT edge lengths)."""
         return float(sum(w.length for w in self.wires))
 
-    def polylines_2d(self) -> list[np.ndarray]:
-        """The polylines in the plane frame, ``(N, 2)`` each."""
+    def to_plane(self, points) -> np.ndarray:
+        """3-D points ``(..., 3)`` in the plane frame ``(..., 2)``."""
         axes = np.stack([self.x_axis, self.y_axis], axis=1)
-        return [(p - self.origin) @ axes for p in self.polylines]
+        return (np.asarray(points, dtype=float) - self.origin) @ axes
+
+    def polylines_2d(self, tolerance: float | None = None) -> list[np.ndarray]:
+        """The curves in the plane frame, ``(N, 2)`` each: the stored polylines, or with
+        ``tolerance`` points whose chords stay within ``tolerance`` of the exact edges
+        (OCCT ``GCPnts_QuasiUniformDeflection``)."""
+        if tolerance is None:
+            return [self.to_plane(p) for p in self.polylines]
+        from ..occ.uses import edge_points, wire_edges
+
+        tol = checks.positive(tolerance, "tolerance")
+        out = []
+        for w in self.wires:
+            pts = [edge_points(e, tol) for e in wire_edges(w)]
+            out.append(self.to_plane(np.concatenate([p if i == 0 else p[1:] for i, p in enumerate(pts)])))
+        return out
+
+    def entities_2d(self) -> list[list[tuple]]:
+        """The exact section curves in the plane frame, per wire a list of
+        ``("line", p0, p1)``, ``("arc", center, radius, start_deg, end_deg)`` (counter-
+        clockwise from start to end), ``("circle", center, radius)`` or
+        ``("spline", degree, control_points (N, 2), knots, weights or None)``; B-splines
+        keep their knots and weights, every other curve type is converted to its exact
+        B-spline form."""
+        from ..occ.uses import wire_edges
+
+        return [[_edge_entity(self, e) for e in wire_edges(w)] for w in self.wires]
 
     def areas(self) -> np.ndarray:
         """Signed areas (shoelace, in the plane frame) of the closed curves; 0 for open ones."""
@@ -106,6 +132,49 @@ class Section:
         return f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}"
 
 
+def _edge_entity(sec: Section, edge) -> tuple:
+    """One section edge as an exact 2-D entity in the section's plane frame."""
+    from ..construct.conics import Conic
+    from ..construct.curves import Line
+    from ..nets.bspline import BSplineCurve
+    from ..occ.geom import read_bspline_curve
+    from ..occ.topo import curve_of_edge, shape_bspline
+    from ..readback import read_curve
+
+    geom, t0, t1 = curve_of_edge(edge)
+    curve = read_curve(geom, (t0, t1))
+    if isinstance(curve, Line):
+        p = sec.to_plane(curve.points(np.array([t0, t1])))
+        return ("line", p[0], p[1])
+    if isinstance(curve, Conic) and curve.a == curve.b and abs(abs(float(curve.normal @ sec.normal)) - 1.0) < 1e-9:
+        center, r = sec.to_plane(curve.center), curve.a
+        if t1 - t0 >= 2 * np.pi * (1 - 1e-12):
+            return ("circle", center, r)
+        ends = sec.to_plane(curve.points(np.array([t0, t1]))) - center
+        a0, a1 = np.degrees(np.arctan2(ends[:, 1], ends[:, 0]))
+        # the conic turns counter-clockwise in the plane frame when its normal is the plane's
+        return ("arc", center, r, a0, a1) if float(curve.normal @ sec.normal) > 0 else ("arc", center, r, a1, a0)
+    data = read_bspline_curve(shape_bspline(edge))
+    c = BSplineCurve(data["points"], data["degree"], data["knots"], data["weights"])
+    return ("spline", c.degree, sec.to_plane(c.control_points), np.asarray(c.knots), None if c.weights is None else np.asarray(c.weights))
+
+
+def planar_faces_in(shape, origin, normal, tol: float) -> list[int]:
+    """Indices of the planar faces of ``shape`` lying in the plane ``(origin, normal)``."""
+    from ..construct.elementary import AnalyticPlane
+    from ..occ.topo import faces_of
+    from ..readback import from_face
+
+    out = []
+    for i, f in enumerate(faces_of(shape)):
+        s = from_face(f).surface
+        if not isinstance(s, AnalyticPlane):
+            continue
+        if abs(abs(float(np.dot(s.z_dir, normal))) - 1.0) < 1e-9 and abs(float(np.dot(s.origin - origin, normal))) < tol:
+            out.append(i)
+    return out
+
+
 def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) -> Section:
     """Planar section of a part (or of surfaces): curves where the plane cuts it.
 
@@ -129,7 +198,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     shape = to_shape(obj, "obj")
     box = occ.bounding_box(shape)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
-    on = occ.planar_faces_in(shape, origin, normal, tol)
+    on = planar_faces_in(shape, origin, normal, tol)
     if on:
         raise SurfmodError(
             f"plane_normal: the section plane is parallel to planar face(s) {on} of obj and lies on them; "

@@ -1,13 +1,8 @@
-"""``from_face`` readers for OCCT's analytic surface types, and the offset surface.
+"""``sm.OffsetSurface``: ``S + d N`` over any surfmod surface, OCCT's ``Geom_OffsetSurface``.
 
-Registered with :func:`surfmod.construct.from_face.reader`: ``Geom_Plane``,
-``Geom_CylindricalSurface``, ``Geom_ConicalSurface``, ``Geom_SphericalSurface``,
-``Geom_ToroidalSurface``, ``Geom_SurfaceOfRevolution``, ``Geom_SurfaceOfLinearExtrusion``,
-``Geom_RectangularTrimmedSurface`` and ``Geom_OffsetSurface``.  Every reader keeps OCCT's
-parametrization (basis curves of swept surfaces are read natively: lines, circles,
-ellipses, parabolas, hyperbolas, B-splines, Béziers), restricts the domain to the face's parameter bounds and
-keeps the OCCT surface it read as ``geom()``, so ``crosscheck`` compares the NumPy
-evaluation with the very surface of the file.
+Positions and partials of any order come from exact jet (truncated Taylor series)
+arithmetic on the base surface's partials; offsets of planes, cylinders, spheres and tori
+are the elementary surfaces they are (OCCT's "equivalent surface").
 """
 
 from __future__ import annotations
@@ -20,7 +15,7 @@ from .. import tolerances, transforms
 from ..errors import SurfmodError
 from ..eval.differential import degenerate_mask
 from ..surface import Surface
-from .from_face import READERS, reader
+from .elementary import AnalyticPlane, CylindricalSurface, SphericalSurface, ToroidalSurface
 
 
 # -- offset surface ------------------------------------------------------------------------------
@@ -90,8 +85,6 @@ def _degenerate(ders):
 def _equivalent(base, d):
     """The elementary surface an offset of a plane, cylinder, sphere or torus is (same
     parametrization, like OCCT's equivalent surface), or None."""
-    from .elementary import AnalyticPlane, CylindricalSurface, SphericalSurface, ToroidalSurface
-
     if not isinstance(base, (AnalyticPlane, CylindricalSurface, SphericalSurface, ToroidalSurface)):
         return None
     o, x, y, z = base.frame
@@ -192,120 +185,3 @@ class OffsetSurface(Surface):
         det = float(np.linalg.det(m[:3, :3]))
         s = abs(det) ** (1.0 / 3.0)
         return OffsetSurface(self.base.transformed(m), self.distance * s * np.sign(det))
-
-
-# -- curve readers ----------------------------------------------------------------------------------
-def curve_from_occ(curve, t_range):
-    """A surfmod curve in OCCT's own parametrization of ``curve`` over ``t_range``."""
-    from ..nets.bezier import BezierCurve
-    from ..nets.bspline import BSplineCurve
-    from ..occ.analytic import read_curve
-    from .conics import Conic, Hyperbola, Parabola
-    from .curves import Line
-
-    t0, t1 = (float(t) for t in t_range)
-    d = read_curve(curve)
-    kind = d["kind"]
-    if kind == "line":
-        return Line.through(d["origin"], d["direction"], (t0, t1))
-    if kind in ("circle", "ellipse"):
-        o, x, _, z = d["frame"]
-        a, b = (d["radius"], d["radius"]) if kind == "circle" else (d["major"], d["minor"])
-        return Conic._from_radians(o, z, x, a, b, (t0, t1))
-    if kind == "parabola":
-        o, x, _, z = d["frame"]
-        return Parabola._make(o, z, x, (d["focal"],), (t0, t1))
-    if kind == "hyperbola":
-        o, x, _, z = d["frame"]
-        return Hyperbola._make(o, z, x, (d["major"], d["minor"]), (t0, t1))
-    if kind == "bspline":
-        c = BSplineCurve(d["points"], d["degree"], d["knots"], d["weights"])
-    else:
-        c = BezierCurve(d["points"], d["weights"])
-    lo, hi = c.domain
-    tol = 1e-9 * max(1.0, hi - lo)
-    if t0 > lo + tol or t1 < hi - tol:
-        c = c.segment(max(t0, lo), min(t1, hi))
-    return c
-
-
-# -- surface readers ---------------------------------------------------------------------------------
-def _elementary(cls, params):
-    def read(surf, bounds):
-        from ..occ.analytic import read_elementary
-
-        data = read_elementary(surf)
-        u0, u1, v0, v1 = bounds
-        obj = cls._trusted(data["frame"], params(data), (u0, u1), (v0, v1))
-        obj._adopt_twin(surf)
-        return obj
-
-    return read
-
-
-def _register_elementary():
-    from .elementary import AnalyticPlane, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
-
-    reader("Geom_Plane")(_elementary(AnalyticPlane, lambda d: ()))
-    reader("Geom_CylindricalSurface")(_elementary(CylindricalSurface, lambda d: (d["radius"],)))
-    reader("Geom_ConicalSurface")(_elementary(ConicalSurface, lambda d: (d["radius"], d["semi_angle"])))
-    reader("Geom_SphericalSurface")(_elementary(SphericalSurface, lambda d: (d["radius"],)))
-    reader("Geom_ToroidalSurface")(_elementary(ToroidalSurface, lambda d: (d["major"], d["minor"])))
-
-
-_register_elementary()
-
-
-@reader("Geom_SurfaceOfRevolution")
-def _revolution(surf, bounds):
-    from ..occ.analytic import read_revolution
-    from .revolution import RevolutionSurface
-
-    data = read_revolution(surf)
-    u0, u1, v0, v1 = bounds
-    obj = RevolutionSurface._trusted(curve_from_occ(data["basis"], (v0, v1)), data["origin"], data["direction"], (u0, u1))
-    obj._adopt_twin(surf)
-    return obj
-
-
-@reader("Geom_SurfaceOfLinearExtrusion")
-def _extrusion(surf, bounds):
-    from ..occ.analytic import read_extrusion
-    from .extrusion import TabulatedCylinder
-
-    data = read_extrusion(surf)
-    u0, u1, v0, v1 = bounds
-    obj = TabulatedCylinder._trusted(curve_from_occ(data["basis"], (u0, u1)), data["direction"], (v0, v1))
-    obj._adopt_twin(surf)
-    return obj
-
-
-def _read_basis(basis, bounds):
-    from ..occ.geom import downcast_surface, surface_type
-
-    name = surface_type(basis)
-    read = READERS.get(name)
-    if read is None:
-        raise SurfmodError(f"face: unsupported OCCT basis surface type {name}")
-    return read(downcast_surface(basis), bounds)
-
-
-@reader("Geom_RectangularTrimmedSurface")
-def _trimmed(surf, bounds):
-    from ..occ.analytic import read_trimmed_surface
-
-    data = read_trimmed_surface(surf)
-    tu0, tu1, tv0, tv1 = data["bounds"]
-    u0, u1, v0, v1 = bounds
-    return _read_basis(data["basis"], (max(u0, tu0), min(u1, tu1), max(v0, tv0), min(v1, tv1)))
-
-
-@reader("Geom_OffsetSurface")
-def _offset(surf, bounds):
-    from ..occ.analytic import read_offset
-
-    data = read_offset(surf)
-    obj = OffsetSurface(_read_basis(data["basis"], bounds), data["distance"])
-    obj._adopt_twin(surf)
-    return obj
-
