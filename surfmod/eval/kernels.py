@@ -330,6 +330,9 @@ def grid_positions(bu, first, p, w, rational, acc, b0, out):
     point-major, the division by the weight fused into the (interleaving) store."""
     nv = w.shape[3]
     dim = 4 if rational else 3
+    if p <= 3:
+        _positions_low_degree(bu, first, p, w, rational, b0, out)
+        return
     for a in range(bu.shape[0]):
         _combine_rows(bu, a, first, p, w, 1, dim, acc, 0)
         if rational:
@@ -343,6 +346,37 @@ def grid_positions(bu, first, p, w, rational, acc, b0, out):
                 out[a, b0 + b, 0] = acc[0, 0, 0, b]
                 out[a, b0 + b, 1] = acc[0, 0, 1, b]
                 out[a, b0 + b, 2] = acc[0, 0, 2, b]
+
+
+@njit(cache=True, error_model="numpy")
+def _positions_low_degree(bu, first, p, w, rational, b0, out):
+    """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point: the four
+    row terms are written out (missing ones get weight 0 on a valid row), so the sums,
+    the division and the store are one vector loop with everything in registers."""
+    nv = w.shape[3]
+    for a in range(bu.shape[0]):
+        r0 = first[a]
+        c0 = bu[a, 0, 0]
+        c1 = bu[a, 0, 1] if p >= 1 else 0.0
+        c2 = bu[a, 0, 2] if p >= 2 else 0.0
+        c3 = bu[a, 0, 3] if p >= 3 else 0.0
+        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+        x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
+        y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
+        z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
+        row = out[a]
+        if rational:
+            h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
+            for b in range(nv):
+                inv_w = 1.0 / (c0 * h0[b] + c1 * h1[b] + c2 * h2[b] + c3 * h3[b])
+                row[b0 + b, 0] = (c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]) * inv_w
+                row[b0 + b, 1] = (c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]) * inv_w
+                row[b0 + b, 2] = (c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]) * inv_w
+        else:
+            for b in range(nv):
+                row[b0 + b, 0] = c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]
+                row[b0 + b, 1] = c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]
+                row[b0 + b, 2] = c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]
 
 
 @njit(cache=True, error_model="numpy")
