@@ -309,9 +309,23 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
 @njit(cache=True, inline="always", error_model="numpy")
 def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
     """``acc[k, l, d, off:off+n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
-    vector axis)."""
+    vector axis); up to degree 3 as one four-term pass per plane."""
     r0 = first[a]
     nv = w.shape[3]
+    if p <= 3:
+        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+        for k in range(kk):
+            c0 = bu[a, k, 0]
+            c1 = bu[a, k, 1] if p >= 1 else 0.0
+            c2 = bu[a, k, 2] if p >= 2 else 0.0
+            c3 = bu[a, k, 3] if p >= 3 else 0.0
+            for l in range(kk):
+                for d in range(dim):
+                    w0, w1, w2, w3 = w[r0, l, d], w[r1, l, d], w[r2, l, d], w[r3, l, d]
+                    dst = acc[k, l, d]
+                    for b in range(nv):
+                        dst[off + b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
+        return
     for k in range(kk):
         for l in range(kk):
             for d in range(dim):
