@@ -309,9 +309,23 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
 @njit(cache=True, inline="always", error_model="numpy")
 def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
     """``acc[k, l, d, off:off+n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
-    vector axis)."""
+    vector axis); up to degree 3 as one four-term pass per plane."""
     r0 = first[a]
     nv = w.shape[3]
+    if p <= 3:
+        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+        for k in range(kk):
+            c0 = bu[a, k, 0]
+            c1 = bu[a, k, 1] if p >= 1 else 0.0
+            c2 = bu[a, k, 2] if p >= 2 else 0.0
+            c3 = bu[a, k, 3] if p >= 3 else 0.0
+            for l in range(kk):
+                for d in range(dim):
+                    w0, w1, w2, w3 = w[r0, l, d], w[r1, l, d], w[r2, l, d], w[r3, l, d]
+                    dst = acc[k, l, d]
+                    for b in range(nv):
+                        dst[off + b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
+        return
     for k in range(kk):
         for l in range(kk):
             for d in range(dim):
@@ -330,6 +344,9 @@ def grid_positions(bu, first, p, w, rational, acc, b0, out):
     point-major, the division by the weight fused into the (interleaving) store."""
     nv = w.shape[3]
     dim = 4 if rational else 3
+    if p <= 3:
+        _positions_low_degree(bu, first, p, w, rational, b0, out)
+        return
     for a in range(bu.shape[0]):
         _combine_rows(bu, a, first, p, w, 1, dim, acc, 0)
         if rational:
@@ -346,6 +363,37 @@ def grid_positions(bu, first, p, w, rational, acc, b0, out):
 
 
 @njit(cache=True, error_model="numpy")
+def _positions_low_degree(bu, first, p, w, rational, b0, out):
+    """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point: the four
+    row terms are written out (missing ones get weight 0 on a valid row), so the sums,
+    the division and the store are one vector loop with everything in registers."""
+    nv = w.shape[3]
+    for a in range(bu.shape[0]):
+        r0 = first[a]
+        c0 = bu[a, 0, 0]
+        c1 = bu[a, 0, 1] if p >= 1 else 0.0
+        c2 = bu[a, 0, 2] if p >= 2 else 0.0
+        c3 = bu[a, 0, 3] if p >= 3 else 0.0
+        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+        x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
+        y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
+        z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
+        row = out[a]
+        if rational:
+            h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
+            for b in range(nv):
+                inv_w = 1.0 / (c0 * h0[b] + c1 * h1[b] + c2 * h2[b] + c3 * h3[b])
+                row[b0 + b, 0] = (c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]) * inv_w
+                row[b0 + b, 1] = (c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]) * inv_w
+                row[b0 + b, 2] = (c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]) * inv_w
+        else:
+            for b in range(nv):
+                row[b0 + b, 0] = c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]
+                row[b0 + b, 1] = c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]
+                row[b0 + b, 2] = c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]
+
+
+@njit(cache=True, error_model="numpy")
 def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
     """Second stage for partials: for each u-point combine its p+1 rows of ``w``, apply
     the quotient rule on the planes (rational), and write ``out[..., b0:b0+n_v]`` of
@@ -353,6 +401,22 @@ def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
     kk = bu.shape[1]
     nv = w.shape[3]
     dim = 4 if rational else 3
+    if p <= 3 and not rational:  # four-term sums straight into each output plane
+        for a in range(bu.shape[0]):
+            r0 = first[a]
+            r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+            for k in range(kk):
+                c0 = bu[a, k, 0]
+                c1 = bu[a, k, 1] if p >= 1 else 0.0
+                c2 = bu[a, k, 2] if p >= 2 else 0.0
+                c3 = bu[a, k, 3] if p >= 3 else 0.0
+                for l in range(kk):
+                    for d in range(3):
+                        w0, w1, w2, w3 = w[r0, l, d], w[r1, l, d], w[r2, l, d], w[r3, l, d]
+                        dst = out[a, k, l, d]
+                        for b in range(nv):
+                            dst[b0 + b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
+        return
     for a in range(bu.shape[0]):
         # accumulate in the cache-resident scratch, then write every output plane once
         _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
