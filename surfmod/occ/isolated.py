@@ -116,7 +116,7 @@ def _worker_main() -> None:
         except SurfmodError as exc:
             msg = str(exc)  # every refusal names the file (a kernel failure names its operation)
             _send(reply, ("error", type(exc).__name__, msg if path in msg else f"path: {path}: {msg}"))
-        except Exception as exc:  # a reader fault must reach the parent as text, not kill the loop
+        except Exception as exc:  # noqa: BLE001 - a reader fault must reach the parent as text, not kill the loop
             _send(reply, ("error", "KernelError", f"path: reading {path} failed ({type(exc).__name__}: {exc})"))
 
 
@@ -157,7 +157,7 @@ class _Worker:
     def _wait_ready(self) -> None:
         proc = self._proc
         try:
-            kind, _ = _recv(proc.stdout.fileno(), time.monotonic() + 120.0)
+            kind = _recv(proc.stdout.fileno(), time.monotonic() + 120.0)[0]
         except (EOFError, TimeoutError):
             kind = None
         if kind != "ready":
@@ -217,8 +217,7 @@ class _Worker:
                 ) from None
         if answer[0] == "ok":
             return answer[1]
-        _, kind, message = answer
-        raise DamagedFileError(message)
+        raise DamagedFileError(answer[2])  # answer = ("error", exception type, message)
 
 
 _WORKER = _Worker()
