@@ -46,9 +46,16 @@ def bspline_surfaces(draw, rational=None, max_degree: int = 7):
     return sm.BSplineSurface(net, (p, q), (ku, kv), w)
 
 
+def _with_knots(lo, hi, knots, count):
+    # a sample a few ulps off a knot (0.6 beside 0.6000000000000001) is a knot to OCCT but not
+    # to an exact comparison: such samples are replaced by the knot itself
+    base = np.linspace(lo, hi, count)
+    inside = knots[(knots >= lo) & (knots <= hi)]
+    near = np.abs(base[:, None] - inside[None, :]).min(axis=1) <= 1e-9 * (hi - lo) if inside.size else False
+    return np.unique(np.concatenate([base[~near] if inside.size else base, inside]))
+
+
 def parameters_with_knots(s, count: int = 7):
     """Parameters including every knot inside the domain and both ends."""
     (u0, u1), (v0, v1) = s.domain
-    us = np.unique(np.concatenate([np.linspace(u0, u1, count), s.knots[0][(s.knots[0] >= u0) & (s.knots[0] <= u1)]]))
-    vs = np.unique(np.concatenate([np.linspace(v0, v1, count), s.knots[1][(s.knots[1] >= v0) & (s.knots[1] <= v1)]]))
-    return us, vs
+    return _with_knots(u0, u1, s.knots[0], count), _with_knots(v0, v1, s.knots[1], count)

@@ -74,7 +74,8 @@ def test_faces_of_a_solid_show_their_outside():
 
     box = bd.Box(2, 3, 4)
     r = sm.analyze(box, "isophote", light=(0, 0, 1), resolution=10)
-    assert len(r.patches) == 6
+    assert len(r.patches) == 6 and all(p.outside_only for p in r.patches)   # drawn from outside
+    assert not sm.analyze(box.faces()[0], "mean", resolution=5).patches[0].outside_only
     for p in r.patches:
         outward = p.points.mean(axis=0)
         assert np.all(p.normals @ outward > 0)

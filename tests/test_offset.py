@@ -110,3 +110,5 @@ def test_thicken_volumes():
     assert gprops(tube.wrapped)["volume"] == pytest.approx(np.pi * (2.5**2 - 4) * 3, rel=1e-7)
     with pytest.raises(sm.SurfmodError, match="thickness: .*radius of curvature"):
         sm.thicken(cyl, -2.5)
+    mid = sm.thicken(cyl, 0.5, tolerance=1e-7, symmetric=True)      # radii 1.75 .. 2.25
+    assert gprops(mid.wrapped)["volume"] == pytest.approx(1.5 / 2 * (2.25**2 - 1.75**2) * 3, rel=1e-7)

@@ -194,10 +194,11 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
     return out
 
 
-def thicken(s: Surface, thickness: float, tolerance: float = 1e-5):
+def thicken(s: Surface, thickness: float, tolerance: float = 1e-5, *, symmetric: bool = False):
     """A closed build123d ``Solid`` between ``s`` and its offset by ``thickness`` (along
-    the normal; negative goes the other way): the two faces plus ruled walls along the
-    four sides, sewn and oriented outwards (:func:`surfmod.make_solid`).  Sides that
+    the normal; negative goes the other way), or with ``symmetric=True`` between the two
+    offsets by ``-thickness/2`` and ``+thickness/2``: the two faces plus ruled walls along
+    the four sides, sewn and oriented outwards (:func:`surfmod.make_solid`).  Sides that
     collapse to a point or close on themselves get no wall.
 
     >>> import surfmod as sm
@@ -219,11 +220,12 @@ def thicken(s: Surface, thickness: float, tolerance: float = 1e-5):
     if not np.isfinite(t) or t == 0.0:
         raise SurfmodError(f"thickness: must be finite and non-zero, got {thickness!r}")
     try:
-        far = offset(s, t, tolerance)
+        far = offset(s, t / 2 if symmetric else t, tolerance)
+        inner = offset(s, -t / 2, tolerance) if symmetric else None
     except SurfmodError as exc:
         raise SurfmodError(str(exc).replace("distance:", "thickness:", 1)) from None
-    near = as_bspline_surface(s, "s")
-    faces = [s, far]
+    near = inner if symmetric else as_bspline_surface(s, "s")
+    faces = [near if symmetric else s, far]
     probe = np.linspace(0.0, 1.0, 7)
     for side in SIDES:
         fixed, end = SIDES[side]

@@ -24,7 +24,7 @@ triangles, so two designs can be compared by a number.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -49,7 +49,8 @@ class Fairness:
 @dataclass(frozen=True)
 class Patch:
     """One sampled surface: parameters ``uv`` ``(N, 2)``, ``points``/``normals`` ``(N, 3)``,
-    ``triangles`` ``(T, 3)``, the analysed ``values`` ``(N,)`` and its ``fairness``."""
+    ``triangles`` ``(T, 3)``, the analysed ``values`` ``(N,)`` and its ``fairness``;
+    ``outside_only`` is True for faces of a solid (their insides are never seen)."""
 
     surface: Surface
     uv: np.ndarray
@@ -58,6 +59,7 @@ class Patch:
     triangles: np.ndarray
     values: np.ndarray
     fairness: Fairness
+    outside_only: bool = False
 
 
 @dataclass(frozen=True)
@@ -168,7 +170,10 @@ def _items(obj, name: str):
             continue
         if wrapped(item) is None:
             raise SurfmodError(f"{name}: expected a surfmod surface, a face or a shape, got {type(item).__name__}")
-        out.extend(("face", f) for f in faces_of(item))
+        from ..occ.uses import solids_of
+
+        kind = "solid face" if solids_of(wrapped(item)) else "face"
+        out.extend((kind, f) for f in faces_of(item))
     if not out:
         raise SurfmodError(f"{name}: has no faces to analyse")
     return out
@@ -299,11 +304,11 @@ def analyze(obj, kind: str, out=None, *, light=None, stripes: int = 8, resolutio
     patches, sources = [], []
     items = _items(obj, "obj")
     target = None
-    if any(what == "face" for what, _ in items):
+    if any(what != "surface" for what, _ in items):
         from ..occ.uses import bounding_box
         from ..occ.exchange import compound
 
-        box = bounding_box(compound([f for what, f in items if what == "face"]))
+        box = bounding_box(compound([f for what, f in items if what != "surface"]))
         target = float(np.linalg.norm(box[1] - box[0])) / resolution
     for what, item in items:
         if what == "surface":
@@ -312,7 +317,10 @@ def analyze(obj, kind: str, out=None, *, light=None, stripes: int = 8, resolutio
         else:
             s, uv, tri, sign = _face_samples(item, target, max(512, TRIANGLE_BUDGET // len(items)))
             face = item
-        patches.append(_patch(kind, s, uv, tri, sign, light_dir, stripes))
+        patch = _patch(kind, s, uv, tri, sign, light_dir, stripes)
+        if what == "solid face":
+            patch = replace(patch, outside_only=True)
+        patches.append(patch)
         sources.append((s, face, sign))
     combs = _combs(sources, comb_curves, max(24, resolution), comb_scale) if kind == "comb" else ()
     result = Analysis(kind, light_dir, tuple(patches), combs)

@@ -48,20 +48,22 @@ def write_png(result, out, eye, *, title=None, stripes: int = 8, dpi: int = 110)
 
     target = target_path(out, "out", (".png",))
     bx, by, bz = _view_basis(np.asarray(eye, float))
-    polys, depth, colours, scalar = [], [], [], []
+    polys, depth, colours, scalar, kept = [], [], [], [], []
     kind = result.kind
     for p in result.patches:
-        tri = p.points[p.triangles]
-        polys.append(np.stack([tri @ bx, tri @ by], axis=-1))
-        depth.append((tri @ bz).mean(axis=1))
         n = p.normals[p.triangles].mean(axis=1)
         n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+        keep = (n @ bz > -1e-3) if p.outside_only else np.ones(len(n), bool)  # back faces of solids
+        kept.append(p.triangles[keep])
+        n, tri = n[keep], p.points[kept[-1]]
+        polys.append(np.stack([tri @ bx, tri @ by], axis=-1))
+        depth.append((tri @ bz).mean(axis=1))
         colours.append(_shade(n, eye))
         if kind == "zebra":
             angle = np.arccos(np.clip(n @ result.light, -1.0, 1.0))
             scalar.append((np.minimum(np.floor(angle * (2 * stripes) / np.pi), 2 * stripes - 1) % 2).astype(float))
         else:
-            scalar.append(p.values[p.triangles].mean(axis=1))
+            scalar.append(p.values[kept[-1]].mean(axis=1))
     polys, depth = np.concatenate(polys), np.concatenate(depth)
     shade, values = np.concatenate(colours), np.concatenate(scalar)
     order = np.argsort(depth)  # far first: larger depth along the eye vector is nearer
@@ -83,8 +85,7 @@ def write_png(result, out, eye, *, title=None, stripes: int = 8, dpi: int = 110)
         rgb = cmap(norm(values))[:, :3] * (0.7 + 0.3 * shade)[:, None]
         if kind == "isophote":  # dark lines where a triangle straddles an isophote level
             levels = np.linspace(-1, 1, 2 * stripes + 1)
-            lv = [np.digitize(p.values[p.triangles], levels) for p in result.patches]
-            lv = np.concatenate(lv)
+            lv = np.concatenate([np.digitize(p.values[t], levels) for p, t in zip(result.patches, kept)])
             rgb[lv.min(axis=1) != lv.max(axis=1)] *= 0.15
         mappable = cm.ScalarMappable(norm=norm, cmap=cmap)
     ax.add_collection(PolyCollection(polys[order], facecolors=np.clip(rgb[order], 0, 1),

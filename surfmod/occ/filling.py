@@ -49,8 +49,8 @@ def make_filling(constraints, *, degree: int = 3, points_on_curve: int = 15, ite
                  max_degree: int = 8, max_segments: int = 9):
     """``BRepOffsetAPI_MakeFilling`` through boundary ``constraints``: a list of
     ``(edge, support_face_or_None, order)`` with order ``"C0"``, ``"G1"`` or ``"G2"``
-    (OCCT accepts G2 as a constraint order only with a support face and then treats
-    curvature approximately).  Returns the filling face (build123d ``Face``)."""
+    (with ``"G2"`` OCCT's builder fails, "The continuity is not G0 G1 or G2", which the
+    guard turns into ``KernelError``).  Returns the filling face (build123d ``Face``)."""
     import build123d as bd
     from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeFilling
     from OCP.GeomAbs import GeomAbs_C0, GeomAbs_G1, GeomAbs_G2
