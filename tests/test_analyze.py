@@ -130,7 +130,7 @@ def test_cli_analyze(tmp_path, capsys):
     assert main(["analyze", str(step), "--kind", "zebra", "--out", str(out), "--resolution", "30"]) == 0
     assert out.read_bytes()[:4] == b"\x89PNG"
     assert "wrote" in capsys.readouterr().out
-    assert main(["analyze", str(tmp_path / "missing.step"), "--out", str(out)]) == 2
+    assert main(["analyze", str(tmp_path / "missing.step"), "--out", str(out)]) == 1  # bad input: one line, exit 1
 
 
 def _normals_against_occt(path):

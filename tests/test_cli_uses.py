@@ -10,7 +10,7 @@ import pytest
 import surfmod as sm
 from surfmod.cli import main
 
-bd = pytest.importorskip("build123d")
+import build123d as bd
 
 
 @pytest.fixture(scope="module")

@@ -3,7 +3,6 @@ cadquery primitives, every basis-curve kind of swept surfaces, trimmed and offse
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
@@ -97,7 +96,8 @@ def test_build123d_primitives_step_round_trip(tmp_path):
 
 
 def test_cadquery_primitives_step_round_trip(tmp_path):
-    cq = pytest.importorskip("cadquery")
+    import cadquery as cq
+
     import build123d as bd
 
     part = (

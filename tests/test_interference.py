@@ -9,7 +9,7 @@ import pytest
 
 import surfmod as sm
 
-bd = pytest.importorskip("build123d")
+import build123d as bd
 
 
 def test_overlapping_boxes():

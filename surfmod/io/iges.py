@@ -41,7 +41,7 @@ def import_iges(path):
     >>> import surfmod as sm, tempfile, os
     >>> path = os.path.join(tempfile.mkdtemp(), "p.iges")
     >>> sm.export_iges(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), path)
-    >>> type(sm.from_face(sm.import_iges(path).faces()[0])).__name__
+    >>> type(sm.from_face(sm.import_iges(path).faces()[0]).surface).__name__
     'BSplineSurface'
     """
     import build123d as bd

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SurfmodError
 
 LABELS = {
     "gaussian": "Gaussian curvature K",
@@ -35,15 +34,12 @@ def _shade(normals_tri, eye):
 
 def write_png(result, out, eye, *, title=None, stripes: int = 8, dpi: int = 110):
     """Draw ``result`` into the PNG ``out`` (atomic write); returns the path."""
-    try:
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.collections import LineCollection, PolyCollection
-        from matplotlib.colors import Normalize, TwoSlopeNorm
-        from matplotlib.figure import Figure
-        import matplotlib
-        import matplotlib.cm as cm
-    except ImportError as exc:  # pragma: no cover - matplotlib is a declared dependency
-        raise SurfmodError("out: writing a PNG needs matplotlib (pip install matplotlib)") from exc
+    import matplotlib  # heavy: imported on the first picture only
+    import matplotlib.cm as cm
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.colors import Normalize, TwoSlopeNorm
+    from matplotlib.figure import Figure
     from ..atomic import atomic_path, target_path
 
     target = target_path(out, "out", (".png",))

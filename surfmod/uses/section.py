@@ -103,28 +103,24 @@ class Section:
         """A PNG drawing of the section in the plane frame (matplotlib, atomic write)."""
         from ..atomic import atomic_path, target_path
 
-        target = target_path(path, "path", (".png",))
-        try:
-            import matplotlib
+        # a local Agg canvas: the caller's pyplot backend is left alone
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
 
-            matplotlib.use("Agg", force=False)
-            import matplotlib.pyplot as plt
-        except ImportError:  # pragma: no cover
-            raise SurfmodError("path: PNG previews need matplotlib (pip install matplotlib)") from None
-        fig, ax = plt.subplots(figsize=(5, 5))
-        try:
-            for q in self.polylines_2d():
-                ax.plot(q[:, 0], q[:, 1], "-", lw=1.2, color="tab:blue")
-            ax.set_aspect("equal")
-            ax.set_xlabel("plane x")
-            ax.set_ylabel("plane y")
-            o, n = self.origin, self.normal
-            ax.set_title(f"section at ({o[0]:.4g}, {o[1]:.4g}, {o[2]:.4g}) n=({n[0]:.3g}, {n[1]:.3g}, {n[2]:.3g})", fontsize=9)
-            ax.grid(True, lw=0.3)
-            with atomic_path(target) as tmp:
-                fig.savefig(tmp, format="png", dpi=dpi)
-        finally:
-            plt.close(fig)
+        target = target_path(path, "path", (".png",))
+        fig = Figure(figsize=(5, 5))
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot()
+        for q in self.polylines_2d():
+            ax.plot(q[:, 0], q[:, 1], "-", lw=1.2, color="tab:blue")
+        ax.set_aspect("equal")
+        ax.set_xlabel("plane x")
+        ax.set_ylabel("plane y")
+        o, n = self.origin, self.normal
+        ax.set_title(f"section at ({o[0]:.4g}, {o[1]:.4g}, {o[2]:.4g}) n=({n[0]:.3g}, {n[1]:.3g}, {n[2]:.3g})", fontsize=9)
+        ax.grid(True, lw=0.3)
+        with atomic_path(target) as tmp:
+            fig.savefig(tmp, format="png", dpi=dpi)
 
     def __str__(self) -> str:
         if self.empty:
