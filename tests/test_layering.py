@@ -133,3 +133,20 @@ def test_import_surfmod_loads_no_kernel():
     code = "import sys, surfmod; print('OCP' in sys.modules, 'build123d' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out == ["False", "False"], "import surfmod must not load OCP/build123d"
+
+
+def test_no_subpackage_shadows_a_public_name():
+    # importing every module binds submodules as package attributes: none may hide a
+    # public function or class of the same name (sm.mesh once did)
+    import importlib
+    import pkgutil
+    import types
+
+    import surfmod as sm
+
+    for info in pkgutil.walk_packages(sm.__path__, "surfmod."):
+        if info.name.endswith("__main__"):
+            continue
+        importlib.import_module(info.name)
+    shadowed = [name for name in sm.__all__ if isinstance(getattr(sm, name), types.ModuleType)]
+    assert not shadowed

@@ -37,7 +37,7 @@ def _note(result) -> str:
 def check_file(path, samples: int = 24) -> list[tuple]:
     """``[(file, face index, surface type, max deviation, passed, note), ...]`` for one
     STEP file; an unreadable file is one row with face index -1."""
-    from ..check import crosscheck
+    from ..verification import crosscheck
     from ..io.step import import_step
     from ..occ.geom import surface_type
     from ..occ.topo import face_surface, faces_of

@@ -21,7 +21,7 @@ class Row:
 
 
 def run_entry(e: Entry, outdir: Path) -> Row:
-    from ..check import crosscheck
+    from ..verification import crosscheck
     from ..io.step import export_step
     from ..io.stl import export_stl
     from ..surface import Surface
