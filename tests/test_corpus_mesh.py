@@ -50,15 +50,27 @@ def _independent_deviation(shape, path, tol, count=120):
     return distances_to_face(getattr(shape, "wrapped", shape), pts).max()
 
 
-def _check_stl(shape, path, tol):
+def closed_and_oriented(path) -> bool:
+    """Every solid in the STL is closed and consistently oriented: after merging equal
+    (float32) vertices, each directed edge is matched by as many opposite ones.  Unlike
+    a single-body watertightness test this holds for an assembly whose solids touch
+    (their shared edges carry four facets)."""
     import trimesh
 
-    tm = trimesh.load(str(path), file_type="stl", process=True)
+    tm = trimesh.load(str(path), file_type="stl", process=False)
+    _, inverse = np.unique(tm.vertices, axis=0, return_inverse=True)
+    f = inverse.reshape(-1)[tm.faces]
+    directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    fwd, n_fwd = np.unique(directed, axis=0, return_counts=True)
+    back, n_back = np.unique(directed[:, ::-1], axis=0, return_counts=True)
+    return bool(np.array_equal(fwd, back) and np.array_equal(n_fwd, n_back))
+
+
+def _check_stl(shape, path, tol):
     n_solids = len(solids_of(getattr(shape, "wrapped", shape)))
     closed = n_solids > 0 and all(f.solid >= 0 for f in brepmesh(shape, 10 * tol))
-    if closed:
-        assert tm.is_watertight and tm.is_winding_consistent
-        assert tm.volume > 0
+    if closed:  # open shells: the STL is written, it need not be watertight
+        assert closed_and_oriented(path)
     st = admesh_stats(path)
     for key in ADMESH_REPAIRS:
         assert st[key] == 0, (key, st)

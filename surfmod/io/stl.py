@@ -33,9 +33,13 @@ def merged(meshes: list[Mesh]) -> Mesh:
 
 
 def facet_normals(tri: np.ndarray) -> np.ndarray:
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    """Unit normals of triangles ``(T, 3, 3)`` as an STL reader recomputes them: from the
+    vertices rounded to float32 (what the file holds), in float32 arithmetic, so a
+    sliver triangle's written normal agrees with the one admesh & co. check it against."""
+    t = np.asarray(tri, dtype=np.float32)
+    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     norm = np.linalg.norm(n, axis=1, keepdims=True)
-    return n / np.where(norm > 0, norm, 1.0)
+    return n / np.where(norm > 0, norm, np.float32(1.0))
 
 
 def write_binary(fh, tri: np.ndarray) -> None:
