@@ -21,7 +21,7 @@ import numpy as np
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.meshing.tessellate import DENSE, measure_face_meshes
+from surfmod.meshing.brep import DENSE, measure_face_meshes
 from surfmod.occ.mesh import brepmesh
 
 

@@ -53,7 +53,7 @@ _EXPORTS = {
     "OffsetSurface": ".construct.offset_surface",
     "from_face": ".readback",
     "TrimmedFace": ".readback",
-    "from_edge": ".construct.from_face",
+    "from_edge": ".construct.from_edge",
     "crosscheck": ".verification",
     "CrossCheck": ".verification",
     "Mesh": ".meshing.grid",

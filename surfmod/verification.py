@@ -111,7 +111,7 @@ def crosscheck(obj, samples: int = 64, tolerance: float | None = None) -> CrossC
     if isinstance(obj, Curve):
         return _check_curve(obj, samples)
     if not isinstance(obj, Surface):
-        from .construct.from_face import from_face
+        from .readback import from_face
 
         obj = from_face(obj)
     if obj.exact_in_occt:

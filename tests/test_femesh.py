@@ -19,8 +19,49 @@ def test_box_tetra_volume_exact():
     assert m.cell_type == "tetra" and m.n_elements > 50
     assert m.volume == pytest.approx(6.0, rel=1e-12)
     assert 0.1 < m.quality["gamma"]["min"] <= m.quality["gamma"]["mean"] <= 1.0
-    assert m.quality["minSICN"]["min"] > 0  # no inverted element
-    assert "tetra elements" in str(m)
+    assert m.quality["SICN"]["min"] > 0 and m.quality["inverted"] == 0
+    assert "tetra elements" in str(m) and "Jacobian" not in str(m)  # always 1 for linear tets
+    assert "SJ" not in m.quality
+
+
+def test_quality_measures_agree_with_their_definitions():
+    """min_angle is recomputed from the tets (dihedral angles by the law of the dihedral
+    cosine of a regular-tetrahedron-like check); gamma from gmsh equals 3 r_in / R_circ
+    computed here from the nodes."""
+    m = sm.fe_mesh(bd.Box(2, 3, 1), size=0.5)
+    t = m.points[m.cells]
+    # inradius r = 3V / A_total, circumradius from the circumsphere solve
+    v = np.abs(np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))) / 6
+    area = sum(np.linalg.norm(np.cross(t[:, b] - t[:, a], t[:, c] - t[:, a]), axis=1) / 2
+               for a, b, c in ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2)))
+    r_in = 3 * v / area
+    a = 2 * (t[:, 1:] - t[:, :1])
+    rhs = np.einsum("tkd,tkd->tk", t[:, 1:], t[:, 1:]) - np.einsum("td,td->t", t[:, 0], t[:, 0])[:, None]
+    centre = np.linalg.solve(a, rhs[..., None])[..., 0]
+    r_out = np.linalg.norm(centre - t[:, 0], axis=1)
+    gamma = 3 * r_in / r_out
+    assert m.quality["gamma"]["min"] == pytest.approx(gamma.min(), rel=1e-6)
+    assert m.quality["gamma"]["mean"] == pytest.approx(gamma.mean(), rel=1e-6)
+    # dihedral angle at edge (a, b): angle between the two faces through it
+    from surfmod.uses.femesh import min_dihedral_angles
+
+    def dihedral(p, a, b, c, d):
+        e = p[b] - p[a]
+        n1 = np.cross(e, p[c] - p[a])
+        n2 = np.cross(e, p[d] - p[a])
+        return np.degrees(np.arccos(np.dot(n1, n2) / np.linalg.norm(n1) / np.linalg.norm(n2)))
+
+    pairs = [(0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2), (1, 2, 0, 3), (1, 3, 0, 2), (2, 3, 0, 1)]
+    for k in range(0, len(t), max(1, len(t) // 50)):
+        expect = min(dihedral(t[k], *q) for q in pairs)
+        assert min_dihedral_angles(t[k], np.array([[0, 1, 2, 3]]))[0] == pytest.approx(expect, abs=1e-9)
+    assert 0 < m.quality["min_angle"]["min"] < 70.53 and m.quality["min_angle"]["max"] <= 70.53 + 1e-9
+
+
+def test_quadratic_elements_report_the_scaled_jacobian():
+    m = sm.fe_mesh(bd.Sphere(2), size=0.8, order=2)
+    assert m.cell_type == "tetra10" and 0 < m.quality["SJ"]["min"] < 1
+    assert "scaled Jacobian" in str(m)
 
 
 def test_sphere_volume_and_area_converge():

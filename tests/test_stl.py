@@ -3,14 +3,14 @@ binary and ASCII; read back with trimesh and with a real STL client (Debian ``ad
 
 from __future__ import annotations
 
-import re
 import shutil
-import subprocess
 
 import numpy as np
 import pytest
 
 import surfmod as sm
+from stlcheck import ADMESH_REPAIRS as _ADMESH_REPAIRS
+from stlcheck import admesh_stats as _admesh_stats
 
 
 def _solid():
@@ -56,33 +56,6 @@ def test_surfmod_sphere_exports_watertight(tmp_path):
     tm = _load(tmp_path / "sphere.stl")
     assert tm.is_watertight and tm.is_winding_consistent and tm.volume > 0
     assert m.info["kind"] == "adaptive" and m.info["max_deviation"] <= 0.01
-
-
-# admesh's counters of problems found or repaired: all zero for an STL that needs no repair
-_ADMESH_REPAIRS = (
-    "Facets with 1 disconnected edge",
-    "Total disconnected facets",
-    "Degenerate facets",
-    "Edges fixed",
-    "Facets removed",
-    "Facets added",
-    "Facets reversed",
-    "Backwards edges",
-    "Normals fixed",
-)
-
-
-def _admesh_stats(path):
-    out = subprocess.run(["admesh", str(path)], capture_output=True, timeout=60).stdout
-    out = out.decode("utf-8", errors="replace")  # admesh echoes the raw 80-byte header
-    stats = {}
-    for key in ("Number of facets", "Number of parts", *_ADMESH_REPAIRS):
-        match = re.search(re.escape(key) + r"\s*:\s*(\d+)", out)
-        assert match, f"admesh output lacks {key!r}:\n{out}"
-        stats[key] = int(match.group(1))
-    vol = re.search(r"Volume\s*:\s*([-0-9.eE+]+)", out)
-    stats["Volume"] = float(vol.group(1))
-    return stats
 
 
 @pytest.mark.skipif(shutil.which("admesh") is None, reason="admesh not installed (apt-get install admesh)")

@@ -10,7 +10,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.meshing.tessellate import _barycentric
+from surfmod.meshing.deviation import _barycentric
 
 
 def _independent_max_distance(s, mesh, per_triangle=3, limit=1500, seed=0):
@@ -87,7 +87,7 @@ def test_plane_needs_two_triangles():
 
 
 def test_fewer_triangles_than_brepmesh_at_equal_tolerance():
-    from surfmod.meshing.tessellate import DENSE, measure_face_meshes
+    from surfmod.meshing.brep import DENSE, measure_face_meshes
     from surfmod.occ.mesh import brepmesh
 
     s = sm.BezierSurface(wavy_net(6, 5))
@@ -182,14 +182,34 @@ def test_mesh_is_refused():
         sm.tessellate(sm.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]), 0.1)
 
 
-def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_refused():
-    """A near-tangent boolean leaves vertices with 0.056 tolerance: no deflection can
-    bring the mesh within 0.01 of the faces, and that is said instead of looping."""
+def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_reported_or_refused_when_strict():
+    """A near-tangent boolean leaves edges with 0.056 tolerance: BRepMesh discretizes no
+    edge finer than that, so one face stays 0.025 off whatever the deflection.  The mesh
+    is written (watertight) and that face is reported with its own tolerance; ``strict``
+    refuses instead."""
     import build123d as bd
 
+    from surfmod.meshing.brep import DENSE, measure_face
+    from surfmod.occ.mesh import brepmesh
+    from surfmod.occ.sample import distances_to_face
+    from surfmod.occ.topo import faces_of
+
     solid = bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 2) - bd.Solid.make_cylinder(2, 10)
-    with pytest.raises(sm.SurfmodError, match="tolerance: 0.01 cannot be met.*modelling tolerance"):
-        sm.tessellate(solid, 0.01)
+    m = sm.tessellate(solid, 0.01)
+    assert m.to_trimesh().is_watertight
+    (face,) = m.info["faces_over_tolerance"]
+    assert face["surface"] == "SphericalSurface"
+    assert 0.01 < face["deviation"] <= face["model_tolerance"] and face["model_tolerance"] > 0.05
+    assert m.info["max_deviation"] == face["deviation"]
+    # the reported deviation is real: OCCT's distance from the worst triangle's samples
+    # to that face (BRepExtrema) agrees with the measurement
+    (fm,) = [f for f in brepmesh(solid, m.info["deflection"]) if f.index == face["face"]]
+    per_triangle, _ = measure_face(fm, 0.0)
+    worst = fm.nodes[fm.triangles[np.argmax(per_triangle)]]
+    occt = distances_to_face(faces_of(solid)[face["face"]], DENSE @ worst)
+    assert occt.max() == pytest.approx(face["deviation"], rel=1e-6)
+    with pytest.raises(sm.SurfmodError, match=r"(?s)tolerance: 0.01 is not met on 1 face.*strict.*model tolerance 0.056"):
+        sm.tessellate(solid, 0.01, strict=True)
 
 
 def test_ear_clipping_never_collapses_onto_a_side():

@@ -151,7 +151,7 @@ MESH_COLUMNS = [("file", "<36.36"), ("triangles", ">10d"), ("watertight", "<10.1
                 ("stl", "<")]
 
 
-def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None) -> list[tuple]:
+def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None, strict: bool = False) -> list[tuple]:
     """Mesh one STEP file to an STL beside it (or in ``out_dir``) with the per-file mesh
     function of ``surfmod mesh``; ``[(file, triangles, watertight, max deviation, stl or
     error)]``."""
@@ -161,7 +161,7 @@ def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None) -> list
     p = Path(path)
     out = (Path(out_dir) / p.with_suffix(".stl").name) if out_dir else p.with_suffix(".stl")
     try:
-        mesh = export_stl(import_step(p), out, tolerance=tolerance, ascii=ascii)
+        mesh = export_stl(import_step(p), out, tolerance=tolerance, ascii=ascii, strict=strict, progress=False)
     except SurfmodError as exc:
         return [(str(p), 0, "-", float("nan"), f"error: {' '.join(str(exc).split())}")]
     dev = mesh.info.get("max_deviation")
@@ -179,7 +179,8 @@ def run_mesh(args) -> int:
             raise SurfmodError(f"out: with several files or folders --out must be an existing folder, got {out_dir}")
     sink = RowSink(MESH_COLUMNS, args.csv)
     bad = 0
-    options = {"tolerance": args.tolerance, "ascii": args.ascii, "out_dir": None if out_dir is None else str(out_dir)}
+    options = {"tolerance": args.tolerance, "ascii": args.ascii, "out_dir": None if out_dir is None else str(out_dir),
+               "strict": bool(getattr(args, "strict", False))}
     for chunk in run_batch(mesh_file, files, options=options, scheduler=args.scheduler, jobs=args.jobs,
                            progress=not getattr(args, "no_progress", False), desc="mesh"):
         for row in chunk:

@@ -1,9 +1,14 @@
-"""``surfmod mesh FILE.step --tolerance T --out part.stl``: STL for CAM and slicers."""
+"""``surfmod mesh FILE.step --tolerance T --out part.stl [--strict]``: STL for CAM and
+slicers, measured against the B-rep; faces whose model is itself off by more than the
+tolerance are reported (or refused with ``--strict``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from ..io.step import import_step
+from ..io.stl import export_stl
+from ..meshing.brep import describe_faces
 from .batch import add_batch_arguments, is_batch, run_mesh
 
 
@@ -13,25 +18,30 @@ def register(sub) -> None:
     p.add_argument("--tolerance", type=float, default=0.01, help="max chordal deviation (model units, default 0.01)")
     p.add_argument("--out", help="output STL (default: beside the input); with several files a folder")
     p.add_argument("--ascii", action="store_true", help="ASCII STL instead of binary")
+    p.add_argument("--strict", action="store_true",
+                   help="refuse (exit non-zero, no file) when a face of the model is itself off by more than the "
+                        "tolerance, instead of writing the STL and reporting those faces")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     add_batch_arguments(p)
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
-    from ..io.step import import_step
-    from ..io.stl import export_stl
-
     if is_batch(args):
         return run_mesh(args)
     args.step = args.step[0]
-
     shape = import_step(args.step)
     out = Path(args.out) if args.out else Path(args.step).with_suffix(".stl")
-    mesh = export_stl(shape, out, tolerance=args.tolerance, ascii=args.ascii)
+    mesh = export_stl(shape, out, tolerance=args.tolerance, ascii=args.ascii, strict=args.strict,
+                      progress=not args.no_progress)
     tm = mesh.to_trimesh()
     dev = mesh.info.get("max_deviation")
     print(f"{out}: {len(mesh.faces)} triangles, {len(mesh.vertices)} vertices, "
           f"watertight {tm.is_watertight}, winding consistent {tm.is_winding_consistent}"
           + (f", measured max deviation {dev:.3g}" if dev is not None else ""))
+    report = mesh.info.get("faces_over_tolerance", [])
+    if report:
+        print(f"{len(report)} face(s) deviate more than {args.tolerance:g} and a finer mesh does not bring them "
+              f"closer: the model's own error (compare each face's model tolerance); --strict refuses such parts")
+        print(describe_faces(report))
     return 0

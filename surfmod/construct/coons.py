@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface, cartesian, homogeneous
-from .from_face import as_curve
+from .from_edge import as_curve
 
 BLENDS = ("linear", "hermite")
 NAMES = ("c0", "c1", "d0", "d1")

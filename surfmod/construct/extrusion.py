@@ -14,7 +14,7 @@ from ..curve import Curve
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface
 from ..surface import Surface
-from .from_face import as_curve
+from .from_edge import as_curve
 
 
 def curve_plane_normal(curve: Curve, name: str = "curve"):

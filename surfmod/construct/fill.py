@@ -264,7 +264,7 @@ class Fill(tuple):
 
 def _ribbon(item, index, order):
     from ..curve import Curve
-    from .from_face import as_curve
+    from .from_edge import as_curve
 
     if isinstance(item, tuple) and len(item) == 2 and isinstance(item[0], Surface):
         surf, side = item

@@ -33,7 +33,7 @@ from ..nets import knots as kn
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..nets.elevate import elevate_degree, make_compatible, merged_knots, reparametrized
 from .fitting import _interp_along, averaging_knots
-from .from_face import as_curve
+from .from_edge import as_curve
 
 #: crossings closer than this (relative to the curve's parameter span) count as equal
 SAME_PARAMETER = 1e-10

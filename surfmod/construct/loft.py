@@ -26,7 +26,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface, cartesian, homogeneous
 from .fitting import averaging_knots
-from .from_face import as_curve
+from .from_edge import as_curve
 
 
 _MAX_DEGREE = 8  # BRepOffsetAPI_ThruSections default max degree

@@ -19,7 +19,7 @@ from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..surface import Surface
 from .elementary import cos_d, sin_d
-from .from_face import as_curve
+from .from_edge import as_curve
 
 
 def revolve_nurbs(profile: BSplineCurve, origin, axis, u_range) -> BSplineSurface:

@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..nets.elevate import make_compatible
-from .from_face import as_curve
+from .from_edge import as_curve
 
 
 def _occt_weights(c: BSplineCurve):

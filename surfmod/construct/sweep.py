@@ -37,7 +37,7 @@ from .. import checks, tolerances, transforms
 from ..errors import SurfmodError
 from ..eval.frames import RotationMinimizingTable, any_normal, axis_rotation, frenet_frames
 from ..surface import Surface
-from .from_face import as_curve
+from .from_edge import as_curve
 
 MODES = ("frenet", "corrected_frenet")
 

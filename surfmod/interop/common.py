@@ -32,7 +32,8 @@ def nurbs_of(obj, name: str = "obj"):
     from ..surface import Surface
 
     if not isinstance(obj, (Surface, Curve)) and hasattr(obj, "wrapped"):
-        from ..construct.from_face import from_edge, from_face
+        from ..construct.from_edge import from_edge
+        from ..readback import from_face
 
         kind = type(obj).__name__
         obj = from_face(obj) if kind == "Face" else from_edge(obj) if kind in ("Edge", "Wire") else obj

@@ -7,21 +7,14 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..meshing.polymesh import Mesh
+from ..meshing.tessellate import tessellate
 from ..atomic import atomic_path, target_path
 
 
-def _mesh_of(obj, tolerance: float) -> Mesh:
-    from ..surface import Surface
-
+def _mesh_of(obj, tolerance: float, strict: bool, progress: bool) -> Mesh:
     if isinstance(obj, Mesh):
         return obj.triangulated()
-    if isinstance(obj, Surface):
-        from ..meshing.tessellate import tessellate
-
-        return tessellate(obj, tolerance)
-    from ..meshing.tessellate import tessellate
-
-    return tessellate(obj, tolerance)
+    return tessellate(obj, tolerance, strict=strict, progress=progress)
 
 
 def merged(meshes: list[Mesh]) -> Mesh:
@@ -35,13 +28,18 @@ def merged(meshes: list[Mesh]) -> Mesh:
     devs = [m.info["max_deviation"] for m in meshes if "max_deviation" in m.info]
     if devs:
         info["max_deviation"] = max(devs)
+    info["faces_over_tolerance"] = [r for m in meshes for r in m.info.get("faces_over_tolerance", [])]
     return Mesh(np.concatenate(verts), np.concatenate(faces), info)
 
 
 def facet_normals(tri: np.ndarray) -> np.ndarray:
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    """Unit normals of triangles ``(T, 3, 3)`` as an STL reader recomputes them: from the
+    vertices rounded to float32 (what the file holds), in float32 arithmetic, so a
+    sliver triangle's written normal agrees with the one admesh & co. check it against."""
+    t = np.asarray(tri, dtype=np.float32)
+    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     norm = np.linalg.norm(n, axis=1, keepdims=True)
-    return n / np.where(norm > 0, norm, 1.0)
+    return n / np.where(norm > 0, norm, np.float32(1.0))
 
 
 def write_binary(fh, tri: np.ndarray) -> None:
@@ -67,12 +65,17 @@ def write_ascii(fh, tri: np.ndarray, name: str = "surfmod") -> None:
     fh.write("\n".join(lines).encode("ascii"))
 
 
-def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False) -> Mesh:
+def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, strict: bool = False,
+               progress: bool = False) -> Mesh:
     """Write meshes, surfaces or build123d shapes to one STL file, atomically.
 
-    Surfaces and shapes are tessellated with :func:`surfmod.tessellate` so the chordal
-    deviation stays below ``tolerance``; a closed solid gives a watertight STL.
-    Returns the mesh that was written.
+    Surfaces and shapes are tessellated with :func:`surfmod.tessellate` so the measured
+    chordal deviation stays below ``tolerance``; a closed solid gives a watertight STL.
+    Faces of a real part that are themselves off by more than ``tolerance`` (the model's
+    own error, within its declared tolerance) are listed in the returned mesh's
+    ``info["faces_over_tolerance"]`` (face index, surface type, measured deviation, model
+    tolerance); ``strict=True`` refuses them instead and writes nothing.  ``progress``
+    shows a tqdm bar while meshing.  Returns the mesh that was written.
 
     >>> import surfmod as sm, tempfile, os
     >>> d = tempfile.mkdtemp()
@@ -85,7 +88,7 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False) -
     items = list(objects) if isinstance(objects, (list, tuple)) else [objects]
     if not items:
         raise SurfmodError("objects: nothing to export")
-    mesh = merged([_mesh_of(o, tolerance) for o in items])
+    mesh = merged([_mesh_of(o, tolerance, strict, progress) for o in items])
     tri = mesh.vertices[mesh.triangles()]
     with atomic_path(target) as tmp, open(tmp, "wb") as fh:
         (write_ascii if ascii else write_binary)(fh, tri)

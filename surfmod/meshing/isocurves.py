@@ -64,7 +64,7 @@ class IsoCurve(Curve):
     def to_bspline(self):
         if hasattr(self.surface, "isocurve"):
             return _spline_iso(self.surface, self.direction, self.value)
-        from ..construct.from_face import from_edge
+        from ..construct.from_edge import from_edge
 
         return from_edge(self.edge())
 
@@ -136,7 +136,7 @@ def isocurves(s, nu: int, nv: int) -> IsoCurves:
     if not isinstance(s, Surface):
         if getattr(s, "wrapped", None) is None and not hasattr(s, "ShapeType"):
             raise SurfmodError(f"s: expected a surfmod surface or a build123d Face, got {type(s).__name__}")
-        from ..construct.from_face import from_face
+        from ..readback import from_face
 
         s = from_face(s)
     counts = []

@@ -62,3 +62,20 @@ class Mesh:
         import trimesh
 
         return trimesh.Trimesh(self.vertices, self.triangles(), process=False)
+
+
+def weld(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge vertices with identical coordinates and drop the triangles that collapse.
+
+    BRepMesh repeats the nodes of a shared edge in every face's triangulation, bit for
+    bit, so exact equality is the right test (no distance threshold to choose).
+
+    >>> v, t = weld(np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0]]),
+    ...             np.array([[0, 1, 2], [3, 4, 2]]))
+    >>> len(v), t.tolist()
+    (4, [[0, 2, 1], [2, 3, 1]])
+    """
+    unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
+    tri = inverse.reshape(-1)[triangles]
+    keep = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
+    return unique, tri[keep]

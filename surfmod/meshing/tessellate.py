@@ -18,9 +18,8 @@ Surfmod surfaces are meshed by our own adaptive refinement on the NumPy evaluato
 
 Closed directions (seams) and collapsed sides (poles) are detected by sampling the
 domain boundary and their vertices are shared, so a sphere or torus gives a watertight
-mesh.  Build123d shapes (several faces, solids) go through OCCT's BRepMesh, which
-discretizes every edge once (faces share boundary vertices: watertight); its deviation is
-measured the same way and the deflection is tightened until the measurement passes.
+mesh.  Build123d shapes (several faces, solids, STEP parts) go through OCCT's BRepMesh,
+measured face by face (:mod:`surfmod.meshing.brep`).
 """
 
 from __future__ import annotations
@@ -29,114 +28,14 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from .brep import MAX_TRIANGLES, tessellate_shape
+from .deviation import COARSE, DENSE, triangle_deviations
 from .polymesh import Mesh
 
-#: Refuse tolerances that would need more triangles than this (checked before meshing).
-MAX_TRIANGLES = 5_000_000
 #: Lattice steps per start cell, as a power of two (depth limit of the refinement).
 LEVELS = 22
 #: Tolerances below this fraction of the object size cannot be certified in float64.
 MIN_RELATIVE_TOLERANCE = 1e-10
-
-
-def _barycentric(n: int) -> np.ndarray:
-    """Barycentric sample points of a triangle on an ``n``-division grid, corners excluded."""
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-    keep = (i + j) <= n
-    b = np.stack([i[keep], j[keep], n - i[keep] - j[keep]], axis=1) / n
-    return b[(b == 1.0).sum(axis=1) == 0]
-
-
-COARSE = _barycentric(4)  # 12 points: edge points and interior
-DENSE = _barycentric(6)  # 25 points
-
-
-# -- measurement ------------------------------------------------------------------------
-def project_distances(d1, points, uv, bounds, iterations: int = 6, threshold: float = 0.0, d0=None) -> np.ndarray:
-    """Distance from ``points`` (N, 3) to a surface, by Gauss-Newton from the parameter
-    guesses ``uv`` (N, 2), clipped to ``bounds = (u0, u1, v0, v1)``.
-
-    ``d1(u, v)`` returns ``(N, >=2, >=2, 3)`` derivatives (``d0`` optionally positions
-    only).  Every iterate is a point of the surface, so the smallest distance seen is an
-    upper bound of the true distance (for the guarantee, over-estimating is the safe
-    side).  Points whose first bound is already ``<= threshold`` are not iterated.
-
-    >>> import numpy as np, surfmod as sm
-    >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
-    >>> d = project_distances(lambda u, v: s._derivatives(u, v, 1),
-    ...     np.array([[0.2, 0.7, 0.5]]), np.array([[0.0, 0.0]]), (0, 1, 0, 1))
-    >>> float(d[0])
-    0.5
-    """
-    u0, u1, v0, v1 = bounds
-    u = np.clip(uv[:, 0], u0, u1)
-    v = np.clip(uv[:, 1], v0, v1)
-    first = d0(u, v) if d0 is not None else d1(u, v)[:, 0, 0]
-    best = np.linalg.norm(points - first, axis=1)
-    act = np.nonzero(best > threshold)[0]
-    step_u, step_v = 0.25 * (u1 - u0), 0.25 * (v1 - v0)
-    ua, va = u[act], v[act]
-    for _ in range(iterations):
-        if act.size == 0:
-            break
-        ders = d1(ua, va)
-        r = points[act] - ders[:, 0, 0]
-        best[act] = np.minimum(best[act], np.linalg.norm(r, axis=1))
-        su, sv = ders[:, 1, 0], ders[:, 0, 1]
-        a = np.einsum("ij,ij->i", su, su)
-        b = np.einsum("ij,ij->i", su, sv)
-        c = np.einsum("ij,ij->i", sv, sv)
-        g1 = np.einsum("ij,ij->i", su, r)
-        g2 = np.einsum("ij,ij->i", sv, r)
-        det = a * c - b * b
-        det = det + 1e-14 * (a + c) ** 2 + np.finfo(float).tiny
-        du = np.clip((c * g1 - b * g2) / det, -step_u, step_u)
-        dv = np.clip((a * g2 - b * g1) / det, -step_v, step_v)
-        un = np.clip(ua + du, u0, u1)
-        vn = np.clip(va + dv, v0, v1)
-        # Gauss-Newton is quadratic near the foot point: once the 3-D step is below 1e-3 of
-        # the distance, the distance is known to ~1e-6 relative and the point is done
-        step3 = np.linalg.norm((un - ua)[:, None] * su + (vn - va)[:, None] * sv, axis=1)
-        moving = step3 > 1e-3 * best[act]
-        # converged points already have their distance in ``best``
-        act, ua, va = act[moving], un[moving], vn[moving]
-    if act.size:
-        last = d0(ua, va) if d0 is not None else d1(ua, va)[:, 0, 0]
-        best[act] = np.minimum(best[act], np.linalg.norm(points[act] - last, axis=1))
-    return best
-
-
-def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None, d0=None, accurate_max=True):
-    """Measured max deviation per triangle: ``positions`` (T, 3, 3), ``uvs`` (T, 3, 2).
-
-    Samples whose parameter-space bound is already at most ``threshold`` are not
-    projected (their bound suffices to pass).  With ``accurate_max``, the samples within
-    30 % of the running maximum are also projected until the maximum is a projected
-    value: an accurate maximum at a fraction of the cost of projecting every sample.
-    """
-    if len(positions) == 0:
-        return np.zeros(0)
-    q = np.einsum("kj,tjd->tkd", bary, positions).reshape(-1, 3)
-    g = np.einsum("kj,tjd->tkd", bary, uvs).reshape(-1, 2)
-    thr = np.inf if threshold is None else threshold
-    d0v = d0(np.clip(g[:, 0], bounds[0], bounds[1]), np.clip(g[:, 1], bounds[2], bounds[3])) if d0 else None
-    first = np.linalg.norm(q - d0v, axis=1) if d0v is not None else None
-    if first is None:
-        d = project_distances(d1, q, g, bounds, threshold=thr)
-        done = d > thr
-    else:
-        d = first.copy()
-        done = d > thr
-        idx = np.nonzero(done)[0]
-        if idx.size:
-            d[idx] = np.minimum(d[idx], project_distances(d1, q[idx], g[idx], bounds, d0=d0))
-    while accurate_max and d.size:
-        cand = np.nonzero(~done & (d >= 0.9 * d.max()))[0]
-        if cand.size == 0:
-            break
-        d[cand] = np.minimum(d[cand], project_distances(d1, q[cand], g[cand], bounds, d0=d0))
-        done[cand] = True
-    return d.reshape(len(positions), len(bary)).max(axis=1)
 
 
 # -- the adaptive refinement of a surfmod surface ---------------------------------------
@@ -512,6 +411,11 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES) 
         if best is None or len(tris) < len(best[1]):
             best = (ref, tris, dev, stuck)
     ref, tris, dev, stuck = best
+    if dev.size and dev.max() > tolerance:
+        raise SurfmodError(
+            f"tolerance: {tolerance:g} not reached: measured {dev.max():.3g} after {ref.iterations} refinement "
+            f"passes ({stuck} cells could not be split further)"
+        )
     flat = tris.reshape(-1, 2)
     cx, cy = ref._canonical(flat[:, 0], flat[:, 1])
     keys = ref._key(cx, cy)
@@ -530,112 +434,7 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES) 
         "closed": (ref.closed_u, ref.closed_v),
         "uv": uv,
     }
-    if stuck:
-        info["unsplittable_cells"] = stuck
     return Mesh(verts, faces[keep], info)
-
-
-# -- shapes: BRepMesh, measured and tightened ---------------------------------------------
-def _face_evaluator(fm):
-    """``(d1, bounds)`` for measuring against one face: NumPy when ``from_face`` reads the
-    face's surface, else OCCT ``D1`` per point."""
-    from ..construct.from_face import from_face
-    from ..occ.mesh import surface_d1
-
-    u0, u1, v0, v1 = fm.bounds
-    try:
-        s = from_face(fm.face)
-    except (SurfmodError, ValueError, TypeError, AttributeError):
-        s = None
-    if s is not None:
-        (a0, a1), (b0, b1) = s.domain
-        return (lambda u, v: s._derivatives(u, v, 1)), (max(u0, a0), min(u1, a1), max(v0, b0), min(v1, b1))
-    surf = fm.surface
-    return (lambda u, v: surface_d1(surf, u, v)), (u0, u1, v0, v1)
-
-
-def measure_face_meshes(face_meshes, bary=COARSE) -> np.ndarray:
-    """Per-face measured max deviation of BRepMesh triangulations from their surfaces."""
-    from ..occ.mesh import analytic_distances
-
-    out = []
-    for fm in face_meshes:
-        pos = fm.nodes[fm.triangles]
-        q = np.einsum("kj,tjd->tkd", bary, pos).reshape(-1, 3)
-        d = analytic_distances(fm.surface, q)
-        if d is None:
-            d1, bounds = _face_evaluator(fm)
-            g = np.einsum("kj,tjd->tkd", bary, fm.uv[fm.triangles]).reshape(-1, 2)
-            d = project_distances(d1, q, g, bounds)
-        out.append(float(d.max()) if d.size else 0.0)
-    return np.array(out)
-
-
-def _weld(vertices: np.ndarray, triangles: np.ndarray):
-    unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
-    tri = inverse.reshape(-1)[triangles]
-    keep = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
-    return unique, tri[keep]
-
-
-def _face_tolerance(face) -> float:
-    from ..occ.mesh import max_tolerance
-
-    return max_tolerance(face)
-
-
-def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES, angular: float = 0.5) -> Mesh:
-    """Watertight BRepMesh triangulation of a build123d/OCP shape whose *measured*
-    deviation is within ``tolerance`` (the deflection is tightened until it is)."""
-    from ..occ.mesh import brepmesh, shape_figures
-
-    figures, diag = shape_figures(shape)
-    if tolerance < MIN_RELATIVE_TOLERANCE * 100 * diag:
-        raise SurfmodError(
-            f"tolerance: {tolerance:g} is below {MIN_RELATIVE_TOLERANCE * 100:g} x the shape size {diag:.3g}"
-        )
-    ell = max(diag, 1e-300)
-    estimate = sum(2 * a * (np.sqrt(k / (8 * tolerance)) + 1 / ell) ** 2 for a, k in figures)
-    if estimate > max_triangles:
-        raise SurfmodError(
-            f"tolerance: {tolerance:g} would need about {estimate:,.0f} triangles, above the limit "
-            f"max_triangles={max_triangles:,}"
-        )
-    deflection = tolerance
-    previous = np.inf
-    for attempt in range(1, 9):
-        fms = brepmesh(shape, deflection, angular)
-        per_face = measure_face_meshes(fms, DENSE)
-        dev = float(per_face.max())
-        if dev <= tolerance:
-            break
-        if dev > 0.9 * previous:  # a finer deflection does not help: the model itself is off
-            worst = int(np.argmax(per_face))
-            raise SurfmodError(
-                f"tolerance: {tolerance:g} cannot be met: face {worst} of the shape deviates {dev:.3g} from its "
-                f"surface whatever the deflection (its own modelling tolerance is "
-                f"{_face_tolerance(fms[worst].face):.3g}); use a tolerance above that"
-            )
-        previous = dev
-        deflection *= max(0.25, 0.9 * tolerance / dev)
-    else:
-        raise SurfmodError(f"tolerance: BRepMesh could not reach {tolerance:g} (measured {dev:g})")
-    verts, tris, offset = [], [], 0
-    for fm in fms:
-        verts.append(fm.nodes)
-        tris.append(fm.triangles + offset)
-        offset += len(fm.nodes)
-    v, t = _weld(np.concatenate(verts), np.concatenate(tris))
-    info = {
-        "kind": "brepmesh",
-        "tolerance": tolerance,
-        "deflection": deflection,
-        "attempts": attempt,
-        "max_deviation": dev,
-        "triangles": len(t),
-        "samples_per_triangle": len(DENSE),
-    }
-    return Mesh(v, t, info)
 
 
 #: default cap for surfmod surfaces, whose adaptive refinement runs in NumPy (about a few
@@ -643,17 +442,23 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
 MAX_SURFACE_TRIANGLES = 250_000
 
 
-def tessellate(obj, tolerance: float, *, max_triangles: int | None = None) -> Mesh:
+def tessellate(obj, tolerance: float, *, max_triangles: int | None = None, strict: bool = False,
+               progress: bool = False) -> Mesh:
     """Triangle mesh of a surfmod surface or a build123d shape whose chordal deviation
     from the exact geometry is at most ``tolerance`` -- measured on 25 sample points per
     triangle and reported in ``info["max_deviation"]``.
 
-    Surfaces are refined adaptively where curvature is high; faces of a shape share their
-    boundary vertices, so a closed solid gives a watertight mesh.  A tolerance <= 0, or
-    one so small that more than ``max_triangles`` triangles would be needed, raises
-    ``SurfmodError`` before anything large is allocated.  The default cap is
-    ``MAX_SURFACE_TRIANGLES`` (250,000) for surfmod surfaces and ``MAX_TRIANGLES``
-    (5,000,000) for shapes meshed by BRepMesh.
+    Surfaces are refined adaptively where curvature is high (a tolerance the refinement
+    cannot reach raises ``SurfmodError``).  Shapes (solids, STEP parts) go through
+    BRepMesh, measured face by face; where a face of the model is itself off by more than
+    ``tolerance`` (its edges' curves stray from the face within their declared
+    tolerance), the mesh is still written and the face is listed in
+    ``info["faces_over_tolerance"]``, or refused with ``strict=True``
+    (:func:`surfmod.meshing.brep.tessellate_shape`).  ``progress`` shows a tqdm bar.
+    A tolerance <= 0, or one so small that more than ``max_triangles`` triangles would
+    be needed, raises ``SurfmodError`` before anything large is allocated.
+    The default cap is ``MAX_SURFACE_TRIANGLES`` (250,000) for surfmod surfaces and
+    ``MAX_TRIANGLES`` (5,000,000) for shapes meshed by BRepMesh.
 
     >>> import surfmod as sm, numpy as np
     >>> net = np.zeros((3, 3, 3)); net[..., 0], net[..., 1] = np.mgrid[0:3, 0:3]
@@ -675,4 +480,4 @@ def tessellate(obj, tolerance: float, *, max_triangles: int | None = None) -> Me
     shape = getattr(obj, "wrapped", obj)
     if not hasattr(shape, "ShapeType") or shape.IsNull():
         raise SurfmodError(f"obj: expected a surfmod surface or a build123d shape, got {type(obj).__name__}")
-    return tessellate_shape(shape, tolerance, max_triangles)
+    return tessellate_shape(shape, tolerance, max_triangles, strict=strict, progress=progress)

@@ -20,7 +20,9 @@ from .guard import kernel
 class FaceMesh:
     """One face's BRepMesh triangulation: 3-D ``nodes`` (global coordinates), ``uv``
     nodes on the face's surface, ``triangles`` oriented outwards (face orientation
-    applied), the face's ``surface`` (global coordinates), its ``face`` and ``bounds``."""
+    applied), the face's ``surface`` (global coordinates, trimmed-surface wrappers
+    removed), its ``face``, ``bounds`` (UV box), ``index`` in exploration order and
+    ``solid`` (index of the solid it belongs to, -1 for faces outside any solid)."""
 
     nodes: np.ndarray
     uv: np.ndarray
@@ -28,6 +30,8 @@ class FaceMesh:
     surface: object
     face: object
     bounds: tuple
+    index: int = 0
+    solid: int = -1
 
 
 def clean(shape) -> None:
@@ -40,16 +44,76 @@ def clean(shape) -> None:
         BRepTools.Clean_s(wrapped(shape))
 
 
-def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False) -> list[FaceMesh]:
-    """Run ``BRepMesh_IncrementalMesh`` (after clearing old triangulations) and return the
-    per-face triangulations.  BRepMesh discretizes each edge once, so nodes of faces that
-    share an edge coincide bit for bit."""
+def basis_surface(surf):
+    """The surface under ``Geom_RectangularTrimmedSurface`` wrappers (same parametrization)."""
+    from .geom import surface_type
+
+    while surface_type(surf) == "Geom_RectangularTrimmedSurface":
+        surf = surf.BasisSurface()
+    return surf
+
+
+def _face_solids(shp) -> dict:
+    """``{face hash: solid index}`` for the faces that belong to a solid."""
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    owner = {}
+    solids = TopExp_Explorer(shp, TopAbs_SOLID)
+    k = 0
+    while solids.More():
+        faces = TopExp_Explorer(solids.Current(), TopAbs_FACE)
+        while faces.More():
+            owner.setdefault(faces.Current().__hash__(), k)
+            faces.Next()
+        k += 1
+        solids.Next()
+    return owner
+
+
+#: Surfaces whose distance has a closed form (:func:`analytic_distances`): their (u, v)
+#: nodes are not needed to measure a mesh.
+ANALYTIC = ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface", "Geom_SphericalSurface",
+            "Geom_ToroidalSurface")
+
+
+def _triangulation(face, with_uv: bool = True):
+    """``(nodes, uv, triangles)`` of a face's stored triangulation (``uv`` NaN unless
+    ``with_uv``), or ``None``."""
     from OCP.BRep import BRep_Tool
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
-    from OCP.BRepTools import BRepTools
     from OCP.TopAbs import TopAbs_REVERSED
     from OCP.TopLoc import TopLoc_Location
 
+    loc = TopLoc_Location()
+    tri = BRep_Tool.Triangulation_s(face, loc)
+    if tri is None or tri.NbTriangles() == 0:
+        return None
+    n = tri.NbNodes()
+    nodes = np.array([tri.Node(i).Coord() for i in range(1, n + 1)], dtype=float)
+    if not loc.IsIdentity():
+        t = loc.Transformation()
+        rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
+        nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
+    if with_uv and tri.HasUVNodes():
+        uv = np.array([tri.UVNode(i).Coord() for i in range(1, n + 1)], dtype=float)
+    else:
+        uv = np.full((n, 2), np.nan)
+    idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
+    if face.Orientation() == TopAbs_REVERSED:
+        idx = idx[:, ::-1]
+    return nodes, uv, idx
+
+
+def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None) -> list[FaceMesh]:
+    """Run ``BRepMesh_IncrementalMesh`` (after clearing old triangulations) and return the
+    per-face triangulations.  BRepMesh discretizes each edge once, so nodes of faces that
+    share an edge coincide bit for bit.  Faces BRepMesh left without triangles are
+    skipped; their indices are appended to ``missing`` when a list is given."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.BRepTools import BRepTools
+
+    from .geom import surface_type
     from .topo import faces_of, wrapped
 
     shp = wrapped(shape)
@@ -57,30 +121,101 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
     out = []
     with kernel("BRepMesh_IncrementalMesh"):
         BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), False)
-        for face in faces_of(shp):
-            loc = TopLoc_Location()
-            tri = BRep_Tool.Triangulation_s(face, loc)
-            if tri is None or tri.NbTriangles() == 0:
+        owner = _face_solids(shp)
+        for k, face in enumerate(faces_of(shp)):
+            surf = basis_surface(BRep_Tool.Surface_s(face))
+            got = _triangulation(face, surface_type(surf) not in ANALYTIC)
+            if got is None:
+                if missing is not None:
+                    missing.append(k)
                 continue
-            trsf = loc.Transformation()
-            n = tri.NbNodes()
-            nodes = np.empty((n, 3))
-            uv = np.full((n, 2), np.nan)
-            has_uv = tri.HasUVNodes()
-            for i in range(1, n + 1):
-                p = tri.Node(i).Transformed(trsf)
-                nodes[i - 1] = (p.X(), p.Y(), p.Z())
-                if has_uv:
-                    q = tri.UVNode(i)
-                    uv[i - 1] = (q.X(), q.Y())
-            idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
-            if face.Orientation() == TopAbs_REVERSED:
-                idx = idx[:, ::-1]
-            surf = BRep_Tool.Surface_s(face)
             bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
-            out.append(FaceMesh(nodes, uv, idx, surf, face, bounds))
+            out.append(FaceMesh(*got, surf, face, bounds, k, owner.get(face.__hash__(), -1)))
     if not out:
         raise SurfmodError("shape: has no faces to triangulate")
+    return out
+
+
+def surface_info(surf) -> dict:
+    """What measuring against a face's surface needs: its OCCT type ``name``, the
+    NumPy-readable ``bspline`` data (B-spline/Bezier surfaces, ``None`` otherwise) and
+    per direction whether it is ``periodic`` with its ``period`` and parameter
+    ``range``."""
+    from .geom import read_bezier_surface, read_bspline_surface, surface_type
+
+    name = surface_type(surf)
+    with kernel(f"{name} parameters"):
+        u0, u1, v0, v1 = surf.Bounds()
+        info = {
+            "name": name,
+            "periodic": (bool(surf.IsUPeriodic()), bool(surf.IsVPeriodic())),
+            "period": (surf.UPeriod() if surf.IsUPeriodic() else 0.0, surf.VPeriod() if surf.IsVPeriodic() else 0.0),
+            "range": ((u0, u1), (v0, v1)),
+            "bspline": None,
+            "bezier": None,
+        }
+    if name == "Geom_BSplineSurface":
+        info["bspline"] = read_bspline_surface(surf)
+    elif name == "Geom_BezierSurface":
+        info["bezier"] = read_bezier_surface(surf)
+    return info
+
+
+def curve_info(curve) -> dict:
+    """A ``Geom_Curve`` as data NumPy can evaluate in OCCT's parametrization:
+    ``{"name", "bspline"|"bezier" (reader dicts), "line": (origin, direction),
+    "conic": (centre, x axis, y axis, a, b) for circles and ellipses}``; trimmed-curve
+    wrappers are removed (same parametrization).  Other types give only ``name``."""
+    from .geom import read_bspline_curve
+
+    name = curve.DynamicType().Name()
+    with kernel(f"{name} parameters"):
+        while name == "Geom_TrimmedCurve":
+            curve = curve.BasisCurve()
+            name = curve.DynamicType().Name()
+        info = {"name": name}
+        if name == "Geom_BSplineCurve":
+            info["bspline"] = read_bspline_curve(curve)
+        elif name == "Geom_BezierCurve":
+            from .arrays import pnts_to_numpy_1d, to_numpy_1d
+            from OCP.TColgp import TColgp_Array1OfPnt
+            from OCP.TColStd import TColStd_Array1OfReal
+
+            poles = TColgp_Array1OfPnt(1, curve.NbPoles())
+            curve.Poles(poles)
+            weights = None
+            if curve.IsRational():
+                w = TColStd_Array1OfReal(1, curve.NbPoles())
+                curve.Weights(w)
+                weights = to_numpy_1d(w)
+            info["bezier"] = {"points": pnts_to_numpy_1d(poles), "weights": weights}
+        elif name == "Geom_Line":
+            ax = curve.Position()
+            info["line"] = (np.array(ax.Location().Coord()), np.array(ax.Direction().Coord()))
+        elif name in ("Geom_Circle", "Geom_Ellipse"):
+            ax = curve.Position()
+            a = curve.Radius() if name == "Geom_Circle" else curve.MajorRadius()
+            b = curve.Radius() if name == "Geom_Circle" else curve.MinorRadius()
+            info["conic"] = (np.array(ax.Location().Coord()), np.array(ax.XDirection().Coord()),
+                             np.array(ax.YDirection().Coord()), a, b)
+    return info
+
+
+def swept_info(surf) -> dict | None:
+    """Axis/direction and basis curve of a surface of revolution (``"axis": (origin,
+    direction)``) or of linear extrusion (``"direction"``); ``None`` for other types."""
+    from .geom import surface_type
+
+    name = surface_type(surf)
+    if name not in ("Geom_SurfaceOfRevolution", "Geom_SurfaceOfLinearExtrusion"):
+        return None
+    with kernel(f"{name} parameters"):
+        out = {"name": name, "curve": curve_info(surf.BasisCurve())}
+        if name == "Geom_SurfaceOfRevolution":
+            ax = surf.Axis()
+            out["axis"] = (np.array(ax.Location().Coord()), np.array(ax.Direction().Coord()))
+        else:
+            out["direction"] = np.array(surf.Direction().Coord())
     return out
 
 
@@ -101,29 +236,43 @@ def surface_d1(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def analytic_distances(surf, points: np.ndarray) -> np.ndarray | None:
-    """Closed-form distance from ``points`` to an untrimmed plane, cylinder, sphere or
-    torus (``None`` for any other surface type)."""
-    from .geom import downcast_surface, surface_type
+    """Closed-form distance from ``points`` to an untrimmed plane, cylinder, cone, sphere
+    or torus (``None`` for any other surface type).
+
+    The foot point of a point on a surface of revolution lies in the point's meridian
+    plane, where the cone and the torus show *two* profiles (the generatrix line and
+    the circle mirrored through the axis, both parts of OCCT's surface: a cone goes on
+    past its apex, a spindle torus' tube crosses the axis): the distance is the smaller
+    of the two."""
+    from .geom import surface_type
 
     name = surface_type(surf)
-    if name not in ("Geom_Plane", "Geom_CylindricalSurface", "Geom_SphericalSurface", "Geom_ToroidalSurface"):
+    if name not in ANALYTIC:
         return None
-    s = downcast_surface(surf)
     with kernel(f"{name} parameters"):
-        ax = s.Position()
-        o = np.array([ax.Location().X(), ax.Location().Y(), ax.Location().Z()])
-        d = ax.Direction()
-        z = np.array([d.X(), d.Y(), d.Z()])
+        ax = surf.Position()
+        o = np.array(ax.Location().Coord())
+        z = np.array(ax.Direction().Coord())
         rel = points - o
         h = rel @ z
         if name == "Geom_Plane":
             return np.abs(h)
         if name == "Geom_SphericalSurface":
-            return np.abs(np.linalg.norm(rel, axis=1) - s.Radius())
+            return np.abs(np.linalg.norm(rel, axis=1) - surf.Radius())
         radial = np.linalg.norm(rel - h[:, None] * z, axis=1)
         if name == "Geom_CylindricalSurface":
-            return np.abs(radial - s.Radius())
-        return np.abs(np.hypot(radial - s.MajorRadius(), h) - s.MinorRadius())
+            return np.abs(radial - surf.Radius())
+        if name == "Geom_ConicalSurface":
+            r0, a = surf.RefRadius(), surf.SemiAngle()
+            # profile lines through (+-r0, 0) with directions (+-sin a, cos a), in (radial, h)
+            sa, ca = np.sin(a), np.cos(a)
+            near = np.abs((radial - r0) * ca - h * sa)
+            far = np.abs((radial + r0) * ca + h * sa)
+            return np.minimum(near, far)
+        big, small = surf.MajorRadius(), surf.MinorRadius()
+        near = np.abs(np.hypot(radial - big, h) - small)
+        far = np.abs(np.hypot(radial + big, h) - small)
+        return np.minimum(near, far)
 
 
 def iso_curve(surf, direction: int, value: float):
@@ -143,20 +292,23 @@ def curve_points(curve, t: np.ndarray) -> np.ndarray:
         return out
 
 
-def shape_figures(shape, samples: int = 9):
-    """Per face ``(area, mean sqrt(|k1| |k2|) with each |k| floored by 1/diagonal)`` and the
-    bounding-box diagonal: enough to estimate how many triangles a chordal tolerance
-    needs before asking BRepMesh for them."""
+def shape_figures(shape, samples: int = 5):
+    """Per curved face ``(area, median sqrt(|k1| |k2|) with each |k| floored by 1/diagonal)``
+    from a ``samples`` x ``samples`` grid over the face's UV box (area of the box's patch:
+    at least the face's), and the bounding-box diagonal: enough to estimate how many
+    triangles a chordal tolerance needs before asking BRepMesh for them.  Planes need
+    no figure (a plane's triangle count does not grow as the tolerance shrinks)."""
     from OCP.Bnd import Bnd_Box
+    from OCP.BRep import BRep_Tool
     from OCP.BRepBndLib import BRepBndLib
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
+    from OCP.BRepTools import BRepTools
     from OCP.GeomLProp import GeomLProp_SLProps
 
+    from .geom import surface_type
     from .topo import faces_of, wrapped
 
     shp = wrapped(shape)
-    with kernel("shape figures (BRepGProp, GeomLProp)"):
+    with kernel("shape figures (Bnd_Box, GeomLProp)"):
         box = Bnd_Box()
         BRepBndLib.Add_s(shp, box)
         if box.IsVoid():
@@ -165,24 +317,25 @@ def shape_figures(shape, samples: int = 9):
         diag = float(np.linalg.norm([x1 - x0, y1 - y0, z1 - z0]))
         floor = 1.0 / max(diag, 1e-300)
         figures = []
-        from OCP.BRep import BRep_Tool
-        from OCP.BRepTools import BRepTools
-
         for face in faces_of(shp):
-            props = GProp_GProps()
-            BRepGProp.SurfaceProperties_s(face, props)
-            area = abs(props.Mass())
-            surf = BRep_Tool.Surface_s(face)
+            surf = basis_surface(BRep_Tool.Surface_s(face))
+            name = surface_type(surf)
+            if name == "Geom_Plane":
+                continue
             u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
             lp = GeomLProp_SLProps(surf, 2, 1e-9)
-            vals = []
-            for uu in np.linspace(u0, u1, samples):
+            vals, jac = [], []
+            # elementary surfaces are curved alike along u: three columns tell them
+            ns = min(samples, 3) if name in ANALYTIC else samples
+            for uu in np.linspace(u0, u1, ns):
                 for vv in np.linspace(v0, v1, samples):
                     lp.SetParameters(float(uu), float(vv))
+                    jac.append(lp.D1U().Crossed(lp.D1V()).Magnitude())
                     if lp.IsCurvatureDefined():
                         k1, k2 = abs(lp.MaxCurvature()), abs(lp.MinCurvature())
                         vals.append(np.sqrt(max(k1, floor) * max(k2, floor)))
-            figures.append((area, float(np.mean(vals)) if vals else floor))
+            area = float(np.mean(jac)) * (u1 - u0) * (v1 - v0)
+            figures.append((area, float(np.median(vals)) if vals else floor))
     return figures, diag
 
 

@@ -339,7 +339,7 @@ def _combined(label, parts):
 
 
 def _shell(shape, samples: int, occt: bool, only_faces=None):
-    from ..construct.from_face import from_face
+    from ..readback import from_face
     from ..occ.continuity import shared_edges
 
     records = shared_edges(shape, samples)
@@ -424,7 +424,7 @@ def _as_surface(obj, name: str) -> Surface:
     if isinstance(obj, Surface):
         return obj
     if _is_shape(obj):
-        from ..construct.from_face import from_face
+        from ..readback import from_face
 
         try:
             return from_face(obj)

@@ -23,17 +23,25 @@ _CELLS = {("surface", 1): "triangle", ("surface", 2): "triangle6",
 class FEMesh:
     """A finite element mesh: ``mesh`` is a ``meshio.Mesh`` holding only the elements
     of ``kind`` (``"surface"``: triangles, ``"volume"``: tetrahedra; 6/10-node when
-    ``order=2``), ``quality`` gmsh's element-quality statistics (scaled Jacobian
-    ``minSJ`` (1 for every straight-sided element, informative for ``order=2``),
-    signed inverse condition number ``minSICN`` and inscribed/circumscribed radius
-    ratio ``gamma``: min, mean, max each) plus ``quality["measure"]``, the total volume
-    (area for surface meshes) of the elements as gmsh integrates them, curved sides
-    included.
+    ``order=2``) and ``quality`` the element-quality figures that mean something for
+    that element type, each as ``{"min", "mean", "max"}``:
+
+    * ``gamma`` (gmsh): inscribed/circumscribed radius ratio, 1 for the regular element;
+    * ``SICN`` (gmsh): signed inverse condition number, <= 0 for an inverted element;
+    * ``min_angle`` (degrees): the smallest dihedral angle of each tetrahedron (the
+      smallest corner angle of each triangle); slivers show here when gamma hides them;
+    * ``SJ`` (gmsh's scaled Jacobian) for ``order=2`` only: a straight-sided element's
+      Jacobian is constant, so for linear elements it is 1 and says nothing;
+
+    plus ``quality["inverted"]``, the number of elements whose signed volume (tets) is
+    not positive (always 0: fe_mesh refuses otherwise), and ``quality["measure"]``, the
+    total volume (area for surface meshes) of the elements as gmsh integrates them,
+    curved sides included.
 
     >>> import surfmod as sm, build123d as bd
     >>> fe = sm.fe_mesh(bd.Box(2, 2, 2), size=1.0)
-    >>> round(fe.quality["measure"], 9), fe.kind
-    (8.0, 'volume')
+    >>> round(fe.quality["measure"], 9), fe.kind, fe.quality["inverted"]
+    (8.0, 'volume', 0)
     """
 
     mesh: object = field(repr=False)
@@ -80,12 +88,69 @@ class FEMesh:
 
     def __str__(self) -> str:
         q = self.quality
-        return (
-            f"FE mesh: {self.n_elements} {self.cell_type} elements, {len(self.points)} nodes, target size {self.size:g}\n"
-            f"  scaled Jacobian min {q['minSJ']['min']:.3f} mean {q['minSJ']['mean']:.3f}\n"
-            f"  SICN            min {q['minSICN']['min']:.3f} mean {q['minSICN']['mean']:.3f}\n"
-            f"  gamma           min {q['gamma']['min']:.3f} mean {q['gamma']['mean']:.3f}"
-        )
+        names = ("gamma", "SICN", "min_angle") + (("SJ",) if "SJ" in q else ())
+        angle = "min dihedral angle" if self.kind == "volume" else "min angle"
+        labels = {"gamma": "gamma (inradius ratio)", "SICN": "SICN", "min_angle": f"{angle} (deg)",
+                  "SJ": "scaled Jacobian"}
+        lines = [f"FE mesh: {self.n_elements} {self.cell_type} elements, {len(self.points)} nodes, target size "
+                 f"{self.size:g}, inverted elements {q['inverted']}"]
+        for name in names:
+            lines.append(f"  {labels[name]:<28s} min {q[name]['min']:.3f} mean {q[name]['mean']:.3f}")
+        return "\n".join(lines)
+
+
+def _stats(values: np.ndarray) -> dict:
+    return {"min": float(values.min()), "mean": float(values.mean()), "max": float(values.max())}
+
+
+def signed_volumes(points: np.ndarray, tets: np.ndarray) -> np.ndarray:
+    """Signed volume of each tetrahedron (corner nodes ``tets[:, :4]``, gmsh's order:
+    positive for a valid element).
+
+    >>> signed_volumes(np.eye(4, 3, -1), np.array([[0, 1, 2, 3], [0, 2, 1, 3]])).tolist()
+    [0.16666666666666666, -0.16666666666666666]
+    """
+    t = points[tets[:, :4]]
+    return np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0])) / 6
+
+
+def min_dihedral_angles(points: np.ndarray, tets: np.ndarray) -> np.ndarray:
+    """Smallest of the six dihedral angles of each tetrahedron, in degrees (70.53 for the
+    regular tetrahedron, near 0 for a sliver).
+
+    >>> regular = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], float)
+    >>> round(float(min_dihedral_angles(regular, np.array([[0, 1, 2, 3]]))[0]), 4)
+    70.5288
+    """
+    t = points[tets[:, :4]]
+    faces = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))  # face k is opposite node k
+    normals = []
+    for k, (a, b, c) in enumerate(faces):
+        n = np.cross(t[:, b] - t[:, a], t[:, c] - t[:, a])
+        # orient outwards: away from the opposite node
+        n *= -np.sign(np.einsum("ij,ij->i", n, t[:, k] - t[:, a]))[:, None]
+        normals.append(n / np.linalg.norm(n, axis=1, keepdims=True))
+    worst = np.full(len(t), np.pi)
+    for i in range(4):
+        for j in range(i + 1, 4):
+            cos = np.clip(-np.einsum("ij,ij->i", normals[i], normals[j]), -1.0, 1.0)
+            worst = np.minimum(worst, np.arccos(cos))
+    return np.degrees(worst)
+
+
+def min_triangle_angles(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """Smallest corner angle of each triangle, in degrees.
+
+    >>> round(float(min_triangle_angles(np.eye(3), np.array([[0, 1, 2]]))[0]), 6)
+    60.0
+    """
+    t = points[tris[:, :3]]
+    worst = np.full(len(t), 180.0)
+    for k in range(3):
+        a, b = t[:, (k + 1) % 3] - t[:, k], t[:, (k + 2) % 3] - t[:, k]
+        cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+        worst = np.minimum(worst, np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+    return worst
 
 
 def _gmsh():
@@ -96,7 +161,22 @@ def _gmsh():
     return gmsh
 
 
-def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int) -> dict:
+#: gmsh's OCC healing, tried when a part does not mesh as read (real STEP parts: tiny or
+#: degenerate edges, faces that touch without sharing edges make "overlapping facets")
+HEALING = {
+    "Geometry.OCCFixDegenerated": 1,
+    "Geometry.OCCFixSmallEdges": 1,
+    "Geometry.OCCFixSmallFaces": 1,
+    "Geometry.OCCSewFaces": 1,
+    "Geometry.OCCMakeSolids": 1,
+}
+
+
+def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bool) -> dict:
+    """Mesh the BREP file with gmsh, write ``msh``; return gmsh's qualities per element.
+
+    Each solid is its own gmsh volume; solids of an assembly that touch or overlap are
+    meshed independently (no conformal interface), as a part list is."""
     gmsh = _gmsh()
     with _GMSH_LOCK:
         own = not gmsh.isInitialized()
@@ -104,10 +184,14 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int) -> dict:
             gmsh.initialize(interruptible=False)
         try:
             gmsh.option.setNumber("General.Terminal", 0)
+            for name, value in HEALING.items():
+                gmsh.option.setNumber(name, value if heal else 0)
             gmsh.model.add("surfmod")
             gmsh.model.occ.importShapes(str(brep))
             gmsh.model.occ.synchronize()
             if dim == 3 and not gmsh.model.getEntities(3):
+                if heal:  # the part had solids when it failed as read
+                    raise _GmshFailure("gmsh's healing left no volume")
                 raise SurfmodError("kind: a volume mesh needs a closed solid; obj has no solid")
             gmsh.option.setNumber("Mesh.MeshSizeMax", size)
             gmsh.option.setNumber("Mesh.MeshSizeMin", size / 10)
@@ -116,14 +200,14 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int) -> dict:
             gmsh.model.mesh.generate(dim)
             if order > 1:
                 gmsh.model.mesh.setOrder(order)
-            quality = {}
-            types, tags, _ = gmsh.model.mesh.getElements(dim)
+            _types, tags, _ = gmsh.model.mesh.getElements(dim)
             all_tags = np.concatenate([np.asarray(t) for t in tags]) if len(tags) else np.array([])
             if all_tags.size == 0:
                 raise SurfmodError("size: gmsh produced no elements (is the part degenerate?)")
-            for name in ("minSJ", "minSICN", "gamma"):
-                q = np.asarray(gmsh.model.mesh.getElementQualities(all_tags, name))
-                quality[name] = {"min": float(q.min()), "mean": float(q.mean()), "max": float(q.max())}
+            quality = {}
+            names = {"gamma": "gamma", "SICN": "minSICN"} | ({"SJ": "minSJ"} if order > 1 else {})
+            for name, gmsh_name in names.items():
+                quality[name] = _stats(np.asarray(gmsh.model.mesh.getElementQualities(all_tags, gmsh_name)))
             # gmsh's own element measures (curved elements for order 2)
             quality["measure"] = float(np.sum(gmsh.model.mesh.getElementQualities(all_tags, "volume")))
             gmsh.write(str(msh))
@@ -131,7 +215,7 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int) -> dict:
         except SurfmodError:
             raise
         except Exception as exc:
-            raise SurfmodError(f"obj: gmsh failed to mesh the part ({exc})") from exc
+            raise _GmshFailure(str(exc)) from exc
         finally:
             try:
                 gmsh.model.remove()
@@ -141,14 +225,25 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int) -> dict:
                 gmsh.finalize()
 
 
+class _GmshFailure(Exception):
+    """gmsh could not mesh the part as given (retried healed, then reported)."""
+
+
+def _part_name(obj) -> str:
+    return f"{obj}" if isinstance(obj, (str, Path)) else "obj"
+
+
 def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None,
             max_elements: int = 2_000_000) -> FEMesh:
     """Triangle (``kind="surface"``) or tetrahedral (``kind="volume"``) FE mesh of a part
     with target element ``size`` (gmsh, also refined by curvature), ``order`` 1 or 2.
 
     ``obj``: a build123d shape, surfmod surface(s) or a STEP path.  The part goes to
-    gmsh as a BREP file (exact geometry); the mesh comes back through meshio.  With
-    ``path`` the mesh is also written (``.msh``, ``.vtu``, ``.inp``).  Meshes estimated
+    gmsh as a BREP file (exact geometry); the mesh comes back through meshio.  A part
+    gmsh cannot mesh as read is retried with gmsh's OCC healing (:data:`HEALING`); one
+    it still cannot mesh raises ``SurfmodError`` naming the file and gmsh's reason.
+    Every tetrahedron's signed volume is checked: an inverted element is an error, never
+    a result.  With ``path`` the mesh is also written (``.msh``, ``.vtu``, ``.inp``).  Meshes estimated
     (from the bounding box and ``size``) above ``max_elements`` elements are refused
     before gmsh runs; raise ``max_elements`` to allow them.
 
@@ -181,22 +276,47 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     else:  # 2 triangles per square on the box's faces
         estimate = 4.0 * float(dims[0] * dims[1] + dims[1] * dims[2] + dims[0] * dims[2]) / size**2
     checks.work(estimate, max_elements, "max_elements", f"a {kind} mesh with element size {size:g} of a part of extent {extent:.4g}")
+    cell = _CELLS[(kind, order)]
+    failures = []
     with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp:
         brep, msh = Path(tmp) / "part.brep", Path(tmp) / "part.msh"
         occ.write_brep(shape, brep)
-        quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order)
-        full = meshio.read(msh, file_format="gmsh")
-    cell = _CELLS[(kind, order)]
+        for heal in (False, True):
+            try:
+                quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order, heal)
+            except _GmshFailure as exc:
+                failures.append(str(exc))
+                continue
+            full = meshio.read(msh, file_format="gmsh")
+            points, data = _cells_of(full, cell)
+            inverted = int(np.sum(signed_volumes(points, data) <= 0)) if kind == "volume" else 0
+            if inverted:
+                failures.append(f"{inverted} inverted tetrahedra")
+                continue
+            break
+        else:
+            raise SurfmodError(
+                f"{_part_name(obj)}: gmsh cannot {kind}-mesh this part at size {size:g}, as read or healed "
+                f"({'; '.join(dict.fromkeys(failures))})"
+            )
+    quality["inverted"] = 0
+    angles = min_dihedral_angles(points, data) if kind == "volume" else min_triangle_angles(points, data)
+    quality["min_angle"] = _stats(angles)
+    result = FEMesh(meshio.Mesh(points, [(cell, data)]), kind, order, size, quality)
+    if path is not None:
+        export_fe_mesh(result, path)
+    return result
+
+
+def _cells_of(full, cell: str):
+    """Points and connectivity of the ``cell`` blocks of a meshio mesh, unused nodes
+    dropped."""
     blocks = [c.data for c in full.cells if c.type == cell]
     data = np.concatenate(blocks) if blocks else np.zeros((0, 3), dtype=int)
     used = np.unique(data)
     remap = np.full(len(full.points), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
-    mesh = meshio.Mesh(full.points[used], [(cell, remap[data])])
-    result = FEMesh(mesh, kind, order, size, quality)
-    if path is not None:
-        export_fe_mesh(result, path)
-    return result
+    return full.points[used], remap[data]
 
 
 def export_fe_mesh(mesh, path) -> None:

@@ -183,7 +183,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     >>> len(s.wires), s.closed, round(s.length, 12) == round(2 * 3.141592653589793 * 3 ** 0.5, 12)
     (1, [True], True)
     """
-    from ..construct.from_face import from_edge
+    from ..construct.from_edge import from_edge
     from ..occ import uses as occ
     from .inputs import to_shape
 

@@ -1,26 +1,12 @@
 """Read OCCT / build123d edges and wires back into surfmod curves (``from_edge``,
 ``as_curve`` wherever a constructor takes a curve).
 
-Faces are read by :mod:`surfmod.readback` (``sm.from_face``); ``from_face`` here forwards
-there for code that imports it from this module.
+Faces are read by :mod:`surfmod.readback` (``sm.from_face``), the one reader of faces.
 """
 
 from __future__ import annotations
 
 from ..errors import SurfmodError
-
-
-def from_face(face):
-    """Same as :func:`surfmod.readback.from_face` (the one reader of OCCT faces).
-
-    >>> import surfmod as sm, build123d as bd
-    >>> type(sm.construct.from_face.from_face(bd.Box(1, 1, 1).faces()[0])).__name__
-    'TrimmedFace'
-    """
-    # readback builds on the constructors of this package, so it is imported on use
-    from ..readback.trimmed import from_face as read_face
-
-    return read_face(face)
 
 
 def from_edge(edge):

@@ -1,0 +1,132 @@
+"""Real parts: every command's job on each file of ../shared/step_corpus, timed beside
+OCCT's own tool for the same job, both on one core, in one process.
+
+| job | surfmod | OCCT's tool |
+|---|---|---|
+| read | ``sm.import_step`` | ``STEPControl_Reader`` (ReadFile + TransferRoots) |
+| check | ``surfmod check``'s per-file work (read, every face read back and cross-checked) | read + ``BRepCheck_Analyzer`` |
+| mesh | ``sm.export_stl`` at 1e-3 of the bbox diagonal (BRepMesh, every face *measured*, STL written) | ``BRepMesh_IncrementalMesh`` at the same deflection (no measurement, no file) |
+| mass | ``sm.mass_properties`` | ``BRepGProp.VolumeProperties_s`` at eps 1e-9 |
+| section | ``sm.section`` through the bbox centre, normal z | ``BRepAlgoAPI_Section`` with that plane |
+
+Each time is the best of ``REPEATS`` runs; "x" is surfmod / OCCT (target <= 2).  A job
+that raises shows its error class instead of a time.
+
+``python -m benchmarks real``
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+import surfmod as sm
+
+CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "step_corpus"
+REPEATS = 2
+
+
+def _best(fn, repeats: int = REPEATS):
+    """Best wall time of ``fn()`` over ``repeats`` runs, or the exception's class name."""
+    best = np.inf
+    for _ in range(repeats):
+        t = time.perf_counter()
+        try:
+            fn()
+        except Exception as exc:  # a failing job is a row entry, not the end of the table
+            return type(exc).__name__
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def _occt_read(path):
+    from OCP.STEPControl import STEPControl_Reader
+
+    reader = STEPControl_Reader()
+    reader.ReadFile(str(path))
+    reader.TransferRoots()
+    return reader.OneShape()
+
+
+def _occt_jobs(path, shape, deflection, centre):
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepGProp import BRepGProp
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.BRepTools import BRepTools
+    from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+    from OCP.GProp import GProp_GProps
+
+    def mesh():
+        BRepTools.Clean_s(shape)
+        BRepMesh_IncrementalMesh(shape, deflection, False, 0.5, False)
+
+    def mass():
+        BRepGProp.VolumeProperties_s(shape, GProp_GProps(), 1e-9)
+
+    def section():
+        BRepAlgoAPI_Section(shape, gp_Pln(gp_Pnt(*centre), gp_Dir(0, 0, 1))).Shape()
+
+    return {
+        "read": lambda: _occt_read(path),
+        "check": lambda: BRepCheck_Analyzer(_occt_read(path)).IsValid(),
+        "mesh": mesh,
+        "mass": mass,
+        "section": section,
+    }
+
+
+def _surfmod_jobs(path, part, tolerance, centre, out):
+    from surfmod.cli.check import check_file
+
+    return {
+        "read": lambda: sm.import_step(path),
+        "check": lambda: check_file(path, 24),
+        "mesh": lambda: sm.export_stl(part, out, tolerance),
+        "mass": lambda: sm.mass_properties(part),
+        "section": lambda: sm.section(part, centre, (0, 0, 1)),
+    }
+
+
+JOBS = ("read", "check", "mesh", "mass", "section")
+
+
+def _cell(ours, theirs) -> str:
+    if isinstance(ours, str):
+        return f"{ours:>22}"
+    if isinstance(theirs, str):
+        return f"{ours:8.3f} {'-':>6} {'-':>6}"
+    return f"{ours:8.3f} {theirs:6.3f} {ours / theirs:5.1f}x"
+
+
+def main() -> None:
+    from surfmod.occ.mesh import shape_figures
+
+    files = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
+    if not files:
+        print(f"no corpus at {CORPUS}")
+        return
+    print("seconds: surfmod, OCCT, ratio (surfmod / OCCT); mesh at 1e-3 of the bbox diagonal")
+    head = f"{'file':<44}" + "".join(f"{j:^23}" for j in JOBS)
+    print(head)
+    print("-" * len(head))
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "part.stl"
+        for path in files:
+            part = sm.import_step(path)
+            _, diag = shape_figures(part, samples=2)
+            bb = part.bounding_box()
+            centre = tuple(float(x) for x in (np.array(bb.min.to_tuple()) + np.array(bb.max.to_tuple())) / 2)
+            ours = _surfmod_jobs(path, part, 1e-3 * diag, centre, out)
+            theirs = _occt_jobs(path, _occt_read(path), 1e-3 * diag, centre)
+            row = f"{path.name[:43]:<44}"
+            for job in JOBS:
+                row += _cell(_best(ours[job]), _best(theirs[job])) + " "
+            print(row, flush=True)
+
+
+if __name__ == "__main__":
+    main()

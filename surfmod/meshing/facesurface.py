@@ -1,0 +1,129 @@
+"""A face's surface evaluated as OCCT evaluates it, vectorized, for measuring meshes of
+real parts: B-spline and Bezier surfaces through the NumPy evaluator, surfaces of
+revolution and of linear extrusion from their basis curve (B-spline, Bezier, line,
+circle, ellipse) in closed form, and OCCT's ``D1`` per point for anything else.
+
+Parameters are OCCT's: periodic directions wrap into their period (a face trimmed
+across the seam of a periodic B-spline lives on both sides of it), other directions
+are clamped to the parameter range (pcurves may overshoot by a tolerance).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..nets.bezier import BezierCurve, BezierSurface
+from ..nets.bspline import BSplineCurve, BSplineSurface
+
+
+class _Curve:
+    """Position and first derivative ``(N, 2, 3)`` of a basis curve in OCCT's
+    parametrization (closed forms for lines and conics, NumPy for splines)."""
+
+    def __init__(self, info: dict):
+        self.spline = None
+        self.info = info
+        if "bspline" in info:
+            d = info["bspline"]
+            self.spline = BSplineCurve(d["points"], d["degree"], d["knots"], d["weights"])
+        elif "bezier" in info:
+            self.spline = BezierCurve(info["bezier"]["points"], info["bezier"]["weights"])
+        self.supported = self.spline is not None or "line" in info or "conic" in info
+
+    def d1(self, t: np.ndarray) -> np.ndarray:
+        if self.spline is not None:
+            lo, hi = self.spline.domain
+            return self.spline._derivatives(np.clip(t, lo, hi), 1)
+        if "line" in self.info:
+            o, d = self.info["line"]
+            return np.stack([o + t[:, None] * d, np.broadcast_to(d, (len(t), 3))], axis=1)
+        c, x, y, a, b = self.info["conic"]
+        cos, sin = np.cos(t)[:, None], np.sin(t)[:, None]
+        return np.stack([c + a * cos * x + b * sin * y, -a * sin * x + b * cos * y], axis=1)
+
+
+class FaceSurface:
+    """``d0(u, v)`` ``(N, 3)`` and ``d1(u, v)`` ``(N, 2, 2, 3)`` of a ``Geom_Surface``.
+
+    >>> import surfmod as sm
+    >>> from surfmod.gallery.synthetic import wavy_net
+    >>> from surfmod.occ.topo import face_surface
+    >>> s = sm.BSplineSurface(wavy_net(5, 4), (3, 2))
+    >>> ev = FaceSurface(face_surface(s.face())[0])
+    >>> import numpy as np; u = np.array([0.2, 0.7]); v = np.array([0.5, 0.1])
+    >>> bool(np.allclose(ev.d0(u, v), s.points(u, v), rtol=0, atol=1e-12)), ev.numpy
+    (True, True)
+    """
+
+    def __init__(self, surf):
+        from ..occ.mesh import surface_info, swept_info
+
+        info = surface_info(surf)
+        self.name = info["name"]
+        self.periodic = info["periodic"]
+        self.period = info["period"]
+        self.range = info["range"]
+        self.surf = surf
+        self._spline = None
+        self._swept = None
+        if info["bspline"] is not None:
+            d = info["bspline"]
+            self._spline = BSplineSurface(d["control_points"], d["degree"], d["knots"], d["weights"])
+        elif info["bezier"] is not None:
+            self._spline = BezierSurface(info["bezier"]["control_points"], info["bezier"]["weights"])
+        else:
+            swept = swept_info(surf)
+            if swept is not None and _Curve(swept["curve"]).supported:
+                self._swept = swept | {"eval": _Curve(swept["curve"])}
+        if self._spline is not None:
+            self.range = tuple(tuple(float(x) for x in r) for r in self._spline.domain)
+
+    @property
+    def numpy(self) -> bool:
+        """Whether evaluation runs in NumPy (else OCCT per point)."""
+        return self._spline is not None or self._swept is not None
+
+    def _map(self, x: np.ndarray, direction: int) -> np.ndarray:
+        lo, hi = self.range[direction]
+        if self.periodic[direction]:
+            return lo + np.mod(x - lo, self.period[direction])
+        return np.clip(x, lo, hi)
+
+    def d1(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        if self._spline is not None:
+            return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 1)
+        if self._swept is not None:
+            return self._swept_d1(np.asarray(u, float), np.asarray(v, float))
+        from ..occ.mesh import surface_d1
+
+        return surface_d1(self.surf, u, v)
+
+    def d0(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        if self._spline is not None:
+            return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 0)[:, 0, 0]
+        return self.d1(u, v)[:, 0, 0]
+
+    def _swept_d1(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        out = np.zeros((len(u), 2, 2, 3))
+        sw = self._swept
+        if "direction" in sw:  # extrusion: S(u, v) = C(u) + v D
+            c = sw["eval"].d1(u)
+            d = sw["direction"]
+            out[:, 0, 0] = c[:, 0] + v[:, None] * d
+            out[:, 1, 0] = c[:, 1]
+            out[:, 0, 1] = d
+            return out
+        # revolution: C(v) turned by the angle u about the axis (Rodrigues)
+        o, a = sw["axis"]
+        c = sw["eval"].d1(v)
+        cos, sin = np.cos(u)[:, None], np.sin(u)[:, None]
+
+        def turn(w):
+            along = (w @ a)[:, None] * a
+            return (w - along) * cos + np.cross(a, w) * sin + along
+
+        w = c[:, 0] - o
+        out[:, 0, 0] = o + turn(w)
+        out[:, 1, 0] = np.cross(a, turn(w))
+        out[:, 0, 1] = turn(c[:, 1])
+        return out
