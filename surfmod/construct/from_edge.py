@@ -38,3 +38,22 @@ def as_curve(value, name: str):
         except SurfmodError as exc:
             raise SurfmodError(f"{name}: {exc}") from None
     raise SurfmodError(f"{name}: expected a surfmod curve or a build123d Edge/Wire, got {type(value).__name__}")
+
+
+def as_curves(value, name: str, purpose: str, minimum: int = 2) -> list:
+    """A list of at least ``minimum`` curves (surfmod curves or build123d edges/wires),
+    each through :func:`as_curve`; ``purpose`` completes the message ("a loft needs...").
+
+    >>> import surfmod as sm
+    >>> as_curves([sm.Line((0, 0, 0), (1, 0, 0))], "sections", "a loft")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: sections: a loft needs at least 2, got 1
+    """
+    try:
+        items = list(value)
+    except TypeError:
+        raise SurfmodError(f"{name}: expected a list of curves, got {type(value).__name__}") from None
+    if len(items) < minimum:
+        raise SurfmodError(f"{name}: {purpose} needs at least {minimum}, got {len(items)}")
+    return [as_curve(c, f"{name}[{k}]") for k, c in enumerate(items)]

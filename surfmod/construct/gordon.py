@@ -33,7 +33,7 @@ from ..nets import knots as kn
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..nets.elevate import elevate_degree, make_compatible, merged_knots, reparametrized
 from .fitting import _interp_along, averaging_knots
-from .from_edge import as_curve
+from .from_edge import as_curves
 
 #: crossings closer than this (relative to the curve's parameter span) count as equal
 SAME_PARAMETER = 1e-10
@@ -216,13 +216,7 @@ def _check_ends(curves, t, tn, tol, name, order, other):
 
 # -- public ---------------------------------------------------------------------------------
 def _curves(value, name):
-    try:
-        items = list(value)
-    except TypeError:
-        raise SurfmodError(f"{name}: expected a list of curves, got {type(value).__name__}") from None
-    if len(items) < 2:
-        raise SurfmodError(f"{name}: a Gordon surface needs at least 2, got {len(items)}")
-    return [as_curve(c, f"{name}[{k}]").to_bspline() for k, c in enumerate(items)]
+    return [c.to_bspline() for c in as_curves(value, name, "a Gordon surface")]
 
 
 def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:

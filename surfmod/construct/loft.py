@@ -26,7 +26,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface, cartesian, homogeneous
 from .fitting import averaging_knots
-from .from_edge import as_curve
+from .from_edge import as_curves
 
 
 _MAX_DEGREE = 8  # BRepOffsetAPI_ThruSections default max degree
@@ -144,13 +144,7 @@ def loft(sections, *, ruled: bool = False) -> LoftSurface:
     >>> bool(np.allclose(s.points(0.5, v[1]), b.points(0.5)))
     True
     """
-    try:
-        items = list(sections)
-    except TypeError:
-        raise SurfmodError(f"sections: expected a list of curves, got {type(sections).__name__}") from None
-    if len(items) < 2:
-        raise SurfmodError(f"sections: a loft needs at least 2 sections, got {len(items)}")
-    curves = [as_curve(c, f"sections[{k}]") for k, c in enumerate(items)]
+    curves = as_curves(sections, "sections", "a loft")
     size = _check_orientation(curves)
     from ..nets.elevate import make_compatible
 

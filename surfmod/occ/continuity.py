@@ -9,13 +9,29 @@ from __future__ import annotations
 
 import numpy as np
 from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 from OCP.GeomAbs import GeomAbs_G2
 from OCP.LocalAnalysis import LocalAnalysis_SurfaceContinuity
 from OCP.TopoDS import TopoDS
+from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 from .guard import kernel
 from .topo import wrapped
 
+
+
+def _pcurve_samples(edge, face, samples: int):
+    """``(uv, tangent)``: ``samples`` points of the edge's p-curve on ``face`` and its
+    (u, v) tangents, evenly in the p-curve's parameter."""
+    pcurve = BRepAdaptor_Curve2d(edge, face)
+    t = np.linspace(pcurve.FirstParameter(), pcurve.LastParameter(), samples)
+    uv, tangent = np.empty((samples, 2)), np.empty((samples, 2))
+    p, d = gp_Pnt2d(), gp_Vec2d()
+    for k, tk in enumerate(t):  # OCCT's per-point D1: a sampler, not an evaluation path
+        pcurve.D1(float(tk), p, d)
+        uv[k] = (p.X(), p.Y())
+        tangent[k] = (d.X(), d.Y())
+    return uv, tangent
 
 def local_analysis(geom_a, uv_a: np.ndarray, geom_b, uv_b: np.ndarray, *, reverse_b: bool = False) -> np.ndarray:
     """``(N, 3)``: OCCT's ``C0Value``, ``G1Angle`` and ``G2CurvatureGap`` at each pair of
@@ -66,9 +82,7 @@ def shared_edges(shape, samples: int) -> list[dict]:
     derivative) and ``inward`` ``(samples, 2)``: the unit parameter-space normal of the
     p-curve pointing into that face.
     """
-    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
     from OCP.BRepTools import BRepTools
-    from OCP.gp import gp_Pnt2d, gp_Vec2d
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp
     from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
@@ -94,14 +108,7 @@ def shared_edges(shape, samples: int) -> list[dict]:
                 face = TopoDS.Face_s(f)
                 rec["faces"].append(next((k for k, g in enumerate(all_faces) if g.IsSame(face)), -1))
                 rec["face_shapes"].append(face)
-                pcurve = BRepAdaptor_Curve2d(edge, face)
-                t = np.linspace(pcurve.FirstParameter(), pcurve.LastParameter(), samples)
-                uv, tangent = np.empty((samples, 2)), np.empty((samples, 2))
-                p, d = gp_Pnt2d(), gp_Vec2d()
-                for k, tk in enumerate(t):
-                    pcurve.D1(float(tk), p, d)
-                    uv[k] = (p.X(), p.Y())
-                    tangent[k] = (d.X(), d.Y())
+                uv, tangent = _pcurve_samples(edge, face, samples)
                 perp = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
                 perp /= np.maximum(np.linalg.norm(perp, axis=1, keepdims=True), 1e-300)
                 u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
@@ -118,8 +125,6 @@ def shared_edges(shape, samples: int) -> list[dict]:
 def face_edges_uv(face, samples: int) -> list:
     """Every non-degenerate edge of one face as ``(uv (samples, 2), tangent (samples, 2))``
     through its p-curve on that face."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-    from OCP.gp import gp_Pnt2d, gp_Vec2d
     from OCP.TopAbs import TopAbs_EDGE
     from OCP.TopExp import TopExp_Explorer
 
@@ -132,13 +137,6 @@ def face_edges_uv(face, samples: int) -> list:
             explorer.Next()
             if BRep_Tool.Degenerated_s(edge):
                 continue
-            pcurve = BRepAdaptor_Curve2d(edge, f)
-            t = np.linspace(pcurve.FirstParameter(), pcurve.LastParameter(), samples)
-            uv, tangent = np.empty((samples, 2)), np.empty((samples, 2))
-            p, d = gp_Pnt2d(), gp_Vec2d()
-            for k, tk in enumerate(t):
-                pcurve.D1(float(tk), p, d)
-                uv[k] = (p.X(), p.Y())
-                tangent[k] = (d.X(), d.Y())
+            uv, tangent = _pcurve_samples(edge, f, samples)
             out.append((uv, tangent))
     return out
