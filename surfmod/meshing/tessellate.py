@@ -29,7 +29,7 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from .brep import MAX_TRIANGLES, tessellate_shape
-from .deviation import COARSE, DENSE, project_distances, triangle_deviations
+from .deviation import COARSE, DENSE, triangle_deviations
 from .polymesh import Mesh
 
 #: Lattice steps per start cell, as a power of two (depth limit of the refinement).
