@@ -119,7 +119,7 @@ def main() -> None:
             part = sm.import_step(path)
             _, diag = shape_figures(part, samples=2)
             bb = part.bounding_box()
-            centre = tuple(float(x) for x in (np.array(bb.min.to_tuple()) + np.array(bb.max.to_tuple())) / 2)
+            centre = tuple(float(x) for x in (np.array(tuple(bb.min)) + np.array(tuple(bb.max))) / 2)
             ours = _surfmod_jobs(path, part, 1e-3 * diag, centre, out)
             theirs = _occt_jobs(path, _occt_read(path), 1e-3 * diag, centre)
             row = f"{path.name[:43]:<44}"

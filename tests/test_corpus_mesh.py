@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import CORPUS
 from stlcheck import ADMESH_REPAIRS, admesh_stats, needs_admesh
 
 import surfmod as sm
-from conftest import CORPUS
 from surfmod.cli import main
 from surfmod.meshing.brep import DENSE, measure_face
 from surfmod.occ.mesh import brepmesh, shape_figures

@@ -125,3 +125,32 @@ def test_bad_input_and_no_partial_files(tmp_path):
     with pytest.raises(sm.SurfmodError, match="mesh"):
         sm.export_fe_mesh("not a mesh", tmp_path / "m.vtu")
     assert list(tmp_path.iterdir()) == []
+
+
+# -- real parts (../shared/step_corpus) -----------------------------------------------
+def _corpus_fe_mesh(path):
+    from surfmod.occ.mesh import shape_figures
+    from surfmod.uses.femesh import signed_volumes
+
+    _, diag = shape_figures(sm.import_step(path), samples=2)
+    m = sm.fe_mesh(path, size=diag / 15)
+    vol = signed_volumes(m.points, m.cells)
+    assert (vol > 0).all() and m.quality["inverted"] == 0
+    assert m.quality["SICN"]["min"] > 0 and m.quality["min_angle"]["min"] > 0
+    return m, vol
+
+
+def test_two_solid_assembly_has_no_inverted_tet():
+    from conftest import CORPUS
+
+    from surfmod.occ.uses import gprops
+
+    path = CORPUS / "cadquery_red_cube_blue_cylinder.step"
+    _, vol = _corpus_fe_mesh(path)
+    # the tets fill both solids: their volume is within 2 % of BRepGProp's
+    assert vol.sum() == pytest.approx(gprops(sm.import_step(path).wrapped)["volume"], rel=0.02)
+
+
+@pytest.mark.corpus
+def test_no_inverted_tet_on_any_corpus_solid(corpus_file):
+    _corpus_fe_mesh(corpus_file)

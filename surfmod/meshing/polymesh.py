@@ -49,7 +49,7 @@ class Mesh:
         f = self.faces
         return np.concatenate([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
 
-    def triangulated(self) -> "Mesh":
+    def triangulated(self) -> Mesh:
         return Mesh(self.vertices, self.triangles(), dict(self.info))
 
     @property

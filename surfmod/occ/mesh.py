@@ -177,9 +177,10 @@ def curve_info(curve) -> dict:
         if name == "Geom_BSplineCurve":
             info["bspline"] = read_bspline_curve(curve)
         elif name == "Geom_BezierCurve":
-            from .arrays import pnts_to_numpy_1d, to_numpy_1d
             from OCP.TColgp import TColgp_Array1OfPnt
             from OCP.TColStd import TColStd_Array1OfReal
+
+            from .arrays import pnts_to_numpy_1d, to_numpy_1d
 
             poles = TColgp_Array1OfPnt(1, curve.NbPoles())
             curve.Poles(poles)
