@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import math
 
+import build123d as bd
+import meshio
 import numpy as np
 import pytest
 
 import surfmod as sm
-
-bd = pytest.importorskip("build123d")
-meshio = pytest.importorskip("meshio")
-pytest.importorskip("gmsh")
 
 
 def test_box_tetra_volume_exact():

@@ -154,10 +154,8 @@ def min_triangle_angles(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
 
 
 def _gmsh():
-    try:
-        import gmsh
-    except ImportError:  # pragma: no cover
-        raise SurfmodError("fe_mesh needs gmsh (pip install gmsh)") from None
+    import gmsh  # a declared dependency, heavy: loaded on the first FE mesh only
+
     return gmsh
 
 
