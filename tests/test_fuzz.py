@@ -439,7 +439,7 @@ def test_damaged_step_files_whole_corpus(driver, tmp_path):
 def _cli_args(command, path: Path, out: Path):
     return {
         "check": ["check", str(path), "--no-progress", "--jobs", "1", "--samples", "4"],
-        "mesh": ["mesh", str(path), "--tolerance", "0.5", "--out", str(out / "m.stl")],
+        "mesh": ["mesh", str(path), "--tolerance", "0.5", "--out", str(out / "m.stl"), "--no-progress"],
         "mass": ["mass", str(path), "--no-progress"],
         "section": ["section", str(path), "--origin", "0", "0", "1", "--normal", "0", "0", "1", "--out",
                     str(out / "s.dxf"), "--no-progress"],
@@ -463,6 +463,10 @@ def check_cli(driver, paths, out: Path):
             continue
         err = r["stderr"].strip()
         prefix = f"surfmod {command}: error: "
+        # mass exits 3 (ambiguous model) or 4 (disagreement with BRepGProp) with its report
+        # on stdout: a verdict on the file, not an error line
+        if command == "mass" and r["code"] in (3, 4) and not err:
+            continue
         if r["code"] not in (0, 1, 2) or "Traceback" in err or (r["code"] and command != "check" and err.count("\n") != 0):
             failures.append(f"{command} {p.name}: exit {r['code']} with {err[-300:]!r}")
         elif r["code"] and command != "check" and not (err.startswith(prefix) and NAMED.match(err[len(prefix):])):

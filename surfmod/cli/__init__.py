@@ -7,6 +7,7 @@ import argparse
 import importlib
 import pkgutil
 import sys
+from pathlib import Path
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -30,8 +31,14 @@ def main(argv=None) -> int:
     try:
         return int(args.run(args) or 0)
     except SurfmodError as exc:
-        # one line, no traceback: bad input is the user's to fix, not a crash
-        print(f"surfmod {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        # one line, no traceback: bad input is the user's to fix, not a crash; a message
+        # about a part that does not say which file it read gets the file appended
+        message = " ".join(str(exc).split())
+        inputs = getattr(args, "path", None) or getattr(args, "step", None) or []
+        inputs = [inputs] if isinstance(inputs, str) else list(inputs)
+        if len(inputs) == 1 and Path(inputs[0]).name not in message:
+            message += f" (in {inputs[0]})"
+        print(f"surfmod {args.command}: error: {message}", file=sys.stderr)
         return 1
 
 

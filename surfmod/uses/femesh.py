@@ -228,7 +228,8 @@ class _GmshFailure(Exception):
 
 
 def _part_name(obj) -> str:
-    return f"{obj}" if isinstance(obj, (str, Path)) else "obj"
+    """``"obj"`` for a shape, ``"obj: part.step"``-style naming for a file."""
+    return f"obj: {Path(obj).name}" if isinstance(obj, (str, Path)) else "obj: this part"
 
 
 def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None,
@@ -294,7 +295,7 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
             break
         else:
             raise SurfmodError(
-                f"{_part_name(obj)}: gmsh cannot {kind}-mesh this part at size {size:g}, as read or healed "
+                f"{_part_name(obj)}: gmsh cannot {kind}-mesh it at size {size:g}, as read or healed "
                 f"({'; '.join(dict.fromkeys(failures))})"
             )
     quality["inverted"] = 0
