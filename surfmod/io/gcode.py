@@ -9,16 +9,38 @@ from ..errors import SurfmodError
 from .atomic import atomic_path, target_path
 
 
+def _is_toolpath(obj) -> bool:
+    """Duck typing (no import of ``uses``, which imports this writer): a tool path has
+    ``(N, 3)`` points and a tool with a kind and a radius."""
+    points = getattr(obj, "points", None)
+    tool = getattr(obj, "tool", None)
+    return (isinstance(points, np.ndarray) and points.ndim == 2 and points.shape[1] == 3 and len(points) > 0
+            and hasattr(tool, "kind") and hasattr(tool, "radius") and hasattr(obj, "stepover"))
+
+
+def _up(values: np.ndarray, digits: int) -> np.ndarray:
+    """Heights rounded up to the written digits: rounding must never lower the tool."""
+    scale = 10.0**digits
+    return np.ceil(np.round(values * scale, 6)) / scale
+
+
 def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = None,
                safe_height: float | None = None, spindle: float | None = None, digits: int = 4) -> str:
-    """G-code for a :class:`~surfmod.uses.toolpath.Toolpath` (millimetres, absolute)."""
-    from ..uses.toolpath import Toolpath
+    """G-code for a :class:`~surfmod.Toolpath` (millimetres, absolute).  Heights are
+    rounded up to ``digits`` decimals, so the written path never sits lower than the
+    verified one; x and y are rounded to nearest.
 
-    if not isinstance(toolpath, Toolpath):
+    >>> import surfmod as sm
+    >>> tp = sm.toolpath(sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0)), sm.Tool("flat", 1.0), stepover=1.5)
+    >>> [ln for ln in gcode_text(tp).splitlines() if ln.startswith("G1")][:2]
+    ['G1 Z0.0000 F200', 'G1 X0.5000 Y0.0000 Z0.0000 F600']
+    """
+    if not _is_toolpath(toolpath):
         raise SurfmodError(f"toolpath: expected a surfmod Toolpath, got {type(toolpath).__name__}")
     feed = checks.positive(feed, "feed")
     plunge = feed / 3 if plunge_feed is None else checks.positive(plunge_feed, "plunge_feed")
-    pts = toolpath.points
+    pts = np.array(toolpath.points, dtype=float)
+    pts[:, 2] = _up(pts[:, 2], int(digits))
     top = float(pts[:, 2].max())
     if safe_height is None:
         safe = top + max(5.0, toolpath.tool.radius)
