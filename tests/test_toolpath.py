@@ -170,8 +170,9 @@ def test_gcode_export(tmp_path):
     path = tmp_path / "p.nc"
     sm.export_gcode(tp, path, feed=800, safe_height=20)
     lines = path.read_text().splitlines()
-    assert lines[:6] == ["%", lines[1], lines[2], "G21 (millimetres)", "G90 (absolute)", "G17 (XY plane)"]
-    assert lines[6] == "G0 Z20.0000" and lines[-2:] == ["M2", "%"] and lines[-3] == "G0 Z20.0000"
+    assert lines[:7] == ["%", lines[1], lines[2], f"(every move checked: no cut deeper than {tp.tolerance:.4g} mm)",
+                         "G21 (millimetres)", "G90 (absolute)", "G17 (XY plane)"]
+    assert lines[7] == "G0 Z20.0000" and lines[-2:] == ["M2", "%"] and lines[-3] == "G0 Z20.0000"
     moves = [ln for ln in lines if ln.startswith("G1 X")]
     assert moves[0].endswith("F800") and len(moves) == len(tp.points) - 1
     xyz = np.array([[float(w[1:]) for w in ln.split()[1:4]] for ln in moves])

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import sys
+
 from ..errors import SurfmodError
 from ..io.atomic import target_path
 from ..io.gcode import export_gcode
 from ..uses.inputs import to_shape
 from ..uses.toolpath import Tool, toolpath
+from ..uses.toolpath_moves import NoSafePathError
 
 GCODE_SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")
 
@@ -32,13 +35,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    """Build and write the path.  Any ``SurfmodError`` (bad input, or no path that keeps
-    every move within the tolerance) prints one line and exits 1 without writing a file."""
-    import sys
-
+    """Build and write the path.  When no path keeps every move within the tolerance, print
+    one line and exit 1 without writing a file (bad input goes to the common handler)."""
     try:
         return _run(args)
-    except SurfmodError as exc:
+    except NoSafePathError as exc:
         print(f"surfmod toolpath: error: {exc}", file=sys.stderr)
         return 1
 

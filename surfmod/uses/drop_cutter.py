@@ -17,7 +17,7 @@ facet is solved in closed form (as OpenCAMLib does), then the highest contact wi
 * flat: vertex ``z`` within the disc; edge: the higher end of the edge's piece inside
   the disc; facet: the disc's rim point uphill along the plane's gradient, when inside.
 
-Candidate pairs come from a uniform (x, y) grid of cell size ~``r`` holding, for each
+Candidate pairs come from a uniform (x, y) grid of cell size ~``r/2`` holding, for each
 cell, every triangle whose (x, y) box grown by ``r`` meets it.
 """
 
@@ -59,9 +59,10 @@ class TriangleGrid:
         self.lo, self.hi = lo, hi
         self.origin = lo.min(axis=0)
         span = hi.max(axis=0) - self.origin
-        # cells of about one radius, but never more than ~4000 along a side (tiny tools on
-        # huge parts would otherwise spread big planar triangles over millions of cells)
-        self.cell = max(self.radius, float(span.max()) / 4000.0)
+        # cells of half a radius (a location's candidates then cover (2.5 r)², not (3 r)²),
+        # but never more than ~4000 along a side (tiny tools on huge parts would otherwise
+        # spread big planar triangles over millions of cells)
+        self.cell = max(self.radius / 2, float(span.max()) / 4000.0)
         self.shape = (np.floor(span / self.cell).astype(np.int64) + 1)
         i0 = np.floor((lo - self.origin) / self.cell).astype(np.int64)
         i1 = np.floor((hi - self.origin) / self.cell).astype(np.int64)
@@ -215,11 +216,6 @@ def _per_location_max(qi: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
-# Triangles tried first per location (those that could lift the tool highest): their best
-# contact is a height that every other triangle must be able to beat to be looked at.
-FIRST_TRIANGLES = 4
-
-
 def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop: np.ndarray):
     """Highest tip height ``(N,)`` (-inf if none) and its contact ``(N, 3)`` over the
     cell-list entries ``start:stop`` of each location, in blocks of about
@@ -238,13 +234,11 @@ def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop
         qi, ti, reach = qi[live], ti[live], reach[live]
         if not len(qi):
             continue
-        # first the few most promising triangles of each location, then the rest that can beat them
-        order = np.lexsort((-reach, qi))  # qi stays grouped: rank = position in the group
-        first = np.r_[0, np.nonzero(np.diff(qi))[0] + 1]
-        rank = np.arange(len(qi)) - np.repeat(first, np.diff(np.r_[first, len(qi)]))
-        early = np.zeros(len(qi), bool)
-        early[order[rank < FIRST_TRIANGLES]] = True
-        q = q_block[qi[early]]
+        # first the triangles right under each location (its (x, y) inside their box): their
+        # best contact bounds from below what every other triangle must be able to beat
+        q = q_block[qi]
+        early = np.all((q >= grid.lo[ti] + grid.radius) & (q <= grid.hi[ti] - grid.radius), axis=1)
+        q = q[early]
         heights, _ = features(q[:, 0], q[:, 1], grid.soa[:, ti[early]], grid.radius)
         bound = _per_location_max(qi[early], np.max(heights, axis=0), len(q_block))
         late = ~early & (reach >= bound[qi])

@@ -27,7 +27,7 @@ from ..errors import SurfmodError
 from ..io.gcode import gcode_text
 from .drop_cutter import TriangleGrid, drop
 from .inputs import to_shape
-from .toolpath_moves import move_gouge, raster, refine_moves, staircase_steep
+from .toolpath_moves import NoSafePathError, move_gouge, raster, refine_moves, staircase_steep
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
 # the refinement inserts a location (the rest is the margin between sample points).
@@ -124,7 +124,7 @@ class Toolpath:
         return (
             f"toolpath: {self.tool.kind} end mill r={self.tool.radius:g}, {self.n_passes} passes along {self.direction}, "
             f"{len(self.points)} points, stepover {self.stepover:.6g} (scallop {self.scallop:.3g} on flat ground), "
-            f"length {self.length:.6g}, every move checked: gouge at most {max(self.gouge + self.deflection, 0.0):.2e} "
+            f"length {self.length:.6g}, every move checked: max gouge {max(self.gouge + self.deflection, 0.0):.2e} "
             f"(tolerance {self.tolerance:.2e})"
         )
 
@@ -258,21 +258,22 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         if allowed <= 0:
             raise SurfmodError(f"tolerance: {tolerance:.3g} is below the part's mesh deflection {part.deflection:.3g}")
         min_length = min(tolerance, step / 64)
-        points, index = staircase_steep(points, index)
-        points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor)
+        for _ in range(2):  # the refinement makes short steep moves at walls: staircase them too
+            points, index = staircase_steep(points, index)
+            points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor)
         points, index = _drop_repeats(points, index)
         bar.update()
-        depth = move_gouge(part.height, points, REFINE_SHARE * allowed)
+        depth = move_gouge(part.height, points)
         if depth.max() > allowed:
             # repair what the verdict's own sample points found, then judge again
             points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor,
                                          centred=True)
             points, index = _drop_repeats(points, index)
-            depth = move_gouge(part.height, points, REFINE_SHARE * allowed)
+            depth = move_gouge(part.height, points)
         gouge = float(depth.max()) if len(depth) else 0.0
         if gouge > allowed:
             worst = int(np.argmax(depth))
-            raise SurfmodError(
+            raise NoSafePathError(
                 f"toolpath: no safe path: move {worst + 1} still cuts {gouge + part.deflection - part.lift:.3g} "
                 f"deep, more than the tolerance {tolerance:.3g}")
         _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True)

@@ -16,11 +16,13 @@ import numpy as np
 
 from ..errors import SurfmodError
 
+class NoSafePathError(SurfmodError):
+    """No tool path within the gouge tolerance could be made (a ``SurfmodError``)."""
+
+
 # Interior samples per move while refining, and for the final verdict (offset from those).
 REFINE_SAMPLES = 2
 CHECK_SAMPLES = 3
-# More samples on moves that climb: one per so much height, up to this many.
-MAX_SAMPLES = 64
 REFINE_ROUNDS = 40
 # Moves steeper than this (rise over run) become vertical + level moves up front.
 STEEP_SLOPE = 2.0
@@ -62,14 +64,6 @@ def raster(lo, hi, stepover: float, step: float, direction: str):
     return np.concatenate(rows), np.concatenate(index), across
 
 
-def _sample_counts(points: np.ndarray, moves: np.ndarray, base: int, depth: float) -> np.ndarray:
-    """Interior samples per move: ``base``, plus one per ``depth`` of height the move
-    climbs or descends (the drop-cutter height bends hardest on the flanks of walls),
-    at most ``MAX_SAMPLES``."""
-    rise = np.abs(points[moves + 1, 2] - points[moves, 2])
-    return np.minimum(base + np.ceil(rise / depth).astype(np.int64), MAX_SAMPLES)
-
-
 def _excess(height, points: np.ndarray, moves: np.ndarray, counts: np.ndarray, centred: bool):
     """Drop height minus move height at interior samples of ``moves`` (-inf where the tool
     touches nothing): ``t = (j + 1)/(n + 1)``, or ``(j + ½)/n`` when ``centred``.  Returns
@@ -96,22 +90,20 @@ def _worst_per_move(excess: np.ndarray, owner: np.ndarray, n_moves: int):
     return worst, arg
 
 
-def move_gouge(height, points: np.ndarray, tolerance: float) -> np.ndarray:
+def move_gouge(height, points: np.ndarray) -> np.ndarray:
     """Per move ``(N-1,)``: the largest depth (drop-cutter height minus the straight
-    move's height) at centred interior samples ``t = (j + ½)/n`` (``n`` grows with the
-    height the move climbs, one sample per ``tolerance``) and at the end points; ≤ 0
-    means the move clears.  ``height(xy)`` is the drop-cutter height.
+    move's height) at ``CHECK_SAMPLES`` centred interior samples ``t = (j + ½)/n`` and at
+    the end points; ≤ 0 means the move clears.  ``height(xy)`` is the drop-cutter height.
 
     >>> import numpy as np
     >>> bump = lambda xy: np.where(np.abs(xy[:, 0] - 1) < 0.3, 1.0, 0.0)
-    >>> move_gouge(bump, np.array([[0.0, 0, 0], [2, 0, 0]]), 0.01).tolist()
+    >>> move_gouge(bump, np.array([[0.0, 0, 0], [2, 0, 0]])).tolist()
     [1.0]
     """
     moves = np.arange(len(points) - 1)
     if not len(moves):
         return np.zeros(0)
-    excess, owner, _, _ = _excess(height, points, moves, _sample_counts(points, moves, CHECK_SAMPLES, tolerance),
-                                  centred=True)
+    excess, owner, _, _ = _excess(height, points, moves, np.full(len(moves), CHECK_SAMPLES), centred=True)
     worst, _ = _worst_per_move(excess, owner, len(moves))
     ends = height(points[:, :2])
     end_excess = np.where(np.isnan(ends), -np.inf, ends - points[:, 2])
@@ -134,9 +126,11 @@ def staircase_steep(points: np.ndarray, index: np.ndarray, slope: float = STEEP_
 
 def refine_moves(height, points: np.ndarray, index: np.ndarray, target: float, min_length: float,
                  floor: float, centred: bool = False):
-    """Insert cutter locations until no sampled point of any move lies deeper than
-    ``target`` below the drop height; moves shorter than ``min_length`` across that still
-    cut become staircases.  Returns the new points and pass indices.  ``floor``: height
+    """Insert cutter locations until every sampled point of every move lies within
+    ``target`` of the drop height, above or below: a move whose samples sit far below its
+    chord is as suspect as one that cuts, since a wall's flank (where the drop height
+    climbs like a square root, or jumps) may hide between them.  Moves shorter than
+    ``min_length`` across that are still off become staircases.  Returns the new points and pass indices.  ``floor``: height
     of locations where the tool touches nothing.  ``centred``: sample where the final
     check does (used to repair moves it rejected)."""
     pending = np.ones(len(points) - 1, bool)  # moves not yet verified
@@ -145,17 +139,22 @@ def refine_moves(height, points: np.ndarray, index: np.ndarray, target: float, m
         moves = np.nonzero(pending)[0]
         if not moves.size:
             return points, index
-        counts = _sample_counts(points, moves, REFINE_SAMPLES, target)
+        counts = np.full(len(moves), REFINE_SAMPLES)
         excess, owner, xy, drop = _excess(height, points, moves, counts, centred)
-        worst, arg = _worst_per_move(excess, owner, len(moves))
-        bad = worst > target
+        # off the chord either way by more than the target (cuts, or a hidden flank)
+        off = np.where(np.isfinite(excess), np.abs(excess), -np.inf)
+        worst, arg = _worst_per_move(off, owner, len(moves))
+        cut, _ = _worst_per_move(excess, owner, len(moves))
+        span = np.linalg.norm((points[moves + 1] - points[moves])[:, :2], axis=1)
+        # short moves are split no further unless they cut (steep ones become staircases
+        # in staircase_steep, which also covers jumps of the drop height at wall edges)
+        bad = ((worst > target) & (span > min_length)) | (cut > target)
         pending[moves[~bad]] = False
         if not bad.any():
             return points, index
-        worst_depth = float(worst[bad].max())
-        moves, arg = moves[bad], arg[bad]
+        worst_depth = float(cut[bad].max())
+        moves, arg, span = moves[bad], arg[bad], span[bad]
         a, b = points[moves], points[moves + 1]
-        span = np.linalg.norm((b - a)[:, :2], axis=1)
         split = span > min_length
         # split: the worst sample becomes a cutter location at its drop height
         new_pts = [np.column_stack([xy[arg[split]], drop[arg[split]]])]
@@ -181,6 +180,6 @@ def refine_moves(height, points: np.ndarray, index: np.ndarray, target: float, m
         is_new[at + np.arange(len(at))] = True
         pending = np.insert(pending, at, True)
         pending |= is_new[1:] | is_new[:-1]
-    raise SurfmodError(
+    raise NoSafePathError(
         f"toolpath: no safe path found: moves still cut {worst_depth:.3g} deep after {REFINE_ROUNDS} rounds of "
         f"refinement (allowed {target:.3g})")
