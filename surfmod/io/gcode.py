@@ -33,7 +33,7 @@ def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = Non
     >>> import surfmod as sm
     >>> tp = sm.toolpath(sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0)), sm.Tool("flat", 1.0), stepover=1.5)
     >>> [ln for ln in gcode_text(tp).splitlines() if ln.startswith("G1 ")][:2]
-    ['G1 Z0.0000 F200', 'G1 X0.5000 Y0.0000 Z0.0000 F600']
+    ['G1 Z0.0000 F200', 'G1 X0.2500 Y0.0000 Z0.0000 F600']
     """
     if not _is_toolpath(toolpath):
         raise SurfmodError(f"toolpath: expected a surfmod Toolpath, got {type(toolpath).__name__}")
