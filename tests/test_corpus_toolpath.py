@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from toolpath_reference import ball_clearance, gcode_positions
+from toolpath_reference import ball_clearance, gcode_positions, material
 
 from surfmod.cli import main as cli_main
 from surfmod.occ.cam import bounding_box
@@ -35,7 +35,7 @@ def run_and_judge(part, tmp_path, capsys):
         assert code == 1 and len(err.splitlines()) == 1 and not out.exists(), err
         pytest.fail(f"no safe path: {err}")
     moves = gcode_positions(out.read_text())
-    depth = radius - ball_clearance(shape, moves, radius, moves[:, 2].max() + radius)
+    depth = radius - ball_clearance(material(shape), moves, radius, moves[:, 2].max() + radius)
     assert depth <= scallop / 10 + ROUNDING, f"cuts {depth:.3g} deep, tolerance {scallop / 10:.3g}"
 
 

@@ -24,6 +24,24 @@ from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
 from OCP.Extrema import Extrema_ExtFlag_MIN
 from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 
+def material(shape):
+    """The faces of ``shape`` as one compound: free edges and vertices of a STEP file
+    (construction wires) are not material a tool can cut."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS_Compound
+
+    shape = getattr(shape, "wrapped", shape)
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        builder.Add(compound, explorer.Current())
+        explorer.Next()
+    return compound
+
+
 WORD = re.compile(r"([XYZ])(-?\d+(?:\.\d*)?)")
 
 

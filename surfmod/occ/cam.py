@@ -20,7 +20,8 @@ def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.
     the linear ``deflection`` (model units) and ``angular`` deflection (radians), in global
     coordinates, and the largest chordal deflection BRepMesh measured on any face (at least
     the requested one; some faces of real parts cannot be meshed finer than their own
-    tolerance allows).  Any triangulation stored on the shape is replaced."""
+    tolerance allows).  Any triangulation stored on the shape is replaced.  A face BRepMesh
+    leaves without triangles raises ``SurfmodError`` (the tool would not see it)."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepMesh import BRepMesh_IncrementalMesh
     from OCP.BRepTools import BRepTools
@@ -30,6 +31,7 @@ def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.
     if shp is None:
         raise SurfmodError(f"obj: expected an OCCT shape, got {type(shape).__name__}")
     blocks = []
+    unmeshed = 0
     measured = float(deflection)
     with kernel("BRepMesh_IncrementalMesh"):
         BRepTools.Clean_s(shp)
@@ -38,6 +40,7 @@ def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.
             loc = TopLoc_Location()
             tri = BRep_Tool.Triangulation_s(face, loc)
             if tri is None or tri.NbTriangles() == 0:
+                unmeshed += 1  # a face the tool cannot see: never skip it silently
                 continue
             trsf = loc.Transformation()
             nodes = np.empty((tri.NbNodes(), 3))
@@ -47,6 +50,9 @@ def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.
             idx = np.array([tri.Triangle(i + 1).Get() for i in range(tri.NbTriangles())], dtype=np.int64) - 1
             blocks.append(nodes[idx])
             measured = max(measured, float(tri.Deflection()))
+    if unmeshed:
+        raise SurfmodError(f"obj: BRepMesh could not triangulate {unmeshed} face(s); a tool path over them "
+                           f"cannot be checked")
     if not blocks:
         raise SurfmodError("obj: has no faces to machine")
     return np.concatenate(blocks), measured

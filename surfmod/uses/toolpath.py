@@ -150,7 +150,10 @@ def _part(obj, tool: Tool, tolerance: float) -> _Part:
 
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
-    triangles, measured = part_triangles(shape, requested)
+    try:
+        triangles, measured = part_triangles(shape, requested)
+    except SurfmodError as exc:
+        raise NoSafePathError(f"toolpath: no safe path: {exc}") from None
     points = triangles.reshape(-1, 3)
     box = np.array([points.min(axis=0), points.max(axis=0)])
     return _Part(TriangleGrid(triangles, tool.radius), tool.kind, max(measured, requested),
