@@ -1,7 +1,8 @@
 """End-to-end CAM: a NURBS surface -> a solid -> STL + G-code for a ball-end mill.
 
-The drop-cutter raster runs on surfmod's NumPy evaluator of the exact NURBS; the path
-is checked for gouges on a denser sample of the exact surface.
+The ball-end mill (with its shank) is dropped onto every face of the solid, walls
+included; every straight G1 move of the zig-zag is checked along its length and refined
+where it would cut deeper than a tenth of the scallop, so the G-code never gouges.
 """
 
 from pathlib import Path
@@ -35,9 +36,10 @@ print(sm.mass_properties(solid))
 sm.export_step(solid, OUT / "cam_part.step")
 sm.export_stl(solid, OUT / "cam_part.stl", tolerance=0.01)
 
-# 3. finishing path: 6 mm ball-end mill, 0.05 mm scallop, zig-zag along x
+# 3. finishing path over the whole solid: 6 mm ball-end mill, 0.05 mm scallop, zig-zag
+#    along x; no move cuts deeper than 0.005 mm (a tenth of the scallop) anywhere
 tool = sm.Tool("ball", 3.0)
-path = sm.toolpath(top, tool, scallop=0.05, step=1.5)
+path = sm.toolpath(solid, tool, scallop=0.05, step=1.5)
 print(path)
 sm.export_gcode(path, OUT / "cam_part.nc", feed=1200, safe_height=40)
-print("G-code:", (OUT / "cam_part.nc").read_text().splitlines()[3:9])
+print("G-code:", (OUT / "cam_part.nc").read_text().splitlines()[3:10])

@@ -45,7 +45,7 @@ GENERIC = [
     (r"watertight:? (\w+)", lambda w: w == "True"),
     (r"valid (\w+)", lambda w: w == "True"),
     (r"complete=(\w+)", lambda w: w == "True"),
-    (rf"max gouge {NUM}", lambda g: float(g) == 0.0),
+    (rf"max gouge {NUM} \(tolerance {NUM}\)", lambda g, t: float(g) <= float(t)),
     (rf"\|A-B\| {NUM}", lambda d: float(d) < 1e-12),
     (rf"max deviation from gp_G?Trsf: {NUM}", lambda d: float(d) < 1e-12),
     (rf"max \|F\| on (?:NURBS )?points(?: =)? {NUM}", lambda f: float(f) < 1e-9),

@@ -2,11 +2,21 @@
 
 from __future__ import annotations
 
+import sys
+
 from ..errors import SurfmodError
+from ..atomic import target_path
+from ..io.gcode import export_gcode
+from ..uses.inputs import to_shape
+from ..uses.toolpath import Tool, toolpath
+from ..uses.toolpath_moves import NoSafePathError
+
+GCODE_SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")
 
 
 def register(sub) -> None:
-    p = sub.add_parser("toolpath", help="drop-cutter zig-zag finishing path over a STEP part, written as G-code")
+    p = sub.add_parser("toolpath", help="drop-cutter zig-zag finishing path over a STEP part, every move "
+                                        "gouge-checked, written as G-code")
     p.add_argument("path", help="STEP file")
     p.add_argument("--tool", default="ball", choices=("ball", "flat"))
     p.add_argument("--radius", type=float, required=True, help="tool radius (mm)")
@@ -14,6 +24,8 @@ def register(sub) -> None:
     g.add_argument("--scallop", type=float, help="scallop (cusp) height for a ball cutter")
     g.add_argument("--stepover", type=float, help="distance between passes")
     p.add_argument("--step", type=float, help="spacing of points along a pass (default radius/4)")
+    p.add_argument("--tolerance", type=float,
+                   help="depth no move may cut (default scallop/10, or radius/100 without a scallop)")
     p.add_argument("--direction", default="x", choices=("x", "y"))
     p.add_argument("--feed", type=float, default=600.0, help="feed rate mm/min")
     p.add_argument("--safe-height", type=float, help="rapid-move height (default 5 mm above the part)")
@@ -23,24 +35,23 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from tqdm import tqdm
+    """Build and write the path.  When no path keeps every move within the tolerance, print
+    one line and exit 1 without writing a file (bad input goes to the common handler)."""
+    try:
+        return _run(args)
+    except NoSafePathError as exc:
+        print(f"surfmod toolpath: error: {exc}", file=sys.stderr)
+        return 1
 
-    from ..atomic import target_path
-    from ..io.gcode import export_gcode
-    from ..uses.inputs import to_shape
-    from ..uses.toolpath import Tool, toolpath
 
-    target_path(args.out, "out", (".nc", ".gcode", ".ngc", ".tap", ".cnc"))
+def _run(args) -> int:
+    target_path(args.out, "out", GCODE_SUFFIXES)
     if args.radius is None or not args.radius > 0:
         raise SurfmodError(f"radius: tool radius must be > 0, got {args.radius}")
-    with tqdm(total=3, desc="toolpath", unit="step", disable=args.no_progress) as bar:
-        shape = to_shape(args.path, "path")
-        bar.update()
-        tp = toolpath(shape, Tool(args.tool, args.radius), args.stepover, scallop=args.scallop,
-                      step=args.step, direction=args.direction, progress=not args.no_progress)
-        bar.update()
-        export_gcode(tp, args.out, feed=args.feed, safe_height=args.safe_height)
-        bar.update()
-    print(tp)
+    shape = to_shape(args.path, "path")
+    path = toolpath(shape, Tool(args.tool, args.radius), args.stepover, scallop=args.scallop, step=args.step,
+                    direction=args.direction, tolerance=args.tolerance, progress=not args.no_progress)
+    export_gcode(path, args.out, feed=args.feed, safe_height=args.safe_height)
+    print(path)
     print(f"wrote {args.out}")
     return 0

@@ -1,0 +1,71 @@
+"""OCCT's side of CAM: the part as one fine triangle soup for the drop-cutter.
+
+Every face of the shape is triangulated by ``BRepMesh_IncrementalMesh``; its triangles lie
+inside the face's trim (BRepMesh meshes the face, not its untrimmed surface) and their
+nodes lie on the exact surface.  The plain loops here run over OCCT calls (one per node
+or triangle): this is the kernel boundary, not a NumPy evaluation path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SurfmodError
+from .guard import kernel
+from .topo import faces_of, wrapped
+
+
+def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.ndarray, float]:
+    """``(triangles (M, 3, 3), deflection)``: all faces of ``shape`` meshed by BRepMesh at
+    the linear ``deflection`` (model units) and ``angular`` deflection (radians), in global
+    coordinates, and the largest chordal deflection BRepMesh measured on any face (at least
+    the requested one; some faces of real parts cannot be meshed finer than their own
+    tolerance allows).  Any triangulation stored on the shape is replaced.  A face BRepMesh
+    leaves without triangles raises ``SurfmodError`` (the tool would not see it)."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.BRepTools import BRepTools
+    from OCP.TopLoc import TopLoc_Location
+
+    shp = wrapped(shape)
+    if shp is None:
+        raise SurfmodError(f"obj: expected an OCCT shape, got {type(shape).__name__}")
+    blocks = []
+    unmeshed = 0
+    measured = float(deflection)
+    with kernel("BRepMesh_IncrementalMesh"):
+        BRepTools.Clean_s(shp)
+        BRepMesh_IncrementalMesh(shp, float(deflection), False, float(angular), False)
+        for face in faces_of(shp):
+            loc = TopLoc_Location()
+            tri = BRep_Tool.Triangulation_s(face, loc)
+            if tri is None or tri.NbTriangles() == 0:
+                unmeshed += 1  # a face the tool cannot see: never skip it silently
+                continue
+            trsf = loc.Transformation()
+            nodes = np.empty((tri.NbNodes(), 3))
+            for i in range(tri.NbNodes()):
+                p = tri.Node(i + 1).Transformed(trsf)
+                nodes[i] = (p.X(), p.Y(), p.Z())
+            idx = np.array([tri.Triangle(i + 1).Get() for i in range(tri.NbTriangles())], dtype=np.int64) - 1
+            blocks.append(nodes[idx])
+            measured = max(measured, float(tri.Deflection()))
+    if unmeshed:
+        raise SurfmodError(f"obj: BRepMesh could not triangulate {unmeshed} face(s); a tool path over them "
+                           f"cannot be checked")
+    if not blocks:
+        raise SurfmodError("obj: has no faces to machine")
+    return np.concatenate(blocks), measured
+
+
+def bounding_box(shape) -> np.ndarray:
+    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` of ``shape``: OCCT's quick box (from a
+    stored triangulation, else from the control points, enlarged by the shape tolerance)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    with kernel("BRepBndLib.Add"):
+        box = Bnd_Box()
+        BRepBndLib.Add_s(wrapped(shape), box, True)
+        x0, y0, z0, x1, y1, z1 = box.Get()
+    return np.array([[x0, y0, z0], [x1, y1, z1]])

@@ -1,0 +1,48 @@
+"""`surfmod toolpath` on every file of the real-parts corpus, judged by an exact OCCT check.
+
+Tool radius 3 % of the part's bounding-box diagonal, scallop a tenth of the radius: the
+written G-code must cut nowhere deeper than a tenth of the scallop (plus the G-code's own
+rounding), by the swept ball-and-shank distance of tests/toolpath_reference.py, and the
+command must exit 0 exactly then.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from toolpath_reference import ball_clearance, gcode_positions, material
+
+from surfmod.cli import main as cli_main
+from surfmod.occ.cam import bounding_box
+from surfmod.uses.inputs import to_shape
+
+RADIUS_SHARE = 0.03
+SCALLOP_SHARE = 0.1
+ROUNDING = 1e-4  # 4 decimals: x, y rounded to nearest
+
+
+def run_and_judge(part, tmp_path, capsys):
+    shape = to_shape(part)
+    box = bounding_box(shape)
+    radius = float(f"{RADIUS_SHARE * np.linalg.norm(box[1] - box[0]):.4g}")
+    scallop = SCALLOP_SHARE * radius
+    out = tmp_path / "path.nc"
+    code = cli_main(["toolpath", str(part), "--radius", repr(radius), "--scallop", repr(scallop),
+                     "--out", str(out), "--no-progress"])
+    err = capsys.readouterr().err.strip()
+    if code != 0:
+        # only a refusal in one line, and no file, is acceptable instead of a safe path
+        assert code == 1 and len(err.splitlines()) == 1 and not out.exists(), err
+        pytest.fail(f"no safe path: {err}")
+    moves = gcode_positions(out.read_text())
+    depth = radius - ball_clearance(material(shape), moves, radius, moves[:, 2].max() + radius)
+    assert depth <= scallop / 10 + ROUNDING, f"cuts {depth:.3g} deep, tolerance {scallop / 10:.3g}"
+
+
+@pytest.mark.corpus
+def test_corpus_toolpath_never_gouges(corpus_file, tmp_path, capsys):
+    run_and_judge(corpus_file, tmp_path, capsys)
+
+
+def test_one_corpus_toolpath_never_gouges(corpus_dir, tmp_path, capsys):
+    run_and_judge(corpus_dir / "cadquery_red_cube_blue_cylinder.step", tmp_path, capsys)

@@ -1,0 +1,121 @@
+"""An exact gouge check of G-code, independent of surfmod's own check.
+
+surfmod verifies its moves against a fine triangulation with sampled drop-cutter heights.
+This module judges the written G-code with OCCT's exact B-rep distance instead:
+
+* ball end + shank of radius ``r``: the tool is the set of points within ``r`` of the
+  segment from the ball centre up the axis, so the volume it sweeps along a run of moves in
+  one vertical plane is exactly the set of points within ``r`` of the planar "ribbon" under
+  the tip polyline lifted by ``r`` and extended straight up.  A move cuts deeper than ``d``
+  into the part exactly when ``BRepExtrema_DistShapeShape(ribbon, part) < r - d``.
+* flat end + shank: the cylinder shrunk by ``d`` (radius ``r - d``, bottom ``d`` higher)
+  is placed at points along each move, at most ``r / 20`` apart and closely enough that the
+  tip height changes by at most ``d / 4`` between them; it must not meet the part.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+from OCP.Extrema import Extrema_ExtFlag_MIN
+from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+def material(shape):
+    """The faces of ``shape`` as one compound: free edges and vertices of a STEP file
+    (construction wires) are not material a tool can cut."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS_Compound
+
+    shape = getattr(shape, "wrapped", shape)
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        builder.Add(compound, explorer.Current())
+        explorer.Next()
+    return compound
+
+
+WORD = re.compile(r"([XYZ])(-?\d+(?:\.\d*)?)")
+
+
+def gcode_positions(text: str) -> np.ndarray:
+    """Tool-tip positions (N, 3) after every motion line (G0/G1), modal coordinates."""
+    pos = [np.nan, np.nan, np.nan]
+    out = []
+    for line in text.splitlines():
+        if not line.startswith(("G0", "G1")):
+            continue
+        for axis, value in WORD.findall(line):
+            pos["XYZ".index(axis)] = float(value)
+        if not np.isnan(pos).any():
+            out.append(list(pos))
+    return np.array(out)
+
+
+def _planar_runs(points: np.ndarray):
+    """Split a polyline into runs whose (x, y) advance monotonically along one line."""
+    runs, start = [], 0
+    direction = None
+    for i in range(1, len(points)):
+        d = points[i, :2] - points[i - 1, :2]
+        n = np.linalg.norm(d)
+        if n < 1e-12:
+            continue
+        d /= n
+        if direction is None:
+            direction = d
+            continue
+        if d @ direction < 1 - 1e-9:
+            runs.append(points[start:i])
+            start, direction = i - 1, d
+    runs.append(points[start:])
+    return runs
+
+
+def ball_clearance(part, points: np.ndarray, radius: float, top: float) -> float:
+    """Smallest distance from the part to the ribbons swept by the ball centre and its
+    axis up to height ``top``; the deepest cut of the path is ``radius`` minus it."""
+    best = np.inf
+    for run in _planar_runs(points):
+        keep = np.r_[True, np.any(np.abs(np.diff(run, axis=0)) > 0, axis=1)]
+        run = run[keep]
+        if len(run) < 2 or np.linalg.norm(run[-1, :2] - run[0, :2]) < 1e-12:
+            continue
+        centre = run + [0.0, 0.0, radius]
+        polygon = BRepBuilderAPI_MakePolygon()
+        for x, y, z in centre:
+            polygon.Add(gp_Pnt(float(x), float(y), float(z)))
+        polygon.Add(gp_Pnt(float(centre[-1, 0]), float(centre[-1, 1]), top))
+        polygon.Add(gp_Pnt(float(centre[0, 0]), float(centre[0, 1]), top))
+        polygon.Close()
+        face = BRepBuilderAPI_MakeFace(polygon.Wire(), True).Face()
+        dist = BRepExtrema_DistShapeShape(face, part, Extrema_ExtFlag_MIN)
+        assert dist.IsDone()
+        best = min(best, dist.Value())
+    return best
+
+
+def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float) -> list[int]:
+    """Indices of moves where the flat end, shrunk by ``depth``, meets the part."""
+    bad = []
+    for i in range(len(points) - 1):
+        a, b = points[i], points[i + 1]
+        n = int(max(np.ceil(np.linalg.norm(b[:2] - a[:2]) / (radius / 20)),
+                    np.ceil(abs(b[2] - a[2]) / (depth / 4)) if np.linalg.norm(b[:2] - a[:2]) > 0 else 0, 1))
+        for t in np.linspace(0.0, 1.0, n + 1):
+            p = a + t * (b - a)
+            axis = gp_Ax2(gp_Pnt(float(p[0]), float(p[1]), float(p[2] + depth)), gp_Dir(0, 0, 1))
+            cutter = BRepPrimAPI_MakeCylinder(axis, radius - depth, top - p[2] - depth).Shape()
+            dist = BRepExtrema_DistShapeShape(cutter, part, Extrema_ExtFlag_MIN)
+            assert dist.IsDone()
+            if dist.Value() <= 1e-9:
+                bad.append(i)
+                break
+    return bad
