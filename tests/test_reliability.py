@@ -437,3 +437,24 @@ def test_14_a_failed_write_removes_its_temporary_file(tmp_path):
         tmp.write_text("half")
         raise RuntimeError("writer failed")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_long_operations_show_progress_on_request(capsys):
+    # tessellate, intersect and fe_mesh draw a tqdm bar on stderr with progress=True, and
+    # stay silent by default (scripts and CI logs)
+    import build123d as bd
+
+    net = np.zeros((4, 4, 3))
+    net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+    net[1:3, 1:3, 2] = 1.5
+    s = sm.BezierSurface(net)
+    plane = ((0, 0, 0.5), (0, 0, 1))
+    sm.tessellate(s, 0.01)
+    sm.intersect(s, plane)
+    sm.fe_mesh(bd.Box(2, 2, 2), size=1.0)
+    assert capsys.readouterr().err == ""
+    sm.tessellate(s, 0.01, progress=True)
+    sm.intersect(s, plane, progress=True)
+    sm.fe_mesh(bd.Box(2, 2, 2), size=1.0, progress=True)
+    err = capsys.readouterr().err
+    assert "tessellate" in err and "intersect" in err and "fe_mesh" in err

@@ -143,7 +143,8 @@ def estimate_triangles(s, tolerance: float, size: float) -> float:
 
 
 class _Refiner:
-    def __init__(self, s, tolerance: float, max_triangles: int, start_scale: float = 1.0):
+    def __init__(self, s, tolerance: float, max_triangles: int, start_scale: float = 1.0, bar=None):
+        self.bar = bar  # a tqdm bar ticked once per refinement pass, or None
         self.s, self.tol, self.max_triangles = s, tolerance, max_triangles
         (u0, u1), (v0, v1) = s.domain
         self.bounds = (u0, u1, v0, v1)
@@ -321,6 +322,8 @@ class _Refiner:
         dense_pass = False
         while True:
             self.iterations += 1
+            if self.bar is not None:
+                self.bar.update()
             if 2 * self.x0.size > self.max_triangles:
                 raise SurfmodError(
                     f"tolerance: {self.tol:g} needs more than {self.max_triangles:,} triangles (limit max_triangles)"
@@ -387,8 +390,11 @@ def _ear_clip(poly: np.ndarray, pos: np.ndarray) -> np.ndarray:
     return poly[np.array(out)]
 
 
-def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES) -> Mesh:
-    """Adaptive tessellation of a surfmod surface (see the module docstring)."""
+def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, progress: bool = False) -> Mesh:
+    """Adaptive tessellation of a surfmod surface (see the module docstring); ``progress``
+    shows a tqdm bar over the refinement passes."""
+    from tqdm import tqdm
+
     size = _surface_size(s)
     if tolerance < MIN_RELATIVE_TOLERANCE * size:
         raise SurfmodError(
@@ -405,11 +411,12 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES) 
     # count or half of it (per direction, completed by dyadic refinement) lands closer to
     # the need depends on the surface, so both are tried and the smaller mesh is kept
     best = None
-    for scale in (1.0,) if getattr(s, "knots", None) is not None else (1.0, 2.0):
-        ref = _Refiner(s, tolerance, max_triangles, scale)
-        tris, dev, stuck = ref.run()
-        if best is None or len(tris) < len(best[1]):
-            best = (ref, tris, dev, stuck)
+    with tqdm(desc="tessellate", unit="pass", disable=not progress, leave=False) as bar:
+        for scale in (1.0,) if getattr(s, "knots", None) is not None else (1.0, 2.0):
+            ref = _Refiner(s, tolerance, max_triangles, scale, bar)
+            tris, dev, stuck = ref.run()
+            if best is None or len(tris) < len(best[1]):
+                best = (ref, tris, dev, stuck)
     ref, tris, dev, stuck = best
     if dev.size and dev.max() > tolerance:
         raise SurfmodError(
@@ -474,7 +481,7 @@ def tessellate(obj, tolerance: float, *, max_triangles: int | None = None, stric
         max_triangles = MAX_SURFACE_TRIANGLES if isinstance(obj, Surface) else MAX_TRIANGLES
     max_triangles = checks.count(max_triangles, "max_triangles", minimum=2)
     if isinstance(obj, Surface):
-        return tessellate_surface(obj, tolerance, max_triangles)
+        return tessellate_surface(obj, tolerance, max_triangles, progress)
     if isinstance(obj, Mesh):
         raise SurfmodError("obj: is already a Mesh")
     shape = getattr(obj, "wrapped", obj)

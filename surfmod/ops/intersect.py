@@ -305,7 +305,7 @@ def _refuse_coincident(a, b, plane, tol: float, names) -> None:
 
 
 def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_angle: float = 4.0,
-              max_points: int = 1_000_000) -> list[IntersectionCurve]:
+              max_points: int = 1_000_000, progress: bool = False) -> list[IntersectionCurve]:
     """Intersection curves of two surfaces, or of a surface and an infinite plane.
 
     ``b`` (or ``a``) may be a surfmod surface (a bounded patch, a ``PlaneSurface``
@@ -318,7 +318,8 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     ``[]``.  Surfaces that coincide over a region (``intersect(s, s)``) raise
     ``SurfmodError`` ("the surfaces coincide over a region") before any tracing; a
     ``step`` so small that the curves would need more than ``max_points`` points (about
-    ten model sizes of curve) is refused up front.
+    ten model sizes of curve) is refused up front.  ``progress`` shows a tqdm bar over the
+    seeds the tracing settles.
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0))
@@ -352,7 +353,10 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
         seeds = _implicit_seeds(problem, a)
         o, x, y, _ = plane_frame(origin, normal)
         uv_b_of = lambda X, P: np.stack([(P - o) @ x, (P - o) @ y], axis=1)  # noqa: E731
-    traced = marching.trace_all(problem, seeds, h, angle)
+    from tqdm import tqdm
+
+    with tqdm(total=len(seeds), desc="intersect", unit="seed", disable=not progress, leave=False) as bar:
+        traced = marching.trace_all(problem, seeds, h, angle, bar)
     # drop slivers (a seed on a seam or at a tangency traced for a vanishing length)
     traced = [(X, c) for X, c in traced if np.ptp(problem.evaluate(X)[2], axis=0).max() > 1e-6 * problem.scale]
     curves = clip_curves(_curves(problem, traced, uv_b_of), a, b, IntersectionCurve)

@@ -175,8 +175,9 @@ def segment_distances(points, polyline):
     return np.linalg.norm(points[:, None, :] - proj, axis=2).min(axis=1)
 
 
-def trace_all(problem, seeds, h: float, max_angle: float):
-    """Trace a curve from every seed not already on a traced curve.
+def trace_all(problem, seeds, h: float, max_angle: float, bar=None):
+    """Trace a curve from every seed not already on a traced curve; ``bar`` (a tqdm bar
+    or None) advances by the seeds each traced curve settles.
 
     Returns a list of ``(X, closed)``."""
     if len(seeds) == 0:
@@ -195,4 +196,6 @@ def trace_all(problem, seeds, h: float, max_angle: float):
         if idx.size:
             near = segment_distances(seed_pts[idx], P) <= 0.05 * h + 10 * problem.tolerance
             remaining[idx[near]] = False
+        if bar is not None:
+            bar.update(len(seeds) - int(remaining.sum()) - bar.n)
     return curves

@@ -233,7 +233,7 @@ def _part_name(obj) -> str:
 
 
 def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None,
-            max_elements: int = 2_000_000) -> FEMesh:
+            max_elements: int = 2_000_000, progress: bool = False) -> FEMesh:
     """Triangle (``kind="surface"``) or tetrahedral (``kind="volume"``) FE mesh of a part
     with target element ``size`` (gmsh, also refined by curvature), ``order`` 1 or 2.
 
@@ -244,7 +244,8 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     Every tetrahedron's signed volume is checked: an inverted element is an error, never
     a result.  With ``path`` the mesh is also written (``.msh``, ``.vtu``, ``.inp``).  Meshes estimated
     (from the bounding box and ``size``) above ``max_elements`` elements are refused
-    before gmsh runs; raise ``max_elements`` to allow them.
+    before gmsh runs; raise ``max_elements`` to allow them.  ``progress`` shows a tqdm bar
+    over the attempts (as read, healed) and the element checks.
 
     >>> import surfmod as sm, build123d as bd
     >>> m = sm.fe_mesh(bd.Box(2, 2, 2), size=1.0)
@@ -277,21 +278,27 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     checks.work(estimate, max_elements, "max_elements", f"a {kind} mesh with element size {size:g} of a part of extent {extent:.4g}")
     cell = _CELLS[(kind, order)]
     failures = []
-    with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp:
+    from tqdm import tqdm
+
+    with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp, \
+            tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:
         brep, msh = Path(tmp) / "part.brep", Path(tmp) / "part.msh"
         occ.write_brep(shape, brep)
         for heal in (False, True):
+            bar.set_postfix_str("gmsh, healed" if heal else "gmsh")
             try:
                 quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order, heal)
             except _GmshFailure as exc:
                 failures.append(str(exc))
                 continue
+            bar.update()
             full = meshio.read(msh, file_format="gmsh")
             points, data = _cells_of(full, cell)
             inverted = int(np.sum(signed_volumes(points, data) <= 0)) if kind == "volume" else 0
             if inverted:
                 failures.append(f"{inverted} inverted tetrahedra")
                 continue
+            bar.update()
             break
         else:
             raise SurfmodError(
