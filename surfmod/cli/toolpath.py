@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import sys
 
 from ..errors import SurfmodError
 from ..atomic import target_path
 from ..io.gcode import export_gcode
 from ..uses.inputs import to_shape
 from ..uses.toolpath import Tool, toolpath
-from ..uses.toolpath_moves import NoSafePathError
 
 GCODE_SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")
 
@@ -35,16 +33,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    """Build and write the path.  When no path keeps every move within the tolerance, print
-    one line and exit 1 without writing a file (bad input goes to the common handler)."""
-    try:
-        return _run(args)
-    except NoSafePathError as exc:
-        print(f"surfmod toolpath: error: {exc}", file=sys.stderr)
-        return 1
-
-
-def _run(args) -> int:
+    """Build and write the path.  When no path keeps every move within the tolerance
+    (``NoSafePathError``, a ``SurfmodError``) the common handler prints one line naming
+    the file and exits 1; no file is written."""
     target_path(args.out, "out", GCODE_SUFFIXES)
     if args.radius is None or not args.radius > 0:
         raise SurfmodError(f"radius: tool radius must be > 0, got {args.radius}")
