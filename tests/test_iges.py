@@ -104,3 +104,11 @@ def test_corpus_bspline_faces_survive_iges_and_the_libraries(corpus_file, tmp_pa
             r = frm(to(s))
             assert r.degree == s.degree and all(np.array_equal(a, c) for a, c in zip(r.knots, s.knots))
             assert np.abs(r.points(uu, vv) - s.points(uu, vv)).max() <= 1e-13 * size
+
+
+def test_export_step_round_trip_is_bit_exact(tmp_path):
+    # the public writer prints 17 significant digits: poles and weights come back unchanged
+    s = _nurbs(11)
+    path = tmp_path / "public.step"
+    sm.export_step(s, path)
+    _same(s, sm.from_face(sm.import_step(path).faces()[0]))
