@@ -40,18 +40,23 @@ def write_step(shape, path: str) -> None:
     write_step_full(shape, path)
 
 
-def read_step(path: str):
-    """Read a STEP file into one TopoDS shape; unreadable files raise ``SurfmodError``."""
+def read_with(reader, kind: str, path: str):
+    """One TopoDS shape from ``path`` through an OCCT ``XSControl_Reader`` subclass
+    instance (STEP, IGES); unreadable files raise ``SurfmodError`` naming ``kind``."""
     from OCP.IFSelect import IFSelect_RetDone
-    from OCP.STEPControl import STEPControl_Reader
 
-    with kernel("STEPControl_Reader"):
-        reader = STEPControl_Reader()
-        status = reader.ReadFile(str(path))
-        if status != IFSelect_RetDone:
-            raise SurfmodError(f"path: {path} is not a readable STEP file")
+    with kernel(f"{type(reader).__name__}"):
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise SurfmodError(f"path: {path} is not a readable {kind} file")
         reader.TransferRoots()
         shape = reader.OneShape()
     if shape is None or shape.IsNull():
         raise SurfmodError(f"path: {path} contains no shape")
     return shape
+
+
+def read_step(path: str):
+    """Read a STEP file into one TopoDS shape; unreadable files raise ``SurfmodError``."""
+    from OCP.STEPControl import STEPControl_Reader
+
+    return read_with(STEPControl_Reader(), "STEP", path)

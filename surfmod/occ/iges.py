@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import io
 
-from ..errors import KernelError, SurfmodError
+from ..errors import KernelError
 from .fullprecision import FLOAT_FORMAT, write_bytes
 from .guard import kernel
 
@@ -45,15 +45,8 @@ def write_iges(shape, path: str, *, brep: bool = False) -> None:
 
 def read_iges(path: str):
     """Read an IGES file into one TopoDS shape; unreadable files raise ``SurfmodError``."""
-    from OCP.IFSelect import IFSelect_RetDone
     from OCP.IGESControl import IGESControl_Reader
 
-    with kernel("IGESControl_Reader"):
-        reader = IGESControl_Reader()
-        if reader.ReadFile(str(path)) != IFSelect_RetDone:
-            raise SurfmodError(f"path: {path} is not a readable IGES file")
-        reader.TransferRoots()
-        shape = reader.OneShape()
-    if shape is None or shape.IsNull():
-        raise SurfmodError(f"path: {path} contains no shape")
-    return shape
+    from .exchange import read_with
+
+    return read_with(IGESControl_Reader(), "IGES", path)
