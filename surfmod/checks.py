@@ -81,10 +81,13 @@ def finite_array(value, name: str, *, ndim: int | None = None, last: int | None 
         raise SurfmodError(f"{name}: expected an array with {ndim} axes, got shape {arr.shape}")
     if last is not None and (arr.ndim == 0 or arr.shape[-1] != last):
         raise SurfmodError(f"{name}: last axis must have length {last}, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise SurfmodError(f"{name}: contains NaN or infinite values")
-    if arr.size and np.abs(arr).max() > LARGEST:
-        raise SurfmodError(f"{name}: magnitude {np.abs(arr).max():.3g} exceeds the limit {LARGEST:g}")
+    if arr.size:
+        # min and max propagate NaN and expose infinities: two passes, no temporaries
+        lo, hi = arr.min(), arr.max()
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise SurfmodError(f"{name}: contains NaN or infinite values")
+        if max(-lo, hi) > LARGEST:
+            raise SurfmodError(f"{name}: magnitude {max(-lo, hi):.3g} exceeds the limit {LARGEST:g}")
     return arr
 
 
@@ -325,10 +328,15 @@ def parameters(value, name: str, domain: tuple[float, float], slack: float = 1e-
     t = finite_array(value, name)
     lo, hi = domain
     span = hi - lo
-    if t.size and (t.min() < lo - slack * span or t.max() > hi + slack * span):
+    if not t.size:
+        return t.copy()
+    t_lo, t_hi = t.min(), t.max()
+    if t_lo < lo - slack * span or t_hi > hi + slack * span:
         raise SurfmodError(
-            f"{name}: parameters must lie in [{lo:g}, {hi:g}], got range [{t.min():g}, {t.max():g}]"
+            f"{name}: parameters must lie in [{lo:g}, {hi:g}], got range [{t_lo:g}, {t_hi:g}]"
         )
+    if t_lo >= lo and t_hi <= hi:  # already inside: no copy (evaluation only reads it)
+        return t
     return np.clip(t, lo, hi)
 
 

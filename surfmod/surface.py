@@ -19,10 +19,24 @@ from .immutable import Immutable
 from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
 
 
+def all_finite(out: np.ndarray) -> bool:
+    """Whether every value of ``out`` is finite.  The sum is one vectorized pass without
+    a boolean temporary: a NaN or an infinity makes it non-finite, so a finite sum proves
+    every term finite; only a non-finite sum (or one that overflowed) needs the exact test.
+
+    >>> all_finite(np.array([1.0, -1e308, -1e308])), all_finite(np.array([1.0, np.nan]))
+    (True, False)
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(out.sum()):
+            return True
+    return bool(np.isfinite(out).all())
+
+
 def finite_result(out: np.ndarray, u: np.ndarray, v: np.ndarray, what: str) -> np.ndarray:
     """``out`` (one row per parameter pair) when every value is finite; otherwise a
     ``SurfmodError`` naming the first parameters where the surface has no finite value."""
-    if np.isfinite(out).all():
+    if all_finite(out):
         return out
     i = int(np.argmax(~np.isfinite(out.reshape(len(out), -1)).all(axis=1)))
     raise SurfmodError(
@@ -145,7 +159,7 @@ class Surface(Immutable, abc.ABC):
         if us.size == 0 or vs.size == 0:  # NumPy-style: empty in, empty out
             return np.empty((us.size, vs.size, order + 1, order + 1, 3))
         out = self._grid_derivatives(us, vs, order)
-        if not np.isfinite(out).all():
+        if not all_finite(out):
             bad = np.argwhere(~np.isfinite(out))[0]
             finite_result(out[bad[0], bad[1]][None], us[bad[:1]], vs[bad[1:2]], "grid")
         return out

@@ -226,3 +226,62 @@ def test_local_kernels_equal_the_dense_blas_path(s):
     if s.rational:
         dense = surface_quotient(dense)
     _assert_partials(s.grid_derivatives(us, vs, 2), dense, s)
+
+
+# -- per-span patches (eval/patches.py) and preallocated partials ----------------------------
+@pytest.mark.parametrize("p, q", [(1, 1), (2, 3), (3, 1), (3, 3)])
+@pytest.mark.parametrize("rational", [False, True])
+def test_patch_positions_match_basis_kernel_and_textbook(p, q, rational):
+    """Many scattered points on a small net go through the per-span Taylor patches; they
+    agree with the basis-function kernel everywhere and with the textbook sums on a
+    sample, including knots (repeated ones too) and both domain ends."""
+    s = _surface(11, 9, p, q, rational, seed=p * 10 + q)
+    rng = np.random.default_rng(4)
+    u, v = _sample_params(s, 3000, rng)
+    net = s._local_net()
+    net.cache.clear()
+    assert 2 * 3000 + 4 >= local.PATCH_MIN_POINTS
+    got = s.points(u, v)
+    assert "patches" in net.cache  # the patch path ran
+    basis = np.empty_like(got)
+    kernels.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
+                                net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, basis)
+    atol = REL * _conditioning(s) * np.abs(s.control_points).max()
+    np.testing.assert_allclose(got, basis, rtol=0, atol=atol)
+    pick = np.r_[0:40, 3000:3040, -4:0]
+    (pp, qq), (ku, kv) = s.degree, s.knots
+    expected = np.array([ref.bspline_surface_derivatives(s.control_points, pp, qq, ku, kv, u[i], v[i], 0, s.weights)[0, 0]
+                         for i in pick])
+    np.testing.assert_allclose(got[pick], expected, rtol=0, atol=atol)
+
+
+def test_patches_are_skipped_for_high_degree_and_few_points():
+    s = _surface(9, 9, 4, 3, True)
+    u, v = _sample_params(s, 3000, np.random.default_rng(1))
+    s.points(u, v)
+    assert "patches" not in s._local_net().cache  # degree 4: the basis kernel
+    s3 = _surface(9, 9, 3, 3, True)
+    s3.points(u[:100], v[:100])
+    assert "patches" not in s3._local_net().cache  # 100 points: not worth a table
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_grid_into_partials_equal_grid_derivatives_and_textbook(rational):
+    s = _surface(30, 12, 3, 2, rational, seed=5)
+    us, vs = parameters_with_knots(s, 7)
+    buf = np.full((us.size, vs.size, 3, 3, 3), np.nan)
+    assert s.grid_into(us, vs, buf, order=2) is buf
+    planar = s.grid_derivatives(us, vs, 2)
+    np.testing.assert_array_equal(buf, planar)  # the same sums, only stored point-major
+    (p, q), (ku, kv) = s.degree, s.knots
+    expected = np.array([[ref.bspline_surface_derivatives(s.control_points, p, q, ku, kv, u, v, 2, s.weights)
+                          for v in vs] for u in us])
+    _assert_partials(buf, expected, s)
+
+
+def test_grid_into_partials_names_a_bad_buffer_or_order():
+    s = _surface(6, 6, 3, 3, True)
+    with pytest.raises(sm.SurfmodError, match="out"):
+        s.grid_into([0, 1], [0, 1], np.empty((2, 2, 3)), order=1)
+    with pytest.raises(sm.SurfmodError, match="order"):
+        s.grid_into([0, 1], [0, 1], np.empty((2, 2, 3)), order=-1)

@@ -429,6 +429,29 @@ def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
                         out[a, k, l, d, b0 + b] = acc[k, l, d, b]
 
 
+@njit(cache=True, error_model="numpy")
+def grid_derivatives_point_major(bu, first, p, w, rational, binom, acc, b0, out):
+    """:func:`grid_derivatives` writing ``out[:, b0:b0+n_v]`` of a point-major
+    ``out (n_u, N_v, K, K, 3)`` (a caller's preallocated array): the partials are formed
+    on the cache-resident planes of ``acc``, then each point's ``3 K^2`` values are stored
+    together, so the output is written once, front to back."""
+    kk = bu.shape[1]
+    nv = w.shape[3]
+    dim = 4 if rational else 3
+    for a in range(bu.shape[0]):
+        _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
+        if rational:
+            _quotient_planes(acc, binom)
+        dst = out[a]
+        for b in range(nv):
+            point = dst[b0 + b]
+            for k in range(kk):
+                for l in range(kk):
+                    point[k, l, 0] = acc[k, l, 0, b]
+                    point[k, l, 1] = acc[k, l, 1, b]
+                    point[k, l, 2] = acc[k, l, 2, b]
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _quotient_planes(acc, binom):
     """The quotient rule in place on planes ``acc (K, K, 4, n)``: coordinates 0..2 of
@@ -436,6 +459,9 @@ def _quotient_planes(acc, binom):
     entries, already converted, and the untouched weight planes).  Every step is a pass
     over the contiguous last axis through 1-D views, so it vectorizes."""
     kk, nv = acc.shape[0], acc.shape[3]
+    if kk == 3:
+        _quotient_planes_order2(acc)
+        return
     inv_w = np.empty(nv)
     w00 = acc[0, 0, 3]
     for b in range(nv):
@@ -455,3 +481,35 @@ def _quotient_planes(acc, binom):
                             dst[b] -= c * wij[b] * src[b]
                 for b in range(nv):
                     dst[b] *= inv_w[b]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _quotient_planes_order2(acc):
+    """:func:`_quotient_planes` for partials to order 2, written out: one pass over the
+    points per coordinate with all nine entries in registers (the general version makes
+    a pass per term).  Same terms in the same order, so the same rounding."""
+    nv = acc.shape[3]
+    w00, w01, w02 = acc[0, 0, 3], acc[0, 1, 3], acc[0, 2, 3]
+    w10, w11, w12 = acc[1, 0, 3], acc[1, 1, 3], acc[1, 2, 3]
+    w20, w21, w22 = acc[2, 0, 3], acc[2, 1, 3], acc[2, 2, 3]
+    for d in range(3):
+        a00, a01, a02 = acc[0, 0, d], acc[0, 1, d], acc[0, 2, d]
+        a10, a11, a12 = acc[1, 0, d], acc[1, 1, d], acc[1, 2, d]
+        a20, a21, a22 = acc[2, 0, d], acc[2, 1, d], acc[2, 2, d]
+        for b in range(nv):
+            iw = 1.0 / w00[b]
+            s00 = a00[b] * iw
+            s01 = (a01[b] - w01[b] * s00) * iw
+            s02 = (a02[b] - 2.0 * w01[b] * s01 - w02[b] * s00) * iw
+            s10 = (a10[b] - w10[b] * s00) * iw
+            s11 = (a11[b] - w01[b] * s10 - w10[b] * s01 - w11[b] * s00) * iw
+            s12 = (a12[b] - 2.0 * w01[b] * s11 - w02[b] * s10 - w10[b] * s02 - 2.0 * w11[b] * s01
+                   - w12[b] * s00) * iw
+            s20 = (a20[b] - 2.0 * w10[b] * s10 - w20[b] * s00) * iw
+            s21 = (a21[b] - w01[b] * s20 - 2.0 * w10[b] * s11 - 2.0 * w11[b] * s10 - w20[b] * s01
+                   - w21[b] * s00) * iw
+            s22 = (a22[b] - 2.0 * w01[b] * s21 - w02[b] * s20 - 2.0 * w10[b] * s12 - 4.0 * w11[b] * s11
+                   - 2.0 * w12[b] * s10 - w20[b] * s02 - 2.0 * w21[b] * s01 - w22[b] * s00) * iw
+            a00[b], a01[b], a02[b] = s00, s01, s02
+            a10[b], a11[b], a12[b] = s10, s11, s12
+            a20[b], a21[b], a22[b] = s20, s21, s22

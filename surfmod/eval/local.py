@@ -60,6 +60,7 @@ class LocalNet(NamedTuple):
     inv_v: np.ndarray
     bucket_u: tuple  # span search buckets (kernels.span_buckets)
     bucket_v: tuple
+    cache: dict  # tables built on first need (the per-span patches of eval/patches.py)
 
 
 def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
@@ -71,16 +72,48 @@ def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
     n, m = ctrl.shape[:2]
     return LocalNet(ku, int(p), kv, int(q), ctrl, hctrl.shape[-1] == 4,
                     k.reciprocal_table(ku, p, n), k.reciprocal_table(kv, q, m),
-                    k.span_buckets(ku, p, n), k.span_buckets(kv, q, m))
+                    k.span_buckets(ku, p, n), k.span_buckets(kv, q, m), {})
+
+
+#: scattered points per span pair from which the per-span patch table pays for itself
+PATCH_POINTS_PER_SPAN = 8
+#: and at least this many points
+PATCH_MIN_POINTS = 4096
+
+
+def _patch_table(net: LocalNet, count: int):
+    """The per-span patch table (eval/patches.py) when it suits the net and ``count``
+    points, built once per net; else None."""
+    table = net.cache.get("patches")
+    if table is not None:
+        return table
+    n, m = net.ctrl.shape[:2]
+    if count < max(PATCH_MIN_POINTS, PATCH_POINTS_PER_SPAN * (n - net.p) * (m - net.q)):
+        return None
+    from . import patches
+
+    if not patches.suits(net.p, net.q, n, m):
+        return None
+    table = net.cache["patches"] = patches.build(net)
+    return table
 
 
 def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
     """Positions at scattered pairs ``(u[a], v[a])``: ``(N, 3)``, written into ``out`` when
-    given (any C-contiguous ``(N, 3)`` float array, e.g. a slice of a larger buffer)."""
+    given (any C-contiguous ``(N, 3)`` float array, e.g. a slice of a larger buffer).
+
+    Many points on a small low-degree net go through per-span polynomial patches
+    (:mod:`surfmod.eval.patches`), the others through the basis-function kernel."""
     k = _kernels()
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, 3))
+    table = _patch_table(net, u.size)
+    if table is not None:
+        from . import patches
+
+        patches.positions(net, table, u, v, out)
+        return out
     k.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
                           net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
     return out
@@ -127,10 +160,10 @@ def _row_blocks(su, p, n, per_row):
 def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     """Cartesian mixed partials on the grid ``us x vs``: ``(len(us), len(vs), K, K, 3)``.
 
-    Positions (``order == 0``) are
-    written point-major, into ``out (len(us), len(vs), 3)`` when given; partials are
-    written planar (every partial and coordinate a contiguous row of v) and returned as
-    the transposed view.
+    Positions (``order == 0``) are written point-major, into ``out (len(us), len(vs), 3)``
+    when given.  Partials are written planar (every partial and coordinate a contiguous
+    row of v) and returned as the transposed view, or, when ``out (len(us), len(vs), K,
+    K, 3)`` is given, point-major into it (the caller's array is filled and returned).
     """
     k = _kernels()
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
@@ -145,8 +178,9 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
         if out is None:
             out = np.empty((us.size, vs.size, 3))
     else:
-        planar = np.empty((us.size, kk, kk, 3, vs.size))
         binom = k.binomials(order)
+        if out is None:
+            planar = np.empty((us.size, kk, kk, 3, vs.size))
     for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
         svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
         accb = acc if svb.size == acc.shape[-1] else np.empty(acc.shape[:-1] + (svb.size,))
@@ -155,8 +189,10 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             k.grid_rows(bvb, svb, q, ctrl, rows, dim, table)
             if order == 0:
                 k.grid_positions(bu[a0:a1], first, p, table, rational, accb, b0, out[a0:a1])
+            elif out is not None:
+                k.grid_derivatives_point_major(bu[a0:a1], first, p, table, rational, binom, accb, b0, out[a0:a1])
             else:
                 k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, accb, b0, planar[a0:a1])
     if order == 0:
         return out[:, :, None, None, :]
-    return planar.transpose(0, 4, 1, 2, 3)
+    return out if out is not None else planar.transpose(0, 4, 1, 2, 3)

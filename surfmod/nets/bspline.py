@@ -245,25 +245,34 @@ class BSplineSurface(Surface):
     def _grid_derivatives(self, us, vs, order):
         return local.surface_grid(self._local_net(), us, vs, order)
 
-    def grid_into(self, us, vs, out) -> np.ndarray:
-        """Positions on the grid ``us x vs`` written into the preallocated C-contiguous
-        float array ``out`` of shape ``(len(us), len(vs), 3)`` (no other array of that
-        size is made); returns ``out``.
+    def grid_into(self, us, vs, out, order: int = 0) -> np.ndarray:
+        """Positions (``order=0``) or partials on the grid ``us x vs`` written into the
+        preallocated C-contiguous float array ``out`` (no other array of that size is
+        made); returns ``out``.  Its shape is ``(len(us), len(vs), 3)`` for positions and
+        ``(len(us), len(vs), order+1, order+1, 3)`` for partials, laid out as
+        :meth:`grid_derivatives` returns them.  Reusing one buffer across calls skips the
+        page faults of a fresh array; values are not checked for finiteness.
 
         >>> import numpy as np, surfmod as sm
         >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
         >>> buf = np.empty((2, 3, 3))
         >>> sm.BSplineSurface(net, (3, 3)).grid_into([0, 1], [0, 0.5, 1], buf)[1, 1]
         array([3. , 1.5, 0. ])
+        >>> ders = sm.BSplineSurface(net, (3, 3)).grid_into([0.5], [0.5], np.empty((1, 1, 2, 2, 3)), order=1)
+        >>> ders[0, 0, 1, 0], ders[0, 0, 0, 1]
+        (array([3., 0., 0.]), array([0., 3., 0.]))
         """
+        order = checks.derivative_order(order)
         (u0, u1), (v0, v1) = self.domain
         us = checks.parameters(np.atleast_1d(us), "us", (u0, u1)).ravel()
         vs = checks.parameters(np.atleast_1d(vs), "vs", (v0, v1)).ravel()
+        shape = (us.size, vs.size, 3) if order == 0 else (us.size, vs.size, order + 1, order + 1, 3)
         if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.flags.c_contiguous
-                and out.flags.writeable and out.shape == (us.size, vs.size, 3)):
+                and out.flags.writeable and out.shape == shape):
             raise SurfmodError(f"out: expected a writable C-contiguous float64 array of shape "
-                               f"{(us.size, vs.size, 3)}, got {getattr(out, 'shape', type(out).__name__)}")
-        local.surface_grid(self._local_net(), us, vs, 0, out=out)
+                               f"{shape}, got {getattr(out, 'shape', type(out).__name__)}")
+        if us.size and vs.size:
+            local.surface_grid(self._local_net(), us, vs, order, out=out)
         return out
 
     def geom(self):

@@ -1,0 +1,171 @@
+"""Per-span polynomial patches for many scattered positions (compiled, numba).
+
+Within one knot span in u and one in v a (rational) B-spline surface is a polynomial
+patch.  Written in Taylor form about the span's midpoint with the normalized parameters
+``x = (u - mid_u) / half_u`` and ``y = (v - mid_v) / half_v`` (both in ``[-1, 1]``),
+
+    H(u, v) = sum_k sum_l C[k, l] x^k y^l,    C[k, l] = sum_i sum_j T_u[k, i] T_v[l, j] P_ij,
+
+where ``T[k, i] = N_i^(k)(mid) half^k / k!`` are the Taylor rows of the basis functions
+(computed by the same division-free Cox-de Boor triangle as every other kernel).  A
+point then costs a span search and a Horner scheme: no basis triangle, no knot look-ups.
+OCCT's ``BSplSLib_Cache`` evaluates the same kind of per-span polynomial.
+
+The table holds ``(p+1)(q+1)`` homogeneous 4-vectors per span pair, so it is built only
+for small nets and degrees up to 3 (:func:`suits`), where the Taylor coefficients of a
+basis function on ``[-1, 1]`` are at most a few units and Horner's rounding stays at the
+level of the basis-function sums (agreement 1e-13 relative, tests/test_eval_local.py).
+
+>>> import numpy as np
+>>> from surfmod.eval import local
+>>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+>>> knots = np.array([0, 0, 0, 0, 1, 1, 1, 1.0])
+>>> table = build(local.prepare(knots, 3, knots, 3, net))
+>>> out = np.empty((1, 3))
+>>> positions(local.prepare(knots, 3, knots, 3, net), table, np.array([0.5]), np.array([0.25]), out)
+>>> out
+array([[1.5 , 0.75, 0.  ]])
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from .kernels import basis_ders_point, find_span_bucketed
+
+#: largest table built (bytes): 100 x 100 bicubic spans fit, the table stays cache-friendly
+MAX_TABLE_BYTES = 8 << 20
+#: highest degree in either direction (see the module docstring on rounding)
+MAX_DEGREE = 3
+
+
+class PatchTable(NamedTuple):
+    """Taylor coefficients of every span pair and the spans' midpoints and scales."""
+
+    coeffs: np.ndarray  # (n - p, m - q, p + 1, q + 1, 4): C[su - p, sv - q, k, l, d]
+    mid_u: np.ndarray  # (n,) span midpoints (0 outside the domain's spans)
+    scale_u: np.ndarray  # (n,) 1 / half-width (0 for an empty span)
+    mid_v: np.ndarray
+    scale_v: np.ndarray
+
+
+def suits(p: int, q: int, n: int, m: int) -> bool:
+    """Whether a table for degrees ``(p, q)`` and an ``n x m`` net is worth building."""
+    size = (n - p) * (m - q) * (p + 1) * (q + 1) * 4 * 8
+    return max(p, q) <= MAX_DEGREE and size <= MAX_TABLE_BYTES
+
+
+@njit(cache=True, error_model="numpy")
+def _taylor_rows(knots, p, n, inv, rows, mid, scale):
+    """``rows[s, k, i] = N_{s-p+i}^(k)(mid_s) half_s^k / k!`` for every non-empty span."""
+    ndu = np.empty((p + 1, p + 1))
+    left, right, tmp = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
+    ders = np.empty((p + 1, p + 1))
+    for s in range(p, n):
+        a, b = knots[s], knots[s + 1]
+        if not b > a:
+            continue  # an empty span is never the span of a parameter
+        half = 0.5 * (b - a)
+        mid[s] = a + half
+        scale[s] = 1.0 / half
+        basis_ders_point(knots, p, s, mid[s], p, inv, ndu, left, right, tmp, ders)
+        factor = 1.0
+        for k in range(p + 1):
+            for i in range(p + 1):
+                rows[s, k, i] = ders[k, i] * factor
+            factor *= half / (k + 1)
+
+
+@njit(cache=True, error_model="numpy")
+def _contract(rows_u, rows_v, p, q, ctrl, coeffs):
+    """``coeffs[su-p, sv-q, k, l] = sum_ij rows_u[su, k, i] rows_v[sv, l, j] P[su-p+i, sv-q+j]``."""
+    n, m = ctrl.shape[0], ctrl.shape[1]
+    by_v = np.empty((q + 1, 4))
+    for su in range(p, n):
+        for sv in range(q, m):
+            c = coeffs[su - p, sv - q]
+            c[:] = 0.0
+            for i in range(p + 1):
+                for l in range(q + 1):
+                    for d in range(4):
+                        acc = 0.0
+                        for j in range(q + 1):
+                            acc += rows_v[sv, l, j] * ctrl[su - p + i, sv - q + j, d]
+                        by_v[l, d] = acc
+                for k in range(p + 1):
+                    t = rows_u[su, k, i]
+                    for l in range(q + 1):
+                        for d in range(4):
+                            c[k, l, d] += t * by_v[l, d]
+
+
+def build(net) -> PatchTable:
+    """The patch table of a :class:`surfmod.eval.local.LocalNet` (see :func:`suits`)."""
+    n, m = net.ctrl.shape[:2]
+    p, q = net.p, net.q
+    rows_u, rows_v = np.zeros((n, p + 1, p + 1)), np.zeros((m, q + 1, q + 1))
+    mid_u, scale_u, mid_v, scale_v = np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(m)
+    _taylor_rows(net.knots_u, p, n, net.inv_u, rows_u, mid_u, scale_u)
+    _taylor_rows(net.knots_v, q, m, net.inv_v, rows_v, mid_v, scale_v)
+    coeffs = np.empty((n - p, m - q, p + 1, q + 1, 4))
+    _contract(rows_u, rows_v, p, q, net.ctrl, coeffs)
+    return PatchTable(coeffs, mid_u, scale_u, mid_v, scale_v)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _bicubic(c, x, y, d):
+    """``sum_kl c[k, l, d] x^k y^l`` for degree 3 x 3, written out: the four inner Horner
+    schemes are independent, so they overlap in the pipeline."""
+    s3 = ((c[3, 3, d] * y + c[3, 2, d]) * y + c[3, 1, d]) * y + c[3, 0, d]
+    s2 = ((c[2, 3, d] * y + c[2, 2, d]) * y + c[2, 1, d]) * y + c[2, 0, d]
+    s1 = ((c[1, 3, d] * y + c[1, 2, d]) * y + c[1, 1, d]) * y + c[1, 0, d]
+    s0 = ((c[0, 3, d] * y + c[0, 2, d]) * y + c[0, 1, d]) * y + c[0, 0, d]
+    return ((s3 * x + s2) * x + s1) * x + s0
+
+
+@njit(cache=True, error_model="numpy")
+def _positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+               bucket_u, bucket_v, u, v, out):
+    t0u, su_scale, table_u = bucket_u
+    t0v, sv_scale, table_v = bucket_v
+    cubic = p == 3 and q == 3
+    for a in range(u.size):
+        su = find_span_bucketed(ku, p, n, u[a], t0u, su_scale, table_u)
+        sv = find_span_bucketed(kv, q, m, v[a], t0v, sv_scale, table_v)
+        x = (u[a] - mid_u[su]) * scale_u[su]
+        y = (v[a] - mid_v[sv]) * scale_v[sv]
+        c = coeffs[su - p, sv - q]
+        if cubic:
+            h0, h1, h2, h3 = _bicubic(c, x, y, 0), _bicubic(c, x, y, 1), _bicubic(c, x, y, 2), _bicubic(c, x, y, 3)
+        else:  # nested Horner schemes, the four coordinates side by side
+            h0 = h1 = h2 = h3 = 0.0
+            for k in range(p, -1, -1):
+                s0, s1, s2, s3 = c[k, q, 0], c[k, q, 1], c[k, q, 2], c[k, q, 3]
+                for l in range(q - 1, -1, -1):
+                    s0 = s0 * y + c[k, l, 0]
+                    s1 = s1 * y + c[k, l, 1]
+                    s2 = s2 * y + c[k, l, 2]
+                    s3 = s3 * y + c[k, l, 3]
+                h0 = h0 * x + s0
+                h1 = h1 * x + s1
+                h2 = h2 * x + s2
+                h3 = h3 * x + s3
+        if rational:
+            inv_w = 1.0 / h3
+            h0 *= inv_w
+            h1 *= inv_w
+            h2 *= inv_w
+        out[a, 0] = h0
+        out[a, 1] = h1
+        out[a, 2] = h2
+
+
+def positions(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    """Positions at the scattered pairs ``(u[a], v[a])`` into ``out (N, 3)`` from ``table``
+    (flat float64 parameter arrays, in the domain)."""
+    n, m = net.ctrl.shape[:2]
+    _positions(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u,
+               table.mid_v, table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
