@@ -81,14 +81,22 @@ def finite_array(value, name: str, *, ndim: int | None = None, last: int | None 
         raise SurfmodError(f"{name}: expected an array with {ndim} axes, got shape {arr.shape}")
     if last is not None and (arr.ndim == 0 or arr.shape[-1] != last):
         raise SurfmodError(f"{name}: last axis must have length {last}, got shape {arr.shape}")
-    if arr.size:
-        # min and max propagate NaN and expose infinities: two passes, no temporaries
-        lo, hi = arr.min(), arr.max()
-        if not (np.isfinite(lo) and np.isfinite(hi)):
-            raise SurfmodError(f"{name}: contains NaN or infinite values")
-        if max(-lo, hi) > LARGEST:
-            raise SurfmodError(f"{name}: magnitude {max(-lo, hi):.3g} exceeds the limit {LARGEST:g}")
+    _finite_range(arr, name)
     return arr
+
+
+def _finite_range(arr: np.ndarray, name: str):
+    """``(min, max)`` of a non-empty ``arr`` (None for an empty one) after refusing NaN,
+    infinities and magnitudes above ``LARGEST``.  Min and max propagate NaN and expose
+    infinities: two passes over the data and no temporary arrays."""
+    if not arr.size:
+        return None
+    lo, hi = arr.min(), arr.max()
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        raise SurfmodError(f"{name}: contains NaN or infinite values")
+    if max(-lo, hi) > LARGEST:
+        raise SurfmodError(f"{name}: magnitude {max(-lo, hi):.3g} exceeds the limit {LARGEST:g}")
+    return lo, hi
 
 
 def real(value, name: str, *, low: float | None = None, high: float | None = None) -> float:
@@ -325,12 +333,12 @@ def degree(value, name: str, n_ctrl: int, maximum: int = 25) -> int:
 
 def parameters(value, name: str, domain: tuple[float, float], slack: float = 1e-9) -> np.ndarray:
     """Finite parameters inside ``domain`` (a little slack for round-off), clipped to it."""
-    t = finite_array(value, name)
+    t = _as_floats(value, name)
     lo, hi = domain
     span = hi - lo
     if not t.size:
         return t.copy()
-    t_lo, t_hi = t.min(), t.max()
+    t_lo, t_hi = _finite_range(t, name)
     if t_lo < lo - slack * span or t_hi > hi + slack * span:
         raise SurfmodError(
             f"{name}: parameters must lie in [{lo:g}, {hi:g}], got range [{t_lo:g}, {t_hi:g}]"

@@ -80,6 +80,11 @@ class Surface(Immutable, abc.ABC):
     def transformed(self, matrix) -> "Surface":
         """A new surface with the 4x4 affine ``matrix`` applied to its definition."""
 
+    def _finite_positions(self) -> bool:
+        """True when every position is finite by construction (no output check needed);
+        subclasses that can prove it (e.g. a convex combination of finite points) override."""
+        return False
+
     def _grid_derivatives(self, us: np.ndarray, vs: np.ndarray, order: int) -> np.ndarray:
         """``(len(us), len(vs), K, K, 3)``; subclasses override with a faster tensor path."""
         uu, vv = np.meshgrid(us, vs, indexing="ij")
@@ -104,7 +109,9 @@ class Surface(Immutable, abc.ABC):
         """
         shape, uf, vf = self._params(u, v, max_points=max_points)
         out = self._evaluate(uf, vf, 0)[:, 0, 0, :]
-        return finite_result(out, uf, vf, "points").reshape(*shape, 3)
+        if not self._finite_positions():
+            out = finite_result(out, uf, vf, "points")
+        return out.reshape(*shape, 3)
 
     def derivatives(self, u, v, order: int = 1, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
         """Partials ``[..., k, l, :] = d^(k+l) S / du^k dv^l`` for ``k, l <= order``.
@@ -159,7 +166,7 @@ class Surface(Immutable, abc.ABC):
         if us.size == 0 or vs.size == 0:  # NumPy-style: empty in, empty out
             return np.empty((us.size, vs.size, order + 1, order + 1, 3))
         out = self._grid_derivatives(us, vs, order)
-        if not all_finite(out):
+        if not (order == 0 and self._finite_positions()) and not all_finite(out):
             bad = np.argwhere(~np.isfinite(out))[0]
             finite_result(out[bad[0], bad[1]][None], us[bad[:1]], vs[bad[1:2]], "grid")
         return out

@@ -285,3 +285,23 @@ def test_grid_into_partials_names_a_bad_buffer_or_order():
         s.grid_into([0, 1], [0, 1], np.empty((2, 2, 3)), order=1)
     with pytest.raises(sm.SurfmodError, match="order"):
         s.grid_into([0, 1], [0, 1], np.empty((2, 2, 3)), order=-1)
+
+
+def test_positions_skip_the_output_check_only_when_provably_finite():
+    """A convex combination of finite poles is finite; nets that could overflow or whose
+    weights could underflow keep the check (and a NaN pole is still reported)."""
+    s = _surface(6, 6, 3, 3, True)
+    assert local.positions_finite(s._local_net())
+    net = s.control_points.copy()
+    huge = sm.BSplineSurface._trusted(net * 1e301, s.degree, s.knots)
+    assert not local.positions_finite(huge._local_net())
+    assert np.isfinite(huge.grid([0.5], [0.5])).all()
+    tiny_w = sm.BSplineSurface._trusted(net, s.degree, s.knots, np.full(net.shape[:2], 1e-300))
+    assert not local.positions_finite(tiny_w._local_net())
+    net[2, 3, 1] = np.nan
+    bad = sm.BSplineSurface._trusted(net, s.degree, s.knots)
+    assert not local.positions_finite(bad._local_net())
+    with pytest.raises(sm.SurfmodError, match="u, v"):
+        bad.points([0.5], [0.5])
+    with pytest.raises(sm.SurfmodError, match="not finite"):
+        bad.grid([0.5], [0.5])

@@ -75,6 +75,28 @@ def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
                     k.span_buckets(ku, p, n), k.span_buckets(kv, q, m), {})
 
 
+def positions_finite(net: LocalNet) -> bool:
+    """Whether every position of the surface is finite whatever the parameters: a point
+    is a convex combination of the control points (non-negative basis functions, positive
+    weights), so finite homogeneous sums that cannot overflow (``|h| < 1e300``) and a
+    weight sum that cannot underflow to zero (every weight above ``1e-290``) prove it.
+    Checked once per net; callers then skip the pass over the output.
+
+    >>> import numpy as np
+    >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+    >>> knots = np.array([0, 0, 0, 0, 1, 1, 1, 1.0])
+    >>> positions_finite(prepare(knots, 3, knots, 3, net))
+    True
+    """
+    known = net.cache.get("positions_finite")
+    if known is None:
+        h = net.ctrl
+        known = bool(np.isfinite(h).all() and np.abs(h).max() < 1e300
+                     and (not net.rational or h[..., 3].min() > 1e-290))
+        net.cache["positions_finite"] = known
+    return known
+
+
 #: scattered points per span pair from which the per-span patch table pays for itself
 PATCH_POINTS_PER_SPAN = 8
 #: and at least this many points

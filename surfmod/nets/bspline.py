@@ -236,6 +236,9 @@ class BSplineSurface(Surface):
             cached = self._local = local.prepare(ku, p, kv, q, self._h)
         return cached
 
+    def _finite_positions(self) -> bool:
+        return local.positions_finite(self._local_net())
+
     def _derivatives(self, u, v, order):
         # local support: each point touches its (p+1) x (q+1) poles only (eval/local.py)
         if order == 0:
