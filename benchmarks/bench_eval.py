@@ -8,7 +8,10 @@ the process (``time.process_time``), best of several runs, so that other load on
 machine inflates neither side; all-core times are wall times.  OCCT per-point rates
 (``Value`` = positions, ``D2`` = all partials to order 2, into preallocated ``gp_Pnt`` /
 ``gp_Vec``, no conversion) are measured on 100² points through OCP and scaled to the point
-count.  The memory-write floor is the time to allocate and fill the output array.
+count.  The memory-write floor is the time to allocate and fill the output array
+("fresh"), or to fill an array that already exists ("reused"); the "into" rows write
+into a preallocated array with ``BSplineSurface.grid_into`` (as OCCT's side writes into
+preallocated points), the others allocate their result.
 
 ``python -m benchmarks eval``
 """
@@ -117,10 +120,12 @@ def measure(single: bool) -> dict:
     """Every timing of the tables, in seconds, for this process's thread setting."""
     out = {"net": {}, "rows": {}}
     grid = np.linspace(0, 1, GRID)
+    buf = np.zeros((GRID, GRID, 3))  # faulted in once, reused by every "into" timing
     for n in NET_SIZES:
         s = nurbs(n)
         s.grid(grid[:10], grid[:10])  # compile / load the kernels outside the timing
-        entry = {"ours": _time(lambda: s.grid(grid, grid), single)}
+        entry = {"ours": _time(lambda: s.grid(grid, grid), single),
+                 "into": _time(lambda: s.grid_into(grid, grid, buf), single)}
         sp = splipy_fn(s)
         entry["splipy"] = _time(lambda: sp(grid, grid), single, 2) if sp else None
         if single:
@@ -129,11 +134,18 @@ def measure(single: bool) -> dict:
     rows = out["rows"]
     s20, b20 = nurbs(20), nurbs(20, rational=False)
     rows["grid_poly20"] = _time(lambda: b20.grid(grid, grid), single)
+    rows["grid_poly20_into"] = _time(lambda: b20.grid_into(grid, grid, buf), single)
     rows["floor_d0"] = write_floor((GRID, GRID, 3), single)
+    rows["floor_d0_reused"] = _time(lambda: buf.fill(0.0), single, 5)
     s20.grid_derivatives(grid[:4], grid[:4], 2)
     rows["grid_d2"] = _time(lambda: s20.grid_derivatives(grid, grid, 2), single)
     rows["grid_d2_poly"] = _time(lambda: b20.grid_derivatives(grid, grid, 2), single)
     rows["floor_d2"] = write_floor((GRID, GRID, 3, 3, 3), single)
+    buf2 = np.zeros((GRID, GRID, 3, 3, 3))
+    rows["grid_d2_into"] = _time(lambda: s20.grid_into(grid, grid, buf2, order=2), single)
+    rows["grid_d2_poly_into"] = _time(lambda: b20.grid_into(grid, grid, buf2, order=2), single)
+    rows["floor_d2_reused"] = _time(lambda: buf2.fill(0.0), single, 5)
+    del buf2
     rng = np.random.default_rng(3)
     u, v = rng.uniform(0, 1, SCATTERED), rng.uniform(0, 1, SCATTERED)
     s20.derivatives(u[:4], v[:4], 2)
@@ -220,26 +232,34 @@ def _x(a, b):
 
 def report(one: dict, every: dict) -> None:
     print(f"{GRID}² grid of positions, rational bicubic net n x n (OCCT: per-point Value x 10^6)")
-    head = (f"{'net':>6} {'surfmod 1c':>11} {'surfmod all':>12} {'OCCT':>8} {'splipy 1c':>10} {'splipy all':>11} "
-            f"{'x OCCT':>8} {'x splipy 1c':>12} {'x splipy all':>13}")
+    head = (f"{'net':>9} {'surfmod 1c':>11} {'into 1c':>8} {'surfmod all':>12} {'OCCT':>7} {'splipy 1c':>10} "
+            f"{'splipy all':>11} {'x OCCT':>7} {'into':>7} {'x splipy 1c':>12} {'x splipy all':>13}")
     print(head)
     print("-" * len(head))
     for n in map(str, NET_SIZES):
         a, b = one["net"][n], every["net"][n]
         occ = a["occt_d0"] * GRID**2
-        print(f"{n + 'x' + n:>6} {_f(a['ours']):>11} {_f(b['ours']):>12} {_f(occ, '.3f'):>8} {_f(a['splipy']):>10} "
-              f"{_f(b['splipy']):>11} {_x(occ, a['ours']):>8} {_x(a['splipy'], a['ours']):>12} "
-              f"{_x(b['splipy'], b['ours']):>13}")
+        print(f"{n + 'x' + n:>9} {_f(a['ours']):>11} {_f(a['into']):>8} {_f(b['ours']):>12} {_f(occ, '.3f'):>7} "
+              f"{_f(a['splipy']):>10} {_f(b['splipy']):>11} {_x(occ, a['ours']):>7} {_x(occ, a['into']):>7} "
+              f"{_x(a['splipy'], a['ours']):>12} {_x(b['splipy'], b['ours']):>13}")
+    print("into = BSplineSurface.grid_into, writing into a preallocated array (x OCCT of that column)")
     r, ra = one["rows"], every["rows"]
     d0_20, d2_20 = one["net"]["20"]["occt_d0"], one["net"]["20"]["occt_d2"]
     print("\ncase (20x20 bicubic unless named)          surfmod 1c  surfmod all        OCCT     x OCCT    floor  x floor")
     print("-" * 107)
     lines = [
         ("1000² grid, rational NURBS", one["net"]["20"]["ours"], every["net"]["20"]["ours"], d0_20 * GRID**2, r["floor_d0"]),
+        ("  into a preallocated array", one["net"]["20"]["into"], every["net"]["20"]["into"], d0_20 * GRID**2,
+         r["floor_d0_reused"]),
         ("1000² grid, polynomial B-spline", r["grid_poly20"], ra["grid_poly20"], r["occt_poly20"] * GRID**2, r["floor_d0"]),
+        ("  into a preallocated array", r["grid_poly20_into"], ra["grid_poly20_into"], r["occt_poly20"] * GRID**2,
+         r["floor_d0_reused"]),
         ("1000² grid, 4x4 polynomial", r["poly4"], ra["poly4"], r["occt_poly4"] * GRID**2, r["floor_d0"]),
         ("1000² grid, partials to 2, NURBS", r["grid_d2"], ra["grid_d2"], d2_20 * GRID**2, r["floor_d2"]),
+        ("  into a preallocated array", r["grid_d2_into"], ra["grid_d2_into"], d2_20 * GRID**2, r["floor_d2_reused"]),
         ("1000² grid, partials to 2, B-spline", r["grid_d2_poly"], ra["grid_d2_poly"], d2_20 * GRID**2, r["floor_d2"]),
+        ("  into a preallocated array", r["grid_d2_poly_into"], ra["grid_d2_poly_into"], d2_20 * GRID**2,
+         r["floor_d2_reused"]),
         ("10⁶ scattered, NURBS positions", r["scattered_d0"], ra["scattered_d0"], d0_20 * SCATTERED, None),
         ("10⁶ scattered, NURBS partials to 2", r["scattered_d2"], ra["scattered_d2"], d2_20 * SCATTERED, None),
     ]
@@ -247,7 +267,8 @@ def report(one: dict, every: dict) -> None:
         print(f"{name:<40} {_f(t1):>11} {_f(ta):>12} {_f(occ, '.3f'):>11} {_x(occ, t1):>10} "
               f"{_f(floor):>8} {_x(t1, floor):>8}")
     print("partials to 2: OCCT D2 gives 6 vectors a point, surfmod the full 3x3 square (27 doubles);")
-    print("floor = allocate and fill the output array; x floor = surfmod / floor (1 = at the floor).")
+    print("floor = allocate and fill the output array (for the \"into\" rows: fill the reused array);")
+    print("x floor = surfmod / floor (1 = at the floor).")
     print("\ngeomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
     for n in (4, 20):
         print(f"  {n}x{n}: geomdl {_f(r[f'geomdl{n}'], '.1f')}  surfmod {_f(r[f'poly{n}'])}  "

@@ -80,9 +80,9 @@ class Surface(Immutable, abc.ABC):
     def transformed(self, matrix) -> "Surface":
         """A new surface with the 4x4 affine ``matrix`` applied to its definition."""
 
-    def _finite_positions(self) -> bool:
-        """True when every position is finite by construction (no output check needed);
-        subclasses that can prove it (e.g. a convex combination of finite points) override."""
+    def _finite_partials(self, order: int) -> bool:
+        """True when every partial up to ``order`` (0: positions) is finite by construction,
+        so no pass over the output is needed; subclasses that can bound them override."""
         return False
 
     def _grid_derivatives(self, us: np.ndarray, vs: np.ndarray, order: int) -> np.ndarray:
@@ -109,7 +109,7 @@ class Surface(Immutable, abc.ABC):
         """
         shape, uf, vf = self._params(u, v, max_points=max_points)
         out = self._evaluate(uf, vf, 0)[:, 0, 0, :]
-        if not self._finite_positions():
+        if not self._finite_partials(0):
             out = finite_result(out, uf, vf, "points")
         return out.reshape(*shape, 3)
 
@@ -126,7 +126,9 @@ class Surface(Immutable, abc.ABC):
         """
         order = checks.derivative_order(order)
         shape, uf, vf = self._params(u, v, (order + 1) ** 2, max_points)
-        out = finite_result(self._evaluate(uf, vf, order), uf, vf, "derivatives")
+        out = self._evaluate(uf, vf, order)
+        if not self._finite_partials(order):
+            out = finite_result(out, uf, vf, "derivatives")
         return out.reshape(*shape, order + 1, order + 1, 3)
 
     def grid(self, us, vs, *, max_points: int = checks.MAX_POINTS) -> np.ndarray:
@@ -166,7 +168,7 @@ class Surface(Immutable, abc.ABC):
         if us.size == 0 or vs.size == 0:  # NumPy-style: empty in, empty out
             return np.empty((us.size, vs.size, order + 1, order + 1, 3))
         out = self._grid_derivatives(us, vs, order)
-        if not (order == 0 and self._finite_positions()) and not all_finite(out):
+        if not self._finite_partials(order) and not all_finite(out):
             bad = np.argwhere(~np.isfinite(out))[0]
             finite_result(out[bad[0], bad[1]][None], us[bad[:1]], vs[bad[1:2]], "grid")
         return out

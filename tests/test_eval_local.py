@@ -272,7 +272,7 @@ def test_grid_into_partials_equal_grid_derivatives_and_textbook(rational):
     buf = np.full((us.size, vs.size, 3, 3, 3), np.nan)
     assert s.grid_into(us, vs, buf, order=2) is buf
     planar = s.grid_derivatives(us, vs, 2)
-    np.testing.assert_array_equal(buf, planar)  # the same sums, only stored point-major
+    np.testing.assert_array_equal(buf, planar)  # the same kernel, into the caller's array
     (p, q), (ku, kv) = s.degree, s.knots
     expected = np.array([[ref.bspline_surface_derivatives(s.control_points, p, q, ku, kv, u, v, 2, s.weights)
                           for v in vs] for u in us])
@@ -287,21 +287,39 @@ def test_grid_into_partials_names_a_bad_buffer_or_order():
         s.grid_into([0, 1], [0, 1], np.empty((2, 2, 3)), order=-1)
 
 
-def test_positions_skip_the_output_check_only_when_provably_finite():
-    """A convex combination of finite poles is finite; nets that could overflow or whose
-    weights could underflow keep the check (and a NaN pole is still reported)."""
+def test_partials_skip_the_output_check_only_when_provably_finite():
+    """Bounded partials of a finite net with positive weights are finite; nets that could
+    overflow or whose weights could underflow keep the check (a NaN pole is reported)."""
     s = _surface(6, 6, 3, 3, True)
-    assert local.positions_finite(s._local_net())
+    for order in range(4):
+        assert local.partials_finite(s._local_net(), order)
     net = s.control_points.copy()
-    huge = sm.BSplineSurface._trusted(net * 1e301, s.degree, s.knots)
-    assert not local.positions_finite(huge._local_net())
-    assert np.isfinite(huge.grid([0.5], [0.5])).all()
+    scale = 1e289 / (16 * np.abs(net).max())  # positions bound: 16 poles x max |P|
+    assert local.partials_finite(sm.BSplineSurface._trusted(net * scale, s.degree, s.knots)._local_net(), 0)
+    huge = sm.BSplineSurface._trusted(net * scale * 100, s.degree, s.knots)
+    assert not local.partials_finite(huge._local_net(), 0)
+    assert np.isfinite(huge.grid_derivatives([0.5], [0.5], 2)).all()  # checked, and finite
     tiny_w = sm.BSplineSurface._trusted(net, s.degree, s.knots, np.full(net.shape[:2], 1e-300))
-    assert not local.positions_finite(tiny_w._local_net())
+    assert not local.partials_finite(tiny_w._local_net(), 0)
     net[2, 3, 1] = np.nan
     bad = sm.BSplineSurface._trusted(net, s.degree, s.knots)
-    assert not local.positions_finite(bad._local_net())
+    assert not local.partials_finite(bad._local_net(), 0)
     with pytest.raises(sm.SurfmodError, match="u, v"):
         bad.points([0.5], [0.5])
+    with pytest.raises(sm.SurfmodError, match="u, v"):
+        bad.derivatives([0.5], [0.5], 1)
     with pytest.raises(sm.SurfmodError, match="not finite"):
         bad.grid([0.5], [0.5])
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_partial_bounds_hold(rational):
+    """The bounds that let evaluation skip the output check are upper bounds: sampled
+    partials (on knots and ends too) of nets with short spans, repeated knots and a weight
+    ratio up to 100 stay below them."""
+    for seed in range(4):
+        s = _surface(12, 9, 3, 2, rational, seed=seed)
+        u, v = _sample_params(s, 300, np.random.default_rng(seed))
+        ders = np.abs(s.derivatives(u, v, 3)).max(axis=(0, 3))
+        bound = local.partial_bounds(s._local_net(), 3)
+        assert np.all(ders <= bound), (ders / bound).max()

@@ -395,46 +395,11 @@ def _positions_low_degree(bu, first, p, w, rational, b0, out):
 
 @njit(cache=True, error_model="numpy")
 def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
-    """Second stage for partials: for each u-point combine its p+1 rows of ``w``, apply
-    the quotient rule on the planes (rational), and write ``out[..., b0:b0+n_v]`` of
-    ``out (n_u, K, K, 3, N_v)``: planar, every partial and coordinate a contiguous row."""
-    kk = bu.shape[1]
-    nv = w.shape[3]
-    dim = 4 if rational else 3
-    if p <= 3 and not rational:  # four-term sums straight into each output plane
-        for a in range(bu.shape[0]):
-            r0 = first[a]
-            r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
-            for k in range(kk):
-                c0 = bu[a, k, 0]
-                c1 = bu[a, k, 1] if p >= 1 else 0.0
-                c2 = bu[a, k, 2] if p >= 2 else 0.0
-                c3 = bu[a, k, 3] if p >= 3 else 0.0
-                for l in range(kk):
-                    for d in range(3):
-                        w0, w1, w2, w3 = w[r0, l, d], w[r1, l, d], w[r2, l, d], w[r3, l, d]
-                        dst = out[a, k, l, d]
-                        for b in range(nv):
-                            dst[b0 + b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
-        return
-    for a in range(bu.shape[0]):
-        # accumulate in the cache-resident scratch, then write every output plane once
-        _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
-        if rational:
-            _quotient_planes(acc, binom)
-        for k in range(kk):
-            for l in range(kk):
-                for d in range(3):
-                    for b in range(nv):
-                        out[a, k, l, d, b0 + b] = acc[k, l, d, b]
-
-
-@njit(cache=True, error_model="numpy")
-def grid_derivatives_point_major(bu, first, p, w, rational, binom, acc, b0, out):
-    """:func:`grid_derivatives` writing ``out[:, b0:b0+n_v]`` of a point-major
-    ``out (n_u, N_v, K, K, 3)`` (a caller's preallocated array): the partials are formed
-    on the cache-resident planes of ``acc``, then each point's ``3 K^2`` values are stored
-    together, so the output is written once, front to back."""
+    """Second stage for partials: for each u-point combine its p+1 rows of ``w`` on the
+    cache-resident planes of ``acc`` (every partial and coordinate a contiguous row of
+    v), apply the quotient rule there (rational), then store each point's ``3 K^2``
+    values together into ``out[:, b0:b0+n_v]`` of the point-major ``out (n_u, N_v, K, K,
+    3)``, so the output is written once, front to back."""
     kk = bu.shape[1]
     nv = w.shape[3]
     dim = 4 if rational else 3

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from math import comb
 from typing import NamedTuple
 
 from .basis import basis_derivatives, find_spans
@@ -75,26 +76,71 @@ def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
                     k.span_buckets(ku, p, n), k.span_buckets(kv, q, m), {})
 
 
-def positions_finite(net: LocalNet) -> bool:
-    """Whether every position of the surface is finite whatever the parameters: a point
-    is a convex combination of the control points (non-negative basis functions, positive
-    weights), so finite homogeneous sums that cannot overflow (``|h| < 1e300``) and a
-    weight sum that cannot underflow to zero (every weight above ``1e-290``) prove it.
-    Checked once per net; callers then skip the pass over the output.
+def partials_finite(net: LocalNet, order: int) -> bool:
+    """Whether every partial up to ``order`` (0: the positions) is finite whatever the
+    parameters, by a bound computed once per net and order; callers then skip the pass
+    over the output.
+
+    A k-th derivative of a degree-p basis function is at most ``(2 p / d)^k`` in
+    magnitude (``d`` the shortest non-empty knot span: eq. 2.9 of The NURBS Book applied
+    k times), the basis functions sum to one, and the weight sum is at least the smallest
+    weight.  So the homogeneous partials, the weight partials and, through the quotient
+    rule, the Cartesian ones have explicit bounds; below ``1e290`` nothing overflows, and
+    weights above ``1e-290`` keep the denominator from underflowing to zero.
 
     >>> import numpy as np
     >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
     >>> knots = np.array([0, 0, 0, 0, 1, 1, 1, 1.0])
-    >>> positions_finite(prepare(knots, 3, knots, 3, net))
+    >>> partials_finite(prepare(knots, 3, knots, 3, net), 2)
     True
     """
-    known = net.cache.get("positions_finite")
+    key = ("partials_finite", order)
+    known = net.cache.get(key)
     if known is None:
-        h = net.ctrl
-        known = bool(np.isfinite(h).all() and np.abs(h).max() < 1e300
-                     and (not net.rational or h[..., 3].min() > 1e-290))
-        net.cache["positions_finite"] = known
+        known = net.cache[key] = _partials_bounded(net, order)
     return known
+
+
+def _partials_bounded(net: LocalNet, order: int) -> bool:
+    bound = partial_bounds(net, order)
+    return bool(bound is not None and np.all(bound < 1e290))
+
+
+def partial_bounds(net: LocalNet, order: int):
+    """``(K, K)`` upper bounds of the magnitudes of the Cartesian partials (see
+    :func:`partials_finite`), or None for a net with a non-finite pole or a weight at or
+    below ``1e-290``."""
+    h = net.ctrl
+    if not np.isfinite(h).all():
+        return None
+    w_min = float(h[..., 3].min()) if net.rational else 1.0
+    if not w_min > 1e-290:
+        return None
+    kk = order + 1
+    (ku, p), (kv, q) = (net.knots_u, net.p), (net.knots_v, net.q)
+
+    def steps(knots, degree):  # (2 p / d)^k for k = 0..order, d the shortest non-empty span
+        gaps = np.diff(knots)
+        rate = 2.0 * degree / gaps[gaps > 0].min()
+        return rate ** np.arange(kk, dtype=float)
+
+    with np.errstate(over="ignore", invalid="ignore"):
+        growth = np.outer(steps(ku, p), steps(kv, q)) * (p + 1) * (q + 1)
+        a_bound = growth * float(np.abs(h[..., :3]).max())
+        if not net.rational:
+            return a_bound
+        w_bound = growth * float(h[..., 3].max())
+        bound = np.zeros((kk, kk))
+        for k in range(kk):  # the quotient rule (A4.4) on magnitudes, entry by entry
+            for l in range(kk):
+                acc = a_bound[k, l]
+                for i in range(k + 1):
+                    for j in range(l + 1):
+                        if i or j:
+                            acc += comb(k, i) * comb(l, j) * w_bound[i, j] * bound[k - i, l - j]
+                bound[k, l] = acc / (0.5 * w_min)
+        # the weight partials are summed too: they must not overflow either
+        return np.where(w_bound < 1e290, bound, np.inf)
 
 
 #: scattered points per span pair from which the per-span patch table pays for itself
@@ -182,10 +228,10 @@ def _row_blocks(su, p, n, per_row):
 def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     """Cartesian mixed partials on the grid ``us x vs``: ``(len(us), len(vs), K, K, 3)``.
 
-    Positions (``order == 0``) are written point-major, into ``out (len(us), len(vs), 3)``
-    when given.  Partials are written planar (every partial and coordinate a contiguous
-    row of v) and returned as the transposed view, or, when ``out (len(us), len(vs), K,
-    K, 3)`` is given, point-major into it (the caller's array is filled and returned).
+    Everything is written point-major (C order), into ``out`` when given: ``(len(us),
+    len(vs), 3)`` for positions (``order == 0``), ``(len(us), len(vs), K, K, 3)`` for
+    partials.  The partials are formed on cache-resident planes (every partial and
+    coordinate a contiguous row of v) and each point's values are then stored together.
     """
     k = _kernels()
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
@@ -202,7 +248,7 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     else:
         binom = k.binomials(order)
         if out is None:
-            planar = np.empty((us.size, kk, kk, 3, vs.size))
+            out = np.empty((us.size, vs.size, kk, kk, 3))
     for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
         svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
         accb = acc if svb.size == acc.shape[-1] else np.empty(acc.shape[:-1] + (svb.size,))
@@ -211,10 +257,8 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             k.grid_rows(bvb, svb, q, ctrl, rows, dim, table)
             if order == 0:
                 k.grid_positions(bu[a0:a1], first, p, table, rational, accb, b0, out[a0:a1])
-            elif out is not None:
-                k.grid_derivatives_point_major(bu[a0:a1], first, p, table, rational, binom, accb, b0, out[a0:a1])
             else:
-                k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, accb, b0, planar[a0:a1])
+                k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, accb, b0, out[a0:a1])
     if order == 0:
         return out[:, :, None, None, :]
-    return out if out is not None else planar.transpose(0, 4, 1, 2, 3)
+    return out

@@ -236,8 +236,8 @@ class BSplineSurface(Surface):
             cached = self._local = local.prepare(ku, p, kv, q, self._h)
         return cached
 
-    def _finite_positions(self) -> bool:
-        return local.positions_finite(self._local_net())
+    def _finite_partials(self, order: int) -> bool:
+        return local.partials_finite(self._local_net(), order)
 
     def _derivatives(self, u, v, order):
         # local support: each point touches its (p+1) x (q+1) poles only (eval/local.py)
