@@ -3,10 +3,14 @@
 size of the control net (a 1000 x 1000 net costs what a 4 x 4 one does).
 
 Scattered pairs run one compiled loop over the points (span search, basis derivatives,
-local contraction, quotient rule).  Grids run in two stages: the net rows that the
-u-points need are contracted with the v-basis once (``W[i, l, :, b]``), then each u-point
-combines its p+1 rows with the v-points on the contiguous axis.  The u-points go in
-blocks so that the row table stays a few MiB whatever the grid or the net.
+local contraction, quotient rule); many positions on a small net of degree <= 3 use
+per-span Taylor patches instead (:mod:`surfmod.eval.patches`: a span search and a Horner
+scheme per point).  Grids run in two stages: the net rows that the u-points need are
+contracted with the v-basis once (``W[i, l, :, b]``), then each u-point combines its p+1
+rows with the v-points on the contiguous axis.  The u-points go in blocks so that the
+row table stays a few MiB whatever the grid or the net.  Results are written point-major,
+into a caller's array when given.  :func:`partials_finite` bounds the partials once per
+net, so callers need not rescan large outputs for NaN or infinity.
 
 The compiled kernels live in :mod:`surfmod.eval.kernels`, imported on first use (so
 ``import surfmod`` does not load numba).
