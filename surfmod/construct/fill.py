@@ -146,8 +146,10 @@ def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: f
     surface; false e.g. where two fillets of different directions meet).  If they do not,
     ``SurfmodError`` names the corner and the measured mismatch, unless
     ``allow_singular_corners``: then the fill still meets every side with ``continuity``
-    up to (not including) that corner point, where its derivatives have no limit.  The
-    per-corner measurements are in ``result.corners`` (``Corner`` records).
+    up to (not including) that corner point, where its derivatives have no limit.  A
+    corner next to a free-curve side is not matched (reported ``"none"``): the fill meets
+    the neighbour with ``continuity`` up to that corner.  The per-corner measurements are
+    in ``result.corners`` (``Corner`` records).
 
     >>> import numpy as np, surfmod as sm
     >>> hole = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
