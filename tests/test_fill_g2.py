@@ -207,3 +207,19 @@ def test_g1_fill_is_exact_at_compatible_corners_too():
         f = sm.fill(boundary, "G1")
         for patch, nb in pairs(f, boundary):
             assert sm.continuity(patch, nb, samples=SAMPLES).g1 < 1e-12
+
+
+def test_non_convex_hole_is_refused_at_its_reflex_corner():
+    pts = np.array([(0, 0, 0), (2, 0, 0), (2, 2, 0), (1, 0.8, 0), (0, 2, 0)], float)
+    sides = []
+    for k in range(5):
+        a, b = pts[k], pts[(k + 1) % 5]
+        out = np.array([b[1] - a[1], a[0] - b[0], 0.0])
+        sides.append((sm.plane(a, b, a + out / np.linalg.norm(out)), "v0"))
+    with pytest.raises(sm.SurfmodError, match=r"not convex at the boundary\[2\] / boundary\[3\] corner "
+                                              r"at \[1\.0, 0\.8, 0\.0\]"):
+        sm.fill(sides)
+    f = sm.fill(sides, allow_singular_corners=True)
+    assert [c.matched for c in f.corners] == ["G1", "G1", "none", "G1", "G1"]
+    for patch, nb in pairs(f, sides):
+        assert sm.continuity(patch, nb, samples=20).g0 < 1e-12

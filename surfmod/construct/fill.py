@@ -143,7 +143,8 @@ def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: f
     Corners: where two neighbour surfaces meet, the fill is made C1 (G1) or C2 (G2)
     through the corner point, which needs the neighbours to agree there: same normal
     for G1, and for G2 also the same curvature (true for a hole cut out of one smooth
-    surface; false e.g. where two fillets of different directions meet).  If they do not,
+    surface; false e.g. where two fillets of different directions meet), and the hole to
+    be convex there (interior angle below 180 degrees).  If they do not,
     ``SurfmodError`` names the corner and the measured mismatch, unless
     ``allow_singular_corners``: then the fill still meets every side with ``continuity``
     up to (not including) that corner point, where its derivatives have no limit.  A

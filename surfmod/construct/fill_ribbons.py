@@ -205,7 +205,12 @@ def _unit(x):
     return x / np.linalg.norm(x)
 
 
-def match_corners(ribbons, order: int, size: float, angle_tol: float = 1e-6, curvature_tol: float = 1e-6):
+ANGLE_TOL = 1e-6       # rad: neighbours' normals at a corner this close count as one tangent plane
+CURVATURE_TOL = 1e-6   # relative: curvatures this close count as equal (the G2 promise)
+
+
+def match_corners(ribbons, order: int, size: float, angle_tol: float = ANGLE_TOL,
+                  curvature_tol: float = CURVATURE_TOL):
     """Set the ribbons' end profiles so that neighbouring ribbons agree to ``order`` (1 or
     2) at every corner where two neighbour surfaces meet; returns a ``Corner`` per corner.
     A corner whose neighbours disagree beyond ``angle_tol`` (normals) keeps the default
@@ -270,6 +275,10 @@ def check_corners(corners, continuity: str, allow_singular: bool, labels):
             continue                      # a free-curve side: nothing to match
         a, b = labels[c.index], labels[(c.index + 1) % len(labels)]
         where = f"boundary[{a}] / boundary[{b}] corner at {np.round(c.point, 6).tolist()}"
+        if c.matched == "none" and c.angle <= ANGLE_TOL:
+            raise SurfmodError(f"boundary: the hole is not convex at the {where} (the next side leaves "
+                               "backwards over the neighbour); split it into convex holes (or pass "
+                               "allow_singular_corners=True to fill anyway, singular at that point)")
         if c.matched == "none":
             raise SurfmodError(f"boundary: the neighbours' tangent planes differ by {c.angle:.3g} rad at the "
                                f"{where}; a fill that is smooth at the corner cannot be {continuity} to both (pass "
