@@ -49,15 +49,16 @@ def pentagon_hole():
 
 def test_four_sided_fill_is_g1_along_every_side():
     boundary, removed = four_sided_hole()
-    f = sm.fill(boundary)
+    f = sm.fill(boundary, tolerance=1e-6)
     assert len(f) == 1 and f.n_sides == 4
+    assert [c.matched for c in f.corners] == ["G1"] * 4        # one smooth skin: C1 through the corners
     for nb, side in boundary:
         c = sm.continuity(nb, f[0], samples=41, occt=True)
         assert c.label.startswith(f"a.{side}")
         assert c.g0 < 1e-12
         assert c.angle[1:-1].max() < 1e-12          # exact along the side
-        assert c.g1 < 1e-6                          # corners: limit taken a hair inside
-        assert np.nanmax(c.occt[:, 1]) < 2e-3       # OCCT sees the bicubic twin (tolerance 1e-4)
+        assert c.g1 < 1e-12                         # the corner samples too
+        assert np.nanmax(c.occt[:, 1]) < 1e-3       # OCCT sees the bicubic twin (tolerance 1e-6)
     assert sm.crosscheck(f[0], samples=16).passed
     # a G0 fill of the same hole has a visible crease
     g0 = sm.fill(boundary, "G0")
@@ -139,12 +140,12 @@ def test_g2_fill_matches_the_neighbours_curvature_along_the_sides():
         c2 = sm.continuity(nb, g2[0], samples=31)
         scale = c2.g2 / c2.g2_relative
         assert c2.g0 < 1e-12 and c2.angle[1:-1].max() < 1e-12
-        # along the open side the 2-jets agree; the corner points are the scheme's singular points
-        assert (c2.jump[1:-1] / scale).max() < 1e-9
+        # the 2-jets agree along the side, corners included (one smooth skin: compatible corners)
+        assert (c2.jump / scale).max() < 1e-9
         c1 = sm.continuity(nb, g1[0], samples=31)
         assert (c1.jump[1:-1] / scale).max() > 1e-2          # the G1 fill does not
-    corner = corner_hole()
-    for patch in sm.fill(corner, "G2"):
+    corner = corner_hole()       # curvatures disagree at the corners: see test_fill_g2
+    for patch in sm.fill(corner, "G2", allow_singular_corners=True):
         for nb, _ in corner:
             try:
                 c = sm.continuity(patch, nb, samples=21)
