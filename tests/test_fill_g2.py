@@ -223,3 +223,27 @@ def test_non_convex_hole_is_refused_at_its_reflex_corner():
     assert [c.matched for c in f.corners] == ["G1", "G1", "none", "G1", "G1"]
     for patch, nb in pairs(f, sides):
         assert sm.continuity(patch, nb, samples=20).g0 < 1e-12
+
+
+def test_continuity_does_not_depend_on_argument_order():
+    """The side of a 3-sided fill's patch covers only half of its neighbour's side:
+    sm.continuity samples the shorter side whichever way round it is called, reports the
+    same gaps, angles and jumps, and signs both curvatures by the first argument's normal."""
+    boundary, _ = polygon_hole(3)
+    fill = sm.fill(boundary, continuity="G2")
+    for patch, nb in pairs(fill, boundary):
+        ab = sm.continuity(patch, nb, samples=20)
+        ba = sm.continuity(nb, patch, samples=20)
+        assert ba.label == f"a.{ab.label.split('b.')[1]} | b.{ab.label.split(' | ')[0][2:]}"
+        np.testing.assert_allclose(ba.points, ab.points, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(ba.params_a, ab.params_b, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(ba.params_b, ab.params_a, rtol=0, atol=1e-12)
+        # curvatures are signed by the first argument's normal: the fill's patches face
+        # the other way from their neighbours, so swapping the arguments flips the signs
+        n_patch = patch.normals(*ab.params_a.T)
+        n_nb = nb.normals(*ab.params_b.T)
+        sign = np.sign(np.einsum("ij,ij->i", n_patch, n_nb))
+        assert np.all(np.abs(np.einsum("ij,ij->i", n_patch, n_nb)) > 1 - 1e-12)
+        np.testing.assert_allclose(ba.curvature_a, sign * ab.curvature_b, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(ba.curvature_b, sign * ab.curvature_a, rtol=1e-9, atol=1e-12)
+        assert ba.g2_relative < 1e-9 and ba.g1 < 1e-12

@@ -405,10 +405,7 @@ def continuity(a, b=None, samples: int = 50, *, edge=None, occt: bool = False) -
     a = _as_surface(a, "a")
     b = _as_surface(b, "b")
     if edge is None:
-        try:
-            side_a, side_b, _ = match_sides(a, b)
-        except SurfmodError:
-            return _projected(a, b, samples, occt)
+        return _matched(a, b, samples, occt)
     else:
         try:
             side_a, side_b = edge
@@ -418,6 +415,29 @@ def continuity(a, b=None, samples: int = 50, *, edge=None, occt: bool = False) -
             if side not in SIDES:
                 raise SurfmodError(f"{name}: side must be one of u0, u1, v0, v1, got {side!r}")
     return _pair(a, b, side_a, side_b, samples, occt, f"a.{side_a} | b.{side_b}")
+
+
+def _matched(a: Surface, b: Surface, samples: int, occt: bool) -> Continuity:
+    """Continuity along the side pair found automatically.  The shorter side is the one
+    sampled: when a side of ``b`` covers only part of a side of ``a`` (a 3- or 5-sided
+    fill against its neighbour), the pair is measured from ``b`` and reported from ``a``'s
+    point of view, so the argument order does not matter."""
+    try:
+        side_a, side_b, _ = match_sides(a, b)
+        return _pair(a, b, side_a, side_b, samples, occt, f"a.{side_a} | b.{side_b}")
+    except SurfmodError:
+        pass
+    try:
+        side_b, side_a, _ = match_sides(b, a)
+    except SurfmodError:
+        return _projected(a, b, samples, occt)
+    r = _pair(b, a, side_b, side_a, samples, occt, "")
+    # r's curvatures are signed by b's normal; report them signed by a's, as _pair does
+    n_a = _unit(np.cross(*np.moveaxis(a.derivatives(*r.params_b.T, 1)[:, [1, 0], [0, 1]], 1, 0)))
+    n_b = _unit(np.cross(*np.moveaxis(b.derivatives(*r.params_a.T, 1)[:, [1, 0], [0, 1]], 1, 0)))
+    sign = np.where(np.einsum("ij,ij->i", n_a, n_b) < 0, -1.0, 1.0)
+    return Continuity(f"a.{side_a} | b.{side_b}", r.points, r.gap, r.angle, r.jump, sign * r.curvature_b,
+                      sign * r.curvature_a, r.params_b, r.params_a, r.occt)
 
 
 def _as_surface(obj, name: str) -> Surface:
