@@ -12,11 +12,15 @@ OCCT's own tool for the same job, both on one core, in one process.
 Each time is the best of ``REPEATS`` runs; "x" is surfmod / OCCT (target <= 2).  A job
 that raises shows its error class instead of a time.
 
-``python -m benchmarks real``
+``python -m benchmarks real``                        every job on every file
+``python -m benchmarks real --only check``           only the named jobs (comma-separated)
+``python -m benchmarks real --only check --files as1``  only files whose name contains a word
 """
 
 from __future__ import annotations
 
+import argparse
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -102,15 +106,30 @@ def _cell(ours, theirs) -> str:
     return f"{ours:8.3f} {theirs:6.3f} {ours / theirs:5.1f}x"
 
 
-def main() -> None:
+def _options(argv):
+    """``--only`` jobs and ``--files`` name filters from the command line (after
+    ``python -m benchmarks real``; other words are ignored)."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks real", add_help=False)
+    parser.add_argument("--only", default=",".join(JOBS), help="comma-separated jobs, e.g. check,mass")
+    parser.add_argument("--files", nargs="*", default=(), help="keep files whose name contains any of these")
+    opts, _ = parser.parse_known_args(argv)
+    jobs = tuple(j for j in JOBS if j in opts.only.split(","))
+    if not jobs:
+        raise SystemExit(f"--only: expected some of {', '.join(JOBS)}, got {opts.only!r}")
+    return jobs, tuple(opts.files)
+
+
+def main(argv=None) -> None:
     from surfmod.occ.mesh import shape_figures
 
+    jobs, words = _options(sys.argv[1:] if argv is None else argv)
     files = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
+    files = [p for p in files if not words or any(w in p.name for w in words)]
     if not files:
-        print(f"no corpus at {CORPUS}")
+        print(f"no corpus file at {CORPUS}" + (f" matching {' '.join(words)}" if words else ""))
         return
     print("seconds: surfmod, OCCT, ratio (surfmod / OCCT); mesh at 1e-3 of the bbox diagonal")
-    head = f"{'file':<44}" + "".join(f"{j:^23}" for j in JOBS)
+    head = f"{'file':<44}" + "".join(f"{j:^23}" for j in jobs)
     print(head)
     print("-" * len(head))
     with tempfile.TemporaryDirectory() as tmp:
@@ -123,7 +142,7 @@ def main() -> None:
             ours = _surfmod_jobs(path, part, 1e-3 * diag, centre, out)
             theirs = _occt_jobs(path, _occt_read(path), 1e-3 * diag, centre)
             row = f"{path.name[:43]:<44}"
-            for job in JOBS:
+            for job in jobs:
                 row += _cell(_best(ours[job]), _best(theirs[job])) + " "
             print(row, flush=True)
 

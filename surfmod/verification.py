@@ -16,6 +16,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import checks, tolerances
+from .errors import SurfmodError
 from .curve import Curve
 from .surface import Surface
 
@@ -98,16 +99,28 @@ def _short_span_points(s, uu, vv) -> np.ndarray:
     return out
 
 
-def crosscheck(obj, samples: int = 64, tolerance: float | None = None) -> CrossCheck:
+SAMPLINGS = ("dense", "sufficient")
+
+
+def crosscheck(obj, samples: int = 64, tolerance: float | None = None, *, sampling: str = "dense") -> CrossCheck:
     """Compare ``obj`` with OCCT; works on surfmod surfaces and curves, and on build123d /
     OCP faces (read back with :func:`surfmod.from_face`).
 
+    ``sampling="dense"`` compares a ``samples`` x ``samples`` grid plus every knot;
+    ``sampling="sufficient"`` (what ``surfmod check`` uses) compares, per direction, the
+    smaller of that grid and a set on which agreement with OCCT implies agreement
+    everywhere on the face (see :func:`sufficient_parameters`).
+
     >>> import surfmod as sm
     >>> r = sm.crosscheck(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), samples=8)
-    >>> r.mode, r.passed
-    ('parametric', True)
+    >>> r.mode, r.passed, r.samples
+    ('parametric', True, 64)
+    >>> sm.crosscheck(sm.CylindricalSurface(2.0, v_range=(0, 5)), samples=24, sampling="sufficient").samples
+    25
     """
     samples = checks.count(samples, "samples", minimum=2)
+    if sampling not in SAMPLINGS:
+        raise SurfmodError(f"sampling: expected one of {', '.join(SAMPLINGS)}, got {sampling!r}")
     if isinstance(obj, Curve):
         return _check_curve(obj, samples)
     if not isinstance(obj, Surface):
@@ -115,21 +128,83 @@ def crosscheck(obj, samples: int = 64, tolerance: float | None = None) -> CrossC
 
         obj = from_face(obj)
     if obj.exact_in_occt:
-        return _check_parametric(obj, samples)
+        return _check_parametric(obj, samples, sampling == "sufficient")
     return _check_geometric(obj, samples, tolerance)
 
 
-def _check_parametric(s: Surface, samples: int) -> CrossCheck:
-    from .occ.sample import surface_d0, surface_d2, surface_props
+#: parameter values per direction on an elementary surface: 5 values over the face's
+#: range give at least 4 distinct angles mod 2 pi (see :func:`sufficient_parameters`)
+ELEMENTARY_SAMPLES = 5
+
+
+def sufficient_parameters(s, direction: int, samples: int) -> np.ndarray:
+    """Parameters of one direction at which agreement with OCCT is enough to conclude
+    agreement over the whole face: the smaller of the dense set (``samples`` values plus
+    every knot) and
+
+    * on planes, cylinders, cones, spheres and tori, ``min(samples, 5)`` equally spaced
+      values.  Both evaluators are ``sum_k c_k phi_k(u, v)`` over a fixed tensor basis
+      (``{1, u} x {1, v}`` for planes; ``{1, cos u, sin u} x {1, v}`` for cylinders and
+      cones; ``{1, cos u, sin u} x {1, cos v, sin v}`` for spheres and tori) with
+      coefficients from the frame and radii, and so are their derivatives; a tensor grid
+      with three distinct angles mod 2 pi (or two distinct linear values) per direction is
+      unisolvent for these spaces, so equal values there mean equal functions.
+    * on B-spline and Bezier directions, ``p + 2`` values per knot span (span ends shared;
+      ``2p + 2`` if rational).  On a span both evaluators are polynomials of degree ``p``
+      (``N / w`` with ``N``, ``w`` of degree ``p`` if rational, and the difference of two
+      such quotients has a numerator of degree ``2p``): ``p + 1`` (``2p + 1``) values fix
+      them, and the ``p`` (``2p``) interior values alone fix the first and second
+      derivatives (degree ``p - 1``) where they jump at the knots.  Parameters a
+      tolerance beyond the knot range continue the end span and belong to it; a periodic
+      direction trimmed across its seam has the knots shifted by the period.
+
+    >>> import surfmod as sm
+    >>> sufficient_parameters(sm.AnalyticPlane((0, 0, 0), (0, 0, 1), u_range=(0, 1), v_range=(0, 1)), 0, 24).tolist()
+    [0.0, 0.25, 0.5, 0.75, 1.0]
+    >>> s = sm.BSplineSurface(np.random.default_rng(0).uniform(size=(4, 4, 3)), (3, 3))
+    >>> sufficient_parameters(s, 0, 24).tolist()   # one bicubic span: 5 values
+    [0.0, 0.25, 0.5, 0.75, 1.0]
+    """
+    from .construct.elementary import ElementarySurface
+    from .readback.trimmed import TrimmedFace
+
+    lo, hi = s.domain[direction]
+    dense = sample_parameters(lo, hi, samples, _knots_in(s, direction))
+    surface = s.surface if isinstance(s, TrimmedFace) else s
+    if isinstance(surface, ElementarySurface):
+        few = np.linspace(lo, hi, min(samples, ELEMENTARY_SAMPLES))
+        return few if few.size < dense.size else dense
+    knots = getattr(surface, "knots", None)
+    if not isinstance(knots, tuple) or hi <= lo:
+        return dense
+    p = int(surface.degree[direction])
+    per_span = 2 * p + 2 if getattr(surface, "weights", None) is not None else p + 2
+    breaks = np.unique(np.asarray(knots[direction], dtype=float))
+    period = s.periods[direction] if isinstance(s, TrimmedFace) else None
+    if period:
+        breaks = np.concatenate([breaks + k * period for k in (-2, -1, 0, 1, 2)])
+    inner = breaks[(breaks > lo) & (breaks < hi)]
+    ends = np.unique(np.concatenate([[lo], inner, [hi]]))
+    if (ends.size - 1) * (per_span - 1) + 1 >= dense.size:
+        return dense
+    t = np.linspace(0.0, 1.0, per_span)[:-1]
+    few = (ends[:-1, None] + np.diff(ends)[:, None] * t).ravel()
+    return np.concatenate([few, [hi]])
+
+
+def _check_parametric(s: Surface, samples: int, sufficient: bool = False) -> CrossCheck:
+    from .occ.sample import surface_props_fast, surface_values_d2
 
     (u0, u1), (v0, v1) = s.domain
-    us = sample_parameters(u0, u1, samples, _knots_in(s, 0))
-    vs = sample_parameters(v0, v1, samples, _knots_in(s, 1))
+    if sufficient:
+        us, vs = sufficient_parameters(s, 0, samples), sufficient_parameters(s, 1, samples)
+    else:
+        us = sample_parameters(u0, u1, samples, _knots_in(s, 0))
+        vs = sample_parameters(v0, v1, samples, _knots_in(s, 1))
     uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
     mine = s._derivatives(uu, vv, 2)
     geom = s.geom()
-    occ = surface_d2(geom, uu, vv)
-    occ[:, 0, 0] = surface_d0(geom, uu, vv)  # Value is exact even where D2 loses digits
+    occ = surface_values_d2(geom, uu, vv)  # positions from Value: exact even where D2 loses digits
     d_tol = tolerances.occt_derivative_rtol(max(getattr(s, "degree", (0, 0))))
 
     # at knots where a derivative jumps it is two-valued; compare it only where smooth
@@ -156,7 +231,7 @@ def _check_parametric(s: Surface, samples: int) -> CrossCheck:
 
     # normals and curvature where both sides call them defined (off degenerate points)
     sub = slice(None, None, max(1, len(uu) // 1024))  # GeomLProp is slow; a dense subset
-    n_occ, k_occ = surface_props(geom, uu[sub], vv[sub])
+    n_occ, k_occ = surface_props_fast(geom, uu[sub], vv[sub])
     n_mine = s.normals(uu[sub], vv[sub])
     # at degenerate points (poles, collapsed edges) OCCT's CSLib normal ignores the side the
     # limit is taken from and may be reversed; surfmod's is the limit from inside
