@@ -169,11 +169,10 @@ def sufficient_parameters(s, direction: int, samples: int) -> np.ndarray:
     from .readback.trimmed import TrimmedFace
 
     lo, hi = s.domain[direction]
-    dense = sample_parameters(lo, hi, samples, _knots_in(s, direction))
     surface = s.surface if isinstance(s, TrimmedFace) else s
-    if isinstance(surface, ElementarySurface):
-        few = np.linspace(lo, hi, min(samples, ELEMENTARY_SAMPLES))
-        return few if few.size < dense.size else dense
+    if isinstance(surface, ElementarySurface) and samples > ELEMENTARY_SAMPLES and hi > lo:
+        return np.linspace(lo, hi, ELEMENTARY_SAMPLES)  # no knots: the dense set is larger
+    dense = sample_parameters(lo, hi, samples, _knots_in(s, direction))
     knots = getattr(surface, "knots", None)
     if not isinstance(knots, tuple) or hi <= lo:
         return dense
