@@ -226,9 +226,18 @@ def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense") -> list
             where.append(i)
         except SurfmodError as exc:
             out[i] = exc
-    for i, result in zip(where, _judge_parametric(batch)):
-        out[i] = result
+        if len(batch) == BATCH_FACES:
+            for j, result in zip(where, _judge_parametric(batch)):
+                out[j] = result
+            batch, where = [], []
+    for j, result in zip(where, _judge_parametric(batch)):
+        out[j] = result
     return out
+
+
+#: faces compared in one vectorized pass: enough to pay NumPy's fixed costs once per
+#: many faces, few enough to bound the memory of a part with thousands of faces
+BATCH_FACES = 256
 
 
 def _check_parametric(s: Surface, samples: int, sufficient: bool = False) -> CrossCheck:

@@ -128,9 +128,20 @@ def test_a_batch_gives_each_face_its_own_figures(rng):
 
 
 def test_a_batch_returns_the_error_of_an_unreadable_object():
-    out = crosscheck_many([sm.sphere(1.0), "not a face"], 4)
-    assert out[0].passed
+    out = crosscheck_many([sm.sphere(1.0), "not a face", sm.BSplineCurve(np.eye(3), 2)], 4)
+    assert out[0].passed and out[2].passed
     assert isinstance(out[1], sm.SurfmodError) and "face" in str(out[1])
+
+
+def test_batches_are_bounded(monkeypatch):
+    """More faces than one batch holds: every face is judged, in pieces."""
+    import surfmod.verification as v
+
+    monkeypatch.setattr(v, "BATCH_FACES", 2)
+    objs = [sm.sphere(1.0 + i) for i in range(5)] + [_WideCylinder(100.0, v_range=(0, 5))]
+    out = crosscheck_many(objs, 6, sampling="sufficient")
+    assert [r.passed for r in out] == [True] * 5 + [False]
+    assert [r.max_deviation for r in out] == [sm.crosscheck(o, 6, sampling="sufficient").max_deviation for o in objs]
 
 
 def test_sampling_must_be_named():
