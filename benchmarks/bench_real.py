@@ -9,14 +9,19 @@ OCCT's own tool for the same job, both on one core, in one process.
 | mass | ``sm.mass_properties`` | ``BRepGProp.VolumeProperties_s`` at eps 1e-9 |
 | section | ``sm.section`` through the bbox centre, normal z | ``BRepAlgoAPI_Section`` with that plane |
 
-Each time is the best of ``REPEATS`` runs; "x" is surfmod / OCCT (target <= 2).  A job
+Each time is the best of ``REPEATS`` runs (ours and OCCT's alternating); "x" is surfmod / OCCT (target <= 2).  A job
 that raises shows its error class instead of a time.
 
-``python -m benchmarks real``
+``python -m benchmarks real``                        every job on every file
+``python -m benchmarks real --only check``           only the named jobs (comma-separated)
+``python -m benchmarks real --only check --files as1``  only files whose name contains a word
+``python -m benchmarks real --repeats 5``            best of 5 runs (on a loaded machine)
 """
 
 from __future__ import annotations
 
+import argparse
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -31,15 +36,25 @@ REPEATS = 2
 
 def _best(fn, repeats: int = REPEATS):
     """Best wall time of ``fn()`` over ``repeats`` runs, or the exception's class name."""
-    best = np.inf
+    return _best_pair(fn, None, repeats)[0]
+
+
+def _best_pair(ours, theirs, repeats: int = REPEATS):
+    """Best wall times of two jobs run alternately (so both see the same machine load);
+    a job that raises gives its exception's class name."""
+    best = [np.inf, np.inf]
     for _ in range(repeats):
-        t = time.perf_counter()
-        try:
-            fn()
-        except Exception as exc:  # a failing job is a row entry, not the end of the table
-            return type(exc).__name__
-        best = min(best, time.perf_counter() - t)
-    return best
+        for k, fn in enumerate((ours, theirs)):
+            if fn is None or isinstance(best[k], str):
+                continue
+            t = time.perf_counter()
+            try:
+                fn()
+            except Exception as exc:  # a failing job is a row entry, not the end of the table
+                best[k] = type(exc).__name__
+                continue
+            best[k] = min(best[k], time.perf_counter() - t)
+    return tuple(best)
 
 
 def _occt_read(path):
@@ -102,15 +117,33 @@ def _cell(ours, theirs) -> str:
     return f"{ours:8.3f} {theirs:6.3f} {ours / theirs:5.1f}x"
 
 
-def main() -> None:
+def _options(argv):
+    """``--only`` jobs and ``--files`` name filters from the command line (after
+    ``python -m benchmarks real``; other words are ignored)."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks real", add_help=False)
+    parser.add_argument("--only", default=",".join(JOBS), help="comma-separated jobs, e.g. check,mass")
+    parser.add_argument("--files", nargs="*", default=(), help="keep files whose name contains any of these")
+    parser.add_argument("--repeats", type=int, default=REPEATS, help=f"best of this many runs (default {REPEATS})")
+    opts, _ = parser.parse_known_args(argv)
+    jobs = tuple(j for j in JOBS if j in opts.only.split(","))
+    if not jobs:
+        raise SystemExit(f"--only: expected some of {', '.join(JOBS)}, got {opts.only!r}")
+    if opts.repeats < 1:
+        raise SystemExit(f"--repeats: expected a positive count, got {opts.repeats}")
+    return jobs, tuple(opts.files), opts.repeats
+
+
+def main(argv=None) -> None:
     from surfmod.occ.mesh import shape_figures
 
+    jobs, words, repeats = _options(sys.argv[1:] if argv is None else argv)
     files = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
+    files = [p for p in files if not words or any(w in p.name for w in words)]
     if not files:
-        print(f"no corpus at {CORPUS}")
+        print(f"no corpus file at {CORPUS}" + (f" matching {' '.join(words)}" if words else ""))
         return
     print("seconds: surfmod, OCCT, ratio (surfmod / OCCT); mesh at 1e-3 of the bbox diagonal")
-    head = f"{'file':<44}" + "".join(f"{j:^23}" for j in JOBS)
+    head = f"{'file':<44}" + "".join(f"{j:^23}" for j in jobs)
     print(head)
     print("-" * len(head))
     with tempfile.TemporaryDirectory() as tmp:
@@ -123,8 +156,8 @@ def main() -> None:
             ours = _surfmod_jobs(path, part, 1e-3 * diag, centre, out)
             theirs = _occt_jobs(path, _occt_read(path), 1e-3 * diag, centre)
             row = f"{path.name[:43]:<44}"
-            for job in JOBS:
-                row += _cell(_best(ours[job]), _best(theirs[job])) + " "
+            for job in jobs:
+                row += _cell(*_best_pair(ours[job], theirs[job], repeats)) + " "
             print(row, flush=True)
 
 

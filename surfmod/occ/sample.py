@@ -81,3 +81,47 @@ def distances_to_surface(surf, points: np.ndarray, bounds) -> np.ndarray:
             proj.Init(gp_Pnt(*map(float, q)), surf, u0, u1, v0, v1)
             out[a] = proj.LowerDistance() if proj.NbPoints() > 0 else np.nan
     return out
+
+
+def surface_values_d2(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """:func:`surface_d2` with positions from ``Value`` (exact even where ``D2`` loses
+    digits), in one loop with as little Python per point as OCP allows: coordinates are
+    collected as tuples (``Coord``) and converted to one array at the end.  Same numbers
+    as ``surface_d2`` + ``surface_d0``, about four times faster."""
+    n = len(u)
+    flat: list = []
+    add = flat.extend
+    p = gp_Pnt()
+    d1u, d1v, d2u, d2v, d2uv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
+    d2, value = surf.D2, surf.Value
+    with kernel("Geom_Surface.D2"):
+        for uu, vv in zip(np.asarray(u, dtype=float).tolist(), np.asarray(v, dtype=float).tolist()):
+            d2(uu, vv, p, d1u, d1v, d2u, d2v, d2uv)
+            add(value(uu, vv).Coord())
+            add(d1u.Coord())
+            add(d1v.Coord())
+            add(d2u.Coord())
+            add(d2v.Coord())
+            add(d2uv.Coord())
+    rows = np.array(flat, dtype=float).reshape(n, 6, 3)
+    out = np.full((n, 3, 3, 3), np.nan)
+    out[:, 0, 0], out[:, 1, 0], out[:, 0, 1] = rows[:, 0], rows[:, 1], rows[:, 2]
+    out[:, 2, 0], out[:, 0, 2], out[:, 1, 1] = rows[:, 3], rows[:, 4], rows[:, 5]
+    return out
+
+
+def surface_props_fast(surf, u: np.ndarray, v: np.ndarray, resolution: float = 1e-9):
+    """:func:`surface_props` (same numbers) with tuples collected per point and one array
+    conversion at the end."""
+    nan3, nan4 = (np.nan,) * 3, (np.nan,) * 4
+    normals: list = []
+    curv: list = []
+    with kernel("GeomLProp_SLProps"):
+        props = GeomLProp_SLProps(surf, 2, resolution)
+        set_params, normal_ok, curv_ok = props.SetParameters, props.IsNormalDefined, props.IsCurvatureDefined
+        for uu, vv in zip(np.asarray(u, dtype=float).tolist(), np.asarray(v, dtype=float).tolist()):
+            set_params(uu, vv)
+            normals.append(props.Normal().Coord() if normal_ok() else nan3)
+            curv.append((props.GaussianCurvature(), props.MeanCurvature(), props.MaxCurvature(), props.MinCurvature())
+                        if curv_ok() else nan4)
+    return np.array(normals, dtype=float).reshape(-1, 3), np.array(curv, dtype=float).reshape(-1, 4)
