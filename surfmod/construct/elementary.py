@@ -25,67 +25,18 @@ import numpy as np
 
 from .. import checks, transforms
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineSurface
 from ..surface import Surface
+from .conics import Arc
+from .curves import Line
+from .frames import cos_d, frame_transformed, make_frame, sin_d
+from .revolution import revolve_nurbs
 
 TWO_PI = 2.0 * math.pi
 
 
-# -- frames ----------------------------------------------------------------------------------
-def default_x_dir(normal) -> np.ndarray:
-    """The X direction OCCT's ``gp_Ax2(P, N)`` chooses for the main direction ``N``.
-
-    >>> default_x_dir((0, 0, 1))
-    array([1., 0., 0.])
-    """
-    a, b, c = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
-    aa, ab, ac = abs(a), abs(b), abs(c)
-    if ab <= aa and ab <= ac:
-        d = (-c, 0.0, a) if aa > ac else (c, 0.0, -a)
-    elif aa <= ab and aa <= ac:
-        d = (0.0, -c, b) if ab > ac else (0.0, c, -b)
-    else:
-        d = (-b, a, 0.0) if aa > ab else (b, -a, 0.0)
-    d = np.array(d, dtype=float) + 0.0
-    return d / np.linalg.norm(d)
-
-
-def make_frame(origin, axis, x_dir=None, *, origin_name="center", axis_name="axis", x_name="x_dir"):
-    """A direct orthonormal frame ``(o, x, y, z)`` from an origin, a main direction and an
-    optional X direction (default: OCCT's ``gp_Ax2`` rule); ``x_dir`` must not be parallel
-    to the axis (its component along the axis is removed)."""
-    o = checks.point(origin, origin_name)
-    z = checks.direction(axis, axis_name)
-    if x_dir is None:
-        x = default_x_dir(z)
-    else:
-        x = checks.direction(x_dir, x_name)
-        x = x - np.dot(x, z) * z
-        if np.linalg.norm(x) < 1e-9:
-            raise SurfmodError(f"{x_name}: parallel to {axis_name}, cannot define the X direction")
-        x /= np.linalg.norm(x)
-    return o, x, np.cross(z, x), z
-
-
-def frame_transformed(frame, matrix):
-    """``(frame', s)``: the frame moved by a similarity matrix and its scale ``|s|``."""
-    o, x, y, z = frame
-    lin = matrix[:3, :3]
-    s = float(abs(np.linalg.det(lin)) ** (1.0 / 3.0))
-    return (transforms.apply(matrix, o), lin @ x / s, lin @ y / s, lin @ z / s), s
-
-
 def _range(value, name, default):
     return default if value is None else checks.interval(value, name)
-
-
-def cos_d(t, k):
-    """k-th derivative of cos at t."""
-    return np.cos(t + k * math.pi / 2.0)
-
-
-def sin_d(t, k):
-    """k-th derivative of sin at t."""
-    return np.sin(t + k * math.pi / 2.0)
 
 
 # -- base ----------------------------------------------------------------------------------------
@@ -202,8 +153,6 @@ class AnalyticPlane(ElementarySurface):
 
     def to_nurbs(self):
         """The same plane as a degree-1 B-spline with the same parametrization."""
-        from ..nets.bspline import BSplineSurface
-
         (u0, u1), (v0, v1) = self._domain
         net = np.array([[self.points(u0, v0), self.points(u0, v1)], [self.points(u1, v0), self.points(u1, v1)]])
         return BSplineSurface._trusted(net, (1, 1), (np.array([u0, u0, u1, u1]), np.array([v0, v0, v1, v1])))
@@ -255,9 +204,6 @@ class CylindricalSurface(ElementarySurface):
 
     def to_nurbs(self):
         """Exact rational B-spline (a revolved line)."""
-        from .revolution import revolve_nurbs
-        from .curves import Line
-
         (u0, u1), (v0, v1) = self._domain
         line = Line.through(self.origin + self.radius * self.x_dir, self.z_dir, (v0, v1))
         return revolve_nurbs(line.to_bspline(), self.origin, self._spin_axis, (u0, u1))
@@ -324,9 +270,6 @@ class ConicalSurface(ElementarySurface):
 
     def to_nurbs(self):
         """Exact rational B-spline (a revolved line)."""
-        from .curves import Line
-        from .revolution import revolve_nurbs
-
         (u0, u1), (v0, v1) = self._domain
         sa, ca = math.sin(self.semi_angle), math.cos(self.semi_angle)
         line = Line.through(self.origin + self.radius * self.x_dir, sa * self.x_dir + ca * self.z_dir, (v0, v1))
@@ -389,9 +332,6 @@ class SphericalSurface(ElementarySurface):
 
     def to_nurbs(self):
         """Exact rational B-spline (degree 2 x 2): a revolved circular arc."""
-        from .conics import Arc
-        from .revolution import revolve_nurbs
-
         (u0, u1), (v0, v1) = self._domain
         arc = Arc._from_radians(self.origin, np.cross(self.x_dir, self.z_dir), self.x_dir, self.radius, self.radius, (v0, v1))
         return revolve_nurbs(arc.to_bspline(), self.origin, self._spin_axis, (u0, u1))
@@ -452,9 +392,6 @@ class ToroidalSurface(ElementarySurface):
 
     def to_nurbs(self):
         """Exact rational B-spline (degree 2 x 2): a revolved circle."""
-        from .conics import Arc
-        from .revolution import revolve_nurbs
-
         (u0, u1), (v0, v1) = self._domain
         center = self.origin + self.major * self.x_dir
         arc = Arc._from_radians(center, np.cross(self.x_dir, self.z_dir), self.x_dir, self.minor, self.minor, (v0, v1))

@@ -16,10 +16,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import checks
+from ..construct.plane import PlaneSurface
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve
+from ..readback.clip import as_face_surface, clip_curves
 from ..surface import Surface
 from . import marching
-from .project import nearest_samples, seed_parameters
+from .project import closest_points, nearest_samples, seed_parameters
 
 # -- problems -------------------------------------------------------------------------------
 
@@ -119,8 +122,6 @@ class IntersectionCurve:
 
     def polyline(self):
         """The points as a degree-1 ``BSplineCurve`` (chord-length knots)."""
-        from ..nets.bspline import BSplineCurve
-
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(self.points, axis=0), axis=1))])
         chord = chord / chord[-1]
         return BSplineCurve._trusted(self.points, 1, np.concatenate([[0.0], chord, [1.0]]))
@@ -234,8 +235,6 @@ def plane_frame(origin, normal):
 def as_plane(value, name: str):
     """``(origin, unit normal)`` from ``(origin, normal)``, a build123d ``Plane`` or a
     surfmod ``PlaneSurface`` (its infinite carrier plane)."""
-    from ..construct.plane import PlaneSurface
-
     if isinstance(value, PlaneSurface):
         return np.array(value.origin), np.array(value.normal)
     if hasattr(value, "z_dir") and hasattr(value, "origin"):  # build123d Plane
@@ -288,8 +287,6 @@ def _near_samples_of(s: Surface, tol: float):
 
 
 def _refuse_coincident(a, b, plane, tol: float, names) -> None:
-    from .project import closest_points
-
     if plane is not None:
         o, n = plane
         hit = _coincide_over_region(a, lambda p: np.abs((p - o) @ n), tol)
@@ -329,8 +326,6 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     >>> sm.intersect(s, ((0, 0, 5), (0, 0, 1)))
     []
     """
-    from ..readback.clip import as_face_surface, clip_curves
-
     tol = checks.positive(tolerance, "tolerance")
     angle = checks.real(max_angle, "max_angle", low=1e-3, high=90.0)
     # faces (build123d / OCP / read back) are trimmed surfaces: curves end at their boundary

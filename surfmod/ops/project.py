@@ -18,8 +18,11 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import checks
+from ..curve import Curve
 from ..errors import SurfmodError
-from ..surface import Surface
+from ..readback.clip import as_face_surface, project_on_face
+from ..readback.trimmed import TrimmedFace
+from ..surface import Surface, require_surface
 
 
 class Projection(NamedTuple):
@@ -273,8 +276,6 @@ def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
 
 
 def _as_points(points_or_curve, samples):
-    from ..curve import Curve
-
     if isinstance(points_or_curve, Curve):
         t0, t1 = points_or_curve.domain
         return points_or_curve.points(np.linspace(t0, t1, samples))
@@ -314,10 +315,7 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8,
     >>> pr.u, pr.v, pr.distance
     (array([0.25, 1.  ]), array([0.5, 0.5]), array([2., 2.]))
     """
-    from ..readback.clip import as_face_surface, project_on_face
-    from ..readback.trimmed import TrimmedFace
-
-    s = checks.surface(as_face_surface(s), "s")  # a face is a trimmed surface: distances are to the face
+    s = require_surface(as_face_surface(s), "s")  # a face is a trimmed surface: distances are to the face
     samples = checks.count(samples, "samples", minimum=2, maximum=checks.MAX_POINTS)
     seeds = checks.count(seeds, "seeds", minimum=1, maximum=64)
     pts = _as_points(points_or_curve, samples)

@@ -222,9 +222,9 @@ def shadow(obj: Surface, light_direction, plane, *, max_angle: float = 2.5) -> S
     left = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1, keepdims=True)
     eps = 1e-3 * size2
     cov = _covered(obj, to2d, np.concatenate([mid + eps * left, mid - eps * left]), 1e-6 * eps)
-    cl, cr = cov[: len(mid)], cov[len(mid) :]
-    keep = cl ^ cr
-    oriented = np.where(cr[keep][:, None, None], pieces[keep][:, ::-1], pieces[keep])
+    covered_left, covered_right = cov[: len(mid)], cov[len(mid) :]
+    keep = covered_left ^ covered_right  # a shadow edge has shadow on exactly one side
+    oriented = np.where(covered_right[keep][:, None, None], pieces[keep][:, ::-1], pieces[keep])
     loops2 = _chain(oriented, size2)
     chained = sum(float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))) for p in loops2)
     kept = float(np.sum(np.linalg.norm(oriented[:, 1] - oriented[:, 0], axis=1)))
