@@ -270,7 +270,8 @@ def needless_lazy_imports(path: Path, package_root: Path = PACKAGE.parent, heavy
     """The function-level imports of ``path`` that have no reason to be lazy (see LAZY)."""
     heavy = heavy_modules(package_root) if heavy is None else heavy
     if path.relative_to(package_root).parts[:2] != ("surfmod", "occ"):
-        heavy = heavy | {m for m in module_level_graph(package_root) if m.startswith("surfmod.occ")}
+        occ = package_root / "surfmod" / "occ"
+        heavy = heavy | {_module_name_under(p, package_root) for p in occ.rglob("*.py")}
     lines = path.read_text().splitlines()
     needless = []
     for node, modules in function_level_imports(path, package_root):
