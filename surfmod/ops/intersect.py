@@ -22,7 +22,7 @@ from ..nets.bspline import BSplineCurve
 from ..readback.clip import as_face_surface, clip_curves
 from ..surface import Surface
 from . import marching
-from .project import closest_points, nearest_samples, seed_parameters
+from .closest import closest_points, nearest_samples, seed_parameters
 
 # -- problems -------------------------------------------------------------------------------
 

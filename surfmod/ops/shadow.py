@@ -23,7 +23,7 @@ from ..errors import SurfmodError
 from ..surface import Surface
 from . import marching
 from .intersect import _Base, _implicit_seeds, _size, as_plane, plane_frame
-from .project import nearest_samples, seed_parameters
+from .closest import nearest_samples, seed_parameters
 
 
 class Silhouette(_Base):
