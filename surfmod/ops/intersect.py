@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import checks
-from ..construct.plane import PlaneSurface
+from ..construct.elementary import PlaneSurface
+from ..construct.plane import ThreePointPlane
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
 from ..readback.clip import as_face_surface, clip_curves
@@ -234,15 +235,15 @@ def plane_frame(origin, normal):
 
 def as_plane(value, name: str):
     """``(origin, unit normal)`` from ``(origin, normal)``, a build123d ``Plane`` or a
-    surfmod ``PlaneSurface`` (its infinite carrier plane)."""
-    if isinstance(value, PlaneSurface):
+    surfmod plane surface (``PlaneSurface`` or ``ThreePointPlane``: its infinite carrier plane)."""
+    if isinstance(value, (PlaneSurface, ThreePointPlane)):
         return np.array(value.origin), np.array(value.normal)
     if hasattr(value, "z_dir") and hasattr(value, "origin"):  # build123d Plane
         return checks.point(tuple(value.origin), f"{name}.origin"), checks.direction(tuple(value.z_dir), f"{name}.z_dir")
     try:
         origin, normal = value
     except (TypeError, ValueError):
-        raise SurfmodError(f"{name}: expected a plane as (origin, normal), a build123d Plane or a PlaneSurface, got {value!r}") from None
+        raise SurfmodError(f"{name}: expected a plane as (origin, normal), a build123d Plane or a plane surface, got {value!r}") from None
     return checks.point(origin, f"{name} origin"), checks.direction(normal, f"{name} normal")
 
 
@@ -305,8 +306,8 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
               max_points: int = 1_000_000, progress: bool = False) -> list[IntersectionCurve]:
     """Intersection curves of two surfaces, or of a surface and an infinite plane.
 
-    ``b`` (or ``a``) may be a surfmod surface (a bounded patch, a ``PlaneSurface``
-    included) or an infinite plane given as ``(origin, normal)`` / a build123d ``Plane``.
+    ``b`` (or ``a``) may be a surfmod surface (a bounded patch, a ``PlaneSurface`` or
+    ``ThreePointPlane`` included) or an infinite plane given as ``(origin, normal)`` / a build123d ``Plane``.
     A build123d / OCP face, or a face read back with :func:`surfmod.from_face`, is a
     trimmed surface: the curves are clipped to its boundary.
     Every returned point lies on both within ``tolerance`` (Newton converges to ~1e-12

@@ -183,7 +183,7 @@ def _chain(pieces, size, gap: float = 2e-3):
 
 def shadow(obj: Surface, light_direction, plane, *, max_angle: float = 2.5) -> Shadow:
     """The shadow of ``obj`` cast by parallel light along ``light_direction`` onto
-    ``plane`` (``(origin, normal)``, a build123d ``Plane`` or a ``PlaneSurface``'s carrier).
+    ``plane`` (``(origin, normal)``, a build123d ``Plane`` or the carrier of a ``PlaneSurface`` / ``ThreePointPlane``).
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 1), (2, 0, 1), (0, 1, 1))
