@@ -32,7 +32,12 @@ def default_x_dir(normal) -> np.ndarray:
 def make_frame(origin, axis, x_dir=None, *, origin_name="center", axis_name="axis", x_name="x_dir"):
     """A direct orthonormal frame ``(o, x, y, z)`` from an origin, a main direction and an
     optional X direction (default: OCCT's ``gp_Ax2`` rule); ``x_dir`` must not be parallel
-    to the axis (its component along the axis is removed)."""
+    to the axis (its component along the axis is removed).
+
+    >>> o, x, y, z = make_frame((1, 2, 3), (0, 0, 2), (1, 0, 1))
+    >>> x, y, z
+    (array([1., 0., 0.]), array([0., 1., 0.]), array([0., 0., 1.]))
+    """
     o = checks.point(origin, origin_name)
     z = checks.direction(axis, axis_name)
     if x_dir is None:
@@ -47,7 +52,13 @@ def make_frame(origin, axis, x_dir=None, *, origin_name="center", axis_name="axi
 
 
 def frame_transformed(frame, matrix):
-    """``(frame', s)``: the frame moved by a similarity matrix and its scale ``|s|``."""
+    """``(frame', s)``: the frame moved by a similarity matrix and its scale ``|s|``.
+
+    >>> frame = make_frame((0, 0, 0), (0, 0, 1))
+    >>> (o, x, y, z), s = frame_transformed(frame, np.diag([2.0, 2.0, 2.0, 1.0]))
+    >>> round(s, 12), z
+    (2.0, array([0., 0., 1.]))
+    """
     o, x, y, z = frame
     lin = matrix[:3, :3]
     s = float(abs(np.linalg.det(lin)) ** (1.0 / 3.0))
@@ -55,10 +66,18 @@ def frame_transformed(frame, matrix):
 
 
 def cos_d(t, k):
-    """k-th derivative of cos at t."""
+    """k-th derivative of cos at t.
+
+    >>> float(cos_d(0.0, 2))
+    -1.0
+    """
     return np.cos(t + k * math.pi / 2.0)
 
 
 def sin_d(t, k):
-    """k-th derivative of sin at t."""
+    """k-th derivative of sin at t.
+
+    >>> float(sin_d(0.0, 1))
+    1.0
+    """
     return np.sin(t + k * math.pi / 2.0)

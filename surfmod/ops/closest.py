@@ -233,7 +233,13 @@ def seed_starts(points, us, vs, g, seeds: int) -> np.ndarray:
 
 
 def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
-    """``(u, v, point, distance)`` flat arrays for ``(N, 3)`` points (trusted input)."""
+    """``(u, v, point, distance)`` flat arrays for ``(N, 3)`` points (trusted input).
+
+    >>> import surfmod as sm
+    >>> u, v, p, d = closest_points(sm.plane((0, 0, 0), (2, 0, 0), (0, 1, 0)), np.array([[1.0, 0.5, 3.0]]))
+    >>> u, v, d
+    (array([0.5]), array([0.5]), array([3.]))
+    """
     us, vs, g = seed_grid(s)
     start = seed_starts(points, us, vs, g, seeds)
     k = start.shape[1]
