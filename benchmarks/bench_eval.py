@@ -176,10 +176,10 @@ def numpy_paths(grid, u, v) -> dict:
     for n in (20, 400):
         s = nurbs(n)
         (p, q), (ku, kv) = s.degree, s.knots
-        res[f"grid{n}"] = _time(lambda: rational_grid_positions(ku, p, kv, q, s._h, grid, grid), True, 2)
+        res[f"grid{n}"] = _time(lambda: rational_grid_positions(ku, p, kv, q, s._homogeneous, grid, grid), True, 2)
     s = nurbs(20)
     (p, q), (ku, kv) = s.degree, s.knots
-    res["scattered"] = _time(lambda: surface_quotient(surface_derivatives(ku, p, kv, q, s._h, u, v, 0)), True, 1)
+    res["scattered"] = _time(lambda: surface_quotient(surface_derivatives(ku, p, kv, q, s._homogeneous, u, v, 0)), True, 1)
     return res
 
 

@@ -20,10 +20,10 @@ patch = sm.BSplineSurface(np.stack([x, y, z], -1), (3, 2), None, w)
 
 uu, vv = (a.ravel() for a in np.meshgrid(np.linspace(0, 1, 9), np.linspace(0, 1, 9), indexing="ij"))
 cases = {
-    "translated": (patch.translated((50, 0, 0)), occ.trsf("translation", (50, 0, 0))),
-    "rotated": (patch.rotated((0, 0, 0), (0, 0, 1), 30), occ.trsf("rotation", (0, 0, 0), (0, 0, 1), 30)),
-    "mirrored": (patch.mirrored((0, 0, 0), (0, 1, 0)), occ.trsf("mirror", (0, 0, 0), (0, 1, 0))),
-    "scaled": (patch.scaled(0.5, (20, 15, 0)), occ.trsf("scale", (20, 15, 0), 0.5)),
+    "translated": (patch.translated((50, 0, 0)), occ.named_trsf("translation", (50, 0, 0))),
+    "rotated": (patch.rotated((0, 0, 0), (0, 0, 1), 30), occ.named_trsf("rotation", (0, 0, 0), (0, 0, 1), 30)),
+    "mirrored": (patch.mirrored((0, 0, 0), (0, 1, 0)), occ.named_trsf("mirror", (0, 0, 0), (0, 1, 0))),
+    "scaled": (patch.scaled(0.5, (20, 15, 0)), occ.named_trsf("scale", (20, 15, 0), 0.5)),
 }
 for name, (mine, trsf) in cases.items():
     theirs = occ.geom_transformed(patch.geom(), trsf)

@@ -225,24 +225,6 @@ def work(estimate: float, cap: int, keyword: str, what: str) -> None:
         )
 
 
-def surface(value, name: str = "s"):
-    """A surfmod :class:`~surfmod.surface.Surface`."""
-    from .surface import Surface
-
-    if not isinstance(value, Surface):
-        raise SurfmodError(f"{name}: expected a surfmod Surface, got {type(value).__name__}")
-    return value
-
-
-def curve(value, name: str = "curve"):
-    """A surfmod :class:`~surfmod.curve.Curve`."""
-    from .curve import Curve
-
-    if not isinstance(value, Curve):
-        raise SurfmodError(f"{name}: expected a surfmod Curve, got {type(value).__name__}")
-    return value
-
-
 def file_path(value, name: str = "path") -> Path:
     """A file path of a usable length (no OSError "File name too long" later).
 

@@ -33,6 +33,19 @@ def all_finite(out: np.ndarray) -> bool:
     return bool(np.isfinite(out).all())
 
 
+def require_surface(value, name: str = "s") -> "Surface":
+    """``value`` itself if it is a surfmod :class:`Surface`, else a SurfmodError naming ``name``.
+
+    >>> require_surface("plane", "s")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: s: expected a surfmod Surface, got str
+    """
+    if not isinstance(value, Surface):
+        raise SurfmodError(f"{name}: expected a surfmod Surface, got {type(value).__name__}")
+    return value
+
+
 def finite_result(out: np.ndarray, u: np.ndarray, v: np.ndarray, what: str) -> np.ndarray:
     """``out`` (one row per parameter pair) when every value is finite; otherwise a
     ``SurfmodError`` naming the first parameters where the surface has no finite value."""

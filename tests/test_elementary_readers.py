@@ -14,7 +14,7 @@ from surfmod.occ.sample import surface_d0
 from surfmod.occ.topo import face_from_surface, face_surface
 
 EXPECTED_CLASS = {
-    "Geom_Plane": sm.AnalyticPlane,
+    "Geom_Plane": sm.PlaneSurface,
     "Geom_CylindricalSurface": sm.CylindricalSurface,
     "Geom_ConicalSurface": sm.ConicalSurface,
     "Geom_SphericalSurface": sm.SphericalSurface,
@@ -155,7 +155,7 @@ def test_rectangular_trimmed_surface_is_unwrapped():
         sm.sphere(2.0),
         sm.torus(3.0, 1.0),
         sm.CylindricalSurface(1.0, v_range=(0, 2)),
-        sm.AnalyticPlane((0, 0, 1), (0, 1, 1), u_range=(0, 2), v_range=(0, 1)),
+        sm.PlaneSurface((0, 0, 1), (0, 1, 1), u_range=(0, 2), v_range=(0, 1)),
         sm.ConicalSurface(0.4, 1.0, v_range=(0.0, 2.0)),
     ],
     ids=["bspline", "sphere", "torus", "cylinder", "plane", "cone"],

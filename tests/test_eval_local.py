@@ -222,7 +222,7 @@ def test_local_kernels_equal_the_dense_blas_path(s):
 
     us, vs = parameters_with_knots(s, 6)
     (p, q), (ku, kv) = s.degree, s.knots
-    dense = surface_grid(ku, p, kv, q, s._h, us, vs, 2, planar=s.rational)
+    dense = surface_grid(ku, p, kv, q, s._homogeneous, us, vs, 2, planar=s.rational)
     if s.rational:
         dense = surface_quotient(dense)
     _assert_partials(s.grid_derivatives(us, vs, 2), dense, s)

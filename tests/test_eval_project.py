@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.ops import project as pj
+from surfmod.ops import closest as pj
 from surfmod.surface import Surface
 
 

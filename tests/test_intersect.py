@@ -8,6 +8,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.occ import ops as occ
+from surfmod.ops.intersect import as_plane
 from surfmod.ops.marching import segment_distances
 
 
@@ -198,3 +199,21 @@ def test_intersection_curve_as_polyline_bspline():
     assert 0 < c.length - poly.length(samples=4 * len(c)) < 1e-3 * c.length
     assert c.tangents.shape == c.points.shape
     np.testing.assert_allclose(np.linalg.norm(c.tangents, axis=1), 1.0, atol=1e-14)
+
+
+def test_plane_surfaces_stand_for_their_infinite_carrier_plane():
+    # both plane types (OCCT's frame plane and the three-point plane) give the same plane as
+    # (origin, normal) does: the z = 1.7 cut of the quarter cylinder is a quarter circle
+    w = np.array([1, 2**-0.5, 1])
+    arc = np.array([[2, 0], [2, 2], [0, 2]], float)
+    net = np.stack([np.c_[arc, np.full(3, z)] for z in (0.0, 5.0)], axis=1)
+    cyl = sm.BSplineSurface(net, (2, 1), ([0, 0, 0, 1, 1, 1], [0, 0, 1, 1]), np.stack([w, w], 1))
+    frame_plane = sm.PlaneSurface((9, 9, 1.7), (0, 0, 2), u_range=(0, 0.1), v_range=(0, 0.1))
+    three_point = sm.plane((9, 9, 1.7), (9.1, 9, 1.7), (9, 9.1, 1.7))
+    for carrier in (frame_plane, three_point):
+        origin, normal = as_plane(carrier, "plane")
+        assert np.array_equal(origin, [9, 9, 1.7]) and np.allclose(normal, [0, 0, 1], atol=1e-15, rtol=0)
+    [reference] = sm.intersect(cyl, ((0, 0, 1.7), (0, 0, 1)))
+    [by_frame] = sm.intersect(cyl, ((9, 9, 1.7), (0, 0, 1)))
+    assert by_frame.length == pytest.approx(reference.length, rel=1e-12)
+    assert np.abs(np.linalg.norm(by_frame.points[:, :2], axis=1) - 2).max() < 1e-12

@@ -182,7 +182,7 @@ def test_stretched_parametrizations_find_the_global_minimum(seed):
 def test_newton_carries_on_across_a_crease():
     # two flat pieces meeting at a C0 crease (degree 1, knot u = 0.5): a start in the
     # first piece reaches the foot of the perpendicular in the second
-    from surfmod.ops.project import newton_closest
+    from surfmod.ops.closest import newton_closest
 
     net = np.array([[[0, 0, 0], [0, 1, 0]], [[1, 0, 0.5], [1, 1, 0.5]], [[2, 0, 0.5], [2, 1, 0.5]]], float)
     s = sm.BSplineSurface(net, (1, 1), ([0, 0, 0.5, 1, 1], [0, 0, 1, 1]))

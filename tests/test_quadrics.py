@@ -72,7 +72,7 @@ def test_sphere_ellipsoid_with_equal_radii_is_the_sphere():
 
 
 ELEMENTARY = {
-    "plane": lambda: sm.AnalyticPlane((1, 2, 3), (1, 1, 1), u_range=(-1, 2), v_range=(0, 3)),
+    "plane": lambda: sm.PlaneSurface((1, 2, 3), (1, 1, 1), u_range=(-1, 2), v_range=(0, 3)),
     "cylinder": lambda: sm.CylindricalSurface(2.0, (1, 0, 0), (0, 1, 1), v_range=(-1, 3)),
     "cone": lambda: sm.ConicalSurface(0.3, 1.5, (1, 0, 0), (0, 1, 1), v_range=(-1, 3)),
     "sphere": lambda: sm.sphere(2.0, (1, 2, 3), (1, 2, 3)),
@@ -161,7 +161,7 @@ def test_default_frame_follows_gp_ax2():
         (lambda: sm.ConicalSurface(0.3, -1.0), "ref_radius"),
         (lambda: sm.CylindricalSurface(1.0, v_range=(2, 1)), "v_range"),
         (lambda: sm.SphericalSurface(1.0, v_range=(-2, 0)), "v_range"),
-        (lambda: sm.AnalyticPlane((0, 0, 0), (0, 0, 0)), "normal"),
+        (lambda: sm.PlaneSurface((0, 0, 0), (0, 0, 0)), "normal"),
         (lambda: sm.sphere(1.0).scaled((1, 0, 1)), "factor"),
     ],
 )
@@ -193,7 +193,7 @@ def test_random_frames_match_occt(kind, center, axis, xref, r, mirror):
         "cone": lambda: sm.ConicalSurface(-0.4, r, center, axis, xref, v_range=(-0.5, 2)),
         "sphere": lambda: sm.SphericalSurface(r, center, axis, xref),
         "torus": lambda: sm.ToroidalSurface(r + 1.0, r * 0.5, center, axis, xref),
-        "plane": lambda: sm.AnalyticPlane(center, axis, xref, u_range=(-r, r), v_range=(0, r)),
+        "plane": lambda: sm.PlaneSurface(center, axis, xref, u_range=(-r, r), v_range=(0, r)),
     }[kind]()
     if mirror:  # an indirect frame
         s = s.mirrored(center, xref if xref is not None else (1, 0, 0))

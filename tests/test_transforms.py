@@ -71,7 +71,7 @@ def test_named_transforms_match_gp_trsf(subject, kind):
     apply, trsf_args = NAMED[kind]
     mine = apply(s)
     assert type(mine) is type(s)  # Hermite stays Hermite, Bezier stays Bezier
-    theirs = occ.geom_transformed(s.geom(), occ.trsf(*trsf_args))
+    theirs = occ.geom_transformed(s.geom(), occ.named_trsf(*trsf_args))
     assert surface_type(theirs) == surface_type(s.geom())
     _assert_same_surface(mine, theirs, 10 * _size(mine))
     # the geom() of the transformed surface is the transformed geom
@@ -93,7 +93,7 @@ def test_named_matrices_equal_gp_trsf_matrices(kind):
     spy = Spy.__new__(Spy)
     sm.BSplineSurface._set(spy, s.control_points, s.degree, s.knots, s.weights)
     apply(spy)
-    np.testing.assert_allclose(captured["m"], occ.trsf_matrix(occ.trsf(*trsf_args)), rtol=0, atol=1e-15 * 8)
+    np.testing.assert_allclose(captured["m"], occ.trsf_matrix(occ.named_trsf(*trsf_args)), rtol=0, atol=1e-15 * 8)
 
 
 @pytest.mark.parametrize("subject", sorted(SUBJECTS))
@@ -142,10 +142,10 @@ coord = st.floats(-10, 10, allow_nan=False)
 def test_random_similarities_match_gp_trsf(s, axis, origin, degrees, shift, factor):
     axis = np.asarray(axis) / np.linalg.norm(axis)
     mine = s.rotated(origin, axis, degrees).translated(shift).mirrored(origin, axis).scaled(factor, shift)
-    t = occ.trsf("scale", shift, factor)
-    t.Multiply(occ.trsf("mirror", origin, axis))
-    t.Multiply(occ.trsf("translation", shift))
-    t.Multiply(occ.trsf("rotation", origin, axis, degrees))
+    t = occ.named_trsf("scale", shift, factor)
+    t.Multiply(occ.named_trsf("mirror", origin, axis))
+    t.Multiply(occ.named_trsf("translation", shift))
+    t.Multiply(occ.named_trsf("rotation", origin, axis, degrees))
     theirs = occ.geom_transformed(s.geom(), t)
     scale = max(1.0, float(np.abs(mine.control_points).max()), 30 * abs(factor))
     _assert_same_surface(mine, theirs, 10 * scale)

@@ -9,6 +9,8 @@ import pkgutil
 import sys
 from pathlib import Path
 
+from ..errors import SurfmodError
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
@@ -24,8 +26,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    from ..errors import SurfmodError
-
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

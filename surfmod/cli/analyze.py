@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+from ..errors import SurfmodError
+
+from ..meshing.analyze import analyze
+
+from ..uses.inputs import load_step
+
 
 def register(sub) -> None:
     p = sub.add_parser("analyze", help="zebra / isophote / curvature map / comb picture of a STEP part")
@@ -15,10 +21,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..errors import SurfmodError
-    from ..meshing.analyze import analyze
-    from ..uses.inputs import load_step
-
     light = None
     if args.light is not None:
         try:

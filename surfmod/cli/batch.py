@@ -20,6 +20,8 @@ from tqdm import tqdm
 
 from ..errors import SurfmodError
 from ..atomic import atomic_path, target_path
+from ..io.step import import_step
+from ..io.stl import export_stl
 
 STEP_SUFFIXES = (".step", ".stp")
 
@@ -155,9 +157,6 @@ def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None, strict:
     """Mesh one STEP file to an STL beside it (or in ``out_dir``) with the per-file mesh
     function of ``surfmod mesh``; ``[(file, triangles, watertight, max deviation, stl or
     error)]``."""
-    from ..io.step import import_step
-    from ..io.stl import export_stl
-
     p = Path(path)
     out = (Path(out_dir) / p.with_suffix(".stl").name) if out_dir else p.with_suffix(".stl")
     try:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..gallery.runner import format_table, run_gallery
+
 
 def register(sub) -> None:
     p = sub.add_parser("gallery", help="build every lecture entity, cross-check it, export STEP/STL/PNG")
@@ -12,8 +14,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..gallery.runner import format_table, run_gallery
-
     rows = run_gallery(args.outdir, progress=not args.no_progress, only=args.only)
     print(format_table(rows))
     failed = [r.name for r in rows if not r.passed]

@@ -27,7 +27,7 @@ from ..eval.basis import basis_matrix
 from ..nets import knots as kn
 from ..nets.bspline import BSplineSurface, cartesian
 from ..nets.elevate import KNOT_TOL, elevate_degree
-from ..ops.continuity import SIDES
+from ..ops.continuity import _as_surface, SIDES
 from ..surface import Surface
 
 ORDERS = {"G0": 0, "G1": 1, "G2": 2}
@@ -80,7 +80,7 @@ def side_curves(s: BSplineSurface, side: str, order: int):
     cross derivatives (k-th derivative along the direction leaving the surface), with
     the side's knots and degree."""
     fixed, end = SIDES[side]
-    h = s._h if s.rational else np.concatenate([s.control_points, np.ones(s.control_points.shape[:2] + (1,))], axis=-1)
+    h = s._homogeneous if s.rational else np.concatenate([s.control_points, np.ones(s.control_points.shape[:2] + (1,))], axis=-1)
     if fixed == 1:
         h = h.transpose(1, 0, 2)
     knots, p = s.knots[fixed], s.degree[fixed]
@@ -156,7 +156,6 @@ def _surface(obj, name):
     """A surfmod surface, or the surface of a build123d / OCP face (``sm.from_face``)."""
     if isinstance(obj, Surface):
         return obj
-    from ..ops.continuity import _as_surface
 
     return _as_surface(obj, name)
 

@@ -31,8 +31,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import checks
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface, cartesian, homogeneous
+from ..nets.elevate import elevated, make_compatible
 from .from_edge import as_curve
 
 BLENDS = ("linear", "hermite")
@@ -145,12 +147,10 @@ def coons(c0, c1, d0, d1, *, blend: str = "linear", tolerance: float = 1e-7) -> 
     """
     if blend not in BLENDS:
         raise SurfmodError(f"blend: expected one of {BLENDS}, got {blend!r}")
-    from .. import checks
 
     tolerance = checks.positive(tolerance, "tolerance")
     given = [as_curve(c, name) for c, name in zip((c0, c1, d0, d1), NAMES)]
     _corner_check(given, tolerance)
-    from ..nets.elevate import make_compatible
 
     # as OCCT's SetSameDistribution: the longer interval wins, ties go to c0 and to d1
     cu = make_compatible([given[0].to_bspline(), given[1].to_bspline()])
@@ -193,8 +193,6 @@ def coons(c0, c1, d0, d1, *, blend: str = "linear", tolerance: float = 1e-7) -> 
 
 
 def _at_least_cubic(pair):
-    from ..nets.elevate import elevated
-
     if len(pair[0].control_points) >= 4:
         return pair
     deg = pair[0].degree + 4 - len(pair[0].control_points)

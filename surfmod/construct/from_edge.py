@@ -6,7 +6,9 @@ Faces are read by :mod:`surfmod.readback` (``sm.from_face``), the one reader of 
 
 from __future__ import annotations
 
+from ..curve import Curve
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve
 
 
 def from_edge(edge):
@@ -18,7 +20,6 @@ def from_edge(edge):
     >>> c.points(c.domain[1])
     array([3., 4., 0.])
     """
-    from ..nets.bspline import BSplineCurve
     from ..occ.geom import read_bspline_curve
     from ..occ.topo import shape_bspline
 
@@ -28,8 +29,6 @@ def from_edge(edge):
 
 def as_curve(value, name: str):
     """Accept a surfmod curve or a build123d Edge/Wire wherever a curve is taken."""
-    from ..curve import Curve
-
     if isinstance(value, Curve):
         return value
     if hasattr(value, "wrapped") or type(value).__name__.startswith("TopoDS"):

@@ -24,7 +24,9 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..eval.basis import basis_matrix
 from ..nets.bspline import BSplineSurface, cartesian, homogeneous
+from ..nets.elevate import make_compatible
 from .fitting import averaging_knots
 from .from_edge import as_curves
 
@@ -146,7 +148,6 @@ def loft(sections, *, ruled: bool = False) -> LoftSurface:
     """
     curves = as_curves(sections, "sections", "a loft")
     size = _check_orientation(curves)
-    from ..nets.elevate import make_compatible
 
     compat = make_compatible(curves)
     rational = any(c.weights is not None for c in compat)
@@ -165,7 +166,6 @@ def loft(sections, *, ruled: bool = False) -> LoftSurface:
     # interpolates exactly then); beyond, OCCT approximates and we skin bicubically
     q = 1 if ruled else (k_sec - 1 if k_sec - 1 <= _MAX_DEGREE else 3)
     kv = averaging_knots(v, q)
-    from ..eval.basis import basis_matrix
 
     b = basis_matrix(kv, q, k_sec, v)[0]
     ctrl = np.linalg.solve(b, hs.reshape(k_sec, -1)).reshape(hs.shape)  # (K, n, dim)

@@ -22,7 +22,12 @@ from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
 from ..nets.bspline import BSplineSurface
+from ..ops.continuity import side_params, SIDES
 from ..surface import Surface
+from ..uses.inputs import make_solid
+from .blend import as_bspline_surface
+from .offset_surface import OffsetSurface
+from .ruled import ruled
 
 #: Margin on ``d k < 1``: closer than this the offset's partials nearly vanish.
 FOLD_MARGIN = 1e-6
@@ -173,8 +178,6 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
     >>> o.max_deviation < 1e-6, round(float(np.linalg.norm(o.points(0.7, 1.0)[:2])), 6)
     (True, 2.5)
     """
-    from .offset_surface import OffsetSurface
-
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
     try:
@@ -206,11 +209,6 @@ def thicken(s: Surface, thickness: float, tolerance: float = 1e-5, *, symmetric:
     >>> round(slab.volume, 9)
     3.0
     """
-    from ..ops.continuity import SIDES, side_params
-    from ..uses.inputs import make_solid
-    from .blend import as_bspline_surface
-    from .ruled import ruled
-
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
     try:

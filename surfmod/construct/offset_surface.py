@@ -15,7 +15,7 @@ from .. import tolerances, transforms
 from ..errors import SurfmodError
 from ..eval.differential import degenerate_mask
 from ..surface import Surface
-from .elementary import AnalyticPlane, CylindricalSurface, SphericalSurface, ToroidalSurface
+from .elementary import PlaneSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
 
 
 # -- offset surface ------------------------------------------------------------------------------
@@ -85,11 +85,11 @@ def _degenerate(ders):
 def _equivalent(base, d):
     """The elementary surface an offset of a plane, cylinder, sphere or torus is (same
     parametrization, like OCCT's equivalent surface), or None."""
-    if not isinstance(base, (AnalyticPlane, CylindricalSurface, SphericalSurface, ToroidalSurface)):
+    if not isinstance(base, (PlaneSurface, CylindricalSurface, SphericalSurface, ToroidalSurface)):
         return None
     o, x, y, z = base.frame
-    if isinstance(base, AnalyticPlane):
-        return AnalyticPlane._trusted((o + d * np.cross(x, y), x, y, z), (), *base.domain)
+    if isinstance(base, PlaneSurface):
+        return PlaneSurface._trusted((o + d * np.cross(x, y), x, y, z), (), *base.domain)
     (u0, u1), (v0, v1) = base.domain
     um, vm = 0.5 * (u0 + u1), 0.5 * (v0 + v1)
     if isinstance(base, SphericalSurface):

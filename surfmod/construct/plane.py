@@ -9,7 +9,7 @@ from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface
 
 
-class PlaneSurface(BSplineSurface):
+class ThreePointPlane(BSplineSurface):
     """A bilinear (degree 1 x 1) B-spline that is exactly the lecture's plane.
 
     OCCT's ``Geom_Plane`` is parametrized by an orthonormal frame, so it matches
@@ -33,10 +33,10 @@ class PlaneSurface(BSplineSurface):
         n = np.cross(self.control_points[1, 0] - self.origin, self.control_points[0, 1] - self.origin)
         return n / np.linalg.norm(n)
 
-    def transformed(self, matrix) -> "PlaneSurface":
+    def transformed(self, matrix) -> "ThreePointPlane":
         """An affine image of a plane is a plane: same class, mapped control points."""
         out = BSplineSurface.transformed(self, matrix)
-        obj = PlaneSurface._construct_fast()
+        obj = ThreePointPlane._construct_fast()
         BSplineSurface._set(obj, out.control_points, out.degree, out.knots, None)
         return obj
 
@@ -45,7 +45,7 @@ class PlaneSurface(BSplineSurface):
         return (np.asarray(xyz, dtype=float) - self.origin) @ self.normal
 
 
-def plane(p0, p1, p2) -> PlaneSurface:
+def plane(p0, p1, p2) -> ThreePointPlane:
     """The plane through three points, parametrized ``P0 + u(P1-P0) + v(P2-P0)`` on [0, 1]^2.
 
     >>> import surfmod as sm
@@ -62,6 +62,6 @@ def plane(p0, p1, p2) -> PlaneSurface:
         raise SurfmodError("p2: collinear with p0 and p1, the three points do not span a plane")
     net = np.array([[a, c], [b, b + e2]])
     k = np.array([0.0, 0.0, 1.0, 1.0])
-    obj = PlaneSurface._construct_fast()
+    obj = ThreePointPlane._construct_fast()
     BSplineSurface._set(obj, net, (1, 1), (k, k), None)
     return obj

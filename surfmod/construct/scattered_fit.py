@@ -36,6 +36,9 @@ from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_derivatives, find_spans
 from ..nets.bspline import BSplineSurface
+from ..ops.closest import newton_closest
+from ..ops.project import project
+from ..surface import Surface
 
 #: points per chunk when assembling the normal equations (memory bound)
 CHUNK = 200_000
@@ -122,9 +125,6 @@ def mean_normal_frame(points: np.ndarray, sample: int = 20_000, neighbours: int 
 
 def base_parameters(points: np.ndarray, base):
     """Parameters in ``[0, 1]^2`` by projection onto ``base`` (a surfmod surface)."""
-    from ..ops.project import project
-    from ..surface import Surface
-
     if not isinstance(base, Surface):
         raise SurfmodError(f"base: expected a surfmod Surface, got {type(base).__name__}")
     pr = project(points, base)
@@ -300,8 +300,6 @@ def _check_max_poles(value, degree):
 
 
 def _foot_points(surface, points, u, v):
-    from ..ops.project import newton_closest
-
     u, v = newton_closest(surface, points, u, v, iterations=8)
     d = np.linalg.norm(surface.points(u, v) - points, axis=-1)
     return u, v, d

@@ -29,7 +29,9 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..eval.basis import basis_matrix
 from .fitting import FittedSurface, averaging_knots, interpolate
+from .forms import ImplicitSurface
 
 _TABLE = 4001  # samples of the quadrant table behind the angle redistribution
 _MAX_SAMPLES = 801
@@ -170,8 +172,6 @@ class Superellipsoid(FittedSurface):
 
     def implicit_surface(self):
         """The implicit form as an :class:`~surfmod.construct.forms.ImplicitSurface`."""
-        from .forms import ImplicitSurface
-
         rx, ry, rz, s1, s2 = self.rx, self.ry, self.rz, self.s1, self.s2
         r = max(rx, ry, rz)
         return ImplicitSurface(
@@ -231,7 +231,6 @@ def _curve_error(angle_map, s, count, radius):
     c, sn = angle_map.cos_sin(t)
     pts = np.stack([signed_power(c, s), signed_power(sn, s)], axis=-1)
     knots = averaging_knots(t, 3)
-    from ..eval.basis import basis_matrix
 
     ctrl = np.linalg.solve(basis_matrix(knots, 3, count, t)[0], pts)
     tc = np.linspace(0.0, 1.0, 3 * (count - 1) + 1)

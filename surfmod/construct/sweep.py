@@ -34,9 +34,12 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks, tolerances, transforms
-from ..errors import SurfmodError
+from ..errors import KernelError, SurfmodError
+from ..eval.basis import basis_matrix
 from ..eval.frames import RotationMinimizingTable, any_normal, axis_rotation, frenet_frames
+from ..nets.bspline import BSplineCurve
 from ..surface import Surface
+from .fitting import averaging_knots
 from .from_edge import as_curve
 
 MODES = ("frenet", "corrected_frenet")
@@ -342,7 +345,6 @@ class SweptSurface(Surface):
             # auxiliary spine traced from our frame makes OCCT sweep *our* definition.
             # OCCT finds the rail point in the normal plane: a rail close to the path
             # keeps that intersection unique (coiled paths), so shrink it on failure.
-            from ..errors import KernelError
 
             for offset in (0.05, 0.01, 0.002):
                 try:
@@ -376,10 +378,6 @@ class SweptSurface(Surface):
         """An auxiliary spine for OCCT: the path offset along our (twisted) normal,
         traced densely and interpolated, so that OCCT's 'normal towards the auxiliary
         spine' is our frame's normal."""
-        from ..nets.bspline import BSplineCurve
-        from .fitting import averaging_knots
-        from ..eval.basis import basis_matrix
-
         v0, v1 = self._v
         vs = np.linspace(v0, v1, 201)
         p = self.path._derivatives(vs, 0)[:, 0]

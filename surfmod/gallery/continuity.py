@@ -8,14 +8,19 @@ from pathlib import Path
 
 import numpy as np
 
+from ..construct.blend import blend
+from ..construct.elementary import CylindricalSurface
+from ..construct.fill import fill
+from ..construct.offset import thicken
+from ..meshing.analyze import analyze
+from ..nets.bspline import BSplineSurface
+from ..ops.continuity import continuity
 from . import entry
 from .synthetic import wavy_net
 
 
 def nurbs_pair():
     """Two NURBS patches facing each other across a gap of 6 units (reproducible)."""
-    from ..nets.bspline import BSplineSurface
-
     net_a = wavy_net(6, 5, 0.4)[:, :, :] * (0.6, 1.0, 1.0)
     w_a = np.ones((6, 5))
     w_a[2:4, 1:4] = 2.0
@@ -29,8 +34,6 @@ def nurbs_pair():
 
 def g2_blend():
     """``(a, blend, b)`` of the gallery's G2 blend."""
-    from ..construct.blend import blend
-
     a, b = nurbs_pair()
     return a, blend(a, "u1", b, "u0", "G2"), b
 
@@ -47,9 +50,6 @@ def _g2_blend():
 def _corner_fill():
     import build123d as bd
 
-    from ..construct.elementary import CylindricalSurface
-    from ..construct.fill import fill
-
     r = 2.0
     sides = [(CylindricalSurface(r, (0, 0, 0), axis, x_dir, u_range=(0, np.pi / 2), v_range=(-6, 0)), "v1")
              for axis, x_dir in (((1, 0, 0), (0, 1, 0)), ((0, 1, 0), (0, 0, 1)), ((0, 0, 1), (1, 0, 0)))]
@@ -58,8 +58,6 @@ def _corner_fill():
 
 @entry("thicken", "thickened NURBS patch (offset + ruled walls)", "sm.thicken(s, 0.8)")
 def _thicken():
-    from ..construct.offset import thicken
-
     a, _ = nurbs_pair()
     return thicken(a, 0.8)
 
@@ -67,9 +65,6 @@ def _thicken():
 def blend_report(outdir) -> str:
     """Write ``g2_blend_zebra.png`` and ``g2_blend_continuity.txt`` into ``outdir``;
     returns the continuity table (both boundaries, OCCT's LocalAnalysis alongside)."""
-    from ..meshing.analyze import analyze
-    from ..ops.continuity import continuity
-
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     a, f, b = g2_blend()

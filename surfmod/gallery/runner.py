@@ -6,6 +6,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import SurfmodError
+from ..io.step import export_step
+from ..io.stl import export_stl
+from ..meshing.render import render
+from ..surface import Surface
+from ..verification import crosscheck
 from . import Entry, entries
 
 
@@ -21,11 +26,6 @@ class Row:
 
 
 def run_entry(e: Entry, outdir: Path) -> Row:
-    from ..verification import crosscheck
-    from ..io.step import export_step
-    from ..io.stl import export_stl
-    from ..surface import Surface
-
     try:
         obj = e.build()
         if isinstance(obj, Surface):
@@ -48,8 +48,6 @@ def run_entry(e: Entry, outdir: Path) -> Row:
 
 
 def _render(obj, path: Path) -> None:
-    from ..meshing.render import render
-
     render([obj], path)
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..subdiv.limit import limit_surface
 from . import entry
 
 CUBE_VERTICES = np.array(
@@ -37,28 +38,20 @@ def torus_cage(n: int = 8, m: int = 6, major: float = 12.0, minor: float = 4.0):
 
 @entry("subdivision_cube", "Catmull–Clark limit of a cube cage (solid)", "sm.limit_surface(v, quads).solid()")
 def _cube():
-    from ..subdiv.limit import limit_surface
-
     return limit_surface(CUBE_VERTICES, CUBE_FACES, levels=2).solid()
 
 
 @entry("subdivision_prism", "Catmull–Clark limit of a pentagonal prism (mixed polygons)", "sm.limit_surface(v, faces, levels=1).solid()")
 def _prism():
-    from ..subdiv.limit import limit_surface
-
     return limit_surface(*prism_cage(), levels=1).solid()
 
 
 @entry("subdivision_torus", "Catmull–Clark limit of a regular torus cage (exact B-splines)", "sm.limit_surface(v, quads, levels=0).solid()")
 def _torus():
-    from ..subdiv.limit import limit_surface
-
     return limit_surface(*torus_cage(), levels=0).solid()
 
 
 @entry("subdivision_creased", "Catmull–Clark limit with a sharp crease loop", "sm.limit_surface(v, quads, creases=ring).solid()")
 def _creased():
-    from ..subdiv.limit import limit_surface
-
     ring = [(0, 1), (1, 2), (2, 3), (3, 0)]  # the bottom square stays a sharp edge
     return limit_surface(CUBE_VERTICES, CUBE_FACES, levels=2, creases=ring).solid()

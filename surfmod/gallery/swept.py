@@ -6,25 +6,25 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..construct.fitting import approximate, interpolate
+from ..construct.forms import explicit
+from ..construct.loft import loft
+from ..construct.superellipsoid import superellipsoid
+from ..construct.sweep import sweep
+from ..nets.bspline import BSplineCurve
 from . import entry
 
 
 def _path():
-    from ..nets.bspline import BSplineCurve
-
     return BSplineCurve([(0, 0, 0), (0, 0, 20), (15, 5, 40), (40, 0, 45), (50, 15, 60)], 3)
 
 
 def _profile():
-    from ..nets.bspline import BSplineCurve
-
     # an open, asymmetric profile in the plane z = 0 (normal to the path at its start)
     return BSplineCurve([(-5, -5, 0), (0, -7.5, 0), (5, -5, 0), (7.5, 0, 0), (5, 5, 0)], 3)
 
 
 def _end_profile(mode):
-    from ..construct.sweep import sweep
-
     base = sweep(_profile(), _path(), mode=mode)
     r = base.frames(np.array([0.0, 1.0]))
     p = _path().points(np.array([0.0, 1.0]))
@@ -36,53 +36,37 @@ def _end_profile(mode):
 
 @entry("sweep_frenet", "swept surface (Frenet frame)", "sm.sweep(profile, path)")
 def _sweep_frenet():
-    from ..construct.sweep import sweep
-
     return sweep(_profile(), _path(), mode="frenet")
 
 
 @entry("sweep_rmf", "swept surface (corrected Frenet)", "sm.sweep(profile, path, mode='corrected_frenet')")
 def _sweep_rmf():
-    from ..construct.sweep import sweep
-
     return sweep(_profile(), _path(), mode="corrected_frenet")
 
 
 @entry("sweep_changing", "swept surface, changing profile", "sm.sweep(a, path, end_profile=b)")
 def _sweep_changing():
-    from ..construct.sweep import sweep
-
     return sweep(_profile(), _path(), mode="frenet", end_profile=_end_profile("frenet"))
 
 
 @entry("sweep_guide", "swept surface with a guide rail", "sm.sweep(profile, path, guide=rail)")
 def _sweep_guide():
-    from ..construct.sweep import sweep
-    from ..nets.bspline import BSplineCurve
-
     rail = BSplineCurve([(0, 10, 0), (0, 12, 20), (15, 15, 40), (40, 5, 45), (50, 20, 60)], 3)
     return sweep(_profile(), _path(), guide=rail)
 
 
 @entry("sweep_guide_scaled", "swept surface scaled to a guide rail", "sm.sweep(profile, path, guide=rail, guide_scale=True)")
 def _sweep_guide_scaled():
-    from ..construct.sweep import sweep
-    from ..nets.bspline import BSplineCurve
-
     rail = BSplineCurve([(0, 10, 0), (0, 16, 20), (15, 20, 40), (40, 6, 45), (50, 25, 60)], 3)
     return sweep(_profile(), _path(), guide=rail, guide_scale=True)
 
 
 @entry("sweep_twisted", "twisted swept surface", "sm.sweep(profile, path, twist=180)")
 def _sweep_twisted():
-    from ..construct.sweep import sweep
-
     return sweep(_profile(), _path(), mode="corrected_frenet", twist=180.0)
 
 
 def _sections():
-    from ..nets.bspline import BSplineCurve
-
     return [
         BSplineCurve([(0, 0, 0), (10, 10, 0), (20, 0, 0), (30, 5, 0)], 3),
         BSplineCurve([(0, 0, 15), (10, -10, 15), (20, 0, 15)], 2),
@@ -93,29 +77,21 @@ def _sections():
 
 @entry("loft", "lofted surface (smooth)", "sm.loft(sections)")
 def _loft():
-    from ..construct.loft import loft
-
     return loft(_sections())
 
 
 @entry("loft_ruled", "lofted surface (ruled)", "sm.loft(sections, ruled=True)")
 def _loft_ruled():
-    from ..construct.loft import loft
-
     return loft(_sections()[:2], ruled=True)
 
 
 @entry("superellipsoid_sharp", "superellipsoid (sharp, s = 0.1)", "sm.superellipsoid(20, 15, 10, 0.1, 0.1)")
 def _superellipsoid_sharp():
-    from ..construct.superellipsoid import superellipsoid
-
     return superellipsoid(20, 15, 10, 0.1, 0.1)
 
 
 @entry("superellipsoid_pinched", "superellipsoid (pinched, s = 3)", "sm.superellipsoid(20, 15, 10, 3, 3)")
 def _superellipsoid_pinched():
-    from ..construct.superellipsoid import superellipsoid
-
     # near its cusp edges Su x Sv nearly vanishes and the normals of any two evaluators
     # agree only to ~1e-7; crosscheck weighs normals by that conditioning
     return superellipsoid(20, 15, 10, 3.0, 3.0)
@@ -123,8 +99,6 @@ def _superellipsoid_pinched():
 
 @entry("explicit", "explicit surface z = f(x, y)", "sm.explicit(f, x_range, y_range)")
 def _explicit():
-    from ..construct.forms import explicit
-
     return explicit(lambda x, y: 8 * np.sin(x / 8) * np.cos(y / 6) + 0.1 * x, (0, 50), (0, 40), tolerance=1e-3)
 
 
@@ -136,13 +110,9 @@ def _scan(n, m):
 
 @entry("interpolate", "interpolation surface", "sm.interpolate(points, (3, 3))")
 def _interpolate():
-    from ..construct.fitting import interpolate
-
     return interpolate(_scan(12, 10))
 
 
 @entry("approximate", "approximation surface", "sm.approximate(points, (3, 3), tolerance)")
 def _approximate():
-    from ..construct.fitting import approximate
-
     return approximate(_scan(40, 30), tolerance=0.01)

@@ -5,6 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..construct.plane import plane
+from ..nets.bezier import BezierSurface
+from ..nets.bspline import BSplineSurface
+from ..nets.hermite import HermiteBicubic
 from . import entry
 
 
@@ -17,30 +21,22 @@ def wavy_net(n: int, m: int, amplitude: float = 0.6) -> np.ndarray:
 
 @entry("plane", "plane through three points", "sm.plane(p0, p1, p2)")
 def _plane():
-    from ..construct.plane import plane
-
     return plane((0, 0, 0), (10, 0, 1), (2, 8, 0))
 
 
 @entry("bezier", "Bézier patch (Bernstein)", "sm.BezierSurface(net)")
 def _bezier():
-    from ..nets.bezier import BezierSurface
-
     return BezierSurface(wavy_net(6, 5))
 
 
 @entry("bezier_rational", "rational Bézier patch", "sm.BezierSurface(net, weights)")
 def _bezier_rational():
-    from ..nets.bezier import BezierSurface
-
     w = 1.0 + 0.5 * np.add.outer(np.sin(np.arange(4)), np.cos(np.arange(4))) ** 2
     return BezierSurface(wavy_net(4, 4), w)
 
 
 @entry("bspline", "B-spline surface (non-uniform)", "sm.BSplineSurface(net, (3, 2), knots)")
 def _bspline():
-    from ..nets.bspline import BSplineSurface
-
     ku = [0, 0, 0, 0, 0.2, 0.5, 0.5, 1, 1, 1, 1]
     kv = [0, 0, 0, 0.3, 0.6, 1, 1, 1]
     return BSplineSurface(wavy_net(7, 5), (3, 2), (ku, kv))
@@ -48,8 +44,6 @@ def _bspline():
 
 @entry("nurbs", "NURBS surface", "sm.BSplineSurface(net, (3, 3), weights=w)")
 def _nurbs():
-    from ..nets.bspline import BSplineSurface
-
     w = np.ones((6, 6))
     w[2:4, 2:4] = 4.0
     w[0, :] = 0.5
@@ -58,15 +52,11 @@ def _nurbs():
 
 @entry("uniform_cubic", "uniform cubic B-spline (matrix form)", "sm.BSplineSurface.uniform_cubic(net)")
 def _uniform_cubic():
-    from ..nets.bspline import BSplineSurface
-
     return BSplineSurface.uniform_cubic(wavy_net(7, 6))
 
 
 @entry("hermite", "Hermite bicubic patch", "sm.HermiteBicubic(corners, du, dv, twist)")
 def _hermite():
-    from ..nets.hermite import HermiteBicubic
-
     corners = np.array([[[0, 0, 0], [0, 6, 1]], [[8, 0, 1], [8, 6, 0]]], dtype=float)
     du = np.array([[[8, 0, 4], [8, 0, -2]], [[8, 0, -4], [8, 0, 2]]], dtype=float)
     dv = np.array([[[0, 6, 3], [0, 6, -3]], [[0, 6, 0], [0, 6, 2]]], dtype=float)

@@ -7,7 +7,12 @@ import importlib
 
 import numpy as np
 
+from ..construct.from_edge import from_edge
+from ..curve import Curve
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve, BSplineSurface
+from ..readback import from_face
+from ..surface import Surface
 
 EXTRA = "pip install surfmod[interop]"
 
@@ -27,14 +32,7 @@ def require(module: str, purpose: str):
 def nurbs_of(obj, name: str = "obj"):
     """The exact B-spline/NURBS form of a surfmod surface or curve (or build123d
     Face/Edge): ``("surface" | "curve", BSplineSurface | BSplineCurve)``."""
-    from ..curve import Curve
-    from ..nets.bspline import BSplineCurve, BSplineSurface
-    from ..surface import Surface
-
     if not isinstance(obj, (Surface, Curve)) and hasattr(obj, "wrapped"):
-        from ..construct.from_edge import from_edge
-        from ..readback import from_face
-
         kind = type(obj).__name__
         obj = from_face(obj) if kind == "Face" else from_edge(obj) if kind in ("Edge", "Wire") else obj
     if isinstance(obj, Curve):

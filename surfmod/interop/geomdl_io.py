@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve, BSplineSurface
 from .common import from_homogeneous, homogeneous_of, nurbs_of, require
 
 
@@ -58,8 +59,6 @@ def from_geomdl(obj):
     """
     require("geomdl", "from_geomdl")
     from geomdl import abstract
-
-    from ..nets.bspline import BSplineCurve, BSplineSurface
 
     rational = hasattr(obj, "ctrlptsw")
     if isinstance(obj, abstract.Curve):

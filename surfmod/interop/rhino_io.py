@@ -13,7 +13,9 @@ import os
 
 import numpy as np
 
+from ..atomic import atomic_path, target_path
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve, BSplineSurface
 from .common import from_homogeneous, nurbs_of, require
 
 
@@ -74,7 +76,6 @@ def from_rhino(obj):
     r3 = require("rhino3dm", "from_rhino")
     if isinstance(obj, (str, os.PathLike)):
         return read_3dm(obj)
-    from ..nets.bspline import BSplineCurve, BSplineSurface
 
     if not isinstance(obj, (r3.NurbsCurve, r3.NurbsSurface)):
         for attr in ("ToNurbsSurface", "ToNurbsCurve"):
@@ -109,7 +110,6 @@ def export_3dm(objects, path) -> list:
     1
     """
     r3 = require("rhino3dm", "export_3dm")
-    from ..atomic import atomic_path, target_path
 
     target = target_path(path, "path", (".3dm",))
     items = list(objects) if isinstance(objects, (list, tuple)) else [objects]

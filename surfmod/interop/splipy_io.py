@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve, BSplineSurface
 from .common import from_homogeneous, homogeneous_of, nurbs_of, require
 
 
@@ -41,7 +42,6 @@ def from_splipy(obj):
     (True, (2, 2))
     """
     splipy = require("splipy", "from_splipy")
-    from ..nets.bspline import BSplineCurve, BSplineSurface
 
     if not isinstance(obj, (splipy.Curve, splipy.Surface)):
         raise SurfmodError(f"obj: expected a splipy Curve or Surface, got {type(obj).__name__}")

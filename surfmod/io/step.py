@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
+from ..curve import Curve
 from ..errors import SurfmodError
 from ..atomic import atomic_path, target_path
+from ..surface import Surface
 
 
 def to_shape(obj):
     """The TopoDS shape of a surfmod surface/curve, build123d object or TopoDS shape."""
-    from ..curve import Curve
-    from ..surface import Surface
-
     if isinstance(obj, Surface):
         return obj.face().wrapped
     if isinstance(obj, Curve):

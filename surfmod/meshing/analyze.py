@@ -30,7 +30,10 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..ops.continuity import normal_curvature
+from ..readback import from_face
 from ..surface import Surface
+from .analyze_plot import write_png
 
 KINDS = ("zebra", "isophote", "gaussian", "mean", "max_abs", "comb")
 #: Triangles shared out among the faces of a shape (keeps a whole part to a few seconds).
@@ -138,7 +141,6 @@ def refine(uv: np.ndarray, tri: np.ndarray):
 
 def _face_samples(face, target: float, max_triangles: int = 20000):
     """OCCT's triangulation of the trimmed region, split until 3-D edges are <= ``target``."""
-    from ..readback import from_face
     from ..occ.topo import face_surface
     from ..occ.uses import face_uv_triangles
 
@@ -224,8 +226,6 @@ def _patch(kind, s, uv, tri, sign, light, stripes):
 
 # -- combs -----------------------------------------------------------------------------------------
 def _comb_along(s: Surface, u, v, du, dv, sign):
-    from ..ops.continuity import normal_curvature
-
     ders = s.derivatives(u, v, 2)
     n = sign * s.normals(u, v)
     direction = ders[:, 1, 0] * du[:, None] + ders[:, 0, 1] * dv[:, None]
@@ -325,8 +325,6 @@ def analyze(obj, kind: str, out=None, *, light=None, stripes: int = 8, resolutio
     combs = _combs(sources, comb_curves, max(24, resolution), comb_scale) if kind == "comb" else ()
     result = Analysis(kind, light_dir, tuple(patches), combs)
     if out is not None:
-        from .analyze_plot import write_png
-
         path = write_png(result, out, eye, title=title, stripes=stripes)
         result = Analysis(kind, light_dir, tuple(patches), combs, path)
     return result

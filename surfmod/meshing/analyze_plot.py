@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..atomic import atomic_path, target_path
+
 
 LABELS = {
     "gaussian": "Gaussian curvature K",
@@ -40,7 +42,6 @@ def write_png(result, out, eye, *, title=None, stripes: int = 8, dpi: int = 110)
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.colors import Normalize, TwoSlopeNorm
     from matplotlib.figure import Figure
-    from ..atomic import atomic_path, target_path
 
     target = target_path(out, "out", (".png",))
     bx, by, bz = _view_basis(np.asarray(eye, float))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks
-from ..surface import Surface
+from ..surface import Surface, require_surface
 from .polymesh import Mesh
 
 
@@ -31,7 +31,7 @@ def mesh(s: Surface, m: int, n: int, *, quads: bool = False, max_points: int = c
     >>> msh.vertices.shape, msh.faces.shape
     ((12, 3), (12, 3))
     """
-    s = checks.surface(s, "s")
+    s = require_surface(s, "s")
     max_points = checks.count(max_points, "max_points")
     m = checks.count(m, "m", minimum=2, maximum=max_points)
     n = checks.count(n, "n", minimum=2, maximum=max_points)

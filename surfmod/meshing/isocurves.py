@@ -14,8 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import checks
+from ..construct.from_edge import from_edge
 from ..curve import Curve
 from ..errors import SurfmodError
+from ..readback import from_face
 from ..surface import Surface
 
 
@@ -64,7 +66,6 @@ class IsoCurve(Curve):
     def to_bspline(self):
         if hasattr(self.surface, "isocurve"):
             return _spline_iso(self.surface, self.direction, self.value)
-        from ..construct.from_edge import from_edge
 
         return from_edge(self.edge())
 
@@ -136,7 +137,6 @@ def isocurves(s, nu: int, nv: int) -> IsoCurves:
     if not isinstance(s, Surface):
         if getattr(s, "wrapped", None) is None and not hasattr(s, "ShapeType"):
             raise SurfmodError(f"s: expected a surfmod surface or a build123d Face, got {type(s).__name__}")
-        from ..readback import from_face
 
         s = from_face(s)
     counts = []

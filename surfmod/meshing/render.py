@@ -13,8 +13,13 @@ from pathlib import Path
 import numpy as np
 
 from .. import checks
+from ..atomic import atomic_path, target_path
 from ..errors import SurfmodError
+from ..surface import Surface
+from .grid import mesh as grid_mesh
+from .isocurves import isocurves as iso
 from .polymesh import Mesh
+from .tessellate import _surface_size, tessellate_surface
 
 #: Display tessellation: chordal tolerance as a fraction of the object's size.
 DISPLAY_TOLERANCE = 0.004
@@ -24,9 +29,6 @@ LIGHT = np.array([0.4, -0.5, 0.77])
 
 
 def _surface_mesh(s) -> Mesh:
-    from .grid import mesh as grid_mesh
-    from .tessellate import _surface_size, tessellate_surface
-
     size = _surface_size(s)
     try:
         m = tessellate_surface(s, max(DISPLAY_TOLERANCE * size, 1e-12), DISPLAY_TRIANGLES)
@@ -66,8 +68,6 @@ def _shape_edges(shape, samples: int = 48) -> list[np.ndarray]:
 
 def _scene(obj, isocurves: bool, control_net: bool, iso_count, eye):
     """``(mesh, lines, net_points)`` for one object."""
-    from ..surface import Surface
-
     lines: list[np.ndarray] = []
     net = None
     if isinstance(obj, Mesh):
@@ -91,8 +91,6 @@ def _scene(obj, isocurves: bool, control_net: bool, iso_count, eye):
 def _iso_lines(s, m: Mesh, iso_count, eye, samples: int = 80) -> list[np.ndarray]:
     """Iso-curve polylines; on a surface that closes on itself (sphere, torus, tube) the
     parts facing away from the viewer are dropped, since lines are drawn over the shading."""
-    from .isocurves import isocurves as iso
-
     fam = iso(s, *iso_count)
     ul, vl = fam.polylines(samples)
     closed = any(m.info.get("closed", (False, False)))
@@ -162,8 +160,6 @@ def render(
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
-
-    from ..atomic import atomic_path, target_path
 
     target = target_path(path, "path", (".png",))
     items = list(objects) if isinstance(objects, (list, tuple)) else [objects]

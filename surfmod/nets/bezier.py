@@ -12,7 +12,8 @@ import numpy as np
 from .. import checks, transforms
 from ..errors import SurfmodError
 from ..eval.basis import clamped_bezier_knots
-from .bspline import BSplineCurve, BSplineSurface
+from . import knots as kn
+from .bspline import BSplineCurve, BSplineSurface, cartesian
 
 MAX_DEGREE = 25  # Geom_BezierSurface::MaxDegree()
 
@@ -97,3 +98,48 @@ class BezierSurface(BSplineSurface):
 
     def to_bspline(self) -> BSplineSurface:
         return BSplineSurface._trusted(self.control_points, self.degree, self.knots, self.weights)
+
+
+# -- Bézier extraction -----------------------------------------------------------------------
+def _pieces(knots: np.ndarray, degree: int, hpoints: np.ndarray):
+    """``[((t0, t1), hpoints_piece), ...]``: every non-empty knot span raised to full
+    multiplicity, leaving ``degree + 1`` homogeneous points per span (along axis 0)."""
+    breaks = np.unique(knots[degree : hpoints.shape[0] + 1])
+    return [
+        ((float(t0), float(t1)), kn.segment(knots, degree, hpoints, t0, t1)[1])
+        for t0, t1 in zip(breaks[:-1], breaks[1:])
+    ]
+
+
+def bezier_pieces(curve: BSplineCurve) -> list[tuple[tuple[float, float], BezierCurve]]:
+    """Bézier extraction of a B-spline curve: one exact Bézier piece per non-empty knot span.
+
+    >>> import surfmod as sm
+    >>> c = sm.BSplineCurve([(0, 0, 0), (1, 1, 0), (2, 0, 0), (3, 1, 0)], 2)
+    >>> [(span, piece.degree) for span, piece in bezier_pieces(c)]
+    [((0.0, 0.5), 2), ((0.5, 1.0), 2)]
+    >>> bool(np.allclose(bezier_pieces(c)[1][1].points(0.0), c.points(0.5), atol=1e-15))
+    True
+    """
+    return [
+        (span, BezierCurve._trusted(*cartesian(h, curve.rational)))
+        for span, h in _pieces(curve.knots, curve.degree, curve._homogeneous)
+    ]
+
+
+def bezier_patches(surface: BSplineSurface) -> list[tuple[tuple[float, float], tuple[float, float], BezierSurface]]:
+    """Bézier extraction of a B-spline surface: one exact Bézier patch per pair of
+    non-empty knot spans, ``[((u0, u1), (v0, v1), BezierSurface), ...]`` (u-major order).
+
+    >>> import surfmod as sm
+    >>> net = np.stack([*np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij"), np.zeros((4, 3))], -1)
+    >>> [(u, v) for u, v, _ in bezier_patches(sm.BSplineSurface(net, (2, 2)))]
+    [((0.0, 0.5), (0.0, 1.0)), ((0.5, 1.0), (0.0, 1.0))]
+    """
+    p, q = surface.degree
+    patches = []
+    for ur, hu in _pieces(surface.knots[0], p, surface._homogeneous):
+        for vr, hv in _pieces(surface.knots[1], q, hu.transpose(1, 0, 2)):
+            pts, w = cartesian(hv.transpose(1, 0, 2), surface.rational)
+            patches.append((ur, vr, BezierSurface._trusted(pts, w)))
+    return patches

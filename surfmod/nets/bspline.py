@@ -15,6 +15,7 @@ from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..eval import local
+from ..eval.basis import basis_matrix
 from ..eval.rational import curve_quotient
 from ..eval.tensor import curve_derivatives
 from ..surface import Surface
@@ -67,7 +68,7 @@ class BSplineCurve(Curve):
         self.degree = p
         self.knots = checks.frozen(k)
         self.weights = None if w is None else checks.frozen(w)
-        self._h = homogeneous(self.control_points, self.weights)
+        self._homogeneous = homogeneous(self.control_points, self.weights)
 
     @classmethod
     def _trusted(cls, pts, p, k, w=None):
@@ -90,7 +91,7 @@ class BSplineCurve(Curve):
         return np.unique(self.knots[self.degree : len(self.control_points) + 1])
 
     def _derivatives(self, t, order):
-        h = curve_derivatives(self.knots, self.degree, self._h, t, order)
+        h = curve_derivatives(self.knots, self.degree, self._homogeneous, t, order)
         return curve_quotient(h) if self.rational else h
 
     def geom(self):
@@ -111,25 +112,23 @@ class BSplineCurve(Curve):
         times = checks.count(times, "times")
         if kn.multiplicity(self.knots, t) + times > self.degree:
             raise SurfmodError(f"times: multiplicity of {t:g} would exceed the degree {self.degree}")
-        return self._rebuilt(*kn.insert_knot(self.knots, self.degree, self._h, t, times))
+        return self._rebuilt(*kn.insert_knot(self.knots, self.degree, self._homogeneous, t, times))
 
     def segment(self, t0: float, t1: float) -> "BSplineCurve":
         """The exact piece over ``[t0, t1]`` (clamped), like OCCT's ``Segment``."""
         a, b = _ordered_range((t0, t1), "t_range", self.domain)
-        return self._rebuilt(*kn.segment(self.knots, self.degree, self._h, a, b))
+        return self._rebuilt(*kn.segment(self.knots, self.degree, self._homogeneous, a, b))
 
     def _rebuilt(self, knots, h):
         pts, w = cartesian(h, self.rational)
         return BSplineCurve._trusted(pts, self.degree, knots, w)
 
     def bezier_pieces(self):
-        """Bézier extraction: ``[((t0, t1), BezierCurve), ...]``."""
-        from .bezier import BezierCurve
+        """Bézier extraction: ``[((t0, t1), BezierCurve), ...]`` (see :func:`surfmod.nets.bezier.bezier_pieces`)."""
+        # cycle: surfmod.nets.bspline <-> surfmod.nets.bezier (BezierCurve subclasses BSplineCurve)
+        from .bezier import bezier_pieces
 
-        return [
-            (span, BezierCurve._trusted(*cartesian(h, self.rational)))
-            for span, h in kn.bezier_pieces(self.knots, self.degree, self._h)
-        ]
+        return bezier_pieces(self)
 
 
 def _ordered_range(rng, name, domain):
@@ -179,7 +178,7 @@ class BSplineSurface(Surface):
         self.degree = (int(degree[0]), int(degree[1]))
         self.knots = (checks.frozen(knots[0]), checks.frozen(knots[1]))
         self.weights = None if w is None else checks.frozen(w)
-        self._h = homogeneous(self.control_points, self.weights)
+        self._homogeneous = homogeneous(self.control_points, self.weights)
         self.__dict__.pop("_local", None)  # kernel tables (_local_net) follow the data
 
     @classmethod
@@ -233,7 +232,7 @@ class BSplineSurface(Surface):
         cached = self.__dict__.get("_local")
         if cached is None:
             (p, q), (ku, kv) = self.degree, self.knots
-            cached = self._local = local.prepare(ku, p, kv, q, self._h)
+            cached = self._local = local.prepare(ku, p, kv, q, self._homogeneous)
         return cached
 
     def _finite_partials(self, order: int) -> bool:
@@ -294,7 +293,7 @@ class BSplineSurface(Surface):
     # -- knot algorithms -------------------------------------------------------------------
     def _along(self, direction: int, fn):
         """Run a knot routine along u (0) or v (1) on the homogeneous net."""
-        h = self._h if direction == 0 else self._h.transpose(1, 0, 2)
+        h = self._homogeneous if direction == 0 else self._homogeneous.transpose(1, 0, 2)
         k, h2 = fn(self.knots[direction], self.degree[direction], h)
         if direction == 1:
             h2 = h2.transpose(1, 0, 2)
@@ -340,21 +339,15 @@ class BSplineSurface(Surface):
         return [self.segment(ur, vr) for ur in us for vr in vs]
 
     def bezier_patches(self):
-        """Bézier extraction: ``[((u0, u1), (v0, v1), BezierSurface), ...]``."""
-        from .bezier import BezierSurface
+        """Bézier extraction: ``[((u0, u1), (v0, v1), BezierSurface), ...]`` (see
+        :func:`surfmod.nets.bezier.bezier_patches`)."""
+        # cycle: surfmod.nets.bspline <-> surfmod.nets.bezier (BezierSurface subclasses BSplineSurface)
+        from .bezier import bezier_patches
 
-        p, q = self.degree
-        patches = []
-        for (ur, hu) in kn.bezier_pieces(self.knots[0], p, self._h):
-            for (vr, hv) in kn.bezier_pieces(self.knots[1], q, hu.transpose(1, 0, 2)):
-                pts, w = cartesian(hv.transpose(1, 0, 2), self.rational)
-                patches.append((ur, vr, BezierSurface._trusted(pts, w)))
-        return patches
+        return bezier_patches(self)
 
     def isocurve(self, u: float | None = None, v: float | None = None) -> BSplineCurve:
         """The exact iso-parametric curve at constant ``u`` (a curve in v) or constant ``v``."""
-        from ..eval.basis import basis_matrix
-
         if (u is None) == (v is None):
             raise SurfmodError("isocurve: give exactly one of u or v")
         direction = 0 if u is not None else 1
@@ -362,7 +355,7 @@ class BSplineSurface(Surface):
         t = checks.parameters(np.atleast_1d(float(value)), "u" if u is not None else "v", self.domain[direction])
         n_ctrl = self.control_points.shape[direction]
         b = basis_matrix(self.knots[direction], self.degree[direction], n_ctrl, t)[0, 0]
-        h = np.tensordot(b, self._h, axes=(0, direction))
+        h = np.tensordot(b, self._homogeneous, axes=(0, direction))
         pts, w = cartesian(h, self.rational)
         other = 1 - direction
         return BSplineCurve._trusted(pts, self.degree[other], self.knots[other], w)

@@ -59,17 +59,6 @@ def segment(knots: np.ndarray, degree: int, ctrl: np.ndarray, a: float, b: float
     return sub_knots, ctrl[s - 1 : e].copy()
 
 
-def bezier_pieces(knots: np.ndarray, degree: int, ctrl: np.ndarray):
-    """Split into Bézier pieces: list of ``((t0, t1), ctrl_piece)`` with ``degree+1`` points."""
-    n = ctrl.shape[0]
-    breaks = np.unique(knots[degree : n + 1])
-    pieces = []
-    for t0, t1 in zip(breaks[:-1], breaks[1:]):
-        _, piece = segment(knots, degree, ctrl, t0, t1)
-        pieces.append(((float(t0), float(t1)), piece))
-    return pieces
-
-
 def smooth_mask(knots: np.ndarray, degree: int, t: np.ndarray, order: int) -> np.ndarray:
     """False where ``t`` is (within a few ulps of) an interior knot across which the
     ``order``-th derivative jumps (multiplicity > degree - order).  There the derivative is

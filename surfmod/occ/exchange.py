@@ -3,14 +3,16 @@
 
 from __future__ import annotations
 
+# loaded at import: the module silences OCCT's STEP banners once, on import
+from OCP.Message import Message, Message_Gravity
+
 from ..errors import SurfmodError
+from .fullprecision import write_step_full
 from .guard import kernel
 
 
 def _quiet_messages() -> None:
     """OCCT's STEP translator prints statistics banners to stdout; keep only failures."""
-    from OCP.Message import Message, Message_Gravity
-
     for printer in Message.DefaultMessenger_s().Printers():
         printer.SetTraceLevel(Message_Gravity.Message_Fail)
 
@@ -35,8 +37,6 @@ def write_step(shape, path: str) -> None:
     """Write a TopoDS shape as AP214 STEP to ``path`` (the caller makes this atomic), reals
     with 17 significant digits so every pole and weight survives the text bit for bit
     (OCCT's default 12 digits move poles by up to ~5e-13 relative)."""
-    from .fullprecision import write_step_full
-
     write_step_full(shape, path)
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import KernelError
 from .guard import kernel
 
 
@@ -67,8 +68,6 @@ def plate_through_points(points: np.ndarray, degree: int = 3, max_segments: int 
             build.Add(GeomPlate_PointConstraint(gp_Pnt(x, y, z), 0))
         build.Perform()
         if not build.IsDone():
-            from ..errors import KernelError
-
             raise KernelError("GeomPlate_BuildPlateSurface: failed")
         approx = GeomPlate_MakeApprox(build.Surface(), float(tolerance), max_segments, 8, float(tolerance) * 10, 0)
         return approx.Surface()

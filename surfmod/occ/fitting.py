@@ -7,6 +7,7 @@ from OCP.Approx import Approx_ParametrizationType
 from OCP.GeomAbs import GeomAbs_Shape
 from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface
 
+from ..errors import KernelError
 from . import arrays
 from .guard import kernel
 
@@ -27,7 +28,5 @@ def points_to_bspline_surface(points: np.ndarray, degree=(3, 3), tolerance: floa
             fit.Init(pts, Approx_ParametrizationType.Approx_ChordLength, deg, max(deg, 8),
                      GeomAbs_Shape.GeomAbs_C2, float(tolerance), False)
         if not fit.IsDone():
-            from ..errors import KernelError
-
             raise KernelError("GeomAPI_PointsToBSplineSurface: fit failed")
         return fit.Surface()

@@ -9,6 +9,7 @@ from __future__ import annotations
 import io
 
 from ..errors import KernelError
+from .exchange import read_with
 from .fullprecision import FLOAT_FORMAT, write_bytes
 from .guard import kernel
 
@@ -46,7 +47,5 @@ def write_iges(shape, path: str, *, brep: bool = False) -> None:
 def read_iges(path: str):
     """Read an IGES file into one TopoDS shape; unreadable files raise ``SurfmodError``."""
     from OCP.IGESControl import IGESControl_Reader
-
-    from .exchange import read_with
 
     return read_with(IGESControl_Reader(), "IGES", path)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import atexit
 import io
+import math
 import os
 import pickle
 import select
@@ -32,7 +33,9 @@ import threading
 import time
 from pathlib import Path
 
+from .. import checks
 from ..errors import DamagedFileError, SurfmodError
+from .guard import kernel
 
 _HEADER = struct.Struct("!Q")
 
@@ -67,14 +70,11 @@ def _recv(fd: int, deadline: float | None):
 # -- the worker side ------------------------------------------------------------------------
 def _read_and_check(path: str, max_coordinate: float) -> bytes:
     """Read ``path`` with OCCT, check its coordinates, return the shape as BinTools bytes."""
-    import math
-
     from OCP.BinTools import BinTools
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
     from .exchange import read_step
-    from .guard import kernel
 
     shape = read_step(path)
     with kernel("BRepBndLib"):
@@ -246,8 +246,6 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     >>> read_step_file(path).ShapeType().name
     'TopAbs_SHELL'
     """
-    from .. import checks
-
     p = checks.file_path(path, name)
     if timeout is not None:
         timeout = checks.positive(timeout, "timeout")
@@ -266,8 +264,6 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     _WORKER.prestart()  # the worker imports OCCT while this process does the same
     from OCP.BinTools import BinTools
     from OCP.TopoDS import TopoDS_Shape
-
-    from .guard import kernel
 
     try:
         data = _WORKER.read(str(p), timeout, max_coordinate)

@@ -13,6 +13,7 @@ import math
 import numpy as np
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_GTrsf, gp_Lin, gp_Mat, gp_Pnt, gp_Trsf, gp_XYZ
 
+from ..errors import SurfmodError
 from . import arrays
 from .geom import downcast_surface
 from .guard import check_done, kernel
@@ -20,11 +21,18 @@ from .guard import check_done, kernel
 # -- transforms ---------------------------------------------------------------------------
 
 
-def trsf(kind: str, *args) -> gp_Trsf:
+def named_trsf(kind: str, *args) -> gp_Trsf:
     """An OCCT ``gp_Trsf`` built with its own named setters (independent of surfmod's matrices).
 
     ``kind``: ``"translation" (vector)``, ``"rotation" (origin, direction, degrees)``,
     ``"mirror" (point, normal)`` (plane symmetry), ``"scale" (center, factor)``.
+
+    >>> named_trsf("translation", (1, 2, 3)).TranslationPart().Coord()
+    (1.0, 2.0, 3.0)
+    >>> named_trsf("shear", (1, 0, 0))
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: kind: expected translation, rotation, mirror or scale, got 'shear'
     """
     t = gp_Trsf()
     with kernel(f"gp_Trsf ({kind})"):
@@ -40,7 +48,7 @@ def trsf(kind: str, *args) -> gp_Trsf:
             c, f = args
             t.SetScale(arrays.pnt(c), float(f))
         else:
-            raise ValueError(kind)
+            raise SurfmodError(f"kind: expected translation, rotation, mirror or scale, got {kind!r}")
     return t
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
@@ -66,7 +67,6 @@ def edge_continuity(shape, samples: int = 17):
     between their outward normals (face orientation applied).  Returns ``(max_gap,
     max_angle_deg, edges)``; a per-edge loop (a check, not an evaluation path).
     """
-    import numpy as np
     from OCP.BRep import BRep_Tool
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
     from OCP.gp import gp_Pnt, gp_Vec

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace
 from OCP.TopoDS import TopoDS
 
+from .. import transforms
 from ..errors import SurfmodError
 from .guard import check_done, kernel
 
@@ -118,11 +120,9 @@ def shells_of(shape):
 def transformed_face(face, matrix):
     """A face mapped by a 4x4 affine matrix: ``BRepBuilderAPI_Transform`` for
     similarities (the surface type is kept), ``BRepBuilderAPI_GTransform`` otherwise."""
-    import numpy as np
     from OCP.BRepBuilderAPI import BRepBuilderAPI_GTransform, BRepBuilderAPI_Transform
     from OCP.gp import gp_GTrsf, gp_Mat, gp_XYZ
 
-    from .. import transforms
     from .analytic import trsf
 
     m = transforms.affine(matrix)
@@ -139,7 +139,6 @@ def transformed_face(face, matrix):
 def classify_uv(face, u, v, tolerance=None):
     """Boolean array: ``(u[i], v[i])`` inside the face or on its boundary
     (``BRepTopAdaptor_FClass2d`` at ``tolerance``, default the face's own tolerance)."""
-    import numpy as np
     from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
     from OCP.gp import gp_Pnt2d
     from OCP.TopAbs import TopAbs_OUT
@@ -155,7 +154,6 @@ def classify_uv(face, u, v, tolerance=None):
 def closest_on_face(face, points):
     """``(distances (N,), points (N, 3))``: closest points on a trimmed face (or any
     shape of faces: shell, compound), boundary included (``BRepExtrema_DistShapeShape``)."""
-    import numpy as np
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
     from OCP.BRepExtrema import BRepExtrema_DistShapeShape
     from OCP.gp import gp_Pnt
@@ -183,7 +181,6 @@ def closest_on_face(face, points):
 def face_wires_uv(face, samples: int):
     """The face's wires as ``(N, 2)`` arrays in ``(u, v)`` (outer wire first), each edge
     sampled at ``samples`` points of its p-curve in the wire's order."""
-    import numpy as np
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
     from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
     from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE

@@ -16,10 +16,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import checks
+from ..construct.elementary import PlaneSurface
+from ..construct.plane import ThreePointPlane
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve
+from ..readback.clip import as_face_surface, clip_curves
 from ..surface import Surface
 from . import marching
-from .project import nearest_samples, seed_parameters
+from .closest import closest_points, nearest_samples, seed_parameters
 
 # -- problems -------------------------------------------------------------------------------
 
@@ -119,8 +123,6 @@ class IntersectionCurve:
 
     def polyline(self):
         """The points as a degree-1 ``BSplineCurve`` (chord-length knots)."""
-        from ..nets.bspline import BSplineCurve
-
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(self.points, axis=0), axis=1))])
         chord = chord / chord[-1]
         return BSplineCurve._trusted(self.points, 1, np.concatenate([[0.0], chord, [1.0]]))
@@ -233,17 +235,15 @@ def plane_frame(origin, normal):
 
 def as_plane(value, name: str):
     """``(origin, unit normal)`` from ``(origin, normal)``, a build123d ``Plane`` or a
-    surfmod ``PlaneSurface`` (its infinite carrier plane)."""
-    from ..construct.plane import PlaneSurface
-
-    if isinstance(value, PlaneSurface):
+    surfmod plane surface (``PlaneSurface`` or ``ThreePointPlane``: its infinite carrier plane)."""
+    if isinstance(value, (PlaneSurface, ThreePointPlane)):
         return np.array(value.origin), np.array(value.normal)
     if hasattr(value, "z_dir") and hasattr(value, "origin"):  # build123d Plane
         return checks.point(tuple(value.origin), f"{name}.origin"), checks.direction(tuple(value.z_dir), f"{name}.z_dir")
     try:
         origin, normal = value
     except (TypeError, ValueError):
-        raise SurfmodError(f"{name}: expected a plane as (origin, normal), a build123d Plane or a PlaneSurface, got {value!r}") from None
+        raise SurfmodError(f"{name}: expected a plane as (origin, normal), a build123d Plane or a plane surface, got {value!r}") from None
     return checks.point(origin, f"{name} origin"), checks.direction(normal, f"{name} normal")
 
 
@@ -288,8 +288,6 @@ def _near_samples_of(s: Surface, tol: float):
 
 
 def _refuse_coincident(a, b, plane, tol: float, names) -> None:
-    from .project import closest_points
-
     if plane is not None:
         o, n = plane
         hit = _coincide_over_region(a, lambda p: np.abs((p - o) @ n), tol)
@@ -308,8 +306,8 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
               max_points: int = 1_000_000, progress: bool = False) -> list[IntersectionCurve]:
     """Intersection curves of two surfaces, or of a surface and an infinite plane.
 
-    ``b`` (or ``a``) may be a surfmod surface (a bounded patch, a ``PlaneSurface``
-    included) or an infinite plane given as ``(origin, normal)`` / a build123d ``Plane``.
+    ``b`` (or ``a``) may be a surfmod surface (a bounded patch, a ``PlaneSurface`` or
+    ``ThreePointPlane`` included) or an infinite plane given as ``(origin, normal)`` / a build123d ``Plane``.
     A build123d / OCP face, or a face read back with :func:`surfmod.from_face`, is a
     trimmed surface: the curves are clipped to its boundary.
     Every returned point lies on both within ``tolerance`` (Newton converges to ~1e-12
@@ -329,8 +327,6 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     >>> sm.intersect(s, ((0, 0, 5), (0, 0, 1)))
     []
     """
-    from ..readback.clip import as_face_surface, clip_curves
-
     tol = checks.positive(tolerance, "tolerance")
     angle = checks.real(max_angle, "max_angle", low=1e-3, high=90.0)
     # faces (build123d / OCP / read back) are trimmed surfaces: curves end at their boundary

@@ -1,15 +1,5 @@
-"""Closest-point projection of many points (or a sampled curve) onto a surface.
-
-Vectorized over all points at once: every point starts from the nearest triangles of a
-sampled grid (resolving every knot span, evenly spaced in chord length) and from the
-valley bottoms of its sampled distance; then a projected Newton iteration on
-``f(u, v) = |S(u, v) - P|^2 / 2`` runs on all starts together.  The domain is a box
-constraint: a parameter at its bound whose gradient points outward is held there and the
-other one is solved alone (the constrained step), so points whose closest point lies on
-an edge or at a corner converge too; a start stopped on a C0 crease with the distance
-still falling across it carries on in the next piece.  The best start wins.  The
-seeding is a dense sampling, not a proof of global optimality.
-"""
+"""Closest-point projection of many points (or a sampled curve) onto a surface or a
+trimmed face (the seeding and Newton iteration live in :mod:`surfmod.ops.closest`)."""
 
 from __future__ import annotations
 
@@ -18,8 +8,12 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import checks
+from ..curve import Curve
 from ..errors import SurfmodError
-from ..surface import Surface
+from ..readback.clip import as_face_surface, project_on_face
+from ..readback.trimmed import TrimmedFace
+from ..surface import Surface, require_surface
+from .closest import closest_points
 
 
 class Projection(NamedTuple):
@@ -37,244 +31,7 @@ class Projection(NamedTuple):
     distance: np.ndarray
 
 
-def seed_parameters(s: Surface, direction: int, per_span: int = 4, minimum: int = 24, maximum: int = 96) -> np.ndarray:
-    """Sample parameters along one direction: ``minimum`` equal steps over the domain
-    (so long spans are not starved when short spans hold most knots), every knot, and
-    ``per_span`` samples inside each knot span while that stays under ``maximum``."""
-    lo, hi = s.domain[direction]
-    even = np.linspace(lo, hi, minimum + 1)
-    knots = getattr(s, "knots", None)
-    if knots is None:
-        return even
-    k = np.asarray(knots[direction])
-    k = np.unique(np.concatenate([[lo, hi], k[(k > lo) & (k < hi)]]))
-    if (len(k) - 1) * per_span > maximum:
-        return np.unique(np.concatenate([np.linspace(lo, hi, maximum + 1), k]))
-    fine = [np.linspace(a, b, per_span, endpoint=False) for a, b in zip(k[:-1], k[1:])]
-    return np.unique(np.concatenate(fine + [even, k]))
-
-
-def nearest_samples(points: np.ndarray, samples: np.ndarray, count: int, chunk: int = 2_000_000) -> np.ndarray:
-    """Indices ``(N, count)`` of the ``count`` nearest ``samples`` to each point (chunked)."""
-    count = min(count, len(samples))
-    out = np.empty((len(points), count), dtype=int)
-    step = max(1, chunk // max(1, len(samples)))
-    s2 = np.einsum("ij,ij->i", samples, samples)
-    for a in range(0, len(points), step):  # loop over memory chunks, not points
-        p = points[a : a + step]
-        d2 = s2[None, :] - 2 * p @ samples.T
-        idx = np.argpartition(d2, count - 1, axis=1)[:, :count] if count < len(samples) else np.argsort(d2, axis=1)
-        out[a : a + step] = idx
-    return out
-
-
-def crease_breaks(s: Surface, direction: int) -> np.ndarray:
-    """Domain ends and the C0 knot lines (multiplicity >= degree) between them.
-
-    Across such a crease the distance has a kink that Newton cannot settle on, so each
-    start works in its own smooth piece between two breaks; a minimum on the crease then
-    becomes a constrained (boundary) minimum of the piece.
-    """
-    lo, hi = s.domain[direction]
-    knots, degree = getattr(s, "knots", None), getattr(s, "degree", None)
-    if knots is None or degree is None:
-        return np.array([lo, hi])
-    values, mult = np.unique(np.asarray(knots[direction]), return_counts=True)
-    creases = values[(mult >= degree[direction]) & (values > lo) & (values < hi)]
-    return np.concatenate([[lo], creases, [hi]])
-
-
-def _piece_of(breaks: np.ndarray, t: np.ndarray) -> np.ndarray:
-    return np.clip(np.searchsorted(breaks, t, side="right") - 1, 0, len(breaks) - 2)
-
-
-def newton_closest(s: Surface, points: np.ndarray, u: np.ndarray, v: np.ndarray, iterations: int = 60):
-    """Projected Newton on ``|S - P|^2 / 2`` from starts ``(u, v)`` (flat arrays, one per
-    point row of ``points``), each kept inside its smooth piece (:func:`crease_breaks`).
-
-    A start that stops on a crease while the distance still falls across it carries on
-    in the neighbouring piece, so a minimum beyond a crease is reached and a minimum on
-    a crease is one from both sides.  Returns refined ``(u, v)``.
-    """
-    u, v = u.astype(float).copy(), v.astype(float).copy()
-    breaks_u, breaks_v = crease_breaks(s, 0), crease_breaks(s, 1)
-    piece_u, piece_v = _piece_of(breaks_u, u), _piece_of(breaks_v, v)
-    todo = np.arange(u.size)
-    for _ in range(len(breaks_u) + len(breaks_v)):  # each crossing moves one piece on
-        pu, pv = piece_u[todo], piece_v[todo]
-        box = (breaks_u[pu], breaks_u[pu + 1], breaks_v[pv], breaks_v[pv + 1])
-        u[todo], v[todo] = _newton_in_boxes(s, points[todo], u[todo], v[todo], box, iterations)
-        d = s._derivatives(u[todo], v[todo], 1)
-        r = d[:, 0, 0] - points[todo]
-        gu, gv = np.einsum("ij,ij->i", r, d[:, 1, 0]), np.einsum("ij,ij->i", r, d[:, 0, 1])
-        # descent leaves the piece through an interior crease: step into the next piece
-        down_u = (u[todo] <= box[0]) & (gu > 0) & (piece_u[todo] > 0)
-        up_u = (u[todo] >= box[1]) & (gu < 0) & (piece_u[todo] < len(breaks_u) - 2)
-        down_v = (v[todo] <= box[2]) & (gv > 0) & (piece_v[todo] > 0)
-        up_v = (v[todo] >= box[3]) & (gv < 0) & (piece_v[todo] < len(breaks_v) - 2)
-        piece_u[todo] += up_u.astype(int) - down_u.astype(int)
-        piece_v[todo] += up_v.astype(int) - down_v.astype(int)
-        todo = todo[down_u | up_u | down_v | up_v]
-        if todo.size == 0:
-            break
-    return u, v
-
-
-def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
-    """The projected Newton iteration, each start confined to its box ``(u0, u1, v0, v1)``."""
-    (du0, du1), (dv0, dv1) = s.domain
-    spanu, spanv = du1 - du0, dv1 - dv0
-    u, v = u.copy(), v.copy()
-    if hasattr(s, "_local_net"):  # B-spline / NURBS: the same iteration, compiled
-        from ..eval.kernels import binomials
-        from .newton import newton_boxes
-
-        net = s._local_net()
-        u, v = np.require(u, float, ["C", "W"]), np.require(v, float, ["C", "W"])
-        bounds = [np.require(b, float, ["C", "W"]) for b in box]
-        newton_boxes(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v,
-                     net.bucket_u, net.bucket_v, binomials(2), binomials(0), np.require(points, float, ["C", "W"]),
-                     u, v, *bounds, float(spanu), float(spanv), int(iterations))
-        return u, v
-    active = np.ones(u.shape, bool)
-    for _ in range(iterations):
-        idx = np.nonzero(active)[0]
-        if idx.size == 0:
-            break
-        uu, vv, pp = u[idx], v[idx], points[idx]
-        u0, u1, v0, v1 = (bound[idx] for bound in box)
-        d = s._derivatives(uu, vv, 2)
-        S, Su, Sv = d[:, 0, 0], d[:, 1, 0], d[:, 0, 1]
-        r = S - pp
-        gu, gv = np.einsum("ij,ij->i", r, Su), np.einsum("ij,ij->i", r, Sv)
-        a, b, c = (np.einsum("ij,ij->i", x, y) for x, y in ((Su, Su), (Su, Sv), (Sv, Sv)))
-        huu = a + np.einsum("ij,ij->i", r, d[:, 2, 0])
-        huv = b + np.einsum("ij,ij->i", r, d[:, 1, 1])
-        hvv = c + np.einsum("ij,ij->i", r, d[:, 0, 2])
-        tiny = 1e-300 + 1e-14 * (a + c) ** 2
-        # held at a bound, the step is one-dimensional: its own second derivative decides
-        # (the 2x2 Hessian may be indefinite through the other direction)
-        huu_1d = np.maximum(np.where(huu > 1e-14 * (a + c), huu, a), 1e-300)
-        hvv_1d = np.maximum(np.where(hvv > 1e-14 * (a + c), hvv, c), 1e-300)
-        indefinite = (huu <= 0) | (hvv <= 0) | (huu * hvv - huv**2 <= tiny)
-        huu, huv, hvv = np.where(indefinite, a, huu), np.where(indefinite, b, huv), np.where(indefinite, c, hvv)
-        huu = np.maximum(huu, 1e-300 + 1e-14 * (a + c))
-        hvv = np.maximum(hvv, 1e-300 + 1e-14 * (a + c))
-        det = np.maximum(huu * hvv - huv**2, tiny)
-        du = (-gu * hvv + gv * huv) / det
-        dv = (-gv * huu + gu * huv) / det
-        # constrained step: a parameter held at its bound when the descent leaves the domain
-        fix_u = ((uu <= u0) & (gu > 0)) | ((uu >= u1) & (gu < 0))
-        fix_v = ((vv <= v0) & (gv > 0)) | ((vv >= v1) & (gv < 0))
-        du = np.where(fix_u, 0.0, np.where(fix_v, -gu / huu_1d, du))
-        dv = np.where(fix_v, 0.0, np.where(fix_u, -gv / hvv_1d, dv))
-        # no jumps across the whole patch in one step
-        du = np.clip(du, -0.25 * spanu, 0.25 * spanu)
-        dv = np.clip(dv, -0.25 * spanv, 0.25 * spanv)
-        f0 = np.einsum("ij,ij->i", r, r)
-        nu, nv = np.clip(uu + du, u0, u1), np.clip(vv + dv, v0, v1)
-        trial = np.arange(idx.size)
-        step = 1.0
-        for _ in range(8):  # backtracking on the points whose distance grew
-            rn = s._derivatives(nu[trial], nv[trial], 0)[:, 0, 0] - pp[trial]
-            worse = np.einsum("ij,ij->i", rn, rn) > f0[trial] * (1 + 1e-12) + 1e-300
-            trial = trial[worse]
-            if trial.size == 0:
-                break
-            step /= 4
-            nu[trial] = np.clip(uu[trial] + step * du[trial], u0[trial], u1[trial])
-            nv[trial] = np.clip(vv[trial] + step * dv[trial], v0[trial], v1[trial])
-        # no decrease even for a tiny step: converged to round-off, stay
-        nu[trial], nv[trial] = uu[trial], vv[trial]
-        moved = np.maximum(np.abs(nu - uu) / spanu, np.abs(nv - vv) / spanv)
-        u[idx], v[idx] = nu, nv
-        # quadratic convergence: a step below 1e-10 leaves an error ~1e-20
-        active[idx] = moved > 1e-10
-    return u, v
-
-
-def _even_chords(t: np.ndarray, chords: np.ndarray) -> np.ndarray:
-    """As many parameters as ``t`` whose steps have equal cumulative chord length."""
-    arc = np.concatenate([[0.0], np.cumsum(chords)])
-    if not arc[-1] > 0:
-        return t
-    return np.interp(np.linspace(0.0, arc[-1], len(t)), arc, t)
-
-
-def seed_grid(s: Surface):
-    """Seed parameters ``(us, vs)`` and their grid points.
-
-    The knot-based samples of :func:`seed_parameters` are moved to equal steps of chord
-    length (the longest chord across the other direction) and the knots added back, so
-    that stretched regions -- strongly varying weights, long spans -- are sampled as
-    finely in space as the rest; otherwise a coarse triangle there may hide the closest
-    point.
-    """
-    us, vs = seed_parameters(s, 0), seed_parameters(s, 1)
-    g = s.grid(us, vs)
-    chords_u = np.linalg.norm(np.diff(g, axis=0), axis=-1).max(axis=1)
-    chords_v = np.linalg.norm(np.diff(g, axis=1), axis=-1).max(axis=0)
-    us = np.unique(np.concatenate([_even_chords(us, chords_u), _knots_inside(s, 0)]))
-    vs = np.unique(np.concatenate([_even_chords(vs, chords_v), _knots_inside(s, 1)]))
-    return us, vs, s.grid(us, vs)
-
-
-def _knots_inside(s: Surface, direction: int) -> np.ndarray:
-    knots = getattr(s, "knots", None)
-    if knots is None:
-        return np.empty(0)
-    lo, hi = s.domain[direction]
-    k = np.asarray(knots[direction])
-    return k[(k >= lo) & (k <= hi)]
-
-
-def seed_starts(points, us, vs, g, seeds: int) -> np.ndarray:
-    """Newton starts ``(N, seeds + seeds // 2, 2)`` in (u, v) for each point.
-
-    The grid ``g`` is split into two triangles per cell.  On each triangle the closest
-    point of its plane with the barycentric coordinates clipped to the triangle (exact
-    inside, a good seed near edges) is the foot.  Starts: the ``seeds`` triangles with
-    the nearest feet, entered at those points; and the bottoms of the deepest valleys of
-    the sampled distance (samples no farther than their eight neighbours), because in a
-    nearly flat valley all nearest triangles sit in one basin.  The search is the
-    compiled branch and bound of :mod:`surfmod.ops.seeding` (cells whose nearest corner
-    is farther than the current ``seeds``-th foot plus the cell's diameter are skipped).
-    """
-    from .seeding import row_diameters, seed_kernel, triangle_tables  # numba, loaded on first use
-
-    e, gram, cross, diam = triangle_tables(g)
-    n_basins = max(2, seeds // 2)
-    out = np.empty((len(points), seeds + n_basins, 2))
-    seed_kernel(np.require(points, float, ["C", "W"]), np.require(g, float, ["C", "W"]),
-                np.require(us, float, ["C", "W"]), np.require(vs, float, ["C", "W"]),
-                e, gram, cross, diam, row_diameters(diam), int(seeds), int(n_basins), out)
-    return out
-
-
-def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
-    """``(u, v, point, distance)`` flat arrays for ``(N, 3)`` points (trusted input)."""
-    us, vs, g = seed_grid(s)
-    start = seed_starts(points, us, vs, g, seeds)
-    k = start.shape[1]
-    rep = np.repeat(points, k, axis=0)
-    # about half the starts of a point repeat another one exactly (a valley bottom at a
-    # triangle's corner, short lists padded): iterate each distinct start once
-    owner = np.repeat(np.arange(len(points)), k)
-    flat = start.reshape(-1, 2)
-    _, first, inverse = np.unique(np.c_[owner, flat], axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.ravel()
-    u, v = newton_closest(s, rep[first], flat[first, 0], flat[first, 1])
-    u, v = u[inverse], v[inverse]
-    pts = s._derivatives(u, v, 0)[:, 0, 0]
-    dist = np.linalg.norm(pts - rep, axis=1).reshape(-1, k)
-    best = np.argmin(dist, axis=1)
-    pick = np.arange(len(points)) * k + best
-    return u[pick], v[pick], pts[pick], dist[np.arange(len(points)), best]
-
-
 def _as_points(points_or_curve, samples):
-    from ..curve import Curve
-
     if isinstance(points_or_curve, Curve):
         t0, t1 = points_or_curve.domain
         return points_or_curve.points(np.linspace(t0, t1, samples))
@@ -314,10 +71,7 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8,
     >>> pr.u, pr.v, pr.distance
     (array([0.25, 1.  ]), array([0.5, 0.5]), array([2., 2.]))
     """
-    from ..readback.clip import as_face_surface, project_on_face
-    from ..readback.trimmed import TrimmedFace
-
-    s = checks.surface(as_face_surface(s), "s")  # a face is a trimmed surface: distances are to the face
+    s = require_surface(as_face_surface(s), "s")  # a face is a trimmed surface: distances are to the face
     samples = checks.count(samples, "samples", minimum=2, maximum=checks.MAX_POINTS)
     seeds = checks.count(seeds, "seeds", minimum=1, maximum=64)
     pts = _as_points(points_or_curve, samples)

@@ -23,7 +23,7 @@ from ..errors import SurfmodError
 from ..surface import Surface
 from . import marching
 from .intersect import _Base, _implicit_seeds, _size, as_plane, plane_frame
-from .project import nearest_samples, seed_parameters
+from .closest import nearest_samples, seed_parameters
 
 
 class Silhouette(_Base):
@@ -183,7 +183,7 @@ def _chain(pieces, size, gap: float = 2e-3):
 
 def shadow(obj: Surface, light_direction, plane, *, max_angle: float = 2.5) -> Shadow:
     """The shadow of ``obj`` cast by parallel light along ``light_direction`` onto
-    ``plane`` (``(origin, normal)``, a build123d ``Plane`` or a ``PlaneSurface``'s carrier).
+    ``plane`` (``(origin, normal)``, a build123d ``Plane`` or the carrier of a ``PlaneSurface`` / ``ThreePointPlane``).
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 1), (2, 0, 1), (0, 1, 1))
@@ -222,9 +222,9 @@ def shadow(obj: Surface, light_direction, plane, *, max_angle: float = 2.5) -> S
     left = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1, keepdims=True)
     eps = 1e-3 * size2
     cov = _covered(obj, to2d, np.concatenate([mid + eps * left, mid - eps * left]), 1e-6 * eps)
-    cl, cr = cov[: len(mid)], cov[len(mid) :]
-    keep = cl ^ cr
-    oriented = np.where(cr[keep][:, None, None], pieces[keep][:, ::-1], pieces[keep])
+    covered_left, covered_right = cov[: len(mid)], cov[len(mid) :]
+    keep = covered_left ^ covered_right  # a shadow edge has shadow on exactly one side
+    oriented = np.where(covered_right[keep][:, None, None], pieces[keep][:, ::-1], pieces[keep])
     loops2 = _chain(oriented, size2)
     chained = sum(float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))) for p in loops2)
     kept = float(np.sum(np.linalg.norm(oriented[:, 1] - oriented[:, 0], axis=1)))

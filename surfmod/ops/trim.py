@@ -12,7 +12,11 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks
+from ..curve import Curve
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve
+from ..readback.clip import as_face_surface
+from ..readback.trimmed import TrimmedFace
 from ..surface import Surface
 
 #: Closing gap allowed between the first and last point of a loop, relative to the domain.
@@ -41,7 +45,6 @@ class Loop:
         if self.kind == "polyline":
             return Loop("polyline", self.data[::-1].copy())
         c = self.data
-        from ..nets.bspline import BSplineCurve
 
         k = c.knots
         return Loop("bspline", BSplineCurve._trusted(c.control_points[::-1], c.degree, (k[0] + k[-1]) - k[::-1], None if c.weights is None else c.weights[::-1]))
@@ -60,8 +63,6 @@ def _curve_breaks(curve, per_span):
 
 
 def _loop(value, name, domain) -> Loop:
-    from ..curve import Curve
-
     (u0, u1), (v0, v1) = domain
     size = max(u1 - u0, v1 - v0)
     if isinstance(value, Curve):
@@ -96,8 +97,6 @@ def _loop(value, name, domain) -> Loop:
 
 def boundary_loops(s: Surface, boundary_curve_uv) -> list[Loop]:
     """Validated loops, oriented: the outer one counter-clockwise, holes clockwise."""
-    from ..curve import Curve
-
     if isinstance(boundary_curve_uv, Curve):
         raw = [boundary_curve_uv]
     elif isinstance(boundary_curve_uv, np.ndarray) or _is_point_list(boundary_curve_uv):
@@ -235,9 +234,6 @@ def trimmed_area(s: Surface, boundary_curve_uv=None, order: int = 24) -> float:
     0.5
     """
     if boundary_curve_uv is None:
-        from ..readback.clip import as_face_surface
-        from ..readback.trimmed import TrimmedFace
-
         face = as_face_surface(s)
         if not isinstance(face, TrimmedFace):
             raise SurfmodError("boundary_curve_uv: needed unless s is a face (it carries its own boundary)")

@@ -39,6 +39,9 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..meshing.polymesh import Mesh
+from ..nets.bezier import BezierSurface
+from ..nets.bspline import BSplineSurface
 from . import topology as tp
 from .catmull_clark import step as cc_step
 from .masks import _cc_limit
@@ -240,10 +243,6 @@ def limit_surface(
 
 def _assemble(v, topo, crease, levels, adaptive, tangent_plane, extra):
     """Patches of every adaptive level, the kept selection, and the measurements."""
-    from ..meshing.polymesh import Mesh
-    from ..nets.bezier import BezierSurface
-    from ..nets.bspline import BSplineSurface
-
     mesh = Mesh(v, topo.quads(), {"levels": levels, "scheme": "catmull-clark"})
     boundary_edges = int(topo.boundary.sum())
     active = np.ones(topo.n_faces, dtype=bool)
@@ -448,21 +447,21 @@ def _measure(v, topo, crease, owner, maps, nets, regular, extra, samples: int = 
     edge_reg = (regular[owner[ff]] & regular[owner[fg]])[smooth]
 
     # 2. against the exact limit: vertices of further levels, placed with the masks
-    vv, tp_, cr, own, mp = v, topo, crease, owner, maps
+    fine_v, fine_topo, fine_crease, fine_owner, fine_maps = v, topo, crease, owner, maps
     for _ in range(extra):
-        vv, tp_, cr, own, mp = _refine(vv, tp_, cr, own, mp)
-    pos, nrm, _ = _cc_limit(vv, tp_, cr)
-    faces = np.repeat(np.arange(tp_.n_faces), 4)
-    corner = np.tile(np.arange(4), tp_.n_faces)
-    vert = tp_.corners
+        fine_v, fine_topo, fine_crease, fine_owner, fine_maps = _refine(fine_v, fine_topo, fine_crease, fine_owner, fine_maps)
+    pos, nrm, _ = _cc_limit(fine_v, fine_topo, fine_crease)
+    faces = np.repeat(np.arange(fine_topo.n_faces), 4)
+    corner = np.tile(np.arange(4), fine_topo.n_faces)
+    vert = fine_topo.corners
     # one sample per (vertex, patch): vertices on patch borders are checked on each side
-    _, first = np.unique(vert * len(nets) + own[faces], return_index=True)
+    _, first = np.unique(vert * len(nets) + fine_owner[faces], return_index=True)
     faces, corner, vert = faces[first], corner[first], vert[first]
-    uv = _apply(mp, faces, _CORNER_UV[corner])
-    p, nn = _bezier_at(nets, own[faces], uv[:, 0], uv[:, 1])
+    uv = _apply(fine_maps, faces, _CORNER_UV[corner])
+    p, nn = _bezier_at(nets, fine_owner[faces], uv[:, 0], uv[:, 1])
     dev = np.linalg.norm(p - pos[vert], axis=1)
     ang = _angle_deg(nn, nrm[vert])
-    reg = regular[own[faces]]
+    reg = regular[fine_owner[faces]]
     return {
         "max_gap": gap,
         "max_gap_rel": gap / size,

@@ -25,6 +25,8 @@ from typing import NamedTuple
 import numpy as np
 
 from . import topology as tp
+from .catmull_clark import step
+from .loop import loop_beta
 
 
 class LimitPoints(NamedTuple):
@@ -125,8 +127,6 @@ def catmull_clark_limit(vertices, faces, *, creases=None) -> LimitPoints:
     sharp = tp.crease_flags(topo, creases)
     n_orig = len(v)
     if np.any(topo.sizes != 4):
-        from .catmull_clark import step
-
         v, topo, sharp = step(v, topo, sharp)
     out = _cc_limit(v, topo, sharp)
     return LimitPoints(*(a[:n_orig] for a in out))
@@ -177,8 +177,6 @@ def loop_limit(vertices, triangles, *, beta: str = "loop") -> LimitPoints:
     >>> sm.loop_limit(tet_v, tet_f).normals[0].round(6)
     array([0.57735, 0.57735, 0.57735])
     """
-    from .loop import loop_beta
-
     v, topo = tp.polygon_mesh(vertices, triangles, faces_name="triangles", face_size=3)
     loop_beta(3, beta)  # validates the name
     sharp = topo.boundary

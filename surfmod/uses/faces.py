@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..construct.elementary import AnalyticPlane, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
+from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
 from ..construct.conics import Conic
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.offset_surface import OffsetSurface
@@ -78,7 +78,7 @@ def direction_breaks(surface, direction: int):
         return "angular" if direction == 0 else _curve_breaks(surface.profile)
     if isinstance(surface, TabulatedCylinder):
         return _curve_breaks(surface.curve) if direction == 0 else None
-    if isinstance(surface, AnalyticPlane):
+    if isinstance(surface, PlaneSurface):
         return None
     if isinstance(surface, (SphericalSurface, ToroidalSurface)):
         return "angular"

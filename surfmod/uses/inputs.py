@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 
 from ..errors import SurfmodError
+from ..surface import Surface
 
 
 def load_step(path, name: str = "obj"):
@@ -21,8 +22,6 @@ def load_step(path, name: str = "obj"):
 
 
 def _single(item, name):
-    from ..surface import Surface
-
     if isinstance(item, Surface):
         return item.face().wrapped
     shape = getattr(item, "wrapped", item)

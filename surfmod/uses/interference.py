@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import checks
+from .inputs import to_shape
 
 
 @dataclass(frozen=True)
@@ -70,7 +71,6 @@ def interference(a, b, tolerance: float = 1e-6) -> Interference:
     (1.0, 'clearance')
     """
     from ..occ import uses as occ
-    from .inputs import to_shape
 
     tolerance = checks.positive(tolerance, "tolerance")
     sa = to_shape(a, "a", solid=True)
