@@ -34,11 +34,12 @@ def _bspline():
     return sm.BSplineSurface(wavy_net(7, 5), (3, 2), (ku, kv))
 
 
+@pytest.mark.parametrize("method", ["grid", "adaptive"])
 @pytest.mark.parametrize("tol", [0.05, 0.01])
-def test_measured_deviation_is_within_tolerance_and_confirmed_by_occt(tol):
+def test_measured_deviation_is_within_tolerance_and_confirmed_by_occt(tol, method):
     s = _bspline()
-    m = sm.tessellate(s, tol)
-    assert m.info["kind"] == "adaptive"
+    m = sm.tessellate(s, tol, method=method)
+    assert m.info["kind"] == method
     assert 0 < m.info["max_deviation"] <= tol
     assert m.info["triangles"] == len(m.faces)
     # independent: OCCT's projection of random triangle points
