@@ -108,7 +108,7 @@ def _ours(s, tol):
 
 
 def rows(tolerances=(0.01, 0.001)):
-    out = []
+    """One tuple per surface and tolerance, yielded as soon as it is measured."""
     for name, s in surfaces().items():
         face = s.face()
         sm.tessellate(s, 0.1)  # warm-up: numba kernels loaded from the cache
@@ -118,8 +118,7 @@ def rows(tolerances=(0.01, 0.001)):
             t_b = _brep_time(face, tol)
             n_ok, dev_ok, d_ok = _brep_ok(face, tol)
             t_ok = _brep_time(face, d_ok)
-            out.append((name, tol, len(m.faces), m.info["max_deviation"], dt, n_b, dev_b, t_b, n_ok, dev_ok, t_ok))
-    return out
+            yield name, tol, len(m.faces), m.info["max_deviation"], dt, n_b, dev_b, t_b, n_ok, dev_ok, t_ok
 
 
 def solid_rows(tolerances=(0.01, 0.001)):
@@ -155,7 +154,8 @@ def main() -> None:
         flag = "" if dev_b <= tol else " (!)"
         print(
             f"| {name:<28} | {tol:>6g} | {n:>9d} | {dev:>9.3g} | {dt:>7.3f} | {n_b:>13d} | {dev_b:>8.3g}{flag:<4} "
-            f"| {t_b:>10.3f} | {n_ok:>16d} | {dev_ok:>9.3g} | {t_ok:>7.3f} | {n / n_ok:>12.2f} | {dt / t_b:>10.2f} |"
+            f"| {t_b:>10.3f} | {n_ok:>16d} | {dev_ok:>9.3g} | {t_ok:>7.3f} | {n / n_ok:>12.2f} | {dt / t_b:>10.2f} |",
+            flush=True,
         )
     print("(!) BRepMesh's measured deviation exceeds the requested deflection\n")
     head2 = (

@@ -107,6 +107,9 @@ def _densities(s, tol: float, us: np.ndarray, vs: np.ndarray):
     ku, kv = lu / np.maximum(E, tiny), lv / np.maximum(G, tiny)  # normal curvatures
     d2 = d[..., 2, 0, :], d[..., 0, 2, :]
     elliptic = (L > 0) & (N > 0) & (np.einsum("...i,...i->...", d2[0], d2[1]) != 0)
+    # at elliptic points a triangle's interior sags by both chords' sagittas: each
+    # direction gets half the tolerance (c = 4) where the other bends as much, all of
+    # it (c = 8) where the other does not bend (measured better than an equal share)
     cu = np.where(elliptic, 4.0 + 4.0 * (1.0 - np.minimum(1.0, kv / np.maximum(ku, tiny))), 8.0)
     cv = np.where(elliptic, 4.0 + 4.0 * (1.0 - np.minimum(1.0, ku / np.maximum(kv, tiny))), 8.0)
     rate_u = np.where(regular, np.sqrt(lu / (cu * tol)), 0.0)
@@ -202,32 +205,41 @@ class GridMesh:
         return float(self.err.max(initial=0.0))
 
     def _project(self, blocks, cand, top: float) -> None:
-        """Replace the bound by the distance measured by Gauss-Newton projection at the
-        samples that decide: near the maximum when the grid passes (the reported
-        maximum is then a measured one), just over the tolerance when it does not
-        (those a projection may clear; farther ones fail anyway)."""
+        """When the grid passes, make its reported maximum a *measured* one: project the
+        samples with the largest bounds onto the surface by Gauss-Newton, in rounds
+        (bounds >= 0.98 of the maximum first, then down to the largest distance
+        measured so far), until no sample left unprojected has a bound above the
+        measured maximum.  A failing grid is refined without projecting (its bound is
+        within a few per cent of the distance, so projections would rarely clear it)."""
+        if top > self.tol or not cand:
+            return
         est_all = np.concatenate([blocks[c[0]][2].ravel()[c[1]] for c in cand])
-        if top <= self.tol:
-            keep = est_all >= 0.9 * top
-        else:
-            keep = (est_all > self.tol) & (est_all <= 1.05 * self.tol)
-        total = sum(b[2].size for b in blocks)
-        if not 0 < keep.sum() <= max(20000, total // 10):
-            return  # too many: the bound stands (it is the larger value)
-        q = np.concatenate([c[2] for c in cand])[keep]
-        uv = np.concatenate([c[3] for c in cand])[keep]
-        s = self.s
-        dist = project_distances(
-            lambda u, v: s._derivatives(u, v, 1), q, uv, self.bounds,
-            d0=lambda u, v: s._derivatives(u, v, 0)[:, 0, 0],
-        )
+        q_all = np.concatenate([c[2] for c in cand])
+        uv_all = np.concatenate([c[3] for c in cand])
         offsets = np.cumsum([0] + [len(c[1]) for c in cand])
-        pos = np.flatnonzero(keep)
+        s = self.s
+        done = np.zeros(len(est_all), bool)
+        hi, measured = np.inf, 0.0
+        lo = 0.98 * top
+        while True:
+            sel = np.flatnonzero(~done & (est_all >= lo) & (est_all < hi))
+            if sel.size:
+                dist = project_distances(
+                    lambda u, v: s._derivatives(u, v, 1), q_all[sel], uv_all[sel], self.bounds,
+                    d0=lambda u, v: s._derivatives(u, v, 0)[:, 0, 0],
+                )
+                est_all[sel] = np.minimum(est_all[sel], dist)
+                done[sel] = True
+                measured = max(measured, float(est_all[sel].max()))
+            rest = est_all[~done]
+            if rest.size == 0 or rest.max() <= measured:
+                break
+            hi, lo = lo, max(measured, 0.9 * lo)
+        # write the measured distances back into the blocks' bounds
         for k, (bi, idx, _, _) in enumerate(cand):
-            sel = pos[(pos >= offsets[k]) & (pos < offsets[k + 1])]
+            part = slice(offsets[k], offsets[k + 1])
             flat = blocks[bi][2].reshape(-1)
-            j = idx[sel - offsets[k]]
-            flat[j] = np.minimum(flat[j], dist[np.searchsorted(pos, sel)])
+            flat[idx] = est_all[part]
 
     def refine(self) -> bool:
         """Refine the strips of failing cells in the direction whose sides sag (both when

@@ -46,8 +46,8 @@ def estimate_triangles(s, tolerance: float, size: float) -> float:
     return float(2.0 * np.sum(da * per_u * per_v))
 
 
-def _check_tolerance(s, tolerance: float, max_triangles: int) -> float:
-    """The surface size; refuses tolerances below float64 resolution or needing more than
+def _check_tolerance(s, tolerance: float, max_triangles: int) -> tuple[float, float]:
+    """The surface size and the curvature estimate of the triangle count; refuses tolerances below float64 resolution or needing more than
     ``max_triangles`` by the curvature estimate (before anything large is allocated)."""
     size = _surface_size(s)
     if tolerance < MIN_RELATIVE_TOLERANCE * size:
@@ -61,7 +61,7 @@ def _check_tolerance(s, tolerance: float, max_triangles: int) -> float:
             f"tolerance: {tolerance:g} would need about {estimate:,.0f} triangles, above the limit "
             f"max_triangles={max_triangles:,}"
         )
-    return size
+    return size, estimate
 
 
 #: a structured grid with more than this many times the curvature estimate of triangles
@@ -88,7 +88,7 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
 
     if method not in ("auto", "grid", "adaptive"):
         raise SurfmodError(f"method: expected 'auto', 'grid' or 'adaptive', got {method!r}")
-    size = _check_tolerance(s, tolerance, max_triangles)
+    size, estimate = _check_tolerance(s, tolerance, max_triangles)
     with tqdm(desc="tessellate", unit="pass", disable=not progress, leave=False) as bar:
         if method == "grid":
             return _grid_mesh(s, tolerance, max_triangles, size, bar)
@@ -98,7 +98,7 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
             grid = _grid_mesh(s, tolerance, max_triangles, size, bar)
         except SurfmodError:
             grid = None  # e.g. over max_triangles as a tensor grid: local refinement may fit
-        if grid is not None and len(grid.faces) <= LOCAL_FEATURE_RATIO * estimate_triangles(s, tolerance, size):
+        if grid is not None and len(grid.faces) <= LOCAL_FEATURE_RATIO * estimate:
             return grid
         try:
             local = _adaptive_mesh(s, tolerance, max_triangles, bar)
