@@ -42,6 +42,8 @@ BLOCK_POINTS = 1 << 18
 MAX_PASSES = 40
 #: verification passes spent on coarsening after the first passing grid
 COARSEN_PASSES = 2
+#: coarsen only when it would leave fewer than this fraction of the cells
+COARSEN_GAIN = 0.9
 
 
 def crease_breaks(s, direction: int) -> np.ndarray:
@@ -305,10 +307,11 @@ class GridMesh:
         stay well inside the tolerance, by ``sqrt(err / tol)`` per strip (a cell's error
         grows at most by the square of the larger of its two strips' step ratios, so
         each cell stays within the tolerance to the model's accuracy), and place the
-        lines again.  False when no strip has room."""
-        changed = False
+        lines again.  False (nothing changed) when that would save less than
+        ``1 - COARSEN_GAIN`` of the cells: not worth the verification it costs."""
+        new_lines, new_rates = [self.us, self.vs], list(self.rates)
         for axis in (0, 1):
-            lines = self.us if axis == 0 else self.vs
+            lines = new_lines[axis]
             worst = self.err.max(axis=1 - axis)  # per strip
             c = np.sqrt(np.maximum(worst, 1e-3 * self.tol) / self.tol) * 1.03
             if not np.any(c < 0.9):
@@ -318,16 +321,17 @@ class GridMesh:
             cs = np.minimum(c[strip], 1.0)
             present = 1.0 / np.diff(lines)[strip]
             # the density the present strips realise, lowered where they have room
-            self.rates[axis] = np.where(cs < 0.9, np.minimum(self.rates[axis], present) * np.maximum(cs, 0.5),
-                                        self.rates[axis])
-            new = equidistribute(params, self.rates[axis], self.breaks[axis])
+            new_rates[axis] = np.where(cs < 0.9, np.minimum(self.rates[axis], present) * np.maximum(cs, 0.5),
+                                       self.rates[axis])
+            new = equidistribute(params, new_rates[axis], self.breaks[axis])
             if len(new) < len(lines):
-                changed = True
-                if axis == 0:
-                    self.us = new
-                else:
-                    self.vs = new
-        return changed
+                new_lines[axis] = new
+        cells = (len(new_lines[0]) - 1) * (len(new_lines[1]) - 1)
+        if cells >= COARSEN_GAIN * (len(self.us) - 1) * (len(self.vs) - 1):
+            return False
+        self.us, self.vs = new_lines
+        self.rates = new_rates
+        return True
 
     def snapshot(self):
         return (self.us, self.vs, self.err, self.diag, self.verts)
