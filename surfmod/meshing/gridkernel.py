@@ -127,7 +127,15 @@ def estimates(S, K, diag, kmax, est, Q):
 def cell_maxima(est, K, err, eu, ev):
     """Per cell the largest ``est`` over its lattice points (sides shared with the
     neighbours), and the largest at the midpoints of its u-sides (``eu``) and v-sides
-    (``ev``)."""
+    (``ev``).
+
+    >>> import numpy as np
+    >>> est = np.zeros((5, 3)); est[2, 0] = 1.0  # K = 2: 2 x 1 cells; a corner both share
+    >>> err, eu, ev = np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1))
+    >>> cell_maxima(est, 2, err, eu, ev)
+    >>> err.ravel().tolist(), ev.ravel().tolist(), eu.ravel().tolist()
+    ([1.0, 1.0], [0.0, 0.0], [0.0, 0.0])
+    """
     nlu, nlv = est.shape
     ncu, ncv = err.shape
     h = K // 2

@@ -11,17 +11,22 @@ equidistributing a chordal-error bound, then *verified* and refined where it fai
    lines.
 2. **Verification.**  Every cell is sampled on a ``6 x 6`` lattice (the 25 sample points
    per triangle of :mod:`surfmod.meshing.deviation`, for either diagonal), evaluated as
-   one tensor grid of positions and first partials.  At each sample ``q = L(u, v)``
-   (the triangles' linear interpolation) the residual ``r = S(u, v) - q`` is split into
-   its tangential part (a Gauss-Newton step ``J delta``) and its normal part; the
-   distance from ``q`` to the surface is at most ``|r_normal| + kappa |J delta|^2 / 2``
-   to second order (``kappa``: the largest sampled normal curvature, times a margin).
-   Samples whose bound exceeds the tolerance, and those within 10 % of the largest, are
-   projected onto the surface by Gauss-Newton (:func:`project_distances`): the reported
-   ``max_deviation`` is that measured maximum.
-3. **Refinement.**  Cells that fail insert the midline of their u- or v-strip (or both),
-   following which of their edges' chords sag more, and the grid is verified again;
-   a tolerance that cannot be reached within ``max_triangles`` raises.
+   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridkernel`).
+   At each sample ``q = L(u, v)`` (the triangles' linear interpolation) the residual
+   ``r = S(u, v) - q`` is split into its tangential part (a Gauss-Newton step
+   ``J delta``, tangents by finite differences on the cell's lattice) and its normal
+   part; the distance from ``q`` to the surface is at most
+   ``|r_normal| + kappa |J delta|^2 / 2`` to second order (``kappa``: the largest
+   sampled normal curvature, times 1.5), and never more than ``|r|``.  When every cell
+   passes, the samples with the largest bounds are projected onto the surface by
+   Gauss-Newton (:func:`project_distances`), in rounds, until no unprojected bound
+   exceeds the measured maximum: the reported ``max_deviation`` is a measured one.
+3. **Refinement.**  Strips of failing cells get their density raised by
+   ``sqrt(err / tol)`` and all lines are placed again (midlines of the failing strips
+   are inserted after three such corrections, which always terminates); after a
+   passing grid, strips with room are coarsened the same way (twice at most, when it
+   saves at least 10 % of the cells) and the smallest passing grid is kept.  A
+   tolerance that cannot be reached within ``max_triangles`` raises.
 
 Each cell is split along the diagonal whose midpoint lies closer to the surface.  Seams
 and poles share their vertices, so spheres and tori are watertight.
@@ -169,7 +174,15 @@ def _lattice(lines: np.ndarray, lo: int, hi: int) -> np.ndarray:
 
 
 class GridMesh:
-    """State of the tensor grid of one surface: lines, per-cell errors and diagonals."""
+    """State of the tensor grid of one surface: the density model, the lines
+    (``us``, ``vs``) and, after :meth:`verify`, per-cell errors, diagonals and vertices.
+
+    >>> import surfmod as sm
+    >>> g = GridMesh(sm.torus(3.0, 1.0), 0.05)
+    >>> dev = g.verify()
+    >>> g.err.shape == (len(g.us) - 1, len(g.vs) - 1), bool(g.err.max() == dev)
+    (True, True)
+    """
 
     def __init__(self, s, tol: float):
         self.s, self.tol = s, tol
@@ -342,8 +355,16 @@ class GridMesh:
 
 def grid_tessellate(s, tol: float, max_triangles: int, sides, bar=None):
     """Tessellate ``s`` as a verified structured grid.  ``sides = (degenerate, closed_u,
-    closed_v)`` from :func:`surfmod.meshing.tessellate._sides`.  Returns
-    ``(vertices, triangles, uv, max_deviation, passes)``."""
+    closed_v)`` from :func:`surfmod.meshing.domain._sides`.  Returns
+    ``(vertices, triangles, uv, max_deviation, passes)``.
+
+    >>> import surfmod as sm
+    >>> from surfmod.meshing.domain import _sides
+    >>> s = sm.sphere(1.0)
+    >>> v, f, uv, dev, passes = grid_tessellate(s, 0.01, 10_000, _sides(s, 2.0))
+    >>> bool(dev <= 0.01), v.shape == (len(uv), 3)
+    (True, True)
+    """
     g = GridMesh(s, tol)
     passes, best, after_pass = 0, None, 0
     while True:
