@@ -1,0 +1,44 @@
+"""Facts about a surface's parameter domain that every tessellator needs: the size of
+the surface, which sides collapse to a point (poles) and which directions close on
+themselves (seams), so that their vertices are shared and the mesh is watertight."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _surface_size(s) -> float:
+    """Bounding-box diagonal of a 17 x 17 sample grid.
+
+    >>> import surfmod as sm
+    >>> round(_surface_size(sm.plane((0, 0, 0), (3, 0, 0), (0, 4, 0))), 12)
+    5.0
+    """
+    (u0, u1), (v0, v1) = s.domain
+    pts = s.grid(np.linspace(u0, u1, 17), np.linspace(v0, v1, 17)).reshape(-1, 3)
+    return float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+
+
+def _sides(s, size: float):
+    """``(degenerate, closed_u, closed_v)``: which domain sides (``"u0"``, ``"u1"``,
+    ``"v0"``, ``"v1"``) collapse to a point and which directions close on themselves.
+
+    >>> import surfmod as sm
+    >>> deg, cu, cv = _sides(sm.sphere(1.0), 2.0)
+    >>> sorted(k for k, d in deg.items() if d), cu, cv
+    (['v0', 'v1'], True, False)
+    """
+    (u0, u1), (v0, v1) = s.domain
+    t = np.linspace(0.0, 1.0, 33)
+    us, vs = u0 + t * (u1 - u0), v0 + t * (v1 - v0)
+    eps = 1e-9 * max(size, 1e-300)
+    side = {
+        "u0": s.points(np.full_like(vs, u0), vs),
+        "u1": s.points(np.full_like(vs, u1), vs),
+        "v0": s.points(us, np.full_like(us, v0)),
+        "v1": s.points(us, np.full_like(us, v1)),
+    }
+    degenerate = {k: bool(np.ptp(p, axis=0).max() <= eps) for k, p in side.items()}
+    closed_u = not degenerate["u0"] and bool(np.abs(side["u0"] - side["u1"]).max() <= eps)
+    closed_v = not degenerate["v0"] and bool(np.abs(side["v0"] - side["v1"]).max() <= eps)
+    return degenerate, closed_u, closed_v
