@@ -35,7 +35,6 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from .faces import Patch, patches
 
 
 @dataclass(frozen=True)
@@ -85,27 +84,17 @@ class MassProperties:
         )
 
 
-def gauss_nodes(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss–Legendre nodes and weights on every interval between ``breaks``."""
-    x, w = np.polynomial.legendre.leggauss(order)
-    a, b = breaks[:-1, None], breaks[1:, None]
-    nodes = (a + b) / 2 + (b - a) / 2 * x
-    weights = (b - a) / 2 * w
-    return nodes.ravel(), weights.ravel()
-
-
-def _moments(ders: np.ndarray, weights: np.ndarray, sign: float, ref: np.ndarray) -> np.ndarray:
-    """[area, V, M(3), S(3,3)] contributions from partials at quadrature nodes."""
+def _moments(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """[area, V, M(3), S(3,3)] contributions from partials at quadrature nodes (``Su``
+    already signed so that ``Su × Sv`` is the outward ``n dA``)."""
     # (3, N) rows, contiguous: np.sum then reduces each row pairwise, which keeps the 1e-14
     # of the closed forms (a reduction over axis 0 of (N, 3), or a BLAS dot, does not)
     x = np.ascontiguousarray((ders[:, 0, 0] - ref).T)
     su, sv = ders[:, 1, 0].T, ders[:, 0, 1].T
-    n = np.empty_like(x)  # sign * (Su x Sv), written out
+    n = np.empty_like(x)  # Su x Sv, written out
     n[0] = su[1] * sv[2] - su[2] * sv[1]
     n[1] = su[2] * sv[0] - su[0] * sv[2]
     n[2] = su[0] * sv[1] - su[1] * sv[0]
-    if sign < 0:
-        n = -n
     area = float(np.sum(weights * np.sqrt(np.sum(n * n, axis=0))))
     vol = float(np.sum(weights * np.sum(x * n, axis=0))) / 3.0
     a = weights * x**2 * n  # w x_i^2 n_i, (3, N)
@@ -113,55 +102,47 @@ def _moments(ders: np.ndarray, weights: np.ndarray, sign: float, ref: np.ndarray
     m = np.array([[np.sum(a[i] * x[j]) for j in range(3)] for i in range(3)])  # sum w x_i^2 n_i x_j
     # off the diagonal: symmetric average of the two equivalent divergence forms
     second = (m + m.T) / 4.0
-    second[np.diag_indices(3)] = np.sum(weights * x**3 * n, axis=1) / 3.0
+    second[np.diag_indices(3)] = np.sum(a * x, axis=1) / 3.0
     return np.concatenate([[area, vol], first, second.ravel()])
 
 
-def patch_moments(patch: Patch, ref: np.ndarray, order: int) -> np.ndarray:
-    """Moment contributions of one face (see :func:`_moments`)."""
-    if patch.natural:
-        un, uw = gauss_nodes(patch.breaks_u, order)
-        vn, vw = gauss_nodes(patch.breaks_v, order)
-        uu, vv = np.meshgrid(un, vn, indexing="ij")
-        w = np.outer(uw, vw).ravel()
-        return _moments(patch.evaluate(uu.ravel(), vv.ravel(), 1), w, patch.sign, ref)
-    return _moments(*green_nodes(patch, order), patch.sign, ref)
+class _Accumulator:
+    """Sums :func:`_moments` over many faces, evaluating them in batches of about
+    ``BATCH`` nodes (one NumPy pass for many small faces, bounded memory for big ones)."""
+
+    BATCH = 200_000
+
+    def __init__(self, ref: np.ndarray):
+        self.ref, self.total, self.parts, self.size = ref, np.zeros(14), [], 0
+
+    def add(self, ders: np.ndarray, weights: np.ndarray) -> None:
+        self.parts.append((ders, weights))
+        self.size += len(weights)
+        if self.size >= self.BATCH:
+            self.flush()
+
+    def flush(self) -> np.ndarray:
+        if self.parts:
+            ders = np.concatenate([d for d, _ in self.parts])
+            weights = np.concatenate([w for _, w in self.parts])
+            self.total += _moments(ders, weights, self.ref)
+            self.parts, self.size = [], 0
+        return self.total
 
 
-def green_nodes(patch: Patch, order: int, base: str = "left"):
-    """Partials and weights for ``∫∫_D g du dv = ∮_∂D G dv`` with
-    ``G(u, v) = ∫_{u0}^{u} g(s, v) ds``: Gauss on the exact p-curves of the trimming
-    boundary, and for each boundary node Gauss in ``u`` from the left edge of the
-    face's box to the node (``base="right"``: ``G = -∫_u^{u1} g ds`` from the right
-    edge), split at the patch's ``u`` break points.  On a closed boundary both bases give
-    the same integral; where the p-curves leave gaps (a model whose edges are off its
-    faces) they differ, which is how :func:`mass_properties` measures that ambiguity."""
-    from ..occ.uses import face_boundary_nodes
+def face_moments(face, ref=(0.0, 0.0, 0.0), order: int = 16) -> np.ndarray:
+    """``[area, V, M(3), S(3, 3)]`` of one face read back with :func:`surfmod.from_face`
+    (its trimmed region; ``V`` etc. are the face's share of the divergence-theorem
+    integrals about ``ref``).
 
-    ub, vb, wb = face_boundary_nodes(patch.face, order, lines_u=patch.breaks_u[1:-1], lines_v=patch.breaks_v[1:-1])
-    u0 = patch.bounds[0]
-    if np.sum(wb * (ub - u0)) < 0:  # boundary traversed clockwise in (u, v): flip
-        wb = -wb
-    # nodes on p-curves along v = const carry dv = 0: no inner integral needed there
-    moving = wb != 0.0
-    ub, vb, wb = ub[moving], vb[moving], wb[moving]
-    x, w = np.polynomial.legendre.leggauss(order)
-    br = patch.breaks_u
-    if base == "left":
-        a = np.clip(br[None, :-1], None, ub[:, None])  # (B, S) span starts clipped to node
-        b = np.clip(br[None, 1:], None, ub[:, None])
-        sign = 1.0
-    else:
-        a = np.clip(br[None, :-1], ub[:, None], None)
-        b = np.clip(br[None, 1:], ub[:, None], None)
-        sign = -1.0
-    keep = b - a > 0
-    bi, si = np.nonzero(keep)
-    a, b = a[bi, si], b[bi, si]
-    s = ((a + b)[:, None] / 2 + (b - a)[:, None] / 2 * x).ravel()
-    ws = sign * ((b - a)[:, None] / 2 * w * wb[bi, None]).ravel()
-    vv = np.repeat(vb[bi], order)
-    return patch.evaluate(s, vv, 1), ws
+    >>> import surfmod as sm, build123d as bd
+    >>> round(float(face_moments(sm.from_face(bd.Box(2, 3, 4).faces()[0]))[0]), 12)
+    12.0
+    """
+    from .mass_green import face_nodes, mass_face
+
+    ders, w, _ = face_nodes(mass_face(face), order)
+    return _moments(ders, w, np.asarray(ref, dtype=float))
 
 
 def _finish(total: np.ndarray, ref: np.ndarray, density: float):
@@ -214,34 +195,37 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str =
     # by (shift . closure defect) / 3, so the same point makes the two comparable.
     ref = occ.vertex_mean(solid)
     from ..surface import Surface
+    from .mass_green import face_nodes, mass_face, surface_mass_face
 
     if isinstance(obj, Surface):
         # one closed surface (sphere, torus, ...): integrate its own NumPy evaluator over
         # its domain; the orientation is fixed by the sign of the enclosed volume
-        from .faces import surface_patch
-
-        pats = [surface_patch(obj)]
-        probe = patch_moments(pats[0], ref, order)
-        if probe[1] < 0:
-            from dataclasses import replace
-
-            pats = [replace(pats[0], sign=-1.0)]
+        faces = [surface_mass_face(obj)]
+        if _moments(*face_nodes(faces[0], order)[:2], ref)[1] < 0:
+            faces[0].sign = -1.0
     else:
-        pats = patches(solid)
-    total = np.zeros(14)
-    low = np.zeros(14)
+        from ..occ.topo import faces_of
+        from ..readback import from_face
+
+        faces = [mass_face(from_face(f)) for f in faces_of(solid)]
+    # faces whose every rule is exact by degree give the same sums at any order: the
+    # lower-order pass behind the error estimate only re-integrates the others
+    exact, high, low = _Accumulator(ref), _Accumulator(ref), _Accumulator(ref)
     low_order = max(2, order - 4)
-    for p in pats:
-        total += patch_moments(p, ref, order)
-        if estimate_error:
-            low += patch_moments(p, ref, low_order)
+    for f in faces:
+        ders, w, is_exact = face_nodes(f, order)
+        (exact if is_exact else high).add(ders, w)
+        if estimate_error and not is_exact:
+            low.add(*face_nodes(f, low_order)[:2])
+    base = exact.flush()
+    total = base + high.flush()
     vol, area, centroid, inertia = _finish(total, ref, density)
-    nat = sum(p.natural for p in pats)
-    est = abs(total[1] - low[1]) / vol if estimate_error else float("nan")
+    nat = sum(f.natural for f in faces)
+    est = abs(high.total[1] - low.flush()[1]) / vol if estimate_error else float("nan")
     return MassProperties(
         vol, area, centroid, inertia, density,
-        faces={"natural": nat, "trimmed": len(pats) - nat},
-        evaluators={"numpy": sum(p.evaluator == "numpy" for p in pats), "occt": sum(p.evaluator == "occt" for p in pats)},
+        faces={"natural": nat, "trimmed": len(faces) - nat},
+        evaluators={"numpy": len(faces), "occt": 0},
         error_estimate=float(est),
     )
 
