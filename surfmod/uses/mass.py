@@ -130,7 +130,7 @@ class _Accumulator:
         return self.total
 
 
-def face_moments(face, ref=(0.0, 0.0, 0.0), order: int = 16) -> np.ndarray:
+def face_moments(face, ref=(0.0, 0.0, 0.0), order: int = 12) -> np.ndarray:
     """``[area, V, M(3), S(3, 3)]`` of one face read back with :func:`surfmod.from_face`
     (its trimmed region; ``V`` etc. are the face's share of the divergence-theorem
     integrals about ``ref``).
@@ -157,7 +157,7 @@ def _finish(total: np.ndarray, ref: np.ndarray, density: float):
     return float(vol), float(area), ref + c, inertia
 
 
-def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str = "numpy",
+def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str = "numpy",
                     eps: float = 1e-9, estimate_error: bool = True) -> MassProperties:
     """Volume, area, centroid and inertia tensor of a solid.
 

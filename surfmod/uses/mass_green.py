@@ -44,7 +44,7 @@ PIECES = 4
 RECTANGLE_RTOL = 1e-7
 
 #: a boundary whose p-curves' increments sum to less than this (relative to the box) is closed
-CLOSURE_RTOL = 1e-12
+CLOSURE_RTOL = 1e-9
 
 _GAUSS: dict = {}
 
@@ -134,31 +134,36 @@ def pcurve_d1(rec: dict, t: np.ndarray) -> np.ndarray:
     return out
 
 
-def _crossings(rec: dict, cuts: np.ndarray, lines: np.ndarray, coord: int, per_piece: int = 8) -> np.ndarray:
-    """Parameters where a p-curve crosses the lines ``u = c`` (``coord`` 0) or ``v = c``
-    (``coord`` 1): exact on straight p-curves, else sign changes on a sampling refined by
-    Newton steps (all crossings at once)."""
-    if not len(lines):
+def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
+    """Parameters where a p-curve crosses the lines ``u = c`` and ``v = c``: exact on
+    straight p-curves, else sign changes on one sampling refined by Newton steps (all
+    crossings at once)."""
+    if not len(lines_u) and not len(lines_v):
         return np.zeros(0)
     f, l = cuts[0], cuts[-1]
+    coord = np.concatenate([np.zeros(len(lines_u), int), np.ones(len(lines_v), int)])
+    lines = np.concatenate([lines_u, lines_v])
     if rec["kind"] == "line":
         d = rec["direction"][coord]
-        if d == 0.0:
-            return np.zeros(0)
-        t = (lines - rec["origin"][coord]) / d
+        ok = d != 0.0
+        t = (lines[ok] - rec["origin"][coord[ok]]) / d[ok]
         return t[(t > f) & (t < l)]
     a, b = cuts[:-1, None], cuts[1:, None]
     t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
-    s = pcurve_d1(rec, t)[:, coord][:, None] - lines[None, :]  # (T, L)
+    s = pcurve_d1(rec, t)[:, coord] - lines[None, :]  # (T, L)
     i, j = np.nonzero(s[:-1] * s[1:] < 0)
     if not len(i):
         return np.zeros(0)
-    lo, hi, c = t[i], t[i + 1], lines[j]
+    lo, hi, c, cj = t[i], t[i + 1], lines[j], coord[j]
     x = lo + (hi - lo) * s[i, j] / (s[i, j] - s[i + 1, j])
-    for _ in range(4):
+    rows = np.arange(len(x))
+    for _ in range(6):
         q = pcurve_d1(rec, x)
-        step = np.divide(q[:, coord] - c, q[:, 2 + coord], out=np.zeros_like(x), where=q[:, 2 + coord] != 0.0)
+        d = q[rows, 2 + cj]
+        step = np.divide(q[rows, cj] - c, d, out=np.zeros_like(x), where=d != 0.0)
         x = np.clip(x - step, lo, hi)
+        if np.all(np.abs(step) <= 1e-15 * max(1.0, abs(l - f))):
+            break
     return x
 
 
@@ -177,7 +182,7 @@ def _boundary(pcurves, outer_order, lines_u, lines_v):
         k = 1 if rec["kind"] == "line" else PIECES
         br = np.concatenate([rec["breaks"], np.linspace(f, l, k + 1)])
         br = np.unique(br[(br >= f) & (br <= l)])
-        extra = np.concatenate([_crossings(rec, br, lines_u, 0), _crossings(rec, br, lines_v, 1)])
+        extra = _crossings(rec, br, lines_u, lines_v)
         if extra.size:
             br = np.unique(np.concatenate([br, extra]))
             br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
