@@ -36,6 +36,7 @@ from ..construct.curves import Line
 from ..construct.elementary import AnalyticPlane, ConicalSurface, CylindricalSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
+from ..eval.tensor import curve_derivatives
 from ..nets.bspline import BSplineCurve, BSplineSurface
 
 #: curved p-curves are cut into at least this many pieces before Gauss
@@ -124,14 +125,41 @@ def pcurve_d1(rec: dict, t: np.ndarray) -> np.ndarray:
         out[:, :2] = rec["centre"] + r * (c * x + s * y)
         out[:, 2:] = r * (c * y - s * x)
     elif kind == "bspline":
-        if "curve" not in rec:
-            rec["curve"] = BSplineCurve._trusted(rec["points"], rec["degree"], rec["knots"], rec["weights"])
-        d = rec["curve"]._derivatives(t, 1)
-        out[:, :2] = d[:, 0, :2]
-        out[:, 2:] = d[:, 1, :2]
+        if "taylor" not in rec:
+            rec["taylor"] = _taylor_pieces(rec)
+        starts, centres, coef = rec["taylor"]
+        j = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(starts) - 1)
+        dt = (t - centres[j])[:, None]
+        c = coef[j]  # (N, p+1, dim)
+        val, der = c[:, -1], np.zeros_like(c[:, -1])
+        for k in range(c.shape[1] - 2, -1, -1):  # Horner for the value and its derivative
+            der = der * dt + val
+            val = val * dt + c[:, k]
+        if rec["weights"] is None:
+            out[:, :2], out[:, 2:] = val, der
+        else:
+            out[:, :2] = val[:, :2] / val[:, 2:]
+            out[:, 2:] = (der[:, :2] - out[:, :2] * der[:, 2:]) / val[:, 2:]
     else:
         out[:] = adaptor_d1(rec["adaptor"], t)
     return out
+
+
+def _taylor_pieces(rec: dict):
+    """A B-spline p-curve as one polynomial per knot span: ``(starts (S,), centres (S,),
+    coefficients (S, p+1, dim))`` with ``C(t) = Σ_k c_k (t - centre)^k`` in homogeneous coordinates
+    ``(w u, w v, w)`` (``(u, v)`` when polynomial).  Beyond the ends the first and last
+    spans continue, as OCCT evaluates."""
+    p, knots, pts, w = rec["degree"], rec["knots"], rec["points"][:, :2], rec["weights"]
+    n = len(pts)
+    ctrl = pts if w is None else np.column_stack([pts * w[:, None], w])
+    starts = np.unique(knots[p:n])  # span starts inside the domain (the last end excluded)
+    starts = starts[starts < knots[n]]
+    # expanded about each span's middle: |t - centre| <= h/2 keeps high degrees accurate
+    centres = (starts + np.append(starts[1:], knots[n])) / 2
+    ders = curve_derivatives(knots, p, ctrl, centres, p)
+    fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
+    return starts, centres, ders / fact[None, :, None]
 
 
 def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
