@@ -3,8 +3,8 @@
 :func:`face_pcurves` reads every edge of a face once: its parameter range, its sign in
 the face (``-1`` for a reversed edge), the breaks of its ``GeomAbs_CN`` intervals and
 the 2-D curve itself -- a line (origin, direction), a circle (centre, axes, radius), a
-B-spline (poles, weights, flat knots, degree) or, for any other type, the OCCT adaptor,
-which :func:`adaptor_d1` samples point by point.  Lines, circles and B-splines are then
+B-spline (poles, weights, flat knots, degree) or any other type, which
+:func:`adaptor_d1` samples point by point through the record's OCCT ``adaptor``.  Lines, circles and B-splines are then
 evaluated for all Gauss nodes at once (:mod:`surfmod.uses.mass_green`), instead of one
 ``Geom2dAdaptor.D1`` call per node.
 """
@@ -59,7 +59,8 @@ def face_pcurves(face) -> list[dict]:
     wire) where ``kind`` is ``"line"`` (``origin``,
     ``direction``: ``P(t) = origin + t direction``), ``"circle"`` (``centre``, ``x``, ``y``,
     ``radius``: ``P(t) = centre + radius (cos t x + sin t y)``), ``"bspline"`` (``points``,
-    ``weights``, ``knots``, ``degree``) or ``"other"`` (``adaptor``, see :func:`adaptor_d1`).
+    ``weights``, ``knots``, ``degree``) or ``"other"``; every record carries its ``adaptor``
+    (see :func:`adaptor_d1`), the reference the data-based evaluation is tested against.
 
     >>> import build123d as bd
     >>> pcs = face_pcurves(bd.Face(bd.Wire.make_circle(1.0)).wrapped)
@@ -113,8 +114,8 @@ def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
     >>> from OCP.BRepAdaptor import BRepAdaptor_Curve2d
     >>> face = bd.Face(bd.Wire.make_circle(1.0)).wrapped
     >>> edge = bd.Face(face).edges()[0].wrapped
-    >>> adaptor_d1(BRepAdaptor_Curve2d(edge, face), np.array([0.0])).round(12).tolist()
-    [[1.0, 0.0, 0.0, 1.0]]
+    >>> adaptor_d1(BRepAdaptor_Curve2d(edge, face), np.array([0.0])).round(12).tolist() == [[1, 0, 0, 1]]
+    True
     """
     from OCP.gp import gp_Pnt2d, gp_Vec2d
 

@@ -45,7 +45,9 @@ class MassProperties:
     (``"natural"``) and over a trimmed region by Green's theorem (``"trimmed"``);
     ``evaluators`` says how many faces used the NumPy evaluator vs. OCCT sampling.
     ``error_estimate`` is the relative change of the volume between the requested
-    quadrature order and a lower one.
+    quadrature order and a lower one; the lower-order pass behind it runs the first time
+    it is read (most callers never do), and faces integrated exactly by degree are not
+    re-integrated (their change is zero).
 
     >>> import surfmod as sm, build123d as bd
     >>> m = sm.mass_properties(bd.Box(1, 2, 3))
@@ -60,8 +62,17 @@ class MassProperties:
     density: float = 1.0
     faces: dict = field(default_factory=dict)
     evaluators: dict = field(default_factory=dict)
-    error_estimate: float = 0.0
     method: str = "numpy"
+    # a float, or a function computing it on first use (see ``error_estimate``)
+    _error: object = field(default=0.0, repr=False, compare=False)
+
+    @property
+    def error_estimate(self) -> float:
+        """Relative change of the volume between the requested Gauss order and one four
+        lower (NaN when not requested; BRepGProp's own estimate for ``method="occt"``)."""
+        if callable(self._error):
+            object.__setattr__(self, "_error", float(self._error()))
+        return self._error
 
     @property
     def mass(self) -> float:
@@ -166,8 +177,8 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     an OCP shape or a STEP file path.  ``method="numpy"`` (default) integrates with
     Gauss quadrature on the NumPy evaluator (see the module notes); ``method="occt"``
     returns OCCT's ``BRepGProp`` at relative tolerance ``eps`` instead (the
-    cross-check).  ``estimate_error=False`` skips the second, lower-order quadrature behind
-    ``error_estimate`` (then NaN), about 40 % of the time.  Open shells are sewn at the
+    cross-check).  ``estimate_error=False`` drops the second, lower-order quadrature behind
+    ``error_estimate`` (then NaN); otherwise it runs when ``error_estimate`` is first read.  Open shells are sewn at the
     model's tolerance; those that stay open raise ``SurfmodError``.
 
     >>> import surfmod as sm, build123d as bd
@@ -188,7 +199,7 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     if method == "occt":
         g = occ.gprops(solid, eps)
         return MassProperties(g["volume"], g["area"], g["centroid"], density * g["inertia"], density,
-                              method=f"occt BRepGProp eps={eps:g}", error_estimate=float(g["volume_error"]))
+                              method=f"occt BRepGProp eps={eps:g}", _error=float(g["volume_error"]))
     # the reference point of the surface integrals: the mean of the vertices, as BRepGProp
     # takes it.  On a boundary that closes exactly any point gives the same result; on a
     # real file whose faces leave gaps (edges off their faces) the integrals depend on it
@@ -210,23 +221,28 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         faces = [mass_face(from_face(f)) for f in faces_of(solid)]
     # faces whose every rule is exact by degree give the same sums at any order: the
     # lower-order pass behind the error estimate only re-integrates the others
-    exact, high, low = _Accumulator(ref), _Accumulator(ref), _Accumulator(ref)
-    low_order = max(2, order - 4)
+    exact, high = _Accumulator(ref), _Accumulator(ref)
+    inexact = []
     for f in faces:
         ders, w, is_exact = face_nodes(f, order)
         (exact if is_exact else high).add(ders, w)
-        if estimate_error and not is_exact:
-            low.add(*face_nodes(f, low_order)[:2])
-    base = exact.flush()
-    total = base + high.flush()
+        if not is_exact:
+            inexact.append(f)
+    total = exact.flush() + high.flush()
     vol, area, centroid, inertia = _finish(total, ref, density)
     nat = sum(f.natural for f in faces)
-    est = abs(high.total[1] - low.flush()[1]) / vol if estimate_error else float("nan")
+
+    def estimate() -> float:
+        low = _Accumulator(ref)
+        for f in inexact:
+            low.add(*face_nodes(f, max(2, order - 4))[:2])
+        return abs(high.total[1] - low.flush()[1]) / vol
+
     return MassProperties(
         vol, area, centroid, inertia, density,
         faces={"natural": nat, "trimmed": len(faces) - nat},
         evaluators={"numpy": len(faces), "occt": 0},
-        error_estimate=float(est),
+        _error=estimate if estimate_error else float("nan"),
     )
 
 

@@ -44,8 +44,8 @@ PIECES = 4
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
 RECTANGLE_RTOL = 1e-7
 
-#: a boundary whose p-curves' increments sum to less than this (relative to the box) is closed
-CLOSURE_RTOL = 1e-9
+#: p-curves that meet within this (relative to the face box) at every vertex close the boundary
+CLOSURE_RTOL = 1e-12
 
 _GAUSS: dict = {}
 
@@ -320,6 +320,23 @@ def face_nodes(mf: MassFace, order: int):
     return ders, w, exact
 
 
+def _largest_gap(mf: MassFace) -> float:
+    """Largest distance, relative to the face box, from the end of an edge's p-curve to
+    the nearest start of one (in the edges' directions in the face): 0 for a boundary
+    whose p-curves join up."""
+    u0, u1, v0, v1 = mf.bounds
+    scale = np.array([max(u1 - u0, 1e-300), max(v1 - v0, 1e-300)])
+    ends = []
+    for rec in mf.pcurves:
+        q = pcurve_d1(rec, np.array(rec["range"]))[:, :2] / scale
+        ends.append(q if rec["sign"] > 0 else q[::-1])
+    if not ends:
+        return 0.0
+    ends = np.array(ends)  # (E, 2 [start, end], 2)
+    d = np.linalg.norm(ends[:, None, 1] - ends[None, :, 0], axis=-1)
+    return float(d.min(axis=1).max())
+
+
 def _green(mf: MassFace, order: int, orders, exacts):
     """Green's theorem nodes (see the module notes)."""
     def outer_order(rec):
@@ -332,9 +349,7 @@ def _green(mf: MassFace, order: int, orders, exacts):
     # inner direction: the one with fewer inner nodes per boundary node, where the
     # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
     # the result depends on the direction, and BRepGProp's is u from the box's left edge.
-    u0, u1, v0, v1 = mf.bounds
-    gap = np.abs(np.sum(wt[:, None] * dP, axis=0))
-    closed = gap[0] <= CLOSURE_RTOL * max(u1 - u0, 1.0) and gap[1] <= CLOSURE_RTOL * max(v1 - v0, 1.0)
+    closed = _largest_gap(mf) <= CLOSURE_RTOL
     cost = [(len(mf.breaks[d]) - 1) * orders[d] for d in (0, 1)]
     k = 1 if closed and cost[1] < cost[0] else 0
     m_in = orders[k]
