@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import math
 
+import build123d as bd
 import numpy as np
 import pytest
 
-import build123d as bd
 import surfmod as sm
 import surfmod.uses.mass_green as mg
 from surfmod.occ.pcurves import adaptor_d1, face_pcurves

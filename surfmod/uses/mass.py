@@ -11,15 +11,24 @@ domain:
 
 * a face whose boundary is its parameter rectangle (the usual case for surfmod
   surfaces, spheres, tori, cylinders, boxes and most spline faces) by tensor
-  Gauss–Legendre on every knot span (quarter turns on periodic directions); the
+  Gauss–Legendre on every knot span (eighth turns on angular directions); the
   result is exact to round-off;
 * a trimmed face (holes, faces cut by booleans) by Green's theorem in the parameter
-  plane: ``∫∫_D g du dv = ∮ G dv`` with ``G(u, v) = ∫_{u0}^{u} g(s, v) ds``; the outer
-  integral runs over Gauss nodes on the exact p-curves of the face's edges (OCCT's
-  2-D curves, split at their breaks), the inner one is Gauss in ``u`` on the
-  untrimmed surface, split at knots.  No triangulation is involved, so the only error
-  is the accuracy of the p-curves themselves (the edge tolerance of the part, about
-  1e-7 for boolean results).
+  plane: ``∫∫_D g du dv = ∮ G dv`` with ``G(u, v) = ∫_{u0}^{u} g(s, v) ds`` (or the same
+  along ``v``); the outer integral runs over Gauss nodes on the exact p-curves of the
+  face's edges (OCCT's 2-D curves, split at their breaks), the inner one is Gauss on
+  the untrimmed surface, split at knots.  No triangulation is involved, so the only
+  error is the accuracy of the p-curves themselves (the edge tolerance of the part,
+  about 1e-7 for boolean results).
+
+The node count is what costs, so :mod:`surfmod.uses.mass_green` gives every direction
+and piece the fewest nodes that keep the result at round-off: Gauss orders from the
+surface's polynomial degree (planes and the axes of cylinders and cones are integrated
+exactly with 3 nodes), Green's inner integral along the cheaper direction (the axis of a
+cylinder, not its angle) where the p-curves join up, p-curves evaluated from their data
+for all nodes at once, and the moment sums of many faces in one pass.  Where a face's
+p-curves leave gaps the result depends on the direction, and the one BRepGProp takes
+(``u``) is kept.
 
 Coordinates are shifted to the mean of the solid's vertices (BRepGProp's reference
 point) before integrating, which also avoids cancellation.  The inertia tensor is about the centroid, ``I = ρ ∫ (|r|² E − r rᵀ) dV``
@@ -177,9 +186,12 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     an OCP shape or a STEP file path.  ``method="numpy"`` (default) integrates with
     Gauss quadrature on the NumPy evaluator (see the module notes); ``method="occt"``
     returns OCCT's ``BRepGProp`` at relative tolerance ``eps`` instead (the
-    cross-check).  ``estimate_error=False`` drops the second, lower-order quadrature behind
-    ``error_estimate`` (then NaN); otherwise it runs when ``error_estimate`` is first read.  Open shells are sewn at the
-    model's tolerance; those that stay open raise ``SurfmodError``.
+    cross-check).  ``order`` is the Gauss order per piece where the integrand is not a
+    polynomial of known degree (angles, rational splines, curved p-curves); polynomial
+    directions get the order that is exact for them.  ``estimate_error=False`` drops the
+    second, lower-order quadrature behind ``error_estimate`` (then NaN); otherwise it runs
+    when ``error_estimate`` is first read.  Open shells are sewn at the model's
+    tolerance; those that stay open raise ``SurfmodError``.
 
     >>> import surfmod as sm, build123d as bd
     >>> r = sm.mass_properties(bd.Box(2, 3, 4))

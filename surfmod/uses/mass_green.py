@@ -31,7 +31,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..construct.conics import Conic
 from ..construct.curves import Line
 from ..construct.elementary import AnalyticPlane, ConicalSurface, CylindricalSurface
 from ..construct.extrusion import TabulatedCylinder
