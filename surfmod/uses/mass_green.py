@@ -44,7 +44,7 @@ PIECES = 4
 RECTANGLE_RTOL = 1e-7
 
 #: p-curves that meet within this (relative to the face box) at every vertex close the boundary
-CLOSURE_RTOL = 1e-12
+CLOSURE_RTOL = 1e-10
 
 _GAUSS: dict = {}
 
