@@ -78,17 +78,21 @@ def face_pcurves(face) -> list[dict]:
             edge = TopoDS.Edge_s(e)
             pc = BRepAdaptor_Curve2d(edge, face)
             f, l = pc.FirstParameter(), pc.LastParameter()
-            n = pc.NbIntervals(GeomAbs_CN)
-            arr = TColStd_Array1OfReal(1, n + 1)
-            pc.Intervals(arr, GeomAbs_CN)
+            kind = pc.GetType()
+            if kind in (GeomAbs_Line, GeomAbs_Circle):  # analytic: one smooth interval
+                breaks = np.array([f, l])
+            else:
+                n = pc.NbIntervals(GeomAbs_CN)
+                arr = TColStd_Array1OfReal(1, n + 1)
+                pc.Intervals(arr, GeomAbs_CN)
+                breaks = np.array([arr.Value(i) for i in range(1, n + 2)])
             rec = {
                 "wire": wire_index,
                 "range": (f, l),
                 "sign": -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0,
-                "breaks": np.array([arr.Value(i) for i in range(1, n + 2)]),
+                "breaks": breaks,
                 "adaptor": pc,
             }
-            kind = pc.GetType()
             if kind == GeomAbs_Line:
                 lin = pc.Line()
                 rec.update(kind="line", origin=np.array(_xy(lin.Location())), direction=np.array(_xy(lin.Direction())))

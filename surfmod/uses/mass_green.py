@@ -244,14 +244,27 @@ class MassFace:
 
 def _on_box_border(pcurves, bounds) -> bool:
     u0, u1, v0, v1 = bounds
-    tu, tv = RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)
-    for rec in pcurves:
-        f, l = rec["range"]
-        q = pcurve_d1(rec, f + (l - f) * np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0]))
-        u, v = q[:, 0], q[:, 1]
-        on = (np.minimum(abs(u - u0), abs(u - u1)) <= tu) | (np.minimum(abs(v - v0), abs(v - v1)) <= tv)
-        if not on.all():
+    tol = np.array([RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)])
+    sides = np.array([u0, u1, v0, v1])
+
+    def on_sides(q):  # (N, 2) -> (N, 4): which border line each point lies on
+        return np.abs(q[:, [0, 0, 1, 1]] - sides) <= tol[[0, 0, 1, 1]]
+
+    lines = [rec for rec in pcurves if rec["kind"] == "line"]
+    if lines:
+        # a straight p-curve lies on the border iff both of its ends lie on one border line
+        o = np.array([rec["origin"] for rec in lines])
+        d = np.array([rec["direction"] for rec in lines])
+        r = np.array([rec["range"] for rec in lines])
+        first, last = on_sides(o + r[:, :1] * d), on_sides(o + r[:, 1:] * d)
+        if not np.all(np.any(first & last, axis=1)):
             return False
+    for rec in pcurves:
+        if rec["kind"] != "line":
+            f, l = rec["range"]
+            q = pcurve_d1(rec, f + (l - f) * np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0]))
+            if not on_sides(q[:, :2]).any(axis=1).all():
+                return False
     return True
 
 
