@@ -204,88 +204,6 @@ def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     return uv, idx
 
 
-def _pcurve_d1(pc, t: np.ndarray) -> np.ndarray:
-    """``(N, 4)``: ``u, v, du/dt, dv/dt`` of a 2-D curve adaptor at parameters ``t``."""
-    from OCP.gp import gp_Pnt2d, gp_Vec2d
-
-    p, d = gp_Pnt2d(), gp_Vec2d()
-    out = np.empty((len(t), 4))
-    for i, ti in enumerate(t):
-        pc.D1(float(ti), p, d)
-        out[i] = (p.X(), p.Y(), d.X(), d.Y())
-    return out
-
-
-def _crossings(pc, cuts: np.ndarray, lines, coord: int, per_piece: int = 8) -> list:
-    """Parameters where a p-curve crosses the lines ``u = c`` (``coord`` 0) or ``v = c``
-    (``coord`` 1): sign changes on a sampling, refined by Newton steps."""
-    if not len(lines):
-        return []
-    a, b = cuts[:-1, None], cuts[1:, None]
-    t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
-    val = _pcurve_d1(pc, t)[:, coord]
-    out = []
-    for c in lines:
-        s = val - c
-        for i in np.nonzero(s[:-1] * s[1:] < 0)[0]:
-            lo, hi = t[i], t[i + 1]
-            x = lo + (hi - lo) * s[i] / (s[i] - s[i + 1])
-            for _ in range(4):
-                q = _pcurve_d1(pc, [x])[0]
-                if q[2 + coord] == 0.0:
-                    break
-                x = min(max(x - (q[coord] - c) / q[2 + coord], lo), hi)
-            out.append(x)
-    return out
-
-
-def face_boundary_nodes(face, order: int, pieces: int = 4, lines_u=(), lines_v=()):
-    """Gauss nodes on the p-curves of a face's boundary, for Green's theorem in (u, v).
-
-    Returns ``(u, v, w)`` with ``w = weight · dv/dt`` signed by the edge's orientation
-    in the face, so that ``Σ w G(u, v) = ∮ G dv`` over the whole boundary (outer wire
-    and holes).  Each p-curve is split wherever Gauss would lose its exactness: at every
-    knot of the p-curve (``GeomAbs_CN`` intervals: a cubic's third derivative jumps at
-    simple knots), where it crosses the surface's own break lines ``u = lines_u[i]``,
-    ``v = lines_v[j]`` (the integrand is piecewise there), and into at least ``pieces``
-    parts.
-    """
-    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-    from OCP.GeomAbs import GeomAbs_CN, GeomAbs_Line
-    from OCP.TColStd import TColStd_Array1OfReal
-
-    x, w = np.polynomial.legendre.leggauss(order)
-    us, vs, ws = [], [], []
-    with kernel("BRepAdaptor_Curve2d (face boundary)"):
-        for e in _explore(face, TopAbs_EDGE):
-            edge = TopoDS.Edge_s(e)
-            pc = BRepAdaptor_Curve2d(edge, face)
-            f, l = pc.FirstParameter(), pc.LastParameter()
-            n = pc.NbIntervals(GeomAbs_CN)
-            arr = TColStd_Array1OfReal(1, n + 1)
-            pc.Intervals(arr, GeomAbs_CN)
-            # a straight p-curve carries a polynomial or trigonometric integrand that the
-            # break-line splits below already make smooth: one piece is enough
-            k = 1 if pc.GetType() == GeomAbs_Line else pieces
-            br = np.unique(np.concatenate([[arr.Value(i) for i in range(1, n + 2)], np.linspace(f, l, k + 1)]))
-            br = br[(br >= f) & (br <= l)]
-            extra = _crossings(pc, br, lines_u, 0) + _crossings(pc, br, lines_v, 1)
-            if extra:
-                br = np.unique(np.concatenate([br, extra]))
-                br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
-            a, b = br[:-1, None], br[1:, None]
-            t = ((a + b) / 2 + (b - a) / 2 * x).ravel()
-            wt = ((b - a) / 2 * w).ravel()
-            sign = -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0
-            q = _pcurve_d1(pc, t)
-            us.append(q[:, 0])
-            vs.append(q[:, 1])
-            ws.append(sign * wt * q[:, 3])
-    if not us:
-        return np.zeros(0), np.zeros(0), np.zeros(0)
-    return np.concatenate(us), np.concatenate(vs), np.concatenate(ws)
-
-
 def edge_deviations(shape, samples: int = 23) -> np.ndarray:
     """``(E, 2)``: per edge of ``shape`` the largest distance between its 3-D curve and the
     image of its p-curve on each of its faces (``samples`` points, as ``BRepCheck`` does),
@@ -424,6 +342,6 @@ def write_brep(shape, path) -> None:
 
 __all__ = [
     "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
-    "face_boundary_nodes", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
+    "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
     "model_tolerance", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

@@ -136,10 +136,9 @@ class TrimmedFace(Surface):
     def area(self) -> float:
         """Area of the trimmed face (Gauss quadrature on the NumPy evaluator; Green's
         theorem over the exact p-curves for trimmed faces)."""
-        from ..uses.faces import face_patch
-        from ..uses.mass import patch_moments
+        from ..uses.mass import face_moments
 
-        return float(patch_moments(face_patch(self), np.zeros(3), 16)[0])
+        return float(face_moments(self)[0])
 
 
 def _periods(geom, surface):

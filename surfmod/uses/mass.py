@@ -11,15 +11,24 @@ domain:
 
 * a face whose boundary is its parameter rectangle (the usual case for surfmod
   surfaces, spheres, tori, cylinders, boxes and most spline faces) by tensor
-  Gauss–Legendre on every knot span (quarter turns on periodic directions); the
+  Gauss–Legendre on every knot span (eighth turns on angular directions); the
   result is exact to round-off;
 * a trimmed face (holes, faces cut by booleans) by Green's theorem in the parameter
-  plane: ``∫∫_D g du dv = ∮ G dv`` with ``G(u, v) = ∫_{u0}^{u} g(s, v) ds``; the outer
-  integral runs over Gauss nodes on the exact p-curves of the face's edges (OCCT's
-  2-D curves, split at their breaks), the inner one is Gauss in ``u`` on the
-  untrimmed surface, split at knots.  No triangulation is involved, so the only error
-  is the accuracy of the p-curves themselves (the edge tolerance of the part, about
-  1e-7 for boolean results).
+  plane: ``∫∫_D g du dv = ∮ G dv`` with ``G(u, v) = ∫_{u0}^{u} g(s, v) ds`` (or the same
+  along ``v``); the outer integral runs over Gauss nodes on the exact p-curves of the
+  face's edges (OCCT's 2-D curves, split at their breaks), the inner one is Gauss on
+  the untrimmed surface, split at knots.  No triangulation is involved, so the only
+  error is the accuracy of the p-curves themselves (the edge tolerance of the part,
+  about 1e-7 for boolean results).
+
+The node count is what costs, so :mod:`surfmod.uses.mass_green` gives every direction
+and piece the fewest nodes that keep the result at round-off: Gauss orders from the
+surface's polynomial degree (planes and the axes of cylinders and cones are integrated
+exactly with 3 nodes), Green's inner integral along the cheaper direction (the axis of a
+cylinder, not its angle) where the p-curves join up, p-curves evaluated from their data
+for all nodes at once, and the moment sums of many faces in one pass.  Where a face's
+p-curves leave gaps the result depends on the direction, and the one BRepGProp takes
+(``u``) is kept.
 
 Coordinates are shifted to the mean of the solid's vertices (BRepGProp's reference
 point) before integrating, which also avoids cancellation.  The inertia tensor is about the centroid, ``I = ρ ∫ (|r|² E − r rᵀ) dV``
@@ -35,7 +44,6 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from .faces import Patch, patches
 
 
 @dataclass(frozen=True)
@@ -46,7 +54,9 @@ class MassProperties:
     (``"natural"``) and over a trimmed region by Green's theorem (``"trimmed"``);
     ``evaluators`` says how many faces used the NumPy evaluator vs. OCCT sampling.
     ``error_estimate`` is the relative change of the volume between the requested
-    quadrature order and a lower one.
+    quadrature order and a lower one; the lower-order pass behind it runs the first time
+    it is read (most callers never do), and faces integrated exactly by degree are not
+    re-integrated (their change is zero).
 
     >>> import surfmod as sm, build123d as bd
     >>> m = sm.mass_properties(bd.Box(1, 2, 3))
@@ -61,8 +71,17 @@ class MassProperties:
     density: float = 1.0
     faces: dict = field(default_factory=dict)
     evaluators: dict = field(default_factory=dict)
-    error_estimate: float = 0.0
     method: str = "numpy"
+    # a float, or a function computing it on first use (see ``error_estimate``)
+    _error: object = field(default=0.0, repr=False, compare=False)
+
+    @property
+    def error_estimate(self) -> float:
+        """Relative change of the volume between the requested Gauss order and one four
+        lower (NaN when not requested; BRepGProp's own estimate for ``method="occt"``)."""
+        if callable(self._error):
+            object.__setattr__(self, "_error", float(self._error()))
+        return self._error
 
     @property
     def mass(self) -> float:
@@ -85,27 +104,17 @@ class MassProperties:
         )
 
 
-def gauss_nodes(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss–Legendre nodes and weights on every interval between ``breaks``."""
-    x, w = np.polynomial.legendre.leggauss(order)
-    a, b = breaks[:-1, None], breaks[1:, None]
-    nodes = (a + b) / 2 + (b - a) / 2 * x
-    weights = (b - a) / 2 * w
-    return nodes.ravel(), weights.ravel()
-
-
-def _moments(ders: np.ndarray, weights: np.ndarray, sign: float, ref: np.ndarray) -> np.ndarray:
-    """[area, V, M(3), S(3,3)] contributions from partials at quadrature nodes."""
+def _moments(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """[area, V, M(3), S(3,3)] contributions from partials at quadrature nodes (``Su``
+    already signed so that ``Su × Sv`` is the outward ``n dA``)."""
     # (3, N) rows, contiguous: np.sum then reduces each row pairwise, which keeps the 1e-14
     # of the closed forms (a reduction over axis 0 of (N, 3), or a BLAS dot, does not)
     x = np.ascontiguousarray((ders[:, 0, 0] - ref).T)
     su, sv = ders[:, 1, 0].T, ders[:, 0, 1].T
-    n = np.empty_like(x)  # sign * (Su x Sv), written out
+    n = np.empty_like(x)  # Su x Sv, written out
     n[0] = su[1] * sv[2] - su[2] * sv[1]
     n[1] = su[2] * sv[0] - su[0] * sv[2]
     n[2] = su[0] * sv[1] - su[1] * sv[0]
-    if sign < 0:
-        n = -n
     area = float(np.sum(weights * np.sqrt(np.sum(n * n, axis=0))))
     vol = float(np.sum(weights * np.sum(x * n, axis=0))) / 3.0
     a = weights * x**2 * n  # w x_i^2 n_i, (3, N)
@@ -113,55 +122,47 @@ def _moments(ders: np.ndarray, weights: np.ndarray, sign: float, ref: np.ndarray
     m = np.array([[np.sum(a[i] * x[j]) for j in range(3)] for i in range(3)])  # sum w x_i^2 n_i x_j
     # off the diagonal: symmetric average of the two equivalent divergence forms
     second = (m + m.T) / 4.0
-    second[np.diag_indices(3)] = np.sum(weights * x**3 * n, axis=1) / 3.0
+    second[np.diag_indices(3)] = np.sum(a * x, axis=1) / 3.0
     return np.concatenate([[area, vol], first, second.ravel()])
 
 
-def patch_moments(patch: Patch, ref: np.ndarray, order: int) -> np.ndarray:
-    """Moment contributions of one face (see :func:`_moments`)."""
-    if patch.natural:
-        un, uw = gauss_nodes(patch.breaks_u, order)
-        vn, vw = gauss_nodes(patch.breaks_v, order)
-        uu, vv = np.meshgrid(un, vn, indexing="ij")
-        w = np.outer(uw, vw).ravel()
-        return _moments(patch.evaluate(uu.ravel(), vv.ravel(), 1), w, patch.sign, ref)
-    return _moments(*green_nodes(patch, order), patch.sign, ref)
+class _Accumulator:
+    """Sums :func:`_moments` over many faces, evaluating them in batches of about
+    ``BATCH`` nodes (one NumPy pass for many small faces, bounded memory for big ones)."""
+
+    BATCH = 200_000
+
+    def __init__(self, ref: np.ndarray):
+        self.ref, self.total, self.parts, self.size = ref, np.zeros(14), [], 0
+
+    def add(self, ders: np.ndarray, weights: np.ndarray) -> None:
+        self.parts.append((ders, weights))
+        self.size += len(weights)
+        if self.size >= self.BATCH:
+            self.flush()
+
+    def flush(self) -> np.ndarray:
+        if self.parts:
+            ders = np.concatenate([d for d, _ in self.parts])
+            weights = np.concatenate([w for _, w in self.parts])
+            self.total += _moments(ders, weights, self.ref)
+            self.parts, self.size = [], 0
+        return self.total
 
 
-def green_nodes(patch: Patch, order: int, base: str = "left"):
-    """Partials and weights for ``∫∫_D g du dv = ∮_∂D G dv`` with
-    ``G(u, v) = ∫_{u0}^{u} g(s, v) ds``: Gauss on the exact p-curves of the trimming
-    boundary, and for each boundary node Gauss in ``u`` from the left edge of the
-    face's box to the node (``base="right"``: ``G = -∫_u^{u1} g ds`` from the right
-    edge), split at the patch's ``u`` break points.  On a closed boundary both bases give
-    the same integral; where the p-curves leave gaps (a model whose edges are off its
-    faces) they differ, which is how :func:`mass_properties` measures that ambiguity."""
-    from ..occ.uses import face_boundary_nodes
+def face_moments(face, ref=(0.0, 0.0, 0.0), order: int = 12) -> np.ndarray:
+    """``[area, V, M(3), S(3, 3)]`` of one face read back with :func:`surfmod.from_face`
+    (its trimmed region; ``V`` etc. are the face's share of the divergence-theorem
+    integrals about ``ref``).
 
-    ub, vb, wb = face_boundary_nodes(patch.face, order, lines_u=patch.breaks_u[1:-1], lines_v=patch.breaks_v[1:-1])
-    u0 = patch.bounds[0]
-    if np.sum(wb * (ub - u0)) < 0:  # boundary traversed clockwise in (u, v): flip
-        wb = -wb
-    # nodes on p-curves along v = const carry dv = 0: no inner integral needed there
-    moving = wb != 0.0
-    ub, vb, wb = ub[moving], vb[moving], wb[moving]
-    x, w = np.polynomial.legendre.leggauss(order)
-    br = patch.breaks_u
-    if base == "left":
-        a = np.clip(br[None, :-1], None, ub[:, None])  # (B, S) span starts clipped to node
-        b = np.clip(br[None, 1:], None, ub[:, None])
-        sign = 1.0
-    else:
-        a = np.clip(br[None, :-1], ub[:, None], None)
-        b = np.clip(br[None, 1:], ub[:, None], None)
-        sign = -1.0
-    keep = b - a > 0
-    bi, si = np.nonzero(keep)
-    a, b = a[bi, si], b[bi, si]
-    s = ((a + b)[:, None] / 2 + (b - a)[:, None] / 2 * x).ravel()
-    ws = sign * ((b - a)[:, None] / 2 * w * wb[bi, None]).ravel()
-    vv = np.repeat(vb[bi], order)
-    return patch.evaluate(s, vv, 1), ws
+    >>> import surfmod as sm, build123d as bd
+    >>> round(float(face_moments(sm.from_face(bd.Box(2, 3, 4).faces()[0]))[0]), 12)
+    12.0
+    """
+    from .mass_green import face_nodes, mass_face
+
+    ders, w, _ = face_nodes(mass_face(face), order)
+    return _moments(ders, w, np.asarray(ref, dtype=float))
 
 
 def _finish(total: np.ndarray, ref: np.ndarray, density: float):
@@ -176,7 +177,7 @@ def _finish(total: np.ndarray, ref: np.ndarray, density: float):
     return float(vol), float(area), ref + c, inertia
 
 
-def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str = "numpy",
+def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str = "numpy",
                     eps: float = 1e-9, estimate_error: bool = True) -> MassProperties:
     """Volume, area, centroid and inertia tensor of a solid.
 
@@ -185,9 +186,12 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str =
     an OCP shape or a STEP file path.  ``method="numpy"`` (default) integrates with
     Gauss quadrature on the NumPy evaluator (see the module notes); ``method="occt"``
     returns OCCT's ``BRepGProp`` at relative tolerance ``eps`` instead (the
-    cross-check).  ``estimate_error=False`` skips the second, lower-order quadrature behind
-    ``error_estimate`` (then NaN), about 40 % of the time.  Open shells are sewn at the
-    model's tolerance; those that stay open raise ``SurfmodError``.
+    cross-check).  ``order`` is the Gauss order per piece where the integrand is not a
+    polynomial of known degree (angles, rational splines, curved p-curves); polynomial
+    directions get the order that is exact for them.  ``estimate_error=False`` drops the
+    second, lower-order quadrature behind ``error_estimate`` (then NaN); otherwise it runs
+    when ``error_estimate`` is first read.  Open shells are sewn at the model's
+    tolerance; those that stay open raise ``SurfmodError``.
 
     >>> import surfmod as sm, build123d as bd
     >>> r = sm.mass_properties(bd.Box(2, 3, 4))
@@ -207,42 +211,50 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 16, method: str =
     if method == "occt":
         g = occ.gprops(solid, eps)
         return MassProperties(g["volume"], g["area"], g["centroid"], density * g["inertia"], density,
-                              method=f"occt BRepGProp eps={eps:g}", error_estimate=float(g["volume_error"]))
+                              method=f"occt BRepGProp eps={eps:g}", _error=float(g["volume_error"]))
     # the reference point of the surface integrals: the mean of the vertices, as BRepGProp
     # takes it.  On a boundary that closes exactly any point gives the same result; on a
     # real file whose faces leave gaps (edges off their faces) the integrals depend on it
     # by (shift . closure defect) / 3, so the same point makes the two comparable.
     ref = occ.vertex_mean(solid)
     from ..surface import Surface
+    from .mass_green import face_nodes, mass_face, surface_mass_face
 
     if isinstance(obj, Surface):
         # one closed surface (sphere, torus, ...): integrate its own NumPy evaluator over
         # its domain; the orientation is fixed by the sign of the enclosed volume
-        from .faces import surface_patch
-
-        pats = [surface_patch(obj)]
-        probe = patch_moments(pats[0], ref, order)
-        if probe[1] < 0:
-            from dataclasses import replace
-
-            pats = [replace(pats[0], sign=-1.0)]
+        faces = [surface_mass_face(obj)]
+        if _moments(*face_nodes(faces[0], order)[:2], ref)[1] < 0:
+            faces[0].sign = -1.0
     else:
-        pats = patches(solid)
-    total = np.zeros(14)
-    low = np.zeros(14)
-    low_order = max(2, order - 4)
-    for p in pats:
-        total += patch_moments(p, ref, order)
-        if estimate_error:
-            low += patch_moments(p, ref, low_order)
+        from ..occ.topo import faces_of
+        from ..readback import from_face
+
+        faces = [mass_face(from_face(f)) for f in faces_of(solid)]
+    # faces whose every rule is exact by degree give the same sums at any order: the
+    # lower-order pass behind the error estimate only re-integrates the others
+    exact, high = _Accumulator(ref), _Accumulator(ref)
+    inexact = []
+    for f in faces:
+        ders, w, is_exact = face_nodes(f, order)
+        (exact if is_exact else high).add(ders, w)
+        if not is_exact:
+            inexact.append(f)
+    total = exact.flush() + high.flush()
     vol, area, centroid, inertia = _finish(total, ref, density)
-    nat = sum(p.natural for p in pats)
-    est = abs(total[1] - low[1]) / vol if estimate_error else float("nan")
+    nat = sum(f.natural for f in faces)
+
+    def estimate() -> float:
+        low = _Accumulator(ref)
+        for f in inexact:
+            low.add(*face_nodes(f, max(2, order - 4))[:2])
+        return abs(high.total[1] - low.flush()[1]) / vol
+
     return MassProperties(
         vol, area, centroid, inertia, density,
-        faces={"natural": nat, "trimmed": len(pats) - nat},
-        evaluators={"numpy": sum(p.evaluator == "numpy" for p in pats), "occt": sum(p.evaluator == "occt" for p in pats)},
-        error_estimate=float(est),
+        faces={"natural": nat, "trimmed": len(faces) - nat},
+        evaluators={"numpy": len(faces), "occt": 0},
+        _error=estimate if estimate_error else float("nan"),
     )
 
 

@@ -1,0 +1,132 @@
+"""The p-curves of a face's edges as plain data, for vectorized evaluation on the NumPy side.
+
+:func:`face_pcurves` reads every edge of a face once: its parameter range, its sign in
+the face (``-1`` for a reversed edge), the breaks of its ``GeomAbs_CN`` intervals and
+the 2-D curve itself -- a line (origin, direction), a circle (centre, axes, radius), a
+B-spline (poles, weights, flat knots, degree) or any other type, which
+:func:`adaptor_d1` samples point by point through the record's OCCT ``adaptor``.  Lines, circles and B-splines are then
+evaluated for all Gauss nodes at once (:mod:`surfmod.uses.mass_green`), instead of one
+``Geom2dAdaptor.D1`` call per node.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopoDS import TopoDS
+
+from .guard import kernel
+from .topo import explore
+
+
+def _xy(p) -> tuple[float, float]:
+    return (p.X(), p.Y())
+
+
+def _bspline_data(pc):
+    """Poles (padded to 3-D with z = 0 for the surfmod evaluator), weights, flat knots and
+    degree of a B-spline p-curve; None for a periodic curve whose edge range leaves its
+    first period (its unwrapped form would continue the end span there instead)."""
+    from OCP.TColgp import TColgp_Array1OfPnt2d
+    from OCP.TColStd import TColStd_Array1OfReal
+
+    b = pc.BSpline()
+    if b.IsPeriodic():
+        b = b.Copy()  # OCP returns the derived type
+        b.SetNotPeriodic()
+        lo, hi = b.FirstParameter(), b.LastParameter()
+        if pc.FirstParameter() < lo or pc.LastParameter() > hi:
+            return None
+    n, p = b.NbPoles(), b.Degree()
+    poles = TColgp_Array1OfPnt2d(1, n)
+    b.Poles(poles)
+    pts = np.zeros((n, 3))
+    pts[:, :2] = [_xy(poles.Value(i)) for i in range(1, n + 1)]
+    weights = None
+    if b.IsRational():
+        w = TColStd_Array1OfReal(1, n)
+        b.Weights(w)
+        weights = np.array([w.Value(i) for i in range(1, n + 1)])
+    k = TColStd_Array1OfReal(1, n + p + 1)
+    b.KnotSequence(k)
+    knots = np.array([k.Value(i) for i in range(1, n + p + 2)])
+    return {"points": pts, "weights": weights, "knots": knots, "degree": p}
+
+
+def face_pcurves(face) -> list[dict]:
+    """Per edge of ``face`` (outer wire and holes, as ``TopExp_Explorer`` visits them):
+    ``{"kind", "wire", "range", "sign", "breaks", ...}`` (``wire``: index of the edge's
+    wire) where ``kind`` is ``"line"`` (``origin``,
+    ``direction``: ``P(t) = origin + t direction``), ``"circle"`` (``centre``, ``x``, ``y``,
+    ``radius``: ``P(t) = centre + radius (cos t x + sin t y)``), ``"bspline"`` (``points``,
+    ``weights``, ``knots``, ``degree``) or ``"other"``; every record carries its ``adaptor``
+    (see :func:`adaptor_d1`), the reference the data-based evaluation is tested against.
+
+    >>> import build123d as bd
+    >>> pcs = face_pcurves(bd.Face(bd.Wire.make_circle(1.0)).wrapped)
+    >>> [(p["kind"], p["sign"]) for p in pcs]
+    [('circle', 1.0)]
+    """
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAbs_Line
+    from OCP.TColStd import TColStd_Array1OfReal
+
+    out = []
+    with kernel("BRepAdaptor_Curve2d (face p-curves)"):
+        edges = [(i, e) for i, wire in enumerate(explore(face, TopAbs_WIRE)) for e in explore(wire, TopAbs_EDGE)]
+        for wire_index, e in edges:
+            edge = TopoDS.Edge_s(e)
+            pc = BRepAdaptor_Curve2d(edge, face)
+            f, l = pc.FirstParameter(), pc.LastParameter()
+            kind = pc.GetType()
+            if kind in (GeomAbs_Line, GeomAbs_Circle):  # analytic: one smooth interval
+                breaks = np.array([f, l])
+            else:
+                n = pc.NbIntervals(GeomAbs_CN)
+                arr = TColStd_Array1OfReal(1, n + 1)
+                pc.Intervals(arr, GeomAbs_CN)
+                breaks = np.array([arr.Value(i) for i in range(1, n + 2)])
+            rec = {
+                "wire": wire_index,
+                "range": (f, l),
+                "sign": -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0,
+                "breaks": breaks,
+                "adaptor": pc,
+            }
+            if kind == GeomAbs_Line:
+                lin = pc.Line()
+                rec.update(kind="line", origin=np.array(_xy(lin.Location())), direction=np.array(_xy(lin.Direction())))
+            elif kind == GeomAbs_Circle:
+                c = pc.Circle()
+                ax = c.Position()
+                rec.update(kind="circle", centre=np.array(_xy(ax.Location())), x=np.array(_xy(ax.XDirection())),
+                           y=np.array(_xy(ax.YDirection())), radius=c.Radius())
+            elif kind == GeomAbs_BSplineCurve and (data := _bspline_data(pc)) is not None:
+                rec.update(kind="bspline", **data)
+            else:
+                rec.update(kind="other")
+            out.append(rec)
+    return out
+
+
+def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
+    """``(N, 4)``: ``u, v, du/dt, dv/dt`` of a 2-D curve adaptor at parameters ``t`` (one
+    OCCT call per parameter: only for p-curve types :func:`face_pcurves` cannot hand over
+    as data).
+
+    >>> import build123d as bd
+    >>> from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    >>> face = bd.Face(bd.Wire.make_circle(1.0)).wrapped
+    >>> edge = bd.Face(face).edges()[0].wrapped
+    >>> adaptor_d1(BRepAdaptor_Curve2d(edge, face), np.array([0.0])).round(12).tolist() == [[1, 0, 0, 1]]
+    True
+    """
+    from OCP.gp import gp_Pnt2d, gp_Vec2d
+
+    p, d = gp_Pnt2d(), gp_Vec2d()
+    out = np.empty((len(t), 4))
+    with kernel("Geom2dAdaptor D1 (p-curve)"):
+        for i, ti in enumerate(t):
+            adaptor.D1(float(ti), p, d)
+            out[i] = (p.X(), p.Y(), d.X(), d.Y())
+    return out

@@ -1,0 +1,130 @@
+"""The quadrature of mass properties face by face: p-curves evaluated from data equal
+OCCT's adaptor, rules exact by degree, Green's theorem along either direction, the
+BRepGProp convention on faces whose p-curves leave gaps, and the lazy error estimate."""
+
+from __future__ import annotations
+
+import math
+
+import build123d as bd
+import numpy as np
+import pytest
+
+import surfmod as sm
+import surfmod.uses.mass_green as mg
+from surfmod.occ.pcurves import adaptor_d1, face_pcurves
+from surfmod.occ.topo import faces_of
+from surfmod.uses.mass import _moments, face_moments
+
+CORPUS_FILE = "pythonocc_face_recognition_sample_part.stp"
+
+
+def _rel(a, b):
+    return abs(a - b) / abs(b)
+
+
+def test_pcurves_from_data_equal_occt(corpus_dir):
+    # every kind the corpus file holds (lines, circles, B-splines), inside and a little
+    # beyond each edge's range (real p-curves are evaluated there)
+    seen = set()
+    for face in faces_of(sm.import_step(corpus_dir / CORPUS_FILE).wrapped):
+        for rec in face_pcurves(face):
+            f, l = rec["range"]
+            t = np.linspace(f, l, 11)
+            mine, ref = mg.pcurve_d1(rec, t), adaptor_d1(rec["adaptor"], t)
+            scale = np.maximum(np.abs(ref).max(axis=0), 1.0)
+            assert (np.abs(mine - ref) / scale).max() < 1e-12, rec["kind"]
+            seen.add(rec["kind"])
+    assert {"line", "circle"} <= seen
+
+
+def _spline_face(kind):
+    pts = [(0, 0, 0), (3, -1, 0), (5, 1, 0), (4, 4, 0), (1, 3, 0)]
+    if kind == "periodic":
+        return bd.Face(bd.Wire([bd.Spline(*pts, periodic=True)]))
+    if kind == "open":
+        return bd.Face(bd.Wire([bd.Spline(*pts), bd.Edge.make_line(pts[-1], pts[0])]))
+    knots = [0, 0, 0, 1 / 3, 2 / 3, 1, 1, 1]
+    curve = sm.BSplineCurve(pts, 2, knots, [1.0, 0.7, 1.3, 0.9, 1.1])  # rational
+    return bd.Face(bd.Wire([curve.edge(), bd.Edge.make_line(pts[-1], pts[0])]))
+
+
+@pytest.mark.parametrize("kind", ["periodic", "open", "rational"])
+def test_bspline_pcurve_taylor_pieces_equal_occt(kind):
+    checked = 0
+    for rec in face_pcurves(_spline_face(kind).wrapped):
+        f, l = rec["range"]
+        # open curves continue their end spans beyond the range, as OCCT does; a periodic
+        # one is only evaluated inside it (OCCT wraps there)
+        pad = 0.0 if kind == "periodic" else 1e-3 * (l - f)
+        t = np.linspace(f - pad, l + pad, 41)
+        ref = adaptor_d1(rec["adaptor"], t)
+        assert np.abs(mg.pcurve_d1(rec, t) - ref).max() < 1e-12 * np.abs(ref).max()
+        checked += rec["kind"] == "bspline"
+    assert checked >= 1
+
+
+def test_exact_orders_integrate_polynomials_exactly():
+    for p in range(1, 8):
+        m = mg.exact_order(p)
+        x, w = mg.gauss(m)
+        # degree 5p on [-1, 1]: ∫ x^(5p) = 2/(5p+1) for even powers, 0 for odd
+        k = 5 * p
+        assert abs(np.sum(w * x**k) - (2 / (k + 1) if k % 2 == 0 else 0.0)) < 1e-14
+        assert 2 * m - 1 >= k
+
+
+def test_green_along_u_and_v_agree_on_a_closed_trimmed_cylinder(monkeypatch):
+    # a cylinder notched by a box: its wall is trimmed by straight p-curves that meet
+    # exactly, integrated along v (the cheap axial direction); along u (the angle) the
+    # result is the same to round-off
+    part = bd.Cylinder(1.0, 4.0) - bd.Box(1, 1, 1).translate((1, 0, 0))
+    wall = next(f for f in part.faces() if f.geom_type == bd.GeomType.CYLINDER)
+    mf = mg.mass_face(sm.from_face(wall))
+    assert not mf.natural and mf.degrees == (None, 1) and mg._largest_gap(mf) < 1e-14
+    along_v = _moments(*mg.face_nodes(mf, 12)[:2], np.zeros(3))
+    monkeypatch.setattr(mg, "CLOSURE_RTOL", -1.0)  # "not closed": BRepGProp's direction u
+    along_u = _moments(*mg.face_nodes(mf, 12)[:2], np.zeros(3))
+    assert np.abs(along_v - along_u).max() < 1e-13 * np.abs(along_u).max()
+    ref = sm.mass_properties(part, method="occt", eps=1e-9)
+    assert _rel(sm.mass_properties(part).volume, ref.volume) < 1e-10
+
+
+def test_faces_whose_pcurves_leave_gaps_keep_brepgprops_direction(monkeypatch):
+    # a slanted cut: approximated p-curves meet only to ~1e-8 of the face box, where the
+    # two directions differ by about that much; the face is integrated along u, as
+    # BRepGProp does, and agrees with it
+    part = bd.Cylinder(1.0, 4.0) - bd.Box(4, 4, 4).rotate(bd.Axis.X, 30).translate((0, 0, 2.5))
+    wall = next(f for f in part.faces() if f.geom_type == bd.GeomType.CYLINDER)
+    mf = mg.mass_face(sm.from_face(wall))
+    assert mg._largest_gap(mf) > mg.CLOSURE_RTOL
+    ref = sm.mass_properties(part, method="occt", eps=1e-9).volume
+    along_u = sm.mass_properties(part).volume
+    monkeypatch.setattr(mg, "CLOSURE_RTOL", 1.0)  # force the cheap direction v
+    along_v = sm.mass_properties(part).volume
+    assert _rel(along_u, ref) < 1e-11 < _rel(along_v, ref)
+
+
+def test_planar_faces_are_exact_and_skip_the_estimate_pass():
+    # a plate with a rectangular hole: every face is a plane bounded by lines, integrated
+    # exactly with 3 nodes per line and per inner span; the estimate is exactly 0
+    part = bd.Box(4, 3, 1) - bd.Box(1, 1, 2)
+    r = sm.mass_properties(part)
+    assert r.volume == pytest.approx(11.0, rel=1e-15) and r.area == pytest.approx(2 * 11 + 14 + 4, rel=1e-15)
+    for f in part.faces():
+        assert mg.face_nodes(mg.mass_face(sm.from_face(f)), 12)[2]
+    assert r.error_estimate == 0.0
+
+
+def test_error_estimate_is_computed_on_first_read_and_kept():
+    r = sm.mass_properties(bd.Box(2, 2, 2) - bd.Sphere(1.3))
+    first = r.error_estimate
+    assert 0.0 <= first < 1e-9 and r.error_estimate == first
+    assert math.isnan(sm.mass_properties(bd.Box(1, 1, 1), estimate_error=False).error_estimate)
+
+
+def test_face_area_on_a_holed_face():
+    plate = bd.Box(4, 3, 1) - bd.Cylinder(1.0, 2)
+    top = max(plate.faces(), key=lambda f: f.center().Z)
+    assert _rel(sm.from_face(top).area(), 12 - math.pi) < 1e-14
+    assert _rel(face_moments(sm.from_face(top))[0], 12 - math.pi) < 1e-14
