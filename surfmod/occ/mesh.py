@@ -77,9 +77,23 @@ ANALYTIC = ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface", "Geo
             "Geom_ToroidalSurface")
 
 
-def _triangulation(face, with_uv: bool = True):
-    """``(nodes, uv, triangles)`` of a face's stored triangulation (``uv`` NaN unless
-    ``with_uv``), or ``None``."""
+@dataclass
+class FaceTriangles:
+    """One face's stored BRepMesh triangulation as arrays: ``nodes`` (N, 3) in global
+    coordinates (the face's location applied), ``uv`` (N, 2) parameter nodes (NaN where
+    not read or absent), ``triangles`` (T, 3) node indices as OCCT stores them (face
+    orientation *not* applied; ``reversed`` says whether to flip them for an outward
+    normal) and ``deflection``, the chordal deflection BRepMesh measured on the face."""
+
+    nodes: np.ndarray
+    uv: np.ndarray
+    triangles: np.ndarray
+    reversed: bool
+    deflection: float
+
+
+def _read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTriangles | None:
+    """The face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has none."""
     from OCP.BRep import BRep_Tool
     from OCP.TopAbs import TopAbs_REVERSED
     from OCP.TopLoc import TopLoc_Location
@@ -89,19 +103,48 @@ def _triangulation(face, with_uv: bool = True):
     if tri is None or tri.NbTriangles() == 0:
         return None
     n = tri.NbNodes()
-    nodes = np.array([tri.Node(i).Coord() for i in range(1, n + 1)], dtype=float)
-    if not loc.IsIdentity():
-        t = loc.Transformation()
-        rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
-        nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
+    nodes = np.full((n, 3), np.nan)
+    if with_nodes:
+        nodes = np.array([tri.Node(i).Coord() for i in range(1, n + 1)], dtype=float)
+        if not loc.IsIdentity():
+            t = loc.Transformation()
+            rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
+            nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
     if with_uv and tri.HasUVNodes():
         uv = np.array([tri.UVNode(i).Coord() for i in range(1, n + 1)], dtype=float)
     else:
         uv = np.full((n, 2), np.nan)
     idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
-    if face.Orientation() == TopAbs_REVERSED:
-        idx = idx[:, ::-1]
-    return nodes, uv, idx
+    return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, float(tri.Deflection()))
+
+
+def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, parallel: bool = False,
+               with_uv=True, with_nodes: bool = True) -> list[tuple]:
+    """The one BRepMesh call of surfmod: clear any stored triangulation, run
+    ``BRepMesh_IncrementalMesh(shape, deflection, relative, angular, parallel)`` and read
+    every face's triangulation back.
+
+    Returns ``[(index, face, FaceTriangles or None)]`` per face in exploration order
+    (``None``: BRepMesh left the face without triangles).  ``with_uv`` is a bool or a
+    predicate ``with_uv(face) -> bool`` choosing the faces whose (u, v) nodes are read;
+    ``with_nodes=False`` skips the 3-D nodes (NaN).
+
+    >>> import build123d as bd
+    >>> [(k, len(t.triangles)) for k, _, t in mesh_faces(bd.Box(1, 1, 1), 0.1)][:2]
+    [(0, 2), (1, 2)]
+    """
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+
+    from .topo import faces_of, wrapped
+
+    shp = wrapped(shape)
+    if shp is None:
+        raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
+    clean(shp)
+    with kernel("BRepMesh_IncrementalMesh"):
+        BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
+        return [(k, face, _read_triangulation(face, with_uv(face) if callable(with_uv) else bool(with_uv), with_nodes))
+                for k, face in enumerate(faces_of(shp))]
 
 
 def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None) -> list[FaceMesh]:
@@ -110,27 +153,32 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
     share an edge coincide bit for bit.  Faces BRepMesh left without triangles are
     skipped; their indices are appended to ``missing`` when a list is given."""
     from OCP.BRep import BRep_Tool
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
     from OCP.BRepTools import BRepTools
 
     from .geom import surface_type
-    from .topo import faces_of, wrapped
+    from .topo import wrapped
 
     shp = wrapped(shape)
-    clean(shp)
+    surfaces = {}
+
+    def needs_uv(face):
+        # analytic faces are measured in closed form, without their (u, v) nodes
+        surfaces[face.__hash__()] = surf = basis_surface(BRep_Tool.Surface_s(face))
+        return surface_type(surf) not in ANALYTIC
+
     out = []
-    with kernel("BRepMesh_IncrementalMesh"):
-        BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), False)
+    meshed = mesh_faces(shp, deflection, angular, relative=relative, with_uv=needs_uv)
+    with kernel("BRepMesh triangulations"):
         owner = _face_solids(shp)
-        for k, face in enumerate(faces_of(shp)):
-            surf = basis_surface(BRep_Tool.Surface_s(face))
-            got = _triangulation(face, surface_type(surf) not in ANALYTIC)
+        for k, face, got in meshed:
             if got is None:
                 if missing is not None:
                     missing.append(k)
                 continue
+            tri = got.triangles[:, ::-1] if got.reversed else got.triangles
             bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
-            out.append(FaceMesh(*got, surf, face, bounds, k, owner.get(face.__hash__(), -1)))
+            out.append(FaceMesh(got.nodes, got.uv, tri, surfaces[face.__hash__()], face, bounds, k,
+                                owner.get(face.__hash__(), -1)))
     if not out:
         raise SurfmodError("shape: has no faces to triangulate")
     return out

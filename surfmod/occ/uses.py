@@ -189,18 +189,12 @@ def is_rectangle(face, bounds) -> bool:
 def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
     face (the face's trimmed parameter region as a polygonal patchwork)."""
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
-    from OCP.BRepTools import BRepTools
-    from OCP.TopLoc import TopLoc_Location
+    from .mesh import mesh_faces
 
-    with kernel("BRepMesh_IncrementalMesh (face)"):
-        BRepTools.Clean_s(face)
-        BRepMesh_IncrementalMesh(face, float(deflection), False, float(angular), True)
-        tri = BRep_Tool.Triangulation_s(face, TopLoc_Location())
-        if tri is None or not tri.HasUVNodes():
-            raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
-        uv = np.array([[p.X(), p.Y()] for p in (tri.UVNode(i) for i in range(1, tri.NbNodes() + 1))])
-        idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
+    ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
+    if got is None or np.isnan(got.uv).any():
+        raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
+    uv, idx = got.uv, got.triangles
     return uv, idx
 
 
