@@ -92,7 +92,7 @@ class FaceTriangles:
     deflection: float
 
 
-def _read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTriangles | None:
+def read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTriangles | None:
     """The face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has none."""
     from OCP.BRep import BRep_Tool
     from OCP.TopAbs import TopAbs_REVERSED
@@ -143,7 +143,7 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
     clean(shp)
     with kernel("BRepMesh_IncrementalMesh"):
         BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
-        return [(k, face, _read_triangulation(face, with_uv(face) if callable(with_uv) else bool(with_uv), with_nodes))
+        return [(k, face, read_triangulation(face, with_uv(face) if callable(with_uv) else bool(with_uv), with_nodes))
                 for k, face in enumerate(faces_of(shp))]
 
 
