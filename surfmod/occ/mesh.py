@@ -9,6 +9,7 @@ the kernel boundary and the measurement side, not a NumPy evaluation path.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import chain
 
 import numpy as np
 
@@ -92,6 +93,12 @@ class FaceTriangles:
     deflection: float
 
 
+def _coords(getter, n: int, dim: int) -> np.ndarray:
+    """``(n, dim)`` coordinates of ``getter(1) ... getter(n)`` (gp_Pnt / gp_Pnt2d): one
+    flat ``fromiter`` instead of a list of tuples (a third less time per node)."""
+    return np.fromiter(chain.from_iterable(getter(i).Coord() for i in range(1, n + 1)), float, dim * n).reshape(n, dim)
+
+
 def read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTriangles | None:
     """The face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has none."""
     from OCP.BRep import BRep_Tool
@@ -105,16 +112,17 @@ def read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTria
     n = tri.NbNodes()
     nodes = np.full((n, 3), np.nan)
     if with_nodes:
-        nodes = np.array([tri.Node(i).Coord() for i in range(1, n + 1)], dtype=float)
+        nodes = _coords(tri.Node, n, 3)
         if not loc.IsIdentity():
             t = loc.Transformation()
             rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
             nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
     if with_uv and tri.HasUVNodes():
-        uv = np.array([tri.UVNode(i).Coord() for i in range(1, n + 1)], dtype=float)
+        uv = _coords(tri.UVNode, n, 2)
     else:
         uv = np.full((n, 2), np.nan)
-    idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
+    triangle, m = tri.Triangle, tri.NbTriangles()
+    idx = np.fromiter(chain.from_iterable(triangle(i).Get() for i in range(1, m + 1)), np.int64, 3 * m).reshape(m, 3) - 1
     return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, float(tri.Deflection()))
 
 
@@ -372,6 +380,15 @@ def shape_figures(shape, samples: int = 5):
             if name == "Geom_Plane":
                 continue
             u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+            if name in ("Geom_CylindricalSurface", "Geom_SphericalSurface"):
+                # closed forms of what the sampled figures below come to (|Su x Sv|, k1, k2)
+                r = surf.Radius()
+                if name == "Geom_CylindricalSurface":
+                    figures.append((r * (u1 - u0) * (v1 - v0), float(np.sqrt(max(1 / r, floor) * floor))))
+                else:
+                    figures.append((r * r * (u1 - u0) * float(np.mean(np.cos(np.linspace(v0, v1, samples)))) * (v1 - v0),
+                                    max(1 / r, floor)))
+                continue
             lp = GeomLProp_SLProps(surf, 2, 1e-9)
             vals, jac = [], []
             # elementary surfaces are curved alike along u: three columns tell them
