@@ -248,6 +248,9 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
             dev, node_dev = np.zeros(len(fms)), np.zeros(len(fms))
             for i, fm in enumerate(tqdm(fms, desc=f"measure pass {attempt}", unit="face", disable=not progress,
                                         leave=False)):
+                if fm.repeats >= 0:  # an isometric repeat of a face measured above
+                    dev[i], node_dev[i] = dev[fm.repeats], node_dev[fm.repeats]
+                    continue
                 d, node_dev[i] = measure_face(fm, tolerance)
                 dev[i] = d.max(initial=0.0)
             bar.update()

@@ -23,7 +23,10 @@ class FaceMesh:
     nodes on the face's surface, ``triangles`` oriented outwards (face orientation
     applied), the face's ``surface`` (global coordinates, trimmed-surface wrappers
     removed), its ``face``, ``bounds`` (UV box), ``index`` in exploration order and
-    ``solid`` (index of the solid it belongs to, -1 for faces outside any solid)."""
+    ``solid`` (index of the solid it belongs to, -1 for faces outside any solid) and
+    ``repeats``: the position in the same list of an earlier face this one repeats at an
+    isometric location (same triangulation, same surface moved rigidly: the same
+    deviations), or -1."""
 
     nodes: np.ndarray
     uv: np.ndarray
@@ -33,6 +36,7 @@ class FaceMesh:
     bounds: tuple
     index: int = 0
     solid: int = -1
+    repeats: int = -1
 
 
 def clean(shape) -> None:
@@ -91,6 +95,8 @@ class FaceTriangles:
     triangles: np.ndarray
     reversed: bool
     deflection: float
+    instance: int = -1
+    rigid: bool = True
 
 
 def _coords(getter, n: int, dim: int) -> np.ndarray:
@@ -99,31 +105,61 @@ def _coords(getter, n: int, dim: int) -> np.ndarray:
     return np.fromiter(chain.from_iterable(getter(i).Coord() for i in range(1, n + 1)), float, dim * n).reshape(n, dim)
 
 
-def read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTriangles | None:
-    """The face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has none."""
+def _local_triangulation(face, with_uv: bool, with_nodes: bool):
+    """``(nodes in the face's own frame, uv, triangles, deflection, location)`` or ``None``."""
     from OCP.BRep import BRep_Tool
-    from OCP.TopAbs import TopAbs_REVERSED
     from OCP.TopLoc import TopLoc_Location
 
     loc = TopLoc_Location()
     tri = BRep_Tool.Triangulation_s(face, loc)
     if tri is None or tri.NbTriangles() == 0:
         return None
-    n = tri.NbNodes()
-    nodes = np.full((n, 3), np.nan)
-    if with_nodes:
-        nodes = _coords(tri.Node, n, 3)
-        if not loc.IsIdentity():
-            t = loc.Transformation()
-            rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
-            nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
-    if with_uv and tri.HasUVNodes():
-        uv = _coords(tri.UVNode, n, 2)
-    else:
-        uv = np.full((n, 2), np.nan)
-    triangle, m = tri.Triangle, tri.NbTriangles()
+    n, m = tri.NbNodes(), tri.NbTriangles()
+    nodes = _coords(tri.Node, n, 3) if with_nodes else np.full((n, 3), np.nan)
+    uv = _coords(tri.UVNode, n, 2) if with_uv and tri.HasUVNodes() else np.full((n, 2), np.nan)
+    triangle = tri.Triangle
     idx = np.fromiter(chain.from_iterable(triangle(i).Get() for i in range(1, m + 1)), np.int64, 3 * m).reshape(m, 3) - 1
-    return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, float(tri.Deflection()))
+    return nodes, uv, idx, float(tri.Deflection()), loc
+
+
+def read_triangulation(face, with_uv: bool, with_nodes: bool = True, instances: dict | None = None) -> FaceTriangles | None:
+    """The face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has none.
+
+    Faces that are located instances of one face (assemblies) share one triangulation:
+    with an ``instances`` dict it is read once and moved to each instance's location;
+    ``FaceTriangles.instance`` then names the instance group (the same for every face
+    of the group) and ``rigid`` says whether the location is an isometry (distances to
+    the instance equal those to the face it repeats)."""
+    from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED
+    from OCP.TopLoc import TopLoc_Location
+
+    key = None
+    if instances is not None:
+        bare = face.Located(TopLoc_Location()).Oriented(TopAbs_FORWARD)
+        key = bare.__hash__()
+        hit = instances.get(key)
+        if hit is not None and hit[0].IsSame(bare) and (hit[2] or not with_uv) and (hit[3] or not with_nodes):
+            got = hit[1]
+            loc = face.Location()
+            got = got[:4] + (loc,)
+        else:
+            got = _local_triangulation(face, with_uv, with_nodes)
+            if got is None:
+                return None
+            instances[key] = (bare, got, with_uv, with_nodes)
+    else:
+        got = _local_triangulation(face, with_uv, with_nodes)
+        if got is None:
+            return None
+    nodes, uv, idx, deflection, loc = got
+    rigid = True
+    if not loc.IsIdentity():
+        t = loc.Transformation()
+        rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
+        nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
+        rigid = abs(abs(t.ScaleFactor()) - 1.0) < 1e-12
+    return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, deflection,
+                         -1 if key is None else key, rigid)
 
 
 def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, parallel: bool = False,
@@ -135,7 +171,8 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
     Returns ``[(index, face, FaceTriangles or None)]`` per face in exploration order
     (``None``: BRepMesh left the face without triangles).  ``with_uv`` is a bool or a
     predicate ``with_uv(face) -> bool`` choosing the faces whose (u, v) nodes are read;
-    ``with_nodes=False`` skips the 3-D nodes (NaN).
+    ``with_nodes=False`` skips the 3-D nodes (NaN).  Located instances of one face
+    (assemblies) are read once (see :func:`read_triangulation`).
 
     >>> import build123d as bd
     >>> [(k, len(t.triangles)) for k, _, t in mesh_faces(bd.Box(1, 1, 1), 0.1)][:2]
@@ -151,7 +188,9 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
     clean(shp)
     with kernel("BRepMesh_IncrementalMesh"):
         BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
-        return [(k, face, read_triangulation(face, with_uv(face) if callable(with_uv) else bool(with_uv), with_nodes))
+        instances: dict = {}
+        return [(k, face, read_triangulation(face, with_uv(face) if callable(with_uv) else bool(with_uv), with_nodes,
+                                             instances))
                 for k, face in enumerate(faces_of(shp))]
 
 
@@ -175,6 +214,7 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
         return surface_type(surf) not in ANALYTIC
 
     out = []
+    first: dict = {}  # instance group -> position in out of its first rigid face
     meshed = mesh_faces(shp, deflection, angular, relative=relative, with_uv=needs_uv)
     with kernel("BRepMesh triangulations"):
         owner = _face_solids(shp)
@@ -185,8 +225,11 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
                 continue
             tri = got.triangles[:, ::-1] if got.reversed else got.triangles
             bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
+            repeats = first.get(got.instance, -1) if got.rigid else -1
+            if got.rigid and got.instance not in first:
+                first[got.instance] = len(out)
             out.append(FaceMesh(got.nodes, got.uv, tri, surfaces[face.__hash__()], face, bounds, k,
-                                owner.get(face.__hash__(), -1)))
+                                owner.get(face.__hash__(), -1), repeats))
     if not out:
         raise SurfmodError("shape: has no faces to triangulate")
     return out
