@@ -65,9 +65,10 @@ def _bounds(fm, ev: FaceSurface) -> tuple:
     return tuple(box)
 
 
-def measure_face(fm, tolerance: float, bary=DENSE) -> tuple[np.ndarray, float]:
+def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None) -> tuple[np.ndarray, float]:
     """Measured deviation of every triangle of a :class:`~surfmod.occ.mesh.FaceMesh`
     (max over ``bary`` samples) and the max deviation of its nodes from the surface.
+    ``ev``: the face's :class:`FaceSurface` when the caller already has it.
 
     Values at most ``tolerance / 2`` may be upper bounds; larger ones are projections.
     """
@@ -79,7 +80,7 @@ def measure_face(fm, tolerance: float, bary=DENSE) -> tuple[np.ndarray, float]:
     if exact is not None:
         node = analytic_distances(fm.surface, fm.nodes)
         return exact.reshape(len(pos), len(bary)).max(axis=1), float(node.max(initial=0.0))
-    ev = FaceSurface(fm.surface)
+    ev = FaceSurface(fm.surface) if ev is None else ev
     box = _bounds(fm, ev)
     if np.isnan(fm.uv).any():
         raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
@@ -161,7 +162,7 @@ def _refine_locally(fms, i: int, dev, node_dev, tolerance: float) -> bool:
         return False
     ev = FaceSurface(fm.surface)
     out = refine_face(replace(fm, uv=with_uv.uv), tolerance, float(node_dev[i]),
-                      lambda f: measure_face(f, tolerance)[0], lambda uv: ev.d0(uv[:, 0], uv[:, 1]))
+                      lambda f: measure_face(f, tolerance, ev=ev)[0], lambda uv: ev.d0(uv[:, 0], uv[:, 1]))
     if out is None:
         return False
     fms[i], tri_dev = out
