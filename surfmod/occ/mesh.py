@@ -9,7 +9,7 @@ the kernel boundary and the measurement side, not a NumPy evaluation path.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import chain
+from itertools import chain, count
 
 import numpy as np
 
@@ -88,7 +88,9 @@ class FaceTriangles:
     coordinates (the face's location applied), ``uv`` (N, 2) parameter nodes (NaN where
     not read or absent), ``triangles`` (T, 3) node indices as OCCT stores them (face
     orientation *not* applied; ``reversed`` says whether to flip them for an outward
-    normal) and ``deflection``, the chordal deflection BRepMesh measured on the face."""
+    normal), ``deflection``, the chordal deflection BRepMesh measured on the face,
+    ``instance`` (faces that are located copies of one face share this number, -1 when
+    not tracked) and ``rigid`` (the face's location is an isometry)."""
 
     nodes: np.ndarray
     uv: np.ndarray
@@ -103,6 +105,10 @@ def _coords(getter, n: int, dim: int) -> np.ndarray:
     """``(n, dim)`` coordinates of ``getter(1) ... getter(n)`` (gp_Pnt / gp_Pnt2d): one
     flat ``fromiter`` instead of a list of tuples (a third less time per node)."""
     return np.fromiter(chain.from_iterable(getter(i).Coord() for i in range(1, n + 1)), float, dim * n).reshape(n, dim)
+
+
+#: Instance-group numbers handed out by :func:`read_triangulation`.
+_GROUPS = count()
 
 
 def _local_triangulation(face, with_uv: bool, with_nodes: bool):
@@ -133,20 +139,19 @@ def read_triangulation(face, with_uv: bool, with_nodes: bool = True, instances: 
     from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED
     from OCP.TopLoc import TopLoc_Location
 
-    key = None
+    group = -1
     if instances is not None:
         bare = face.Located(TopLoc_Location()).Oriented(TopAbs_FORWARD)
         key = bare.__hash__()
         hit = instances.get(key)
         if hit is not None and hit[0].IsSame(bare) and (hit[2] or not with_uv) and (hit[3] or not with_nodes):
-            got = hit[1]
-            loc = face.Location()
-            got = got[:4] + (loc,)
+            got, group = hit[1][:4] + (face.Location(),), hit[4]
         else:
             got = _local_triangulation(face, with_uv, with_nodes)
             if got is None:
                 return None
-            instances[key] = (bare, got, with_uv, with_nodes)
+            group = next(_GROUPS)  # unique even if two faces' hashes collide
+            instances[key] = (bare, got, with_uv, with_nodes, group)
     else:
         got = _local_triangulation(face, with_uv, with_nodes)
         if got is None:
@@ -158,8 +163,7 @@ def read_triangulation(face, with_uv: bool, with_nodes: bool = True, instances: 
         rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
         nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
         rigid = abs(abs(t.ScaleFactor()) - 1.0) < 1e-12
-    return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, deflection,
-                         -1 if key is None else key, rigid)
+    return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, deflection, group, rigid)
 
 
 def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, parallel: bool = False,
@@ -225,8 +229,9 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
                 continue
             tri = got.triangles[:, ::-1] if got.reversed else got.triangles
             bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
-            repeats = first.get(got.instance, -1) if got.rigid else -1
-            if got.rigid and got.instance not in first:
+            shared = got.rigid and got.instance >= 0
+            repeats = first.get(got.instance, -1) if shared else -1
+            if shared and got.instance not in first:
                 first[got.instance] = len(out)
             out.append(FaceMesh(got.nodes, got.uv, tri, surfaces[face.__hash__()], face, bounds, k,
                                 owner.get(face.__hash__(), -1), repeats))
