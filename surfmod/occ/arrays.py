@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 from OCP.gp import gp_Pnt, gp_Vec
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
@@ -68,20 +70,23 @@ def knots_and_mults(flat_knots: np.ndarray):
 
 
 def to_numpy_1d(arr) -> np.ndarray:
-    return np.array([arr.Value(i) for i in range(arr.Lower(), arr.Upper() + 1)], dtype=float)
+    value = arr.Value
+    return np.fromiter((value(i) for i in range(arr.Lower(), arr.Upper() + 1)), float, arr.Upper() - arr.Lower() + 1)
 
 
 def pnts_to_numpy_1d(arr) -> np.ndarray:
-    return np.array([xyz(arr.Value(i)) for i in range(arr.Lower(), arr.Upper() + 1)])
+    # one flat fromiter over Coord() tuples: a third of the time of a list of arrays
+    value, n = arr.Value, arr.Upper() - arr.Lower() + 1
+    return np.fromiter(chain.from_iterable(value(i).Coord() for i in range(arr.Lower(), arr.Upper() + 1)),
+                       float, 3 * n).reshape(n, 3)
 
 
 def pnts_to_numpy_2d(arr) -> np.ndarray:
-    return np.array(
-        [
-            [xyz(arr.Value(i, j)) for j in range(arr.LowerCol(), arr.UpperCol() + 1)]
-            for i in range(arr.LowerRow(), arr.UpperRow() + 1)
-        ]
-    )
+    value = arr.Value
+    rows, cols = range(arr.LowerRow(), arr.UpperRow() + 1), range(arr.LowerCol(), arr.UpperCol() + 1)
+    flat = np.fromiter(chain.from_iterable(value(i, j).Coord() for i in rows for j in cols), float,
+                       3 * len(rows) * len(cols))
+    return flat.reshape(len(rows), len(cols), 3)
 
 
 def reals_to_numpy_2d(arr) -> np.ndarray:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import SurfmodError
 from .guard import kernel
-from .topo import faces_of, wrapped
+from .topo import wrapped
 
 
 def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.ndarray, float]:
@@ -22,34 +22,19 @@ def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.
     the requested one; some faces of real parts cannot be meshed finer than their own
     tolerance allows).  Any triangulation stored on the shape is replaced.  A face BRepMesh
     leaves without triangles raises ``SurfmodError`` (the tool would not see it)."""
-    from OCP.BRep import BRep_Tool
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
-    from OCP.BRepTools import BRepTools
-    from OCP.TopLoc import TopLoc_Location
+    from .mesh import mesh_faces
 
-    shp = wrapped(shape)
-    if shp is None:
+    if wrapped(shape) is None:
         raise SurfmodError(f"obj: expected an OCCT shape, got {type(shape).__name__}")
     blocks = []
     unmeshed = 0
     measured = float(deflection)
-    with kernel("BRepMesh_IncrementalMesh"):
-        BRepTools.Clean_s(shp)
-        BRepMesh_IncrementalMesh(shp, float(deflection), False, float(angular), False)
-        for face in faces_of(shp):
-            loc = TopLoc_Location()
-            tri = BRep_Tool.Triangulation_s(face, loc)
-            if tri is None or tri.NbTriangles() == 0:
-                unmeshed += 1  # a face the tool cannot see: never skip it silently
-                continue
-            trsf = loc.Transformation()
-            nodes = np.empty((tri.NbNodes(), 3))
-            for i in range(tri.NbNodes()):
-                p = tri.Node(i + 1).Transformed(trsf)
-                nodes[i] = (p.X(), p.Y(), p.Z())
-            idx = np.array([tri.Triangle(i + 1).Get() for i in range(tri.NbTriangles())], dtype=np.int64) - 1
-            blocks.append(nodes[idx])
-            measured = max(measured, float(tri.Deflection()))
+    for _, _, got in mesh_faces(shape, deflection, angular, with_uv=False):
+        if got is None:
+            unmeshed += 1  # a face the tool cannot see: never skip it silently
+            continue
+        blocks.append(got.nodes[got.triangles])
+        measured = max(measured, got.deflection)
     if unmeshed:
         raise SurfmodError(f"obj: BRepMesh could not triangulate {unmeshed} face(s); a tool path over them "
                            f"cannot be checked")

@@ -9,6 +9,7 @@ the kernel boundary and the measurement side, not a NumPy evaluation path.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import chain, count
 
 import numpy as np
 
@@ -22,7 +23,10 @@ class FaceMesh:
     nodes on the face's surface, ``triangles`` oriented outwards (face orientation
     applied), the face's ``surface`` (global coordinates, trimmed-surface wrappers
     removed), its ``face``, ``bounds`` (UV box), ``index`` in exploration order and
-    ``solid`` (index of the solid it belongs to, -1 for faces outside any solid)."""
+    ``solid`` (index of the solid it belongs to, -1 for faces outside any solid) and
+    ``repeats``: the position in the same list of an earlier face this one repeats at an
+    isometric location (same triangulation, same surface moved rigidly: the same
+    deviations), or -1."""
 
     nodes: np.ndarray
     uv: np.ndarray
@@ -32,6 +36,7 @@ class FaceMesh:
     bounds: tuple
     index: int = 0
     solid: int = -1
+    repeats: int = -1
 
 
 def clean(shape) -> None:
@@ -77,31 +82,120 @@ ANALYTIC = ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface", "Geo
             "Geom_ToroidalSurface")
 
 
-def _triangulation(face, with_uv: bool = True):
-    """``(nodes, uv, triangles)`` of a face's stored triangulation (``uv`` NaN unless
-    ``with_uv``), or ``None``."""
+@dataclass
+class FaceTriangles:
+    """One face's stored BRepMesh triangulation as arrays: ``nodes`` (N, 3) in global
+    coordinates (the face's location applied), ``uv`` (N, 2) parameter nodes (NaN where
+    not read or absent), ``triangles`` (T, 3) node indices as OCCT stores them (face
+    orientation *not* applied; ``reversed`` says whether to flip them for an outward
+    normal), ``deflection``, the chordal deflection BRepMesh measured on the face,
+    ``instance`` (faces that are located copies of one face share this number, -1 when
+    not tracked) and ``rigid`` (the face's location is an isometry)."""
+
+    nodes: np.ndarray
+    uv: np.ndarray
+    triangles: np.ndarray
+    reversed: bool
+    deflection: float
+    instance: int = -1
+    rigid: bool = True
+
+
+def _coords(getter, n: int, dim: int) -> np.ndarray:
+    """``(n, dim)`` coordinates of ``getter(1) ... getter(n)`` (gp_Pnt / gp_Pnt2d): one
+    flat ``fromiter`` instead of a list of tuples (a third less time per node)."""
+    return np.fromiter(chain.from_iterable(getter(i).Coord() for i in range(1, n + 1)), float, dim * n).reshape(n, dim)
+
+
+#: Instance-group numbers handed out by :func:`read_triangulation`.
+_GROUPS = count()
+
+
+def _local_triangulation(face, with_uv: bool, with_nodes: bool):
+    """``(nodes in the face's own frame, uv, triangles, deflection, location)`` or ``None``."""
     from OCP.BRep import BRep_Tool
-    from OCP.TopAbs import TopAbs_REVERSED
     from OCP.TopLoc import TopLoc_Location
 
     loc = TopLoc_Location()
     tri = BRep_Tool.Triangulation_s(face, loc)
     if tri is None or tri.NbTriangles() == 0:
         return None
-    n = tri.NbNodes()
-    nodes = np.array([tri.Node(i).Coord() for i in range(1, n + 1)], dtype=float)
+    n, m = tri.NbNodes(), tri.NbTriangles()
+    nodes = _coords(tri.Node, n, 3) if with_nodes else np.full((n, 3), np.nan)
+    uv = _coords(tri.UVNode, n, 2) if with_uv and tri.HasUVNodes() else np.full((n, 2), np.nan)
+    triangle = tri.Triangle
+    idx = np.fromiter(chain.from_iterable(triangle(i).Get() for i in range(1, m + 1)), np.int64, 3 * m).reshape(m, 3) - 1
+    return nodes, uv, idx, float(tri.Deflection()), loc
+
+
+def read_triangulation(face, with_uv: bool, with_nodes: bool = True, instances: dict | None = None) -> FaceTriangles | None:
+    """The face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has none.
+
+    Faces that are located instances of one face (assemblies) share one triangulation:
+    with an ``instances`` dict it is read once and moved to each instance's location;
+    ``FaceTriangles.instance`` then names the instance group (the same for every face
+    of the group) and ``rigid`` says whether the location is an isometry (distances to
+    the instance equal those to the face it repeats)."""
+    from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED
+    from OCP.TopLoc import TopLoc_Location
+
+    group = -1
+    if instances is not None:
+        bare = face.Located(TopLoc_Location()).Oriented(TopAbs_FORWARD)
+        key = bare.__hash__()
+        hit = instances.get(key)
+        if hit is not None and hit[0].IsSame(bare) and (hit[2] or not with_uv) and (hit[3] or not with_nodes):
+            got, group = hit[1][:4] + (face.Location(),), hit[4]
+        else:
+            got = _local_triangulation(face, with_uv, with_nodes)
+            if got is None:
+                return None
+            group = next(_GROUPS)  # unique even if two faces' hashes collide
+            instances[key] = (bare, got, with_uv, with_nodes, group)
+    else:
+        got = _local_triangulation(face, with_uv, with_nodes)
+        if got is None:
+            return None
+    nodes, uv, idx, deflection, loc = got
+    rigid = True
     if not loc.IsIdentity():
         t = loc.Transformation()
         rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
         nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
-    if with_uv and tri.HasUVNodes():
-        uv = np.array([tri.UVNode(i).Coord() for i in range(1, n + 1)], dtype=float)
-    else:
-        uv = np.full((n, 2), np.nan)
-    idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
-    if face.Orientation() == TopAbs_REVERSED:
-        idx = idx[:, ::-1]
-    return nodes, uv, idx
+        rigid = abs(abs(t.ScaleFactor()) - 1.0) < 1e-12
+    return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, deflection, group, rigid)
+
+
+def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, parallel: bool = False,
+               with_uv=True, with_nodes: bool = True) -> list[tuple]:
+    """The one BRepMesh call of surfmod: clear any stored triangulation, run
+    ``BRepMesh_IncrementalMesh(shape, deflection, relative, angular, parallel)`` and read
+    every face's triangulation back.
+
+    Returns ``[(index, face, FaceTriangles or None)]`` per face in exploration order
+    (``None``: BRepMesh left the face without triangles).  ``with_uv`` is a bool or a
+    predicate ``with_uv(face) -> bool`` choosing the faces whose (u, v) nodes are read;
+    ``with_nodes=False`` skips the 3-D nodes (NaN).  Located instances of one face
+    (assemblies) are read once (see :func:`read_triangulation`).
+
+    >>> import build123d as bd
+    >>> [(k, len(t.triangles)) for k, _, t in mesh_faces(bd.Box(1, 1, 1), 0.1)][:2]
+    [(0, 2), (1, 2)]
+    """
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+
+    from .topo import faces_of, wrapped
+
+    shp = wrapped(shape)
+    if shp is None:
+        raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
+    clean(shp)
+    with kernel("BRepMesh_IncrementalMesh"):
+        BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
+        instances: dict = {}
+        return [(k, face, read_triangulation(face, with_uv(face) if callable(with_uv) else bool(with_uv), with_nodes,
+                                             instances))
+                for k, face in enumerate(faces_of(shp))]
 
 
 def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None) -> list[FaceMesh]:
@@ -110,27 +204,37 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
     share an edge coincide bit for bit.  Faces BRepMesh left without triangles are
     skipped; their indices are appended to ``missing`` when a list is given."""
     from OCP.BRep import BRep_Tool
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
     from OCP.BRepTools import BRepTools
 
     from .geom import surface_type
-    from .topo import faces_of, wrapped
+    from .topo import wrapped
 
     shp = wrapped(shape)
-    clean(shp)
+    surfaces = {}
+
+    def needs_uv(face):
+        # analytic faces are measured in closed form, without their (u, v) nodes
+        surfaces[face.__hash__()] = surf = basis_surface(BRep_Tool.Surface_s(face))
+        return surface_type(surf) not in ANALYTIC
+
     out = []
-    with kernel("BRepMesh_IncrementalMesh"):
-        BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), False)
+    first: dict = {}  # instance group -> position in out of its first rigid face
+    meshed = mesh_faces(shp, deflection, angular, relative=relative, with_uv=needs_uv)
+    with kernel("BRepMesh triangulations"):
         owner = _face_solids(shp)
-        for k, face in enumerate(faces_of(shp)):
-            surf = basis_surface(BRep_Tool.Surface_s(face))
-            got = _triangulation(face, surface_type(surf) not in ANALYTIC)
+        for k, face, got in meshed:
             if got is None:
                 if missing is not None:
                     missing.append(k)
                 continue
+            tri = got.triangles[:, ::-1] if got.reversed else got.triangles
             bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
-            out.append(FaceMesh(*got, surf, face, bounds, k, owner.get(face.__hash__(), -1)))
+            shared = got.rigid and got.instance >= 0
+            repeats = first.get(got.instance, -1) if shared else -1
+            if shared and got.instance not in first:
+                first[got.instance] = len(out)
+            out.append(FaceMesh(got.nodes, got.uv, tri, surfaces[face.__hash__()], face, bounds, k,
+                                owner.get(face.__hash__(), -1), repeats))
     if not out:
         raise SurfmodError("shape: has no faces to triangulate")
     return out
@@ -324,6 +428,15 @@ def shape_figures(shape, samples: int = 5):
             if name == "Geom_Plane":
                 continue
             u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+            if name in ("Geom_CylindricalSurface", "Geom_SphericalSurface"):
+                # closed forms of what the sampled figures below come to (|Su x Sv|, k1, k2)
+                r = surf.Radius()
+                if name == "Geom_CylindricalSurface":
+                    figures.append((r * (u1 - u0) * (v1 - v0), float(np.sqrt(max(1 / r, floor) * floor))))
+                else:
+                    figures.append((r * r * (u1 - u0) * float(np.mean(np.cos(np.linspace(v0, v1, samples)))) * (v1 - v0),
+                                    max(1 / r, floor)))
+                continue
             lp = GeomLProp_SLProps(surf, 2, 1e-9)
             vals, jac = [], []
             # elementary surfaces are curved alike along u: three columns tell them

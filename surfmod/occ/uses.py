@@ -189,18 +189,12 @@ def is_rectangle(face, bounds) -> bool:
 def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
     face (the face's trimmed parameter region as a polygonal patchwork)."""
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
-    from OCP.BRepTools import BRepTools
-    from OCP.TopLoc import TopLoc_Location
+    from .mesh import mesh_faces
 
-    with kernel("BRepMesh_IncrementalMesh (face)"):
-        BRepTools.Clean_s(face)
-        BRepMesh_IncrementalMesh(face, float(deflection), False, float(angular), True)
-        tri = BRep_Tool.Triangulation_s(face, TopLoc_Location())
-        if tri is None or not tri.HasUVNodes():
-            raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
-        uv = np.array([[p.X(), p.Y()] for p in (tri.UVNode(i) for i in range(1, tri.NbNodes() + 1))])
-        idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
+    ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
+    if got is None or np.isnan(got.uv).any():
+        raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
+    uv, idx = got.uv, got.triangles
     return uv, idx
 
 
@@ -295,6 +289,29 @@ def section_edges(shape, origin, normal):
         return [bd.Wire(TopoDS.Wire_s(wires.Value(i))) for i in range(1, wires.Length() + 1)]
 
 
+def planar_faces_on(shape, origin, normal, tol: float) -> list[int]:
+    """Exploration indices of the planar faces of ``shape`` that lie in the plane
+    ``(origin, normal)`` (parallel within 1e-9, offset within ``tol``): OCCT's plane of
+    each face, with the face's location applied (``BRepAdaptor_Surface``)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.GeomAbs import GeomAbs_Plane
+
+    from .topo import faces_of
+
+    origin, normal = np.asarray(origin, dtype=float), np.asarray(normal, dtype=float)
+    out = []
+    with kernel("BRepAdaptor_Surface (planar faces)"):
+        for i, face in enumerate(faces_of(shape)):
+            adaptor = BRepAdaptor_Surface(face, False)
+            if adaptor.GetType() != GeomAbs_Plane:
+                continue
+            ax = adaptor.Plane().Axis()
+            z, o = xyz(ax.Direction()), xyz(ax.Location())
+            if abs(abs(float(z @ normal)) - 1.0) < 1e-9 and abs(float((o - origin) @ normal)) < tol:
+                out.append(i)
+    return out
+
+
 def wire_edges(wire):
     """The edges of a wire in connection order."""
     from OCP.BRepTools import BRepTools_WireExplorer
@@ -343,5 +360,5 @@ def write_brep(shape, path) -> None:
 __all__ = [
     "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
     "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
-    "model_tolerance", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
+    "model_tolerance", "planar_faces_on", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

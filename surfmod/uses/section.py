@@ -156,19 +156,16 @@ def _edge_entity(sec: Section, edge) -> tuple:
 
 
 def planar_faces_in(shape, origin, normal, tol: float) -> list[int]:
-    """Indices of the planar faces of ``shape`` lying in the plane ``(origin, normal)``."""
-    from ..construct.elementary import AnalyticPlane
-    from ..occ.topo import faces_of
-    from ..readback import from_face
+    """Indices of the planar faces of ``shape`` lying in the plane ``(origin, normal)``
+    (offset within ``tol``).
 
-    out = []
-    for i, f in enumerate(faces_of(shape)):
-        s = from_face(f).surface
-        if not isinstance(s, AnalyticPlane):
-            continue
-        if abs(abs(float(np.dot(s.z_dir, normal))) - 1.0) < 1e-9 and abs(float(np.dot(s.origin - origin, normal))) < tol:
-            out.append(i)
-    return out
+    >>> import build123d as bd, numpy as np
+    >>> planar_faces_in(bd.Box(2, 2, 2), np.array([0, 0, 1.0]), np.array([0, 0, -1.0]), 1e-9)
+    [5]
+    """
+    from ..occ.uses import planar_faces_on
+
+    return planar_faces_on(shape, origin, normal, tol)
 
 
 def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) -> Section:
@@ -185,6 +182,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     """
     from ..construct.from_edge import from_edge
     from ..occ import uses as occ
+    from ..occ.cam import bounding_box as quick_box
     from .inputs import to_shape
 
     origin = checks.point(plane_origin, "plane_origin")
@@ -192,7 +190,9 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     samples = checks.count(samples, "samples", minimum=2)
     xa, ya = plane_frame(normal, x_axis)
     shape = to_shape(obj, "obj")
-    box = occ.bounding_box(shape)
+    # only a length scale for the on-face test: OCCT's quick box, not the optimal one
+    # (which costs more than the section itself on B-spline parts)
+    box = quick_box(shape)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
     on = planar_faces_in(shape, origin, normal, tol)
     if on:
