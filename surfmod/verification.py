@@ -16,8 +16,13 @@ from typing import NamedTuple
 import numpy as np
 
 from . import checks, tolerances
+from .construct.elementary import ElementarySurface
 from .errors import SurfmodError
 from .curve import Curve
+from .eval.differential import curvatures, degenerate_mask, unit_normals
+from .nets.knots import smooth_mask
+from .readback import from_face
+from .readback.trimmed import TrimmedFace
 from .surface import Surface
 
 
@@ -68,8 +73,6 @@ def _knots_in(obj, direction):
 
 
 def _smooth(s, direction, t, order):
-    from .nets.knots import smooth_mask
-
     knots = getattr(s, "knots", None)
     if knots is None:
         return np.ones(t.shape, dtype=bool)
@@ -124,8 +127,6 @@ def crosscheck(obj, samples: int = 64, tolerance: float | None = None, *, sampli
     if isinstance(obj, Curve):
         return _check_curve(obj, samples)
     if not isinstance(obj, Surface):
-        from .readback import from_face
-
         obj = from_face(obj)
     if obj.exact_in_occt:
         return _check_parametric(obj, samples, sampling == "sufficient")
@@ -159,15 +160,12 @@ def sufficient_parameters(s, direction: int, samples: int) -> np.ndarray:
       direction trimmed across its seam has the knots shifted by the period.
 
     >>> import surfmod as sm
-    >>> sufficient_parameters(sm.AnalyticPlane((0, 0, 0), (0, 0, 1), u_range=(0, 1), v_range=(0, 1)), 0, 24).tolist()
+    >>> sufficient_parameters(sm.PlaneSurface((0, 0, 0), (0, 0, 1), u_range=(0, 1), v_range=(0, 1)), 0, 24).tolist()
     [0.0, 0.25, 0.5, 0.75, 1.0]
     >>> s = sm.BSplineSurface(np.random.default_rng(0).uniform(size=(4, 4, 3)), (3, 3))
     >>> sufficient_parameters(s, 0, 24).tolist()   # one bicubic span: 5 values
     [0.0, 0.25, 0.5, 0.75, 1.0]
     """
-    from .construct.elementary import ElementarySurface
-    from .readback.trimmed import TrimmedFace
-
     lo, hi = s.domain[direction]
     surface = s.surface if isinstance(s, TrimmedFace) else s
     if isinstance(surface, ElementarySurface) and samples > ELEMENTARY_SAMPLES and hi > lo:
@@ -216,8 +214,6 @@ def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense") -> list
                 out[i] = _check_curve(obj, samples)
                 continue
             if not isinstance(obj, Surface):
-                from .readback import from_face
-
                 obj = from_face(obj)
             if not obj.exact_in_occt:
                 out[i] = _check_geometric(obj, samples, None)
@@ -310,8 +306,6 @@ def _segment_max(values, starts, mask=None, empty=0.0, ignore_nan=False):
 def _judge_parametric(faces: list) -> list:
     """Compare the gathered samples of many faces in one vectorized pass (per-face maxima
     by segment) and judge each face against its limits."""
-    from .eval.differential import curvatures, degenerate_mask, unit_normals
-
     if not faces:
         return []
     sizes = np.array([len(f["mine"]) for f in faces])

@@ -6,6 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import SurfmodError
+from ..io.step import import_step
+from ..readback import from_face
+from ..verification import crosscheck_many
 from .batch import RowSink, run_batch, step_files
 
 COLUMNS = [("file", "<36.36"), ("face", ">5d"), ("surface type", "<30.30"), ("max dev", ">10.2e"),
@@ -51,11 +54,8 @@ def check_file(path, samples: int = 24) -> list[tuple]:
     >>> len(rows), all(r[4] for r in rows), rows[0][2]
     (6, True, 'Geom_Plane')
     """
-    from ..io.step import import_step
     from ..occ.geom import surface_type
     from ..occ.topo import faces_of
-    from ..readback import from_face
-    from ..verification import crosscheck_many
 
     name = str(path)
     try:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from ..atomic import target_path
+from ..uses.femesh import fe_mesh, FORMATS
+
 
 def register(sub) -> None:
     p = sub.add_parser("femesh", help="finite element mesh of a STEP part (gmsh; .msh/.vtu/.inp)")
@@ -16,9 +19,6 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from tqdm import tqdm
-
-    from ..atomic import target_path
-    from ..uses.femesh import FORMATS, fe_mesh
 
     target_path(args.out, "out", tuple(FORMATS))
     with tqdm(total=2, desc="femesh", unit="step", disable=args.no_progress) as bar:

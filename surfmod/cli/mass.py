@@ -3,7 +3,11 @@ against ``BRepGProp``; a disagreement is never printed with exit code 0."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from .. import tolerances
+from ..uses.inputs import to_shape
+from ..uses.mass import boundary_ambiguity, mass_properties
 
 #: exit code when surfmod and BRepGProp differ by less than the model's own ambiguity
 EXIT_AMBIGUOUS = 3
@@ -21,11 +25,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import numpy as np
     from tqdm import tqdm
-
-    from ..uses.inputs import to_shape
-    from ..uses.mass import boundary_ambiguity, mass_properties
 
     with tqdm(total=3, desc="mass", unit="step", disable=args.no_progress) as bar:
         solid = to_shape(args.path, "path", solid=True)

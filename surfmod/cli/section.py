@@ -5,6 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import SurfmodError
+from ..io.svg import export_svg
+from ..uses.inputs import to_shape
+from ..uses.section import section
 
 
 def register(sub) -> None:
@@ -22,9 +25,6 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from ..io.dxf import export_dxf
-    from ..io.svg import export_svg
-    from ..uses.inputs import to_shape
-    from ..uses.section import section
 
     suffix = Path(args.out).suffix.lower()
     if suffix not in (".dxf", ".svg"):

@@ -402,8 +402,3 @@ class ToroidalSurface(ElementarySurface):
         arc = Arc._from_radians(center, np.cross(self.x_dir, self.z_dir), self.x_dir, self.minor, self.minor, (v0, v1))
         return revolve_nurbs(arc.to_bspline(), self.origin, self._spin_axis, (u0, u1))
 
-
-# The name before issue 15 (one name per idea: the plane of the elementary family is
-# PlaneSurface). readback/readers.py and uses/section.py, edited on other branches when the
-# rename landed, still import it; it goes once they say PlaneSurface.
-AnalyticPlane = PlaneSurface

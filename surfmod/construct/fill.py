@@ -33,11 +33,14 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks, transforms
+from ..curve import Curve
 from ..errors import SurfmodError
 from ..ops.continuity import SIDES
 from ..surface import Surface
 from .fill_domain import polygon, side_blend
 from .fill_ribbons import Corner, Ribbon, check_corners, match_corners
+from .from_edge import as_curve
+from .offset import bicubic_approximation
 
 __all__ = ["Corner", "Fill", "FillPatch", "fill", "occt_fill"]
 
@@ -85,8 +88,6 @@ class FillPatch(Surface):
 
     def geom(self):
         if self._occ is None:
-            from .offset import bicubic_approximation
-
             fit, _ = bicubic_approximation(self, np.linspace(0, 1, 9), np.linspace(0, 1, 9), self.tolerance)
             self._occ = fit.geom()
         return self._occ
@@ -117,9 +118,6 @@ class Fill(tuple):
 
 
 def _ribbon(item, index):
-    from ..curve import Curve
-    from .from_edge import as_curve
-
     if isinstance(item, tuple) and len(item) == 2 and isinstance(item[0], Surface):
         surf, side = item
         if side not in SIDES:

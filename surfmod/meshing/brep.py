@@ -24,6 +24,8 @@ tolerance, and refused only with ``strict=True``.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import SurfmodError
@@ -152,8 +154,6 @@ def _refine_locally(fms, i: int, dev, node_dev, tolerance: float) -> bool:
     """Refine face ``fms[i]`` inside its boundary (:mod:`surfmod.meshing.refine`) until
     every triangle is within ``tolerance`` beyond the face's node deviation; ``False``
     (face left as it was) when the deviation is not the interior's."""
-    from dataclasses import replace
-
     from ..occ.mesh import read_triangulation
 
     fm = fms[i]

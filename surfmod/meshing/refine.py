@@ -13,6 +13,8 @@ Every new triangle is measured against the exact face like the others.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 #: Refinement rounds per face before handing the face back to a finer BRepMesh pass.
@@ -107,8 +109,6 @@ def refine_face(fm, tolerance: float, node_deviation: float, measure, evaluate, 
     ``None`` when ``rounds`` rounds do not bring every triangle within the bound (the
     deviation then sits on the boundary, which only a finer BRepMesh pass changes).
     """
-    from dataclasses import replace
-
     limit = tolerance + node_deviation
     nodes, uv, tri = fm.nodes, fm.uv, fm.triangles
     dev = measure(fm)

@@ -19,10 +19,12 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..surface import Surface
 from .brep import MAX_TRIANGLES, tessellate_shape
 from .adaptive import _ear_clip, _Refiner  # noqa: F401  (_ear_clip: tested here)
 from .deviation import DENSE
 from .domain import _sides, _surface_size
+from .gridmesh import grid_tessellate
 from .polymesh import Mesh
 
 #: Tolerances below this fraction of the object size cannot be certified in float64.
@@ -110,8 +112,6 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
 
 
 def _grid_mesh(s, tolerance: float, max_triangles: int, size: float, bar) -> Mesh:
-    from .gridmesh import grid_tessellate
-
     sides = _sides(s, size)
     verts, faces, uv, dev, passes = grid_tessellate(s, tolerance, max_triangles, sides, bar)
     info = {
@@ -201,8 +201,6 @@ def tessellate(obj, tolerance: float, *, max_triangles: int | None = None, stric
     >>> m.info["max_deviation"] <= 0.01
     True
     """
-    from ..surface import Surface
-
     tolerance = checks.positive(tolerance, "tolerance")
     if max_triangles is None:
         max_triangles = MAX_SURFACE_TRIANGLES if isinstance(obj, Surface) else MAX_TRIANGLES

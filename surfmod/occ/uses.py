@@ -16,6 +16,7 @@ from OCP.TopoDS import TopoDS
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import check_done, kernel
+from .mesh import mesh_faces
 from .topo import explore as _explore, shells_of, solids_of
 
 SEW_TOLERANCE = 1e-6
@@ -189,8 +190,6 @@ def is_rectangle(face, bounds) -> bool:
 def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
     face (the face's trimmed parameter region as a polygonal patchwork)."""
-    from .mesh import mesh_faces
-
     ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
     if got is None or np.isnan(got.uv).any():
         raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")

@@ -27,7 +27,9 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..readback import from_face
 from ..surface import Surface
+from .project import closest_points
 
 #: side name -> (fixed parameter index: 0 = u fixed, 1 = v fixed; end: 0 low, 1 high)
 SIDES = {"u0": (0, 0), "u1": (0, 1), "v0": (1, 0), "v1": (1, 1)}
@@ -266,8 +268,6 @@ def _projected(a: Surface, b: Surface, samples: int, occt: bool):
     """Fallback when no side of ``b`` runs along a side of ``a`` (e.g. ``b`` is a trimmed
     face such as OCCT's filling): the side of ``a`` lying on ``b`` is found by projecting
     its samples onto ``b``; ``b`` is taken to continue ``a`` across that side."""
-    from .project import closest_points
-
     size = max(np.ptp(a.grid(*(np.linspace(*d, 5) for d in a.domain)).reshape(-1, 3), axis=0).max(), 1e-300)
     best = (np.inf, None)
     for side in SIDES:
@@ -339,7 +339,6 @@ def _combined(label, parts):
 
 
 def _shell(shape, samples: int, occt: bool, only_faces=None):
-    from ..readback import from_face
     from ..occ.continuity import shared_edges
 
     records = shared_edges(shape, samples)
@@ -444,8 +443,6 @@ def _as_surface(obj, name: str) -> Surface:
     if isinstance(obj, Surface):
         return obj
     if _is_shape(obj):
-        from ..readback import from_face
-
         try:
             return from_face(obj)
         except SurfmodError as exc:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..ops.closest import closest_points
 from ..surface import Surface
 from .trimmed import TrimmedFace, from_face
 
@@ -87,7 +88,6 @@ def project_on_face(face: TrimmedFace, points: np.ndarray, u, v, p, d):
     lies outside the face, the face's own closest point (``BRepExtrema_DistShapeShape``,
     boundary and interior minima alike) replaces it."""
     from ..occ.topo import closest_on_face
-    from ..ops.project import closest_points
 
     outside = ~face.contains(u, v)
     if not outside.any():

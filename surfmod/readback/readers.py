@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from ..construct.conics import Conic, Hyperbola, Parabola
 from ..construct.curves import Line
-from ..construct.elementary import AnalyticPlane, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
+from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.offset_surface import OffsetSurface
 from ..construct.revolution import RevolutionSurface
@@ -115,7 +115,7 @@ def _elementary(cls, params):
     return read
 
 
-reader("Geom_Plane")(_elementary(AnalyticPlane, lambda d: ()))
+reader("Geom_Plane")(_elementary(PlaneSurface, lambda d: ()))
 reader("Geom_CylindricalSurface")(_elementary(CylindricalSurface, lambda d: (d["radius"],)))
 reader("Geom_ConicalSurface")(_elementary(ConicalSurface, lambda d: (d["radius"], d["semi_angle"])))
 reader("Geom_SphericalSurface")(_elementary(SphericalSurface, lambda d: (d["radius"],)))

@@ -136,6 +136,7 @@ class TrimmedFace(Surface):
     def area(self) -> float:
         """Area of the trimmed face (Gauss quadrature on the NumPy evaluator; Green's
         theorem over the exact p-curves for trimmed faces)."""
+        # cycle: surfmod.readback.trimmed <-> surfmod.uses.mass (area() delegates up to uses/)
         from ..uses.mass import face_moments
 
         return float(face_moments(self)[0])

@@ -44,6 +44,10 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..readback import from_face
+from ..surface import Surface
+from .inputs import to_shape
+from .mass_green import face_nodes, mass_face, surface_mass_face
 
 
 @dataclass(frozen=True)
@@ -159,8 +163,6 @@ def face_moments(face, ref=(0.0, 0.0, 0.0), order: int = 12) -> np.ndarray:
     >>> round(float(face_moments(sm.from_face(bd.Box(2, 3, 4).faces()[0]))[0]), 12)
     12.0
     """
-    from .mass_green import face_nodes, mass_face
-
     ders, w, _ = face_nodes(mass_face(face), order)
     return _moments(ders, w, np.asarray(ref, dtype=float))
 
@@ -201,7 +203,6 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     [50.0, 40.0, 26.0]
     """
     from ..occ import uses as occ
-    from .inputs import to_shape
 
     density = checks.positive(density, "density")
     order = checks.count(order, "order", minimum=2)
@@ -217,8 +218,6 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     # real file whose faces leave gaps (edges off their faces) the integrals depend on it
     # by (shift . closure defect) / 3, so the same point makes the two comparable.
     ref = occ.vertex_mean(solid)
-    from ..surface import Surface
-    from .mass_green import face_nodes, mass_face, surface_mass_face
 
     if isinstance(obj, Surface):
         # one closed surface (sphere, torus, ...): integrate its own NumPy evaluator over
@@ -228,7 +227,6 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
             faces[0].sign = -1.0
     else:
         from ..occ.topo import faces_of
-        from ..readback import from_face
 
         faces = [mass_face(from_face(f)) for f in faces_of(solid)]
     # faces whose every rule is exact by degree give the same sums at any order: the
@@ -272,7 +270,6 @@ def boundary_ambiguity(obj) -> float:
     True
     """
     from ..occ import uses as occ
-    from .inputs import to_shape
 
     solid = to_shape(obj, "obj", solid=True)
     box = occ.bounding_box(solid)

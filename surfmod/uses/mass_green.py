@@ -32,11 +32,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..construct.curves import Line
-from ..construct.elementary import AnalyticPlane, ConicalSurface, CylindricalSurface
+from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..eval.tensor import curve_derivatives
 from ..nets.bspline import BSplineCurve, BSplineSurface
+from .faces import _breaks, _patch_breaks, direction_breaks
 
 #: curved p-curves are cut into at least this many pieces before Gauss
 PIECES = 4
@@ -88,7 +89,7 @@ def direction_degree(surface, direction: int):
     >>> direction_degree(c, 0), direction_degree(c, 1)
     (None, 1)
     """
-    if isinstance(surface, AnalyticPlane):
+    if isinstance(surface, PlaneSurface):
         return 1
     if isinstance(surface, (CylindricalSurface, ConicalSurface)):
         return 1 if direction == 1 else None
@@ -277,7 +278,6 @@ def mass_face(face) -> MassFace:
     (True, (1, 1), True)
     """
     from ..occ.pcurves import face_pcurves
-    from .faces import _patch_breaks
 
     u0, u1, v0, v1 = bounds = tuple(b for r in face.domain for b in r)
     breaks = (_patch_breaks(face, u0, u1, 0, face.periods[0]), _patch_breaks(face, v0, v1, 1, face.periods[1]))
@@ -287,13 +287,11 @@ def mass_face(face) -> MassFace:
     natural = len(wires) == 1 and _on_box_border(pcurves, bounds)
     return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
-                    isinstance(surf, AnalyticPlane))
+                    isinstance(surf, PlaneSurface))
 
 
 def surface_mass_face(surf) -> MassFace:
     """A :class:`MassFace` for a closed surfmod surface over its whole domain."""
-    from .faces import _breaks, direction_breaks
-
     breaks = []
     for direction, (lo, hi) in enumerate(surf.domain):
         b = direction_breaks(surf, direction)
@@ -301,7 +299,7 @@ def surface_mass_face(surf) -> MassFace:
         breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None else _breaks(lo, hi, b, None))
     (u0, u1), (v0, v1) = surf.domain
     return MassFace(surf._derivatives, (u0, u1, v0, v1), tuple(breaks), 1.0,
-                    (direction_degree(surf, 0), direction_degree(surf, 1)), None, isinstance(surf, AnalyticPlane))
+                    (direction_degree(surf, 0), direction_degree(surf, 1)), None, isinstance(surf, PlaneSurface))
 
 
 def _direction_order(mf: MassFace, direction: int, order: int) -> tuple[int, bool]:

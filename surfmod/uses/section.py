@@ -7,7 +7,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import checks
+from ..atomic import atomic_path, target_path
+from ..construct.conics import Conic
+from ..construct.curves import Line
+from ..construct.from_edge import from_edge
 from ..errors import SurfmodError
+from ..nets.bspline import BSplineCurve
+from ..readback import read_curve
+from .inputs import to_shape
 
 
 def plane_frame(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray]:
@@ -101,8 +108,6 @@ class Section:
 
     def preview(self, path, *, dpi: int = 120) -> None:
         """A PNG drawing of the section in the plane frame (matplotlib, atomic write)."""
-        from ..atomic import atomic_path, target_path
-
         # a local Agg canvas: the caller's pyplot backend is left alone
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
@@ -130,12 +135,8 @@ class Section:
 
 def _edge_entity(sec: Section, edge) -> tuple:
     """One section edge as an exact 2-D entity in the section's plane frame."""
-    from ..construct.conics import Conic
-    from ..construct.curves import Line
-    from ..nets.bspline import BSplineCurve
     from ..occ.geom import read_bspline_curve
     from ..occ.topo import curve_of_edge, shape_bspline
-    from ..readback import read_curve
 
     geom, t0, t1 = curve_of_edge(edge)
     curve = read_curve(geom, (t0, t1))
@@ -180,10 +181,8 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     >>> len(s.wires), s.closed, round(s.length, 12) == round(2 * 3.141592653589793 * 3 ** 0.5, 12)
     (1, [True], True)
     """
-    from ..construct.from_edge import from_edge
     from ..occ import uses as occ
     from ..occ.cam import bounding_box as quick_box
-    from .inputs import to_shape
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
