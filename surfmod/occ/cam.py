@@ -15,13 +15,15 @@ from .guard import kernel
 from .topo import faces_of, wrapped
 
 
-def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.ndarray, float]:
+def part_triangles(shape, deflection: float, angular: float = 0.35, *, face_index: bool = False):
     """``(triangles (M, 3, 3), deflection)``: all faces of ``shape`` meshed by BRepMesh at
     the linear ``deflection`` (model units) and ``angular`` deflection (radians), in global
     coordinates, and the largest chordal deflection BRepMesh measured on any face (at least
     the requested one; some faces of real parts cannot be meshed finer than their own
     tolerance allows).  Any triangulation stored on the shape is replaced.  A face BRepMesh
-    leaves without triangles raises ``SurfmodError`` (the tool would not see it)."""
+    leaves without triangles raises ``SurfmodError`` (the tool would not see it).  With
+    ``face_index`` a third item: the faces (``faces_of`` order) and each triangle's
+    index into them ``(M,)``."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepMesh import BRepMesh_IncrementalMesh
     from OCP.BRepTools import BRepTools
@@ -30,7 +32,7 @@ def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.
     shp = wrapped(shape)
     if shp is None:
         raise SurfmodError(f"obj: expected an OCCT shape, got {type(shape).__name__}")
-    blocks = []
+    blocks, owners, faces = [], [], []
     unmeshed = 0
     measured = float(deflection)
     with kernel("BRepMesh_IncrementalMesh"):
@@ -49,12 +51,16 @@ def part_triangles(shape, deflection: float, angular: float = 0.35) -> tuple[np.
                 nodes[i] = (p.X(), p.Y(), p.Z())
             idx = np.array([tri.Triangle(i + 1).Get() for i in range(tri.NbTriangles())], dtype=np.int64) - 1
             blocks.append(nodes[idx])
+            owners.append(np.full(len(idx), len(faces)))
+            faces.append(face)
             measured = max(measured, float(tri.Deflection()))
     if unmeshed:
         raise SurfmodError(f"obj: BRepMesh could not triangulate {unmeshed} face(s); a tool path over them "
                            f"cannot be checked")
     if not blocks:
         raise SurfmodError("obj: has no faces to machine")
+    if face_index:
+        return np.concatenate(blocks), measured, (faces, np.concatenate(owners))
     return np.concatenate(blocks), measured
 
 
