@@ -168,14 +168,6 @@ LAZY = frozenset({
 })
 CYCLE_MARK = re.compile(r"#\s*cycle:")
 
-# Files that still hold function-level imports of light modules because other branches were
-# editing them while the rest was hoisted; /work/briefs/hoist.py finishes each one.
-_NOT_YET_HOISTED = {
-    "surfmod/occ/cam.py",
-    "surfmod/uses/femesh.py",
-}
-
-
 def _module_path(module: str, package_root: Path) -> Path | None:
     base = package_root.joinpath(*module.split("."))
     for candidate in (base.with_suffix(".py"), base / "__init__.py"):
@@ -283,13 +275,11 @@ def _needless_by_file(package_root: Path = PACKAGE.parent) -> dict[str, list[str
 
 def test_function_level_imports_are_lazy_doors_only():
     found = _needless_by_file()
-    offenders = [f"{f}:{line}" for f, lines in found.items() if f not in _NOT_YET_HOISTED for line in lines]
+    offenders = [f"{f}:{line}" for f, lines in found.items() for line in lines]
     assert not offenders, (
         "imports inside functions that are neither LAZY libraries, modules loading them, nor marked "
         "'# cycle: a <-> b' (move them to the top of their module):\n" + "\n".join(offenders)
     )
-    done = sorted(_NOT_YET_HOISTED - set(found))
-    assert not done, f"hoisted already, drop from _NOT_YET_HOISTED: {done}"
 
 
 def test_lazy_import_check_detects_a_needless_one(tmp_path):

@@ -217,13 +217,15 @@ def _per_location_max(qi: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
 
 
 def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop: np.ndarray):
-    """Highest tip height ``(N,)`` (-inf if none) and its contact ``(N, 3)`` over the
+    """Highest tip height ``(N,)`` (-inf if none), its contact ``(N, 3)`` and the index of
+    the touched triangle ``(N,)`` (-1 if none) over the
     cell-list entries ``start:stop`` of each location, in blocks of about
     ``PAIRS_PER_BLOCK`` pairs.  Pairs whose upper bound (:func:`_reach`) is below a height
     already reached at their location are skipped."""
     features = _ball_features if kind == "ball" else _flat_features
     z = np.full(len(xy), -np.inf)
     touch = np.full((len(xy), 3), np.nan)
+    touched = np.full(len(xy), -1, dtype=np.int64)
     block = np.cumsum(np.maximum(stop - start, 0)) // PAIRS_PER_BLOCK
     starts = np.r_[0, np.nonzero(np.diff(block))[0] + 1]
     for s0, s1 in zip(starts, np.r_[starts[1:], len(xy)]):
@@ -258,13 +260,15 @@ def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop
         heights, contacts = features(qw[:, 0], qw[:, 1], grid.soa[:, ti[winner]], grid.radius)
         feature = np.argmax(heights, axis=0)
         touch[rows] = np.array(contacts)[feature, :, np.arange(len(winner))]
-    return z, touch
+        touched[rows] = ti[winner]
+    return z, touch, touched
 
 
-def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = False):
+def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = False, triangles: bool = False):
     """Tip heights ``(N,)`` (NaN where the tool touches nothing) of the ``kind`` (``"ball"``
     or ``"flat"``) end mill of the grid's radius dropped at ``xy`` (N, 2); with
-    ``contacts`` also the contact points ``(N, 3)``.
+    ``contacts`` also the contact points ``(N, 3)``, with ``triangles`` also the index of
+    the touched triangle ``(N,)`` (-1 where none).
 
     >>> import numpy as np
     >>> tri = np.array([[[-5, -5, 2], [5, -5, 2], [0, 5, 2]]], float)
@@ -275,6 +279,6 @@ def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = Fals
         raise SurfmodError(f"tool: kind must be 'ball' or 'flat', got {kind!r}")
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     start, stop = grid.segments(xy)
-    z, touch = _best(grid, kind, xy, start, stop)
+    z, touch, touched = _best(grid, kind, xy, start, stop)
     z[~np.isfinite(z)] = np.nan
-    return (z, touch) if contacts else z
+    return (z,) + ((touch,) if contacts else ()) + ((touched,) if triangles else ()) if contacts or triangles else z

@@ -10,7 +10,10 @@ from pathlib import Path
 import numpy as np
 
 from .. import checks
+from ..atomic import atomic_path, target_path
 from ..errors import SurfmodError
+from ..meshing.brep import tessellate_shape
+from .inputs import to_shape
 
 _GMSH_LOCK = threading.Lock()  # gmsh keeps global state: one mesh at a time
 
@@ -33,7 +36,9 @@ class FEMesh:
     * ``SJ`` (gmsh's scaled Jacobian) for ``order=2`` only: a straight-sided element's
       Jacobian is constant, so for linear elements it is 1 and says nothing;
 
-    plus ``quality["inverted"]``, the number of elements whose signed volume (tets) is
+    plus ``quality["surface"]`` when the tetrahedra were made from surfmod's measured
+    triangulation because gmsh could not mesh the B-rep (see :func:`fe_mesh`), and
+    ``quality["inverted"]``, the number of elements whose signed volume (tets) is
     not positive (always 0: fe_mesh refuses otherwise), and ``quality["measure"]``, the
     total volume (area for surface meshes) of the elements as gmsh integrates them,
     curved sides included.
@@ -94,6 +99,11 @@ class FEMesh:
                   "SJ": "scaled Jacobian"}
         lines = [f"FE mesh: {self.n_elements} {self.cell_type} elements, {len(self.points)} nodes, target size "
                  f"{self.size:g}, inverted elements {q['inverted']}"]
+        if "surface" in q:
+            sf = q["surface"]
+            lines.append(f"  meshed from the measured surface triangulation at tolerance {sf['tolerance']:.3g} "
+                         f"(gmsh could not mesh the B-rep; max deviation {sf['max_deviation']:.3g}, tet volume "
+                         f"{self.volume:.6g} vs BRepGProp {sf['reference_volume']:.6g}, bound {sf['volume_bound']:.3g})")
         for name in names:
             lines.append(f"  {labels[name]:<28s} min {q[name]['min']:.3f} mean {q[name]['mean']:.3f}")
         return "\n".join(lines)
@@ -191,25 +201,68 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bo
                 if heal:  # the part had solids when it failed as read
                     raise _GmshFailure("gmsh's healing left no volume")
                 raise SurfmodError("kind: a volume mesh needs a closed solid; obj has no solid")
-            gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-            gmsh.option.setNumber("Mesh.MeshSizeMin", size / 10)
             gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)
-            gmsh.option.setNumber("Mesh.Binary", 0)
-            gmsh.model.mesh.generate(dim)
-            if order > 1:
-                gmsh.model.mesh.setOrder(order)
-            _types, tags, _ = gmsh.model.mesh.getElements(dim)
-            all_tags = np.concatenate([np.asarray(t) for t in tags]) if len(tags) else np.array([])
-            if all_tags.size == 0:
-                raise SurfmodError("size: gmsh produced no elements (is the part degenerate?)")
-            quality = {}
-            names = {"gamma": "gamma", "SICN": "minSICN"} | ({"SJ": "minSJ"} if order > 1 else {})
-            for name, gmsh_name in names.items():
-                quality[name] = _stats(np.asarray(gmsh.model.mesh.getElementQualities(all_tags, gmsh_name)))
-            # gmsh's own element measures (curved elements for order 2)
-            quality["measure"] = float(np.sum(gmsh.model.mesh.getElementQualities(all_tags, "volume")))
-            gmsh.write(str(msh))
-            return quality
+            return _generate(gmsh, msh, dim, size, order)
+        except SurfmodError:
+            raise
+        except Exception as exc:
+            raise _GmshFailure(str(exc)) from exc
+        finally:
+            try:
+                gmsh.model.remove()
+            except Exception:  # pragma: no cover
+                pass
+            if own:
+                gmsh.finalize()
+
+
+def _generate(gmsh, msh: Path, dim: int, size: float, order: int) -> dict:
+    """Generate the ``dim`` mesh of gmsh's current model, write ``msh``, return gmsh's
+    qualities per element."""
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", size / 10)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.model.mesh.generate(dim)
+    if order > 1:
+        gmsh.model.mesh.setOrder(order)
+    _types, tags, _ = gmsh.model.mesh.getElements(dim)
+    all_tags = np.concatenate([np.asarray(t) for t in tags]) if len(tags) else np.array([])
+    if all_tags.size == 0:
+        raise SurfmodError("size: gmsh produced no elements (is the part degenerate?)")
+    quality = {}
+    names = {"gamma": "gamma", "SICN": "minSICN"} | ({"SJ": "minSJ"} if order > 1 else {})
+    for name, gmsh_name in names.items():
+        quality[name] = _stats(np.asarray(gmsh.model.mesh.getElementQualities(all_tags, gmsh_name)))
+    # gmsh's own element measures (curved elements for order 2)
+    quality["measure"] = float(np.sum(gmsh.model.mesh.getElementQualities(all_tags, "volume")))
+    gmsh.write(str(msh))
+    return quality
+
+
+def _run_gmsh_triangulation(surfaces, msh: Path, size: float, order: int) -> dict:
+    """Tetrahedra inside closed triangulations: ``surfaces`` is a list of ``(vertices
+    (V, 3), triangles (T, 3))``, one closed surface per solid.  Each becomes a gmsh
+    discrete surface whose triangles are kept as the boundary mesh, bounding a volume of
+    its own; the interior is meshed at ``size``."""
+    gmsh = _gmsh()
+    with _GMSH_LOCK:
+        own = not gmsh.isInitialized()
+        if own:
+            gmsh.initialize(interruptible=False)
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.model.add("surfmod-triangulation")
+            first = 1
+            for vertices, triangles in surfaces:
+                surface = gmsh.model.addDiscreteEntity(2)
+                tags = np.arange(first, first + len(vertices))
+                gmsh.model.mesh.addNodes(2, surface, tags, np.asarray(vertices, float).ravel())
+                gmsh.model.mesh.addElementsByType(surface, 2, [], (np.asarray(triangles) + first).ravel())
+                first += len(vertices)
+                loop = gmsh.model.geo.addSurfaceLoop([surface])
+                gmsh.model.geo.addVolume([loop])
+            gmsh.model.geo.synchronize()
+            return _generate(gmsh, msh, 3, size, order)
         except SurfmodError:
             raise
         except Exception as exc:
@@ -239,8 +292,13 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
 
     ``obj``: a build123d shape, surfmod surface(s) or a STEP path.  The part goes to
     gmsh as a BREP file (exact geometry); the mesh comes back through meshio.  A part
-    gmsh cannot mesh as read is retried with gmsh's OCC healing (:data:`HEALING`); one
-    it still cannot mesh raises ``SurfmodError`` naming the file and gmsh's reason.
+    gmsh cannot mesh as read is retried with gmsh's OCC healing (:data:`HEALING`).  A
+    volume it still cannot mesh is meshed from surfmod's watertight triangulation of
+    each solid, measured against the exact faces at ``min(1e-3 x diagonal, size / 4)``
+    (``surfmod mesh``'s STL): its triangles are kept as the boundary and gmsh fills the
+    inside; the tetrahedra's volume must equal BRepGProp's within area x measured
+    deviation, and the result says so (``quality["surface"]``, printed).  A part none of
+    these can mesh raises ``SurfmodError`` naming the file and gmsh's reasons.
     Every tetrahedron's signed volume is checked: an inverted element is an error, never
     a result.  With ``path`` the mesh is also written (``.msh``, ``.vtu``, ``.inp``).  Meshes estimated
     (from the bounding box and ``size``) above ``max_elements`` elements are refused
@@ -255,7 +313,6 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     import meshio
 
     from ..occ import uses as occ
-    from .inputs import to_shape
 
     size = checks.positive(size, "size")
     if order not in (1, 2):
@@ -284,10 +341,15 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
             tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:
         brep, msh = Path(tmp) / "part.brep", Path(tmp) / "part.msh"
         occ.write_brep(shape, brep)
-        for heal in (False, True):
-            bar.set_postfix_str("gmsh, healed" if heal else "gmsh")
+        # as read, healed by gmsh, then (volumes) from surfmod's measured closed triangulation
+        attempts = (False, True, None) if kind == "volume" else (False, True)
+        for heal in attempts:
+            bar.set_postfix_str({False: "gmsh", True: "gmsh, healed", None: "triangulation"}[heal])
             try:
-                quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order, heal)
+                if heal is None:
+                    quality, surface = _triangulation_attempt(shape, msh, size, order)
+                else:
+                    quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order, heal)
             except _GmshFailure as exc:
                 failures.append(str(exc))
                 continue
@@ -298,11 +360,19 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
             if inverted:
                 failures.append(f"{inverted} inverted tetrahedra")
                 continue
+            if heal is None:
+                miss = abs(float(signed_volumes(points, data).sum()) - surface["reference_volume"])
+                if miss > surface["volume_bound"]:
+                    failures.append(f"the tetrahedra from the triangulation hold {miss:.3g} more or less than "
+                                    f"BRepGProp's volume, beyond the triangulation's bound {surface['volume_bound']:.3g}")
+                    continue
+                quality["surface"] = surface
             bar.update()
             break
         else:
+            tried = "as read, healed or from its measured surface triangulation" if kind == "volume" else "as read or healed"
             raise SurfmodError(
-                f"{_part_name(obj)}: gmsh cannot {kind}-mesh it at size {size:g}, as read or healed "
+                f"{_part_name(obj)}: gmsh cannot {kind}-mesh it at size {size:g}, {tried} "
                 f"({'; '.join(dict.fromkeys(failures))})"
             )
     quality["inverted"] = 0
@@ -312,6 +382,39 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     if path is not None:
         export_fe_mesh(result, path)
     return result
+
+
+#: The fallback triangulation's chordal tolerance, as a share of the bounding-box diagonal
+#: (the STL standard of ``surfmod mesh``), and at most this share of the element size.
+TRIANGULATION_SHARE = 1e-3
+TRIANGULATION_SIZE_SHARE = 0.25
+
+
+def _triangulation_attempt(shape, msh: Path, size: float, order: int):
+    """Volume-mesh every solid of ``shape`` from its watertight triangulation, measured
+    against the exact faces (:func:`surfmod.meshing.brep.tessellate_shape`), for parts
+    whose B-rep gmsh cannot mesh.  Returns gmsh's qualities and what the boundary is:
+    ``{"tolerance", "max_deviation", "reference_volume" (BRepGProp), "volume_bound"}``:
+    every boundary point lies within ``max_deviation`` of the part, so the tetrahedra's
+    volume is within ``volume_bound`` = area x deviation of the part's."""
+    from ..occ import uses as occ
+
+    box = occ.bounding_box(shape)
+    tolerance = min(TRIANGULATION_SHARE * float(np.linalg.norm(box[1] - box[0])), TRIANGULATION_SIZE_SHARE * size)
+    surfaces, deviation, bound, reference = [], 0.0, 0.0, 0.0
+    for solid in occ.solids_of(shape):
+        try:
+            mesh = tessellate_shape(solid, tolerance)
+        except SurfmodError as exc:
+            raise _GmshFailure(f"no measured triangulation: {exc}") from None
+        surfaces.append((mesh.vertices, mesh.triangles()))
+        dev = max(float(mesh.info["max_deviation"]), tolerance)
+        deviation = max(deviation, dev)
+        bound += mesh.area * dev
+        reference += abs(occ.gprops(solid)["volume"])
+    quality = _run_gmsh_triangulation(surfaces, msh, size, order)
+    return quality, {"tolerance": tolerance, "max_deviation": deviation, "reference_volume": reference,
+                     "volume_bound": bound}
 
 
 def _cells_of(full, cell: str):
@@ -336,8 +439,6 @@ def export_fe_mesh(mesh, path) -> None:
     'triangle'
     """
     import meshio
-
-    from ..atomic import atomic_path, target_path
 
     target = target_path(path, "path", tuple(FORMATS))
     m = mesh.mesh if isinstance(mesh, FEMesh) else mesh

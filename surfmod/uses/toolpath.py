@@ -28,6 +28,7 @@ from ..io.gcode import gcode_text
 from .drop_cutter import TriangleGrid, drop
 from .inputs import to_shape
 from .toolpath_moves import NoSafePathError, move_gouge, raster, refine_moves, staircase_steep
+from .toolpath_exact import exact_ball_heights
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
 # the refinement inserts a location (the rest is the margin between sample points).
@@ -139,6 +140,8 @@ class _Part:
     deflection: float
     lift: float
     box: np.ndarray
+    faces: list = field(default_factory=list, repr=False)  # OCCT faces, and the face of each triangle
+    owner: np.ndarray = field(default=None, repr=False)
 
     def height(self, xy: np.ndarray) -> np.ndarray:
         """Tip heights at ``xy`` (N, 2), NaN where the tool touches nothing."""
@@ -151,13 +154,13 @@ def _part(obj, tool: Tool, tolerance: float) -> _Part:
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
     try:
-        triangles, measured = part_triangles(shape, requested)
+        triangles, measured, (faces, owner) = part_triangles(shape, requested, face_index=True)
     except SurfmodError as exc:
         raise NoSafePathError(f"toolpath: no safe path: {exc}") from None
     points = triangles.reshape(-1, 3)
     box = np.array([points.min(axis=0), points.max(axis=0)])
     return _Part(TriangleGrid(triangles, tool.radius), tool.kind, max(measured, requested),
-                 max(measured - requested, 0.0), box)
+                 max(measured - requested, 0.0), box, faces, owner)
 
 
 def _check_tool(tool) -> Tool:
@@ -166,11 +169,17 @@ def _check_tool(tool) -> Tool:
     return tool
 
 
-def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None):
+def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: bool = False):
     """Tool-tip heights ``(N,)`` and contact points ``(N, 3)`` of ``tool`` dropped onto
     every face of ``obj`` at the (x, y) locations ``xy`` ``(N, 2)`` (NaN where the tool
     touches nothing).  The faces are meshed to 40 % of ``tolerance`` (default
     ``radius / 1000``); heights are exact for that mesh.
+
+    ``exact=True`` (ball end mills) polishes each height on the exact face the ball rests
+    on (:mod:`surfmod.uses.toolpath_exact`: Newton on the face's own evaluator, inside
+    its trim), so it is exact to rounding on the B-rep, contact points included; where
+    the ball rests on an edge or a vertex of the mesh the mesh height is kept, lifted
+    as above.  A flat end's mesh height is already exact on planar faces and edges.
 
     >>> import surfmod as sm
     >>> from surfmod.uses.toolpath import drop_cutter
@@ -181,9 +190,14 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None):
     tool = _check_tool(tool)
     cl = checks.finite_array(xy, "xy", ndim=2, last=2)
     tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
+    if exact and tool.kind != "ball":
+        raise SurfmodError("exact: heights polished on the exact faces need a ball end mill (tool kind 'ball')")
     part = _part(obj, tool, tolerance)
-    z, contacts = drop(part.grid, part.kind, cl, contacts=True)
-    return z + part.lift, contacts
+    z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True)
+    z = z + part.lift
+    if exact:
+        z, contacts, _ = exact_ball_heights(part.faces, part.owner, cl, z, contacts, touched, tool.radius)
+    return z, contacts
 
 
 def _stepover(tool: Tool, stepover, scallop) -> float:

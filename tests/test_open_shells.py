@@ -1,0 +1,131 @@
+"""Open shells from real parts (a corpus solid with its largest faces taken out, see
+tests/open_shells.py): commands that need a closed solid (``mass``, ``femesh``) refuse
+in one line naming the file, exit 1 and write nothing; ``mesh``, ``section`` and
+``toolpath`` work on them and are judged as on closed parts (OCCT's distance for the
+STL, ``BRepAlgoAPI_Section``'s length for the DXF, the exact swept-tool check for the
+G-code).  One file in the default run, several under the ``corpus`` marker."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import CORPUS
+from open_shells import open_shell_step
+from test_corpus_mesh import _independent_deviation
+from test_corpus_readback import dxf_length
+from test_corpus_toolpath import run_and_judge
+
+import surfmod as sm
+from surfmod.cli import main
+from surfmod.occ import uses as occ
+
+QUICK = CORPUS / "cadquery_red_cube_blue_cylinder.step"
+SWEEP = ["occt_screw.step", "trimesh_featuretype.STEP", "pythonocc_face_recognition_sample_part.stp",
+         "build123d_M6-1x12-countersunk-screw.step", "occt_linkrods.step", "trimesh_box_sides.STEP"]
+
+
+@pytest.fixture(scope="module")
+def quick_shell(tmp_path_factory):
+    return open_shell_step(QUICK, tmp_path_factory.mktemp("open"))
+
+
+def _refused(command, path, out, capsys):
+    capsys.readouterr()
+    code = main([command, str(path), *out, "--no-progress"])
+    captured = capsys.readouterr()
+    err = captured.err.strip()
+    assert code == 1 and len(err.splitlines()) == 1, err
+    assert path.name in err and "not closed" in err, err
+    return captured.out
+
+
+def check_needs_closed(path, tmp_path, capsys):
+    """``mass`` and ``femesh`` refuse the open shell: one line naming the file, exit 1,
+    no output file."""
+    assert _refused("mass", path, [], capsys) == ""
+    msh = tmp_path / "part.msh"
+    _refused("femesh", path, ["--size", "1", "--out", str(msh)], capsys)
+    assert not msh.exists()
+    with pytest.raises(sm.SurfmodError, match="not closed"):
+        sm.mass_properties(sm.import_step(path))
+
+
+def _edge_uses(path):
+    """How many facets use each edge of the STL (vertices merged)."""
+    import trimesh
+
+    tm = trimesh.load(str(path), file_type="stl", process=False)
+    _, inverse = np.unique(tm.vertices, axis=0, return_inverse=True)
+    f = inverse.reshape(-1)[tm.faces]
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    return np.unique(edges, axis=0, return_counts=True)[1]
+
+
+def check_mesh(path, tmp_path, capsys):
+    """The STL is written, measured within the tolerance by OCCT's distance, open exactly
+    along the missing faces (edges used once), and says it is not watertight."""
+    shape = sm.import_step(path)
+    box = occ.bounding_box(shape.wrapped)
+    tol = 1e-3 * float(np.linalg.norm(box[1] - box[0]))
+    out = tmp_path / "part.stl"
+    capsys.readouterr()
+    assert main(["mesh", str(path), "--tolerance", repr(tol), "--out", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    assert "watertight False" in printed, printed
+    uses = _edge_uses(out)
+    assert (uses == 1).any() and uses.max() == 2
+    assert _independent_deviation(shape, out, tol) <= tol
+
+
+def check_section(path, tmp_path, capsys):
+    """DXF through the bounding-box centre: length equal to BRepAlgoAPI_Section's.  The
+    first plane (z, tilted, x, y) that OCCT finds crossing the shell is used (the faces
+    taken out may be all the z plane met; a plane lying on a planar face is refused)."""
+    shell = sm.import_step(path).wrapped
+    centre = occ.bounding_box(shell).mean(axis=0)
+    out = tmp_path / "part.dxf"
+    tilted = np.array([0.1, 0.2, 1.0]) / math.sqrt(1.05)
+    for normal in (np.array([0.0, 0.0, 1.0]), tilted, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])):
+        ref = sum(occ.edge_length(e) for w in occ.section_edges(shell, centre, normal) for e in occ.wire_edges(w))
+        if ref == 0:
+            continue
+        capsys.readouterr()
+        code = main(["section", str(path), "--origin", *(repr(float(x)) for x in centre), "--normal",
+                     *(repr(float(x)) for x in normal), "--out", str(out), "--no-progress"])
+        if code == 0:
+            break
+        assert "lies on" in capsys.readouterr().err
+    assert code == 0
+    assert abs(dxf_length(out) - ref) <= 1e-6 * ref
+
+
+def check_all(source, tmp_path, capsys, drop):
+    path = open_shell_step(source, tmp_path, drop)
+    check_needs_closed(path, tmp_path, capsys)
+    check_mesh(path, tmp_path, capsys)
+    check_section(path, tmp_path, capsys)
+    run_and_judge(path, tmp_path, capsys)
+
+
+def test_open_shell_needs_closed_commands_refuse(quick_shell, tmp_path, capsys):
+    check_needs_closed(quick_shell, tmp_path, capsys)
+
+
+def test_open_shell_mesh(quick_shell, tmp_path, capsys):
+    check_mesh(quick_shell, tmp_path, capsys)
+
+
+def test_open_shell_section(quick_shell, tmp_path, capsys):
+    check_section(quick_shell, tmp_path, capsys)
+
+
+def test_open_shell_toolpath_never_gouges(quick_shell, tmp_path, capsys):
+    run_and_judge(quick_shell, tmp_path, capsys)
+
+
+@pytest.mark.corpus
+@pytest.mark.parametrize("name", SWEEP)
+def test_open_shells_of_corpus_parts(name, tmp_path, capsys):
+    check_all(CORPUS / name, tmp_path, capsys, drop=2)

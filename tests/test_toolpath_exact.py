@@ -1,0 +1,67 @@
+"""Ball drop-cutter heights polished on the exact faces (``drop_cutter(..., exact=True)``):
+closed-form cutter locations on a sphere, a cylinder, a tilted plane and at a box's edge,
+to rounding, from a deliberately coarse mesh whose own heights are visibly off."""
+
+from __future__ import annotations
+
+import build123d as bd
+import numpy as np
+import pytest
+
+import surfmod as sm
+from surfmod.uses.toolpath import drop_cutter
+
+R_BALL = 1.5
+COARSE = 0.05  # mesh deflection 0.02: mesh heights miss by ~1e-2, exact ones must not
+
+
+def test_sphere_closed_form():
+    """Ball on a sphere of radius R: centre at distance R + r, z = sqrt((R + r)² − d²) − r."""
+    R = 10.0
+    xy = np.column_stack([np.linspace(-6, 6, 25), np.linspace(-3, 4, 25)])
+    z, contact = drop_cutter(bd.Sphere(R), sm.Tool("ball", R_BALL), xy, tolerance=COARSE, exact=True)
+    expected = np.sqrt((R + R_BALL) ** 2 - (xy**2).sum(axis=1)) - R_BALL
+    assert np.abs(z - expected).max() <= 1e-12 * R
+    # the contact lies on the sphere, on the line from its centre to the ball's
+    assert np.abs(np.linalg.norm(contact, axis=1) - R).max() <= 1e-12 * R
+    centre = np.column_stack([xy, z + R_BALL])
+    assert np.abs(contact - centre * R / (R + R_BALL)).max() <= 1e-12 * R
+    mesh, _ = drop_cutter(bd.Sphere(R), sm.Tool("ball", R_BALL), xy, tolerance=COARSE)
+    assert np.abs(mesh - expected).max() > 1e-4  # the mesh alone is not exact
+
+
+def test_cylinder_closed_form():
+    """Ball on a cylinder of radius a along x: z = sqrt((a + r)² − y²) − r."""
+    a = 5.0
+    cylinder = bd.Rot(0, 90, 0) * bd.Cylinder(a, 40)
+    xy = np.column_stack([np.linspace(-10, 10, 21), np.linspace(-4, 4, 21)])
+    z, _ = drop_cutter(cylinder, sm.Tool("ball", R_BALL), xy, tolerance=COARSE, exact=True)
+    assert np.abs(z - (np.sqrt((a + R_BALL) ** 2 - xy[:, 1] ** 2) - R_BALL)).max() <= 1e-12 * a
+
+
+def test_tilted_plane_closed_form():
+    """Plane z = p x + q y + c: the ball touches it r along the normal, so the tip is
+    r (sqrt(1 + p² + q²) − 1) above the plane."""
+    p, q, c = 0.3, -0.2, 1.0
+    corners = [(x, y, p * x + q * y + c) for x, y in ((-10, -10), (10, -10), (-10, 10))]
+    plane = sm.plane(*corners)
+    xy = np.column_stack([np.linspace(-5, 5, 11), np.linspace(-4, 3, 11)])
+    z, _ = drop_cutter(plane, sm.Tool("ball", R_BALL), xy, tolerance=COARSE, exact=True)
+    expected = p * xy[:, 0] + q * xy[:, 1] + c + R_BALL * (np.sqrt(1 + p * p + q * q) - 1)
+    assert np.abs(z - expected).max() <= 1e-13 * 10
+
+
+def test_trim_respected_at_a_box_edge():
+    """Past the top face's edge the ball rests on the edge (the face's trim), not on the
+    face's untrimmed plane: z = h + sqrt(r² − d²) − r, d the distance past the edge."""
+    box = bd.Box(10, 10, 4)  # top face z = 2, edges at x = ±5
+    d = np.array([-0.5, 0.0, 0.3, 0.9, 1.4])
+    xy = np.column_stack([5.0 + d, np.zeros_like(d)])
+    z, _ = drop_cutter(box, sm.Tool("ball", R_BALL), xy, tolerance=COARSE, exact=True)
+    past = np.maximum(d, 0.0)
+    assert np.abs(z - (2.0 + np.sqrt(R_BALL**2 - past**2) - R_BALL)).max() <= 1e-13 * 10
+
+
+def test_exact_needs_a_ball():
+    with pytest.raises(sm.SurfmodError, match="exact"):
+        drop_cutter(bd.Box(2, 2, 2), sm.Tool("flat", 1.0), [[0.0, 0.0]], exact=True)
