@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import tempfile
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -180,11 +181,11 @@ HEALING = {
 }
 
 
-def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bool) -> dict:
-    """Mesh the BREP file with gmsh, write ``msh``; return gmsh's qualities per element.
-
-    Each solid is its own gmsh volume; solids of an assembly that touch or overlap are
-    meshed independently (no conformal interface), as a part list is."""
+@contextmanager
+def _gmsh_model(name: str):
+    """gmsh, initialized (if no caller did) and holding one fresh model ``name``, under the
+    process-wide lock (gmsh is one global state).  gmsh's own exceptions become
+    ``_GmshFailure`` (retried healed, then reported); the model is removed afterwards."""
     gmsh = _gmsh()
     with _GMSH_LOCK:
         own = not gmsh.isInitialized()
@@ -192,17 +193,8 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bo
             gmsh.initialize(interruptible=False)
         try:
             gmsh.option.setNumber("General.Terminal", 0)
-            for name, value in HEALING.items():
-                gmsh.option.setNumber(name, value if heal else 0)
-            gmsh.model.add("surfmod")
-            gmsh.model.occ.importShapes(str(brep))
-            gmsh.model.occ.synchronize()
-            if dim == 3 and not gmsh.model.getEntities(3):
-                if heal:  # the part had solids when it failed as read
-                    raise _GmshFailure("gmsh's healing left no volume")
-                raise SurfmodError("kind: a volume mesh needs a closed solid; obj has no solid")
-            gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)
-            return _generate(gmsh, msh, dim, size, order)
+            gmsh.model.add(name)
+            yield gmsh
         except SurfmodError:
             raise
         except Exception as exc:
@@ -214,6 +206,24 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bo
                 pass
             if own:
                 gmsh.finalize()
+
+
+def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bool) -> dict:
+    """Mesh the BREP file with gmsh, write ``msh``; return gmsh's qualities per element.
+
+    Each solid is its own gmsh volume; solids of an assembly that touch or overlap are
+    meshed independently (no conformal interface), as a part list is."""
+    with _gmsh_model("surfmod") as gmsh:
+        for name, value in HEALING.items():
+            gmsh.option.setNumber(name, value if heal else 0)
+        gmsh.model.occ.importShapes(str(brep))
+        gmsh.model.occ.synchronize()
+        if dim == 3 and not gmsh.model.getEntities(3):
+            if heal:  # the part had solids when it failed as read
+                raise _GmshFailure("gmsh's healing left no volume")
+            raise SurfmodError("kind: a volume mesh needs a closed solid; obj has no solid")
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)
+        return _generate(gmsh, msh, dim, size, order)
 
 
 def _generate(gmsh, msh: Path, dim: int, size: float, order: int) -> dict:
@@ -244,36 +254,18 @@ def _run_gmsh_triangulation(surfaces, msh: Path, size: float, order: int) -> dic
     (V, 3), triangles (T, 3))``, one closed surface per solid.  Each becomes a gmsh
     discrete surface whose triangles are kept as the boundary mesh, bounding a volume of
     its own; the interior is meshed at ``size``."""
-    gmsh = _gmsh()
-    with _GMSH_LOCK:
-        own = not gmsh.isInitialized()
-        if own:
-            gmsh.initialize(interruptible=False)
-        try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            gmsh.model.add("surfmod-triangulation")
-            first = 1
-            for vertices, triangles in surfaces:
-                surface = gmsh.model.addDiscreteEntity(2)
-                tags = np.arange(first, first + len(vertices))
-                gmsh.model.mesh.addNodes(2, surface, tags, np.asarray(vertices, float).ravel())
-                gmsh.model.mesh.addElementsByType(surface, 2, [], (np.asarray(triangles) + first).ravel())
-                first += len(vertices)
-                loop = gmsh.model.geo.addSurfaceLoop([surface])
-                gmsh.model.geo.addVolume([loop])
-            gmsh.model.geo.synchronize()
-            return _generate(gmsh, msh, 3, size, order)
-        except SurfmodError:
-            raise
-        except Exception as exc:
-            raise _GmshFailure(str(exc)) from exc
-        finally:
-            try:
-                gmsh.model.remove()
-            except Exception:  # pragma: no cover
-                pass
-            if own:
-                gmsh.finalize()
+    with _gmsh_model("surfmod-triangulation") as gmsh:
+        first = 1
+        for vertices, triangles in surfaces:
+            surface = gmsh.model.addDiscreteEntity(2)
+            tags = np.arange(first, first + len(vertices))
+            gmsh.model.mesh.addNodes(2, surface, tags, np.asarray(vertices, float).ravel())
+            gmsh.model.mesh.addElementsByType(surface, 2, [], (np.asarray(triangles) + first).ravel())
+            first += len(vertices)
+            loop = gmsh.model.geo.addSurfaceLoop([surface])
+            gmsh.model.geo.addVolume([loop])
+        gmsh.model.geo.synchronize()
+        return _generate(gmsh, msh, 3, size, order)
 
 
 class _GmshFailure(Exception):
