@@ -24,10 +24,11 @@ array([[1.5 , 0.75, 0.  ]])
 
 from __future__ import annotations
 
-import numpy as np
-
+import warnings
 from math import comb
 from typing import NamedTuple
+
+import numpy as np
 
 from .basis import basis_derivatives, find_spans
 
@@ -45,8 +46,12 @@ def _kernels():
 
 def writable(t) -> np.ndarray:
     """A flat, C-contiguous, writable float64 array (copied only when needed): one
-    array type for the compiled kernels, so they are compiled once."""
-    return np.require(np.asarray(t, dtype=float).ravel(), float, ["C", "W"])
+    array type for the compiled kernels, so they are compiled once.  The kernels only
+    read it; a view from ``np.broadcast_arrays`` is passed as it is (NumPy warns that it
+    will turn such views read-only, in which case ``np.require`` copies them)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "future versions will not create a writeable array", FutureWarning)
+        return np.require(np.asarray(t, dtype=float).ravel(), float, ["C", "W"])
 
 
 _as_float = writable
