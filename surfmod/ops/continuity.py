@@ -432,8 +432,7 @@ def _matched(a: Surface, b: Surface, samples: int, occt: bool) -> Continuity:
         return _projected(a, b, samples, occt)
     r = _pair(b, a, side_b, side_a, samples, occt, "")
     # r's curvatures are signed by b's normal; report them signed by a's, as _pair does
-    n_a = _unit(np.cross(*np.moveaxis(a.derivatives(*r.params_b.T, 1)[:, [1, 0], [0, 1]], 1, 0)))
-    n_b = _unit(np.cross(*np.moveaxis(b.derivatives(*r.params_a.T, 1)[:, [1, 0], [0, 1]], 1, 0)))
+    n_a, n_b = a.normals(*r.params_b.T), b.normals(*r.params_a.T)
     sign = np.where(np.einsum("ij,ij->i", n_a, n_b) < 0, -1.0, 1.0)
     return Continuity(f"a.{side_a} | b.{side_b}", r.points, r.gap, r.angle, r.jump, sign * r.curvature_b,
                       sign * r.curvature_a, r.params_b, r.params_a, r.occt)
