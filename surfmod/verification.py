@@ -255,7 +255,7 @@ def _own_differentials(s) -> bool:
 def _parametric_samples(s: Surface, samples: int, sufficient: bool) -> dict:
     """Everything the parametric comparison needs from one surface: both sides' samples
     (OCCT's ``Value``/``D2`` and ``GeomLProp``), masks and per-face scales."""
-    from .occ.sample import surface_props_fast, surface_values_d2
+    from .occ.sample import surface_props, surface_values_d2
 
     (u0, u1), (v0, v1) = s.domain
     if sufficient:
@@ -279,7 +279,7 @@ def _parametric_samples(s: Surface, samples: int, sufficient: bool) -> dict:
             occ[short, k, l] = mine[short, k, l]
     pos_scale = max(float(np.abs(mine[:, 0, 0]).max()), 1.0)
     sub = np.arange(0, uu.size, max(1, uu.size // 1024))  # GeomLProp is slow; a dense subset
-    n_occ, k_occ = surface_props_fast(geom, uu[sub], vv[sub])
+    n_occ, k_occ = surface_props(geom, uu[sub], vv[sub])
     own = None
     if _own_differentials(s):
         c = s.curvatures(uu[sub], vv[sub])

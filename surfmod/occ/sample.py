@@ -16,15 +16,7 @@ from .guard import kernel
 
 def surface_d2(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``(N, 3, 3, 3)`` derivative squares from ``D2`` (entries with k+l > 2 are NaN)."""
-    out = np.full((len(u), 3, 3, 3), np.nan)
-    p = gp_Pnt()
-    d1u, d1v, d2u, d2v, d2uv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    with kernel("Geom_Surface.D2"):
-        for a, (uu, vv) in enumerate(zip(u, v)):
-            surf.D2(float(uu), float(vv), p, d1u, d1v, d2u, d2v, d2uv)
-            out[a, 0, 0], out[a, 1, 0], out[a, 0, 1] = xyz(p), xyz(d1u), xyz(d1v)
-            out[a, 2, 0], out[a, 0, 2], out[a, 1, 1] = xyz(d2u), xyz(d2v), xyz(d2uv)
-    return out
+    return _d2_square(surf, u, v, positions_from_value=False)
 
 
 def surface_d0(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -35,18 +27,21 @@ def surface_d0(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def surface_props(surf, u: np.ndarray, v: np.ndarray, resolution: float = 1e-9):
     """Normals ``(N, 3)`` (NaN where undefined) and curvatures ``(N, 4)`` = (K, H, max, min)
-    from ``GeomLProp_SLProps`` (NaN where undefined)."""
-    normals = np.full((len(u), 3), np.nan)
-    curv = np.full((len(u), 4), np.nan)
+    from ``GeomLProp_SLProps`` (NaN where undefined).  Coordinates are collected as
+    tuples per point and converted to arrays once at the end (the per-point Python cost
+    dominates this loop)."""
+    nan3, nan4 = (np.nan,) * 3, (np.nan,) * 4
+    normals: list = []
+    curv: list = []
     with kernel("GeomLProp_SLProps"):
         props = GeomLProp_SLProps(surf, 2, resolution)
-        for a, (uu, vv) in enumerate(zip(u, v)):
-            props.SetParameters(float(uu), float(vv))
-            if props.IsNormalDefined():
-                normals[a] = xyz(props.Normal())
-            if props.IsCurvatureDefined():
-                curv[a] = (props.GaussianCurvature(), props.MeanCurvature(), props.MaxCurvature(), props.MinCurvature())
-    return normals, curv
+        set_params, normal_ok, curv_ok = props.SetParameters, props.IsNormalDefined, props.IsCurvatureDefined
+        for uu, vv in zip(np.asarray(u, dtype=float).tolist(), np.asarray(v, dtype=float).tolist()):
+            set_params(uu, vv)
+            normals.append(props.Normal().Coord() if normal_ok() else nan3)
+            curv.append((props.GaussianCurvature(), props.MeanCurvature(), props.MaxCurvature(), props.MinCurvature())
+                        if curv_ok() else nan4)
+    return np.array(normals, dtype=float).reshape(-1, 3), np.array(curv, dtype=float).reshape(-1, 4)
 
 
 def curve_d2(curve, t: np.ndarray) -> np.ndarray:
@@ -85,9 +80,13 @@ def distances_to_surface(surf, points: np.ndarray, bounds) -> np.ndarray:
 
 def surface_values_d2(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """:func:`surface_d2` with positions from ``Value`` (exact even where ``D2`` loses
-    digits), in one loop with as little Python per point as OCP allows: coordinates are
-    collected as tuples (``Coord``) and converted to one array at the end.  Same numbers
-    as ``surface_d2`` + ``surface_d0``, about four times faster."""
+    digits): the same numbers as ``surface_d2`` + ``surface_d0`` in one loop."""
+    return _d2_square(surf, u, v, positions_from_value=True)
+
+
+def _d2_square(surf, u, v, positions_from_value: bool) -> np.ndarray:
+    """The loop of :func:`surface_d2`, with as little Python per point as OCP allows:
+    coordinates are collected as tuples (``Coord``) and converted to one array at the end."""
     n = len(u)
     flat: list = []
     add = flat.extend
@@ -97,7 +96,7 @@ def surface_values_d2(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     with kernel("Geom_Surface.D2"):
         for uu, vv in zip(np.asarray(u, dtype=float).tolist(), np.asarray(v, dtype=float).tolist()):
             d2(uu, vv, p, d1u, d1v, d2u, d2v, d2uv)
-            add(value(uu, vv).Coord())
+            add(value(uu, vv).Coord() if positions_from_value else p.Coord())
             add(d1u.Coord())
             add(d1v.Coord())
             add(d2u.Coord())
@@ -108,20 +107,3 @@ def surface_values_d2(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     out[:, 0, 0], out[:, 1, 0], out[:, 0, 1] = rows[:, 0], rows[:, 1], rows[:, 2]
     out[:, 2, 0], out[:, 0, 2], out[:, 1, 1] = rows[:, 3], rows[:, 4], rows[:, 5]
     return out
-
-
-def surface_props_fast(surf, u: np.ndarray, v: np.ndarray, resolution: float = 1e-9):
-    """:func:`surface_props` (same numbers) with tuples collected per point and one array
-    conversion at the end."""
-    nan3, nan4 = (np.nan,) * 3, (np.nan,) * 4
-    normals: list = []
-    curv: list = []
-    with kernel("GeomLProp_SLProps"):
-        props = GeomLProp_SLProps(surf, 2, resolution)
-        set_params, normal_ok, curv_ok = props.SetParameters, props.IsNormalDefined, props.IsCurvatureDefined
-        for uu, vv in zip(np.asarray(u, dtype=float).tolist(), np.asarray(v, dtype=float).tolist()):
-            set_params(uu, vv)
-            normals.append(props.Normal().Coord() if normal_ok() else nan3)
-            curv.append((props.GaussianCurvature(), props.MeanCurvature(), props.MaxCurvature(), props.MinCurvature())
-                        if curv_ok() else nan4)
-    return np.array(normals, dtype=float).reshape(-1, 3), np.array(curv, dtype=float).reshape(-1, 4)
