@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface
 
 from . import arrays
@@ -98,15 +100,19 @@ def read_bezier_surface(surf: Geom_BezierSurface) -> dict:
 
 
 def read_bspline_curve(curve: Geom_BSplineCurve) -> dict:
+    """Poles ``(n, 3)``, weights (None if polynomial), flat knots and degree of a
+    ``Geom_BSplineCurve`` or of a ``Geom2d_BSplineCurve`` (a p-curve: its poles get
+    z = 0, so the surfmod evaluator reads both); a periodic curve is unwrapped."""
     with kernel("reading Geom_BSplineCurve"):
-        from OCP.TColgp import TColgp_Array1OfPnt
+        from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array1OfPnt2d
         from OCP.TColStd import TColStd_Array1OfReal
 
         if curve.IsPeriodic():
             curve = curve.Copy()  # OCP returns the derived type (no DownCast in OCP)
             curve.SetNotPeriodic()
         n, p = curve.NbPoles(), curve.Degree()
-        poles = TColgp_Array1OfPnt(1, n)
+        planar = type(curve).__name__.startswith("Geom2d")
+        poles = (TColgp_Array1OfPnt2d if planar else TColgp_Array1OfPnt)(1, n)
         curve.Poles(poles)
         weights = None
         if curve.IsRational():
@@ -115,7 +121,12 @@ def read_bspline_curve(curve: Geom_BSplineCurve) -> dict:
             weights = arrays.to_numpy_1d(w)
         k = TColStd_Array1OfReal(1, n + p + 1)
         curve.KnotSequence(k)
-    return {"points": arrays.pnts_to_numpy_1d(poles), "weights": weights, "knots": arrays.to_numpy_1d(k), "degree": p}
+        if planar:
+            points = np.zeros((n, 3))
+            points[:, :2] = [poles.Value(i).Coord() for i in range(1, n + 1)]
+        else:
+            points = arrays.pnts_to_numpy_1d(poles)
+    return {"points": points, "weights": weights, "knots": arrays.to_numpy_1d(k), "degree": p}
 
 
 def surface_type(surf) -> str:

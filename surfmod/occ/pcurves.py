@@ -15,6 +15,7 @@ import numpy as np
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS
 
+from .geom import read_bspline_curve
 from .guard import kernel
 from .topo import explore
 
@@ -27,30 +28,13 @@ def _bspline_data(pc):
     """Poles (padded to 3-D with z = 0 for the surfmod evaluator), weights, flat knots and
     degree of a B-spline p-curve; None for a periodic curve whose edge range leaves its
     first period (its unwrapped form would continue the end span there instead)."""
-    from OCP.TColgp import TColgp_Array1OfPnt2d
-    from OCP.TColStd import TColStd_Array1OfReal
-
     b = pc.BSpline()
     if b.IsPeriodic():
         b = b.Copy()  # OCP returns the derived type
         b.SetNotPeriodic()
-        lo, hi = b.FirstParameter(), b.LastParameter()
-        if pc.FirstParameter() < lo or pc.LastParameter() > hi:
+        if pc.FirstParameter() < b.FirstParameter() or pc.LastParameter() > b.LastParameter():
             return None
-    n, p = b.NbPoles(), b.Degree()
-    poles = TColgp_Array1OfPnt2d(1, n)
-    b.Poles(poles)
-    pts = np.zeros((n, 3))
-    pts[:, :2] = [_xy(poles.Value(i)) for i in range(1, n + 1)]
-    weights = None
-    if b.IsRational():
-        w = TColStd_Array1OfReal(1, n)
-        b.Weights(w)
-        weights = np.array([w.Value(i) for i in range(1, n + 1)])
-    k = TColStd_Array1OfReal(1, n + p + 1)
-    b.KnotSequence(k)
-    knots = np.array([k.Value(i) for i in range(1, n + p + 2)])
-    return {"points": pts, "weights": weights, "knots": knots, "degree": p}
+    return read_bspline_curve(b)
 
 
 def face_pcurves(face) -> list[dict]:
