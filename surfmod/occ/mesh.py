@@ -8,6 +8,7 @@ the kernel boundary and the measurement side, not a NumPy evaluation path.
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass
 from itertools import chain, count
 
@@ -107,63 +108,123 @@ def _coords(getter, n: int, dim: int) -> np.ndarray:
     return np.fromiter(chain.from_iterable(getter(i).Coord() for i in range(1, n + 1)), float, dim * n).reshape(n, dim)
 
 
-#: Instance-group numbers handed out by :func:`read_triangulation`.
+#: Instance-group numbers handed out by :func:`read_triangulation` and :func:`mesh_faces`.
 _GROUPS = count()
 
 
-def _local_triangulation(face, with_uv: bool, with_nodes: bool):
-    """``(nodes in the face's own frame, uv, triangles, deflection, location)`` or ``None``."""
+def _local_triangulation(face):
+    """``(nodes in the face's own frame, uv or None, triangles, deflection)`` of one
+    face's stored triangulation, read node by node, or ``None``."""
     from OCP.BRep import BRep_Tool
     from OCP.TopLoc import TopLoc_Location
 
-    loc = TopLoc_Location()
-    tri = BRep_Tool.Triangulation_s(face, loc)
-    if tri is None or tri.NbTriangles() == 0:
+    tri = BRep_Tool.Triangulation_s(face, TopLoc_Location())
+    if tri is None:
         return None
     n, m = tri.NbNodes(), tri.NbTriangles()
-    nodes = _coords(tri.Node, n, 3) if with_nodes else np.full((n, 3), np.nan)
-    uv = _coords(tri.UVNode, n, 2) if with_uv and tri.HasUVNodes() else np.full((n, 2), np.nan)
+    uv = _coords(tri.UVNode, n, 2) if tri.HasUVNodes() else None
     triangle = tri.Triangle
     idx = np.fromiter(chain.from_iterable(triangle(i).Get() for i in range(1, m + 1)), np.int64, 3 * m).reshape(m, 3) - 1
-    return nodes, uv, idx, float(tri.Deflection()), loc
+    return _coords(tri.Node, n, 3), uv, idx, float(tri.Deflection())
 
 
-def read_triangulation(face, with_uv: bool, with_nodes: bool = True, instances: dict | None = None) -> FaceTriangles | None:
-    """The face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has none.
+def _parse_triangulations(data, version: int) -> list | None:
+    """The triangulation table that ``BinTools_ShapeSet::WriteTriangulation`` writes
+    (OCCT's binary BRep format: a ``Triangulations N`` line, then per triangulation the
+    int32 node and triangle counts, a UV flag byte, from format 4 on a normals flag
+    byte, the float64 deflection, the nodes, the UV nodes, the 1-based int32 triangles
+    and float32 normals, all little-endian) as ``(nodes, uv or None, triangles,
+    deflection)`` tuples, or ``None`` when the bytes do not follow that layout."""
+    end = data.find(b"\n")
+    words = bytes(data[:end]).split() if end > 0 else []
+    if len(words) != 2 or words[0] != b"Triangulations" or not words[1].isdigit():
+        return None
+    pos, size = end + 1, len(data)
+    flags = 2 if version >= 4 else 1
+    out = []
+    for _ in range(int(words[1])):
+        if pos + 16 + flags > size:
+            return None
+        n, m = (int(x) for x in np.frombuffer(data, "<i4", 2, pos))
+        has_uv, has_normals = data[pos + 8], (data[pos + 9] if flags == 2 else 0)
+        deflection = float(np.frombuffer(data, "<f8", 1, pos + 8 + flags)[0])
+        pos += 16 + flags
+        if n < 0 or m < 0 or pos + n * (24 + 16 * bool(has_uv) + 12 * bool(has_normals)) + 12 * m > size:
+            return None
+        # copies: aligned, writable arrays that do not keep the whole dump alive
+        nodes = np.frombuffer(data, "<f8", 3 * n, pos).reshape(n, 3).copy()
+        pos += 24 * n
+        uv = None
+        if has_uv:
+            uv = np.frombuffer(data, "<f8", 2 * n, pos).reshape(n, 2).copy()
+            pos += 16 * n
+        triangles = np.frombuffer(data, "<i4", 3 * m, pos).reshape(m, 3).astype(np.int64) - 1
+        pos += 12 * m + 12 * n * bool(has_normals)
+        out.append((nodes, uv, triangles, deflection))
+    return out if pos == size else None
 
-    Faces that are located instances of one face (assemblies) share one triangulation:
-    with an ``instances`` dict it is read once and moved to each instance's location;
-    ``FaceTriangles.instance`` then names the instance group (the same for every face
-    of the group) and ``rigid`` says whether the location is an isometry (distances to
-    the instance equal those to the face it repeats)."""
-    from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED
+
+def _triangulation_table(faces: list) -> list | None:
+    """Every face's stored triangulation as :func:`_local_triangulation` gives it, read
+    for all faces at once: OCCT serializes the triangulations into one binary buffer
+    (``BinTools_ShapeSet``) that NumPy reads at memory speed, where reading node by node
+    costs a Python call per node.  Located instances of one face share one entry
+    (the same tuple object).  ``None`` when the buffer cannot be matched to the faces
+    (an unexpected layout, or two faces sharing one triangulation object)."""
+    from OCP.BinTools import BinTools_ShapeSet
+    from OCP.BRep import BRep_Tool
     from OCP.TopLoc import TopLoc_Location
 
-    group = -1
-    if instances is not None:
-        bare = face.Located(TopLoc_Location()).Oriented(TopAbs_FORWARD)
-        key = bare.__hash__()
-        hit = instances.get(key)
-        if hit is not None and hit[0].IsSame(bare) and (hit[2] or not with_uv) and (hit[3] or not with_nodes):
-            got, group = hit[1][:4] + (face.Location(),), hit[4]
-        else:
-            got = _local_triangulation(face, with_uv, with_nodes)
-            if got is None:
-                return None
-            group = next(_GROUPS)  # unique even if two faces' hashes collide
-            instances[key] = (bare, got, with_uv, with_nodes, group)
-    else:
-        got = _local_triangulation(face, with_uv, with_nodes)
-        if got is None:
-            return None
-    nodes, uv, idx, deflection, loc = got
+    table = BinTools_ShapeSet()
+    table.SetWithTriangles(True)
+    buckets: dict = {}  # hash of the unlocated face -> [(unlocated face, slot)]
+    slots = []
+    n_slots = 0
+    for face in faces:
+        if BRep_Tool.Triangulation_s(face, TopLoc_Location()) is None:
+            slots.append(-1)
+            continue
+        bare = face.Located(TopLoc_Location())
+        bucket = buckets.setdefault(bare.__hash__(), [])
+        slot = next((s for other, s in bucket if other.IsSame(bare)), -1)
+        if slot < 0:
+            slot, n_slots = n_slots, n_slots + 1
+            bucket.append((bare, slot))
+            table.AddShape(bare)  # this face's geometry and triangulation, not its edges
+        slots.append(slot)
+    buffer = io.BytesIO()
+    table.WriteTriangulation(buffer)
+    parsed = _parse_triangulations(buffer.getvalue(), table.FormatNb())
+    if parsed is None or len(parsed) != n_slots:
+        return None
+    return [parsed[s] if s >= 0 else None for s in slots]
+
+
+def _face_triangles(face, got, with_uv: bool, with_nodes: bool, group: int) -> FaceTriangles | None:
+    """:class:`FaceTriangles` of ``face`` from its local triangulation ``got``."""
+    from OCP.TopAbs import TopAbs_REVERSED
+
+    if got is None or len(got[2]) == 0:
+        return None
+    nodes, uv, idx, deflection = got
+    n = len(nodes)
+    uv = uv if with_uv and uv is not None else np.full((n, 2), np.nan)
     rigid = True
-    if not loc.IsIdentity():
+    loc = face.Location()
+    if not with_nodes:
+        nodes = np.full((n, 3), np.nan)
+    elif not loc.IsIdentity():
         t = loc.Transformation()
         rot = np.array([[t.Value(i, j) for j in range(1, 4)] for i in range(1, 4)])
         nodes = nodes @ rot.T + np.array([t.Value(i, 4) for i in range(1, 4)])
         rigid = abs(abs(t.ScaleFactor()) - 1.0) < 1e-12
     return FaceTriangles(nodes, uv, idx, face.Orientation() == TopAbs_REVERSED, deflection, group, rigid)
+
+
+def read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTriangles | None:
+    """One face's stored triangulation as :class:`FaceTriangles`, or ``None`` when it has
+    none (:func:`mesh_faces` reads all faces of a shape at once)."""
+    return _face_triangles(face, _local_triangulation(face), with_uv, with_nodes, next(_GROUPS))
 
 
 def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, parallel: bool = False,
@@ -174,9 +235,9 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
 
     Returns ``[(index, face, FaceTriangles or None)]`` per face in exploration order
     (``None``: BRepMesh left the face without triangles).  ``with_uv`` is a bool or a
-    predicate ``with_uv(face) -> bool`` choosing the faces whose (u, v) nodes are read;
-    ``with_nodes=False`` skips the 3-D nodes (NaN).  Located instances of one face
-    (assemblies) are read once (see :func:`read_triangulation`).
+    predicate ``with_uv(face) -> bool`` choosing the faces whose (u, v) nodes are kept;
+    ``with_nodes=False`` leaves the 3-D nodes NaN.  Located instances of one face
+    (assemblies) are read once and share ``FaceTriangles.instance``.
 
     >>> import build123d as bd
     >>> [(k, len(t.triangles)) for k, _, t in mesh_faces(bd.Box(1, 1, 1), 0.1)][:2]
@@ -192,10 +253,17 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
     clean(shp)
     with kernel("BRepMesh_IncrementalMesh"):
         BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
-        instances: dict = {}
-        return [(k, face, read_triangulation(face, with_uv(face) if callable(with_uv) else bool(with_uv), with_nodes,
-                                             instances))
-                for k, face in enumerate(faces_of(shp))]
+        faces = list(faces_of(shp))
+        table = _triangulation_table(faces)
+        if table is None:  # read face by face, sharing nothing
+            table = [_local_triangulation(face) for face in faces]
+        groups: dict = {}  # id of a shared entry -> its instance group
+        out = []
+        for k, (face, got) in enumerate(zip(faces, table)):
+            group = groups.setdefault(id(got), next(_GROUPS)) if got is not None else -1
+            keep_uv = with_uv(face) if callable(with_uv) else bool(with_uv)
+            out.append((k, face, _face_triangles(face, got, keep_uv, with_nodes, group)))
+        return out
 
 
 def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None) -> list[FaceMesh]:
