@@ -110,3 +110,18 @@ def test_isometric_repeats_have_the_deviation_of_their_first_instance(corpus_dir
         d0, nd0 = measure_face(first, tol)
         assert d.max() == pytest.approx(d0.max(), rel=1e-9, abs=1e-12 * tol)
         assert nd == pytest.approx(nd0, rel=1e-9, abs=1e-12 * tol)
+
+
+def test_spline_figures_in_one_pass_equal_geomlprop(corpus_dir):
+    """The triangle estimate samples B-spline faces with surfmod's evaluator (all faces'
+    curvatures at once) and gets what GeomLProp, face by face, gives."""
+    from surfmod.meshing.brep import _estimate
+
+    part = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+    evaluators: dict = {}
+    for tolerance in (0.05, 0.5):
+        by_occt, diag = _estimate(part, tolerance)
+        ours, same_diag = _estimate(part, tolerance, evaluators)
+        assert same_diag == diag
+        assert ours == pytest.approx(by_occt, rel=1e-6)
+    assert len(evaluators) == 189  # every B-spline face, kept for measuring

@@ -134,12 +134,11 @@ def reciprocal_table(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
     difference spans the non-empty knot interval ``[knots[span], knots[span+1])``."""
     p = degree
     inv = np.zeros((n_ctrl, p + 1, p + 1))
-    span = np.arange(p, n_ctrl)
-    for j in range(1, p + 1):
-        for r in range(j):
-            diff = knots[span + r + 1] - knots[span + r + 1 - j]
-            with np.errstate(divide="ignore"):
-                inv[p:, j, r] = np.where(diff > 0, 1.0 / np.where(diff > 0, diff, 1.0), 0.0)
+    j, r = np.tril_indices(p + 1, -1)  # every (j, r) with 0 <= r < j <= p, in one gather
+    span = np.arange(p, n_ctrl)[:, None]
+    diff = knots[span + r + 1] - knots[span + r + 1 - j]
+    positive = diff > 0
+    inv[p:, j, r] = np.where(positive, 1.0 / np.where(positive, diff, 1.0), 0.0)
     return inv
 
 

@@ -25,10 +25,12 @@ tolerance, and refused only with ``strict=True``.
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
 from ..errors import SurfmodError
+from ..eval.differential import curvatures, degenerate_mask, raw_normals
 from .deviation import DENSE, project_distances, triangle_deviations
 from .facesurface import FaceSurface
 from .polymesh import Mesh, weld
@@ -77,7 +79,7 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
     from ..occ.mesh import analytic_distances
 
     pos = fm.nodes[fm.triangles]
-    q = np.einsum("kj,tjd->tkd", bary, pos).reshape(-1, 3)
+    q = np.matmul(bary, pos).reshape(-1, 3)
     exact = analytic_distances(fm.surface, q)
     if exact is not None:
         node = analytic_distances(fm.surface, fm.nodes)
@@ -108,17 +110,51 @@ def measure_face_meshes(face_meshes, bary=DENSE) -> np.ndarray:
 
 
 # -- the mesh of a shape ------------------------------------------------------------------
-def _estimate(shape, tolerance: float) -> tuple[float, float]:
+def _estimate(shape, tolerance: float, evaluators: dict | None = None) -> tuple[float, float]:
     """``(triangles, bbox diagonal)``: a chord of length ``h`` on curvature ``k`` sags
     ``k h^2 / 8``; per face the median curvature (robust to the singular points of real
     B-spline faces, which made a mean "need" 1.7e17 triangles), at most ``1 / tolerance`` (smaller features are covered by a
-    triangle of the tolerance's size)."""
+    triangle of the tolerance's size).  With ``evaluators``, B-spline and Bezier faces
+    are sampled by their :class:`FaceSurface` (all faces' curvatures in one vectorized
+    pass), which is kept there by face hash for measuring."""
     from ..occ.mesh import shape_figures
 
-    figures, diag = shape_figures(shape)
+    splines: list = []  # (partials to order 2 on the face's sample grid, UV box area)
+    sample = None if evaluators is None else partial(_sample_spline, evaluators, splines)
+    figures, diag = shape_figures(shape, sample_face=sample)
+    if splines:
+        figures = figures + _spline_figures(splines, 1.0 / max(diag, 1e-300))
     ell = max(diag, 1e-300)
     est = sum(2 * a * (np.sqrt(min(k, 1 / tolerance) / (8 * tolerance)) + 1 / ell) ** 2 for a, k in figures)
     return float(est), diag
+
+
+def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples: int, floor: float):
+    """``shape_figures``' ``sample_face`` for B-spline and Bezier faces: their partials on
+    a ``samples`` x ``samples`` grid of the UV box go to ``splines`` (``False``: the face
+    is accounted for here); ``None`` leaves other faces to ``GeomLProp``."""
+    from ..occ.geom import surface_type
+
+    if surface_type(surf) not in ("Geom_BSplineSurface", "Geom_BezierSurface"):
+        return None
+    ev = evaluators[face.__hash__()] = FaceSurface(surf)
+    u0, u1, v0, v1 = bounds
+    uu, vv = np.meshgrid(np.linspace(u0, u1, samples), np.linspace(v0, v1, samples), indexing="ij")
+    splines.append((ev.d2(uu.ravel(), vv.ravel()), (u1 - u0) * (v1 - v0)))
+    return False
+
+
+def _spline_figures(splines: list, floor: float) -> list:
+    """Per face ``(area of the UV box's patch, median sqrt(|k1| |k2|))``, as
+    ``shape_figures`` gives them with ``GeomLProp`` (no curvature where the normal is
+    undefined), for all sampled faces at once."""
+    ders = np.stack([d for d, _ in splines])  # (faces, samples, 3, 3, 3)
+    area = np.linalg.norm(raw_normals(ders), axis=-1).mean(axis=1) * np.array([a for _, a in splines])
+    c = curvatures(ders)
+    vals = np.sqrt(np.maximum(np.abs(c.k1), floor) * np.maximum(np.abs(c.k2), floor))
+    defined = ~degenerate_mask(ders, 1e-9)
+    median = np.array([float(np.median(v[ok])) if ok.any() else floor for v, ok in zip(vals, defined)])
+    return list(zip(area.tolist(), median.tolist()))
 
 
 def _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared) -> list[int]:
@@ -150,17 +186,18 @@ def _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared) -
     return out
 
 
-def _refine_locally(fms, i: int, dev, node_dev, tolerance: float) -> bool:
+def _refine_locally(fms, i: int, dev, node_dev, tolerance: float, ev: FaceSurface | None = None) -> bool:
     """Refine face ``fms[i]`` inside its boundary (:mod:`surfmod.meshing.refine`) until
     every triangle is within ``tolerance`` beyond the face's node deviation; ``False``
-    (face left as it was) when the deviation is not the interior's."""
+    (face left as it was) when the deviation is not the interior's.  ``ev``: the face's
+    :class:`FaceSurface` when the caller already has it."""
     from ..occ.mesh import read_triangulation
 
     fm = fms[i]
     with_uv = read_triangulation(fm.face, True)  # analytic faces were read without (u, v)
     if with_uv is None or len(with_uv.uv) != len(fm.nodes) or np.isnan(with_uv.uv).any():
         return False
-    ev = FaceSurface(fm.surface)
+    ev = FaceSurface(fm.surface) if ev is None else ev
     out = refine_face(replace(fm, uv=with_uv.uv), tolerance, float(node_dev[i]),
                       lambda f: measure_face(f, tolerance, ev=ev)[0], lambda uv: ev.d0(uv[:, 0], uv[:, 1]))
     if out is None:
@@ -222,7 +259,8 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
 
     from ..occ.mesh import brepmesh
 
-    estimate, diag = _estimate(shape, tolerance)
+    evaluators: dict = {}  # face hash -> FaceSurface of its B-spline/Bezier surface
+    estimate, diag = _estimate(shape, tolerance, evaluators)
     if tolerance < MIN_RELATIVE_TOLERANCE * diag:
         raise SurfmodError(
             f"tolerance: {tolerance:g} is below {MIN_RELATIVE_TOLERANCE:g} x the shape size {diag:.3g}"
@@ -252,13 +290,14 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
                 if fm.repeats >= 0:  # an isometric repeat of a face measured above
                     dev[i], node_dev[i] = dev[fm.repeats], node_dev[fm.repeats]
                     continue
-                d, node_dev[i] = measure_face(fm, tolerance)
+                d, node_dev[i] = measure_face(fm, tolerance, ev=evaluators.get(fm.face.__hash__()))
                 dev[i] = d.max(initial=0.0)
             bar.update()
             refine = _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared)
             # BRepMesh overshoots by a few percent inside some faces: refining those
             # faces alone costs far less than a second pass over the whole shape
-            fixed = [i for i in refine if _refine_locally(fms, i, dev, node_dev, tolerance)]
+            fixed = [i for i in refine
+                     if _refine_locally(fms, i, dev, node_dev, tolerance, evaluators.get(fms[i].face.__hash__()))]
             refined = len(fixed)  # the faces refined in the pass that is kept
             refine = [i for i in refine if i not in fixed]
             if not refine:

@@ -51,11 +51,9 @@ def project_distances(d1, points, uv, bounds, iterations: int = 6, threshold: fl
         r = points[act] - ders[:, 0, 0]
         best[act] = np.minimum(best[act], np.linalg.norm(r, axis=1))
         su, sv = ders[:, 1, 0], ders[:, 0, 1]
-        a = np.einsum("ij,ij->i", su, su)
-        b = np.einsum("ij,ij->i", su, sv)
-        c = np.einsum("ij,ij->i", sv, sv)
-        g1 = np.einsum("ij,ij->i", su, r)
-        g2 = np.einsum("ij,ij->i", sv, r)
+        # the Gram matrix of (Su, Sv, r) per point in one product: a, b, c and the gradient
+        gram = np.matmul(np.stack([su, sv, r], axis=1), np.stack([su, sv], axis=2))
+        a, b, c, g1, g2 = gram[:, 0, 0], gram[:, 0, 1], gram[:, 1, 1], gram[:, 2, 0], gram[:, 2, 1]
         det = a * c - b * b
         det = det + 1e-14 * (a + c) ** 2 + np.finfo(float).tiny
         du = np.clip((c * g1 - b * g2) / det, -step_u, step_u)
@@ -84,8 +82,8 @@ def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None,
     """
     if len(positions) == 0:
         return np.zeros(0)
-    q = np.einsum("kj,tjd->tkd", bary, positions).reshape(-1, 3)
-    g = np.einsum("kj,tjd->tkd", bary, uvs).reshape(-1, 2)
+    q = np.matmul(bary, positions).reshape(-1, 3)
+    g = np.matmul(bary, uvs).reshape(-1, 2)
     thr = np.inf if threshold is None else threshold
     d0v = d0(np.clip(g[:, 0], bounds[0], bounds[1]), np.clip(g[:, 1], bounds[2], bounds[3])) if d0 else None
     first = np.linalg.norm(q - d0v, axis=1) if d0v is not None else None

@@ -465,12 +465,17 @@ def curve_points(curve, t: np.ndarray) -> np.ndarray:
         return out
 
 
-def shape_figures(shape, samples: int = 5):
+def shape_figures(shape, samples: int = 5, sample_face=None):
     """Per curved face ``(area, median sqrt(|k1| |k2|) with each |k| floored by 1/diagonal)``
     from a ``samples`` x ``samples`` grid over the face's UV box (area of the box's patch:
     at least the face's), and the bounding-box diagonal: enough to estimate how many
     triangles a chordal tolerance needs before asking BRepMesh for them.  Planes need
-    no figure (a plane's triangle count does not grow as the tolerance shrinks)."""
+    no figure (a plane's triangle count does not grow as the tolerance shrinks).
+
+    ``sample_face(face, surface, (u0, u1, v0, v1), samples, floor)``, when given, is asked first
+    for each curved face and returns its figure, ``None`` to leave the face to
+    ``GeomLProp`` here, or ``False`` when the caller accounts for the face itself (its
+    vectorized evaluator, where ``GeomLProp`` makes several calls per sample)."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRep import BRep_Tool
     from OCP.BRepBndLib import BRepBndLib
@@ -496,6 +501,11 @@ def shape_figures(shape, samples: int = 5):
             if name == "Geom_Plane":
                 continue
             u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+            figure = sample_face(face, surf, (u0, u1, v0, v1), samples, floor) if sample_face is not None else None
+            if figure is not None:
+                if figure is not False:
+                    figures.append(figure)
+                continue
             if name in ("Geom_CylindricalSurface", "Geom_SphericalSurface"):
                 # closed forms of what the sampled figures below come to (|Su x Sv|, k1, k2)
                 r = surf.Radius()
