@@ -5,7 +5,7 @@ OCCT's own tool for the same job, both on one core, in one process.
 |---|---|---|
 | read | ``sm.import_step`` | ``STEPControl_Reader`` (ReadFile + TransferRoots) |
 | check | ``surfmod check``'s per-file work (read, every face read back and cross-checked) | read + ``BRepCheck_Analyzer`` |
-| mesh | ``sm.export_stl`` at 1e-3 of the bbox diagonal (BRepMesh, every face *measured*, STL written) | ``BRepMesh_IncrementalMesh`` at the same deflection (no measurement, no file) |
+| mesh | ``sm.export_stl`` at 1e-3 of the bbox diagonal (BRepMesh, every face *measured*, STL written) | ``BRepMesh_IncrementalMesh`` at the same deflection, then ``StlAPI_Writer`` (the same job: an STL on disk; no measurement) |
 | mass | ``sm.mass_properties`` | ``BRepGProp.VolumeProperties_s`` at eps 1e-9 |
 | section | ``sm.section`` through the bbox centre, normal z | ``BRepAlgoAPI_Section`` with that plane |
 
@@ -66,7 +66,7 @@ def _occt_read(path):
     return reader.OneShape()
 
 
-def _occt_jobs(path, shape, deflection, centre):
+def _occt_jobs(path, shape, deflection, centre, out):
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
     from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.BRepGProp import BRepGProp
@@ -74,10 +74,12 @@ def _occt_jobs(path, shape, deflection, centre):
     from OCP.BRepTools import BRepTools
     from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
     from OCP.GProp import GProp_GProps
+    from OCP.StlAPI import StlAPI_Writer
 
     def mesh():
         BRepTools.Clean_s(shape)
         BRepMesh_IncrementalMesh(shape, deflection, False, 0.5, False)
+        StlAPI_Writer().Write(shape, str(out))
 
     def mass():
         BRepGProp.VolumeProperties_s(shape, GProp_GProps(), 1e-9)
@@ -147,14 +149,14 @@ def main(argv=None) -> None:
     print(head)
     print("-" * len(head))
     with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "part.stl"
+        out, occt_out = Path(tmp) / "part.stl", Path(tmp) / "occt.stl"
         for path in files:
             part = sm.import_step(path)
             _, diag = shape_figures(part, samples=2)
             bb = part.bounding_box()
             centre = tuple(float(x) for x in (np.array(tuple(bb.min)) + np.array(tuple(bb.max))) / 2)
             ours = _surfmod_jobs(path, part, 1e-3 * diag, centre, out)
-            theirs = _occt_jobs(path, _occt_read(path), 1e-3 * diag, centre)
+            theirs = _occt_jobs(path, _occt_read(path), 1e-3 * diag, centre, occt_out)
             row = f"{path.name[:43]:<44}"
             for job in jobs:
                 row += _cell(*_best_pair(ours[job], theirs[job], repeats)) + " "
