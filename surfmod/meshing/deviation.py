@@ -27,7 +27,8 @@ def project_distances(d1, points, uv, bounds, iterations: int = 6, threshold: fl
     ``d1(u, v)`` returns ``(N, >=2, >=2, 3)`` derivatives (``d0`` optionally positions
     only).  Every iterate is a point of the surface, so the smallest distance seen is an
     upper bound of the true distance (for the guarantee, over-estimating is the safe
-    side).  Points whose first bound is already ``<= threshold`` are not iterated.
+    side).  Points whose bound is ``<= threshold`` (at first or after an iteration) are
+    not iterated further: below the threshold the bound is all that is asked.
 
     >>> import numpy as np, surfmod as sm
     >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
@@ -63,7 +64,7 @@ def project_distances(d1, points, uv, bounds, iterations: int = 6, threshold: fl
         # Gauss-Newton is quadratic near the foot point: once the 3-D step is below 1e-3 of
         # the distance, the distance is known to ~1e-6 relative and the point is done
         step3 = np.linalg.norm((un - ua)[:, None] * su + (vn - va)[:, None] * sv, axis=1)
-        moving = step3 > 1e-3 * best[act]
+        moving = (step3 > 1e-3 * best[act]) & (best[act] > threshold)
         # converged points already have their distance in ``best``
         act, ua, va = act[moving], un[moving], vn[moving]
     if act.size:
@@ -95,7 +96,9 @@ def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None,
         done = d > thr
         idx = np.nonzero(done)[0]
         if idx.size:
-            d[idx] = np.minimum(d[idx], project_distances(d1, q[idx], g[idx], bounds, d0=d0))
+            # without accurate_max, a sample's bound need only come within the threshold
+            stop = 0.0 if accurate_max else thr
+            d[idx] = np.minimum(d[idx], project_distances(d1, q[idx], g[idx], bounds, threshold=stop, d0=d0))
     while accurate_max and d.size:
         cand = np.nonzero(~done & (d >= 0.9 * d.max()))[0]
         if cand.size == 0:
