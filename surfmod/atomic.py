@@ -1,10 +1,16 @@
-"""Atomic file writes: write a temporary file beside the target, fsync, then rename.
+"""Atomic file writes: write a temporary file beside the target, then rename it over
+the target.
 
 A failure at any point removes the temporary file and leaves an existing target as it
-was, so no reader ever sees a half-written file.  A writer killed outright (SIGKILL,
-power loss) cannot clean up, so its temporary file is named for what it is,
+was, so no reader ever sees a half-written file.  A writer killed outright (SIGKILL)
+cannot clean up, so its temporary file is named for what it is,
 ``.<target name>.surfmod-tmp-<pid>-<random>``, and the next write to the same target
 removes every such file whose writer process is gone.
+
+The file is not ``fsync``-ed before the rename: on this project's machines that alone
+took 3-4 ms a file, more than meshing a small part, and durability across a power loss
+is left to the file system (ext4, by default, writes a file's data out before a rename
+that replaces another file; OCCT's own writers do not sync either).
 
 This module sits low (beside ``checks.py``) so that ``io/``, ``meshing/`` and ``uses/``
 all write files the same way.
@@ -109,8 +115,6 @@ def atomic_path(path: Path):
     os.close(fd)
     try:
         yield tmp
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
         os.chmod(tmp, _final_mode(path))
         os.replace(tmp, path)
     except BaseException:

@@ -80,10 +80,10 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
     pos = fm.nodes[fm.triangles]
     q = np.matmul(bary, pos).reshape(-1, 3)
-    exact = analytic_distances(fm.surface, q)
+    exact = analytic_distances(fm.surface, np.concatenate([q, fm.nodes]))  # samples and nodes in one call
     if exact is not None:
-        node = analytic_distances(fm.surface, fm.nodes)
-        return exact.reshape(len(pos), len(bary)).max(axis=1), float(node.max(initial=0.0))
+        samples, node = exact[: len(q)], exact[len(q) :]
+        return samples.reshape(len(pos), len(bary)).max(axis=1), float(node.max(initial=0.0))
     ev = FaceSurface(fm.surface) if ev is None else ev
     box = _bounds(fm, ev)
     if np.isnan(fm.uv).any():
