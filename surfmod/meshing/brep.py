@@ -119,11 +119,11 @@ def _estimate(shape, tolerance: float, evaluators: dict | None = None) -> tuple[
     pass), which is kept there by face hash for measuring."""
     from ..occ.mesh import shape_figures
 
-    splines: list = []  # (partials to order 2 on the face's sample grid, UV box area)
+    splines: list = []  # (partials on the face's sample grid, UV box area, its figure to fill)
     sample = None if evaluators is None else partial(_sample_spline, evaluators, splines)
     figures, diag = shape_figures(shape, sample_face=sample)
     if splines:
-        figures = figures + _spline_figures(splines, 1.0 / max(diag, 1e-300))
+        _fill_spline_figures(splines, 1.0 / max(diag, 1e-300))
     ell = max(diag, 1e-300)
     est = sum(2 * a * (np.sqrt(min(k, 1 / tolerance) / (8 * tolerance)) + 1 / ell) ** 2 for a, k in figures)
     return float(est), diag
@@ -131,8 +131,9 @@ def _estimate(shape, tolerance: float, evaluators: dict | None = None) -> tuple[
 
 def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples: int, floor: float):
     """``shape_figures``' ``sample_face`` for B-spline and Bezier faces: their partials on
-    a ``samples`` x ``samples`` grid of the UV box go to ``splines`` (``False``: the face
-    is accounted for here); ``None`` leaves other faces to ``GeomLProp``."""
+    a ``samples`` x ``samples`` grid of the UV box go to ``splines`` with the figure
+    returned, which :func:`_fill_spline_figures` fills in; ``None`` leaves other faces
+    to ``GeomLProp``."""
     from ..occ.geom import surface_type
 
     if surface_type(surf) not in ("Geom_BSplineSurface", "Geom_BezierSurface"):
@@ -140,21 +141,22 @@ def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples:
     ev = evaluators[face.__hash__()] = FaceSurface(surf)
     u0, u1, v0, v1 = bounds
     uu, vv = np.meshgrid(np.linspace(u0, u1, samples), np.linspace(v0, v1, samples), indexing="ij")
-    splines.append((ev.d2(uu.ravel(), vv.ravel()), (u1 - u0) * (v1 - v0)))
-    return False
+    figure = [0.0, floor]
+    splines.append((ev.d2(uu.ravel(), vv.ravel()), (u1 - u0) * (v1 - v0), figure))
+    return figure
 
 
-def _spline_figures(splines: list, floor: float) -> list:
-    """Per face ``(area of the UV box's patch, median sqrt(|k1| |k2|))``, as
-    ``shape_figures`` gives them with ``GeomLProp`` (no curvature where the normal is
-    undefined), for all sampled faces at once."""
-    ders = np.stack([d for d, _ in splines])  # (faces, samples, 3, 3, 3)
-    area = np.linalg.norm(raw_normals(ders), axis=-1).mean(axis=1) * np.array([a for _, a in splines])
+def _fill_spline_figures(splines: list, floor: float) -> None:
+    """Fill each sampled face's figure ``[area of the UV box's patch, median
+    sqrt(|k1| |k2|)]``, as ``shape_figures`` gives it with ``GeomLProp`` (no curvature
+    where the normal is undefined), for all sampled faces at once."""
+    ders = np.stack([d for d, _, _ in splines])  # (faces, samples, 3, 3, 3)
+    area = np.linalg.norm(raw_normals(ders), axis=-1).mean(axis=1) * np.array([a for _, a, _ in splines])
     c = curvatures(ders)
     vals = np.sqrt(np.maximum(np.abs(c.k1), floor) * np.maximum(np.abs(c.k2), floor))
     defined = ~degenerate_mask(ders, 1e-9)
-    median = np.array([float(np.median(v[ok])) if ok.any() else floor for v, ok in zip(vals, defined)])
-    return list(zip(area.tolist(), median.tolist()))
+    for (_, _, figure), a, v, ok in zip(splines, area.tolist(), vals, defined):
+        figure[:] = a, float(np.median(v[ok])) if ok.any() else floor
 
 
 def _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared) -> list[int]:

@@ -470,19 +470,18 @@ def shape_figures(shape, samples: int = 5, sample_face=None):
     from a ``samples`` x ``samples`` grid over the face's UV box (area of the box's patch:
     at least the face's), and the bounding-box diagonal: enough to estimate how many
     triangles a chordal tolerance needs before asking BRepMesh for them.  Planes need
-    no figure (a plane's triangle count does not grow as the tolerance shrinks).
+    no figure (a plane's triangle count does not grow as the tolerance shrinks), and a
+    face that repeats an earlier one at an isometric location (assemblies) repeats its
+    figure without being sampled again.
 
-    ``sample_face(face, surface, (u0, u1, v0, v1), samples, floor)``, when given, is asked first
-    for each curved face and returns its figure, ``None`` to leave the face to
-    ``GeomLProp`` here, or ``False`` when the caller accounts for the face itself (its
-    vectorized evaluator, where ``GeomLProp`` makes several calls per sample)."""
+    ``sample_face(face, surface, (u0, u1, v0, v1), samples, floor)``, when given, is asked
+    first for each curved face and returns its figure (any pair, e.g. a list the caller
+    fills in after this returns, to sample all its faces at once), or ``None`` to leave
+    the face to ``GeomLProp`` here."""
     from OCP.Bnd import Bnd_Box
-    from OCP.BRep import BRep_Tool
     from OCP.BRepBndLib import BRepBndLib
-    from OCP.BRepTools import BRepTools
-    from OCP.GeomLProp import GeomLProp_SLProps
+    from OCP.TopLoc import TopLoc_Location
 
-    from .geom import surface_type
     from .topo import faces_of, wrapped
 
     shp = wrapped(shape)
@@ -495,40 +494,58 @@ def shape_figures(shape, samples: int = 5, sample_face=None):
         diag = float(np.linalg.norm([x1 - x0, y1 - y0, z1 - z0]))
         floor = 1.0 / max(diag, 1e-300)
         figures = []
+        seen: dict = {}  # hash of the unlocated face -> [(unlocated face, its figure)]
         for face in faces_of(shp):
-            surf = basis_surface(BRep_Tool.Surface_s(face))
-            name = surface_type(surf)
-            if name == "Geom_Plane":
-                continue
-            u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
-            figure = sample_face(face, surf, (u0, u1, v0, v1), samples, floor) if sample_face is not None else None
-            if figure is not None:
-                if figure is not False:
-                    figures.append(figure)
-                continue
-            if name in ("Geom_CylindricalSurface", "Geom_SphericalSurface"):
-                # closed forms of what the sampled figures below come to (|Su x Sv|, k1, k2)
-                r = surf.Radius()
-                if name == "Geom_CylindricalSurface":
-                    figures.append((r * (u1 - u0) * (v1 - v0), float(np.sqrt(max(1 / r, floor) * floor))))
-                else:
-                    figures.append((r * r * (u1 - u0) * float(np.mean(np.cos(np.linspace(v0, v1, samples)))) * (v1 - v0),
-                                    max(1 / r, floor)))
-                continue
-            lp = GeomLProp_SLProps(surf, 2, 1e-9)
-            vals, jac = [], []
-            # elementary surfaces are curved alike along u: three columns tell them
-            ns = min(samples, 3) if name in ANALYTIC else samples
-            for uu in np.linspace(u0, u1, ns):
-                for vv in np.linspace(v0, v1, samples):
-                    lp.SetParameters(float(uu), float(vv))
-                    jac.append(lp.D1U().Crossed(lp.D1V()).Magnitude())
-                    if lp.IsCurvatureDefined():
-                        k1, k2 = abs(lp.MaxCurvature()), abs(lp.MinCurvature())
-                        vals.append(np.sqrt(max(k1, floor) * max(k2, floor)))
-            area = float(np.mean(jac)) * (u1 - u0) * (v1 - v0)
-            figures.append((area, float(np.median(vals)) if vals else floor))
+            loc = face.Location()
+            rigid = loc.IsIdentity() or abs(abs(loc.Transformation().ScaleFactor()) - 1.0) < 1e-12
+            bare = face.Located(TopLoc_Location())
+            bucket = seen.setdefault(bare.__hash__(), [])
+            known = next((f for other, f in bucket if other.IsSame(bare)), None) if rigid else None
+            if known is None:
+                known = _face_figure(face, samples, floor, sample_face)
+                if rigid:
+                    bucket.append((bare, known))
+            if known is not False:  # False: a plane
+                figures.append(known)
     return figures, diag
+
+
+def _face_figure(face, samples: int, floor: float, sample_face):
+    """:func:`shape_figures`' figure of one face, or ``False`` for a plane."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepTools import BRepTools
+    from OCP.GeomLProp import GeomLProp_SLProps
+
+    from .geom import surface_type
+
+    surf = basis_surface(BRep_Tool.Surface_s(face))
+    name = surface_type(surf)
+    if name == "Geom_Plane":
+        return False
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+    figure = sample_face(face, surf, (u0, u1, v0, v1), samples, floor) if sample_face is not None else None
+    if figure is not None:
+        return figure
+    if name in ("Geom_CylindricalSurface", "Geom_SphericalSurface"):
+        # closed forms of what the sampled figures below come to (|Su x Sv|, k1, k2)
+        r = surf.Radius()
+        if name == "Geom_CylindricalSurface":
+            return r * (u1 - u0) * (v1 - v0), float(np.sqrt(max(1 / r, floor) * floor))
+        return (r * r * (u1 - u0) * float(np.mean(np.cos(np.linspace(v0, v1, samples)))) * (v1 - v0),
+                max(1 / r, floor))
+    lp = GeomLProp_SLProps(surf, 2, 1e-9)
+    vals, jac = [], []
+    # elementary surfaces are curved alike along u: three columns tell them
+    ns = min(samples, 3) if name in ANALYTIC else samples
+    for uu in np.linspace(u0, u1, ns):
+        for vv in np.linspace(v0, v1, samples):
+            lp.SetParameters(float(uu), float(vv))
+            jac.append(lp.D1U().Crossed(lp.D1V()).Magnitude())
+            if lp.IsCurvatureDefined():
+                k1, k2 = abs(lp.MaxCurvature()), abs(lp.MinCurvature())
+                vals.append(np.sqrt(max(k1, floor) * max(k2, floor)))
+    area = float(np.mean(jac)) * (u1 - u0) * (v1 - v0)
+    return area, float(np.median(vals)) if vals else floor
 
 
 def max_tolerance(shape) -> float:
