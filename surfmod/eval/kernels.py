@@ -14,6 +14,8 @@ Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polyno
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from numba import njit
 
@@ -128,13 +130,19 @@ def quotient_point(h, binom, out):
                 out[k, l, d] = v * inv_w
 
 
+@lru_cache(maxsize=None)
+def _triangle_indices(p: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every ``(j, r)`` with ``0 <= r < j <= p`` (the Cox-de Boor divisors), for one gather."""
+    return np.tril_indices(p + 1, -1)
+
+
 def reciprocal_table(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
     """``inv[span, j, r] = 1 / (knots[span+r+1] - knots[span+r+1-j])`` for the spans of the
     domain (other entries 0): the divisors of the Cox-de Boor triangle.  Every such
     difference spans the non-empty knot interval ``[knots[span], knots[span+1])``."""
     p = degree
     inv = np.zeros((n_ctrl, p + 1, p + 1))
-    j, r = np.tril_indices(p + 1, -1)  # every (j, r) with 0 <= r < j <= p, in one gather
+    j, r = _triangle_indices(p)
     span = np.arange(p, n_ctrl)[:, None]
     diff = knots[span + r + 1] - knots[span + r + 1 - j]
     positive = diff > 0

@@ -68,7 +68,13 @@ class FaceSurface:
         self._swept = None
         if info["bspline"] is not None:
             d = info["bspline"]
-            self._spline = BSplineSurface(d["control_points"], d["degree"], d["knots"], d["weights"])
+            net = np.asarray(d["control_points"], float)
+            if np.isfinite(net).all():
+                # OCCT's Geom_BSplineSurface has validated its knots, multiplicities and
+                # weights; only the poles of a damaged file can be non-finite
+                self._spline = BSplineSurface._trusted(net, d["degree"], d["knots"], d["weights"])
+            else:  # refused with the argument named
+                self._spline = BSplineSurface(net, d["degree"], d["knots"], d["weights"])
         elif info["bezier"] is not None:
             self._spline = BezierSurface(info["bezier"]["control_points"], info["bezier"]["weights"])
         else:
