@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 
 from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface
@@ -50,7 +52,13 @@ def bezier_curve(points, weights=None) -> Geom_BezierCurve:
 def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
     """Poles, weights (None if polynomial), flat knots and degrees of a B-spline surface.
 
-    Periodic surfaces are read through a non-periodic copy (same shape, OCCT converts)."""
+    Periodic surfaces are read through a non-periodic copy (same shape, OCCT converts).
+    OCCT serializes the surface in C++ (``BinTools_SurfaceSet``) and NumPy reads the
+    buffer, where reading pole by pole costs Python calls per pole (the STEP parts'
+    surfaces have hundreds of poles each); a buffer that does not parse as expected is
+    read pole by pole instead."""
+    from OCP.BinTools import BinTools_SurfaceSet
+
     with kernel("reading Geom_BSplineSurface"):
         if surf.IsUPeriodic() or surf.IsVPeriodic():
             surf = surf.Copy()  # OCP returns the derived type (no DownCast in OCP)
@@ -58,10 +66,57 @@ def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
                 surf.SetUNotPeriodic()
             if surf.IsVPeriodic():
                 surf.SetVNotPeriodic()
-        n, m = surf.NbUPoles(), surf.NbVPoles()
-        from OCP.TColgp import TColgp_Array2OfPnt
-        from OCP.TColStd import TColStd_Array1OfReal, TColStd_Array2OfReal
+        table = BinTools_SurfaceSet()
+        table.Add(surf)
+        buffer = io.BytesIO()
+        table.Write(buffer)
+        read = _parse_bspline_surface(buffer.getvalue())
+        return read if read is not None else _read_bspline_surface_by_pole(surf)
 
+
+#: ``(knot, multiplicity)`` records of OCCT's binary format (little-endian, packed)
+_KNOT_RECORD = np.dtype([("knot", "<f8"), ("mult", "<i4")])
+
+
+def _parse_bspline_surface(data: bytes) -> dict | None:
+    """One ``Geom_BSplineSurface`` as ``BinTools_SurfaceSet::Write`` stores it (a
+    ``Surfaces 1`` line, type byte 9, four flag bytes (u/v rational, u/v periodic), the
+    degrees as uint16, the pole and knot counts as int32, the poles row by row each
+    followed by its weight when rational, then (knot, multiplicity) records in u and in
+    v), or ``None`` when the bytes do not follow that layout."""
+    end = data.find(b"\n")
+    if end < 0 or data[:end].split() != [b"Surfaces", b"1"] or len(data) < end + 26 or data[end + 1] != 9:
+        return None
+    pos = end + 2
+    rational = bool(data[pos] or data[pos + 1])
+    p, q = (int(x) for x in np.frombuffer(data, "<u2", 2, pos + 4))
+    n, m, nku, nkv = (int(x) for x in np.frombuffer(data, "<i4", 4, pos + 8))
+    pos += 24
+    dim = 4 if rational else 3
+    if min(n, m, nku, nkv) < 1 or len(data) != pos + 8 * n * m * dim + _KNOT_RECORD.itemsize * (nku + nkv):
+        return None
+    poles = np.frombuffer(data, "<f8", n * m * dim, pos).reshape(n, m, dim)
+    pos += 8 * n * m * dim
+    u = np.frombuffer(data, _KNOT_RECORD, nku, pos)
+    v = np.frombuffer(data, _KNOT_RECORD, nkv, pos + _KNOT_RECORD.itemsize * nku)
+    ku, kv = np.repeat(u["knot"], u["mult"]), np.repeat(v["knot"], v["mult"])
+    if len(ku) != n + p + 1 or len(kv) != m + q + 1:
+        return None
+    return {
+        "control_points": poles[..., :3].astype(float),  # aligned, writable copies
+        "weights": poles[..., 3].astype(float) if rational else None,
+        "knots": (ku.astype(float), kv.astype(float)),
+        "degree": (p, q),
+    }
+
+
+def _read_bspline_surface_by_pole(surf: Geom_BSplineSurface) -> dict:
+    """:func:`read_bspline_surface` through OCCT's per-pole accessors (non-periodic surface)."""
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfReal, TColStd_Array2OfReal
+
+    with kernel("reading Geom_BSplineSurface"):
+        n, m = surf.NbUPoles(), surf.NbVPoles()
         poles = TColgp_Array2OfPnt(1, n, 1, m)
         surf.Poles(poles)
         net = arrays.pnts_to_numpy_2d(poles)
