@@ -14,7 +14,7 @@ Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polyno
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 from numba import njit
@@ -130,7 +130,7 @@ def quotient_point(h, binom, out):
                 out[k, l, d] = v * inv_w
 
 
-@lru_cache(maxsize=None)
+@cache
 def _triangle_indices(p: int) -> tuple[np.ndarray, np.ndarray]:
     """Every ``(j, r)`` with ``0 <= r < j <= p`` (the Cox-de Boor divisors), for one gather."""
     return np.tril_indices(p + 1, -1)

@@ -49,8 +49,10 @@ def writable(t) -> np.ndarray:
     array type for the compiled kernels, so they are compiled once.  The kernels only
     read it; a view from ``np.broadcast_arrays`` is passed as it is (NumPy warns that it
     will turn such views read-only, in which case ``np.require`` copies them)."""
-    if type(t) is np.ndarray and t.dtype == np.float64 and t.ndim == 1 and t.flags.c_contiguous and t.flags.writeable:
-        return t  # the common case, without the cost of catching warnings
+    if type(t) is np.ndarray and t.dtype == np.float64 and t.ndim == 1:
+        flags = t.flags  # own data first: reading .writeable of a broadcast view warns
+        if flags.c_contiguous and flags.owndata and flags.writeable:
+            return t  # the common case, without the cost of catching warnings
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", "future versions will not create a writeable array", FutureWarning)
         return np.require(np.asarray(t, dtype=float).ravel(), float, ["C", "W"])
