@@ -24,6 +24,7 @@ tolerance, and refused only with ``strict=True``.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import replace
 from functools import partial
 
@@ -140,9 +141,10 @@ def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples:
         return None
     ev = evaluators[face.__hash__()] = FaceSurface(surf)
     u0, u1, v0, v1 = bounds
-    uu, vv = np.meshgrid(np.linspace(u0, u1, samples), np.linspace(v0, v1, samples), indexing="ij")
+    t = np.arange(samples) / (samples - 1)
     figure = [0.0, floor]
-    splines.append((ev.d2(uu.ravel(), vv.ravel()), (u1 - u0) * (v1 - v0), figure))
+    uu, vv = np.repeat(u0 + (u1 - u0) * t, samples), np.tile(v0 + (v1 - v0) * t, samples)  # the grid, u-major
+    splines.append((ev.d2(uu, vv), (u1 - u0) * (v1 - v0), figure))
     return figure
 
 
@@ -155,8 +157,13 @@ def _fill_spline_figures(splines: list, floor: float) -> None:
     c = curvatures(ders)
     vals = np.sqrt(np.maximum(np.abs(c.k1), floor) * np.maximum(np.abs(c.k2), floor))
     defined = ~degenerate_mask(ders, 1e-9)
-    for (_, _, figure), a, v, ok in zip(splines, area.tolist(), vals, defined):
-        figure[:] = a, float(np.median(v[ok])) if ok.any() else floor
+    ok = defined.any(axis=1)
+    median = np.full(len(splines), floor)
+    with warnings.catch_warnings():  # faces without any defined curvature stay at the floor
+        warnings.simplefilter("ignore", RuntimeWarning)
+        median[ok] = np.nanmedian(np.where(defined, vals, np.nan)[ok], axis=1)
+    for (_, _, figure), a, k in zip(splines, area.tolist(), median.tolist()):
+        figure[:] = a, k
 
 
 def _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared) -> list[int]:
