@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import checks
 from ..atomic import atomic_path, target_path
-from ..errors import SurfmodError
+from ..errors import KernelError, SurfmodError
 from ..meshing.brep import tessellate_shape
 from .inputs import to_shape
 
@@ -447,7 +447,6 @@ def _triangulation_attempt(shape, msh: Path, size: float, order: int, *, regions
     "volume_bound", "regions" (pieces meshed)}``: every boundary point lies within
     ``max_deviation`` of the part, so the tetrahedra's volume is within ``volume_bound`` =
     area x deviation of the part's."""
-    from ..errors import KernelError
     from ..occ import uses as occ
     from ..occ.regions import material_regions
 
