@@ -37,8 +37,12 @@ class FEMesh:
     * ``SJ`` (gmsh's scaled Jacobian) for ``order=2`` only: a straight-sided element's
       Jacobian is constant, so for linear elements it is 1 and says nothing;
 
-    plus ``quality["surface"]`` when the tetrahedra were made from surfmod's measured
-    triangulation because gmsh could not mesh the B-rep (see :func:`fe_mesh`), and
+    plus, for tetrahedra gmsh made from the B-rep, ``quality["chordal"]``: how far the
+    straight boundary triangles are from the exact faces (``max_deviation``, sampled) and
+    the resulting bound on the tetrahedra's volume error (``volume_bound``, see
+    :func:`_chordal_error`); ``quality["surface"]`` instead when the tetrahedra were made
+    from surfmod's measured triangulation because gmsh could not mesh the B-rep (see
+    :func:`fe_mesh`), and
     ``quality["inverted"]``, the number of elements whose signed volume (tets) is
     not positive (always 0: fe_mesh refuses otherwise), and ``quality["measure"]``, the
     total volume (area for surface meshes) of the elements as gmsh integrates them,
@@ -100,6 +104,10 @@ class FEMesh:
                   "SJ": "scaled Jacobian"}
         lines = [f"FE mesh: {self.n_elements} {self.cell_type} elements, {len(self.points)} nodes, target size "
                  f"{self.size:g}, inverted elements {q['inverted']}"]
+        if "chordal" in q:
+            ch = q["chordal"]
+            lines.append(f"  boundary chord error (sampled, to the exact faces) max {ch['max_deviation']:.3g}; tet volume "
+                         f"{self.volume:.6g} vs the solid's within {ch['volume_bound']:.3g}")
         if "surface" in q:
             sf = q["surface"]
             split = f" of its {sf['regions']} material regions" if sf.get("split") else ""
@@ -224,7 +232,47 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bo
                 raise _GmshFailure("gmsh's healing left no volume")
             raise SurfmodError("kind: a volume mesh needs a closed solid; obj has no solid")
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)
-        return _generate(gmsh, msh, dim, size, order)
+        quality = _generate(gmsh, msh, dim, size, order)
+        if dim == 3:
+            quality["chordal"] = _chordal_error(gmsh)
+        return quality
+
+
+#: A triangle's chord error is sampled at its centroid and edge midpoints; for a sag that
+#: is quadratic over the triangle (any smooth surface, to leading order) the largest value
+#: over the triangle is at most 4/3 of the largest of those samples.
+_SAMPLES = np.array([[1, 1, 1], [1, 1, 0], [0, 1, 1], [1, 0, 1]], float)
+_SAMPLES /= _SAMPLES.sum(axis=1, keepdims=True)
+_SAMPLE_FACTOR = 4.0 / 3.0
+
+
+def _chordal_error(gmsh) -> dict:
+    """How far gmsh's straight boundary triangles (corner nodes) are from the exact
+    faces they mesh: each triangle's distance to its face's surface at the samples
+    (:data:`_SAMPLES`, gmsh's ``getClosestPoint``); returns ``{"max_deviation",
+    "volume_bound"}``, the bound being sum(area x 4/3 x sampled deviation): the
+    straight-sided tetrahedra's volume is the solid's within it."""
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    tags = np.asarray(tags, dtype=np.int64)
+    position = np.zeros((int(tags.max(initial=0)) + 1, 3))
+    position[tags] = np.asarray(coords).reshape(-1, 3)
+    deviation, bound = 0.0, 0.0
+    for _, tag in gmsh.model.getEntities(2):
+        types, _, nodes = gmsh.model.mesh.getElements(2, tag)
+        for etype, enodes in zip(types, nodes):
+            n_nodes = gmsh.model.mesh.getElementProperties(etype)[3]
+            corners = np.asarray(enodes, dtype=np.int64).reshape(-1, n_nodes)[:, :3]
+            if not len(corners):
+                continue
+            t = position[corners]
+            samples = np.einsum("sk,tkd->tsd", _SAMPLES, t).reshape(-1, 3)
+            closest, _ = gmsh.model.getClosestPoint(2, tag, samples.ravel())
+            dist = np.linalg.norm(np.asarray(closest).reshape(-1, 3) - samples, axis=1).reshape(len(t), -1)
+            per_triangle = _SAMPLE_FACTOR * dist.max(axis=1)
+            area = np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1) / 2
+            deviation = max(deviation, float(per_triangle.max()))
+            bound += float(area @ per_triangle)
+    return {"max_deviation": deviation, "volume_bound": bound}
 
 
 def _generate(gmsh, msh: Path, dim: int, size: float, order: int) -> dict:
