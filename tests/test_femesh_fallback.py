@@ -83,11 +83,12 @@ def test_material_regions_drop_the_void():
 @pytest.mark.corpus
 def test_11752_meshes_from_its_material_regions(tmp_path):
     """pythonocc_11752.stp: gmsh cannot mesh its B-rep (ninety 1147 mm long holes of
-    radius 1.08 mm: at the size floor of size/10 a hole gets three nodes around and its
-    facets overlap).  Its measured triangulation crosses itself: the solid has two void
-    shells (blind bores, 3 faces each) whose rim circles lie on the outer shell, where a
-    boss is attached by that same circle only, and the bore's circle edge and the outer
-    shell's are distinct edges discretized apart.  Split into its material regions (body
+    radius 1.08 mm: surface 194 gets 82 triangles, the size floor size/10 = 8.6 mm
+    exceeding its 6.8 mm circumference, and its facets overlap).  Its measured
+    triangulation crosses itself: the solid has two void shells (blind bores, 3 faces
+    each) whose rim circles lie on the outer shell, where a boss is attached by that same
+    circle only, and the bore's circle edge and the outer shell's are distinct edges
+    discretized apart.  Split into its material regions (body
     and two bosses, sharing their circle edges), it meshes with no inverted tetrahedron,
     and the tetrahedra's volume is BRepGProp's within the triangulation's bound."""
     from conftest import CORPUS
@@ -104,10 +105,9 @@ def test_11752_meshes_from_its_material_regions(tmp_path):
     volumes = sorted(gprops(r)["volume"] for r in regions)
     assert len(regions) == 3 and volumes[0] == pytest.approx(volumes[1], rel=1e-12)
     assert sum(volumes) == pytest.approx(gprops(solid)["volume"], rel=1e-9)
-    quality, surface = femesh._triangulation_attempt(shape, tmp_path / "part.msh", 86.4, 1, regions=True)
-    assert surface["regions"] == 3 and quality["SICN"]["min"] > 0
     fe = sm.fe_mesh(CORPUS / "pythonocc_11752.stp", size=86.4)
-    assert fe.quality["surface"]["split"] and fe.quality["inverted"] == 0
+    assert fe.quality["surface"]["split"] and fe.quality["surface"]["regions"] == 3
+    assert fe.quality["inverted"] == 0 and fe.quality["SICN"]["min"] > 0
     assert np.all(femesh.signed_volumes(fe.points, fe.cells) > 0)
     assert abs(fe.volume - gprops(solid)["volume"]) <= fe.quality["surface"]["volume_bound"]
     assert "of its 3 material regions" in str(fe)
