@@ -80,6 +80,43 @@ def test_material_regions_drop_the_void():
     assert len(regions) == 1 and gprops(regions[0])["volume"] == pytest.approx(56.0, rel=1e-12)
 
 
+def _boss_on_a_bore():
+    """The shape of pythonocc_11752.stp's defect, small: a box with a boss below, and a
+    void shell (a blind bore above the boss) whose rim circle lies on the outer shell,
+    where the boss meets the box, without sharing an edge with it.  The boss is joined to
+    the box by that circle only; volume 64 (box) + pi (boss) - pi (bore)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Solid
+
+    from surfmod.occ.uses import shells_of
+
+    centre = (bd.Align.CENTER, bd.Align.CENTER)
+    outer = bd.Box(4, 4, 4, align=(*centre, bd.Align.MIN)) + bd.Cylinder(1, 1, align=(*centre, bd.Align.MAX))
+    bore = bd.Cylinder(1, 1, align=(*centre, bd.Align.MIN))
+    builder, solid = BRep_Builder(), TopoDS_Solid()
+    builder.MakeSolid(solid)
+    builder.Add(solid, shells_of(outer.wrapped)[0])
+    builder.Add(solid, shells_of(bore.wrapped)[0].Reversed())
+    return solid
+
+
+def test_solid_touching_itself_meshes_from_its_material_regions():
+    from surfmod.occ.regions import material_regions
+    from surfmod.occ.uses import gprops
+
+    solid = _boss_on_a_bore()
+    assert gprops(solid)["volume"] == pytest.approx(64.0, rel=1e-12)
+    regions = sorted(gprops(r)["volume"] for r in material_regions(solid))
+    assert regions == pytest.approx([math.pi, 64.0 - math.pi], rel=1e-9)  # the boss, the box with its bore
+    fe = sm.fe_mesh(solid, size=0.5)
+    surface = fe.quality["surface"]
+    assert surface["split"] and surface["regions"] == 2
+    assert np.all(femesh.signed_volumes(fe.points, fe.cells) > 0) and fe.quality["SICN"]["min"] > 0
+    # the bore stays empty and the boss is filled: the tets hold the solid's volume
+    assert abs(fe.volume - 64.0) <= surface["volume_bound"] and abs(fe.volume - 64.0) < 0.1
+    assert "of its 2 material regions" in str(fe)
+
+
 @pytest.mark.corpus
 def test_11752_meshes_from_its_material_regions(tmp_path):
     """pythonocc_11752.stp: gmsh cannot mesh its B-rep (ninety 1147 mm long holes of
