@@ -115,7 +115,8 @@ class FEMesh:
                          f"(gmsh could not mesh the B-rep; max deviation {sf['max_deviation']:.3g}, tet volume "
                          f"{self.volume:.6g} vs BRepGProp {sf['reference_volume']:.6g}, bound {sf['volume_bound']:.3g})")
         for name in names:
-            lines.append(f"  {labels[name]:<28s} min {q[name]['min']:.3f} mean {q[name]['mean']:.3f}")
+            # 3 significant digits: a sliver's 2e-5 must not print as 0.000
+            lines.append(f"  {labels[name]:<28s} min {q[name]['min']:.3g} mean {q[name]['mean']:.3g}")
         return "\n".join(lines)
 
 
