@@ -158,9 +158,9 @@ def test_two_solid_assembly_has_no_inverted_tet():
     from surfmod.occ.uses import gprops
 
     path = CORPUS / "cadquery_red_cube_blue_cylinder.step"
-    _, vol = _corpus_fe_mesh(path)
-    # the tets fill both solids: their volume is within 2 % of BRepGProp's
-    assert vol.sum() == pytest.approx(gprops(sm.import_step(path).wrapped)["volume"], rel=0.02)
+    m, vol = _corpus_fe_mesh(path)
+    # the tets fill both solids: their volume is BRepGProp's within the boundary's chord bound
+    assert abs(vol.sum() - gprops(sm.import_step(path).wrapped)["volume"]) <= m.quality["chordal"]["volume_bound"]
 
 
 @pytest.mark.corpus
@@ -177,3 +177,7 @@ def test_no_inverted_tet_on_any_corpus_solid(corpus_file):
     assert abs(vol.sum() - reference) <= bound
     if "surface" in m.quality:
         assert m.quality["surface"]["reference_volume"] == pytest.approx(reference, rel=1e-12)
+        # only 11752 gets here: its triangulation crosses itself, its material regions do not
+        # (tests/test_femesh_fallback.py::test_11752_meshes_from_its_material_regions)
+        assert m.quality["surface"]["split"] and m.quality["surface"]["regions"] == 3
+        assert "of its 3 material regions" in str(m)
