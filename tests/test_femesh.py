@@ -20,6 +20,20 @@ def test_box_tetra_volume_exact():
     assert m.quality["SICN"]["min"] > 0 and m.quality["inverted"] == 0
     assert "tetra elements" in str(m) and "Jacobian" not in str(m)  # always 1 for linear tets
     assert "SJ" not in m.quality
+    # planar faces: the boundary triangles lie on them
+    assert m.quality["chordal"]["max_deviation"] < 1e-12
+
+
+@pytest.mark.parametrize("part, exact", [(bd.Cylinder(1.0, 2.0), 2 * math.pi), (bd.Sphere(1.0), 4 / 3 * math.pi)])
+def test_chordal_bound_holds_and_is_tight(part, exact):
+    """Convex parts: the inscribed tetrahedra hold less than the solid, by no more than
+    the chord bound and by at least a third of it (the bound says something)."""
+    m = sm.fe_mesh(part, size=0.3)
+    chordal = m.quality["chordal"]
+    assert chordal["volume_bound"] / 3 < exact - m.volume <= chordal["volume_bound"]
+    # the largest sag of a chord of length h on a unit circle is h^2 / 8 at most
+    assert 0 < chordal["max_deviation"] < 0.3**2
+    assert "boundary chord error" in str(m)
 
 
 def test_quality_measures_agree_with_their_definitions():
@@ -144,22 +158,26 @@ def test_two_solid_assembly_has_no_inverted_tet():
     from surfmod.occ.uses import gprops
 
     path = CORPUS / "cadquery_red_cube_blue_cylinder.step"
-    _, vol = _corpus_fe_mesh(path)
-    # the tets fill both solids: their volume is within 2 % of BRepGProp's
-    assert vol.sum() == pytest.approx(gprops(sm.import_step(path).wrapped)["volume"], rel=0.02)
-
-
-#: corpus parts gmsh cannot volume-mesh as read nor healed (tried: gmsh's OCC healing
-#: with and without sewing, 2-D algorithms MeshAdapt, Delaunay, Frontal-Delaunay): each
-#: gives "Invalid boundary mesh (overlapping facets)" on some of its 1018 faces
-GMSH_CANNOT = {"pythonocc_11752.stp"}
+    m, vol = _corpus_fe_mesh(path)
+    # the tets fill both solids: their volume is BRepGProp's within the boundary's chord bound
+    assert abs(vol.sum() - gprops(sm.import_step(path).wrapped)["volume"]) <= m.quality["chordal"]["volume_bound"]
 
 
 @pytest.mark.corpus
 def test_no_inverted_tet_on_any_corpus_solid(corpus_file):
-    if corpus_file.name in GMSH_CANNOT:
-        with pytest.raises(sm.SurfmodError, match=f"{corpus_file.name}: gmsh cannot volume-mesh .*overlapping facets"
-                                                  r".* on surface \d+"):
-            _corpus_fe_mesh(corpus_file)
-        return
-    _corpus_fe_mesh(corpus_file)
+    """Every corpus part volume-meshes with no inverted tetrahedron, and the tetrahedra
+    fill the solids: their volume is BRepGProp's within the chordal error of their
+    boundary: the measured triangulation's bound where fe_mesh filled a triangulation
+    (pythonocc_11752.stp), the sampled chord bound where gmsh meshed the B-rep."""
+    from surfmod.occ.uses import gprops, solids_of
+
+    m, vol = _corpus_fe_mesh(corpus_file)
+    reference = sum(abs(gprops(s)["volume"]) for s in solids_of(sm.import_step(corpus_file).wrapped))
+    bound = m.quality["surface" if "surface" in m.quality else "chordal"]["volume_bound"]
+    assert abs(vol.sum() - reference) <= bound
+    if "surface" in m.quality:
+        assert m.quality["surface"]["reference_volume"] == pytest.approx(reference, rel=1e-12)
+        # only 11752 gets here: its triangulation crosses itself, its material regions do not
+        # (tests/test_femesh_fallback.py::test_11752_meshes_from_its_material_regions)
+        assert m.quality["surface"]["split"] and m.quality["surface"]["regions"] == 3
+        assert "of its 3 material regions" in str(m)

@@ -53,15 +53,93 @@ def test_cli_reports_the_fallback(brep_fails, tmp_path, capsys):
     assert "meshed from the measured surface triangulation" in capsys.readouterr().out and out.exists()
 
 
+def test_void_stays_empty(brep_fails):
+    """A solid with an inner void shell: the triangulation's void shell is a hole of the
+    volume, so the tetrahedra hold the box minus the void exactly (planar faces)."""
+    fe = sm.fe_mesh(bd.Box(4, 4, 4) - bd.Box(2, 2, 2), size=1.0)
+    assert fe.volume == pytest.approx(56.0, rel=1e-13)
+    assert fe.quality["surface"]["split"] is False
+    assert np.all(femesh.signed_volumes(fe.points, fe.cells) > 0)
+
+
+def test_shells_of_a_hollow_triangulation():
+    from surfmod.meshing.brep import tessellate_shape
+
+    mesh = tessellate_shape((bd.Box(4, 4, 4) - bd.Box(2, 2, 2)).wrapped, 0.01)
+    shells = femesh.shells_of_triangulation(mesh.vertices, mesh.triangles())
+    assert [round(volume, 12) for _, volume in shells] == [64.0, -8.0]
+    assert sum(len(tris) for tris, _ in shells) == len(mesh.triangles())
+
+
+def test_material_regions_drop_the_void():
+    from surfmod.occ.regions import material_regions
+    from surfmod.occ.uses import gprops
+
+    hollow = (bd.Box(4, 4, 4) - bd.Box(2, 2, 2)).wrapped
+    regions = material_regions(hollow)
+    assert len(regions) == 1 and gprops(regions[0])["volume"] == pytest.approx(56.0, rel=1e-12)
+
+
+def _boss_on_a_bore():
+    """The shape of pythonocc_11752.stp's defect, small: a box with a boss below, and a
+    void shell (a blind bore above the boss) whose rim circle lies on the outer shell,
+    where the boss meets the box, without sharing an edge with it.  The boss is joined to
+    the box by that circle only; volume 64 (box) + pi (boss) - pi (bore)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Solid
+
+    from surfmod.occ.uses import shells_of
+
+    centre = (bd.Align.CENTER, bd.Align.CENTER)
+    outer = bd.Box(4, 4, 4, align=(*centre, bd.Align.MIN)) + bd.Cylinder(1, 1, align=(*centre, bd.Align.MAX))
+    bore = bd.Cylinder(1, 1, align=(*centre, bd.Align.MIN))
+    builder, solid = BRep_Builder(), TopoDS_Solid()
+    builder.MakeSolid(solid)
+    builder.Add(solid, shells_of(outer.wrapped)[0])
+    builder.Add(solid, shells_of(bore.wrapped)[0].Reversed())
+    return solid
+
+
+def test_solid_touching_itself_meshes_from_its_material_regions():
+    from surfmod.occ.regions import material_regions
+    from surfmod.occ.uses import gprops
+
+    solid = _boss_on_a_bore()
+    assert gprops(solid)["volume"] == pytest.approx(64.0, rel=1e-12)
+    regions = sorted(gprops(r)["volume"] for r in material_regions(solid))
+    assert regions == pytest.approx([math.pi, 64.0 - math.pi], rel=1e-9)  # the boss, the box with its bore
+    fe = sm.fe_mesh(solid, size=0.5)
+    surface = fe.quality["surface"]
+    assert surface["split"] and surface["regions"] == 2
+    assert np.all(femesh.signed_volumes(fe.points, fe.cells) > 0) and fe.quality["SICN"]["min"] > 0
+    # the bore stays empty and the boss is filled: the tets hold the solid's volume
+    assert abs(fe.volume - 64.0) <= surface["volume_bound"] and abs(fe.volume - 64.0) < 0.1
+    assert "of its 2 material regions" in str(fe)
+
+
 @pytest.mark.corpus
-def test_11752_triangulation_crosses_itself(tmp_path):
-    """pythonocc_11752.stp: gmsh cannot mesh its B-rep (overlapping facets), and the
-    fallback cannot either: its measured triangulation, watertight with 0 admesh repairs,
-    still has a triangle edge crossing another face's triangle (tangent B-spline/torus
-    blends whose chords cross), which gmsh's boundary recovery rejects.  The fallback
-    reports that instead of meshing a self-intersecting boundary."""
+def test_11752_meshes_from_its_material_regions(tmp_path):
+    """pythonocc_11752.stp: gmsh cannot mesh its B-rep (ninety 1147 mm long holes of
+    radius 1.08 mm: surface 194 gets 82 triangles, the size floor size/10 = 8.6 mm
+    exceeding its 6.8 mm circumference, and its facets overlap).  Its measured
+    triangulation crosses itself: the solid has two void shells (blind bores, 3 faces
+    each) whose rim circles lie on the outer shell, where a boss is attached by that same
+    circle only, and the bore's circle edge and the outer shell's are distinct edges
+    discretized apart.  Split into its material regions (body and two bosses, sharing
+    their circle edges, volumes adding up to BRepGProp's), it meshes."""
     from conftest import CORPUS
 
+    from surfmod.occ.regions import material_regions
+    from surfmod.occ.uses import gprops, shells_of, solids_of
+
     shape = sm.import_step(CORPUS / "pythonocc_11752.stp").wrapped
+    (solid,) = solids_of(shape)
+    assert len(shells_of(solid)) == 3
     with pytest.raises(femesh._GmshFailure, match="segment and a facet intersect"):
-        femesh._triangulation_attempt(shape, tmp_path / "part.msh", 40.0, 1)
+        femesh._triangulation_attempt(shape, tmp_path / "part.msh", 86.4, 1)
+    regions = material_regions(solid)
+    volumes = sorted(gprops(r)["volume"] for r in regions)
+    assert len(regions) == 3 and volumes[0] == pytest.approx(volumes[1], rel=1e-12)
+    assert sum(volumes) == pytest.approx(gprops(solid)["volume"], rel=1e-9)
+    # fe_mesh's own result on this part (its 3 regions meshed, no inverted tet, volume
+    # within the bound) is checked by the corpus sweep in test_femesh.py

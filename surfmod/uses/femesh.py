@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import checks
 from ..atomic import atomic_path, target_path
-from ..errors import SurfmodError
+from ..errors import KernelError, SurfmodError
 from ..meshing.brep import tessellate_shape
 from .inputs import to_shape
 
@@ -37,8 +37,13 @@ class FEMesh:
     * ``SJ`` (gmsh's scaled Jacobian) for ``order=2`` only: a straight-sided element's
       Jacobian is constant, so for linear elements it is 1 and says nothing;
 
-    plus ``quality["surface"]`` when the tetrahedra were made from surfmod's measured
-    triangulation because gmsh could not mesh the B-rep (see :func:`fe_mesh`), and
+    plus, for tetrahedra gmsh made from the B-rep, ``quality["chordal"]``: how far the
+    straight boundary triangles are from the exact faces (``max_deviation``, from their
+    edge midpoints) and
+    the resulting bound on the tetrahedra's volume error (``volume_bound``, see
+    :func:`_chordal_error`); ``quality["surface"]`` instead when the tetrahedra were made
+    from surfmod's measured triangulation because gmsh could not mesh the B-rep (see
+    :func:`fe_mesh`), and
     ``quality["inverted"]``, the number of elements whose signed volume (tets) is
     not positive (always 0: fe_mesh refuses otherwise), and ``quality["measure"]``, the
     total volume (area for surface meshes) of the elements as gmsh integrates them,
@@ -100,13 +105,19 @@ class FEMesh:
                   "SJ": "scaled Jacobian"}
         lines = [f"FE mesh: {self.n_elements} {self.cell_type} elements, {len(self.points)} nodes, target size "
                  f"{self.size:g}, inverted elements {q['inverted']}"]
+        if "chordal" in q:
+            ch = q["chordal"]
+            lines.append(f"  boundary chord error (edge midpoints to the exact faces, x4/3) max {ch['max_deviation']:.3g}; tet volume "
+                         f"{self.volume:.6g} vs the solid's within {ch['volume_bound']:.3g}")
         if "surface" in q:
             sf = q["surface"]
-            lines.append(f"  meshed from the measured surface triangulation at tolerance {sf['tolerance']:.3g} "
+            split = f" of its {sf['regions']} material regions" if sf.get("split") else ""
+            lines.append(f"  meshed from the measured surface triangulation{split} at tolerance {sf['tolerance']:.3g} "
                          f"(gmsh could not mesh the B-rep; max deviation {sf['max_deviation']:.3g}, tet volume "
                          f"{self.volume:.6g} vs BRepGProp {sf['reference_volume']:.6g}, bound {sf['volume_bound']:.3g})")
         for name in names:
-            lines.append(f"  {labels[name]:<28s} min {q[name]['min']:.3f} mean {q[name]['mean']:.3f}")
+            # 3 significant digits: a sliver's 2e-5 must not print as 0.000
+            lines.append(f"  {labels[name]:<28s} min {q[name]['min']:.3g} mean {q[name]['mean']:.3g}")
         return "\n".join(lines)
 
 
@@ -223,7 +234,49 @@ def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bo
                 raise _GmshFailure("gmsh's healing left no volume")
             raise SurfmodError("kind: a volume mesh needs a closed solid; obj has no solid")
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)
-        return _generate(gmsh, msh, dim, size, order)
+        quality = _generate(gmsh, msh, dim, size, order)
+        if dim == 3:
+            quality["chordal"] = _chordal_error(gmsh)
+        return quality
+
+
+#: A triangle's chord error is sampled at its edge midpoints: for a sag that is quadratic
+#: over the triangle (any smooth surface, to leading order) and zero at the corners,
+#: ``sum c_ij b_i b_j``, the midpoints give ``c_ij / 4`` and the largest value over the
+#: triangle is at most ``max|c_ij| / 3``, 4/3 of the largest midpoint sample.
+_SAMPLE_FACTOR = 4.0 / 3.0
+
+
+def _chordal_error(gmsh) -> dict:
+    """How far gmsh's straight boundary triangles (corner nodes) are from the exact
+    faces they mesh: the distance of each edge midpoint to its face's surface (gmsh's
+    ``getClosestPoint``, once per edge of each face), times 4/3 for the triangle (see
+    :data:`_SAMPLE_FACTOR`).  Returns ``{"max_deviation", "volume_bound"}``, the bound
+    being sum(area x deviation): the straight-sided tetrahedra's volume is the solid's
+    within it."""
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    tags = np.asarray(tags, dtype=np.int64)
+    position = np.zeros((int(tags.max(initial=0)) + 1, 3))
+    position[tags] = np.asarray(coords).reshape(-1, 3)
+    deviation, bound = 0.0, 0.0
+    for _, tag in gmsh.model.getEntities(2):
+        types, _, nodes = gmsh.model.mesh.getElements(2, tag)
+        for etype, enodes in zip(types, nodes):
+            n_nodes = gmsh.model.mesh.getElementProperties(etype)[3]
+            corners = np.asarray(enodes, dtype=np.int64).reshape(-1, n_nodes)[:, :3]
+            if not len(corners):
+                continue
+            edges = np.sort(np.stack([corners, np.roll(corners, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
+            unique, which = np.unique(edges, axis=0, return_inverse=True)
+            middle = position[unique].mean(axis=1)
+            closest, _ = gmsh.model.getClosestPoint(2, tag, middle.ravel())
+            sag = np.linalg.norm(np.asarray(closest).reshape(-1, 3) - middle, axis=1)
+            per_triangle = _SAMPLE_FACTOR * sag[which.reshape(-1)].reshape(-1, 3).max(axis=1)
+            t = position[corners]
+            area = np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1) / 2
+            deviation = max(deviation, float(per_triangle.max()))
+            bound += float(area @ per_triangle)
+    return {"max_deviation": deviation, "volume_bound": bound}
 
 
 def _generate(gmsh, msh: Path, dim: int, size: float, order: int) -> dict:
@@ -249,21 +302,62 @@ def _generate(gmsh, msh: Path, dim: int, size: float, order: int) -> dict:
     return quality
 
 
+def shells_of_triangulation(vertices: np.ndarray, triangles: np.ndarray) -> list:
+    """The closed shells of a solid's triangulation: its vertex-connected components, each
+    as ``(triangles (T, 3), signed volume)``, the outer shells (positive volume, the
+    triangles facing outwards) before the voids (negative), larger first.
+
+    >>> import trimesh
+    >>> outer, inner = trimesh.creation.box((4, 4, 4)), trimesh.creation.box((2, 2, 2))
+    >>> v = np.vstack([outer.vertices, inner.vertices])
+    >>> t = np.vstack([outer.faces, inner.faces[:, ::-1] + len(outer.vertices)])  # a void
+    >>> [(len(tris), round(vol, 9)) for tris, vol in shells_of_triangulation(v, t)]
+    [(12, 64.0), (12, -8.0)]
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    triangles = np.asarray(triangles)
+    n = len(vertices)
+    # vertices joined along each triangle's edges: one component per shell
+    rows, cols = triangles.ravel(), np.roll(triangles, 1, axis=1).ravel()
+    _, label = connected_components(coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n)), directed=False)
+    shells = []
+    for comp in np.unique(label[triangles[:, 0]]):
+        tris = triangles[label[triangles[:, 0]] == comp]
+        t = np.asarray(vertices, float)[tris]
+        volume = float(np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])).sum() / 6)
+        shells.append((tris, volume))
+    return sorted(shells, key=lambda shell: -shell[1])
+
+
 def _run_gmsh_triangulation(surfaces, msh: Path, size: float, order: int) -> dict:
     """Tetrahedra inside closed triangulations: ``surfaces`` is a list of ``(vertices
-    (V, 3), triangles (T, 3))``, one closed surface per solid.  Each becomes a gmsh
-    discrete surface whose triangles are kept as the boundary mesh, bounding a volume of
-    its own; the interior is meshed at ``size``."""
+    (V, 3), triangles (T, 3))``, one closed triangulation per solid.  Each of its shells
+    becomes a gmsh discrete surface whose triangles are kept as the boundary mesh; each
+    outer shell bounds a volume of its own, with the void shells inside it as holes (a
+    void is not filled); the interior is meshed at ``size``."""
     with _gmsh_model("surfmod-triangulation") as gmsh:
         first = 1
         for vertices, triangles in surfaces:
-            surface = gmsh.model.addDiscreteEntity(2)
-            tags = np.arange(first, first + len(vertices))
-            gmsh.model.mesh.addNodes(2, surface, tags, np.asarray(vertices, float).ravel())
-            gmsh.model.mesh.addElementsByType(surface, 2, [], (np.asarray(triangles) + first).ravel())
+            vertices = np.asarray(vertices, float)
+            volumes = []  # (outer surface, its box, its void surfaces)
+            for tris, volume in shells_of_triangulation(vertices, triangles):
+                surface = gmsh.model.addDiscreteEntity(2)
+                used = np.unique(tris)
+                gmsh.model.mesh.addNodes(2, surface, used + first, vertices[used].ravel())
+                gmsh.model.mesh.addElementsByType(surface, 2, [], (tris + first).ravel())
+                box = (vertices[used].min(axis=0), vertices[used].max(axis=0))
+                if volume > 0 or not volumes:
+                    volumes.append((surface, box, []))
+                    continue
+                # a void goes into the smallest outer shell whose box holds its box
+                holders = [v for v in volumes if np.all(v[1][0] <= box[0]) and np.all(box[1] <= v[1][1])]
+                min(holders or volumes, key=lambda v: float(np.prod(v[1][1] - v[1][0])))[2].append(surface)
             first += len(vertices)
-            loop = gmsh.model.geo.addSurfaceLoop([surface])
-            gmsh.model.geo.addVolume([loop])
+            for surface, _box, voids in volumes:
+                loops = [gmsh.model.geo.addSurfaceLoop([s]) for s in [surface, *voids]]
+                gmsh.model.geo.addVolume(loops)
         gmsh.model.geo.synchronize()
         return _generate(gmsh, msh, 3, size, order)
 
@@ -288,14 +382,19 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     volume it still cannot mesh is meshed from surfmod's watertight triangulation of
     each solid, measured against the exact faces at ``min(1e-3 x diagonal, size / 4)``
     (``surfmod mesh``'s STL): its triangles are kept as the boundary and gmsh fills the
-    inside; the tetrahedra's volume must equal BRepGProp's within area x measured
-    deviation, and the result says so (``quality["surface"]``, printed).  A part none of
+    inside (void shells stay empty); the tetrahedra's volume must equal BRepGProp's within
+    area x measured deviation, and the result says so (``quality["surface"]``, printed).
+    Where that triangulation crosses itself (a solid whose shells touch along a curve
+    without sharing an edge there, as a void whose rim lies on the outer shell), each
+    solid is split into its material regions (:func:`surfmod.occ.regions.material_regions`,
+    OCCT's ``BOPAlgo_MakerVolume``), whose boundaries share their contact edges, and those
+    are triangulated and filled (``quality["surface"]["split"]``).  A part none of
     these can mesh raises ``SurfmodError`` naming the file and gmsh's reasons.
     Every tetrahedron's signed volume is checked: an inverted element is an error, never
     a result.  With ``path`` the mesh is also written (``.msh``, ``.vtu``, ``.inp``).  Meshes estimated
     (from the bounding box and ``size``) above ``max_elements`` elements are refused
     before gmsh runs; raise ``max_elements`` to allow them.  ``progress`` shows a tqdm bar
-    over the attempts (as read, healed) and the element checks.
+    over the attempts (:data:`ATTEMPTS`) and the element checks.
 
     >>> import surfmod as sm, build123d as bd
     >>> m = sm.fe_mesh(bd.Box(2, 2, 2), size=1.0)
@@ -333,38 +432,39 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
             tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:
         brep, msh = Path(tmp) / "part.brep", Path(tmp) / "part.msh"
         occ.write_brep(shape, brep)
-        # as read, healed by gmsh, then (volumes) from surfmod's measured closed triangulation
-        attempts = (False, True, None) if kind == "volume" else (False, True)
-        for heal in attempts:
-            bar.set_postfix_str({False: "gmsh", True: "gmsh, healed", None: "triangulation"}[heal])
+        # as read, healed by gmsh, then (volumes) from surfmod's measured closed
+        # triangulation, of each solid and then of each solid's material regions
+        attempts = ATTEMPTS[kind]
+        for attempt in attempts:
+            bar.set_postfix_str(attempt)
             try:
-                if heal is None:
-                    quality, surface = _triangulation_attempt(shape, msh, size, order)
+                if attempt in ("triangulation", "regions"):
+                    quality, surface = _triangulation_attempt(shape, msh, size, order, regions=attempt == "regions")
                 else:
-                    quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order, heal)
+                    quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order, attempt == "healed")
             except _GmshFailure as exc:
-                failures.append(str(exc))
+                failures.append(f"{attempt}: {exc}")
                 continue
             bar.update()
             full = meshio.read(msh, file_format="gmsh")
             points, data = _cells_of(full, cell)
             inverted = int(np.sum(signed_volumes(points, data) <= 0)) if kind == "volume" else 0
             if inverted:
-                failures.append(f"{inverted} inverted tetrahedra")
+                failures.append(f"{attempt}: {inverted} inverted tetrahedra")
                 continue
-            if heal is None:
+            if attempt in ("triangulation", "regions"):
                 miss = abs(float(signed_volumes(points, data).sum()) - surface["reference_volume"])
                 if miss > surface["volume_bound"]:
-                    failures.append(f"the tetrahedra from the triangulation hold {miss:.3g} more or less than "
+                    failures.append(f"{attempt}: the tetrahedra hold {miss:.3g} more or less than "
                                     f"BRepGProp's volume, beyond the triangulation's bound {surface['volume_bound']:.3g}")
                     continue
-                quality["surface"] = surface
+                quality["surface"] = surface | {"split": attempt == "regions"}
             bar.update()
             break
         else:
-            tried = "as read, healed or from its measured surface triangulation" if kind == "volume" else "as read or healed"
+            tried = ", ".join(attempts[:-1]) + " or " + attempts[-1]
             raise SurfmodError(
-                f"{_part_name(obj)}: gmsh cannot {kind}-mesh it at size {size:g}, {tried} "
+                f"{_part_name(obj)}: gmsh cannot {kind}-mesh it at size {size:g}, tried {tried} "
                 f"({'; '.join(dict.fromkeys(failures))})"
             )
     quality["inverted"] = 0
@@ -376,37 +476,55 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     return result
 
 
+#: What fe_mesh tries, in order: gmsh on the B-rep as read, then healed by gmsh's OCC
+#: healing (:data:`HEALING`); for volumes, gmsh filling surfmod's measured triangulation of
+#: each solid, then of each solid's material regions (:func:`surfmod.occ.regions.material_regions`:
+#: a solid whose shells touch along a curve without sharing an edge there has triangles
+#: crossing at that curve, which gmsh's boundary recovery rejects).
+ATTEMPTS = {"volume": ("as read", "healed", "triangulation", "regions"), "surface": ("as read", "healed")}
+
 #: The fallback triangulation's chordal tolerance, as a share of the bounding-box diagonal
 #: (the STL standard of ``surfmod mesh``), and at most this share of the element size.
 TRIANGULATION_SHARE = 1e-3
 TRIANGULATION_SIZE_SHARE = 0.25
 
 
-def _triangulation_attempt(shape, msh: Path, size: float, order: int):
+def _triangulation_attempt(shape, msh: Path, size: float, order: int, *, regions: bool = False):
     """Volume-mesh every solid of ``shape`` from its watertight triangulation, measured
     against the exact faces (:func:`surfmod.meshing.brep.tessellate_shape`), for parts
-    whose B-rep gmsh cannot mesh.  Returns gmsh's qualities and what the boundary is:
-    ``{"tolerance", "max_deviation", "reference_volume" (BRepGProp), "volume_bound"}``:
-    every boundary point lies within ``max_deviation`` of the part, so the tetrahedra's
-    volume is within ``volume_bound`` = area x deviation of the part's."""
+    whose B-rep gmsh cannot mesh; with ``regions`` each solid is first split into its
+    material regions (:func:`surfmod.occ.regions.material_regions`), each triangulated and
+    filled on its own.  Returns gmsh's qualities and what the boundary is:
+    ``{"tolerance", "max_deviation", "reference_volume" (BRepGProp of the solids),
+    "volume_bound", "regions" (pieces meshed)}``: every boundary point lies within
+    ``max_deviation`` of the part, so the tetrahedra's volume is within ``volume_bound`` =
+    area x deviation of the part's."""
     from ..occ import uses as occ
+    from ..occ.regions import material_regions
 
     box = occ.bounding_box(shape)
     tolerance = min(TRIANGULATION_SHARE * float(np.linalg.norm(box[1] - box[0])), TRIANGULATION_SIZE_SHARE * size)
-    surfaces, deviation, bound, reference = [], 0.0, 0.0, 0.0
-    for solid in occ.solids_of(shape):
+    solids = occ.solids_of(shape)
+    reference = sum(abs(occ.gprops(solid)["volume"]) for solid in solids)
+    pieces = solids
+    if regions:
         try:
-            mesh = tessellate_shape(solid, tolerance)
+            pieces = [region for solid in solids for region in material_regions(solid)]
+        except KernelError as exc:
+            raise _GmshFailure(f"no material regions: {exc}") from None
+    surfaces, deviation, bound = [], 0.0, 0.0
+    for piece in pieces:
+        try:
+            mesh = tessellate_shape(piece, tolerance)
         except SurfmodError as exc:
             raise _GmshFailure(f"no measured triangulation: {exc}") from None
         surfaces.append((mesh.vertices, mesh.triangles()))
         dev = max(float(mesh.info["max_deviation"]), tolerance)
         deviation = max(deviation, dev)
         bound += mesh.area * dev
-        reference += abs(occ.gprops(solid)["volume"])
     quality = _run_gmsh_triangulation(surfaces, msh, size, order)
     return quality, {"tolerance": tolerance, "max_deviation": deviation, "reference_volume": reference,
-                     "volume_bound": bound}
+                     "volume_bound": bound, "regions": len(pieces)}
 
 
 def _cells_of(full, cell: str):
