@@ -58,11 +58,6 @@ def run_and_judge_flat(part, tmp_path, capsys):
     assert flat_cuts(material(shape), moves, radius, depth, moves[:, 2].max() + radius) == []
 
 
-#: files on which surfmod refuses the flat-end path (exit 1, one line, no file) because
-#: its refinement leaves a move cutting deeper than the tolerance: safe, but no path
-FLAT_NO_SAFE_PATH = {"pythonocc_Ventilator.stp"}  # "move 442 still cuts 0.043 deep" (tolerance 0.0359)
-
-
 #: the exact judge places the flat cutter along every move and asks OCCT for its distance
 #: to the part: on the largest part (11752, 1018 faces) that alone ran over eight minutes
 #: on the 2-core CI machine, so the flat-end sweep leaves out the two largest parts (with
@@ -74,8 +69,6 @@ FLAT_TOO_SLOW_TO_JUDGE = {"pythonocc_11752.stp", "trimesh_box_sides.STEP"}
 @pytest.mark.parametrize("corpus_file", [p for p in CORPUS_FILES if p.name not in FLAT_TOO_SLOW_TO_JUDGE],
                          ids=lambda p: p.name)
 def test_corpus_flat_end_toolpath_never_gouges(corpus_file, tmp_path, capsys):
-    if corpus_file.name in FLAT_NO_SAFE_PATH:
-        pytest.xfail("flat end: the move refinement finds no safe path on this part (refused, exit 1)")
     run_and_judge_flat(corpus_file, tmp_path, capsys)
 
 

@@ -12,8 +12,10 @@ Every straight G1 move between cutter locations is then checked along its length
 at its ends (:mod:`surfmod.uses.toolpath_moves`): locations are inserted where a move would
 cut deeper than half the tolerance, steps at walls become vertical-level-vertical
 staircases, and a final check on other sample points must find every move within
-``tolerance - deflection``.  A path that still cuts deeper raises ``SurfmodError``:
-gouging G-code is never returned.  The default tolerance is a tenth of the scallop height.
+``tolerance - deflection``.  Moves the refinement cannot bring within it are lifted
+(:func:`~surfmod.uses.toolpath_moves.lift_moves`: material is left there, reported as
+``Toolpath.lifted``); a path that still cuts deeper raises ``SurfmodError``: gouging
+G-code is never returned.  The default tolerance is a tenth of the scallop height.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from ..errors import SurfmodError
 from ..io.gcode import gcode_text
 from .drop_cutter import TriangleGrid, drop
 from .inputs import to_shape
-from .toolpath_moves import NoSafePathError, move_gouge, raster, refine_moves, staircase_steep
+from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
 from .toolpath_exact import exact_ball_heights
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
@@ -88,7 +90,9 @@ class Toolpath:
     location's (x, y) (NaN where it touches nothing); ``pass_index`` ``(N,)``: raster pass
     of each point (-1 on links and staircases).  ``gouge``: the deepest any move was found
     below the drop-cutter height (≤ 0: nowhere), ``deflection``: the mesh's chordal
-    deflection, ``tolerance``: the depth no move may cut (``gouge + deflection`` is within it).
+    deflection, ``tolerance``: the depth no move may cut (``gouge + deflection`` is within it),
+    ``lifted``: the most any location was raised above its drop-cutter height where
+    refining could not keep a move from cutting (0: nowhere; material is left there).
 
     >>> import surfmod as sm
     >>> flat = sm.plane((0, 0, 0), (10, 0, 0), (0, 10, 0))
@@ -108,6 +112,7 @@ class Toolpath:
     gouge: float
     tolerance: float
     deflection: float
+    lifted: float = 0.0
 
     @property
     def n_passes(self) -> int:
@@ -127,6 +132,8 @@ class Toolpath:
             f"{len(self.points)} points, stepover {self.stepover:.6g} (scallop {self.scallop:.3g} on flat ground), "
             f"length {self.length:.6g}, every move checked: max gouge {max(self.gouge + self.deflection, 0.0):.2e} "
             f"(tolerance {self.tolerance:.2e})"
+            + (f", moves lifted by up to {self.lifted:.3g} where refining could not follow the part (material left)"
+               if self.lifted > 0 else "")
         )
 
 
@@ -302,6 +309,12 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
                                          centred=True)
             points, index = _drop_repeats(points, index)
             depth = move_gouge(part.height, points)
+        lifted = 0.0
+        if len(depth) and depth.max() > allowed:
+            # the refinement could not follow the part here (walls meeting at a sliver of a
+            # face, say): lift those moves, which leaves material but never cuts
+            points, lift, depth = lift_moves(part.height, points, depth, REFINE_SHARE * allowed)
+            lifted = float(lift.max())
         gouge = float(depth.max()) if len(depth) else 0.0
         if gouge > allowed:
             worst = int(np.argmax(depth))
@@ -312,4 +325,4 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         bar.update()
     actual = float(np.diff(across).max()) if len(across) > 1 else 0.0
     return Toolpath(checks.frozen(points), checks.frozen(contacts), index, tool, actual, step,
-                    tool.scallop_for_stepover(actual), direction, gouge - part.lift, tolerance, part.deflection)
+                    tool.scallop_for_stepover(actual), direction, gouge - part.lift, tolerance, part.deflection, lifted)

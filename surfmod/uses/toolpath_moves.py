@@ -110,6 +110,36 @@ def move_gouge(height, points: np.ndarray) -> np.ndarray:
     return np.maximum(worst, np.maximum(end_excess[:-1], end_excess[1:]))
 
 
+def lift_moves(height, points: np.ndarray, depth: np.ndarray, target: float, rounds: int = 4):
+    """Raise the end points of every move that cuts deeper than ``target`` until none
+    does: ``(points, lift per point, depth per move)``.
+
+    Raising both ends of a straight move by ``d`` raises the whole move by ``d``, so its
+    depth drops by ``d``; a move sharing a raised end is raised along part of its length
+    and cuts no deeper than before.  Lifting therefore never makes a move cut, it only
+    leaves material (at most the lift) where the refinement could not follow the part.
+
+    >>> import numpy as np
+    >>> bump = lambda xy: np.where(np.abs(xy[:, 0] - 1) < 0.3, 1.0, 0.0)
+    >>> pts = np.array([[0.0, 0, 0], [2, 0, 0], [3, 0, 0]])
+    >>> moved, lift, depth = lift_moves(bump, pts, move_gouge(bump, pts), 0.1)
+    >>> lift.tolist(), np.round(depth, 12).tolist()   # the bump's move now cuts 0.1 at most
+    ([0.9, 0.9, 0.0], [0.1, 0.0])
+    """
+    points, lift = points.copy(), np.zeros(len(points))
+    for _ in range(rounds):
+        over = np.nonzero(depth > target)[0]
+        if not over.size:
+            break
+        up = np.zeros(len(points))
+        np.maximum.at(up, over, depth[over] - target)
+        np.maximum.at(up, over + 1, depth[over] - target)
+        points[:, 2] += up
+        lift += up
+        depth = move_gouge(height, points)
+    return points, lift, depth
+
+
 def staircase_steep(points: np.ndarray, index: np.ndarray, slope: float = STEEP_SLOPE):
     """Replace moves steeper than ``slope`` (wall flanks, where a straight move cuts the
     corner) by a vertical and a level move: rising moves go up first, falling moves
