@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -40,8 +41,8 @@ class Section:
 
     ``wires`` are build123d ``Wire``s (OCCT's section edges chained end to end);
     ``polylines`` the same curves sampled by the NumPy evaluator (each edge read back
-    exactly with :func:`surfmod.from_edge`), one ``(N, 3)`` array per wire;
-    ``closed`` says which wires close up.  The plane frame is ``origin`` with axes
+    exactly with :func:`surfmod.from_edge`, ``samples`` points an edge), one ``(N, 3)``
+    array per wire, computed on first use; ``closed`` says which wires close up.  The plane frame is ``origin`` with axes
     ``x_axis``, ``y_axis`` and ``normal``; :meth:`polylines_2d` gives the curves in it.
     An empty section (the plane misses the part) has no wires.
 
@@ -56,8 +57,23 @@ class Section:
     x_axis: np.ndarray
     y_axis: np.ndarray
     wires: list = field(repr=False)
-    polylines: list = field(repr=False)
     closed: list
+    samples: int = field(default=64, repr=False)
+
+    @cached_property
+    def polylines(self) -> list[np.ndarray]:
+        from ..occ.uses import wire_edges
+
+        out = []
+        for w in self.wires:
+            pts = []
+            for e in wire_edges(w):
+                curve = from_edge(e)
+                t0, t1 = curve.domain
+                p = curve.points(np.linspace(t0, t1, self.samples))  # from_edge follows the edge's orientation
+                pts.append(p if not pts else p[1:])
+            out.append(checks.frozen(np.concatenate(pts)))
+        return out
 
     @property
     def empty(self) -> bool:
@@ -200,16 +216,5 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
             "move plane_origin off the face or tilt the plane"
         )
     wires = occ.section_edges(shape, origin, normal)
-    polylines, closed = [], []
-    for w in wires:
-        pts = []
-        for e in occ.wire_edges(w):
-            curve = from_edge(e)
-            (t0, t1) = curve.domain
-            p = curve.points(np.linspace(t0, t1, samples))  # from_edge follows the edge's orientation
-            pts.append(p if not pts else p[1:])
-        poly = np.concatenate(pts)
-        polylines.append(checks.frozen(poly))
-        closed.append(bool(w.is_closed) if hasattr(w, "is_closed") else bool(np.allclose(poly[0], poly[-1])))
     return Section(checks.frozen(origin), checks.frozen(normal), checks.frozen(xa), checks.frozen(ya),
-                   wires, polylines, closed)
+                   wires, [bool(w.is_closed) for w in wires], samples)
