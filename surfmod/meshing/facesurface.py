@@ -113,6 +113,30 @@ class FaceSurface:
         """Partials to order 2, ``(N, 3, 3, 3)``, of a B-spline or Bezier surface."""
         return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 2)
 
+    @property
+    def projector(self):
+        """``project(points, uv, bounds, threshold) -> distances``, the compiled
+        equivalent of :func:`surfmod.meshing.deviation.project_distances` on this
+        surface (:mod:`surfmod.eval.projection_kernel`), or ``None`` when the surface is
+        not a B-spline net."""
+        if not isinstance(self._spline, BSplineSurface):
+            return None
+        return self._project
+
+    def _project(self, points: np.ndarray, uv: np.ndarray, bounds, threshold: float = 0.0) -> np.ndarray:
+        from ..eval import projection_kernel  # numba: compiled on first use, then cached
+
+        net = self._spline._local_net()
+        lo = np.array([r[0] for r in self.range], float)
+        hi = np.array([r[1] for r in self.range], float)
+        period = np.array([float(t) if k else 0.0 for t, k in zip(self.period, self.periodic)])
+        out = np.empty(len(points))
+        projection_kernel.project_distances(
+            net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v, net.bucket_u,
+            net.bucket_v, lo, hi, period, np.array(self.periodic, bool), np.array(bounds, float),
+            np.ascontiguousarray(points, float), np.ascontiguousarray(uv, float), float(threshold), out)
+        return out
+
     def d0(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self._spline is not None:
             return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 0)[:, 0, 0]

@@ -1,0 +1,65 @@
+"""The compiled Gauss-Newton distance bounds (surfmod.eval.projection_kernel, used by
+mesh measurement on B-spline faces) equal the NumPy iteration of
+surfmod.meshing.deviation.project_distances to round-off: polynomial and rational
+nets, a periodic direction (parameters past the seam wrap), guesses outside the box
+(clipped), thresholds that stop the iteration early; and every value is a distance to
+a point of the surface (an upper bound of the true distance)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import surfmod as sm
+from surfmod.gallery.synthetic import wavy_net
+from surfmod.meshing.deviation import project_distances
+from surfmod.meshing.facesurface import FaceSurface
+from surfmod.occ.topo import face_surface
+
+
+def _surfaces():
+    net = wavy_net(7, 6)
+    weights = 1.0 + 0.6 * np.random.default_rng(5).random((7, 6))
+    plain = face_surface(sm.BSplineSurface(net, (3, 2)).face())[0]
+    rational = face_surface(sm.BSplineSurface(net, (2, 3), weights=weights).face())[0]
+    periodic = rational.Copy()
+    periodic.SetUPeriodic()
+    return {"plain": plain, "rational": rational, "periodic": periodic}
+
+
+@pytest.mark.parametrize("name", ["plain", "rational", "periodic"])
+@pytest.mark.parametrize("threshold", [0.0, 0.05])
+def test_compiled_projection_equals_numpy(name, threshold):
+    ev = FaceSurface(_surfaces()[name])
+    assert ev.projector is not None
+    rng = np.random.default_rng(11)
+    (u0, u1), (v0, v1) = ev.range
+    uv = np.column_stack([rng.uniform(u0 - 0.2, u1 + 0.2, 400), rng.uniform(v0 - 0.2, v1 + 0.2, 400)])
+    if ev.periodic[0]:
+        uv[:50, 0] += ev.period[0]  # past the seam: wraps
+    # points off the surface, their guesses disturbed
+    points = ev.d0(uv[:, 0], uv[:, 1]) + 0.1 * rng.standard_normal((400, 3))
+    guesses = uv + 0.05 * rng.standard_normal((400, 2))
+    box = (u0 - 0.1, u1 + 0.1, v0, v1) if ev.periodic[0] else (u0, u1, v0, v1)
+    ours = ev.projector(points, guesses, box, threshold)
+    numpy_path = project_distances(ev.d1, points, guesses, box, threshold=threshold, d0=ev.d0)
+    scale = float(np.abs(points).max())
+    assert np.max(np.abs(ours - numpy_path)) <= 1e-12 * scale
+    assert np.all(ours >= 0)
+
+
+def test_projection_finds_the_foot_point_of_points_off_the_surface():
+    ev = FaceSurface(_surfaces()["rational"])
+    (u0, u1), (v0, v1) = ev.range
+    u = np.linspace(u0 + 0.1, u1 - 0.1, 9)
+    v = np.linspace(v0 + 0.1, v1 - 0.1, 9)
+    uu, vv = (g.ravel() for g in np.meshgrid(u, v, indexing="ij"))
+    d = ev.d1(uu, vv)
+    normal = np.cross(d[:, 1, 0], d[:, 0, 1])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    offset = 1e-3  # small enough that every foot point is the base point
+    points = d[:, 0, 0] + offset * normal
+    got = ev.projector(points, np.column_stack([uu, vv]) + 0.01, (u0, u1, v0, v1))
+    # an upper bound (a point of the surface), within the stopping rule's 1e-6 relative
+    assert np.all(got >= offset * (1 - 1e-12))
+    assert np.allclose(got, offset, rtol=1e-6, atol=0)
