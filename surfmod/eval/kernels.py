@@ -156,7 +156,9 @@ def binomials(order: int) -> np.ndarray:
 
 #: points per block of the scattered-derivative kernel (its planes stay in L1/L2)
 POINT_BLOCK = 128
-
+#: scattered points per chunk: the unit of work of the parallel variants
+#: (:mod:`surfmod.eval.parallel`); a multiple of :data:`POINT_BLOCK`
+SCATTER_CHUNK = 4096
 
 @njit(cache=True, error_model="numpy")
 def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
@@ -166,6 +168,16 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_
     otherwise.  Points go in blocks: per point the spans, the basis derivatives and a
     gather of the local ``(p+1) x (q+1)`` net into planes; then the contraction and the
     quotient rule run over the block with the points on the contiguous (vector) axis."""
+    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v,
+                                    bucket_u, bucket_v, out, c)
+
+
+@njit(cache=True, error_model="numpy")
+def scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u,
+                                bucket_v, out, chunk):
+    """Points ``chunk * SCATTER_CHUNK`` onwards (one chunk) of :func:`scattered_derivatives`,
+    with their own scratch planes: chunks are independent."""
     n, m = ctrl.shape[0], ctrl.shape[1]
     kk = order + 1
     nb = POINT_BLOCK
@@ -180,8 +192,9 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_
     h = np.ones((kk, kk, 4, nb))  # lanes past a short last block keep finite values
     t0u, scale_u, table_u = bucket_u
     t0v, scale_v, table_v = bucket_v
-    for a0 in range(0, u.size, nb):
-        cnt = min(nb, u.size - a0)
+    end = min(u.size, (chunk + 1) * SCATTER_CHUNK)
+    for a0 in range(chunk * SCATTER_CHUNK, end, nb):
+        cnt = min(nb, end - a0)
         for b in range(cnt):
             su = find_span_bucketed(ku, p, n, u[a0 + b], t0u, scale_u, table_u)
             sv = find_span_bucketed(kv, q, m, v[a0 + b], t0v, scale_v, table_v)
@@ -227,13 +240,20 @@ def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket
     """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
     :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
     sums kept in registers."""
+    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c)
+
+
+@njit(cache=True, error_model="numpy")
+def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, chunk):
+    """One chunk of :func:`scattered_positions` (points ``chunk * SCATTER_CHUNK`` on)."""
     n, m = ctrl.shape[0], ctrl.shape[1]
     nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
     lu, ru = np.empty(p + 1), np.empty(p + 1)
     lv, rv = np.empty(q + 1), np.empty(q + 1)
     t0u, scale_u, table_u = bucket_u
     t0v, scale_v, table_v = bucket_v
-    for a in range(u.size):
+    for a in range(chunk * SCATTER_CHUNK, min(u.size, (chunk + 1) * SCATTER_CHUNK)):
         su = find_span_bucketed(ku, p, n, u[a], t0u, scale_u, table_u)
         sv = find_span_bucketed(kv, q, m, v[a], t0v, scale_v, table_v)
         _basis_funs(ku, p, su, u[a], inv_u, lu, ru, nu_)
@@ -279,6 +299,48 @@ def _basis_funs(knots, p, span, t, inv, left, right, out):
             out[r] = saved + right[r + 1] * temp
             saved = left[j - r] * temp
         out[j] = saved
+
+
+@njit(cache=True, error_model="numpy")
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts, first):
+    """The grid ``us x vs[b0:b0+n_v]`` into ``out`` (point-major: ``(n_u, N_v, 3)`` for
+    positions, ``(n_u, N_v, K, K, 3)`` for partials, ``K = bu.shape[1]``), block by block
+    of u-points (:func:`grid_block_positions`, :func:`grid_block_derivatives`); block
+    ``k`` is u-points ``starts[k]:starts[k+1]``, its net rows
+    ``rows[row_starts[k]:row_starts[k+1]]``, ``first[a]`` the place of u-point ``a``'s
+    first row among them."""
+    for blk in range(starts.size - 1):
+        if out.ndim == 3:
+            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, starts, rows, row_starts, first, blk)
+        else:
+            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts,
+                                   first, blk)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _block_table(bv, sv, q, ctrl, dim, starts, rows, row_starts, blk):
+    """A block's net rows contracted with the v-basis (:func:`grid_rows`) into a table of
+    its own, and its u-range.  Blocks share nothing but the read-only inputs, so the
+    parallel variant (:mod:`surfmod.eval.parallel`) runs them on several threads."""
+    mine = rows[row_starts[blk] : row_starts[blk + 1]]
+    table = np.empty((mine.size, bv.shape[1], dim, sv.size))
+    grid_rows(bv, sv, q, ctrl, mine, dim, table)
+    return table, starts[blk], starts[blk + 1]
+
+
+@njit(cache=True, error_model="numpy")
+def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, starts, rows, row_starts, first, blk):
+    """One block of :func:`grid` for positions."""
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, starts, rows, row_starts, blk)
+    grid_positions(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1])
+
+
+@njit(cache=True, error_model="numpy")
+def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts, first,
+                           blk):
+    """One block of :func:`grid` for partials."""
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, starts, rows, row_starts, blk)
+    grid_derivatives(bu[a0:a1], first[a0:a1], p, table, rational, binom, b0, out[a0:a1])
 
 
 @njit(cache=True, error_model="numpy")
@@ -339,7 +401,7 @@ def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
 
 
 @njit(cache=True, error_model="numpy")
-def grid_positions(bu, first, p, w, rational, acc, b0, out):
+def grid_positions(bu, first, p, w, rational, b0, out):
     """Second stage for positions: ``out[:, b0:b0+n_v]`` of ``out (n_u, N_v, 3)``
     point-major, the division by the weight fused into the (interleaving) store."""
     nv = w.shape[3]
@@ -347,6 +409,7 @@ def grid_positions(bu, first, p, w, rational, acc, b0, out):
     if p <= 3:
         _positions_low_degree(bu, first, p, w, rational, b0, out)
         return
+    acc = np.empty((1, 1, 4, nv))
     for a in range(bu.shape[0]):
         _combine_rows(bu, a, first, p, w, 1, dim, acc, 0)
         if rational:
@@ -362,7 +425,7 @@ def grid_positions(bu, first, p, w, rational, acc, b0, out):
                 out[a, b0 + b, 2] = acc[0, 0, 2, b]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _positions_low_degree(bu, first, p, w, rational, b0, out):
     """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point: the four
     row terms are written out (missing ones get weight 0 on a valid row), so the sums,
@@ -394,15 +457,16 @@ def _positions_low_degree(bu, first, p, w, rational, b0, out):
 
 
 @njit(cache=True, error_model="numpy")
-def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
+def grid_derivatives(bu, first, p, w, rational, binom, b0, out):
     """Second stage for partials: for each u-point combine its p+1 rows of ``w`` on the
-    cache-resident planes of ``acc`` (every partial and coordinate a contiguous row of
-    v), apply the quotient rule there (rational), then store each point's ``3 K^2``
+    cache-resident planes of a scratch ``acc`` (every partial and coordinate a contiguous
+    row of v), apply the quotient rule there (rational), then store each point's ``3 K^2``
     values together into ``out[:, b0:b0+n_v]`` of the point-major ``out (n_u, N_v, K, K,
     3)``, so the output is written once, front to back."""
     kk = bu.shape[1]
     nv = w.shape[3]
     dim = 4 if rational else 3
+    acc = np.empty((kk, kk, 4, nv))
     for a in range(bu.shape[0]):
         _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
         if rational:

@@ -25,23 +25,44 @@ array([[1.5 , 0.75, 0.  ]])
 from __future__ import annotations
 
 import warnings
+from contextlib import nullcontext
 from math import comb
 from typing import NamedTuple
 
 import numpy as np
 
 from .basis import basis_derivatives, find_spans
+from .threads import running_on, threads_for
 
 #: doubles in the per-block row table of the grid stage (4 MiB): fits in L2/L3
 ROW_TABLE = 1 << 19
 #: v-points per block of the grid: the rows a u-point combines stay in cache
 V_BLOCK = 1024
+#: fewest u-points per block when blocks are split among threads
+GRID_MIN_BLOCK = 16
 
 
 def _kernels():
     from . import kernels  # numba: compiled on first use, then from its disk cache
 
     return kernels
+
+
+def _kernels_for(points: int):
+    """The kernels for ``points`` evaluations and their thread count: the
+    single-threaded ones, or their parallel variants (:mod:`surfmod.eval.parallel`, equal
+    bit for bit) when :mod:`surfmod.eval.threads` allows several threads."""
+    count = threads_for(points)
+    if count > 1:
+        from . import parallel
+
+        return parallel, count
+    return _kernels(), 1
+
+
+def _on(count: int):
+    """The ``with`` context that runs numba's parallel kernels on ``count`` threads."""
+    return running_on(count) if count > 1 else nullcontext()
 
 
 def writable(t) -> np.ndarray:
@@ -181,7 +202,6 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
 
     Many points on a small low-degree net go through per-span polynomial patches
     (:mod:`surfmod.eval.patches`), the others through the basis-function kernel."""
-    k = _kernels()
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, 3))
@@ -191,8 +211,10 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
 
         patches.positions(net, table, u, v, out)
         return out
-    k.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
-                          net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
+    run, count = _kernels_for(u.size)
+    with _on(count):
+        run.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
+                                net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
     return out
 
 
@@ -203,8 +225,11 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
-    k.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order), net.rational,
-                            k.binomials(order), net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
+    run, count = _kernels_for(u.size)
+    with _on(count):
+        run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),
+                                  net.rational, k.binomials(order), net.inv_u, net.inv_v, net.bucket_u,
+                                  net.bucket_v, out)
     return out
 
 
@@ -224,14 +249,26 @@ def homogeneous4(ctrl: np.ndarray) -> np.ndarray:
     return out
 
 
-def _row_blocks(su, p, n, per_row):
-    """Blocks of u-points whose net rows fit the row table: ``(a0, a1, rows, first)``."""
+def _row_blocks(su, p, n, per_row, threads=1):
+    """Blocks of u-points whose net rows fit the row table, as the arrays of
+    :func:`surfmod.eval.kernels.grid`: ``(starts, rows, row_starts, first)``.  With
+    several threads there are at least two blocks a thread (rows at a boundary between
+    blocks are contracted by both; the values do not depend on the blocking)."""
     max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
     step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
-    for a0 in range(0, su.size, step):  # loop over memory blocks, not points
-        s = su[a0 : a0 + step]
-        rows = np.unique((s[:, None] - p + np.arange(p + 1)).ravel())
-        yield a0, a0 + s.size, rows, np.searchsorted(rows, s - p)
+    if threads > 1:
+        step = min(step, max(GRID_MIN_BLOCK, -(-su.size // (2 * threads))))
+    starts = np.arange(0, su.size + step, step).clip(max=su.size)
+    starts = starts[np.r_[True, np.diff(starts) > 0]]
+    rows, row_starts, first = [], [0], np.empty(su.size, dtype=np.int64)
+    for a0, a1 in zip(starts[:-1], starts[1:]):  # loop over memory blocks, not points
+        s = su[a0:a1]
+        block = np.unique((s[:, None] - p + np.arange(p + 1)).ravel())
+        first[a0:a1] = np.searchsorted(block, s - p)
+        rows.append(block)
+        row_starts.append(row_starts[-1] + block.size)
+    rows = np.concatenate(rows) if rows else np.empty(0, dtype=np.int64)
+    return starts.astype(np.int64), rows.astype(np.int64), np.array(row_starts, dtype=np.int64), first
 
 
 def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
@@ -250,24 +287,19 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     dim = 4 if rational else 3
     su, bu = _basis(knots_u, p, n, us, order)
     sv, bv = _basis(knots_v, q, m, vs, order)
-    acc = np.empty((kk, kk, 4, min(V_BLOCK, vs.size)))
+    binom = k.binomials(order)
     if order == 0:
         if out is None:
             out = np.empty((us.size, vs.size, 3))
     else:
-        binom = k.binomials(order)
         if out is None:
             out = np.empty((us.size, vs.size, kk, kk, 3))
-    for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
-        svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
-        accb = acc if svb.size == acc.shape[-1] else np.empty(acc.shape[:-1] + (svb.size,))
-        for a0, a1, rows, first in _row_blocks(su, p, n, kk * dim * svb.size):
-            table = np.empty((rows.size, kk, dim, svb.size))
-            k.grid_rows(bvb, svb, q, ctrl, rows, dim, table)
-            if order == 0:
-                k.grid_positions(bu[a0:a1], first, p, table, rational, accb, b0, out[a0:a1])
-            else:
-                k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, accb, b0, out[a0:a1])
+    run, count = _kernels_for(us.size * vs.size)
+    with _on(count):
+        for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
+            svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
+            blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, *blocks)
     if order == 0:
         return out[:, :, None, None, :]
     return out

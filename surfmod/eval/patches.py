@@ -34,7 +34,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .kernels import basis_ders_point, find_span_bucketed
+from .kernels import SCATTER_CHUNK, basis_ders_point, find_span_bucketed
+from .threads import running_on, threads_for
 
 #: largest table built (bytes): 100 x 100 bicubic spans fit, the table stays cache-friendly
 MAX_TABLE_BYTES = 8 << 20
@@ -123,16 +124,26 @@ def _cubic_in_y(c, o, y):
 
 # Horner steps may fuse into FMAs ("contract"): one rounding instead of two, never a
 # reassociated sum, so the results stay within an ulp or so of the unfused ones.
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy")
 def _positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
                bucket_u, bucket_v, u, v, out):
+    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                        bucket_u, bucket_v, u, v, out, c)
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
+def positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                    bucket_u, bucket_v, u, v, out, chunk):
+    """Points ``chunk * SCATTER_CHUNK`` onwards (one chunk) of :func:`positions`; the
+    parallel variant (:mod:`surfmod.eval.parallel`) runs the chunks on several threads."""
     t0u, su_scale, table_u = bucket_u
     t0v, sv_scale, table_v = bucket_v
     flat = coeffs.reshape(-1)  # flat offsets: no array view per point
     per_span = (p + 1) * (q + 1) * 4
     per_row = (m - q) * per_span
     cubic = p == 3 and q == 3
-    for a in range(u.size):
+    for a in range(chunk * SCATTER_CHUNK, min(u.size, (chunk + 1) * SCATTER_CHUNK)):
         su = find_span_bucketed(ku, p, n, u[a], t0u, su_scale, table_u)
         sv = find_span_bucketed(kv, q, m, v[a], t0v, sv_scale, table_v)
         x = (u[a] - mid_u[su]) * scale_u[su]
@@ -173,5 +184,14 @@ def positions(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndar
     """Positions at the scattered pairs ``(u[a], v[a])`` into ``out (N, 3)`` from ``table``
     (flat float64 parameter arrays, in the domain)."""
     n, m = net.ctrl.shape[:2]
+    count = threads_for(u.size)
+    if count > 1:
+        from . import parallel
+
+        with running_on(count):
+            parallel.patch_positions(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u,
+                                     table.scale_u, table.mid_v, table.scale_v, net.rational, net.bucket_u,
+                                     net.bucket_v, u, v, out)
+        return
     _positions(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u,
                table.mid_v, table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
