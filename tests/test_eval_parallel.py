@@ -98,3 +98,20 @@ def test_numba_thread_count_is_restored(monkeypatch):
     with threads.limit(None):
         s.grid(np.linspace(0, 1, 50), np.linspace(0, 1, 50))
     assert numba.get_num_threads() == before
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_grid_rows_do_not_depend_on_order_or_blocking(rational, monkeypatch):
+    """Sorted u-points go in blocks as large as the row table allows, shuffled ones in
+    smaller blocks: every point's values are the same bit for bit, in any order."""
+    s = _surface(120, 50, 3, 3, rational, seed=4)
+    us, vs = np.linspace(0, 1, 400), np.linspace(0, 1, 90)
+    perm = np.random.default_rng(0).permutation(us.size)
+    monkeypatch.setattr(local, "ROW_TABLE", 1 << 13)
+    with threads.limit(1):
+        for order in (0, 2):
+            ordered = s.grid_derivatives(us, vs, order)
+            np.testing.assert_array_equal(s.grid_derivatives(us[perm], vs, order), ordered[perm])
+            monkeypatch.setattr(local, "ROW_TABLE", 1 << 19)  # one block
+            np.testing.assert_array_equal(s.grid_derivatives(us, vs, order), ordered)
+            monkeypatch.setattr(local, "ROW_TABLE", 1 << 13)

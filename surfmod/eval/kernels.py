@@ -15,7 +15,11 @@ Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polyno
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, uint64
+
+# unsigned index steps: unsigned offsets spare numba's negative-index wraparound (a
+# compare and a select per access), which otherwise keeps loops from vectorizing
+U1, U2, U3 = np.uint64(1), np.uint64(2), np.uint64(3)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -302,44 +306,49 @@ def _basis_funs(knots, p, span, t, inv, left, right, out):
 
 
 @njit(cache=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts, first):
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first):
     """The grid ``us x vs[b0:b0+n_v]`` into ``out`` (point-major: ``(n_u, N_v, 3)`` for
     positions, ``(n_u, N_v, K, K, 3)`` for partials, ``K = bu.shape[1]``), block by block
     of u-points (:func:`grid_block_positions`, :func:`grid_block_derivatives`); block
     ``k`` is u-points ``starts[k]:starts[k+1]``, its net rows
     ``rows[row_starts[k]:row_starts[k+1]]``, ``first[a]`` the place of u-point ``a``'s
-    first row among them."""
+    first row among them; ``scratch[0]`` holds a block's row table (reused: a fresh
+    table per block would be paged in again and again)."""
     for blk in range(starts.size - 1):
         if out.ndim == 3:
-            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, starts, rows, row_starts, first, blk)
+            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,
+                                 first, blk)
         else:
-            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts,
-                                   first, blk)
+            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[0], starts, rows,
+                                   row_starts, first, blk)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _block_table(bv, sv, q, ctrl, dim, starts, rows, row_starts, blk):
-    """A block's net rows contracted with the v-basis (:func:`grid_rows`) into a table of
-    its own, and its u-range.  Blocks share nothing but the read-only inputs, so the
-    parallel variant (:mod:`surfmod.eval.parallel`) runs them on several threads."""
+def _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk):
+    """A block's net rows contracted with the v-basis (:func:`grid_rows`) into a table in
+    ``space`` (its thread's scratch), and its u-range.  Blocks share nothing but the
+    read-only inputs, so the parallel variant (:mod:`surfmod.eval.parallel`) runs them
+    on several threads."""
     mine = rows[row_starts[blk] : row_starts[blk + 1]]
-    table = np.empty((mine.size, bv.shape[1], dim, sv.size))
+    kk, nv = bv.shape[1], sv.size
+    table = space[: mine.size * kk * dim * nv].reshape((mine.size, kk, dim, nv))
     grid_rows(bv, sv, q, ctrl, mine, dim, table)
     return table, starts[blk], starts[blk + 1]
 
 
 @njit(cache=True, error_model="numpy")
-def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, starts, rows, row_starts, first, blk):
+def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts, first,
+                         blk):
     """One block of :func:`grid` for positions."""
-    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, starts, rows, row_starts, blk)
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk)
     grid_positions(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1])
 
 
 @njit(cache=True, error_model="numpy")
-def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts, first,
-                           blk):
+def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows, row_starts,
+                           first, blk):
     """One block of :func:`grid` for partials."""
-    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, starts, rows, row_starts, blk)
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk)
     grid_derivatives(bu[a0:a1], first[a0:a1], p, table, rational, binom, b0, out[a0:a1])
 
 
@@ -349,23 +358,31 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
     for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
     with the v-basis."""
     kk = bv.shape[1]
+    nv = sv.size
+    basis = bv.reshape(-1)
+    per_point = uint64(kk * (q + 1))
     for r in range(rows.size):
-        i = rows[r]
-        for b in range(sv.size):
-            s = sv[b] - q
+        net_row = ctrl[rows[r]].reshape(-1)  # flat, unsigned offsets (see U1)
+        dst = out[r].reshape(-1)
+        for b in range(nv):
+            ub = uint64(b)
+            s = uint64(4 * (sv[b] - q))
             for l in range(kk):
                 x = y = z = w = 0.0
+                o = ub * per_point + uint64(l * (q + 1))
                 for j in range(q + 1):
-                    c = bv[b, l, j]
-                    x += c * ctrl[i, s + j, 0]
-                    y += c * ctrl[i, s + j, 1]
-                    z += c * ctrl[i, s + j, 2]
-                    w += c * ctrl[i, s + j, 3]
-                out[r, l, 0, b] = x
-                out[r, l, 1, b] = y
-                out[r, l, 2, b] = z
+                    c = basis[o + uint64(j)]
+                    t = s + uint64(4 * j)
+                    x += c * net_row[t]
+                    y += c * net_row[t + U1]
+                    z += c * net_row[t + U2]
+                    w += c * net_row[t + U3]
+                t = uint64(l * dim * nv) + ub
+                dst[t] = x
+                dst[t + uint64(nv)] = y
+                dst[t + uint64(2 * nv)] = z
                 if dim == 4:
-                    out[r, l, 3, b] = w
+                    dst[t + uint64(3 * nv)] = w
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -441,19 +458,24 @@ def _positions_low_degree(bu, first, p, w, rational, b0, out):
         x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
         y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
         z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
-        row = out[a]
+        row = out[a].reshape(-1)  # flat, unsigned offsets: no wraparound select, the loop vectorizes
+        o = uint64(3 * b0)
         if rational:
             h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
             for b in range(nv):
-                inv_w = 1.0 / (c0 * h0[b] + c1 * h1[b] + c2 * h2[b] + c3 * h3[b])
-                row[b0 + b, 0] = (c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]) * inv_w
-                row[b0 + b, 1] = (c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]) * inv_w
-                row[b0 + b, 2] = (c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]) * inv_w
+                ub = uint64(b)
+                inv_w = 1.0 / (c0 * h0[ub] + c1 * h1[ub] + c2 * h2[ub] + c3 * h3[ub])
+                t = o + U3 * ub
+                row[t] = (c0 * x0[ub] + c1 * x1[ub] + c2 * x2[ub] + c3 * x3[ub]) * inv_w
+                row[t + U1] = (c0 * y0[ub] + c1 * y1[ub] + c2 * y2[ub] + c3 * y3[ub]) * inv_w
+                row[t + U2] = (c0 * z0[ub] + c1 * z1[ub] + c2 * z2[ub] + c3 * z3[ub]) * inv_w
         else:
             for b in range(nv):
-                row[b0 + b, 0] = c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]
-                row[b0 + b, 1] = c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]
-                row[b0 + b, 2] = c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]
+                ub = uint64(b)
+                t = o + U3 * ub
+                row[t] = c0 * x0[ub] + c1 * x1[ub] + c2 * x2[ub] + c3 * x3[ub]
+                row[t + U1] = c0 * y0[ub] + c1 * y1[ub] + c2 * y2[ub] + c3 * y3[ub]
+                row[t + U2] = c0 * z0[ub] + c1 * z1[ub] + c2 * z2[ub] + c3 * z3[ub]
 
 
 @njit(cache=True, error_model="numpy")

@@ -24,6 +24,7 @@ array([[1.5 , 0.75, 0.  ]])
 
 from __future__ import annotations
 
+import threading
 import warnings
 from contextlib import nullcontext
 from math import comb
@@ -35,7 +36,7 @@ from .basis import basis_derivatives, find_spans
 from .threads import running_on, threads_for
 
 #: doubles in the per-block row table of the grid stage (4 MiB): fits in L2/L3
-ROW_TABLE = 1 << 19
+ROW_TABLE = 1 << 18
 #: v-points per block of the grid: the rows a u-point combines stay in cache
 V_BLOCK = 1024
 #: fewest u-points per block when blocks are split among threads
@@ -249,6 +250,26 @@ def homogeneous4(ctrl: np.ndarray) -> np.ndarray:
     return out
 
 
+_workspace = threading.local()
+
+
+def _scratch(count: int, per_slot: int) -> np.ndarray:
+    """``(slots, per_slot)`` scratch for the grid's row tables, one slot per thread that
+    may run (numba's thread ids when ``count > 1``), kept per calling thread and reused:
+    a fresh multi-MiB table per call would be paged in each time."""
+    slots = 1 if count == 1 else _numba_threads()
+    buf = getattr(_workspace, "rows", None)
+    if buf is None or buf.size < slots * per_slot:
+        buf = _workspace.rows = np.empty(slots * per_slot)
+    return buf[: slots * per_slot].reshape(slots, per_slot)
+
+
+def _numba_threads() -> int:
+    import numba
+
+    return int(numba.config.NUMBA_NUM_THREADS)
+
+
 def _row_blocks(su, p, n, per_row, threads=1):
     """Blocks of u-points whose net rows fit the row table, as the arrays of
     :func:`surfmod.eval.kernels.grid`: ``(starts, rows, row_starts, first)``.  With
@@ -256,10 +277,22 @@ def _row_blocks(su, p, n, per_row, threads=1):
     blocks are contracted by both; the values do not depend on the blocking)."""
     max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
     step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
+    most = su.size  # u-points per block at most: with threads, at least two blocks each
     if threads > 1:
-        step = min(step, max(GRID_MIN_BLOCK, -(-su.size // (2 * threads))))
-    starts = np.arange(0, su.size + step, step).clip(max=su.size)
-    starts = starts[np.r_[True, np.diff(starts) > 0]]
+        most = max(GRID_MIN_BLOCK, -(-su.size // (2 * threads)))
+        step = min(step, most)
+    if n > max_rows and su.size > 1 and np.all(su[1:] >= su[:-1]):
+        # sorted u (the usual grid): a block takes u-points while its rows fit, not
+        # max_rows / (p+1) of them (which assumes p+1 new rows per u-point)
+        cuts = [0]
+        while cuts[-1] < su.size:  # loop over memory blocks, not points
+            a0 = cuts[-1]
+            a1 = int(np.searchsorted(su, su[a0] + max_rows - p - 1, side="right"))
+            cuts.append(min(max(a1, a0 + 1), a0 + most))
+        starts = np.array(cuts)
+    else:
+        starts = np.arange(0, su.size + step, step).clip(max=su.size)
+        starts = starts[np.r_[True, np.diff(starts) > 0]]
     rows, row_starts, first = [], [0], np.empty(su.size, dtype=np.int64)
     for a0, a1 in zip(starts[:-1], starts[1:]):  # loop over memory blocks, not points
         s = su[a0:a1]
@@ -299,7 +332,8 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
         for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
             blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
-            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, *blocks)
+            per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks)
     if order == 0:
         return out[:, :, None, None, :]
     return out

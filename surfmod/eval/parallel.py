@@ -11,7 +11,7 @@ thread pool) is loaded only then.
 
 from __future__ import annotations
 
-from numba import njit, prange
+from numba import get_thread_id, njit, prange
 
 from .kernels import (SCATTER_CHUNK, grid_block_derivatives, grid_block_positions, scattered_derivatives_chunk,
                       scattered_positions_chunk)
@@ -19,14 +19,17 @@ from .patches import positions_chunk
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts, first):
-    """:func:`surfmod.eval.kernels.grid`, a block of u-points per task."""
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first):
+    """:func:`surfmod.eval.kernels.grid`, a block of u-points per task; each thread
+    builds its blocks' row tables in its own row of ``scratch``."""
     for blk in prange(starts.size - 1):
+        space = scratch[get_thread_id()]
         if out.ndim == 3:
-            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, starts, rows, row_starts, first, blk)
+            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts,
+                                 first, blk)
         else:
-            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, starts, rows, row_starts,
-                                   first, blk)
+            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows,
+                                   row_starts, first, blk)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
