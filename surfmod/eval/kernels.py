@@ -386,8 +386,8 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
-    """``acc[k, l, d, off:off+n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
+def _combine_rows(bu, a, first, p, w, kk, dim, acc):
+    """``acc[k, l, d, :n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
     vector axis); up to degree 3 as one four-term pass per plane."""
     r0 = first[a]
     nv = w.shape[3]
@@ -403,18 +403,18 @@ def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
                     w0, w1, w2, w3 = w[r0, l, d], w[r1, l, d], w[r2, l, d], w[r3, l, d]
                     dst = acc[k, l, d]
                     for b in range(nv):
-                        dst[off + b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
+                        dst[b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
         return
     for k in range(kk):
         for l in range(kk):
             for d in range(dim):
                 c = bu[a, k, 0]
                 for b in range(nv):
-                    acc[k, l, d, off + b] = c * w[r0, l, d, b]
+                    acc[k, l, d, b] = c * w[r0, l, d, b]
                 for i in range(1, p + 1):
                     c = bu[a, k, i]
                     for b in range(nv):
-                        acc[k, l, d, off + b] += c * w[r0 + i, l, d, b]
+                        acc[k, l, d, b] += c * w[r0 + i, l, d, b]
 
 
 @njit(cache=True, error_model="numpy")
@@ -428,18 +428,15 @@ def grid_positions(bu, first, p, w, rational, b0, out):
         return
     acc = np.empty((1, 1, 4, nv))
     for a in range(bu.shape[0]):
-        _combine_rows(bu, a, first, p, w, 1, dim, acc, 0)
-        if rational:
-            for b in range(nv):
-                inv_w = 1.0 / acc[0, 0, 3, b]
-                out[a, b0 + b, 0] = acc[0, 0, 0, b] * inv_w
-                out[a, b0 + b, 1] = acc[0, 0, 1, b] * inv_w
-                out[a, b0 + b, 2] = acc[0, 0, 2, b] * inv_w
-        else:
-            for b in range(nv):
-                out[a, b0 + b, 0] = acc[0, 0, 0, b]
-                out[a, b0 + b, 1] = acc[0, 0, 1, b]
-                out[a, b0 + b, 2] = acc[0, 0, 2, b]
+        _combine_rows(bu, a, first, p, w, 1, dim, acc)
+        row = out[a].reshape(-1)  # flat, unsigned offsets (see U1)
+        o = uint64(3 * b0)
+        for b in range(nv):
+            t = o + U3 * uint64(b)
+            inv_w = 1.0 / acc[0, 0, 3, b] if rational else 1.0
+            row[t] = acc[0, 0, 0, b] * inv_w
+            row[t + U1] = acc[0, 0, 1, b] * inv_w
+            row[t + U2] = acc[0, 0, 2, b] * inv_w
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -490,12 +487,18 @@ def grid_derivatives(bu, first, p, w, rational, binom, b0, out):
     dim = 4 if rational else 3
     acc = np.empty((kk, kk, 4, nv))
     for a in range(bu.shape[0]):
-        _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
+        _combine_rows(bu, a, first, p, w, kk, dim, acc)
+        dst = out[a].reshape(-1)  # flat, unsigned offsets (see U1)
+        per_point = uint64(3 * kk * kk)
+        o = uint64(b0) * per_point
+        if rational and kk == 3:  # the quotient rule fused into the store
+            _store_quotient_order2(acc, dst, o)
+            continue
         if rational:
             _quotient_planes(acc, binom)
-        dst = out[a]
+        points = out[a]
         for b in range(nv):
-            point = dst[b0 + b]
+            point = points[b0 + b]
             for k in range(kk):
                 for l in range(kk):
                     point[k, l, 0] = acc[k, l, 0, b]
@@ -564,3 +567,41 @@ def _quotient_planes_order2(acc):
             a00[b], a01[b], a02[b] = s00, s01, s02
             a10[b], a11[b], a12[b] = s10, s11, s12
             a20[b], a21[b], a22[b] = s20, s21, s22
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _store_quotient_order2(acc, dst, o):
+    """:func:`_quotient_planes_order2` fused with the point-major store of
+    :func:`grid_derivatives`: each point's 27 Cartesian values go straight from
+    registers to ``dst[o + 27 b:]`` (same terms in the same order, so the same
+    rounding), without writing the planes back."""
+    nv = acc.shape[3]
+    w00, w01, w02 = acc[0, 0, 3], acc[0, 1, 3], acc[0, 2, 3]
+    w10, w11, w12 = acc[1, 0, 3], acc[1, 1, 3], acc[1, 2, 3]
+    w20, w21, w22 = acc[2, 0, 3], acc[2, 1, 3], acc[2, 2, 3]
+    for b in range(nv):
+        iw = 1.0 / w00[b]
+        t = o + uint64(27) * uint64(b)
+        for d in range(3):
+            s00 = acc[0, 0, d, b] * iw
+            s01 = (acc[0, 1, d, b] - w01[b] * s00) * iw
+            s02 = (acc[0, 2, d, b] - 2.0 * w01[b] * s01 - w02[b] * s00) * iw
+            s10 = (acc[1, 0, d, b] - w10[b] * s00) * iw
+            s11 = (acc[1, 1, d, b] - w01[b] * s10 - w10[b] * s01 - w11[b] * s00) * iw
+            s12 = (acc[1, 2, d, b] - 2.0 * w01[b] * s11 - w02[b] * s10 - w10[b] * s02 - 2.0 * w11[b] * s01
+                   - w12[b] * s00) * iw
+            s20 = (acc[2, 0, d, b] - 2.0 * w10[b] * s10 - w20[b] * s00) * iw
+            s21 = (acc[2, 1, d, b] - w01[b] * s20 - 2.0 * w10[b] * s11 - 2.0 * w11[b] * s10 - w20[b] * s01
+                   - w21[b] * s00) * iw
+            s22 = (acc[2, 2, d, b] - 2.0 * w01[b] * s21 - w02[b] * s20 - 2.0 * w10[b] * s12 - 4.0 * w11[b] * s11
+                   - 2.0 * w12[b] * s10 - w20[b] * s02 - 2.0 * w21[b] * s01 - w22[b] * s00) * iw
+            e = t + uint64(d)
+            dst[e] = s00
+            dst[e + U3] = s01
+            dst[e + uint64(6)] = s02
+            dst[e + uint64(9)] = s10
+            dst[e + uint64(12)] = s11
+            dst[e + uint64(15)] = s12
+            dst[e + uint64(18)] = s20
+            dst[e + uint64(21)] = s21
+            dst[e + uint64(24)] = s22
