@@ -177,21 +177,26 @@ def _store(out, a, h0, h1, h2, h3, rational):
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _bicubic_points(ku, kv, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
                     u, v, out, a0, a1):
-    """Bicubic patches: the four coordinates side by side, every offset a constant."""
+    """Bicubic patches: the four coordinates of a row side by side in one 4-wide loop.
+    Its trip count ``coeffs.shape[-1]`` (4) is a run-time value on purpose: LLVM then
+    keeps the loop and vectorizes it (4-wide FMAs) instead of unrolling it into scalar
+    code (numba runs no SLP vectorizer); about a tenth faster."""
     flat = coeffs.reshape(-1)  # flat offsets: no array view per point
+    dim = coeffs.shape[-1]
     per_span = uint64(64)
     per_row = uint64(m - 3) * per_span
+    h = np.empty(4)
     for a in range(a0, a1):
         base, x, y = _local_parameters(ku, 3, kv, 3, n, m, mid_u, scale_u, mid_v, scale_v, bucket_u, bucket_v,
                                        u[a], v[a], per_row, per_span)
-        h0 = h1 = h2 = h3 = 0.0
-        for k in range(4):
-            o = base + uint64(16 * (3 - k))
-            h0 = h0 * x + _cubic_in_y(flat, o, y)
-            h1 = h1 * x + _cubic_in_y(flat, o + U1, y)
-            h2 = h2 * x + _cubic_in_y(flat, o + U2, y)
-            h3 = h3 * x + _cubic_in_y(flat, o + U3, y)
-        _store(out, a, h0, h1, h2, h3, rational)
+        o = base + uint64(48)
+        for d in range(dim):
+            h[d] = _cubic_in_y(flat, o + uint64(d), y)
+        for k in range(2, -1, -1):
+            o = base + uint64(16 * k)
+            for d in range(dim):
+                h[d] = h[d] * x + _cubic_in_y(flat, o + uint64(d), y)
+        _store(out, a, h[0], h[1], h[2], h[3], rational)
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
