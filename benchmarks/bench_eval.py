@@ -41,7 +41,7 @@ def _clock(single: bool):
     return time.process_time if single else time.perf_counter
 
 
-def _time(fn, single: bool, repeat: int = 3) -> float:
+def _time(fn, single: bool, repeat: int = 7) -> float:
     clock = _clock(single)
     best = np.inf
     for _ in range(repeat):

@@ -41,6 +41,8 @@ ROW_TABLE = 1 << 18
 V_BLOCK = 1024
 #: fewest u-points per block when blocks are split among threads
 GRID_MIN_BLOCK = 16
+#: blocks per thread (at least): threads that finish early take more of them
+BLOCKS_PER_THREAD = 8
 
 
 def _kernels():
@@ -273,13 +275,13 @@ def _numba_threads() -> int:
 def _row_blocks(su, p, n, per_row, threads=1):
     """Blocks of u-points whose net rows fit the row table, as the arrays of
     :func:`surfmod.eval.kernels.grid`: ``(starts, rows, row_starts, first)``.  With
-    several threads there are at least two blocks a thread (rows at a boundary between
+    several threads there are :data:`BLOCKS_PER_THREAD` blocks a thread or more (rows at a boundary between
     blocks are contracted by both; the values do not depend on the blocking)."""
     max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
     step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
-    most = su.size  # u-points per block at most: with threads, at least two blocks each
+    most = su.size  # u-points per block at most: with threads, several blocks each
     if threads > 1:
-        most = max(GRID_MIN_BLOCK, -(-su.size // (2 * threads)))
+        most = max(GRID_MIN_BLOCK, -(-su.size // (BLOCKS_PER_THREAD * threads)))
         step = min(step, most)
     if n > max_rows and su.size > 1 and np.all(su[1:] >= su[:-1]):
         # sorted u (the usual grid): a block takes u-points while its rows fit, not

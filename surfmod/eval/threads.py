@@ -120,7 +120,12 @@ def running_on(count: int):
 
     previous = numba.get_num_threads()
     numba.set_num_threads(count)
+    # hand out the iterations of a prange one at a time (numba's default splits them
+    # evenly up front): on a shared machine a descheduled thread then delays only the
+    # chunk it holds, the others take the rest
+    chunk = numba.set_parallel_chunksize(1)
     try:
         yield
     finally:
+        numba.set_parallel_chunksize(chunk)
         numba.set_num_threads(previous)
