@@ -361,7 +361,40 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
     nv = sv.size
     basis = bv.reshape(-1)
     per_point = uint64(kk * (q + 1))
-    for r in range(rows.size):
+    pairs = rows.size // 2
+    for r2 in range(pairs):  # two rows per pass: the basis values are loaded once for both
+        ra, rb = 2 * r2, 2 * r2 + 1
+        row_a, row_b = ctrl[rows[ra]].reshape(-1), ctrl[rows[rb]].reshape(-1)
+        dst_a, dst_b = out[ra].reshape(-1), out[rb].reshape(-1)
+        for b in range(nv):
+            ub = uint64(b)
+            s = uint64(4 * (sv[b] - q))
+            for l in range(kk):
+                x = y = z = w = 0.0
+                x2 = y2 = z2 = w2 = 0.0
+                o = ub * per_point + uint64(l * (q + 1))
+                for j in range(q + 1):
+                    c = basis[o + uint64(j)]
+                    t = s + uint64(4 * j)
+                    x += c * row_a[t]
+                    y += c * row_a[t + U1]
+                    z += c * row_a[t + U2]
+                    w += c * row_a[t + U3]
+                    x2 += c * row_b[t]
+                    y2 += c * row_b[t + U1]
+                    z2 += c * row_b[t + U2]
+                    w2 += c * row_b[t + U3]
+                t = uint64(l * dim * nv) + ub
+                dst_a[t] = x
+                dst_a[t + uint64(nv)] = y
+                dst_a[t + uint64(2 * nv)] = z
+                dst_b[t] = x2
+                dst_b[t + uint64(nv)] = y2
+                dst_b[t + uint64(2 * nv)] = z2
+                if dim == 4:
+                    dst_a[t + uint64(3 * nv)] = w
+                    dst_b[t + uint64(3 * nv)] = w2
+    for r in range(2 * pairs, rows.size):
         net_row = ctrl[rows[r]].reshape(-1)  # flat, unsigned offsets (see U1)
         dst = out[r].reshape(-1)
         for b in range(nv):
