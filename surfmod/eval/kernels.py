@@ -474,11 +474,17 @@ def grid_positions(bu, first, p, w, rational, b0, out):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _positions_low_degree(bu, first, p, w, rational, b0, out):
-    """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point: the four
-    row terms are written out (missing ones get weight 0 on a valid row), so the sums,
-    the division and the store are one vector loop with everything in registers."""
+    """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point (or per
+    pair of u-points on the same rows, :func:`_low_degree_pair`): the four row terms are
+    written out (missing ones get weight 0 on a valid row), so the sums, the division and
+    the store are one vector loop with everything in registers."""
     nv = w.shape[3]
-    for a in range(bu.shape[0]):
+    a = 0
+    while a < bu.shape[0]:
+        if a + 1 < bu.shape[0] and first[a + 1] == first[a]:  # two u-points on the same rows
+            _low_degree_pair(bu, first, p, w, rational, b0, out, a)
+            a += 2
+            continue
         r0 = first[a]
         c0 = bu[a, 0, 0]
         c1 = bu[a, 0, 1] if p >= 1 else 0.0
@@ -506,6 +512,56 @@ def _positions_low_degree(bu, first, p, w, rational, b0, out):
                 row[t] = c0 * x0[ub] + c1 * x1[ub] + c2 * x2[ub] + c3 * x3[ub]
                 row[t + U1] = c0 * y0[ub] + c1 * y1[ub] + c2 * y2[ub] + c3 * y3[ub]
                 row[t + U2] = c0 * z0[ub] + c1 * z1[ub] + c2 * z2[ub] + c3 * z3[ub]
+        a += 1
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _low_degree_pair(bu, first, p, w, rational, b0, out, a):
+    """u-points ``a`` and ``a + 1`` of :func:`_positions_low_degree` when they share their
+    rows (same span): one pass loads each row value once for both (the arithmetic of
+    each point is that of the single pass, so the values are the same)."""
+    nv = w.shape[3]
+    r0 = first[a]
+    r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+    c0, e0 = bu[a, 0, 0], bu[a + 1, 0, 0]
+    c1, e1 = (bu[a, 0, 1], bu[a + 1, 0, 1]) if p >= 1 else (0.0, 0.0)
+    c2, e2 = (bu[a, 0, 2], bu[a + 1, 0, 2]) if p >= 2 else (0.0, 0.0)
+    c3, e3 = (bu[a, 0, 3], bu[a + 1, 0, 3]) if p >= 3 else (0.0, 0.0)
+    x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
+    y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
+    z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
+    row, nxt = out[a].reshape(-1), out[a + 1].reshape(-1)
+    o = uint64(3 * b0)
+    if rational:
+        h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
+        for b in range(nv):
+            ub = uint64(b)
+            t = o + U3 * ub
+            vx0, vx1, vx2, vx3 = x0[ub], x1[ub], x2[ub], x3[ub]
+            vy0, vy1, vy2, vy3 = y0[ub], y1[ub], y2[ub], y3[ub]
+            vz0, vz1, vz2, vz3 = z0[ub], z1[ub], z2[ub], z3[ub]
+            vw0, vw1, vw2, vw3 = h0[ub], h1[ub], h2[ub], h3[ub]
+            inv_w = 1.0 / (c0 * vw0 + c1 * vw1 + c2 * vw2 + c3 * vw3)
+            row[t] = (c0 * vx0 + c1 * vx1 + c2 * vx2 + c3 * vx3) * inv_w
+            row[t + U1] = (c0 * vy0 + c1 * vy1 + c2 * vy2 + c3 * vy3) * inv_w
+            row[t + U2] = (c0 * vz0 + c1 * vz1 + c2 * vz2 + c3 * vz3) * inv_w
+            inv_w = 1.0 / (e0 * vw0 + e1 * vw1 + e2 * vw2 + e3 * vw3)
+            nxt[t] = (e0 * vx0 + e1 * vx1 + e2 * vx2 + e3 * vx3) * inv_w
+            nxt[t + U1] = (e0 * vy0 + e1 * vy1 + e2 * vy2 + e3 * vy3) * inv_w
+            nxt[t + U2] = (e0 * vz0 + e1 * vz1 + e2 * vz2 + e3 * vz3) * inv_w
+    else:
+        for b in range(nv):
+            ub = uint64(b)
+            t = o + U3 * ub
+            vx0, vx1, vx2, vx3 = x0[ub], x1[ub], x2[ub], x3[ub]
+            vy0, vy1, vy2, vy3 = y0[ub], y1[ub], y2[ub], y3[ub]
+            vz0, vz1, vz2, vz3 = z0[ub], z1[ub], z2[ub], z3[ub]
+            row[t] = c0 * vx0 + c1 * vx1 + c2 * vx2 + c3 * vx3
+            row[t + U1] = c0 * vy0 + c1 * vy1 + c2 * vy2 + c3 * vy3
+            row[t + U2] = c0 * vz0 + c1 * vz1 + c2 * vz2 + c3 * vz3
+            nxt[t] = e0 * vx0 + e1 * vx1 + e2 * vx2 + e3 * vx3
+            nxt[t + U1] = e0 * vy0 + e1 * vy1 + e2 * vy2 + e3 * vy3
+            nxt[t + U2] = e0 * vz0 + e1 * vz1 + e2 * vz2 + e3 * vz3
 
 
 @njit(cache=True, error_model="numpy")
