@@ -25,7 +25,10 @@ True
 from __future__ import annotations
 
 import os
+import sys
 from contextlib import contextmanager
+
+from ..errors import SurfmodError
 
 #: fewest points (grid points or scattered pairs) worth starting the worker threads for
 PARALLEL_MIN_POINTS = 1 << 16
@@ -37,8 +40,6 @@ def _available() -> int:
     """Threads numba may start: ``NUMBA_NUM_THREADS`` (read by numba at import), which
     defaults to the number of cores.  Read from the environment while numba is not
     imported yet, so that asking does not import it."""
-    import sys
-
     numba = sys.modules.get("numba")
     if numba is not None:
         return int(numba.config.NUMBA_NUM_THREADS)
@@ -61,8 +62,6 @@ def set_threads(count: int | None) -> int | None:
     """
     global _requested
     if count is not None:
-        from ..errors import SurfmodError
-
         if isinstance(count, bool) or not isinstance(count, int) or count < 1:
             raise SurfmodError(f"count: expected a positive integer or None, got {count!r}")
     previous, _requested = _requested, count
