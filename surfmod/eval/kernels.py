@@ -3,8 +3,10 @@
 Every point touches only its ``(p+1) x (q+1)`` poles, so the cost depends on the number
 of points and the degrees, never on the size of the control net.  The kernels are
 imported lazily (``import surfmod`` never imports numba) and compiled once into numba's
-on-disk cache (``cache=True``).  All arrays they write are allocated by the NumPy caller,
-so ``tracemalloc`` sees the memory and the caller decides the blocking.
+on-disk cache (``cache=True``).  Every sizeable array they write (outputs, the grid's
+row tables) is allocated by the NumPy caller, so ``tracemalloc`` sees the memory and the
+caller decides the blocking; inside there are only per-chunk scratch planes of a few
+hundred KiB at most.  Multi-threaded variants live in :mod:`surfmod.eval.parallel`.
 
 Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polynomial,
 4 rational ``(w x, w y, w z, w)``), C-contiguous float64.  Spans follow
@@ -356,7 +358,8 @@ def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out
 def grid_rows(bv, sv, q, ctrl, rows, dim, out):
     """First stage of the grid: ``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]``
     for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
-    with the v-basis."""
+    with the v-basis, two rows per pass (a v-point's basis values and window are loaded
+    once for both; each row's sums are those of the one-row pass, so the same values)."""
     kk = bv.shape[1]
     nv = sv.size
     basis = bv.reshape(-1)

@@ -35,7 +35,7 @@ import numpy as np
 from .basis import basis_derivatives, find_spans
 from .threads import running_on, threads_for
 
-#: doubles in the per-block row table of the grid stage (4 MiB): fits in L2/L3
+#: doubles in the per-block row table of the grid stage (2 MiB): stays in L2
 ROW_TABLE = 1 << 18
 #: v-points per block of the grid: the rows a u-point combines stay in cache
 V_BLOCK = 1024
@@ -275,8 +275,9 @@ def _numba_threads() -> int:
 def _row_blocks(su, p, n, per_row, threads=1):
     """Blocks of u-points whose net rows fit the row table, as the arrays of
     :func:`surfmod.eval.kernels.grid`: ``(starts, rows, row_starts, first)``.  With
-    several threads there are :data:`BLOCKS_PER_THREAD` blocks a thread or more (rows at a boundary between
-    blocks are contracted by both; the values do not depend on the blocking)."""
+    several threads there are :data:`BLOCKS_PER_THREAD` blocks a thread or more (rows at
+    a boundary between blocks are contracted by both; the values do not depend on the
+    blocking)."""
     max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
     step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
     most = su.size  # u-points per block at most: with threads, several blocks each
