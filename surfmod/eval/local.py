@@ -12,7 +12,8 @@ row table stays a few MiB whatever the grid or the net.  Results are written poi
 into a caller's array when given.  :func:`partials_finite` bounds the partials once per
 net, so callers need not rescan large outputs for NaN or infinity.
 
-The compiled kernels live in :mod:`surfmod.eval.kernels`, imported on first use (so
+The compiled kernels live in :mod:`surfmod.eval.kernels` and
+:mod:`surfmod.eval.grid_kernels`, imported on first use (so
 ``import surfmod`` does not load numba).
 
 >>> import numpy as np
@@ -27,6 +28,7 @@ from __future__ import annotations
 import threading
 import warnings
 from contextlib import nullcontext
+from itertools import pairwise
 from math import comb
 from typing import NamedTuple
 
@@ -51,15 +53,20 @@ def _kernels():
     return kernels
 
 
-def _kernels_for(points: int):
-    """The kernels for ``points`` evaluations and their thread count: the
-    single-threaded ones, or their parallel variants (:mod:`surfmod.eval.parallel`, equal
-    bit for bit) when :mod:`surfmod.eval.threads` allows several threads."""
+def _kernels_for(points: int, grid: bool = False):
+    """The kernels for ``points`` evaluations (scattered, or a grid) and their thread
+    count: the single-threaded ones, or their parallel variants
+    (:mod:`surfmod.eval.parallel`, equal bit for bit) when :mod:`surfmod.eval.threads`
+    allows several threads."""
     count = threads_for(points)
     if count > 1:
         from . import parallel
 
         return parallel, count
+    if grid:
+        from . import grid_kernels
+
+        return grid_kernels, 1
     return _kernels(), 1
 
 
@@ -274,7 +281,7 @@ def _numba_threads() -> int:
 
 def _row_blocks(su, p, n, per_row, threads=1):
     """Blocks of u-points whose net rows fit the row table, as the arrays of
-    :func:`surfmod.eval.kernels.grid`: ``(starts, rows, row_starts, first)``.  With
+    :func:`surfmod.eval.grid_kernels.grid`: ``(starts, rows, row_starts, first)``.  With
     several threads there are :data:`BLOCKS_PER_THREAD` blocks a thread or more (rows at
     a boundary between blocks are contracted by both; the values do not depend on the
     blocking)."""
@@ -297,7 +304,7 @@ def _row_blocks(su, p, n, per_row, threads=1):
         starts = np.arange(0, su.size + step, step).clip(max=su.size)
         starts = starts[np.r_[True, np.diff(starts) > 0]]
     rows, row_starts, first = [], [0], np.empty(su.size, dtype=np.int64)
-    for a0, a1 in zip(starts[:-1], starts[1:]):  # loop over memory blocks, not points
+    for a0, a1 in pairwise(starts):  # loop over memory blocks, not points
         s = su[a0:a1]
         block = np.unique((s[:, None] - p + np.arange(p + 1)).ravel())
         first[a0:a1] = np.searchsorted(block, s - p)
@@ -330,7 +337,7 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     else:
         if out is None:
             out = np.empty((us.size, vs.size, kk, kk, 3))
-    run, count = _kernels_for(us.size * vs.size)
+    run, count = _kernels_for(us.size * vs.size, grid=True)
     with _on(count):
         for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]

@@ -1,7 +1,7 @@
 """Multi-threaded variants of the evaluation kernels (numba ``parallel=True``, ``prange``).
 
 Each variant has the signature of its single-threaded kernel in :mod:`surfmod.eval.kernels`
-(or :mod:`surfmod.eval.patches`) and runs the same compiled chunk functions, only with
+(:mod:`surfmod.eval.grid_kernels`, :mod:`surfmod.eval.patches`) and runs the same compiled chunk functions, only with
 the chunks (blocks of rows, of u-points, of scattered points) shared among threads.  A
 chunk writes only its own part of the output and has its own scratch, and no value
 depends on which chunk computes it, so the results equal the single-threaded ones bit
@@ -13,14 +13,14 @@ from __future__ import annotations
 
 from numba import get_thread_id, njit, prange
 
-from .kernels import (SCATTER_CHUNK, grid_block_derivatives, grid_block_positions, scattered_derivatives_chunk,
-                      scattered_positions_chunk)
+from .grid_kernels import grid_block_derivatives, grid_block_positions
+from .kernels import SCATTER_CHUNK, scattered_derivatives_chunk, scattered_positions_chunk
 from .patches import positions_chunk
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first):
-    """:func:`surfmod.eval.kernels.grid`, a block of u-points per task; each thread
+    """:func:`surfmod.eval.grid_kernels.grid`, a block of u-points per task; each thread
     builds its blocks' row tables in its own row of ``scratch``."""
     for blk in prange(starts.size - 1):
         space = scratch[get_thread_id()]

@@ -61,9 +61,8 @@ def set_threads(count: int | None) -> int | None:
     2
     """
     global _requested
-    if count is not None:
-        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-            raise SurfmodError(f"count: expected a positive integer or None, got {count!r}")
+    if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 1):
+        raise SurfmodError(f"count: expected a positive integer or None, got {count!r}")
     previous, _requested = _requested, count
     return previous
 
