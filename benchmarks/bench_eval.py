@@ -3,7 +3,8 @@ splipy and geomdl, on nets of 4 to 1000 poles per direction.
 
 Every timing runs twice, in two subprocesses: *1 core* with BLAS and numba pinned to one
 thread (``OMP/OPENBLAS/MKL/NUMBA_NUM_THREADS=1``; OCCT's per-point loop is single-threaded
-anyway) and *all cores* with the machine's defaults.  Single-core times are CPU times of
+anyway) and *all cores* with the machine's defaults, where work of 2^16 points or more
+runs in the parallel kernel variants (:mod:`surfmod.eval.parallel`) on every core.  Single-core times are CPU times of
 the process (``time.process_time``), best of several runs, so that other load on a shared
 machine inflates neither side; all-core times are wall times.  OCCT per-point rates
 (``Value`` = positions, ``D2`` = all partials to order 2, into preallocated ``gp_Pnt`` /
@@ -40,7 +41,7 @@ def _clock(single: bool):
     return time.process_time if single else time.perf_counter
 
 
-def _time(fn, single: bool, repeat: int = 3) -> float:
+def _time(fn, single: bool, repeat: int = 7) -> float:
     clock = _clock(single)
     best = np.inf
     for _ in range(repeat):
@@ -120,6 +121,9 @@ def measure(single: bool) -> dict:
     """Every timing of the tables, in seconds, for this process's thread setting."""
     out = {"net": {}, "rows": {}}
     grid = np.linspace(0, 1, GRID)
+    from surfmod.eval.threads import threads_for
+
+    out["threads"] = threads_for(GRID**2)
     buf = np.zeros((GRID, GRID, 3))  # faulted in once, reused by every "into" timing
     for n in NET_SIZES:
         s = nurbs(n)
@@ -231,6 +235,8 @@ def _x(a, b):
 
 
 def report(one: dict, every: dict) -> None:
+    print(f"threads of the compiled kernels: 1c {one['threads']}, all {every['threads']} "
+          f"(parallel variants, equal bit for bit; the machine has {os.cpu_count()} cores)\n")
     print(f"{GRID}² grid of positions, rational bicubic net n x n (OCCT: per-point Value x 10^6)")
     head = (f"{'net':>9} {'surfmod 1c':>11} {'into 1c':>8} {'surfmod all':>12} {'OCCT':>7} {'splipy 1c':>10} "
             f"{'splipy all':>11} {'x OCCT':>7} {'into':>7} {'x splipy 1c':>12} {'x splipy all':>13}")

@@ -3,8 +3,11 @@
 Every point touches only its ``(p+1) x (q+1)`` poles, so the cost depends on the number
 of points and the degrees, never on the size of the control net.  The kernels are
 imported lazily (``import surfmod`` never imports numba) and compiled once into numba's
-on-disk cache (``cache=True``).  All arrays they write are allocated by the NumPy caller,
-so ``tracemalloc`` sees the memory and the caller decides the blocking.
+on-disk cache (``cache=True``).  Every sizeable array they write (outputs, the grid's
+row tables) is allocated by the NumPy caller, so ``tracemalloc`` sees the memory and the
+caller decides the blocking; inside there are only per-chunk scratch planes of a few
+hundred KiB at most.  The grid kernels are in :mod:`surfmod.eval.grid_kernels`, the multi-threaded variants
+in :mod:`surfmod.eval.parallel`.
 
 Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polynomial,
 4 rational ``(w x, w y, w z, w)``), C-contiguous float64.  Spans follow
@@ -18,6 +21,10 @@ from functools import cache
 
 import numpy as np
 from numba import njit
+
+# unsigned index steps: unsigned offsets spare numba's negative-index wraparound (a
+# compare and a select per access), which otherwise keeps loops from vectorizing
+U1, U2, U3 = np.uint64(1), np.uint64(2), np.uint64(3)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -163,7 +170,9 @@ def binomials(order: int) -> np.ndarray:
 
 #: points per block of the scattered-derivative kernel (its planes stay in L1/L2)
 POINT_BLOCK = 128
-
+#: scattered points per chunk: the unit of work of the parallel variants
+#: (:mod:`surfmod.eval.parallel`); a multiple of :data:`POINT_BLOCK`
+SCATTER_CHUNK = 4096
 
 @njit(cache=True, error_model="numpy")
 def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
@@ -173,6 +182,16 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_
     otherwise.  Points go in blocks: per point the spans, the basis derivatives and a
     gather of the local ``(p+1) x (q+1)`` net into planes; then the contraction and the
     quotient rule run over the block with the points on the contiguous (vector) axis."""
+    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v,
+                                    bucket_u, bucket_v, out, c)
+
+
+@njit(cache=True, error_model="numpy")
+def scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u,
+                                bucket_v, out, chunk):
+    """Points ``chunk * SCATTER_CHUNK`` onwards (one chunk) of :func:`scattered_derivatives`,
+    with their own scratch planes: chunks are independent."""
     n, m = ctrl.shape[0], ctrl.shape[1]
     kk = order + 1
     nb = POINT_BLOCK
@@ -187,8 +206,9 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_
     h = np.ones((kk, kk, 4, nb))  # lanes past a short last block keep finite values
     t0u, scale_u, table_u = bucket_u
     t0v, scale_v, table_v = bucket_v
-    for a0 in range(0, u.size, nb):
-        cnt = min(nb, u.size - a0)
+    end = min(u.size, (chunk + 1) * SCATTER_CHUNK)
+    for a0 in range(chunk * SCATTER_CHUNK, end, nb):
+        cnt = min(nb, end - a0)
         for b in range(cnt):
             su = find_span_bucketed(ku, p, n, u[a0 + b], t0u, scale_u, table_u)
             sv = find_span_bucketed(kv, q, m, v[a0 + b], t0v, scale_v, table_v)
@@ -221,7 +241,7 @@ def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_
                             for b in range(cnt):
                                 h[k, l, d, b] += bu[k, i, b] * row[l, d, b]
         if rational:  # on the whole block: contiguous planes vectorize
-            _quotient_planes(h, binom)
+            quotient_planes(h, binom)
         for b in range(cnt):
             for k in range(kk):
                 for l in range(kk):
@@ -234,13 +254,20 @@ def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket
     """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
     :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
     sums kept in registers."""
+    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c)
+
+
+@njit(cache=True, error_model="numpy")
+def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, chunk):
+    """One chunk of :func:`scattered_positions` (points ``chunk * SCATTER_CHUNK`` on)."""
     n, m = ctrl.shape[0], ctrl.shape[1]
     nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
     lu, ru = np.empty(p + 1), np.empty(p + 1)
     lv, rv = np.empty(q + 1), np.empty(q + 1)
     t0u, scale_u, table_u = bucket_u
     t0v, scale_v, table_v = bucket_v
-    for a in range(u.size):
+    for a in range(chunk * SCATTER_CHUNK, min(u.size, (chunk + 1) * SCATTER_CHUNK)):
         su = find_span_bucketed(ku, p, n, u[a], t0u, scale_u, table_u)
         sv = find_span_bucketed(kv, q, m, v[a], t0v, scale_v, table_v)
         _basis_funs(ku, p, su, u[a], inv_u, lu, ru, nu_)
@@ -288,144 +315,8 @@ def _basis_funs(knots, p, span, t, inv, left, right, out):
         out[j] = saved
 
 
-@njit(cache=True, error_model="numpy")
-def grid_rows(bv, sv, q, ctrl, rows, dim, out):
-    """First stage of the grid: ``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]``
-    for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
-    with the v-basis."""
-    kk = bv.shape[1]
-    for r in range(rows.size):
-        i = rows[r]
-        for b in range(sv.size):
-            s = sv[b] - q
-            for l in range(kk):
-                x = y = z = w = 0.0
-                for j in range(q + 1):
-                    c = bv[b, l, j]
-                    x += c * ctrl[i, s + j, 0]
-                    y += c * ctrl[i, s + j, 1]
-                    z += c * ctrl[i, s + j, 2]
-                    w += c * ctrl[i, s + j, 3]
-                out[r, l, 0, b] = x
-                out[r, l, 1, b] = y
-                out[r, l, 2, b] = z
-                if dim == 4:
-                    out[r, l, 3, b] = w
-
-
 @njit(cache=True, inline="always", error_model="numpy")
-def _combine_rows(bu, a, first, p, w, kk, dim, acc, off):
-    """``acc[k, l, d, off:off+n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
-    vector axis); up to degree 3 as one four-term pass per plane."""
-    r0 = first[a]
-    nv = w.shape[3]
-    if p <= 3:
-        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
-        for k in range(kk):
-            c0 = bu[a, k, 0]
-            c1 = bu[a, k, 1] if p >= 1 else 0.0
-            c2 = bu[a, k, 2] if p >= 2 else 0.0
-            c3 = bu[a, k, 3] if p >= 3 else 0.0
-            for l in range(kk):
-                for d in range(dim):
-                    w0, w1, w2, w3 = w[r0, l, d], w[r1, l, d], w[r2, l, d], w[r3, l, d]
-                    dst = acc[k, l, d]
-                    for b in range(nv):
-                        dst[off + b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
-        return
-    for k in range(kk):
-        for l in range(kk):
-            for d in range(dim):
-                c = bu[a, k, 0]
-                for b in range(nv):
-                    acc[k, l, d, off + b] = c * w[r0, l, d, b]
-                for i in range(1, p + 1):
-                    c = bu[a, k, i]
-                    for b in range(nv):
-                        acc[k, l, d, off + b] += c * w[r0 + i, l, d, b]
-
-
-@njit(cache=True, error_model="numpy")
-def grid_positions(bu, first, p, w, rational, acc, b0, out):
-    """Second stage for positions: ``out[:, b0:b0+n_v]`` of ``out (n_u, N_v, 3)``
-    point-major, the division by the weight fused into the (interleaving) store."""
-    nv = w.shape[3]
-    dim = 4 if rational else 3
-    if p <= 3:
-        _positions_low_degree(bu, first, p, w, rational, b0, out)
-        return
-    for a in range(bu.shape[0]):
-        _combine_rows(bu, a, first, p, w, 1, dim, acc, 0)
-        if rational:
-            for b in range(nv):
-                inv_w = 1.0 / acc[0, 0, 3, b]
-                out[a, b0 + b, 0] = acc[0, 0, 0, b] * inv_w
-                out[a, b0 + b, 1] = acc[0, 0, 1, b] * inv_w
-                out[a, b0 + b, 2] = acc[0, 0, 2, b] * inv_w
-        else:
-            for b in range(nv):
-                out[a, b0 + b, 0] = acc[0, 0, 0, b]
-                out[a, b0 + b, 1] = acc[0, 0, 1, b]
-                out[a, b0 + b, 2] = acc[0, 0, 2, b]
-
-
-@njit(cache=True, error_model="numpy")
-def _positions_low_degree(bu, first, p, w, rational, b0, out):
-    """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point: the four
-    row terms are written out (missing ones get weight 0 on a valid row), so the sums,
-    the division and the store are one vector loop with everything in registers."""
-    nv = w.shape[3]
-    for a in range(bu.shape[0]):
-        r0 = first[a]
-        c0 = bu[a, 0, 0]
-        c1 = bu[a, 0, 1] if p >= 1 else 0.0
-        c2 = bu[a, 0, 2] if p >= 2 else 0.0
-        c3 = bu[a, 0, 3] if p >= 3 else 0.0
-        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
-        x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
-        y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
-        z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
-        row = out[a]
-        if rational:
-            h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
-            for b in range(nv):
-                inv_w = 1.0 / (c0 * h0[b] + c1 * h1[b] + c2 * h2[b] + c3 * h3[b])
-                row[b0 + b, 0] = (c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]) * inv_w
-                row[b0 + b, 1] = (c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]) * inv_w
-                row[b0 + b, 2] = (c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]) * inv_w
-        else:
-            for b in range(nv):
-                row[b0 + b, 0] = c0 * x0[b] + c1 * x1[b] + c2 * x2[b] + c3 * x3[b]
-                row[b0 + b, 1] = c0 * y0[b] + c1 * y1[b] + c2 * y2[b] + c3 * y3[b]
-                row[b0 + b, 2] = c0 * z0[b] + c1 * z1[b] + c2 * z2[b] + c3 * z3[b]
-
-
-@njit(cache=True, error_model="numpy")
-def grid_derivatives(bu, first, p, w, rational, binom, acc, b0, out):
-    """Second stage for partials: for each u-point combine its p+1 rows of ``w`` on the
-    cache-resident planes of ``acc`` (every partial and coordinate a contiguous row of
-    v), apply the quotient rule there (rational), then store each point's ``3 K^2``
-    values together into ``out[:, b0:b0+n_v]`` of the point-major ``out (n_u, N_v, K, K,
-    3)``, so the output is written once, front to back."""
-    kk = bu.shape[1]
-    nv = w.shape[3]
-    dim = 4 if rational else 3
-    for a in range(bu.shape[0]):
-        _combine_rows(bu, a, first, p, w, kk, dim, acc, 0)
-        if rational:
-            _quotient_planes(acc, binom)
-        dst = out[a]
-        for b in range(nv):
-            point = dst[b0 + b]
-            for k in range(kk):
-                for l in range(kk):
-                    point[k, l, 0] = acc[k, l, 0, b]
-                    point[k, l, 1] = acc[k, l, 1, b]
-                    point[k, l, 2] = acc[k, l, 2, b]
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _quotient_planes(acc, binom):
+def quotient_planes(acc, binom):
     """The quotient rule in place on planes ``acc (K, K, 4, n)``: coordinates 0..2 of
     every entry become Cartesian, entry by entry in rising order (each needs only lower
     entries, already converted, and the untouched weight planes).  Every step is a pass
@@ -457,7 +348,7 @@ def _quotient_planes(acc, binom):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _quotient_planes_order2(acc):
-    """:func:`_quotient_planes` for partials to order 2, written out: one pass over the
+    """:func:`quotient_planes` for partials to order 2, written out: one pass over the
     points per coordinate with all nine entries in registers (the general version makes
     a pass per term).  Same terms in the same order, so the same rounding."""
     nv = acc.shape[3]

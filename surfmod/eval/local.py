@@ -12,7 +12,8 @@ row table stays a few MiB whatever the grid or the net.  Results are written poi
 into a caller's array when given.  :func:`partials_finite` bounds the partials once per
 net, so callers need not rescan large outputs for NaN or infinity.
 
-The compiled kernels live in :mod:`surfmod.eval.kernels`, imported on first use (so
+The compiled kernels live in :mod:`surfmod.eval.kernels` and
+:mod:`surfmod.eval.grid_kernels`, imported on first use (so
 ``import surfmod`` does not load numba).
 
 >>> import numpy as np
@@ -24,24 +25,54 @@ array([[1.5 , 0.75, 0.  ]])
 
 from __future__ import annotations
 
+import threading
 import warnings
+from contextlib import nullcontext
+from itertools import pairwise
 from math import comb
 from typing import NamedTuple
 
 import numpy as np
 
 from .basis import basis_derivatives, find_spans
+from .threads import running_on, threads_for
 
-#: doubles in the per-block row table of the grid stage (4 MiB): fits in L2/L3
-ROW_TABLE = 1 << 19
+#: doubles in the per-block row table of the grid stage (2 MiB): stays in L2
+ROW_TABLE = 1 << 18
 #: v-points per block of the grid: the rows a u-point combines stay in cache
 V_BLOCK = 1024
+#: fewest u-points per block when blocks are split among threads
+GRID_MIN_BLOCK = 16
+#: blocks per thread (at least): threads that finish early take more of them
+BLOCKS_PER_THREAD = 8
 
 
 def _kernels():
     from . import kernels  # numba: compiled on first use, then from its disk cache
 
     return kernels
+
+
+def _kernels_for(points: int, grid: bool = False):
+    """The kernels for ``points`` evaluations (scattered, or a grid) and their thread
+    count: the single-threaded ones, or their parallel variants
+    (:mod:`surfmod.eval.parallel`, equal bit for bit) when :mod:`surfmod.eval.threads`
+    allows several threads."""
+    count = threads_for(points)
+    if count > 1:
+        from . import parallel
+
+        return parallel, count
+    if grid:
+        from . import grid_kernels
+
+        return grid_kernels, 1
+    return _kernels(), 1
+
+
+def _on(count: int):
+    """The ``with`` context that runs numba's parallel kernels on ``count`` threads."""
+    return running_on(count) if count > 1 else nullcontext()
 
 
 def writable(t) -> np.ndarray:
@@ -185,7 +216,6 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
 
     Many points on a small low-degree net go through per-span polynomial patches
     (:mod:`surfmod.eval.patches`), the others through the basis-function kernel."""
-    k = _kernels()
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, 3))
@@ -195,8 +225,10 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
 
         patches.positions(net, table, u, v, out)
         return out
-    k.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
-                          net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
+    run, count = _kernels_for(u.size)
+    with _on(count):
+        run.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
+                                net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
     return out
 
 
@@ -207,8 +239,11 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
-    k.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order), net.rational,
-                            k.binomials(order), net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
+    run, count = _kernels_for(u.size)
+    with _on(count):
+        run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),
+                                  net.rational, k.binomials(order), net.inv_u, net.inv_v, net.bucket_u,
+                                  net.bucket_v, out)
     return out
 
 
@@ -228,14 +263,59 @@ def homogeneous4(ctrl: np.ndarray) -> np.ndarray:
     return out
 
 
-def _row_blocks(su, p, n, per_row):
-    """Blocks of u-points whose net rows fit the row table: ``(a0, a1, rows, first)``."""
+_workspace = threading.local()
+
+
+def _scratch(count: int, per_slot: int) -> np.ndarray:
+    """``(slots, per_slot)`` scratch for the grid's row tables, one slot per thread that
+    may run (numba's thread ids when ``count > 1``), kept per calling thread and reused:
+    a fresh multi-MiB table per call would be paged in each time."""
+    slots = 1 if count == 1 else _numba_threads()
+    buf = getattr(_workspace, "rows", None)
+    if buf is None or buf.size < slots * per_slot:
+        buf = _workspace.rows = np.empty(slots * per_slot)
+    return buf[: slots * per_slot].reshape(slots, per_slot)
+
+
+def _numba_threads() -> int:
+    import numba
+
+    return int(numba.config.NUMBA_NUM_THREADS)
+
+
+def _row_blocks(su, p, n, per_row, threads=1):
+    """Blocks of u-points whose net rows fit the row table, as the arrays of
+    :func:`surfmod.eval.grid_kernels.grid`: ``(starts, rows, row_starts, first)``.  With
+    several threads there are :data:`BLOCKS_PER_THREAD` blocks a thread or more (rows at
+    a boundary between blocks are contracted by both; the values do not depend on the
+    blocking)."""
     max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
     step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
-    for a0 in range(0, su.size, step):  # loop over memory blocks, not points
-        s = su[a0 : a0 + step]
-        rows = np.unique((s[:, None] - p + np.arange(p + 1)).ravel())
-        yield a0, a0 + s.size, rows, np.searchsorted(rows, s - p)
+    most = su.size  # u-points per block at most: with threads, several blocks each
+    if threads > 1:
+        most = max(GRID_MIN_BLOCK, -(-su.size // (BLOCKS_PER_THREAD * threads)))
+        step = min(step, most)
+    if n > max_rows and su.size > 1 and np.all(su[1:] >= su[:-1]):
+        # sorted u (the usual grid): a block takes u-points while its rows fit, not
+        # max_rows / (p+1) of them (which assumes p+1 new rows per u-point)
+        cuts = [0]
+        while cuts[-1] < su.size:  # loop over memory blocks, not points
+            a0 = cuts[-1]
+            a1 = int(np.searchsorted(su, su[a0] + max_rows - p - 1, side="right"))
+            cuts.append(min(max(a1, a0 + 1), a0 + most))
+        starts = np.array(cuts)
+    else:
+        starts = np.arange(0, su.size + step, step).clip(max=su.size)
+        starts = starts[np.r_[True, np.diff(starts) > 0]]
+    rows, row_starts, first = [], [0], np.empty(su.size, dtype=np.int64)
+    for a0, a1 in pairwise(starts):  # loop over memory blocks, not points
+        s = su[a0:a1]
+        block = np.unique((s[:, None] - p + np.arange(p + 1)).ravel())
+        first[a0:a1] = np.searchsorted(block, s - p)
+        rows.append(block)
+        row_starts.append(row_starts[-1] + block.size)
+    rows = np.concatenate(rows) if rows else np.empty(0, dtype=np.int64)
+    return starts.astype(np.int64), rows.astype(np.int64), np.array(row_starts, dtype=np.int64), first
 
 
 def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
@@ -254,24 +334,20 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     dim = 4 if rational else 3
     su, bu = _basis(knots_u, p, n, us, order)
     sv, bv = _basis(knots_v, q, m, vs, order)
-    acc = np.empty((kk, kk, 4, min(V_BLOCK, vs.size)))
+    binom = k.binomials(order)
     if order == 0:
         if out is None:
             out = np.empty((us.size, vs.size, 3))
     else:
-        binom = k.binomials(order)
         if out is None:
             out = np.empty((us.size, vs.size, kk, kk, 3))
-    for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
-        svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
-        accb = acc if svb.size == acc.shape[-1] else np.empty(acc.shape[:-1] + (svb.size,))
-        for a0, a1, rows, first in _row_blocks(su, p, n, kk * dim * svb.size):
-            table = np.empty((rows.size, kk, dim, svb.size))
-            k.grid_rows(bvb, svb, q, ctrl, rows, dim, table)
-            if order == 0:
-                k.grid_positions(bu[a0:a1], first, p, table, rational, accb, b0, out[a0:a1])
-            else:
-                k.grid_derivatives(bu[a0:a1], first, p, table, rational, binom, accb, b0, out[a0:a1])
+    run, count = _kernels_for(us.size * vs.size, grid=True)
+    with _on(count):
+        for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
+            svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
+            blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
+            per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks)
     if order == 0:
         return out[:, :, None, None, :]
     return out

@@ -1,0 +1,343 @@
+"""Compiled (numba) kernels for grids ``us x vs`` with local support, in two stages:
+the net rows the u-points need contracted with the v-basis once (:func:`grid_rows`),
+then p+1 rows combined per u-point with the v-points on the vector axis
+(:func:`grid_positions`, :func:`grid_derivatives`), block by block of u-points
+(:func:`grid`).  Conventions as in :mod:`surfmod.eval.kernels`; the multi-threaded
+variant of :func:`grid` is in :mod:`surfmod.eval.parallel`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, uint64
+
+from .kernels import U1, U2, U3, quotient_planes
+
+
+@njit(cache=True, error_model="numpy")
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first):
+    """The grid ``us x vs[b0:b0+n_v]`` into ``out`` (point-major: ``(n_u, N_v, 3)`` for
+    positions, ``(n_u, N_v, K, K, 3)`` for partials, ``K = bu.shape[1]``), block by block
+    of u-points (:func:`grid_block_positions`, :func:`grid_block_derivatives`); block
+    ``k`` is u-points ``starts[k]:starts[k+1]``, its net rows
+    ``rows[row_starts[k]:row_starts[k+1]]``, ``first[a]`` the place of u-point ``a``'s
+    first row among them; ``scratch[0]`` holds a block's row table (reused: a fresh
+    table per block would be paged in again and again)."""
+    for blk in range(starts.size - 1):
+        if out.ndim == 3:
+            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,
+                                 first, blk)
+        else:
+            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[0], starts, rows,
+                                   row_starts, first, blk)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk):
+    """A block's net rows contracted with the v-basis (:func:`grid_rows`) into a table in
+    ``space`` (its thread's scratch), and its u-range.  Blocks share nothing but the
+    read-only inputs, so the parallel variant (:mod:`surfmod.eval.parallel`) runs them
+    on several threads."""
+    mine = rows[row_starts[blk] : row_starts[blk + 1]]
+    kk, nv = bv.shape[1], sv.size
+    table = space[: mine.size * kk * dim * nv].reshape((mine.size, kk, dim, nv))
+    grid_rows(bv, sv, q, ctrl, mine, dim, table)
+    return table, starts[blk], starts[blk + 1]
+
+
+@njit(cache=True, error_model="numpy")
+def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts, first,
+                         blk):
+    """One block of :func:`grid` for positions."""
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk)
+    grid_positions(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1])
+
+
+@njit(cache=True, error_model="numpy")
+def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows, row_starts,
+                           first, blk):
+    """One block of :func:`grid` for partials."""
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk)
+    grid_derivatives(bu[a0:a1], first[a0:a1], p, table, rational, binom, b0, out[a0:a1])
+
+
+@njit(cache=True, error_model="numpy")
+def grid_rows(bv, sv, q, ctrl, rows, dim, out):
+    """First stage of the grid: ``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]``
+    for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
+    with the v-basis, two rows per pass (a v-point's basis values and window are loaded
+    once for both; each row's sums are those of the one-row pass, so the same values)."""
+    kk = bv.shape[1]
+    nv = sv.size
+    basis = bv.reshape(-1)
+    per_point = uint64(kk * (q + 1))
+    pairs = rows.size // 2
+    for r2 in range(pairs):  # two rows per pass: the basis values are loaded once for both
+        ra, rb = 2 * r2, 2 * r2 + 1
+        row_a, row_b = ctrl[rows[ra]].reshape(-1), ctrl[rows[rb]].reshape(-1)
+        dst_a, dst_b = out[ra].reshape(-1), out[rb].reshape(-1)
+        for b in range(nv):
+            ub = uint64(b)
+            s = uint64(4 * (sv[b] - q))
+            for l in range(kk):
+                x = y = z = w = 0.0
+                x2 = y2 = z2 = w2 = 0.0
+                o = ub * per_point + uint64(l * (q + 1))
+                for j in range(q + 1):
+                    c = basis[o + uint64(j)]
+                    t = s + uint64(4 * j)
+                    x += c * row_a[t]
+                    y += c * row_a[t + U1]
+                    z += c * row_a[t + U2]
+                    w += c * row_a[t + U3]
+                    x2 += c * row_b[t]
+                    y2 += c * row_b[t + U1]
+                    z2 += c * row_b[t + U2]
+                    w2 += c * row_b[t + U3]
+                t = uint64(l * dim * nv) + ub
+                dst_a[t] = x
+                dst_a[t + uint64(nv)] = y
+                dst_a[t + uint64(2 * nv)] = z
+                dst_b[t] = x2
+                dst_b[t + uint64(nv)] = y2
+                dst_b[t + uint64(2 * nv)] = z2
+                if dim == 4:
+                    dst_a[t + uint64(3 * nv)] = w
+                    dst_b[t + uint64(3 * nv)] = w2
+    for r in range(2 * pairs, rows.size):
+        net_row = ctrl[rows[r]].reshape(-1)  # flat, unsigned offsets (see U1)
+        dst = out[r].reshape(-1)
+        for b in range(nv):
+            ub = uint64(b)
+            s = uint64(4 * (sv[b] - q))
+            for l in range(kk):
+                x = y = z = w = 0.0
+                o = ub * per_point + uint64(l * (q + 1))
+                for j in range(q + 1):
+                    c = basis[o + uint64(j)]
+                    t = s + uint64(4 * j)
+                    x += c * net_row[t]
+                    y += c * net_row[t + U1]
+                    z += c * net_row[t + U2]
+                    w += c * net_row[t + U3]
+                t = uint64(l * dim * nv) + ub
+                dst[t] = x
+                dst[t + uint64(nv)] = y
+                dst[t + uint64(2 * nv)] = z
+                if dim == 4:
+                    dst[t + uint64(3 * nv)] = w
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _combine_rows(bu, a, first, p, w, kk, dim, acc):
+    """``acc[k, l, d, :n_v] = sum_i bu[a, k, i] w[first[a]+i, l, d, :]`` (v on the
+    vector axis); up to degree 3 as one four-term pass per plane."""
+    r0 = first[a]
+    nv = w.shape[3]
+    if p <= 3:
+        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+        for k in range(kk):
+            c0 = bu[a, k, 0]
+            c1 = bu[a, k, 1] if p >= 1 else 0.0
+            c2 = bu[a, k, 2] if p >= 2 else 0.0
+            c3 = bu[a, k, 3] if p >= 3 else 0.0
+            for l in range(kk):
+                for d in range(dim):
+                    w0, w1, w2, w3 = w[r0, l, d], w[r1, l, d], w[r2, l, d], w[r3, l, d]
+                    dst = acc[k, l, d]
+                    for b in range(nv):
+                        dst[b] = c0 * w0[b] + c1 * w1[b] + c2 * w2[b] + c3 * w3[b]
+        return
+    for k in range(kk):
+        for l in range(kk):
+            for d in range(dim):
+                c = bu[a, k, 0]
+                for b in range(nv):
+                    acc[k, l, d, b] = c * w[r0, l, d, b]
+                for i in range(1, p + 1):
+                    c = bu[a, k, i]
+                    for b in range(nv):
+                        acc[k, l, d, b] += c * w[r0 + i, l, d, b]
+
+
+@njit(cache=True, error_model="numpy")
+def grid_positions(bu, first, p, w, rational, b0, out):
+    """Second stage for positions: ``out[:, b0:b0+n_v]`` of ``out (n_u, N_v, 3)``
+    point-major, the division by the weight fused into the (interleaving) store."""
+    nv = w.shape[3]
+    dim = 4 if rational else 3
+    if p <= 3:
+        _positions_low_degree(bu, first, p, w, rational, b0, out)
+        return
+    acc = np.empty((1, 1, 4, nv))
+    for a in range(bu.shape[0]):
+        _combine_rows(bu, a, first, p, w, 1, dim, acc)
+        row = out[a].reshape(-1)  # flat, unsigned offsets (see U1)
+        o = uint64(3 * b0)
+        for b in range(nv):
+            t = o + U3 * uint64(b)
+            inv_w = 1.0 / acc[0, 0, 3, b] if rational else 1.0
+            row[t] = acc[0, 0, 0, b] * inv_w
+            row[t + U1] = acc[0, 0, 1, b] * inv_w
+            row[t + U2] = acc[0, 0, 2, b] * inv_w
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _positions_low_degree(bu, first, p, w, rational, b0, out):
+    """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point (or per
+    pair of u-points on the same rows, :func:`_low_degree_pair`): the four row terms are
+    written out (missing ones get weight 0 on a valid row), so the sums, the division and
+    the store are one vector loop with everything in registers."""
+    nv = w.shape[3]
+    a = 0
+    while a < bu.shape[0]:
+        if a + 1 < bu.shape[0] and first[a + 1] == first[a]:  # two u-points on the same rows
+            _low_degree_pair(bu, first, p, w, rational, b0, out, a)
+            a += 2
+            continue
+        r0 = first[a]
+        c0 = bu[a, 0, 0]
+        c1 = bu[a, 0, 1] if p >= 1 else 0.0
+        c2 = bu[a, 0, 2] if p >= 2 else 0.0
+        c3 = bu[a, 0, 3] if p >= 3 else 0.0
+        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+        x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
+        y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
+        z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
+        row = out[a].reshape(-1)  # flat, unsigned offsets: no wraparound select, the loop vectorizes
+        o = uint64(3 * b0)
+        if rational:
+            h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
+            for b in range(nv):
+                ub = uint64(b)
+                inv_w = 1.0 / (c0 * h0[ub] + c1 * h1[ub] + c2 * h2[ub] + c3 * h3[ub])
+                t = o + U3 * ub
+                row[t] = (c0 * x0[ub] + c1 * x1[ub] + c2 * x2[ub] + c3 * x3[ub]) * inv_w
+                row[t + U1] = (c0 * y0[ub] + c1 * y1[ub] + c2 * y2[ub] + c3 * y3[ub]) * inv_w
+                row[t + U2] = (c0 * z0[ub] + c1 * z1[ub] + c2 * z2[ub] + c3 * z3[ub]) * inv_w
+        else:
+            for b in range(nv):
+                ub = uint64(b)
+                t = o + U3 * ub
+                row[t] = c0 * x0[ub] + c1 * x1[ub] + c2 * x2[ub] + c3 * x3[ub]
+                row[t + U1] = c0 * y0[ub] + c1 * y1[ub] + c2 * y2[ub] + c3 * y3[ub]
+                row[t + U2] = c0 * z0[ub] + c1 * z1[ub] + c2 * z2[ub] + c3 * z3[ub]
+        a += 1
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _low_degree_pair(bu, first, p, w, rational, b0, out, a):
+    """u-points ``a`` and ``a + 1`` of :func:`_positions_low_degree` when they share their
+    rows (same span): one pass loads each row value once for both (the arithmetic of
+    each point is that of the single pass, so the values are the same)."""
+    nv = w.shape[3]
+    r0 = first[a]
+    r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
+    c0, e0 = bu[a, 0, 0], bu[a + 1, 0, 0]
+    c1, e1 = (bu[a, 0, 1], bu[a + 1, 0, 1]) if p >= 1 else (0.0, 0.0)
+    c2, e2 = (bu[a, 0, 2], bu[a + 1, 0, 2]) if p >= 2 else (0.0, 0.0)
+    c3, e3 = (bu[a, 0, 3], bu[a + 1, 0, 3]) if p >= 3 else (0.0, 0.0)
+    x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
+    y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
+    z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
+    row, nxt = out[a].reshape(-1), out[a + 1].reshape(-1)
+    o = uint64(3 * b0)
+    if rational:
+        h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
+        for b in range(nv):
+            ub = uint64(b)
+            t = o + U3 * ub
+            vx0, vx1, vx2, vx3 = x0[ub], x1[ub], x2[ub], x3[ub]
+            vy0, vy1, vy2, vy3 = y0[ub], y1[ub], y2[ub], y3[ub]
+            vz0, vz1, vz2, vz3 = z0[ub], z1[ub], z2[ub], z3[ub]
+            vw0, vw1, vw2, vw3 = h0[ub], h1[ub], h2[ub], h3[ub]
+            inv_w = 1.0 / (c0 * vw0 + c1 * vw1 + c2 * vw2 + c3 * vw3)
+            row[t] = (c0 * vx0 + c1 * vx1 + c2 * vx2 + c3 * vx3) * inv_w
+            row[t + U1] = (c0 * vy0 + c1 * vy1 + c2 * vy2 + c3 * vy3) * inv_w
+            row[t + U2] = (c0 * vz0 + c1 * vz1 + c2 * vz2 + c3 * vz3) * inv_w
+            inv_w = 1.0 / (e0 * vw0 + e1 * vw1 + e2 * vw2 + e3 * vw3)
+            nxt[t] = (e0 * vx0 + e1 * vx1 + e2 * vx2 + e3 * vx3) * inv_w
+            nxt[t + U1] = (e0 * vy0 + e1 * vy1 + e2 * vy2 + e3 * vy3) * inv_w
+            nxt[t + U2] = (e0 * vz0 + e1 * vz1 + e2 * vz2 + e3 * vz3) * inv_w
+    else:
+        for b in range(nv):
+            ub = uint64(b)
+            t = o + U3 * ub
+            vx0, vx1, vx2, vx3 = x0[ub], x1[ub], x2[ub], x3[ub]
+            vy0, vy1, vy2, vy3 = y0[ub], y1[ub], y2[ub], y3[ub]
+            vz0, vz1, vz2, vz3 = z0[ub], z1[ub], z2[ub], z3[ub]
+            row[t] = c0 * vx0 + c1 * vx1 + c2 * vx2 + c3 * vx3
+            row[t + U1] = c0 * vy0 + c1 * vy1 + c2 * vy2 + c3 * vy3
+            row[t + U2] = c0 * vz0 + c1 * vz1 + c2 * vz2 + c3 * vz3
+            nxt[t] = e0 * vx0 + e1 * vx1 + e2 * vx2 + e3 * vx3
+            nxt[t + U1] = e0 * vy0 + e1 * vy1 + e2 * vy2 + e3 * vy3
+            nxt[t + U2] = e0 * vz0 + e1 * vz1 + e2 * vz2 + e3 * vz3
+
+
+@njit(cache=True, error_model="numpy")
+def grid_derivatives(bu, first, p, w, rational, binom, b0, out):
+    """Second stage for partials: for each u-point combine its p+1 rows of ``w`` on the
+    cache-resident planes of a scratch ``acc`` (every partial and coordinate a contiguous
+    row of v), apply the quotient rule there (rational), then store each point's ``3 K^2``
+    values together into ``out[:, b0:b0+n_v]`` of the point-major ``out (n_u, N_v, K, K,
+    3)``, so the output is written once, front to back."""
+    kk = bu.shape[1]
+    nv = w.shape[3]
+    dim = 4 if rational else 3
+    acc = np.empty((kk, kk, 4, nv))
+    for a in range(bu.shape[0]):
+        _combine_rows(bu, a, first, p, w, kk, dim, acc)
+        dst = out[a].reshape(-1)  # flat, unsigned offsets (see U1)
+        per_point = uint64(3 * kk * kk)
+        o = uint64(b0) * per_point
+        if rational and kk == 3:  # the quotient rule fused into the store
+            _store_quotient_order2(acc, dst, o)
+            continue
+        if rational:
+            quotient_planes(acc, binom)
+        points = out[a]
+        for b in range(nv):
+            point = points[b0 + b]
+            for k in range(kk):
+                for l in range(kk):
+                    point[k, l, 0] = acc[k, l, 0, b]
+                    point[k, l, 1] = acc[k, l, 1, b]
+                    point[k, l, 2] = acc[k, l, 2, b]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _store_quotient_order2(acc, dst, o):
+    """The quotient rule to order 2 (:func:`surfmod.eval.kernels.quotient_planes`) fused
+    with the point-major store of :func:`grid_derivatives`: each point's 27 Cartesian
+    values go straight from registers to ``dst[o + 27 b:]`` (same terms in the same
+    order, so the same rounding), without writing the planes back."""
+    nv = acc.shape[3]
+    w00, w01, w02 = acc[0, 0, 3], acc[0, 1, 3], acc[0, 2, 3]
+    w10, w11, w12 = acc[1, 0, 3], acc[1, 1, 3], acc[1, 2, 3]
+    w20, w21, w22 = acc[2, 0, 3], acc[2, 1, 3], acc[2, 2, 3]
+    for b in range(nv):
+        iw = 1.0 / w00[b]
+        t = o + uint64(27) * uint64(b)
+        for d in range(3):
+            s00 = acc[0, 0, d, b] * iw
+            s01 = (acc[0, 1, d, b] - w01[b] * s00) * iw
+            s02 = (acc[0, 2, d, b] - 2.0 * w01[b] * s01 - w02[b] * s00) * iw
+            s10 = (acc[1, 0, d, b] - w10[b] * s00) * iw
+            s11 = (acc[1, 1, d, b] - w01[b] * s10 - w10[b] * s01 - w11[b] * s00) * iw
+            s12 = (acc[1, 2, d, b] - 2.0 * w01[b] * s11 - w02[b] * s10 - w10[b] * s02 - 2.0 * w11[b] * s01
+                   - w12[b] * s00) * iw
+            s20 = (acc[2, 0, d, b] - 2.0 * w10[b] * s10 - w20[b] * s00) * iw
+            s21 = (acc[2, 1, d, b] - w01[b] * s20 - 2.0 * w10[b] * s11 - 2.0 * w11[b] * s10 - w20[b] * s01
+                   - w21[b] * s00) * iw
+            s22 = (acc[2, 2, d, b] - 2.0 * w01[b] * s21 - w02[b] * s20 - 2.0 * w10[b] * s12 - 4.0 * w11[b] * s11
+                   - 2.0 * w12[b] * s10 - w20[b] * s02 - 2.0 * w21[b] * s01 - w22[b] * s00) * iw
+            e = t + uint64(d)
+            dst[e] = s00
+            dst[e + U3] = s01
+            dst[e + uint64(6)] = s02
+            dst[e + uint64(9)] = s10
+            dst[e + uint64(12)] = s11
+            dst[e + uint64(15)] = s12
+            dst[e + uint64(18)] = s20
+            dst[e + uint64(21)] = s21
+            dst[e + uint64(24)] = s22

@@ -1,0 +1,56 @@
+"""Multi-threaded variants of the evaluation kernels (numba ``parallel=True``, ``prange``).
+
+Each variant has the signature of its single-threaded kernel in :mod:`surfmod.eval.kernels`
+(:mod:`surfmod.eval.grid_kernels`, :mod:`surfmod.eval.patches`) and runs the same compiled chunk functions, only with
+the chunks (blocks of rows, of u-points, of scattered points) shared among threads.  A
+chunk writes only its own part of the output and has its own scratch, and no value
+depends on which chunk computes it, so the results equal the single-threaded ones bit
+for bit.  :mod:`surfmod.eval.threads` decides when they run; this module (and numba's
+thread pool) is loaded only then.
+"""
+
+from __future__ import annotations
+
+from numba import get_thread_id, njit, prange
+
+from .grid_kernels import grid_block_derivatives, grid_block_positions
+from .kernels import SCATTER_CHUNK, scattered_derivatives_chunk, scattered_positions_chunk
+from .patches import positions_chunk
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first):
+    """:func:`surfmod.eval.grid_kernels.grid`, a block of u-points per task; each thread
+    builds its blocks' row tables in its own row of ``scratch``."""
+    for blk in prange(starts.size - 1):
+        space = scratch[get_thread_id()]
+        if out.ndim == 3:
+            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts,
+                                 first, blk)
+        else:
+            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows,
+                                   row_starts, first, blk)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out):
+    """:func:`surfmod.eval.kernels.scattered_positions`, a chunk of points per task."""
+    for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
+    """:func:`surfmod.eval.kernels.scattered_derivatives`, a chunk of points per task."""
+    for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v,
+                                    bucket_u, bucket_v, out, c)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def patch_positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
+                    u, v, out):
+    """The per-span patch kernel of :mod:`surfmod.eval.patches`, a chunk of points per task."""
+    for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
+                        u, v, out, c)
