@@ -371,14 +371,105 @@ def _green(mf: MassFace, order: int, orders, exacts):
     # nodes on p-curves along the inner direction carry no outer differential
     moving = wb != 0.0
     P, wb = P[moving], wb[moving]
-    x, w = gauss(m_in)
-    br = mf.breaks[k]
-    a = np.clip(br[None, :-1], None, P[:, k, None])  # (B, S) span starts clipped to the node
-    b = np.clip(br[None, 1:], None, P[:, k, None])
-    bi, si = np.nonzero(b - a > 0)
-    a, b = a[bi, si], b[bi, si]
-    s = ((a + b)[:, None] / 2 + (b - a)[:, None] / 2 * x).ravel()
-    ws = ((b - a)[:, None] / 2 * w * wb[bi, None]).ravel()
-    other = np.repeat(P[bi, 1 - k], m_in)
+    s, other, ws = _inner_nodes(mf, k, m_in, P, wb)
     ders = mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1)
     return ders, ws, exact and exacts[k]
+
+
+def chebyshev_lobatto(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n >= 2`` Chebyshev–Lobatto points on ``[-1, 1]`` (descending) and their barycentric
+    weights: interpolation there is well conditioned at any degree.
+
+    >>> x, bw = chebyshev_lobatto(3)
+    >>> x.round(12).tolist(), bw.tolist()
+    [[1.0, 0.0, -1.0], [0.5, -1.0, 0.5]]
+    """
+    key = ("lobatto", n)
+    if key not in _GAUSS:
+        j = np.arange(n)
+        bw = np.where(j % 2 == 0, 1.0, -1.0)
+        bw[[0, -1]] *= 0.5
+        _GAUSS[key] = (np.cos(np.pi * j / (n - 1)), bw)
+    return _GAUSS[key]
+
+
+def lagrange_values(y: np.ndarray, x: np.ndarray, bw: np.ndarray) -> np.ndarray:
+    """``(N, K)``: the Lagrange basis of the points ``x`` (barycentric weights ``bw``) at
+    ``y``, so that ``Σ_k L_k(y) f(x_k)`` is the interpolant of ``f`` (exact for
+    polynomials of degree ``< K``).
+
+    >>> x, bw = chebyshev_lobatto(4)
+    >>> L = lagrange_values(np.array([0.3, x[1]]), x, bw)
+    >>> float(round(L[0] @ (x**3), 14)), L[1].round(15).tolist() == [0, 1, 0, 0]
+    (0.027, True)
+    """
+    d = y[:, None] - x[None, :]
+    hit = d == 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = bw / d
+        L = t / t.sum(axis=1, keepdims=True)
+    rows = hit.any(axis=1)
+    L[rows] = hit[rows]  # a value at an interpolation point is that point's value
+    return L
+
+
+def _inner_nodes(mf: MassFace, k: int, m_in: int, P: np.ndarray, wb: np.ndarray):
+    """Nodes ``(s, other, weights)`` of Green's inner integrals ``∫_{lo}^{P_k} g`` along
+    direction ``k`` for the boundary nodes ``P`` (outer weights ``wb``).
+
+    A node's inner integral is its partial span (the span's start to ``P_k``) plus the
+    whole spans below it.  Where the surface is a polynomial of degree ``p`` along the
+    outer direction, a whole span's integral is a polynomial of degree ``5p`` in the outer
+    coordinate on each outer span, so it equals its interpolant at ``5p + 1``
+    Chebyshev–Lobatto points there: the whole spans of all boundary nodes collapse onto
+    those fixed points (weights summed through the Lagrange basis), instead of
+    ``m_in`` nodes per whole span per boundary node."""
+    x, w = gauss(m_in)
+    br = mf.breaks[k]
+    n_spans = len(br) - 1
+    u = P[:, k]
+    # spans wholly below each node (br[i + 1] <= u); the next one, when it starts below u, is partial
+    full = np.searchsorted(br[1:], u, side="right")
+    part = np.flatnonzero((full < n_spans) & (br[np.minimum(full, n_spans - 1)] < u))
+    s_parts, o_parts, w_parts = [], [], []
+
+    def add(a, b, other, weight):  # Gauss on [a, b] per row, at outer coordinate ``other``
+        s_parts.append(((a + b)[:, None] / 2 + (b - a)[:, None] / 2 * x).ravel())
+        w_parts.append(((b - a)[:, None] / 2 * w * weight[:, None]).ravel())
+        o_parts.append(np.repeat(other, m_in))
+
+    if part.size:
+        add(br[full[part]], u[part], P[part, 1 - k], wb[part])
+    p_out = mf.degrees[1 - k]
+    obr = mf.breaks[1 - k]
+    t = P[:, 1 - k]
+    # the outer coordinate inside the face box (p-curves may reach a hair beyond it,
+    # where the surface's next span may hold): those nodes keep their whole spans as nodes
+    collapse = (full > 0) & (t >= obr[0]) & (t <= obr[-1])
+    if p_out is not None and collapse.any():
+        n_pts = 5 * p_out + 1
+        q = np.clip(np.searchsorted(obr, t[collapse], side="right") - 1, 0, len(obr) - 2)
+        # worth it when the fixed points are fewer than the whole spans they replace
+        deepest = np.zeros(len(obr) - 1, int)
+        np.maximum.at(deepest, q, full[collapse])
+        if n_pts * deepest.sum() < np.sum(full[collapse]):
+            xc, bw = chebyshev_lobatto(n_pts)
+            a, b = obr[q], obr[q + 1]
+            L = lagrange_values((2 * t[collapse] - a - b) / (b - a), xc, bw) * wb[collapse, None]
+            acc = np.zeros((len(obr) - 1, n_spans + 1, n_pts))
+            np.add.at(acc, (q, full[collapse]), L)
+            # whole span i of a node counts where the node lies beyond it (full > i)
+            W = np.cumsum(acc[:, ::-1], axis=1)[:, ::-1][:, 1:]  # (Q, S, K)
+            qi, si, ki = np.nonzero(W)
+            oa, ob = obr[qi], obr[qi + 1]
+            add(br[si], br[si + 1], (oa + ob) / 2 + (ob - oa) / 2 * xc[ki], W[qi, si, ki])
+            full = np.where(collapse, 0, full)
+    rows = np.flatnonzero(full)
+    if rows.size:  # whole spans node by node
+        reps = full[rows]
+        node = np.repeat(rows, reps)
+        span = np.arange(reps.sum()) - np.repeat(np.cumsum(reps) - reps, reps)
+        add(br[span], br[span + 1], P[node, 1 - k], wb[node])
+    if not s_parts:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    return np.concatenate(s_parts), np.concatenate(o_parts), np.concatenate(w_parts)
