@@ -47,7 +47,7 @@ from ..errors import SurfmodError
 from ..readback import from_face
 from ..surface import Surface
 from .inputs import to_shape
-from .mass_green import face_nodes, mass_face, surface_mass_face
+from .mass_green import face_nodes, mass_face, plane_nodes, surface_mass_face
 
 
 @dataclass(frozen=True)
@@ -233,7 +233,12 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     # lower-order pass behind the error estimate only re-integrates the others
     exact, high = _Accumulator(ref), _Accumulator(ref)
     inexact = []
+    planes = [f for f in faces if f.plane and f.natural and f.frame is not None]
+    if planes:  # whole planar rectangles (most faces of prismatic parts): all at once
+        exact.add(*plane_nodes(planes))
     for f in faces:
+        if f.plane and f.natural and f.frame is not None:
+            continue
         ders, w, is_exact = face_nodes(f, order)
         (exact if is_exact else high).add(ders, w)
         if not is_exact:
