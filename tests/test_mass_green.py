@@ -128,3 +128,87 @@ def test_face_area_on_a_holed_face():
     top = max(plate.faces(), key=lambda f: f.center().Z)
     assert _rel(sm.from_face(top).area(), 12 - math.pi) < 1e-14
     assert _rel(face_moments(sm.from_face(top))[0], 12 - math.pi) < 1e-14
+
+
+# -- Green's grids -------------------------------------------------------------------------------
+def test_chebyshev_interpolation_and_antiderivatives_are_exact_for_polynomials():
+    rng = np.random.default_rng(7)
+    for n in (3, 6, 16, 26):
+        x, bw, _ = mg.chebyshev(n)
+        y = np.concatenate([rng.uniform(-1, 1, 40), [-1.0, 1.0, x[0]]])
+        L, A = mg.lagrange_values(y, x, bw), mg.antiderivative_weights(y, n)
+        for k in range(n):  # every degree below n: interpolant and ∫_{-1}^{y} exact
+            assert np.abs(L @ x**k - y**k).max() < 1e-13
+            assert np.abs(A @ x**k - (y ** (k + 1) - (-1.0) ** (k + 1)) / (k + 1)).max() < 1e-13
+
+
+def _grid_vs_node_by_node(monkeypatch, face, order=12):
+    mf = mg.mass_face(sm.from_face(face))
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)  # always the grid
+    grid = _moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", 1e18)  # never
+    nodes = _moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
+    return grid, nodes
+
+
+@pytest.mark.parametrize("cut", ["slanted box", "sphere", "spline"])
+def test_green_grid_equals_node_by_node(monkeypatch, cut):
+    # trimmed cylinders (angle x axis, p-curves with gaps), a trimmed sphere (both
+    # directions trigonometric) and a trimmed polynomial spline face (the grid is exact)
+    if cut == "slanted box":
+        part = bd.Cylinder(1.0, 4.0) - bd.Box(4, 4, 4).rotate(bd.Axis.X, 30).translate((0, 0, 2.5))
+    elif cut == "sphere":
+        part = bd.Sphere(1.0) - bd.Box(1, 1, 1).translate((0.6, 0.3, 0.2))
+    else:
+        net = np.zeros((4, 4, 3))
+        net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+        net[..., 2] = [[0, 1, 0, 1], [1, 2, 1, 0], [0, 1, 3, 1], [1, 0, 1, 0]]
+        face = sm.BSplineSurface(net, (3, 3), ([0] * 4 + [1] * 4, [0] * 4 + [1] * 4)).face()
+        part = bd.extrude(bd.Face(face.wrapped), amount=2.0, dir=(0, 0, -1)) & bd.Cylinder(1.2, 20).translate((1.5, 1.5, 0))
+    checked = 0
+    for f in part.faces():
+        mf = mg.mass_face(sm.from_face(f))
+        if mf.natural or mf.plane:
+            continue
+        grid, nodes = _grid_vs_node_by_node(monkeypatch, f)
+        # the moment integrands are polynomials where the surface is: equal to round-off;
+        # the area's |Su x Sv| is a square root, which neither rule integrates exactly
+        assert np.abs(grid[1:] - nodes[1:]).max() < 1e-12 * np.abs(nodes[1:]).max(), f.geom_type
+        assert _rel(grid[0], nodes[0]) < 1e-8
+        checked += 1
+    assert checked >= 1
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)
+    ref = sm.mass_properties(part, method="occt", eps=1e-9).volume
+    assert _rel(sm.mass_properties(part).volume, ref) < 1e-9
+
+
+def test_green_grid_on_a_holed_plate_is_exact(monkeypatch):
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)
+    plate = bd.Box(4, 3, 1) - bd.Cylinder(1.0, 2)
+    r = sm.mass_properties(plate)
+    assert _rel(r.volume, 12 - math.pi) < 1e-14
+    top = max(plate.faces(), key=lambda f: f.center().Z)
+    assert _rel(sm.from_face(top).area(), 12 - math.pi) < 1e-14
+
+
+@pytest.mark.corpus
+def test_green_grid_equals_node_by_node_on_the_corpus(monkeypatch, corpus_file):
+    # every trimmed face of every file: the moment integrals (volume, first and second
+    # moments) of both routes agree at order 16, where node-by-node Gauss has converged
+    for face in faces_of(sm.import_step(corpus_file).wrapped):
+        mf = mg.mass_face(sm.from_face(face))
+        if mf.natural:
+            continue
+        grid, nodes = _grid_vs_node_by_node(monkeypatch, face, 16)
+        assert np.abs(grid[1:] - nodes[1:]).max() < 1e-10 * np.abs(nodes[1:]).max()
+
+
+def test_whole_planar_faces_at_once_equal_face_by_face():
+    part = bd.Box(2, 3, 4) + bd.Box(1, 1, 6)
+    mfs = [mg.mass_face(sm.from_face(f)) for f in part.faces()]
+    planes = [m for m in mfs if m.natural and m.plane]
+    assert len(planes) >= 6
+    ders, w = mg.plane_nodes(planes)
+    one = [mg.face_nodes(m, 12) for m in planes]
+    assert np.abs(w - np.concatenate([x[1] for x in one])).max() < 1e-15
+    assert np.abs(ders - np.concatenate([x[0] for x in one])).max() < 1e-15

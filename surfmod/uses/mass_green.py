@@ -49,6 +49,9 @@ CLOSURE_RTOL = 1e-10
 
 #: a Green grid serves boundary nodes up to this fraction of its outer span beyond it
 GRID_REACH = 1e-3
+#: the grid's own work (Lagrange and antiderivative weights, per-cell sums), in evaluated
+#: nodes: below this saving node-by-node Gauss is faster
+GRID_OVERHEAD = 1500
 
 _GAUSS: dict = {}
 
@@ -414,7 +417,7 @@ def _green(mf: MassFace, order: int, orders, exacts):
     deepest = np.zeros(len(obr) - 1, int)  # per outer span, the inner spans its nodes reach
     np.maximum.at(deepest, q[on_grid], (full + partial)[on_grid])
     grid = counts[0][0] * counts[1][0] * deepest.sum()
-    if grid < m_in * (partial[on_grid].sum() + full[on_grid].sum()):
+    if grid + GRID_OVERHEAD < m_in * (partial[on_grid].sum() + full[on_grid].sum()):
         g = _grid_nodes(mf, k, (counts[0][0], counts[1][0]), P[on_grid], wb[on_grid], full[on_grid],
                         partial[on_grid], q[on_grid])
         rest = ~on_grid
@@ -446,6 +449,7 @@ def chebyshev(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         A = 2.0 / n * np.cos(np.outer(theta, np.arange(n)))
         A[:, 0] /= 2
         _GAUSS[key] = (np.cos(theta), bw, A)
+        _GAUSS[("span integral", n)] = antiderivative_weights(np.ones(1), n)[0]
     return _GAUSS[key]
 
 
@@ -558,7 +562,7 @@ def _grid_nodes(mf: MassFace, k: int, counts, P: np.ndarray, wb: np.ndarray, ful
     ks, kt = counts
     xs = chebyshev(ks)[0]
     xt, bwt, _ = chebyshev(kt)
-    iws = antiderivative_weights(np.ones(1), ks)[0]  # ∫_{-1}^{1} ℓ_j
+    iws = _GAUSS[("span integral", ks)]  # ∫_{-1}^{1} ℓ_j
     br, obr = mf.breaks[k], mf.breaks[1 - k]
     n_spans, n_out = len(br) - 1, len(obr) - 1
     a, b = obr[q], obr[q + 1]
