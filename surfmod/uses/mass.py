@@ -47,7 +47,7 @@ from ..errors import SurfmodError
 from ..readback import from_face
 from ..surface import Surface
 from .inputs import to_shape
-from .mass_green import face_nodes, mass_face, plane_nodes, surface_mass_face
+from .mass_green import face_nodes, mass_face, plane_nodes, surface_mass_face, taylor_pieces
 
 
 @dataclass(frozen=True)
@@ -228,7 +228,12 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     else:
         from ..occ.topo import faces_of
 
-        faces = [mass_face(from_face(f)) for f in faces_of(solid)]
+        from ..occ.pcurves import face_pcurves
+
+        read = [from_face(f) for f in faces_of(solid)]
+        pcurves = [face_pcurves(f.face_shape) for f in read]
+        taylor_pieces([rec for pcs in pcurves for rec in pcs])  # all B-spline p-curves at once
+        faces = [mass_face(f, pcs) for f, pcs in zip(read, pcurves)]
     # faces whose every rule is exact by degree give the same sums at any order: the
     # lower-order pass behind the error estimate only re-integrates the others
     exact, high = _Accumulator(ref), _Accumulator(ref)

@@ -156,16 +156,62 @@ def _taylor_pieces(rec: dict):
     coefficients (S, p+1, dim))`` with ``C(t) = Σ_k c_k (t - centre)^k`` in homogeneous coordinates
     ``(w u, w v, w)`` (``(u, v)`` when polynomial).  Beyond the ends the first and last
     spans continue, as OCCT evaluates."""
-    p, knots, pts, w = rec["degree"], rec["knots"], rec["points"][:, :2], rec["weights"]
-    n = len(pts)
-    ctrl = pts if w is None else np.column_stack([pts * w[:, None], w])
-    starts = np.unique(knots[p:n])  # span starts inside the domain (the last end excluded)
-    starts = starts[starts < knots[n]]
-    # expanded about each span's middle: |t - centre| <= h/2 keeps high degrees accurate
-    centres = (starts + np.append(starts[1:], knots[n])) / 2
-    ders = curve_derivatives(knots, p, ctrl, centres, p)
-    fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
-    return starts, centres, ders / fact[None, :, None]
+    taylor_pieces([rec])
+    return rec["taylor"]
+
+
+def taylor_pieces(records: list) -> None:
+    """Set ``rec["taylor"]`` (see :func:`_taylor_pieces`) on every B-spline p-curve record
+    that lacks it, with one basis evaluation per degree for all of them: their knot
+    vectors and control points are laid end to end, and each span's basis reads only its
+    own curve's knots (``knots[span - p + 1 .. span + p]``), so one call serves all.
+
+    >>> import build123d as bd
+    >>> from surfmod.occ.pcurves import face_pcurves
+    >>> recs = [r for r in face_pcurves(bd.Face(bd.Wire([bd.Spline((0, 0), (1, 1), (2, 0), (1, -1)),
+    ...         bd.Edge.make_line((1, -1), (0, 0))])).wrapped) if r["kind"] == "bspline"]
+    >>> taylor_pieces(recs); starts, centres, coef = recs[0]["taylor"]
+    >>> coef.shape[1:] == (recs[0]["degree"] + 1, 2)
+    True
+    """
+    from ..eval.basis import basis_derivatives, find_spans
+
+    groups: dict = {}
+    for rec in records:
+        if rec["kind"] == "bspline" and "taylor" not in rec:
+            groups.setdefault(rec["degree"], []).append(rec)
+    for p, group in groups.items():
+        knots, ctrl, spans, centres, firsts, counts = [], [], [], [], [], []
+        k_off = c_off = 0
+        for rec in group:
+            k, pts, w = rec["knots"], rec["points"][:, :2], rec["weights"]
+            n = len(pts)
+            # homogeneous (w u, w v, w) for all; w = 1 leaves a polynomial curve's u, v as they are
+            ones = np.ones(n) if w is None else w
+            ctrl.append(np.column_stack([pts * ones[:, None], ones]))
+            starts = np.unique(k[p:n])  # span starts inside the domain (the last end excluded)
+            starts = starts[starts < k[n]]
+            # expanded about each span's middle: |t - centre| <= h/2 keeps high degrees accurate
+            mid = (starts + np.append(starts[1:], k[n])) / 2
+            local = find_spans(k, p, n, mid)
+            knots.append(k)
+            spans.append(local + k_off)
+            firsts.append(local - p + c_off)
+            centres.append(mid)
+            counts.append((starts, mid))
+            k_off += len(k)
+            c_off += n
+        all_knots, all_ctrl = np.concatenate(knots), np.concatenate(ctrl)
+        span, first, mid = np.concatenate(spans), np.concatenate(firsts), np.concatenate(centres)
+        basis = basis_derivatives(all_knots, p, span, mid, p)  # (S, p+1 derivatives, p+1 functions)
+        local_ctrl = all_ctrl[first[:, None] + np.arange(p + 1)]  # (S, p+1, 3)
+        fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
+        coef = np.einsum("skr,srd->skd", basis, local_ctrl) / fact[None, :, None]
+        at = 0
+        for rec, (starts, mid) in zip(group, counts):
+            c = coef[at : at + len(starts)]
+            at += len(starts)
+            rec["taylor"] = (starts, mid, c if rec["weights"] is not None else np.ascontiguousarray(c[:, :, :2]))
 
 
 def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
@@ -276,8 +322,9 @@ def _on_box_border(pcurves, bounds) -> bool:
     return True
 
 
-def mass_face(face) -> MassFace:
-    """A :class:`MassFace` for a face read back with :func:`surfmod.from_face`.
+def mass_face(face, pcurves: list | None = None) -> MassFace:
+    """A :class:`MassFace` for a face read back with :func:`surfmod.from_face` (``pcurves``:
+    its :func:`~surfmod.occ.pcurves.face_pcurves`, when already read).
 
     >>> import surfmod as sm, build123d as bd
     >>> m = mass_face(sm.from_face(bd.Box(1, 1, 1).faces()[0]))
@@ -293,7 +340,9 @@ def mass_face(face) -> MassFace:
         breaks = (np.array([u0, u1]), np.array([v0, v1]))
     else:
         breaks = (_patch_breaks(face, u0, u1, 0, face.periods[0]), _patch_breaks(face, v0, v1, 1, face.periods[1]))
-    pcurves = face_pcurves(face.face_shape)
+    if pcurves is None:
+        pcurves = face_pcurves(face.face_shape)
+        taylor_pieces(pcurves)
     natural = bool(pcurves) and all(rec["wire"] == 0 for rec in pcurves) and _on_box_border(pcurves, bounds)
     return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
