@@ -228,3 +228,17 @@ def test_whole_planar_faces_at_once_equal_face_by_face():
     one = [mg.face_nodes(m, 12) for m in planes]
     assert np.abs(w - np.concatenate([x[1] for x in one])).max() < 1e-15
     assert np.abs(ders - np.concatenate([x[0] for x in one])).max() < 1e-15
+
+
+def test_circle_crossings_in_closed_form_equal_newton_on_occt():
+    # a hole's circle p-curve on a plane crosses lines u = c and v = c: the closed form
+    # equals sampling + Newton on OCCT's own adaptor (the route of other curve types)
+    plate = bd.Box(4, 3, 1) - bd.Cylinder(1.0, 2)
+    top = max(plate.faces(), key=lambda f: f.center().Z)
+    (rec,) = [r for r in face_pcurves(top.wrapped) if r["kind"] == "circle"]
+    c = rec["centre"]  # lines through the circle (4 x 2 crossings) and one beside it
+    lines_u, lines_v = c[0] + np.array([-0.5, 0.1, 0.99, 2.0]), c[1] + np.array([-0.999, 0.3])
+    cuts = np.linspace(*rec["range"], 5)
+    mine = np.sort(mg._crossings(rec, cuts, lines_u, lines_v))
+    ref = np.sort(mg._crossings(dict(rec, kind="other"), cuts, lines_u, lines_v))
+    assert len(mine) == len(ref) == 10 and np.abs(mine - ref).max() < 1e-12

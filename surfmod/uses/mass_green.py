@@ -228,6 +228,17 @@ def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.nda
         ok = d != 0.0
         t = (lines[ok] - rec["origin"][coord[ok]]) / d[ok]
         return t[(t > f) & (t < l)]
+    if rec["kind"] == "circle":
+        # centre + r (cos t x + sin t y) = line: A cos t + B sin t = C, t = phi ± acos(C / R)
+        r = rec["radius"]
+        A, B, C = r * rec["x"][coord], r * rec["y"][coord], lines - rec["centre"][coord]
+        R = np.hypot(A, B)
+        ok = np.abs(C) < R
+        phi, half = np.arctan2(B[ok], A[ok]), np.arccos(C[ok] / R[ok])
+        base = np.concatenate([phi + half, phi - half])
+        turns = np.arange(np.floor((f - base.max()) / (2 * np.pi)), np.ceil((l - base.min()) / (2 * np.pi)) + 1)
+        t = (base[:, None] + 2 * np.pi * turns[None, :]).ravel()
+        return t[(t > f) & (t < l)]
     a, b = cuts[:-1, None], cuts[1:, None]
     t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
     s = pcurve_d1(rec, t)[:, coord] - lines[None, :]  # (T, L)
@@ -267,9 +278,10 @@ def _boundary(pcurves, outer_order, lines_u, lines_v):
             br = np.unique(np.concatenate([br, extra]))
             br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
         t, w = _spans(br, m)
-        q = pcurve_d1(rec, t)
-        ps.append(q[:, :2])
-        ds.append(q[:, 2:])
+        q = pcurve_d1(rec, np.concatenate([t, [f, l]]))
+        rec["ends"] = q[-2:, :2]  # for _largest_gap, from the same call
+        ps.append(q[:-2, :2])
+        ds.append(q[:-2, 2:])
         ws.append(rec["sign"] * w)
     if not ps:
         return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), exact
@@ -423,7 +435,7 @@ def _largest_gap(mf: MassFace) -> float:
     scale = np.array([max(u1 - u0, 1e-300), max(v1 - v0, 1e-300)])
     ends = []
     for rec in mf.pcurves:
-        q = pcurve_d1(rec, np.array(rec["range"]))[:, :2] / scale
+        q = (rec["ends"] if "ends" in rec else pcurve_d1(rec, np.array(rec["range"]))[:, :2]) / scale
         ends.append(q if rec["sign"] > 0 else q[::-1])
     if not ends:
         return 0.0
