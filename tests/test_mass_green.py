@@ -12,6 +12,7 @@ import pytest
 
 import surfmod as sm
 import surfmod.uses.mass_green as mg
+import surfmod.uses.mass_grid as mgrid
 from surfmod.occ.pcurves import adaptor_d1, face_pcurves
 from surfmod.occ.topo import faces_of
 from surfmod.uses.mass import _moments, face_moments
@@ -150,9 +151,9 @@ def test_face_area_on_a_holed_face():
 def test_chebyshev_interpolation_and_antiderivatives_are_exact_for_polynomials():
     rng = np.random.default_rng(7)
     for n in (3, 6, 16, 26):
-        x, bw, _ = mg.chebyshev(n)
+        x, bw, _ = mgrid.chebyshev(n)
         y = np.concatenate([rng.uniform(-1, 1, 40), [-1.0, 1.0, x[0]]])
-        L, A = mg.lagrange_values(y, x, bw), mg.antiderivative_weights(y, n)
+        L, A = mgrid.lagrange_values(y, x, bw), mgrid.antiderivative_weights(y, n)
         for k in range(n):  # every degree below n: interpolant and ∫_{-1}^{y} exact
             assert np.abs(L @ x**k - y**k).max() < 1e-13
             assert np.abs(A @ x**k - (y ** (k + 1) - (-1.0) ** (k + 1)) / (k + 1)).max() < 1e-13

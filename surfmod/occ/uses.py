@@ -8,6 +8,8 @@ Everything here returns plain Python/NumPy data; the NumPy work lives in
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
@@ -149,8 +151,6 @@ def vertex_mean(shape) -> np.ndarray:
     (BRepGProp's rough barycentre, the reference point of its integrals); the bounding
     box centre when the shape has no vertex (one periodic face: a full sphere)."""
     from OCP.TopAbs import TopAbs_VERTEX
-
-    from itertools import chain
 
     pnt, vertex = BRep_Tool.Pnt_s, TopoDS.Vertex_s
     # one flat fromiter over Coord() tuples (no array per vertex)

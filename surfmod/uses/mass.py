@@ -16,8 +16,9 @@ domain:
 * a trimmed face (holes, faces cut by booleans) by Green's theorem in the parameter
   plane: ``∫∫_D g du dv = ∮ G dv`` with ``G(u, v) = ∫_{u0}^{u} g(s, v) ds`` (or the same
   along ``v``); the outer integral runs over Gauss nodes on the exact p-curves of the
-  face's edges (OCCT's 2-D curves, split at their breaks), the inner one is Gauss on
-  the untrimmed surface, split at knots.  No triangulation is involved, so the only
+  face's edges (OCCT's 2-D curves, split at their breaks), the inner one runs on the
+  untrimmed surface, split at knots (Gauss per boundary node, or one interpolation grid
+  per knot cell shared by all boundary nodes: see :mod:`surfmod.uses.mass_green`).  No triangulation is involved, so the only
   error is the accuracy of the p-curves themselves (the edge tolerance of the part,
   about 1e-7 for boolean results).
 
