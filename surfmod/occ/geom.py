@@ -7,6 +7,7 @@ import numpy as np
 from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface
 
 from . import arrays
+from .binary import bspline_curves
 from .guard import kernel
 
 
@@ -102,31 +103,35 @@ def read_bezier_surface(surf: Geom_BezierSurface) -> dict:
 def read_bspline_curve(curve: Geom_BSplineCurve) -> dict:
     """Poles ``(n, 3)``, weights (None if polynomial), flat knots and degree of a
     ``Geom_BSplineCurve`` or of a ``Geom2d_BSplineCurve`` (a p-curve: its poles get
-    z = 0, so the surfmod evaluator reads both); a periodic curve is unwrapped."""
-    with kernel("reading Geom_BSplineCurve"):
-        from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array1OfPnt2d
-        from OCP.TColStd import TColStd_Array1OfReal
+    z = 0, so the surfmod evaluator reads both); a periodic curve is unwrapped.  The
+    data come through OCCT's binary writer in one piece (:mod:`surfmod.occ.binary`).
 
+    >>> import surfmod as sm
+    >>> d = read_bspline_curve(sm.BSplineCurve([(0, 0, 0), (1, 2, 0), (3, 1, 1)], 2, [0, 0, 0, 1, 1, 1]).geom())
+    >>> d["points"].shape, d["weights"], d["degree"]
+    ((3, 3), None, 2)
+    """
+    with kernel("reading Geom_BSplineCurve"):
         if curve.IsPeriodic():
             curve = curve.Copy()  # OCP returns the derived type (no DownCast in OCP)
             curve.SetNotPeriodic()
-        n, p = curve.NbPoles(), curve.Degree()
         planar = type(curve).__name__.startswith("Geom2d")
-        poles = (TColgp_Array1OfPnt2d if planar else TColgp_Array1OfPnt)(1, n)
-        curve.Poles(poles)
-        weights = None
-        if curve.IsRational():
-            w = TColStd_Array1OfReal(1, n)
-            curve.Weights(w)
-            weights = arrays.to_numpy_1d(w)
-        k = TColStd_Array1OfReal(1, n + p + 1)
-        curve.KnotSequence(k)
-        if planar:
-            points = np.zeros((n, 3))
-            points[:, :2] = [poles.Value(i).Coord() for i in range(1, n + 1)]
-        else:
-            points = arrays.pnts_to_numpy_1d(poles)
-    return {"points": points, "weights": weights, "knots": arrays.to_numpy_1d(k), "degree": p}
+    return _padded(bspline_curves([curve], 2 if planar else 3)[0])
+
+
+def _padded(data: dict) -> dict:
+    """A :func:`surfmod.occ.binary.bspline_curves` record as :func:`read_bspline_curve`
+    returns it: 2-D poles get z = 0."""
+    points = data["points"]
+    if points.shape[1] == 2:
+        points = np.column_stack([points, np.zeros(len(points))])
+    return {"points": points, "weights": data["weights"], "knots": data["knots"], "degree": data["degree"]}
+
+
+def read_bspline_curves_2d(curves: list) -> list[dict]:
+    """:func:`read_bspline_curve` of many non-periodic ``Geom2d_BSplineCurve`` (the
+    B-spline p-curves of a face) through one binary table."""
+    return [_padded(d) for d in bspline_curves(curves, 2)]
 
 
 def surface_type(surf) -> str:

@@ -18,7 +18,7 @@ from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS
 
-from .geom import read_bspline_curve
+from .geom import read_bspline_curve, read_bspline_curves_2d
 from .guard import kernel
 from .topo import explore
 
@@ -58,6 +58,7 @@ def face_pcurves(face) -> list[dict]:
     with kernel("BRepAdaptor_Curve2d (face p-curves)"):
         edges = [(i, e) for i, wire in enumerate(explore(face, TopAbs_WIRE)) for e in explore(wire, TopAbs_EDGE)]
         to_edge = TopoDS.Edge_s
+        splines = []
         for wire_index, e in edges:
             edge = to_edge(e)
             pc = BRepAdaptor_Curve2d(edge, face)
@@ -85,11 +86,15 @@ def face_pcurves(face) -> list[dict]:
                 ax = c.Position()
                 rec.update(kind="circle", centre=_xy(ax.Location()), x=_xy(ax.XDirection()),
                            y=_xy(ax.YDirection()), radius=c.Radius())
+            elif kind == GeomAbs_BSplineCurve and not (b := pc.BSpline()).IsPeriodic():
+                splines.append((rec, b))  # read below, all in one binary table
             elif kind == GeomAbs_BSplineCurve and (data := _bspline_data(pc)) is not None:
                 rec.update(kind="bspline", **data)
             else:
                 rec.update(kind="other")
             out.append(rec)
+        for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
+            rec.update(kind="bspline", **data)
     return out
 
 

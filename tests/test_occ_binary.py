@@ -1,0 +1,91 @@
+"""B-spline curves read through OCCT's binary writer equal the same curves read pole by
+pole through OCP, bit for bit: polynomial, rational, periodic (unwrapped), 3-D curves and
+2-D p-curves, repeated handles, and every B-spline p-curve of the corpus."""
+
+from __future__ import annotations
+
+import build123d as bd
+import numpy as np
+import pytest
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.GeomAbs import GeomAbs_BSplineCurve
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopoDS import TopoDS
+
+import surfmod as sm
+from surfmod.occ.binary import bspline_curves
+from surfmod.occ.geom import read_bspline_curve, read_bspline_curves_2d
+from surfmod.occ.topo import explore, faces_of
+
+
+def _pole_by_pole(curve) -> dict:
+    if curve.IsPeriodic():
+        curve = curve.Copy()
+        curve.SetNotPeriodic()
+    n = curve.NbPoles()
+    pts = np.array([curve.Pole(i).Coord() for i in range(1, n + 1)])
+    if pts.shape[1] == 2:
+        pts = np.column_stack([pts, np.zeros(n)])
+    w = np.array([curve.Weight(i) for i in range(1, n + 1)]) if curve.IsRational() else None
+    k = curve.NbKnots()
+    knots = np.repeat([curve.Knot(i) for i in range(1, k + 1)], [curve.Multiplicity(i) for i in range(1, k + 1)])
+    return {"points": pts, "weights": w, "knots": knots, "degree": curve.Degree()}
+
+
+def _same(a: dict, b: dict) -> bool:
+    return (a["degree"] == b["degree"] and np.array_equal(a["points"], b["points"])
+            and np.array_equal(a["knots"], b["knots"])
+            and ((a["weights"] is None and b["weights"] is None) or np.array_equal(a["weights"], b["weights"])))
+
+
+def _pcurves(shape):
+    out = []
+    for face in faces_of(shape):
+        for e in explore(face, TopAbs_EDGE):
+            pc = BRepAdaptor_Curve2d(TopoDS.Edge_s(e), face)
+            if pc.GetType() == GeomAbs_BSplineCurve:
+                out.append(pc.BSpline())
+    return out
+
+
+PTS = [(0, 0, 0), (3, -1, 0.5), (5, 1, 1), (4, 4, 0), (1, 3, -1)]
+
+
+@pytest.mark.parametrize("kind", ["polynomial", "rational", "periodic"])
+def test_3d_curves_equal_pole_by_pole(kind):
+    if kind == "periodic":
+        geom = BRep_Tool.Curve_s(bd.Spline(*PTS, periodic=True).wrapped, 0.0, 0.0)
+        assert geom.IsPeriodic()
+    else:
+        w = [1.0, 0.7, 1.3, 0.9, 1.1] if kind == "rational" else None
+        geom = sm.BSplineCurve(PTS, 3, [0, 0, 0, 0, 0.4, 1, 1, 1, 1], w).geom()
+    assert _same(read_bspline_curve(geom), _pole_by_pole(geom))
+
+
+def test_pcurves_rational_and_periodic_and_repeated_equal_pole_by_pole():
+    knots = [0, 0, 0, 1 / 3, 2 / 3, 1, 1, 1]
+    rational = sm.BSplineCurve([p[:2] + (0,) for p in PTS], 2, knots, [1.0, 0.7, 1.3, 0.9, 1.1])
+    faces = [bd.Face(bd.Wire([rational.edge(), bd.Edge.make_line(PTS[-1][:2] + (0,), (0, 0, 0))])),
+             bd.Face(bd.Wire([bd.Spline(*[p[:2] + (0,) for p in PTS], periodic=True)]))]
+    curves = [c for f in faces for c in _pcurves(f.wrapped)]
+    assert any(c.IsRational() for c in curves) and any(c.IsPeriodic() for c in curves)
+    for c in curves:
+        assert _same(read_bspline_curve(c), _pole_by_pole(c))
+    plain = [c for c in curves if not c.IsPeriodic()]
+    # one table for many curves, one of them twice: every entry in the caller's order
+    for got, c in zip(read_bspline_curves_2d(plain + plain[:1]), plain + plain[:1]):
+        assert _same(got, _pole_by_pole(c))
+    raw = bspline_curves([c for c in curves if c.IsPeriodic()], 2)[0]
+    assert raw["periodic"]  # stored as is; read_bspline_curve unwraps
+
+
+@pytest.mark.corpus
+def test_every_corpus_pcurve_equals_pole_by_pole(corpus_file):
+    curves = _pcurves(sm.import_step(corpus_file).wrapped)
+    plain = [c for c in curves if not c.IsPeriodic()]
+    for got, c in zip(read_bspline_curves_2d(plain), plain):
+        assert _same(got, _pole_by_pole(c))
+    for c in curves:
+        if c.IsPeriodic():
+            assert _same(read_bspline_curve(c), _pole_by_pole(c))
