@@ -1,6 +1,7 @@
-"""B-spline curves read through OCCT's binary writer equal the same curves read pole by
-pole through OCP, bit for bit: polynomial, rational, periodic (unwrapped), 3-D curves and
-2-D p-curves, repeated handles, and every B-spline p-curve of the corpus."""
+"""B-spline curves and B-spline / Bézier surfaces read through OCCT's binary writer equal
+the same geometry read pole by pole through OCP, bit for bit: polynomial, rational,
+periodic (unwrapped), 3-D curves and 2-D p-curves, repeated handles, Bézier surfaces, and
+every B-spline p-curve and spline surface of the corpus."""
 
 from __future__ import annotations
 
@@ -9,13 +10,16 @@ import numpy as np
 import pytest
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.Geom import Geom_BSplineSurface
 from OCP.GeomAbs import GeomAbs_BSplineCurve
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopoDS import TopoDS
 
 import surfmod as sm
+from surfmod.occ import arrays
 from surfmod.occ.binary import bspline_curves
-from surfmod.occ.geom import read_bspline_curve, read_bspline_curves_2d
+from surfmod.occ.geom import (downcast_surface, read_bezier_surface, read_bspline_curve, read_bspline_curves_2d,
+                               read_bspline_surface)
 from surfmod.occ.topo import explore, faces_of
 
 
@@ -89,3 +93,68 @@ def test_every_corpus_pcurve_equals_pole_by_pole(corpus_file):
     for c in curves:
         if c.IsPeriodic():
             assert _same(read_bspline_curve(c), _pole_by_pole(c))
+
+
+# -- surfaces ------------------------------------------------------------------------------------
+def _surface_pole_by_pole(surf) -> dict:
+    if surf.IsUPeriodic() or surf.IsVPeriodic():
+        surf = surf.Copy()
+        if surf.IsUPeriodic():
+            surf.SetUNotPeriodic()
+        if surf.IsVPeriodic():
+            surf.SetVNotPeriodic()
+    n, m = surf.NbUPoles(), surf.NbVPoles()
+    pts = np.array([[surf.Pole(i, j).Coord() for j in range(1, m + 1)] for i in range(1, n + 1)])
+    rational = surf.IsURational() or surf.IsVRational()
+    w = np.array([[surf.Weight(i, j) for j in range(1, m + 1)] for i in range(1, n + 1)]) if rational else None
+    out = {"control_points": pts, "weights": w}
+    if hasattr(surf, "NbUKnots"):
+        def flat(knot, mult, count):
+            return np.repeat([knot(i) for i in range(1, count + 1)], [mult(i) for i in range(1, count + 1)])
+
+        out["knots"] = (flat(surf.UKnot, surf.UMultiplicity, surf.NbUKnots()),
+                        flat(surf.VKnot, surf.VMultiplicity, surf.NbVKnots()))
+        out["degree"] = (surf.UDegree(), surf.VDegree())
+    return out
+
+
+def _same_surface(a: dict, b: dict) -> bool:
+    same = np.array_equal(a["control_points"], b["control_points"]) and (
+        (a["weights"] is None and b["weights"] is None) or np.array_equal(a["weights"], b["weights"]))
+    if "knots" in b:
+        same = same and a["degree"] == b["degree"] and all(np.array_equal(x, y) for x, y in zip(a["knots"], b["knots"]))
+    return same
+
+
+NET = np.zeros((4, 5, 3))
+NET[..., 0], NET[..., 1] = np.mgrid[0:4, 0:5]
+NET[..., 2] = np.sin(NET[..., 0]) * np.cos(NET[..., 1])
+WEIGHTS = 1.0 + 0.1 * np.arange(20.0).reshape(4, 5) % 3
+
+
+@pytest.mark.parametrize("kind", ["polynomial", "rational", "periodic", "bezier", "rational bezier"])
+def test_surfaces_equal_pole_by_pole(kind):
+    if kind in ("bezier", "rational bezier"):
+        geom = sm.BezierSurface(NET, WEIGHTS if kind == "rational bezier" else None).geom()
+        assert _same_surface(read_bezier_surface(geom), _surface_pole_by_pole(geom))
+        return
+    if kind == "periodic":  # periodic in u (4 poles, 5 simple knots), rational
+        uk, um = arrays.reals_1d([0, 1, 2, 3, 4]), arrays.ints_1d([1] * 5)
+        vk, vm = arrays.knots_and_mults([0, 0, 0, 0, 0.3, 1, 1, 1, 1])
+        geom = Geom_BSplineSurface(arrays.points_2d(NET), arrays.reals_2d(WEIGHTS), uk, vk, um, vm, 2, 3, True, False)
+        assert geom.IsUPeriodic()
+    else:
+        w = WEIGHTS if kind == "rational" else None
+        geom = sm.BSplineSurface(NET, (2, 3), ([0, 0, 0, 0.5, 1, 1, 1], [0, 0, 0, 0, 0.3, 1, 1, 1, 1]), w).geom()
+    assert _same_surface(read_bspline_surface(geom), _surface_pole_by_pole(geom))
+
+
+@pytest.mark.corpus
+def test_every_corpus_spline_surface_equals_pole_by_pole(corpus_file):
+    for face in faces_of(sm.import_step(corpus_file).wrapped):
+        geom = downcast_surface(BRep_Tool.Surface_s(face))
+        name = type(geom).__name__
+        if name == "Geom_BSplineSurface":
+            assert _same_surface(read_bspline_surface(geom), _surface_pole_by_pole(geom))
+        elif name == "Geom_BezierSurface":
+            assert _same_surface(read_bezier_surface(geom), _surface_pole_by_pole(geom))

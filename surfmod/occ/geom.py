@@ -7,7 +7,7 @@ import numpy as np
 from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface
 
 from . import arrays
-from .binary import bspline_curves
+from .binary import bspline_curves, spline_surface
 from .guard import kernel
 
 
@@ -51,7 +51,15 @@ def bezier_curve(points, weights=None) -> Geom_BezierCurve:
 def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
     """Poles, weights (None if polynomial), flat knots and degrees of a B-spline surface.
 
-    Periodic surfaces are read through a non-periodic copy (same shape, OCCT converts)."""
+    Periodic surfaces are read through a non-periodic copy (same shape, OCCT converts).
+    The data come through OCCT's binary writer in one piece (:mod:`surfmod.occ.binary`).
+
+    >>> import numpy as np, surfmod as sm
+    >>> net = np.zeros((3, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:3, 0:4]
+    >>> d = read_bspline_surface(sm.BSplineSurface(net, (2, 3), ([0] * 3 + [1] * 3, [0] * 4 + [1] * 4)).geom())
+    >>> d["control_points"].shape, d["degree"], d["knots"][1].tolist()
+    ((3, 4, 3), (2, 3), [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0])
+    """
     with kernel("reading Geom_BSplineSurface"):
         if surf.IsUPeriodic() or surf.IsVPeriodic():
             surf = surf.Copy()  # OCP returns the derived type (no DownCast in OCP)
@@ -59,45 +67,14 @@ def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
                 surf.SetUNotPeriodic()
             if surf.IsVPeriodic():
                 surf.SetVNotPeriodic()
-        n, m = surf.NbUPoles(), surf.NbVPoles()
-        from OCP.TColgp import TColgp_Array2OfPnt
-        from OCP.TColStd import TColStd_Array1OfReal, TColStd_Array2OfReal
-
-        poles = TColgp_Array2OfPnt(1, n, 1, m)
-        surf.Poles(poles)
-        net = arrays.pnts_to_numpy_2d(poles)
-        weights = None
-        if surf.IsURational() or surf.IsVRational():
-            w = TColStd_Array2OfReal(1, n, 1, m)
-            surf.Weights(w)
-            weights = arrays.reals_to_numpy_2d(w)
-        p, q = surf.UDegree(), surf.VDegree()
-        ku = TColStd_Array1OfReal(1, n + p + 1)
-        surf.UKnotSequence(ku)
-        kv = TColStd_Array1OfReal(1, m + q + 1)
-        surf.VKnotSequence(kv)
-    return {
-        "control_points": net,
-        "weights": weights,
-        "knots": (arrays.to_numpy_1d(ku), arrays.to_numpy_1d(kv)),
-        "degree": (p, q),
-    }
+    data = spline_surface(surf)
+    return {key: data[key] for key in ("control_points", "weights", "knots", "degree")}
 
 
 def read_bezier_surface(surf: Geom_BezierSurface) -> dict:
-    with kernel("reading Geom_BezierSurface"):
-        from OCP.TColgp import TColgp_Array2OfPnt
-        from OCP.TColStd import TColStd_Array2OfReal
-
-        n, m = surf.NbUPoles(), surf.NbVPoles()
-        poles = TColgp_Array2OfPnt(1, n, 1, m)
-        surf.Poles(poles)
-        weights = None
-        if surf.IsURational() or surf.IsVRational():
-            w = TColStd_Array2OfReal(1, n, 1, m)
-            surf.Weights(w)
-            weights = arrays.reals_to_numpy_2d(w)
-    return {"control_points": arrays.pnts_to_numpy_2d(poles), "weights": weights}
+    """Poles and weights (None if polynomial) of a Bézier surface (binary, as above)."""
+    data = spline_surface(surf)
+    return {"control_points": data["control_points"], "weights": data["weights"]}
 
 
 def read_bspline_curve(curve: Geom_BSplineCurve) -> dict:
