@@ -12,6 +12,7 @@ import pytest
 
 import surfmod as sm
 import surfmod.uses.mass_green as mg
+import surfmod.uses.mass_grid as mgrid
 from surfmod.occ.pcurves import adaptor_d1, face_pcurves
 from surfmod.occ.topo import faces_of
 from surfmod.uses.mass import _moments, face_moments
@@ -23,19 +24,35 @@ def _rel(a, b):
     return abs(a - b) / abs(b)
 
 
+def _pcurves_equal_occt(path):
+    # inside and a little beyond each edge's range (real p-curves are evaluated there);
+    # the B-splines of the whole part get their span polynomials in one pass per degree
+    records = [rec for face in faces_of(sm.import_step(path).wrapped) for rec in face_pcurves(face)]
+    mg.taylor_pieces(records)
+    for rec in records:
+        f, l = rec["range"]
+        t = np.linspace(f - 1e-3 * (l - f), l + 1e-3 * (l - f), 11)
+        mine, ref = mg.pcurve_d1(rec, t), adaptor_d1(rec["adaptor"], t)
+        scale = np.maximum(np.abs(ref).max(axis=0), 1.0)
+        err = (np.abs(mine - ref) / scale).max(axis=0)
+        # points to 1e-12; derivatives from polynomials about span centres far from t = 0
+        # lose a few more digits (occt_screw: 3e-11)
+        assert err[:2].max() < 1e-12 and err[2:].max() < 1e-10, (path.name, rec["kind"], rec.get("degree"), err)
+        if rec["kind"] == "bspline":  # the batch equals the curve's own expansion
+            alone = dict(rec)
+            del alone["taylor"]
+            mg.taylor_pieces([alone])
+            assert np.abs(alone["taylor"][2] - rec["taylor"][2]).max() <= 1e-15 * np.abs(rec["taylor"][2]).max()
+    return {rec["kind"] for rec in records}
+
+
 def test_pcurves_from_data_equal_occt(corpus_dir):
-    # every kind the corpus file holds (lines, circles, B-splines), inside and a little
-    # beyond each edge's range (real p-curves are evaluated there)
-    seen = set()
-    for face in faces_of(sm.import_step(corpus_dir / CORPUS_FILE).wrapped):
-        for rec in face_pcurves(face):
-            f, l = rec["range"]
-            t = np.linspace(f, l, 11)
-            mine, ref = mg.pcurve_d1(rec, t), adaptor_d1(rec["adaptor"], t)
-            scale = np.maximum(np.abs(ref).max(axis=0), 1.0)
-            assert (np.abs(mine - ref) / scale).max() < 1e-12, rec["kind"]
-            seen.add(rec["kind"])
-    assert {"line", "circle"} <= seen
+    assert {"line", "circle"} <= _pcurves_equal_occt(corpus_dir / CORPUS_FILE)
+
+
+@pytest.mark.corpus
+def test_pcurves_from_data_equal_occt_on_the_corpus(corpus_file):
+    _pcurves_equal_occt(corpus_file)
 
 
 def _spline_face(kind):
@@ -128,3 +145,101 @@ def test_face_area_on_a_holed_face():
     top = max(plate.faces(), key=lambda f: f.center().Z)
     assert _rel(sm.from_face(top).area(), 12 - math.pi) < 1e-14
     assert _rel(face_moments(sm.from_face(top))[0], 12 - math.pi) < 1e-14
+
+
+# -- Green's grids -------------------------------------------------------------------------------
+def test_chebyshev_interpolation_and_antiderivatives_are_exact_for_polynomials():
+    rng = np.random.default_rng(7)
+    for n in (3, 6, 16, 26):
+        x, bw, _ = mgrid.chebyshev(n)
+        y = np.concatenate([rng.uniform(-1, 1, 40), [-1.0, 1.0, x[0]]])
+        L, A = mgrid.lagrange_values(y, x, bw), mgrid.antiderivative_weights(y, n)
+        for k in range(n):  # every degree below n: interpolant and ∫_{-1}^{y} exact
+            assert np.abs(L @ x**k - y**k).max() < 1e-13
+            assert np.abs(A @ x**k - (y ** (k + 1) - (-1.0) ** (k + 1)) / (k + 1)).max() < 1e-13
+
+
+def _grid_vs_node_by_node(monkeypatch, face, order=12):
+    mf = mg.mass_face(sm.from_face(face))
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)  # always the grid
+    grid = _moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", 1e18)  # never
+    nodes = _moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
+    return grid, nodes
+
+
+@pytest.mark.parametrize("cut", ["slanted box", "sphere", "spline"])
+def test_green_grid_equals_node_by_node(monkeypatch, cut):
+    # trimmed cylinders (angle x axis, p-curves with gaps), a trimmed sphere (both
+    # directions trigonometric) and a trimmed polynomial spline face (the grid is exact)
+    if cut == "slanted box":
+        part = bd.Cylinder(1.0, 4.0) - bd.Box(4, 4, 4).rotate(bd.Axis.X, 30).translate((0, 0, 2.5))
+    elif cut == "sphere":
+        part = bd.Sphere(1.0) - bd.Box(1, 1, 1).translate((0.6, 0.3, 0.2))
+    else:
+        net = np.zeros((4, 4, 3))
+        net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+        net[..., 2] = [[0, 1, 0, 1], [1, 2, 1, 0], [0, 1, 3, 1], [1, 0, 1, 0]]
+        face = sm.BSplineSurface(net, (3, 3), ([0] * 4 + [1] * 4, [0] * 4 + [1] * 4)).face()
+        part = bd.extrude(bd.Face(face.wrapped), amount=2.0, dir=(0, 0, -1)) & bd.Cylinder(1.2, 20).translate((1.5, 1.5, 0))
+    checked = 0
+    for f in part.faces():
+        mf = mg.mass_face(sm.from_face(f))
+        if mf.natural or mf.plane:
+            continue
+        grid, nodes = _grid_vs_node_by_node(monkeypatch, f)
+        # the moment integrands are polynomials where the surface is: equal to round-off;
+        # the area's |Su x Sv| is a square root, which neither rule integrates exactly
+        assert np.abs(grid[1:] - nodes[1:]).max() < 1e-12 * np.abs(nodes[1:]).max(), f.geom_type
+        assert _rel(grid[0], nodes[0]) < 1e-8
+        checked += 1
+    assert checked >= 1
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)
+    ref = sm.mass_properties(part, method="occt", eps=1e-9).volume
+    assert _rel(sm.mass_properties(part).volume, ref) < 1e-9
+
+
+def test_green_grid_on_a_holed_plate_is_exact(monkeypatch):
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)
+    plate = bd.Box(4, 3, 1) - bd.Cylinder(1.0, 2)
+    r = sm.mass_properties(plate)
+    assert _rel(r.volume, 12 - math.pi) < 1e-14
+    top = max(plate.faces(), key=lambda f: f.center().Z)
+    assert _rel(sm.from_face(top).area(), 12 - math.pi) < 1e-14
+
+
+@pytest.mark.corpus
+def test_green_grid_equals_node_by_node_on_the_corpus(monkeypatch, corpus_file):
+    # every trimmed face of every file: the moment integrals (volume, first and second
+    # moments) of both routes agree at order 16, where node-by-node Gauss has converged
+    for face in faces_of(sm.import_step(corpus_file).wrapped):
+        mf = mg.mass_face(sm.from_face(face))
+        if mf.natural:
+            continue
+        grid, nodes = _grid_vs_node_by_node(monkeypatch, face, 16)
+        assert np.abs(grid[1:] - nodes[1:]).max() <= 1e-10 * np.abs(nodes[1:]).max()
+
+
+def test_whole_planar_faces_at_once_equal_face_by_face():
+    part = bd.Box(2, 3, 4) + bd.Box(1, 1, 6)
+    mfs = [mg.mass_face(sm.from_face(f)) for f in part.faces()]
+    planes = [m for m in mfs if m.natural and m.plane]
+    assert len(planes) >= 6
+    ders, w = mg.plane_nodes(planes)
+    one = [mg.face_nodes(m, 12) for m in planes]
+    assert np.abs(w - np.concatenate([x[1] for x in one])).max() < 1e-15
+    assert np.abs(ders - np.concatenate([x[0] for x in one])).max() < 1e-15
+
+
+def test_circle_crossings_in_closed_form_equal_newton_on_occt():
+    # a hole's circle p-curve on a plane crosses lines u = c and v = c: the closed form
+    # equals sampling + Newton on OCCT's own adaptor (the route of other curve types)
+    plate = bd.Box(4, 3, 1) - bd.Cylinder(1.0, 2)
+    top = max(plate.faces(), key=lambda f: f.center().Z)
+    (rec,) = [r for r in face_pcurves(top.wrapped) if r["kind"] == "circle"]
+    c = rec["centre"]  # lines through the circle (4 x 2 crossings) and one beside it
+    lines_u, lines_v = c[0] + np.array([-0.5, 0.1, 0.99, 2.0]), c[1] + np.array([-0.999, 0.3])
+    cuts = np.linspace(*rec["range"], 5)
+    mine = np.sort(mg._crossings(rec, cuts, lines_u, lines_v))
+    ref = np.sort(mg._crossings(dict(rec, kind="other"), cuts, lines_u, lines_v))
+    assert len(mine) == len(ref) == 10 and np.abs(mine - ref).max() < 1e-12

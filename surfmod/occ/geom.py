@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
+
 from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface
 
 from . import arrays
+from .binary import bspline_curves, spline_surface
 from .guard import kernel
 
 
@@ -52,12 +52,14 @@ def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
     """Poles, weights (None if polynomial), flat knots and degrees of a B-spline surface.
 
     Periodic surfaces are read through a non-periodic copy (same shape, OCCT converts).
-    OCCT serializes the surface in C++ (``BinTools_SurfaceSet``) and NumPy reads the
-    buffer, where reading pole by pole costs Python calls per pole (the STEP parts'
-    surfaces have hundreds of poles each); a buffer that does not parse as expected is
-    read pole by pole instead."""
-    from OCP.BinTools import BinTools_SurfaceSet
+    The data come through OCCT's binary writer in one piece (:mod:`surfmod.occ.binary`).
 
+    >>> import numpy as np, surfmod as sm
+    >>> net = np.zeros((3, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:3, 0:4]
+    >>> d = read_bspline_surface(sm.BSplineSurface(net, (2, 3), ([0] * 3 + [1] * 3, [0] * 4 + [1] * 4)).geom())
+    >>> d["control_points"].shape, d["degree"], d["knots"][1].tolist()
+    ((3, 4, 3), (2, 3), [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0])
+    """
     with kernel("reading Geom_BSplineSurface"):
         if surf.IsUPeriodic() or surf.IsVPeriodic():
             surf = surf.Copy()  # OCP returns the derived type (no DownCast in OCP)
@@ -65,122 +67,48 @@ def read_bspline_surface(surf: Geom_BSplineSurface) -> dict:
                 surf.SetUNotPeriodic()
             if surf.IsVPeriodic():
                 surf.SetVNotPeriodic()
-        table = BinTools_SurfaceSet()
-        table.Add(surf)
-        buffer = io.BytesIO()
-        table.Write(buffer)
-        read = _parse_bspline_surface(buffer.getvalue())
-        return read if read is not None else _read_bspline_surface_by_pole(surf)
-
-
-#: ``(knot, multiplicity)`` records of OCCT's binary format (little-endian, packed)
-_KNOT_RECORD = np.dtype([("knot", "<f8"), ("mult", "<i4")])
-
-
-def _parse_bspline_surface(data: bytes) -> dict | None:
-    """One ``Geom_BSplineSurface`` as ``BinTools_SurfaceSet::Write`` stores it (a
-    ``Surfaces 1`` line, type byte 9, four flag bytes (u/v rational, u/v periodic), the
-    degrees as uint16, the pole and knot counts as int32, the poles row by row each
-    followed by its weight when rational, then (knot, multiplicity) records in u and in
-    v), or ``None`` when the bytes do not follow that layout."""
-    end = data.find(b"\n")
-    if end < 0 or data[:end].split() != [b"Surfaces", b"1"] or len(data) < end + 26 or data[end + 1] != 9:
-        return None
-    pos = end + 2
-    rational = bool(data[pos] or data[pos + 1])
-    p, q = (int(x) for x in np.frombuffer(data, "<u2", 2, pos + 4))
-    n, m, nku, nkv = (int(x) for x in np.frombuffer(data, "<i4", 4, pos + 8))
-    pos += 24
-    dim = 4 if rational else 3
-    if min(n, m, nku, nkv) < 1 or len(data) != pos + 8 * n * m * dim + _KNOT_RECORD.itemsize * (nku + nkv):
-        return None
-    poles = np.frombuffer(data, "<f8", n * m * dim, pos).reshape(n, m, dim)
-    pos += 8 * n * m * dim
-    u = np.frombuffer(data, _KNOT_RECORD, nku, pos)
-    v = np.frombuffer(data, _KNOT_RECORD, nkv, pos + _KNOT_RECORD.itemsize * nku)
-    ku, kv = np.repeat(u["knot"], u["mult"]), np.repeat(v["knot"], v["mult"])
-    if len(ku) != n + p + 1 or len(kv) != m + q + 1:
-        return None
-    return {
-        "control_points": poles[..., :3].astype(float),  # aligned, writable copies
-        "weights": poles[..., 3].astype(float) if rational else None,
-        "knots": (ku.astype(float), kv.astype(float)),
-        "degree": (p, q),
-    }
-
-
-def _read_bspline_surface_by_pole(surf: Geom_BSplineSurface) -> dict:
-    """:func:`read_bspline_surface` through OCCT's per-pole accessors (non-periodic surface)."""
-    from OCP.TColgp import TColgp_Array2OfPnt
-    from OCP.TColStd import TColStd_Array1OfReal, TColStd_Array2OfReal
-
-    with kernel("reading Geom_BSplineSurface"):
-        n, m = surf.NbUPoles(), surf.NbVPoles()
-        poles = TColgp_Array2OfPnt(1, n, 1, m)
-        surf.Poles(poles)
-        net = arrays.pnts_to_numpy_2d(poles)
-        weights = None
-        if surf.IsURational() or surf.IsVRational():
-            w = TColStd_Array2OfReal(1, n, 1, m)
-            surf.Weights(w)
-            weights = arrays.reals_to_numpy_2d(w)
-        p, q = surf.UDegree(), surf.VDegree()
-        ku = TColStd_Array1OfReal(1, n + p + 1)
-        surf.UKnotSequence(ku)
-        kv = TColStd_Array1OfReal(1, m + q + 1)
-        surf.VKnotSequence(kv)
-    return {
-        "control_points": net,
-        "weights": weights,
-        "knots": (arrays.to_numpy_1d(ku), arrays.to_numpy_1d(kv)),
-        "degree": (p, q),
-    }
+    data = spline_surface(surf)
+    return {key: data[key] for key in ("control_points", "weights", "knots", "degree")}
 
 
 def read_bezier_surface(surf: Geom_BezierSurface) -> dict:
-    with kernel("reading Geom_BezierSurface"):
-        from OCP.TColgp import TColgp_Array2OfPnt
-        from OCP.TColStd import TColStd_Array2OfReal
-
-        n, m = surf.NbUPoles(), surf.NbVPoles()
-        poles = TColgp_Array2OfPnt(1, n, 1, m)
-        surf.Poles(poles)
-        weights = None
-        if surf.IsURational() or surf.IsVRational():
-            w = TColStd_Array2OfReal(1, n, 1, m)
-            surf.Weights(w)
-            weights = arrays.reals_to_numpy_2d(w)
-    return {"control_points": arrays.pnts_to_numpy_2d(poles), "weights": weights}
+    """Poles and weights (None if polynomial) of a Bézier surface (binary, as above)."""
+    data = spline_surface(surf)
+    return {"control_points": data["control_points"], "weights": data["weights"]}
 
 
 def read_bspline_curve(curve: Geom_BSplineCurve) -> dict:
     """Poles ``(n, 3)``, weights (None if polynomial), flat knots and degree of a
     ``Geom_BSplineCurve`` or of a ``Geom2d_BSplineCurve`` (a p-curve: its poles get
-    z = 0, so the surfmod evaluator reads both); a periodic curve is unwrapped."""
-    with kernel("reading Geom_BSplineCurve"):
-        from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array1OfPnt2d
-        from OCP.TColStd import TColStd_Array1OfReal
+    z = 0, so the surfmod evaluator reads both); a periodic curve is unwrapped.  The
+    data come through OCCT's binary writer in one piece (:mod:`surfmod.occ.binary`).
 
+    >>> import surfmod as sm
+    >>> d = read_bspline_curve(sm.BSplineCurve([(0, 0, 0), (1, 2, 0), (3, 1, 1)], 2, [0, 0, 0, 1, 1, 1]).geom())
+    >>> d["points"].shape, d["weights"], d["degree"]
+    ((3, 3), None, 2)
+    """
+    with kernel("reading Geom_BSplineCurve"):
         if curve.IsPeriodic():
             curve = curve.Copy()  # OCP returns the derived type (no DownCast in OCP)
             curve.SetNotPeriodic()
-        n, p = curve.NbPoles(), curve.Degree()
         planar = type(curve).__name__.startswith("Geom2d")
-        poles = (TColgp_Array1OfPnt2d if planar else TColgp_Array1OfPnt)(1, n)
-        curve.Poles(poles)
-        weights = None
-        if curve.IsRational():
-            w = TColStd_Array1OfReal(1, n)
-            curve.Weights(w)
-            weights = arrays.to_numpy_1d(w)
-        k = TColStd_Array1OfReal(1, n + p + 1)
-        curve.KnotSequence(k)
-        if planar:
-            points = np.zeros((n, 3))
-            points[:, :2] = [poles.Value(i).Coord() for i in range(1, n + 1)]
-        else:
-            points = arrays.pnts_to_numpy_1d(poles)
-    return {"points": points, "weights": weights, "knots": arrays.to_numpy_1d(k), "degree": p}
+    return _padded(bspline_curves([curve], 2 if planar else 3)[0])
+
+
+def _padded(data: dict) -> dict:
+    """A :func:`surfmod.occ.binary.bspline_curves` record as :func:`read_bspline_curve`
+    returns it: 2-D poles get z = 0."""
+    points = data["points"]
+    if points.shape[1] == 2:
+        points = np.column_stack([points, np.zeros(len(points))])
+    return {"points": points, "weights": data["weights"], "knots": data["knots"], "degree": data["degree"]}
+
+
+def read_bspline_curves_2d(curves: list) -> list[dict]:
+    """:func:`read_bspline_curve` of many non-periodic ``Geom2d_BSplineCurve`` (the
+    B-spline p-curves of a face) through one binary table."""
+    return [_padded(d) for d in bspline_curves(curves, 2)]
 
 
 def surface_type(surf) -> str:

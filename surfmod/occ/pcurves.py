@@ -12,16 +12,19 @@ evaluated for all Gauss nodes at once (:mod:`surfmod.uses.mass_green`), instead 
 from __future__ import annotations
 
 import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAbs_Line
+from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS
 
-from .geom import read_bspline_curve
+from .geom import read_bspline_curve, read_bspline_curves_2d
 from .guard import kernel
 from .topo import explore
 
 
-def _xy(p) -> tuple[float, float]:
-    return (p.X(), p.Y())
+def _xy(p) -> np.ndarray:
+    return np.array(p.Coord())
 
 
 def _bspline_data(pc):
@@ -51,15 +54,13 @@ def face_pcurves(face) -> list[dict]:
     >>> [(p["kind"], p["sign"]) for p in pcs]
     [('circle', 1.0)]
     """
-    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-    from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAbs_Line
-    from OCP.TColStd import TColStd_Array1OfReal
-
     out = []
     with kernel("BRepAdaptor_Curve2d (face p-curves)"):
         edges = [(i, e) for i, wire in enumerate(explore(face, TopAbs_WIRE)) for e in explore(wire, TopAbs_EDGE)]
+        to_edge = TopoDS.Edge_s
+        splines = []
         for wire_index, e in edges:
-            edge = TopoDS.Edge_s(e)
+            edge = to_edge(e)
             pc = BRepAdaptor_Curve2d(edge, face)
             f, l = pc.FirstParameter(), pc.LastParameter()
             kind = pc.GetType()
@@ -79,17 +80,21 @@ def face_pcurves(face) -> list[dict]:
             }
             if kind == GeomAbs_Line:
                 lin = pc.Line()
-                rec.update(kind="line", origin=np.array(_xy(lin.Location())), direction=np.array(_xy(lin.Direction())))
+                rec.update(kind="line", origin=_xy(lin.Location()), direction=_xy(lin.Direction()))
             elif kind == GeomAbs_Circle:
                 c = pc.Circle()
                 ax = c.Position()
-                rec.update(kind="circle", centre=np.array(_xy(ax.Location())), x=np.array(_xy(ax.XDirection())),
-                           y=np.array(_xy(ax.YDirection())), radius=c.Radius())
+                rec.update(kind="circle", centre=_xy(ax.Location()), x=_xy(ax.XDirection()),
+                           y=_xy(ax.YDirection()), radius=c.Radius())
+            elif kind == GeomAbs_BSplineCurve and not (b := pc.BSpline()).IsPeriodic():
+                splines.append((rec, b))  # read below, all in one binary table
             elif kind == GeomAbs_BSplineCurve and (data := _bspline_data(pc)) is not None:
                 rec.update(kind="bspline", **data)
             else:
                 rec.update(kind="other")
             out.append(rec)
+        for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
+            rec.update(kind="bspline", **data)
     return out
 
 

@@ -8,6 +8,8 @@ Everything here returns plain Python/NumPy data; the NumPy work lives in
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
@@ -150,8 +152,10 @@ def vertex_mean(shape) -> np.ndarray:
     box centre when the shape has no vertex (one periodic face: a full sphere)."""
     from OCP.TopAbs import TopAbs_VERTEX
 
-    pts = [xyz(BRep_Tool.Pnt_s(TopoDS.Vertex_s(v))) for v in _explore(shape, TopAbs_VERTEX)]
-    return np.mean(pts, axis=0) if pts else bounding_box(shape).mean(axis=0)
+    pnt, vertex = BRep_Tool.Pnt_s, TopoDS.Vertex_s
+    # one flat fromiter over Coord() tuples (no array per vertex)
+    pts = np.fromiter(chain.from_iterable(pnt(vertex(v)).Coord() for v in _explore(shape, TopAbs_VERTEX)), float)
+    return pts.reshape(-1, 3).mean(axis=0) if pts.size else bounding_box(shape).mean(axis=0)
 
 
 def bounding_box(shape) -> np.ndarray:

@@ -16,8 +16,9 @@ domain:
 * a trimmed face (holes, faces cut by booleans) by Green's theorem in the parameter
   plane: ``∫∫_D g du dv = ∮ G dv`` with ``G(u, v) = ∫_{u0}^{u} g(s, v) ds`` (or the same
   along ``v``); the outer integral runs over Gauss nodes on the exact p-curves of the
-  face's edges (OCCT's 2-D curves, split at their breaks), the inner one is Gauss on
-  the untrimmed surface, split at knots.  No triangulation is involved, so the only
+  face's edges (OCCT's 2-D curves, split at their breaks), the inner one runs on the
+  untrimmed surface, split at knots (Gauss per boundary node, or one interpolation grid
+  per knot cell shared by all boundary nodes: see :mod:`surfmod.uses.mass_green`).  No triangulation is involved, so the only
   error is the accuracy of the p-curves themselves (the edge tolerance of the part,
   about 1e-7 for boolean results).
 
@@ -47,7 +48,7 @@ from ..errors import SurfmodError
 from ..readback import from_face
 from ..surface import Surface
 from .inputs import to_shape
-from .mass_green import face_nodes, mass_face, surface_mass_face
+from .mass_green import face_nodes, mass_face, plane_nodes, surface_mass_face, taylor_pieces
 
 
 @dataclass(frozen=True)
@@ -228,12 +229,22 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     else:
         from ..occ.topo import faces_of
 
-        faces = [mass_face(from_face(f)) for f in faces_of(solid)]
+        from ..occ.pcurves import face_pcurves
+
+        read = [from_face(f) for f in faces_of(solid)]
+        pcurves = [face_pcurves(f.face_shape) for f in read]
+        taylor_pieces([rec for pcs in pcurves for rec in pcs])  # all B-spline p-curves at once
+        faces = [mass_face(f, pcs) for f, pcs in zip(read, pcurves)]
     # faces whose every rule is exact by degree give the same sums at any order: the
     # lower-order pass behind the error estimate only re-integrates the others
     exact, high = _Accumulator(ref), _Accumulator(ref)
     inexact = []
+    planes = [f for f in faces if f.plane and f.natural and f.frame is not None]
+    if planes:  # whole planar rectangles (most faces of prismatic parts): all at once
+        exact.add(*plane_nodes(planes))
     for f in faces:
+        if f.plane and f.natural and f.frame is not None:
+            continue
         ders, w, is_exact = face_nodes(f, order)
         (exact if is_exact else high).add(ders, w)
         if not is_exact:

@@ -8,7 +8,14 @@ integrands ``g`` of the divergence theorem (``x·n``, ``x_i² n_i``, ``x_i³ n_i
 * a trimmed face: Green's theorem, ``∫∫_D g = ∮ G dv`` with ``G = ∫_{u0}^{u} g du``
   (inner direction ``u``) or ``∫∫_D g = -∮ H du`` with ``H = ∫_{v0}^{v} g dv`` (inner
   direction ``v``): Gauss on the exact p-curves of the boundary (outer integral),
-  and Gauss along the inner direction from the face box's edge to each boundary node.
+  and the inner integral from the face box's edge to each boundary node, either by
+  Gauss node by node or, where that evaluates fewer points, on one fixed grid per cell
+  (inner span × outer span, :func:`_grid_nodes`): the integrands' tensor interpolant at
+  Chebyshev points, whose inner antiderivative is exact, so every boundary node only adds
+  weights to the grid points and the surface is evaluated on the grids alone (exact
+  where the surface is a polynomial in both directions; ``2 order`` points per span
+  elsewhere, Gauss ``order``'s polynomial degree).  Whole-rectangle planar faces of a
+  part are integrated all at once (:func:`plane_nodes`).
 
 The Gauss order is chosen per direction and per piece from what the integrand is.  On a
 direction in which the surface is a polynomial of degree ``p`` (planes: 1; the axial
@@ -22,7 +29,9 @@ splines, curved p-curves on curved faces) takes the caller's ``order`` per piece
 turns on angular directions, knot spans, and at least ``PIECES`` pieces per curved edge.
 
 Every p-curve is evaluated from data (:func:`surfmod.occ.pcurves.face_pcurves`): lines,
-circles and B-splines for all nodes at once; other types through OCCT per node.
+circles and B-splines for all nodes at once (B-splines as one polynomial per span, built
+for all p-curves of a part in one pass per degree, :func:`taylor_pieces`); other types
+through OCCT per node.  Lines and circles cross the break lines in closed form.
 """
 
 from __future__ import annotations
@@ -35,9 +44,10 @@ from ..construct.curves import Line
 from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
-from ..eval.tensor import curve_derivatives
+from ..eval.basis import basis_derivatives, find_spans
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from .faces import _breaks, _patch_breaks, direction_breaks
+from .mass_grid import exact_order, gauss, grid_nodes, inner_nodes, interpolation_points, green_layout
 
 #: curved p-curves are cut into at least this many pieces before Gauss
 PIECES = 4
@@ -47,30 +57,11 @@ RECTANGLE_RTOL = 1e-7
 #: p-curves that meet within this (relative to the face box) at every vertex close the boundary
 CLOSURE_RTOL = 1e-10
 
-_GAUSS: dict = {}
-
-
-def gauss(order: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss–Legendre nodes and weights on ``[-1, 1]`` (cached).
-
-    >>> x, w = gauss(3)
-    >>> round(float(w.sum()), 15), round(float((w * x**4).sum()), 15)
-    (2.0, 0.4)
-    """
-    if order not in _GAUSS:
-        _GAUSS[order] = np.polynomial.legendre.leggauss(order)
-    return _GAUSS[order]
-
-
-def exact_order(degree: int) -> int:
-    """Gauss nodes per span that integrate the mass integrands exactly on a direction in
-    which the surface is a polynomial of ``degree`` (integrand degree ``5 degree``).
-
-    >>> exact_order(1), exact_order(3), exact_order(5)
-    (3, 8, 13)
-    """
-    return (5 * degree + 2) // 2
-
+#: a Green grid serves boundary nodes up to this fraction of its outer span beyond it
+GRID_REACH = 1e-3
+#: the grid's own work (Lagrange and antiderivative weights, per-cell sums), in evaluated
+#: nodes: below this saving node-by-node Gauss is faster
+GRID_OVERHEAD = 1500
 
 def _curve_degree(curve):
     if isinstance(curve, Line):
@@ -150,16 +141,60 @@ def _taylor_pieces(rec: dict):
     coefficients (S, p+1, dim))`` with ``C(t) = Σ_k c_k (t - centre)^k`` in homogeneous coordinates
     ``(w u, w v, w)`` (``(u, v)`` when polynomial).  Beyond the ends the first and last
     spans continue, as OCCT evaluates."""
-    p, knots, pts, w = rec["degree"], rec["knots"], rec["points"][:, :2], rec["weights"]
-    n = len(pts)
-    ctrl = pts if w is None else np.column_stack([pts * w[:, None], w])
-    starts = np.unique(knots[p:n])  # span starts inside the domain (the last end excluded)
-    starts = starts[starts < knots[n]]
-    # expanded about each span's middle: |t - centre| <= h/2 keeps high degrees accurate
-    centres = (starts + np.append(starts[1:], knots[n])) / 2
-    ders = curve_derivatives(knots, p, ctrl, centres, p)
-    fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
-    return starts, centres, ders / fact[None, :, None]
+    taylor_pieces([rec])
+    return rec["taylor"]
+
+
+def taylor_pieces(records: list) -> None:
+    """Set ``rec["taylor"]`` (see :func:`_taylor_pieces`) on every B-spline p-curve record
+    that lacks it, with one basis evaluation per degree for all of them: their knot
+    vectors and control points are laid end to end, and each span's basis reads only its
+    own curve's knots (``knots[span - p + 1 .. span + p]``), so one call serves all.
+
+    >>> import build123d as bd
+    >>> from surfmod.occ.pcurves import face_pcurves
+    >>> recs = [r for r in face_pcurves(bd.Face(bd.Wire([bd.Spline((0, 0), (1, 1), (2, 0), (1, -1)),
+    ...         bd.Edge.make_line((1, -1), (0, 0))])).wrapped) if r["kind"] == "bspline"]
+    >>> taylor_pieces(recs); starts, centres, coef = recs[0]["taylor"]
+    >>> coef.shape[1:] == (recs[0]["degree"] + 1, 2)
+    True
+    """
+    groups: dict = {}
+    for rec in records:
+        if rec["kind"] == "bspline" and "taylor" not in rec:
+            groups.setdefault(rec["degree"], []).append(rec)
+    for p, group in groups.items():
+        knots, ctrl, spans, centres, firsts, counts = [], [], [], [], [], []
+        k_off = c_off = 0
+        for rec in group:
+            k, pts, w = rec["knots"], rec["points"][:, :2], rec["weights"]
+            n = len(pts)
+            # homogeneous (w u, w v, w) for all; w = 1 leaves a polynomial curve's u, v as they are
+            ones = np.ones(n) if w is None else w
+            ctrl.append(np.column_stack([pts * ones[:, None], ones]))
+            starts = np.unique(k[p:n])  # span starts inside the domain (the last end excluded)
+            starts = starts[starts < k[n]]
+            # expanded about each span's middle: |t - centre| <= h/2 keeps high degrees accurate
+            mid = (starts + np.append(starts[1:], k[n])) / 2
+            local = find_spans(k, p, n, mid)
+            knots.append(k)
+            spans.append(local + k_off)
+            firsts.append(local - p + c_off)
+            centres.append(mid)
+            counts.append((starts, mid))
+            k_off += len(k)
+            c_off += n
+        all_knots, all_ctrl = np.concatenate(knots), np.concatenate(ctrl)
+        span, first, mid = np.concatenate(spans), np.concatenate(firsts), np.concatenate(centres)
+        basis = basis_derivatives(all_knots, p, span, mid, p)  # (S, p+1 derivatives, p+1 functions)
+        local_ctrl = all_ctrl[first[:, None] + np.arange(p + 1)]  # (S, p+1, 3)
+        fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
+        coef = np.einsum("skr,srd->skd", basis, local_ctrl) / fact[None, :, None]
+        at = 0
+        for rec, (starts, mid) in zip(group, counts):
+            c = coef[at : at + len(starts)]
+            at += len(starts)
+            rec["taylor"] = (starts, mid, c if rec["weights"] is not None else np.ascontiguousarray(c[:, :, :2]))
 
 
 def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
@@ -175,6 +210,17 @@ def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.nda
         d = rec["direction"][coord]
         ok = d != 0.0
         t = (lines[ok] - rec["origin"][coord[ok]]) / d[ok]
+        return t[(t > f) & (t < l)]
+    if rec["kind"] == "circle":
+        # centre + r (cos t x + sin t y) = line: A cos t + B sin t = C, t = phi ± acos(C / R)
+        r = rec["radius"]
+        A, B, C = r * rec["x"][coord], r * rec["y"][coord], lines - rec["centre"][coord]
+        R = np.hypot(A, B)
+        ok = np.abs(C) < R
+        phi, half = np.arctan2(B[ok], A[ok]), np.arccos(C[ok] / R[ok])
+        base = np.concatenate([phi + half, phi - half])
+        turns = np.arange(np.floor((f - base.max()) / (2 * np.pi)), np.ceil((l - base.min()) / (2 * np.pi)) + 1)
+        t = (base[:, None] + 2 * np.pi * turns[None, :]).ravel()
         return t[(t > f) & (t < l)]
     a, b = cuts[:-1, None], cuts[1:, None]
     t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
@@ -215,9 +261,10 @@ def _boundary(pcurves, outer_order, lines_u, lines_v):
             br = np.unique(np.concatenate([br, extra]))
             br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
         t, w = _spans(br, m)
-        q = pcurve_d1(rec, t)
-        ps.append(q[:, :2])
-        ds.append(q[:, 2:])
+        q = pcurve_d1(rec, np.concatenate([t, [f, l]]))
+        rec["ends"] = q[-2:, :2]  # for _largest_gap, from the same call
+        ps.append(q[:-2, :2])
+        ds.append(q[:-2, 2:])
         ws.append(rec["sign"] * w)
     if not ps:
         return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), exact
@@ -237,6 +284,7 @@ class MassFace:
     degrees: tuple
     pcurves: list | None  # None: the face is its whole parameter rectangle
     plane: bool = False
+    frame: tuple | None = None  # planes: origin, x, y (S = O + u X + v Y)
 
     @property
     def natural(self) -> bool:
@@ -269,8 +317,9 @@ def _on_box_border(pcurves, bounds) -> bool:
     return True
 
 
-def mass_face(face) -> MassFace:
-    """A :class:`MassFace` for a face read back with :func:`surfmod.from_face`.
+def mass_face(face, pcurves: list | None = None) -> MassFace:
+    """A :class:`MassFace` for a face read back with :func:`surfmod.from_face` (``pcurves``:
+    its :func:`~surfmod.occ.pcurves.face_pcurves`, when already read).
 
     >>> import surfmod as sm, build123d as bd
     >>> m = mass_face(sm.from_face(bd.Box(1, 1, 1).faces()[0]))
@@ -280,14 +329,19 @@ def mass_face(face) -> MassFace:
     from ..occ.pcurves import face_pcurves
 
     u0, u1, v0, v1 = bounds = tuple(b for r in face.domain for b in r)
-    breaks = (_patch_breaks(face, u0, u1, 0, face.periods[0]), _patch_breaks(face, v0, v1, 1, face.periods[1]))
     surf = face.surface
-    pcurves = face_pcurves(face.face_shape)
-    wires = {rec["wire"] for rec in pcurves}
-    natural = len(wires) == 1 and _on_box_border(pcurves, bounds)
+    plane = isinstance(surf, PlaneSurface)
+    if plane:  # one polynomial piece each way
+        breaks = (np.array([u0, u1]), np.array([v0, v1]))
+    else:
+        breaks = (_patch_breaks(face, u0, u1, 0, face.periods[0]), _patch_breaks(face, v0, v1, 1, face.periods[1]))
+    if pcurves is None:
+        pcurves = face_pcurves(face.face_shape)
+        taylor_pieces(pcurves)
+    natural = bool(pcurves) and all(rec["wire"] == 0 for rec in pcurves) and _on_box_border(pcurves, bounds)
     return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
-                    isinstance(surf, PlaneSurface))
+                    plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None)
 
 
 def surface_mass_face(surf) -> MassFace:
@@ -330,6 +384,32 @@ def face_nodes(mf: MassFace, order: int):
     return ders, w, exact
 
 
+def plane_nodes(faces: list) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`face_nodes` of many whole-rectangle planar faces at once (``S = O + u X +
+    v Y``: 3 × 3 Gauss nodes per face, exact), without a Python call per face.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> mfs = [mass_face(sm.from_face(f)) for f in bd.Box(1, 2, 3).faces()]
+    >>> d, w = plane_nodes(mfs)
+    >>> d.shape, round(float(w.sum()), 12)
+    ((54, 2, 2, 3), 22.0)
+    """
+    x, w = gauss(3)
+    b = np.array([mf.bounds for mf in faces])  # (F, 4)
+    o, ex, ey = (np.array([mf.frame[i] for mf in faces]) for i in range(3))
+    sign = np.array([mf.sign for mf in faces])
+    hu, hv = (b[:, 1] - b[:, 0]) / 2, (b[:, 3] - b[:, 2]) / 2
+    u = ((b[:, 0] + b[:, 1]) / 2)[:, None] + hu[:, None] * x  # (F, 3)
+    v = ((b[:, 2] + b[:, 3]) / 2)[:, None] + hv[:, None] * x
+    uu, vv = np.repeat(u, 3, axis=1), np.tile(v, (1, 3))  # (F, 9), u-major as face_nodes
+    ders = np.zeros((len(faces), 9, 2, 2, 3))
+    ders[:, :, 0, 0] = o[:, None] + uu[..., None] * ex[:, None] + vv[..., None] * ey[:, None]
+    ders[:, :, 1, 0] = (sign[:, None] * ex)[:, None]
+    ders[:, :, 0, 1] = ey[:, None]
+    weights = (hu * hv)[:, None] * np.outer(w, w).ravel()
+    return ders.reshape(-1, 2, 2, 3), weights.ravel()
+
+
 def _largest_gap(mf: MassFace) -> float:
     """Largest distance, relative to the face box, from the end of an edge's p-curve to
     the nearest start of one (in the edges' directions in the face): 0 for a boundary
@@ -338,7 +418,7 @@ def _largest_gap(mf: MassFace) -> float:
     scale = np.array([max(u1 - u0, 1e-300), max(v1 - v0, 1e-300)])
     ends = []
     for rec in mf.pcurves:
-        q = pcurve_d1(rec, np.array(rec["range"]))[:, :2] / scale
+        q = (rec["ends"] if "ends" in rec else pcurve_d1(rec, np.array(rec["range"]))[:, :2]) / scale
         ends.append(q if rec["sign"] > 0 else q[::-1])
     if not ends:
         return 0.0
@@ -371,14 +451,25 @@ def _green(mf: MassFace, order: int, orders, exacts):
     # nodes on p-curves along the inner direction carry no outer differential
     moving = wb != 0.0
     P, wb = P[moving], wb[moving]
-    x, w = gauss(m_in)
-    br = mf.breaks[k]
-    a = np.clip(br[None, :-1], None, P[:, k, None])  # (B, S) span starts clipped to the node
-    b = np.clip(br[None, 1:], None, P[:, k, None])
-    bi, si = np.nonzero(b - a > 0)
-    a, b = a[bi, si], b[bi, si]
-    s = ((a + b)[:, None] / 2 + (b - a)[:, None] / 2 * x).ravel()
-    ws = ((b - a)[:, None] / 2 * w * wb[bi, None]).ravel()
-    other = np.repeat(P[bi, 1 - k], m_in)
+    full, partial, q = green_layout(mf, k, P)
+    # node by node, or all nodes onto fixed grids per cell: whichever evaluates fewer
+    # points.  Grids serve the nodes inside their outer span (p-curves reach a hair
+    # beyond the face box, where a short end span must not be extrapolated far)
+    obr = mf.breaks[1 - k]
+    on_grid = np.abs(2 * P[:, 1 - k] - obr[q] - obr[q + 1]) <= (1 + GRID_REACH) * (obr[q + 1] - obr[q])
+    counts = [interpolation_points(mf.degrees[d], order) for d in (k, 1 - k)]
+    deepest = np.zeros(len(obr) - 1, int)  # per outer span, the inner spans its nodes reach
+    np.maximum.at(deepest, q[on_grid], (full + partial)[on_grid])
+    grid = counts[0][0] * counts[1][0] * deepest.sum()
+    if grid + GRID_OVERHEAD < m_in * (partial[on_grid].sum() + full[on_grid].sum()):
+        g = grid_nodes(mf, k, (counts[0][0], counts[1][0]), P[on_grid], wb[on_grid], full[on_grid],
+                        partial[on_grid], q[on_grid])
+        rest = ~on_grid
+        exact = exact and counts[0][1] and counts[1][1] and (exacts[k] or not rest.any())
+    else:
+        g, rest = (np.zeros(0),) * 3, np.ones(len(P), bool)
+        exact = exact and exacts[k]
+    n = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
+    s, other, ws = (np.concatenate([a, b]) for a, b in zip(g, n))
     ders = mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1)
-    return ders, ws, exact and exacts[k]
+    return ders, ws, exact

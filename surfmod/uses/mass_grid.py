@@ -1,0 +1,202 @@
+"""Quadrature rules and Green's theorem grids for :mod:`surfmod.uses.mass_green`.
+
+Gauss–Legendre rules (cached), the orders exact for polynomial directions, and the
+inner integrals of Green's theorem: node by node (:func:`inner_nodes`) or on one fixed
+interpolation grid per cell (:func:`grid_nodes`).  On a cell (inner span × outer span)
+the integrands are replaced by their tensor interpolant at Chebyshev points of the
+first kind (inside the span: a degree-1 spline's derivatives jump at its ends), exact
+where the surface is a polynomial of degree ``p`` there (``5p + 1`` points: the
+integrands' degree); the interpolant's antiderivative along the inner direction is
+integrated exactly through the Chebyshev polynomials, so each boundary node adds weights
+to the grid points and the surface is evaluated on the grids only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_GAUSS: dict = {}
+
+
+def gauss(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights on ``[-1, 1]`` (cached).
+
+    >>> x, w = gauss(3)
+    >>> round(float(w.sum()), 15), round(float((w * x**4).sum()), 15)
+    (2.0, 0.4)
+    """
+    if order not in _GAUSS:
+        _GAUSS[order] = np.polynomial.legendre.leggauss(order)
+    return _GAUSS[order]
+
+
+def exact_order(degree: int) -> int:
+    """Gauss nodes per span that integrate the mass integrands exactly on a direction in
+    which the surface is a polynomial of ``degree`` (integrand degree ``5 degree``).
+
+    >>> exact_order(1), exact_order(3), exact_order(5)
+    (3, 8, 13)
+    """
+    return (5 * degree + 2) // 2
+
+
+def chebyshev(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` Chebyshev points (first kind: inside ``(-1, 1)``, never on a span's end, where
+    a degree-1 spline's derivatives jump), their barycentric weights, and the Chebyshev
+    coefficients of their Lagrange basis, ``ℓ_j = Σ_m A[j, m] T_m`` (cached).
+    Interpolation there is well conditioned at any degree.
+
+    >>> x, bw, A = chebyshev(3)
+    >>> x.round(12).tolist(), round(float(antiderivative_weights(np.array([1.0]), 3)[0] @ x**2), 14)
+    ([0.866025403784, 0.0, -0.866025403784], 0.66666666666667)
+    """
+    key = ("chebyshev", n)
+    if key not in _GAUSS:
+        theta = (2 * np.arange(n) + 1) * np.pi / (2 * n)
+        bw = np.where(np.arange(n) % 2 == 0, 1.0, -1.0) * np.sin(theta)
+        # discrete orthogonality of T_m at these points: ℓ_j = (1/n) T_0 + (2/n) Σ_{m>0} T_m(x_j) T_m
+        A = 2.0 / n * np.cos(np.outer(theta, np.arange(n)))
+        A[:, 0] /= 2
+        _GAUSS[key] = (np.cos(theta), bw, A)
+        _GAUSS[("span integral", n)] = antiderivative_weights(np.ones(1), n)[0]
+    return _GAUSS[key]
+
+
+def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
+    """``(N, n)``: ``∫_{-1}^{x1} ℓ_j`` for the Lagrange basis ``ℓ_j`` of :func:`chebyshev`
+    points, by the exact antiderivatives of the Chebyshev polynomials,
+    ``∫ T_m = (T_{m+1}/(m+1) - T_{m-1}/(m-1)) / 2``."""
+    _, _, A = chebyshev(n)
+    theta = np.arccos(np.clip(x1, -1.0, 1.0))
+    m = np.arange(n + 1)
+    T = np.cos(np.outer(theta, m))  # (N, n + 1): T_0 .. T_n
+    ends = np.where(m % 2 == 0, 1.0, -1.0)  # T_m(-1)
+    I = np.empty((len(x1), n))
+    I[:, 0] = T[:, 1] + 1.0
+    if n > 1:
+        I[:, 1] = (T[:, 2] - 1.0) / 4.0  # ∫ T_1 = x² / 2 = (T_2 + 1) / 4
+    if n > 2:
+        k = np.arange(2, n)
+        I[:, 2:] = (T[:, 3:] / (k + 1) - T[:, 1:-2] / (k - 1)) / 2 - (ends[3:] / (k + 1) - ends[1:-2] / (k - 1)) / 2
+    return I @ A.T
+
+
+def lagrange_values(y: np.ndarray, x: np.ndarray, bw: np.ndarray) -> np.ndarray:
+    """``(N, K)``: the Lagrange basis of the points ``x`` (barycentric weights ``bw``) at
+    ``y``, so that ``Σ_k L_k(y) f(x_k)`` is the interpolant of ``f`` (exact for
+    polynomials of degree ``< K``).
+
+    >>> x, bw, _ = chebyshev(4)
+    >>> L = lagrange_values(np.array([0.3, x[1]]), x, bw)
+    >>> float(round(L[0] @ (x**3), 14)), L[1].round(15).tolist() == [0, 1, 0, 0]
+    (0.027, True)
+    """
+    d = y[:, None] - x[None, :]
+    hit = d == 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = bw / d
+        L = t / t.sum(axis=1, keepdims=True)
+    rows = hit.any(axis=1)
+    L[rows] = hit[rows]  # a value at an interpolation point is that point's value
+    return L
+
+
+def interpolation_points(degree, order: int) -> tuple[int, bool]:
+    """Interpolation points per span along a direction for Green's grid
+    (:func:`grid_nodes`): ``5p + 1`` where the surface is a polynomial of degree ``p``
+    (the integrands' degree: exact), else ``2 order`` (the polynomial degree Gauss of
+    ``order`` integrates exactly).
+
+    >>> interpolation_points(1, 12), interpolation_points(None, 12)
+    ((6, True), (24, False))
+    """
+    if degree is not None and exact_order(degree) <= order:
+        return 5 * degree + 1, True
+    return 2 * order, False
+
+
+def green_layout(mf, k: int, P: np.ndarray):
+    """Per boundary node: the inner spans wholly below it (``full``), whether the next one
+    is partial, and its outer span ``q``."""
+    br, obr = mf.breaks[k], mf.breaks[1 - k]
+    n_spans = len(br) - 1
+    u = P[:, k]
+    full = np.searchsorted(br[1:], u, side="right")  # br[i + 1] <= u
+    partial = (full < n_spans) & (br[np.minimum(full, n_spans - 1)] < u)
+    q = np.clip(np.searchsorted(obr, P[:, 1 - k], side="right") - 1, 0, len(obr) - 2)
+    return full, partial, q
+
+
+def inner_nodes(mf, k: int, m_in: int, P: np.ndarray, wb: np.ndarray, full, partial):
+    """Nodes ``(s, other, weights)`` of Green's inner integrals ``∫_{lo}^{P_k} g`` along
+    direction ``k`` node by node: Gauss of ``m_in`` on the partial span (its start to
+    ``P_k``) and on every whole span below it."""
+    x, w = gauss(m_in)
+    br = mf.breaks[k]
+    u, other = P[:, k], P[:, 1 - k]
+    rows = np.flatnonzero(partial)
+    reps = full
+    node = np.concatenate([rows, np.repeat(np.arange(len(P)), reps)])
+    start = np.concatenate([full[rows], np.arange(reps.sum()) - np.repeat(np.cumsum(reps) - reps, reps)])
+    a = br[start]
+    b = np.concatenate([u[rows], br[start[len(rows):] + 1]])
+    s = ((a + b)[:, None] / 2 + (b - a)[:, None] / 2 * x).ravel()
+    ws = ((b - a)[:, None] / 2 * w * wb[node, None]).ravel()
+    return s, np.repeat(other[node], m_in), ws
+
+
+def _sum_rows(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """``(n, ...)``: the rows of ``values`` summed by ``index`` (a sort and one
+    ``add.reduceat``: ``np.add.at`` is many times slower)."""
+    out = np.zeros((n,) + values.shape[1:])
+    if len(index):
+        order = np.argsort(index, kind="stable")
+        idx = index[order]
+        starts = np.flatnonzero(np.concatenate([[True], idx[1:] != idx[:-1]]))
+        out[idx[starts]] = np.add.reduceat(values[order], starts, axis=0)
+    return out
+
+
+def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial, q):
+    """Green's inner integrals of all boundary nodes on one fixed grid per cell (inner span
+    × outer span): on each cell the integrands are replaced by their tensor interpolant at
+    ``counts`` Chebyshev points (exact where the surface is a polynomial there, see
+    :func:`interpolation_points`), whose inner antiderivative is integrated exactly.  Then
+
+        Σ_n wb_n ∫_{lo}^{u_n} g(s, t_n) ds = Σ_cells Σ_jl Ω_jl g(s_j, t_l),
+
+    ``Ω`` summing, over the boundary nodes, ``wb · L_l(t_n) · ∫ ℓ_j`` (over the whole
+    spans below the node and the partial one): the surface is evaluated on the grids only,
+    whatever the number of boundary nodes."""
+    ks, kt = counts
+    xs = chebyshev(ks)[0]
+    xt, bwt, _ = chebyshev(kt)
+    iws = _GAUSS[("span integral", ks)]  # ∫_{-1}^{1} ℓ_j
+    br, obr = mf.breaks[k], mf.breaks[1 - k]
+    n_spans, n_out = len(br) - 1, len(obr) - 1
+    a, b = obr[q], obr[q + 1]
+    lt = lagrange_values((2 * P[:, 1 - k] - a - b) / (b - a), xt, bwt) * wb[:, None]  # (N, kt)
+    # whole spans: node n covers spans i < full_n; ∫ over a span of ℓ_j is h/2 · iws_j
+    acc = _sum_rows(q * (n_spans + 1) + full, lt, n_out * (n_spans + 1)).reshape(n_out, n_spans + 1, kt)
+    whole = np.cumsum(acc[:, ::-1], axis=1)[:, ::-1][:, 1:]  # (Q, S, kt): Σ over nodes with full > i
+    h = np.diff(br)
+    omega = (h / 2)[None, :, None, None] * iws[None, None, :, None] * whole[:, :, None, :]
+    rows = np.flatnonzero(partial)
+    if rows.size:
+        # partial span f: ∫_{br_f}^{u_n} ℓ_j, exactly
+        f = full[rows]
+        x1 = (2 * P[rows, k] - br[f] - br[f + 1]) / h[f]  # in (-1, 1)
+        c = antiderivative_weights(x1, ks) * (h[f] / 2)[:, None]  # (n, ks)
+        cell = q[rows] * n_spans + f
+        order = np.argsort(cell, kind="stable")
+        cell, c, lp = cell[order], c[order], lt[rows[order]]
+        cuts = np.flatnonzero(np.diff(cell)) + 1
+        flat = omega.reshape(n_out * n_spans, ks, kt)
+        for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(cell)]])):
+            flat[cell[lo]] += c[lo:hi].T @ lp[lo:hi]  # Σ_n c_nj lt_nl, one product per cell
+    qi, si = np.nonzero(np.any(omega != 0.0, axis=(2, 3)))
+    s = ((br[si] + br[si + 1])[:, None] / 2 + (h[si] / 2)[:, None] * xs)  # (C, ks)
+    t = ((obr[qi] + obr[qi + 1])[:, None] / 2 + ((obr[qi + 1] - obr[qi]) / 2)[:, None] * xt)  # (C, kt)
+    shape = (len(qi), ks, kt)
+    return (np.broadcast_to(s[:, :, None], shape).ravel(), np.broadcast_to(t[:, None, :], shape).ravel(),
+            omega[qi, si].ravel())
