@@ -170,6 +170,20 @@ def _fill_spline_figures(splines: list, floor: float) -> None:
         figure[:] = a, k
 
 
+def _evaluator(evaluators: dict, fm) -> FaceSurface | None:
+    """The :class:`FaceSurface` of a face measured against it (built once per face and
+    kept in ``evaluators`` for the passes and the refinement), or ``None`` for the
+    surfaces measured in closed form."""
+    from ..occ.geom import surface_type
+    from ..occ.mesh import ANALYTIC
+
+    key = fm.face.__hash__()
+    ev = evaluators.get(key)
+    if ev is None and surface_type(fm.surface) not in ANALYTIC:
+        ev = evaluators[key] = FaceSurface(fm.surface)
+    return ev
+
+
 def _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared) -> list[int]:
     """Positions in ``fms`` of the faces a finer deflection should bring within tolerance.
 
@@ -272,7 +286,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
 
     from ..occ.mesh import brepmesh
 
-    evaluators: dict = {}  # face hash -> FaceSurface of its B-spline/Bezier surface
+    evaluators: dict = {}  # face hash -> FaceSurface (splines from the estimate, others when measured)
     estimate, diag = _estimate(shape, tolerance, evaluators)
     if tolerance < MIN_RELATIVE_TOLERANCE * diag:
         raise SurfmodError(
@@ -303,14 +317,14 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
                 if fm.repeats >= 0:  # an isometric repeat of a face measured above
                     dev[i], node_dev[i] = dev[fm.repeats], node_dev[fm.repeats]
                     continue
-                d, node_dev[i] = measure_face(fm, tolerance, ev=evaluators.get(fm.face.__hash__()))
+                d, node_dev[i] = measure_face(fm, tolerance, ev=_evaluator(evaluators, fm))
                 dev[i] = d.max(initial=0.0)
             bar.update()
             refine = _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared)
             # BRepMesh overshoots by a few percent inside some faces: refining those
             # faces alone costs far less than a second pass over the whole shape
             fixed = [i for i in refine
-                     if _refine_locally(fms, i, dev, node_dev, tolerance, evaluators.get(fms[i].face.__hash__()))]
+                     if _refine_locally(fms, i, dev, node_dev, tolerance, _evaluator(evaluators, fms[i]))]
             refined = len(fixed)  # the faces refined in the pass that is kept
             refine = [i for i in refine if i not in fixed]
             if not refine:

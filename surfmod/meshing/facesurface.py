@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..eval import local
 from ..nets.bezier import BezierCurve, BezierSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
 
@@ -23,9 +24,15 @@ class _Curve:
     def __init__(self, info: dict):
         self.spline = None
         self.info = info
+        self._net = None
         if "bspline" in info:
             d = info["bspline"]
             self.spline = BSplineCurve(d["points"], d["degree"], d["knots"], d["weights"])
+            # the compiled surface kernels evaluate the curve as the ruled surface between
+            # two copies of it (degree 1 across): C(t) = S(0, t), C'(t) = S_v(0, t)
+            h = self.spline._homogeneous
+            self._net = local.prepare(np.array([0.0, 0.0, 1.0, 1.0]), 1, self.spline.knots, self.spline.degree,
+                                      np.stack([h, h]))
         elif "bezier" in info:
             self.spline = BezierCurve(info["bezier"]["points"], info["bezier"]["weights"])
         self.supported = self.spline is not None or "line" in info or "conic" in info
@@ -33,7 +40,10 @@ class _Curve:
     def d1(self, t: np.ndarray) -> np.ndarray:
         if self.spline is not None:
             lo, hi = self.spline.domain
-            return self.spline._derivatives(np.clip(t, lo, hi), 1)
+            t = np.clip(t, lo, hi)
+            if self._net is not None:
+                return local.surface_derivatives(self._net, np.zeros(len(t)), t, 1)[:, 0]
+            return self.spline._derivatives(t, 1)
         if "line" in self.info:
             o, d = self.info["line"]
             return np.stack([o + t[:, None] * d, np.broadcast_to(d, (len(t), 3))], axis=1)
