@@ -22,6 +22,7 @@ _EXPORTS = {
     "Surface": ".surface",
     "Curve": ".curve",
     "Curvatures": ".eval.differential",
+    "set_threads": ".eval.threads",
     "BSplineSurface": ".nets.bspline",
     "BSplineCurve": ".nets.bspline",
     "BezierSurface": ".nets.bezier",

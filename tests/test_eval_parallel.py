@@ -89,6 +89,7 @@ def test_thread_setting_caps_and_names_bad_counts(monkeypatch):
     for bad in (0, -2, 1.5, True):
         with pytest.raises(sm.SurfmodError, match="count"):
             threads.set_threads(bad)
+    assert sm.set_threads is threads.set_threads  # the public name
 
 
 def test_numba_thread_count_is_restored(monkeypatch):
