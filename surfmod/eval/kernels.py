@@ -249,6 +249,37 @@ def scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom
                         out[a0 + b, k, l, d] = h[k, l, d, b]
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u, v, lu, ru, nu_, lv, rv, nv_):
+    """``(x, y, z)`` at one pair: bucketed span search, the A2.2 triangle in each
+    direction and the ``(p+1) x (q+1)`` sum kept in registers (``lu``... ``nv_``: the
+    caller's scratch of ``p + 1`` and ``q + 1`` values)."""
+    n, m = ctrl.shape[0], ctrl.shape[1]
+    su = find_span_bucketed(ku, p, n, u, bucket_u[0], bucket_u[1], bucket_u[2])
+    sv = find_span_bucketed(kv, q, m, v, bucket_v[0], bucket_v[1], bucket_v[2])
+    _basis_funs(ku, p, su, u, inv_u, lu, ru, nu_)
+    _basis_funs(kv, q, sv, v, inv_v, lv, rv, nv_)
+    x = y = z = w = 0.0
+    for i in range(p + 1):
+        rx = ry = rz = rw = 0.0
+        ci = su - p + i
+        for j in range(q + 1):
+            c = nv_[j]
+            cj = sv - q + j
+            rx += c * ctrl[ci, cj, 0]
+            ry += c * ctrl[ci, cj, 1]
+            rz += c * ctrl[ci, cj, 2]
+            rw += c * ctrl[ci, cj, 3]
+        c = nu_[i]
+        x += c * rx
+        y += c * ry
+        z += c * rz
+        w += c * rw
+    if rational:
+        return x / w, y / w, z / w
+    return x, y, z
+
+
 @njit(cache=True, error_model="numpy")
 def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out):
     """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
@@ -261,37 +292,12 @@ def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket
 @njit(cache=True, error_model="numpy")
 def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, chunk):
     """One chunk of :func:`scattered_positions` (points ``chunk * SCATTER_CHUNK`` on)."""
-    n, m = ctrl.shape[0], ctrl.shape[1]
     nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
     lu, ru = np.empty(p + 1), np.empty(p + 1)
     lv, rv = np.empty(q + 1), np.empty(q + 1)
-    t0u, scale_u, table_u = bucket_u
-    t0v, scale_v, table_v = bucket_v
     for a in range(chunk * SCATTER_CHUNK, min(u.size, (chunk + 1) * SCATTER_CHUNK)):
-        su = find_span_bucketed(ku, p, n, u[a], t0u, scale_u, table_u)
-        sv = find_span_bucketed(kv, q, m, v[a], t0v, scale_v, table_v)
-        _basis_funs(ku, p, su, u[a], inv_u, lu, ru, nu_)
-        _basis_funs(kv, q, sv, v[a], inv_v, lv, rv, nv_)
-        x = y = z = w = 0.0
-        for i in range(p + 1):
-            rx = ry = rz = rw = 0.0
-            ci = su - p + i
-            for j in range(q + 1):
-                c = nv_[j]
-                cj = sv - q + j
-                rx += c * ctrl[ci, cj, 0]
-                ry += c * ctrl[ci, cj, 1]
-                rz += c * ctrl[ci, cj, 2]
-                rw += c * ctrl[ci, cj, 3]
-            c = nu_[i]
-            x += c * rx
-            y += c * ry
-            z += c * rz
-            w += c * rw
-        if rational:
-            x /= w
-            y /= w
-            z /= w
+        x, y, z = position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u[a], v[a],
+                              lu, ru, nu_, lv, rv, nv_)
         out[a, 0] = x
         out[a, 1] = y
         out[a, 2] = z

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .kernels import _basis_funs, basis_ders_point, find_span_bucketed
+from .kernels import basis_ders_point, find_span_bucketed, position_at
 
 #: Gauss-Newton iterations per point (as ``project_distances``)
 ITERATIONS = 6
@@ -26,35 +26,6 @@ def _wrap(x, lo, hi, period, periodic):
     if periodic:
         return lo + np.mod(x - lo, period)
     return min(max(x, lo), hi)
-
-
-@njit(cache=True, error_model="numpy")
-def _position(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u, v, lu, ru, nu_, lv, rv, nv_):
-    """``(x, y, z)`` at one pair (the A2.2 triangle, as ``kernels.scattered_positions``)."""
-    n, m = ctrl.shape[0], ctrl.shape[1]
-    su = find_span_bucketed(ku, p, n, u, bucket_u[0], bucket_u[1], bucket_u[2])
-    sv = find_span_bucketed(kv, q, m, v, bucket_v[0], bucket_v[1], bucket_v[2])
-    _basis_funs(ku, p, su, u, inv_u, lu, ru, nu_)
-    _basis_funs(kv, q, sv, v, inv_v, lv, rv, nv_)
-    x = y = z = w = 0.0
-    for i in range(p + 1):
-        rx = ry = rz = rw = 0.0
-        ci = su - p + i
-        for j in range(q + 1):
-            c = nv_[j]
-            cj = sv - q + j
-            rx += c * ctrl[ci, cj, 0]
-            ry += c * ctrl[ci, cj, 1]
-            rz += c * ctrl[ci, cj, 2]
-            rw += c * ctrl[ci, cj, 3]
-        c = nu_[i]
-        x += c * rx
-        y += c * ry
-        z += c * rz
-        w += c * rw
-    if rational:
-        return x / w, y / w, z / w
-    return x, y, z
 
 
 @njit(cache=True, error_model="numpy")
@@ -103,7 +74,7 @@ def project_distances(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, buck
     for a in range(points.shape[0]):
         px, py, pz = points[a, 0], points[a, 1], points[a, 2]
         ua, va = min(max(uv[a, 0], u0), u1), min(max(uv[a, 1], v0), v1)
-        x, y, z = _position(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
+        x, y, z = position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
                             _wrap(ua, lo[0], hi[0], period[0], periodic[0]),
                             _wrap(va, lo[1], hi[1], period[1], periodic[1]), lu, ru, tu, lv, rv, tv)
         best = np.sqrt((px - x) ** 2 + (py - y) ** 2 + (pz - z) ** 2)
@@ -134,7 +105,7 @@ def project_distances(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, buck
                     active = False
                     break
         if active:  # still moving after the last iteration: its last iterate counts too
-            x, y, z = _position(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
+            x, y, z = position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
                                 _wrap(ua, lo[0], hi[0], period[0], periodic[0]),
                                 _wrap(va, lo[1], hi[1], period[1], periodic[1]), lu, ru, tu, lv, rv, tv)
             best = min(best, np.sqrt((px - x) ** 2 + (py - y) ** 2 + (pz - z) ** 2))
