@@ -79,20 +79,3 @@ def pnts_to_numpy_1d(arr) -> np.ndarray:
     value, n = arr.Value, arr.Upper() - arr.Lower() + 1
     return np.fromiter(chain.from_iterable(value(i).Coord() for i in range(arr.Lower(), arr.Upper() + 1)),
                        float, 3 * n).reshape(n, 3)
-
-
-def pnts_to_numpy_2d(arr) -> np.ndarray:
-    value = arr.Value
-    rows, cols = range(arr.LowerRow(), arr.UpperRow() + 1), range(arr.LowerCol(), arr.UpperCol() + 1)
-    flat = np.fromiter(chain.from_iterable(value(i, j).Coord() for i in rows for j in cols), float,
-                       3 * len(rows) * len(cols))
-    return flat.reshape(len(rows), len(cols), 3)
-
-
-def reals_to_numpy_2d(arr) -> np.ndarray:
-    return np.array(
-        [
-            [arr.Value(i, j) for j in range(arr.LowerCol(), arr.UpperCol() + 1)]
-            for i in range(arr.LowerRow(), arr.UpperRow() + 1)
-        ]
-    )
