@@ -77,8 +77,14 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
     Values at most ``tolerance / 2`` may be upper bounds; larger ones are projections.
     """
+    from ..occ.geom import surface_type
     from ..occ.mesh import analytic_distances
 
+    if surface_type(fm.surface) == "Geom_Plane":
+        # the signed distance to a plane is linear on a flat triangle: its extremes are
+        # at the corners, so the nodes' distances give every triangle's exactly
+        node = analytic_distances(fm.surface, fm.nodes)
+        return node[fm.triangles].max(axis=1), float(node.max(initial=0.0))
     pos = fm.nodes[fm.triangles]
     q = np.matmul(bary, pos).reshape(-1, 3)
     exact = analytic_distances(fm.surface, np.concatenate([q, fm.nodes]))  # samples and nodes in one call
