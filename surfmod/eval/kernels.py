@@ -17,8 +17,6 @@ Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polyno
 
 from __future__ import annotations
 
-from functools import cache
-
 import numpy as np
 from numba import njit
 
@@ -69,9 +67,20 @@ def span_buckets(knots: np.ndarray, degree: int, n_ctrl: int, per_span: int = 4)
     knot span over ``[knots[degree], knots[n_ctrl]]``, each holding the span of its start."""
     t0, t1 = float(knots[degree]), float(knots[n_ctrl])
     count = max(1, per_span * (n_ctrl - degree))
-    starts = t0 + (t1 - t0) * np.arange(count) / count
-    table = np.clip(np.searchsorted(knots, starts, side="right") - 1, degree, n_ctrl - 1).astype(np.int64)
+    table = np.empty(count, np.int64)
+    _fill_buckets(knots, degree, n_ctrl, t0, t1, table)
     return t0, (count / (t1 - t0) if t1 > t0 else 0.0), table
+
+
+@njit(cache=True, error_model="numpy")
+def _fill_buckets(knots, degree, n_ctrl, t0, t1, table):
+    """``table[k]``: the span holding ``t0 + (t1 - t0) k / count`` (compiled: one call per
+    surface direction costs less than the NumPy steps it replaces)."""
+    count = table.size
+    for k in range(count):
+        start = t0 + (t1 - t0) * k / count
+        span = np.searchsorted(knots, start, side="right") - 1
+        table[k] = min(max(span, degree), n_ctrl - 1)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -137,24 +146,22 @@ def quotient_point(h, binom, out):
                 out[k, l, d] = v * inv_w
 
 
-@cache
-def _triangle_indices(p: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every ``(j, r)`` with ``0 <= r < j <= p`` (the Cox-de Boor divisors), for one gather."""
-    return np.tril_indices(p + 1, -1)
-
-
 def reciprocal_table(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
     """``inv[span, j, r] = 1 / (knots[span+r+1] - knots[span+r+1-j])`` for the spans of the
     domain (other entries 0): the divisors of the Cox-de Boor triangle.  Every such
     difference spans the non-empty knot interval ``[knots[span], knots[span+1])``."""
-    p = degree
-    inv = np.zeros((n_ctrl, p + 1, p + 1))
-    j, r = _triangle_indices(p)
-    span = np.arange(p, n_ctrl)[:, None]
-    diff = knots[span + r + 1] - knots[span + r + 1 - j]
-    positive = diff > 0
-    inv[p:, j, r] = np.where(positive, 1.0 / np.where(positive, diff, 1.0), 0.0)
+    inv = np.zeros((n_ctrl, degree + 1, degree + 1))
+    _fill_reciprocals(knots, degree, n_ctrl, inv)
     return inv
+
+
+@njit(cache=True, error_model="numpy")
+def _fill_reciprocals(knots, p, n_ctrl, inv):
+    for span in range(p, n_ctrl):
+        for j in range(1, p + 1):
+            for r in range(j):
+                diff = knots[span + r + 1] - knots[span + r + 1 - j]
+                inv[span, j, r] = 1.0 / diff if diff > 0 else 0.0
 
 
 def binomials(order: int) -> np.ndarray:
