@@ -125,3 +125,37 @@ def test_spline_figures_in_one_pass_equal_geomlprop(corpus_dir):
         assert same_diag == diag
         assert ours == pytest.approx(by_occt, rel=1e-6)
     assert len(evaluators) == 189  # every B-spline face, kept for measuring
+
+
+def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):
+    """Cones and tori get the estimate's figures from their radii in closed form: the
+    same numbers GeomLProp's samples give (3 columns x 5 rows, no curvature at an apex)."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepTools import BRepTools
+    from OCP.GeomLProp import GeomLProp_SLProps
+
+    from surfmod.occ import mesh as occ_mesh
+    from surfmod.occ.geom import surface_type
+    from surfmod.occ.topo import faces_of
+
+    shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp").wrapped
+    floor = 1.0 / shape_figures(shape)[1]
+    seen = set()
+    for face in faces_of(shape):
+        surf = occ_mesh.basis_surface(BRep_Tool.Surface_s(face))
+        name = surface_type(surf)
+        if name not in ("Geom_ConicalSurface", "Geom_ToroidalSurface"):
+            continue
+        seen.add(name)
+        area, k = occ_mesh._face_figure(face, 5, floor, None)
+        u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+        props, jac, vals = GeomLProp_SLProps(surf, 2, 1e-9), [], []
+        for u in np.linspace(u0, u1, 3):
+            for v in np.linspace(v0, v1, 5):
+                props.SetParameters(float(u), float(v))
+                jac.append(props.D1U().Crossed(props.D1V()).Magnitude())
+                if props.IsCurvatureDefined():
+                    vals.append(np.sqrt(max(abs(props.MaxCurvature()), floor) * max(abs(props.MinCurvature()), floor)))
+        assert area == pytest.approx(np.mean(jac) * (u1 - u0) * (v1 - v0), rel=1e-12)
+        assert k == pytest.approx(np.median(vals) if vals else floor, rel=1e-12)
+    assert seen == {"Geom_ConicalSurface", "Geom_ToroidalSurface"}

@@ -121,18 +121,20 @@ def measure_face_meshes(face_meshes, bary=DENSE) -> np.ndarray:
 
 
 # -- the mesh of a shape ------------------------------------------------------------------
-def _estimate(shape, tolerance: float, evaluators: dict | None = None) -> tuple[float, float]:
+def _estimate(shape, tolerance: float, evaluators: dict | None = None,
+              uv_bounds: dict | None = None) -> tuple[float, float]:
     """``(triangles, bbox diagonal)``: a chord of length ``h`` on curvature ``k`` sags
     ``k h^2 / 8``; per face the median curvature (robust to the singular points of real
     B-spline faces, which made a mean "need" 1.7e17 triangles), at most ``1 / tolerance`` (smaller features are covered by a
     triangle of the tolerance's size).  With ``evaluators``, B-spline and Bezier faces
     are sampled by their :class:`FaceSurface` (all faces' curvatures in one vectorized
-    pass), which is kept there by face hash for measuring."""
+    pass), which is kept there by face hash for measuring; ``uv_bounds`` receives the
+    faces' UV boxes (see ``shape_figures``)."""
     from ..occ.mesh import shape_figures
 
     splines: list = []  # (partials on the face's sample grid, UV box area, its figure to fill)
     sample = None if evaluators is None else partial(_sample_spline, evaluators, splines)
-    figures, diag = shape_figures(shape, sample_face=sample)
+    figures, diag = shape_figures(shape, sample_face=sample, uv_bounds=uv_bounds)
     if splines:
         _fill_spline_figures(splines, 1.0 / max(diag, 1e-300))
     ell = max(diag, 1e-300)
@@ -293,7 +295,8 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     from ..occ.mesh import brepmesh
 
     evaluators: dict = {}  # face hash -> FaceSurface (splines from the estimate, others when measured)
-    estimate, diag = _estimate(shape, tolerance, evaluators)
+    uv_bounds: dict = {}  # face hash -> UV box, read once
+    estimate, diag = _estimate(shape, tolerance, evaluators, uv_bounds)
     if tolerance < MIN_RELATIVE_TOLERANCE * diag:
         raise SurfmodError(
             f"tolerance: {tolerance:g} is below {MIN_RELATIVE_TOLERANCE:g} x the shape size {diag:.3g}"
@@ -311,7 +314,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     with tqdm(total=ATTEMPTS, desc="mesh", unit="pass", disable=not progress, leave=False) as bar:
         for attempt in range(1, ATTEMPTS + 1):
             missing: list = []
-            fms = brepmesh(shape, deflection, angular, missing=missing)
+            fms = brepmesh(shape, deflection, angular, missing=missing, uv_bounds=uv_bounds)
             n_tri = sum(len(fm.triangles) for fm in fms)
             if n_tri > max_triangles:
                 raise SurfmodError(

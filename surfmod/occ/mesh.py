@@ -266,11 +266,13 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
         return out
 
 
-def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None) -> list[FaceMesh]:
+def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None,
+             uv_bounds: dict | None = None) -> list[FaceMesh]:
     """Run ``BRepMesh_IncrementalMesh`` (after clearing old triangulations) and return the
     per-face triangulations.  BRepMesh discretizes each edge once, so nodes of faces that
     share an edge coincide bit for bit.  Faces BRepMesh left without triangles are
-    skipped; their indices are appended to ``missing`` when a list is given."""
+    skipped; their indices are appended to ``missing`` when a list is given.
+    ``uv_bounds``: faces' UV boxes already known (by face hash, from :func:`shape_figures`)."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepTools import BRepTools
 
@@ -296,7 +298,8 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
                     missing.append(k)
                 continue
             tri = got.triangles[:, ::-1] if got.reversed else got.triangles
-            bounds = tuple(float(b) for b in BRepTools.UVBounds_s(face))
+            known = uv_bounds.get(face.__hash__()) if uv_bounds is not None else None
+            bounds = tuple(float(b) for b in (known if known is not None else BRepTools.UVBounds_s(face)))
             shared = got.rigid and got.instance >= 0
             repeats = first.get(got.instance, -1) if shared else -1
             if shared and got.instance not in first:
@@ -465,7 +468,7 @@ def curve_points(curve, t: np.ndarray) -> np.ndarray:
         return out
 
 
-def shape_figures(shape, samples: int = 5, sample_face=None):
+def shape_figures(shape, samples: int = 5, sample_face=None, uv_bounds: dict | None = None):
     """Per curved face ``(area, median sqrt(|k1| |k2|) with each |k| floored by 1/diagonal)``
     from a ``samples`` x ``samples`` grid over the face's UV box (area of the box's patch:
     at least the face's), and the bounding-box diagonal: enough to estimate how many
@@ -477,7 +480,8 @@ def shape_figures(shape, samples: int = 5, sample_face=None):
     ``sample_face(face, surface, (u0, u1, v0, v1), samples, floor)``, when given, is asked
     first for each curved face and returns its figure (any pair, e.g. a list the caller
     fills in after this returns, to sample all its faces at once), or ``None`` to leave
-    the face to ``GeomLProp`` here."""
+    the face to ``GeomLProp`` here.  ``uv_bounds``, a dict, receives each sampled face's
+    ``BRepTools.UVBounds`` by face hash (for :func:`brepmesh`)."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
     from OCP.TopLoc import TopLoc_Location
@@ -502,7 +506,7 @@ def shape_figures(shape, samples: int = 5, sample_face=None):
             bucket = seen.setdefault(bare.__hash__(), [])
             known = next((f for other, f in bucket if other.IsSame(bare)), None) if rigid else None
             if known is None:
-                known = _face_figure(face, samples, floor, sample_face)
+                known = _face_figure(face, samples, floor, sample_face, uv_bounds)
                 if rigid:
                     bucket.append((bare, known))
             if known is not False:  # False: a plane
@@ -510,7 +514,7 @@ def shape_figures(shape, samples: int = 5, sample_face=None):
     return figures, diag
 
 
-def _face_figure(face, samples: int, floor: float, sample_face):
+def _face_figure(face, samples: int, floor: float, sample_face, uv_bounds: dict | None = None):
     """:func:`shape_figures`' figure of one face, or ``False`` for a plane."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepTools import BRepTools
@@ -523,6 +527,8 @@ def _face_figure(face, samples: int, floor: float, sample_face):
     if name == "Geom_Plane":
         return False
     u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+    if uv_bounds is not None:
+        uv_bounds[face.__hash__()] = (u0, u1, v0, v1)
     figure = sample_face(face, surf, (u0, u1, v0, v1), samples, floor) if sample_face is not None else None
     if figure is not None:
         return figure
@@ -533,6 +539,21 @@ def _face_figure(face, samples: int, floor: float, sample_face):
             return r * (u1 - u0) * (v1 - v0), float(np.sqrt(max(1 / r, floor) * floor))
         return (r * r * (u1 - u0) * float(np.mean(np.cos(np.linspace(v0, v1, samples)))) * (v1 - v0),
                 max(1 / r, floor))
+    if name in ("Geom_ConicalSurface", "Geom_ToroidalSurface"):
+        # the same for surfaces of revolution whose figures vary along v only: the
+        # circle's radius rho(v) gives |Su x Sv| and the parallel's curvature
+        v = np.linspace(v0, v1, samples)
+        if name == "Geom_ConicalSurface":
+            a = surf.SemiAngle()
+            rho = surf.RefRadius() + v * np.sin(a)
+            jac, k_meridian, k_parallel = np.abs(rho), 0.0, np.cos(a) / np.where(rho != 0, rho, np.inf)
+        else:
+            r = surf.MinorRadius()
+            rho = surf.MajorRadius() + r * np.cos(v)
+            jac, k_meridian, k_parallel = r * np.abs(rho), 1.0 / r, np.cos(v) / np.where(rho != 0, rho, np.inf)
+        defined = rho != 0  # GeomLProp: no curvature at the apex / on the axis
+        vals = np.sqrt(max(k_meridian, floor) * np.maximum(np.abs(k_parallel), floor))[defined]
+        return float(np.mean(jac)) * (u1 - u0) * (v1 - v0), float(np.median(vals)) if vals.size else floor
     lp = GeomLProp_SLProps(surf, 2, 1e-9)
     vals, jac = [], []
     # elementary surfaces are curved alike along u: three columns tell them
