@@ -96,8 +96,8 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
     if np.isnan(fm.uv).any():
         raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
     project = ev.projector  # compiled Gauss-Newton on B-spline faces
-    tri_dev = triangle_deviations(ev.d1, pos, fm.uv[fm.triangles], box, bary, 0.5 * tolerance, ev.d0, accurate_max=False,
-                                  project=project)
+    tri_dev = triangle_deviations(ev.d1, pos, fm.uv[fm.triangles], box, bary, 0.5 * tolerance, ev.d0,
+                                  accurate_max=False, project=project)
     node = np.linalg.norm(fm.nodes - ev.d0(fm.uv[:, 0], fm.uv[:, 1]), axis=1)
     far = np.nonzero(node > 0.5 * tolerance)[0]
     if far.size:

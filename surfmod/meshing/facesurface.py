@@ -114,11 +114,6 @@ class FaceSurface:
 
         return surface_d1(self.surf, u, v)
 
-    @property
-    def spline(self) -> bool:
-        """Whether the surface is a B-spline or Bezier net (:meth:`d2` available)."""
-        return self._spline is not None
-
     def d2(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Partials to order 2, ``(N, 3, 3, 3)``, of a B-spline or Bezier surface."""
         return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 2)

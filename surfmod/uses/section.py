@@ -42,8 +42,9 @@ class Section:
     ``wires`` are build123d ``Wire``s (OCCT's section edges chained end to end);
     ``polylines`` the same curves sampled by the NumPy evaluator (each edge read back
     exactly with :func:`surfmod.from_edge`, ``samples`` points an edge), one ``(N, 3)``
-    array per wire, computed on first use; ``closed`` says which wires close up.  The plane frame is ``origin`` with axes
-    ``x_axis``, ``y_axis`` and ``normal``; :meth:`polylines_2d` gives the curves in it.
+    array per wire, computed on first use; ``closed`` says which wires close up.  The
+    plane frame is ``origin`` with axes ``x_axis``, ``y_axis`` and ``normal``;
+    :meth:`polylines_2d` gives the curves in it.
     An empty section (the plane misses the part) has no wires.
 
     >>> import surfmod as sm, build123d as bd
@@ -64,16 +65,11 @@ class Section:
     def polylines(self) -> list[np.ndarray]:
         from ..occ.uses import wire_edges
 
-        out = []
-        for w in self.wires:
-            pts = []
-            for e in wire_edges(w):
-                curve = from_edge(e)
-                t0, t1 = curve.domain
-                p = curve.points(np.linspace(t0, t1, self.samples))  # from_edge follows the edge's orientation
-                pts.append(p if not pts else p[1:])
-            out.append(checks.frozen(np.concatenate(pts)))
-        return out
+        def sampled(edge):  # from_edge follows the edge's orientation
+            curve = from_edge(edge)
+            return curve.points(np.linspace(*curve.domain, self.samples))
+
+        return [checks.frozen(_chained([sampled(e) for e in wire_edges(w)])) for w in self.wires]
 
     @property
     def empty(self) -> bool:
@@ -98,11 +94,7 @@ class Section:
         from ..occ.uses import edge_points, wire_edges
 
         tol = checks.positive(tolerance, "tolerance")
-        out = []
-        for w in self.wires:
-            pts = [edge_points(e, tol) for e in wire_edges(w)]
-            out.append(self.to_plane(np.concatenate([p if i == 0 else p[1:] for i, p in enumerate(pts)])))
-        return out
+        return [self.to_plane(_chained([edge_points(e, tol) for e in wire_edges(w)])) for w in self.wires]
 
     def entities_2d(self) -> list[list[tuple]]:
         """The exact section curves in the plane frame, per wire a list of
@@ -147,6 +139,12 @@ class Section:
         if self.empty:
             return "section: empty (the plane misses the part)"
         return f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}"
+
+
+def _chained(pieces: list[np.ndarray]) -> np.ndarray:
+    """One polyline from a wire's edge polylines, each starting where the one before ends
+    (the shared point kept once)."""
+    return np.concatenate([p if i == 0 else p[1:] for i, p in enumerate(pieces)])
 
 
 def _edge_entity(sec: Section, edge) -> tuple:
