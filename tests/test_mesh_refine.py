@@ -124,7 +124,7 @@ def test_spline_figures_in_one_pass_equal_geomlprop(corpus_dir):
         ours, same_diag = _estimate(part, tolerance, evaluators)
         assert same_diag == diag
         assert ours == pytest.approx(by_occt, rel=1e-6)
-    assert len(evaluators) == 189  # every B-spline face, kept for measuring
+    assert len(evaluators) == 189 + 26  # every B-spline face and extrusion, kept for measuring
 
 
 def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):

@@ -52,6 +52,8 @@ ATTEMPTS = 6
 #: error is a fraction of its deflection, so a face still off at tolerance / 4 is off
 #: for a reason a finer mesh does not remove.
 MIN_DEFLECTION = 1.0 / 4
+#: Surface types a :class:`FaceSurface` may evaluate as a spline net (see ``FaceSurface.spline``).
+SPLINE_EVALUATED = ("Geom_BSplineSurface", "Geom_BezierSurface", "Geom_SurfaceOfLinearExtrusion")
 
 
 def _bounds(fm, ev: FaceSurface) -> tuple:
@@ -91,7 +93,7 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
     if exact is not None:
         samples, node = exact[: len(q)], exact[len(q) :]
         return samples.reshape(len(pos), len(bary)).max(axis=1), float(node.max(initial=0.0))
-    ev = FaceSurface(fm.surface) if ev is None else ev
+    ev = FaceSurface(fm.surface, fm.bounds) if ev is None else ev
     box = _bounds(fm, ev)
     if np.isnan(fm.uv).any():
         raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
@@ -143,15 +145,17 @@ def _estimate(shape, tolerance: float, evaluators: dict | None = None,
 
 
 def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples: int, floor: float):
-    """``shape_figures``' ``sample_face`` for B-spline and Bezier faces: their partials on
-    a ``samples`` x ``samples`` grid of the UV box go to ``splines`` with the figure
-    returned, which :func:`_fill_spline_figures` fills in; ``None`` leaves other faces
-    to ``GeomLProp``."""
+    """``shape_figures``' ``sample_face`` for faces evaluated as splines (B-spline and
+    Bezier surfaces, extrusions of spline curves): their partials on a ``samples`` x
+    ``samples`` grid of the UV box go to ``splines`` with the figure returned, which
+    :func:`_fill_spline_figures` fills in; ``None`` leaves other faces to ``GeomLProp``."""
     from ..occ.geom import surface_type
 
-    if surface_type(surf) not in ("Geom_BSplineSurface", "Geom_BezierSurface"):
+    if surface_type(surf) not in SPLINE_EVALUATED:
         return None
-    ev = evaluators[face.__hash__()] = FaceSurface(surf)
+    ev = evaluators[face.__hash__()] = FaceSurface(surf, bounds)
+    if not ev.spline:
+        return None
     u0, u1, v0, v1 = bounds
     t = np.arange(samples) / (samples - 1)
     figure = [0.0, floor]
@@ -188,7 +192,7 @@ def _evaluator(evaluators: dict, fm) -> FaceSurface | None:
     key = fm.face.__hash__()
     ev = evaluators.get(key)
     if ev is None and surface_type(fm.surface) not in ANALYTIC:
-        ev = evaluators[key] = FaceSurface(fm.surface)
+        ev = evaluators[key] = FaceSurface(fm.surface, fm.bounds)
     return ev
 
 
@@ -221,20 +225,24 @@ def _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared) -
     return out
 
 
-def _refine_locally(fms, i: int, dev, node_dev, tolerance: float, ev: FaceSurface | None = None) -> bool:
+def _refine_locally(fms, i: int, dev, node_dev, tolerance: float, ev: FaceSurface | None = None,
+                    tri_dev: np.ndarray | None = None) -> bool:
     """Refine face ``fms[i]`` inside its boundary (:mod:`surfmod.meshing.refine`) until
     every triangle is within ``tolerance`` beyond the face's node deviation; ``False``
     (face left as it was) when the deviation is not the interior's.  ``ev``: the face's
-    :class:`FaceSurface` when the caller already has it."""
+    :class:`FaceSurface` and ``tri_dev`` its triangles' measured deviations, when the
+    caller already has them."""
     from ..occ.mesh import read_triangulation
 
     fm = fms[i]
-    with_uv = read_triangulation(fm.face, True)  # analytic faces were read without (u, v)
-    if with_uv is None or len(with_uv.uv) != len(fm.nodes) or np.isnan(with_uv.uv).any():
-        return False
-    ev = FaceSurface(fm.surface) if ev is None else ev
-    out = refine_face(replace(fm, uv=with_uv.uv), tolerance, float(node_dev[i]),
-                      lambda f: measure_face(f, tolerance, ev=ev)[0], lambda uv: ev.d0(uv[:, 0], uv[:, 1]))
+    if fm.uv is None or len(fm.uv) != len(fm.nodes) or np.isnan(fm.uv).any():
+        with_uv = read_triangulation(fm.face, True)  # analytic faces were read without (u, v)
+        if with_uv is None or len(with_uv.uv) != len(fm.nodes) or np.isnan(with_uv.uv).any():
+            return False
+        fm = replace(fm, uv=with_uv.uv)
+    ev = FaceSurface(fm.surface, fm.bounds) if ev is None else ev
+    out = refine_face(fm, tolerance, float(node_dev[i]), lambda f: measure_face(f, tolerance, ev=ev)[0],
+                      lambda uv: ev.d0(uv[:, 0], uv[:, 1]), measured=tri_dev)
     if out is None:
         return False
     fms[i], tri_dev = out
@@ -321,19 +329,22 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
                     f"tolerance: {tolerance:g} needs more than {max_triangles:,} triangles (limit max_triangles)"
                 )
             dev, node_dev = np.zeros(len(fms)), np.zeros(len(fms))
+            tri_devs: list = []  # per face, its triangles' deviations (for the local refinement)
             for i, fm in enumerate(tqdm(fms, desc=f"measure pass {attempt}", unit="face", disable=not progress,
                                         leave=False)):
                 if fm.repeats >= 0:  # an isometric repeat of a face measured above
                     dev[i], node_dev[i] = dev[fm.repeats], node_dev[fm.repeats]
+                    tri_devs.append(tri_devs[fm.repeats])
                     continue
                 d, node_dev[i] = measure_face(fm, tolerance, ev=_evaluator(evaluators, fm))
                 dev[i] = d.max(initial=0.0)
+                tri_devs.append(d)
             bar.update()
             refine = _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared)
             # BRepMesh overshoots by a few percent inside some faces: refining those
             # faces alone costs far less than a second pass over the whole shape
             fixed = [i for i in refine
-                     if _refine_locally(fms, i, dev, node_dev, tolerance, _evaluator(evaluators, fms[i]))]
+                     if _refine_locally(fms, i, dev, node_dev, tolerance, _evaluator(evaluators, fms[i]), tri_devs[i])]
             refined = len(fixed)  # the faces refined in the pass that is kept
             refine = [i for i in refine if i not in fixed]
             if not refine:

@@ -3,6 +3,11 @@ real parts: B-spline and Bezier surfaces through the NumPy evaluator, surfaces o
 revolution and of linear extrusion from their basis curve (B-spline, Bezier, line,
 circle, ellipse) in closed form, and OCCT's ``D1`` per point for anything else.
 
+An extrusion of a B-spline or Bezier curve over a known UV box *is* a B-spline surface
+(the curve's net and its copy moved along the direction, degree 1 across, linear in v
+as OCCT's ``C(u) + v D``), so it goes through the same compiled kernels as B-spline
+faces: projection, partials to order 2.
+
 Parameters are OCCT's: periodic directions wrap into their period (a face trimmed
 across the seam of a periodic B-spline lives on both sides of it), other directions
 are clamped to the parameter range (pcurves may overshoot by a tolerance).
@@ -65,7 +70,11 @@ class FaceSurface:
     (True, True)
     """
 
-    def __init__(self, surf):
+    def __init__(self, surf, bounds=None):
+        """``bounds``: the face's UV box ``(u0, u1, v0, v1)``, when known; an extrusion of a
+        spline curve is then evaluated as a B-spline surface over that box widened by
+        its own size on each side (and clamped there, as the other non-periodic
+        directions are clamped to their range)."""
         from ..occ.mesh import surface_info, swept_info
 
         info = surface_info(surf)
@@ -89,10 +98,20 @@ class FaceSurface:
             self._spline = BezierSurface(info["bezier"]["control_points"], info["bezier"]["weights"])
         else:
             swept = swept_info(surf)
-            if swept is not None and _Curve(swept["curve"]).supported:
-                self._swept = swept | {"eval": _Curve(swept["curve"])}
+            curve = None if swept is None else _Curve(swept["curve"])
+            if curve is not None and curve.spline is not None and "direction" in swept and bounds is not None:
+                self._spline = _extrusion_net(curve.spline.to_bspline(), swept["direction"], bounds[2:])
+            elif curve is not None and curve.supported:
+                self._swept = swept | {"eval": curve}
         if self._spline is not None:
             self.range = tuple(tuple(float(x) for x in r) for r in self._spline.domain)
+
+    @property
+    def spline(self) -> bool:
+        """Whether the surface is evaluated as a B-spline or Bezier net (B-spline and
+        Bezier surfaces, extrusions of spline curves given their box): :meth:`d2` and,
+        for B-splines, :attr:`projector` are available."""
+        return self._spline is not None
 
     @property
     def numpy(self) -> bool:
@@ -109,13 +128,14 @@ class FaceSurface:
         if self._spline is not None:
             return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 1)
         if self._swept is not None:
-            return self._swept_d1(np.asarray(u, float), np.asarray(v, float))
+            return self._swept_d1(self._map(np.asarray(u, float), 0), self._map(np.asarray(v, float), 1))
         from ..occ.mesh import surface_d1
 
         return surface_d1(self.surf, u, v)
 
     def d2(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """Partials to order 2, ``(N, 3, 3, 3)``, of a B-spline or Bezier surface."""
+        """Partials to order 2, ``(N, 3, 3, 3)``, of a surface evaluated as a spline
+        (``spline`` is true)."""
         return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 2)
 
     @property
@@ -171,3 +191,16 @@ class FaceSurface:
         out[:, 1, 0] = np.cross(a, turn(w))
         out[:, 0, 1] = turn(c[:, 1])
         return out
+
+
+def _extrusion_net(curve: BSplineCurve, direction: np.ndarray, v_box) -> BSplineSurface:
+    """``C(u) + v D`` for ``v`` over ``v_box`` widened by its length on each side, as a
+    B-spline surface of degree 1 in v: the curve's homogeneous net at both ends of the
+    v interval (exact: the v basis functions are the two linear weights of v)."""
+    v0, v1 = float(v_box[0]), float(v_box[1])
+    margin = max(v1 - v0, 1e-6 * (1.0 + abs(v0) + abs(v1)))
+    lo, hi = v0 - margin, v1 + margin
+    pts = curve.control_points
+    net = np.stack([pts + lo * direction, pts + hi * direction], axis=1)
+    weights = None if curve.weights is None else np.stack([curve.weights, curve.weights], axis=1)
+    return BSplineSurface._trusted(net, (curve.degree, 1), (curve.knots, np.array([lo, lo, hi, hi])), weights)
