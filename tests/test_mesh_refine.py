@@ -159,3 +159,21 @@ def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):
         assert area == pytest.approx(np.mean(jac) * (u1 - u0) * (v1 - v0), rel=1e-12)
         assert k == pytest.approx(np.median(vals) if vals else floor, rel=1e-12)
     assert seen == {"Geom_ConicalSurface", "Geom_ToroidalSurface"}
+
+
+def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
+    """measure_spline_faces (every B-spline face of a part in one compiled call) gives
+    each face the triangle and node deviations measure_face gives it alone."""
+    from surfmod.meshing.brep import _evaluator, measure_spline_faces
+
+    shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+    tol = 1e-3 * shape_figures(shape, samples=2)[1]
+    fms = brepmesh(shape, tol)
+    evaluators: dict = {}
+    pairs = [(fm, ev) for fm in fms if (ev := _evaluator(evaluators, fm)) is not None and ev.projector is not None]
+    assert len(pairs) > 150  # B-spline faces and extrusions of B-spline curves
+    together = measure_spline_faces([fm for fm, _ in pairs], [ev for _, ev in pairs], tol)
+    for (fm, ev), (tri, node) in zip(pairs, together):
+        alone_tri, alone_node = measure_face(fm, tol, ev=ev)
+        np.testing.assert_allclose(tri, alone_tri, rtol=1e-12, atol=1e-15 * tol)
+        assert node == pytest.approx(alone_node, rel=1e-12, abs=1e-15 * tol)

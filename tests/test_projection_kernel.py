@@ -63,3 +63,39 @@ def test_projection_finds_the_foot_point_of_points_off_the_surface():
     # an upper bound (a point of the surface), within the stopping rule's 1e-6 relative
     assert np.all(got >= offset * (1 - 1e-12))
     assert np.allclose(got, offset, rtol=1e-6, atol=0)
+
+
+def test_packed_segments_equal_one_call_per_net():
+    """surfmod.eval.packed runs many nets' projections in one call, segment by segment,
+    each with its own start and threshold: the values of one projector call per net."""
+    from surfmod.eval.packed import pack, project_segments
+
+    evs = [FaceSurface(s) for s in _surfaces().values()]
+    rng = np.random.default_rng(7)
+    pts, guesses, boxes, expected, segments, start, stop = [], [], [], [], [], [], []
+    at = 0
+    for f, ev in enumerate(evs):
+        (u0, u1), (v0, v1) = ev.range
+        box = (u0, u1, v0, v1)
+        for first, last in ((0.05, 0.05), (0.05, 0.0), (0.0, 0.0)):
+            uv = np.column_stack([rng.uniform(u0, u1, 150), rng.uniform(v0, v1, 150)])
+            p = ev.d0(uv[:, 0], uv[:, 1]) + 0.08 * rng.standard_normal((150, 3))
+            g = uv + 0.03 * rng.standard_normal((150, 2))
+            # start above threshold: the one-net kernel called as the packed one calls it
+            from surfmod.eval import projection_kernel as pkern
+            net = ev._spline._local_net()
+            ref = np.empty(150)
+            pkern.project_distances(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u,
+                                    net.inv_v, net.bucket_u, net.bucket_v, *ev.parameter_map, np.array(box), p, g,
+                                    last, ref, first)
+            if first == last:
+                np.testing.assert_array_equal(ref, ev.projector(p, g, box, last))
+            pts.append(p), guesses.append(g), expected.append(ref)
+            segments.append((f, at, at + 150)), start.append(first), stop.append(last)
+            at += 150
+        boxes.append(box)
+    pk = pack([ev._spline._local_net() for ev in evs], *(np.array([ev.parameter_map[k] for ev in evs])
+                                                        for k in range(4)))
+    got = project_segments(pk, np.array(boxes), np.concatenate(pts), np.concatenate(guesses), np.array(segments),
+                           np.array(start), np.array(stop))
+    np.testing.assert_array_equal(got, np.concatenate(expected))

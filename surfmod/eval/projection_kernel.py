@@ -59,11 +59,14 @@ def _first_partials(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket
 
 @njit(cache=True, error_model="numpy")
 def project_distances(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, lo, hi, period, periodic, box,
-                      points, uv, threshold, out):
+                      points, uv, threshold, out, start=None):
     """Distance bounds from ``points (N, 3)`` to the surface into ``out (N,)``, from the
     guesses ``uv (N, 2)`` clipped to ``box = (u0, u1, v0, v1)``; parameters are mapped as
     OCCT evaluates them (``lo``/``hi``/``period``/``periodic`` per direction).  Every
-    iterate is a point of the surface, so the least distance seen is an upper bound."""
+    iterate is a point of the surface, so the least distance seen is an upper bound.
+    Points whose first bound is at most ``start`` (default: ``threshold``) are not
+    iterated; the others iterate until their bound is within ``threshold``."""
+    first_stop = threshold if start is None else start
     ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
     lu, ru, tu = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
     lv, rv, tv = np.empty(q + 1), np.empty(q + 1), np.empty(q + 1)
@@ -78,7 +81,7 @@ def project_distances(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, buck
                             _wrap(ua, lo[0], hi[0], period[0], periodic[0]),
                             _wrap(va, lo[1], hi[1], period[1], periodic[1]), lu, ru, tu, lv, rv, tv)
         best = np.sqrt((px - x) ** 2 + (py - y) ** 2 + (pz - z) ** 2)
-        active = best > threshold
+        active = best > first_stop
         if active:
             for _ in range(ITERATIONS):
                 _first_partials(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,

@@ -109,6 +109,39 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
     return tri_dev, float(node.max(initial=0.0))
 
 
+def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> list[tuple[np.ndarray, float]]:
+    """:func:`measure_face` of many B-spline faces (``evs``: their :class:`FaceSurface`,
+    each with a ``projector``) in one compiled call (:mod:`surfmod.eval.packed`): per face
+    its triangles' deviations and its nodes' max deviation, the same values."""
+    from ..eval.packed import pack, project_segments
+
+    for fm in fms:
+        if np.isnan(fm.uv).any():
+            raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
+    maps = [ev.parameter_map for ev in evs]
+    pk = pack([ev._spline._local_net() for ev in evs], *(np.array([m[k] for m in maps]) for k in range(4)))
+    boxes = np.array([_bounds(fm, ev) for fm, ev in zip(fms, evs)])
+    tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
+    node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
+    nb = len(bary)
+    samples = np.matmul(bary, np.concatenate([fm.nodes[fm.triangles] for fm in fms])).reshape(-1, 3)
+    guesses = np.matmul(bary, np.concatenate([fm.uv[fm.triangles] for fm in fms])).reshape(-1, 2)
+    count = len(samples)
+    faces = np.arange(len(fms))
+    # one segment per face for its samples (within half the tolerance, the bound is all
+    # that is asked), one for its nodes (projected to convergence when off by more)
+    segments = np.concatenate([np.c_[faces, nb * tri_at[:-1], nb * tri_at[1:]],
+                               np.c_[faces, count + node_at[:-1], count + node_at[1:]]])
+    half = np.full(len(fms), 0.5 * tolerance)
+    dist = project_segments(pk, boxes, np.concatenate([samples, np.concatenate([fm.nodes for fm in fms])]),
+                            np.concatenate([guesses, np.concatenate([fm.uv for fm in fms])]), segments,
+                            np.concatenate([half, half]), np.concatenate([half, np.zeros(len(fms))]))
+    tri = dist[:count].reshape(-1, nb).max(axis=1)
+    node = np.maximum.reduceat(dist[count:], node_at[:-1]) if count < len(dist) else np.zeros(len(fms))
+    return [(tri[tri_at[f]:tri_at[f + 1]], float(node[f]) if node_at[f + 1] > node_at[f] else 0.0)
+            for f in range(len(fms))]
+
+
 def measure_face_meshes(face_meshes, bary=DENSE) -> np.ndarray:
     """Per-face measured max deviation of BRepMesh triangulations from their surfaces
     (every sample projected: the accurate figure, for comparisons).
@@ -330,13 +363,19 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
                 )
             dev, node_dev = np.zeros(len(fms)), np.zeros(len(fms))
             tri_devs: list = []  # per face, its triangles' deviations (for the local refinement)
+            evs = [None if fm.repeats >= 0 else _evaluator(evaluators, fm) for fm in fms]
+            # B-spline faces all at once: one compiled call instead of one per face
+            splines = [i for i, ev in enumerate(evs)
+                       if ev is not None and ev.projector is not None and len(fms[i].nodes)]
+            measured = dict(zip(splines, measure_spline_faces([fms[i] for i in splines], [evs[i] for i in splines],
+                                                              tolerance))) if splines else {}
             for i, fm in enumerate(tqdm(fms, desc=f"measure pass {attempt}", unit="face", disable=not progress,
                                         leave=False)):
                 if fm.repeats >= 0:  # an isometric repeat of a face measured above
                     dev[i], node_dev[i] = dev[fm.repeats], node_dev[fm.repeats]
                     tri_devs.append(tri_devs[fm.repeats])
                     continue
-                d, node_dev[i] = measure_face(fm, tolerance, ev=_evaluator(evaluators, fm))
+                d, node_dev[i] = measured[i] if i in measured else measure_face(fm, tolerance, ev=evs[i])
                 dev[i] = d.max(initial=0.0)
                 tri_devs.append(d)
             bar.update()

@@ -148,17 +148,26 @@ class FaceSurface:
             return None
         return self._project
 
+    @property
+    def parameter_map(self) -> tuple:
+        """``(lo, hi, period, periodic)`` per direction as the compiled kernels take them
+        (how parameters wrap or clamp)."""
+        cached = self.__dict__.get("_parameter_map")
+        if cached is None:
+            cached = self._parameter_map = (
+                np.array([r[0] for r in self.range], float), np.array([r[1] for r in self.range], float),
+                np.array([float(t) if k else 0.0 for t, k in zip(self.period, self.periodic)]),
+                np.array(self.periodic, bool))
+        return cached
+
     def _project(self, points: np.ndarray, uv: np.ndarray, bounds, threshold: float = 0.0) -> np.ndarray:
         from ..eval import projection_kernel  # numba: compiled on first use, then cached
 
         net = self._spline._local_net()
-        lo = np.array([r[0] for r in self.range], float)
-        hi = np.array([r[1] for r in self.range], float)
-        period = np.array([float(t) if k else 0.0 for t, k in zip(self.period, self.periodic)])
         out = np.empty(len(points))
         projection_kernel.project_distances(
             net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v, net.bucket_u,
-            net.bucket_v, lo, hi, period, np.array(self.periodic, bool), np.array(bounds, float),
+            net.bucket_v, *self.parameter_map, np.array(bounds, float),
             np.ascontiguousarray(points, float), np.ascontiguousarray(uv, float), float(threshold), out)
         return out
 

@@ -1,0 +1,127 @@
+"""Many B-spline nets in one set of flat arrays, so that one compiled call works through
+the B-spline faces of a whole part.
+
+Measuring a real part's mesh projects a few hundred to a few thousand samples per face
+on a few hundred faces; one call per face costs tens of microseconds of Python and
+dispatch, about as much as the arithmetic.  :func:`pack` lays every net's tables
+(:class:`~surfmod.eval.local.LocalNet`) end to end with offsets, and the kernels here
+slice them back, face by face, inside one compiled loop.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from .projection_kernel import project_distances
+
+
+class NetPack(NamedTuple):
+    """Nets end to end: per net ``p``, ``q``, ``n``, ``m``, ``rational`` and the bucket
+    origins/scales; flat ``knots_u``/``knots_v``/``ctrl``/``inv_u``/``inv_v`` and bucket
+    tables with ``(F + 1,)`` offsets (``*_at``); ``lo``/``hi``/``period``/``periodic``
+    ``(F, 2)``: how each surface maps its parameters (as OCCT evaluates it)."""
+
+    p: np.ndarray
+    q: np.ndarray
+    n: np.ndarray
+    m: np.ndarray
+    rational: np.ndarray
+    knots_u: np.ndarray
+    knots_u_at: np.ndarray
+    knots_v: np.ndarray
+    knots_v_at: np.ndarray
+    ctrl: np.ndarray
+    ctrl_at: np.ndarray
+    inv_u: np.ndarray
+    inv_u_at: np.ndarray
+    inv_v: np.ndarray
+    inv_v_at: np.ndarray
+    bucket_u_origin: np.ndarray
+    bucket_u_scale: np.ndarray
+    bucket_u: np.ndarray
+    bucket_u_at: np.ndarray
+    bucket_v_origin: np.ndarray
+    bucket_v_scale: np.ndarray
+    bucket_v: np.ndarray
+    bucket_v_at: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    period: np.ndarray
+    periodic: np.ndarray
+
+
+def _flat(arrays: list, dtype) -> tuple[np.ndarray, np.ndarray]:
+    """Arrays end to end (raveled) and their ``(F + 1,)`` start offsets."""
+    sizes = [a.size for a in arrays]
+    at = np.zeros(len(arrays) + 1, np.int64)
+    np.cumsum(sizes, out=at[1:])
+    flat = np.concatenate([a.ravel() for a in arrays]).astype(dtype, copy=False) if arrays else np.zeros(0, dtype)
+    return flat, at
+
+
+def pack(nets: list, lo, hi, period, periodic) -> NetPack:
+    """One :class:`NetPack` of :class:`~surfmod.eval.local.LocalNet` s, with each
+    surface's parameter map (``(F, 2)`` arrays-likes, see
+    :func:`surfmod.eval.projection_kernel.project_distances`).
+
+    >>> import numpy as np, surfmod as sm
+    >>> from surfmod.gallery.synthetic import wavy_net
+    >>> nets = [sm.BSplineSurface(wavy_net(5, 4), (3, 2))._local_net()] * 2
+    >>> pk = pack(nets, [[0, 0]] * 2, [[1, 1]] * 2, [[0, 0]] * 2, [[False, False]] * 2)
+    >>> pk.ctrl_at.tolist(), pk.p.tolist()
+    ([0, 80, 160], [3, 3])
+    """
+    knots_u, knots_u_at = _flat([t.knots_u for t in nets], float)
+    knots_v, knots_v_at = _flat([t.knots_v for t in nets], float)
+    ctrl, ctrl_at = _flat([t.ctrl for t in nets], float)
+    inv_u, inv_u_at = _flat([t.inv_u for t in nets], float)
+    inv_v, inv_v_at = _flat([t.inv_v for t in nets], float)
+    bucket_u, bucket_u_at = _flat([t.bucket_u[2] for t in nets], np.int64)
+    bucket_v, bucket_v_at = _flat([t.bucket_v[2] for t in nets], np.int64)
+    return NetPack(
+        np.array([t.p for t in nets], np.int64), np.array([t.q for t in nets], np.int64),
+        np.array([t.ctrl.shape[0] for t in nets], np.int64), np.array([t.ctrl.shape[1] for t in nets], np.int64),
+        np.array([t.rational for t in nets], bool),
+        knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v, inv_v_at,
+        np.array([t.bucket_u[0] for t in nets], float), np.array([t.bucket_u[1] for t in nets], float),
+        bucket_u, bucket_u_at,
+        np.array([t.bucket_v[0] for t in nets], float), np.array([t.bucket_v[1] for t in nets], float),
+        bucket_v, bucket_v_at,
+        np.asarray(lo, float).reshape(-1, 2), np.asarray(hi, float).reshape(-1, 2),
+        np.asarray(period, float).reshape(-1, 2), np.asarray(periodic, bool).reshape(-1, 2),
+    )
+
+
+def project_segments(pk: NetPack, boxes: np.ndarray, points: np.ndarray, uv: np.ndarray, segments: np.ndarray,
+                     start: np.ndarray, threshold: np.ndarray) -> np.ndarray:
+    """Distance bounds of ``points (N, 3)`` from their nets, segment by segment:
+    ``segments (S, 3)`` rows ``(net, first point, end point)``, each with its ``start``
+    and ``threshold`` (``(S,)``; see :func:`surfmod.eval.projection_kernel.project_distances`)
+    and its net's Gauss-Newton ``boxes[net]`` ``(u0, u1, v0, v1)``.  Returns ``(N,)``."""
+    out = np.zeros(len(points))
+    _project_segments(*pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(points, float),
+                      np.ascontiguousarray(uv, float), np.ascontiguousarray(segments, np.int64),
+                      np.ascontiguousarray(start, float), np.ascontiguousarray(threshold, float), out)
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def _project_segments(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at,
+                      inv_v, inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v,
+                      bucket_v_at, lo, hi, period, periodic, boxes, points, uv, segments, start, threshold, out):
+    for s in range(segments.shape[0]):
+        f, a, b = segments[s, 0], segments[s, 1], segments[s, 2]
+        if a == b:
+            continue
+        pf, qf, nf, mf = p[f], q[f], n[f], m[f]
+        net = ctrl[ctrl_at[f]:ctrl_at[f + 1]].reshape((nf, mf, 4))
+        iu = inv_u[inv_u_at[f]:inv_u_at[f + 1]].reshape((nf, pf + 1, pf + 1))
+        iv = inv_v[inv_v_at[f]:inv_v_at[f + 1]].reshape((mf, qf + 1, qf + 1))
+        bu = (bu_origin[f], bu_scale[f], bucket_u[bucket_u_at[f]:bucket_u_at[f + 1]])
+        bv = (bv_origin[f], bv_scale[f], bucket_v[bucket_v_at[f]:bucket_v_at[f + 1]])
+        project_distances(knots_u[knots_u_at[f]:knots_u_at[f + 1]], pf, knots_v[knots_v_at[f]:knots_v_at[f + 1]], qf,
+                          net, rational[f], iu, iv, bu, bv, lo[f], hi[f], period[f], periodic[f], boxes[f],
+                          points[a:b], uv[a:b], threshold[s], out[a:b], start[s])
