@@ -108,6 +108,72 @@ def project_segments(pk: NetPack, boxes: np.ndarray, points: np.ndarray, uv: np.
     return out
 
 
+def triangle_deviations(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: np.ndarray, triangles: np.ndarray,
+                        faces: np.ndarray, bary: np.ndarray, threshold: np.ndarray) -> np.ndarray:
+    """Max distance bound per triangle over its barycentric samples ``bary (K, 3)``:
+    each sample ``bary @ corners`` in space and in ``(u, v)`` (``nodes (N, 3)``, ``uv
+    (N, 2)``, ``triangles (T, 3)`` indexing them), projected onto its net from its
+    ``(u, v)`` while its bound exceeds its net's ``threshold`` (as
+    :func:`surfmod.meshing.deviation.triangle_deviations` with a projector).
+    ``faces (F, 3)`` rows ``(net, first triangle, end triangle)``.  Returns ``(T,)``."""
+    out = np.zeros(len(triangles))
+    _triangle_deviations(*pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(nodes, float),
+                         np.ascontiguousarray(uv, float), np.ascontiguousarray(triangles, np.int64),
+                         np.ascontiguousarray(faces, np.int64), np.ascontiguousarray(bary, float),
+                         np.ascontiguousarray(threshold, float), out)
+    return out
+
+
+@njit(cache=True, inline="always")
+def _net(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
+         inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f):
+    """Net ``f`` of a pack as the one-net kernels take it."""
+    pf, qf, nf, mf = p[f], q[f], n[f], m[f]
+    return (knots_u[knots_u_at[f]:knots_u_at[f + 1]], pf, knots_v[knots_v_at[f]:knots_v_at[f + 1]], qf,
+            ctrl[ctrl_at[f]:ctrl_at[f + 1]].reshape((nf, mf, 4)), rational[f],
+            inv_u[inv_u_at[f]:inv_u_at[f + 1]].reshape((nf, pf + 1, pf + 1)),
+            inv_v[inv_v_at[f]:inv_v_at[f + 1]].reshape((mf, qf + 1, qf + 1)),
+            (bu_origin[f], bu_scale[f], bucket_u[bucket_u_at[f]:bucket_u_at[f + 1]]),
+            (bv_origin[f], bv_scale[f], bucket_v[bucket_v_at[f]:bucket_v_at[f + 1]]))
+
+
+@njit(cache=True, error_model="numpy")
+def _triangle_deviations(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u,
+                         inv_u_at, inv_v, inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale,
+                         bucket_v, bucket_v_at, lo, hi, period, periodic, boxes, nodes, uv, triangles, faces, bary,
+                         threshold, out):
+    for r in range(faces.shape[0]):
+        f, a, b = faces[r, 0], faces[r, 1], faces[r, 2]
+        if a == b:
+            continue
+        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(
+            p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
+            inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f)
+        # the face's samples, then one projection call over them (a call per sample
+        # would cost its arrays' reference counting every time)
+        count = (b - a) * bary.shape[0]
+        pts, guess, dist = np.empty((count, 3)), np.empty((count, 2)), np.empty(count)
+        at = 0
+        for t in range(a, b):
+            i, j, k = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+            for s in range(bary.shape[0]):
+                w0, w1, w2 = bary[s, 0], bary[s, 1], bary[s, 2]
+                for c in range(3):
+                    pts[at, c] = w0 * nodes[i, c] + w1 * nodes[j, c] + w2 * nodes[k, c]
+                for c in range(2):
+                    guess[at, c] = w0 * uv[i, c] + w1 * uv[j, c] + w2 * uv[k, c]
+                at += 1
+        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, lo[f], hi[f], period[f], periodic[f], boxes[f],
+                          pts, guess, threshold[f], dist)
+        at = 0
+        for t in range(a, b):
+            worst = 0.0
+            for s in range(bary.shape[0]):
+                worst = max(worst, dist[at])
+                at += 1
+            out[t] = worst
+
+
 @njit(cache=True, error_model="numpy")
 def _project_segments(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at,
                       inv_v, inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v,
@@ -116,12 +182,8 @@ def _project_segments(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_
         f, a, b = segments[s, 0], segments[s, 1], segments[s, 2]
         if a == b:
             continue
-        pf, qf, nf, mf = p[f], q[f], n[f], m[f]
-        net = ctrl[ctrl_at[f]:ctrl_at[f + 1]].reshape((nf, mf, 4))
-        iu = inv_u[inv_u_at[f]:inv_u_at[f + 1]].reshape((nf, pf + 1, pf + 1))
-        iv = inv_v[inv_v_at[f]:inv_v_at[f + 1]].reshape((mf, qf + 1, qf + 1))
-        bu = (bu_origin[f], bu_scale[f], bucket_u[bucket_u_at[f]:bucket_u_at[f + 1]])
-        bv = (bv_origin[f], bv_scale[f], bucket_v[bucket_v_at[f]:bucket_v_at[f + 1]])
-        project_distances(knots_u[knots_u_at[f]:knots_u_at[f + 1]], pf, knots_v[knots_v_at[f]:knots_v_at[f + 1]], qf,
-                          net, rational[f], iu, iv, bu, bv, lo[f], hi[f], period[f], periodic[f], boxes[f],
+        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(
+            p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
+            inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f)
+        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, lo[f], hi[f], period[f], periodic[f], boxes[f],
                           points[a:b], uv[a:b], threshold[s], out[a:b], start[s])

@@ -111,9 +111,9 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
 def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> list[tuple[np.ndarray, float]]:
     """:func:`measure_face` of many B-spline faces (``evs``: their :class:`FaceSurface`,
-    each with a ``projector``) in one compiled call (:mod:`surfmod.eval.packed`): per face
-    its triangles' deviations and its nodes' max deviation, the same values."""
-    from ..eval.packed import pack, project_segments
+    each with a ``projector``) in two compiled calls (:mod:`surfmod.eval.packed`): per
+    face its triangles' deviations and its nodes' max deviation, the same values."""
+    from ..eval.packed import pack, project_segments, triangle_deviations
 
     for fm in fms:
         if np.isnan(fm.uv).any():
@@ -123,22 +123,17 @@ def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> 
     boxes = np.array([_bounds(fm, ev) for fm, ev in zip(fms, evs)])
     tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
     node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
-    nb = len(bary)
-    samples = np.matmul(bary, np.concatenate([fm.nodes[fm.triangles] for fm in fms])).reshape(-1, 3)
-    guesses = np.matmul(bary, np.concatenate([fm.uv[fm.triangles] for fm in fms])).reshape(-1, 2)
-    count = len(samples)
+    nodes, uv = np.concatenate([fm.nodes for fm in fms]), np.concatenate([fm.uv for fm in fms])
+    triangles = np.concatenate([fm.triangles + o for fm, o in zip(fms, node_at)])
     faces = np.arange(len(fms))
-    # one segment per face for its samples (within half the tolerance, the bound is all
-    # that is asked), one for its nodes (projected to convergence when off by more)
-    segments = np.concatenate([np.c_[faces, nb * tri_at[:-1], nb * tri_at[1:]],
-                               np.c_[faces, count + node_at[:-1], count + node_at[1:]]])
     half = np.full(len(fms), 0.5 * tolerance)
-    dist = project_segments(pk, boxes, np.concatenate([samples, np.concatenate([fm.nodes for fm in fms])]),
-                            np.concatenate([guesses, np.concatenate([fm.uv for fm in fms])]), segments,
-                            np.concatenate([half, half]), np.concatenate([half, np.zeros(len(fms))]))
-    tri = dist[:count].reshape(-1, nb).max(axis=1)
-    node = np.maximum.reduceat(dist[count:], node_at[:-1]) if count < len(dist) else np.zeros(len(fms))
-    return [(tri[tri_at[f]:tri_at[f + 1]], float(node[f]) if node_at[f + 1] > node_at[f] else 0.0)
+    # a sample within half the tolerance needs only its bound; nodes farther off than
+    # that are projected to convergence (the model's own error)
+    tri = triangle_deviations(pk, boxes, nodes, uv, triangles, np.c_[faces, tri_at[:-1], tri_at[1:]], bary, half)
+    node = project_segments(pk, boxes, nodes, uv, np.c_[faces, node_at[:-1], node_at[1:]], half,
+                            np.zeros(len(fms)))
+    node_max = np.maximum.reduceat(node, node_at[:-1]) if len(node) else np.zeros(len(fms))
+    return [(tri[tri_at[f]:tri_at[f + 1]], float(node_max[f]) if node_at[f + 1] > node_at[f] else 0.0)
             for f in range(len(fms))]
 
 
