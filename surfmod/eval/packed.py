@@ -15,7 +15,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .projection_kernel import project_distances
+from .kernels import binomials, scattered_derivatives
+from .projection_kernel import _wrap, project_distances
 
 
 class NetPack(NamedTuple):
@@ -124,6 +125,16 @@ def triangle_deviations(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: n
     return out
 
 
+def derivatives_segments(pk: NetPack, u: np.ndarray, v: np.ndarray, segments: np.ndarray, order: int) -> np.ndarray:
+    """Partials to ``order`` ``(N, K, K, 3)`` at ``(u, v)`` pairs, segment by segment:
+    ``segments (S, 3)`` rows ``(net, first point, end point)``; parameters are mapped
+    as each surface maps them (periodic wrap, clamp) before evaluating."""
+    out = np.zeros((len(u), order + 1, order + 1, 3))
+    _derivatives_segments(*pk, np.ascontiguousarray(u, float), np.ascontiguousarray(v, float),
+                          np.ascontiguousarray(segments, np.int64), int(order), binomials(order), out)
+    return out
+
+
 @njit(cache=True, inline="always")
 def _net(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
          inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f):
@@ -187,3 +198,21 @@ def _project_segments(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_
             inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f)
         project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, lo[f], hi[f], period[f], periodic[f], boxes[f],
                           points[a:b], uv[a:b], threshold[s], out[a:b], start[s])
+
+
+@njit(cache=True, error_model="numpy")
+def _derivatives_segments(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u,
+                          inv_u_at, inv_v, inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale,
+                          bucket_v, bucket_v_at, lo, hi, period, periodic, u, v, segments, order, binom, out):
+    for s in range(segments.shape[0]):
+        f, a, b = segments[s, 0], segments[s, 1], segments[s, 2]
+        if a == b:
+            continue
+        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(
+            p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
+            inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f)
+        uu, vv = np.empty(b - a), np.empty(b - a)
+        for i in range(b - a):
+            uu[i] = _wrap(u[a + i], lo[f, 0], hi[f, 0], period[f, 0], periodic[f, 0])
+            vv[i] = _wrap(v[a + i], lo[f, 1], hi[f, 1], period[f, 1], periodic[f, 1])
+        scattered_derivatives(ku, pf, kv, qf, net, uu, vv, order, rat, binom, iu, iv, bu, bv, out[a:b])

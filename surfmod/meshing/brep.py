@@ -162,7 +162,7 @@ def _estimate(shape, tolerance: float, evaluators: dict | None = None,
     faces' UV boxes (see ``shape_figures``)."""
     from ..occ.mesh import shape_figures
 
-    splines: list = []  # (partials on the face's sample grid, UV box area, its figure to fill)
+    splines: list = []  # (FaceSurface, sample grid u, v, UV box area, its figure to fill)
     sample = None if evaluators is None else partial(_sample_spline, evaluators, splines)
     figures, diag = shape_figures(shape, sample_face=sample, uv_bounds=uv_bounds)
     if splines:
@@ -174,8 +174,8 @@ def _estimate(shape, tolerance: float, evaluators: dict | None = None,
 
 def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples: int, floor: float):
     """``shape_figures``' ``sample_face`` for faces evaluated as splines (B-spline and
-    Bezier surfaces, extrusions of spline curves): their partials on a ``samples`` x
-    ``samples`` grid of the UV box go to ``splines`` with the figure returned, which
+    Bezier surfaces, extrusions of spline curves): each goes to ``splines`` with its
+    ``samples`` x ``samples`` grid and the figure returned, which
     :func:`_fill_spline_figures` fills in; ``None`` leaves other faces to ``GeomLProp``."""
     from ..occ.geom import surface_type
 
@@ -188,16 +188,39 @@ def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples:
     t = np.arange(samples) / (samples - 1)
     figure = [0.0, floor]
     uu, vv = np.repeat(u0 + (u1 - u0) * t, samples), np.tile(v0 + (v1 - v0) * t, samples)  # the grid, u-major
-    splines.append((ev.d2(uu, vv), (u1 - u0) * (v1 - v0), figure))
+    splines.append((ev, uu, vv, (u1 - u0) * (v1 - v0), figure))
     return figure
+
+
+def _spline_partials(splines: list) -> np.ndarray:
+    """Partials to order 2 of every sampled face on its grid, ``(faces, samples, 3, 3, 3)``:
+    the B-spline ones in one compiled call (:mod:`surfmod.eval.packed`)."""
+    from ..eval.packed import derivatives_segments, pack
+
+    size = len(splines[0][1])
+    out = np.empty((len(splines), size, 3, 3, 3))
+    nets = [i for i, (ev, *_) in enumerate(splines) if ev.projector is not None]  # B-spline nets
+    if nets:
+        maps = [splines[i][0].parameter_map for i in nets]
+        pk = pack([splines[i][0]._spline._local_net() for i in nets], *(np.array([m[k] for m in maps])
+                                                                         for k in range(4)))
+        at = size * np.arange(len(nets) + 1)
+        ders = derivatives_segments(pk, np.concatenate([splines[i][1] for i in nets]),
+                                    np.concatenate([splines[i][2] for i in nets]),
+                                    np.c_[np.arange(len(nets)), at[:-1], at[1:]], 2)
+        out[nets] = ders.reshape(len(nets), size, 3, 3, 3)
+    for i, (ev, uu, vv, *_) in enumerate(splines):
+        if ev.projector is None:  # Bezier
+            out[i] = ev.d2(uu, vv)
+    return out
 
 
 def _fill_spline_figures(splines: list, floor: float) -> None:
     """Fill each sampled face's figure ``[area of the UV box's patch, median
     sqrt(|k1| |k2|)]``, as ``shape_figures`` gives it with ``GeomLProp`` (no curvature
     where the normal is undefined), for all sampled faces at once."""
-    ders = np.stack([d for d, _, _ in splines])  # (faces, samples, 3, 3, 3)
-    area = np.linalg.norm(raw_normals(ders), axis=-1).mean(axis=1) * np.array([a for _, a, _ in splines])
+    ders = _spline_partials(splines)  # (faces, samples, 3, 3, 3)
+    area = np.linalg.norm(raw_normals(ders), axis=-1).mean(axis=1) * np.array([s[3] for s in splines])
     c = curvatures(ders)
     vals = np.sqrt(np.maximum(np.abs(c.k1), floor) * np.maximum(np.abs(c.k2), floor))
     defined = ~degenerate_mask(ders, 1e-9)
@@ -206,7 +229,7 @@ def _fill_spline_figures(splines: list, floor: float) -> None:
     with warnings.catch_warnings():  # faces without any defined curvature stay at the floor
         warnings.simplefilter("ignore", RuntimeWarning)
         median[ok] = np.nanmedian(np.where(defined, vals, np.nan)[ok], axis=1)
-    for (_, _, figure), a, k in zip(splines, area.tolist(), median.tolist()):
+    for (*_, figure), a, k in zip(splines, area.tolist(), median.tolist()):
         figure[:] = a, k
 
 
