@@ -109,6 +109,39 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
     return tri_dev, float(node.max(initial=0.0))
 
 
+def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np.ndarray, float]]:
+    """:func:`measure_face` of many plane, sphere, cylinder, cone and torus faces
+    (``params``: their ``occ.mesh.analytic_parameters``) in one vectorized pass: per
+    face its triangles' deviations and its nodes' max deviation, the same values."""
+    from . import analytic
+
+    kinds = np.array([k for k, _, _ in params])
+    frames = np.array([f for _, f, _ in params], float).reshape(-1, 2, 3)
+    sizes = np.array([z for _, _, z in params], float).reshape(-1, 2)
+    # planes are measured at their nodes (exact: the distance is linear on a triangle),
+    # the others at their triangles' samples too
+    curved = [i for i, k in enumerate(kinds) if k != analytic.PLANE]
+    samples = (np.matmul(bary, np.concatenate([fms[i].nodes[fms[i].triangles] for i in curved])).reshape(-1, 3)
+               if curved else np.zeros((0, 3)))
+    counts = np.array([len(fm.nodes) for fm in fms])
+    points = np.concatenate([samples] + [fm.nodes for fm in fms])
+    owner = np.concatenate([np.repeat(np.array(curved, np.intp), [len(bary) * len(fms[i].triangles) for i in curved]),
+                            np.repeat(np.arange(len(fms)), counts)])
+    dist = analytic.distances(kinds, frames, sizes, points, owner)
+    per_sample, per_node = dist[:len(samples)], dist[len(samples):]
+    node_at = np.cumsum(np.r_[0, counts])
+    sample_at = dict(zip(curved, np.cumsum([0] + [len(bary) * len(fms[i].triangles) for i in curved])))
+    out = []
+    for i, fm in enumerate(fms):
+        node = per_node[node_at[i]:node_at[i + 1]]
+        if i in sample_at:
+            tri = per_sample[sample_at[i]:sample_at[i] + len(bary) * len(fm.triangles)].reshape(-1, len(bary))
+            out.append((tri.max(axis=1, initial=0.0), float(node.max(initial=0.0))))
+        else:
+            out.append((node[fm.triangles].max(axis=1, initial=0.0), float(node.max(initial=0.0))))
+    return out
+
+
 def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> list[tuple[np.ndarray, float]]:
     """:func:`measure_face` of many B-spline faces (``evs``: their :class:`FaceSurface`,
     each with a ``projector``) in two compiled calls (:mod:`surfmod.eval.packed`): per
@@ -351,7 +384,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     """
     from tqdm import tqdm
 
-    from ..occ.mesh import brepmesh
+    from ..occ.mesh import analytic_parameters, brepmesh
 
     evaluators: dict = {}  # face hash -> FaceSurface (splines from the estimate, others when measured)
     uv_bounds: dict = {}  # face hash -> UV box, read once
@@ -387,6 +420,12 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
                        if ev is not None and ev.projector is not None and len(fms[i].nodes)]
             measured = dict(zip(splines, measure_spline_faces([fms[i] for i in splines], [evs[i] for i in splines],
                                                               tolerance))) if splines else {}
+            # planes, spheres, cylinders, cones and tori: closed forms, all at once
+            analytic = [(i, a) for i, fm in enumerate(fms) if fm.repeats < 0 and evs[i] is None
+                        and (a := analytic_parameters(fm.surface)) is not None]
+            if analytic:
+                measured.update(zip([i for i, _ in analytic],
+                                    measure_analytic_faces([fms[i] for i, _ in analytic], [a for _, a in analytic])))
             for i, fm in enumerate(tqdm(fms, desc=f"measure pass {attempt}", unit="face", disable=not progress,
                                         leave=False)):
                 if fm.repeats >= 0:  # an isometric repeat of a face measured above

@@ -411,15 +411,11 @@ def surface_d1(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return out
 
 
-def analytic_distances(surf, points: np.ndarray) -> np.ndarray | None:
-    """Closed-form distance from ``points`` to an untrimmed plane, cylinder, cone, sphere
-    or torus (``None`` for any other surface type).
-
-    The foot point of a point on a surface of revolution lies in the point's meridian
-    plane, where the cone and the torus show *two* profiles (the generatrix line and
-    the circle mirrored through the axis, both parts of OCCT's surface: a cone goes on
-    past its apex, a spindle torus' tube crosses the axis): the distance is the smaller
-    of the two."""
+def analytic_parameters(surf) -> tuple | None:
+    """``(kind, frame (2, 3), sizes (2,))`` of a plane, sphere, cylinder, cone or torus
+    as :func:`surfmod.meshing.analytic.distances` takes them, ``None`` for any other
+    surface type."""
+    from ..meshing import analytic
     from .geom import surface_type
 
     name = surface_type(surf)
@@ -427,28 +423,29 @@ def analytic_distances(surf, points: np.ndarray) -> np.ndarray | None:
         return None
     with kernel(f"{name} parameters"):
         ax = surf.Position()
-        o = np.array(ax.Location().Coord())
-        z = np.array(ax.Direction().Coord())
-        rel = points - o
-        h = rel @ z
+        frame = (ax.Location().Coord(), ax.Direction().Coord())
         if name == "Geom_Plane":
-            return np.abs(h)
+            return analytic.PLANE, frame, (0.0, 0.0)
         if name == "Geom_SphericalSurface":
-            return np.abs(np.linalg.norm(rel, axis=1) - surf.Radius())
-        radial = np.linalg.norm(rel - h[:, None] * z, axis=1)
+            return analytic.SPHERE, frame, (surf.Radius(), 0.0)
         if name == "Geom_CylindricalSurface":
-            return np.abs(radial - surf.Radius())
+            return analytic.CYLINDER, frame, (surf.Radius(), 0.0)
         if name == "Geom_ConicalSurface":
-            r0, a = surf.RefRadius(), surf.SemiAngle()
-            # profile lines through (+-r0, 0) with directions (+-sin a, cos a), in (radial, h)
-            sa, ca = np.sin(a), np.cos(a)
-            near = np.abs((radial - r0) * ca - h * sa)
-            far = np.abs((radial + r0) * ca + h * sa)
-            return np.minimum(near, far)
-        big, small = surf.MajorRadius(), surf.MinorRadius()
-        near = np.abs(np.hypot(radial - big, h) - small)
-        far = np.abs(np.hypot(radial + big, h) - small)
-        return np.minimum(near, far)
+            return analytic.CONE, frame, (surf.RefRadius(), surf.SemiAngle())
+        return analytic.TORUS, frame, (surf.MajorRadius(), surf.MinorRadius())
+
+
+def analytic_distances(surf, points: np.ndarray) -> np.ndarray | None:
+    """Closed-form distance from ``points`` to an untrimmed plane, cylinder, cone, sphere
+    or torus (``None`` for any other surface type): see :mod:`surfmod.meshing.analytic`."""
+    from ..meshing import analytic
+
+    params = analytic_parameters(surf)
+    if params is None:
+        return None
+    kind, frame, sizes = params
+    return analytic.distances(np.array([kind]), np.array([frame], float), np.array([sizes], float), points,
+                              np.zeros(len(points), np.intp))
 
 
 def iso_curve(surf, direction: int, value: float):
