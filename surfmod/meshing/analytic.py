@@ -7,11 +7,15 @@ The foot point of a point on a surface of revolution lies in the point's meridia
 where the cone and the torus show *two* profiles (the generatrix line and the circle
 mirrored through the axis, both parts of OCCT's surface: a cone goes on past its apex, a
 spindle torus' tube crosses the axis): the distance is the smaller of the two.
+
+Compiled (numba): a point costs a few arithmetic operations, which in NumPy would be
+a dozen array passes.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 #: Kinds of :func:`distances`' surfaces (``occ.mesh.analytic_parameters`` reads them).
 PLANE, SPHERE, CYLINDER, CONE, TORUS = range(5)
@@ -29,29 +33,126 @@ def distances(kinds: np.ndarray, frames: np.ndarray, sizes: np.ndarray, points: 
     >>> d.tolist()
     [3.0, 1.0]
     """
-    kind = kinds[owner]
-    rel = points - frames[owner, 0]
-    z = frames[owner, 1]
-    h = np.einsum("ij,ij->i", rel, z)
-    out = np.abs(h)  # planes
-    a, b = sizes[owner, 0], sizes[owner, 1]
-    sphere = kind == SPHERE
-    if sphere.any():
-        out[sphere] = np.abs(np.linalg.norm(rel[sphere], axis=1) - a[sphere])
-    round_ = kind >= CYLINDER
-    if round_.any():
-        hr, ar, br, kr = h[round_], a[round_], b[round_], kind[round_]
-        radial = np.linalg.norm(rel[round_] - hr[:, None] * z[round_], axis=1)
-        got = np.abs(radial - ar)  # cylinders
-        cone = kr == CONE
-        if cone.any():
-            # profile lines through (+-r0, 0) with directions (+-sin a, cos a), in (radial, h)
-            rad, hc, r0 = radial[cone], hr[cone], ar[cone]
-            sa, ca = np.sin(br[cone]), np.cos(br[cone])
-            got[cone] = np.minimum(np.abs((rad - r0) * ca - hc * sa), np.abs((rad + r0) * ca + hc * sa))
-        torus = kr == TORUS
-        if torus.any():
-            rad, ht, big, small = radial[torus], hr[torus], ar[torus], br[torus]
-            got[torus] = np.minimum(np.abs(np.hypot(rad - big, ht) - small), np.abs(np.hypot(rad + big, ht) - small))
-        out[round_] = got
+    out = np.empty(len(points))
+    _point_distances(*_tables(kinds, frames, sizes), np.ascontiguousarray(points, float),
+                     np.ascontiguousarray(owner, np.int64), out)
     return out
+
+
+def triangle_distances(kinds: np.ndarray, frames: np.ndarray, sizes: np.ndarray, nodes: np.ndarray,
+                       triangles: np.ndarray, faces: np.ndarray, bary: np.ndarray) -> np.ndarray:
+    """Max distance per triangle over its barycentric samples ``bary (K, 3)`` (points
+    ``bary @ corners`` of ``nodes (N, 3)`` indexed by ``triangles (T, 3)``), from the
+    surface of its face: ``faces (F, 3)`` rows ``(surface, first triangle, end
+    triangle)``.  Returns ``(T,)``.
+
+    >>> import numpy as np
+    >>> nodes = np.array([[1.0, 0, 0], [0, 1, 0], [-1, 0, 0]])  # on a unit cylinder about z
+    >>> d = triangle_distances(np.array([CYLINDER]), np.array([[[0, 0, 0], [0, 0, 1.0]]]),
+    ...                        np.array([[1.0, 0]]), nodes, np.array([[0, 1, 2]]), np.array([[0, 0, 1]]),
+    ...                        np.array([[1 / 3, 1 / 3, 1 / 3]]))
+    >>> round(float(d[0]), 12)  # the centroid (0, 1/3, 0) is 2/3 inside
+    0.666666666667
+    """
+    out = np.zeros(len(triangles))
+    _triangle_distances(*_tables(kinds, frames, sizes), np.ascontiguousarray(nodes, float),
+                        np.ascontiguousarray(triangles, np.int64), np.ascontiguousarray(faces, np.int64),
+                        np.ascontiguousarray(bary, float), out)
+    return out
+
+
+def _tables(kinds, frames, sizes):
+    return (np.ascontiguousarray(kinds, np.int64), np.ascontiguousarray(frames, float).reshape(-1, 2, 3),
+            np.ascontiguousarray(sizes, float).reshape(-1, 2))
+
+
+@njit(cache=True, error_model="numpy")
+def _distance(kind, frame, size, x, y, z):
+    """Distance from ``(x, y, z)`` to one surface (see :func:`distances`)."""
+    rx, ry, rz = x - frame[0, 0], y - frame[0, 1], z - frame[0, 2]
+    h = rx * frame[1, 0] + ry * frame[1, 1] + rz * frame[1, 2]
+    if kind == PLANE:
+        return abs(h)
+    if kind == SPHERE:
+        return abs(np.sqrt(rx * rx + ry * ry + rz * rz) - size[0])
+    px, py, pz = rx - h * frame[1, 0], ry - h * frame[1, 1], rz - h * frame[1, 2]
+    radial = np.sqrt(px * px + py * py + pz * pz)
+    if kind == CYLINDER:
+        return abs(radial - size[0])
+    if kind == CONE:
+        # profile lines through (+-r0, 0) with directions (+-sin a, cos a), in (radial, h)
+        sa, ca = np.sin(size[1]), np.cos(size[1])
+        return min(abs((radial - size[0]) * ca - h * sa), abs((radial + size[0]) * ca + h * sa))
+    return min(abs(np.hypot(radial - size[0], h) - size[1]), abs(np.hypot(radial + size[0], h) - size[1]))
+
+
+@njit(cache=True, error_model="numpy")
+def _point_distances(kinds, frames, sizes, points, owner, out):
+    for i in range(points.shape[0]):
+        f = owner[i]
+        out[i] = _distance(kinds[f], frames[f], sizes[f], points[i, 0], points[i, 1], points[i, 2])
+
+
+@njit(cache=True, error_model="numpy")
+def _triangle_distances(kinds, frames, sizes, nodes, triangles, faces, bary, out):
+    for r in range(faces.shape[0]):
+        f = faces[r, 0]
+        kind, frame, size = kinds[f], frames[f], sizes[f]
+        for t in range(faces[r, 1], faces[r, 2]):
+            i, j, k = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+            worst = 0.0
+            for s in range(bary.shape[0]):
+                w0, w1, w2 = bary[s, 0], bary[s, 1], bary[s, 2]
+                worst = max(worst, _distance(kind, frame, size, w0 * nodes[i, 0] + w1 * nodes[j, 0] + w2 * nodes[k, 0],
+                                             w0 * nodes[i, 1] + w1 * nodes[j, 1] + w2 * nodes[k, 1],
+                                             w0 * nodes[i, 2] + w1 * nodes[j, 2] + w2 * nodes[k, 2]))
+            out[t] = worst
+
+
+def revolved(origin, axis, curve: dict, rtol: float = 1e-12):
+    """``(kind, frame, sizes)`` of the surface a circle or line sweeps about the axis
+    ``(origin, unit axis)`` when it lies in a plane through the axis (to ``rtol`` of its
+    size): a torus (a sphere when the circle's centre is on the axis), a cone, a
+    cylinder or a plane, the same point sets as OCCT's surface of revolution;
+    ``None`` for any other basis curve (``curve``: ``occ.mesh.curve_info``'s dict).
+
+    >>> import numpy as np
+    >>> circle = {"conic": (np.array([3.0, 0, 1]), np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), 0.5, 0.5)}
+    >>> kind, frame, sizes = revolved(np.zeros(3), np.array([0, 0, 1.0]), circle)
+    >>> kind == TORUS, frame[0].tolist(), sizes
+    (True, [0.0, 0.0, 1.0], (3.0, 0.5))
+    """
+    origin, axis = np.asarray(origin, float), np.asarray(axis, float)
+    if "conic" in curve:
+        centre, x, y, a, b = curve["conic"]
+        if a != b:
+            return None  # an ellipse
+        normal = np.cross(x, y)
+        offset = centre - origin
+        scale = 1.0 + np.linalg.norm(offset) + a
+        if abs(normal @ axis) > rtol or abs(offset @ normal) > rtol * scale:
+            return None
+        foot = origin + (offset @ axis) * axis
+        big = float(np.linalg.norm(centre - foot))
+        if big <= rtol * scale:
+            return SPHERE, (foot, axis), (float(a), 0.0)
+        return TORUS, (foot, axis), (big, float(a))
+    if "line" in curve:
+        point, direction = (np.asarray(v, float) for v in curve["line"])
+        offset = point - origin
+        scale = 1.0 + np.linalg.norm(offset)
+        if abs(offset @ np.cross(axis, direction)) > rtol * scale:
+            return None  # skew to the axis: a hyperboloid
+        along = direction @ axis
+        if along < 0:
+            direction, along = -direction, -along
+        foot = origin + (offset @ axis) * axis
+        radial = point - foot
+        r0 = float(np.linalg.norm(radial))
+        outward = direction @ (radial / r0) if r0 > rtol * scale else float(np.linalg.norm(direction - along * axis))
+        if along <= rtol:
+            return PLANE, (foot, axis), (0.0, 0.0)  # a line across the axis sweeps a plane
+        if abs(outward) <= rtol:
+            return CYLINDER, (foot, axis), (r0, 0.0)
+        return CONE, (foot, axis), (r0, float(np.arctan2(outward, along)))
+    return None

@@ -111,35 +111,27 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
 def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np.ndarray, float]]:
     """:func:`measure_face` of many plane, sphere, cylinder, cone and torus faces
-    (``params``: their ``occ.mesh.analytic_parameters``) in one vectorized pass: per
-    face its triangles' deviations and its nodes' max deviation, the same values."""
+    (``params``: their ``occ.mesh.analytic_parameters``) in two compiled calls: per face
+    its triangles' deviations and its nodes' max deviation, the same values."""
     from . import analytic
 
     kinds = np.array([k for k, _, _ in params])
     frames = np.array([f for _, f, _ in params], float).reshape(-1, 2, 3)
     sizes = np.array([z for _, _, z in params], float).reshape(-1, 2)
+    node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
+    tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
+    nodes = np.concatenate([fm.nodes for fm in fms])
+    triangles = np.concatenate([fm.triangles + o for fm, o in zip(fms, node_at)])
+    node = analytic.distances(kinds, frames, sizes, nodes, np.repeat(np.arange(len(fms)), np.diff(node_at)))
     # planes are measured at their nodes (exact: the distance is linear on a triangle),
-    # the others at their triangles' samples too
-    curved = [i for i, k in enumerate(kinds) if k != analytic.PLANE]
-    samples = (np.matmul(bary, np.concatenate([fms[i].nodes[fms[i].triangles] for i in curved])).reshape(-1, 3)
-               if curved else np.zeros((0, 3)))
-    counts = np.array([len(fm.nodes) for fm in fms])
-    points = np.concatenate([samples] + [fm.nodes for fm in fms])
-    owner = np.concatenate([np.repeat(np.array(curved, np.intp), [len(bary) * len(fms[i].triangles) for i in curved]),
-                            np.repeat(np.arange(len(fms)), counts)])
-    dist = analytic.distances(kinds, frames, sizes, points, owner)
-    per_sample, per_node = dist[:len(samples)], dist[len(samples):]
-    node_at = np.cumsum(np.r_[0, counts])
-    sample_at = dict(zip(curved, np.cumsum([0] + [len(bary) * len(fms[i].triangles) for i in curved])))
-    out = []
-    for i, fm in enumerate(fms):
-        node = per_node[node_at[i]:node_at[i + 1]]
-        if i in sample_at:
-            tri = per_sample[sample_at[i]:sample_at[i] + len(bary) * len(fm.triangles)].reshape(-1, len(bary))
-            out.append((tri.max(axis=1, initial=0.0), float(node.max(initial=0.0))))
-        else:
-            out.append((node[fm.triangles].max(axis=1, initial=0.0), float(node.max(initial=0.0))))
-    return out
+    # the others at their triangles' samples
+    curved = np.nonzero(kinds != analytic.PLANE)[0]
+    tri = analytic.triangle_distances(kinds, frames, sizes, nodes, triangles,
+                                      np.c_[curved, tri_at[curved], tri_at[curved + 1]], bary)
+    on_plane = np.repeat(kinds == analytic.PLANE, np.diff(tri_at))
+    tri[on_plane] = node[triangles[on_plane]].max(axis=1, initial=0.0)
+    return [(tri[tri_at[f]:tri_at[f + 1]], float(node[node_at[f]:node_at[f + 1]].max(initial=0.0)))
+            for f in range(len(fms))]
 
 
 def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> list[tuple[np.ndarray, float]]:
@@ -280,6 +272,37 @@ def _evaluator(evaluators: dict, fm) -> FaceSurface | None:
     return ev
 
 
+def _measure_faces(fms: list, evaluators: dict, tolerance: float, desc: str, progress: bool):
+    """``(deviation, node deviation, triangles' deviations)`` of every face: closed forms
+    for the analytic faces and one compiled call for the B-spline nets (all faces of each
+    kind at once), the other faces one by one; an isometric repeat of a face takes its
+    first instance's figures."""
+    from tqdm import tqdm
+
+    from ..occ.mesh import analytic_parameters
+
+    first = [i for i, fm in enumerate(fms) if fm.repeats < 0]
+    params = {i: a for i in first if (a := analytic_parameters(fms[i].surface)) is not None}
+    evs = {i: _evaluator(evaluators, fms[i]) for i in first if i not in params}
+    splines = [i for i, ev in evs.items() if ev is not None and ev.projector is not None and len(fms[i].nodes)]
+    measured = {}
+    if splines:
+        measured.update(zip(splines, measure_spline_faces([fms[i] for i in splines], [evs[i] for i in splines],
+                                                          tolerance)))
+    if params:
+        measured.update(zip(params, measure_analytic_faces([fms[i] for i in params], list(params.values()))))
+    tri_devs: list = []
+    node_dev = np.zeros(len(fms))
+    for i, fm in enumerate(tqdm(fms, desc=desc, unit="face", disable=not progress, leave=False)):
+        if fm.repeats >= 0:
+            tri_devs.append(tri_devs[fm.repeats])
+            node_dev[i] = node_dev[fm.repeats]
+            continue
+        d, node_dev[i] = measured[i] if i in measured else measure_face(fm, tolerance, ev=evs[i])
+        tri_devs.append(d)
+    return np.array([d.max(initial=0.0) for d in tri_devs]), node_dev, tri_devs
+
+
 def _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared) -> list[int]:
     """Positions in ``fms`` of the faces a finer deflection should bring within tolerance.
 
@@ -384,7 +407,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     """
     from tqdm import tqdm
 
-    from ..occ.mesh import analytic_parameters, brepmesh
+    from ..occ.mesh import brepmesh
 
     evaluators: dict = {}  # face hash -> FaceSurface (splines from the estimate, others when measured)
     uv_bounds: dict = {}  # face hash -> UV box, read once
@@ -412,29 +435,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
                 raise SurfmodError(
                     f"tolerance: {tolerance:g} needs more than {max_triangles:,} triangles (limit max_triangles)"
                 )
-            dev, node_dev = np.zeros(len(fms)), np.zeros(len(fms))
-            tri_devs: list = []  # per face, its triangles' deviations (for the local refinement)
-            evs = [None if fm.repeats >= 0 else _evaluator(evaluators, fm) for fm in fms]
-            # B-spline faces all at once: one compiled call instead of one per face
-            splines = [i for i, ev in enumerate(evs)
-                       if ev is not None and ev.projector is not None and len(fms[i].nodes)]
-            measured = dict(zip(splines, measure_spline_faces([fms[i] for i in splines], [evs[i] for i in splines],
-                                                              tolerance))) if splines else {}
-            # planes, spheres, cylinders, cones and tori: closed forms, all at once
-            analytic = [(i, a) for i, fm in enumerate(fms) if fm.repeats < 0 and evs[i] is None
-                        and (a := analytic_parameters(fm.surface)) is not None]
-            if analytic:
-                measured.update(zip([i for i, _ in analytic],
-                                    measure_analytic_faces([fms[i] for i, _ in analytic], [a for _, a in analytic])))
-            for i, fm in enumerate(tqdm(fms, desc=f"measure pass {attempt}", unit="face", disable=not progress,
-                                        leave=False)):
-                if fm.repeats >= 0:  # an isometric repeat of a face measured above
-                    dev[i], node_dev[i] = dev[fm.repeats], node_dev[fm.repeats]
-                    tri_devs.append(tri_devs[fm.repeats])
-                    continue
-                d, node_dev[i] = measured[i] if i in measured else measure_face(fm, tolerance, ev=evs[i])
-                dev[i] = d.max(initial=0.0)
-                tri_devs.append(d)
+            dev, node_dev, tri_devs = _measure_faces(fms, evaluators, tolerance, f"measure pass {attempt}", progress)
             bar.update()
             refine = _faces_to_refine(fms, dev, node_dev, tolerance, previous, stuck, declared)
             # BRepMesh overshoots by a few percent inside some faces: refining those

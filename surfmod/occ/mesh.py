@@ -413,12 +413,16 @@ def surface_d1(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def analytic_parameters(surf) -> tuple | None:
     """``(kind, frame (2, 3), sizes (2,))`` of a plane, sphere, cylinder, cone or torus
-    as :func:`surfmod.meshing.analytic.distances` takes them, ``None`` for any other
-    surface type."""
+    as :func:`surfmod.meshing.analytic.distances` takes them (also of a surface of
+    revolution that is one of those, see :func:`surfmod.meshing.analytic.revolved`),
+    ``None`` for any other surface."""
     from ..meshing import analytic
     from .geom import surface_type
 
     name = surface_type(surf)
+    if name == "Geom_SurfaceOfRevolution":  # of a circle or line in a plane through the axis
+        swept = swept_info(surf)
+        return analytic.revolved(*swept["axis"], swept["curve"])
     if name not in ANALYTIC:
         return None
     with kernel(f"{name} parameters"):
