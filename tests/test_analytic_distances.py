@@ -7,9 +7,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from OCP.Geom import (Geom_ConicalSurface, Geom_CylindricalSurface, Geom_Plane, Geom_SphericalSurface,
-                      Geom_SurfaceOfRevolution, Geom_ToroidalSurface)
 from OCP.GC import GC_MakeCircle, GC_MakeEllipse, GC_MakeLine
+from OCP.Geom import (
+    Geom_ConicalSurface,
+    Geom_CylindricalSurface,
+    Geom_Plane,
+    Geom_SphericalSurface,
+    Geom_SurfaceOfRevolution,
+    Geom_ToroidalSurface,
+)
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Elips, gp_Pnt
 
