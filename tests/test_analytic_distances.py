@@ -20,7 +20,7 @@ from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Elips, gp_Pnt
 
 from surfmod.meshing import analytic
-from surfmod.occ.mesh import analytic_distances, analytic_parameters
+from surfmod.occ.mesh import analytic_parameters
 
 AXIS = gp_Ax1(gp_Pnt(0.5, -1.0, 0.2), gp_Dir(0.2, 0.3, 0.9))
 
@@ -83,7 +83,8 @@ def test_revolved_circles_and_lines_are_their_analytic_surfaces(name):
         return
     assert params[0] == kind
     pts = _points()
-    ours = analytic_distances(surf, pts)
+    ours = analytic.distances(np.array([params[0]]), np.array([params[1]], float), np.array([params[2]], float),
+                              pts, np.zeros(len(pts), int))
     np.testing.assert_allclose(ours, _occt_distances(surf, pts), rtol=0, atol=1e-9)
 
 

@@ -165,7 +165,8 @@ def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
     """measure_spline_faces (every B-spline face of a part in one compiled call) gives
     each face the triangle and node deviations measure_face gives it alone (to the
     round-off of the samples' coordinates)."""
-    from surfmod.meshing.brep import _evaluator, measure_spline_faces
+    from surfmod.meshing.brep import _bounds, _evaluator, measure_spline_faces
+    from surfmod.meshing.deviation import DENSE, triangle_deviations
 
     shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
     tol = 1e-3 * shape_figures(shape, samples=2)[1]
@@ -174,10 +175,15 @@ def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
     pairs = [(fm, ev) for fm in fms if (ev := _evaluator(evaluators, fm)) is not None and ev.projector is not None]
     assert len(pairs) > 150  # B-spline faces and extrusions of B-spline curves
     together = measure_spline_faces([fm for fm, _ in pairs], [ev for _, ev in pairs], tol)
-    for (fm, ev), (tri, node) in zip(pairs, together):
+    for k, ((fm, ev), (tri, node)) in enumerate(zip(pairs, together)):
         alone_tri, alone_node = measure_face(fm, tol, ev=ev)
         np.testing.assert_allclose(tri, alone_tri, rtol=1e-12, atol=1e-12 * tol)
         assert node == pytest.approx(alone_node, rel=1e-12, abs=1e-12 * tol)
+        if k % 10 == 0:  # and the NumPy Gauss-Newton iteration gives the same bounds
+            box = _bounds(fm, ev)
+            by_numpy = triangle_deviations(ev.d1, fm.nodes[fm.triangles], fm.uv[fm.triangles], box, DENSE,
+                                           0.5 * tol, ev.d0, accurate_max=False)
+            np.testing.assert_allclose(tri, by_numpy, rtol=1e-9, atol=1e-12 * tol)
 
 
 def test_analytic_faces_measured_at_once_equal_face_by_face(corpus_dir):

@@ -79,33 +79,23 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
     Values at most ``tolerance / 2`` may be upper bounds; larger ones are projections.
     """
-    from ..occ.geom import surface_type
-    from ..occ.mesh import analytic_distances
+    from ..occ.mesh import analytic_parameters
 
-    if surface_type(fm.surface) == "Geom_Plane":
-        # the signed distance to a plane is linear on a flat triangle: its extremes are
-        # at the corners, so the nodes' distances give every triangle's exactly
-        node = analytic_distances(fm.surface, fm.nodes)
-        return node[fm.triangles].max(axis=1), float(node.max(initial=0.0))
-    pos = fm.nodes[fm.triangles]
-    q = np.matmul(bary, pos).reshape(-1, 3)
-    exact = analytic_distances(fm.surface, np.concatenate([q, fm.nodes]))  # samples and nodes in one call
-    if exact is not None:
-        samples, node = exact[: len(q)], exact[len(q) :]
-        return samples.reshape(len(pos), len(bary)).max(axis=1), float(node.max(initial=0.0))
+    params = analytic_parameters(fm.surface)
+    if params is not None:  # closed forms
+        return measure_analytic_faces([fm], [params], bary)[0]
     ev = FaceSurface(fm.surface, fm.bounds) if ev is None else ev
+    if ev.projector is not None:  # a B-spline net: compiled Gauss-Newton
+        return measure_spline_faces([fm], [ev], tolerance, bary)[0]
     box = _bounds(fm, ev)
     if np.isnan(fm.uv).any():
         raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
-    project = ev.projector  # compiled Gauss-Newton on B-spline faces
-    tri_dev = triangle_deviations(ev.d1, pos, fm.uv[fm.triangles], box, bary, 0.5 * tolerance, ev.d0,
-                                  accurate_max=False, project=project)
+    tri_dev = triangle_deviations(ev.d1, fm.nodes[fm.triangles], fm.uv[fm.triangles], box, bary, 0.5 * tolerance,
+                                  ev.d0, accurate_max=False)
     node = np.linalg.norm(fm.nodes - ev.d0(fm.uv[:, 0], fm.uv[:, 1]), axis=1)
     far = np.nonzero(node > 0.5 * tolerance)[0]
     if far.size:
-        bound = (project(fm.nodes[far], fm.uv[far], box) if project is not None
-                 else project_distances(ev.d1, fm.nodes[far], fm.uv[far], box, d0=ev.d0))
-        node[far] = np.minimum(node[far], bound)
+        node[far] = np.minimum(node[far], project_distances(ev.d1, fm.nodes[far], fm.uv[far], box, d0=ev.d0))
     return tri_dev, float(node.max(initial=0.0))
 
 

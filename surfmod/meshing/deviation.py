@@ -89,10 +89,6 @@ def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None,
     q = np.matmul(bary, positions).reshape(-1, 3)
     g = np.matmul(bary, uvs).reshape(-1, 2)
     thr = np.inf if threshold is None else threshold
-    if project is not None and not accurate_max:
-        # the compiled projection starts from each sample's parametric bound and stops
-        # there when it is within the threshold: the whole measurement in one call
-        return project(q, g, bounds, thr).reshape(len(positions), len(bary)).max(axis=1)
     d0v = d0(np.clip(g[:, 0], bounds[0], bounds[1]), np.clip(g[:, 1], bounds[2], bounds[3])) if d0 else None
     first = np.linalg.norm(q - d0v, axis=1) if d0v is not None else None
     if first is None:

@@ -77,7 +77,7 @@ def _face_solids(shp) -> dict:
     return owner
 
 
-#: Surfaces whose distance has a closed form (:func:`analytic_distances`): their (u, v)
+#: Surfaces whose distance has a closed form (:func:`analytic_parameters`): their (u, v)
 #: nodes are not needed to measure a mesh.
 ANALYTIC = ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface", "Geom_SphericalSurface",
             "Geom_ToroidalSurface")
@@ -437,19 +437,6 @@ def analytic_parameters(surf) -> tuple | None:
         if name == "Geom_ConicalSurface":
             return analytic.CONE, frame, (surf.RefRadius(), surf.SemiAngle())
         return analytic.TORUS, frame, (surf.MajorRadius(), surf.MinorRadius())
-
-
-def analytic_distances(surf, points: np.ndarray) -> np.ndarray | None:
-    """Closed-form distance from ``points`` to an untrimmed plane, cylinder, cone, sphere
-    or torus (``None`` for any other surface type): see :mod:`surfmod.meshing.analytic`."""
-    from ..meshing import analytic
-
-    params = analytic_parameters(surf)
-    if params is None:
-        return None
-    kind, frame, sizes = params
-    return analytic.distances(np.array([kind]), np.array([frame], float), np.array([sizes], float), points,
-                              np.zeros(len(points), np.intp))
 
 
 def iso_curve(surf, direction: int, value: float):
