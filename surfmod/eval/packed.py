@@ -103,7 +103,7 @@ def project_segments(pk: NetPack, boxes: np.ndarray, points: np.ndarray, uv: np.
     and ``threshold`` (``(S,)``; see :func:`surfmod.eval.projection_kernel.project_distances`)
     and its net's Gauss-Newton ``boxes[net]`` ``(u0, u1, v0, v1)``.  Returns ``(N,)``."""
     out = np.zeros(len(points))
-    _project_segments(*pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(points, float),
+    _project_segments(pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(points, float),
                       np.ascontiguousarray(uv, float), np.ascontiguousarray(segments, np.int64),
                       np.ascontiguousarray(start, float), np.ascontiguousarray(threshold, float), out)
     return out
@@ -118,7 +118,7 @@ def triangle_deviations(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: n
     :func:`surfmod.meshing.deviation.triangle_deviations` with a projector).
     ``faces (F, 3)`` rows ``(net, first triangle, end triangle)``.  Returns ``(T,)``."""
     out = np.zeros(len(triangles))
-    _triangle_deviations(*pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(nodes, float),
+    _triangle_deviations(pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(nodes, float),
                          np.ascontiguousarray(uv, float), np.ascontiguousarray(triangles, np.int64),
                          np.ascontiguousarray(faces, np.int64), np.ascontiguousarray(bary, float),
                          np.ascontiguousarray(threshold, float), out)
@@ -130,36 +130,30 @@ def derivatives_segments(pk: NetPack, u: np.ndarray, v: np.ndarray, segments: np
     ``segments (S, 3)`` rows ``(net, first point, end point)``; parameters are mapped
     as each surface maps them (periodic wrap, clamp) before evaluating."""
     out = np.zeros((len(u), order + 1, order + 1, 3))
-    _derivatives_segments(*pk, np.ascontiguousarray(u, float), np.ascontiguousarray(v, float),
+    _derivatives_segments(pk, np.ascontiguousarray(u, float), np.ascontiguousarray(v, float),
                           np.ascontiguousarray(segments, np.int64), int(order), binomials(order), out)
     return out
 
 
 @njit(cache=True, inline="always")
-def _net(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
-         inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f):
+def _net(pk, f):
     """Net ``f`` of a pack as the one-net kernels take it."""
-    pf, qf, nf, mf = p[f], q[f], n[f], m[f]
-    return (knots_u[knots_u_at[f]:knots_u_at[f + 1]], pf, knots_v[knots_v_at[f]:knots_v_at[f + 1]], qf,
-            ctrl[ctrl_at[f]:ctrl_at[f + 1]].reshape((nf, mf, 4)), rational[f],
-            inv_u[inv_u_at[f]:inv_u_at[f + 1]].reshape((nf, pf + 1, pf + 1)),
-            inv_v[inv_v_at[f]:inv_v_at[f + 1]].reshape((mf, qf + 1, qf + 1)),
-            (bu_origin[f], bu_scale[f], bucket_u[bucket_u_at[f]:bucket_u_at[f + 1]]),
-            (bv_origin[f], bv_scale[f], bucket_v[bucket_v_at[f]:bucket_v_at[f + 1]]))
+    pf, qf, nf, mf = pk.p[f], pk.q[f], pk.n[f], pk.m[f]
+    return (pk.knots_u[pk.knots_u_at[f]:pk.knots_u_at[f + 1]], pf, pk.knots_v[pk.knots_v_at[f]:pk.knots_v_at[f + 1]],
+            qf, pk.ctrl[pk.ctrl_at[f]:pk.ctrl_at[f + 1]].reshape((nf, mf, 4)), pk.rational[f],
+            pk.inv_u[pk.inv_u_at[f]:pk.inv_u_at[f + 1]].reshape((nf, pf + 1, pf + 1)),
+            pk.inv_v[pk.inv_v_at[f]:pk.inv_v_at[f + 1]].reshape((mf, qf + 1, qf + 1)),
+            (pk.bucket_u_origin[f], pk.bucket_u_scale[f], pk.bucket_u[pk.bucket_u_at[f]:pk.bucket_u_at[f + 1]]),
+            (pk.bucket_v_origin[f], pk.bucket_v_scale[f], pk.bucket_v[pk.bucket_v_at[f]:pk.bucket_v_at[f + 1]]))
 
 
 @njit(cache=True, error_model="numpy")
-def _triangle_deviations(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u,
-                         inv_u_at, inv_v, inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale,
-                         bucket_v, bucket_v_at, lo, hi, period, periodic, boxes, nodes, uv, triangles, faces, bary,
-                         threshold, out):
+def _triangle_deviations(pk, boxes, nodes, uv, triangles, faces, bary, threshold, out):
     for r in range(faces.shape[0]):
         f, a, b = faces[r, 0], faces[r, 1], faces[r, 2]
         if a == b:
             continue
-        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(
-            p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
-            inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f)
+        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(pk, f)
         # the face's samples, then one projection call over them (a call per sample
         # would cost its arrays' reference counting every time)
         count = (b - a) * bary.shape[0]
@@ -174,8 +168,8 @@ def _triangle_deviations(p, q, n, m, rational, knots_u, knots_u_at, knots_v, kno
                 for c in range(2):
                     guess[at, c] = w0 * uv[i, c] + w1 * uv[j, c] + w2 * uv[k, c]
                 at += 1
-        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, lo[f], hi[f], period[f], periodic[f], boxes[f],
-                          pts, guess, threshold[f], dist)
+        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, pk.lo[f], pk.hi[f], pk.period[f],
+                          pk.periodic[f], boxes[f], pts, guess, threshold[f], dist)
         at = 0
         for t in range(a, b):
             worst = 0.0
@@ -186,33 +180,25 @@ def _triangle_deviations(p, q, n, m, rational, knots_u, knots_u_at, knots_v, kno
 
 
 @njit(cache=True, error_model="numpy")
-def _project_segments(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at,
-                      inv_v, inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v,
-                      bucket_v_at, lo, hi, period, periodic, boxes, points, uv, segments, start, threshold, out):
+def _project_segments(pk, boxes, points, uv, segments, start, threshold, out):
     for s in range(segments.shape[0]):
         f, a, b = segments[s, 0], segments[s, 1], segments[s, 2]
         if a == b:
             continue
-        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(
-            p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
-            inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f)
-        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, lo[f], hi[f], period[f], periodic[f], boxes[f],
-                          points[a:b], uv[a:b], threshold[s], out[a:b], start[s])
+        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(pk, f)
+        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, pk.lo[f], pk.hi[f], pk.period[f],
+                          pk.periodic[f], boxes[f], points[a:b], uv[a:b], threshold[s], out[a:b], start[s])
 
 
 @njit(cache=True, error_model="numpy")
-def _derivatives_segments(p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u,
-                          inv_u_at, inv_v, inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale,
-                          bucket_v, bucket_v_at, lo, hi, period, periodic, u, v, segments, order, binom, out):
+def _derivatives_segments(pk, u, v, segments, order, binom, out):
     for s in range(segments.shape[0]):
         f, a, b = segments[s, 0], segments[s, 1], segments[s, 2]
         if a == b:
             continue
-        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(
-            p, q, n, m, rational, knots_u, knots_u_at, knots_v, knots_v_at, ctrl, ctrl_at, inv_u, inv_u_at, inv_v,
-            inv_v_at, bu_origin, bu_scale, bucket_u, bucket_u_at, bv_origin, bv_scale, bucket_v, bucket_v_at, f)
+        ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(pk, f)
         uu, vv = np.empty(b - a), np.empty(b - a)
         for i in range(b - a):
-            uu[i] = _wrap(u[a + i], lo[f, 0], hi[f, 0], period[f, 0], periodic[f, 0])
-            vv[i] = _wrap(v[a + i], lo[f, 1], hi[f, 1], period[f, 1], periodic[f, 1])
+            uu[i] = _wrap(u[a + i], pk.lo[f, 0], pk.hi[f, 0], pk.period[f, 0], pk.periodic[f, 0])
+            vv[i] = _wrap(v[a + i], pk.lo[f, 1], pk.hi[f, 1], pk.period[f, 1], pk.periodic[f, 1])
         scattered_derivatives(ku, pf, kv, qf, net, uu, vv, order, rat, binom, iu, iv, bu, bv, out[a:b])
