@@ -17,6 +17,8 @@ from surfmod.meshing.facesurface import FaceSurface
 
 def _curve(kind: str):
     pts = np.array([[0, 0, 0], [1, 2, 0.5], [2.5, 1.5, -0.3], [3, -0.5, 0.2], [4.2, 0.4, 1.0], [5, 1, 0]], float)
+    if kind == "bezier":
+        return sm.BezierCurve(pts, weights=[1.0, 0.8, 1.5, 1.1, 0.9, 1.0]).geom()
     knots = [0, 0, 0, 0, 0.3, 0.7, 1, 1, 1, 1]
     weights = None if kind == "plain" else np.array([1.0, 1.7, 0.6, 1.2, 2.0, 1.0])
     geom = sm.BSplineCurve(pts, 3, knots, weights).geom()
@@ -35,7 +37,7 @@ def _occt_d2(surf, u, v) -> np.ndarray:
     return out
 
 
-@pytest.mark.parametrize("kind", ["plain", "rational", "periodic"])
+@pytest.mark.parametrize("kind", ["plain", "rational", "periodic", "bezier"])
 def test_extrusion_of_a_spline_is_an_exact_net(kind):
     surf = Geom_SurfaceOfLinearExtrusion(_curve(kind), gp_Dir(0.3, -0.2, 0.9))
     bounds = (0.1, 0.8, -1.5, 2.0)
