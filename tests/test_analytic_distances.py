@@ -20,7 +20,6 @@ from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Elips, gp_Pnt
 
 from surfmod.meshing import analytic
-from surfmod.occ.mesh import analytic_parameters
 
 AXIS = gp_Ax1(gp_Pnt(0.5, -1.0, 0.2), gp_Dir(0.2, 0.3, 0.9))
 
@@ -77,7 +76,7 @@ def _points(n=200):
 def test_revolved_circles_and_lines_are_their_analytic_surfaces(name):
     curve, kind = _revolutions()[name]
     surf = Geom_SurfaceOfRevolution(curve, AXIS)
-    params = analytic_parameters(surf)
+    params = analytic.parameters(surf)
     if kind is None:
         assert params is None
         return
@@ -93,7 +92,7 @@ def test_elementary_surfaces_and_batched_triangles_equal_occt():
     surfaces = [Geom_Plane(ax3), Geom_SphericalSurface(ax3, 2.0), Geom_CylindricalSurface(ax3, 1.5),
                 Geom_ConicalSurface(ax3, 0.4, 1.0), Geom_ToroidalSurface(ax3, 3.0, 1.0)]
     pts = _points(120)
-    params = [analytic_parameters(s) for s in surfaces]
+    params = [analytic.parameters(s) for s in surfaces]
     kinds = np.array([p[0] for p in params])
     frames = np.array([p[1] for p in params], float)
     sizes = np.array([p[2] for p in params], float)

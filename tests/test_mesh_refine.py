@@ -188,13 +188,13 @@ def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
 
 def test_analytic_faces_measured_at_once_equal_face_by_face(corpus_dir):
     """measure_analytic_faces (every plane, cylinder, cone and torus face of a part in
-    one vectorized pass) gives each face what measure_face gives it alone."""
+    one compiled pass) gives each face what measure_face gives it alone."""
+    from surfmod.meshing import analytic
     from surfmod.meshing.brep import measure_analytic_faces
-    from surfmod.occ.mesh import analytic_parameters
 
     shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
     tol = 1e-3 * shape_figures(shape, samples=2)[1]
-    pairs = [(fm, a) for fm in brepmesh(shape, tol) if (a := analytic_parameters(fm.surface)) is not None]
+    pairs = [(fm, a) for fm in brepmesh(shape, tol) if (a := analytic.parameters(fm.surface)) is not None]
     assert len({a[0] for _, a in pairs}) == 4  # planes, cylinders, cones and tori
     together = measure_analytic_faces([fm for fm, _ in pairs], [a for _, a in pairs])
     for (fm, _), (tri, node) in zip(pairs, together):

@@ -17,8 +17,34 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-#: Kinds of :func:`distances`' surfaces (``occ.mesh.analytic_parameters`` reads them).
+#: Kinds of :func:`distances`' surfaces (:func:`parameters` reads them).
 PLANE, SPHERE, CYLINDER, CONE, TORUS = range(5)
+_KINDS = {"Geom_Plane": PLANE, "Geom_SphericalSurface": SPHERE, "Geom_CylindricalSurface": CYLINDER,
+          "Geom_ConicalSurface": CONE, "Geom_ToroidalSurface": TORUS}
+
+
+def parameters(surf) -> tuple | None:
+    """``(kind, frame (2, 3), sizes (2,))`` of an OCCT plane, sphere, cylinder, cone or
+    torus as :func:`distances` takes them (also of a surface of revolution that is one of
+    those, see :func:`revolved`), ``None`` for any other surface.
+
+    >>> import build123d as bd
+    >>> from surfmod.occ.topo import face_surface
+    >>> kind, frame, sizes = parameters(face_surface(bd.Face.make_rect(2, 3))[0])
+    >>> kind == PLANE, sizes
+    (True, (0.0, 0.0))
+    """
+    from ..occ.geom import surface_type
+    from ..occ.mesh import elementary_parameters, swept_info
+
+    if surface_type(surf) == "Geom_SurfaceOfRevolution":  # of a circle or line in a plane through the axis
+        swept = swept_info(surf)
+        return revolved(*swept["axis"], swept["curve"])
+    params = elementary_parameters(surf)
+    if params is None:
+        return None
+    name, origin, axis, sizes = params
+    return _KINDS[name], (origin, axis), sizes
 
 
 def distances(kinds: np.ndarray, frames: np.ndarray, sizes: np.ndarray, points: np.ndarray,

@@ -79,9 +79,9 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
     Values at most ``tolerance / 2`` may be upper bounds; larger ones are projections.
     """
-    from ..occ.mesh import analytic_parameters
+    from . import analytic
 
-    params = analytic_parameters(fm.surface)
+    params = analytic.parameters(fm.surface)
     if params is not None:  # closed forms
         return measure_analytic_faces([fm], [params], bary)[0]
     ev = FaceSurface(fm.surface, fm.bounds) if ev is None else ev
@@ -101,8 +101,8 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
 def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np.ndarray, float]]:
     """:func:`measure_face` of many plane, sphere, cylinder, cone and torus faces
-    (``params``: their ``occ.mesh.analytic_parameters``) in two compiled calls: per face
-    its triangles' deviations and its nodes' max deviation, the same values."""
+    (``params``: their :func:`surfmod.meshing.analytic.parameters`) in two compiled
+    calls: per face its triangles' deviations and its nodes' max deviation."""
     from . import analytic
 
     kinds = np.array([k for k, _, _ in params])
@@ -269,10 +269,10 @@ def _measure_faces(fms: list, evaluators: dict, tolerance: float, desc: str, pro
     first instance's figures."""
     from tqdm import tqdm
 
-    from ..occ.mesh import analytic_parameters
+    from . import analytic
 
     first = [i for i, fm in enumerate(fms) if fm.repeats < 0]
-    params = {i: a for i in first if (a := analytic_parameters(fms[i].surface)) is not None}
+    params = {i: a for i in first if (a := analytic.parameters(fms[i].surface)) is not None}
     evs = {i: _evaluator(evaluators, fms[i]) for i in first if i not in params}
     splines = [i for i, ev in evs.items() if ev is not None and ev.projector is not None and len(fms[i].nodes)]
     measured = {}

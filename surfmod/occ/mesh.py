@@ -77,7 +77,7 @@ def _face_solids(shp) -> dict:
     return owner
 
 
-#: Surfaces whose distance has a closed form (:func:`analytic_parameters`): their (u, v)
+#: Surfaces whose distance has a closed form (:func:`elementary_parameters`): their (u, v)
 #: nodes are not needed to measure a mesh.
 ANALYTIC = ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface", "Geom_SphericalSurface",
             "Geom_ToroidalSurface")
@@ -411,32 +411,29 @@ def surface_d1(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return out
 
 
-def analytic_parameters(surf) -> tuple | None:
-    """``(kind, frame (2, 3), sizes (2,))`` of a plane, sphere, cylinder, cone or torus
-    as :func:`surfmod.meshing.analytic.distances` takes them (also of a surface of
-    revolution that is one of those, see :func:`surfmod.meshing.analytic.revolved`),
-    ``None`` for any other surface."""
-    from ..meshing import analytic
+def elementary_parameters(surf) -> tuple | None:
+    """``(type name, origin, axis, sizes)`` of a plane, sphere, cylinder, cone or torus:
+    its placement's location and direction and ``(0, 0)``, ``(radius, 0)``, ``(radius,
+    0)``, ``(reference radius, semi-angle)`` or ``(major, minor radius)``; ``None`` for
+    any other surface type (:func:`surfmod.meshing.analytic.parameters` turns these
+    into closed-form distances)."""
     from .geom import surface_type
 
     name = surface_type(surf)
-    if name == "Geom_SurfaceOfRevolution":  # of a circle or line in a plane through the axis
-        swept = swept_info(surf)
-        return analytic.revolved(*swept["axis"], swept["curve"])
     if name not in ANALYTIC:
         return None
     with kernel(f"{name} parameters"):
         ax = surf.Position()
-        frame = (ax.Location().Coord(), ax.Direction().Coord())
+        frame = ax.Location().Coord(), ax.Direction().Coord()
         if name == "Geom_Plane":
-            return analytic.PLANE, frame, (0.0, 0.0)
-        if name == "Geom_SphericalSurface":
-            return analytic.SPHERE, frame, (surf.Radius(), 0.0)
-        if name == "Geom_CylindricalSurface":
-            return analytic.CYLINDER, frame, (surf.Radius(), 0.0)
-        if name == "Geom_ConicalSurface":
-            return analytic.CONE, frame, (surf.RefRadius(), surf.SemiAngle())
-        return analytic.TORUS, frame, (surf.MajorRadius(), surf.MinorRadius())
+            sizes = (0.0, 0.0)
+        elif name in ("Geom_SphericalSurface", "Geom_CylindricalSurface"):
+            sizes = (surf.Radius(), 0.0)
+        elif name == "Geom_ConicalSurface":
+            sizes = (surf.RefRadius(), surf.SemiAngle())
+        else:
+            sizes = (surf.MajorRadius(), surf.MinorRadius())
+    return name, *frame, sizes
 
 
 def iso_curve(surf, direction: int, value: float):
