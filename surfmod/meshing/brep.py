@@ -2,14 +2,20 @@
 against the exact faces, tightened where meshing is the cause and reported where the
 model itself is the cause.
 
-Measurement (per face, every triangle, 25 sample points each):
+Measurement (per face, every triangle, 25 sample points each; all faces of a kind at
+once):
 
-* planes, cylinders, cones, spheres and tori: the exact distance in closed form;
-* B-spline and Bezier faces: the *UV-parametric error* ``|q - S(uv)|`` of each sample
-  ``q`` of a triangle and its UV-interpolated parameter (an upper bound of the distance,
-  ``S(uv)`` being a point of the face), then Gauss-Newton projection of the samples whose
-  bound exceeds the tolerance; periodic directions wrap, as OCCT evaluates them;
-* any other surface (extrusion, revolution, offset): the same, with OCCT's ``D1``.
+* planes, cylinders, cones, spheres and tori, and surfaces of revolution that are one of
+  those (a circle or line in a plane through the axis): the exact distance in closed
+  form (:mod:`surfmod.meshing.analytic`);
+* B-spline faces, and extrusions of spline curves (exact B-spline nets over their
+  box): the *UV-parametric error* ``|q - S(uv)|`` of each sample ``q`` of a triangle and
+  its UV-interpolated parameter (an upper bound of the distance, ``S(uv)`` being a point
+  of the face), then Gauss-Newton projection of the samples whose bound exceeds half the
+  tolerance, compiled (:mod:`surfmod.eval.packed`); periodic directions wrap, as OCCT
+  evaluates them;
+* any other surface (Bezier, other surfaces of revolution and extrusions, offset): the
+  same in NumPy, with :class:`FaceSurface` (closed-form swept surfaces) or OCCT's ``D1``.
 
 A real part is not exact: BRepMesh puts the nodes of a face's boundary on the *edges'*
 3-D curves, which the model only keeps within the edges' declared tolerance of the
