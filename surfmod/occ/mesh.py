@@ -9,6 +9,8 @@ the kernel boundary and the measurement side, not a NumPy evaluation path.
 from __future__ import annotations
 
 import io
+import math
+import statistics
 from dataclasses import dataclass
 from itertools import chain, count
 
@@ -527,18 +529,21 @@ def _face_figure(face, samples: int, floor: float, sample_face, uv_bounds: dict 
     if name in ("Geom_ConicalSurface", "Geom_ToroidalSurface"):
         # the same for surfaces of revolution whose figures vary along v only: the
         # circle's radius rho(v) gives |Su x Sv| and the parallel's curvature
-        v = np.linspace(v0, v1, samples)
+        # (five samples: plain floats cost less than NumPy's per-call overhead)
+        vs = [v0 + (v1 - v0) * k / (samples - 1) for k in range(samples)]
         if name == "Geom_ConicalSurface":
-            a = surf.SemiAngle()
-            rho = surf.RefRadius() + v * np.sin(a)
-            jac, k_meridian, k_parallel = np.abs(rho), 0.0, np.cos(a) / np.where(rho != 0, rho, np.inf)
+            a, r0 = surf.SemiAngle(), surf.RefRadius()
+            sa, ca = math.sin(a), math.cos(a)
+            rows = [(r0 + v * sa, 1.0, ca) for v in vs]  # (rho, |Su x Sv| / |rho|, cos of the normal's tilt)
+            k_meridian = 0.0
         else:
-            r = surf.MinorRadius()
-            rho = surf.MajorRadius() + r * np.cos(v)
-            jac, k_meridian, k_parallel = r * np.abs(rho), 1.0 / r, np.cos(v) / np.where(rho != 0, rho, np.inf)
-        defined = rho != 0  # GeomLProp: no curvature at the apex / on the axis
-        vals = np.sqrt(max(k_meridian, floor) * np.maximum(np.abs(k_parallel), floor))[defined]
-        return float(np.mean(jac)) * (u1 - u0) * (v1 - v0), float(np.median(vals)) if vals.size else floor
+            big, r = surf.MajorRadius(), surf.MinorRadius()
+            rows = [(big + r * math.cos(v), r, math.cos(v)) for v in vs]
+            k_meridian = 1.0 / r
+        # GeomLProp: no curvature at the apex / on the axis (rho = 0)
+        vals = [math.sqrt(max(k_meridian, floor) * max(abs(c / rho), floor)) for rho, _, c in rows if rho != 0]
+        area = sum(f * abs(rho) for rho, f, _ in rows) / samples * (u1 - u0) * (v1 - v0)
+        return area, statistics.median(vals) if vals else floor
     lp = GeomLProp_SLProps(surf, 2, 1e-9)
     vals, jac = [], []
     # elementary surfaces are curved alike along u: three columns tell them
