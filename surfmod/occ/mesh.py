@@ -25,21 +25,32 @@ class FaceMesh:
     """One face's BRepMesh triangulation: 3-D ``nodes`` (global coordinates), ``uv``
     nodes on the face's surface, ``triangles`` oriented outwards (face orientation
     applied), the face's ``surface`` (global coordinates, trimmed-surface wrappers
-    removed), its ``face``, ``bounds`` (UV box), ``index`` in exploration order and
-    ``solid`` (index of the solid it belongs to, -1 for faces outside any solid) and
-    ``repeats``: the position in the same list of an earlier face this one repeats at an
-    isometric location (same triangulation, same surface moved rigidly: the same
-    deviations), or -1."""
+    removed), its ``face``, ``bounds`` (UV box: given, or read on first use; closed-form
+    measurement never needs it), ``index`` in exploration order and ``solid`` (index of
+    the solid it belongs to, -1 for faces outside any solid) and ``repeats``: the
+    position in the same list of an earlier face this one repeats at an isometric
+    location (same triangulation, same surface moved rigidly: the same deviations), or
+    -1."""
 
     nodes: np.ndarray
     uv: np.ndarray
     triangles: np.ndarray
     surface: object
     face: object
-    bounds: tuple
+    uv_box: tuple | None
     index: int = 0
     solid: int = -1
     repeats: int = -1
+
+    @property
+    def bounds(self) -> tuple:
+        """The face's UV box ``(u0, u1, v0, v1)`` (``BRepTools.UVBounds``)."""
+        if self.uv_box is None:
+            from OCP.BRepTools import BRepTools
+
+            with kernel("BRepTools.UVBounds"):
+                self.uv_box = tuple(float(b) for b in BRepTools.UVBounds_s(self.face))
+        return self.uv_box
 
 
 def clean(shape) -> None:
@@ -276,7 +287,6 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
     skipped; their indices are appended to ``missing`` when a list is given.
     ``uv_bounds``: faces' UV boxes already known (by face hash, from :func:`shape_figures`)."""
     from OCP.BRep import BRep_Tool
-    from OCP.BRepTools import BRepTools
 
     from .geom import surface_type
     from .topo import wrapped
@@ -301,7 +311,7 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
                 continue
             tri = got.triangles[:, ::-1] if got.reversed else got.triangles
             known = uv_bounds.get(face.__hash__()) if uv_bounds is not None else None
-            bounds = tuple(float(b) for b in (known if known is not None else BRepTools.UVBounds_s(face)))
+            bounds = None if known is None else tuple(float(b) for b in known)  # else read when needed
             shared = got.rigid and got.instance >= 0
             repeats = first.get(got.instance, -1) if shared else -1
             if shared and got.instance not in first:
