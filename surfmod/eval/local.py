@@ -318,6 +318,32 @@ def _row_blocks(su, p, n, per_row, threads=1):
     return starts.astype(np.int64), rows.astype(np.int64), np.array(row_starts, dtype=np.int64), first
 
 
+_NO_RUNS = (np.empty((0, 0, 0)), np.empty((0, 4, 0)), np.zeros(1, dtype=np.int64), np.empty(0, dtype=np.int64))
+
+
+def _vector_runs(net: LocalNet, sv, bv, rows: int):
+    """The arguments of the grid's vector row stage (:mod:`surfmod.eval.row_stage`) for
+    v-points with spans ``sv`` and basis ``bv`` when ``rows`` net rows are contracted:
+    ``(bplan, planes, run_starts, run_kinds)``, or no runs (one point at a time).
+
+    Vector loops need runs of v-points in consecutive spans (a net with about as many
+    spans as points) and the net as coordinate planes, built once per surface, and only
+    when the stage reads a quarter of the net or more (a few rows of a big net are not
+    worth a copy of all of it)."""
+    from . import row_stage
+
+    n = net.ctrl.shape[0]
+    if rows < max(64, n // 4):
+        return _NO_RUNS
+    starts, kinds = row_stage.runs(sv)
+    if not np.any(kinds == row_stage.NEXT_SPAN):
+        return _NO_RUNS
+    planes = net.cache.get("planes")
+    if planes is None:
+        planes = net.cache["planes"] = row_stage.net_planes(net.ctrl)
+    return np.ascontiguousarray(bv.transpose(1, 2, 0)), planes, starts, kinds
+
+
 def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     """Cartesian mixed partials on the grid ``us x vs``: ``(len(us), len(vs), K, K, 3)``.
 
@@ -347,7 +373,8 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
             blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
             per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
-            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks)
+            vruns = _vector_runs(net, svb, bvb, blocks[1].size)
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns)
     if order == 0:
         return out[:, :, None, None, :]
     return out
