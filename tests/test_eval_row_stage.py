@@ -6,6 +6,8 @@ run) agree with the scattered kernel, the textbook and OCCT."""
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numba
 import numpy as np
 import pytest
@@ -144,3 +146,20 @@ def test_parallel_vector_paths_equal_serial_bit_for_bit(rational, monkeypatch):
         threaded = s.grid(us, vs), s.grid_derivatives(us[::5], vs, 2)
     np.testing.assert_array_equal(threaded[0], serial[0])
     np.testing.assert_array_equal(threaded[1], serial[1])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_sorted_block_rows_are_each_blocks_needed_rows(seed):
+    """The rows of each block of sorted u-points, found without a pass per block, are the
+    sorted union of its points' p+1 rows, and ``first`` places each point's lowest."""
+    rng = np.random.default_rng(seed)
+    p = int(rng.integers(1, 6))
+    n = int(rng.integers(p + 2, 900))
+    su = np.sort(rng.integers(p, n, int(rng.integers(2, 2000))))
+    for per_row in (1, 400, 4000):
+        starts, rows, row_starts, first = local._row_blocks(su, p, n, per_row)
+        for k, (a0, a1) in enumerate(pairwise(starts)):
+            block = rows[row_starts[k] : row_starts[k + 1]]
+            expected = np.unique((su[a0:a1, None] - p + np.arange(p + 1)).ravel())
+            np.testing.assert_array_equal(block, expected)
+            np.testing.assert_array_equal(block[first[a0:a1]], su[a0:a1] - p)

@@ -295,7 +295,8 @@ def _row_blocks(su, p, n, per_row, threads=1):
     if threads > 1:
         most = max(GRID_MIN_BLOCK, -(-su.size // (BLOCKS_PER_THREAD * threads)))
         step = min(step, most)
-    if n > max_rows and su.size > 1 and np.all(su[1:] >= su[:-1]):
+    ordered = su.size > 1 and bool(np.all(su[1:] >= su[:-1]))
+    if n > max_rows and ordered:
         # sorted u (the usual grid): a block takes u-points while its rows fit, not
         # max_rows / (p+1) of them (which assumes p+1 new rows per u-point)
         cuts = [0]
@@ -307,6 +308,8 @@ def _row_blocks(su, p, n, per_row, threads=1):
     else:
         starts = np.arange(0, su.size + step, step).clip(max=su.size)
         starts = starts[np.r_[True, np.diff(starts) > 0]]
+    if ordered:
+        return (starts.astype(np.int64),) + _sorted_block_rows(su, p, n, starts)
     rows, row_starts, first = [], [0], np.empty(su.size, dtype=np.int64)
     for a0, a1 in pairwise(starts):  # loop over memory blocks, not points
         s = su[a0:a1]
@@ -316,6 +319,22 @@ def _row_blocks(su, p, n, per_row, threads=1):
         row_starts.append(row_starts[-1] + block.size)
     rows = np.concatenate(rows) if rows else np.empty(0, dtype=np.int64)
     return starts.astype(np.int64), rows.astype(np.int64), np.array(row_starts, dtype=np.int64), first
+
+
+def _sorted_block_rows(su, p, n, starts):
+    """``(rows, row_starts, first)`` of :func:`_row_blocks` for sorted spans ``su``,
+    without a pass per block: the rows a block needs are all the needed rows from its
+    first point's lowest to its last point's highest (a needed row in between belongs to
+    a point in between), so each block's rows are a slice of the sorted needed rows."""
+    needed = np.zeros(n, dtype=bool)
+    needed[(su[:, None] - p + np.arange(p + 1)).ravel()] = True
+    every = np.flatnonzero(needed)
+    lo = np.searchsorted(every, su[starts[:-1]] - p)
+    hi = np.searchsorted(every, su[starts[1:] - 1], side="right")
+    row_starts = np.r_[0, np.cumsum(hi - lo)]
+    rows = every[np.arange(row_starts[-1]) - np.repeat(row_starts[:-1] - lo, hi - lo)]
+    first = np.searchsorted(every, su - p) - np.repeat(lo, np.diff(starts))
+    return rows.astype(np.int64), row_starts.astype(np.int64), first.astype(np.int64)
 
 
 _NO_RUNS = (np.empty((0, 0, 0)), np.empty((0, 4, 0)), np.zeros(1, dtype=np.int64), np.empty(0, dtype=np.int64))
