@@ -14,7 +14,7 @@ import pytest
 import reference as ref
 
 import surfmod as sm
-from surfmod.eval import grid_kernels, local, row_stage, threads
+from surfmod.eval import grid_kernels, local, row_stage, sliding, threads
 from surfmod.occ.sample import surface_d2
 
 
@@ -163,3 +163,24 @@ def test_sorted_block_rows_are_each_blocks_needed_rows(seed):
             expected = np.unique((su[a0:a1, None] - p + np.arange(p + 1)).ravel())
             np.testing.assert_array_equal(block, expected)
             np.testing.assert_array_equal(block[first[a0:a1]], su[a0:a1] - p)
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_interleaved_stages_over_several_v_chunks(rational, monkeypatch):
+    """More v-points than a chunk of the ring (surfmod/eval/sliding.py), u-points skipping
+    spans, pairs and single points: the same bits as the two-stage path, and the points
+    of the scattered kernel."""
+    s = _uniform_surface(90, 700, 3, 3, rational, seed=11)
+    us = np.sort(np.r_[np.linspace(0, 1, 60), np.linspace(0.2, 0.3, 25), 0.5, 0.5])
+    spans = 700 - 3
+    vs = np.sort(np.r_[(np.arange(spans) + 0.5) / spans, 0.25, 0.25, 1.0])  # one a span, and a few more
+    assert vs.size > 2 * sliding.CHUNK
+    _, kinds = row_stage.runs(local._basis(s.knots[1], 3, 700, vs, 0)[0])
+    assert np.count_nonzero(kinds == row_stage.NEXT_SPAN) >= 2 and np.any(kinds == row_stage.SCALAR)
+    grid = s.grid(us, vs)
+    assert "planes" in s._local_net().cache
+    monkeypatch.setattr(local, "_vector_runs", lambda *args: local._NO_RUNS)
+    np.testing.assert_array_equal(grid, s.grid(us, vs))
+    uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
+    np.testing.assert_allclose(grid.reshape(-1, 3), s.points(uu, vv), rtol=0,
+                               atol=1e-13 * np.abs(s.control_points).max())

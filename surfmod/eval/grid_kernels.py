@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, uint64
 
+from . import sliding
 from .kernels import U1, U2, U3, quotient_planes
 from .position_stage import positions_low_degree
 from .row_stage import contract_rows, row_points
@@ -56,7 +57,13 @@ def _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vru
 @njit(cache=True, error_model="numpy")
 def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts, first,
                          blk, vruns):
-    """One block of :func:`grid` for positions."""
+    """One block of :func:`grid` for positions (on a big net with the stages interleaved,
+    :mod:`surfmod.eval.sliding`, when it suits)."""
+    a0, a1 = starts[blk], starts[blk + 1]
+    if sliding.suits(p, first, a0, a1, space, dim, sv.size, vruns[3]):
+        sliding.block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space,
+                                rows[row_starts[blk] : row_starts[blk + 1]], a0, a1, first, vruns)
+        return
     table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns)
     grid_positions(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1])
 
@@ -115,7 +122,7 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
                     dst_a[t + uint64(3 * nv)] = w
                     dst_b[t + uint64(3 * nv)] = w2
     for r in range(2 * pairs, rows.size):
-        row_points(bv, sv, q, ctrl[rows[r]].reshape(-1), dim, out[r].reshape(-1), 0, nv)
+        row_points(bv, sv, q, ctrl[rows[r]].reshape(-1), dim, out[r].reshape(-1), 0, nv, 0, nv)
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -85,34 +85,48 @@ def contract_rows(bv, bplan, sv, q, ctrl, planes, rows, dim, out, starts, kinds)
     in vector loops over ``bplan`` (the v-basis ``(K, q+1, n_v)``, v-points on the last
     axis) and ``planes`` (the net as coordinate planes, :func:`net_planes`), the others
     one at a time (:func:`row_points`).  Every entry is the sum of the scalar loop (first
-    term first, then one term at a time), so the values do not depend on the runs.  The
-    vector loops index three flat arrays by offsets: an array view per run would cost its
-    reference counting, and a loop storing to one array needs few runtime alias checks
-    before LLVM vectorizes it."""
-    kk, nv, m = bplan.shape[0], sv.size, planes.shape[2]
-    basis = bplan.reshape(-1)
-    per_l = (q + 1) * nv
+    term first, then one term at a time), so the values do not depend on the runs."""
+    nv = sv.size
     for r in range(rows.size):
-        src = planes[rows[r]].reshape(-1)
-        dst = out[r].reshape(-1)
-        for k in range(kinds.size):
-            b0, b1 = starts[k], starts[k + 1]
-            if kinds[k] == SCALAR:
-                row_points(bv, sv, q, ctrl[rows[r]].reshape(-1), dim, dst, b0, b1)
-                continue
-            for l in range(kk):
-                for d in range(dim):
-                    _next_span(basis, l * per_l, nv, src, d * m + sv[b0] - q - b0, q, dst, (l * dim + d) * nv, b0, b1)
+        contract_row(bv, bplan, sv, q, ctrl[rows[r]], planes[rows[r]], dim, out[r].reshape(-1), 0, nv, starts, kinds,
+                     0, nv)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def row_points(bv, sv, q, net_row, dim, dst, b0, b1):
+def contract_row(bv, bplan, sv, q, net_row, row_planes, dim, dst, o_dst, stride, starts, kinds, v0, v1):
+    """One net row (``net_row`` ``(m, 4)``, ``row_planes`` ``(4, m)``) contracted for the
+    v-points ``v0:v1``: ``dst[o_dst + (l dim + d) stride + b]`` for ``b`` in ``v0:v1``.
+    The vector loops index three flat arrays by offsets: an array view per run would cost
+    its reference counting, and a loop storing to one array needs few runtime alias
+    checks before LLVM vectorizes it."""
+    kk, nv, m = bplan.shape[0], sv.size, row_planes.shape[1]
+    basis = bplan.reshape(-1)
+    per_l = (q + 1) * nv
+    src = row_planes.reshape(-1)
+    for k in range(kinds.size):
+        b0, b1 = starts[k], starts[k + 1]
+        lo, hi = max(b0, v0), min(b1, v1)
+        if lo >= hi:
+            continue
+        if kinds[k] == SCALAR:
+            row_points(bv, sv, q, net_row.reshape(-1), dim, dst, o_dst, stride, lo, hi)
+            continue
+        for l in range(kk):
+            for d in range(dim):
+                _next_span(basis, l * per_l, nv, src, d * m + sv[b0] - q - b0, q, dst, o_dst + (l * dim + d) * stride,
+                           lo, hi)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def row_points(bv, sv, q, net_row, dim, dst, o_dst, stride, b0, b1):
     """v-points ``b0:b1`` of one net row (``net_row``: ``(m, 4)`` flat) one at a time, the
-    four coordinates of a pole together: ``dst[(l dim + d) n_v + b] = sum_j bv[b, l, j]
-    net_row[4 (sv[b] - q + j) + d]`` (unsigned offsets: no wraparound checks)."""
-    kk, nv = bv.shape[1], sv.size
+    four coordinates of a pole together: ``dst[o_dst + (l dim + d) stride + b] = sum_j
+    bv[b, l, j] net_row[4 (sv[b] - q + j) + d]`` (unsigned offsets: no wraparound
+    checks)."""
+    kk = bv.shape[1]
     basis = bv.reshape(-1)
     per_point = uint64(kk * (q + 1))
+    step = uint64(stride)
     for b in range(b0, b1):
         ub = uint64(b)
         s = uint64(4 * (sv[b] - q))
@@ -127,12 +141,12 @@ def row_points(bv, sv, q, net_row, dim, dst, b0, b1):
                 y += c * net_row[t + U1]
                 z += c * net_row[t + U2]
                 w += c * net_row[t + U3]
-            t = uint64(l * dim * nv) + ub
+            t = uint64(o_dst + l * dim * stride + b)
             dst[t] = x
-            dst[t + uint64(nv)] = y
-            dst[t + uint64(2 * nv)] = z
+            dst[t + step] = y
+            dst[t + U2 * step] = z
             if dim == 4:
-                dst[t + uint64(3 * nv)] = w
+                dst[t + U3 * step] = w
 
 
 @njit(cache=True, inline="always", error_model="numpy")
