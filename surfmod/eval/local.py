@@ -387,12 +387,20 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
         if out is None:
             out = np.empty((us.size, vs.size, kk, kk, 3))
     run, count = _kernels_for(us.size * vs.size, grid=True)
+    ordered = bool(np.all(su[1:] >= su[:-1]))
     with _on(count):
         for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
             blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
             per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
             vruns = _vector_runs(net, svb, bvb, blocks[1].size)
+            if order == 0 and p <= 3 and vruns[3].size and ordered:
+                # the stages interleave in a ring (eval/sliding.py): no row table, so the
+                # blocks need not be cut to its size (only shared among the threads)
+                from .sliding import CHUNK, RING
+
+                blocks = _row_blocks(su, p, n, 1, count)
+                per_slot = RING * dim * min(svb.size, CHUNK)
             run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns)
     if order == 0:
         return out[:, :, None, None, :]
