@@ -118,6 +118,43 @@ def contract_row(bv, bplan, sv, q, net_row, row_planes, dim, dst, o_dst, stride,
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def contract_row_pair(bv, bplan, sv, q, ctrl, planes, ra, rb, dim, dst, o_a, o_b, stride, starts, kinds, v0, v1):
+    """:func:`contract_row` for net rows ``ra`` and ``rb`` at once (into ``dst`` from
+    ``o_a`` and ``o_b``): the cubic vector loop loads each basis value once for both
+    rows; every sum is the one-row sum, term for term."""
+    if q != 3:
+        contract_row(bv, bplan, sv, q, ctrl[ra], planes[ra], dim, dst, o_a, stride, starts, kinds, v0, v1)
+        contract_row(bv, bplan, sv, q, ctrl[rb], planes[rb], dim, dst, o_b, stride, starts, kinds, v0, v1)
+        return
+    kk, nv, m = bplan.shape[0], sv.size, planes.shape[2]
+    basis = bplan.reshape(-1)
+    per_l = 4 * nv
+    src = planes.reshape(-1)  # both rows through one array: few runtime alias checks
+    for k in range(kinds.size):
+        b0, b1 = starts[k], starts[k + 1]
+        lo, hi = max(b0, v0), min(b1, v1)
+        if lo >= hi:
+            continue
+        if kinds[k] == SCALAR:
+            row_points(bv, sv, q, ctrl[ra].reshape(-1), dim, dst, o_a, stride, lo, hi)
+            row_points(bv, sv, q, ctrl[rb].reshape(-1), dim, dst, o_b, stride, lo, hi)
+            continue
+        shift = sv[b0] - q - b0
+        for l in range(kk):
+            for d in range(dim):
+                sa, sb = ra * 4 * m + d * m + shift, rb * 4 * m + d * m + shift
+                da, db = o_a + (l * dim + d) * stride, o_b + (l * dim + d) * stride
+                o_basis = l * per_l
+                for b in range(lo, hi):
+                    c = uint64(o_basis + b)
+                    c0, c1, c2, c3 = basis[c], basis[c + uint64(nv)], basis[c + uint64(2 * nv)], basis[c + uint64(3 * nv)]
+                    t = uint64(sa + b)
+                    dst[uint64(da + b)] = c0 * src[t] + c1 * src[t + U1] + c2 * src[t + U2] + c3 * src[t + U3]
+                    t = uint64(sb + b)
+                    dst[uint64(db + b)] = c0 * src[t] + c1 * src[t + U1] + c2 * src[t + U2] + c3 * src[t + U3]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def row_points(bv, sv, q, net_row, dim, dst, o_dst, stride, b0, b1):
     """v-points ``b0:b1`` of one net row (``net_row``: ``(m, 4)`` flat) one at a time, the
     four coordinates of a pole together: ``dst[o_dst + (l dim + d) stride + b] = sum_j

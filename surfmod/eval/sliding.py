@@ -23,7 +23,7 @@ from __future__ import annotations
 from numba import njit
 
 from .position_stage import pass_extent, positions_pass
-from .row_stage import contract_row
+from .row_stage import contract_row, contract_row_pair
 
 #: rows in the ring: a pass reads at most five (a cubic pair on rows shifted by one)
 RING = 8
@@ -61,7 +61,12 @@ def block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, mine,
         a = a0
         while a < a1:
             _, top = pass_extent(first, p, a, a1)
-            while ready <= top:
+            while ready < top:  # two rows a pass: their basis values loaded once
+                contract_row_pair(bv, bplan, sv, q, ctrl, planes, mine[ready], mine[ready + 1], dim, flat,
+                                  (ready % RING) * dim * chunk - c0, ((ready + 1) % RING) * dim * chunk - c0, chunk,
+                                  run_starts, run_kinds, c0, c1)
+                ready += 2
+            if ready == top:
                 r = mine[ready]
                 contract_row(bv, bplan, sv, q, ctrl[r], planes[r], dim, flat, (ready % RING) * dim * chunk - c0, chunk,
                              run_starts, run_kinds, c0, c1)
