@@ -5,8 +5,9 @@ their rows from the ring.
 
 With about one u-point a span every u-point brings a new net row, so the row table of
 :mod:`surfmod.eval.grid_kernels` (several MiB per block) is written to L2 and read back
-row by row, four times over.  The ring (8 rows x 4 coordinates x 256 v-points, 64 KiB)
-stays in L1 instead, and rows at a block boundary are not contracted twice.  The sums are
+row by row, four times over.  In the ring (8 rows x 4 coordinates x 256 v-points, 64
+KiB) the rows a pass reads (five at most, 40 KiB) stay in the 48 KiB L1 cache instead,
+and rows at a block boundary are not contracted twice.  The sums are
 those of the two-stage path term for term (the same row stage,
 :func:`surfmod.eval.row_stage.contract_row`, and the same passes,
 :func:`surfmod.eval.position_stage.positions_pass`), so the values are identical.
