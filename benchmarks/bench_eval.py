@@ -6,11 +6,13 @@ thread (``OMP/OPENBLAS/MKL/NUMBA_NUM_THREADS=1``; OCCT's per-point loop is singl
 anyway) and *all cores* with the machine's defaults, where work of 2^16 points or more
 runs in the parallel kernel variants (:mod:`surfmod.eval.parallel`) on every core.  Single-core times are CPU times of
 the process (``time.process_time``), best of several runs, so that other load on a shared
-machine inflates neither side; all-core times are wall times.  OCCT per-point rates
+machine inflates neither side (best of 15 for both sides, since the machine is shared);
+all-core times are wall times.  OCCT per-point rates
 (``Value`` = positions, ``D2`` = all partials to order 2, into preallocated ``gp_Pnt`` /
 ``gp_Vec``, no conversion) are measured on 100² points through OCP and scaled to the point
 count.  The memory-write floor is the time to allocate and fill the output array
-("fresh"), or to fill an array that already exists ("reused"); the "into" rows write
+("fresh"), or to fill an array that already exists ("reused"), and, for comparison, a
+compiled loop that only writes every double of the reused array; the "into" rows write
 into a preallocated array with ``BSplineSurface.grid_into`` (as OCCT's side writes into
 preallocated points), the others allocate their result.
 
@@ -41,7 +43,7 @@ def _clock(single: bool):
     return time.process_time if single else time.perf_counter
 
 
-def _time(fn, single: bool, repeat: int = 7) -> float:
+def _time(fn, single: bool, repeat: int = 15) -> float:
     clock = _clock(single)
     best = np.inf
     for _ in range(repeat):
@@ -117,6 +119,20 @@ def write_floor(shape, single: bool) -> float:
     return _time(lambda: np.empty(shape).fill(0.0), single, 5)
 
 
+def _write_every(out):
+    flat = out.reshape(-1)
+    for i in range(flat.size):
+        flat[i] = i
+
+
+def numba_write_floor():
+    """A compiled loop that only writes every double of an array (the value of its
+    index): the memory-write floor as a kernel sees it, to set beside NumPy's ``fill``."""
+    from numba import njit
+
+    return njit(_write_every)
+
+
 def measure(single: bool) -> dict:
     """Every timing of the tables, in seconds, for this process's thread setting."""
     out = {"net": {}, "rows": {}}
@@ -149,6 +165,10 @@ def measure(single: bool) -> dict:
     rows["grid_d2_into"] = _time(lambda: s20.grid_into(grid, grid, buf2, order=2), single)
     rows["grid_d2_poly_into"] = _time(lambda: b20.grid_into(grid, grid, buf2, order=2), single)
     rows["floor_d2_reused"] = _time(lambda: buf2.fill(0.0), single, 5)
+    write = numba_write_floor()
+    write(buf2[:1])
+    rows["floor_d2_numba"] = _time(lambda: write(buf2), single, 5)
+    rows["floor_d0_numba"] = _time(lambda: write(buf), single, 5)
     del buf2
     rng = np.random.default_rng(3)
     u, v = rng.uniform(0, 1, SCATTERED), rng.uniform(0, 1, SCATTERED)
@@ -275,6 +295,8 @@ def report(one: dict, every: dict) -> None:
     print("partials to 2: OCCT D2 gives 6 vectors a point, surfmod the full 3x3 square (27 doubles);")
     print("floor = allocate and fill the output array (for the \"into\" rows: fill the reused array);")
     print("x floor = surfmod / floor (1 = at the floor).")
+    print(f"a compiled loop that only writes the reused array: {_f(r['floor_d0_numba'])} (positions), "
+          f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2 at most)")
     print("\ngeomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
     for n in (4, 20):
         print(f"  {n}x{n}: geomdl {_f(r[f'geomdl{n}'], '.1f')}  surfmod {_f(r[f'poly{n}'])}  "

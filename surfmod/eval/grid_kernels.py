@@ -11,29 +11,34 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, uint64
 
+from . import sliding
 from .kernels import U1, U2, U3, quotient_planes
+from .position_stage import positions_low_degree
+from .row_stage import contract_rows, row_points
 
 
 @njit(cache=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first):
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns):
     """The grid ``us x vs[b0:b0+n_v]`` into ``out`` (point-major: ``(n_u, N_v, 3)`` for
     positions, ``(n_u, N_v, K, K, 3)`` for partials, ``K = bu.shape[1]``), block by block
     of u-points (:func:`grid_block_positions`, :func:`grid_block_derivatives`); block
     ``k`` is u-points ``starts[k]:starts[k+1]``, its net rows
     ``rows[row_starts[k]:row_starts[k+1]]``, ``first[a]`` the place of u-point ``a``'s
     first row among them; ``scratch[0]`` holds a block's row table (reused: a fresh
-    table per block would be paged in again and again)."""
+    table per block would be paged in again and again).  ``vruns`` is ``(bplan, planes,
+    run_starts, run_kinds)`` for the vector loops of :func:`surfmod.eval.row_stage.contract_rows`,
+    or empty arrays (no run kinds) for the one-point-at-a-time stage :func:`grid_rows`."""
     for blk in range(starts.size - 1):
         if out.ndim == 3:
             grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,
-                                 first, blk)
+                                 first, blk, vruns)
         else:
             grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[0], starts, rows,
-                                   row_starts, first, blk)
+                                   row_starts, first, blk, vruns)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk):
+def _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns):
     """A block's net rows contracted with the v-basis (:func:`grid_rows`) into a table in
     ``space`` (its thread's scratch), and its u-range.  Blocks share nothing but the
     read-only inputs, so the parallel variant (:mod:`surfmod.eval.parallel`) runs them
@@ -41,23 +46,33 @@ def _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk):
     mine = rows[row_starts[blk] : row_starts[blk + 1]]
     kk, nv = bv.shape[1], sv.size
     table = space[: mine.size * kk * dim * nv].reshape((mine.size, kk, dim, nv))
-    grid_rows(bv, sv, q, ctrl, mine, dim, table)
+    bplan, planes, run_starts, run_kinds = vruns
+    if run_kinds.size:
+        contract_rows(bv, bplan, sv, q, ctrl, planes, mine, dim, table, run_starts, run_kinds)
+    else:
+        grid_rows(bv, sv, q, ctrl, mine, dim, table)
     return table, starts[blk], starts[blk + 1]
 
 
 @njit(cache=True, error_model="numpy")
 def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts, first,
-                         blk):
-    """One block of :func:`grid` for positions."""
-    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk)
+                         blk, vruns):
+    """One block of :func:`grid` for positions (on a big net with the stages interleaved,
+    :mod:`surfmod.eval.sliding`, when it suits)."""
+    a0, a1 = starts[blk], starts[blk + 1]
+    if sliding.suits(p, first, a0, a1, space, dim, sv.size, vruns[3]):
+        sliding.block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space,
+                                rows[row_starts[blk] : row_starts[blk + 1]], a0, a1, first, vruns)
+        return
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns)
     grid_positions(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1])
 
 
 @njit(cache=True, error_model="numpy")
 def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows, row_starts,
-                           first, blk):
+                           first, blk, vruns):
     """One block of :func:`grid` for partials."""
-    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk)
+    table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns)
     grid_derivatives(bu[a0:a1], first[a0:a1], p, table, rational, binom, b0, out[a0:a1])
 
 
@@ -66,7 +81,8 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
     """First stage of the grid: ``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]``
     for ``d < dim``: the net rows ``rows`` (only those the u-points need) contracted
     with the v-basis, two rows per pass (a v-point's basis values and window are loaded
-    once for both; each row's sums are those of the one-row pass, so the same values)."""
+    once for both; each row's sums are those of the one-row pass,
+    :func:`surfmod.eval.row_stage.row_points`, so the same values)."""
     kk = bv.shape[1]
     nv = sv.size
     basis = bv.reshape(-1)
@@ -80,10 +96,11 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
             ub = uint64(b)
             s = uint64(4 * (sv[b] - q))
             for l in range(kk):
-                x = y = z = w = 0.0
-                x2 = y2 = z2 = w2 = 0.0
                 o = ub * per_point + uint64(l * (q + 1))
-                for j in range(q + 1):
+                c = basis[o]  # first term first: the sums of row_stage.row_points
+                x, y, z, w = c * row_a[s], c * row_a[s + U1], c * row_a[s + U2], c * row_a[s + U3]
+                x2, y2, z2, w2 = c * row_b[s], c * row_b[s + U1], c * row_b[s + U2], c * row_b[s + U3]
+                for j in range(1, q + 1):
                     c = basis[o + uint64(j)]
                     t = s + uint64(4 * j)
                     x += c * row_a[t]
@@ -105,27 +122,7 @@ def grid_rows(bv, sv, q, ctrl, rows, dim, out):
                     dst_a[t + uint64(3 * nv)] = w
                     dst_b[t + uint64(3 * nv)] = w2
     for r in range(2 * pairs, rows.size):
-        net_row = ctrl[rows[r]].reshape(-1)  # flat, unsigned offsets (see U1)
-        dst = out[r].reshape(-1)
-        for b in range(nv):
-            ub = uint64(b)
-            s = uint64(4 * (sv[b] - q))
-            for l in range(kk):
-                x = y = z = w = 0.0
-                o = ub * per_point + uint64(l * (q + 1))
-                for j in range(q + 1):
-                    c = basis[o + uint64(j)]
-                    t = s + uint64(4 * j)
-                    x += c * net_row[t]
-                    y += c * net_row[t + U1]
-                    z += c * net_row[t + U2]
-                    w += c * net_row[t + U3]
-                t = uint64(l * dim * nv) + ub
-                dst[t] = x
-                dst[t + uint64(nv)] = y
-                dst[t + uint64(2 * nv)] = z
-                if dim == 4:
-                    dst[t + uint64(3 * nv)] = w
+        row_points(bv, sv, q, ctrl[rows[r]].reshape(-1), dim, out[r].reshape(-1), 0, nv, 0, nv)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -167,7 +164,7 @@ def grid_positions(bu, first, p, w, rational, b0, out):
     nv = w.shape[3]
     dim = 4 if rational else 3
     if p <= 3:
-        _positions_low_degree(bu, first, p, w, rational, b0, out)
+        positions_low_degree(bu, first, p, w, rational, b0, out)
         return
     acc = np.empty((1, 1, 4, nv))
     for a in range(bu.shape[0]):
@@ -180,98 +177,6 @@ def grid_positions(bu, first, p, w, rational, b0, out):
             row[t] = acc[0, 0, 0, b] * inv_w
             row[t + U1] = acc[0, 0, 1, b] * inv_w
             row[t + U2] = acc[0, 0, 2, b] * inv_w
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _positions_low_degree(bu, first, p, w, rational, b0, out):
-    """:func:`grid_positions` for degrees up to 3 in u, in one pass per u-point (or per
-    pair of u-points on the same rows, :func:`_low_degree_pair`): the four row terms are
-    written out (missing ones get weight 0 on a valid row), so the sums, the division and
-    the store are one vector loop with everything in registers."""
-    nv = w.shape[3]
-    a = 0
-    while a < bu.shape[0]:
-        if a + 1 < bu.shape[0] and first[a + 1] == first[a]:  # two u-points on the same rows
-            _low_degree_pair(bu, first, p, w, rational, b0, out, a)
-            a += 2
-            continue
-        r0 = first[a]
-        c0 = bu[a, 0, 0]
-        c1 = bu[a, 0, 1] if p >= 1 else 0.0
-        c2 = bu[a, 0, 2] if p >= 2 else 0.0
-        c3 = bu[a, 0, 3] if p >= 3 else 0.0
-        r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
-        x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
-        y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
-        z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
-        row = out[a].reshape(-1)  # flat, unsigned offsets: no wraparound select, the loop vectorizes
-        o = uint64(3 * b0)
-        if rational:
-            h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
-            for b in range(nv):
-                ub = uint64(b)
-                inv_w = 1.0 / (c0 * h0[ub] + c1 * h1[ub] + c2 * h2[ub] + c3 * h3[ub])
-                t = o + U3 * ub
-                row[t] = (c0 * x0[ub] + c1 * x1[ub] + c2 * x2[ub] + c3 * x3[ub]) * inv_w
-                row[t + U1] = (c0 * y0[ub] + c1 * y1[ub] + c2 * y2[ub] + c3 * y3[ub]) * inv_w
-                row[t + U2] = (c0 * z0[ub] + c1 * z1[ub] + c2 * z2[ub] + c3 * z3[ub]) * inv_w
-        else:
-            for b in range(nv):
-                ub = uint64(b)
-                t = o + U3 * ub
-                row[t] = c0 * x0[ub] + c1 * x1[ub] + c2 * x2[ub] + c3 * x3[ub]
-                row[t + U1] = c0 * y0[ub] + c1 * y1[ub] + c2 * y2[ub] + c3 * y3[ub]
-                row[t + U2] = c0 * z0[ub] + c1 * z1[ub] + c2 * z2[ub] + c3 * z3[ub]
-        a += 1
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _low_degree_pair(bu, first, p, w, rational, b0, out, a):
-    """u-points ``a`` and ``a + 1`` of :func:`_positions_low_degree` when they share their
-    rows (same span): one pass loads each row value once for both (the arithmetic of
-    each point is that of the single pass, so the values are the same)."""
-    nv = w.shape[3]
-    r0 = first[a]
-    r1, r2, r3 = r0 + min(1, p), r0 + min(2, p), r0 + min(3, p)
-    c0, e0 = bu[a, 0, 0], bu[a + 1, 0, 0]
-    c1, e1 = (bu[a, 0, 1], bu[a + 1, 0, 1]) if p >= 1 else (0.0, 0.0)
-    c2, e2 = (bu[a, 0, 2], bu[a + 1, 0, 2]) if p >= 2 else (0.0, 0.0)
-    c3, e3 = (bu[a, 0, 3], bu[a + 1, 0, 3]) if p >= 3 else (0.0, 0.0)
-    x0, x1, x2, x3 = w[r0, 0, 0], w[r1, 0, 0], w[r2, 0, 0], w[r3, 0, 0]
-    y0, y1, y2, y3 = w[r0, 0, 1], w[r1, 0, 1], w[r2, 0, 1], w[r3, 0, 1]
-    z0, z1, z2, z3 = w[r0, 0, 2], w[r1, 0, 2], w[r2, 0, 2], w[r3, 0, 2]
-    row, nxt = out[a].reshape(-1), out[a + 1].reshape(-1)
-    o = uint64(3 * b0)
-    if rational:
-        h0, h1, h2, h3 = w[r0, 0, 3], w[r1, 0, 3], w[r2, 0, 3], w[r3, 0, 3]
-        for b in range(nv):
-            ub = uint64(b)
-            t = o + U3 * ub
-            vx0, vx1, vx2, vx3 = x0[ub], x1[ub], x2[ub], x3[ub]
-            vy0, vy1, vy2, vy3 = y0[ub], y1[ub], y2[ub], y3[ub]
-            vz0, vz1, vz2, vz3 = z0[ub], z1[ub], z2[ub], z3[ub]
-            vw0, vw1, vw2, vw3 = h0[ub], h1[ub], h2[ub], h3[ub]
-            inv_w = 1.0 / (c0 * vw0 + c1 * vw1 + c2 * vw2 + c3 * vw3)
-            row[t] = (c0 * vx0 + c1 * vx1 + c2 * vx2 + c3 * vx3) * inv_w
-            row[t + U1] = (c0 * vy0 + c1 * vy1 + c2 * vy2 + c3 * vy3) * inv_w
-            row[t + U2] = (c0 * vz0 + c1 * vz1 + c2 * vz2 + c3 * vz3) * inv_w
-            inv_w = 1.0 / (e0 * vw0 + e1 * vw1 + e2 * vw2 + e3 * vw3)
-            nxt[t] = (e0 * vx0 + e1 * vx1 + e2 * vx2 + e3 * vx3) * inv_w
-            nxt[t + U1] = (e0 * vy0 + e1 * vy1 + e2 * vy2 + e3 * vy3) * inv_w
-            nxt[t + U2] = (e0 * vz0 + e1 * vz1 + e2 * vz2 + e3 * vz3) * inv_w
-    else:
-        for b in range(nv):
-            ub = uint64(b)
-            t = o + U3 * ub
-            vx0, vx1, vx2, vx3 = x0[ub], x1[ub], x2[ub], x3[ub]
-            vy0, vy1, vy2, vy3 = y0[ub], y1[ub], y2[ub], y3[ub]
-            vz0, vz1, vz2, vz3 = z0[ub], z1[ub], z2[ub], z3[ub]
-            row[t] = c0 * vx0 + c1 * vx1 + c2 * vx2 + c3 * vx3
-            row[t + U1] = c0 * vy0 + c1 * vy1 + c2 * vy2 + c3 * vy3
-            row[t + U2] = c0 * vz0 + c1 * vz1 + c2 * vz2 + c3 * vz3
-            nxt[t] = e0 * vx0 + e1 * vx1 + e2 * vx2 + e3 * vx3
-            nxt[t + U1] = e0 * vy0 + e1 * vy1 + e2 * vy2 + e3 * vy3
-            nxt[t + U2] = e0 * vz0 + e1 * vz1 + e2 * vz2 + e3 * vz3
 
 
 @njit(cache=True, error_model="numpy")

@@ -295,7 +295,8 @@ def _row_blocks(su, p, n, per_row, threads=1):
     if threads > 1:
         most = max(GRID_MIN_BLOCK, -(-su.size // (BLOCKS_PER_THREAD * threads)))
         step = min(step, most)
-    if n > max_rows and su.size > 1 and np.all(su[1:] >= su[:-1]):
+    ordered = su.size > 1 and bool(np.all(su[1:] >= su[:-1]))
+    if n > max_rows and ordered:
         # sorted u (the usual grid): a block takes u-points while its rows fit, not
         # max_rows / (p+1) of them (which assumes p+1 new rows per u-point)
         cuts = [0]
@@ -307,6 +308,8 @@ def _row_blocks(su, p, n, per_row, threads=1):
     else:
         starts = np.arange(0, su.size + step, step).clip(max=su.size)
         starts = starts[np.r_[True, np.diff(starts) > 0]]
+    if ordered:
+        return (starts.astype(np.int64),) + _sorted_block_rows(su, p, n, starts)
     rows, row_starts, first = [], [0], np.empty(su.size, dtype=np.int64)
     for a0, a1 in pairwise(starts):  # loop over memory blocks, not points
         s = su[a0:a1]
@@ -316,6 +319,48 @@ def _row_blocks(su, p, n, per_row, threads=1):
         row_starts.append(row_starts[-1] + block.size)
     rows = np.concatenate(rows) if rows else np.empty(0, dtype=np.int64)
     return starts.astype(np.int64), rows.astype(np.int64), np.array(row_starts, dtype=np.int64), first
+
+
+def _sorted_block_rows(su, p, n, starts):
+    """``(rows, row_starts, first)`` of :func:`_row_blocks` for sorted spans ``su``,
+    without a pass per block: the rows a block needs are all the needed rows from its
+    first point's lowest to its last point's highest (a needed row in between belongs to
+    a point in between), so each block's rows are a slice of the sorted needed rows."""
+    needed = np.zeros(n, dtype=bool)
+    needed[(su[:, None] - p + np.arange(p + 1)).ravel()] = True
+    every = np.flatnonzero(needed)
+    lo = np.searchsorted(every, su[starts[:-1]] - p)
+    hi = np.searchsorted(every, su[starts[1:] - 1], side="right")
+    row_starts = np.r_[0, np.cumsum(hi - lo)]
+    rows = every[np.arange(row_starts[-1]) - np.repeat(row_starts[:-1] - lo, hi - lo)]
+    first = np.searchsorted(every, su - p) - np.repeat(lo, np.diff(starts))
+    return rows.astype(np.int64), row_starts.astype(np.int64), first.astype(np.int64)
+
+
+_NO_RUNS = (np.empty((0, 0, 0)), np.empty((0, 4, 0)), np.zeros(1, dtype=np.int64), np.empty(0, dtype=np.int64))
+
+
+def _vector_runs(net: LocalNet, sv, bv, rows: int):
+    """The arguments of the grid's vector row stage (:mod:`surfmod.eval.row_stage`) for
+    v-points with spans ``sv`` and basis ``bv`` when ``rows`` net rows are contracted:
+    ``(bplan, planes, run_starts, run_kinds)``, or no runs (one point at a time).
+
+    Vector loops need runs of v-points in consecutive spans (a net with about as many
+    spans as points) and the net as coordinate planes, built once per surface, and only
+    when the stage reads a quarter of the net or more (a few rows of a big net are not
+    worth a copy of all of it)."""
+    from . import row_stage
+
+    n = net.ctrl.shape[0]
+    if rows < max(64, n // 4):
+        return _NO_RUNS
+    starts, kinds = row_stage.runs(sv)
+    if not np.any(kinds == row_stage.NEXT_SPAN):
+        return _NO_RUNS
+    planes = net.cache.get("planes")
+    if planes is None:
+        planes = net.cache["planes"] = row_stage.net_planes(net.ctrl)
+    return np.ascontiguousarray(bv.transpose(1, 2, 0)), planes, starts, kinds
 
 
 def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
@@ -342,12 +387,21 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
         if out is None:
             out = np.empty((us.size, vs.size, kk, kk, 3))
     run, count = _kernels_for(us.size * vs.size, grid=True)
+    ordered = bool(np.all(su[1:] >= su[:-1]))
     with _on(count):
         for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
             blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
             per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
-            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks)
+            vruns = _vector_runs(net, svb, bvb, blocks[1].size)
+            if order == 0 and p <= 3 and vruns[3].size and ordered:
+                # the stages interleave in a ring (eval/sliding.py): no row table, so the
+                # blocks need not be cut to its size (only shared among the threads)
+                from .sliding import CHUNK, RING
+
+                blocks = _row_blocks(su, p, n, 1, count)
+                per_slot = RING * dim * min(svb.size, CHUNK)
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns)
     if order == 0:
         return out[:, :, None, None, :]
     return out

@@ -19,17 +19,17 @@ from .patches import positions_chunk
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first):
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns):
     """:func:`surfmod.eval.grid_kernels.grid`, a block of u-points per task; each thread
     builds its blocks' row tables in its own row of ``scratch``."""
     for blk in prange(starts.size - 1):
         space = scratch[get_thread_id()]
         if out.ndim == 3:
             grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts,
-                                 first, blk)
+                                 first, blk, vruns)
         else:
             grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows,
-                                   row_starts, first, blk)
+                                   row_starts, first, blk, vruns)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
