@@ -28,10 +28,8 @@ a straight p-curve needs 3 nodes.  Everything else (angular directions, rational
 splines, curved p-curves on curved faces) takes the caller's ``order`` per piece: eighth
 turns on angular directions, knot spans, and at least ``PIECES`` pieces per curved edge.
 
-Every p-curve is evaluated from data (:func:`surfmod.occ.pcurves.face_pcurves`): lines,
-circles and B-splines for all nodes at once (B-splines as one polynomial per span, built
-for all p-curves of a part in one pass per degree, :func:`taylor_pieces`); other types
-through OCCT per node.  Lines and circles cross the break lines in closed form.
+The p-curves are evaluated from data, all of a face's at once
+(:mod:`surfmod.uses.mass_boundary`).
 """
 
 from __future__ import annotations
@@ -44,13 +42,11 @@ from ..construct.curves import Line
 from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
-from ..eval.basis import basis_derivatives, find_spans
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from .faces import _breaks, _patch_breaks, direction_breaks
+from .mass_boundary import PIECES, _boundary, _crossings, _spans, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
 from .mass_grid import exact_order, gauss, grid_nodes, inner_nodes, interpolation_points, green_layout
 
-#: curved p-curves are cut into at least this many pieces before Gauss
-PIECES = 4
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
 RECTANGLE_RTOL = 1e-7
 
@@ -91,184 +87,6 @@ def direction_degree(surface, direction: int):
     if isinstance(surface, RevolutionSurface):
         return _curve_degree(surface.profile) if direction == 1 else None
     return None
-
-
-def _spans(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
-    x, w = gauss(order)
-    a, b = breaks[:-1, None], breaks[1:, None]
-    return ((a + b) / 2 + (b - a) / 2 * x).ravel(), ((b - a) / 2 * w).ravel()
-
-
-# -- p-curves ---------------------------------------------------------------------------------
-def pcurve_d1(rec: dict, t: np.ndarray) -> np.ndarray:
-    """``(N, 4)``: ``u, v, du/dt, dv/dt`` of a p-curve record at parameters ``t``."""
-    from ..occ.pcurves import adaptor_d1
-
-    kind = rec["kind"]
-    t = np.asarray(t, dtype=float)
-    out = np.empty((t.size, 4))
-    if kind == "line":
-        out[:, :2] = rec["origin"] + t[:, None] * rec["direction"]
-        out[:, 2:] = rec["direction"]
-    elif kind == "circle":
-        c, s = np.cos(t)[:, None], np.sin(t)[:, None]
-        r, x, y = rec["radius"], rec["x"], rec["y"]
-        out[:, :2] = rec["centre"] + r * (c * x + s * y)
-        out[:, 2:] = r * (c * y - s * x)
-    elif kind == "bspline":
-        if "taylor" not in rec:
-            rec["taylor"] = _taylor_pieces(rec)
-        starts, centres, coef = rec["taylor"]
-        j = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(starts) - 1)
-        dt = (t - centres[j])[:, None]
-        c = coef[j]  # (N, p+1, dim)
-        val, der = c[:, -1], np.zeros_like(c[:, -1])
-        for k in range(c.shape[1] - 2, -1, -1):  # Horner for the value and its derivative
-            der = der * dt + val
-            val = val * dt + c[:, k]
-        if rec["weights"] is None:
-            out[:, :2], out[:, 2:] = val, der
-        else:
-            out[:, :2] = val[:, :2] / val[:, 2:]
-            out[:, 2:] = (der[:, :2] - out[:, :2] * der[:, 2:]) / val[:, 2:]
-    else:
-        out[:] = adaptor_d1(rec["adaptor"], t)
-    return out
-
-
-def _taylor_pieces(rec: dict):
-    """A B-spline p-curve as one polynomial per knot span: ``(starts (S,), centres (S,),
-    coefficients (S, p+1, dim))`` with ``C(t) = Σ_k c_k (t - centre)^k`` in homogeneous coordinates
-    ``(w u, w v, w)`` (``(u, v)`` when polynomial).  Beyond the ends the first and last
-    spans continue, as OCCT evaluates."""
-    taylor_pieces([rec])
-    return rec["taylor"]
-
-
-def taylor_pieces(records: list) -> None:
-    """Set ``rec["taylor"]`` (see :func:`_taylor_pieces`) on every B-spline p-curve record
-    that lacks it, with one basis evaluation per degree for all of them: their knot
-    vectors and control points are laid end to end, and each span's basis reads only its
-    own curve's knots (``knots[span - p + 1 .. span + p]``), so one call serves all.
-
-    >>> import build123d as bd
-    >>> from surfmod.occ.pcurves import face_pcurves
-    >>> recs = [r for r in face_pcurves(bd.Face(bd.Wire([bd.Spline((0, 0), (1, 1), (2, 0), (1, -1)),
-    ...         bd.Edge.make_line((1, -1), (0, 0))])).wrapped) if r["kind"] == "bspline"]
-    >>> taylor_pieces(recs); starts, centres, coef = recs[0]["taylor"]
-    >>> coef.shape[1:] == (recs[0]["degree"] + 1, 2)
-    True
-    """
-    groups: dict = {}
-    for rec in records:
-        if rec["kind"] == "bspline" and "taylor" not in rec:
-            groups.setdefault(rec["degree"], []).append(rec)
-    for p, group in groups.items():
-        knots, ctrl, spans, centres, firsts, counts = [], [], [], [], [], []
-        k_off = c_off = 0
-        for rec in group:
-            k, pts, w = rec["knots"], rec["points"][:, :2], rec["weights"]
-            n = len(pts)
-            # homogeneous (w u, w v, w) for all; w = 1 leaves a polynomial curve's u, v as they are
-            ones = np.ones(n) if w is None else w
-            ctrl.append(np.column_stack([pts * ones[:, None], ones]))
-            starts = np.unique(k[p:n])  # span starts inside the domain (the last end excluded)
-            starts = starts[starts < k[n]]
-            # expanded about each span's middle: |t - centre| <= h/2 keeps high degrees accurate
-            mid = (starts + np.append(starts[1:], k[n])) / 2
-            local = find_spans(k, p, n, mid)
-            knots.append(k)
-            spans.append(local + k_off)
-            firsts.append(local - p + c_off)
-            centres.append(mid)
-            counts.append((starts, mid))
-            k_off += len(k)
-            c_off += n
-        all_knots, all_ctrl = np.concatenate(knots), np.concatenate(ctrl)
-        span, first, mid = np.concatenate(spans), np.concatenate(firsts), np.concatenate(centres)
-        basis = basis_derivatives(all_knots, p, span, mid, p)  # (S, p+1 derivatives, p+1 functions)
-        local_ctrl = all_ctrl[first[:, None] + np.arange(p + 1)]  # (S, p+1, 3)
-        fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
-        coef = np.einsum("skr,srd->skd", basis, local_ctrl) / fact[None, :, None]
-        at = 0
-        for rec, (starts, mid) in zip(group, counts):
-            c = coef[at : at + len(starts)]
-            at += len(starts)
-            rec["taylor"] = (starts, mid, c if rec["weights"] is not None else np.ascontiguousarray(c[:, :, :2]))
-
-
-def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
-    """Parameters where a p-curve crosses the lines ``u = c`` and ``v = c``: exact on
-    straight p-curves, else sign changes on one sampling refined by Newton steps (all
-    crossings at once)."""
-    if not len(lines_u) and not len(lines_v):
-        return np.zeros(0)
-    f, l = cuts[0], cuts[-1]
-    coord = np.concatenate([np.zeros(len(lines_u), int), np.ones(len(lines_v), int)])
-    lines = np.concatenate([lines_u, lines_v])
-    if rec["kind"] == "line":
-        d = rec["direction"][coord]
-        ok = d != 0.0
-        t = (lines[ok] - rec["origin"][coord[ok]]) / d[ok]
-        return t[(t > f) & (t < l)]
-    if rec["kind"] == "circle":
-        # centre + r (cos t x + sin t y) = line: A cos t + B sin t = C, t = phi ± acos(C / R)
-        r = rec["radius"]
-        A, B, C = r * rec["x"][coord], r * rec["y"][coord], lines - rec["centre"][coord]
-        R = np.hypot(A, B)
-        ok = np.abs(C) < R
-        phi, half = np.arctan2(B[ok], A[ok]), np.arccos(C[ok] / R[ok])
-        base = np.concatenate([phi + half, phi - half])
-        turns = np.arange(np.floor((f - base.max()) / (2 * np.pi)), np.ceil((l - base.min()) / (2 * np.pi)) + 1)
-        t = (base[:, None] + 2 * np.pi * turns[None, :]).ravel()
-        return t[(t > f) & (t < l)]
-    a, b = cuts[:-1, None], cuts[1:, None]
-    t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
-    s = pcurve_d1(rec, t)[:, coord] - lines[None, :]  # (T, L)
-    i, j = np.nonzero(s[:-1] * s[1:] < 0)
-    if not len(i):
-        return np.zeros(0)
-    lo, hi, c, cj = t[i], t[i + 1], lines[j], coord[j]
-    x = lo + (hi - lo) * s[i, j] / (s[i, j] - s[i + 1, j])
-    rows = np.arange(len(x))
-    for _ in range(6):
-        q = pcurve_d1(rec, x)
-        d = q[rows, 2 + cj]
-        step = np.divide(q[rows, cj] - c, d, out=np.zeros_like(x), where=d != 0.0)
-        x = np.clip(x - step, lo, hi)
-        if np.all(np.abs(step) <= 1e-15 * max(1.0, abs(l - f))):
-            break
-    return x
-
-
-def _boundary(pcurves, outer_order, lines_u, lines_v):
-    """Gauss nodes on every p-curve: ``(P (N, 2), dP (N, 2), weights (N,))`` with the
-    weights signed by the edge's orientation in the face; ``outer_order(rec)`` is the
-    Gauss order for a p-curve (``(order, exact)``)."""
-    ps, ds, ws = [], [], []
-    exact = True
-    for rec in pcurves:
-        f, l = rec["range"]
-        if not l > f:
-            continue
-        m, ok = outer_order(rec)
-        exact &= ok
-        k = 1 if rec["kind"] == "line" else PIECES
-        br = np.concatenate([rec["breaks"], np.linspace(f, l, k + 1)])
-        br = np.unique(br[(br >= f) & (br <= l)])
-        extra = _crossings(rec, br, lines_u, lines_v)
-        if extra.size:
-            br = np.unique(np.concatenate([br, extra]))
-            br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
-        t, w = _spans(br, m)
-        q = pcurve_d1(rec, np.concatenate([t, [f, l]]))
-        rec["ends"] = q[-2:, :2]  # for _largest_gap, from the same call
-        ps.append(q[:-2, :2])
-        ds.append(q[:-2, 2:])
-        ws.append(rec["sign"] * w)
-    if not ps:
-        return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), exact
-    return np.concatenate(ps), np.concatenate(ds), np.concatenate(ws), exact
 
 
 # -- faces -----------------------------------------------------------------------------------
