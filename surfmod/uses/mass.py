@@ -229,10 +229,10 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     else:
         from ..occ.topo import faces_of
 
-        from ..occ.pcurves import face_pcurves
+        from ..occ.pcurves import faces_pcurves
 
         read = [from_face(f) for f in faces_of(solid)]
-        pcurves = [face_pcurves(f.face_shape) for f in read]
+        pcurves = faces_pcurves([f.face_shape for f in read])  # B-splines in one table
         taylor_pieces([rec for pcs in pcurves for rec in pcs])  # all B-spline p-curves at once
         faces = [mass_face(f, pcs) for f, pcs in zip(read, pcurves)]
     # faces whose every rule is exact by degree give the same sums at any order: the

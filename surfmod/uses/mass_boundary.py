@@ -315,15 +315,16 @@ def _table_crossings(table: PcurveTable, recs, cuts, lines_u, lines_v, per_piece
     return x, rec
 
 
-def _boundary(pcurves, outer_order, lines_u, lines_v):
+def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None = None):
     """Gauss nodes on every p-curve: ``(P (N, 2), dP (N, 2), weights (N,), exact)`` with
     the weights signed by the edge's orientation in the face; ``outer_order(rec)`` is the
-    Gauss order for a p-curve (``(order, exact)``).  Each record also gets ``"ends"``,
-    its points at the ends of its range."""
+    Gauss order for a p-curve (``(order, exact)``); ``table``: their :class:`PcurveTable`,
+    when already built.  Each record also gets ``"ends"``, its points at the ends of its
+    range."""
     live = [i for i, rec in enumerate(pcurves) if rec["range"][1] > rec["range"][0]]
     if not live:
         return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), True
-    table = PcurveTable(pcurves)
+    table = PcurveTable(pcurves) if table is None else table
     exact, cuts, orders = True, {}, {}
     for i in live:
         rec = pcurves[i]

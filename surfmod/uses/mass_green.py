@@ -43,8 +43,8 @@ from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurf
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from .faces import _breaks, _patch_breaks, direction_breaks
-from .mass_boundary import PIECES, _boundary, _crossings, _spans, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
+from .faces import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks
+from .mass_boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
 from .mass_grid import exact_order, gauss, grid_nodes, inner_nodes, interpolation_points, green_layout
 
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
@@ -103,36 +103,54 @@ class MassFace:
     pcurves: list | None  # None: the face is its whole parameter rectangle
     plane: bool = False
     frame: tuple | None = None  # planes: origin, x, y (S = O + u X + v Y)
+    table: PcurveTable | None = None  # the p-curves as arrays (built once per face)
 
     @property
     def natural(self) -> bool:
         return self.pcurves is None
 
 
-def _on_box_border(pcurves, bounds) -> bool:
+def _lines_on_box_border(lines: list, bounds) -> bool:
+    """:func:`_on_box_border` of straight p-curves only: both ends of each on one border
+    line (a few array operations, without building a :class:`PcurveTable`)."""
     u0, u1, v0, v1 = bounds
-    tol = np.array([RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)])
+    tol = np.array([RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)])[[0, 0, 1, 1]]
     sides = np.array([u0, u1, v0, v1])
+    o = np.array([rec["origin"] for rec in lines])
+    d = np.array([rec["direction"] for rec in lines])
+    r = np.array([rec["range"] for rec in lines])
+    ends = np.concatenate([o + r[:, :1] * d, o + r[:, 1:] * d])[:, [0, 0, 1, 1]]
+    on = np.abs(ends - sides) <= tol
+    return bool(np.all(np.any(on[: len(lines)] & on[len(lines):], axis=1)))
 
-    def on_sides(q):  # (N, 2) -> (N, 4): which border line each point lies on
-        return np.abs(q[:, [0, 0, 1, 1]] - sides) <= tol[[0, 0, 1, 1]]
 
-    lines = [rec for rec in pcurves if rec["kind"] == "line"]
-    if lines:
-        # a straight p-curve lies on the border iff both of its ends lie on one border line
-        o = np.array([rec["origin"] for rec in lines])
-        d = np.array([rec["direction"] for rec in lines])
-        r = np.array([rec["range"] for rec in lines])
-        first, last = on_sides(o + r[:, :1] * d), on_sides(o + r[:, 1:] * d)
-        if not np.all(np.any(first & last, axis=1)):
-            return False
-    for rec in pcurves:
-        if rec["kind"] != "line":
-            f, l = rec["range"]
-            q = pcurve_d1(rec, f + (l - f) * np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0]))
-            if not on_sides(q[:, :2]).any(axis=1).all():
-                return False
-    return True
+def _on_box_border(table: PcurveTable, bounds) -> bool:
+    """Whether the p-curves run along the face box's border only: a straight p-curve iff
+    both of its ends lie on one border line, others at seven samples each (all p-curves
+    in one evaluation)."""
+    u0, u1, v0, v1 = bounds
+    tol = np.array([RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)])[[0, 0, 1, 1]]
+    sides = np.array([u0, u1, v0, v1])
+    straight = table.kind == 0
+    samples = np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0])  # ends first, then inside
+    ranges = np.array([rec["range"] for rec in table.records])
+    f, l = ranges[:, :1], ranges[:, 1:]
+    t = f + (l - f) * samples  # (R, 7); lines use the first two columns (their ends)
+    t[straight, 1] = l[straight, 0]
+    q = table.d1(np.repeat(np.arange(len(ranges)), len(samples)), t.ravel())[:, :2]
+    on = (np.abs(q[:, [0, 0, 1, 1]] - sides) <= tol).reshape(len(ranges), len(samples), 4)
+    lines_ok = np.any(on[:, 0] & on[:, 1], axis=1)
+    curves_ok = np.all(np.any(on, axis=2), axis=1)
+    return bool(np.all(np.where(straight, lines_ok, curves_ok)))
+
+
+def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
+    """:func:`surfmod.uses.faces._patch_breaks`, angular directions without its general
+    merging (equal pieces of at most an eighth turn, the same points)."""
+    b = direction_breaks(face, direction)
+    if isinstance(b, str) and hi - lo > 1e-9:
+        return np.linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1)
+    return _patch_breaks(face, lo, hi, direction, face.periods[direction])
 
 
 def mass_face(face, pcurves: list | None = None) -> MassFace:
@@ -152,14 +170,21 @@ def mass_face(face, pcurves: list | None = None) -> MassFace:
     if plane:  # one polynomial piece each way
         breaks = (np.array([u0, u1]), np.array([v0, v1]))
     else:
-        breaks = (_patch_breaks(face, u0, u1, 0, face.periods[0]), _patch_breaks(face, v0, v1, 1, face.periods[1]))
+        breaks = (_mass_breaks(face, u0, u1, 0), _mass_breaks(face, v0, v1, 1))
     if pcurves is None:
         pcurves = face_pcurves(face.face_shape)
         taylor_pieces(pcurves)
-    natural = bool(pcurves) and all(rec["wire"] == 0 for rec in pcurves) and _on_box_border(pcurves, bounds)
+    table = None
+    if not pcurves or any(rec["wire"] != 0 for rec in pcurves):
+        natural = False
+    elif all(rec["kind"] == "line" for rec in pcurves):  # most natural faces: no table needed
+        natural = _lines_on_box_border(pcurves, bounds)
+    else:
+        table = PcurveTable(pcurves)
+        natural = _on_box_border(table, bounds)
     return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
-                    plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None)
+                    plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table)
 
 
 def surface_mass_face(surf) -> MassFace:
@@ -253,7 +278,7 @@ def _green(mf: MassFace, order: int, orders, exacts):
         return order, False
 
     lines = [mf.breaks[0][1:-1], mf.breaks[1][1:-1]]
-    P, dP, wt, exact = _boundary(mf.pcurves, outer_order, lines[0], lines[1])
+    P, dP, wt, exact = _boundary(mf.pcurves, outer_order, lines[0], lines[1], mf.table)
     # inner direction: the one with fewer inner nodes per boundary node, where the
     # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
     # the result depends on the direction, and BRepGProp's is u from the box's left edge.
