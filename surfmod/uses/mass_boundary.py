@@ -266,8 +266,12 @@ class PcurveTable:
                     out[sel] = adaptor_d1(self.records[i]["adaptor"], t[sel])
         return out
 
+    def span_of(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Row of the span polynomial of B-spline record ``r[n]`` at ``t[n]``."""
+        return np.clip(np.searchsorted(self.keys, r + 1j * t, side="right") - 1, self.first[r], self.last[r])
+
     def _spline_d1(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
-        j = np.clip(np.searchsorted(self.keys, r + 1j * t, side="right") - 1, self.first[r], self.last[r])
+        j = self.span_of(r, t)
         dt = (t - self.centres[j])[:, None]
         c = self.coef[j]  # (N, p+1, dim)
         val, der = c[:, -1], np.zeros_like(c[:, -1])
@@ -283,25 +287,25 @@ class PcurveTable:
         return out
 
 
-def _table_crossings(table: PcurveTable, recs, cuts, lines_u, lines_v, per_piece: int = 8):
-    """:func:`_crossings` of the curved p-curves ``recs`` (indices into ``table``, their
-    ``cuts``) at once: one sampling and one evaluation per Newton step for all of them.
+def _table_crossings(table: PcurveTable, owner, a, b, scale, lines_u, lines_v, per_piece: int = 8):
+    """:func:`_crossings` of curved p-curves at once: pieces ``[a, b]`` of records ``owner``
+    (indices into ``table``; ``scale`` per piece: its record's parameter length, for the
+    Newton tolerance), one sampling and one evaluation per Newton step for all of them.
     Returns the crossing parameters and their records."""
     coord = np.concatenate([np.zeros(len(lines_u), int), np.ones(len(lines_v), int)])
     lines = np.concatenate([lines_u, lines_v])
-    a = np.concatenate([c[:-1] for c in cuts])[:, None]
-    b = np.concatenate([c[1:] for c in cuts])[:, None]
-    owner = np.repeat(np.array(recs), [len(c) - 1 for c in cuts])
-    t = (a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel()
+    t = (a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, per_piece + 1)).ravel()
     which = np.repeat(owner, per_piece + 1)
     s = table.d1(which, t)[:, coord] - lines[None, :]  # (T, L)
-    i, j = np.nonzero((s[:-1] * s[1:] < 0) & (which[:-1] == which[1:])[:, None])
+    # sign changes inside one piece only (consecutive pieces of a record share their ends)
+    same = np.ones(len(t) - 1, bool)
+    same[per_piece :: per_piece + 1] = False
+    i, j = np.nonzero((s[:-1] * s[1:] < 0) & same[:, None])
     if not len(i):
         return np.zeros(0), np.zeros(0, int)
     lo, hi, c, cj, rec = t[i], t[i + 1], lines[j], coord[j], which[i]
     x = lo + (hi - lo) * s[i, j] / (s[i, j] - s[i + 1, j])
-    span = np.array([max(1.0, abs(cut[-1] - cut[0])) for cut in cuts])
-    tol = 1e-15 * span[np.searchsorted(np.array(recs), rec)]
+    tol = 1e-15 * np.maximum(1.0, np.repeat(scale, per_piece + 1)[i])
     active = np.arange(len(x))
     for _ in range(6):  # each crossing stops once its own Newton step is at round-off
         q = table.d1(rec[active], x[active])
@@ -315,12 +319,39 @@ def _table_crossings(table: PcurveTable, recs, cuts, lines_u, lines_v, per_piece
     return x, rec
 
 
-def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None = None):
+def _long_pieces(table: PcurveTable, owner, a, b, directions) -> np.ndarray:
+    """Which pieces ``[a, b]`` of records ``owner`` may run more than an eighth turn
+    (``ANGULAR_PIECE``) along the angular ``directions``: a bound from the span's own
+    polynomial, ``2 Σ_k |c_k| r^k`` (``r`` the reach from its centre); every piece of a
+    rational or non-spline p-curve counts as long."""
+    from .faces import ANGULAR_PIECE
+
+    long = np.ones(len(owner), bool)
+    spline = table.kind[owner] == 2
+    spline[spline] = np.array([table.records[r]["weights"] is None for r in owner[spline]], bool)
+    if not spline.any():
+        return long
+    r_own, lo, hi = owner[spline], a[spline], b[spline]
+    j = table.span_of(r_own, (lo + hi) / 2)
+    reach = np.maximum(np.abs(lo - table.centres[j]), np.abs(hi - table.centres[j]))
+    c = np.abs(table.coef[j][:, 1:, :2])  # (P, top - 1, 2): the non-constant terms
+    powers = reach[:, None] ** np.arange(1, c.shape[1] + 1)
+    extent = 2 * np.einsum("pk,pkd->pd", powers, c)
+    long[spline] = np.any(extent[:, list(directions)] > ANGULAR_PIECE, axis=1)
+    return long
+
+
+def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None = None, angular=(False, False)):
     """Gauss nodes on every p-curve: ``(P (N, 2), dP (N, 2), weights (N,), exact)`` with
     the weights signed by the edge's orientation in the face; ``outer_order(rec)`` is the
     Gauss order for a p-curve (``(order, exact)``); ``table``: their :class:`PcurveTable`,
     when already built.  Each record also gets ``"ends"``, its points at the ends of its
-    range."""
+    range.
+
+    The p-curves are cut where they cross the lines ``u = lines_u``, ``v = lines_v``.  Where
+    those are only the eighth turns of an analytic angle (``angular`` per direction; no
+    knot: the integrands are smooth across them) they keep Gauss within an eighth turn, so
+    a B-spline piece that cannot reach that far (:func:`_long_pieces`) is not searched."""
     live = [i for i, rec in enumerate(pcurves) if rec["range"][1] > rec["range"][0]]
     if not live:
         return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), True
@@ -343,7 +374,22 @@ def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None 
         extra = {i: _crossings(pcurves[i], cuts[i], lines_u, lines_v) for i in live if table.kind[i] < 2}
         curved = [i for i in live if table.kind[i] >= 2]
         if curved:
-            x, rec = _table_crossings(table, curved, [cuts[i] for i in curved], lines_u, lines_v)
+            owner = np.repeat(np.array(curved), [len(cuts[i]) - 1 for i in curved])
+            a = np.concatenate([cuts[i][:-1] for i in curved])
+            b = np.concatenate([cuts[i][1:] for i in curved])
+            scale = np.array([abs(pcurves[i]["range"][1] - pcurves[i]["range"][0]) for i in curved])
+            scale = np.repeat(scale, [len(cuts[i]) - 1 for i in curved])
+            knot = [np.zeros(0) if angular[0] else lines_u, np.zeros(0) if angular[1] else lines_v]
+            found = []
+            if len(knot[0]) or len(knot[1]):
+                found.append(_table_crossings(table, owner, a, b, scale, *knot))
+            turn = [lines_u if angular[0] else np.zeros(0), lines_v if angular[1] else np.zeros(0)]
+            if len(turn[0]) or len(turn[1]):
+                long = _long_pieces(table, owner, a, b, [d for d in (0, 1) if len(turn[d])])
+                if long.any():
+                    found.append(_table_crossings(table, owner[long], a[long], b[long], scale[long], *turn))
+            x = np.concatenate([f[0] for f in found]) if found else np.zeros(0)
+            rec = np.concatenate([f[1] for f in found]) if found else np.zeros(0, int)
             extra.update({i: x[rec == i] for i in curved})
         for i, e in extra.items():
             if e.size:

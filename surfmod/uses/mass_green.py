@@ -104,6 +104,8 @@ class MassFace:
     plane: bool = False
     frame: tuple | None = None  # planes: origin, x, y (S = O + u X + v Y)
     table: PcurveTable | None = None  # the p-curves as arrays (built once per face)
+    # per direction: its breaks are only the eighth turns of an analytic angle (no knot)
+    angular: tuple = (False, False)
 
     @property
     def natural(self) -> bool:
@@ -145,12 +147,13 @@ def _on_box_border(table: PcurveTable, bounds) -> bool:
 
 
 def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
-    """:func:`surfmod.uses.faces._patch_breaks`, angular directions without its general
-    merging (equal pieces of at most an eighth turn, the same points)."""
+    """:func:`surfmod.uses.faces._patch_breaks` (angular directions without its general
+    merging: equal pieces of at most an eighth turn, the same points) and whether the
+    direction is an analytic angle (its breaks are no knots)."""
     b = direction_breaks(face, direction)
     if isinstance(b, str) and hi - lo > 1e-9:
-        return np.linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1)
-    return _patch_breaks(face, lo, hi, direction, face.periods[direction])
+        return np.linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1), True
+    return _patch_breaks(face, lo, hi, direction, face.periods[direction]), isinstance(b, str)
 
 
 def mass_face(face, pcurves: list | None = None) -> MassFace:
@@ -167,10 +170,12 @@ def mass_face(face, pcurves: list | None = None) -> MassFace:
     u0, u1, v0, v1 = bounds = tuple(b for r in face.domain for b in r)
     surf = face.surface
     plane = isinstance(surf, PlaneSurface)
+    angular = (False, False)
     if plane:  # one polynomial piece each way
         breaks = (np.array([u0, u1]), np.array([v0, v1]))
     else:
-        breaks = (_mass_breaks(face, u0, u1, 0), _mass_breaks(face, v0, v1, 1))
+        (bu, au), (bv, av) = _mass_breaks(face, u0, u1, 0), _mass_breaks(face, v0, v1, 1)
+        breaks, angular = (bu, bv), (au, av)
     if pcurves is None:
         pcurves = face_pcurves(face.face_shape)
         taylor_pieces(pcurves)
@@ -184,7 +189,8 @@ def mass_face(face, pcurves: list | None = None) -> MassFace:
         natural = _on_box_border(table, bounds)
     return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
-                    plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table)
+                    plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table,
+                    angular)
 
 
 def surface_mass_face(surf) -> MassFace:
@@ -278,7 +284,7 @@ def _green(mf: MassFace, order: int, orders, exacts):
         return order, False
 
     lines = [mf.breaks[0][1:-1], mf.breaks[1][1:-1]]
-    P, dP, wt, exact = _boundary(mf.pcurves, outer_order, lines[0], lines[1], mf.table)
+    P, dP, wt, exact = _boundary(mf.pcurves, outer_order, lines[0], lines[1], mf.table, mf.angular)
     # inner direction: the one with fewer inner nodes per boundary node, where the
     # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
     # the result depends on the direction, and BRepGProp's is u from the box's left edge.
