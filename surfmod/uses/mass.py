@@ -50,7 +50,7 @@ from ..errors import SurfmodError
 from ..readback import from_face
 from ..surface import Surface
 from .inputs import to_shape
-from .mass_green import face_nodes, mass_face, plane_nodes, surface_mass_face, taylor_pieces
+from .mass_green import face_nodes, mass_face, mass_faces, plane_nodes, prepare_boundaries, surface_mass_face, taylor_pieces
 from .mass_plane import plane_moments
 
 
@@ -262,7 +262,8 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         read = _read_faces(faces_of(solid))
         pcurves = faces_pcurves([f.face_shape for f in read])  # B-splines in one table
         taylor_pieces([rec for pcs in pcurves for rec in pcs])  # all B-spline p-curves at once
-        faces = [mass_face(f, pcs) for f, pcs in zip(read, pcurves)]
+        faces = mass_faces(read, pcurves)
+        prepare_boundaries(faces, order)  # the p-curves of all trimmed faces in one pass
     # faces whose every rule is exact by degree give the same sums at any order: the
     # lower-order pass behind the error estimate only re-integrates the others
     exact, high = _Accumulator(ref), _Accumulator(ref)

@@ -287,25 +287,28 @@ class PcurveTable:
         return out
 
 
-def _table_crossings(table: PcurveTable, owner, a, b, scale, lines_u, lines_v, per_piece: int = 8):
+def _table_crossings(table: PcurveTable, owner, a, b, scale, lines, coord, per_piece: int = 8):
     """:func:`_crossings` of curved p-curves at once: pieces ``[a, b]`` of records ``owner``
     (indices into ``table``; ``scale`` per piece: its record's parameter length, for the
-    Newton tolerance), one sampling and one evaluation per Newton step for all of them.
-    Returns the crossing parameters and their records."""
-    coord = np.concatenate([np.zeros(len(lines_u), int), np.ones(len(lines_v), int)])
-    lines = np.concatenate([lines_u, lines_v])
+    Newton tolerance) against per piece the lines ``lines[piece]`` of coordinate
+    ``coord[piece]`` (``(pieces, L)``, NaN-padded: each face has its own), one sampling and
+    one evaluation per Newton step for all of them.  Returns the crossing parameters and
+    their records."""
     t = (a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, per_piece + 1)).ravel()
     which = np.repeat(owner, per_piece + 1)
-    s = table.d1(which, t)[:, coord] - lines[None, :]  # (T, L)
+    piece = np.repeat(np.arange(len(owner)), per_piece + 1)
+    vals = table.d1(which, t)
+    s = np.take_along_axis(vals, coord[piece], axis=1) - lines[piece]  # (T, L); NaN never changes sign
     # sign changes inside one piece only (consecutive pieces of a record share their ends)
     same = np.ones(len(t) - 1, bool)
     same[per_piece :: per_piece + 1] = False
     i, j = np.nonzero((s[:-1] * s[1:] < 0) & same[:, None])
     if not len(i):
         return np.zeros(0), np.zeros(0, int)
-    lo, hi, c, cj, rec = t[i], t[i + 1], lines[j], coord[j], which[i]
+    lo, hi, rec = t[i], t[i + 1], which[i]
+    c, cj = lines[piece[i], j], coord[piece[i], j]
     x = lo + (hi - lo) * s[i, j] / (s[i, j] - s[i + 1, j])
-    tol = 1e-15 * np.maximum(1.0, np.repeat(scale, per_piece + 1)[i])
+    tol = 1e-15 * np.maximum(1.0, scale[piece[i]])
     active = np.arange(len(x))
     for _ in range(6):  # each crossing stops once its own Newton step is at round-off
         q = table.d1(rec[active], x[active])
@@ -321,9 +324,9 @@ def _table_crossings(table: PcurveTable, owner, a, b, scale, lines_u, lines_v, p
 
 def _long_pieces(table: PcurveTable, owner, a, b, directions) -> np.ndarray:
     """Which pieces ``[a, b]`` of records ``owner`` may run more than an eighth turn
-    (``ANGULAR_PIECE``) along the angular ``directions``: a bound from the span's own
-    polynomial, ``2 Σ_k |c_k| r^k`` (``r`` the reach from its centre); every piece of a
-    rational or non-spline p-curve counts as long."""
+    (``ANGULAR_PIECE``) along their angular directions (``directions``: ``(pieces, 2)``
+    booleans): a bound from the span's own polynomial, ``2 Σ_k |c_k| r^k`` (``r`` the reach
+    from its centre); every piece of a rational or non-spline p-curve counts as long."""
     from .faces import ANGULAR_PIECE
 
     long = np.ones(len(owner), bool)
@@ -337,71 +340,67 @@ def _long_pieces(table: PcurveTable, owner, a, b, directions) -> np.ndarray:
     c = np.abs(table.coef[j][:, 1:, :2])  # (P, top - 1, 2): the non-constant terms
     powers = reach[:, None] ** np.arange(1, c.shape[1] + 1)
     extent = 2 * np.einsum("pk,pkd->pd", powers, c)
-    long[spline] = np.any(extent[:, list(directions)] > ANGULAR_PIECE, axis=1)
+    long[spline] = np.any((extent > ANGULAR_PIECE) & directions[spline], axis=1)
     return long
 
 
-def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None = None, angular=(False, False)):
-    """Gauss nodes on every p-curve: ``(P (N, 2), dP (N, 2), weights (N,), exact)`` with
-    the weights signed by the edge's orientation in the face; ``outer_order(rec)`` is the
-    Gauss order for a p-curve (``(order, exact)``); ``table``: their :class:`PcurveTable`,
-    when already built.  Each record also gets ``"ends"``, its points at the ends of its
-    range.
+def _padded(rows: list, n: int, fill) -> np.ndarray:
+    out = np.full((n, max([len(r) for r in rows] + [0])), fill)
+    for i, r in enumerate(rows):
+        out[i, : len(r)] = r
+    return out
 
-    The p-curves are cut where they cross the lines ``u = lines_u``, ``v = lines_v``.  Where
-    those are only the eighth turns of an analytic angle (``angular`` per direction; no
-    knot: the integrands are smooth across them) they keep Gauss within an eighth turn, so
-    a B-spline piece that cannot reach that far (:func:`_long_pieces`) is not searched."""
-    live = [i for i, rec in enumerate(pcurves) if rec["range"][1] > rec["range"][0]]
-    if not live:
-        return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), True
-    table = PcurveTable(pcurves) if table is None else table
-    exact, cuts, orders = True, {}, {}
-    for i in live:
-        rec = pcurves[i]
-        f, l = rec["range"]
-        m, ok = outer_order(rec)
-        exact &= ok
-        orders[i] = m
-        if rec["kind"] == "line":
-            cuts[i] = np.array([f, l])
-        elif rec["kind"] == "circle":  # one smooth interval: its breaks are its ends
-            cuts[i] = np.linspace(f, l, PIECES + 1)
+
+def boundaries(faces: list, table: PcurveTable | None = None) -> list:
+    """Gauss nodes on the p-curves of many faces in one pass: per face ``(P (N, 2), dP (N,
+    2), weights (N,), exact)``, the weights signed by each edge's orientation in its face.
+
+    ``faces``: per face ``(pcurves, orders, exacts, lines_u, lines_v, angular)`` -- per
+    p-curve the Gauss order of its pieces and whether that rule is exact; the lines
+    ``u = c``, ``v = c`` the p-curves are cut at (the surface's breaks); per direction
+    whether those are only the eighth turns of an analytic angle (no knot: the integrands
+    are smooth across them; they keep Gauss within an eighth turn, so a B-spline piece that
+    cannot reach that far (:func:`_long_pieces`) is not searched).  ``table``: the
+    :class:`PcurveTable` of all their p-curves laid end to end, when already built.  Each
+    record also gets ``"ends"``, its points at the ends of its range.
+
+    The records of all faces are laid end to end: their cuts, crossings, Newton steps and
+    Gauss nodes are found with a few array passes for the whole part, not per face.
+    """
+    records = [rec for face in faces for rec in face[0]]
+    counts = [len(face[0]) for face in faces]
+    face_of = np.repeat(np.arange(len(faces)), counts)
+    if not records:
+        return [(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), True) for _ in faces]
+    table = PcurveTable(records) if table is None else table
+    orders = np.concatenate([np.asarray(face[1], int) for face in faces])
+    exacts = np.concatenate([np.asarray(face[2], bool) for face in faces])
+    ranges = np.array([rec["range"] for rec in records])
+    f_all, l_all = ranges[:, 0], ranges[:, 1]
+    live = l_all > f_all
+    # cuts of every live record, as one array sorted by (record, parameter): complex keys
+    # record + 1j * t sort lexicographically, so np.unique merges each record's own breaks
+    keys = []
+    for i in np.flatnonzero(live):
+        rec, f, l = records[i], f_all[i], l_all[i]
+        if table.kind[i] == 0:
+            keys.append(i + 1j * np.array([f, l]))
+        elif table.kind[i] == 1:  # one smooth interval: its breaks are its ends
+            keys.append(i + 1j * np.linspace(f, l, PIECES + 1))
         else:
             br = np.concatenate([rec["breaks"], np.linspace(f, l, PIECES + 1)])
-            cuts[i] = np.unique(br[(br >= f) & (br <= l)])
-    if len(lines_u) or len(lines_v):
-        extra = {i: _crossings(pcurves[i], cuts[i], lines_u, lines_v) for i in live if table.kind[i] < 2}
-        curved = [i for i in live if table.kind[i] >= 2]
-        if curved:
-            owner = np.repeat(np.array(curved), [len(cuts[i]) - 1 for i in curved])
-            a = np.concatenate([cuts[i][:-1] for i in curved])
-            b = np.concatenate([cuts[i][1:] for i in curved])
-            scale = np.array([abs(pcurves[i]["range"][1] - pcurves[i]["range"][0]) for i in curved])
-            scale = np.repeat(scale, [len(cuts[i]) - 1 for i in curved])
-            knot = [np.zeros(0) if angular[0] else lines_u, np.zeros(0) if angular[1] else lines_v]
-            found = []
-            if len(knot[0]) or len(knot[1]):
-                found.append(_table_crossings(table, owner, a, b, scale, *knot))
-            turn = [lines_u if angular[0] else np.zeros(0), lines_v if angular[1] else np.zeros(0)]
-            if len(turn[0]) or len(turn[1]):
-                long = _long_pieces(table, owner, a, b, [d for d in (0, 1) if len(turn[d])])
-                if long.any():
-                    found.append(_table_crossings(table, owner[long], a[long], b[long], scale[long], *turn))
-            x = np.concatenate([f[0] for f in found]) if found else np.zeros(0)
-            rec = np.concatenate([f[1] for f in found]) if found else np.zeros(0, int)
-            extra.update({i: x[rec == i] for i in curved})
-        for i, e in extra.items():
-            if e.size:
-                f, l = pcurves[i]["range"]
-                br = np.unique(np.concatenate([cuts[i], e]))
-                cuts[i] = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
-    # Gauss nodes of every piece of every p-curve, in p-curve order, one order at a time
-    pieces = np.array([len(cuts[i]) - 1 for i in live])
-    owner = np.repeat(np.array(live), pieces)
-    a = np.concatenate([cuts[i][:-1] for i in live])
-    b = np.concatenate([cuts[i][1:] for i in live])
-    count = np.repeat(np.array([orders[i] for i in live]), pieces)
+            keys.append(i + 1j * br[(br >= f) & (br <= l)])
+    cuts = np.unique(np.concatenate(keys))
+    lines_u = [np.asarray(face[3], float) for face in faces]
+    lines_v = [np.asarray(face[4], float) for face in faces]
+    angular = np.array([face[5] for face in faces], bool).reshape(len(faces), 2)
+    if any(len(u) or len(v) for u, v in zip(lines_u, lines_v)):
+        cuts = _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges)
+    # Gauss nodes of every piece of every p-curve, in record order, one order at a time
+    rec_of, val = cuts.real.astype(int), cuts.imag
+    inner = rec_of[:-1] == rec_of[1:]
+    owner, a, b = rec_of[:-1][inner], val[:-1][inner], val[1:][inner]
+    count = orders[owner]
     start = np.concatenate([[0], np.cumsum(count)[:-1]])
     t, w = np.empty(count.sum()), np.empty(count.sum())
     for m in np.unique(count):
@@ -412,10 +411,77 @@ def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None 
         t[at] = ((aa + bb) / 2 + (bb - aa) / 2 * x).ravel()
         w[at] = ((bb - aa) / 2 * gw).ravel()
     which = np.repeat(owner, count)
-    ranges = np.array([pcurves[i]["range"] for i in live])
-    q = table.d1(np.concatenate([which, np.repeat(live, 2)]), np.concatenate([t, ranges.ravel()]))
+    live_idx = np.flatnonzero(live)
+    q = table.d1(np.concatenate([which, np.repeat(live_idx, 2)]), np.concatenate([t, ranges[live_idx].ravel()]))
     n = len(t)
-    for k, i in enumerate(live):  # for _largest_gap, from the same evaluation
-        pcurves[i]["ends"] = q[n + 2 * k : n + 2 * k + 2, :2]
-    sign = np.array([rec["sign"] for rec in pcurves])
-    return q[:n, :2], q[:n, 2:], sign[which] * w, exact
+    for k, i in enumerate(live_idx):  # for _largest_gap, from the same evaluation
+        records[i]["ends"] = q[n + 2 * k : n + 2 * k + 2, :2]
+    sign = np.array([rec["sign"] for rec in records])
+    w = sign[which] * w
+    node_face = face_of[which]
+    bounds = np.searchsorted(node_face, np.arange(len(faces) + 1))
+    out = []
+    for k in range(len(faces)):
+        lo, hi = bounds[k], bounds[k + 1]
+        mine = face_of == k
+        exact = bool(np.all(exacts[mine & live]))
+        out.append((q[lo:hi, :2], q[lo:hi, 2:], w[lo:hi], exact))
+    return out
+
+
+def _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges):
+    """``cuts`` (complex keys record + 1j t) with the crossings of every record with its
+    face's lines added (closed form for lines and circles, sampling and Newton for the
+    others; see :func:`boundaries`)."""
+    records = table.records
+    rec_of, val = cuts.real.astype(int), cuts.imag
+    extra_keys = []
+    for i in np.unique(rec_of[table.kind[rec_of] < 2]):  # straight and circular: closed form
+        k = face_of[i]
+        if len(lines_u[k]) or len(lines_v[k]):
+            x = _crossings(records[i], val[rec_of == i], lines_u[k], lines_v[k])
+            extra_keys.append(i + 1j * x)
+    inner = (rec_of[:-1] == rec_of[1:]) & (table.kind[rec_of[:-1]] >= 2)
+    owner, a, b = rec_of[:-1][inner], val[:-1][inner], val[1:][inner]
+    has_lines = np.array([len(lines_u[k]) + len(lines_v[k]) > 0 for k in face_of[owner]], bool)
+    owner, a, b = owner[has_lines], a[has_lines], b[has_lines]
+    if len(owner):
+        scale = np.abs(ranges[owner, 1] - ranges[owner, 0])
+        piece_face = face_of[owner]
+        n_faces = len(lines_u)
+        for turn in (False, True):  # knot lines on every piece, eighth turns on long ones
+            rows, coords = [], []
+            for k in range(n_faces):
+                u = lines_u[k] if angular[k, 0] == turn else np.zeros(0)
+                v = lines_v[k] if angular[k, 1] == turn else np.zeros(0)
+                rows.append(np.concatenate([u, v]))
+                coords.append(np.concatenate([np.zeros(len(u), int), np.ones(len(v), int)]))
+            if not any(len(r) for r in rows):
+                continue
+            lines, coord = _padded(rows, n_faces, np.nan), _padded(coords, n_faces, 0).astype(int)
+            sel = np.array([len(rows[k]) > 0 for k in piece_face], bool)
+            if turn:
+                sel[sel] = _long_pieces(table, owner[sel], a[sel], b[sel], angular[piece_face[sel]])
+            if sel.any():
+                pf = piece_face[sel]
+                x, rec = _table_crossings(table, owner[sel], a[sel], b[sel], scale[sel], lines[pf], coord[pf])
+                extra_keys.append(rec + 1j * x)
+    extra = np.concatenate(extra_keys) if extra_keys else np.zeros(0, complex)
+    if not extra.size:
+        return cuts
+    merged = np.unique(np.concatenate([cuts, extra]))
+    # within a record that gained crossings, drop cuts closer than 1e-13 of its length
+    rec_m, val_m = merged.real.astype(int), merged.imag
+    gained = np.zeros(len(records), bool)
+    gained[extra.real.astype(int)] = True
+    tol = 1e-13 * np.maximum(1.0, ranges[rec_m, 1] - ranges[rec_m, 0])
+    close = (rec_m[1:] == rec_m[:-1]) & (np.diff(val_m) <= tol[1:]) & gained[rec_m[1:]]
+    return merged[np.concatenate([[True], ~close])]
+
+
+def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None = None, angular=(False, False)):
+    """:func:`boundaries` of one face: ``(P (N, 2), dP (N, 2), weights (N,), exact)``;
+    ``outer_order(rec)`` is the Gauss order for a p-curve (``(order, exact)``)."""
+    rules = [outer_order(rec) for rec in pcurves]
+    face = (pcurves, [m for m, _ in rules], [ok for _, ok in rules], lines_u, lines_v, tuple(angular))
+    return boundaries([face], table)[0]

@@ -34,7 +34,7 @@ The p-curves are evaluated from data, all of a face's at once
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -44,7 +44,7 @@ from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from .faces import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks
-from .mass_boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
+from .mass_boundary import PIECES, PcurveTable, _boundary, boundaries, _crossings, _spans, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
 from .mass_grid import exact_order, gauss, grid_nodes, inner_nodes, interpolation_points, green_layout
 
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
@@ -106,6 +106,8 @@ class MassFace:
     table: PcurveTable | None = None  # the p-curves as arrays (built once per face)
     # per direction: its breaks are only the eighth turns of an analytic angle (no knot)
     angular: tuple = (False, False)
+    # Gauss nodes on the p-curves per order, when computed for many faces at once
+    boundary: dict = field(default_factory=dict)
 
     @property
     def natural(self) -> bool:
@@ -130,20 +132,27 @@ def _on_box_border(table: PcurveTable, bounds) -> bool:
     """Whether the p-curves run along the face box's border only: a straight p-curve iff
     both of its ends lie on one border line, others at seven samples each (all p-curves
     in one evaluation)."""
-    u0, u1, v0, v1 = bounds
-    tol = np.array([RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)])[[0, 0, 1, 1]]
-    sides = np.array([u0, u1, v0, v1])
+    return bool(np.all(_records_on_box_border(table, np.tile(bounds, (len(table.records), 1)))))
+
+
+def _records_on_box_border(table: PcurveTable, bounds: np.ndarray) -> np.ndarray:
+    """Per record of ``table``: whether it runs along the border of its face box
+    (``bounds`` ``(R, 4)``, per record), see :func:`_on_box_border`."""
+    bounds = np.asarray(bounds, dtype=float)
+    u0, u1, v0, v1 = bounds.T
+    tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
+    tol = tol[:, [0, 0, 1, 1]]
     straight = table.kind == 0
     samples = np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0])  # ends first, then inside
     ranges = np.array([rec["range"] for rec in table.records])
     f, l = ranges[:, :1], ranges[:, 1:]
     t = f + (l - f) * samples  # (R, 7); lines use the first two columns (their ends)
     t[straight, 1] = l[straight, 0]
-    q = table.d1(np.repeat(np.arange(len(ranges)), len(samples)), t.ravel())[:, :2]
-    on = (np.abs(q[:, [0, 0, 1, 1]] - sides) <= tol).reshape(len(ranges), len(samples), 4)
+    q = table.d1(np.repeat(np.arange(len(ranges)), len(samples)), t.ravel())[:, :2].reshape(len(ranges), len(samples), 2)
+    on = np.abs(q[:, :, [0, 0, 1, 1]] - bounds[:, None, :]) <= tol[:, None, :]  # (R, 7, 4)
     lines_ok = np.any(on[:, 0] & on[:, 1], axis=1)
     curves_ok = np.all(np.any(on, axis=2), axis=1)
-    return bool(np.all(np.where(straight, lines_ok, curves_ok)))
+    return np.where(straight, lines_ok, curves_ok)
 
 
 def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
@@ -156,7 +165,33 @@ def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
     return _patch_breaks(face, lo, hi, direction, face.periods[direction]), isinstance(b, str)
 
 
-def mass_face(face, pcurves: list | None = None) -> MassFace:
+def mass_faces(read: list, pcurves: list) -> list:
+    """:func:`mass_face` of every face of a part (``pcurves`` per face, their B-splines'
+    Taylor pieces built); the rectangle test of all faces with curved p-curves runs in
+    one evaluation of one :class:`PcurveTable` (:func:`_on_box_border`, face by face
+    there).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> from surfmod.occ.pcurves import faces_pcurves
+    >>> read = [sm.from_face(f) for f in bd.Cylinder(1, 2).faces()]
+    >>> pcs = faces_pcurves([f.face_shape for f in read])
+    >>> taylor_pieces([r for p in pcs for r in p])
+    >>> [m.natural for m in mass_faces(read, pcs)]
+    [True, False, False]
+    """
+    test = [i for i, pcs in enumerate(pcurves)
+            if pcs and all(rec["wire"] == 0 for rec in pcs) and not all(rec["kind"] == "line" for rec in pcs)]
+    natural = {}
+    if test:
+        records = [rec for i in test for rec in pcurves[i]]
+        counts = [len(pcurves[i]) for i in test]
+        bounds = np.repeat(np.array([[b for r in read[i].domain for b in r] for i in test]), counts, axis=0)
+        ok = _records_on_box_border(PcurveTable(records), bounds)
+        natural = dict(zip(test, np.logical_and.reduceat(ok, np.cumsum([0] + counts[:-1])).tolist()))
+    return [mass_face(f, pcs, natural.get(i)) for i, (f, pcs) in enumerate(zip(read, pcurves))]
+
+
+def mass_face(face, pcurves: list | None = None, natural: bool | None = None) -> MassFace:
     """A :class:`MassFace` for a face read back with :func:`surfmod.from_face` (``pcurves``:
     its :func:`~surfmod.occ.pcurves.face_pcurves`, when already read).
 
@@ -164,6 +199,9 @@ def mass_face(face, pcurves: list | None = None) -> MassFace:
     >>> m = mass_face(sm.from_face(bd.Box(1, 1, 1).faces()[0]))
     >>> m.natural, m.degrees, m.plane
     (True, (1, 1), True)
+
+    ``natural``: whether the face is its whole parameter rectangle, when the caller has
+    tested it already.
     """
     from ..occ.pcurves import face_pcurves
 
@@ -180,7 +218,9 @@ def mass_face(face, pcurves: list | None = None) -> MassFace:
         pcurves = face_pcurves(face.face_shape)
         taylor_pieces(pcurves)
     table = None
-    if not pcurves or any(rec["wire"] != 0 for rec in pcurves):
+    if natural is not None:  # tested by the caller (mass_faces)
+        pass
+    elif not pcurves or any(rec["wire"] != 0 for rec in pcurves):
         natural = False
     elif all(rec["kind"] == "line" for rec in pcurves):  # most natural faces: no table needed
         natural = _lines_on_box_border(pcurves, bounds)
@@ -276,15 +316,42 @@ def _largest_gap(mf: MassFace) -> float:
     return float(d.min(axis=1).max())
 
 
+def _boundary_rule(mf: MassFace, order: int) -> tuple:
+    """The face's entry for :func:`surfmod.uses.mass_boundary.boundaries`: per p-curve the
+    Gauss order and whether it is exact, the break lines and their kind."""
+    orders, exacts = [], []
+    for rec in mf.pcurves:
+        if mf.plane and rec["kind"] == "line":
+            # G is a polynomial of degree 4 in (u, v), affine along the line: 3 nodes are exact
+            orders.append(3)
+            exacts.append(True)
+        else:
+            orders.append(order)
+            exacts.append(False)
+    return mf.pcurves, orders, exacts, mf.breaks[0][1:-1], mf.breaks[1][1:-1], mf.angular
+
+
+def face_boundary(mf: MassFace, order: int):
+    """``(P, dP, weights, exact)``: Gauss nodes on a trimmed face's p-curves (computed
+    now, or taken from :func:`prepare_boundaries`)."""
+    if order in mf.boundary:
+        return mf.boundary.pop(order)  # used once: the estimate pass has its own order
+    return boundaries([_boundary_rule(mf, order)], mf.table)[0]
+
+
+def prepare_boundaries(faces: list, order: int) -> None:
+    """The Gauss nodes on the p-curves of every trimmed face of ``faces`` at ``order``, in
+    one pass for all of them (:func:`surfmod.uses.mass_boundary.boundaries`), kept for
+    :func:`face_nodes` / :func:`surfmod.uses.mass_plane.plane_moments`."""
+    trimmed = [mf for mf in faces if not mf.natural and mf.pcurves]
+    if trimmed:
+        for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed])):
+            mf.boundary[order] = got
+
+
 def _green(mf: MassFace, order: int, orders, exacts):
     """Green's theorem nodes (see the module notes)."""
-    def outer_order(rec):
-        if mf.plane and rec["kind"] == "line":
-            return 3, True  # G is a polynomial of degree 4 in (u, v), affine along the line
-        return order, False
-
-    lines = [mf.breaks[0][1:-1], mf.breaks[1][1:-1]]
-    P, dP, wt, exact = _boundary(mf.pcurves, outer_order, lines[0], lines[1], mf.table, mf.angular)
+    P, dP, wt, exact = face_boundary(mf, order)
     # inner direction: the one with fewer inner nodes per boundary node, where the
     # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
     # the result depends on the direction, and BRepGProp's is u from the box's left edge.

@@ -67,9 +67,8 @@ def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
     points, by the exact antiderivatives of the Chebyshev polynomials,
     ``∫ T_m = (T_{m+1}/(m+1) - T_{m-1}/(m-1)) / 2``."""
     _, _, A = chebyshev(n)
-    theta = np.arccos(np.clip(x1, -1.0, 1.0))
     m = np.arange(n + 1)
-    T = np.cos(np.outer(theta, m))  # (N, n + 1): T_0 .. T_n
+    T = chebyshev_polynomials(np.clip(x1, -1.0, 1.0), n + 1)  # (N, n + 1): T_0 .. T_n
     ends = np.where(m % 2 == 0, 1.0, -1.0)  # T_m(-1)
     I = np.empty((len(x1), n))
     I[:, 0] = T[:, 1] + 1.0
@@ -79,6 +78,41 @@ def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
         k = np.arange(2, n)
         I[:, 2:] = (T[:, 3:] / (k + 1) - T[:, 1:-2] / (k - 1)) / 2 - (ends[3:] / (k + 1) - ends[1:-2] / (k - 1)) / 2
     return I @ A.T
+
+
+def chebyshev_polynomials(y: np.ndarray, count: int) -> np.ndarray:
+    """``(N, count)``: ``T_0(y) .. T_{count-1}(y)`` by the three-term recurrence
+    ``T_{m+1} = 2 y T_m - T_{m-1}`` (stable on ``[-1, 1]``; one vector operation per
+    degree instead of a cosine per entry).
+
+    >>> y = np.array([-1.0, 0.3, 1.0])
+    >>> bool(np.allclose(chebyshev_polynomials(y, 6), np.cos(np.outer(np.arccos(y), np.arange(6))), atol=1e-15))
+    True
+    """
+    T = np.empty((count, len(y)))  # rows contiguous for the recurrence
+    T[0] = 1.0
+    if count > 1:
+        T[1] = y
+    y2 = 2.0 * y
+    for m in range(2, count):
+        np.multiply(y2, T[m - 1], out=T[m])
+        T[m] -= T[m - 2]
+    return T.T
+
+
+def chebyshev_lagrange(y: np.ndarray, n: int) -> np.ndarray:
+    """``(N, n)``: the Lagrange basis of the ``n`` :func:`chebyshev` points at ``y`` (in
+    ``[-1, 1]``), as ``ℓ_j = Σ_m A[j, m] T_m``: :func:`lagrange_values` to round-off, with
+    ``n`` vector operations and one small product instead of several passes over the
+    ``(N, n)`` table.
+
+    >>> x, bw, _ = chebyshev(5)
+    >>> y = np.array([-0.7, 0.1, x[2]])
+    >>> bool(np.abs(chebyshev_lagrange(y, 5) - lagrange_values(y, x, bw)).max() < 1e-14)
+    True
+    """
+    _, _, A = chebyshev(n)
+    return chebyshev_polynomials(y, n) @ A.T
 
 
 def lagrange_values(y: np.ndarray, x: np.ndarray, bw: np.ndarray) -> np.ndarray:
@@ -175,7 +209,8 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
     br, obr = mf.breaks[k], mf.breaks[1 - k]
     n_spans, n_out = len(br) - 1, len(obr) - 1
     a, b = obr[q], obr[q + 1]
-    lt = lagrange_values((2 * P[:, 1 - k] - a - b) / (b - a), xt, bwt) * wb[:, None]  # (N, kt)
+    # boundary nodes reach a hair beyond their cell (GRID_REACH): the polynomial continues
+    lt = chebyshev_lagrange((2 * P[:, 1 - k] - a - b) / (b - a), kt) * wb[:, None]  # (N, kt)
     # whole spans: node n covers spans i < full_n; ∫ over a span of ℓ_j is h/2 · iws_j
     acc = _sum_rows(q * (n_spans + 1) + full, lt, n_out * (n_spans + 1)).reshape(n_out, n_spans + 1, kt)
     whole = np.cumsum(acc[:, ::-1], axis=1)[:, ::-1][:, 1:]  # (Q, S, kt): Σ over nodes with full > i

@@ -13,7 +13,7 @@ the inner integral from the face box's edge ``u0`` exactly as the node-by-node r
 :mod:`surfmod.uses.mass_green` takes it (so a boundary whose p-curves leave gaps gives the
 same result as there), evaluated as ``(u - u0) Σ A^k B^(p-k) / (p + 1)`` without
 cancellation.  The outer integral runs on the same Gauss nodes of the p-curves
-(:func:`surfmod.uses.mass_boundary._boundary`: 3 per straight piece, exact).  Then with
+(:func:`surfmod.uses.mass_boundary.boundaries`: 3 per straight piece, exact).  Then with
 ``x = c + a X + b Y`` the sums are tensor contractions of the moments with ``[c, X, Y]``:
 no surface is evaluated and no inner node is made, one pass for all planar faces of a
 part.
@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mass_boundary import _boundary
 
 # the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
 # product e_i e_j e_k is (T3[i, j, k] = M[_CUBE[i, j, k]]), likewise for fewer factors
@@ -43,14 +42,12 @@ _LINE = np.array([_product_index(i) for i in range(3)])
 def _region_moments(faces: list, foot: np.ndarray, order: int):
     """Per face: the ten moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
     is positive) about its ``foot`` ``(uc, vc)``, and whether every boundary rule was exact."""
-    def outer_order(rec):
-        if rec["kind"] == "line":
-            return 3, True  # degree 4 along a straight p-curve: 3 Gauss nodes are exact
-        return order, False
+    from .mass_green import face_boundary
 
     parts, exact = [], np.ones(len(faces), bool)
     for i, mf in enumerate(faces):
-        P, dP, wt, exact[i] = _boundary(mf.pcurves, outer_order, np.zeros(0), np.zeros(0), mf.table)
+        # 3 Gauss nodes per straight piece: the integrands are of degree 4 along it, exact
+        P, dP, wt, exact[i] = face_boundary(mf, order)
         parts.append((P, wt * dP[:, 1]))
     count = np.array([len(w) for _, w in parts])
     moments = np.zeros((len(faces), len(_POWERS)))
