@@ -114,18 +114,19 @@ class MassFace:
         return self.pcurves is None
 
 
-def _lines_on_box_border(lines: list, bounds) -> bool:
-    """:func:`_on_box_border` of straight p-curves only: both ends of each on one border
-    line (a few array operations, without building a :class:`PcurveTable`)."""
-    u0, u1, v0, v1 = bounds
-    tol = np.array([RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)])[[0, 0, 1, 1]]
-    sides = np.array([u0, u1, v0, v1])
-    o = np.array([rec["origin"] for rec in lines])
-    d = np.array([rec["direction"] for rec in lines])
-    r = np.array([rec["range"] for rec in lines])
-    ends = np.concatenate([o + r[:, :1] * d, o + r[:, 1:] * d])[:, [0, 0, 1, 1]]
-    on = np.abs(ends - sides) <= tol
-    return bool(np.all(np.any(on[: len(lines)] & on[len(lines):], axis=1)))
+def _lines_on_box_border(lines: list, bounds: np.ndarray) -> np.ndarray:
+    """:func:`_records_on_box_border` of straight p-curves only (``bounds`` ``(R, 4)``, per
+    record): both ends of each on one border line, a few array operations for all of them
+    without a :class:`PcurveTable`."""
+    bounds = np.asarray(bounds, dtype=float)
+    u0, u1, v0, v1 = bounds.T
+    tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
+    tol = tol[:, [0, 0, 1, 1]]
+    data = np.array([np.concatenate([rec["origin"], rec["direction"], rec["range"]]) for rec in lines])
+    o, d, r = data[:, :2], data[:, 2:4], data[:, 4:]
+    first = np.abs((o + r[:, :1] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
+    last = np.abs((o + r[:, 1:] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
+    return np.any(first & last, axis=1)
 
 
 def _on_box_border(table: PcurveTable, bounds) -> bool:
@@ -160,6 +161,8 @@ def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
     merging: equal pieces of at most an eighth turn, the same points) and whether the
     direction is an analytic angle (its breaks are no knots)."""
     b = direction_breaks(face, direction)
+    if b is None and hi - lo > 1e-9:  # one polynomial piece (planes, axes of cylinders)
+        return np.array([lo, hi]), False
     if isinstance(b, str) and hi - lo > 1e-9:
         return np.linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1), True
     return _patch_breaks(face, lo, hi, direction, face.periods[direction]), isinstance(b, str)
@@ -179,16 +182,18 @@ def mass_faces(read: list, pcurves: list) -> list:
     >>> [m.natural for m in mass_faces(read, pcs)]
     [True, False, False]
     """
-    test = [i for i, pcs in enumerate(pcurves)
-            if pcs and all(rec["wire"] == 0 for rec in pcs) and not all(rec["kind"] == "line" for rec in pcs)]
-    natural = {}
-    if test:
-        records = [rec for i in test for rec in pcurves[i]]
-        counts = [len(pcurves[i]) for i in test]
-        bounds = np.repeat(np.array([[b for r in read[i].domain for b in r] for i in test]), counts, axis=0)
-        ok = _records_on_box_border(PcurveTable(records), bounds)
-        natural = dict(zip(test, np.logical_and.reduceat(ok, np.cumsum([0] + counts[:-1])).tolist()))
-    return [mass_face(f, pcs, natural.get(i)) for i, (f, pcs) in enumerate(zip(read, pcurves))]
+    one_wire = [i for i, pcs in enumerate(pcurves) if pcs and all(rec["wire"] == 0 for rec in pcs)]
+    straight = [i for i in one_wire if all(rec["kind"] == "line" for rec in pcurves[i])]
+    curved = sorted(set(one_wire) - set(straight))
+    natural = {i: False for i in range(len(read))}
+    for test, check in ((straight, _lines_on_box_border), (curved, _records_on_box_border)):
+        if test:
+            records = [rec for i in test for rec in pcurves[i]]
+            counts = [len(pcurves[i]) for i in test]
+            bounds = np.repeat(np.array([[b for r in read[i].domain for b in r] for i in test]), counts, axis=0)
+            ok = check(records if check is _lines_on_box_border else PcurveTable(records), bounds)
+            natural.update(zip(test, np.logical_and.reduceat(ok, np.cumsum([0] + counts[:-1])).tolist()))
+    return [mass_face(f, pcs, natural[i]) for i, (f, pcs) in enumerate(zip(read, pcurves))]
 
 
 def mass_face(face, pcurves: list | None = None, natural: bool | None = None) -> MassFace:
@@ -223,7 +228,7 @@ def mass_face(face, pcurves: list | None = None, natural: bool | None = None) ->
     elif not pcurves or any(rec["wire"] != 0 for rec in pcurves):
         natural = False
     elif all(rec["kind"] == "line" for rec in pcurves):  # most natural faces: no table needed
-        natural = _lines_on_box_border(pcurves, bounds)
+        natural = bool(np.all(_lines_on_box_border(pcurves, np.tile(bounds, (len(pcurves), 1)))))
     else:
         table = PcurveTable(pcurves)
         natural = _on_box_border(table, bounds)
