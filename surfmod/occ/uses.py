@@ -412,6 +412,6 @@ def write_brep(shape, path) -> None:
 
 __all__ = [
     "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
-    "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
+    "elementary_faces", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
     "model_tolerance", "planar_faces_on", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

@@ -44,13 +44,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import checks
-from ..construct.elementary import (ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface,
-                                    ToroidalSurface)
+from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface, ToroidalSurface
 from ..errors import SurfmodError
 from ..readback import from_face
+from ..readback.trimmed import TrimmedFace, _periods
 from ..surface import Surface
 from .inputs import to_shape
-from .mass_green import face_nodes, mass_face, mass_faces, plane_nodes, prepare_boundaries, surface_mass_face, taylor_pieces
+from .mass_green import (
+    face_nodes,
+    mass_face,
+    mass_faces,
+    plane_nodes,
+    prepare_boundaries,
+    surface_mass_face,
+    taylor_pieces,
+)
 from .mass_plane import plane_moments
 
 
@@ -194,7 +202,6 @@ def _read_faces(shapes: list) -> list:
     elementary ones (planes, cylinders, cones, spheres, tori: most faces of real parts)
     built from one pass over their OCCT data (:func:`surfmod.occ.uses.elementary_faces`)."""
     from ..occ import uses as occ
-    from ..readback.trimmed import TrimmedFace, _periods
 
     out = []
     for shape, data in zip(shapes, occ.elementary_faces(shapes)):
@@ -255,9 +262,8 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         if _moments(*face_nodes(faces[0], order)[:2], ref)[1] < 0:
             faces[0].sign = -1.0
     else:
-        from ..occ.topo import faces_of
-
         from ..occ.pcurves import faces_pcurves
+        from ..occ.topo import faces_of
 
         read = _read_faces(faces_of(solid))
         pcurves = faces_pcurves([f.face_shape for f in read])  # B-splines in one table

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..eval.basis import basis_derivatives
+from .faces import ANGULAR_PIECE
 from .mass_grid import gauss
 
 #: curved p-curves are cut into at least this many pieces before Gauss
@@ -119,7 +120,7 @@ def taylor_pieces(records: list) -> None:
         basis = basis_derivatives(all_knots, p, span, mid, p)  # (S, p+1 derivatives, p+1 functions)
         local_ctrl = all_ctrl[first[:, None] + np.arange(p + 1)]  # (S, p+1, 3)
         fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
-        coef = np.einsum("skr,srd->skd", basis, local_ctrl) / fact[None, :, None]
+        coef = np.matmul(basis, local_ctrl) / fact[None, :, None]  # Σ_r basis_skr ctrl_srd
         cuts = np.searchsorted(rec_of, np.arange(len(group) + 1))
         for i, rec in enumerate(group):
             lo, hi = cuts[i], cuts[i + 1]
@@ -327,8 +328,6 @@ def _long_pieces(table: PcurveTable, owner, a, b, directions) -> np.ndarray:
     (``ANGULAR_PIECE``) along their angular directions (``directions``: ``(pieces, 2)``
     booleans): a bound from the span's own polynomial, ``2 Σ_k |c_k| r^k`` (``r`` the reach
     from its centre); every piece of a rational or non-spline p-curve counts as long."""
-    from .faces import ANGULAR_PIECE
-
     long = np.ones(len(owner), bool)
     spline = table.kind[owner] == 2
     spline[spline] = np.array([table.records[r]["weights"] is None for r in owner[spline]], bool)
@@ -443,7 +442,8 @@ def _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges):
             extra_keys.append(i + 1j * x)
     inner = (rec_of[:-1] == rec_of[1:]) & (table.kind[rec_of[:-1]] >= 2)
     owner, a, b = rec_of[:-1][inner], val[:-1][inner], val[1:][inner]
-    has_lines = np.array([len(lines_u[k]) + len(lines_v[k]) > 0 for k in face_of[owner]], bool)
+    face_has_lines = np.array([len(u) + len(v) > 0 for u, v in zip(lines_u, lines_v)], bool)
+    has_lines = face_has_lines[face_of[owner]]
     owner, a, b = owner[has_lines], a[has_lines], b[has_lines]
     if len(owner):
         scale = np.abs(ranges[owner, 1] - ranges[owner, 0])
@@ -459,7 +459,7 @@ def _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges):
             if not any(len(r) for r in rows):
                 continue
             lines, coord = _padded(rows, n_faces, np.nan), _padded(coords, n_faces, 0).astype(int)
-            sel = np.array([len(rows[k]) > 0 for k in piece_face], bool)
+            sel = np.array([len(r) > 0 for r in rows], bool)[piece_face]
             if turn:
                 sel[sel] = _long_pieces(table, owner[sel], a[sel], b[sel], angular[piece_face[sel]])
             if sel.any():

@@ -39,13 +39,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..construct.curves import Line
-from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface
+from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from .faces import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks
-from .mass_boundary import PIECES, PcurveTable, _boundary, boundaries, _crossings, _spans, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
-from .mass_grid import exact_order, gauss, grid_nodes, inner_nodes, interpolation_points, green_layout
+from .mass_boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
+from .mass_grid import exact_order, gauss, green_layout, grid_nodes, inner_nodes, interpolation_points
 
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
 RECTANGLE_RTOL = 1e-7
@@ -390,7 +390,10 @@ def _green(mf: MassFace, order: int, orders, exacts):
     else:
         g, rest = (np.zeros(0),) * 3, np.ones(len(P), bool)
         exact = exact and exacts[k]
-    n = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
-    s, other, ws = (np.concatenate([a, b]) for a, b in zip(g, n))
+    if rest.any():
+        n = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
+        s, other, ws = (np.concatenate([a, b]) for a, b in zip(g, n))
+    else:  # every node on a grid
+        s, other, ws = g
     ders = mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1)
     return ders, ws, exact

@@ -204,7 +204,7 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
     whatever the number of boundary nodes."""
     ks, kt = counts
     xs = chebyshev(ks)[0]
-    xt, bwt, _ = chebyshev(kt)
+    xt = chebyshev(kt)[0]
     iws = _GAUSS[("span integral", ks)]  # ∫_{-1}^{1} ℓ_j
     br, obr = mf.breaks[k], mf.breaks[1 - k]
     n_spans, n_out = len(br) - 1, len(obr) - 1

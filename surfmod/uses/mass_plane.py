@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .mass_green import face_boundary
 
 # the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
 # product e_i e_j e_k is (T3[i, j, k] = M[_CUBE[i, j, k]]), likewise for fewer factors
@@ -42,8 +43,6 @@ _LINE = np.array([_product_index(i) for i in range(3)])
 def _region_moments(faces: list, foot: np.ndarray, order: int):
     """Per face: the ten moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
     is positive) about its ``foot`` ``(uc, vc)``, and whether every boundary rule was exact."""
-    from .mass_green import face_boundary
-
     parts, exact = [], np.ones(len(faces), bool)
     for i, mf in enumerate(faces):
         # 3 Gauss nodes per straight piece: the integrands are of degree 4 along it, exact
