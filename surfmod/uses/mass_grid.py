@@ -66,7 +66,13 @@ def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
     """``(N, n)``: ``∫_{-1}^{x1} ℓ_j`` for the Lagrange basis ``ℓ_j`` of :func:`chebyshev`
     points, by the exact antiderivatives of the Chebyshev polynomials,
     ``∫ T_m = (T_{m+1}/(m+1) - T_{m-1}/(m-1)) / 2``."""
-    _, _, A = chebyshev(n)
+    return chebyshev_antiderivatives(x1, n) @ chebyshev(n)[2].T
+
+
+def chebyshev_antiderivatives(x1: np.ndarray, n: int) -> np.ndarray:
+    """``(N, n)``: ``∫_{-1}^{x1} T_m`` for ``m < n`` (:func:`antiderivative_weights` before
+    the change to the Lagrange basis, which callers summing over many ``x1`` apply once to
+    the sum)."""
     m = np.arange(n + 1)
     T = chebyshev_polynomials(np.clip(x1, -1.0, 1.0), n + 1)  # (N, n + 1): T_0 .. T_n
     ends = np.where(m % 2 == 0, 1.0, -1.0)  # T_m(-1)
@@ -77,7 +83,7 @@ def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
     if n > 2:
         k = np.arange(2, n)
         I[:, 2:] = (T[:, 3:] / (k + 1) - T[:, 1:-2] / (k - 1)) / 2 - (ends[3:] / (k + 1) - ends[1:-2] / (k - 1)) / 2
-    return I @ A.T
+    return I
 
 
 def chebyshev_polynomials(y: np.ndarray, count: int) -> np.ndarray:
@@ -98,21 +104,6 @@ def chebyshev_polynomials(y: np.ndarray, count: int) -> np.ndarray:
         np.multiply(y2, T[m - 1], out=T[m])
         T[m] -= T[m - 2]
     return T.T
-
-
-def chebyshev_lagrange(y: np.ndarray, n: int) -> np.ndarray:
-    """``(N, n)``: the Lagrange basis of the ``n`` :func:`chebyshev` points at ``y`` (in
-    ``[-1, 1]``), as ``ℓ_j = Σ_m A[j, m] T_m``: :func:`lagrange_values` to round-off, with
-    ``n`` vector operations and one small product instead of several passes over the
-    ``(N, n)`` table.
-
-    >>> x, bw, _ = chebyshev(5)
-    >>> y = np.array([-0.7, 0.1, x[2]])
-    >>> bool(np.abs(chebyshev_lagrange(y, 5) - lagrange_values(y, x, bw)).max() < 1e-14)
-    True
-    """
-    _, _, A = chebyshev(n)
-    return chebyshev_polynomials(y, n) @ A.T
 
 
 def lagrange_values(y: np.ndarray, x: np.ndarray, bw: np.ndarray) -> np.ndarray:
@@ -209,10 +200,14 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
     br, obr = mf.breaks[k], mf.breaks[1 - k]
     n_spans, n_out = len(br) - 1, len(obr) - 1
     a, b = obr[q], obr[q + 1]
-    # boundary nodes reach a hair beyond their cell (GRID_REACH): the polynomial continues
-    lt = chebyshev_lagrange((2 * P[:, 1 - k] - a - b) / (b - a), kt) * wb[:, None]  # (N, kt)
+    # the outer Lagrange basis ℓ_l = Σ_m At[l, m] T_m is linear: sums over nodes are taken
+    # in the Chebyshev basis (N x kt) and changed to the Lagrange basis once per cell.
+    # Boundary nodes reach a hair beyond their cell (GRID_REACH): the polynomial continues
+    At, As = chebyshev(kt)[2], chebyshev(ks)[2]
+    tw = chebyshev_polynomials((2 * P[:, 1 - k] - a - b) / (b - a), kt) * wb[:, None]  # (N, kt)
     # whole spans: node n covers spans i < full_n; ∫ over a span of ℓ_j is h/2 · iws_j
-    acc = _sum_rows(q * (n_spans + 1) + full, lt, n_out * (n_spans + 1)).reshape(n_out, n_spans + 1, kt)
+    acc = _sum_rows(q * (n_spans + 1) + full, tw, n_out * (n_spans + 1)) @ At.T
+    acc = acc.reshape(n_out, n_spans + 1, kt)
     whole = np.cumsum(acc[:, ::-1], axis=1)[:, ::-1][:, 1:]  # (Q, S, kt): Σ over nodes with full > i
     h = np.diff(br)
     omega = (h / 2)[None, :, None, None] * iws[None, None, :, None] * whole[:, :, None, :]
@@ -221,14 +216,15 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
         # partial span f: ∫_{br_f}^{u_n} ℓ_j, exactly
         f = full[rows]
         x1 = (2 * P[rows, k] - br[f] - br[f + 1]) / h[f]  # in (-1, 1)
-        c = antiderivative_weights(x1, ks) * (h[f] / 2)[:, None]  # (n, ks)
+        c = chebyshev_antiderivatives(x1, ks) * (h[f] / 2)[:, None]  # (n, ks), Chebyshev basis
         cell = q[rows] * n_spans + f
         order = np.argsort(cell, kind="stable")
-        cell, c, lp = cell[order], c[order], lt[rows[order]]
+        cell, c, lp = cell[order], c[order], tw[rows[order]]
         cuts = np.flatnonzero(np.diff(cell)) + 1
+        starts = np.concatenate([[0], cuts])
+        M = np.stack([c[lo:hi].T @ lp[lo:hi] for lo, hi in zip(starts, np.concatenate([cuts, [len(cell)]]))])
         flat = omega.reshape(n_out * n_spans, ks, kt)
-        for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(cell)]])):
-            flat[cell[lo]] += c[lo:hi].T @ lp[lo:hi]  # Σ_n c_nj lt_nl, one product per cell
+        flat[cell[starts]] += As @ M @ At.T  # Σ_n c_nj lt_nl per cell, in the Lagrange bases
     qi, si = np.nonzero(np.any(omega != 0.0, axis=(2, 3)))
     s = ((br[si] + br[si + 1])[:, None] / 2 + (h[si] / 2)[:, None] * xs)  # (C, ks)
     t = ((obr[qi] + obr[qi + 1])[:, None] / 2 + ((obr[qi + 1] - obr[qi]) / 2)[:, None] * xt)  # (C, kt)
