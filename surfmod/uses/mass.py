@@ -47,7 +47,7 @@ from .. import checks
 from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface, ToroidalSurface
 from ..errors import SurfmodError
 from ..readback import from_face
-from ..readback.trimmed import TrimmedFace, _periods
+from ..readback.trimmed import TrimmedFace
 from ..surface import Surface
 from .inputs import to_shape
 from .mass_green import (
@@ -211,8 +211,24 @@ def _read_faces(shapes: list) -> list:
         name, geom, bounds, reversed_, frame, radii = data
         u0, u1, v0, v1 = bounds
         surface = _ELEMENTARY[name]._trusted(frame, radii, (u0, u1), (v0, v1))
-        out.append(TrimmedFace(surface, shape, geom, bounds, _periods(geom, surface), reversed_))
+        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(name, bounds), reversed_))
     return out
+
+
+# which directions of OCCT's elementary surfaces are periodic (``IsUPeriodic``/``IsVPeriodic``;
+# the period is 2π): what readback's ``_periods`` asks the surface, without asking
+_PERIODIC = {"Geom_Plane": (False, False), "Geom_CylindricalSurface": (True, False),
+             "Geom_ConicalSurface": (True, False), "Geom_SphericalSurface": (True, False),
+             "Geom_ToroidalSurface": (True, True)}
+
+
+def _elementary_periods(name: str, bounds) -> tuple:
+    """readback's ``_periods`` of an elementary surface over ``bounds``: 2π where the
+    direction is periodic and the face spans one whole period, else None."""
+    period = 2 * np.pi
+    spans = (bounds[1] - bounds[0], bounds[3] - bounds[2])
+    return tuple(period if periodic and abs(span - period) <= 1e-9 * period else None
+                 for periodic, span in zip(_PERIODIC[name], spans))
 
 
 def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str = "numpy",

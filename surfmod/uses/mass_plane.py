@@ -95,9 +95,12 @@ def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]
     sign = np.array([mf.sign for mf in faces])
     n = sign[:, None] * np.cross(ex, ey)
     T1, T2, T3 = M[:, _LINE], M[:, _SQUARE], M[:, _CUBE]
-    X1 = np.einsum("fip,fp->fi", frame, T1)
-    X2 = np.einsum("fip,fiq,fpq->fi", frame, frame, T2)  # ∫ x_i²
-    X3 = np.einsum("fip,fiq,fjr,fpqr->fij", frame, frame, frame, T3)  # ∫ x_i² x_j
+    X1 = (frame @ T1[:, :, None])[:, :, 0]  # ∫ x_i
+    X2 = np.sum((frame @ T2) * frame, axis=2)  # ∫ x_i² = Σ_pq F_ip F_iq T2_pq
+    # ∫ x_i² x_j = Σ_pqr F_ip F_iq F_jr T3_pqr, as three batched products
+    Y = T3 @ frame.transpose(0, 2, 1)[:, None]  # (F, p, q, j)
+    Z = (frame @ Y.reshape(len(faces), 3, 9)).reshape(len(faces), 3, 3, 3)  # (F, i, q, j)
+    X3 = np.sum(frame[:, :, :, None] * Z, axis=2)  # (F, i, j)
     out = np.empty((len(faces), 14))
     out[:, 0] = np.linalg.norm(np.cross(ex, ey), axis=1) * M[:, 0]
     out[:, 1] = np.sum(n * X1, axis=1) / 3.0
