@@ -379,17 +379,22 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
     live = l_all > f_all
     # cuts of every live record, as one array sorted by (record, parameter): complex keys
     # record + 1j * t sort lexicographically, so np.unique merges each record's own breaks
-    keys = []
-    for i in np.flatnonzero(live):
-        rec, f, l = records[i], f_all[i], l_all[i]
-        if table.kind[i] == 0:
-            keys.append(i + 1j * np.array([f, l]))
-        elif table.kind[i] == 1:  # one smooth interval: its breaks are its ends
-            keys.append(i + 1j * np.linspace(f, l, PIECES + 1))
-        else:
-            br = np.concatenate([rec["breaks"], np.linspace(f, l, PIECES + 1)])
-            keys.append(i + 1j * br[(br >= f) & (br <= l)])
-    cuts = np.unique(np.concatenate(keys))
+    # lines: their ends; circles (one smooth interval) and curved p-curves: PIECES equal
+    # pieces, the curved ones also cut at their own breaks (knots) inside the range
+    idx = np.flatnonzero(live)
+    straight = table.kind[idx] == 0
+    frac = np.linspace(0.0, 1.0, PIECES + 1)
+    f, l = f_all[idx, None], l_all[idx, None]
+    even = f + (l - f) * frac
+    even[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it
+    even[straight, 1:-1] = np.nan  # a line's pieces: just its ends
+    curved = idx[table.kind[idx] >= 2]
+    breaks = [records[i]["breaks"] for i in curved]
+    b_rec = np.repeat(curved, [len(b) for b in breaks])
+    b_val = np.concatenate(breaks) if breaks else np.zeros(0)
+    inside = (b_val >= f_all[b_rec]) & (b_val <= l_all[b_rec])
+    keys = np.concatenate([(idx[:, None] + 1j * even).ravel(), b_rec[inside] + 1j * b_val[inside]])
+    cuts = np.unique(keys[~np.isnan(keys.imag)])
     lines_u = [np.asarray(face[3], float) for face in faces]
     lines_v = [np.asarray(face[4], float) for face in faces]
     angular = np.array([face[5] for face in faces], bool).reshape(len(faces), 2)
