@@ -393,6 +393,17 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
     b_rec = np.repeat(curved, [len(b) for b in breaks])
     b_val = np.concatenate(breaks) if breaks else np.zeros(0)
     inside = (b_val >= f_all[b_rec]) & (b_val <= l_all[b_rec])
+    # a curved p-curve whose own breaks already cut it into pieces of at most 1/PIECES of
+    # its range needs no equal pieces on top (they would only add nodes)
+    fine = np.zeros(len(records), bool)
+    if len(curved):
+        longest = np.zeros(len(records))
+        ends = np.concatenate([b_rec[inside] + 1j * b_val[inside], curved + 1j * f_all[curved], curved + 1j * l_all[curved]])
+        ends = np.unique(ends)
+        same = ends.real[1:] == ends.real[:-1]
+        np.maximum.at(longest, ends.real[1:][same].astype(int), np.diff(ends.imag)[same])
+        fine[curved] = longest[curved] <= (l_all[curved] - f_all[curved]) / PIECES * (1 + 1e-12)
+    even[fine[idx], 1:-1] = np.nan
     keys = np.concatenate([(idx[:, None] + 1j * even).ravel(), b_rec[inside] + 1j * b_val[inside]])
     cuts = np.unique(keys[~np.isnan(keys.imag)])
     lines_u = [np.asarray(face[3], float) for face in faces]
