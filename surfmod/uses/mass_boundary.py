@@ -365,6 +365,13 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
 
     The records of all faces are laid end to end: their cuts, crossings, Newton steps and
     Gauss nodes are found with a few array passes for the whole part, not per face.
+
+    >>> import build123d as bd
+    >>> from surfmod.occ.pcurves import face_pcurves
+    >>> disc = face_pcurves(bd.Face(bd.Wire.make_circle(1.0)).wrapped)
+    >>> ((P, dP, w, exact),) = boundaries([(disc, [12], [False], [], [], (False, False))])
+    >>> P.shape, round(float(np.sum(w * P[:, 0] * dP[:, 1])), 12), exact  # ∮ u dv = area
+    ((48, 2), 3.14159265359, False)
     """
     records = [rec for face in faces for rec in face[0]]
     counts = [len(face[0]) for face in faces]

@@ -338,7 +338,14 @@ def _boundary_rule(mf: MassFace, order: int) -> tuple:
 
 def face_boundary(mf: MassFace, order: int):
     """``(P, dP, weights, exact)``: Gauss nodes on a trimmed face's p-curves (computed
-    now, or taken from :func:`prepare_boundaries`)."""
+    now, or taken from :func:`prepare_boundaries`).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> disc = mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(1.0))))
+    >>> P, dP, w, exact = face_boundary(disc, 12)
+    >>> len(w), exact
+    (48, False)
+    """
     if order in mf.boundary:
         return mf.boundary.pop(order)  # used once: the estimate pass has its own order
     return boundaries([_boundary_rule(mf, order)], mf.table)[0]
@@ -347,7 +354,14 @@ def face_boundary(mf: MassFace, order: int):
 def prepare_boundaries(faces: list, order: int) -> None:
     """The Gauss nodes on the p-curves of every trimmed face of ``faces`` at ``order``, in
     one pass for all of them (:func:`surfmod.uses.mass_boundary.boundaries`), kept for
-    :func:`face_nodes` / :func:`surfmod.uses.mass_plane.plane_moments`."""
+    :func:`face_nodes` / :func:`surfmod.uses.mass_plane.plane_moments`.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> faces = [mass_face(sm.from_face(f)) for f in (bd.Box(4, 4, 2) - bd.Cylinder(1, 2)).faces()]
+    >>> prepare_boundaries(faces, 12)
+    >>> sorted(len(f.boundary) for f in faces)
+    [0, 0, 0, 0, 0, 1, 1]
+    """
     trimmed = [mf for mf in faces if not mf.natural and mf.pcurves]
     if trimmed:
         for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed])):

@@ -72,7 +72,11 @@ def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
 def chebyshev_antiderivatives(x1: np.ndarray, n: int) -> np.ndarray:
     """``(N, n)``: ``∫_{-1}^{x1} T_m`` for ``m < n`` (:func:`antiderivative_weights` before
     the change to the Lagrange basis, which callers summing over many ``x1`` apply once to
-    the sum)."""
+    the sum).
+
+    >>> chebyshev_antiderivatives(np.array([1.0, 0.0]), 3).round(12).tolist()  # ∫ 1, ∫ x, ∫ 2x² - 1
+    [[2.0, 0.0, -0.666666666667], [1.0, -0.5, -0.333333333333]]
+    """
     m = np.arange(n + 1)
     T = chebyshev_polynomials(np.clip(x1, -1.0, 1.0), n + 1)  # (N, n + 1): T_0 .. T_n
     ends = np.where(m % 2 == 0, 1.0, -1.0)  # T_m(-1)
