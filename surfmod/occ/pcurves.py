@@ -5,8 +5,9 @@ the face (``-1`` for a reversed edge), the breaks of its ``GeomAbs_CN`` interval
 the 2-D curve itself -- a line (origin, direction), a circle (centre, axes, radius), a
 B-spline (poles, weights, flat knots, degree) or any other type, which
 :func:`adaptor_d1` samples point by point through the record's OCCT ``adaptor``.  Lines, circles and B-splines are then
-evaluated for all Gauss nodes at once (:mod:`surfmod.uses.mass_green`), instead of one
-``Geom2dAdaptor.D1`` call per node.
+evaluated for all Gauss nodes at once (:mod:`surfmod.uses.mass_boundary`), instead of one
+``Geom2dAdaptor.D1`` call per node; :func:`faces_pcurves` reads the B-spline p-curves
+of many faces through one binary table.
 """
 
 from __future__ import annotations
@@ -54,47 +55,70 @@ def face_pcurves(face) -> list[dict]:
     >>> [(p["kind"], p["sign"]) for p in pcs]
     [('circle', 1.0)]
     """
-    out = []
+    return faces_pcurves([face])[0]
+
+
+def faces_pcurves(faces: list) -> list[list[dict]]:
+    """:func:`face_pcurves` of many faces (a part's), their B-spline p-curves read through
+    one binary table for all of them rather than one per face.
+
+    >>> import build123d as bd
+    >>> box = bd.Box(1, 2, 3)
+    >>> [len(pcs) for pcs in faces_pcurves([f.wrapped for f in box.faces()])]
+    [4, 4, 4, 4, 4, 4]
+    """
+    splines, lines, out = [], [], []
     with kernel("BRepAdaptor_Curve2d (face p-curves)"):
-        edges = [(i, e) for i, wire in enumerate(explore(face, TopAbs_WIRE)) for e in explore(wire, TopAbs_EDGE)]
-        to_edge = TopoDS.Edge_s
-        splines = []
-        for wire_index, e in edges:
+        for face in faces:
+            out.append(_face_records(face, splines, lines))
+        for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
+            rec.update(kind="bspline", **data)
+    if lines:  # every straight p-curve's data in one array (rows are views: no array per line)
+        data = np.array([d for _, d in lines])  # (L, 6): origin, direction, range
+        for k, (rec, _) in enumerate(lines):
+            rec["origin"], rec["direction"], rec["breaks"] = data[k, :2], data[k, 2:4], data[k, 4:]
+    return out
+
+
+def _face_records(face, splines: list, lines: list) -> list[dict]:
+    """The records of :func:`face_pcurves` of one face.  Non-periodic B-spline p-curves
+    are appended to ``splines`` as ``(record, curve)``, straight ones to ``lines`` as
+    ``(record, (origin, direction, range))``, for the caller to read in bulk."""
+    out = []
+    to_edge = TopoDS.Edge_s
+    for wire_index, wire in enumerate(explore(face, TopAbs_WIRE)):
+        for e in explore(wire, TopAbs_EDGE):
             edge = to_edge(e)
             pc = BRepAdaptor_Curve2d(edge, face)
             f, l = pc.FirstParameter(), pc.LastParameter()
             kind = pc.GetType()
-            if kind in (GeomAbs_Line, GeomAbs_Circle):  # analytic: one smooth interval
-                breaks = np.array([f, l])
-            else:
-                n = pc.NbIntervals(GeomAbs_CN)
-                arr = TColStd_Array1OfReal(1, n + 1)
-                pc.Intervals(arr, GeomAbs_CN)
-                breaks = np.array([arr.Value(i) for i in range(1, n + 2)])
             rec = {
                 "wire": wire_index,
                 "range": (f, l),
                 "sign": -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0,
-                "breaks": breaks,
                 "adaptor": pc,
             }
-            if kind == GeomAbs_Line:
+            if kind == GeomAbs_Line:  # analytic: one smooth interval, its ends
                 lin = pc.Line()
-                rec.update(kind="line", origin=_xy(lin.Location()), direction=_xy(lin.Direction()))
+                rec["kind"] = "line"
+                lines.append((rec, lin.Location().Coord() + lin.Direction().Coord() + (f, l)))
             elif kind == GeomAbs_Circle:
                 c = pc.Circle()
                 ax = c.Position()
-                rec.update(kind="circle", centre=_xy(ax.Location()), x=_xy(ax.XDirection()),
+                rec.update(kind="circle", breaks=np.array([f, l]), centre=_xy(ax.Location()), x=_xy(ax.XDirection()),
                            y=_xy(ax.YDirection()), radius=c.Radius())
-            elif kind == GeomAbs_BSplineCurve and not (b := pc.BSpline()).IsPeriodic():
-                splines.append((rec, b))  # read below, all in one binary table
-            elif kind == GeomAbs_BSplineCurve and (data := _bspline_data(pc)) is not None:
-                rec.update(kind="bspline", **data)
             else:
-                rec.update(kind="other")
+                n = pc.NbIntervals(GeomAbs_CN)
+                arr = TColStd_Array1OfReal(1, n + 1)
+                pc.Intervals(arr, GeomAbs_CN)
+                rec["breaks"] = np.array([arr.Value(i) for i in range(1, n + 2)])
+                if kind == GeomAbs_BSplineCurve and not (b := pc.BSpline()).IsPeriodic():
+                    splines.append((rec, b))  # read by the caller, all in one binary table
+                elif kind == GeomAbs_BSplineCurve and (data := _bspline_data(pc)) is not None:
+                    rec.update(kind="bspline", **data)
+                else:
+                    rec.update(kind="other")
             out.append(rec)
-        for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
-            rec.update(kind="bspline", **data)
     return out
 
 

@@ -170,6 +170,56 @@ def bounding_box(shape) -> np.ndarray:
 
 
 # -- per-face data for the NumPy quadrature ---------------------------------------------
+_ELEMENTARY = ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface", "Geom_SphericalSurface",
+               "Geom_ToroidalSurface")
+
+
+def elementary_faces(faces) -> list:
+    """Per ``TopoDS_Face`` of ``faces`` (a part's, for the mass integrals): ``None`` unless
+    its surface is a plane, cylinder, cone, sphere or torus, else ``(type name, located
+    surface handle, (u0, u1, v0, v1), reversed, frame (4, 3), radii)`` -- what
+    :func:`surfmod.from_face` reads for it (the same OCCT calls and values), without its
+    general dispatch, which costs more than the reading on parts of many small faces.
+
+    >>> import build123d as bd
+    >>> [(d[0], d[5]) for d in elementary_faces([f.wrapped for f in bd.Cylinder(1, 2).faces()])]
+    [('Geom_CylindricalSurface', (1.0,)), ('Geom_Plane', ()), ('Geom_Plane', ())]
+    """
+    import OCP.Geom as G
+    from OCP.BRepTools import BRepTools
+
+    surface_of, uv_bounds = BRep_Tool.Surface_s, BRepTools.UVBounds_s
+    out, frames = [], []
+    with kernel("reading elementary faces"):
+        for face in faces:
+            surf = surface_of(face)
+            name = surf.DynamicType().Name()
+            if name not in _ELEMENTARY:
+                out.append(None)
+                continue
+            cls = getattr(G, name)  # OCP hands back the derived type already (no DownCast)
+            geom = cls.DownCast(surf) if hasattr(cls, "DownCast") else surf
+            pos = geom.Position()
+            frames.append(pos.Location().Coord() + pos.XDirection().Coord() + pos.YDirection().Coord()
+                          + pos.Direction().Coord())
+            if name == "Geom_Plane":
+                radii = ()
+            elif name == "Geom_ConicalSurface":
+                radii = (geom.RefRadius(), geom.SemiAngle())
+            elif name == "Geom_ToroidalSurface":
+                radii = (geom.MajorRadius(), geom.MinorRadius())
+            else:
+                radii = (geom.Radius(),)
+            out.append([name, geom, uv_bounds(face), face.Orientation() == TopAbs_REVERSED, None, radii])
+    frames = np.array(frames).reshape(-1, 4, 3)  # one array for all frames
+    k = 0
+    for d in out:
+        if d is not None:
+            d[4] = frames[k]
+            k += 1
+    return [None if d is None else tuple(d) for d in out]
+
+
 def is_rectangle(face, bounds) -> bool:
     """True when every edge's p-curve lies on the border of the face's UV box (one wire)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
@@ -362,6 +412,6 @@ def write_brep(shape, path) -> None:
 
 __all__ = [
     "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
-    "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
+    "elementary_faces", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
     "model_tolerance", "planar_faces_on", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

@@ -44,11 +44,22 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import checks
+from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface, ToroidalSurface
 from ..errors import SurfmodError
 from ..readback import from_face
+from ..readback.trimmed import TrimmedFace
 from ..surface import Surface
 from .inputs import to_shape
-from .mass_green import face_nodes, mass_face, plane_nodes, surface_mass_face, taylor_pieces
+from .mass_green import (
+    face_nodes,
+    mass_face,
+    mass_faces,
+    plane_nodes,
+    prepare_boundaries,
+    surface_mass_face,
+    taylor_pieces,
+)
+from .mass_plane import plane_moments
 
 
 @dataclass(frozen=True)
@@ -180,6 +191,46 @@ def _finish(total: np.ndarray, ref: np.ndarray, density: float):
     return float(vol), float(area), ref + c, inertia
 
 
+_ELEMENTARY = {
+    "Geom_Plane": PlaneSurface, "Geom_CylindricalSurface": CylindricalSurface, "Geom_ConicalSurface": ConicalSurface,
+    "Geom_SphericalSurface": SphericalSurface, "Geom_ToroidalSurface": ToroidalSurface,
+}
+
+
+def _read_faces(shapes: list) -> list:
+    """:func:`surfmod.from_face` of every face of a part: the same ``TrimmedFace``, the
+    elementary ones (planes, cylinders, cones, spheres, tori: most faces of real parts)
+    built from one pass over their OCCT data (:func:`surfmod.occ.uses.elementary_faces`)."""
+    from ..occ import uses as occ
+
+    out = []
+    for shape, data in zip(shapes, occ.elementary_faces(shapes)):
+        if data is None:
+            out.append(from_face(shape))
+            continue
+        name, geom, bounds, reversed_, frame, radii = data
+        u0, u1, v0, v1 = bounds
+        surface = _ELEMENTARY[name]._trusted(frame, radii, (u0, u1), (v0, v1))
+        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(name, bounds), reversed_))
+    return out
+
+
+# which directions of OCCT's elementary surfaces are periodic (``IsUPeriodic``/``IsVPeriodic``;
+# the period is 2π): what readback's ``_periods`` asks the surface, without asking
+_PERIODIC = {"Geom_Plane": (False, False), "Geom_CylindricalSurface": (True, False),
+             "Geom_ConicalSurface": (True, False), "Geom_SphericalSurface": (True, False),
+             "Geom_ToroidalSurface": (True, True)}
+
+
+def _elementary_periods(name: str, bounds) -> tuple:
+    """readback's ``_periods`` of an elementary surface over ``bounds``: 2π where the
+    direction is periodic and the face spans one whole period, else None."""
+    period = 2 * np.pi
+    spans = (bounds[1] - bounds[0], bounds[3] - bounds[2])
+    return tuple(period if periodic and abs(span - period) <= 1e-9 * period else None
+                 for periodic, span in zip(_PERIODIC[name], spans))
+
+
 def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str = "numpy",
                     eps: float = 1e-9, estimate_error: bool = True) -> MassProperties:
     """Volume, area, centroid and inertia tensor of a solid.
@@ -227,14 +278,14 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         if _moments(*face_nodes(faces[0], order)[:2], ref)[1] < 0:
             faces[0].sign = -1.0
     else:
+        from ..occ.pcurves import faces_pcurves
         from ..occ.topo import faces_of
 
-        from ..occ.pcurves import face_pcurves
-
-        read = [from_face(f) for f in faces_of(solid)]
-        pcurves = [face_pcurves(f.face_shape) for f in read]
+        read = _read_faces(faces_of(solid))
+        pcurves = faces_pcurves([f.face_shape for f in read])  # B-splines in one table
         taylor_pieces([rec for pcs in pcurves for rec in pcs])  # all B-spline p-curves at once
-        faces = [mass_face(f, pcs) for f, pcs in zip(read, pcurves)]
+        faces = mass_faces(read, pcurves)
+        prepare_boundaries(faces, order)  # the p-curves of all trimmed faces in one pass
     # faces whose every rule is exact by degree give the same sums at any order: the
     # lower-order pass behind the error estimate only re-integrates the others
     exact, high = _Accumulator(ref), _Accumulator(ref)
@@ -242,8 +293,16 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     planes = [f for f in faces if f.plane and f.natural and f.frame is not None]
     if planes:  # whole planar rectangles (most faces of prismatic parts): all at once
         exact.add(*plane_nodes(planes))
+    # trimmed planar faces: closed form from their boundary moments, all at once
+    trimmed_planes = [f for f in faces if f.plane and not f.natural and f.frame is not None]
+    inexact_planes = []
+    if trimmed_planes:
+        sums, is_exact = plane_moments(trimmed_planes, order, ref)
+        exact.total += sums[is_exact].sum(axis=0)
+        high.total += sums[~is_exact].sum(axis=0)
+        inexact_planes = [f for f, e in zip(trimmed_planes, is_exact) if not e]
     for f in faces:
-        if f.plane and f.natural and f.frame is not None:
+        if f.plane and f.frame is not None:
             continue
         ders, w, is_exact = face_nodes(f, order)
         (exact if is_exact else high).add(ders, w)
@@ -257,6 +316,8 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         low = _Accumulator(ref)
         for f in inexact:
             low.add(*face_nodes(f, max(2, order - 4))[:2])
+        if inexact_planes:
+            low.total += plane_moments(inexact_planes, max(2, order - 4), ref)[0].sum(axis=0)
         return abs(high.total[1] - low.flush()[1]) / vol
 
     return MassProperties(

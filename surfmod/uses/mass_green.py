@@ -28,29 +28,25 @@ a straight p-curve needs 3 nodes.  Everything else (angular directions, rational
 splines, curved p-curves on curved faces) takes the caller's ``order`` per piece: eighth
 turns on angular directions, knot spans, and at least ``PIECES`` pieces per curved edge.
 
-Every p-curve is evaluated from data (:func:`surfmod.occ.pcurves.face_pcurves`): lines,
-circles and B-splines for all nodes at once (B-splines as one polynomial per span, built
-for all p-curves of a part in one pass per degree, :func:`taylor_pieces`); other types
-through OCCT per node.  Lines and circles cross the break lines in closed form.
+The p-curves are evaluated from data, all of a face's at once
+(:mod:`surfmod.uses.mass_boundary`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..construct.curves import Line
-from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface
+from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
-from ..eval.basis import basis_derivatives, find_spans
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from .faces import _breaks, _patch_breaks, direction_breaks
-from .mass_grid import exact_order, gauss, grid_nodes, inner_nodes, interpolation_points, green_layout
+from .faces import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks
+from .mass_boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
+from .mass_grid import exact_order, gauss, green_layout, grid_nodes, inner_nodes, interpolation_points
 
-#: curved p-curves are cut into at least this many pieces before Gauss
-PIECES = 4
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
 RECTANGLE_RTOL = 1e-7
 
@@ -93,184 +89,6 @@ def direction_degree(surface, direction: int):
     return None
 
 
-def _spans(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
-    x, w = gauss(order)
-    a, b = breaks[:-1, None], breaks[1:, None]
-    return ((a + b) / 2 + (b - a) / 2 * x).ravel(), ((b - a) / 2 * w).ravel()
-
-
-# -- p-curves ---------------------------------------------------------------------------------
-def pcurve_d1(rec: dict, t: np.ndarray) -> np.ndarray:
-    """``(N, 4)``: ``u, v, du/dt, dv/dt`` of a p-curve record at parameters ``t``."""
-    from ..occ.pcurves import adaptor_d1
-
-    kind = rec["kind"]
-    t = np.asarray(t, dtype=float)
-    out = np.empty((t.size, 4))
-    if kind == "line":
-        out[:, :2] = rec["origin"] + t[:, None] * rec["direction"]
-        out[:, 2:] = rec["direction"]
-    elif kind == "circle":
-        c, s = np.cos(t)[:, None], np.sin(t)[:, None]
-        r, x, y = rec["radius"], rec["x"], rec["y"]
-        out[:, :2] = rec["centre"] + r * (c * x + s * y)
-        out[:, 2:] = r * (c * y - s * x)
-    elif kind == "bspline":
-        if "taylor" not in rec:
-            rec["taylor"] = _taylor_pieces(rec)
-        starts, centres, coef = rec["taylor"]
-        j = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(starts) - 1)
-        dt = (t - centres[j])[:, None]
-        c = coef[j]  # (N, p+1, dim)
-        val, der = c[:, -1], np.zeros_like(c[:, -1])
-        for k in range(c.shape[1] - 2, -1, -1):  # Horner for the value and its derivative
-            der = der * dt + val
-            val = val * dt + c[:, k]
-        if rec["weights"] is None:
-            out[:, :2], out[:, 2:] = val, der
-        else:
-            out[:, :2] = val[:, :2] / val[:, 2:]
-            out[:, 2:] = (der[:, :2] - out[:, :2] * der[:, 2:]) / val[:, 2:]
-    else:
-        out[:] = adaptor_d1(rec["adaptor"], t)
-    return out
-
-
-def _taylor_pieces(rec: dict):
-    """A B-spline p-curve as one polynomial per knot span: ``(starts (S,), centres (S,),
-    coefficients (S, p+1, dim))`` with ``C(t) = Σ_k c_k (t - centre)^k`` in homogeneous coordinates
-    ``(w u, w v, w)`` (``(u, v)`` when polynomial).  Beyond the ends the first and last
-    spans continue, as OCCT evaluates."""
-    taylor_pieces([rec])
-    return rec["taylor"]
-
-
-def taylor_pieces(records: list) -> None:
-    """Set ``rec["taylor"]`` (see :func:`_taylor_pieces`) on every B-spline p-curve record
-    that lacks it, with one basis evaluation per degree for all of them: their knot
-    vectors and control points are laid end to end, and each span's basis reads only its
-    own curve's knots (``knots[span - p + 1 .. span + p]``), so one call serves all.
-
-    >>> import build123d as bd
-    >>> from surfmod.occ.pcurves import face_pcurves
-    >>> recs = [r for r in face_pcurves(bd.Face(bd.Wire([bd.Spline((0, 0), (1, 1), (2, 0), (1, -1)),
-    ...         bd.Edge.make_line((1, -1), (0, 0))])).wrapped) if r["kind"] == "bspline"]
-    >>> taylor_pieces(recs); starts, centres, coef = recs[0]["taylor"]
-    >>> coef.shape[1:] == (recs[0]["degree"] + 1, 2)
-    True
-    """
-    groups: dict = {}
-    for rec in records:
-        if rec["kind"] == "bspline" and "taylor" not in rec:
-            groups.setdefault(rec["degree"], []).append(rec)
-    for p, group in groups.items():
-        knots, ctrl, spans, centres, firsts, counts = [], [], [], [], [], []
-        k_off = c_off = 0
-        for rec in group:
-            k, pts, w = rec["knots"], rec["points"][:, :2], rec["weights"]
-            n = len(pts)
-            # homogeneous (w u, w v, w) for all; w = 1 leaves a polynomial curve's u, v as they are
-            ones = np.ones(n) if w is None else w
-            ctrl.append(np.column_stack([pts * ones[:, None], ones]))
-            starts = np.unique(k[p:n])  # span starts inside the domain (the last end excluded)
-            starts = starts[starts < k[n]]
-            # expanded about each span's middle: |t - centre| <= h/2 keeps high degrees accurate
-            mid = (starts + np.append(starts[1:], k[n])) / 2
-            local = find_spans(k, p, n, mid)
-            knots.append(k)
-            spans.append(local + k_off)
-            firsts.append(local - p + c_off)
-            centres.append(mid)
-            counts.append((starts, mid))
-            k_off += len(k)
-            c_off += n
-        all_knots, all_ctrl = np.concatenate(knots), np.concatenate(ctrl)
-        span, first, mid = np.concatenate(spans), np.concatenate(firsts), np.concatenate(centres)
-        basis = basis_derivatives(all_knots, p, span, mid, p)  # (S, p+1 derivatives, p+1 functions)
-        local_ctrl = all_ctrl[first[:, None] + np.arange(p + 1)]  # (S, p+1, 3)
-        fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
-        coef = np.einsum("skr,srd->skd", basis, local_ctrl) / fact[None, :, None]
-        at = 0
-        for rec, (starts, mid) in zip(group, counts):
-            c = coef[at : at + len(starts)]
-            at += len(starts)
-            rec["taylor"] = (starts, mid, c if rec["weights"] is not None else np.ascontiguousarray(c[:, :, :2]))
-
-
-def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
-    """Parameters where a p-curve crosses the lines ``u = c`` and ``v = c``: exact on
-    straight p-curves, else sign changes on one sampling refined by Newton steps (all
-    crossings at once)."""
-    if not len(lines_u) and not len(lines_v):
-        return np.zeros(0)
-    f, l = cuts[0], cuts[-1]
-    coord = np.concatenate([np.zeros(len(lines_u), int), np.ones(len(lines_v), int)])
-    lines = np.concatenate([lines_u, lines_v])
-    if rec["kind"] == "line":
-        d = rec["direction"][coord]
-        ok = d != 0.0
-        t = (lines[ok] - rec["origin"][coord[ok]]) / d[ok]
-        return t[(t > f) & (t < l)]
-    if rec["kind"] == "circle":
-        # centre + r (cos t x + sin t y) = line: A cos t + B sin t = C, t = phi ± acos(C / R)
-        r = rec["radius"]
-        A, B, C = r * rec["x"][coord], r * rec["y"][coord], lines - rec["centre"][coord]
-        R = np.hypot(A, B)
-        ok = np.abs(C) < R
-        phi, half = np.arctan2(B[ok], A[ok]), np.arccos(C[ok] / R[ok])
-        base = np.concatenate([phi + half, phi - half])
-        turns = np.arange(np.floor((f - base.max()) / (2 * np.pi)), np.ceil((l - base.min()) / (2 * np.pi)) + 1)
-        t = (base[:, None] + 2 * np.pi * turns[None, :]).ravel()
-        return t[(t > f) & (t < l)]
-    a, b = cuts[:-1, None], cuts[1:, None]
-    t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
-    s = pcurve_d1(rec, t)[:, coord] - lines[None, :]  # (T, L)
-    i, j = np.nonzero(s[:-1] * s[1:] < 0)
-    if not len(i):
-        return np.zeros(0)
-    lo, hi, c, cj = t[i], t[i + 1], lines[j], coord[j]
-    x = lo + (hi - lo) * s[i, j] / (s[i, j] - s[i + 1, j])
-    rows = np.arange(len(x))
-    for _ in range(6):
-        q = pcurve_d1(rec, x)
-        d = q[rows, 2 + cj]
-        step = np.divide(q[rows, cj] - c, d, out=np.zeros_like(x), where=d != 0.0)
-        x = np.clip(x - step, lo, hi)
-        if np.all(np.abs(step) <= 1e-15 * max(1.0, abs(l - f))):
-            break
-    return x
-
-
-def _boundary(pcurves, outer_order, lines_u, lines_v):
-    """Gauss nodes on every p-curve: ``(P (N, 2), dP (N, 2), weights (N,))`` with the
-    weights signed by the edge's orientation in the face; ``outer_order(rec)`` is the
-    Gauss order for a p-curve (``(order, exact)``)."""
-    ps, ds, ws = [], [], []
-    exact = True
-    for rec in pcurves:
-        f, l = rec["range"]
-        if not l > f:
-            continue
-        m, ok = outer_order(rec)
-        exact &= ok
-        k = 1 if rec["kind"] == "line" else PIECES
-        br = np.concatenate([rec["breaks"], np.linspace(f, l, k + 1)])
-        br = np.unique(br[(br >= f) & (br <= l)])
-        extra = _crossings(rec, br, lines_u, lines_v)
-        if extra.size:
-            br = np.unique(np.concatenate([br, extra]))
-            br = br[np.concatenate([[True], np.diff(br) > 1e-13 * max(1.0, l - f)])]
-        t, w = _spans(br, m)
-        q = pcurve_d1(rec, np.concatenate([t, [f, l]]))
-        rec["ends"] = q[-2:, :2]  # for _largest_gap, from the same call
-        ps.append(q[:-2, :2])
-        ds.append(q[:-2, 2:])
-        ws.append(rec["sign"] * w)
-    if not ps:
-        return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), exact
-    return np.concatenate(ps), np.concatenate(ds), np.concatenate(ws), exact
-
-
 # -- faces -----------------------------------------------------------------------------------
 @dataclass
 class MassFace:
@@ -285,39 +103,100 @@ class MassFace:
     pcurves: list | None  # None: the face is its whole parameter rectangle
     plane: bool = False
     frame: tuple | None = None  # planes: origin, x, y (S = O + u X + v Y)
+    table: PcurveTable | None = None  # the p-curves as arrays (built once per face)
+    # per direction: its breaks are only the eighth turns of an analytic angle (no knot)
+    angular: tuple = (False, False)
+    # Gauss nodes on the p-curves per order, when computed for many faces at once
+    boundary: dict = field(default_factory=dict)
 
     @property
     def natural(self) -> bool:
         return self.pcurves is None
 
 
-def _on_box_border(pcurves, bounds) -> bool:
-    u0, u1, v0, v1 = bounds
-    tol = np.array([RECTANGLE_RTOL * max(1.0, u1 - u0), RECTANGLE_RTOL * max(1.0, v1 - v0)])
-    sides = np.array([u0, u1, v0, v1])
-
-    def on_sides(q):  # (N, 2) -> (N, 4): which border line each point lies on
-        return np.abs(q[:, [0, 0, 1, 1]] - sides) <= tol[[0, 0, 1, 1]]
-
-    lines = [rec for rec in pcurves if rec["kind"] == "line"]
-    if lines:
-        # a straight p-curve lies on the border iff both of its ends lie on one border line
-        o = np.array([rec["origin"] for rec in lines])
-        d = np.array([rec["direction"] for rec in lines])
-        r = np.array([rec["range"] for rec in lines])
-        first, last = on_sides(o + r[:, :1] * d), on_sides(o + r[:, 1:] * d)
-        if not np.all(np.any(first & last, axis=1)):
-            return False
-    for rec in pcurves:
-        if rec["kind"] != "line":
-            f, l = rec["range"]
-            q = pcurve_d1(rec, f + (l - f) * np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0]))
-            if not on_sides(q[:, :2]).any(axis=1).all():
-                return False
-    return True
+def _lines_on_box_border(lines: list, bounds: np.ndarray) -> np.ndarray:
+    """:func:`_records_on_box_border` of straight p-curves only (``bounds`` ``(R, 4)``, per
+    record): both ends of each on one border line, a few array operations for all of them
+    without a :class:`PcurveTable`."""
+    bounds = np.asarray(bounds, dtype=float)
+    u0, u1, v0, v1 = bounds.T
+    tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
+    tol = tol[:, [0, 0, 1, 1]]
+    data = np.array([np.concatenate([rec["origin"], rec["direction"], rec["range"]]) for rec in lines])
+    o, d, r = data[:, :2], data[:, 2:4], data[:, 4:]
+    first = np.abs((o + r[:, :1] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
+    last = np.abs((o + r[:, 1:] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
+    return np.any(first & last, axis=1)
 
 
-def mass_face(face, pcurves: list | None = None) -> MassFace:
+def _on_box_border(table: PcurveTable, bounds) -> bool:
+    """Whether the p-curves run along the face box's border only: a straight p-curve iff
+    both of its ends lie on one border line, others at seven samples each (all p-curves
+    in one evaluation)."""
+    return bool(np.all(_records_on_box_border(table, np.tile(bounds, (len(table.records), 1)))))
+
+
+def _records_on_box_border(table: PcurveTable, bounds: np.ndarray) -> np.ndarray:
+    """Per record of ``table``: whether it runs along the border of its face box
+    (``bounds`` ``(R, 4)``, per record), see :func:`_on_box_border`."""
+    bounds = np.asarray(bounds, dtype=float)
+    u0, u1, v0, v1 = bounds.T
+    tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
+    tol = tol[:, [0, 0, 1, 1]]
+    straight = table.kind == 0
+    samples = np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0])  # ends first, then inside
+    ranges = np.array([rec["range"] for rec in table.records])
+    f, l = ranges[:, :1], ranges[:, 1:]
+    t = f + (l - f) * samples  # (R, 7); lines use the first two columns (their ends)
+    t[straight, 1] = l[straight, 0]
+    q = table.d1(np.repeat(np.arange(len(ranges)), len(samples)), t.ravel())[:, :2].reshape(len(ranges), len(samples), 2)
+    on = np.abs(q[:, :, [0, 0, 1, 1]] - bounds[:, None, :]) <= tol[:, None, :]  # (R, 7, 4)
+    lines_ok = np.any(on[:, 0] & on[:, 1], axis=1)
+    curves_ok = np.all(np.any(on, axis=2), axis=1)
+    return np.where(straight, lines_ok, curves_ok)
+
+
+def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
+    """:func:`surfmod.uses.faces._patch_breaks` (angular directions without its general
+    merging: equal pieces of at most an eighth turn, the same points) and whether the
+    direction is an analytic angle (its breaks are no knots)."""
+    b = direction_breaks(face, direction)
+    if b is None and hi - lo > 1e-9:  # one polynomial piece (planes, axes of cylinders)
+        return np.array([lo, hi]), False
+    if isinstance(b, str) and hi - lo > 1e-9:
+        return np.linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1), True
+    return _patch_breaks(face, lo, hi, direction, face.periods[direction]), isinstance(b, str)
+
+
+def mass_faces(read: list, pcurves: list) -> list:
+    """:func:`mass_face` of every face of a part (``pcurves`` per face, their B-splines'
+    Taylor pieces built); the rectangle test of all faces with curved p-curves runs in
+    one evaluation of one :class:`PcurveTable` (:func:`_on_box_border`, face by face
+    there).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> from surfmod.occ.pcurves import faces_pcurves
+    >>> read = [sm.from_face(f) for f in bd.Cylinder(1, 2).faces()]
+    >>> pcs = faces_pcurves([f.face_shape for f in read])
+    >>> taylor_pieces([r for p in pcs for r in p])
+    >>> [m.natural for m in mass_faces(read, pcs)]
+    [True, False, False]
+    """
+    one_wire = [i for i, pcs in enumerate(pcurves) if pcs and all(rec["wire"] == 0 for rec in pcs)]
+    straight = [i for i in one_wire if all(rec["kind"] == "line" for rec in pcurves[i])]
+    curved = sorted(set(one_wire) - set(straight))
+    natural = {i: False for i in range(len(read))}
+    for test, check in ((straight, _lines_on_box_border), (curved, _records_on_box_border)):
+        if test:
+            records = [rec for i in test for rec in pcurves[i]]
+            counts = [len(pcurves[i]) for i in test]
+            bounds = np.repeat(np.array([[b for r in read[i].domain for b in r] for i in test]), counts, axis=0)
+            ok = check(records if check is _lines_on_box_border else PcurveTable(records), bounds)
+            natural.update(zip(test, np.logical_and.reduceat(ok, np.cumsum([0] + counts[:-1])).tolist()))
+    return [mass_face(f, pcs, natural[i]) for i, (f, pcs) in enumerate(zip(read, pcurves))]
+
+
+def mass_face(face, pcurves: list | None = None, natural: bool | None = None) -> MassFace:
     """A :class:`MassFace` for a face read back with :func:`surfmod.from_face` (``pcurves``:
     its :func:`~surfmod.occ.pcurves.face_pcurves`, when already read).
 
@@ -325,23 +204,38 @@ def mass_face(face, pcurves: list | None = None) -> MassFace:
     >>> m = mass_face(sm.from_face(bd.Box(1, 1, 1).faces()[0]))
     >>> m.natural, m.degrees, m.plane
     (True, (1, 1), True)
+
+    ``natural``: whether the face is its whole parameter rectangle, when the caller has
+    tested it already.
     """
     from ..occ.pcurves import face_pcurves
 
     u0, u1, v0, v1 = bounds = tuple(b for r in face.domain for b in r)
     surf = face.surface
     plane = isinstance(surf, PlaneSurface)
+    angular = (False, False)
     if plane:  # one polynomial piece each way
         breaks = (np.array([u0, u1]), np.array([v0, v1]))
     else:
-        breaks = (_patch_breaks(face, u0, u1, 0, face.periods[0]), _patch_breaks(face, v0, v1, 1, face.periods[1]))
+        (bu, au), (bv, av) = _mass_breaks(face, u0, u1, 0), _mass_breaks(face, v0, v1, 1)
+        breaks, angular = (bu, bv), (au, av)
     if pcurves is None:
         pcurves = face_pcurves(face.face_shape)
         taylor_pieces(pcurves)
-    natural = bool(pcurves) and all(rec["wire"] == 0 for rec in pcurves) and _on_box_border(pcurves, bounds)
+    table = None
+    if natural is not None:  # tested by the caller (mass_faces)
+        pass
+    elif not pcurves or any(rec["wire"] != 0 for rec in pcurves):
+        natural = False
+    elif all(rec["kind"] == "line" for rec in pcurves):  # most natural faces: no table needed
+        natural = bool(np.all(_lines_on_box_border(pcurves, np.tile(bounds, (len(pcurves), 1)))))
+    else:
+        table = PcurveTable(pcurves)
+        natural = _on_box_border(table, bounds)
     return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
-                    plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None)
+                    plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table,
+                    angular)
 
 
 def surface_mass_face(surf) -> MassFace:
@@ -427,15 +321,56 @@ def _largest_gap(mf: MassFace) -> float:
     return float(d.min(axis=1).max())
 
 
+def _boundary_rule(mf: MassFace, order: int) -> tuple:
+    """The face's entry for :func:`surfmod.uses.mass_boundary.boundaries`: per p-curve the
+    Gauss order and whether it is exact, the break lines and their kind."""
+    orders, exacts = [], []
+    for rec in mf.pcurves:
+        if mf.plane and rec["kind"] == "line":
+            # G is a polynomial of degree 4 in (u, v), affine along the line: 3 nodes are exact
+            orders.append(3)
+            exacts.append(True)
+        else:
+            orders.append(order)
+            exacts.append(False)
+    return mf.pcurves, orders, exacts, mf.breaks[0][1:-1], mf.breaks[1][1:-1], mf.angular
+
+
+def face_boundary(mf: MassFace, order: int):
+    """``(P, dP, weights, exact)``: Gauss nodes on a trimmed face's p-curves (computed
+    now, or taken from :func:`prepare_boundaries`).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> disc = mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(1.0))))
+    >>> P, dP, w, exact = face_boundary(disc, 12)
+    >>> len(w), exact
+    (48, False)
+    """
+    if order in mf.boundary:
+        return mf.boundary.pop(order)  # used once: the estimate pass has its own order
+    return boundaries([_boundary_rule(mf, order)], mf.table)[0]
+
+
+def prepare_boundaries(faces: list, order: int) -> None:
+    """The Gauss nodes on the p-curves of every trimmed face of ``faces`` at ``order``, in
+    one pass for all of them (:func:`surfmod.uses.mass_boundary.boundaries`), kept for
+    :func:`face_nodes` / :func:`surfmod.uses.mass_plane.plane_moments`.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> faces = [mass_face(sm.from_face(f)) for f in (bd.Box(4, 4, 2) - bd.Cylinder(1, 2)).faces()]
+    >>> prepare_boundaries(faces, 12)
+    >>> sorted(len(f.boundary) for f in faces)
+    [0, 0, 0, 0, 0, 1, 1]
+    """
+    trimmed = [mf for mf in faces if not mf.natural and mf.pcurves]
+    if trimmed:
+        for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed])):
+            mf.boundary[order] = got
+
+
 def _green(mf: MassFace, order: int, orders, exacts):
     """Green's theorem nodes (see the module notes)."""
-    def outer_order(rec):
-        if mf.plane and rec["kind"] == "line":
-            return 3, True  # G is a polynomial of degree 4 in (u, v), affine along the line
-        return order, False
-
-    lines = [mf.breaks[0][1:-1], mf.breaks[1][1:-1]]
-    P, dP, wt, exact = _boundary(mf.pcurves, outer_order, lines[0], lines[1])
+    P, dP, wt, exact = face_boundary(mf, order)
     # inner direction: the one with fewer inner nodes per boundary node, where the
     # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
     # the result depends on the direction, and BRepGProp's is u from the box's left edge.
@@ -469,7 +404,10 @@ def _green(mf: MassFace, order: int, orders, exacts):
     else:
         g, rest = (np.zeros(0),) * 3, np.ones(len(P), bool)
         exact = exact and exacts[k]
-    n = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
-    s, other, ws = (np.concatenate([a, b]) for a, b in zip(g, n))
+    if rest.any():
+        n = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
+        s, other, ws = (np.concatenate([a, b]) for a, b in zip(g, n))
+    else:  # every node on a grid
+        s, other, ws = g
     ders = mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1)
     return ders, ws, exact

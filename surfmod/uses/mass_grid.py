@@ -66,10 +66,19 @@ def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
     """``(N, n)``: ``∫_{-1}^{x1} ℓ_j`` for the Lagrange basis ``ℓ_j`` of :func:`chebyshev`
     points, by the exact antiderivatives of the Chebyshev polynomials,
     ``∫ T_m = (T_{m+1}/(m+1) - T_{m-1}/(m-1)) / 2``."""
-    _, _, A = chebyshev(n)
-    theta = np.arccos(np.clip(x1, -1.0, 1.0))
+    return chebyshev_antiderivatives(x1, n) @ chebyshev(n)[2].T
+
+
+def chebyshev_antiderivatives(x1: np.ndarray, n: int) -> np.ndarray:
+    """``(N, n)``: ``∫_{-1}^{x1} T_m`` for ``m < n`` (:func:`antiderivative_weights` before
+    the change to the Lagrange basis, which callers summing over many ``x1`` apply once to
+    the sum).
+
+    >>> chebyshev_antiderivatives(np.array([1.0, 0.0]), 3).round(12).tolist()  # ∫ 1, ∫ x, ∫ 2x² - 1
+    [[2.0, 0.0, -0.666666666667], [1.0, -0.5, -0.333333333333]]
+    """
     m = np.arange(n + 1)
-    T = np.cos(np.outer(theta, m))  # (N, n + 1): T_0 .. T_n
+    T = chebyshev_polynomials(np.clip(x1, -1.0, 1.0), n + 1)  # (N, n + 1): T_0 .. T_n
     ends = np.where(m % 2 == 0, 1.0, -1.0)  # T_m(-1)
     I = np.empty((len(x1), n))
     I[:, 0] = T[:, 1] + 1.0
@@ -78,7 +87,27 @@ def antiderivative_weights(x1: np.ndarray, n: int) -> np.ndarray:
     if n > 2:
         k = np.arange(2, n)
         I[:, 2:] = (T[:, 3:] / (k + 1) - T[:, 1:-2] / (k - 1)) / 2 - (ends[3:] / (k + 1) - ends[1:-2] / (k - 1)) / 2
-    return I @ A.T
+    return I
+
+
+def chebyshev_polynomials(y: np.ndarray, count: int) -> np.ndarray:
+    """``(N, count)``: ``T_0(y) .. T_{count-1}(y)`` by the three-term recurrence
+    ``T_{m+1} = 2 y T_m - T_{m-1}`` (stable on ``[-1, 1]``; one vector operation per
+    degree instead of a cosine per entry).
+
+    >>> y = np.array([-1.0, 0.3, 1.0])
+    >>> bool(np.allclose(chebyshev_polynomials(y, 6), np.cos(np.outer(np.arccos(y), np.arange(6))), atol=1e-15))
+    True
+    """
+    T = np.empty((count, len(y)))  # rows contiguous for the recurrence
+    T[0] = 1.0
+    if count > 1:
+        T[1] = y
+    y2 = 2.0 * y
+    for m in range(2, count):
+        np.multiply(y2, T[m - 1], out=T[m])
+        T[m] -= T[m - 2]
+    return T.T
 
 
 def lagrange_values(y: np.ndarray, x: np.ndarray, bw: np.ndarray) -> np.ndarray:
@@ -170,14 +199,19 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
     whatever the number of boundary nodes."""
     ks, kt = counts
     xs = chebyshev(ks)[0]
-    xt, bwt, _ = chebyshev(kt)
+    xt = chebyshev(kt)[0]
     iws = _GAUSS[("span integral", ks)]  # ∫_{-1}^{1} ℓ_j
     br, obr = mf.breaks[k], mf.breaks[1 - k]
     n_spans, n_out = len(br) - 1, len(obr) - 1
     a, b = obr[q], obr[q + 1]
-    lt = lagrange_values((2 * P[:, 1 - k] - a - b) / (b - a), xt, bwt) * wb[:, None]  # (N, kt)
+    # the outer Lagrange basis ℓ_l = Σ_m At[l, m] T_m is linear: sums over nodes are taken
+    # in the Chebyshev basis (N x kt) and changed to the Lagrange basis once per cell.
+    # Boundary nodes reach a hair beyond their cell (GRID_REACH): the polynomial continues
+    At, As = chebyshev(kt)[2], chebyshev(ks)[2]
+    tw = chebyshev_polynomials((2 * P[:, 1 - k] - a - b) / (b - a), kt) * wb[:, None]  # (N, kt)
     # whole spans: node n covers spans i < full_n; ∫ over a span of ℓ_j is h/2 · iws_j
-    acc = _sum_rows(q * (n_spans + 1) + full, lt, n_out * (n_spans + 1)).reshape(n_out, n_spans + 1, kt)
+    acc = _sum_rows(q * (n_spans + 1) + full, tw, n_out * (n_spans + 1)) @ At.T
+    acc = acc.reshape(n_out, n_spans + 1, kt)
     whole = np.cumsum(acc[:, ::-1], axis=1)[:, ::-1][:, 1:]  # (Q, S, kt): Σ over nodes with full > i
     h = np.diff(br)
     omega = (h / 2)[None, :, None, None] * iws[None, None, :, None] * whole[:, :, None, :]
@@ -186,14 +220,15 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
         # partial span f: ∫_{br_f}^{u_n} ℓ_j, exactly
         f = full[rows]
         x1 = (2 * P[rows, k] - br[f] - br[f + 1]) / h[f]  # in (-1, 1)
-        c = antiderivative_weights(x1, ks) * (h[f] / 2)[:, None]  # (n, ks)
+        c = chebyshev_antiderivatives(x1, ks) * (h[f] / 2)[:, None]  # (n, ks), Chebyshev basis
         cell = q[rows] * n_spans + f
         order = np.argsort(cell, kind="stable")
-        cell, c, lp = cell[order], c[order], lt[rows[order]]
+        cell, c, lp = cell[order], c[order], tw[rows[order]]
         cuts = np.flatnonzero(np.diff(cell)) + 1
+        starts = np.concatenate([[0], cuts])
+        M = np.stack([c[lo:hi].T @ lp[lo:hi] for lo, hi in zip(starts, np.concatenate([cuts, [len(cell)]]))])
         flat = omega.reshape(n_out * n_spans, ks, kt)
-        for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(cell)]])):
-            flat[cell[lo]] += c[lo:hi].T @ lp[lo:hi]  # Σ_n c_nj lt_nl, one product per cell
+        flat[cell[starts]] += As @ M @ At.T  # Σ_n c_nj lt_nl per cell, in the Lagrange bases
     qi, si = np.nonzero(np.any(omega != 0.0, axis=(2, 3)))
     s = ((br[si] + br[si + 1])[:, None] / 2 + (h[si] / 2)[:, None] * xs)  # (C, ks)
     t = ((obr[qi] + obr[qi + 1])[:, None] / 2 + ((obr[qi + 1] - obr[qi]) / 2)[:, None] * xt)  # (C, kt)

@@ -1,0 +1,113 @@
+"""Trimmed planar faces in closed form: their mass integrals from boundary integrals alone.
+
+On a plane ``S = O + u X + v Y`` every integrand of :mod:`surfmod.uses.mass` is a
+polynomial of degree at most 3 in ``(u, v)`` (``x_i² x_j n_i`` with ``x`` affine and ``n``
+constant), so a face's share is fixed by the ten moments ``M_pq = ∫∫_D a^p b^q`` of its
+parameter region ``D`` (``p + q ≤ 3``, ``a, b`` the parameters shifted to the foot of the
+reference point: no cancellation).  Green's theorem turns each into a boundary integral
+with the inner antiderivative written out,
+
+    M_pq = ∮ [∫_{u0}^{u} (s - uc)^p ds] b^q dv,
+
+the inner integral from the face box's edge ``u0`` exactly as the node-by-node rule of
+:mod:`surfmod.uses.mass_green` takes it (so a boundary whose p-curves leave gaps gives the
+same result as there), evaluated as ``(u - u0) Σ A^k B^(p-k) / (p + 1)`` without
+cancellation.  The outer integral runs on the same Gauss nodes of the p-curves
+(:func:`surfmod.uses.mass_boundary.boundaries`: 3 per straight piece, exact).  Then with
+``x = c + a X + b Y`` the sums are tensor contractions of the moments with ``[c, X, Y]``:
+no surface is evaluated and no inner node is made, one pass for all planar faces of a
+part.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .mass_green import face_boundary
+
+# the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
+# product e_i e_j e_k is (T3[i, j, k] = M[_CUBE[i, j, k]]), likewise for fewer factors
+_POWERS = [(p, q) for p in range(4) for q in range(4 - p)]
+_INDEX = {pq: i for i, pq in enumerate(_POWERS)}
+
+
+def _product_index(*axes: int) -> int:
+    return _INDEX[(axes.count(1), axes.count(2))]
+
+
+_CUBE = np.array([[[_product_index(i, j, k) for k in range(3)] for j in range(3)] for i in range(3)])
+_SQUARE = np.array([[_product_index(i, j) for j in range(3)] for i in range(3)])
+_LINE = np.array([_product_index(i) for i in range(3)])
+
+
+def _region_moments(faces: list, foot: np.ndarray, order: int):
+    """Per face: the ten moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
+    is positive) about its ``foot`` ``(uc, vc)``, and whether every boundary rule was exact."""
+    parts, exact = [], np.ones(len(faces), bool)
+    for i, mf in enumerate(faces):
+        # 3 Gauss nodes per straight piece: the integrands are of degree 4 along it, exact
+        P, dP, wt, exact[i] = face_boundary(mf, order)
+        parts.append((P, wt * dP[:, 1]))
+    count = np.array([len(w) for _, w in parts])
+    moments = np.zeros((len(faces), len(_POWERS)))
+    if not count.sum():
+        return moments, exact
+    P, wb = np.concatenate([p for p, _ in parts]), np.concatenate([w for _, w in parts])
+    owner = np.repeat(np.arange(len(faces)), count)
+    u0 = np.array([mf.bounds[0] for mf in faces])[owner]
+    A, B, b = P[:, 0] - foot[owner, 0], u0 - foot[owner, 0], P[:, 1] - foot[owner, 1]
+    d = P[:, 0] - u0
+    # ∫_{u0}^{u} (s - uc)^p ds = (A^(p+1) - B^(p+1)) / (p + 1) = d Σ_k A^k B^(p-k) / (p + 1)
+    sums = [np.ones_like(A)]
+    for p in range(1, 4):
+        sums.append(sums[-1] * B + A**p)  # Σ_{k=0}^{p} A^k B^(p-k), Horner in B
+    inner = [wb * d * sums[p] / (p + 1) for p in range(4)]
+    b_pow = [np.ones_like(b), b, b * b, b * b * b]
+    values = np.stack([inner[p] * b_pow[q] for p, q in _POWERS], axis=1)  # (N, 10)
+    starts = np.concatenate([[0], np.cumsum(count)[:-1]])
+    live = count > 0
+    moments[live] = np.add.reduceat(values, starts[live], axis=0)
+    moments[moments[:, 0] < 0] *= -1.0  # boundary traversed clockwise in (u, v)
+    return moments, exact
+
+
+def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]:
+    """``(F, 14)`` ``[area, V, M(3), S(3, 3)]`` of trimmed planar faces (each a
+    :class:`~surfmod.uses.mass_green.MassFace` with its frame), the sums
+    :func:`surfmod.uses.mass._moments` makes of their quadrature nodes, in closed form
+    from the moments of their parameter regions (module notes); and per face whether no
+    rule depended on ``order`` (straight p-curves only).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> from surfmod.uses.mass_green import mass_face
+    >>> disc = mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(2.0))))
+    >>> m, exact = plane_moments([disc], 12, np.zeros(3))
+    >>> bool(abs(m[0, 0] - 4 * np.pi) < 1e-13), bool(exact[0])
+    (True, False)
+    """
+    ref = np.asarray(ref, dtype=float)
+    origin, ex, ey = (np.array([mf.frame[i] for mf in faces]) for i in range(3))
+    # the foot of the reference point on each plane, in its parameters (X, Y orthonormal)
+    foot = np.stack([np.sum((ref - origin) * ex, axis=1), np.sum((ref - origin) * ey, axis=1)], axis=1)
+    M, exact = _region_moments(faces, foot, order)
+    c = origin + foot[:, :1] * ex + foot[:, 1:] * ey - ref  # x = c + a X + b Y
+    frame = np.stack([c, ex, ey], axis=2)  # (F, 3 coordinates, 3 basis functions)
+    sign = np.array([mf.sign for mf in faces])
+    n = sign[:, None] * np.cross(ex, ey)
+    T1, T2, T3 = M[:, _LINE], M[:, _SQUARE], M[:, _CUBE]
+    X1 = (frame @ T1[:, :, None])[:, :, 0]  # ∫ x_i
+    X2 = np.sum((frame @ T2) * frame, axis=2)  # ∫ x_i² = Σ_pq F_ip F_iq T2_pq
+    # ∫ x_i² x_j = Σ_pqr F_ip F_iq F_jr T3_pqr, as three batched products
+    Y = T3 @ frame.transpose(0, 2, 1)[:, None]  # (F, p, q, j)
+    Z = (frame @ Y.reshape(len(faces), 3, 9)).reshape(len(faces), 3, 3, 3)  # (F, i, q, j)
+    X3 = np.sum(frame[:, :, :, None] * Z, axis=2)  # (F, i, j)
+    out = np.empty((len(faces), 14))
+    out[:, 0] = np.linalg.norm(np.cross(ex, ey), axis=1) * M[:, 0]
+    out[:, 1] = np.sum(n * X1, axis=1) / 3.0
+    out[:, 2:5] = n * X2 / 2.0
+    m = n[:, :, None] * X3  # Σ w x_i² n_i x_j
+    second = (m + m.transpose(0, 2, 1)) / 4.0
+    idx = np.arange(3)
+    second[:, idx, idx] = n * X3[:, idx, idx] / 3.0
+    out[:, 5:] = second.reshape(len(faces), 9)
+    return out, exact

@@ -1,0 +1,155 @@
+"""The part-wide passes of the mass integrals equal their face-by-face forms: p-curves read
+for many faces at once, evaluated together (``PcurveTable``), elementary faces read in
+one pass, and trimmed planar faces in closed form (boundary moments) -- against the
+node-by-node quadrature on the corpus and closed-form solids."""
+
+from __future__ import annotations
+
+import math
+
+import build123d as bd
+import numpy as np
+import pytest
+
+import surfmod as sm
+from surfmod.occ import uses as occ
+from surfmod.occ.pcurves import face_pcurves, faces_pcurves
+from surfmod.occ.topo import faces_of
+from surfmod.readback import from_face
+from surfmod.uses.inputs import to_shape
+from surfmod.uses.mass import _moments, _read_faces
+from surfmod.uses.mass_boundary import PcurveTable, pcurve_d1, taylor_pieces
+from surfmod.uses.mass_green import face_nodes, mass_face
+from surfmod.uses.mass_plane import plane_moments
+
+QUICK = ("occt_screw.step", "pythonocc_face_recognition_sample_part.stp")
+
+
+def _part(path):
+    solid = to_shape(sm.import_step(path), "obj", solid=True)
+    shapes = faces_of(solid)
+    return solid, shapes
+
+
+def _table_equals_records(path):
+    _, shapes = _part(path)
+    kinds = set()
+    for records in faces_pcurves(shapes):
+        taylor_pieces(records)
+        table = PcurveTable(records)
+        t = np.concatenate([np.linspace(*rec["range"], 9) for rec in records])
+        which = np.repeat(np.arange(len(records)), 9)
+        mixed = np.random.default_rng(7).permutation(len(t))  # records interleaved
+        got = table.d1(which[mixed], t[mixed])
+        want = np.vstack([pcurve_d1(rec, np.linspace(*rec["range"], 9)) for rec in records])[mixed]
+        assert np.array_equal(got, want), path.name  # bit for bit
+        kinds |= {rec["kind"] for rec in records}
+    return kinds
+
+
+@pytest.mark.parametrize("name", QUICK)
+def test_pcurve_table_equals_record_by_record(corpus_dir, name):
+    assert _table_equals_records(corpus_dir / name)
+
+
+@pytest.mark.corpus
+def test_pcurve_table_equals_record_by_record_on_the_corpus(corpus_file):
+    _table_equals_records(corpus_file)
+
+
+def test_pcurve_table_mixes_rational_and_polynomial_splines():
+    # a rational p-curve beside polynomial ones: the polynomial rows as (u, v, 1)
+    circle = bd.Face(bd.Wire.make_circle(1.0)).wrapped
+    spline = bd.Face(bd.Wire([bd.Spline((0, 0), (1, 1), (2, 0), (1, -1)), bd.Edge.make_line((1, -1), (0, 0))])).wrapped
+    records = face_pcurves(spline) + face_pcurves(circle)
+    rational = dict(records[0], weights=np.linspace(1.0, 2.0, len(records[0]["points"])))
+    rational.pop("taylor", None)
+    records = [records[0], rational] + records[1:]
+    taylor_pieces(records)
+    t = np.concatenate([np.linspace(*rec["range"], 5) for rec in records])
+    which = np.repeat(np.arange(len(records)), 5)
+    want = np.vstack([pcurve_d1(rec, np.linspace(*rec["range"], 5)) for rec in records])
+    assert np.array_equal(PcurveTable(records).d1(which, t), want)
+
+
+def test_faces_pcurves_equal_face_by_face(corpus_dir):
+    _, shapes = _part(corpus_dir / QUICK[0])
+    together = faces_pcurves(shapes)
+    for shape, mine in zip(shapes, together):
+        alone = face_pcurves(shape)
+        assert [r["kind"] for r in mine] == [r["kind"] for r in alone]
+        for a, b in zip(mine, alone):
+            for key in ("range", "sign", "wire", "breaks", "origin", "direction", "centre", "radius", "points", "knots"):
+                if key in b:
+                    assert np.array_equal(a[key], b[key]), key
+
+
+@pytest.mark.parametrize("name", QUICK + ("cadquery_red_cube_blue_cylinder.step",))
+def test_elementary_faces_read_as_from_face(corpus_dir, name):
+    _, shapes = _part(corpus_dir / name)
+    fast, slow = _read_faces(shapes), [from_face(s) for s in shapes]
+    assert sum(d is not None for d in occ.elementary_faces(shapes)) >= 6
+    for a, b in zip(fast, slow):
+        assert type(a.surface) is type(b.surface)
+        assert a.domain == b.domain and a.periods == b.periods and a.reversed == b.reversed
+        for key in ("origin", "x_dir", "y_dir", "z_dir", "radius", "semi_angle", "major", "minor"):
+            if hasattr(b.surface, key) and not hasattr(b.surface, "control_points"):
+                assert np.array_equal(getattr(a.surface, key), getattr(b.surface, key)), key
+        u = np.linspace(*b.domain[0], 5)
+        v = np.linspace(*b.domain[1], 5)
+        assert np.array_equal(a._derivatives(u, v, 1), b._derivatives(u, v, 1))
+
+
+def _planes_equal_node_by_node(path):
+    solid, shapes = _part(path)
+    ref = occ.vertex_mean(solid)
+    read = _read_faces(shapes)
+    records = faces_pcurves(shapes)
+    taylor_pieces([r for recs in records for r in recs])
+    faces = [mass_face(f, recs) for f, recs in zip(read, records)]
+    planes = [f for f in faces if f.plane and not f.natural]
+    if not planes:
+        return 0
+    closed, exact = plane_moments(planes, 12, ref)
+    for mf, mine, is_exact in zip(planes, closed, exact):
+        ders, w, node_exact = face_nodes(mf, 12)
+        nodes = _moments(ders, w, ref)
+        assert np.abs(mine - nodes).max() <= 1e-13 * np.abs(nodes).max(), path.name
+        assert is_exact == node_exact
+    return len(planes)
+
+
+def test_trimmed_planes_in_closed_form_equal_node_by_node(corpus_dir):
+    assert _planes_equal_node_by_node(corpus_dir / QUICK[1]) >= 8
+
+
+@pytest.mark.corpus
+def test_trimmed_planes_in_closed_form_equal_node_by_node_on_the_corpus(corpus_file):
+    _planes_equal_node_by_node(corpus_file)
+
+
+def _box_minus_cylinder_inertia(a, b, c, r, h, d):
+    """Volume, centroid and inertia (about the centroid) of an a x b x c box centred at
+    the origin minus a z-cylinder (radius r, height h, centred at d)."""
+    def box(m, x, y, z):
+        return m / 12 * np.diag([y * y + z * z, x * x + z * z, x * x + y * y])
+
+    mb, mc = a * b * c, math.pi * r * r * h
+    d = np.asarray(d, dtype=float)
+    jc = mc / 12 * np.diag([3 * r * r + h * h, 3 * r * r + h * h, 6 * r * r]) + mc * (d @ d * np.eye(3) - np.outer(d, d))
+    vol = mb - mc
+    cen = -mc * d / vol
+    j = box(mb, a, b, c) - jc - vol * (cen @ cen * np.eye(3) - np.outer(cen, cen))
+    return vol, cen, j
+
+
+def test_holed_plate_equals_closed_form():
+    # top and bottom are planar faces trimmed by a circle: the closed-form path
+    d = (1.0, 0.5, 0.0)
+    part = bd.Box(4, 4, 2) - bd.Pos(*d) * bd.Cylinder(1, 2)
+    vol, cen, j = _box_minus_cylinder_inertia(4, 4, 2, 1, 2, d)
+    m = sm.mass_properties(part)
+    assert abs(m.volume - vol) <= 1e-13 * vol
+    assert np.abs(m.centroid - cen).max() <= 1e-13 * 4
+    assert np.abs(m.inertia - j).max() <= 1e-12 * np.abs(j).max()
+    assert m.faces["trimmed"] >= 2
