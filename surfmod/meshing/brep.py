@@ -105,6 +105,24 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
     return tri_dev, float(node.max(initial=0.0))
 
 
+def _concatenated(fms: list) -> tuple:
+    """``(nodes, triangles, node offsets, triangle offsets)`` of many face meshes end to
+    end, the triangles indexing the joined nodes."""
+    node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
+    tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
+    triangles = np.concatenate([fm.triangles + o for fm, o in zip(fms, node_at)])
+    return np.concatenate([fm.nodes for fm in fms]), triangles, node_at, tri_at
+
+
+def _packed(evs: list):
+    """The B-spline nets of :class:`FaceSurface` s (``projector`` not None) with their
+    parameter maps, as one :class:`surfmod.eval.packed.NetPack`."""
+    from ..eval.packed import pack
+
+    maps = [ev.parameter_map for ev in evs]
+    return pack([ev._spline._local_net() for ev in evs], *(np.array([m[k] for m in maps]) for k in range(4)))
+
+
 def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np.ndarray, float]]:
     """:func:`measure_face` of many plane, sphere, cylinder, cone and torus faces
     (``params``: their :func:`surfmod.meshing.analytic.parameters`) in two compiled
@@ -114,10 +132,7 @@ def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np
     kinds = np.array([k for k, _, _ in params])
     frames = np.array([f for _, f, _ in params], float).reshape(-1, 2, 3)
     sizes = np.array([z for _, _, z in params], float).reshape(-1, 2)
-    node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
-    tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
-    nodes = np.concatenate([fm.nodes for fm in fms])
-    triangles = np.concatenate([fm.triangles + o for fm, o in zip(fms, node_at)])
+    nodes, triangles, node_at, tri_at = _concatenated(fms)
     node = analytic.distances(kinds, frames, sizes, nodes, np.repeat(np.arange(len(fms)), np.diff(node_at)))
     # planes are measured at their nodes (exact: the distance is linear on a triangle),
     # the others at their triangles' samples
@@ -134,18 +149,15 @@ def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> 
     """:func:`measure_face` of many B-spline faces (``evs``: their :class:`FaceSurface`,
     each with a ``projector``) in two compiled calls (:mod:`surfmod.eval.packed`): per
     face its triangles' deviations and its nodes' max deviation, the same values."""
-    from ..eval.packed import pack, project_segments, triangle_deviations
+    from ..eval.packed import project_segments, triangle_deviations
 
     for fm in fms:
         if np.isnan(fm.uv).any():
             raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
-    maps = [ev.parameter_map for ev in evs]
-    pk = pack([ev._spline._local_net() for ev in evs], *(np.array([m[k] for m in maps]) for k in range(4)))
+    pk = _packed(evs)
     boxes = np.array([_bounds(fm, ev) for fm, ev in zip(fms, evs)])
-    tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
-    node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
-    nodes, uv = np.concatenate([fm.nodes for fm in fms]), np.concatenate([fm.uv for fm in fms])
-    triangles = np.concatenate([fm.triangles + o for fm, o in zip(fms, node_at)])
+    nodes, triangles, node_at, tri_at = _concatenated(fms)
+    uv = np.concatenate([fm.uv for fm in fms])
     faces = np.arange(len(fms))
     half = np.full(len(fms), 0.5 * tolerance)
     # a sample within half the tolerance needs only its bound; nodes farther off than
@@ -216,15 +228,13 @@ def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples:
 def _spline_partials(splines: list) -> np.ndarray:
     """Partials to order 2 of every sampled face on its grid, ``(faces, samples, 3, 3, 3)``:
     the B-spline ones in one compiled call (:mod:`surfmod.eval.packed`)."""
-    from ..eval.packed import derivatives_segments, pack
+    from ..eval.packed import derivatives_segments
 
     size = len(splines[0][1])
     out = np.empty((len(splines), size, 3, 3, 3))
     nets = [i for i, (ev, *_) in enumerate(splines) if ev.projector is not None]  # B-spline nets
     if nets:
-        maps = [splines[i][0].parameter_map for i in nets]
-        pk = pack([splines[i][0]._spline._local_net() for i in nets], *(np.array([m[k] for m in maps])
-                                                                         for k in range(4)))
+        pk = _packed([splines[i][0] for i in nets])
         at = size * np.arange(len(nets) + 1)
         ders = derivatives_segments(pk, np.concatenate([splines[i][1] for i in nets]),
                                     np.concatenate([splines[i][2] for i in nets]),
