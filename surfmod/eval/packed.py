@@ -101,7 +101,17 @@ def project_segments(pk: NetPack, boxes: np.ndarray, points: np.ndarray, uv: np.
     """Distance bounds of ``points (N, 3)`` from their nets, segment by segment:
     ``segments (S, 3)`` rows ``(net, first point, end point)``, each with its ``start``
     and ``threshold`` (``(S,)``; see :func:`surfmod.eval.projection_kernel.project_distances`)
-    and its net's Gauss-Newton ``boxes[net]`` ``(u0, u1, v0, v1)``.  Returns ``(N,)``."""
+    and its net's Gauss-Newton ``boxes[net]`` ``(u0, u1, v0, v1)``.  Returns ``(N,)``.
+
+    >>> import numpy as np, surfmod as sm
+    >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+    >>> s = sm.BSplineSurface(net, (3, 3))  # the square [0, 3]^2 in z = 0
+    >>> pk = pack([s._local_net()], [[0, 0]], [[1, 1]], [[0, 0]], [[False, False]])
+    >>> d = project_segments(pk, np.array([[0, 1, 0, 1.0]]), np.array([[1.0, 2.0, 0.25]]),
+    ...                      np.array([[0.5, 0.5]]), np.array([[0, 0, 1]]), np.zeros(1), np.zeros(1))
+    >>> round(float(d[0]), 12)  # from the guess (0.5, 0.5) down to the foot point
+    0.25
+    """
     out = np.zeros(len(points))
     _project_segments(pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(points, float),
                       np.ascontiguousarray(uv, float), np.ascontiguousarray(segments, np.int64),
@@ -116,7 +126,19 @@ def triangle_deviations(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: n
     (N, 2)``, ``triangles (T, 3)`` indexing them), projected onto its net from its
     ``(u, v)`` while its bound exceeds its net's ``threshold`` (as
     :func:`surfmod.meshing.deviation.triangle_deviations` with a projector).
-    ``faces (F, 3)`` rows ``(net, first triangle, end triangle)``.  Returns ``(T,)``."""
+    ``faces (F, 3)`` rows ``(net, first triangle, end triangle)``.  Returns ``(T,)``.
+
+    >>> import numpy as np, surfmod as sm
+    >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+    >>> net[1:3, 1:3, 2] = 1.0  # a bump
+    >>> s = sm.BSplineSurface(net, (3, 3))
+    >>> pk = pack([s._local_net()], [[0, 0]], [[1, 1]], [[0, 0]], [[False, False]])
+    >>> uv = np.array([[0.2, 0.2], [0.8, 0.2], [0.5, 0.8]])
+    >>> d = triangle_deviations(pk, np.array([[0, 1, 0, 1.0]]), s.points(uv[:, 0], uv[:, 1]), uv,
+    ...                         np.array([[0, 1, 2]]), np.array([[0, 0, 1]]), np.array([[1 / 3] * 3]), np.zeros(1))
+    >>> bool(0.0 < d[0] < 0.6)  # the chord sags below the bump's top
+    True
+    """
     out = np.zeros(len(triangles))
     _triangle_deviations(pk, np.ascontiguousarray(boxes, float), np.ascontiguousarray(nodes, float),
                          np.ascontiguousarray(uv, float), np.ascontiguousarray(triangles, np.int64),
@@ -128,7 +150,16 @@ def triangle_deviations(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: n
 def derivatives_segments(pk: NetPack, u: np.ndarray, v: np.ndarray, segments: np.ndarray, order: int) -> np.ndarray:
     """Partials to ``order`` ``(N, K, K, 3)`` at ``(u, v)`` pairs, segment by segment:
     ``segments (S, 3)`` rows ``(net, first point, end point)``; parameters are mapped
-    as each surface maps them (periodic wrap, clamp) before evaluating."""
+    as each surface maps them (periodic wrap, clamp) before evaluating.
+
+    >>> import numpy as np, surfmod as sm
+    >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+    >>> s = sm.BSplineSurface(net, (3, 3))
+    >>> pk = pack([s._local_net()], [[0, 0]], [[1, 1]], [[0, 0]], [[False, False]])
+    >>> d = derivatives_segments(pk, [0.5, 1.7], [0.5, 0.5], np.array([[0, 0, 2]]), 1)
+    >>> d[1, 0, 0].tolist()  # 1.7 clamped to the domain's end
+    [3.0, 1.5, 0.0]
+    """
     out = np.zeros((len(u), order + 1, order + 1, 3))
     _derivatives_segments(pk, np.ascontiguousarray(u, float), np.ascontiguousarray(v, float),
                           np.ascontiguousarray(segments, np.int64), int(order), binomials(order), out)
