@@ -73,11 +73,10 @@ def project_distances(d1, points, uv, bounds, iterations: int = 6, threshold: fl
     return best
 
 
-def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None, d0=None, accurate_max=True,
-                        project=None):
-    """Measured max deviation per triangle: ``positions`` (T, 3, 3), ``uvs`` (T, 3, 2).
-    ``project(points, uv, bounds, threshold)``: a compiled equivalent of
-    :func:`project_distances` on this surface, used instead of it when given.
+def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None, d0=None, accurate_max=True):
+    """Measured max deviation per triangle: ``positions`` (T, 3, 3), ``uvs`` (T, 3, 2)
+    (B-spline faces of real parts go through the compiled
+    :func:`surfmod.eval.packed.triangle_deviations` instead).
 
     Samples whose parameter-space bound is already at most ``threshold`` are not
     projected (their bound suffices to pass).  With ``accurate_max``, the samples within
@@ -101,9 +100,7 @@ def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None,
         if idx.size:
             # without accurate_max, a sample's bound need only come within the threshold
             stop = 0.0 if accurate_max else thr
-            bound = (project(q[idx], g[idx], bounds, stop) if project is not None
-                     else project_distances(d1, q[idx], g[idx], bounds, threshold=stop, d0=d0))
-            d[idx] = np.minimum(d[idx], bound)
+            d[idx] = np.minimum(d[idx], project_distances(d1, q[idx], g[idx], bounds, threshold=stop, d0=d0))
     while accurate_max and d.size:
         cand = np.nonzero(~done & (d >= 0.9 * d.max()))[0]
         if cand.size == 0:
