@@ -12,7 +12,9 @@ all-core times are wall times.  OCCT per-point rates
 ``gp_Vec``, no conversion) are measured on 100² points through OCP and scaled to the point
 count.  The memory-write floor is the time to allocate and fill the output array
 ("fresh"), or to fill an array that already exists ("reused"), and, for comparison, a
-compiled loop that only writes every double of the reused array; the "into" rows write
+compiled loop that only writes every double of the reused array, with ordinary and with
+non-temporal stores (surfmod streams grids of partials to order 2 of 16 MiB and more,
+:mod:`surfmod.eval.streaming`); the "into" rows write
 into a preallocated array with ``BSplineSurface.grid_into`` (as OCCT's side writes into
 preallocated points), the others allocate their result.
 
@@ -133,6 +135,29 @@ def numba_write_floor():
     return njit(_write_every)
 
 
+def _stream_every(out):
+    from surfmod.eval.streaming import aligned_16, fence, stream_pair
+
+    flat = out.reshape(-1)
+    start = 0 if aligned_16(flat, 0) else 1
+    if start:
+        flat[0] = 0.0
+    for i in range(start, flat.size - 1, 2):
+        stream_pair(flat, i, float(i), float(i + 1))
+    if (flat.size - start) % 2:
+        flat[flat.size - 1] = 0.0
+    fence()
+
+
+def numba_stream_floor():
+    """:func:`numba_write_floor` with non-temporal 16-byte stores
+    (:mod:`surfmod.eval.streaming`), as surfmod writes large grids of partials to order 2:
+    no read for ownership, so about half the memory traffic."""
+    from numba import njit
+
+    return njit(_stream_every)
+
+
 def measure(single: bool) -> dict:
     """Every timing of the tables, in seconds, for this process's thread setting."""
     out = {"net": {}, "rows": {}}
@@ -168,6 +193,9 @@ def measure(single: bool) -> dict:
     write = numba_write_floor()
     write(buf2[:1])
     rows["floor_d2_numba"] = _time(lambda: write(buf2), single, 5)
+    stream = numba_stream_floor()
+    stream(buf2[:1])
+    rows["floor_d2_stream"] = _time(lambda: stream(buf2), single, 5)
     rows["floor_d0_numba"] = _time(lambda: write(buf), single, 5)
     del buf2
     rng = np.random.default_rng(3)
@@ -296,7 +324,9 @@ def report(one: dict, every: dict) -> None:
     print("floor = allocate and fill the output array (for the \"into\" rows: fill the reused array);")
     print("x floor = surfmod / floor (1 = at the floor).")
     print(f"a compiled loop that only writes the reused array: {_f(r['floor_d0_numba'])} (positions), "
-          f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2 at most)")
+          f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2);")
+    print(f"  with non-temporal stores, as surfmod writes partials to 2 past 16 MiB: {_f(r['floor_d2_stream'])} "
+          f"({_x(d2_20 * GRID**2, r['floor_d2_stream'])} OCCT D2 at most)")
     print("\ngeomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
     for n in (4, 20):
         print(f"  {n}x{n}: geomdl {_f(r[f'geomdl{n}'], '.1f')}  surfmod {_f(r[f'poly{n}'])}  "

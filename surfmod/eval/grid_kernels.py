@@ -13,12 +13,14 @@ from numba import njit, uint64
 
 from . import sliding
 from .kernels import U1, U2, U3, quotient_planes
+from .partials_stage import order2_block
 from .position_stage import positions_low_degree
 from .row_stage import contract_rows, row_points
 
 
 @njit(cache=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns):
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns,
+         stream):
     """The grid ``us x vs[b0:b0+n_v]`` into ``out`` (point-major: ``(n_u, N_v, 3)`` for
     positions, ``(n_u, N_v, K, K, 3)`` for partials, ``K = bu.shape[1]``), block by block
     of u-points (:func:`grid_block_positions`, :func:`grid_block_derivatives`); block
@@ -27,14 +29,16 @@ def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts,
     first row among them; ``scratch[0]`` holds a block's row table (reused: a fresh
     table per block would be paged in again and again).  ``vruns`` is ``(bplan, planes,
     run_starts, run_kinds)`` for the vector loops of :func:`surfmod.eval.row_stage.contract_rows`,
-    or empty arrays (no run kinds) for the one-point-at-a-time stage :func:`grid_rows`."""
+    or empty arrays (no run kinds) for the one-point-at-a-time stage :func:`grid_rows`.
+    ``stream``: partials to order 2 go to ``out`` with non-temporal stores
+    (:mod:`surfmod.eval.partials_stage`), for outputs far larger than the caches."""
     for blk in range(starts.size - 1):
         if out.ndim == 3:
             grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,
                                  first, blk, vruns)
         else:
             grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[0], starts, rows,
-                                   row_starts, first, blk, vruns)
+                                   row_starts, first, blk, vruns, stream)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -70,10 +74,14 @@ def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, 
 
 @njit(cache=True, error_model="numpy")
 def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows, row_starts,
-                           first, blk, vruns):
-    """One block of :func:`grid` for partials."""
+                           first, blk, vruns, stream):
+    """One block of :func:`grid` for partials: to order 2 by
+    :func:`surfmod.eval.partials_stage.order2_block`, other orders by :func:`grid_derivatives`."""
     table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns)
-    grid_derivatives(bu[a0:a1], first[a0:a1], p, table, rational, binom, b0, out[a0:a1])
+    if bu.shape[1] == 3:
+        order2_block(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1], stream)
+    else:
+        grid_derivatives(bu[a0:a1], first[a0:a1], p, table, rational, binom, b0, out[a0:a1])
 
 
 @njit(cache=True, error_model="numpy")
@@ -181,23 +189,18 @@ def grid_positions(bu, first, p, w, rational, b0, out):
 
 @njit(cache=True, error_model="numpy")
 def grid_derivatives(bu, first, p, w, rational, binom, b0, out):
-    """Second stage for partials: for each u-point combine its p+1 rows of ``w`` on the
-    cache-resident planes of a scratch ``acc`` (every partial and coordinate a contiguous
-    row of v), apply the quotient rule there (rational), then store each point's ``3 K^2``
-    values together into ``out[:, b0:b0+n_v]`` of the point-major ``out (n_u, N_v, K, K,
-    3)``, so the output is written once, front to back."""
+    """Second stage for partials of any order (order 2 has its own,
+    :mod:`surfmod.eval.partials_stage`): for each u-point combine its p+1 rows of ``w`` on
+    the cache-resident planes of a scratch ``acc`` (every partial and coordinate a
+    contiguous row of v), apply the quotient rule there (rational), then store each
+    point's ``3 K^2`` values together into ``out[:, b0:b0+n_v]`` of the point-major ``out
+    (n_u, N_v, K, K, 3)``, so the output is written once, front to back."""
     kk = bu.shape[1]
     nv = w.shape[3]
     dim = 4 if rational else 3
     acc = np.empty((kk, kk, 4, nv))
     for a in range(bu.shape[0]):
         _combine_rows(bu, a, first, p, w, kk, dim, acc)
-        dst = out[a].reshape(-1)  # flat, unsigned offsets (see U1)
-        per_point = uint64(3 * kk * kk)
-        o = uint64(b0) * per_point
-        if rational and kk == 3:  # the quotient rule fused into the store
-            _store_quotient_order2(acc, dst, o)
-            continue
         if rational:
             quotient_planes(acc, binom)
         points = out[a]
@@ -208,41 +211,3 @@ def grid_derivatives(bu, first, p, w, rational, binom, b0, out):
                     point[k, l, 0] = acc[k, l, 0, b]
                     point[k, l, 1] = acc[k, l, 1, b]
                     point[k, l, 2] = acc[k, l, 2, b]
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _store_quotient_order2(acc, dst, o):
-    """The quotient rule to order 2 (:func:`surfmod.eval.kernels.quotient_planes`) fused
-    with the point-major store of :func:`grid_derivatives`: each point's 27 Cartesian
-    values go straight from registers to ``dst[o + 27 b:]`` (same terms in the same
-    order, so the same rounding), without writing the planes back."""
-    nv = acc.shape[3]
-    w00, w01, w02 = acc[0, 0, 3], acc[0, 1, 3], acc[0, 2, 3]
-    w10, w11, w12 = acc[1, 0, 3], acc[1, 1, 3], acc[1, 2, 3]
-    w20, w21, w22 = acc[2, 0, 3], acc[2, 1, 3], acc[2, 2, 3]
-    for b in range(nv):
-        iw = 1.0 / w00[b]
-        t = o + uint64(27) * uint64(b)
-        for d in range(3):
-            s00 = acc[0, 0, d, b] * iw
-            s01 = (acc[0, 1, d, b] - w01[b] * s00) * iw
-            s02 = (acc[0, 2, d, b] - 2.0 * w01[b] * s01 - w02[b] * s00) * iw
-            s10 = (acc[1, 0, d, b] - w10[b] * s00) * iw
-            s11 = (acc[1, 1, d, b] - w01[b] * s10 - w10[b] * s01 - w11[b] * s00) * iw
-            s12 = (acc[1, 2, d, b] - 2.0 * w01[b] * s11 - w02[b] * s10 - w10[b] * s02 - 2.0 * w11[b] * s01
-                   - w12[b] * s00) * iw
-            s20 = (acc[2, 0, d, b] - 2.0 * w10[b] * s10 - w20[b] * s00) * iw
-            s21 = (acc[2, 1, d, b] - w01[b] * s20 - 2.0 * w10[b] * s11 - 2.0 * w11[b] * s10 - w20[b] * s01
-                   - w21[b] * s00) * iw
-            s22 = (acc[2, 2, d, b] - 2.0 * w01[b] * s21 - w02[b] * s20 - 2.0 * w10[b] * s12 - 4.0 * w11[b] * s11
-                   - 2.0 * w12[b] * s10 - w20[b] * s02 - 2.0 * w21[b] * s01 - w22[b] * s00) * iw
-            e = t + uint64(d)
-            dst[e] = s00
-            dst[e + U3] = s01
-            dst[e + uint64(6)] = s02
-            dst[e + uint64(9)] = s10
-            dst[e + uint64(12)] = s11
-            dst[e + uint64(15)] = s12
-            dst[e + uint64(18)] = s20
-            dst[e + uint64(21)] = s21
-            dst[e + uint64(24)] = s22

@@ -45,6 +45,10 @@ V_BLOCK = 1024
 GRID_MIN_BLOCK = 16
 #: blocks per thread (at least): threads that finish early take more of them
 BLOCKS_PER_THREAD = 8
+#: output bytes from which grids of partials to order 2 are written with non-temporal
+#: stores (:mod:`surfmod.eval.streaming`): far beyond the L2 caches, where writing
+#: through them only evicts everything else
+STREAM_BYTES = 1 << 24
 
 
 def _kernels():
@@ -369,7 +373,9 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     Everything is written point-major (C order), into ``out`` when given: ``(len(us),
     len(vs), 3)`` for positions (``order == 0``), ``(len(us), len(vs), K, K, 3)`` for
     partials.  The partials are formed on cache-resident planes (every partial and
-    coordinate a contiguous row of v) and each point's values are then stored together.
+    coordinate a contiguous row of v) and each point's values are then stored together;
+    partials to order 2 in chunks of v-points held in L1, streamed past the caches into
+    outputs of ``STREAM_BYTES`` or more (:mod:`surfmod.eval.partials_stage`).
     """
     k = _kernels()
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
@@ -388,6 +394,9 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             out = np.empty((us.size, vs.size, kk, kk, 3))
     run, count = _kernels_for(us.size * vs.size, grid=True)
     ordered = bool(np.all(su[1:] >= su[:-1]))
+    # 16-byte streaming stores need the doubles on 8-byte boundaries (a row then starts
+    # on or 8 bytes past a 16-byte one); a misaligned caller's array is written plainly
+    stream = order == 2 and out.nbytes >= STREAM_BYTES and out.ctypes.data % 8 == 0
     with _on(count):
         for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
@@ -401,7 +410,8 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
 
                 blocks = _row_blocks(su, p, n, 1, count)
                 per_slot = RING * dim * min(svb.size, CHUNK)
-            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns)
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns,
+                     stream)
     if order == 0:
         return out[:, :, None, None, :]
     return out

@@ -1,0 +1,89 @@
+"""The grid's stage for partials to order 2 (surfmod/eval/partials_stage.py): equal to
+the general stage to rounding for every degree, chunk tail, alignment and v-offset,
+streamed or not; and through the public API on a grid large enough to stream."""
+
+import numpy as np
+import pytest
+
+import surfmod as sm
+from surfmod.eval import local
+from surfmod.eval.grid_kernels import grid_derivatives
+from surfmod.eval.kernels import binomials
+from surfmod.eval.partials_stage import CHUNK, order2_block
+from surfmod.gallery.synthetic import wavy_net
+
+
+def _table(rng, p, rational, nu, nv):
+    """A random row table, u-basis and first rows, shaped as the grid's first stage
+    makes them; weights and their combinations stay well away from 0."""
+    rows = p + 4
+    w = rng.uniform(0.5, 1.5, (rows, 3, 4 if rational else 3, nv))
+    bu = rng.uniform(0.0, 1.0, (nu, 3, p + 1))
+    first = rng.integers(0, rows - p, nu)
+    return w, bu, first
+
+
+def _assert_within(got, ref, rel):
+    """``got`` equals ``ref`` within ``rel`` of each partial's largest size (over the
+    points and coordinates)."""
+    scale = np.abs(ref).max(axis=(0, 1, 4), keepdims=True)
+    worst = (np.abs(got - ref) / scale).max()
+    assert worst <= rel, f"off by {worst:.2e} of a partial's size"
+
+
+def _general(bu, first, p, w, rational, b0, shape):
+    out = np.full(shape, np.nan)
+    grid_derivatives(bu, first, p, w, rational, binomials(2), b0, out)
+    return out
+
+
+@pytest.mark.parametrize("p", [1, 2, 3, 4, 5])
+@pytest.mark.parametrize("rational", [False, True])
+@pytest.mark.parametrize("nv", [1, 2, CHUNK - 1, CHUNK, 2 * CHUNK + 3])
+def test_stage_equals_the_general_path_streamed_or_not(p, rational, nv):
+    rng = np.random.default_rng(100 * p + nv + rational)
+    w, bu, first = _table(rng, p, rational, 3, nv)
+    for b0 in (0, 1, 2):  # the rows start on, and 8 bytes past, a 16-byte boundary
+        shape = (3, nv + b0 + 1, 3, 3, 3)
+        expected = _general(bu, first, p, w, rational, b0, shape)
+        got = {}
+        for stream in (False, True):
+            out = np.full(shape, np.nan)
+            order2_block(bu, first, p, w, rational, b0, out, stream)
+            got[stream] = out
+        np.testing.assert_array_equal(got[True], got[False])  # the same values, only stored differently
+        # points outside [b0, b0 + nv) are untouched; inside, the general path's values
+        # to rounding (fused multiply-adds; a few ulps after the quotient rule's differences)
+        assert np.isnan(got[True][:, :b0]).all() and np.isnan(got[True][:, b0 + nv:]).all()
+        _assert_within(got[True][:, b0 : b0 + nv], expected[:, b0 : b0 + nv], 5e-14)
+
+
+def test_stage_writes_a_misaligned_array():
+    """A caller's array whose rows start 8 bytes past a 16-byte boundary (a view one
+    double into a buffer) is written from its first 16-byte boundary on, the same values."""
+    rng = np.random.default_rng(5)
+    w, bu, first = _table(rng, 3, True, 4, 2 * CHUNK + 1)
+    buffer = np.full(1 + 4 * w.shape[3] * 27, np.nan)
+    shifted = buffer[1:].reshape(4, w.shape[3], 3, 3, 3)
+    aligned = np.full(shifted.shape, np.nan)
+    order2_block(bu, first, 3, w, True, 0, shifted, True)
+    order2_block(bu, first, 3, w, True, 0, aligned, True)
+    np.testing.assert_array_equal(shifted, aligned)
+    assert np.isnan(buffer[0])
+
+
+def test_a_streamed_grid_equals_the_plain_one_and_scattered_partials(monkeypatch):
+    """300 x 300 partials to order 2 (19 MB) are past ``STREAM_BYTES``: streamed into a
+    caller's array they equal the plain stores bit for bit, and the scattered kernel's
+    partials (a different algorithm) to 1e-13 of each partial's size."""
+    rng = np.random.default_rng(11)
+    s = sm.BSplineSurface(wavy_net(9, 8), (3, 2), weights=10 ** rng.uniform(-1, 1, (9, 8)))
+    us, vs = np.linspace(0, 1, 300), np.sort(rng.uniform(0, 1, 300))
+    assert 300 * 300 * 27 * 8 >= local.STREAM_BYTES
+    streamed = s.grid_into(us, vs, np.empty((300, 300, 3, 3, 3)), order=2)
+    monkeypatch.setattr(local, "STREAM_BYTES", 1 << 62)
+    plain = s.grid_into(us, vs, np.empty((300, 300, 3, 3, 3)), order=2)
+    np.testing.assert_array_equal(streamed, plain)
+    uu, vv = np.meshgrid(us, vs, indexing="ij")
+    scattered = s.derivatives(uu.ravel(), vv.ravel(), 2).reshape(streamed.shape)
+    _assert_within(streamed, scattered, 1e-13)
