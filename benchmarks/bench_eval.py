@@ -33,6 +33,7 @@ import tracemalloc
 import numpy as np
 
 import surfmod as sm
+from surfmod.eval.streaming import aligned_16, fence, stream_pair
 from surfmod.gallery.synthetic import wavy_net
 
 NET_SIZES = (4, 20, 100, 400, 1000)
@@ -136,8 +137,6 @@ def numba_write_floor():
 
 
 def _stream_every(out):
-    from surfmod.eval.streaming import aligned_16, fence, stream_pair
-
     flat = out.reshape(-1)
     start = 0 if aligned_16(flat, 0) else 1
     if start:
