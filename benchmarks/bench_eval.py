@@ -13,8 +13,8 @@ all-core times are wall times.  OCCT per-point rates
 count.  The memory-write floor is the time to allocate and fill the output array
 ("fresh"), or to fill an array that already exists ("reused"), and, for comparison, a
 compiled loop that only writes every double of the reused array, with ordinary and with
-non-temporal stores (surfmod streams grids of partials to order 2 of 16 MiB and more,
-:mod:`surfmod.eval.streaming`); the "into" rows write
+non-temporal stores (surfmod streams grids of partials to order 2 into a caller's array
+of 16 MiB and more, :mod:`surfmod.eval.streaming`); the "into" rows write
 into a preallocated array with ``BSplineSurface.grid_into`` (as OCCT's side writes into
 preallocated points), the others allocate their result.
 
@@ -324,7 +324,7 @@ def report(one: dict, every: dict) -> None:
     print("x floor = surfmod / floor (1 = at the floor).")
     print(f"a compiled loop that only writes the reused array: {_f(r['floor_d0_numba'])} (positions), "
           f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2);")
-    print(f"  with non-temporal stores, as surfmod writes partials to 2 past 16 MiB: {_f(r['floor_d2_stream'])} "
+    print(f"  with non-temporal stores, as surfmod writes partials to 2 into arrays past 16 MiB: {_f(r['floor_d2_stream'])} "
           f"({_x(d2_20 * GRID**2, r['floor_d2_stream'])} OCCT D2 at most)")
     print("\ngeomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
     for n in (4, 20):

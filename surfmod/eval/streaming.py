@@ -7,7 +7,10 @@ memory and evicts everything else from the caches.  A non-temporal store goes to
 write-combining buffers and from there to memory in whole lines: on this project's
 reference machine a compiled loop fills such an array about 2.5 times faster with them
 (``benchmarks/bench_eval.py`` prints both floors).  They pay off only for output the
-caller will not read back at once, so callers use them above a size threshold.
+caller will not read back at once, so callers use them above a size threshold, and only
+into memory already paged in: the kernel zeroes a fresh page through the caches when it
+is first touched, and ordinary stores then hit those lines
+(:func:`surfmod.eval.local.surface_grid` streams into a caller's array only).
 
 The stores are LLVM ``store`` instructions with ``!nontemporal`` metadata, emitted
 through numba intrinsics: x86-64 compiles the 16-byte vector form to ``movntpd``, other
