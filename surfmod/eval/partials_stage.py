@@ -20,7 +20,7 @@ on one thread or several, for any blocking).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, uint64
+from numba import literally, njit, uint64
 
 from .streaming import aligned_16, fence, stream_pair
 
@@ -36,39 +36,30 @@ def order2_block(bu, first, p, w, rational, b0, out, stream):
     table ``w (rows, 3, dim, n_v)``, ``first[a]`` the place of u-point ``a``'s first row
     in it, ``bu (n_u, 3, p+1)`` the u-basis with its derivatives."""
     if p <= 3:
-        _chunks_low_degree(bu, first, p, w, rational, b0, out, stream)
+        _chunks(bu, first, p, w, rational, b0, out, stream, False)
     else:
-        _chunks_high_degree(bu, first, p, w, rational, b0, out, stream)
+        _chunks(bu, first, p, w, rational, b0, out, stream, True)
     if stream:
         fence()
 
 
-# Two loops, one per way to combine the rows, with the steps written out in each:
-# measured, a branch between the two combines inside the loop (or a helper wrapped around
-# the last two steps) made LLVM compile the loop to half the speed.
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _chunks_low_degree(bu, first, p, w, rational, b0, out, stream):
+def _chunks(bu, first, p, w, rational, b0, out, stream, high_degree):
+    """The chunk loop of :func:`order2_block`, compiled once for each way to combine the
+    rows: ``high_degree`` is a compile-time constant (``literally``), so each version
+    holds only its own combine (measured, with both in one loop LLVM compiled it to half
+    the speed)."""
+    literally(high_degree)
     acc = np.empty((3, 3, 4, CHUNK))
     planes = acc.reshape(-1)
     for a in range(bu.shape[0]):
         row = out[a].reshape(-1)
         for c0 in range(0, w.shape[3], CHUNK):
             n = min(CHUNK, w.shape[3] - c0)
-            _combine_chunk(bu, a, first[a], p, w, 4 if rational else 3, c0, n, acc)
-            if rational:
-                _quotient_chunk(acc, n)
-            _store_points(planes, n, row, 27 * (b0 + c0), stream)
-
-
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _chunks_high_degree(bu, first, p, w, rational, b0, out, stream):
-    acc = np.empty((3, 3, 4, CHUNK))
-    planes = acc.reshape(-1)
-    for a in range(bu.shape[0]):
-        row = out[a].reshape(-1)
-        for c0 in range(0, w.shape[3], CHUNK):
-            n = min(CHUNK, w.shape[3] - c0)
-            _combine_chunk_high(bu, a, first[a], p, w, 4 if rational else 3, c0, n, acc)
+            if high_degree:
+                _combine_chunk_high(bu, a, first[a], p, w, 4 if rational else 3, c0, n, acc)
+            else:
+                _combine_chunk(bu, a, first[a], p, w, 4 if rational else 3, c0, n, acc)
             if rational:
                 _quotient_chunk(acc, n)
             _store_points(planes, n, row, 27 * (b0 + c0), stream)
