@@ -255,6 +255,35 @@ def test_patch_positions_match_basis_kernel_and_textbook(p, q, rational):
     np.testing.assert_allclose(got[pick], expected, rtol=0, atol=atol)
 
 
+@pytest.mark.parametrize("p, q", [(1, 1), (2, 3), (3, 1), (3, 3)])
+@pytest.mark.parametrize("rational", [False, True])
+@pytest.mark.parametrize("order", [1, 2])
+def test_patch_partials_match_basis_kernel_and_textbook(p, q, rational, order):
+    """Partials to order 1 and 2 of many scattered points go through the patches too
+    (Horner schemes with their derivatives, the chain rule, the quotient rule): they
+    agree with the basis-function kernel everywhere and with the textbook on a sample,
+    knots and domain ends included."""
+    s = _surface(11, 9, p, q, rational, seed=p * 10 + q)
+    u, v = _sample_params(s, 3000, np.random.default_rng(6))
+    net = s._local_net()
+    net.cache.clear()
+    got = s.derivatives(u, v, order)
+    assert "patches" in net.cache  # the patch path ran
+    basis = np.empty_like(got)
+    kernels.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, order, net.rational,
+                                  kernels.binomials(order), net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, basis)
+    _assert_partials(got, basis, s)
+    pick = np.r_[0:40, 3000:3040, -4:0]
+    (pp, qq), (ku, kv) = s.degree, s.knots
+    expected = np.array([ref.bspline_surface_derivatives(s.control_points, pp, qq, ku, kv, u[i], v[i], order, s.weights)
+                         for i in pick])
+    # past the degree the textbook's differences of basis functions leave rounding noise
+    # where the patches' Horner schemes give exact zeros (polynomial nets)
+    _assert_partials(got[pick], expected, s, mask=lambda k, l: k <= pp and l <= qq)
+    if not rational:
+        assert not got[:, pp + 1 :].any() and not got[:, :, qq + 1 :].any()
+
+
 def test_patches_are_skipped_for_high_degree_and_few_points():
     s = _surface(9, 9, 4, 3, True)
     u, v = _sample_params(s, 3000, np.random.default_rng(1))

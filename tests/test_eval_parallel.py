@@ -73,6 +73,7 @@ def test_parallel_scattered_equals_serial_bit_for_bit(rational, monkeypatch):
     serial, threaded = _both(run, monkeypatch)
     assert "patches" in small._local_net().cache  # the per-span patch path ran
     assert parallel.patch_positions.signatures and parallel.scattered_positions.signatures
+    assert parallel.patch_derivatives.signatures  # order 2 on the small net: patches too
     for a, b in zip(serial, threaded):
         np.testing.assert_array_equal(b, a)
 

@@ -238,11 +238,21 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
 
 def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray:
     """Cartesian mixed partials at scattered pairs: ``(N, K, K, 3)``, ``K = order + 1``;
-    entry ``[a, k, l]`` is d^(k+l) S / du^k dv^l (the rational quotient rule included)."""
+    entry ``[a, k, l]`` is d^(k+l) S / du^k dv^l (the rational quotient rule included).
+
+    Partials to order 1 or 2 of many points on a small low-degree net go through the
+    per-span patches (:mod:`surfmod.eval.patches`, as positions do), the others through
+    the basis-function kernel."""
     k = _kernels()
     u, v = _as_float(u), _as_float(v)
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
+    table = _patch_table(net, u.size) if order in (1, 2) else None
+    if table is not None:
+        from . import patches
+
+        patches.derivatives(net, table, u, v, out)
+        return out
     run, count = _kernels_for(u.size)
     with _on(count):
         run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),

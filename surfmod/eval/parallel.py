@@ -15,7 +15,7 @@ from numba import get_thread_id, njit, prange
 
 from .grid_kernels import grid_block_derivatives, grid_block_positions
 from .kernels import SCATTER_CHUNK, scattered_derivatives_chunk, scattered_positions_chunk
-from .patches import positions_chunk
+from .patches import derivatives_chunk, positions_chunk
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -55,3 +55,12 @@ def patch_positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, 
     for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
                         u, v, out, c)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def patch_derivatives(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
+                      u, v, out):
+    """The patch kernel for partials of :mod:`surfmod.eval.patches`, a chunk of points per task."""
+    for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
+                          u, v, out, c)

@@ -1,4 +1,5 @@
-"""Per-span polynomial patches for many scattered positions (compiled, numba).
+"""Per-span polynomial patches for many scattered positions and partials to order 2
+(compiled, numba).
 
 Within one knot span in u and one in v a (rational) B-spline surface is a polynomial
 patch.  Written in Taylor form about the span's midpoint with the normalized parameters
@@ -231,6 +232,94 @@ def _patch_points(flat, p, q, base, xs, ys, rational, out, c0, c1):
         _store(out, c0 + i, h0, h1, h2, h3, rational)
 
 
+@njit(cache=True, error_model="numpy")
+def _derivatives(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                 bucket_u, bucket_v, u, v, out):
+    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
+        derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                          bucket_u, bucket_v, u, v, out, c)
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
+def derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                      bucket_u, bucket_v, u, v, out, chunk):
+    """Partials to order 1 or 2 (``out (N, K, K, 3)``, ``K = 2, 3``) of the points of
+    one chunk from their patches: per point, Horner schemes with their first two
+    derivatives, in y over each x-power's row, then in x over the results; the chain
+    rule's scales ``scale^k``; the quotient rule.  The four homogeneous coordinates go
+    side by side in 4-wide loops whose trip count is a run-time value, so that LLVM
+    vectorizes them (as in :func:`_bicubic_points`)."""
+    a0, a1 = chunk * SCATTER_CHUNK, min(u.size, (chunk + 1) * SCATTER_CHUNK)
+    kk = out.shape[1]
+    dim = coeffs.shape[-1]
+    flat = coeffs.reshape(-1)
+    per_span = uint64((p + 1) * (q + 1) * 4)
+    per_row = uint64(m - q) * per_span
+    by_y = np.empty((p + 1, 3, 4))  # [x power, y-derivative order, coordinate]
+    h = np.empty((3, 3, 4))  # [u-order, v-order, coordinate]
+    for a in range(a0, a1):
+        su = find_span_bucketed(ku, p, n, u[a], bucket_u[0], bucket_u[1], bucket_u[2])
+        sv = find_span_bucketed(kv, q, m, v[a], bucket_v[0], bucket_v[1], bucket_v[2])
+        x = (u[a] - mid_u[su]) * scale_u[su]
+        y = (v[a] - mid_v[sv]) * scale_v[sv]
+        base = uint64(su - p) * per_row + uint64(sv - q) * per_span
+        for k in range(p + 1):
+            row = base + uint64(4 * (q + 1) * k)
+            for d in range(dim):
+                f0 = flat[row + uint64(4 * q + d)]
+                f1 = f2 = 0.0
+                for j in range(q - 1, -1, -1):
+                    f2 = f2 * y + f1
+                    f1 = f1 * y + f0
+                    f0 = f0 * y + flat[row + uint64(4 * j + d)]
+                by_y[k, 0, d], by_y[k, 1, d], by_y[k, 2, d] = f0, f1, 2.0 * f2
+        sx, sy = scale_u[su], scale_v[sv]
+        for l in range(3):
+            for d in range(dim):
+                f0 = by_y[p, l, d]
+                f1 = f2 = 0.0
+                for i in range(p - 1, -1, -1):
+                    f2 = f2 * x + f1
+                    f1 = f1 * x + f0
+                    f0 = f0 * x + by_y[i, l, d]
+                h[0, l, d], h[1, l, d], h[2, l, d] = f0, f1 * sx, 2.0 * f2 * sx * sx
+            sl = sy if l == 1 else (sy * sy if l == 2 else 1.0)
+            for k in range(3):
+                for d in range(dim):
+                    h[k, l, d] *= sl
+        _store_partials(h, rational, out, a, kk)
+
+
+@njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
+def _store_partials(h, rational, out, a, kk):
+    """``out[a, :kk, :kk]`` from the homogeneous partials ``h[k, l, :]`` (the quotient rule
+    to order 2 when rational, with the terms of :func:`surfmod.eval.kernels.quotient_planes`)."""
+    if not rational:
+        for k in range(kk):
+            for l in range(kk):
+                for d in range(3):
+                    out[a, k, l, d] = h[k, l, d]
+        return
+    iw = 1.0 / h[0, 0, 3]
+    v01, v02, v10, v11, v12 = h[0, 1, 3], h[0, 2, 3], h[1, 0, 3], h[1, 1, 3], h[1, 2, 3]
+    v20, v21, v22 = h[2, 0, 3], h[2, 1, 3], h[2, 2, 3]
+    for d in range(3):
+        s00 = h[0, 0, d] * iw
+        s01 = (h[0, 1, d] - v01 * s00) * iw
+        s10 = (h[1, 0, d] - v10 * s00) * iw
+        s11 = (h[1, 1, d] - v01 * s10 - v10 * s01 - v11 * s00) * iw
+        out[a, 0, 0, d], out[a, 0, 1, d], out[a, 1, 0, d], out[a, 1, 1, d] = s00, s01, s10, s11
+        if kk == 3:
+            s02 = (h[0, 2, d] - 2.0 * v01 * s01 - v02 * s00) * iw
+            s12 = (h[1, 2, d] - 2.0 * v01 * s11 - v02 * s10 - v10 * s02 - 2.0 * v11 * s01 - v12 * s00) * iw
+            s20 = (h[2, 0, d] - 2.0 * v10 * s10 - v20 * s00) * iw
+            s21 = (h[2, 1, d] - v01 * s20 - 2.0 * v10 * s11 - 2.0 * v11 * s10 - v20 * s01 - v21 * s00) * iw
+            s22 = (h[2, 2, d] - 2.0 * v01 * s21 - v02 * s20 - 2.0 * v10 * s12 - 4.0 * v11 * s11
+                   - 2.0 * v12 * s10 - v20 * s02 - 2.0 * v21 * s01 - v22 * s00) * iw
+            out[a, 0, 2, d], out[a, 1, 2, d] = s02, s12
+            out[a, 2, 0, d], out[a, 2, 1, d], out[a, 2, 2, d] = s20, s21, s22
+
+
 def positions(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """Positions at the scattered pairs ``(u[a], v[a])`` into ``out (N, 3)`` from ``table``
     (flat float64 parameter arrays, in the domain)."""
@@ -246,3 +335,20 @@ def positions(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndar
         return
     _positions(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u,
                table.mid_v, table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
+
+
+def derivatives(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    """Partials to order 1 or 2 at the scattered pairs ``(u[a], v[a])`` into ``out (N, K, K,
+    3)`` from ``table`` (flat float64 parameter arrays, in the domain)."""
+    n, m = net.ctrl.shape[:2]
+    count = threads_for(u.size)
+    if count > 1:
+        from . import parallel
+
+        with running_on(count):
+            parallel.patch_derivatives(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u,
+                                       table.scale_u, table.mid_v, table.scale_v, net.rational, net.bucket_u,
+                                       net.bucket_v, u, v, out)
+        return
+    _derivatives(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u,
+                 table.mid_v, table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
