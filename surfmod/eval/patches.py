@@ -9,8 +9,11 @@ patch.  Written in Taylor form about the span's midpoint with the normalized par
 
 where ``T[k, i] = N_i^(k)(mid) half^k / k!`` are the Taylor rows of the basis functions
 (computed by the same division-free Cox-de Boor triangle as every other kernel).  A
-point then costs a span search and a Horner scheme: no basis triangle, no knot look-ups.
-OCCT's ``BSplSLib_Cache`` evaluates the same kind of per-span polynomial.
+point then costs a span search and a Horner scheme: no basis triangle, no knot look-ups;
+its partials, Horner schemes that carry their first two derivatives, the chain rule's
+factors ``(1 / half)^k`` and the quotient rule (:func:`derivatives`: about a third of
+the basis-function kernel's time on a 20x20 bicubic NURBS).  OCCT's ``BSplSLib_Cache``
+evaluates the same kind of per-span polynomial.
 
 The table holds ``(p+1)(q+1)`` homogeneous 4-vectors per span pair, so it is built only
 for small nets and degrees up to 3 (:func:`suits`), where the Taylor coefficients of a
