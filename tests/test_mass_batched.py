@@ -6,6 +6,7 @@ node-by-node quadrature on the corpus and closed-form solids."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import build123d as bd
 import numpy as np
@@ -19,7 +20,9 @@ from surfmod.readback import from_face
 from surfmod.uses.inputs import to_shape
 from surfmod.uses.mass import _moments, _read_faces
 from surfmod.uses.mass_boundary import PcurveTable, pcurve_d1, taylor_pieces
-from surfmod.uses.mass_green import face_nodes, mass_face
+import surfmod.uses.mass_green as mg
+import surfmod.uses.mass_grid as mgrid
+from surfmod.uses.mass_green import face_nodes, mass_face, mass_faces
 from surfmod.uses.mass_plane import plane_moments
 
 QUICK = ("occt_screw.step", "pythonocc_face_recognition_sample_part.stp")
@@ -153,3 +156,46 @@ def test_holed_plate_equals_closed_form():
     assert np.abs(m.centroid - cen).max() <= 1e-13 * 4
     assert np.abs(m.inertia - j).max() <= 1e-12 * np.abs(j).max()
     assert m.faces["trimmed"] >= 2
+
+
+def _nodes_with_and_without_tensor(mf, order=12):
+    tensor = face_nodes(mf, order)
+    pointwise = face_nodes(replace(mf, grid_evaluate=None, boundary={}), order)
+    return tensor, pointwise
+
+
+@pytest.mark.parametrize("name", QUICK)
+def test_tensor_grid_evaluation_equals_point_by_point(corpus_dir, name):
+    # Green's grids and natural faces on the surface's tensor evaluator: the same nodes,
+    # weights and partials as evaluating every point (the screw's tori and cone: bit for bit)
+    _, shapes = _part(corpus_dir / name)
+    read = _read_faces(shapes)
+    pcs = faces_pcurves(shapes)
+    taylor_pieces([r for p in pcs for r in p])
+    checked = 0
+    for mf in mass_faces(read, pcs):
+        if mf.plane:
+            continue
+        (d1, w1, e1), (d2, w2, e2) = _nodes_with_and_without_tensor(mf)
+        assert e1 == e2 and np.array_equal(w1, w2)
+        assert np.array_equal(d1, d2), name
+        checked += 1
+    assert checked >= 3
+
+
+@pytest.mark.parametrize("inner", ["cheaper", "u"])
+def test_tensor_grid_on_a_spline_face_and_its_fallback_equal_point_by_point(monkeypatch, inner):
+    if inner == "u":  # as on faces whose p-curves leave gaps: Green's inner integral along u
+        monkeypatch.setattr(mg, "CLOSURE_RTOL", -1.0)
+    net = np.zeros((5, 4, 3))
+    net[..., 0], net[..., 1] = np.mgrid[0:5, 0:4]
+    net[..., 2] = np.sin(net[..., 0]) * np.cos(net[..., 1])
+    face = sm.BSplineSurface(net, (3, 2), ([0] * 4 + [0.5] + [1] * 4, [0] * 3 + [0.5] + [1] * 3)).face()
+    part = bd.extrude(bd.Face(face.wrapped), amount=3.0, dir=(0, 0, -1)) & bd.Cylinder(1.3, 20).translate((2, 1.5, 0))
+    top = next(mass_face(from_face(f)) for f in part.faces() if f.geom_type == bd.GeomType.BSPLINE)
+    assert not top.natural
+    for slack in (mgrid.GreenGrid.TENSOR_SLACK, 0.0):  # the tensor, then point by point
+        monkeypatch.setattr(mgrid.GreenGrid, "TENSOR_SLACK", slack)
+        (d1, w1, _), (d2, w2, _) = _nodes_with_and_without_tensor(top)
+        assert np.array_equal(w1, w2)
+        assert np.abs(d1 - d2).max() <= 1e-14 * np.abs(d2).max()

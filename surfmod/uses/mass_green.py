@@ -108,6 +108,8 @@ class MassFace:
     angular: tuple = (False, False)
     # Gauss nodes on the p-curves per order, when computed for many faces at once
     boundary: dict = field(default_factory=dict)
+    # the same partials as ``evaluate`` on a tensor grid ``us × vs`` (``(nu, nv, 2, 2, 3)``)
+    grid_evaluate: object = None
 
     @property
     def natural(self) -> bool:
@@ -235,7 +237,7 @@ def mass_face(face, pcurves: list | None = None, natural: bool | None = None) ->
     return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
                     plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table,
-                    angular)
+                    angular, grid_evaluate=face._grid_derivatives)
 
 
 def surface_mass_face(surf) -> MassFace:
@@ -247,7 +249,8 @@ def surface_mass_face(surf) -> MassFace:
         breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None else _breaks(lo, hi, b, None))
     (u0, u1), (v0, v1) = surf.domain
     return MassFace(surf._derivatives, (u0, u1, v0, v1), tuple(breaks), 1.0,
-                    (direction_degree(surf, 0), direction_degree(surf, 1)), None, isinstance(surf, PlaneSurface))
+                    (direction_degree(surf, 0), direction_degree(surf, 1)), None, isinstance(surf, PlaneSurface),
+                    grid_evaluate=surf._grid_derivatives)
 
 
 def _direction_order(mf: MassFace, direction: int, order: int) -> tuple[int, bool]:
@@ -267,7 +270,10 @@ def face_nodes(mf: MassFace, order: int):
     if mf.natural:
         un, uw = _spans(mf.breaks[0], mu)
         vn, vw = _spans(mf.breaks[1], mv)
-        ders = mf.evaluate(np.repeat(un, vn.size), np.tile(vn, un.size), 1)
+        if mf.grid_evaluate is not None:  # u-major, as the repeat/tile below
+            ders = mf.grid_evaluate(un, vn, 1).reshape(-1, 2, 2, 3)
+        else:
+            ders = mf.evaluate(np.repeat(un, vn.size), np.tile(vn, un.size), 1)
         w = np.outer(uw, vw).ravel()
         exact = eu and ev
     else:
@@ -397,17 +403,21 @@ def _green(mf: MassFace, order: int, orders, exacts):
     np.maximum.at(deepest, q[on_grid], (full + partial)[on_grid])
     grid = counts[0][0] * counts[1][0] * deepest.sum()
     if grid + GRID_OVERHEAD < m_in * (partial[on_grid].sum() + full[on_grid].sum()):
-        g = grid_nodes(mf, k, (counts[0][0], counts[1][0]), P[on_grid], wb[on_grid], full[on_grid],
-                        partial[on_grid], q[on_grid])
+        grid = grid_nodes(mf, k, (counts[0][0], counts[1][0]), P[on_grid], wb[on_grid], full[on_grid],
+                          partial[on_grid], q[on_grid])
         rest = ~on_grid
         exact = exact and counts[0][1] and counts[1][1] and (exacts[k] or not rest.any())
     else:
-        g, rest = (np.zeros(0),) * 3, np.ones(len(P), bool)
+        grid, rest = None, np.ones(len(P), bool)
         exact = exact and exacts[k]
+    parts, weights = [], []
+    if grid is not None:  # the grid points first, on the surface's tensor evaluator
+        parts.append(grid.derivatives(k, mf.evaluate, mf.grid_evaluate))
+        weights.append(grid.weights)
     if rest.any():
-        n = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
-        s, other, ws = (np.concatenate([a, b]) for a, b in zip(g, n))
-    else:  # every node on a grid
-        s, other, ws = g
-    ders = mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1)
-    return ders, ws, exact
+        s, other, ws = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
+        parts.append(mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1))
+        weights.append(ws)
+    if len(parts) == 1:
+        return parts[0], weights[0], exact
+    return np.concatenate(parts), np.concatenate(weights), exact

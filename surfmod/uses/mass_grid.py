@@ -196,7 +196,8 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
 
     ``Ω`` summing, over the boundary nodes, ``wb · L_l(t_n) · ∫ ℓ_j`` (over the whole
     spans below the node and the partial one): the surface is evaluated on the grids only,
-    whatever the number of boundary nodes."""
+    whatever the number of boundary nodes.  Returns the used cells' points and weights
+    (:class:`GreenGrid`)."""
     ks, kt = counts
     xs = chebyshev(ks)[0]
     xt = chebyshev(kt)[0]
@@ -232,6 +233,48 @@ def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial,
     qi, si = np.nonzero(np.any(omega != 0.0, axis=(2, 3)))
     s = ((br[si] + br[si + 1])[:, None] / 2 + (h[si] / 2)[:, None] * xs)  # (C, ks)
     t = ((obr[qi] + obr[qi + 1])[:, None] / 2 + ((obr[qi + 1] - obr[qi]) / 2)[:, None] * xt)  # (C, kt)
-    shape = (len(qi), ks, kt)
-    return (np.broadcast_to(s[:, :, None], shape).ravel(), np.broadcast_to(t[:, None, :], shape).ravel(),
-            omega[qi, si].ravel())
+    return GreenGrid(si, qi, s, t, omega[qi, si].ravel())
+
+
+class GreenGrid:
+    """The grid points of :func:`grid_nodes`: per used cell ``c`` (inner span ``si[c]``,
+    outer span ``qi[c]``) the tensor ``s[c] × t[c]`` (``(C, ks)``, ``(C, kt)``: inner and
+    outer coordinates), flattened cell by cell, inner index before outer, with
+    ``weights``; :meth:`coordinates` lays the points out flat, :meth:`derivatives`
+    evaluates them through a surface's tensor evaluator (the trigonometry of an
+    elementary surface runs on the grid lines, not on every point)."""
+
+    #: evaluate on the full tensor of used inner × outer spans when it holds at most
+    #: this many times the points of the used cells (else point by point)
+    TENSOR_SLACK = 1.25
+
+    def __init__(self, si, qi, s, t, weights):
+        self.si, self.qi, self.s, self.t, self.weights = si, qi, s, t, weights
+
+    def coordinates(self) -> tuple[np.ndarray, np.ndarray]:
+        """Flat ``(s, t)`` of every grid point."""
+        shape = (len(self.qi), self.s.shape[1], self.t.shape[1])
+        return np.broadcast_to(self.s[:, :, None], shape).ravel(), np.broadcast_to(self.t[:, None, :], shape).ravel()
+
+    def derivatives(self, k: int, evaluate, grid_evaluate) -> np.ndarray:
+        """``(N, 2, 2, 3)`` partials at the grid points (``k``: the inner direction, 0 for
+        ``u``): from ``grid_evaluate(us, vs, 1)`` on the used spans' lines when that
+        tensor is not much larger than the cells, else ``evaluate(u, v, 1)`` point by point."""
+        ks, kt = self.s.shape[1], self.t.shape[1]
+        su, s_pos = np.unique(self.si, return_inverse=True)
+        qu, q_pos = np.unique(self.qi, return_inverse=True)
+        if grid_evaluate is None or len(su) * len(qu) > self.TENSOR_SLACK * len(self.qi):
+            s, t = self.coordinates()
+            return evaluate(s, t, 1) if k == 0 else evaluate(t, s, 1)
+        # the lines of each used span, once (cells of one span share them)
+        s_lines = np.empty((len(su), ks))
+        s_lines[s_pos] = self.s
+        t_lines = np.empty((len(qu), kt))
+        t_lines[q_pos] = self.t
+        rows = (s_pos[:, None] * ks + np.arange(ks))[:, :, None]  # (C, ks, 1)
+        cols = (q_pos[:, None] * kt + np.arange(kt))[:, None, :]  # (C, 1, kt)
+        if k == 0:
+            ders = grid_evaluate(s_lines.ravel(), t_lines.ravel(), 1)[rows, cols]
+        else:
+            ders = grid_evaluate(t_lines.ravel(), s_lines.ravel(), 1)[cols, rows]
+        return ders.reshape(-1, *ders.shape[3:])
