@@ -199,3 +199,23 @@ def test_tensor_grid_on_a_spline_face_and_its_fallback_equal_point_by_point(monk
         (d1, w1, _), (d2, w2, _) = _nodes_with_and_without_tensor(top)
         assert np.array_equal(w1, w2)
         assert np.abs(d1 - d2).max() <= 1e-14 * np.abs(d2).max()
+
+
+@pytest.mark.parametrize("cells", [mg.GRID_BATCH_CELLS, 8])
+def test_green_grids_of_many_faces_equal_face_by_face(corpus_dir, monkeypatch, cells):
+    # the screw's three tori share one grids pass (or several, when the padded cells
+    # are capped): every face's nodes, weights and partials as alone, bit for bit
+    monkeypatch.setattr(mg, "GRID_BATCH_CELLS", cells)
+    calls = []
+    real = mgrid.grids_nodes
+    monkeypatch.setattr(mg, "grids_nodes", lambda jobs, counts: calls.append(len(jobs)) or real(jobs, counts))
+    _, shapes = _part(corpus_dir / "occt_screw.step")
+    read = _read_faces(shapes)
+    pcs = faces_pcurves(shapes)
+    taylor_pieces([r for p in pcs for r in p])
+    faces = [mf for mf in mass_faces(read, pcs) if not mf.plane]
+    together = mg.faces_nodes(faces, 12)
+    assert max(calls) >= (2 if cells == 8 else 3)  # the three tori together (the cone has its own counts)
+    for mf, (d, w, e) in zip(faces, together):
+        d1, w1, e1 = face_nodes(mf, 12)
+        assert e == e1 and np.array_equal(w, w1) and np.array_equal(d, d1)

@@ -52,6 +52,7 @@ from ..surface import Surface
 from .inputs import to_shape
 from .mass_green import (
     face_nodes,
+    faces_nodes,
     mass_face,
     mass_faces,
     plane_nodes,
@@ -301,10 +302,8 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         exact.total += sums[is_exact].sum(axis=0)
         high.total += sums[~is_exact].sum(axis=0)
         inexact_planes = [f for f, e in zip(trimmed_planes, is_exact) if not e]
-    for f in faces:
-        if f.plane and f.frame is not None:
-            continue
-        ders, w, is_exact = face_nodes(f, order)
+    curved = [f for f in faces if not (f.plane and f.frame is not None)]
+    for f, (ders, w, is_exact) in zip(curved, faces_nodes(curved, order)):  # small Green grids shared
         (exact if is_exact else high).add(ders, w)
         if not is_exact:
             inexact.append(f)

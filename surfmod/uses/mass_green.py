@@ -39,13 +39,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..construct.curves import Line
-from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface
+from ..construct.elementary import ConicalSurface, CylindricalSurface, ElementarySurface, PlaneSurface
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
+from ..readback.trimmed import TrimmedFace
 from .faces import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks
 from .mass_boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
-from .mass_grid import exact_order, gauss, green_layout, grid_nodes, inner_nodes, interpolation_points
+from .mass_grid import (GridJob, exact_order, gauss, green_layout, grid_nodes, grids_nodes, inner_nodes,  # noqa: F401
+                        interpolation_points)
 
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
 RECTANGLE_RTOL = 1e-7
@@ -87,6 +89,46 @@ def direction_degree(surface, direction: int):
     if isinstance(surface, RevolutionSurface):
         return _curve_degree(surface.profile) if direction == 1 else None
     return None
+
+
+def evaluators(obj):
+    """``(evaluate, grid_evaluate)``: the partials of a face read back with
+    :func:`surfmod.from_face` (or of a surfmod surface) at points ``(u, v)`` and on a
+    tensor grid ``us × vs`` (``(nu, nv, K, K, 3)``), as its ``_derivatives`` and
+    ``_grid_derivatives`` give them.  On planes, cylinders, cones, spheres and tori the
+    frame is applied to the partials in the frame's axes (their ``_coefficients``) by one
+    matrix product, where the surfaces' own evaluators broadcast every point against each
+    axis (three passes with an innermost dimension of 3, most of the evaluation's time).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> face = sm.from_face(bd.Torus(5, 1).faces()[0])
+    >>> evaluate, grid = evaluators(face)
+    >>> u, v = np.array([0.3, 1.2]), np.array([2.0, 5.5])
+    >>> bool(np.allclose(evaluate(u, v, 1), face._derivatives(u, v, 1), rtol=0, atol=1e-14))
+    True
+    >>> grid(u, v, 1).shape
+    (2, 2, 2, 2, 3)
+    """
+    face = isinstance(obj, TrimmedFace)
+    surf = obj.surface if face else obj
+    if not isinstance(surf, ElementarySurface):
+        return obj._derivatives, obj._grid_derivatives
+    axes, origin = np.array([surf.x_dir, surf.y_dir, surf.z_dir]), surf.origin
+    wrap = obj._wrap if face else (lambda t, direction: t)  # a face evaluates where it lives (periodic wrap)
+
+    def combine(fx, fy, fz):
+        f = np.stack([fx, fy, fz], axis=-1)
+        out = (f.reshape(-1, 3) @ axes).reshape(f.shape)
+        out[..., 0, 0, :] += origin
+        return out
+
+    def evaluate(u, v, order):
+        return combine(*surf._coefficients(wrap(u, 0), wrap(v, 1), order))
+
+    def grid_evaluate(us, vs, order):
+        return combine(*surf._coefficients(wrap(us, 0)[:, None], wrap(vs, 1)[None, :], order))
+
+    return evaluate, grid_evaluate
 
 
 # -- faces -----------------------------------------------------------------------------------
@@ -234,10 +276,11 @@ def mass_face(face, pcurves: list | None = None, natural: bool | None = None) ->
     else:
         table = PcurveTable(pcurves)
         natural = _on_box_border(table, bounds)
-    return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
+    evaluate, grid_evaluate = evaluators(face)
+    return MassFace(evaluate, bounds, breaks, -1.0 if face.reversed else 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
                     plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table,
-                    angular, grid_evaluate=face._grid_derivatives)
+                    angular, grid_evaluate=grid_evaluate)
 
 
 def surface_mass_face(surf) -> MassFace:
@@ -248,9 +291,10 @@ def surface_mass_face(surf) -> MassFace:
         # analytic directions without knots: eight pieces keep Gauss converged
         breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None else _breaks(lo, hi, b, None))
     (u0, u1), (v0, v1) = surf.domain
-    return MassFace(surf._derivatives, (u0, u1, v0, v1), tuple(breaks), 1.0,
+    evaluate, grid_evaluate = evaluators(surf)
+    return MassFace(evaluate, (u0, u1, v0, v1), tuple(breaks), 1.0,
                     (direction_degree(surf, 0), direction_degree(surf, 1)), None, isinstance(surf, PlaneSurface),
-                    grid_evaluate=surf._grid_derivatives)
+                    grid_evaluate=grid_evaluate)
 
 
 def _direction_order(mf: MassFace, direction: int, order: int) -> tuple[int, bool]:
@@ -278,10 +322,15 @@ def face_nodes(mf: MassFace, order: int):
         exact = eu and ev
     else:
         ders, w, exact = _green(mf, order, (mu, mv), (eu, ev))
+    return _signed(mf, ders), w, exact
+
+
+def _signed(mf: MassFace, ders: np.ndarray) -> np.ndarray:
+    """``ders`` with ``Su`` negated on a reversed face (``Su × Sv`` the outward ``n dA``)."""
     if mf.sign < 0:
         ders = ders.copy()
         ders[:, 1, 0] *= -1.0
-    return ders, w, exact
+    return ders
 
 
 def plane_nodes(faces: list) -> tuple[np.ndarray, np.ndarray]:
@@ -376,6 +425,22 @@ def prepare_boundaries(faces: list, order: int) -> None:
 
 def _green(mf: MassFace, order: int, orders, exacts):
     """Green's theorem nodes (see the module notes)."""
+    plan = _green_plan(mf, order, orders, exacts)
+    grid = grids_nodes([plan.job], plan.counts)[0] if plan.job is not None else None
+    return _green_nodes(mf, plan, grid)
+
+
+class _GreenPlan:
+    """What :func:`_green` decides for a face before its grids are built: the inner
+    direction ``k``, the boundary nodes ``P`` with their weights and layout, which of them
+    go onto grids (``job``, a :class:`~surfmod.uses.mass_grid.GridJob`, or None) and the
+    rest, node by node."""
+
+    __slots__ = ("k", "m_in", "P", "wb", "full", "partial", "rest", "job", "counts", "exact")
+
+
+def _green_plan(mf: MassFace, order: int, orders, exacts) -> _GreenPlan:
+    plan = _GreenPlan()
     P, dP, wt, exact = face_boundary(mf, order)
     # inner direction: the one with fewer inner nodes per boundary node, where the
     # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
@@ -403,21 +468,91 @@ def _green(mf: MassFace, order: int, orders, exacts):
     np.maximum.at(deepest, q[on_grid], (full + partial)[on_grid])
     grid = counts[0][0] * counts[1][0] * deepest.sum()
     if grid + GRID_OVERHEAD < m_in * (partial[on_grid].sum() + full[on_grid].sum()):
-        grid = grid_nodes(mf, k, (counts[0][0], counts[1][0]), P[on_grid], wb[on_grid], full[on_grid],
-                          partial[on_grid], q[on_grid])
+        Pg = P[on_grid]
+        plan.job = GridJob(mf.breaks[k], obr, Pg[:, k], Pg[:, 1 - k], wb[on_grid], full[on_grid], partial[on_grid],
+                           q[on_grid])
+        plan.counts = (counts[0][0], counts[1][0])
         rest = ~on_grid
         exact = exact and counts[0][1] and counts[1][1] and (exacts[k] or not rest.any())
     else:
-        grid, rest = None, np.ones(len(P), bool)
+        plan.job, plan.counts, rest = None, None, np.ones(len(P), bool)
         exact = exact and exacts[k]
+    plan.k, plan.m_in, plan.P, plan.wb, plan.full, plan.partial, plan.rest, plan.exact = (
+        k, m_in, P, wb, full, partial, rest, exact)
+    return plan
+
+
+def _green_nodes(mf: MassFace, plan: _GreenPlan, grid):
+    """The partials and weights of a planned face: its grid's points (``grid``, from
+    :func:`~surfmod.uses.mass_grid.grids_nodes`) first, then the rest node by node."""
+    k, rest = plan.k, plan.rest
     parts, weights = [], []
-    if grid is not None:  # the grid points first, on the surface's tensor evaluator
+    if grid is not None:  # on the surface's tensor evaluator
         parts.append(grid.derivatives(k, mf.evaluate, mf.grid_evaluate))
         weights.append(grid.weights)
     if rest.any():
-        s, other, ws = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
+        s, other, ws = inner_nodes(mf, k, plan.m_in, plan.P[rest], plan.wb[rest], plan.full[rest], plan.partial[rest])
         parts.append(mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1))
         weights.append(ws)
     if len(parts) == 1:
-        return parts[0], weights[0], exact
-    return np.concatenate(parts), np.concatenate(weights), exact
+        return parts[0], weights[0], plan.exact
+    return np.concatenate(parts), np.concatenate(weights), plan.exact
+
+
+#: faces whose grids have at most this many cells (inner × outer spans) share one
+#: :func:`~surfmod.uses.mass_grid.grids_nodes` pass, in batches of at most
+#: ``GRID_BATCH_CELLS`` padded cells (bounded memory: ``ks kt`` weights per cell)
+GRID_BATCH_FACE_CELLS = 64
+GRID_BATCH_CELLS = 1024
+
+
+def faces_nodes(faces: list, order: int) -> list:
+    """:func:`face_nodes` of many faces, the same nodes, weights and partials: the Green
+    grids of the small trimmed faces (those of a part's many small fillets, tori and cones)
+    built in shared passes (:func:`~surfmod.uses.mass_grid.grids_nodes`), where one pass
+    per face cost more than its arithmetic.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> mfs = [mass_face(sm.from_face(f)) for f in (bd.Cylinder(2, 3) - bd.Box(1, 1, 9).translate((2, 0, 0))).faces()]
+    >>> both = faces_nodes(mfs, 12)
+    >>> all(np.array_equal(d, face_nodes(m, 12)[0]) for m, (d, _, _) in zip(mfs, both))
+    True
+    """
+    out: list = [None] * len(faces)
+    plans, batches = {}, {}
+    for i, mf in enumerate(faces):
+        if mf.natural:
+            out[i] = face_nodes(mf, order)
+            continue
+        mu, eu = _direction_order(mf, 0, order)
+        mv, ev = _direction_order(mf, 1, order)
+        plan = plans[i] = _green_plan(mf, order, (mu, mv), (eu, ev))
+        if plan.job is not None:
+            size = (len(plan.job.br) - 1) * (len(plan.job.obr) - 1)
+            key = plan.counts if size <= GRID_BATCH_FACE_CELLS else ("alone", i)
+            batches.setdefault(key, []).append(i)
+    grids = {}
+    for key, members in batches.items():
+        counts = plans[members[0]].counts
+        for chunk in _grid_chunks(members, plans):
+            grids.update(zip(chunk, grids_nodes([plans[i].job for i in chunk], counts)))
+    for i, plan in plans.items():
+        ders, w, exact = _green_nodes(faces[i], plan, grids.get(i))
+        out[i] = _signed(faces[i], ders), w, exact
+    return out
+
+
+def _grid_chunks(members: list, plans: dict) -> list:
+    """``members`` cut into runs whose padded cell count (faces × most inner spans × most
+    outer spans) stays within ``GRID_BATCH_CELLS``."""
+    chunks, chunk, most = [], [], (0, 0)
+    for i in members:
+        job = plans[i].job
+        shape = (max(most[0], len(job.br) - 1), max(most[1], len(job.obr) - 1))
+        if chunk and (len(chunk) + 1) * shape[0] * shape[1] > GRID_BATCH_CELLS:
+            chunks.append(chunk)
+            chunk, shape = [], (len(job.br) - 1, len(job.obr) - 1)
+        chunk.append(i)
+        most = shape
+    chunks.append(chunk)
+    return chunks
