@@ -91,7 +91,10 @@ def test_faces_pcurves_equal_face_by_face(corpus_dir):
 def test_elementary_faces_read_as_from_face(corpus_dir, name):
     _, shapes = _part(corpus_dir / name)
     fast, slow = _read_faces(shapes), [from_face(s) for s in shapes]
-    assert sum(d is not None for d in occ.elementary_faces(shapes)) >= 6
+    fast_faces = sum(d is not None for d in occ.elementary_faces(shapes))
+    assert fast_faces >= 6
+    if name.startswith("cadquery"):  # its cylinder is a Geom_RectangularTrimmedSurface: read fast too
+        assert fast_faces == len(shapes) == 9
     for a, b in zip(fast, slow):
         assert type(a.surface) is type(b.surface)
         assert a.domain == b.domain and a.periods == b.periods and a.reversed == b.reversed

@@ -209,27 +209,21 @@ def _read_faces(shapes: list) -> list:
         if data is None:
             out.append(from_face(shape))
             continue
-        name, geom, bounds, reversed_, frame, radii = data
+        name, geom, bounds, reversed_, frame, radii, periodic = data
         u0, u1, v0, v1 = bounds
         surface = _ELEMENTARY[name]._trusted(frame, radii, (u0, u1), (v0, v1))
-        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(name, bounds), reversed_))
+        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(periodic, bounds), reversed_))
     return out
 
 
-# which directions of OCCT's elementary surfaces are periodic (``IsUPeriodic``/``IsVPeriodic``;
-# the period is 2π): what readback's ``_periods`` asks the surface, without asking
-_PERIODIC = {"Geom_Plane": (False, False), "Geom_CylindricalSurface": (True, False),
-             "Geom_ConicalSurface": (True, False), "Geom_SphericalSurface": (True, False),
-             "Geom_ToroidalSurface": (True, True)}
-
-
-def _elementary_periods(name: str, bounds) -> tuple:
-    """readback's ``_periods`` of an elementary surface over ``bounds``: 2π where the
+def _elementary_periods(periodic, bounds) -> tuple:
+    """readback's ``_periods`` of an elementary surface over ``bounds`` (``periodic``: per
+    direction whether OCCT's surface is periodic; the period is then 2π): 2π where the
     direction is periodic and the face spans one whole period, else None."""
     period = 2 * np.pi
     spans = (bounds[1] - bounds[0], bounds[3] - bounds[2])
     return tuple(period if periodic and abs(span - period) <= 1e-9 * period else None
-                 for periodic, span in zip(_PERIODIC[name], spans))
+                 for periodic, span in zip(periodic, spans))
 
 
 def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str = "numpy",
