@@ -222,3 +222,24 @@ def test_green_grids_of_many_faces_equal_face_by_face(corpus_dir, monkeypatch, c
     for mf, (d, w, e) in zip(faces, together):
         d1, w1, e1 = face_nodes(mf, 12)
         assert e == e1 and np.array_equal(w, w1) and np.array_equal(d, d1)
+
+
+@pytest.mark.parametrize("name", QUICK + ("cadquery_red_cube_blue_cylinder.step",))
+def test_face_records_visit_edges_as_the_explorer_does(corpus_dir, name):
+    # wires and edges by TopoDS_Iterator: the order, orientation and p-curve of
+    # TopExp_Explorer(face, WIRE) / (wire, EDGE)
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
+    from OCP.TopoDS import TopoDS
+
+    from surfmod.occ.topo import explore
+
+    _, shapes = _part(corpus_dir / name)
+    for face, records in zip(shapes, faces_pcurves(shapes)):
+        want = []
+        for w, wire in enumerate(explore(face, TopAbs_WIRE)):
+            for e in explore(wire, TopAbs_EDGE):
+                edge = TopoDS.Edge_s(e)
+                pc = BRepAdaptor_Curve2d(edge, face)
+                want.append((w, (pc.FirstParameter(), pc.LastParameter()), -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0))
+        assert [(r["wire"], r["range"], r["sign"]) for r in records] == want

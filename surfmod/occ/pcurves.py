@@ -16,12 +16,11 @@ import numpy as np
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAbs_Line
 from OCP.TColStd import TColStd_Array1OfReal
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
-from OCP.TopoDS import TopoDS
+from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopoDS import TopoDS, TopoDS_Iterator
 
 from .geom import read_bspline_curve, read_bspline_curves_2d
 from .guard import kernel
-from .topo import explore
 
 
 def _xy(p) -> np.ndarray:
@@ -80,29 +79,45 @@ def faces_pcurves(faces: list) -> list[list[dict]]:
     return out
 
 
+# enum members as ints: comparing pybind11 enums costs several times an int comparison,
+# and these run once per edge of a part
+_LINE, _CIRCLE, _BSPLINE, _REVERSED = int(GeomAbs_Line), int(GeomAbs_Circle), int(GeomAbs_BSplineCurve), int(TopAbs_REVERSED)
+
+
 def _face_records(face, splines: list, lines: list) -> list[dict]:
     """The records of :func:`face_pcurves` of one face.  Non-periodic B-spline p-curves
     are appended to ``splines`` as ``(record, curve)``, straight ones to ``lines`` as
     ``(record, (origin, direction, range))``, for the caller to read in bulk."""
     out = []
     to_edge = TopoDS.Edge_s
-    for wire_index, wire in enumerate(explore(face, TopAbs_WIRE)):
-        for e in explore(wire, TopAbs_EDGE):
-            edge = to_edge(e)
+    # the face's wires and their edges as TopExp_Explorer visits them (children in order,
+    # orientations composed), by TopoDS_Iterator: no explorer stack per wire
+    wires = TopoDS_Iterator(face)
+    wire_index = -1
+    while wires.More():
+        wire = wires.Value()
+        wires.Next()
+        if wire.ShapeType() != TopAbs_WIRE:
+            continue
+        wire_index += 1
+        edges = TopoDS_Iterator(wire)
+        while edges.More():
+            edge = to_edge(edges.Value())
+            edges.Next()
             pc = BRepAdaptor_Curve2d(edge, face)
             f, l = pc.FirstParameter(), pc.LastParameter()
-            kind = pc.GetType()
+            kind = int(pc.GetType())
             rec = {
                 "wire": wire_index,
                 "range": (f, l),
-                "sign": -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0,
+                "sign": -1.0 if int(edge.Orientation()) == _REVERSED else 1.0,
                 "adaptor": pc,
             }
-            if kind == GeomAbs_Line:  # analytic: one smooth interval, its ends
+            if kind == _LINE:  # analytic: one smooth interval, its ends
                 lin = pc.Line()
                 rec["kind"] = "line"
                 lines.append((rec, lin.Location().Coord() + lin.Direction().Coord() + (f, l)))
-            elif kind == GeomAbs_Circle:
+            elif kind == _CIRCLE:
                 c = pc.Circle()
                 ax = c.Position()
                 rec.update(kind="circle", breaks=np.array([f, l]), centre=_xy(ax.Location()), x=_xy(ax.XDirection()),
@@ -112,9 +127,9 @@ def _face_records(face, splines: list, lines: list) -> list[dict]:
                 arr = TColStd_Array1OfReal(1, n + 1)
                 pc.Intervals(arr, GeomAbs_CN)
                 rec["breaks"] = np.array([arr.Value(i) for i in range(1, n + 2)])
-                if kind == GeomAbs_BSplineCurve and not (b := pc.BSpline()).IsPeriodic():
+                if kind == _BSPLINE and not (b := pc.BSpline()).IsPeriodic():
                     splines.append((rec, b))  # read by the caller, all in one binary table
-                elif kind == GeomAbs_BSplineCurve and (data := _bspline_data(pc)) is not None:
+                elif kind == _BSPLINE and (data := _bspline_data(pc)) is not None:
                     rec.update(kind="bspline", **data)
                 else:
                     rec.update(kind="other")
