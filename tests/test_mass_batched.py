@@ -243,3 +243,32 @@ def test_face_records_visit_edges_as_the_explorer_does(corpus_dir, name):
                 pc = BRepAdaptor_Curve2d(edge, face)
                 want.append((w, (pc.FirstParameter(), pc.LastParameter()), -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0))
         assert [(r["wire"], r["range"], r["sign"]) for r in records] == want
+
+
+def _explorer_vertex_mean(shape):
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_VERTEX
+    from OCP.TopoDS import TopoDS
+
+    from surfmod.occ.topo import explore
+
+    return np.array([BRep_Tool.Pnt_s(TopoDS.Vertex_s(v)).Coord() for v in explore(shape, TopAbs_VERTEX)]).mean(axis=0)
+
+
+@pytest.mark.parametrize("name", QUICK + ("cadquery_red_cube_blue_cylinder.step", "pythonocc_Ventilator.stp"))
+def test_vertex_mean_equals_the_explorers_visits(corpus_dir, name):
+    # each distinct vertex weighted by its ancestor edges: the explorer's visits, to round-off
+    solid, _ = _part(corpus_dir / name)
+    want = _explorer_vertex_mean(solid)
+    size = np.ptp(occ.bounding_box(solid), axis=0).max()
+    assert np.abs(occ.vertex_mean(solid) - want).max() <= 1e-14 * size
+
+
+def test_vertex_mean_weights_shared_vertices_by_their_visits():
+    # a box with a cylinder boss: corners met 6 times, the boss's seam vertices otherwise;
+    # a plain mean of the distinct vertices would differ
+    part = bd.Box(4, 4, 2) + bd.Cylinder(1, 3).translate((1, 0, 1))
+    want = _explorer_vertex_mean(part.wrapped)
+    assert np.abs(occ.vertex_mean(part.wrapped) - want).max() <= 1e-15
+    distinct = np.array([tuple(v) for v in part.vertices()]).mean(axis=0)
+    assert np.abs(distinct - want).max() > 1e-3
