@@ -272,3 +272,21 @@ def test_vertex_mean_weights_shared_vertices_by_their_visits():
     assert np.abs(occ.vertex_mean(part.wrapped) - want).max() <= 1e-15
     distinct = np.array([tuple(v) for v in part.vertices()]).mean(axis=0)
     assert np.abs(distinct - want).max() > 1e-3
+
+
+def test_moments_of_groups_equal_one_call_per_group(corpus_dir):
+    # the integrands of both totals (exact and not) in one pass: each group's sums are the
+    # ones its own call makes, bit for bit
+    from surfmod.uses.mass import _moments_of_groups
+
+    _, shapes = _part(corpus_dir / "occt_screw.step")
+    read = _read_faces(shapes)
+    pcs = faces_pcurves(shapes)
+    taylor_pieces([r for p in pcs for r in p])
+    nodes = [face_nodes(mf, 12)[:2] for mf in mass_faces(read, pcs) if not mf.plane]
+    ders, w = np.concatenate([d for d, _ in nodes]), np.concatenate([x for _, x in nodes])
+    ref = np.array([0.3, -1.0, 2.0])
+    cuts = [0, len(nodes[0][1]), len(nodes[0][1]) + len(nodes[1][1]), len(w)]
+    groups = _moments_of_groups(ders, w, ref, cuts)
+    for g in range(3):
+        assert np.array_equal(groups[g], _moments(ders[cuts[g]:cuts[g + 1]], w[cuts[g]:cuts[g + 1]], ref))

@@ -201,6 +201,8 @@ class PcurveTable:
             self.origin, self.direction = np.zeros((n, 2)), np.zeros((n, 2))
         if 1 in self.present:
             self.centre, self.ax, self.ay, self.radius = np.zeros((n, 2)), np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n)
+        # per record: a B-spline without weights (a polynomial p-curve)
+        self.polynomial = np.zeros(n, bool)
         splines = []
         for i, rec in enumerate(records):
             kind = self.kind[i]
@@ -212,6 +214,7 @@ class PcurveTable:
                 if "taylor" not in rec:
                     rec["taylor"] = _taylor_pieces(rec)
                 splines.append((i, rec))
+                self.polynomial[i] = rec["weights"] is None
         if splines:
             self._spline_table(splines, n)
 
@@ -221,21 +224,23 @@ class PcurveTable:
         self.rational = any(rec["weights"] is not None for _, rec in splines)
         dim = 3 if self.rational else 2
         top = max(rec["taylor"][2].shape[1] for _, rec in splines)
-        keys, centres, coefs = [], [], []
+        index = np.array([i for i, _ in splines])
+        lens = np.array([len(rec["taylor"][0]) for _, rec in splines])
         self.first, self.last = np.zeros(n, int), np.zeros(n, int)
-        at = 0
-        for i, rec in splines:
-            starts, mid, c = rec["taylor"]
-            full = np.zeros((len(starts), top, dim))  # higher powers padded with zeros
-            full[:, : c.shape[1], : c.shape[2]] = c
-            if c.shape[2] < dim:
-                full[:, 0, 2] = 1.0
-            keys.append(i + 1j * starts)
-            centres.append(mid)
-            coefs.append(full)
-            self.first[i], self.last[i] = at, at + len(starts) - 1
-            at += len(starts)
-        self.keys, self.centres, self.coef = np.concatenate(keys), np.concatenate(centres), np.concatenate(coefs)
+        ends = np.cumsum(lens)
+        self.first[index], self.last[index] = ends - lens, ends - 1
+        self.keys = np.repeat(index, lens) + 1j * np.concatenate([rec["taylor"][0] for _, rec in splines])
+        self.centres = np.concatenate([rec["taylor"][1] for _, rec in splines])
+        # higher powers padded with zeros; the records of one coefficient shape in one assignment
+        self.coef = np.zeros((int(ends[-1]), top, dim))
+        shapes: dict = {}
+        for k, (_, rec) in enumerate(splines):
+            shapes.setdefault(rec["taylor"][2].shape[1:], []).append(k)
+        for (width, cdim), members in shapes.items():
+            rows = np.concatenate([np.arange(ends[k] - lens[k], ends[k]) for k in members])
+            self.coef[rows, :width, :cdim] = np.concatenate([splines[k][1]["taylor"][2] for k in members])
+            if cdim < dim:
+                self.coef[rows, 0, 2] = 1.0
 
     def d1(self, which: np.ndarray, t: np.ndarray) -> np.ndarray:
         """``(N, 4)``: ``u, v, du/dt, dv/dt`` of record ``which[n]`` at ``t[n]``."""
@@ -330,7 +335,7 @@ def _long_pieces(table: PcurveTable, owner, a, b, directions) -> np.ndarray:
     from its centre); every piece of a rational or non-spline p-curve counts as long."""
     long = np.ones(len(owner), bool)
     spline = table.kind[owner] == 2
-    spline[spline] = np.array([table.records[r]["weights"] is None for r in owner[spline]], bool)
+    spline[spline] = table.polynomial[owner[spline]]
     if not spline.any():
         return long
     r_own, lo, hi = owner[spline], a[spline], b[spline]
@@ -442,13 +447,11 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
     w = sign[which] * w
     node_face = face_of[which]
     bounds = np.searchsorted(node_face, np.arange(len(faces) + 1))
-    out = []
-    for k in range(len(faces)):
-        lo, hi = bounds[k], bounds[k + 1]
-        mine = face_of == k
-        exact = bool(np.all(exacts[mine & live]))
-        out.append((q[lo:hi, :2], q[lo:hi, 2:], w[lo:hi], exact))
-    return out
+    # per face: every rule of its live p-curves exact (records are laid out face by face)
+    inexact = np.zeros(len(faces), int)
+    np.add.at(inexact, face_of, ~exacts & live)
+    P, dP = q[:, :2], q[:, 2:]
+    return [(P[lo:hi], dP[lo:hi], w[lo:hi], not bad) for lo, hi, bad in zip(bounds[:-1], bounds[1:], inexact.tolist())]
 
 
 def _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges):
