@@ -187,21 +187,34 @@ def test_tensor_grid_evaluation_equals_point_by_point(corpus_dir, name):
 
 
 @pytest.mark.parametrize("inner", ["cheaper", "u"])
-def test_tensor_grid_on_a_spline_face_and_its_fallback_equal_point_by_point(monkeypatch, inner):
+def test_tensor_grid_on_a_trimmed_cylinder_and_its_fallback_equal_point_by_point(monkeypatch, inner):
+    # Green's inner integral along the axis (v) or the angle (u): the tensor's gather
+    # both ways round, and with the tensor refused (TENSOR_SLACK 0) the points themselves
     if inner == "u":  # as on faces whose p-curves leave gaps: Green's inner integral along u
         monkeypatch.setattr(mg, "CLOSURE_RTOL", -1.0)
-    net = np.zeros((5, 4, 3))
-    net[..., 0], net[..., 1] = np.mgrid[0:5, 0:4]
-    net[..., 2] = np.sin(net[..., 0]) * np.cos(net[..., 1])
-    face = sm.BSplineSurface(net, (3, 2), ([0] * 4 + [0.5] + [1] * 4, [0] * 3 + [0.5] + [1] * 3)).face()
-    part = bd.extrude(bd.Face(face.wrapped), amount=3.0, dir=(0, 0, -1)) & bd.Cylinder(1.3, 20).translate((2, 1.5, 0))
-    top = next(mass_face(from_face(f)) for f in part.faces() if f.geom_type == bd.GeomType.BSPLINE)
-    assert not top.natural
+    part = bd.Cylinder(1.0, 4.0) - bd.Box(4, 4, 4).rotate(bd.Axis.X, 30).translate((0, 0, 2.5))
+    side = next(mass_face(from_face(f)) for f in part.faces() if f.geom_type == bd.GeomType.CYLINDER)
+    assert not side.natural and side.grid_evaluate is not None
+    seen = []
+    real = mgrid.GreenGrid.derivatives
+    monkeypatch.setattr(mgrid.GreenGrid, "derivatives", lambda self, k, *a: seen.append(k) or real(self, k, *a))
+    monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)  # always on grids
     for slack in (mgrid.GreenGrid.TENSOR_SLACK, 0.0):  # the tensor, then point by point
         monkeypatch.setattr(mgrid.GreenGrid, "TENSOR_SLACK", slack)
-        (d1, w1, _), (d2, w2, _) = _nodes_with_and_without_tensor(top)
+        (d1, w1, _), (d2, w2, _) = _nodes_with_and_without_tensor(side)
         assert np.array_equal(w1, w2)
-        assert np.abs(d1 - d2).max() <= 1e-14 * np.abs(d2).max()
+        assert np.abs(d1 - d2).max() <= 1e-15 * np.abs(d2).max()
+    assert seen and (inner != "u" or set(seen) == {0})  # (the screw's tori take v: test above)
+
+
+def test_spline_faces_are_evaluated_point_by_point():
+    net = np.zeros((4, 4, 3))
+    net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
+    face = sm.BSplineSurface(net, (3, 3), ([0] * 4 + [1] * 4, [0] * 4 + [1] * 4)).face()
+    mf = mass_face(from_face(face))
+    assert mf.grid_evaluate is None
+    assert np.array_equal(mf.evaluate(np.array([0.2]), np.array([0.7]), 1),
+                          from_face(face)._derivatives(np.array([0.2]), np.array([0.7]), 1))
 
 
 @pytest.mark.parametrize("cells", [mg.GRID_BATCH_CELLS, 8])

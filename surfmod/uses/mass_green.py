@@ -95,10 +95,12 @@ def evaluators(obj):
     """``(evaluate, grid_evaluate)``: the partials of a face read back with
     :func:`surfmod.from_face` (or of a surfmod surface) at points ``(u, v)`` and on a
     tensor grid ``us × vs`` (``(nu, nv, K, K, 3)``), as its ``_derivatives`` and
-    ``_grid_derivatives`` give them.  On planes, cylinders, cones, spheres and tori the
-    frame is applied to the partials in the frame's axes (their ``_coefficients``) by one
-    matrix product, where the surfaces' own evaluators broadcast every point against each
-    axis (three passes with an innermost dimension of 3, most of the evaluation's time).
+    ``_grid_derivatives`` give them (``grid_evaluate`` None: evaluate point by point).  On
+    planes, cylinders, cones, spheres and tori the trigonometry of a grid runs on its
+    lines, and the frame is applied to the partials in the frame's axes (their
+    ``_coefficients``) by one matrix product, where the surfaces' own evaluators broadcast
+    every point against each axis (three passes with an innermost dimension of 3, most of
+    the evaluation's time).
 
     >>> import surfmod as sm, build123d as bd
     >>> face = sm.from_face(bd.Torus(5, 1).faces()[0])
@@ -112,7 +114,9 @@ def evaluators(obj):
     face = isinstance(obj, TrimmedFace)
     surf = obj.surface if face else obj
     if not isinstance(surf, ElementarySurface):
-        return obj._derivatives, obj._grid_derivatives
+        # splines, sweeps, offsets: point by point (their tensor evaluators pay off only
+        # on grids much larger than a face's quadrature nodes)
+        return obj._derivatives, None
     axes, origin = np.array([surf.x_dir, surf.y_dir, surf.z_dir]), surf.origin
     wrap = obj._wrap if face else (lambda t, direction: t)  # a face evaluates where it lives (periodic wrap)
 
