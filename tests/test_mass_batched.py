@@ -23,7 +23,11 @@ from surfmod.uses.mass_boundary import PcurveTable, pcurve_d1, taylor_pieces
 import surfmod.uses.mass_green as mg
 import surfmod.uses.mass_grid as mgrid
 from surfmod.uses.mass_green import face_nodes, mass_face, mass_faces
-from surfmod.uses.mass_plane import plane_moments
+from surfmod.uses.mass_plane import is_conic, plane_moments
+
+def _rel(a, b):
+    return abs(a - b) / abs(b)
+
 
 QUICK = ("occt_screw.step", "pythonocc_face_recognition_sample_part.stp")
 
@@ -121,7 +125,7 @@ def _planes_equal_node_by_node(path):
         ders, w, node_exact = face_nodes(mf, 12)
         nodes = _moments(ders, w, ref)
         assert np.abs(mine - nodes).max() <= 1e-13 * np.abs(nodes).max(), path.name
-        assert is_exact == node_exact
+        assert is_exact == (node_exact or is_conic(mf))  # circles: closed form, exact at any order
     return len(planes)
 
 
@@ -303,3 +307,31 @@ def test_moments_of_groups_equal_one_call_per_group(corpus_dir):
     groups = _moments_of_groups(ders, w, ref, cuts)
     for g in range(3):
         assert np.array_equal(groups[g], _moments(ders[cuts[g]:cuts[g + 1]], w[cuts[g]:cuts[g + 1]], ref))
+
+
+@pytest.mark.parametrize("cut", ["disc", "holed plate", "slot"])
+def test_circular_arcs_in_closed_form_equal_gauss_and_closed_solids(monkeypatch, cut):
+    # plates with holes and rounded slots: the arcs' trigonometric integrals in closed form
+    # equal high-order Gauss on the same p-curves (the node route), and the solids' exact volumes
+    import surfmod.uses.mass_plane as mp
+
+    if cut == "disc":
+        part, volume = bd.Cylinder(1.5, 2.0), math.pi * 1.5**2 * 2.0
+    elif cut == "holed plate":
+        part = bd.Box(6, 4, 1) - bd.Cylinder(1.0, 2).translate((1.2, 0.3, 0)) - bd.Cylinder(0.5, 2).translate((-2, -1, 0))
+        volume = 24 - math.pi * (1.0 + 0.25)
+    else:
+        slot = bd.extrude(bd.SlotCenterToCenter(3.0, 1.0), amount=2).translate((0, 0, -1))
+        part, volume = bd.Box(6, 4, 1) - slot, 24 - (3.0 * 1.0 + math.pi * 0.25)
+    mfs = [mass_face(from_face(f)) for f in part.faces()]
+    conic = [mf for mf in mfs if mp.is_conic(mf)]
+    assert conic and any(rec["kind"] == "circle" for mf in conic for rec in mf.pcurves)
+    ref = np.array([0.4, -0.7, 0.2])
+    closed, exact = plane_moments(conic, 12, ref)
+    assert exact.all()
+    monkeypatch.setattr(mp, "is_conic", lambda mf: False)  # every p-curve on Gauss nodes
+    gauss_route, _ = plane_moments(conic, 24, ref)
+    assert np.abs(closed - gauss_route).max() <= 1e-14 * np.abs(gauss_route).max()
+    monkeypatch.undo()
+    r = sm.mass_properties(part)
+    assert _rel(r.volume, volume) < 1e-14 if cut != "slot" else _rel(r.volume, volume) < 1e-13

@@ -416,12 +416,16 @@ def prepare_boundaries(faces: list, order: int) -> None:
     :func:`face_nodes` / :func:`surfmod.uses.mass_plane.plane_moments`.
 
     >>> import surfmod as sm, build123d as bd
-    >>> faces = [mass_face(sm.from_face(f)) for f in (bd.Box(4, 4, 2) - bd.Cylinder(1, 2)).faces()]
-    >>> prepare_boundaries(faces, 12)
+    >>> part = bd.Cylinder(1.0, 4.0) - bd.Box(4, 4, 4).rotate(bd.Axis.X, 30).translate((0, 0, 2.5))
+    >>> faces = [mass_face(sm.from_face(f)) for f in part.faces()]
+    >>> prepare_boundaries(faces, 12)  # the cut side and the slanted ellipse; the bottom disc is closed form
     >>> sorted(len(f.boundary) for f in faces)
-    [0, 0, 0, 0, 0, 1, 1]
+    [0, 1, 1, 1]
     """
-    trimmed = [mf for mf in faces if not mf.natural and mf.pcurves]
+    from .mass_plane import is_conic
+
+    # planar faces bounded by lines and circles need none (closed form, mass_plane)
+    trimmed = [mf for mf in faces if not mf.natural and mf.pcurves and not is_conic(mf)]
     if trimmed:
         for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed])):
             mf.boundary[order] = got
