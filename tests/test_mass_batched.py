@@ -311,7 +311,7 @@ def test_moments_of_groups_equal_one_call_per_group(corpus_dir):
 
 @pytest.mark.parametrize("cut", ["disc", "holed plate", "slot"])
 def test_circular_arcs_in_closed_form_equal_gauss_and_closed_solids(monkeypatch, cut):
-    # plates with holes and rounded slots: the arcs' trigonometric integrals in closed form
+    # plates with holes and rounded slots: the arcs' exact trigonometric rule
     # equal high-order Gauss on the same p-curves (the node route), and the solids' exact volumes
     import surfmod.uses.mass_plane as mp
 

@@ -15,17 +15,15 @@ same result as there), evaluated as ``(u - u0) Σ A^k B^(p-k) / (p + 1)`` withou
 cancellation.  The outer integral runs on the same Gauss nodes of the p-curves
 (:func:`surfmod.uses.mass_boundary.boundaries`: 3 per straight piece, exact); on faces
 bounded by lines and circles only (plates with holes, slots) the circular arcs are
-integrated in closed form instead: along an arc every integrand is a trigonometric
-polynomial of degree at most 5, integrated term by term (:func:`_conic_moments`), so such
-faces need no boundary pass at all.  Then with
+integrated exactly instead: along an arc every integrand is a trigonometric polynomial
+of degree at most 5, which 11 values integrate exactly (:func:`_arc_nodes`), so such faces
+need no boundary pass at all.  Then with
 ``x = c + a X + b Y`` the sums are tensor contractions of the moments with ``[c, X, Y]``:
 no surface is evaluated and no inner node is made, one pass for all planar faces of a
 part.
 """
 
 from __future__ import annotations
-
-from math import comb
 
 import numpy as np
 
@@ -49,8 +47,8 @@ _LINE = np.array([_product_index(i) for i in range(3)])
 
 def is_conic(mf) -> bool:
     """Whether a trimmed planar face is bounded by straight and circular p-curves only
-    (holes, slots, rounded pockets): its region moments are then found in closed form
-    (:func:`_conic_moments`), without Gauss nodes on its circles.
+    (holes, slots, rounded pockets): its region moments are then exact
+    (:func:`_arc_nodes`), without a boundary pass.
 
     >>> import surfmod as sm, build123d as bd
     >>> from surfmod.uses.mass_green import mass_face
@@ -64,25 +62,33 @@ def is_conic(mf) -> bool:
 def _region_moments(faces: list, foot: np.ndarray, order: int):
     """Per face: the ten moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
     is positive) about its ``foot`` ``(uc, vc)``, and whether every boundary rule was exact."""
-    parts, exact = [], np.ones(len(faces), bool)
-    conic = [i for i, mf in enumerate(faces) if is_conic(mf)]
-    arcs = []
+    parts, owners, exact = [], [], np.ones(len(faces), bool)
+    lines, arcs = [], []  # of the faces bounded by lines and circles, all at once
     for i, mf in enumerate(faces):
-        if i in conic:
-            # its lines by 3 Gauss nodes (as boundaries() lays them), its arcs in closed form
-            P, dP, wt = _line_nodes([rec for rec in mf.pcurves if rec["kind"] == "line"])
+        if is_conic(mf):
+            lines.extend((i, rec) for rec in mf.pcurves if rec["kind"] == "line")
             arcs.extend((i, rec) for rec in mf.pcurves if rec["kind"] == "circle")
-        else:
-            # 3 Gauss nodes per straight piece: the integrands are of degree 4 along it, exact
-            P, dP, wt, exact[i] = face_boundary(mf, order)
+            continue
+        # 3 Gauss nodes per straight piece: the integrands are of degree 4 along it, exact
+        P, dP, wt, exact[i] = face_boundary(mf, order)
         parts.append((P, wt * dP[:, 1]))
-    count = np.array([len(w) for _, w in parts])
+        owners.append(np.full(len(wt), i))
+    if lines:  # 3 Gauss nodes each, as boundaries() lays them
+        P, dP, wt, owner = _line_nodes(lines)
+        parts.append((P, wt * dP[:, 1]))
+        owners.append(owner)
+    if arcs:  # the rule exact for them
+        P, wb, owner = _arc_nodes(arcs)
+        parts.append((P, wb))
+        owners.append(owner)
     moments = np.zeros((len(faces), len(_POWERS)))
-    u0_face = np.array([mf.bounds[0] for mf in faces])
-    if count.sum():
-        P, wb = np.concatenate([p for p, _ in parts]), np.concatenate([w for _, w in parts])
-        owner = np.repeat(np.arange(len(faces)), count)
-        u0 = u0_face[owner]
+    owner = np.concatenate(owners) if owners else np.zeros(0, int)
+    if len(owner):
+        order_ = np.argsort(owner, kind="stable")  # face by face, each face's nodes in order
+        owner = owner[order_]
+        P, wb = np.concatenate([p for p, _ in parts])[order_], np.concatenate([w for _, w in parts])[order_]
+        count = np.bincount(owner, minlength=len(faces))
+        u0 = np.array([mf.bounds[0] for mf in faces])[owner]
         A, B, b = P[:, 0] - foot[owner, 0], u0 - foot[owner, 0], P[:, 1] - foot[owner, 1]
         d = P[:, 0] - u0
         # ∫_{u0}^{u} (s - uc)^p ds = (A^(p+1) - B^(p+1)) / (p + 1) = d Σ_k A^k B^(p-k) / (p + 1)
@@ -95,20 +101,19 @@ def _region_moments(faces: list, foot: np.ndarray, order: int):
         starts = np.concatenate([[0], np.cumsum(count)[:-1]])
         live = count > 0
         moments[live] = np.add.reduceat(values, starts[live], axis=0)
-    if arcs:
-        owner = np.array([i for i, _ in arcs])
-        np.add.at(moments, owner, _conic_moments([rec for _, rec in arcs], foot[owner], u0_face[owner]))
     moments[moments[:, 0] < 0] *= -1.0  # boundary traversed clockwise in (u, v)
     return moments, exact
 
 
 def _line_nodes(lines: list):
-    """``(P, dP, weights)``: 3 Gauss nodes on each straight p-curve, the values
-    :func:`surfmod.uses.mass_boundary.boundaries` gives a line on a plane (one piece, its
-    ends; the weights signed by the edge's orientation)."""
-    live = [rec for rec in lines if rec["range"][1] > rec["range"][0]]
+    """``(P, dP, weights, owner)``: 3 Gauss nodes on each straight p-curve of ``lines``
+    (``(owner, record)`` pairs), the values :func:`surfmod.uses.mass_boundary.boundaries`
+    gives a line on a plane (one piece, its ends; the weights signed by the edge's
+    orientation)."""
+    live = [rec for _, rec in lines if rec["range"][1] > rec["range"][0]]
+    owner = np.repeat([i for i, rec in lines if rec["range"][1] > rec["range"][0]], 3).astype(int)
     if not live:
-        return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0)
+        return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), owner
     x, gw = gauss(3)
     data = np.array([(*rec["range"], rec["sign"]) for rec in live])
     a, b, sign = data[:, :1], data[:, 1:2], data[:, 2:]
@@ -116,71 +121,44 @@ def _line_nodes(lines: list):
     w = (sign * ((b - a) / 2 * gw)).ravel()
     origin = np.repeat(np.array([rec["origin"] for rec in live]), 3, axis=0)
     direction = np.repeat(np.array([rec["direction"] for rec in live]), 3, axis=0)
-    return origin + t[:, None] * direction, direction, w
+    return origin + t[:, None] * direction, direction, w, owner
 
 
-# -- circular arcs in closed form ------------------------------------------------------------
-# a trigonometric polynomial Σ_k c_k e^{ikt}, |k| <= 5, as complex coefficients (n, 11),
-# column k + 5: the moment integrands along an arc are products of at most five factors
-# of degree 1 (a + b cos t + c sin t), integrated exactly term by term
-_TOP = 5
+# -- circular arcs, exactly -----------------------------------------------------------------
+#: along a circular arc ``P(t) = C + r (cos t X + sin t Y)`` every integrand of
+#: :func:`_region_moments` is a trigonometric polynomial of degree at most 5 in ``t`` (``u``,
+#: ``v`` and ``dv/dt`` are of degree 1), fixed by its values at 11 equally spaced angles
+ARC_NODES = 11
 
 
-def _trig(a0, a1, a2) -> np.ndarray:
-    """``a0 + a1 cos t + a2 sin t`` as coefficients: ``c_0 = a0``, ``c_±1 = (a1 ∓ i a2) / 2``."""
-    out = np.zeros((len(a0), 2 * _TOP + 1), complex)
-    out[:, _TOP] = a0
-    out[:, _TOP + 1] = (a1 - 1j * a2) / 2
-    out[:, _TOP - 1] = (a1 + 1j * a2) / 2
-    return out
+def _arc_nodes(arcs: list):
+    """``(P, dP_v · weights, owner)``: a rule exact for trigonometric polynomials of degree
+    <= 5 on each circular p-curve's range ``[t0, t1]`` (``arcs``: ``(owner, record)``
+    pairs): its values at the angles ``t_m = 2π m / 11``
+    (around the whole circle) interpolate it exactly, and the interpolant's integral over
+    the range weighs them by
 
+        G_m = (Δ + Σ_{k=1}^{5} 4 sin(k Δ/2) / k · cos(k (t_mid - t_m))) / 11,
 
-def _times(poly: np.ndarray, factor: np.ndarray) -> np.ndarray:
-    """``poly · factor`` for a factor of degree 1 (the product keeps degree <= 5)."""
-    out = poly * factor[:, _TOP, None]
-    out[:, 1:] += poly[:, :-1] * factor[:, _TOP + 1, None]
-    out[:, :-1] += poly[:, 1:] * factor[:, _TOP - 1, None]
-    return out
-
-
-def _integral(poly: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
-    """``∫_{t0}^{t1}`` of each row, exactly: ``c_0 Δ + Σ c_k e^{ik t_m} 2 sin(k Δ/2) / k``
-    (about the arc's middle ``t_m``: no cancellation on short arcs)."""
-    k = np.arange(-_TOP, _TOP + 1)
-    half, mid = (t1 - t0)[:, None] / 2, ((t0 + t1) / 2)[:, None]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        weight = np.where(k == 0, 2 * half, 2 * np.sin(k * half) / np.where(k == 0, 1, k)) * np.exp(1j * k * mid)
-    return np.real(np.sum(poly * weight, axis=1))
-
-
-def _conic_moments(arcs: list, foot: np.ndarray, u0: np.ndarray) -> np.ndarray:
-    """``(n, 10)``: each circular p-curve's share ``∮ [∫_{u0}^{u} (s - uc)^p ds] (v - vc)^q dv``
-    of the region moments (signed by its orientation), exactly: along ``P(t) = C + r (cos t
-    X + sin t Y)`` the inner integral is ``Σ_j binom(p+1, j) B^(p+1-j) δ^j / (p + 1)`` with
-    ``δ = u - u0`` and ``B = u0 - uc`` (no cancellation near ``u0``), a trigonometric
-    polynomial, and so is ``(v - vc)^q dv/dt``."""
-    c = np.array([rec["centre"] for rec in arcs])
-    x = np.array([rec["x"] for rec in arcs])
-    y = np.array([rec["y"] for rec in arcs])
-    r = np.array([rec["radius"] for rec in arcs])
-    t0, t1 = np.array([rec["range"] for rec in arcs]).T
-    sign = np.array([rec["sign"] for rec in arcs])
-    B = u0 - foot[:, 0]
-    delta = _trig(c[:, 0] - u0, r * x[:, 0], r * y[:, 0])  # u - u0
-    beta = _trig(c[:, 1] - foot[:, 1], r * x[:, 1], r * y[:, 1])  # v - vc
-    dv = _trig(np.zeros(len(arcs)), r * y[:, 1], -r * x[:, 1])  # dv/dt
-    delta_pow = [None, delta]
-    for j in range(2, 5):
-        delta_pow.append(_times(delta_pow[-1], delta))
-    out = np.zeros((len(arcs), len(_POWERS)))
-    for p in range(4):
-        # (A^(p+1) - B^(p+1)) / (p + 1) with A = B + δ, times dv/dt
-        inner = sum(comb(p + 1, j) * B[:, None] ** (p + 1 - j) * delta_pow[j] for j in range(1, p + 2)) / (p + 1)
-        term = _times(inner, dv)
-        for q in range(4 - p):
-            out[:, _INDEX[(p, q)]] = _integral(term, t0, t1)
-            term = _times(term, beta)
-    return sign[:, None] * out
+    ``Δ = t1 - t0``, ``t_mid`` the range's middle (each term of the order of ``Δ``: no
+    cancellation on short arcs).  The weights carry ``dv/dt`` and the edge's orientation,
+    as :func:`surfmod.uses.mass_boundary.boundaries` signs its own."""
+    n = ARC_NODES
+    tm = 2 * np.pi * np.arange(n) / n
+    data = np.array([(*rec["range"], rec["sign"], rec["radius"], *rec["centre"], *rec["x"], *rec["y"]) for _, rec in arcs])
+    t0, t1, sign, r = data[:, 0], data[:, 1], data[:, 2], data[:, 3]
+    centre, ax, ay = data[:, 4:6], data[:, 6:8], data[:, 8:10]
+    half = (t1 - t0) / 2
+    k = np.arange(1, n // 2 + 1)
+    sinc = 4 * np.sin(k * half[:, None]) / k  # (A, 5)
+    phase = ((t0 + t1) / 2)[:, None, None] - tm[None, None, :]  # (A, 1, 11)
+    G = (2 * half[:, None] + np.einsum("ak,akm->am", sinc, np.cos(k[None, :, None] * phase))) / n  # (A, 11)
+    c, s = np.cos(tm), np.sin(tm)
+    P = centre[:, None, :] + r[:, None, None] * (c[None, :, None] * ax[:, None, :] + s[None, :, None] * ay[:, None, :])
+    dv = r[:, None] * (c[None, :] * ay[:, None, 1] - s[None, :] * ax[:, None, 1])  # (A, 11)
+    live = (t1 > t0)[:, None]  # an empty range adds nothing, as on Gauss nodes
+    owner = np.repeat(np.array([i for i, _ in arcs], int), n)
+    return P.reshape(-1, 2), (np.where(live, sign[:, None] * G * dv, 0.0)).ravel(), owner
 
 
 def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]:
@@ -189,7 +167,7 @@ def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]
     :func:`surfmod.uses.mass._moments` makes of their quadrature nodes, in closed form
     from the moments of their parameter regions (module notes); and per face whether no
     rule depended on ``order`` (straight and circular p-curves only: circles are integrated
-    in closed form, :func:`_conic_moments`).
+    exactly, :func:`_arc_nodes`).
 
     >>> import surfmod as sm, build123d as bd
     >>> from surfmod.uses.mass_green import mass_face
