@@ -335,3 +335,24 @@ def test_circular_arcs_in_closed_form_equal_gauss_and_closed_solids(monkeypatch,
     monkeypatch.undo()
     r = sm.mass_properties(part)
     assert _rel(r.volume, volume) < 1e-14 if cut != "slot" else _rel(r.volume, volume) < 1e-13
+
+
+def _spline_breaks_equal_occt(path):
+    from surfmod.occ.pcurves import _intervals
+    from OCP.GeomAbs import GeomAbs_CN
+
+    _, shapes = _part(path)
+    splines = [r for recs in faces_pcurves(shapes) for r in recs if r["kind"] == "bspline"]
+    for rec in splines:  # from the knots read in bulk: the adaptor's own interval bounds, bit for bit
+        pc = rec["adaptor"]
+        assert np.array_equal(rec["breaks"], _intervals(pc, pc.NbIntervals(GeomAbs_CN))), path.name
+    return len(splines)
+
+
+def test_spline_pcurve_breaks_from_knots_equal_occt_intervals(corpus_dir):
+    assert _spline_breaks_equal_occt(corpus_dir / "occt_screw.step") >= 20
+
+
+@pytest.mark.corpus
+def test_spline_pcurve_breaks_from_knots_equal_occt_intervals_on_the_corpus(corpus_file):
+    _spline_breaks_equal_occt(corpus_file)

@@ -72,6 +72,7 @@ def faces_pcurves(faces: list) -> list[list[dict]]:
             out.append(_face_records(face, splines, lines))
         for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
             rec.update(kind="bspline", **data)
+            rec["breaks"] = _spline_breaks(rec, rec.pop("intervals"))
     if lines:  # every straight p-curve's data in one array (rows are views: no array per line)
         data = np.array([d for _, d in lines])  # (L, 6): origin, direction, range
         for k, (rec, _) in enumerate(lines):
@@ -124,17 +125,40 @@ def _face_records(face, splines: list, lines: list) -> list[dict]:
                            y=_xy(ax.YDirection()), radius=c.Radius())
             else:
                 n = pc.NbIntervals(GeomAbs_CN)
-                arr = TColStd_Array1OfReal(1, n + 1)
-                pc.Intervals(arr, GeomAbs_CN)
-                rec["breaks"] = np.array([arr.Value(i) for i in range(1, n + 2)])
                 if kind == _BSPLINE and not (b := pc.BSpline()).IsPeriodic():
+                    rec["intervals"] = n  # its breaks from its knots, once they are read
                     splines.append((rec, b))  # read by the caller, all in one binary table
-                elif kind == _BSPLINE and (data := _bspline_data(pc)) is not None:
+                    out.append(rec)
+                    continue
+                rec["breaks"] = _intervals(pc, n)
+                if kind == _BSPLINE and (data := _bspline_data(pc)) is not None:
                     rec.update(kind="bspline", **data)
                 else:
                     rec.update(kind="other")
             out.append(rec)
     return out
+
+
+def _intervals(pc, n: int) -> np.ndarray:
+    """The ``n + 1`` bounds of the ``GeomAbs_CN`` intervals of a p-curve adaptor."""
+    arr = TColStd_Array1OfReal(1, n + 1)
+    pc.Intervals(arr, GeomAbs_CN)
+    return np.array([arr.Value(i) for i in range(1, n + 2)])
+
+
+def _spline_breaks(rec: dict, n: int) -> np.ndarray:
+    """The adaptor's ``n`` ``GeomAbs_CN`` intervals of a (non-periodic) B-spline p-curve from
+    its knots: every distinct knot inside the edge's range is a break (a spline is no more
+    than ``C^(p-1)`` there), between the range's ends.  OCCT merges a knot closer to an end
+    than its parametric tolerance; where the count then differs from ``n``, the
+    adaptor's own bounds are read instead (one OCCT call per bound)."""
+    f, l = rec["range"]
+    knots = rec["knots"]
+    distinct = knots[np.flatnonzero(np.diff(knots)) + 1]  # each knot value once, after the first
+    inside = distinct[(distinct > f) & (distinct < l)]
+    if len(inside) == n - 1:
+        return np.concatenate([[f], inside, [l]])
+    return _intervals(rec["adaptor"], n)
 
 
 def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
