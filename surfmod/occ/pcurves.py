@@ -72,7 +72,8 @@ def faces_pcurves(faces: list) -> list[list[dict]]:
             out.append(_face_records(face, splines, lines))
         for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
             rec.update(kind="bspline", **data)
-            rec["breaks"] = _spline_breaks(rec, rec.pop("intervals"))
+        if splines:
+            _spline_breaks([rec for rec, _ in splines])
     if lines:  # every straight p-curve's data in one array (rows are views: no array per line)
         data = np.array([d for _, d in lines])  # (L, 6): origin, direction, range
         for k, (rec, _) in enumerate(lines):
@@ -146,19 +147,32 @@ def _intervals(pc, n: int) -> np.ndarray:
     return np.array([arr.Value(i) for i in range(1, n + 2)])
 
 
-def _spline_breaks(rec: dict, n: int) -> np.ndarray:
-    """The adaptor's ``n`` ``GeomAbs_CN`` intervals of a (non-periodic) B-spline p-curve from
-    its knots: every distinct knot inside the edge's range is a break (a spline is no more
-    than ``C^(p-1)`` there), between the range's ends.  OCCT merges a knot closer to an end
-    than its parametric tolerance; where the count then differs from ``n``, the
+def _spline_breaks(records: list) -> None:
+    """Set ``"breaks"`` on (non-periodic) B-spline p-curve records: the adaptor's
+    ``GeomAbs_CN`` interval bounds (their count ``"intervals"``, dropped here) from the
+    knots, for all records at once: every distinct knot inside the edge's range is a break
+    (a spline is no more than ``C^(p-1)`` there), between the range's ends.  OCCT merges a
+    knot closer to an end than its parametric tolerance; where the count then differs, the
     adaptor's own bounds are read instead (one OCCT call per bound)."""
-    f, l = rec["range"]
-    knots = rec["knots"]
-    distinct = knots[np.flatnonzero(np.diff(knots)) + 1]  # each knot value once, after the first
-    inside = distinct[(distinct > f) & (distinct < l)]
-    if len(inside) == n - 1:
-        return np.concatenate([[f], inside, [l]])
-    return _intervals(rec["adaptor"], n)
+    knots = [rec["knots"] for rec in records]
+    count = len(records)
+    owner = np.repeat(np.arange(count), [len(k) for k in knots])
+    flat = np.concatenate(knots)
+    ranges = np.array([rec["range"] for rec in records])
+    # each knot value once (where it first appears), strictly inside its record's range
+    first = np.ones(len(flat), bool)
+    first[1:] = (flat[1:] != flat[:-1]) | (owner[1:] != owner[:-1])
+    keep = first & (flat > ranges[owner, 0]) & (flat < ranges[owner, 1])
+    inside = np.bincount(owner[keep], minlength=count)
+    # per record [first, knots inside..., last], laid end to end, cut into views
+    values = np.concatenate([ranges[:, 0], flat[keep], ranges[:, 1]])
+    rows = np.concatenate([np.arange(count), owner[keep], np.arange(count)])
+    rank = np.concatenate([np.zeros(count), np.ones(keep.sum()), np.full(count, 2.0)])
+    order = np.lexsort((values, rank, rows))  # by record, then ends around the knots
+    pieces = np.split(values[order], np.cumsum(inside + 2)[:-1])
+    for rec, mine, knots_in in zip(records, pieces, inside.tolist()):
+        n = rec.pop("intervals")
+        rec["breaks"] = mine if knots_in == n - 1 else _intervals(rec["adaptor"], n)
 
 
 def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:

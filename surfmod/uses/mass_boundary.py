@@ -237,7 +237,8 @@ class PcurveTable:
         for k, (_, rec) in enumerate(splines):
             shapes.setdefault(rec["taylor"][2].shape[1:], []).append(k)
         for (width, cdim), members in shapes.items():
-            rows = np.concatenate([np.arange(ends[k] - lens[k], ends[k]) for k in members])
+            m_lens = lens[members]  # the members' span rows, laid end to end
+            rows = np.arange(m_lens.sum()) + np.repeat(ends[members] - lens[members] - (np.cumsum(m_lens) - m_lens), m_lens)
             self.coef[rows, :width, :cdim] = np.concatenate([splines[k][1]["taylor"][2] for k in members])
             if cdim < dim:
                 self.coef[rows, 0, 2] = 1.0

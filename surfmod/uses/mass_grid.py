@@ -281,6 +281,14 @@ def grids_nodes(jobs: list, counts) -> list:
     return out
 
 
+def _used(index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(index, return_inverse=True)`` of small non-negative span indices, by a
+    mark per span (no sort)."""
+    mark = np.zeros(int(index.max()) + 1 if len(index) else 0, bool)
+    mark[index] = True
+    return np.flatnonzero(mark), (np.cumsum(mark) - 1)[index]
+
+
 class GreenGrid:
     """The grid points of :func:`grid_nodes`: per used cell ``c`` (inner span ``si[c]``,
     outer span ``qi[c]``) the tensor ``s[c] × t[c]`` (``(C, ks)``, ``(C, kt)``: inner and
@@ -306,8 +314,8 @@ class GreenGrid:
         ``u``): from ``grid_evaluate(us, vs, 1)`` on the used spans' lines when that
         tensor is not much larger than the cells, else ``evaluate(u, v, 1)`` point by point."""
         ks, kt = self.s.shape[1], self.t.shape[1]
-        su, s_pos = np.unique(self.si, return_inverse=True)
-        qu, q_pos = np.unique(self.qi, return_inverse=True)
+        su, s_pos = _used(self.si)
+        qu, q_pos = _used(self.qi)
         if grid_evaluate is None or len(su) * len(qu) > self.TENSOR_SLACK * len(self.qi):
             s, t = self.coordinates()
             return evaluate(s, t, 1) if k == 0 else evaluate(t, s, 1)

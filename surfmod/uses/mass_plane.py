@@ -14,10 +14,9 @@ the inner integral from the face box's edge ``u0`` exactly as the node-by-node r
 same result as there), evaluated as ``(u - u0) Σ A^k B^(p-k) / (p + 1)`` without
 cancellation.  The outer integral runs on the same Gauss nodes of the p-curves
 (:func:`surfmod.uses.mass_boundary.boundaries`: 3 per straight piece, exact); on faces
-bounded by lines and circles only (plates with holes, slots) the circular arcs are
-integrated exactly instead: along an arc every integrand is a trigonometric polynomial
-of degree at most 5, which 11 values integrate exactly (:func:`_arc_nodes`), so such faces
-need no boundary pass at all.  Then with
+bounded by lines and circles only (plates with holes, slots) the same nodes are laid
+directly, all such faces at once (:func:`_line_nodes`, :func:`_arc_nodes`), without the
+boundary pass (its cuts, crossings and p-curve table serve curved p-curves).  Then with
 ``x = c + a X + b Y`` the sums are tensor contractions of the moments with ``[c, X, Y]``:
 no surface is evaluated and no inner node is made, one pass for all planar faces of a
 part.
@@ -28,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from .mass_green import face_boundary
+from .mass_boundary import PIECES
 from .mass_grid import gauss
 
 # the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
@@ -47,8 +47,8 @@ _LINE = np.array([_product_index(i) for i in range(3)])
 
 def is_conic(mf) -> bool:
     """Whether a trimmed planar face is bounded by straight and circular p-curves only
-    (holes, slots, rounded pockets): its region moments are then exact
-    (:func:`_arc_nodes`), without a boundary pass.
+    (holes, slots, rounded pockets): its boundary's Gauss nodes are then laid directly
+    (:func:`_line_nodes`, :func:`_arc_nodes`), without the boundary pass.
 
     >>> import surfmod as sm, build123d as bd
     >>> from surfmod.uses.mass_green import mass_face
@@ -77,10 +77,11 @@ def _region_moments(faces: list, foot: np.ndarray, order: int):
         P, dP, wt, owner = _line_nodes(lines)
         parts.append((P, wt * dP[:, 1]))
         owners.append(owner)
-    if arcs:  # the rule exact for them
-        P, wb, owner = _arc_nodes(arcs)
+    if arcs:  # Gauss on equal pieces, as boundaries() lays them (not exact: order matters)
+        P, wb, owner = _arc_nodes(arcs, order)
         parts.append((P, wb))
         owners.append(owner)
+        exact[np.unique(owner)] = False
     moments = np.zeros((len(faces), len(_POWERS)))
     owner = np.concatenate(owners) if owners else np.zeros(0, int)
     if len(owner):
@@ -124,41 +125,29 @@ def _line_nodes(lines: list):
     return origin + t[:, None] * direction, direction, w, owner
 
 
-# -- circular arcs, exactly -----------------------------------------------------------------
-#: along a circular arc ``P(t) = C + r (cos t X + sin t Y)`` every integrand of
-#: :func:`_region_moments` is a trigonometric polynomial of degree at most 5 in ``t`` (``u``,
-#: ``v`` and ``dv/dt`` are of degree 1), fixed by its values at 11 equally spaced angles
-ARC_NODES = 11
-
-
-def _arc_nodes(arcs: list):
-    """``(P, dP_v · weights, owner)``: a rule exact for trigonometric polynomials of degree
-    <= 5 on each circular p-curve's range ``[t0, t1]`` (``arcs``: ``(owner, record)``
-    pairs): its values at the angles ``t_m = 2π m / 11``
-    (around the whole circle) interpolate it exactly, and the interpolant's integral over
-    the range weighs them by
-
-        G_m = (Δ + Σ_{k=1}^{5} 4 sin(k Δ/2) / k · cos(k (t_mid - t_m))) / 11,
-
-    ``Δ = t1 - t0``, ``t_mid`` the range's middle (each term of the order of ``Δ``: no
-    cancellation on short arcs).  The weights carry ``dv/dt`` and the edge's orientation,
-    as :func:`surfmod.uses.mass_boundary.boundaries` signs its own."""
-    n = ARC_NODES
-    tm = 2 * np.pi * np.arange(n) / n
+def _arc_nodes(arcs: list, order: int):
+    """``(P, dP_v · weights, owner)``: the Gauss nodes
+    :func:`surfmod.uses.mass_boundary.boundaries` lays on circular p-curves of a plane
+    (``arcs``: ``(owner, record)`` pairs): ``order`` nodes on each of ``PIECES`` equal
+    pieces of the range, ``P(t) = C + r (cos t X + sin t Y)``, the weights signed by the
+    edge's orientation and multiplied by ``dv/dt``."""
     data = np.array([(*rec["range"], rec["sign"], rec["radius"], *rec["centre"], *rec["x"], *rec["y"]) for _, rec in arcs])
-    t0, t1, sign, r = data[:, 0], data[:, 1], data[:, 2], data[:, 3]
+    f, l, sign, r = data[:, :1], data[:, 1:2], data[:, 2:3], data[:, 3:4]
     centre, ax, ay = data[:, 4:6], data[:, 6:8], data[:, 8:10]
-    half = (t1 - t0) / 2
-    k = np.arange(1, n // 2 + 1)
-    sinc = 4 * np.sin(k * half[:, None]) / k  # (A, 5)
-    phase = ((t0 + t1) / 2)[:, None, None] - tm[None, None, :]  # (A, 1, 11)
-    G = (2 * half[:, None] + np.einsum("ak,akm->am", sinc, np.cos(k[None, :, None] * phase))) / n  # (A, 11)
-    c, s = np.cos(tm), np.sin(tm)
-    P = centre[:, None, :] + r[:, None, None] * (c[None, :, None] * ax[:, None, :] + s[None, :, None] * ay[:, None, :])
-    dv = r[:, None] * (c[None, :] * ay[:, None, 1] - s[None, :] * ax[:, None, 1])  # (A, 11)
-    live = (t1 > t0)[:, None]  # an empty range adds nothing, as on Gauss nodes
-    owner = np.repeat(np.array([i for i, _ in arcs], int), n)
-    return P.reshape(-1, 2), (np.where(live, sign[:, None] * G * dv, 0.0)).ravel(), owner
+    live = (l > f)[:, 0]
+    cuts = f + (l - f) * np.linspace(0.0, 1.0, PIECES + 1)
+    cuts[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it
+    a, b = cuts[:, :-1, None], cuts[:, 1:, None]  # (A, PIECES, 1)
+    x, gw = gauss(order)
+    t = ((a + b) / 2 + (b - a) / 2 * x).reshape(len(arcs), -1)  # (A, PIECES order)
+    w = sign * ((b - a) / 2 * gw).reshape(len(arcs), -1)
+    c, s_ = np.cos(t)[:, :, None], np.sin(t)[:, :, None]
+    rr = r[:, :, None]
+    P = centre[:, None, :] + rr * (c * ax[:, None, :] + s_ * ay[:, None, :])
+    dv = (rr * (c * ay[:, None, :] - s_ * ax[:, None, :]))[:, :, 1]
+    owner = np.repeat(np.array([i for i, _ in arcs], int), t.shape[1])
+    keep = np.repeat(live, t.shape[1])  # an empty range has no nodes
+    return P.reshape(-1, 2)[keep], (w * dv).ravel()[keep], owner[keep]
 
 
 def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]:
@@ -166,15 +155,14 @@ def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]
     :class:`~surfmod.uses.mass_green.MassFace` with its frame), the sums
     :func:`surfmod.uses.mass._moments` makes of their quadrature nodes, in closed form
     from the moments of their parameter regions (module notes); and per face whether no
-    rule depended on ``order`` (straight and circular p-curves only: circles are integrated
-    exactly, :func:`_arc_nodes`).
+    rule depended on ``order`` (straight p-curves only).
 
     >>> import surfmod as sm, build123d as bd
     >>> from surfmod.uses.mass_green import mass_face
     >>> disc = mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(2.0))))
     >>> m, exact = plane_moments([disc], 12, np.zeros(3))
-    >>> bool(abs(m[0, 0] - 4 * np.pi) < 1e-14), bool(exact[0])
-    (True, True)
+    >>> bool(abs(m[0, 0] - 4 * np.pi) < 1e-13), bool(exact[0])
+    (True, False)
     """
     ref = np.asarray(ref, dtype=float)
     origin, ex, ey = (np.array([mf.frame[i] for mf in faces]) for i in range(3))
