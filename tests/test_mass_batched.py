@@ -359,3 +359,23 @@ def test_spline_pcurve_breaks_from_knots_equal_occt_intervals(corpus_dir):
 @pytest.mark.corpus
 def test_spline_pcurve_breaks_from_knots_equal_occt_intervals_on_the_corpus(corpus_file):
     _spline_breaks_equal_occt(corpus_file)
+
+
+def test_boundary_nodes_with_span_hints_equal_the_search(corpus_dir, monkeypatch):
+    # the span of each piece's middle serves all its Gauss nodes: the same values as
+    # searching every node's span (the screw's helical B-spline p-curves, bit for bit)
+    import surfmod.uses.mass_green as mg
+    from surfmod.uses.mass_boundary import PcurveTable, boundaries
+
+    _, shapes = _part(corpus_dir / "occt_screw.step")
+    read = _read_faces(shapes)
+    pcs = faces_pcurves(shapes)
+    taylor_pieces([r for p in pcs for r in p])
+    rules = [mg._boundary_rule(mf, 12) for mf in mass_faces(read, pcs) if not mf.natural]
+    hinted = boundaries(rules)
+    real = PcurveTable.d1
+    monkeypatch.setattr(PcurveTable, "d1", lambda self, which, t, span=None: real(self, which, t))
+    searched = boundaries(rules)
+    assert sum(len(h[2]) for h in hinted) > 3000
+    for h, s in zip(hinted, searched):
+        assert all(np.array_equal(x, y) for x, y in zip(h[:3], s[:3])) and h[3] == s[3]

@@ -242,9 +242,12 @@ class PcurveTable:
             self.coef[rows, :width, :cdim] = np.concatenate([splines[k][1]["taylor"][2] for k in members])
             if cdim < dim:
                 self.coef[rows, 0, 2] = 1.0
+        self.coef_by_power = np.ascontiguousarray(self.coef.transpose(1, 0, 2))  # (p+1, S, dim)
 
-    def d1(self, which: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """``(N, 4)``: ``u, v, du/dt, dv/dt`` of record ``which[n]`` at ``t[n]``."""
+    def d1(self, which: np.ndarray, t: np.ndarray, span: np.ndarray | None = None) -> np.ndarray:
+        """``(N, 4)``: ``u, v, du/dt, dv/dt`` of record ``which[n]`` at ``t[n]``; ``span``
+        (optional, per row): the B-spline rows' span polynomial when the caller knows it
+        (:meth:`span_of`), ``-1`` where not."""
         out = np.empty((len(t), 4))
         if len(self.present) == 1:
             masks = {next(iter(self.present)): slice(None)}
@@ -263,7 +266,7 @@ class PcurveTable:
                 out[m, :2] = self.centre[r] + rad * (c * x + s * y)
                 out[m, 2:] = rad * (c * y - s * x)
             elif k == 2:
-                out[m] = self._spline_d1(r, tt)
+                out[m] = self._spline_d1(r, tt, None if span is None else span[m])
             else:
                 from ..occ.pcurves import adaptor_d1
 
@@ -277,14 +280,18 @@ class PcurveTable:
         """Row of the span polynomial of B-spline record ``r[n]`` at ``t[n]``."""
         return np.clip(np.searchsorted(self.keys, r + 1j * t, side="right") - 1, self.first[r], self.last[r])
 
-    def _spline_d1(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
-        j = self.span_of(r, t)
+    def _spline_d1(self, r: np.ndarray, t: np.ndarray, j: np.ndarray | None = None) -> np.ndarray:
+        if j is None:
+            j = self.span_of(r, t)
+        elif (unknown := j < 0).any():
+            j = j.copy()
+            j[unknown] = self.span_of(r[unknown], t[unknown])
         dt = (t - self.centres[j])[:, None]
-        c = self.coef[j]  # (N, p+1, dim)
-        val, der = c[:, -1], np.zeros_like(c[:, -1])
-        for k in range(c.shape[1] - 2, -1, -1):  # Horner for the value and its derivative
+        c = self.coef_by_power[:, j]  # (p+1, N, dim): each power's rows contiguous
+        val, der = c[-1], np.zeros_like(c[-1])
+        for k in range(c.shape[0] - 2, -1, -1):  # Horner for the value and its derivative
             der = der * dt + val
-            val = val * dt + c[:, k]
+            val = val * dt + c[k]
         out = np.empty((len(t), 4))
         if not self.rational:
             out[:, :2], out[:, 2:] = val, der
@@ -440,7 +447,14 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
         w[at] = ((bb - aa) / 2 * gw).ravel()
     which = np.repeat(owner, count)
     live_idx = np.flatnonzero(live)
-    q = table.d1(np.concatenate([which, np.repeat(live_idx, 2)]), np.concatenate([t, ranges[live_idx].ravel()]))
+    # a piece lies within one span of its B-spline (the cuts hold its knots): the span of
+    # its middle serves all its nodes, one search per piece instead of per node
+    piece_span = np.full(len(owner), -1)
+    spline = table.kind[owner] == 2
+    if spline.any():
+        piece_span[spline] = table.span_of(owner[spline], (a[spline] + b[spline]) / 2)
+    span = np.concatenate([np.repeat(piece_span, count), np.full(2 * len(live_idx), -1)])
+    q = table.d1(np.concatenate([which, np.repeat(live_idx, 2)]), np.concatenate([t, ranges[live_idx].ravel()]), span)
     n = len(t)
     for k, i in enumerate(live_idx):  # for _largest_gap, from the same evaluation
         records[i]["ends"] = q[n + 2 * k : n + 2 * k + 2, :2]
