@@ -247,7 +247,10 @@ def grids_nodes(jobs: list, counts) -> list:
     At, As = chebyshev(kt)[2], chebyshev(ks)[2]
     tw = chebyshev_polynomials((2 * outer - a - b) / (b - a), kt) * wb[:, None]  # (N, kt)
     # whole spans: node n covers spans i < full_n; ∫ over a span of ℓ_j is h/2 · iws_j
-    acc = _sum_rows(row * (n_spans + 1) + full, tw, n_faces * n_out * (n_spans + 1)) @ At.T
+    # (nodes in their first inner span cover none: left out, as they would only add to a
+    # sum nothing reads)
+    covers = np.flatnonzero(full > 0)
+    acc = _sum_rows((row * (n_spans + 1) + full)[covers], tw[covers], n_faces * n_out * (n_spans + 1)) @ At.T
     acc = acc.reshape(n_faces * n_out, n_spans + 1, kt)
     whole = np.cumsum(acc[:, ::-1], axis=1)[:, ::-1][:, 1:]  # (F Q, S, kt): Σ over nodes with full > i
     h = np.diff(br, axis=1)  # (F, S)
