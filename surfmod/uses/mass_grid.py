@@ -78,16 +78,16 @@ def chebyshev_antiderivatives(x1: np.ndarray, n: int) -> np.ndarray:
     [[2.0, 0.0, -0.666666666667], [1.0, -0.5, -0.333333333333]]
     """
     m = np.arange(n + 1)
-    T = chebyshev_polynomials(np.clip(x1, -1.0, 1.0), n + 1)  # (N, n + 1): T_0 .. T_n
+    T = _chebyshev_rows(np.clip(x1, -1.0, 1.0), n + 1)  # (n + 1, N): T_0 .. T_n, rows contiguous
     ends = np.where(m % 2 == 0, 1.0, -1.0)  # T_m(-1)
-    I = np.empty((len(x1), n))
-    I[:, 0] = T[:, 1] + 1.0
+    I = np.empty((n, len(x1)))
+    I[0] = T[1] + 1.0
     if n > 1:
-        I[:, 1] = (T[:, 2] - 1.0) / 4.0  # ∫ T_1 = x² / 2 = (T_2 + 1) / 4
+        I[1] = (T[2] - 1.0) / 4.0  # ∫ T_1 = x² / 2 = (T_2 + 1) / 4
     if n > 2:
-        k = np.arange(2, n)
-        I[:, 2:] = (T[:, 3:] / (k + 1) - T[:, 1:-2] / (k - 1)) / 2 - (ends[3:] / (k + 1) - ends[1:-2] / (k - 1)) / 2
-    return I
+        k = np.arange(2, n)[:, None]
+        I[2:] = (T[3:] / (k + 1) - T[1:-2] / (k - 1)) / 2 - (ends[3:, None] / (k + 1) - ends[1:-2, None] / (k - 1)) / 2
+    return I.T
 
 
 def chebyshev_polynomials(y: np.ndarray, count: int) -> np.ndarray:
@@ -99,6 +99,11 @@ def chebyshev_polynomials(y: np.ndarray, count: int) -> np.ndarray:
     >>> bool(np.allclose(chebyshev_polynomials(y, 6), np.cos(np.outer(np.arccos(y), np.arange(6))), atol=1e-15))
     True
     """
+    return _chebyshev_rows(y, count).T
+
+
+def _chebyshev_rows(y: np.ndarray, count: int) -> np.ndarray:
+    """:func:`chebyshev_polynomials` as ``(count, N)``, each degree's row contiguous."""
     T = np.empty((count, len(y)))  # rows contiguous for the recurrence
     T[0] = 1.0
     if count > 1:
@@ -107,7 +112,7 @@ def chebyshev_polynomials(y: np.ndarray, count: int) -> np.ndarray:
     for m in range(2, count):
         np.multiply(y2, T[m - 1], out=T[m])
         T[m] -= T[m - 2]
-    return T.T
+    return T
 
 
 def lagrange_values(y: np.ndarray, x: np.ndarray, bw: np.ndarray) -> np.ndarray:
