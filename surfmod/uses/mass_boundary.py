@@ -121,11 +121,11 @@ def taylor_pieces(records: list) -> None:
         local_ctrl = all_ctrl[first[:, None] + np.arange(p + 1)]  # (S, p+1, 3)
         fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
         coef = np.matmul(basis, local_ctrl) / fact[None, :, None]  # Σ_r basis_skr ctrl_srd
-        cuts = np.searchsorted(rec_of, np.arange(len(group) + 1))
+        cuts = np.searchsorted(rec_of, np.arange(len(group) + 1)).tolist()
+        planar = np.ascontiguousarray(coef[:, :, :2])  # polynomial records: (u, v) only, one copy for all
         for i, rec in enumerate(group):
             lo, hi = cuts[i], cuts[i + 1]
-            c = coef[lo:hi]
-            rec["taylor"] = (starts[lo:hi], mid[lo:hi], c if rec["weights"] is not None else np.ascontiguousarray(c[:, :, :2]))
+            rec["taylor"] = (starts[lo:hi], mid[lo:hi], coef[lo:hi] if rec["weights"] is not None else planar[lo:hi])
 
 
 def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
