@@ -27,6 +27,17 @@ PIECES = 4
 
 _KINDS = {"line": 0, "circle": 1, "bspline": 2}
 
+#: np.linspace(0, 1, PIECES + 1), made once
+_FRACTIONS = np.linspace(0.0, 1.0, PIECES + 1)
+_FRACTION_CACHE: dict = {}
+
+
+def _fractions(pieces: int) -> np.ndarray:
+    """``np.linspace(0, 1, pieces + 1)`` (cached: the same few counts every call)."""
+    if pieces not in _FRACTION_CACHE:
+        _FRACTION_CACHE[pieces] = np.linspace(0.0, 1.0, pieces + 1)
+    return _FRACTION_CACHE[pieces]
+
 
 def _spans(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
     x, w = gauss(order)
@@ -308,7 +319,7 @@ def _table_crossings(table: PcurveTable, owner, a, b, scale, lines, coord, per_p
     ``coord[piece]`` (``(pieces, L)``, NaN-padded: each face has its own), one sampling and
     one evaluation per Newton step for all of them.  Returns the crossing parameters and
     their records."""
-    t = (a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, per_piece + 1)).ravel()
+    t = (a[:, None] + (b - a)[:, None] * _fractions(per_piece)).ravel()
     which = np.repeat(owner, per_piece + 1)
     piece = np.repeat(np.arange(len(owner)), per_piece + 1)
     vals = table.d1(which, t)
@@ -403,7 +414,7 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
     # pieces, the curved ones also cut at their own breaks (knots) inside the range
     idx = np.flatnonzero(live)
     straight = table.kind[idx] == 0
-    frac = np.linspace(0.0, 1.0, PIECES + 1)
+    frac = _FRACTIONS
     f, l = f_all[idx, None], l_all[idx, None]
     even = f + (l - f) * frac
     even[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it

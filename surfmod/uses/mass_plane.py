@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from .mass_green import face_boundary
-from .mass_boundary import PIECES
+from .mass_boundary import _FRACTIONS, PIECES  # noqa: F401
 from .mass_grid import gauss
 
 # the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
@@ -135,7 +135,7 @@ def _arc_nodes(arcs: list, order: int):
     f, l, sign, r = data[:, :1], data[:, 1:2], data[:, 2:3], data[:, 3:4]
     centre, ax, ay = data[:, 4:6], data[:, 6:8], data[:, 8:10]
     live = (l > f)[:, 0]
-    cuts = f + (l - f) * np.linspace(0.0, 1.0, PIECES + 1)
+    cuts = f + (l - f) * _FRACTIONS
     cuts[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it
     a, b = cuts[:, :-1, None], cuts[:, 1:, None]  # (A, PIECES, 1)
     x, gw = gauss(order)
