@@ -379,3 +379,24 @@ def test_boundary_nodes_with_span_hints_equal_the_search(corpus_dir, monkeypatch
     assert sum(len(h[2]) for h in hinted) > 3000
     for h, s in zip(hinted, searched):
         assert all(np.array_equal(x, y) for x, y in zip(h[:3], s[:3])) and h[3] == s[3]
+
+
+@pytest.mark.parametrize("name", QUICK)
+def test_pcurve_table_subset_equals_a_table_of_those_records(corpus_dir, name):
+    # the boundary pass takes its table from the rectangle test's: the same arrays, and
+    # the same evaluations bit for bit
+    _, shapes = _part(corpus_dir / name)
+    pcs = faces_pcurves(shapes)
+    records = [r for p in pcs for r in p]
+    taylor_pieces(records)
+    table = PcurveTable(records)
+    rows = np.arange(len(records))[::-2][::-1]  # every other record, in order
+    sub, fresh = table.subset(rows), PcurveTable([records[i] for i in rows])
+    assert np.array_equal(sub.kind, fresh.kind)
+    t = np.concatenate([np.linspace(*records[i]["range"], 9) for i in rows])
+    which = np.repeat(np.arange(len(rows)), 9)
+    assert np.array_equal(sub.d1(which, t), fresh.d1(which, t))
+    spline = fresh.kind[which] == 2
+    if spline.any():
+        assert np.array_equal(sub.span_of(which[spline], t[spline]) - sub.first[which[spline]],
+                              fresh.span_of(which[spline], t[spline]) - fresh.first[which[spline]])

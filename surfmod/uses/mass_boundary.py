@@ -255,6 +255,34 @@ class PcurveTable:
                 self.coef[rows, 0, 2] = 1.0
         self.coef_by_power = np.ascontiguousarray(self.coef.transpose(1, 0, 2))  # (p+1, S, dim)
 
+    def subset(self, rows: np.ndarray) -> "PcurveTable":
+        """The table of the records ``rows`` (in that order), taken from this one's arrays:
+        the same values :class:`PcurveTable` builds from those records (a table with a
+        rational record keeps the homogeneous form, whose division by ``w = 1`` leaves
+        polynomial records bit for bit)."""
+        rows = np.asarray(rows, int)
+        out = PcurveTable.__new__(PcurveTable)
+        out.records = [self.records[i] for i in rows]
+        out.kind = self.kind[rows]
+        out.present = set(out.kind.tolist())
+        out.polynomial = self.polynomial[rows]
+        for name in ("origin", "direction", "centre", "ax", "ay", "radius"):
+            if hasattr(self, name):
+                setattr(out, name, getattr(self, name)[rows])
+        spline = np.flatnonzero(out.kind == 2)
+        if len(spline):
+            old = rows[spline]
+            lens = self.last[old] - self.first[old] + 1
+            ends = np.cumsum(lens)
+            spans = np.arange(ends[-1]) + np.repeat(self.first[old] - (ends - lens), lens)
+            out.first, out.last = np.zeros(len(rows), int), np.zeros(len(rows), int)
+            out.first[spline], out.last[spline] = ends - lens, ends - 1
+            out.keys = np.repeat(spline, lens) + 1j * self.keys.imag[spans]
+            out.centres, out.coef = self.centres[spans], self.coef[spans]
+            out.coef_by_power = self.coef_by_power[:, spans]
+            out.rational = self.rational
+        return out
+
     def d1(self, which: np.ndarray, t: np.ndarray, span: np.ndarray | None = None) -> np.ndarray:
         """``(N, 4)``: ``u, v, du/dt, dv/dt`` of record ``which[n]`` at ``t[n]``; ``span``
         (optional, per row): the B-spline rows' span polynomial when the caller knows it

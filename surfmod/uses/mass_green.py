@@ -156,6 +156,8 @@ class MassFace:
     boundary: dict = field(default_factory=dict)
     # the same partials as ``evaluate`` on a tensor grid ``us × vs`` (``(nu, nv, 2, 2, 3)``)
     grid_evaluate: object = None
+    # ``(table, first row)``: the face's p-curves are rows of a part's shared PcurveTable
+    rows: tuple | None = None
 
     @property
     def natural(self) -> bool:
@@ -247,14 +249,23 @@ def mass_faces(read: list, pcurves: list) -> list:
     straight = [i for i in one_wire if all(rec["kind"] == "line" for rec in pcurves[i])]
     curved = sorted(set(one_wire) - set(straight))
     natural = {i: False for i in range(len(read))}
+    shared = {}
     for test, check in ((straight, _lines_on_box_border), (curved, _records_on_box_border)):
         if test:
             records = [rec for i in test for rec in pcurves[i]]
             counts = [len(pcurves[i]) for i in test]
             bounds = np.repeat(np.array([[b for r in read[i].domain for b in r] for i in test]), counts, axis=0)
-            ok = check(records if check is _lines_on_box_border else PcurveTable(records), bounds)
+            if check is _lines_on_box_border:
+                ok = check(records, bounds)
+            else:  # the table serves the boundary pass of these faces too (prepare_boundaries)
+                table = PcurveTable(records)
+                ok = check(table, bounds)
+                shared = {i: (table, first) for i, first in zip(test, np.cumsum([0] + counts[:-1]).tolist())}
             natural.update(zip(test, np.logical_and.reduceat(ok, np.cumsum([0] + counts[:-1])).tolist()))
-    return [mass_face(f, pcs, natural[i]) for i, (f, pcs) in enumerate(zip(read, pcurves))]
+    out = [mass_face(f, pcs, natural[i]) for i, (f, pcs) in enumerate(zip(read, pcurves))]
+    for i, rows in shared.items():
+        out[i].rows = rows
+    return out
 
 
 def mass_face(face, pcurves: list | None = None, natural: bool | None = None) -> MassFace:
@@ -440,7 +451,12 @@ def prepare_boundaries(faces: list, order: int) -> None:
     # planar faces bounded by lines and circles need none (closed form, mass_plane)
     trimmed = [mf for mf in faces if not mf.natural and mf.pcurves and not is_conic(mf)]
     if trimmed:
-        for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed])):
+        table = None
+        if all(mf.rows is not None and mf.rows[0] is trimmed[0].rows[0] for mf in trimmed):
+            # their p-curves are rows of the table mass_faces built: taken, not rebuilt
+            table = trimmed[0].rows[0].subset(np.concatenate(
+                [np.arange(mf.rows[1], mf.rows[1] + len(mf.pcurves)) for mf in trimmed]))
+        for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed], table)):
             mf.boundary[order] = got
 
 
