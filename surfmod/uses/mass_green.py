@@ -393,13 +393,12 @@ def _largest_gap(mf: MassFace) -> float:
     whose p-curves join up."""
     u0, u1, v0, v1 = mf.bounds
     scale = np.array([max(u1 - u0, 1e-300), max(v1 - v0, 1e-300)])
-    ends = []
-    for rec in mf.pcurves:
-        q = (rec["ends"] if "ends" in rec else pcurve_d1(rec, np.array(rec["range"]))[:, :2]) / scale
-        ends.append(q if rec["sign"] > 0 else q[::-1])
-    if not ends:
+    if not mf.pcurves:
         return 0.0
-    ends = np.array(ends)  # (E, 2 [start, end], 2)
+    ends = np.array([rec["ends"] if "ends" in rec else pcurve_d1(rec, np.array(rec["range"]))[:, :2]
+                     for rec in mf.pcurves]) / scale  # (E, 2 [start, end], 2)
+    backwards = np.array([rec["sign"] <= 0 for rec in mf.pcurves])
+    ends[backwards] = ends[backwards, ::-1]  # in the edges' directions in the face
     d = np.linalg.norm(ends[:, None, 1] - ends[None, :, 0], axis=-1)
     return float(d.min(axis=1).max())
 
