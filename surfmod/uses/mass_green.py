@@ -403,6 +403,19 @@ def _largest_gap(mf: MassFace) -> float:
     return float(d.min(axis=1).max())
 
 
+def is_conic(mf) -> bool:
+    """Whether a trimmed planar face is bounded by straight and circular p-curves only
+    (holes, slots, rounded pockets): its boundary's Gauss nodes are then laid directly
+    (:func:`surfmod.uses.mass_plane._arc_nodes`), without the boundary pass.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> is_conic(mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(2.0)))))
+    True
+    """
+    return bool(mf.plane and not mf.natural and mf.pcurves
+                and all(rec["kind"] in ("line", "circle") for rec in mf.pcurves))
+
+
 def _boundary_rule(mf: MassFace, order: int) -> tuple:
     """The face's entry for :func:`surfmod.uses.mass_boundary.boundaries`: per p-curve the
     Gauss order and whether it is exact, the break lines and their kind."""
@@ -445,9 +458,8 @@ def prepare_boundaries(faces: list, order: int) -> None:
     >>> sorted(len(f.boundary) for f in faces)
     [0, 1, 1, 1]
     """
-    from .mass_plane import is_conic
-
-    # planar faces bounded by lines and circles need none (closed form, mass_plane)
+    # planar faces bounded by lines and circles need none (their nodes are laid directly
+    # by surfmod.uses.mass_plane)
     trimmed = [mf for mf in faces if not mf.natural and mf.pcurves and not is_conic(mf)]
     if trimmed:
         table = None

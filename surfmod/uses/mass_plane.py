@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mass_green import face_boundary
+from .mass_green import face_boundary, is_conic  # noqa: F401 (is_conic re-exported)
 from .mass_boundary import _FRACTIONS, PIECES  # noqa: F401
 from .mass_grid import gauss
 
@@ -43,20 +43,6 @@ def _product_index(*axes: int) -> int:
 _CUBE = np.array([[[_product_index(i, j, k) for k in range(3)] for j in range(3)] for i in range(3)])
 _SQUARE = np.array([[_product_index(i, j) for j in range(3)] for i in range(3)])
 _LINE = np.array([_product_index(i) for i in range(3)])
-
-
-def is_conic(mf) -> bool:
-    """Whether a trimmed planar face is bounded by straight and circular p-curves only
-    (holes, slots, rounded pockets): its boundary's Gauss nodes are then laid directly
-    (:func:`_line_nodes`, :func:`_arc_nodes`), without the boundary pass.
-
-    >>> import surfmod as sm, build123d as bd
-    >>> from surfmod.uses.mass_green import mass_face
-    >>> is_conic(mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(2.0)))))
-    True
-    """
-    return bool(mf.plane and not mf.natural and mf.pcurves
-                and all(rec["kind"] in ("line", "circle") for rec in mf.pcurves))
 
 
 def _region_moments(faces: list, foot: np.ndarray, order: int):
