@@ -352,7 +352,16 @@ def _spline_breaks_equal_occt(path):
     return len(splines)
 
 
-def test_spline_pcurve_breaks_from_knots_equal_occt_intervals(corpus_dir):
+def test_spline_pcurve_breaks_from_knots_equal_occt_intervals(corpus_dir, monkeypatch):
+    # the screw's helical p-curves reach past their end knots: still no adaptor read
+    import surfmod.occ.pcurves as pcm
+
+    real, read = pcm._intervals, []
+    monkeypatch.setattr(pcm, "_intervals", lambda pc, n: read.append(n) or real(pc, n))
+    _, shapes = _part(corpus_dir / "occt_screw.step")
+    faces_pcurves(shapes)
+    assert not read
+    monkeypatch.undo()
     assert _spline_breaks_equal_occt(corpus_dir / "occt_screw.step") >= 20
 
 

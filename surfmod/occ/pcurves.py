@@ -159,10 +159,14 @@ def _spline_breaks(records: list) -> None:
     owner = np.repeat(np.arange(count), [len(k) for k in knots])
     flat = np.concatenate(knots)
     ranges = np.array([rec["range"] for rec in records])
-    # each knot value once (where it first appears), strictly inside its record's range
+    # each interior knot value once (where it first appears), strictly inside its record's
+    # range (the end knots bound no interval: a range reaching past them continues the end
+    # spans)
     first = np.ones(len(flat), bool)
     first[1:] = (flat[1:] != flat[:-1]) | (owner[1:] != owner[:-1])
-    keep = first & (flat > ranges[owner, 0]) & (flat < ranges[owner, 1])
+    ends = np.cumsum([len(k) for k in knots])
+    lo, hi = flat[ends - np.array([len(k) for k in knots])], flat[ends - 1]
+    keep = first & (flat > np.maximum(ranges[:, 0], lo)[owner]) & (flat < np.minimum(ranges[:, 1], hi)[owner])
     inside = np.bincount(owner[keep], minlength=count)
     # per record [first, knots inside..., last], laid end to end, cut into views
     values = np.concatenate([ranges[:, 0], flat[keep], ranges[:, 1]])
