@@ -409,3 +409,16 @@ def test_pcurve_table_subset_equals_a_table_of_those_records(corpus_dir, name):
     if spline.any():
         assert np.array_equal(sub.span_of(which[spline], t[spline]) - sub.first[which[spline]],
                               fresh.span_of(which[spline], t[spline]) - fresh.first[which[spline]])
+
+
+def test_elementary_degrees_by_type_equal_direction_degree():
+    import surfmod.uses.mass_green as mg
+
+    solids = [bd.Box(1, 2, 3), bd.Cylinder(1, 2), bd.Cone(2, 1, 3), bd.Sphere(1), bd.Torus(3, 1)]
+    kinds = set()
+    for solid in solids:
+        for f in solid.faces():
+            surf = from_face(f).surface
+            kinds.add(type(surf))
+            assert mg._degrees(surf) == (mg.direction_degree(surf, 0), mg.direction_degree(surf, 1))
+    assert kinds == set(mg._ELEMENTARY_DEGREES)

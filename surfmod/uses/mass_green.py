@@ -39,7 +39,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..construct.curves import Line
-from ..construct.elementary import ConicalSurface, CylindricalSurface, ElementarySurface, PlaneSurface
+from ..construct.elementary import (ConicalSurface, CylindricalSurface, ElementarySurface, PlaneSurface, SphericalSurface,
+                                    ToroidalSurface)
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
@@ -67,6 +68,18 @@ def _curve_degree(curve):
     if isinstance(curve, BSplineCurve) and curve.weights is None:
         return int(curve.degree)
     return None
+
+
+# the degrees of the elementary surfaces by exact type: most faces of real parts, where
+# the isinstance chain of direction_degree (abstract base classes) costs more than the rest
+_ELEMENTARY_DEGREES = {PlaneSurface: (1, 1), CylindricalSurface: (None, 1), ConicalSurface: (None, 1),
+                       SphericalSurface: (None, None), ToroidalSurface: (None, None)}
+
+
+def _degrees(surface) -> tuple:
+    """``(direction_degree(surface, 0), direction_degree(surface, 1))``."""
+    known = _ELEMENTARY_DEGREES.get(type(surface))
+    return known if known is not None else (direction_degree(surface, 0), direction_degree(surface, 1))
 
 
 def direction_degree(surface, direction: int):
@@ -111,9 +124,9 @@ def evaluators(obj):
     >>> grid(u, v, 1).shape
     (2, 2, 2, 2, 3)
     """
-    face = isinstance(obj, TrimmedFace)
+    face = type(obj) is TrimmedFace or isinstance(obj, TrimmedFace)
     surf = obj.surface if face else obj
-    if not isinstance(surf, ElementarySurface):
+    if type(surf) not in _ELEMENTARY_DEGREES and not isinstance(surf, ElementarySurface):
         # splines, sweeps, offsets: point by point (their tensor evaluators pay off only
         # on grids much larger than a face's quadrature nodes)
         return obj._derivatives, None
@@ -306,7 +319,7 @@ def mass_face(face, pcurves: list | None = None, natural: bool | None = None) ->
         natural = _on_box_border(table, bounds)
     evaluate, grid_evaluate = evaluators(face)
     return MassFace(evaluate, bounds, breaks, -1.0 if face.reversed else 1.0,
-                    (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
+                    _degrees(surf), None if natural else pcurves,
                     plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table,
                     angular, grid_evaluate=grid_evaluate)
 
@@ -321,7 +334,7 @@ def surface_mass_face(surf) -> MassFace:
     (u0, u1), (v0, v1) = surf.domain
     evaluate, grid_evaluate = evaluators(surf)
     return MassFace(evaluate, (u0, u1, v0, v1), tuple(breaks), 1.0,
-                    (direction_degree(surf, 0), direction_degree(surf, 1)), None, isinstance(surf, PlaneSurface),
+                    _degrees(surf), None, isinstance(surf, PlaneSurface),
                     grid_evaluate=grid_evaluate)
 
 
