@@ -155,8 +155,9 @@ def _spline_breaks(records: list) -> None:
     knot closer to an end than its parametric tolerance; where the count then differs, the
     adaptor's own bounds are read instead (one OCCT call per bound)."""
     knots = [rec["knots"] for rec in records]
+    sizes = np.array([len(k) for k in knots])
     count = len(records)
-    owner = np.repeat(np.arange(count), [len(k) for k in knots])
+    owner = np.repeat(np.arange(count), sizes)
     flat = np.concatenate(knots)
     ranges = np.array([rec["range"] for rec in records])
     # each interior knot value once (where it first appears), strictly inside its record's
@@ -164,19 +165,22 @@ def _spline_breaks(records: list) -> None:
     # spans)
     first = np.ones(len(flat), bool)
     first[1:] = (flat[1:] != flat[:-1]) | (owner[1:] != owner[:-1])
-    ends = np.cumsum([len(k) for k in knots])
-    lo, hi = flat[ends - np.array([len(k) for k in knots])], flat[ends - 1]
+    ends = np.cumsum(sizes)
+    lo, hi = flat[ends - sizes], flat[ends - 1]
     keep = first & (flat > np.maximum(ranges[:, 0], lo)[owner]) & (flat < np.minimum(ranges[:, 1], hi)[owner])
-    inside = np.bincount(owner[keep], minlength=count)
-    # per record [first, knots inside..., last], laid end to end, cut into views
-    values = np.concatenate([ranges[:, 0], flat[keep], ranges[:, 1]])
-    rows = np.concatenate([np.arange(count), owner[keep], np.arange(count)])
-    rank = np.concatenate([np.zeros(count), np.ones(keep.sum()), np.full(count, 2.0)])
-    order = np.lexsort((values, rank, rows))  # by record, then ends around the knots
-    pieces = np.split(values[order], np.cumsum(inside + 2)[:-1])
-    for rec, mine, knots_in in zip(records, pieces, inside.tolist()):
+    kept, kept_owner = flat[keep], owner[keep]
+    inside = np.bincount(kept_owner, minlength=count)
+    # per record [first, knots inside..., last], laid end to end (kept knots are grouped
+    # by record already), handed out as views
+    width = inside + 2
+    start = np.cumsum(width) - width
+    out = np.empty(int(width.sum()))
+    out[start] = ranges[:, 0]
+    out[start + width - 1] = ranges[:, 1]
+    out[np.arange(len(kept)) - (np.cumsum(inside) - inside)[kept_owner] + start[kept_owner] + 1] = kept
+    for rec, lo_, n_in in zip(records, start.tolist(), inside.tolist()):
         n = rec.pop("intervals")
-        rec["breaks"] = mine if knots_in == n - 1 else _intervals(rec["adaptor"], n)
+        rec["breaks"] = out[lo_ : lo_ + n_in + 2] if n_in == n - 1 else _intervals(rec["adaptor"], n)
 
 
 def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
