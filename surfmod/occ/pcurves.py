@@ -19,7 +19,8 @@ from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS, TopoDS_Iterator
 
-from .geom import read_bspline_curve, read_bspline_curves_2d
+from .binary import bspline_curves
+from .geom import read_bspline_curve
 from .guard import kernel
 
 
@@ -28,8 +29,7 @@ def _xy(p) -> np.ndarray:
 
 
 def _bspline_data(pc):
-    """Poles (padded to 3-D with z = 0 for the surfmod evaluator), weights, flat knots and
-    degree of a B-spline p-curve; None for a periodic curve whose edge range leaves its
+    """Poles ``(n, 2)``, weights, flat knots and degree of a B-spline p-curve; None for a periodic curve whose edge range leaves its
     first period (its unwrapped form would continue the end span there instead)."""
     b = pc.BSpline()
     if b.IsPeriodic():
@@ -37,7 +37,9 @@ def _bspline_data(pc):
         b.SetNotPeriodic()
         if pc.FirstParameter() < b.FirstParameter() or pc.LastParameter() > b.LastParameter():
             return None
-    return read_bspline_curve(b)
+    data = read_bspline_curve(b)
+    data["points"] = data["points"][:, :2]  # (u, v), as the non-periodic ones
+    return data
 
 
 def face_pcurves(face) -> list[dict]:
@@ -45,8 +47,8 @@ def face_pcurves(face) -> list[dict]:
     ``{"kind", "wire", "range", "sign", "breaks", ...}`` (``wire``: index of the edge's
     wire) where ``kind`` is ``"line"`` (``origin``,
     ``direction``: ``P(t) = origin + t direction``), ``"circle"`` (``centre``, ``x``, ``y``,
-    ``radius``: ``P(t) = centre + radius (cos t x + sin t y)``), ``"bspline"`` (``points``,
-    ``weights``, ``knots``, ``degree``) or ``"other"``; every record carries its ``adaptor``
+    ``radius``: ``P(t) = centre + radius (cos t x + sin t y)``), ``"bspline"`` (``points``
+    ``(n, 2)``, ``weights``, ``knots``, ``degree``) or ``"other"``; every record carries its ``adaptor``
     (see :func:`adaptor_d1`), the reference the data-based evaluation is tested against.
 
     >>> import build123d as bd
@@ -70,8 +72,9 @@ def faces_pcurves(faces: list) -> list[list[dict]]:
     with kernel("BRepAdaptor_Curve2d (face p-curves)"):
         for face in faces:
             out.append(_face_records(face, splines, lines))
-        for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
-            rec.update(kind="bspline", **data)
+        for (rec, _), data in zip(splines, bspline_curves([b for _, b in splines], 2)):
+            rec.update(kind="bspline", points=data["points"], weights=data["weights"], knots=data["knots"],
+                       degree=data["degree"])
         if splines:
             _spline_breaks([rec for rec, _ in splines])
     if lines:  # every straight p-curve's data in one array (rows are views: no array per line)
