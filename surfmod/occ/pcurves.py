@@ -81,6 +81,7 @@ def faces_pcurves(faces: list) -> list[list[dict]]:
         data = np.array([d for _, d in lines])  # (L, 6): origin, direction, range
         for k, (rec, _) in enumerate(lines):
             rec["origin"], rec["direction"], rec["breaks"] = data[k, :2], data[k, 2:4], data[k, 4:]
+            rec["line"] = data[k]  # all six: origin, direction, range
     return out
 
 

@@ -185,7 +185,8 @@ def _lines_on_box_border(lines: list, bounds: np.ndarray) -> np.ndarray:
     u0, u1, v0, v1 = bounds.T
     tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
     tol = tol[:, [0, 0, 1, 1]]
-    data = np.array([np.concatenate([rec["origin"], rec["direction"], rec["range"]]) for rec in lines])
+    data = np.array([rec["line"] if "line" in rec else np.concatenate([rec["origin"], rec["direction"], rec["range"]])
+                     for rec in lines])  # (origin, direction, range) rows, as faces_pcurves reads them
     o, d, r = data[:, :2], data[:, 2:4], data[:, 4:]
     first = np.abs((o + r[:, :1] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
     last = np.abs((o + r[:, 1:] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
