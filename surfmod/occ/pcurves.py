@@ -16,12 +16,12 @@ import numpy as np
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAbs_Line
 from OCP.TColStd import TColStd_Array1OfReal
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
-from OCP.TopoDS import TopoDS
+from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopoDS import TopoDS, TopoDS_Iterator
 
-from .geom import read_bspline_curve, read_bspline_curves_2d
+from .binary import bspline_curves
+from .geom import read_bspline_curve
 from .guard import kernel
-from .topo import explore
 
 
 def _xy(p) -> np.ndarray:
@@ -29,8 +29,7 @@ def _xy(p) -> np.ndarray:
 
 
 def _bspline_data(pc):
-    """Poles (padded to 3-D with z = 0 for the surfmod evaluator), weights, flat knots and
-    degree of a B-spline p-curve; None for a periodic curve whose edge range leaves its
+    """Poles ``(n, 2)``, weights, flat knots and degree of a B-spline p-curve; None for a periodic curve whose edge range leaves its
     first period (its unwrapped form would continue the end span there instead)."""
     b = pc.BSpline()
     if b.IsPeriodic():
@@ -38,7 +37,9 @@ def _bspline_data(pc):
         b.SetNotPeriodic()
         if pc.FirstParameter() < b.FirstParameter() or pc.LastParameter() > b.LastParameter():
             return None
-    return read_bspline_curve(b)
+    data = read_bspline_curve(b)
+    data["points"] = data["points"][:, :2]  # (u, v), as the non-periodic ones
+    return data
 
 
 def face_pcurves(face) -> list[dict]:
@@ -46,8 +47,8 @@ def face_pcurves(face) -> list[dict]:
     ``{"kind", "wire", "range", "sign", "breaks", ...}`` (``wire``: index of the edge's
     wire) where ``kind`` is ``"line"`` (``origin``,
     ``direction``: ``P(t) = origin + t direction``), ``"circle"`` (``centre``, ``x``, ``y``,
-    ``radius``: ``P(t) = centre + radius (cos t x + sin t y)``), ``"bspline"`` (``points``,
-    ``weights``, ``knots``, ``degree``) or ``"other"``; every record carries its ``adaptor``
+    ``radius``: ``P(t) = centre + radius (cos t x + sin t y)``), ``"bspline"`` (``points``
+    ``(n, 2)``, ``weights``, ``knots``, ``degree``) or ``"other"``; every record carries its ``adaptor``
     (see :func:`adaptor_d1`), the reference the data-based evaluation is tested against.
 
     >>> import build123d as bd
@@ -71,13 +72,22 @@ def faces_pcurves(faces: list) -> list[list[dict]]:
     with kernel("BRepAdaptor_Curve2d (face p-curves)"):
         for face in faces:
             out.append(_face_records(face, splines, lines))
-        for (rec, _), data in zip(splines, read_bspline_curves_2d([b for _, b in splines])):
-            rec.update(kind="bspline", **data)
+        for (rec, _), data in zip(splines, bspline_curves([b for _, b in splines], 2)):
+            rec.update(kind="bspline", points=data["points"], weights=data["weights"], knots=data["knots"],
+                       degree=data["degree"])
+        if splines:
+            _spline_breaks([rec for rec, _ in splines])
     if lines:  # every straight p-curve's data in one array (rows are views: no array per line)
         data = np.array([d for _, d in lines])  # (L, 6): origin, direction, range
         for k, (rec, _) in enumerate(lines):
             rec["origin"], rec["direction"], rec["breaks"] = data[k, :2], data[k, 2:4], data[k, 4:]
+            rec["line"] = data[k]  # all six: origin, direction, range
     return out
+
+
+# enum members as ints: comparing pybind11 enums costs several times an int comparison,
+# and these run once per edge of a part
+_LINE, _CIRCLE, _BSPLINE, _REVERSED = int(GeomAbs_Line), int(GeomAbs_Circle), int(GeomAbs_BSplineCurve), int(TopAbs_REVERSED)
 
 
 def _face_records(face, splines: list, lines: list) -> list[dict]:
@@ -86,40 +96,95 @@ def _face_records(face, splines: list, lines: list) -> list[dict]:
     ``(record, (origin, direction, range))``, for the caller to read in bulk."""
     out = []
     to_edge = TopoDS.Edge_s
-    for wire_index, wire in enumerate(explore(face, TopAbs_WIRE)):
-        for e in explore(wire, TopAbs_EDGE):
-            edge = to_edge(e)
+    # the face's wires and their edges as TopExp_Explorer visits them (children in order,
+    # orientations composed), by TopoDS_Iterator: no explorer stack per wire
+    wires = TopoDS_Iterator(face)
+    wire_index = -1
+    while wires.More():
+        wire = wires.Value()
+        wires.Next()
+        if wire.ShapeType() != TopAbs_WIRE:
+            continue
+        wire_index += 1
+        edges = TopoDS_Iterator(wire)
+        while edges.More():
+            edge = to_edge(edges.Value())
+            edges.Next()
             pc = BRepAdaptor_Curve2d(edge, face)
             f, l = pc.FirstParameter(), pc.LastParameter()
-            kind = pc.GetType()
+            kind = int(pc.GetType())
             rec = {
                 "wire": wire_index,
                 "range": (f, l),
-                "sign": -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0,
+                "sign": -1.0 if int(edge.Orientation()) == _REVERSED else 1.0,
                 "adaptor": pc,
             }
-            if kind == GeomAbs_Line:  # analytic: one smooth interval, its ends
+            if kind == _LINE:  # analytic: one smooth interval, its ends
                 lin = pc.Line()
                 rec["kind"] = "line"
                 lines.append((rec, lin.Location().Coord() + lin.Direction().Coord() + (f, l)))
-            elif kind == GeomAbs_Circle:
+            elif kind == _CIRCLE:
                 c = pc.Circle()
                 ax = c.Position()
                 rec.update(kind="circle", breaks=np.array([f, l]), centre=_xy(ax.Location()), x=_xy(ax.XDirection()),
                            y=_xy(ax.YDirection()), radius=c.Radius())
             else:
                 n = pc.NbIntervals(GeomAbs_CN)
-                arr = TColStd_Array1OfReal(1, n + 1)
-                pc.Intervals(arr, GeomAbs_CN)
-                rec["breaks"] = np.array([arr.Value(i) for i in range(1, n + 2)])
-                if kind == GeomAbs_BSplineCurve and not (b := pc.BSpline()).IsPeriodic():
+                if kind == _BSPLINE and not (b := pc.BSpline()).IsPeriodic():
+                    rec["intervals"] = n  # its breaks from its knots, once they are read
                     splines.append((rec, b))  # read by the caller, all in one binary table
-                elif kind == GeomAbs_BSplineCurve and (data := _bspline_data(pc)) is not None:
+                    out.append(rec)
+                    continue
+                rec["breaks"] = _intervals(pc, n)
+                if kind == _BSPLINE and (data := _bspline_data(pc)) is not None:
                     rec.update(kind="bspline", **data)
                 else:
                     rec.update(kind="other")
             out.append(rec)
     return out
+
+
+def _intervals(pc, n: int) -> np.ndarray:
+    """The ``n + 1`` bounds of the ``GeomAbs_CN`` intervals of a p-curve adaptor."""
+    arr = TColStd_Array1OfReal(1, n + 1)
+    pc.Intervals(arr, GeomAbs_CN)
+    return np.array([arr.Value(i) for i in range(1, n + 2)])
+
+
+def _spline_breaks(records: list) -> None:
+    """Set ``"breaks"`` on (non-periodic) B-spline p-curve records: the adaptor's
+    ``GeomAbs_CN`` interval bounds (their count ``"intervals"``, dropped here) from the
+    knots, for all records at once: every distinct knot inside the edge's range is a break
+    (a spline is no more than ``C^(p-1)`` there), between the range's ends.  OCCT merges a
+    knot closer to an end than its parametric tolerance; where the count then differs, the
+    adaptor's own bounds are read instead (one OCCT call per bound)."""
+    knots = [rec["knots"] for rec in records]
+    sizes = np.array([len(k) for k in knots])
+    count = len(records)
+    owner = np.repeat(np.arange(count), sizes)
+    flat = np.concatenate(knots)
+    ranges = np.array([rec["range"] for rec in records])
+    # each interior knot value once (where it first appears), strictly inside its record's
+    # range (the end knots bound no interval: a range reaching past them continues the end
+    # spans)
+    first = np.ones(len(flat), bool)
+    first[1:] = (flat[1:] != flat[:-1]) | (owner[1:] != owner[:-1])
+    ends = np.cumsum(sizes)
+    lo, hi = flat[ends - sizes], flat[ends - 1]
+    keep = first & (flat > np.maximum(ranges[:, 0], lo)[owner]) & (flat < np.minimum(ranges[:, 1], hi)[owner])
+    kept, kept_owner = flat[keep], owner[keep]
+    inside = np.bincount(kept_owner, minlength=count)
+    # per record [first, knots inside..., last], laid end to end (kept knots are grouped
+    # by record already), handed out as views
+    width = inside + 2
+    start = np.cumsum(width) - width
+    out = np.empty(int(width.sum()))
+    out[start] = ranges[:, 0]
+    out[start + width - 1] = ranges[:, 1]
+    out[np.arange(len(kept)) - (np.cumsum(inside) - inside)[kept_owner] + start[kept_owner] + 1] = kept
+    for rec, lo_, n_in in zip(records, start.tolist(), inside.tolist()):
+        n = rec.pop("intervals")
+        rec["breaks"] = out[lo_ : lo_ + n_in + 2] if n_in == n - 1 else _intervals(rec["adaptor"], n)
 
 
 def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:

@@ -149,13 +149,33 @@ def gprops(shape, eps: float = 1e-9) -> dict:
 def vertex_mean(shape) -> np.ndarray:
     """Mean of the shape's vertex points, visited with repeats as ``TopExp_Explorer`` does
     (BRepGProp's rough barycentre, the reference point of its integrals); the bounding
-    box centre when the shape has no vertex (one periodic face: a full sphere)."""
-    from OCP.TopAbs import TopAbs_VERTEX
+    box centre when the shape has no vertex (one periodic face: a full sphere).
 
-    pnt, vertex = BRep_Tool.Pnt_s, TopoDS.Vertex_s
-    # one flat fromiter over Coord() tuples (no array per vertex)
-    pts = np.fromiter(chain.from_iterable(pnt(vertex(v)).Coord() for v in _explore(shape, TopAbs_VERTEX)), float)
-    return pts.reshape(-1, 3).mean(axis=0) if pts.size else bounding_box(shape).mean(axis=0)
+    The explorer meets a vertex once per occurrence under an edge occurrence (an edge
+    once per face that holds it), which is the length of its ancestor list in
+    ``TopExp::MapShapesAndAncestors(VERTEX, EDGE)`` (one entry per such occurrence): each
+    distinct vertex is read once and repeated that many times (a vertex under no edge,
+    once), instead of one OCCT call chain per visit.
+
+    >>> import build123d as bd
+    >>> vertex_mean(bd.Box(2, 4, 6).wrapped).round(12).tolist()  # 8 corners, 6 visits each
+    [0.0, 0.0, 0.0]
+    """
+    from OCP.TopAbs import TopAbs_VERTEX
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    with kernel("TopExp.MapShapesAndAncestors_s"):
+        ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
+        TopExp.MapShapesAndAncestors_s(shape, TopAbs_VERTEX, TopAbs_EDGE, ancestors)
+        n = ancestors.Extent()
+        if not n:
+            return bounding_box(shape).mean(axis=0)
+        pnt, vertex, key, edges = BRep_Tool.Pnt_s, TopoDS.Vertex_s, ancestors.FindKey, ancestors.FindFromIndex
+        # one flat fromiter over Coord() tuples (no array per vertex)
+        pts = np.fromiter(chain.from_iterable(pnt(vertex(key(i))).Coord() for i in range(1, n + 1)), float, 3 * n)
+        visits = np.fromiter((edges(i).Size() for i in range(1, n + 1)), int, n)
+    return np.repeat(pts.reshape(n, 3), np.maximum(visits, 1), axis=0).mean(axis=0)
 
 
 def bounding_box(shape) -> np.ndarray:
@@ -170,16 +190,16 @@ def bounding_box(shape) -> np.ndarray:
 
 
 # -- per-face data for the NumPy quadrature ---------------------------------------------
-_ELEMENTARY = ("Geom_Plane", "Geom_CylindricalSurface", "Geom_ConicalSurface", "Geom_SphericalSurface",
-               "Geom_ToroidalSurface")
-
-
 def elementary_faces(faces) -> list:
     """Per ``TopoDS_Face`` of ``faces`` (a part's, for the mass integrals): ``None`` unless
-    its surface is a plane, cylinder, cone, sphere or torus, else ``(type name, located
-    surface handle, (u0, u1, v0, v1), reversed, frame (4, 3), radii)`` -- what
+    its surface is a plane, cylinder, cone, sphere or torus (or a
+    ``Geom_RectangularTrimmedSurface`` of one), else ``(type name, located surface handle,
+    (u0, u1, v0, v1), reversed, frame (4, 3), radii, periodic)`` -- what
     :func:`surfmod.from_face` reads for it (the same OCCT calls and values), without its
     general dispatch, which costs more than the reading on parts of many small faces.
+    ``type name`` is the elementary surface's (the basis of a trimmed one), ``periodic``
+    whether the face's own surface is periodic in ``u`` and ``v`` (a rectangular trim may
+    make it not).
 
     >>> import build123d as bd
     >>> [(d[0], d[5]) for d in elementary_faces([f.wrapped for f in bd.Cylinder(1, 2).faces()])]
@@ -189,28 +209,35 @@ def elementary_faces(faces) -> list:
     from OCP.BRepTools import BRepTools
 
     surface_of, uv_bounds = BRep_Tool.Surface_s, BRepTools.UVBounds_s
+    reversed_ = TopAbs_REVERSED
     out, frames = [], []
     with kernel("reading elementary faces"):
         for face in faces:
-            surf = surface_of(face)
-            name = surf.DynamicType().Name()
-            if name not in _ELEMENTARY:
+            geom = surface_of(face)  # OCP hands back the derived type already (no DownCast)
+            name = geom.DynamicType().Name()
+            periodic = _PERIODIC.get(name)
+            basis = geom
+            if name == "Geom_RectangularTrimmedSurface":
+                basis = geom.BasisSurface()
+                name = basis.DynamicType().Name()
+                periodic = (geom.IsUPeriodic(), geom.IsVPeriodic()) if name in _PERIODIC else None
+            if periodic is None:
                 out.append(None)
                 continue
-            cls = getattr(G, name)  # OCP hands back the derived type already (no DownCast)
-            geom = cls.DownCast(surf) if hasattr(cls, "DownCast") else surf
-            pos = geom.Position()
+            if type(basis).__name__ != name:  # an older OCP: the generic handle
+                basis = getattr(G, name).DownCast(basis)
+            pos = basis.Position()
             frames.append(pos.Location().Coord() + pos.XDirection().Coord() + pos.YDirection().Coord()
                           + pos.Direction().Coord())
             if name == "Geom_Plane":
                 radii = ()
             elif name == "Geom_ConicalSurface":
-                radii = (geom.RefRadius(), geom.SemiAngle())
+                radii = (basis.RefRadius(), basis.SemiAngle())
             elif name == "Geom_ToroidalSurface":
-                radii = (geom.MajorRadius(), geom.MinorRadius())
+                radii = (basis.MajorRadius(), basis.MinorRadius())
             else:
-                radii = (geom.Radius(),)
-            out.append([name, geom, uv_bounds(face), face.Orientation() == TopAbs_REVERSED, None, radii])
+                radii = (basis.Radius(),)
+            out.append([name, geom, uv_bounds(face), face.Orientation() == reversed_, None, radii, periodic])
     frames = np.array(frames).reshape(-1, 4, 3)  # one array for all frames
     k = 0
     for d in out:
@@ -218,6 +245,13 @@ def elementary_faces(faces) -> list:
             d[4] = frames[k]
             k += 1
     return [None if d is None else tuple(d) for d in out]
+
+
+# which directions of OCCT's elementary surfaces are periodic (their ``IsUPeriodic``,
+# ``IsVPeriodic``; the period is 2π), known without asking
+_PERIODIC = {"Geom_Plane": (False, False), "Geom_CylindricalSurface": (True, False),
+             "Geom_ConicalSurface": (True, False), "Geom_SphericalSurface": (True, False),
+             "Geom_ToroidalSurface": (True, True)}
 
 
 def is_rectangle(face, bounds) -> bool:

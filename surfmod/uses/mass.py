@@ -52,6 +52,7 @@ from ..surface import Surface
 from .inputs import to_shape
 from .mass_green import (
     face_nodes,
+    faces_nodes,
     mass_face,
     mass_faces,
     plane_nodes,
@@ -123,6 +124,13 @@ class MassProperties:
 def _moments(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray) -> np.ndarray:
     """[area, V, M(3), S(3,3)] contributions from partials at quadrature nodes (``Su``
     already signed so that ``Su × Sv`` is the outward ``n dA``)."""
+    return _moments_of_groups(ders, weights, ref, [0, len(weights)])[0]
+
+
+def _moments_of_groups(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray, bounds) -> np.ndarray:
+    """``(G, 14)``: :func:`_moments` of the node groups ``[bounds[g], bounds[g + 1])``,
+    the integrands computed once for all of them and summed group by group (each sum the
+    one the group's own call makes, bit for bit: contiguous rows, pairwise)."""
     # (3, N) rows, contiguous: np.sum then reduces each row pairwise, which keeps the 1e-14
     # of the closed forms (a reduction over axis 0 of (N, 3), or a BLAS dot, does not)
     x = np.ascontiguousarray((ders[:, 0, 0] - ref).T)
@@ -131,39 +139,58 @@ def _moments(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray) -> np.ndarr
     n[0] = su[1] * sv[2] - su[2] * sv[1]
     n[1] = su[2] * sv[0] - su[0] * sv[2]
     n[2] = su[0] * sv[1] - su[1] * sv[0]
-    area = float(np.sum(weights * np.sqrt(np.sum(n * n, axis=0))))
-    vol = float(np.sum(weights * np.sum(x * n, axis=0))) / 3.0
+    area = weights * np.sqrt(np.sum(n * n, axis=0))
+    vol = weights * np.sum(x * n, axis=0)
     a = weights * x**2 * n  # w x_i^2 n_i, (3, N)
-    first = np.sum(a, axis=1) / 2.0
-    m = np.array([[np.sum(a[i] * x[j]) for j in range(3)] for i in range(3)])  # sum w x_i^2 n_i x_j
-    # off the diagonal: symmetric average of the two equivalent divergence forms
-    second = (m + m.T) / 4.0
-    second[np.diag_indices(3)] = np.sum(a * x, axis=1) / 3.0
-    return np.concatenate([[area, vol], first, second.ravel()])
+    ax = a * x
+    cross = a[:, None, :] * x[None, :, :]  # w x_i^2 n_i x_j, (3, 3, N)
+    out = np.empty((len(bounds) - 1, 14))
+    for g, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:])):
+        m = np.sum(cross[:, :, lo:hi], axis=2)  # sum w x_i^2 n_i x_j
+        # off the diagonal: symmetric average of the two equivalent divergence forms
+        second = (m + m.T) / 4.0
+        second[np.diag_indices(3)] = np.sum(ax[:, lo:hi], axis=1) / 3.0
+        out[g, 0] = float(np.sum(area[lo:hi]))
+        out[g, 1] = float(np.sum(vol[lo:hi])) / 3.0
+        out[g, 2:5] = np.sum(a[:, lo:hi], axis=1) / 2.0
+        out[g, 5:] = second.ravel()
+    return out
 
 
 class _Accumulator:
-    """Sums :func:`_moments` over many faces, evaluating them in batches of about
-    ``BATCH`` nodes (one NumPy pass for many small faces, bounded memory for big ones)."""
+    """Sums :func:`_moments` over many faces in ``groups`` separate totals (e.g. rules
+    exact by degree and the others), evaluating them in batches of about ``BATCH`` nodes
+    (one NumPy pass for many small faces and both groups, bounded memory for big ones)."""
 
     BATCH = 200_000
 
-    def __init__(self, ref: np.ndarray):
-        self.ref, self.total, self.parts, self.size = ref, np.zeros(14), [], 0
+    def __init__(self, ref: np.ndarray, groups: int = 1):
+        self.ref, self.totals, self.size = ref, np.zeros((groups, 14)), 0
+        self.parts = [[] for _ in range(groups)]
 
-    def add(self, ders: np.ndarray, weights: np.ndarray) -> None:
-        self.parts.append((ders, weights))
+    @property
+    def total(self) -> np.ndarray:
+        return self.totals[0]
+
+    def add(self, ders: np.ndarray, weights: np.ndarray, group: int = 0) -> None:
+        self.parts[group].append((ders, weights))
         self.size += len(weights)
         if self.size >= self.BATCH:
             self.flush()
 
     def flush(self) -> np.ndarray:
-        if self.parts:
-            ders = np.concatenate([d for d, _ in self.parts])
-            weights = np.concatenate([w for _, w in self.parts])
-            self.total += _moments(ders, weights, self.ref)
-            self.parts, self.size = [], 0
-        return self.total
+        """The totals, ``(groups, 14)`` (one group: its row)."""
+        pieces = [piece for parts in self.parts for piece in parts]
+        if pieces:
+            counts = [sum(len(w) for _, w in parts) for parts in self.parts]
+            ders = np.concatenate([d for d, _ in pieces]) if len(pieces) > 1 else pieces[0][0]
+            weights = np.concatenate([w for _, w in pieces]) if len(pieces) > 1 else pieces[0][1]
+            bounds = np.concatenate([[0], np.cumsum(counts)])
+            live = [g for g, c in enumerate(counts) if c]  # an empty group adds nothing
+            sums = _moments_of_groups(ders, weights, self.ref, bounds)
+            self.totals[live] += sums[live]
+            self.parts, self.size = [[] for _ in self.parts], 0
+        return self.totals[0] if len(self.totals) == 1 else self.totals
 
 
 def face_moments(face, ref=(0.0, 0.0, 0.0), order: int = 12) -> np.ndarray:
@@ -208,27 +235,21 @@ def _read_faces(shapes: list) -> list:
         if data is None:
             out.append(from_face(shape))
             continue
-        name, geom, bounds, reversed_, frame, radii = data
+        name, geom, bounds, reversed_, frame, radii, periodic = data
         u0, u1, v0, v1 = bounds
         surface = _ELEMENTARY[name]._trusted(frame, radii, (u0, u1), (v0, v1))
-        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(name, bounds), reversed_))
+        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(periodic, bounds), reversed_))
     return out
 
 
-# which directions of OCCT's elementary surfaces are periodic (``IsUPeriodic``/``IsVPeriodic``;
-# the period is 2π): what readback's ``_periods`` asks the surface, without asking
-_PERIODIC = {"Geom_Plane": (False, False), "Geom_CylindricalSurface": (True, False),
-             "Geom_ConicalSurface": (True, False), "Geom_SphericalSurface": (True, False),
-             "Geom_ToroidalSurface": (True, True)}
-
-
-def _elementary_periods(name: str, bounds) -> tuple:
-    """readback's ``_periods`` of an elementary surface over ``bounds``: 2π where the
+def _elementary_periods(periodic, bounds) -> tuple:
+    """readback's ``_periods`` of an elementary surface over ``bounds`` (``periodic``: per
+    direction whether OCCT's surface is periodic; the period is then 2π): 2π where the
     direction is periodic and the face spans one whole period, else None."""
     period = 2 * np.pi
     spans = (bounds[1] - bounds[0], bounds[3] - bounds[2])
     return tuple(period if periodic and abs(span - period) <= 1e-9 * period else None
-                 for periodic, span in zip(_PERIODIC[name], spans))
+                 for periodic, span in zip(periodic, spans))
 
 
 def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str = "numpy",
@@ -288,27 +309,27 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         prepare_boundaries(faces, order)  # the p-curves of all trimmed faces in one pass
     # faces whose every rule is exact by degree give the same sums at any order: the
     # lower-order pass behind the error estimate only re-integrates the others
-    exact, high = _Accumulator(ref), _Accumulator(ref)
+    # two totals: faces whose every rule is exact by degree (0) and the others (1)
+    sums = _Accumulator(ref, groups=2)
     inexact = []
     planes = [f for f in faces if f.plane and f.natural and f.frame is not None]
     if planes:  # whole planar rectangles (most faces of prismatic parts): all at once
-        exact.add(*plane_nodes(planes))
+        sums.add(*plane_nodes(planes))
     # trimmed planar faces: closed form from their boundary moments, all at once
     trimmed_planes = [f for f in faces if f.plane and not f.natural and f.frame is not None]
     inexact_planes = []
     if trimmed_planes:
-        sums, is_exact = plane_moments(trimmed_planes, order, ref)
-        exact.total += sums[is_exact].sum(axis=0)
-        high.total += sums[~is_exact].sum(axis=0)
+        closed, is_exact = plane_moments(trimmed_planes, order, ref)
+        sums.totals[0] += closed[is_exact].sum(axis=0)
+        sums.totals[1] += closed[~is_exact].sum(axis=0)
         inexact_planes = [f for f, e in zip(trimmed_planes, is_exact) if not e]
-    for f in faces:
-        if f.plane and f.frame is not None:
-            continue
-        ders, w, is_exact = face_nodes(f, order)
-        (exact if is_exact else high).add(ders, w)
+    curved = [f for f in faces if not (f.plane and f.frame is not None)]
+    for f, (ders, w, is_exact) in zip(curved, faces_nodes(curved, order)):  # small Green grids shared
+        sums.add(ders, w, 0 if is_exact else 1)
         if not is_exact:
             inexact.append(f)
-    total = exact.flush() + high.flush()
+    exact_total, high_total = sums.flush()
+    total = exact_total + high_total
     vol, area, centroid, inertia = _finish(total, ref, density)
     nat = sum(f.natural for f in faces)
 
@@ -317,8 +338,8 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         for f in inexact:
             low.add(*face_nodes(f, max(2, order - 4))[:2])
         if inexact_planes:
-            low.total += plane_moments(inexact_planes, max(2, order - 4), ref)[0].sum(axis=0)
-        return abs(high.total[1] - low.flush()[1]) / vol
+            low.totals[0] += plane_moments(inexact_planes, max(2, order - 4), ref)[0].sum(axis=0)
+        return abs(high_total[1] - low.flush()[1]) / vol
 
     return MassProperties(
         vol, area, centroid, inertia, density,

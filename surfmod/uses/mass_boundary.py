@@ -27,6 +27,17 @@ PIECES = 4
 
 _KINDS = {"line": 0, "circle": 1, "bspline": 2}
 
+#: np.linspace(0, 1, PIECES + 1), made once
+_FRACTIONS = np.linspace(0.0, 1.0, PIECES + 1)
+_FRACTION_CACHE: dict = {}
+
+
+def _fractions(pieces: int) -> np.ndarray:
+    """``np.linspace(0, 1, pieces + 1)`` (cached: the same few counts every call)."""
+    if pieces not in _FRACTION_CACHE:
+        _FRACTION_CACHE[pieces] = np.linspace(0.0, 1.0, pieces + 1)
+    return _FRACTION_CACHE[pieces]
+
 
 def _spans(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
     x, w = gauss(order)
@@ -121,11 +132,11 @@ def taylor_pieces(records: list) -> None:
         local_ctrl = all_ctrl[first[:, None] + np.arange(p + 1)]  # (S, p+1, 3)
         fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
         coef = np.matmul(basis, local_ctrl) / fact[None, :, None]  # Σ_r basis_skr ctrl_srd
-        cuts = np.searchsorted(rec_of, np.arange(len(group) + 1))
+        cuts = np.searchsorted(rec_of, np.arange(len(group) + 1)).tolist()
+        planar = np.ascontiguousarray(coef[:, :, :2])  # polynomial records: (u, v) only, one copy for all
         for i, rec in enumerate(group):
             lo, hi = cuts[i], cuts[i + 1]
-            c = coef[lo:hi]
-            rec["taylor"] = (starts[lo:hi], mid[lo:hi], c if rec["weights"] is not None else np.ascontiguousarray(c[:, :, :2]))
+            rec["taylor"] = (starts[lo:hi], mid[lo:hi], coef[lo:hi] if rec["weights"] is not None else planar[lo:hi])
 
 
 def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
@@ -201,6 +212,8 @@ class PcurveTable:
             self.origin, self.direction = np.zeros((n, 2)), np.zeros((n, 2))
         if 1 in self.present:
             self.centre, self.ax, self.ay, self.radius = np.zeros((n, 2)), np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n)
+        # per record: a B-spline without weights (a polynomial p-curve)
+        self.polynomial = np.zeros(n, bool)
         splines = []
         for i, rec in enumerate(records):
             kind = self.kind[i]
@@ -212,6 +225,7 @@ class PcurveTable:
                 if "taylor" not in rec:
                     rec["taylor"] = _taylor_pieces(rec)
                 splines.append((i, rec))
+                self.polynomial[i] = rec["weights"] is None
         if splines:
             self._spline_table(splines, n)
 
@@ -221,24 +235,58 @@ class PcurveTable:
         self.rational = any(rec["weights"] is not None for _, rec in splines)
         dim = 3 if self.rational else 2
         top = max(rec["taylor"][2].shape[1] for _, rec in splines)
-        keys, centres, coefs = [], [], []
+        index = np.array([i for i, _ in splines])
+        lens = np.array([len(rec["taylor"][0]) for _, rec in splines])
         self.first, self.last = np.zeros(n, int), np.zeros(n, int)
-        at = 0
-        for i, rec in splines:
-            starts, mid, c = rec["taylor"]
-            full = np.zeros((len(starts), top, dim))  # higher powers padded with zeros
-            full[:, : c.shape[1], : c.shape[2]] = c
-            if c.shape[2] < dim:
-                full[:, 0, 2] = 1.0
-            keys.append(i + 1j * starts)
-            centres.append(mid)
-            coefs.append(full)
-            self.first[i], self.last[i] = at, at + len(starts) - 1
-            at += len(starts)
-        self.keys, self.centres, self.coef = np.concatenate(keys), np.concatenate(centres), np.concatenate(coefs)
+        ends = np.cumsum(lens)
+        self.first[index], self.last[index] = ends - lens, ends - 1
+        self.keys = np.repeat(index, lens) + 1j * np.concatenate([rec["taylor"][0] for _, rec in splines])
+        self.centres = np.concatenate([rec["taylor"][1] for _, rec in splines])
+        # higher powers padded with zeros; the records of one coefficient shape in one assignment
+        self.coef = np.zeros((int(ends[-1]), top, dim))
+        shapes: dict = {}
+        for k, (_, rec) in enumerate(splines):
+            shapes.setdefault(rec["taylor"][2].shape[1:], []).append(k)
+        for (width, cdim), members in shapes.items():
+            m_lens = lens[members]  # the members' span rows, laid end to end
+            rows = np.arange(m_lens.sum()) + np.repeat(ends[members] - lens[members] - (np.cumsum(m_lens) - m_lens), m_lens)
+            self.coef[rows, :width, :cdim] = np.concatenate([splines[k][1]["taylor"][2] for k in members])
+            if cdim < dim:
+                self.coef[rows, 0, 2] = 1.0
+        self.coef_by_power = np.ascontiguousarray(self.coef.transpose(1, 0, 2))  # (p+1, S, dim)
 
-    def d1(self, which: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """``(N, 4)``: ``u, v, du/dt, dv/dt`` of record ``which[n]`` at ``t[n]``."""
+    def subset(self, rows: np.ndarray) -> "PcurveTable":
+        """The table of the records ``rows`` (in that order), taken from this one's arrays:
+        the same values :class:`PcurveTable` builds from those records (a table with a
+        rational record keeps the homogeneous form, whose division by ``w = 1`` leaves
+        polynomial records bit for bit)."""
+        rows = np.asarray(rows, int)
+        out = PcurveTable.__new__(PcurveTable)
+        out.records = [self.records[i] for i in rows]
+        out.kind = self.kind[rows]
+        out.present = set(out.kind.tolist())
+        out.polynomial = self.polynomial[rows]
+        for name in ("origin", "direction", "centre", "ax", "ay", "radius"):
+            if hasattr(self, name):
+                setattr(out, name, getattr(self, name)[rows])
+        spline = np.flatnonzero(out.kind == 2)
+        if len(spline):
+            old = rows[spline]
+            lens = self.last[old] - self.first[old] + 1
+            ends = np.cumsum(lens)
+            spans = np.arange(ends[-1]) + np.repeat(self.first[old] - (ends - lens), lens)
+            out.first, out.last = np.zeros(len(rows), int), np.zeros(len(rows), int)
+            out.first[spline], out.last[spline] = ends - lens, ends - 1
+            out.keys = np.repeat(spline, lens) + 1j * self.keys.imag[spans]
+            out.centres, out.coef = self.centres[spans], self.coef[spans]
+            out.coef_by_power = self.coef_by_power[:, spans]
+            out.rational = self.rational
+        return out
+
+    def d1(self, which: np.ndarray, t: np.ndarray, span: np.ndarray | None = None) -> np.ndarray:
+        """``(N, 4)``: ``u, v, du/dt, dv/dt`` of record ``which[n]`` at ``t[n]``; ``span``
+        (optional, per row): the B-spline rows' span polynomial when the caller knows it
+        (:meth:`span_of`), ``-1`` where not."""
         out = np.empty((len(t), 4))
         if len(self.present) == 1:
             masks = {next(iter(self.present)): slice(None)}
@@ -257,7 +305,7 @@ class PcurveTable:
                 out[m, :2] = self.centre[r] + rad * (c * x + s * y)
                 out[m, 2:] = rad * (c * y - s * x)
             elif k == 2:
-                out[m] = self._spline_d1(r, tt)
+                out[m] = self._spline_d1(r, tt, None if span is None else span[m])
             else:
                 from ..occ.pcurves import adaptor_d1
 
@@ -271,14 +319,18 @@ class PcurveTable:
         """Row of the span polynomial of B-spline record ``r[n]`` at ``t[n]``."""
         return np.clip(np.searchsorted(self.keys, r + 1j * t, side="right") - 1, self.first[r], self.last[r])
 
-    def _spline_d1(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
-        j = self.span_of(r, t)
+    def _spline_d1(self, r: np.ndarray, t: np.ndarray, j: np.ndarray | None = None) -> np.ndarray:
+        if j is None:
+            j = self.span_of(r, t)
+        elif (unknown := j < 0).any():
+            j = j.copy()
+            j[unknown] = self.span_of(r[unknown], t[unknown])
         dt = (t - self.centres[j])[:, None]
-        c = self.coef[j]  # (N, p+1, dim)
-        val, der = c[:, -1], np.zeros_like(c[:, -1])
-        for k in range(c.shape[1] - 2, -1, -1):  # Horner for the value and its derivative
+        c = self.coef_by_power[:, j]  # (p+1, N, dim): each power's rows contiguous
+        val, der = c[-1], np.zeros_like(c[-1])
+        for k in range(c.shape[0] - 2, -1, -1):  # Horner for the value and its derivative
             der = der * dt + val
-            val = val * dt + c[:, k]
+            val = val * dt + c[k]
         out = np.empty((len(t), 4))
         if not self.rational:
             out[:, :2], out[:, 2:] = val, der
@@ -295,7 +347,7 @@ def _table_crossings(table: PcurveTable, owner, a, b, scale, lines, coord, per_p
     ``coord[piece]`` (``(pieces, L)``, NaN-padded: each face has its own), one sampling and
     one evaluation per Newton step for all of them.  Returns the crossing parameters and
     their records."""
-    t = (a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, per_piece + 1)).ravel()
+    t = (a[:, None] + (b - a)[:, None] * _fractions(per_piece)).ravel()
     which = np.repeat(owner, per_piece + 1)
     piece = np.repeat(np.arange(len(owner)), per_piece + 1)
     vals = table.d1(which, t)
@@ -330,7 +382,7 @@ def _long_pieces(table: PcurveTable, owner, a, b, directions) -> np.ndarray:
     from its centre); every piece of a rational or non-spline p-curve counts as long."""
     long = np.ones(len(owner), bool)
     spline = table.kind[owner] == 2
-    spline[spline] = np.array([table.records[r]["weights"] is None for r in owner[spline]], bool)
+    spline[spline] = table.polynomial[owner[spline]]
     if not spline.any():
         return long
     r_own, lo, hi = owner[spline], a[spline], b[spline]
@@ -390,7 +442,7 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
     # pieces, the curved ones also cut at their own breaks (knots) inside the range
     idx = np.flatnonzero(live)
     straight = table.kind[idx] == 0
-    frac = np.linspace(0.0, 1.0, PIECES + 1)
+    frac = _FRACTIONS
     f, l = f_all[idx, None], l_all[idx, None]
     even = f + (l - f) * frac
     even[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it
@@ -434,7 +486,14 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
         w[at] = ((bb - aa) / 2 * gw).ravel()
     which = np.repeat(owner, count)
     live_idx = np.flatnonzero(live)
-    q = table.d1(np.concatenate([which, np.repeat(live_idx, 2)]), np.concatenate([t, ranges[live_idx].ravel()]))
+    # a piece lies within one span of its B-spline (the cuts hold its knots): the span of
+    # its middle serves all its nodes, one search per piece instead of per node
+    piece_span = np.full(len(owner), -1)
+    spline = table.kind[owner] == 2
+    if spline.any():
+        piece_span[spline] = table.span_of(owner[spline], (a[spline] + b[spline]) / 2)
+    span = np.concatenate([np.repeat(piece_span, count), np.full(2 * len(live_idx), -1)])
+    q = table.d1(np.concatenate([which, np.repeat(live_idx, 2)]), np.concatenate([t, ranges[live_idx].ravel()]), span)
     n = len(t)
     for k, i in enumerate(live_idx):  # for _largest_gap, from the same evaluation
         records[i]["ends"] = q[n + 2 * k : n + 2 * k + 2, :2]
@@ -442,13 +501,11 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
     w = sign[which] * w
     node_face = face_of[which]
     bounds = np.searchsorted(node_face, np.arange(len(faces) + 1))
-    out = []
-    for k in range(len(faces)):
-        lo, hi = bounds[k], bounds[k + 1]
-        mine = face_of == k
-        exact = bool(np.all(exacts[mine & live]))
-        out.append((q[lo:hi, :2], q[lo:hi, 2:], w[lo:hi], exact))
-    return out
+    # per face: every rule of its live p-curves exact (records are laid out face by face)
+    inexact = np.zeros(len(faces), int)
+    np.add.at(inexact, face_of, ~exacts & live)
+    P, dP = q[:, :2], q[:, 2:]
+    return [(P[lo:hi], dP[lo:hi], w[lo:hi], not bad) for lo, hi, bad in zip(bounds[:-1], bounds[1:], inexact.tolist())]
 
 
 def _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges):

@@ -39,13 +39,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..construct.curves import Line
-from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface
+from ..construct.elementary import (ConicalSurface, CylindricalSurface, ElementarySurface, PlaneSurface, SphericalSurface,
+                                    ToroidalSurface)
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
+from ..readback.trimmed import TrimmedFace
 from .faces import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks
 from .mass_boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
-from .mass_grid import exact_order, gauss, green_layout, grid_nodes, inner_nodes, interpolation_points
+from .mass_grid import (GridJob, exact_order, gauss, green_layout, grid_nodes, grids_nodes, inner_nodes,  # noqa: F401
+                        interpolation_points)
 
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
 RECTANGLE_RTOL = 1e-7
@@ -65,6 +68,18 @@ def _curve_degree(curve):
     if isinstance(curve, BSplineCurve) and curve.weights is None:
         return int(curve.degree)
     return None
+
+
+# the degrees of the elementary surfaces by exact type: most faces of real parts, where
+# the isinstance chain of direction_degree (abstract base classes) costs more than the rest
+_ELEMENTARY_DEGREES = {PlaneSurface: (1, 1), CylindricalSurface: (None, 1), ConicalSurface: (None, 1),
+                       SphericalSurface: (None, None), ToroidalSurface: (None, None)}
+
+
+def _degrees(surface) -> tuple:
+    """``(direction_degree(surface, 0), direction_degree(surface, 1))``."""
+    known = _ELEMENTARY_DEGREES.get(type(surface))
+    return known if known is not None else (direction_degree(surface, 0), direction_degree(surface, 1))
 
 
 def direction_degree(surface, direction: int):
@@ -89,6 +104,50 @@ def direction_degree(surface, direction: int):
     return None
 
 
+def evaluators(obj):
+    """``(evaluate, grid_evaluate)``: the partials of a face read back with
+    :func:`surfmod.from_face` (or of a surfmod surface) at points ``(u, v)`` and on a
+    tensor grid ``us × vs`` (``(nu, nv, K, K, 3)``), as its ``_derivatives`` and
+    ``_grid_derivatives`` give them (``grid_evaluate`` None: evaluate point by point).  On
+    planes, cylinders, cones, spheres and tori the trigonometry of a grid runs on its
+    lines, and the frame is applied to the partials in the frame's axes (their
+    ``_coefficients``) by one matrix product, where the surfaces' own evaluators broadcast
+    every point against each axis (three passes with an innermost dimension of 3, most of
+    the evaluation's time).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> face = sm.from_face(bd.Torus(5, 1).faces()[0])
+    >>> evaluate, grid = evaluators(face)
+    >>> u, v = np.array([0.3, 1.2]), np.array([2.0, 5.5])
+    >>> bool(np.allclose(evaluate(u, v, 1), face._derivatives(u, v, 1), rtol=0, atol=1e-14))
+    True
+    >>> grid(u, v, 1).shape
+    (2, 2, 2, 2, 3)
+    """
+    face = type(obj) is TrimmedFace or isinstance(obj, TrimmedFace)
+    surf = obj.surface if face else obj
+    if type(surf) not in _ELEMENTARY_DEGREES and not isinstance(surf, ElementarySurface):
+        # splines, sweeps, offsets: point by point (their tensor evaluators pay off only
+        # on grids much larger than a face's quadrature nodes)
+        return obj._derivatives, None
+    axes, origin = np.array([surf.x_dir, surf.y_dir, surf.z_dir]), surf.origin
+    wrap = obj._wrap if face else (lambda t, direction: t)  # a face evaluates where it lives (periodic wrap)
+
+    def combine(fx, fy, fz):
+        f = np.stack([fx, fy, fz], axis=-1)
+        out = (f.reshape(-1, 3) @ axes).reshape(f.shape)
+        out[..., 0, 0, :] += origin
+        return out
+
+    def evaluate(u, v, order):
+        return combine(*surf._coefficients(wrap(u, 0), wrap(v, 1), order))
+
+    def grid_evaluate(us, vs, order):
+        return combine(*surf._coefficients(wrap(us, 0)[:, None], wrap(vs, 1)[None, :], order))
+
+    return evaluate, grid_evaluate
+
+
 # -- faces -----------------------------------------------------------------------------------
 @dataclass
 class MassFace:
@@ -108,6 +167,10 @@ class MassFace:
     angular: tuple = (False, False)
     # Gauss nodes on the p-curves per order, when computed for many faces at once
     boundary: dict = field(default_factory=dict)
+    # the same partials as ``evaluate`` on a tensor grid ``us × vs`` (``(nu, nv, 2, 2, 3)``)
+    grid_evaluate: object = None
+    # ``(table, first row)``: the face's p-curves are rows of a part's shared PcurveTable
+    rows: tuple | None = None
 
     @property
     def natural(self) -> bool:
@@ -122,7 +185,8 @@ def _lines_on_box_border(lines: list, bounds: np.ndarray) -> np.ndarray:
     u0, u1, v0, v1 = bounds.T
     tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
     tol = tol[:, [0, 0, 1, 1]]
-    data = np.array([np.concatenate([rec["origin"], rec["direction"], rec["range"]]) for rec in lines])
+    data = np.array([rec["line"] if "line" in rec else np.concatenate([rec["origin"], rec["direction"], rec["range"]])
+                     for rec in lines])  # (origin, direction, range) rows, as faces_pcurves reads them
     o, d, r = data[:, :2], data[:, 2:4], data[:, 4:]
     first = np.abs((o + r[:, :1] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
     last = np.abs((o + r[:, 1:] * d)[:, [0, 0, 1, 1]] - bounds) <= tol
@@ -156,6 +220,19 @@ def _records_on_box_border(table: PcurveTable, bounds: np.ndarray) -> np.ndarray
     return np.where(straight, lines_ok, curves_ok)
 
 
+def _linspace(lo: float, hi: float, num: int) -> np.ndarray:
+    """``np.linspace(lo, hi, num)`` for floats, the same values (``arange · step + lo``, the
+    last point ``hi``) without its general argument handling, which costs more than the
+    few points a face's angular breaks are.
+
+    >>> bool(np.array_equal(_linspace(0.3, 2.9, 7), np.linspace(0.3, 2.9, 7)))
+    True
+    """
+    out = np.arange(num) * ((hi - lo) / (num - 1)) + lo
+    out[-1] = hi
+    return out
+
+
 def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
     """:func:`surfmod.uses.faces._patch_breaks` (angular directions without its general
     merging: equal pieces of at most an eighth turn, the same points) and whether the
@@ -164,7 +241,7 @@ def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
     if b is None and hi - lo > 1e-9:  # one polynomial piece (planes, axes of cylinders)
         return np.array([lo, hi]), False
     if isinstance(b, str) and hi - lo > 1e-9:
-        return np.linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1), True
+        return _linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1), True
     return _patch_breaks(face, lo, hi, direction, face.periods[direction]), isinstance(b, str)
 
 
@@ -186,14 +263,23 @@ def mass_faces(read: list, pcurves: list) -> list:
     straight = [i for i in one_wire if all(rec["kind"] == "line" for rec in pcurves[i])]
     curved = sorted(set(one_wire) - set(straight))
     natural = {i: False for i in range(len(read))}
+    shared = {}
     for test, check in ((straight, _lines_on_box_border), (curved, _records_on_box_border)):
         if test:
             records = [rec for i in test for rec in pcurves[i]]
             counts = [len(pcurves[i]) for i in test]
             bounds = np.repeat(np.array([[b for r in read[i].domain for b in r] for i in test]), counts, axis=0)
-            ok = check(records if check is _lines_on_box_border else PcurveTable(records), bounds)
+            if check is _lines_on_box_border:
+                ok = check(records, bounds)
+            else:  # the table serves the boundary pass of these faces too (prepare_boundaries)
+                table = PcurveTable(records)
+                ok = check(table, bounds)
+                shared = {i: (table, first) for i, first in zip(test, np.cumsum([0] + counts[:-1]).tolist())}
             natural.update(zip(test, np.logical_and.reduceat(ok, np.cumsum([0] + counts[:-1])).tolist()))
-    return [mass_face(f, pcs, natural[i]) for i, (f, pcs) in enumerate(zip(read, pcurves))]
+    out = [mass_face(f, pcs, natural[i]) for i, (f, pcs) in enumerate(zip(read, pcurves))]
+    for i, rows in shared.items():
+        out[i].rows = rows
+    return out
 
 
 def mass_face(face, pcurves: list | None = None, natural: bool | None = None) -> MassFace:
@@ -232,10 +318,11 @@ def mass_face(face, pcurves: list | None = None, natural: bool | None = None) ->
     else:
         table = PcurveTable(pcurves)
         natural = _on_box_border(table, bounds)
-    return MassFace(face._derivatives, bounds, breaks, -1.0 if face.reversed else 1.0,
-                    (direction_degree(surf, 0), direction_degree(surf, 1)), None if natural else pcurves,
+    evaluate, grid_evaluate = evaluators(face)
+    return MassFace(evaluate, bounds, breaks, -1.0 if face.reversed else 1.0,
+                    _degrees(surf), None if natural else pcurves,
                     plane, (surf.origin, surf.x_dir, surf.y_dir) if plane else None, None if natural else table,
-                    angular)
+                    angular, grid_evaluate=grid_evaluate)
 
 
 def surface_mass_face(surf) -> MassFace:
@@ -246,8 +333,10 @@ def surface_mass_face(surf) -> MassFace:
         # analytic directions without knots: eight pieces keep Gauss converged
         breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None else _breaks(lo, hi, b, None))
     (u0, u1), (v0, v1) = surf.domain
-    return MassFace(surf._derivatives, (u0, u1, v0, v1), tuple(breaks), 1.0,
-                    (direction_degree(surf, 0), direction_degree(surf, 1)), None, isinstance(surf, PlaneSurface))
+    evaluate, grid_evaluate = evaluators(surf)
+    return MassFace(evaluate, (u0, u1, v0, v1), tuple(breaks), 1.0,
+                    _degrees(surf), None, isinstance(surf, PlaneSurface),
+                    grid_evaluate=grid_evaluate)
 
 
 def _direction_order(mf: MassFace, direction: int, order: int) -> tuple[int, bool]:
@@ -267,15 +356,23 @@ def face_nodes(mf: MassFace, order: int):
     if mf.natural:
         un, uw = _spans(mf.breaks[0], mu)
         vn, vw = _spans(mf.breaks[1], mv)
-        ders = mf.evaluate(np.repeat(un, vn.size), np.tile(vn, un.size), 1)
+        if mf.grid_evaluate is not None:  # u-major, as the repeat/tile below
+            ders = mf.grid_evaluate(un, vn, 1).reshape(-1, 2, 2, 3)
+        else:
+            ders = mf.evaluate(np.repeat(un, vn.size), np.tile(vn, un.size), 1)
         w = np.outer(uw, vw).ravel()
         exact = eu and ev
     else:
         ders, w, exact = _green(mf, order, (mu, mv), (eu, ev))
+    return _signed(mf, ders), w, exact
+
+
+def _signed(mf: MassFace, ders: np.ndarray) -> np.ndarray:
+    """``ders`` with ``Su`` negated on a reversed face (``Su × Sv`` the outward ``n dA``)."""
     if mf.sign < 0:
         ders = ders.copy()
         ders[:, 1, 0] *= -1.0
-    return ders, w, exact
+    return ders
 
 
 def plane_nodes(faces: list) -> tuple[np.ndarray, np.ndarray]:
@@ -310,15 +407,27 @@ def _largest_gap(mf: MassFace) -> float:
     whose p-curves join up."""
     u0, u1, v0, v1 = mf.bounds
     scale = np.array([max(u1 - u0, 1e-300), max(v1 - v0, 1e-300)])
-    ends = []
-    for rec in mf.pcurves:
-        q = (rec["ends"] if "ends" in rec else pcurve_d1(rec, np.array(rec["range"]))[:, :2]) / scale
-        ends.append(q if rec["sign"] > 0 else q[::-1])
-    if not ends:
+    if not mf.pcurves:
         return 0.0
-    ends = np.array(ends)  # (E, 2 [start, end], 2)
+    ends = np.array([rec["ends"] if "ends" in rec else pcurve_d1(rec, np.array(rec["range"]))[:, :2]
+                     for rec in mf.pcurves]) / scale  # (E, 2 [start, end], 2)
+    backwards = np.array([rec["sign"] <= 0 for rec in mf.pcurves])
+    ends[backwards] = ends[backwards, ::-1]  # in the edges' directions in the face
     d = np.linalg.norm(ends[:, None, 1] - ends[None, :, 0], axis=-1)
     return float(d.min(axis=1).max())
+
+
+def is_conic(mf) -> bool:
+    """Whether a trimmed planar face is bounded by straight and circular p-curves only
+    (holes, slots, rounded pockets): its boundary's Gauss nodes are then laid directly
+    (:func:`surfmod.uses.mass_plane._arc_nodes`), without the boundary pass.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> is_conic(mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(2.0)))))
+    True
+    """
+    return bool(mf.plane and not mf.natural and mf.pcurves
+                and all(rec["kind"] in ("line", "circle") for rec in mf.pcurves))
 
 
 def _boundary_rule(mf: MassFace, order: int) -> tuple:
@@ -357,19 +466,43 @@ def prepare_boundaries(faces: list, order: int) -> None:
     :func:`face_nodes` / :func:`surfmod.uses.mass_plane.plane_moments`.
 
     >>> import surfmod as sm, build123d as bd
-    >>> faces = [mass_face(sm.from_face(f)) for f in (bd.Box(4, 4, 2) - bd.Cylinder(1, 2)).faces()]
-    >>> prepare_boundaries(faces, 12)
+    >>> part = bd.Cylinder(1.0, 4.0) - bd.Box(4, 4, 4).rotate(bd.Axis.X, 30).translate((0, 0, 2.5))
+    >>> faces = [mass_face(sm.from_face(f)) for f in part.faces()]
+    >>> prepare_boundaries(faces, 12)  # the cut side and the slanted ellipse; the bottom disc is closed form
     >>> sorted(len(f.boundary) for f in faces)
-    [0, 0, 0, 0, 0, 1, 1]
+    [0, 1, 1, 1]
     """
-    trimmed = [mf for mf in faces if not mf.natural and mf.pcurves]
+    # planar faces bounded by lines and circles need none (their nodes are laid directly
+    # by surfmod.uses.mass_plane)
+    trimmed = [mf for mf in faces if not mf.natural and mf.pcurves and not is_conic(mf)]
     if trimmed:
-        for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed])):
+        table = None
+        if all(mf.rows is not None and mf.rows[0] is trimmed[0].rows[0] for mf in trimmed):
+            # their p-curves are rows of the table mass_faces built: taken, not rebuilt
+            table = trimmed[0].rows[0].subset(np.concatenate(
+                [np.arange(mf.rows[1], mf.rows[1] + len(mf.pcurves)) for mf in trimmed]))
+        for mf, got in zip(trimmed, boundaries([_boundary_rule(mf, order) for mf in trimmed], table)):
             mf.boundary[order] = got
 
 
 def _green(mf: MassFace, order: int, orders, exacts):
     """Green's theorem nodes (see the module notes)."""
+    plan = _green_plan(mf, order, orders, exacts)
+    grid = grids_nodes([plan.job], plan.counts)[0] if plan.job is not None else None
+    return _green_nodes(mf, plan, grid)
+
+
+class _GreenPlan:
+    """What :func:`_green` decides for a face before its grids are built: the inner
+    direction ``k``, the boundary nodes ``P`` with their weights and layout, which of them
+    go onto grids (``job``, a :class:`~surfmod.uses.mass_grid.GridJob`, or None) and the
+    rest, node by node."""
+
+    __slots__ = ("k", "m_in", "P", "wb", "full", "partial", "rest", "job", "counts", "exact")
+
+
+def _green_plan(mf: MassFace, order: int, orders, exacts) -> _GreenPlan:
+    plan = _GreenPlan()
     P, dP, wt, exact = face_boundary(mf, order)
     # inner direction: the one with fewer inner nodes per boundary node, where the
     # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
@@ -397,17 +530,91 @@ def _green(mf: MassFace, order: int, orders, exacts):
     np.maximum.at(deepest, q[on_grid], (full + partial)[on_grid])
     grid = counts[0][0] * counts[1][0] * deepest.sum()
     if grid + GRID_OVERHEAD < m_in * (partial[on_grid].sum() + full[on_grid].sum()):
-        g = grid_nodes(mf, k, (counts[0][0], counts[1][0]), P[on_grid], wb[on_grid], full[on_grid],
-                        partial[on_grid], q[on_grid])
+        Pg = P[on_grid]
+        plan.job = GridJob(mf.breaks[k], obr, Pg[:, k], Pg[:, 1 - k], wb[on_grid], full[on_grid], partial[on_grid],
+                           q[on_grid])
+        plan.counts = (counts[0][0], counts[1][0])
         rest = ~on_grid
         exact = exact and counts[0][1] and counts[1][1] and (exacts[k] or not rest.any())
     else:
-        g, rest = (np.zeros(0),) * 3, np.ones(len(P), bool)
+        plan.job, plan.counts, rest = None, None, np.ones(len(P), bool)
         exact = exact and exacts[k]
+    plan.k, plan.m_in, plan.P, plan.wb, plan.full, plan.partial, plan.rest, plan.exact = (
+        k, m_in, P, wb, full, partial, rest, exact)
+    return plan
+
+
+def _green_nodes(mf: MassFace, plan: _GreenPlan, grid):
+    """The partials and weights of a planned face: its grid's points (``grid``, from
+    :func:`~surfmod.uses.mass_grid.grids_nodes`) first, then the rest node by node."""
+    k, rest = plan.k, plan.rest
+    parts, weights = [], []
+    if grid is not None:  # on the surface's tensor evaluator
+        parts.append(grid.derivatives(k, mf.evaluate, mf.grid_evaluate))
+        weights.append(grid.weights)
     if rest.any():
-        n = inner_nodes(mf, k, m_in, P[rest], wb[rest], full[rest], partial[rest])
-        s, other, ws = (np.concatenate([a, b]) for a, b in zip(g, n))
-    else:  # every node on a grid
-        s, other, ws = g
-    ders = mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1)
-    return ders, ws, exact
+        s, other, ws = inner_nodes(mf, k, plan.m_in, plan.P[rest], plan.wb[rest], plan.full[rest], plan.partial[rest])
+        parts.append(mf.evaluate(s, other, 1) if k == 0 else mf.evaluate(other, s, 1))
+        weights.append(ws)
+    if len(parts) == 1:
+        return parts[0], weights[0], plan.exact
+    return np.concatenate(parts), np.concatenate(weights), plan.exact
+
+
+#: faces whose grids have at most this many cells (inner × outer spans) share one
+#: :func:`~surfmod.uses.mass_grid.grids_nodes` pass, in batches of at most
+#: ``GRID_BATCH_CELLS`` padded cells (bounded memory: ``ks kt`` weights per cell)
+GRID_BATCH_FACE_CELLS = 64
+GRID_BATCH_CELLS = 1024
+
+
+def faces_nodes(faces: list, order: int) -> list:
+    """:func:`face_nodes` of many faces, the same nodes, weights and partials: the Green
+    grids of the small trimmed faces (those of a part's many small fillets, tori and cones)
+    built in shared passes (:func:`~surfmod.uses.mass_grid.grids_nodes`), where one pass
+    per face cost more than its arithmetic.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> mfs = [mass_face(sm.from_face(f)) for f in (bd.Cylinder(2, 3) - bd.Box(1, 1, 9).translate((2, 0, 0))).faces()]
+    >>> both = faces_nodes(mfs, 12)
+    >>> all(np.array_equal(d, face_nodes(m, 12)[0]) for m, (d, _, _) in zip(mfs, both))
+    True
+    """
+    out: list = [None] * len(faces)
+    plans, batches = {}, {}
+    for i, mf in enumerate(faces):
+        if mf.natural:
+            out[i] = face_nodes(mf, order)
+            continue
+        mu, eu = _direction_order(mf, 0, order)
+        mv, ev = _direction_order(mf, 1, order)
+        plan = plans[i] = _green_plan(mf, order, (mu, mv), (eu, ev))
+        if plan.job is not None:
+            size = (len(plan.job.br) - 1) * (len(plan.job.obr) - 1)
+            key = plan.counts if size <= GRID_BATCH_FACE_CELLS else ("alone", i)
+            batches.setdefault(key, []).append(i)
+    grids = {}
+    for key, members in batches.items():
+        counts = plans[members[0]].counts
+        for chunk in _grid_chunks(members, plans):
+            grids.update(zip(chunk, grids_nodes([plans[i].job for i in chunk], counts)))
+    for i, plan in plans.items():
+        ders, w, exact = _green_nodes(faces[i], plan, grids.get(i))
+        out[i] = _signed(faces[i], ders), w, exact
+    return out
+
+
+def _grid_chunks(members: list, plans: dict) -> list:
+    """``members`` cut into runs whose padded cell count (faces × most inner spans × most
+    outer spans) stays within ``GRID_BATCH_CELLS``."""
+    chunks, chunk, most = [], [], (0, 0)
+    for i in members:
+        job = plans[i].job
+        shape = (max(most[0], len(job.br) - 1), max(most[1], len(job.obr) - 1))
+        if chunk and (len(chunk) + 1) * shape[0] * shape[1] > GRID_BATCH_CELLS:
+            chunks.append(chunk)
+            chunk, shape = [], (len(job.br) - 1, len(job.obr) - 1)
+        chunk.append(i)
+        most = shape
+    chunks.append(chunk)
+    return chunks

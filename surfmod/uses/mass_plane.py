@@ -13,7 +13,10 @@ the inner integral from the face box's edge ``u0`` exactly as the node-by-node r
 :mod:`surfmod.uses.mass_green` takes it (so a boundary whose p-curves leave gaps gives the
 same result as there), evaluated as ``(u - u0) Σ A^k B^(p-k) / (p + 1)`` without
 cancellation.  The outer integral runs on the same Gauss nodes of the p-curves
-(:func:`surfmod.uses.mass_boundary.boundaries`: 3 per straight piece, exact).  Then with
+(:func:`surfmod.uses.mass_boundary.boundaries`: 3 per straight piece, exact); on faces
+bounded by lines and circles only (plates with holes, slots) the same nodes are laid
+directly, all such faces at once (:func:`_line_nodes`, :func:`_arc_nodes`), without the
+boundary pass (its cuts, crossings and p-curve table serve curved p-curves).  Then with
 ``x = c + a X + b Y`` the sums are tensor contractions of the moments with ``[c, X, Y]``:
 no surface is evaluated and no inner node is made, one pass for all planar faces of a
 part.
@@ -23,7 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mass_green import face_boundary
+from .mass_green import face_boundary, is_conic  # noqa: F401 (is_conic re-exported)
+from .mass_boundary import _FRACTIONS, PIECES  # noqa: F401
+from .mass_grid import gauss
 
 # the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
 # product e_i e_j e_k is (T3[i, j, k] = M[_CUBE[i, j, k]]), likewise for fewer factors
@@ -43,32 +48,92 @@ _LINE = np.array([_product_index(i) for i in range(3)])
 def _region_moments(faces: list, foot: np.ndarray, order: int):
     """Per face: the ten moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
     is positive) about its ``foot`` ``(uc, vc)``, and whether every boundary rule was exact."""
-    parts, exact = [], np.ones(len(faces), bool)
+    parts, owners, exact = [], [], np.ones(len(faces), bool)
+    lines, arcs = [], []  # of the faces bounded by lines and circles, all at once
     for i, mf in enumerate(faces):
+        if is_conic(mf):
+            lines.extend((i, rec) for rec in mf.pcurves if rec["kind"] == "line")
+            arcs.extend((i, rec) for rec in mf.pcurves if rec["kind"] == "circle")
+            continue
         # 3 Gauss nodes per straight piece: the integrands are of degree 4 along it, exact
         P, dP, wt, exact[i] = face_boundary(mf, order)
         parts.append((P, wt * dP[:, 1]))
-    count = np.array([len(w) for _, w in parts])
+        owners.append(np.full(len(wt), i))
+    if lines:  # 3 Gauss nodes each, as boundaries() lays them
+        P, dP, wt, owner = _line_nodes(lines)
+        parts.append((P, wt * dP[:, 1]))
+        owners.append(owner)
+    if arcs:  # Gauss on equal pieces, as boundaries() lays them (not exact: order matters)
+        P, wb, owner = _arc_nodes(arcs, order)
+        parts.append((P, wb))
+        owners.append(owner)
+        exact[np.unique(owner)] = False
     moments = np.zeros((len(faces), len(_POWERS)))
-    if not count.sum():
-        return moments, exact
-    P, wb = np.concatenate([p for p, _ in parts]), np.concatenate([w for _, w in parts])
-    owner = np.repeat(np.arange(len(faces)), count)
-    u0 = np.array([mf.bounds[0] for mf in faces])[owner]
-    A, B, b = P[:, 0] - foot[owner, 0], u0 - foot[owner, 0], P[:, 1] - foot[owner, 1]
-    d = P[:, 0] - u0
-    # ∫_{u0}^{u} (s - uc)^p ds = (A^(p+1) - B^(p+1)) / (p + 1) = d Σ_k A^k B^(p-k) / (p + 1)
-    sums = [np.ones_like(A)]
-    for p in range(1, 4):
-        sums.append(sums[-1] * B + A**p)  # Σ_{k=0}^{p} A^k B^(p-k), Horner in B
-    inner = [wb * d * sums[p] / (p + 1) for p in range(4)]
-    b_pow = [np.ones_like(b), b, b * b, b * b * b]
-    values = np.stack([inner[p] * b_pow[q] for p, q in _POWERS], axis=1)  # (N, 10)
-    starts = np.concatenate([[0], np.cumsum(count)[:-1]])
-    live = count > 0
-    moments[live] = np.add.reduceat(values, starts[live], axis=0)
+    owner = np.concatenate(owners) if owners else np.zeros(0, int)
+    if len(owner):
+        order_ = np.argsort(owner, kind="stable")  # face by face, each face's nodes in order
+        owner = owner[order_]
+        P, wb = np.concatenate([p for p, _ in parts])[order_], np.concatenate([w for _, w in parts])[order_]
+        count = np.bincount(owner, minlength=len(faces))
+        u0 = np.array([mf.bounds[0] for mf in faces])[owner]
+        A, B, b = P[:, 0] - foot[owner, 0], u0 - foot[owner, 0], P[:, 1] - foot[owner, 1]
+        d = P[:, 0] - u0
+        # ∫_{u0}^{u} (s - uc)^p ds = (A^(p+1) - B^(p+1)) / (p + 1) = d Σ_k A^k B^(p-k) / (p + 1)
+        sums = [np.ones_like(A)]
+        for p in range(1, 4):
+            sums.append(sums[-1] * B + A**p)  # Σ_{k=0}^{p} A^k B^(p-k), Horner in B
+        inner = [wb * d * sums[p] / (p + 1) for p in range(4)]
+        b_pow = [np.ones_like(b), b, b * b, b * b * b]
+        values = np.stack([inner[p] * b_pow[q] for p, q in _POWERS], axis=1)  # (N, 10)
+        starts = np.concatenate([[0], np.cumsum(count)[:-1]])
+        live = count > 0
+        moments[live] = np.add.reduceat(values, starts[live], axis=0)
     moments[moments[:, 0] < 0] *= -1.0  # boundary traversed clockwise in (u, v)
     return moments, exact
+
+
+def _line_nodes(lines: list):
+    """``(P, dP, weights, owner)``: 3 Gauss nodes on each straight p-curve of ``lines``
+    (``(owner, record)`` pairs), the values :func:`surfmod.uses.mass_boundary.boundaries`
+    gives a line on a plane (one piece, its ends; the weights signed by the edge's
+    orientation)."""
+    live = [rec for _, rec in lines if rec["range"][1] > rec["range"][0]]
+    owner = np.repeat([i for i, rec in lines if rec["range"][1] > rec["range"][0]], 3).astype(int)
+    if not live:
+        return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), owner
+    x, gw = gauss(3)
+    data = np.array([(*rec["range"], rec["sign"]) for rec in live])
+    a, b, sign = data[:, :1], data[:, 1:2], data[:, 2:]
+    t = ((a + b) / 2 + (b - a) / 2 * x).ravel()
+    w = (sign * ((b - a) / 2 * gw)).ravel()
+    origin = np.repeat(np.array([rec["origin"] for rec in live]), 3, axis=0)
+    direction = np.repeat(np.array([rec["direction"] for rec in live]), 3, axis=0)
+    return origin + t[:, None] * direction, direction, w, owner
+
+
+def _arc_nodes(arcs: list, order: int):
+    """``(P, dP_v · weights, owner)``: the Gauss nodes
+    :func:`surfmod.uses.mass_boundary.boundaries` lays on circular p-curves of a plane
+    (``arcs``: ``(owner, record)`` pairs): ``order`` nodes on each of ``PIECES`` equal
+    pieces of the range, ``P(t) = C + r (cos t X + sin t Y)``, the weights signed by the
+    edge's orientation and multiplied by ``dv/dt``."""
+    data = np.array([(*rec["range"], rec["sign"], rec["radius"], *rec["centre"], *rec["x"], *rec["y"]) for _, rec in arcs])
+    f, l, sign, r = data[:, :1], data[:, 1:2], data[:, 2:3], data[:, 3:4]
+    centre, ax, ay = data[:, 4:6], data[:, 6:8], data[:, 8:10]
+    live = (l > f)[:, 0]
+    cuts = f + (l - f) * _FRACTIONS
+    cuts[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it
+    a, b = cuts[:, :-1, None], cuts[:, 1:, None]  # (A, PIECES, 1)
+    x, gw = gauss(order)
+    t = ((a + b) / 2 + (b - a) / 2 * x).reshape(len(arcs), -1)  # (A, PIECES order)
+    w = sign * ((b - a) / 2 * gw).reshape(len(arcs), -1)
+    c, s_ = np.cos(t)[:, :, None], np.sin(t)[:, :, None]
+    rr = r[:, :, None]
+    P = centre[:, None, :] + rr * (c * ax[:, None, :] + s_ * ay[:, None, :])
+    dv = (rr * (c * ay[:, None, :] - s_ * ax[:, None, :]))[:, :, 1]
+    owner = np.repeat(np.array([i for i, _ in arcs], int), t.shape[1])
+    keep = np.repeat(live, t.shape[1])  # an empty range has no nodes
+    return P.reshape(-1, 2)[keep], (w * dv).ravel()[keep], owner[keep]
 
 
 def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]:
