@@ -10,7 +10,7 @@ integrands ``g`` of the divergence theorem (``x·n``, ``x_i² n_i``, ``x_i³ n_i
   direction ``v``): Gauss on the exact p-curves of the boundary (outer integral),
   and the inner integral from the face box's edge to each boundary node, either by
   Gauss node by node or, where that evaluates fewer points, on one fixed grid per cell
-  (inner span × outer span, :func:`_grid_nodes`): the integrands' tensor interpolant at
+  (inner span × outer span, :func:`surfmod.uses.mass_grid.grid_nodes`): the integrands' tensor interpolant at
   Chebyshev points, whose inner antiderivative is exact, so every boundary node only adds
   weights to the grid points and the surface is evaluated on the grids alone (exact
   where the surface is a polynomial in both directions; ``2 order`` points per span
