@@ -326,32 +326,26 @@ def _store_partials(h, rational, out, a, kk):
 def positions(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """Positions at the scattered pairs ``(u[a], v[a])`` into ``out (N, 3)`` from ``table``
     (flat float64 parameter arrays, in the domain)."""
-    n, m = net.ctrl.shape[:2]
-    count = threads_for(u.size)
-    if count > 1:
-        from . import parallel
-
-        with running_on(count):
-            parallel.patch_positions(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u,
-                                     table.scale_u, table.mid_v, table.scale_v, net.rational, net.bucket_u,
-                                     net.bucket_v, u, v, out)
-        return
-    _positions(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u,
-               table.mid_v, table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
+    _run(_positions, "patch_positions", net, table, u, v, out)
 
 
 def derivatives(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """Partials to order 1 or 2 at the scattered pairs ``(u[a], v[a])`` into ``out (N, K, K,
     3)`` from ``table`` (flat float64 parameter arrays, in the domain)."""
+    _run(_derivatives, "patch_derivatives", net, table, u, v, out)
+
+
+def _run(serial, parallel_name: str, net, table: PatchTable, u, v, out) -> None:
+    """``serial``, or its variant ``parallel_name`` of :mod:`surfmod.eval.parallel` when
+    :mod:`surfmod.eval.threads` allows several threads, on the patch table's arrays."""
     n, m = net.ctrl.shape[:2]
+    args = (net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u, table.mid_v,
+            table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
     count = threads_for(u.size)
     if count > 1:
         from . import parallel
 
         with running_on(count):
-            parallel.patch_derivatives(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u,
-                                       table.scale_u, table.mid_v, table.scale_v, net.rational, net.bucket_u,
-                                       net.bucket_v, u, v, out)
+            getattr(parallel, parallel_name)(*args)
         return
-    _derivatives(net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u,
-                 table.mid_v, table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
+    serial(*args)
