@@ -168,10 +168,6 @@ class _Accumulator:
         self.ref, self.totals, self.size = ref, np.zeros((groups, 14)), 0
         self.parts = [[] for _ in range(groups)]
 
-    @property
-    def total(self) -> np.ndarray:
-        return self.totals[0]
-
     def add(self, ders: np.ndarray, weights: np.ndarray, group: int = 0) -> None:
         self.parts[group].append((ders, weights))
         self.size += len(weights)
