@@ -167,14 +167,16 @@ def test_sorted_block_rows_are_each_blocks_needed_rows(seed):
 
 @pytest.mark.parametrize("rational", [False, True])
 def test_interleaved_stages_over_several_v_chunks(rational, monkeypatch):
-    """More v-points than a chunk of the ring (surfmod/eval/sliding.py), u-points skipping
-    spans, pairs and single points: the same bits as the two-stage path, and the points
-    of the scattered kernel."""
-    s = _uniform_surface(90, 700, 3, 3, rational, seed=11)
+    """More v-points than a chunk of the ring (surfmod/eval/sliding.py; v-blocks made
+    longer than a chunk, which is as long as a v-block), u-points skipping spans, pairs
+    and single points: the same bits as the two-stage path, and the points of the
+    scattered kernel."""
+    monkeypatch.setattr(local, "V_BLOCK", 4 * sliding.CHUNK)
+    s = _uniform_surface(90, 2200, 3, 3, rational, seed=11)
     us = np.sort(np.r_[np.linspace(0, 1, 60), np.linspace(0.2, 0.3, 25), 0.5, 0.5])
-    spans = 700 - 3
+    spans = 2200 - 3
     vs = np.sort(np.r_[(np.arange(spans) + 0.5) / spans, 0.25, 0.25, 1.0])  # one a span, and a few more
-    assert vs.size > 2 * sliding.CHUNK
+    assert 2 * sliding.CHUNK < vs.size <= local.V_BLOCK
     _, kinds = row_stage.runs(local._basis(s.knots[1], 3, 700, vs, 0)[0])
     assert np.count_nonzero(kinds == row_stage.NEXT_SPAN) >= 2 and np.any(kinds == row_stage.SCALAR)
     grid = s.grid(us, vs)

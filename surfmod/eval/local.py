@@ -335,14 +335,19 @@ def _row_blocks(su, p, n, per_row, threads=1):
     return starts.astype(np.int64), rows.astype(np.int64), np.array(row_starts, dtype=np.int64), first
 
 
+def _needed_rows(su, p, n):
+    """Which of the ``n`` net rows the u-points of spans ``su`` read (a mask)."""
+    needed = np.zeros(n, dtype=bool)
+    needed[(su[:, None] - p + np.arange(p + 1)).ravel()] = True
+    return needed
+
+
 def _sorted_block_rows(su, p, n, starts):
     """``(rows, row_starts, first)`` of :func:`_row_blocks` for sorted spans ``su``,
     without a pass per block: the rows a block needs are all the needed rows from its
     first point's lowest to its last point's highest (a needed row in between belongs to
     a point in between), so each block's rows are a slice of the sorted needed rows."""
-    needed = np.zeros(n, dtype=bool)
-    needed[(su[:, None] - p + np.arange(p + 1)).ravel()] = True
-    every = np.flatnonzero(needed)
+    every = np.flatnonzero(_needed_rows(su, p, n))
     lo = np.searchsorted(every, su[starts[:-1]] - p)
     hi = np.searchsorted(every, su[starts[1:] - 1], side="right")
     row_starts = np.r_[0, np.cumsum(hi - lo)]
@@ -408,12 +413,11 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
         out = np.empty((us.size, vs.size, 3) if order == 0 else (us.size, vs.size, kk, kk, 3))
     run, count = _kernels_for(us.size * vs.size, grid=True)
     ordered = bool(np.all(su[1:] >= su[:-1]))
+    needed = int(np.count_nonzero(_needed_rows(su, p, n)))
     with _on(count):
         for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
-            blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
-            per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
-            vruns = _vector_runs(net, svb, bvb, blocks[1].size)
+            vruns = _vector_runs(net, svb, bvb, needed)
             if order == 0 and p <= 3 and vruns[3].size and ordered:
                 # the stages interleave in a ring (eval/sliding.py): no row table, so the
                 # blocks need not be cut to its size (only shared among the threads)
@@ -421,6 +425,9 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
 
                 blocks = _row_blocks(su, p, n, 1, count)
                 per_slot = RING * dim * min(svb.size, CHUNK)
+            else:
+                blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
+                per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
             run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns,
                      stream)
     if order == 0:
