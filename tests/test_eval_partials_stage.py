@@ -58,6 +58,23 @@ def test_stage_equals_the_general_path_streamed_or_not(p, rational, nv):
         _assert_within(got[True][:, b0 : b0 + nv], expected[:, b0 : b0 + nv], 5e-14)
 
 
+@pytest.mark.parametrize("nu", [1, 2, 5])
+def test_pipelined_columns_equal_the_plain_chunks(nu):
+    """Streamed rational chunks overlap their stores with the next u-point's quotient
+    rule (column by column, two sets of planes): for one u-point (only the last flush),
+    two, and an odd count, whole chunks and a partial one, the plain path's values."""
+    rng = np.random.default_rng(nu)
+    nv = 3 * CHUNK + 5
+    w, bu, first = _table(rng, 3, True, nu, nv)
+    shape = (nu, nv + 1, 3, 3, 3)  # rows of an even number of points: every row 16-byte aligned
+    streamed, plain = np.full(shape, np.nan), np.full(shape, np.nan)
+    order2_block(bu, first, 3, w, True, 0, streamed, True)
+    order2_block(bu, first, 3, w, True, 0, plain, False)
+    np.testing.assert_array_equal(streamed, plain)
+    assert np.isnan(streamed[:, nv:]).all()
+    _assert_within(streamed[:, :nv], _general(bu, first, 3, w, True, 0, shape)[:, :nv], 5e-14)
+
+
 def test_stage_writes_a_misaligned_array():
     """A caller's array whose rows start 8 bytes past a 16-byte boundary (a view one
     double into a buffer) is written from its first 16-byte boundary on, the same values."""
