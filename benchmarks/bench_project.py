@@ -2,7 +2,7 @@
 ``GeomAPI_ProjectPointOnSurf`` called per point through OCP.
 
 Points are scattered within ±30 % of the part size around a 12x10 bicubic NURBS height
-field.  The table gives time per point for both, how many of OCCT's answers surfmod
+field.  The table gives time per point for both (best of three runs), how many of OCCT's answers surfmod
 matches (to 1e-9), and how many points each side answers strictly closer: OCCT only
 returns orthogonal projections, while surfmod also finds the closest boundary points.
 
@@ -26,6 +26,18 @@ def _surface():
     return sm.BSplineSurface(net, (3, 3), weights=10 ** rng.uniform(-0.5, 0.5, (12, 10)))
 
 
+def _best(fn, repeat: int = 3):
+    """``fn()``'s result and its best CPU time over ``repeat`` runs: the first run also
+    loads the compiled kernels its path needs from numba's disk cache and builds the
+    surface's cached tables (about 25 ms for surfmod, once per process and surface)."""
+    best = np.inf
+    for _ in range(repeat):
+        t = time.process_time()
+        result = fn()
+        best = min(best, time.process_time() - t)
+    return result, best
+
+
 def main() -> None:
     s = _surface()
     (u0, u1), (v0, v1) = s.domain
@@ -33,15 +45,10 @@ def main() -> None:
     head = f"{'points':>7} {'surfmod':>10} {'OCCT':>10} {'speed-up':>9} {'same':>6} {'ours closer':>12} {'OCCT closer':>12}"
     print(head)
     print("-" * len(head))
-    sm.project([(1.0, 2.0, 3.0)], s)  # load the compiled kernels outside the timing
     for n in (1_000, 10_000):
         pts = np.c_[rng.uniform(-5, 45, n), rng.uniform(-5, 35, n), rng.uniform(-12, 12, n)]
-        t = time.process_time()
-        ours = sm.project(pts, s)
-        t_ours = time.process_time() - t
-        t = time.process_time()
-        theirs = project_points(s.geom(), (u0, u1, v0, v1), pts)
-        t_occ = time.process_time() - t
+        ours, t_ours = _best(lambda: sm.project(pts, s))
+        theirs, t_occ = _best(lambda: project_points(s.geom(), (u0, u1, v0, v1), pts))
         found = np.isfinite(theirs[:, 2])
         diff = ours.distance - np.where(found, theirs[:, 2], np.inf)
         same = int(np.sum(np.abs(diff) <= 1e-9))
