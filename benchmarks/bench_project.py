@@ -2,9 +2,10 @@
 ``GeomAPI_ProjectPointOnSurf`` called per point through OCP.
 
 Points are scattered within ±30 % of the part size around a 12x10 bicubic NURBS height
-field.  The table gives time per point for both (best of three runs), how many of OCCT's answers surfmod
-matches (to 1e-9), and how many points each side answers strictly closer: OCCT only
-returns orthogonal projections, while surfmod also finds the closest boundary points.
+field.  The table gives time per point for both (best of three runs), how many of
+OCCT's answers surfmod matches (to 1e-9), and how many points each side answers strictly
+closer: OCCT only returns orthogonal projections, while surfmod also finds the closest
+boundary points.
 
 ``python -m benchmarks project``
 """
@@ -26,14 +27,14 @@ def _surface():
     return sm.BSplineSurface(net, (3, 3), weights=10 ** rng.uniform(-0.5, 0.5, (12, 10)))
 
 
-def _best(fn, repeat: int = 3):
-    """``fn()``'s result and its best CPU time over ``repeat`` runs: the first run also
-    loads the compiled kernels its path needs from numba's disk cache and builds the
+def _best(fn, *args, repeat: int = 3):
+    """``fn(*args)``'s result and its best CPU time over ``repeat`` runs: the first run
+    also loads the compiled kernels its path needs from numba's disk cache and builds the
     surface's cached tables (about 25 ms for surfmod, once per process and surface)."""
     best = np.inf
     for _ in range(repeat):
         t = time.process_time()
-        result = fn()
+        result = fn(*args)
         best = min(best, time.process_time() - t)
     return result, best
 
@@ -47,8 +48,8 @@ def main() -> None:
     print("-" * len(head))
     for n in (1_000, 10_000):
         pts = np.c_[rng.uniform(-5, 45, n), rng.uniform(-5, 35, n), rng.uniform(-12, 12, n)]
-        ours, t_ours = _best(lambda: sm.project(pts, s))
-        theirs, t_occ = _best(lambda: project_points(s.geom(), (u0, u1, v0, v1), pts))
+        ours, t_ours = _best(sm.project, pts, s)
+        theirs, t_occ = _best(project_points, s.geom(), (u0, u1, v0, v1), pts)
         found = np.isfinite(theirs[:, 2])
         diff = ours.distance - np.where(found, theirs[:, 2], np.inf)
         same = int(np.sum(np.abs(diff) <= 1e-9))

@@ -23,7 +23,7 @@ from surfmod.uses.mass_boundary import PcurveTable, pcurve_d1, taylor_pieces
 import surfmod.uses.mass_green as mg
 import surfmod.uses.mass_grid as mgrid
 from surfmod.uses.mass_green import face_nodes, mass_face, mass_faces
-from surfmod.uses.mass_plane import is_conic, plane_moments
+from surfmod.uses.mass_plane import plane_moments
 
 def _rel(a, b):
     return abs(a - b) / abs(b)
