@@ -1,12 +1,12 @@
-"""Ball drop-cutter heights polished on the exact faces (``drop_cutter(..., exact=True)``):
-closed-form cutter locations on a sphere, a cylinder, a tilted plane and at a box's edge,
-to rounding, from a deliberately coarse mesh whose own heights are visibly off."""
+"""Drop-cutter heights polished on the exact faces (``drop_cutter(..., exact=True)``):
+closed-form cutter locations of ball and flat end mills on a sphere, a cylinder, a tilted
+plane and at a box's edge, to rounding, from a deliberately coarse mesh whose own
+heights are visibly off."""
 
 from __future__ import annotations
 
 import build123d as bd
 import numpy as np
-import pytest
 
 import surfmod as sm
 from surfmod.uses.toolpath import drop_cutter
@@ -62,6 +62,44 @@ def test_trim_respected_at_a_box_edge():
     assert np.abs(z - (2.0 + np.sqrt(R_BALL**2 - past**2) - R_BALL)).max() <= 1e-13 * 10
 
 
-def test_exact_needs_a_ball():
-    with pytest.raises(sm.SurfmodError, match="exact"):
-        drop_cutter(bd.Box(2, 2, 2), sm.Tool("flat", 1.0), [[0.0, 0.0]], exact=True)
+def test_flat_on_a_sphere_closed_form():
+    """Flat end of radius R_f on a sphere of radius R, axis d from the sphere's: off the
+    summit the rim touches at d − R_f from the axis of the sphere, z = sqrt(R² − (d −
+    R_f)²), contact on the sphere towards its summit; over the summit (d < R_f) the
+    bottom rests on it, z = R."""
+    R = 10.0
+    angle = np.linspace(0.0, 2 * np.pi, 15)
+    d = np.r_[np.linspace(2.5, 7.0, 15), np.linspace(0.0, 1.0, 15)]
+    xy = np.column_stack([d * np.cos(np.r_[angle, angle]), d * np.sin(np.r_[angle, angle])])
+    sphere = bd.Rot(35, 20, 0) * bd.Sphere(R)  # the summit is no pole, so no mesh vertex
+    z, contact = drop_cutter(sphere, sm.Tool("flat", R_BALL), xy, tolerance=COARSE, exact=True)
+    rim = d > R_BALL
+    expected = np.where(rim, np.sqrt(R**2 - np.maximum(d - R_BALL, 0.0) ** 2), R)
+    assert np.abs(z - expected).max() <= 1e-12 * R
+    towards = np.where(rim, d - R_BALL, 0.0) / np.where(d > 0, d, 1.0)
+    np.testing.assert_allclose(contact, np.column_stack([xy * towards[:, None], expected]), rtol=0, atol=1e-12 * R)
+    mesh, _ = drop_cutter(sphere, sm.Tool("flat", R_BALL), xy, tolerance=COARSE)
+    assert np.abs(mesh - expected)[rim].max() > 1e-4 and np.abs(mesh - expected)[~rim].max() > 1e-4  # off
+
+
+def test_flat_on_a_cylinder_closed_form():
+    """Flat end on a cylinder of radius a along x: z = sqrt(a² − (|y| − R_f)²) off its
+    crest, a over it."""
+    a = 5.0
+    cylinder = bd.Rot(0, 90, 0) * bd.Cylinder(a, 40)
+    y = np.r_[np.linspace(-4, -2, 7), np.linspace(-1, 1, 5), np.linspace(2, 4, 7)]
+    xy = np.column_stack([np.linspace(-10, 10, y.size), y])
+    z, _ = drop_cutter(cylinder, sm.Tool("flat", R_BALL), xy, tolerance=COARSE, exact=True)
+    assert np.abs(z - np.sqrt(a**2 - np.maximum(np.abs(y) - R_BALL, 0.0) ** 2)).max() <= 1e-12 * a
+
+
+def test_flat_on_a_tilted_plane_closed_form():
+    """Plane z = p x + q y + c: the rim touches at its uphill point, R_f sqrt(p² + q²)
+    above the plane at the axis."""
+    p, q, c = 0.3, -0.2, 1.0
+    corners = [(x, y, p * x + q * y + c) for x, y in ((-10, -10), (10, -10), (-10, 10))]
+    plane = sm.plane(*corners)
+    xy = np.column_stack([np.linspace(-5, 5, 11), np.linspace(-4, 3, 11)])
+    z, _ = drop_cutter(plane, sm.Tool("flat", R_BALL), xy, tolerance=COARSE, exact=True)
+    expected = p * xy[:, 0] + q * xy[:, 1] + c + R_BALL * np.hypot(p, q)
+    assert np.abs(z - expected).max() <= 1e-13 * 10

@@ -29,8 +29,8 @@ from ..errors import SurfmodError
 from ..io.gcode import gcode_text
 from .drop_cutter import TriangleGrid, drop
 from .inputs import to_shape
+from .toolpath_exact import exact_heights
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
-from .toolpath_exact import exact_ball_heights
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
 # the refinement inserts a location (the rest is the margin between sample points).
@@ -182,11 +182,12 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     touches nothing).  The faces are meshed to 40 % of ``tolerance`` (default
     ``radius / 1000``); heights are exact for that mesh.
 
-    ``exact=True`` (ball end mills) polishes each height on the exact face the ball rests
-    on (:mod:`surfmod.uses.toolpath_exact`: Newton on the face's own evaluator, inside
-    its trim), so it is exact to rounding on the B-rep, contact points included; where
-    the ball rests on an edge or a vertex of the mesh the mesh height is kept, lifted
-    as above.  A flat end's mesh height is already exact on planar faces and edges.
+    ``exact=True`` polishes each height on the exact face the tool rests on
+    (:mod:`surfmod.uses.toolpath_exact`: Newton on the face's own evaluator, inside its
+    trim: the ball's centre, a flat end's rim on a sloped face or its bottom on a
+    summit), so it is exact to rounding on the B-rep, contact points included; where the
+    tool rests on an edge or a vertex of the mesh the mesh height is kept, lifted as
+    above.
 
     >>> import surfmod as sm
     >>> from surfmod.uses.toolpath import drop_cutter
@@ -197,13 +198,11 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     tool = _check_tool(tool)
     cl = checks.finite_array(xy, "xy", ndim=2, last=2)
     tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
-    if exact and tool.kind != "ball":
-        raise SurfmodError("exact: heights polished on the exact faces need a ball end mill (tool kind 'ball')")
     part = _part(obj, tool, tolerance)
     z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True)
     z = z + part.lift
     if exact:
-        z, contacts, _ = exact_ball_heights(part.faces, part.owner, cl, z, contacts, touched, tool.radius)
+        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.kind, tool.radius)
     return z, contacts
 
 
