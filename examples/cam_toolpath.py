@@ -43,3 +43,14 @@ path = sm.toolpath(solid, tool, scallop=0.05, step=1.5)
 print(path)
 sm.export_gcode(path, OUT / "cam_part.nc", feed=1200, safe_height=40)
 print("G-code:", (OUT / "cam_part.nc").read_text().splitlines()[3:10])
+
+# 4. cutter locations on the exact faces: a 10 mm flat end mill dropped at a few points,
+#    its mesh heights polished by Newton on the faces themselves (rim or bottom contact)
+from surfmod.uses.toolpath import drop_cutter  # noqa: E402
+
+xy = np.array([[20.0, 15.0], [40.0, 30.0], [60.0, 45.0]])
+flat = sm.Tool("flat", 5.0)
+z_mesh, _ = drop_cutter(solid, flat, xy, tolerance=0.01)
+z_exact, contact = drop_cutter(solid, flat, xy, tolerance=0.01, exact=True)
+print("flat end mill tip heights, exact:", z_exact.round(6),
+      "mesh (lifted by its deflection) - exact:", (z_mesh - z_exact).round(6))
