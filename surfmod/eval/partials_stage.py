@@ -46,27 +46,24 @@ def order2_block(bu, first, p, w, rational, b0, out, stream):
     """Partials to order 2 of a block of u-points: ``out[a, b0:b0+n_v]`` from the row
     table ``w (rows, 3, dim, n_v)``, ``first[a]`` the place of u-point ``a``'s first row
     in it, ``bu (n_u, 3, p+1)`` the u-basis with its derivatives."""
-    # one compiled chunk loop per (stream, combine): each holds only its own loop order
-    # and combine (measured: with both in one loop, LLVM compiled it to half the speed)
+    # one compiled chunk loop per combine, and the overlapped one on its own: each holds
+    # only its own hot loop (measured: with two in one function, LLVM compiled them to
+    # half the speed)
     planes = np.empty(2 * PLANES)
-    if stream:
-        if p <= 3 and rational:
-            _streamed_rational(bu, first, p, w, b0, out, planes)
-        elif p <= 3:
-            _chunks(bu, first, p, w, rational, b0, out, planes, 0, True, False)
-        else:
-            _chunks(bu, first, p, w, rational, b0, out, planes, 0, True, True)
-        fence()
+    if stream and p <= 3 and rational:
+        _streamed_rational(bu, first, p, w, b0, out, planes)
     elif p <= 3:
-        _chunks(bu, first, p, w, rational, b0, out, planes, 0, False, False)
+        _chunks(bu, first, p, w, rational, b0, out, planes, 0, stream, False)
     else:
-        _chunks(bu, first, p, w, rational, b0, out, planes, 0, False, True)
+        _chunks(bu, first, p, w, rational, b0, out, planes, 0, stream, True)
+    if stream:
+        fence()
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _chunks(bu, first, p, w, rational, b0, out, planes, v_first, stream, high_degree):
     """The chunk loop of :func:`order2_block` from v-point ``v_first`` on, one chunk at a
-    time in ``planes[:PLANES]``; ``stream`` and ``high_degree`` are compile-time constants
+    time in ``planes[:PLANES]``; ``high_degree`` is a compile-time constant
     (``literally``).
 
     Streamed, the chunks go column by column: all u-points of one chunk of v-points,
@@ -76,7 +73,6 @@ def _chunks(bu, first, p, w, rational, b0, out, planes, v_first, stream, high_de
     whatever their order (1000² partials of a 20x20 NURBS: 17-18 ms against 19-20 ms).
     Plain stores go row by row, along the output, since each of them first reads its
     line (column by column: 41 ms against 36 ms)."""
-    literally(stream)
     literally(high_degree)
     flat = out.reshape(-1)
     stride = out.shape[1] * 27
