@@ -89,17 +89,20 @@ def test_stage_writes_a_misaligned_array():
     assert np.isnan(buffer[0])
 
 
-def test_a_streamed_grid_equals_the_plain_one_and_scattered_partials(monkeypatch):
-    """300 x 300 partials to order 2 (19 MB) are past ``STREAM_BYTES``: streamed into a
-    caller's array they equal the plain stores bit for bit, and the scattered kernel's
-    partials (a different algorithm) to 1e-13 of each partial's size."""
+@pytest.mark.parametrize("nu, nv", [(300, 300), (90, 1100), (80, 1101)])
+def test_a_streamed_grid_equals_the_plain_one_and_scattered_partials(monkeypatch, nu, nv):
+    """Partials to order 2 past ``STREAM_BYTES`` (19-21 MB; one v-block, or two with the
+    second starting at point 1024, rows of an even or an odd number of points: every row
+    16-byte aligned, or every other one): streamed into a caller's array they equal the
+    plain stores bit for bit, and the scattered kernel's partials (a different
+    algorithm) to 1e-13 of each partial's size."""
     rng = np.random.default_rng(11)
     s = sm.BSplineSurface(wavy_net(9, 8), (3, 2), weights=10 ** rng.uniform(-1, 1, (9, 8)))
-    us, vs = np.linspace(0, 1, 300), np.sort(rng.uniform(0, 1, 300))
-    assert 300 * 300 * 27 * 8 >= local.STREAM_BYTES
-    streamed = s.grid_into(us, vs, np.empty((300, 300, 3, 3, 3)), order=2)
+    us, vs = np.linspace(0, 1, nu), np.sort(rng.uniform(0, 1, nv))
+    assert nu * nv * 27 * 8 >= local.STREAM_BYTES
+    streamed = s.grid_into(us, vs, np.empty((nu, nv, 3, 3, 3)), order=2)
     monkeypatch.setattr(local, "STREAM_BYTES", 1 << 62)
-    plain = s.grid_into(us, vs, np.empty((300, 300, 3, 3, 3)), order=2)
+    plain = s.grid_into(us, vs, np.empty((nu, nv, 3, 3, 3)), order=2)
     np.testing.assert_array_equal(streamed, plain)
     uu, vv = np.meshgrid(us, vs, indexing="ij")
     scattered = s.derivatives(uu.ravel(), vv.ravel(), 2).reshape(streamed.shape)
