@@ -75,6 +75,15 @@ def test_pipelined_columns_equal_the_plain_chunks(nu):
     _assert_within(streamed[:, :nv], _general(bu, first, 3, w, True, 0, shape)[:, :nv], 5e-14)
 
 
+def test_an_empty_block_is_streamed_as_nothing():
+    """A block of no u-points (the overlapped path starts from u-point 0) leaves the
+    rest of the array alone."""
+    w, bu, first = _table(np.random.default_rng(3), 3, True, 0, 2 * CHUNK)
+    out = np.full((2, 2 * CHUNK, 3, 3, 3), np.nan)
+    order2_block(bu, first, 3, w, True, 0, out[:0], True)
+    assert np.isnan(out).all()
+
+
 def test_stage_writes_a_misaligned_array():
     """A caller's array whose rows start 8 bytes past a 16-byte boundary (a view one
     double into a buffer) is written from its first 16-byte boundary on, the same values."""

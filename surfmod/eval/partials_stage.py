@@ -97,11 +97,11 @@ def _streamed_rational(bu, first, p, w, b0, out, planes):
     """:func:`_chunks` streamed, rational, degree <= 3, with the stores of each chunk
     overlapping the next one's quotient rule (:func:`_column`), column by column over the
     whole chunks when every row of ``out`` starts on a 16-byte boundary; the last
-    partial chunk, and misaligned rows, as :func:`_chunks` does them."""
+    partial chunk, misaligned rows and an empty block as :func:`_chunks` does them."""
     flat = out.reshape(-1)
     stride = out.shape[1] * 27
     whole = w.shape[3] // CHUNK
-    if stride % 2 or not aligned_16(flat, 27 * b0):
+    if bu.shape[0] == 0 or stride % 2 or not aligned_16(flat, 27 * b0):
         whole = 0
     for c in range(whole):
         _column(bu, first, p, w, planes, flat, 27 * (b0 + c * CHUNK), stride, c * CHUNK)
