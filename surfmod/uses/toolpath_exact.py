@@ -138,16 +138,17 @@ def polish_flat(face, xy: np.ndarray, contacts: np.ndarray, radius: float):
     z, touch = np.full(len(xy), np.nan), np.full((len(xy), 3), np.nan)
     on = np.zeros(len(xy), bool)
     rim = np.linalg.norm(contacts[:, :2] - xy, axis=1) >= radius * (1.0 - 1e-6)
-    for kind, rows in ((_rim_axis, np.flatnonzero(rim)), (_slope, np.flatnonzero(~rim))):
-        if not rows.size:
-            continue
-        target = xy[rows] if kind is _rim_axis else np.zeros((rows.size, 2))
-        ur, vr, hit = _solve(face, kind, target, u[rows], v[rows], radius, radius if kind is _rim_axis else 1.0)
+    rows = np.flatnonzero(rim)
+    if rows.size:  # the rim on a sloped face, seen from above
+        ur, vr, hit = _solve(face, _rim_axis, xy[rows], u[rows], v[rows], radius, radius)
         p, n = _frames(face, ur, vr)
-        if kind is _rim_axis:  # a sloped face, seen from above
-            hit &= (n[:, 2] > 0) & (np.linalg.norm(n[:, :2], axis=1) > 0)
-        else:  # a summit under the disc
-            hit &= np.linalg.norm(p[:, :2] - xy[rows], axis=1) <= radius
+        hit &= (n[:, 2] > 0) & (np.linalg.norm(n[:, :2], axis=1) > 0)
+        z[rows], touch[rows], on[rows] = _inside(face, ur, vr, hit, p[:, 2], p)
+    rows = np.flatnonzero(~rim)
+    if rows.size:  # the bottom on a summit under the disc
+        ur, vr, hit = _solve(face, _slope, np.zeros((rows.size, 2)), u[rows], v[rows], radius, 1.0)
+        p = _frames(face, ur, vr)[0]
+        hit &= np.linalg.norm(p[:, :2] - xy[rows], axis=1) <= radius
         z[rows], touch[rows], on[rows] = _inside(face, ur, vr, hit, p[:, 2], p)
     return z, touch, on
 
