@@ -373,19 +373,33 @@ def _quotient_planes_order2(acc):
         a10, a11, a12 = acc[1, 0, d], acc[1, 1, d], acc[1, 2, d]
         a20, a21, a22 = acc[2, 0, d], acc[2, 1, d], acc[2, 2, d]
         for b in range(nv):
-            iw = 1.0 / w00[b]
-            s00 = a00[b] * iw
-            s01 = (a01[b] - w01[b] * s00) * iw
-            s02 = (a02[b] - 2.0 * w01[b] * s01 - w02[b] * s00) * iw
-            s10 = (a10[b] - w10[b] * s00) * iw
-            s11 = (a11[b] - w01[b] * s10 - w10[b] * s01 - w11[b] * s00) * iw
-            s12 = (a12[b] - 2.0 * w01[b] * s11 - w02[b] * s10 - w10[b] * s02 - 2.0 * w11[b] * s01
-                   - w12[b] * s00) * iw
-            s20 = (a20[b] - 2.0 * w10[b] * s10 - w20[b] * s00) * iw
-            s21 = (a21[b] - w01[b] * s20 - 2.0 * w10[b] * s11 - 2.0 * w11[b] * s10 - w20[b] * s01
-                   - w21[b] * s00) * iw
-            s22 = (a22[b] - 2.0 * w01[b] * s21 - w02[b] * s20 - 2.0 * w10[b] * s12 - 4.0 * w11[b] * s11
-                   - 2.0 * w12[b] * s10 - w20[b] * s02 - 2.0 * w21[b] * s01 - w22[b] * s00) * iw
-            a00[b], a01[b], a02[b] = s00, s01, s02
-            a10[b], a11[b], a12[b] = s10, s11, s12
-            a20[b], a21[b], a22[b] = s20, s21, s22
+            s = quotient_order2(a00[b], a01[b], a02[b], a10[b], a11[b], a12[b], a20[b], a21[b], a22[b],
+                                1.0 / w00[b], w01[b], w02[b], w10[b], w11[b], w12[b], w20[b], w21[b], w22[b])
+            a00[b], a01[b], a02[b], a10[b], a11[b], a12[b], a20[b], a21[b], a22[b] = s
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def quotient_order2(a00, a01, a02, a10, a11, a12, a20, a21, a22, iw, v01, v02, v10, v11, v12, v20, v21, v22):
+    """The quotient rule to order 2 for one coordinate of one point: the Cartesian
+    partials ``s_kl`` of ``x / w`` from the homogeneous ``a_kl`` (of ``x w``), the
+    weight's partials ``v_kl`` and ``iw = 1 / w``, each entry in rising order from the
+    lower ones, ``s_kl = (a_kl - sum C(k,i) C(l,j) v_ij s_(k-i)(l-j)) iw``, the terms in
+    the order of :func:`quotient_planes`.  Shared by every kernel that applies it (grid
+    planes, the grid's order-2 stage, the per-span patches), whose layouts differ; it is
+    inlined, so each is compiled with its caller's flags (fused multiply-adds or not).
+
+    >>> s = quotient_order2(2.0, 0, 0, 0, 0, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0, 0, 0, 0)
+    >>> s[0], s[8]
+    (1.0, 0.0)
+    """
+    s00 = a00 * iw
+    s01 = (a01 - v01 * s00) * iw
+    s02 = (a02 - 2.0 * v01 * s01 - v02 * s00) * iw
+    s10 = (a10 - v10 * s00) * iw
+    s11 = (a11 - v01 * s10 - v10 * s01 - v11 * s00) * iw
+    s12 = (a12 - 2.0 * v01 * s11 - v02 * s10 - v10 * s02 - 2.0 * v11 * s01 - v12 * s00) * iw
+    s20 = (a20 - 2.0 * v10 * s10 - v20 * s00) * iw
+    s21 = (a21 - v01 * s20 - 2.0 * v10 * s11 - 2.0 * v11 * s10 - v20 * s01 - v21 * s00) * iw
+    s22 = (a22 - 2.0 * v01 * s21 - v02 * s20 - 2.0 * v10 * s12 - 4.0 * v11 * s11 - 2.0 * v12 * s10 - v20 * s02
+           - 2.0 * v21 * s01 - v22 * s00) * iw
+    return s00, s01, s02, s10, s11, s12, s20, s21, s22

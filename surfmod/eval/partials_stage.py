@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import literally, njit, uint64
 
+from .kernels import quotient_order2
 from .streaming import aligned_16, fence, stream_pair
 
 #: v-points per chunk: 36 planes of 16 doubles (4.6 KiB) beside the row windows in L1
@@ -186,10 +187,9 @@ def _four(bu, a, k, p):
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
 def _quotient(planes, base, lo, hi):
-    """The quotient rule to order 2 in place on points ``lo:hi`` of the chunk at
-    ``planes[base:]``: the terms and their order of
-    :func:`surfmod.eval.kernels.quotient_planes`, with each point's weights, their
-    doubles (exact) and the reciprocal loaded or formed once for the three coordinates."""
+    """The quotient rule to order 2 (:func:`surfmod.eval.kernels.quotient_order2`) in
+    place on points ``lo:hi`` of the chunk at ``planes[base:]``, with each point's
+    weights and their reciprocal loaded or formed once for the three coordinates."""
     c = CHUNK
     for b in range(lo, hi):
         i = uint64(base + b)
@@ -197,24 +197,14 @@ def _quotient(planes, base, lo, hi):
         v01, v02 = planes[i + uint64(7 * c)], planes[i + uint64(11 * c)]
         v10, v11, v12 = planes[i + uint64(15 * c)], planes[i + uint64(19 * c)], planes[i + uint64(23 * c)]
         v20, v21, v22 = planes[i + uint64(27 * c)], planes[i + uint64(31 * c)], planes[i + uint64(35 * c)]
-        t01, t10, t11, t12, t21, f11 = 2.0 * v01, 2.0 * v10, 2.0 * v11, 2.0 * v12, 2.0 * v21, 4.0 * v11
         for d in range(3):
             j = i + uint64(d * c)
             j01, j02, j10, j11 = j + uint64(4 * c), j + uint64(8 * c), j + uint64(12 * c), j + uint64(16 * c)
             j12, j20, j21, j22 = j + uint64(20 * c), j + uint64(24 * c), j + uint64(28 * c), j + uint64(32 * c)
-            s00 = planes[j] * iw
-            s01 = (planes[j01] - v01 * s00) * iw
-            s02 = (planes[j02] - t01 * s01 - v02 * s00) * iw
-            s10 = (planes[j10] - v10 * s00) * iw
-            s11 = (planes[j11] - v01 * s10 - v10 * s01 - v11 * s00) * iw
-            s12 = (planes[j12] - t01 * s11 - v02 * s10 - v10 * s02 - t11 * s01 - v12 * s00) * iw
-            s20 = (planes[j20] - t10 * s10 - v20 * s00) * iw
-            s21 = (planes[j21] - v01 * s20 - t10 * s11 - t11 * s10 - v20 * s01 - v21 * s00) * iw
-            s22 = (planes[j22] - t01 * s21 - v02 * s20 - t10 * s12 - f11 * s11 - t12 * s10 - v20 * s02
-                   - t21 * s01 - v22 * s00) * iw
-            planes[j], planes[j01], planes[j02] = s00, s01, s02
-            planes[j10], planes[j11], planes[j12] = s10, s11, s12
-            planes[j20], planes[j21], planes[j22] = s20, s21, s22
+            (planes[j], planes[j01], planes[j02], planes[j10], planes[j11], planes[j12], planes[j20], planes[j21],
+             planes[j22]) = quotient_order2(planes[j], planes[j01], planes[j02], planes[j10], planes[j11], planes[j12],
+                                            planes[j20], planes[j21], planes[j22], iw, v01, v02, v10, v11, v12, v20,
+                                            v21, v22)
 
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})

@@ -38,7 +38,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, uint64
 
-from .kernels import SCATTER_CHUNK, basis_ders_point, find_span_bucketed
+from .kernels import SCATTER_CHUNK, basis_ders_point, find_span_bucketed, quotient_order2
 from .threads import running_on, threads_for
 
 #: largest table built (bytes): 100 x 100 bicubic spans fit, the table stays cache-friendly
@@ -295,8 +295,9 @@ def derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
 def _store_partials(h, rational, out, a, kk):
-    """``out[a, :kk, :kk]`` from the homogeneous partials ``h[k, l, :]`` (the quotient rule
-    to order 2 when rational, with the terms of :func:`surfmod.eval.kernels.quotient_planes`)."""
+    """``out[a, :kk, :kk]`` from the homogeneous partials ``h[k, l, :]`` (the quotient rule,
+    :func:`surfmod.eval.kernels.quotient_order2`, when rational: the entries of order 1
+    need only lower ones, so they are the same as to order 2)."""
     if not rational:
         for k in range(kk):
             for l in range(kk):
@@ -307,18 +308,11 @@ def _store_partials(h, rational, out, a, kk):
     v01, v02, v10, v11, v12 = h[0, 1, 3], h[0, 2, 3], h[1, 0, 3], h[1, 1, 3], h[1, 2, 3]
     v20, v21, v22 = h[2, 0, 3], h[2, 1, 3], h[2, 2, 3]
     for d in range(3):
-        s00 = h[0, 0, d] * iw
-        s01 = (h[0, 1, d] - v01 * s00) * iw
-        s10 = (h[1, 0, d] - v10 * s00) * iw
-        s11 = (h[1, 1, d] - v01 * s10 - v10 * s01 - v11 * s00) * iw
+        s00, s01, s02, s10, s11, s12, s20, s21, s22 = quotient_order2(
+            h[0, 0, d], h[0, 1, d], h[0, 2, d], h[1, 0, d], h[1, 1, d], h[1, 2, d], h[2, 0, d], h[2, 1, d], h[2, 2, d],
+            iw, v01, v02, v10, v11, v12, v20, v21, v22)
         out[a, 0, 0, d], out[a, 0, 1, d], out[a, 1, 0, d], out[a, 1, 1, d] = s00, s01, s10, s11
         if kk == 3:
-            s02 = (h[0, 2, d] - 2.0 * v01 * s01 - v02 * s00) * iw
-            s12 = (h[1, 2, d] - 2.0 * v01 * s11 - v02 * s10 - v10 * s02 - 2.0 * v11 * s01 - v12 * s00) * iw
-            s20 = (h[2, 0, d] - 2.0 * v10 * s10 - v20 * s00) * iw
-            s21 = (h[2, 1, d] - v01 * s20 - 2.0 * v10 * s11 - 2.0 * v11 * s10 - v20 * s01 - v21 * s00) * iw
-            s22 = (h[2, 2, d] - 2.0 * v01 * s21 - v02 * s20 - 2.0 * v10 * s12 - 4.0 * v11 * s11
-                   - 2.0 * v12 * s10 - v20 * s02 - 2.0 * v21 * s01 - v22 * s00) * iw
             out[a, 0, 2, d], out[a, 1, 2, d] = s02, s12
             out[a, 2, 0, d], out[a, 2, 1, d], out[a, 2, 2, d] = s20, s21, s22
 
