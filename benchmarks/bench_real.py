@@ -1,4 +1,4 @@
-"""Real parts: every command's job on each file of ../shared/step_corpus, timed beside
+"""Real parts: every command's job on each file of tests/data/step, timed beside
 OCCT's own tool for the same job, both on one core, in one process.
 
 | job | surfmod | OCCT's tool |
@@ -30,7 +30,7 @@ import numpy as np
 
 import surfmod as sm
 
-CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "step_corpus"
+CORPUS = Path(__file__).resolve().parent.parent / "tests" / "data" / "step"
 REPEATS = 2
 
 

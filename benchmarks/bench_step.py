@@ -16,7 +16,7 @@ import surfmod as sm
 from surfmod.occ import isolated
 from surfmod.occ.exchange import read_step
 
-CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "step_corpus"
+CORPUS = Path(__file__).resolve().parent.parent / "tests" / "data" / "step"
 
 
 def main() -> None:

@@ -1,5 +1,5 @@
 """Reverse engineering: the BRepMesh nodes of a fan blade face of a real part
-(../shared/step_corpus/pythonocc_Ventilator.stp), unordered and noisy like a scan,
+(tests/data/step/pythonocc_Ventilator.stp), unordered and noisy like a scan,
 fitted by one B-spline surface with a guaranteed deviation."""
 
 from pathlib import Path
@@ -10,9 +10,7 @@ import numpy as np
 import surfmod as sm
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
-CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "step_corpus" / "pythonocc_Ventilator.stp"
-if not CORPUS.exists():  # examples may run from a copy of the folder
-    CORPUS = Path("/work/shared/step_corpus/pythonocc_Ventilator.stp")
+CORPUS = Path(__file__).resolve().parent.parent / "tests" / "data" / "step" / "pythonocc_Ventilator.stp"
 
 part = sm.import_step(CORPUS)
 blade = max((f for f in part.faces() if f.geom_type == bd.GeomType.BSPLINE), key=lambda f: f.area)

@@ -24,22 +24,25 @@ def rng():
     return np.random.default_rng(12345)
 
 
-# The real-parts corpus (../shared/step_corpus beside the checkout).  Tests over every file
-# of it are marked ``corpus`` and run as the second command of .ci/run:
+# The real-parts corpus (tests/data/step, each file's origin and licence in its SOURCES.md).
+# Tests over every file of it are marked ``corpus`` and run as the second command of .ci/run:
 # ``python -m pytest -q -m corpus``; the default run (``-m "not corpus"`` in pyproject)
 # keeps the quick per-file cases.
-CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "step_corpus"
+CORPUS = Path(__file__).resolve().parent / "data" / "step"
 CORPUS_FILES = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
 
 
-@pytest.fixture(params=CORPUS_FILES, ids=lambda p: p.name)
+# An empty corpus must fail, not skip: with no params pytest would skip every corpus test.
+@pytest.fixture(params=CORPUS_FILES or [None], ids=lambda p: p.name if p else "missing")
 def corpus_file(request):
     """Each STEP file of the real-parts corpus in turn."""
+    if request.param is None:
+        pytest.fail(f"the real-parts corpus is missing: {CORPUS}")
     return request.param
 
 
 @pytest.fixture(scope="session")
 def corpus_dir():
     if not CORPUS_FILES:
-        pytest.fail(f"the real-parts corpus is missing: {CORPUS} (CI clones ../shared beside main)")
+        pytest.fail(f"the real-parts corpus is missing: {CORPUS}")
     return CORPUS

@@ -1,4 +1,4 @@
-"""`surfmod mesh` / `export_stl` on real STEP parts (../shared/step_corpus): the STL is
+"""`surfmod mesh` / `export_stl` on real STEP parts (tests/data/step): the STL is
 watertight and needs no admesh repair on every solid, its deviation is measured against
 the exact faces (checked here by OCCT's own distance), and faces the model itself
 holds off the surface are reported, or refused with ``--strict``.

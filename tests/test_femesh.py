@@ -139,7 +139,7 @@ def test_bad_input_and_no_partial_files(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-# -- real parts (../shared/step_corpus) -----------------------------------------------
+# -- real parts (tests/data/step) -----------------------------------------------
 def _corpus_fe_mesh(path):
     from surfmod.occ.mesh import shape_figures
     from surfmod.uses.femesh import signed_volumes
