@@ -11,7 +11,7 @@ from pathlib import Path
 import build123d as bd
 
 import surfmod as sm
-from surfmod.construct.blend import occt_blend
+from surfmod.ops.blend import occt_blend
 from surfmod.gallery.continuity import blend_report, nurbs_pair
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"

@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..ops.continuity import normal_curvature
+from ..sides import normal_curvature
 from ..readback import from_face
 from ..surface import Surface
 from .analyze_plot import write_png
