@@ -189,7 +189,7 @@ def _pair(a: Surface, b: Surface, side_a: str, side_b: str, samples: int, occt: 
     uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
     ref = None
     if occt:
-        from ..occ.continuity import local_analysis
+        from ..occ.local_analysis import local_analysis
 
         ref = local_analysis(a.geom(), uv_a, b.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
     return Continuity(label, pa, gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
@@ -222,7 +222,7 @@ def _projected(a: Surface, b: Surface, samples: int, occt: bool):
     uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
     ref = None
     if occt:
-        from ..occ.continuity import local_analysis
+        from ..occ.local_analysis import local_analysis
 
         ref = local_analysis(a.geom(), uv_a, b.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
     return Continuity(f"a.{side_a} | b (projected)", da[:, 0, 0], gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
@@ -249,7 +249,7 @@ def _edge_result(rec, surfaces, occt: bool, label: str):
     uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
     ref = None
     if occt:
-        from ..occ.continuity import local_analysis
+        from ..occ.local_analysis import local_analysis
 
         ref = local_analysis(sa.geom(), uv_a, sb.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
     return Continuity(label, da[:, 0, 0], gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
@@ -270,7 +270,7 @@ def _combined(label, parts):
 
 
 def _shell(shape, samples: int, occt: bool, only_faces=None):
-    from ..occ.continuity import shared_edges
+    from ..occ.local_analysis import shared_edges
 
     records = shared_edges(shape, samples)
     cache: dict = {}
