@@ -28,7 +28,7 @@ from .. import checks
 from ..errors import SurfmodError
 from .gcode import gcode_text
 from .drop_cutter import TriangleGrid, drop
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from .toolpath_exact import exact_heights
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
 

@@ -29,7 +29,7 @@ from ..nets.bspline import BSplineSurface
 from ..surface import Surface
 from .conics import Arc
 from .curves import Line
-from .frames import cos_d, frame_transformed, make_frame, sin_d
+from .axes import cos_d, frame_transformed, make_frame, sin_d
 from .revolution import revolve_nurbs
 
 TWO_PI = 2.0 * math.pi
