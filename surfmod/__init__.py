@@ -111,7 +111,7 @@ _EXPORTS = {
     "export_fe_mesh": ".uses.femesh",
     "toolpath": ".cam.toolpath",
     "Toolpath": ".cam.toolpath",
-    "Tool": ".cam.toolpath",
+    "Tool": ".cam.tool",
     "export_gcode": ".cam.gcode",
     "make_solid": ".uses.inputs",
     "coons": ".construct.coons",
