@@ -110,7 +110,7 @@ _EXPORTS = {
     "export_fe_mesh": ".uses.femesh",
     "toolpath": ".cam.toolpath",
     "Toolpath": ".cam.toolpath",
-    "Tool": ".cam.toolpath",
+    "Tool": ".cam.tool",
     "export_gcode": ".cam.gcode",
     "make_solid": ".inputs",
     "coons": ".construct.coons",
