@@ -210,7 +210,7 @@ def test_cam_part_toolpath_in_stock(tmp_path):
     rounding), no rapid touching stock; the residual on the reachable surface is measured
     and reported.  What issue 26 says is missing is asserted missing: the spindle is never
     started."""
-    from surfmod.occ.cam import part_triangles
+    from surfmod.occ.triangulation import part_triangles
     from surfmod.uses.inputs import to_shape
 
     tri, deflection = part_triangles(to_shape(SAMPLES / "cam_part.step"), 0.001)
