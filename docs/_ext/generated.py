@@ -1,0 +1,107 @@
+"""Sphinx extension: pages whose content comes from the code, not from a copy of it.
+
+* ``api.rst``: the marker ``.. surfmod-api-reference`` becomes one section per group of
+  :mod:`api_groups`, an ``autosummary`` table and an ``autoclass``/``autofunction`` entry
+  for each public name, every one addressed as ``surfmod.NAME``.
+* ``cli.md``: the marker ``<!-- surfmod-cli-reference -->`` becomes one section per
+  subcommand of the ``surfmod`` parser: its usage line and a table of its arguments,
+  taken from argparse (what ``surfmod CMD --help`` prints).
+"""
+
+from __future__ import annotations
+
+import argparse
+import inspect
+
+import surfmod
+
+from . import api_groups
+
+API_MARKER = ".. surfmod-api-reference"
+CLI_MARKER = "<!-- surfmod-cli-reference -->"
+
+
+def _grouped() -> list[tuple[str, str, list[str]]]:
+    public = set(surfmod.__all__)
+    groups, seen = [], set()
+    for title, blurb, names in api_groups.GROUPS:
+        kept = [n for n in names if n in public]
+        seen.update(kept)
+        if kept:
+            groups.append((title, blurb, kept))
+    rest = sorted(public - seen)
+    if rest:
+        groups.append(("Other public names", "Public names not yet placed in a section.", rest))
+    return groups
+
+
+def api_rst() -> str:
+    lines = [".. currentmodule:: surfmod", ""]
+    for title, blurb, names in _grouped():
+        lines += [title, "-" * len(title), "", blurb, "", ".. autosummary::", ""]
+        lines += [f"   {n}" for n in names]
+        lines.append("")
+        for n in names:
+            obj = getattr(surfmod, n)
+            if inspect.isclass(obj):
+                lines += [f".. autoclass:: {n}", "   :members:", ""]
+            else:
+                lines += [f".. autofunction:: {n}", ""]
+    return "\n".join(lines)
+
+
+def _subcommands(parser: argparse.ArgumentParser):
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            helps = {a.dest: a.help for a in action._choices_actions}
+            for name, sub in action.choices.items():
+                yield name, helps.get(name, ""), sub
+
+
+def _cell(text: str) -> str:
+    return " ".join(str(text).split()).replace("|", "\\|")
+
+
+def _argument_rows(sub: argparse.ArgumentParser):
+    for a in sub._actions:
+        if isinstance(a, argparse._HelpAction):
+            continue
+        if a.option_strings:
+            flag = ", ".join(a.option_strings)
+            if a.nargs != 0:
+                if a.choices:
+                    flag += " {" + ",".join(map(str, a.choices)) + "}"
+                else:
+                    meta = a.metavar if a.metavar is not None else a.dest.upper()
+                    flag += " " + (" ".join(meta) if isinstance(meta, tuple) else meta)
+        else:
+            flag = a.metavar or a.dest
+        required = "yes" if (a.required or not a.option_strings) else ""
+        default = "" if a.default in (None, False, argparse.SUPPRESS) or not a.option_strings else repr(a.default)
+        yield f"| `{_cell(flag)}` | {required} | {_cell(default)} | {_cell(a.help or '')} |"
+
+
+def cli_md() -> str:
+    from surfmod.cli import build_parser
+
+    parser = build_parser()
+    out = []
+    for name, blurb, sub in sorted(_subcommands(parser)):
+        usage = " ".join(sub.format_usage().split())
+        out += [f"### `surfmod {name}`", "", _cell(blurb).capitalize() + ".", "", "```text", usage, "```", "",
+                "| argument | required | default | meaning |", "|---|---|---|---|", *_argument_rows(sub), ""]
+    return "\n".join(out)
+
+
+def _source_read(app, docname, source):
+    text = source[0]
+    if API_MARKER in text:
+        text = text.replace(API_MARKER, api_rst())
+    if CLI_MARKER in text:
+        text = text.replace(CLI_MARKER, cli_md())
+    source[0] = text
+
+
+def setup(app):
+    app.connect("source-read", _source_read)
+    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
