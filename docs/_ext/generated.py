@@ -3,6 +3,12 @@
 * ``api.rst``: the marker ``.. surfmod-api-reference`` becomes one section per group of
   :mod:`api_groups`, an ``autosummary`` table and an ``autoclass``/``autofunction`` entry
   for each public name, every one addressed as ``surfmod.NAME``.
+* ``errors.md``: the marker ``<!-- surfmod-tolerances -->`` becomes a table of the named
+  tolerances of :mod:`surfmod.tolerances`, each value read from the module and each meaning
+  from its docstring.
+* ``gallery.md``: the marker ``<!-- surfmod-gallery -->`` becomes one figure per PNG in
+  ``docs/gallery/`` (made by ``docs/gallery_pictures.py``), captioned with its gallery
+  entry's lecture entity and call.
 * ``cli.md``: the marker ``<!-- surfmod-cli-reference -->`` becomes one section per
   subcommand of the ``surfmod`` parser: its usage line and a table of its arguments,
   taken from argparse (what ``surfmod CMD --help`` prints).
@@ -12,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import inspect
+from pathlib import Path
 
 import surfmod
 
@@ -19,6 +26,9 @@ from . import api_groups
 
 API_MARKER = ".. surfmod-api-reference"
 CLI_MARKER = "<!-- surfmod-cli-reference -->"
+TOL_MARKER = "<!-- surfmod-tolerances -->"
+GALLERY_MARKER = "<!-- surfmod-gallery -->"
+GALLERY = Path(__file__).resolve().parent.parent / "gallery"
 
 
 def _grouped() -> list[tuple[str, str, list[str]]]:
@@ -93,10 +103,43 @@ def cli_md() -> str:
     return "\n".join(out)
 
 
+def tolerances_md() -> str:
+    from surfmod import tolerances
+
+    meaning, name = {}, None
+    for line in (tolerances.__doc__ or "").splitlines():
+        if line.startswith("``") and line.rstrip().endswith("``"):
+            name = line.strip().strip("`")
+            meaning[name] = []
+        elif name and line.strip():
+            meaning[name].append(line.strip())
+    rows = ["| name | value | meaning |", "|---|---|---|"]
+    for name, words in meaning.items():
+        value = getattr(tolerances, name)
+        rows.append(f"| `{name}` | {value:g} | {_cell(' '.join(words))} |")
+    return "\n".join(rows)
+
+
+def gallery_md() -> str:
+    from surfmod.gallery import entries
+
+    known = {e.name: e for e in entries()}
+    out = []
+    for png in sorted(GALLERY.glob("*.png")):
+        e = known.get(png.stem)
+        caption = f"{e.entity}: `{e.call}`" if e else png.stem
+        out += [f"```{{figure}} gallery/{png.name}", f":width: 320px", f":alt: {png.stem}", "", caption, "```", ""]
+    return "\n".join(out) if out else "(no pictures yet: run `python docs/gallery_pictures.py`)"
+
+
 def _source_read(app, docname, source):
     text = source[0]
     if API_MARKER in text:
         text = text.replace(API_MARKER, api_rst())
+    if GALLERY_MARKER in text:
+        text = text.replace(GALLERY_MARKER, gallery_md())
+    if TOL_MARKER in text:
+        text = text.replace(TOL_MARKER, tolerances_md())
     if CLI_MARKER in text:
         text = text.replace(CLI_MARKER, cli_md())
     source[0] = text
