@@ -15,11 +15,11 @@ from toolpath_reference import ball_clearance, flat_cuts, gcode_positions
 
 import surfmod as sm
 from surfmod.cli import main as cli_main
-from surfmod.occ.cam import part_triangles
-from surfmod.uses import toolpath_moves
-from surfmod.uses.drop_cutter import TriangleGrid, drop
+from surfmod.occ.triangulation import part_triangles
+from surfmod.cam import toolpath_moves
+from surfmod.cam.drop_cutter import TriangleGrid, drop
 from surfmod.uses.inputs import to_shape
-from surfmod.uses.toolpath import drop_cutter
+from surfmod.cam.toolpath import drop_cutter
 
 CORPUS_PART = "trimesh_featuretype.STEP"
 # G-code writes 4 decimals: x, y rounded to nearest (a wall may come 5e-5·√2 closer)

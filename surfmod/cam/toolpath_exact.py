@@ -1,7 +1,7 @@
 """Drop-cutter heights on the exact faces, polished from the mesh's (ball and flat end
 mills).
 
-The mesh drop (:mod:`surfmod.uses.drop_cutter`) is exact for BRepMesh's triangles, which
+The mesh drop (:mod:`surfmod.cam.drop_cutter`) is exact for BRepMesh's triangles, which
 are chords of the faces.  Where the tool touches a face inside its trim, the exact cutter
 location solves two equations in the face's ``(u, v)``, with ``S`` the face point, ``N``
 its upward unit normal and ``(x, y)`` the tool axis:

@@ -3,17 +3,17 @@
 The part is every face of the input (walls, undersides and trimmed faces included), meshed
 by OCCT's BRepMesh inside each face's trim at a chordal deflection of 40 % of the
 gouge ``tolerance``.  The end mill (ball or flat end, with a shank of its own radius up to
-infinity) is dropped onto that mesh in closed form (:mod:`surfmod.uses.drop_cutter`), so a
+infinity) is dropped onto that mesh in closed form (:mod:`surfmod.cam.drop_cutter`), so a
 cutter location touches but never enters the triangles; where BRepMesh reports a larger
 deflection than asked for (faces of real parts that cannot be meshed finer than their own
 tolerance) every height is lifted by the difference.
 
 Every straight G1 move between cutter locations is then checked along its length, not only
-at its ends (:mod:`surfmod.uses.toolpath_moves`): locations are inserted where a move would
+at its ends (:mod:`surfmod.cam.toolpath_moves`): locations are inserted where a move would
 cut deeper than half the tolerance, steps at walls become vertical-level-vertical
 staircases, and a final check on other sample points must find every move within
 ``tolerance - deflection``.  Moves the refinement cannot bring within it are lifted
-(:func:`~surfmod.uses.toolpath_moves.lift_moves`: material is left there, reported as
+(:func:`~surfmod.cam.toolpath_moves.lift_moves`: material is left there, reported as
 ``Toolpath.lifted``); a path that still cuts deeper raises ``SurfmodError``: gouging
 G-code is never returned.  The default tolerance is a tenth of the scallop height.
 """
@@ -26,9 +26,9 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..io.gcode import gcode_text
+from .gcode import gcode_text
 from .drop_cutter import TriangleGrid, drop
-from .inputs import to_shape
+from ..uses.inputs import to_shape
 from .toolpath_exact import exact_heights
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
 
@@ -156,7 +156,7 @@ class _Part:
 
 
 def _part(obj, tool: Tool, tolerance: float) -> _Part:
-    from ..occ.cam import part_triangles
+    from ..occ.triangulation import part_triangles
 
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
@@ -183,14 +183,14 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     ``radius / 1000``); heights are exact for that mesh.
 
     ``exact=True`` polishes each height on the exact face the tool rests on
-    (:mod:`surfmod.uses.toolpath_exact`: Newton on the face's own evaluator, inside its
+    (:mod:`surfmod.cam.toolpath_exact`: Newton on the face's own evaluator, inside its
     trim: the ball's centre, a flat end's rim on a sloped face or its bottom on a
     summit), so it is exact to rounding on the B-rep, contact points included; where the
     tool rests on an edge or a vertex of the mesh the mesh height is kept, lifted as
     above.
 
     >>> import surfmod as sm
-    >>> from surfmod.uses.toolpath import drop_cutter
+    >>> from surfmod.cam.toolpath import drop_cutter
     >>> z, contact = drop_cutter(sm.plane((0, 0, 2), (4, 0, 2), (0, 4, 2)), sm.Tool("ball", 1.0), [[1.0, 1.0]])
     >>> z.tolist(), contact.tolist()
     ([2.0], [[1.0, 1.0, 2.0]])
