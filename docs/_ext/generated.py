@@ -9,6 +9,9 @@
 * ``gallery.md``: the marker ``<!-- surfmod-gallery -->`` becomes one figure per PNG in
   ``docs/gallery/`` (made by ``docs/gallery_pictures.py``), captioned with its gallery
   entry's lecture entity and call.
+* ``design.md``: the marker ``<!-- surfmod-package-map -->`` becomes a table of the
+  subpackages of surfmod, each with the first sentence of its docstring and its modules
+  (read with :mod:`ast`, nothing imported).
 * ``cli.md``: the marker ``<!-- surfmod-cli-reference -->`` becomes one section per
   subcommand of the ``surfmod`` parser: its usage line and a table of its arguments,
   taken from argparse (what ``surfmod CMD --help`` prints).
@@ -17,6 +20,7 @@
 from __future__ import annotations
 
 import argparse
+import ast
 import inspect
 from pathlib import Path
 
@@ -28,6 +32,8 @@ API_MARKER = ".. surfmod-api-reference"
 CLI_MARKER = "<!-- surfmod-cli-reference -->"
 TOL_MARKER = "<!-- surfmod-tolerances -->"
 GALLERY_MARKER = "<!-- surfmod-gallery -->"
+MAP_MARKER = "<!-- surfmod-package-map -->"
+PACKAGE = Path(surfmod.__file__).resolve().parent
 GALLERY = Path(__file__).resolve().parent.parent / "gallery"
 
 
@@ -132,10 +138,31 @@ def gallery_md() -> str:
     return "\n".join(out) if out else "(no pictures yet: run `python docs/gallery_pictures.py`)"
 
 
+def _first_sentence(path: Path) -> str:
+    doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
+    paragraph = " ".join(doc.split("\n\n")[0].split())
+    end = paragraph.find(". ")
+    return paragraph if end < 0 else paragraph[: end + 1]
+
+
+def package_map_md() -> str:
+    rows = ["| package | what it holds | modules |", "|---|---|---|"]
+    top = sorted(p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__")
+    rows.append(f"| `surfmod` | {_cell(_first_sentence(PACKAGE / '__init__.py'))} | "
+                + ", ".join(f"`{m}`" for m in top) + " |")
+    for init in sorted(PACKAGE.glob("*/__init__.py")):
+        pkg = init.parent
+        modules = sorted(p.stem for p in pkg.glob("*.py") if p.stem != "__init__")
+        rows.append(f"| `{pkg.name}/` | {_cell(_first_sentence(init))} | " + ", ".join(f"`{m}`" for m in modules) + " |")
+    return "\n".join(rows)
+
+
 def _source_read(app, docname, source):
     text = source[0]
     if API_MARKER in text:
         text = text.replace(API_MARKER, api_rst())
+    if MAP_MARKER in text:
+        text = text.replace(MAP_MARKER, package_map_md())
     if GALLERY_MARKER in text:
         text = text.replace(GALLERY_MARKER, gallery_md())
     if TOL_MARKER in text:
