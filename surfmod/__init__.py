@@ -14,8 +14,7 @@ from __future__ import annotations
 import importlib
 
 from .errors import DamagedFileError, KernelError, SurfmodError
-
-__version__ = "0.1.0"
+from .version import installed_version
 
 # public name -> module that defines it (relative to this package)
 _EXPORTS = {
@@ -109,10 +108,10 @@ _EXPORTS = {
     "fe_mesh": ".uses.femesh",
     "FEMesh": ".uses.femesh",
     "export_fe_mesh": ".uses.femesh",
-    "toolpath": ".uses.toolpath",
-    "Toolpath": ".uses.toolpath",
-    "Tool": ".uses.toolpath",
-    "export_gcode": ".io.gcode",
+    "toolpath": ".cam.toolpath",
+    "Toolpath": ".cam.toolpath",
+    "Tool": ".cam.tool",
+    "export_gcode": ".cam.gcode",
     "make_solid": ".inputs",
     "coons": ".construct.coons",
     "CoonsSurface": ".construct.coons",
@@ -145,6 +144,9 @@ __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError"])
 
 
 def __getattr__(name: str):
+    if name == "__version__":
+        globals()[name] = value = installed_version()
+        return value
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'surfmod' has no attribute {name!r}")

@@ -89,6 +89,11 @@ class TrimmedFace(Surface):
     def _grid_derivatives(self, us, vs, order):
         return self.surface._grid_derivatives(self._wrap(us, 0), self._wrap(vs, 1), order)
 
+    def _closest_parameters(self, points):
+        # closed forms of the untrimmed surface, over the face's own parameter box
+        closed_form = getattr(self.surface, "_closest_in", None)
+        return None if closed_form is None else closed_form(points, self._domain)
+
     def geom(self):
         """The face's own OCCT surface (located), the file's exact geometry."""
         return self._geom

@@ -199,7 +199,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     (1, [True], True)
     """
     from ..occ import uses as occ
-    from ..occ.cam import bounding_box as quick_box
+    from ..occ.triangulation import bounding_box as quick_box
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
