@@ -6,7 +6,7 @@ level holds):
 ====  =========================================================================
 rank  packages / modules
 ====  =========================================================================
-0     errors, tolerances: the error contract and the tolerance floors
+0     errors, tolerances, version: the error contract, the tolerance floors, the version
 1     checks: argument validation at the door of every public entry
 2     immutable, transforms, atomic: frozen arrays, affine maps, atomic writes
 3     eval: the NumPy/numba evaluation core (bases, kernels, frames)
@@ -56,7 +56,7 @@ ROOT = Path(surfmod.__file__).parent
 PACKAGE = ROOT
 
 RANKS = [
-    ["errors", "tolerances"],
+    ["errors", "tolerances", "version"],
     ["checks"],
     ["immutable", "transforms", "atomic"],
     ["eval"],
@@ -108,10 +108,9 @@ OCC_LAZY = {
     "surfmod.occ.isolated": "read_step_file overlaps its own OCCT import with the reader process's",
 }
 
-#: the CAM branch moves these into surfmod/cam and reshapes them (issue 23, its CAM item):
-#: their function-level imports are checked once it has merged (then this is empty)
-CAM_BRANCH = ("surfmod.uses.toolpath", "surfmod.uses.toolpath_exact", "surfmod.uses.toolpath_moves",
-              "surfmod.uses.drop_cutter", "surfmod.io.gcode", "surfmod.occ.cam")
+#: the CAM helper's modules (issue 23's CAM item, issue 26): their function-level imports
+#: and names are its to settle; checked here once it has (then this is empty)
+CAM_BRANCH = ("surfmod.cam.toolpath", "surfmod.occ.triangulation")
 
 #: import cycles that another branch removes (each says which); empty once merged
 KNOWN_CYCLES: set[frozenset] = {
@@ -120,10 +119,7 @@ KNOWN_CYCLES: set[frozenset] = {
 }
 
 #: upward imports that another branch removes (each says which); empty once merged
-KNOWN_UPWARD: set[tuple[str, str]] = {
-    # the tool-path code and its G-code writer move together into surfmod/cam (issue 23, CAM)
-    ("surfmod.uses.toolpath", "surfmod.io.gcode"),
-}
+KNOWN_UPWARD: set[tuple[str, str]] = set()
 
 
 def scan(package_root: Path):
@@ -363,7 +359,7 @@ def test_module_names_are_unique_or_the_same_concept():
     assert not bad, "modules of one name in several packages whose docstring does not say why:\n" + "\n".join(bad)
 
 
-@pytest.mark.parametrize("key", [k for names in RANKS for k in names if k != "cam"])  # cam: the CAM branch adds it
+@pytest.mark.parametrize("key", [k for names in RANKS for k in names])
 def test_rank_table_names_a_module(key):
     assert any(n.split(".")[1:2] == [key] for n in MODULES), f"{key}: no such module or package"
 

@@ -1,6 +1,6 @@
 """``surfmod toolpath FILE.step --tool ball --radius R --scallop h --out path.nc``.
 
-The same concept as :mod:`surfmod.uses.toolpath`, one level up: the command over it.
+The same concept as :mod:`surfmod.cam.toolpath`, one level up: the command over it.
 """
 
 from __future__ import annotations
