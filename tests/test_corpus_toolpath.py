@@ -18,7 +18,7 @@ from toolpath_reference import ball_clearance, flat_cuts, gcode_positions, mater
 
 from surfmod.cli import main as cli_main
 from surfmod.occ.triangulation import bounding_box
-from surfmod.uses.inputs import to_shape
+from surfmod.inputs import to_shape
 
 RADIUS_SHARE = 0.03
 SCALLOP_SHARE = 0.1

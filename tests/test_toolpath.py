@@ -18,7 +18,7 @@ from surfmod.cli import main as cli_main
 from surfmod.occ.triangulation import part_triangles
 from surfmod.cam import toolpath_moves
 from surfmod.cam.drop_cutter import TriangleGrid, drop
-from surfmod.uses.inputs import to_shape
+from surfmod.inputs import to_shape
 from surfmod.cam.toolpath import drop_cutter
 
 CORPUS_PART = "trimesh_featuretype.STEP"
@@ -185,7 +185,7 @@ def test_gcode_export(tmp_path):
 @pytest.mark.parametrize("make, arg", [
     (lambda: sm.Tool("ball", 0), "radius"),
     (lambda: sm.Tool("ball", -1), "radius"),
-    (lambda: sm.Tool("bull", 1), "kind"),
+    (lambda: sm.Tool("cone", 1), "kind"), (lambda: sm.Tool("bull", 1), "corner_radius"), (lambda: sm.Tool("bull", 1, 1), "corner_radius"),
     (lambda: sm.toolpath(bumpy(), sm.Tool("ball", 1), stepover=2.5), "stepover"),
     (lambda: sm.toolpath(bumpy(), sm.Tool("ball", 1), scallop=1.0), "scallop"),
     (lambda: sm.toolpath(bumpy(), sm.Tool("flat", 1), scallop=0.1), "scallop"),

@@ -2,7 +2,7 @@
 
 The part is every face of the input (walls, undersides and trimmed faces included), meshed
 by OCCT's BRepMesh inside each face's trim at a chordal deflection of 40 % of the
-gouge ``tolerance``.  The end mill (ball or flat end, with a shank of its own radius up to
+gouge ``tolerance``.  The end mill (ball, flat or bull nose, with a shank of its own radius up to
 infinity) is dropped onto that mesh in closed form (:mod:`surfmod.cam.drop_cutter`), so a
 cutter location touches but never enters the triangles; where BRepMesh reports a larger
 deflection than asked for (faces of real parts that cannot be meshed finer than their own
@@ -28,8 +28,9 @@ from .. import checks
 from ..errors import SurfmodError
 from .gcode import gcode_text
 from .drop_cutter import TriangleGrid, drop
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from .toolpath_exact import exact_heights
+from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
@@ -38,46 +39,6 @@ MESH_SHARE = 0.4
 REFINE_SHARE = 0.5
 # More cutter locations than this is a mistake in step/stepover, not a finishing path.
 MAX_LOCATIONS = 2_000_000
-
-
-@dataclass(frozen=True)
-class Tool:
-    """An end mill: ``kind`` ``"ball"`` or ``"flat"``, ``radius`` > 0.
-
-    >>> import surfmod as sm
-    >>> t = sm.Tool("ball", 3.0)
-    >>> round(t.stepover_for_scallop(0.01), 6)
-    0.48949
-    """
-
-    kind: str
-    radius: float
-
-    def __post_init__(self):
-        if self.kind not in ("ball", "flat"):
-            raise SurfmodError(f"tool: kind must be 'ball' or 'flat', got {self.kind!r}")
-        object.__setattr__(self, "radius", checks.positive(self.radius, "tool radius"))
-
-    @property
-    def diameter(self) -> float:
-        return 2.0 * self.radius
-
-    def stepover_for_scallop(self, scallop: float) -> float:
-        """Stepover giving cusps of height ``scallop`` on flat ground (ball cutters):
-        ``2 sqrt(2 r h − h²)``."""
-        h = checks.positive(scallop, "scallop")
-        if self.kind != "ball":
-            raise SurfmodError("scallop: a flat end mill leaves no scallop on flat ground; give stepover instead")
-        if h >= self.radius:
-            raise SurfmodError(f"scallop: must be smaller than the tool radius {self.radius:g}, got {h:g}")
-        return float(2.0 * np.sqrt(2.0 * self.radius * h - h * h))
-
-    def scallop_for_stepover(self, stepover: float) -> float:
-        """Cusp height on flat ground for a given stepover (0 for a flat end mill)."""
-        if self.kind != "ball":
-            return 0.0
-        r = self.radius
-        return float(r - np.sqrt(max(r * r - (stepover / 2.0) ** 2, 0.0)))
 
 
 @dataclass(frozen=True)
@@ -128,7 +89,9 @@ class Toolpath:
 
     def __str__(self) -> str:
         return (
-            f"toolpath: {self.tool.kind} end mill r={self.tool.radius:g}, {self.n_passes} passes along {self.direction}, "
+            f"toolpath: {self.tool.kind} end mill r={self.tool.radius:g}"
+            + (f" corner r={self.tool.corner_radius:g}" if self.tool.kind == "bull" else "")
+            + f", {self.n_passes} passes along {self.direction}, "
             f"{len(self.points)} points, stepover {self.stepover:.6g} (scallop {self.scallop:.3g} on flat ground), "
             f"length {self.length:.6g}, every move checked: max gouge {max(self.gouge + self.deflection, 0.0):.2e} "
             f"(tolerance {self.tolerance:.2e})"
@@ -144,6 +107,7 @@ class _Part:
 
     grid: TriangleGrid
     kind: str
+    corner: float
     deflection: float
     lift: float
     box: np.ndarray
@@ -152,7 +116,7 @@ class _Part:
 
     def height(self, xy: np.ndarray) -> np.ndarray:
         """Tip heights at ``xy`` (N, 2), NaN where the tool touches nothing."""
-        return drop(self.grid, self.kind, xy) + self.lift
+        return drop(self.grid, self.kind, xy, corner=self.corner) + self.lift
 
 
 def _part(obj, tool: Tool, tolerance: float) -> _Part:
@@ -166,7 +130,7 @@ def _part(obj, tool: Tool, tolerance: float) -> _Part:
         raise NoSafePathError(f"toolpath: no safe path: {exc}") from None
     points = triangles.reshape(-1, 3)
     box = np.array([points.min(axis=0), points.max(axis=0)])
-    return _Part(TriangleGrid(triangles, tool.radius), tool.kind, max(measured, requested),
+    return _Part(TriangleGrid(triangles, tool.radius), tool.kind, tool.corner, max(measured, requested),
                  max(measured - requested, 0.0), box, faces, owner)
 
 
@@ -199,10 +163,11 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     cl = checks.finite_array(xy, "xy", ndim=2, last=2)
     tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
     part = _part(obj, tool, tolerance)
-    z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True)
+    z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True, corner=part.corner)
     z = z + part.lift
     if exact:
-        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.kind, tool.radius)
+        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.kind, tool.radius,
+                                       tool.corner)
     return z, contacts
 
 
@@ -320,7 +285,7 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
             raise NoSafePathError(
                 f"toolpath: no safe path: move {worst + 1} still cuts {gouge + part.deflection - part.lift:.3g} "
                 f"deep, more than the tolerance {tolerance:.3g}")
-        _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True)
+        _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
         bar.update()
     actual = float(np.diff(across).max()) if len(across) > 1 else 0.0
     return Toolpath(checks.frozen(points), checks.frozen(contacts), index, tool, actual, step,

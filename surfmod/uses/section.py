@@ -15,7 +15,7 @@ from ..construct.from_edge import from_edge
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
 from ..readback import read_curve
-from .inputs import to_shape
+from ..inputs import to_shape
 
 
 def plane_frame(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray]:
