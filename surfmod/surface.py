@@ -98,6 +98,12 @@ class Surface(Immutable, abc.ABC):
         so no pass over the output is needed; subclasses that can bound them override."""
         return False
 
+    def _closest_parameters(self, points: np.ndarray):
+        """``(u, v)`` of the closest points of the domain to ``(N, 3)`` points where the
+        surface has them in closed form (the elementary surfaces), else ``None``: then
+        :func:`surfmod.ops.closest.closest_points` seeds and iterates."""
+        return None
+
     def _grid_derivatives(self, us: np.ndarray, vs: np.ndarray, order: int) -> np.ndarray:
         """``(len(us), len(vs), K, K, 3)``; subclasses override with a faster tensor path."""
         uu, vv = np.meshgrid(us, vs, indexing="ij")
@@ -250,6 +256,13 @@ class Surface(Immutable, abc.ABC):
 
         (u0, u1), (v0, v1) = self.domain
         return face_from_surface(self.geom(), u0, u1, v0, v1)
+
+    def _repr_png_(self) -> bytes | None:
+        """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        # cycle: surfmod.surface <-> surfmod.meshing.render (the picture tessellates surfaces)
+        from .meshing.render import repr_png
+
+        return repr_png(self)
 
     # -- named transforms (all through ``transformed``) ----------------------------------
     def translated(self, vector) -> "Surface":

@@ -9,6 +9,13 @@ from OCP.Message import Message, Message_Gravity
 from ..errors import SurfmodError
 from .fullprecision import write_step_full
 from .guard import kernel
+from OCP.BRep import BRep_Builder
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.STEPControl import STEPControl_Reader
+from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shell, TopoDS_Solid
 
 
 def _quiet_messages() -> None:
@@ -22,9 +29,6 @@ _quiet_messages()
 
 def compound(shapes):
     """One TopoDS_Compound of the given TopoDS shapes."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
-
     builder = BRep_Builder()
     comp = TopoDS_Compound()
     builder.MakeCompound(comp)
@@ -36,11 +40,6 @@ def compound(shapes):
 def _solid_shells_forward(solid):
     """``solid`` (as stored) with each REVERSED shell replaced by :func:`_forward_shell`,
     or ``solid`` itself when none is reversed."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopAbs import TopAbs_REVERSED, TopAbs_SHELL
-    from OCP.TopLoc import TopLoc_Location
-    from OCP.TopoDS import TopoDS_Iterator, TopoDS_Solid
-
     children, changed = [], False
     it = TopoDS_Iterator(solid, False, False)  # the shells as the solid holds them
     while it.More():
@@ -56,7 +55,7 @@ def _solid_shells_forward(solid):
     builder.MakeSolid(out)
     for child in children:
         builder.Add(out, child)
-    out.Location(solid.Location() if not solid.Location().IsIdentity() else TopLoc_Location())
+    out.Location(solid.Location())
     out.Orientation(solid.Orientation())
     return out
 
@@ -64,9 +63,6 @@ def _solid_shells_forward(solid):
 def _forward_shell(shell):
     """The same faces in a FORWARD shell: each face's orientation composed with the
     shell's (and its location with the shell's), so the faces face the same way."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Iterator, TopoDS_Shell
-
     builder = BRep_Builder()
     out = TopoDS_Shell()
     builder.MakeShell(out)
@@ -83,10 +79,6 @@ def map_solids(shape, fn):
     itself to keep it); compounds that hold a replaced solid are rebuilt with their own
     location and orientation, everything else is shared.  ``shape`` itself when nothing
     changes."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_SOLID
-    from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator
-
     kind = shape.ShapeType()
     if kind == TopAbs_SOLID:
         return fn(shape)
@@ -117,17 +109,15 @@ def write_step(shape, path: str) -> None:
     (OCCT's default 12 digits move poles by up to ~5e-13 relative).
 
     A solid whose shell is used REVERSED (OCCT's reader makes one of a file's inside-out
-    closed shell) is written with that shell's faces reversed instead: STEP's
-    CLOSED_SHELL carries no orientation, so OCCT's writer drops the flag and the file
-    read again would be inside out (negative volume)."""
+    closed shell) is written as a FORWARD shell of its faces reversed: the same solid, and
+    the file holds every face the way it faces, for any reader (a STEP CLOSED_SHELL has
+    no orientation of its own)."""
     write_step_full(map_solids(shape, _solid_shells_forward), path)
 
 
 def read_with(reader, kind: str, path: str):
     """One TopoDS shape from ``path`` through an OCCT ``XSControl_Reader`` subclass
     instance (STEP, IGES); unreadable files raise ``SurfmodError`` naming ``kind``."""
-    from OCP.IFSelect import IFSelect_RetDone
-
     with kernel(f"{type(reader).__name__}"):
         if reader.ReadFile(str(path)) != IFSelect_RetDone:
             raise SurfmodError(f"path: {path} is not a readable {kind} file")
@@ -149,9 +139,6 @@ def outward_solids(shape):
     out.  The sign of the volume (the divergence theorem over the faces as oriented)
     decides instead.
     """
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
     def outward(solid):
         props = GProp_GProps()
         BRepGProp.VolumeProperties_s(solid, props)
@@ -164,6 +151,4 @@ def outward_solids(shape):
 def read_step(path: str):
     """Read a STEP file into one TopoDS shape, its solids :func:`outward_solids`;
     unreadable files raise ``SurfmodError``."""
-    from OCP.STEPControl import STEPControl_Reader
-
     return outward_solids(read_with(STEPControl_Reader(), "STEP", path))

@@ -36,8 +36,8 @@ from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_derivatives, find_spans
 from ..nets.bspline import BSplineSurface
-from ..ops.closest import newton_closest
-from ..ops.project import project
+from .closest import newton_closest
+from .project import project
 from ..surface import Surface
 
 #: points per chunk when assembling the normal equations (memory bound)

@@ -10,7 +10,7 @@ from ..atomic import atomic_path, target_path
 
 
 def _is_toolpath(obj) -> bool:
-    """Duck typing (no import of ``uses``, which imports this writer): a tool path has
+    """Duck typing (no import of ``toolpath``, which imports this writer): a tool path has
     ``(N, 3)`` points and a tool with a kind and a radius."""
     points = getattr(obj, "points", None)
     tool = getattr(obj, "tool", None)

@@ -1,6 +1,6 @@
-"""Trimmed planar faces in closed form: their mass integrals from boundary integrals alone.
+"""Stage five of the mass pipeline (:mod:`surfmod.mass`): trimmed planar faces in closed form, their mass integrals from boundary integrals alone.
 
-On a plane ``S = O + u X + v Y`` every integrand of :mod:`surfmod.uses.mass` is a
+On a plane ``S = O + u X + v Y`` every integrand of :mod:`surfmod.mass` is a
 polynomial of degree at most 3 in ``(u, v)`` (``x_i² x_j n_i`` with ``x`` affine and ``n``
 constant), so a face's share is fixed by the ten moments ``M_pq = ∫∫_D a^p b^q`` of its
 parameter region ``D`` (``p + q ≤ 3``, ``a, b`` the parameters shifted to the foot of the
@@ -10,10 +10,10 @@ with the inner antiderivative written out,
     M_pq = ∮ [∫_{u0}^{u} (s - uc)^p ds] b^q dv,
 
 the inner integral from the face box's edge ``u0`` exactly as the node-by-node rule of
-:mod:`surfmod.uses.mass_green` takes it (so a boundary whose p-curves leave gaps gives the
+:mod:`surfmod.mass.nodes` takes it (so a boundary whose p-curves leave gaps gives the
 same result as there), evaluated as ``(u - u0) Σ A^k B^(p-k) / (p + 1)`` without
 cancellation.  The outer integral runs on the same Gauss nodes of the p-curves
-(:func:`surfmod.uses.mass_boundary.boundaries`: 3 per straight piece, exact); on faces
+(:func:`surfmod.mass.boundary.boundaries`: 3 per straight piece, exact); on faces
 bounded by lines and circles only (plates with holes, slots) the same nodes are laid
 directly, all such faces at once (:func:`_line_nodes`, :func:`_arc_nodes`), without the
 boundary pass (its cuts, crossings and p-curve table serve curved p-curves).  Then with
@@ -26,9 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mass_green import face_boundary, is_conic  # noqa: F401 (is_conic re-exported)
-from .mass_boundary import _FRACTIONS, PIECES  # noqa: F401
-from .mass_grid import gauss
+from .nodes import face_boundary, is_conic  # noqa: F401 (is_conic re-exported)
+from .boundary import _FRACTIONS, PIECES  # noqa: F401
+from .rules import gauss
 
 # the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
 # product e_i e_j e_k is (T3[i, j, k] = M[_CUBE[i, j, k]]), likewise for fewer factors
@@ -94,7 +94,7 @@ def _region_moments(faces: list, foot: np.ndarray, order: int):
 
 def _line_nodes(lines: list):
     """``(P, dP, weights, owner)``: 3 Gauss nodes on each straight p-curve of ``lines``
-    (``(owner, record)`` pairs), the values :func:`surfmod.uses.mass_boundary.boundaries`
+    (``(owner, record)`` pairs), the values :func:`surfmod.mass.boundary.boundaries`
     gives a line on a plane (one piece, its ends; the weights signed by the edge's
     orientation)."""
     live = [rec for _, rec in lines if rec["range"][1] > rec["range"][0]]
@@ -113,7 +113,7 @@ def _line_nodes(lines: list):
 
 def _arc_nodes(arcs: list, order: int):
     """``(P, dP_v · weights, owner)``: the Gauss nodes
-    :func:`surfmod.uses.mass_boundary.boundaries` lays on circular p-curves of a plane
+    :func:`surfmod.mass.boundary.boundaries` lays on circular p-curves of a plane
     (``arcs``: ``(owner, record)`` pairs): ``order`` nodes on each of ``PIECES`` equal
     pieces of the range, ``P(t) = C + r (cos t X + sin t Y)``, the weights signed by the
     edge's orientation and multiplied by ``dv/dt``."""
@@ -138,13 +138,13 @@ def _arc_nodes(arcs: list, order: int):
 
 def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]:
     """``(F, 14)`` ``[area, V, M(3), S(3, 3)]`` of trimmed planar faces (each a
-    :class:`~surfmod.uses.mass_green.MassFace` with its frame), the sums
-    :func:`surfmod.uses.mass._moments` makes of their quadrature nodes, in closed form
+    :class:`~surfmod.mass.nodes.MassFace` with its frame), the sums
+    :func:`surfmod.mass.moments._moments` makes of their quadrature nodes, in closed form
     from the moments of their parameter regions (module notes); and per face whether no
     rule depended on ``order`` (straight p-curves only).
 
     >>> import surfmod as sm, build123d as bd
-    >>> from surfmod.uses.mass_green import mass_face
+    >>> from surfmod.mass.nodes import mass_face
     >>> disc = mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(2.0))))
     >>> m, exact = plane_moments([disc], 12, np.zeros(3))
     >>> bool(abs(m[0, 0] - 4 * np.pi) < 1e-13), bool(exact[0])

@@ -1,4 +1,4 @@
-"""Quadrature nodes for the surface integrals of :mod:`surfmod.uses.mass`, face by face.
+"""Stage four of the mass pipeline (:mod:`surfmod.mass`): faces prepared for quadrature and their nodes, face by face.
 
 A face contributes ``∫∫_D g(u, v) du dv`` over its parameter region ``D`` for the
 integrands ``g`` of the divergence theorem (``x·n``, ``x_i² n_i``, ``x_i³ n_i``, ...).
@@ -10,7 +10,7 @@ integrands ``g`` of the divergence theorem (``x·n``, ``x_i² n_i``, ``x_i³ n_i
   direction ``v``): Gauss on the exact p-curves of the boundary (outer integral),
   and the inner integral from the face box's edge to each boundary node, either by
   Gauss node by node or, where that evaluates fewer points, on one fixed grid per cell
-  (inner span × outer span, :func:`surfmod.uses.mass_grid.grid_nodes`): the integrands' tensor interpolant at
+  (inner span × outer span, :func:`surfmod.mass.rules.grid_nodes`): the integrands' tensor interpolant at
   Chebyshev points, whose inner antiderivative is exact, so every boundary node only adds
   weights to the grid points and the surface is evaluated on the grids alone (exact
   where the surface is a polynomial in both directions; ``2 order`` points per span
@@ -29,7 +29,7 @@ splines, curved p-curves on curved faces) takes the caller's ``order`` per piece
 turns on angular directions, knot spans, and at least ``PIECES`` pieces per curved edge.
 
 The p-curves are evaluated from data, all of a face's at once
-(:mod:`surfmod.uses.mass_boundary`).
+(:mod:`surfmod.mass.boundary`).
 """
 
 from __future__ import annotations
@@ -44,10 +44,9 @@ from ..construct.elementary import (ConicalSurface, CylindricalSurface, Elementa
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from ..readback.trimmed import TrimmedFace
-from .faces import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks
-from .mass_boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
-from .mass_grid import (GridJob, exact_order, gauss, green_layout, grid_nodes, grids_nodes, inner_nodes,  # noqa: F401
+from .breaks import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks, is_face
+from .boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
+from .rules import (GridJob, exact_order, gauss, green_layout, grid_nodes, grids_nodes, inner_nodes,  # noqa: F401
                         interpolation_points)
 
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"
@@ -124,7 +123,7 @@ def evaluators(obj):
     >>> grid(u, v, 1).shape
     (2, 2, 2, 2, 3)
     """
-    face = type(obj) is TrimmedFace or isinstance(obj, TrimmedFace)
+    face = is_face(obj)
     surf = obj.surface if face else obj
     if type(surf) not in _ELEMENTARY_DEGREES and not isinstance(surf, ElementarySurface):
         # splines, sweeps, offsets: point by point (their tensor evaluators pay off only
@@ -234,7 +233,7 @@ def _linspace(lo: float, hi: float, num: int) -> np.ndarray:
 
 
 def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
-    """:func:`surfmod.uses.faces._patch_breaks` (angular directions without its general
+    """:func:`surfmod.mass.breaks._patch_breaks` (angular directions without its general
     merging: equal pieces of at most an eighth turn, the same points) and whether the
     direction is an analytic angle (its breaks are no knots)."""
     b = direction_breaks(face, direction)
@@ -420,7 +419,7 @@ def _largest_gap(mf: MassFace) -> float:
 def is_conic(mf) -> bool:
     """Whether a trimmed planar face is bounded by straight and circular p-curves only
     (holes, slots, rounded pockets): its boundary's Gauss nodes are then laid directly
-    (:func:`surfmod.uses.mass_plane._arc_nodes`), without the boundary pass.
+    (:func:`surfmod.mass.planes._arc_nodes`), without the boundary pass.
 
     >>> import surfmod as sm, build123d as bd
     >>> is_conic(mass_face(sm.from_face(bd.Face(bd.Wire.make_circle(2.0)))))
@@ -431,7 +430,7 @@ def is_conic(mf) -> bool:
 
 
 def _boundary_rule(mf: MassFace, order: int) -> tuple:
-    """The face's entry for :func:`surfmod.uses.mass_boundary.boundaries`: per p-curve the
+    """The face's entry for :func:`surfmod.mass.boundary.boundaries`: per p-curve the
     Gauss order and whether it is exact, the break lines and their kind."""
     orders, exacts = [], []
     for rec in mf.pcurves:
@@ -462,8 +461,8 @@ def face_boundary(mf: MassFace, order: int):
 
 def prepare_boundaries(faces: list, order: int) -> None:
     """The Gauss nodes on the p-curves of every trimmed face of ``faces`` at ``order``, in
-    one pass for all of them (:func:`surfmod.uses.mass_boundary.boundaries`), kept for
-    :func:`face_nodes` / :func:`surfmod.uses.mass_plane.plane_moments`.
+    one pass for all of them (:func:`surfmod.mass.boundary.boundaries`), kept for
+    :func:`face_nodes` / :func:`surfmod.mass.planes.plane_moments`.
 
     >>> import surfmod as sm, build123d as bd
     >>> part = bd.Cylinder(1.0, 4.0) - bd.Box(4, 4, 4).rotate(bd.Axis.X, 30).translate((0, 0, 2.5))
@@ -473,7 +472,7 @@ def prepare_boundaries(faces: list, order: int) -> None:
     [0, 1, 1, 1]
     """
     # planar faces bounded by lines and circles need none (their nodes are laid directly
-    # by surfmod.uses.mass_plane)
+    # by surfmod.mass.planes)
     trimmed = [mf for mf in faces if not mf.natural and mf.pcurves and not is_conic(mf)]
     if trimmed:
         table = None
@@ -495,7 +494,7 @@ def _green(mf: MassFace, order: int, orders, exacts):
 class _GreenPlan:
     """What :func:`_green` decides for a face before its grids are built: the inner
     direction ``k``, the boundary nodes ``P`` with their weights and layout, which of them
-    go onto grids (``job``, a :class:`~surfmod.uses.mass_grid.GridJob`, or None) and the
+    go onto grids (``job``, a :class:`~surfmod.mass.rules.GridJob`, or None) and the
     rest, node by node."""
 
     __slots__ = ("k", "m_in", "P", "wb", "full", "partial", "rest", "job", "counts", "exact")
@@ -546,7 +545,7 @@ def _green_plan(mf: MassFace, order: int, orders, exacts) -> _GreenPlan:
 
 def _green_nodes(mf: MassFace, plan: _GreenPlan, grid):
     """The partials and weights of a planned face: its grid's points (``grid``, from
-    :func:`~surfmod.uses.mass_grid.grids_nodes`) first, then the rest node by node."""
+    :func:`~surfmod.mass.rules.grids_nodes`) first, then the rest node by node."""
     k, rest = plan.k, plan.rest
     parts, weights = [], []
     if grid is not None:  # on the surface's tensor evaluator
@@ -562,7 +561,7 @@ def _green_nodes(mf: MassFace, plan: _GreenPlan, grid):
 
 
 #: faces whose grids have at most this many cells (inner × outer spans) share one
-#: :func:`~surfmod.uses.mass_grid.grids_nodes` pass, in batches of at most
+#: :func:`~surfmod.mass.rules.grids_nodes` pass, in batches of at most
 #: ``GRID_BATCH_CELLS`` padded cells (bounded memory: ``ks kt`` weights per cell)
 GRID_BATCH_FACE_CELLS = 64
 GRID_BATCH_CELLS = 1024
@@ -571,7 +570,7 @@ GRID_BATCH_CELLS = 1024
 def faces_nodes(faces: list, order: int) -> list:
     """:func:`face_nodes` of many faces, the same nodes, weights and partials: the Green
     grids of the small trimmed faces (those of a part's many small fillets, tori and cones)
-    built in shared passes (:func:`~surfmod.uses.mass_grid.grids_nodes`), where one pass
+    built in shared passes (:func:`~surfmod.mass.rules.grids_nodes`), where one pass
     per face cost more than its arithmetic.
 
     >>> import surfmod as sm, build123d as bd

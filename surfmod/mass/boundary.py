@@ -1,5 +1,5 @@
-"""Gauss nodes on a face's p-curves, the outer integral of Green's theorem in
-:mod:`surfmod.uses.mass_green`.
+"""Stage three of the mass pipeline (:mod:`surfmod.mass`): the boundary pieces, Gauss nodes on a face's p-curves, the outer integral of Green's theorem in
+:mod:`surfmod.mass.nodes`.
 
 Every p-curve is evaluated from data (:func:`surfmod.occ.pcurves.face_pcurves`): lines,
 circles and B-splines for all nodes at once (B-splines as one polynomial per span, built
@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..eval.basis import basis_derivatives
-from .faces import ANGULAR_PIECE
-from .mass_grid import gauss
+from .breaks import ANGULAR_PIECE
+from .rules import gauss
 
 #: curved p-curves are cut into at least this many pieces before Gauss
 PIECES = 4

@@ -1,4 +1,4 @@
-"""Quadrature rules and Green's theorem grids for :mod:`surfmod.uses.mass_green`.
+"""Stage one of the mass pipeline (:mod:`surfmod.mass`): quadrature rules and Green's theorem grids for :mod:`surfmod.mass.nodes`.
 
 Gauss–Legendre rules (cached), the orders exact for polynomial directions, and the
 inner integrals of Green's theorem: node by node (:func:`inner_nodes`) or on one fixed

@@ -1,16 +1,17 @@
-"""Per-face evaluators on the NumPy side, for quadrature and drop-cutting.
+"""Stage two of the mass pipeline (:mod:`surfmod.mass`): where a face's parametrization
+breaks into pieces that Gauss–Legendre integrates to round-off.
 
-Every face of a shape becomes a :class:`Patch`: its parameter box, its outward sign, the
-break points of its parametrization (knots of splines and of the basis curves of swept
-surfaces; quarter turns on angular directions) and an ``evaluate(u, v, order)`` returning
-``(N, order+1, order+1, 3)`` partials.  Faces are read only through
-:func:`surfmod.from_face` (:mod:`surfmod.readback`), so every surface type the reader
-knows is evaluated by the NumPy evaluator, wherever the face lives.
+Knots of splines and of the basis curves of swept surfaces, eighth turns on angular
+(trigonometric) directions, one piece on polynomial directions.  Faces are those read
+back by :func:`surfmod.from_face`: a ``TrimmedFace`` (which ranks above this package and
+calls it for its ``area()``) is recognized by the OCCT face it carries (:func:`is_face`).
+
+>>> import surfmod as sm
+>>> direction_breaks(sm.sphere(1.0), 0)
+'angular'
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,24 +20,16 @@ from ..construct.conics import Conic
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.offset_surface import OffsetSurface
 from ..construct.revolution import RevolutionSurface
-from ..readback import TrimmedFace, from_face
+from ..surface import Surface
 
 # Gauss–Legendre converges on cos/sin within a quarter turn; pieces on angular directions
 ANGULAR_PIECE = np.pi / 4
 
 
-@dataclass(frozen=True)
-class Patch:
-    index: int
-    kind: str
-    bounds: tuple
-    sign: float
-    natural: bool
-    breaks_u: np.ndarray
-    breaks_v: np.ndarray
-    evaluator: str
-    evaluate: object = field(repr=False)
-    face: object = field(repr=False, default=None)
+def is_face(obj) -> bool:
+    """Whether ``obj`` is a face read back (``surfmod.readback.TrimmedFace``: a surface
+    over an untrimmed ``surface`` that carries its OCCT ``face_shape``)."""
+    return isinstance(getattr(obj, "surface", None), Surface) and "face_shape" in vars(obj)
 
 
 def _breaks(lo: float, hi: float, knots, periodic_piece: float | None, period: float | None = None) -> np.ndarray:
@@ -67,7 +60,7 @@ def _curve_breaks(curve):
 def direction_breaks(surface, direction: int):
     """What splits a surface's parametrization in one direction: knots (array),
     ``"angular"`` (trigonometric) or None (polynomial, one piece)."""
-    if isinstance(surface, TrimmedFace):
+    if is_face(surface):
         surface = surface.surface
     if isinstance(surface, OffsetSurface):
         return direction_breaks(surface.base, direction)
@@ -94,33 +87,3 @@ def _patch_breaks(surface, lo, hi, direction, period):
     if isinstance(b, str):
         return _breaks(lo, hi, None, ANGULAR_PIECE)
     return _breaks(lo, hi, b, None, period)
-
-
-def face_patch(face: TrimmedFace, index: int = 0) -> Patch:
-    """The :class:`Patch` of one face read back with :func:`surfmod.from_face`."""
-    from ..occ.uses import is_rectangle
-
-    u0, u1, v0, v1 = (b for r in face.domain for b in r)
-    bu = _patch_breaks(face, u0, u1, 0, face.periods[0])
-    bv = _patch_breaks(face, v0, v1, 1, face.periods[1])
-    return Patch(index, face.geom().DynamicType().Name(), (u0, u1, v0, v1), -1.0 if face.reversed else 1.0,
-                 is_rectangle(face.face_shape, (u0, u1, v0, v1)), bu, bv, "numpy", face._derivatives, face.face_shape)
-
-
-def surface_patch(surf, index: int = 0) -> Patch:
-    """A :class:`Patch` for a surfmod surface over its whole domain (NumPy evaluator)."""
-    (u0, u1), (v0, v1) = surf.domain
-    breaks = []
-    for direction, (lo, hi) in enumerate(surf.domain):
-        b = direction_breaks(surf, direction)
-        # analytic directions without knots: eight pieces keep Gauss converged
-        breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None else _breaks(lo, hi, b, None))
-    return Patch(index, type(surf).__name__, (u0, u1, v0, v1), 1.0, True, breaks[0], breaks[1],
-                 "numpy", surf._derivatives, None)
-
-
-def patches(shape) -> list[Patch]:
-    """Patches for every face of an OCCT or build123d shape."""
-    from ..occ.topo import faces_of
-
-    return [face_patch(from_face(f), i) for i, f in enumerate(faces_of(shape))]

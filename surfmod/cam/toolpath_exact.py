@@ -1,7 +1,7 @@
-"""Drop-cutter heights on the exact faces, polished from the mesh's (ball and flat end
-mills).
+"""Drop-cutter heights on the exact faces, polished from the mesh's (ball, flat and bull
+nose end mills).
 
-The mesh drop (:mod:`surfmod.uses.drop_cutter`) is exact for BRepMesh's triangles, which
+The mesh drop (:mod:`surfmod.cam.drop_cutter`) is exact for BRepMesh's triangles, which
 are chords of the faces.  Where the tool touches a face inside its trim, the exact cutter
 location solves two equations in the face's ``(u, v)``, with ``S`` the face point, ``N``
 its upward unit normal and ``(x, y)`` the tool axis:
@@ -12,7 +12,12 @@ its upward unit normal and ``(x, y)`` the tool axis:
   ``R`` from the axis, towards where the face rises, and the rim is tangent to the face
   there, so ``S_xy + R N_xy / |N_xy| = (x, y)``, and the tip height is ``S_z``;
 - flat end touching with its bottom (a summit of the face under the disc): ``N_xy = 0``
-  at a point within ``R`` of the axis, and the tip height is ``S_z`` there.
+  at a point within ``R`` of the axis, and the tip height is ``S_z`` there;
+- bull nose of radius ``R`` and corner ``c`` touching with its torus: the tube's centre
+  ``S + c N`` lies on the ring of radius ``a = R - c``, ``a`` uphill of the axis, so
+  ``(S + c N)_xy + a N_xy / |N_xy| = (x, y)``, and the tip height is ``(S + c N)_z - c``
+  (the ball's equations for ``a = 0``, the rim's for ``c = 0``); with its core on a summit,
+  as a flat end of radius ``a``.
 
 Newton's method solves them for every location at once (per face, vectorized), started
 from the projection of the mesh contact onto the face; the Jacobian comes from central
@@ -58,6 +63,14 @@ def _rim_axis(face, u, v, radius: float):
     s, n = _frames(face, u, v)
     level = np.linalg.norm(n[..., :2], axis=-1, keepdims=True)
     return s[..., :2] + radius * n[..., :2] / np.where(level > 0, level, 1.0)
+
+
+def _torus_axis(face, u, v, radius: float, corner: float):
+    """``(S + c N)_xy + a N_xy / |N_xy|``: the axis of a bull nose whose torus touches the
+    face at ``(u, v)``."""
+    s, n = _frames(face, u, v)
+    level = np.linalg.norm(n[..., :2], axis=-1, keepdims=True)
+    return (s + corner * n)[..., :2] + (radius - corner) * n[..., :2] / np.where(level > 0, level, 1.0)
 
 
 def _slope(face, u, v, radius: float):
@@ -153,6 +166,42 @@ def polish_flat(face, xy: np.ndarray, contacts: np.ndarray, radius: float):
     return z, touch, on
 
 
+def polish_bull(face, xy: np.ndarray, contacts: np.ndarray, radius: float, corner: float):
+    """:func:`polish_ball` for a bull nose of ``radius`` and ``corner`` radius: the torus's
+    contact where the mesh contact lies on it, the core's (a summit) where it lies within
+    the flat core.
+
+    >>> import surfmod as sm, build123d as bd, numpy as np
+    >>> face = sm.from_face(bd.Sphere(5.0).faces()[0])
+    >>> z, contact, ok = polish_bull(face, np.array([[3.0, 0.0]]), np.array([[2.0, 0.0, 4.58]]), 1.0, 0.5)
+    >>> # the tube centre on the sphere of radius 5.5 at x = 3 - 0.5: tip = sqrt(5.5² - 2.5²) - 0.5
+    >>> bool(ok[0]), bool(abs(z[0] - (np.sqrt(5.5**2 - 2.5**2) - 0.5)) < 1e-12)
+    (True, True)
+    """
+    core = radius - corner
+    u, v = _start(face, contacts)
+    z, touch = np.full(len(xy), np.nan), np.full((len(xy), 3), np.nan)
+    on = np.zeros(len(xy), bool)
+    torus = np.linalg.norm(contacts[:, :2] - xy, axis=1) >= core * (1.0 - 1e-6)
+    rows = np.flatnonzero(torus)
+    if rows.size:
+
+        def axis(face, u, v, r):
+            return _torus_axis(face, u, v, r, corner)
+
+        ur, vr, hit = _solve(face, axis, xy[rows], u[rows], v[rows], radius, radius)
+        p, n = _frames(face, ur, vr)
+        hit &= (n[:, 2] > 0) & (np.linalg.norm(n[:, :2], axis=1) > 0)
+        z[rows], touch[rows], on[rows] = _inside(face, ur, vr, hit, p[:, 2] + corner * n[:, 2] - corner, p)
+    rows = np.flatnonzero(~torus)
+    if rows.size:  # the core on a summit
+        ur, vr, hit = _solve(face, _slope, np.zeros((rows.size, 2)), u[rows], v[rows], radius, 1.0)
+        p = _frames(face, ur, vr)[0]
+        hit &= np.linalg.norm(p[:, :2] - xy[rows], axis=1) <= core
+        z[rows], touch[rows], on[rows] = _inside(face, ur, vr, hit, p[:, 2], p)
+    return z, touch, on
+
+
 def _inside(face, u, v, on, z, p):
     """Heights and contacts where ``on`` and the contact lies inside the face's trim."""
     on = on.copy()
@@ -162,14 +211,19 @@ def _inside(face, u, v, on, z, p):
 
 
 def exact_heights(faces, owner: np.ndarray, xy: np.ndarray, z: np.ndarray, contacts: np.ndarray,
-                  touched: np.ndarray, kind: str, radius: float):
-    """Mesh heights ``z`` of a ``kind`` (``"ball"`` or ``"flat"``) end mill polished on
+                  touched: np.ndarray, kind: str, radius: float, corner: float = 0.0):
+    """Mesh heights ``z`` of a ``kind`` (``"ball"``, ``"flat"`` or ``"bull"`` with its
+    ``corner`` radius) end mill polished on
     the exact faces: ``faces`` (OCCT faces), ``owner`` (face index of each mesh
     triangle), ``touched`` (triangle the tool rests on, -1 for none).  Returns the
     heights, the contact points (exact where polished) and a mask of the locations
     polished (the others keep their mesh height: the tool rests on an edge or vertex, or
     touches nothing)."""
-    polish = polish_ball if kind == "ball" else polish_flat
+    if kind == "bull":
+        def polish(face, xy, contacts, radius):
+            return polish_bull(face, xy, contacts, radius, corner)
+    else:
+        polish = polish_ball if kind == "ball" else polish_flat
     z = np.array(z, dtype=float)
     contacts = np.array(contacts, dtype=float)
     polished = np.zeros(len(z), bool)

@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import os
 
-from ..errors import SurfmodError
-from ..surface import Surface
+from .errors import SurfmodError
+from .surface import Surface
 
 
 def load_step(path, name: str = "obj"):
     """The TopoDS shape in a STEP file, read in the isolated reader process
     (:func:`surfmod.import_step`); unreadable or damaged files raise ``SurfmodError``."""
-    from ..occ.isolated import read_step_file
+    from .occ.isolated import read_step_file
 
     return read_step_file(path, name)
 
@@ -38,7 +38,7 @@ def _single(item, name):
 def to_shape(obj, name: str = "obj", *, solid: bool = False):
     """The OCCT shape for ``obj``; with ``solid=True`` a closed, outward-oriented solid
     (open shells raise ``SurfmodError``)."""
-    from ..occ import uses as occ
+    from .occ import uses as occ
 
     if isinstance(obj, (str, os.PathLike)):
         shape = load_step(obj, name)
@@ -48,7 +48,7 @@ def to_shape(obj, name: str = "obj", *, solid: bool = False):
         faces = [_single(o, name) for o in obj]
         if solid:
             return occ.sew_solid(faces)
-        from ..occ.exchange import compound
+        from .occ.exchange import compound
 
         shape = compound(faces)
     else:

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..ops.closest import closest_points
+from .closest import closest_points
 from ..surface import Surface
-from .trimmed import TrimmedFace, from_face
+from ..readback.trimmed import TrimmedFace, from_face
 
 
 def as_face_surface(value):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..construct.blend import blend
+from ..ops.blend import blend
 from ..construct.elementary import CylindricalSurface
 from ..construct.fill import fill
 from ..construct.offset import thicken

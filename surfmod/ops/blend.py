@@ -26,8 +26,10 @@ from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
 from ..nets import knots as kn
 from ..nets.bspline import BSplineSurface, cartesian
+from ..nets.convert import as_bspline_surface
 from ..nets.elevate import KNOT_TOL, elevate_degree
-from ..ops.continuity import _as_surface, SIDES
+from ..sides import SIDES
+from .continuity import _as_surface
 from ..surface import Surface
 
 ORDERS = {"G0": 0, "G1": 1, "G2": 2}
@@ -43,36 +45,6 @@ class BlendSurface(BSplineSurface):
     sides: tuple = ()
     continuity_order: str = "G2"
     tension: tuple = (1.0, 1.0)
-
-
-def as_bspline_surface(s: Surface, name: str) -> BSplineSurface:
-    """An exact, clamped B-spline form of ``s`` (OCCT's ``GeomConvert`` for analytic
-    surfaces; the parametrization may differ, the geometry and the side names do not)."""
-    if isinstance(s, BSplineSurface):
-        out = s.to_bspline()
-        return out.segment(*out.domain) if not _clamped(out) else out
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"{name}: expected a surfmod surface, got {type(s).__name__}")
-    if not s.exact_in_occt:
-        raise SurfmodError(f"{name}: {type(s).__name__} has no exact B-spline form (fit it first)")
-    from ..occ.filling import bspline_over
-
-    (u0, u1), (v0, v1) = s.domain
-    data = bspline_over(s.geom(), (u0, u1, v0, v1))
-    out = BSplineSurface(data["control_points"], data["degree"], data["knots"], data["weights"])
-    corners = s.points(np.array([u0, u1, u0, u1]), np.array([v0, v0, v1, v1]))
-    (a0, a1), (b0, b1) = out.domain
-    mine = out.points(np.array([a0, a1, a0, a1]), np.array([b0, b0, b1, b1]))
-    if not np.allclose(corners, mine, atol=1e-9 * max(1.0, np.ptp(corners).max())):
-        raise SurfmodError(f"{name}: OCCT's B-spline conversion changed the parameter directions")
-    return out
-
-
-def _clamped(s: BSplineSurface) -> bool:
-    ok = True
-    for k, p, n in zip(s.knots, s.degree, s.control_points.shape[:2]):
-        ok &= bool(np.all(k[: p + 1] == k[p]) and np.all(k[n:] == k[n]))
-    return ok
 
 
 def side_curves(s: BSplineSurface, side: str, order: int):
@@ -264,7 +236,7 @@ def occt_blend(a: Surface, side_a: str, b: Surface, side_b: str, lateral: BSplin
     >>> import numpy as np, surfmod as sm
     >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
     >>> a, b = sm.BSplineSurface(net), sm.BSplineSurface(net + (6.0, 0.0, 2.0))
-    >>> face, fa, fb = sm.construct.blend.occt_blend(a, "u1", b, "u0", sm.blend(a, "u1", b, "u0"))
+    >>> face, fa, fb = sm.ops.blend.occt_blend(a, "u1", b, "u0", sm.blend(a, "u1", b, "u0"))
     >>> sm.continuity(fa, face).g1 < 0.05
     True
     """

@@ -1,8 +1,9 @@
 """Drop-cutter against a triangle soup, vectorized over (cutter location, triangle) pairs.
 
 The tool is an end mill with an endless shank of its own radius above the tip: a ball
-end (sphere of radius ``r`` centred ``r`` above the tip) or a flat end (a disc at the
-tip).  Dropped along -Z at the cutter location ``(x, y)``, it stops at the lowest tip
+end (sphere of radius ``r`` centred ``r`` above the tip), a flat end (a disc at the
+tip) or a bull nose (a flat core of radius ``a = r - c`` rounded by a torus of corner
+radius ``c``).  Dropped along -Z at the cutter location ``(x, y)``, it stops at the lowest tip
 height where no triangle point lies inside it.  Since the shank is as wide as the end,
 every triangle point within horizontal distance ``r`` of the axis bounds the tip from
 below, so the shank is included without extra work (the "full cutter").
@@ -15,7 +16,14 @@ facet is solved in closed form (as OpenCAMLib does), then the highest contact wi
   falls inside the edge; facet: the centre at ``r`` along the upward unit normal, kept
   when the contact point ``(x, y) - r·n_xy`` lies inside the triangle;
 * flat: vertex ``z`` within the disc; edge: the higher end of the edge's piece inside
-  the disc; facet: the disc's rim point uphill along the plane's gradient, when inside.
+  the disc; facet: the disc's rim point uphill along the plane's gradient, when inside;
+* bull: vertex ``z - f(d)`` with the profile ``f(d) = 0`` on the core (``d ≤ a``) and
+  ``c - sqrt(c² - (d - a)²)`` on the torus; facet: the torus's ring point ``a`` uphill of
+  the axis, pushed out by ``c`` along the normal (the ball's rule for ``a = 0``, the flat
+  end's for ``c = 0``); edge: along the edge ``z(u) - f(d(u))`` is concave (``f`` convex
+  and increasing, ``d`` convex), so its maximum is the one root of the decreasing
+  derivative, found by bisection to rounding (the torus-line contact is a quartic;
+  OpenCAMLib also solves it numerically).
 
 Candidate pairs come from a uniform (x, y) grid of cell size ~``r/2`` holding, for each
 cell, every triangle whose (x, y) box grown by ``r`` meets it.
@@ -196,6 +204,95 @@ def _flat_features(qx, qy, t, r: float):
     return heights, contacts
 
 
+#: Bisection steps for the bull's edge contact: the parameter to 2^-36 of the edge, the
+#: height (second order in it at an interior maximum) to rounding.
+BULL_EDGE_STEPS = 36
+
+
+def _bull_profile(d, a: float, c: float):
+    """Height of the bull's surface above its tip at distance ``d`` from the axis (inf
+    beyond the radius), and its slope ``df/dd``."""
+    t = np.maximum(d - a, 0.0)
+    root = np.sqrt(np.maximum(c * c - t * t, 0.0))
+    inside = d <= a + c
+    f = np.where(inside, c - root, np.inf)
+    slope = np.where(t <= 0, 0.0, np.where(root > 0, t / np.where(root > 0, root, 1.0), np.inf))
+    return f, slope
+
+
+def _bull_edge_argmax(rows, default, lo, hi, dx, dy, ex, ey, ez, A, B, a: float, c: float):
+    """Edge parameter ``u`` in ``[lo, hi]`` maximizing the concave ``u ez - f(d(u))`` at
+    ``rows`` (``default`` elsewhere): bisection on the sign of the decreasing derivative."""
+    u = default.copy()
+    if not rows.size:
+        return u
+    dx, dy, ex, ey, ez, A, B = (w[rows] for w in (dx, dy, ex, ey, ez, A, B))
+    left, right = lo[rows], hi[rows]
+    for _ in range(BULL_EDGE_STEPS):
+        mid = 0.5 * (left + right)
+        ddx, ddy = dx + mid * ex, dy + mid * ey
+        d = np.sqrt(ddx * ddx + ddy * ddy)
+        _, slope = _bull_profile(d, a, c)
+        rate = (mid * A + B) / np.where(d > 0, d, 1.0)  # d'(u)
+        with np.errstate(invalid="ignore"):
+            up = ez > np.where(rate == 0, 0.0, slope * rate)
+        left = np.where(up, mid, left)
+        right = np.where(up, right, mid)
+    u[rows] = 0.5 * (left + right)
+    return u
+
+
+def _bull_features(qx, qy, t, r: float, c: float):
+    """As :func:`_ball_features` for a bull nose of radius ``r`` and corner radius ``c``."""
+    a = r - c
+    heights, contacts = [], []
+    r2 = r * r
+    for j in range(3):
+        px, py, pz = t[3 * j], t[3 * j + 1], t[3 * j + 2]
+        dx, dy = px - qx, py - qy
+        f, _ = _bull_profile(np.sqrt(dx * dx + dy * dy), a, c)
+        heights.append(np.where(np.isfinite(f), pz - f, -np.inf))
+        contacts.append((px, py, pz))
+        # edge p + u e: the piece inside the radius, then the maximum of the concave height
+        k3 = 3 * ((j + 1) % 3)
+        ex, ey, ez = t[k3] - px, t[k3 + 1] - py, t[k3 + 2] - pz
+        A = ex * ex + ey * ey
+        B = ex * dx + ey * dy
+        C = dx * dx + dy * dy - r2
+        disc = B * B - A * C
+        ok = (A > 1e-14 * (A + ez * ez)) & (disc >= 0)
+        root = np.sqrt(np.where(ok, disc, 0.0))
+        Ad = np.where(ok, A, 1.0)
+        lo = np.clip((-B - root) / Ad, 0.0, 1.0)
+        hi = np.clip((-B + root) / Ad, 0.0, 1.0)
+        ok &= hi > lo
+        # a piece wholly on the core (d convex: both ends within a) is highest at an end
+        core = (np.hypot(dx + lo * ex, dy + lo * ey) <= a) & (np.hypot(dx + hi * ex, dy + hi * ey) <= a)
+        u = _bull_edge_argmax(np.flatnonzero(ok & ~core), np.where(ez > 0, hi, lo), lo, hi,
+                              dx, dy, ex, ey, ez, A, B, a, c)
+        ddx, ddy = dx + u * ex, dy + u * ey
+        f, _ = _bull_profile(np.sqrt(ddx * ddx + ddy * ddy), a, c)
+        heights.append(np.where(ok & np.isfinite(f), pz + u * ez - f, -np.inf))
+        contacts.append((px + u * ex, py + u * ey, pz + u * ez))
+    slope = np.hypot(t[9], t[10])
+    scale = np.where(slope > 1e-15, a / np.where(slope > 0, slope, 1.0), 0.0)
+    cx, cy = qx - scale * t[9] - c * t[9], qy - scale * t[10] - c * t[10]
+    z = _plane_z(t, cx, cy)
+    ok = (t[11] > 1e-12) & _inside_xy(t, cx, cy)
+    heights.append(np.where(ok, z + c * t[11] - c, -np.inf))
+    contacts.append((cx, cy, z))
+    return heights, contacts
+
+
+def _features(kind: str, corner: float):
+    """The feature function ``(qx, qy, t, r)`` of a tool kind."""
+    if kind == "ball":
+        return _ball_features
+    if kind == "flat":
+        return _flat_features
+    return lambda qx, qy, t, r: _bull_features(qx, qy, t, r, corner)
+
+
 def _reach(grid: TriangleGrid, kind: str, q: np.ndarray, ti: np.ndarray) -> np.ndarray:
     """Upper bound of the tip height each triangle can give: its highest vertex, lifted
     (ball) by how far the ball can rise over the nearest point of its (x, y) box."""
@@ -216,13 +313,13 @@ def _per_location_max(qi: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
-def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop: np.ndarray):
+def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop: np.ndarray, corner: float = 0.0):
     """Highest tip height ``(N,)`` (-inf if none), its contact ``(N, 3)`` and the index of
     the touched triangle ``(N,)`` (-1 if none) over the
     cell-list entries ``start:stop`` of each location, in blocks of about
     ``PAIRS_PER_BLOCK`` pairs.  Pairs whose upper bound (:func:`_reach`) is below a height
     already reached at their location are skipped."""
-    features = _ball_features if kind == "ball" else _flat_features
+    features = _features(kind, corner)
     z = np.full(len(xy), -np.inf)
     touch = np.full((len(xy), 3), np.nan)
     touched = np.full(len(xy), -1, dtype=np.int64)
@@ -264,9 +361,11 @@ def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop
     return z, touch, touched
 
 
-def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = False, triangles: bool = False):
-    """Tip heights ``(N,)`` (NaN where the tool touches nothing) of the ``kind`` (``"ball"``
-    or ``"flat"``) end mill of the grid's radius dropped at ``xy`` (N, 2); with
+def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = False, triangles: bool = False,
+         corner: float = 0.0):
+    """Tip heights ``(N,)`` (NaN where the tool touches nothing) of the ``kind`` (``"ball"``,
+    ``"flat"`` or ``"bull"`` of corner radius ``corner``) end mill of the grid's radius
+    dropped at ``xy`` (N, 2); with
     ``contacts`` also the contact points ``(N, 3)``, with ``triangles`` also the index of
     the touched triangle ``(N,)`` (-1 where none).
 
@@ -275,10 +374,12 @@ def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = Fals
     >>> drop(TriangleGrid(tri, 1.0), "ball", np.array([[0.0, 0.0], [20.0, 0.0]])).tolist()
     [2.0, nan]
     """
-    if kind not in ("ball", "flat"):
-        raise SurfmodError(f"tool: kind must be 'ball' or 'flat', got {kind!r}")
+    if kind not in ("ball", "flat", "bull"):
+        raise SurfmodError(f"tool: kind must be 'ball', 'flat' or 'bull', got {kind!r}")
+    if kind == "bull" and not 0.0 < corner < grid.radius:
+        raise SurfmodError(f"corner_radius: must be > 0 and < the radius {grid.radius:g}, got {corner!r}")
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     start, stop = grid.segments(xy)
-    z, touch, touched = _best(grid, kind, xy, start, stop)
+    z, touch, touched = _best(grid, kind, xy, start, stop, corner)
     z[~np.isfinite(z)] = np.nan
     return (z,) + ((touch,) if contacts else ()) + ((touched,) if triangles else ()) if contacts or triangles else z

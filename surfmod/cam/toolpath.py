@@ -2,18 +2,18 @@
 
 The part is every face of the input (walls, undersides and trimmed faces included), meshed
 by OCCT's BRepMesh inside each face's trim at a chordal deflection of 40 % of the
-gouge ``tolerance``.  The end mill (ball or flat end, with a shank of its own radius up to
-infinity) is dropped onto that mesh in closed form (:mod:`surfmod.uses.drop_cutter`), so a
+gouge ``tolerance``.  The end mill (ball, flat or bull nose, with a shank of its own radius up to
+infinity) is dropped onto that mesh in closed form (:mod:`surfmod.cam.drop_cutter`), so a
 cutter location touches but never enters the triangles; where BRepMesh reports a larger
 deflection than asked for (faces of real parts that cannot be meshed finer than their own
 tolerance) every height is lifted by the difference.
 
 Every straight G1 move between cutter locations is then checked along its length, not only
-at its ends (:mod:`surfmod.uses.toolpath_moves`): locations are inserted where a move would
+at its ends (:mod:`surfmod.cam.toolpath_moves`): locations are inserted where a move would
 cut deeper than half the tolerance, steps at walls become vertical-level-vertical
 staircases, and a final check on other sample points must find every move within
 ``tolerance - deflection``.  Moves the refinement cannot bring within it are lifted
-(:func:`~surfmod.uses.toolpath_moves.lift_moves`: material is left there, reported as
+(:func:`~surfmod.cam.toolpath_moves.lift_moves`: material is left there, reported as
 ``Toolpath.lifted``); a path that still cuts deeper raises ``SurfmodError``: gouging
 G-code is never returned.  The default tolerance is a tenth of the scallop height.
 """
@@ -26,10 +26,12 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..io.gcode import gcode_text
+from .gcode import gcode_text
+from ..meshing.render import Drawing, polyline_runs, repr_png
 from .drop_cutter import TriangleGrid, drop
-from .inputs import to_shape
+from ..inputs import to_shape
 from .toolpath_exact import exact_heights
+from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
@@ -38,46 +40,6 @@ MESH_SHARE = 0.4
 REFINE_SHARE = 0.5
 # More cutter locations than this is a mistake in step/stepover, not a finishing path.
 MAX_LOCATIONS = 2_000_000
-
-
-@dataclass(frozen=True)
-class Tool:
-    """An end mill: ``kind`` ``"ball"`` or ``"flat"``, ``radius`` > 0.
-
-    >>> import surfmod as sm
-    >>> t = sm.Tool("ball", 3.0)
-    >>> round(t.stepover_for_scallop(0.01), 6)
-    0.48949
-    """
-
-    kind: str
-    radius: float
-
-    def __post_init__(self):
-        if self.kind not in ("ball", "flat"):
-            raise SurfmodError(f"tool: kind must be 'ball' or 'flat', got {self.kind!r}")
-        object.__setattr__(self, "radius", checks.positive(self.radius, "tool radius"))
-
-    @property
-    def diameter(self) -> float:
-        return 2.0 * self.radius
-
-    def stepover_for_scallop(self, scallop: float) -> float:
-        """Stepover giving cusps of height ``scallop`` on flat ground (ball cutters):
-        ``2 sqrt(2 r h − h²)``."""
-        h = checks.positive(scallop, "scallop")
-        if self.kind != "ball":
-            raise SurfmodError("scallop: a flat end mill leaves no scallop on flat ground; give stepover instead")
-        if h >= self.radius:
-            raise SurfmodError(f"scallop: must be smaller than the tool radius {self.radius:g}, got {h:g}")
-        return float(2.0 * np.sqrt(2.0 * self.radius * h - h * h))
-
-    def scallop_for_stepover(self, stepover: float) -> float:
-        """Cusp height on flat ground for a given stepover (0 for a flat end mill)."""
-        if self.kind != "ball":
-            return 0.0
-        r = self.radius
-        return float(r - np.sqrt(max(r * r - (stepover / 2.0) ** 2, 0.0)))
 
 
 @dataclass(frozen=True)
@@ -126,9 +88,25 @@ class Toolpath:
         """The G-code text (see :func:`surfmod.export_gcode`)."""
         return gcode_text(self, **kw)
 
+    def drawing(self) -> list[Drawing]:
+        """The path as lines for :func:`surfmod.render`: raster passes in blue, links and
+        staircases (``pass_index`` -1) in orange."""
+        on_pass = (self.pass_index[1:] >= 0) & (self.pass_index[1:] == self.pass_index[:-1])
+        runs = polyline_runs(self.points, on_pass)
+        return [
+            Drawing(lines=runs.get(True, []), line_color=(0.1, 0.3, 0.8, 0.9), line_width=0.7),
+            Drawing(lines=runs.get(False, []), line_color=(0.95, 0.5, 0.1, 0.9), line_width=0.7),
+        ]
+
+    def _repr_png_(self) -> bytes | None:
+        """A picture of the moves for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        return repr_png(self)
+
     def __str__(self) -> str:
         return (
-            f"toolpath: {self.tool.kind} end mill r={self.tool.radius:g}, {self.n_passes} passes along {self.direction}, "
+            f"toolpath: {self.tool.kind} end mill r={self.tool.radius:g}"
+            + (f" corner r={self.tool.corner_radius:g}" if self.tool.kind == "bull" else "")
+            + f", {self.n_passes} passes along {self.direction}, "
             f"{len(self.points)} points, stepover {self.stepover:.6g} (scallop {self.scallop:.3g} on flat ground), "
             f"length {self.length:.6g}, every move checked: max gouge {max(self.gouge + self.deflection, 0.0):.2e} "
             f"(tolerance {self.tolerance:.2e})"
@@ -144,6 +122,7 @@ class _Part:
 
     grid: TriangleGrid
     kind: str
+    corner: float
     deflection: float
     lift: float
     box: np.ndarray
@@ -152,11 +131,11 @@ class _Part:
 
     def height(self, xy: np.ndarray) -> np.ndarray:
         """Tip heights at ``xy`` (N, 2), NaN where the tool touches nothing."""
-        return drop(self.grid, self.kind, xy) + self.lift
+        return drop(self.grid, self.kind, xy, corner=self.corner) + self.lift
 
 
 def _part(obj, tool: Tool, tolerance: float) -> _Part:
-    from ..occ.cam import part_triangles
+    from ..occ.triangulation import part_triangles
 
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
@@ -166,7 +145,7 @@ def _part(obj, tool: Tool, tolerance: float) -> _Part:
         raise NoSafePathError(f"toolpath: no safe path: {exc}") from None
     points = triangles.reshape(-1, 3)
     box = np.array([points.min(axis=0), points.max(axis=0)])
-    return _Part(TriangleGrid(triangles, tool.radius), tool.kind, max(measured, requested),
+    return _Part(TriangleGrid(triangles, tool.radius), tool.kind, tool.corner, max(measured, requested),
                  max(measured - requested, 0.0), box, faces, owner)
 
 
@@ -183,14 +162,14 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     ``radius / 1000``); heights are exact for that mesh.
 
     ``exact=True`` polishes each height on the exact face the tool rests on
-    (:mod:`surfmod.uses.toolpath_exact`: Newton on the face's own evaluator, inside its
+    (:mod:`surfmod.cam.toolpath_exact`: Newton on the face's own evaluator, inside its
     trim: the ball's centre, a flat end's rim on a sloped face or its bottom on a
     summit), so it is exact to rounding on the B-rep, contact points included; where the
     tool rests on an edge or a vertex of the mesh the mesh height is kept, lifted as
     above.
 
     >>> import surfmod as sm
-    >>> from surfmod.uses.toolpath import drop_cutter
+    >>> from surfmod.cam.toolpath import drop_cutter
     >>> z, contact = drop_cutter(sm.plane((0, 0, 2), (4, 0, 2), (0, 4, 2)), sm.Tool("ball", 1.0), [[1.0, 1.0]])
     >>> z.tolist(), contact.tolist()
     ([2.0], [[1.0, 1.0, 2.0]])
@@ -199,10 +178,11 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     cl = checks.finite_array(xy, "xy", ndim=2, last=2)
     tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
     part = _part(obj, tool, tolerance)
-    z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True)
+    z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True, corner=part.corner)
     z = z + part.lift
     if exact:
-        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.kind, tool.radius)
+        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.kind, tool.radius,
+                                       tool.corner)
     return z, contacts
 
 
@@ -320,7 +300,7 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
             raise NoSafePathError(
                 f"toolpath: no safe path: move {worst + 1} still cuts {gouge + part.deflection - part.lift:.3g} "
                 f"deep, more than the tolerance {tolerance:.3g}")
-        _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True)
+        _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
         bar.update()
     actual = float(np.diff(across).max()) if len(across) > 1 else 0.0
     return Toolpath(checks.frozen(points), checks.frozen(contacts), index, tool, actual, step,
