@@ -51,8 +51,7 @@ class FittedSurface(BSplineSurface):
 
     @classmethod
     def _make(cls, net, degree, knots, data, params, kind, tolerance=None):
-        obj = cls._construct_fast()
-        BSplineSurface._set(obj, net, degree, knots, None)
+        obj = cls._trusted(net, degree, knots, None)
         obj.data = checks.frozen(data)
         obj.parameters = (checks.frozen(params[0]), checks.frozen(params[1]))
         obj.kind = kind

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import tempfile
 import threading
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -99,7 +100,9 @@ class FEMesh:
         return float(np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum() / 2)
 
     def export(self, path) -> None:
-        """Same as :func:`export_fe_mesh`."""
+        """Deprecated (one release): :func:`surfmod.export_fe_mesh`, the one name, beside
+        ``export_step``/``export_stl``."""
+        warnings.warn("FEMesh.export is deprecated: use sm.export_fe_mesh(mesh, path)", DeprecationWarning, stacklevel=2)
         export_fe_mesh(self, path)
 
     def __str__(self) -> str:
