@@ -498,3 +498,17 @@ def test_no_subpackage_shadows_a_public_name():
         importlib.import_module(info.name)
     shadowed = [name for name in sm.__all__ if isinstance(getattr(sm, name), types.ModuleType)]
     assert not shadowed
+
+
+# --- the mass pipeline: each stage calls only the stages before it ---------------------------
+MASS_STAGES = ["rules", "breaks", "boundary", "nodes", "planes", "moments", "totals"]
+
+
+def test_mass_stages_call_only_earlier_stages():
+    bad = []
+    for i, stage in enumerate(MASS_STAGES):
+        for target, line, _ in EDGES[f"surfmod.mass.{stage}"]:
+            if target.startswith("surfmod.mass.") and target.rsplit(".", 1)[1] not in MASS_STAGES[:i]:
+                bad.append(f"surfmod.mass.{stage}:{line} imports {target}")
+    assert not bad, bad
+    assert sorted(MASS_STAGES) == sorted(n.rsplit(".", 1)[1] for n in MODULES if n.startswith("surfmod.mass."))
