@@ -20,6 +20,8 @@ Fairness, per patch: ``bending = integral of (k1^2 + k2^2) dA`` (thin-plate ener
 ``variation = integral of |grad H|^2 dA`` (the squared surface gradient of the mean
 curvature: zero on spheres, cylinders and planes), both by the trapezoid rule on the
 triangles, so two designs can be compared by a number.
+
+The same concept as :mod:`surfmod.cli.analyze` (the ``surfmod analyze`` command over this).
 """
 
 from __future__ import annotations

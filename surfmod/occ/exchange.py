@@ -9,6 +9,10 @@ from OCP.Message import Message, Message_Gravity
 from ..errors import SurfmodError
 from .fullprecision import write_step_full
 from .guard import kernel
+from OCP.BRep import BRep_Builder
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.STEPControl import STEPControl_Reader
+from OCP.TopoDS import TopoDS_Compound
 
 
 def _quiet_messages() -> None:
@@ -22,9 +26,6 @@ _quiet_messages()
 
 def compound(shapes):
     """One TopoDS_Compound of the given TopoDS shapes."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
-
     builder = BRep_Builder()
     comp = TopoDS_Compound()
     builder.MakeCompound(comp)
@@ -43,8 +44,6 @@ def write_step(shape, path: str) -> None:
 def read_with(reader, kind: str, path: str):
     """One TopoDS shape from ``path`` through an OCCT ``XSControl_Reader`` subclass
     instance (STEP, IGES); unreadable files raise ``SurfmodError`` naming ``kind``."""
-    from OCP.IFSelect import IFSelect_RetDone
-
     with kernel(f"{type(reader).__name__}"):
         if reader.ReadFile(str(path)) != IFSelect_RetDone:
             raise SurfmodError(f"path: {path} is not a readable {kind} file")
@@ -57,6 +56,4 @@ def read_with(reader, kind: str, path: str):
 
 def read_step(path: str):
     """Read a STEP file into one TopoDS shape; unreadable files raise ``SurfmodError``."""
-    from OCP.STEPControl import STEPControl_Reader
-
     return read_with(STEPControl_Reader(), "STEP", path)

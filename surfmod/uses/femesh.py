@@ -1,4 +1,7 @@
-"""Finite element meshes of parts with a target element size (gmsh), written via meshio."""
+"""Finite element meshes of parts with a target element size (gmsh), written via meshio.
+
+The same concept as :mod:`surfmod.cli.femesh` (the ``surfmod femesh`` command over this).
+"""
 
 from __future__ import annotations
 
@@ -15,6 +18,7 @@ from ..atomic import atomic_path, target_path
 from ..errors import KernelError, SurfmodError
 from ..meshing.brep import tessellate_shape
 from ..inputs import to_shape
+from tqdm import tqdm
 
 _GMSH_LOCK = threading.Lock()  # gmsh keeps global state: one mesh at a time
 
@@ -426,7 +430,6 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     checks.work(estimate, max_elements, "max_elements", f"a {kind} mesh with element size {size:g} of a part of extent {extent:.4g}")
     cell = _CELLS[(kind, order)]
     failures = []
-    from tqdm import tqdm
 
     with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp, \
             tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:

@@ -1,4 +1,7 @@
-"""Cross-section views: planar sections of a part as curves, in 3-D and in the plane's frame."""
+"""Cross-section views: planar sections of a part as curves, in 3-D and in the plane's frame.
+
+The same concept as :mod:`surfmod.cli.section` (the ``surfmod section`` command over this).
+"""
 
 from __future__ import annotations
 
