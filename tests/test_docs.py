@@ -87,3 +87,11 @@ def test_benchmark_tables_print_markdown(capsys):
         tables.MARKDOWN = False
     lines = capsys.readouterr().out.strip().splitlines()
     assert lines == ["| net | max \\|dv\\| | note |", "|---:|---:|---|", "| 4x4 | 1e-16 | ok |"]
+
+
+def test_design_page_rank_table_is_the_layering_tests():
+    import test_layering
+
+    md = _generated().rank_table_md()
+    for rank, names in enumerate(test_layering.RANKS):
+        assert f"| {rank} | " + ", ".join(f"`{n}`" for n in names) + " |" in md

@@ -1,6 +1,6 @@
 """The packages of surfmod rank: every import goes down the table below, never up or around.
 
-Read from the bottom up, the table is the house (docs/design_layers.md says what each
+Read from the bottom up, the table is the house (docs/design.md shows it with what each
 level holds):
 
 ====  =========================================================================
