@@ -239,6 +239,8 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
     tol = checks.positive(tolerance, "tolerance")
     prof = _curves(profiles, "profiles")
     guid = _curves(guides, "guides")
+    net = np.concatenate([c.control_points.reshape(-1, c.control_points.shape[-1])[:, :3] for c in prof + guid])
+    tol = checks.tolerance(tol, "tolerance", float(np.linalg.norm(np.ptp(net, axis=0))))
     u, v, gap = _crossings(prof, guid)
     if gap.max() > tol:
         i, j = np.unravel_index(int(gap.argmax()), gap.shape)

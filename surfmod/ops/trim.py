@@ -19,7 +19,7 @@ from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
 from .clip import as_face_surface
 from ..readback.trimmed import TrimmedFace
-from ..surface import Surface
+from ..surface import Surface, model_size
 
 #: Closing gap allowed between the first and last point of a loop, relative to the domain.
 CLOSURE_RTOL = 1e-9
@@ -147,7 +147,7 @@ def trim(s: Surface, boundary_curve_uv, *, tolerance: float = 1e-7):
     """
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
-    tol = checks.positive(tolerance, "tolerance")
+    tol = checks.tolerance(tolerance, "tolerance", model_size(s))
     loops = boundary_loops(s, boundary_curve_uv)
     from ..occ.ops import trimmed_face
 
