@@ -1,5 +1,5 @@
 """The NumPy lattice bounds (meshing/gridbounds.py) equal the compiled loops
-(meshing/gridkernel.py) bit for bit, on real lattices of surfaces and on hostile ones
+(meshing/gridmesh_kernels.py) bit for bit, on real lattices of surfaces and on hostile ones
 (degenerate cells, a pole, NaN), and meshes do not depend on which ran."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.meshing import gridbounds, gridkernel, gridmesh
+from surfmod.meshing import gridbounds, gridmesh_kernels, gridmesh
 
 
 def _lattice(s, ncu, ncv, K=gridmesh.K):
@@ -21,15 +21,15 @@ def _lattice(s, ncu, ncv, K=gridmesh.K):
 def _compare(S, K, kmax):
     ncu, ncv = (S.shape[0] - 1) // K, (S.shape[1] - 1) // K
     diag = np.zeros((ncu, ncv), bool)
-    gridkernel.diagonals(S, K, diag)
+    gridmesh_kernels.diagonals(S, K, diag)
     np.testing.assert_array_equal(gridbounds.diagonals(S, K, (ncu, ncv)), diag)
     est, Q = np.empty(S.shape[:2]), np.empty_like(S)
-    gridkernel.estimates(S, K, diag, kmax, est, Q)
+    gridmesh_kernels.estimates(S, K, diag, kmax, est, Q)
     est2, Q2 = gridbounds.estimates(S, K, diag, kmax)
     np.testing.assert_array_equal(Q2, Q)
     np.testing.assert_array_equal(est2, est)
     parts = [np.full((ncu, ncv), -1.0) for _ in range(3)]
-    gridkernel.cell_maxima(est, K, *parts)
+    gridmesh_kernels.cell_maxima(est, K, *parts)
     for mine, theirs in zip(gridbounds.cell_maxima(est, K, (ncu, ncv)), parts):
         np.testing.assert_array_equal(mine, theirs)
 

@@ -11,7 +11,7 @@ equidistributing a chordal-error bound, then *verified* and refined where it fai
    lines.
 2. **Verification.**  Every cell is sampled on a ``6 x 6`` lattice (the 25 sample points
    per triangle of :mod:`surfmod.meshing.deviation`, for either diagonal), evaluated as
-   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridkernel`).
+   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridmesh_kernels`).
    At each sample ``q = L(u, v)`` (the triangles' linear interpolation) the residual
    ``r = S(u, v) - q`` is split into its tangential part (a Gauss-Newton step
    ``J delta``, tangents by finite differences on the cell's lattice) and its normal
@@ -44,7 +44,7 @@ from .deviation import project_distances
 K = 6
 #: lattice points per verification block (bounded memory)
 BLOCK_POINTS = 1 << 18
-#: lattice points from which a block is bounded by the compiled loops (gridkernel.py);
+#: lattice points from which a block is bounded by the compiled loops (gridmesh_kernels.py);
 #: smaller ones in NumPy (gridbounds.py, the same values), which spares the first mesh
 #: of a process numba's import and load
 COMPILED_LATTICE = 1 << 16
@@ -225,7 +225,7 @@ class GridMesh:
             diag = self.diag[i0:i1]
             compiled = S.shape[0] * S.shape[1] >= COMPILED_LATTICE
             if compiled:
-                from . import gridkernel as gk  # numba: loaded on the first large lattice
+                from . import gridmesh_kernels as gk  # numba: loaded on the first large lattice
 
                 gk.diagonals(S, K, diag)
                 est = np.empty(S.shape[:2])
@@ -244,7 +244,7 @@ class GridMesh:
         for i0, i1, est in blocks:
             parts = self.err[i0:i1], self.eu[i0:i1], self.ev[i0:i1]
             if est.size >= COMPILED_LATTICE:
-                from . import gridkernel as gk
+                from . import gridmesh_kernels as gk
 
                 gk.cell_maxima(est, K, *parts)
             else:

@@ -26,6 +26,7 @@ from .deviation import DENSE
 from .domain import _sides, _surface_size
 from .gridmesh import grid_tessellate
 from .polymesh import Mesh
+from tqdm import tqdm
 
 #: Tolerances below this fraction of the object size cannot be certified in float64.
 MIN_RELATIVE_TOLERANCE = 1e-10
