@@ -90,7 +90,7 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
     if method not in ("auto", "grid", "adaptive"):
         raise SurfmodError(f"method: expected 'auto', 'grid' or 'adaptive', got {method!r}")
     size, estimate = _check_tolerance(s, tolerance, max_triangles)
-    with _progress_bar(progress) as bar:
+    with tqdm(desc="tessellate", unit="pass", disable=not progress, leave=False) as bar:
         if method == "grid":
             return _grid_mesh(s, tolerance, max_triangles, size, bar)
         if method == "adaptive":
@@ -108,29 +108,6 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
                 raise
             return grid
         return local if grid is None or len(local.faces) < len(grid.faces) else grid
-
-
-class _NoBar:
-    """What the passes call on a progress bar, doing nothing (no bar shown)."""
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
-
-    def update(self, n: int = 1) -> None:
-        pass
-
-
-def _progress_bar(progress: bool):
-    """A tqdm bar over the refinement passes, or :class:`_NoBar`: tqdm takes 0.2 s to
-    import, a tenth of a small mesh, so it is loaded only when a bar is shown."""
-    if not progress:
-        return _NoBar()
-    from tqdm import tqdm
-
-    return tqdm(desc="tessellate", unit="pass", leave=False)
 
 
 def _grid_mesh(s, tolerance: float, max_triangles: int, size: float, bar) -> Mesh:
