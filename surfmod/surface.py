@@ -98,6 +98,12 @@ class Surface(Immutable, abc.ABC):
         so no pass over the output is needed; subclasses that can bound them override."""
         return False
 
+    def _closest_parameters(self, points: np.ndarray):
+        """``(u, v)`` of the closest points of the domain to ``(N, 3)`` points where the
+        surface has them in closed form (the elementary surfaces), else ``None``: then
+        :func:`surfmod.ops.closest.closest_points` seeds and iterates."""
+        return None
+
     def _grid_derivatives(self, us: np.ndarray, vs: np.ndarray, order: int) -> np.ndarray:
         """``(len(us), len(vs), K, K, 3)``; subclasses override with a faster tensor path."""
         uu, vv = np.meshgrid(us, vs, indexing="ij")

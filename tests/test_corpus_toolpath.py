@@ -17,8 +17,8 @@ from conftest import CORPUS_FILES
 from toolpath_reference import ball_clearance, flat_cuts, gcode_positions, material
 
 from surfmod.cli import main as cli_main
-from surfmod.occ.cam import bounding_box
-from surfmod.uses.inputs import to_shape
+from surfmod.occ.triangulation import bounding_box
+from surfmod.inputs import to_shape
 
 RADIUS_SHARE = 0.03
 SCALLOP_SHARE = 0.1
@@ -80,7 +80,7 @@ def test_ventilator_flat_end_path_is_lifted_where_refining_fails_and_those_moves
     lifted (material left) instead of refusing the path, and the exact judge finds no
     cut on any move that lifting changed."""
     import surfmod as sm
-    from surfmod.uses import toolpath as toolpath_module
+    from surfmod.cam import toolpath as toolpath_module
 
     seen, original = [], toolpath_module.lift_moves
 

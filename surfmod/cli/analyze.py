@@ -6,7 +6,7 @@ from ..errors import SurfmodError
 
 from ..meshing.analyze import analyze
 
-from ..uses.inputs import load_step
+from ..inputs import load_step
 
 
 def register(sub) -> None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import tolerances
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from ..uses.mass import boundary_ambiguity, mass_properties
 
 #: exit code when surfmod and BRepGProp differ by less than the model's own ambiguity

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..errors import SurfmodError
 from ..io.svg import export_svg
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from ..uses.section import section
 
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from ..errors import SurfmodError
 from ..atomic import target_path
-from ..io.gcode import export_gcode
-from ..uses.inputs import to_shape
-from ..uses.toolpath import Tool, toolpath
+from ..cam.gcode import export_gcode
+from ..inputs import to_shape
+from ..cam.toolpath import Tool, toolpath
 
 GCODE_SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")
 

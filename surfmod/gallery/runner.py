@@ -10,7 +10,7 @@ from ..io.step import export_step
 from ..io.stl import export_stl
 from ..meshing.render import render
 from ..surface import Surface
-from ..verification import crosscheck
+from ..crosscheck import crosscheck
 from . import Entry, entries
 
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..ops.continuity import normal_curvature
+from ..sides import normal_curvature
 from ..readback import from_face
 from ..surface import Surface
 from .analyze_plot import write_png
@@ -252,7 +252,7 @@ def _combs(patches_src, count: int, samples: int, scale):
                 p, k, n = _comb_along(s, u, v, np.full_like(u, du), np.full_like(v, dv), sign)
                 raw.append((where, p, k, n))
         else:
-            from ..occ.continuity import face_edges_uv
+            from ..occ.local_analysis import face_edges_uv
 
             (a0, a1), (b0, b1) = s.domain
             for i, (uv, tangent) in enumerate(face_edges_uv(face, samples)):

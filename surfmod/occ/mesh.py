@@ -427,7 +427,7 @@ def elementary_parameters(surf) -> tuple | None:
     """``(type name, origin, axis, sizes)`` of a plane, sphere, cylinder, cone or torus:
     its placement's location and direction and ``(0, 0)``, ``(radius, 0)``, ``(radius,
     0)``, ``(reference radius, semi-angle)`` or ``(major, minor radius)``; ``None`` for
-    any other surface type (:func:`surfmod.meshing.analytic.parameters` turns these
+    any other surface type (:func:`surfmod.meshing.analytic_distance.parameters` turns these
     into closed-form distances)."""
     from .geom import surface_type
 

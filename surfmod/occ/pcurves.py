@@ -5,7 +5,7 @@ the face (``-1`` for a reversed edge), the breaks of its ``GeomAbs_CN`` interval
 the 2-D curve itself -- a line (origin, direction), a circle (centre, axes, radius), a
 B-spline (poles, weights, flat knots, degree) or any other type, which
 :func:`adaptor_d1` samples point by point through the record's OCCT ``adaptor``.  Lines, circles and B-splines are then
-evaluated for all Gauss nodes at once (:mod:`surfmod.uses.mass_boundary`), instead of one
+evaluated for all Gauss nodes at once (:mod:`surfmod.mass.boundary`), instead of one
 ``Geom2dAdaptor.D1`` call per node; :func:`faces_pcurves` reads the B-spline p-curves
 of many faces through one binary table.
 """

@@ -240,6 +240,11 @@ def closest_points(s: Surface, points: np.ndarray, seeds: int = 8):
     >>> u, v, d
     (array([0.5]), array([0.5]), array([3.]))
     """
+    closed_form = s._closest_parameters(points)
+    if closed_form is not None:  # planes, cylinders, cones, spheres, tori: no search
+        u, v = closed_form
+        pts = s._derivatives(u, v, 0)[:, 0, 0]
+        return u, v, pts, np.linalg.norm(pts - points, axis=1)
     us, vs, g = seed_grid(s)
     start = seed_starts(points, us, vs, g, seeds)
     k = start.shape[1]

@@ -20,7 +20,7 @@ from ..construct.elementary import PlaneSurface
 from ..construct.plane import ThreePointPlane
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
-from ..readback.clip import as_face_surface, clip_curves
+from .clip import as_face_surface, clip_curves
 from ..surface import Surface
 from . import marching
 from .closest import closest_points, nearest_samples, seed_parameters

@@ -10,7 +10,7 @@ import numpy as np
 from .. import checks
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..readback.clip import as_face_surface, project_on_face
+from .clip import as_face_surface, project_on_face
 from ..readback.trimmed import TrimmedFace
 from ..surface import Surface, require_surface
 from .closest import closest_points

@@ -15,7 +15,7 @@ from .. import checks
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
-from ..readback.clip import as_face_surface
+from .clip import as_face_surface
 from ..readback.trimmed import TrimmedFace
 from ..surface import Surface
 

@@ -14,7 +14,7 @@ from .. import checks
 from ..atomic import atomic_path, target_path
 from ..errors import KernelError, SurfmodError
 from ..meshing.brep import tessellate_shape
-from .inputs import to_shape
+from ..inputs import to_shape
 
 _GMSH_LOCK = threading.Lock()  # gmsh keeps global state: one mesh at a time
 

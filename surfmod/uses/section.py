@@ -15,7 +15,7 @@ from ..construct.from_edge import from_edge
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
 from ..readback import read_curve
-from .inputs import to_shape
+from ..inputs import to_shape
 
 
 def plane_frame(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray]:
@@ -196,7 +196,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     (1, [True], True)
     """
     from ..occ import uses as occ
-    from ..occ.cam import bounding_box as quick_box
+    from ..occ.triangulation import bounding_box as quick_box
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
