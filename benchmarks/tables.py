@@ -17,26 +17,27 @@ MARKDOWN = False
 
 
 class Table:
-    """Columns of ``(title, width)``; cells are strings the caller has formatted.
+    """Columns of ``(title, width)`` or ``(title, width, "<")``; cells are strings the caller
+    has formatted.
 
-    The first column is left-aligned when ``left_first`` is true; the others are right-aligned
-    (numbers).  In Markdown the widths are ignored and the number columns get ``---:``.
+    Columns are right-aligned (numbers) unless marked ``"<"``; ``left_first`` marks the first.
+    In Markdown the widths are ignored and the right-aligned columns get ``---:``.
     """
 
-    def __init__(self, *columns: tuple[str, int], left_first: bool = False):
-        self.columns = columns
-        self.left_first = left_first
+    def __init__(self, *columns: tuple, left_first: bool = False):
+        self.columns = [(c[0], c[1]) for c in columns]
+        self.left = [len(c) > 2 and c[2] == "<" or (i == 0 and left_first) for i, c in enumerate(columns)]
 
     def _text(self, cells) -> str:
         out = []
-        for i, (cell, (_, width)) in enumerate(zip(cells, self.columns)):
-            out.append(f"{cell:<{width}}" if i == 0 and self.left_first else f"{cell:>{width}}")
+        for cell, (_, width), left in zip(cells, self.columns, self.left):
+            out.append(f"{cell:<{width}}" if left else f"{cell:>{width}}")
         return " ".join(out)
 
     def header(self) -> None:
         titles = [title for title, _ in self.columns]
         if MARKDOWN:
-            rule = ["---" if i == 0 else "---:" for i in range(len(titles))]
+            rule = ["---" if left else "---:" for left in self.left]
             print("\n| " + " | ".join(_escaped(t) for t in titles) + " |")
             print("|" + "|".join(rule) + "|")
         else:

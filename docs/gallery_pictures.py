@@ -3,8 +3,8 @@
     python docs/gallery_pictures.py            # runs `surfmod gallery` into a temporary folder
     python docs/gallery_pictures.py OUTDIR     # uses the PNGs an earlier `surfmod gallery OUTDIR` wrote
 
-Each entity's PNG is copied into ``docs/gallery/`` scaled down to WIDTH pixels, so the
-committed pictures stay small; the page itself (``gallery.md``) lists whatever pictures
+Each entity's PNG is copied into ``docs/gallery/`` scaled down to WIDTH pixels with a
+palette, so the committed pictures stay small; the page itself (``gallery.md``) lists whatever pictures
 are there, with each entry's lecture entity and call.
 """
 
@@ -32,7 +32,8 @@ def copy_pictures(outdir: Path, target: Path = TARGET, width: int = WIDTH) -> li
         with Image.open(png) as im:
             im = im.convert("RGB")
             height = round(im.height * width / im.width)
-            small = im.resize((width, height), Image.Resampling.LANCZOS)
+            # a 128-colour palette keeps the shading and makes each file a few kB
+            small = im.resize((width, height), Image.Resampling.LANCZOS).quantize(colors=128)
             path = target / png.name
             small.save(path, optimize=True)
             written.append(path)

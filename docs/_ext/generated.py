@@ -10,8 +10,12 @@
   ``docs/gallery/`` (made by ``docs/gallery_pictures.py``), captioned with its gallery
   entry's lecture entity and call.
 * ``design.md``: the marker ``<!-- surfmod-package-map -->`` becomes a table of the
-  subpackages of surfmod, each with the first sentence of its docstring and its modules
-  (read with :mod:`ast`, nothing imported).
+  subpackages and top-level modules of surfmod, each with the first sentence of its
+  docstring, its modules and the surfmod packages it imports (read with :mod:`ast`,
+  nothing imported, function-level imports included).
+* ``design.md``: the marker ``<!-- surfmod-rank-table -->`` becomes the rank table of
+  ``tests/test_layering.py`` (its ``RANKS`` list, and what each rank holds from the table
+  in its docstring), so the page and the test cannot disagree.
 * ``cli.md``: the marker ``<!-- surfmod-cli-reference -->`` becomes one section per
   subcommand of the ``surfmod`` parser: its usage line and a table of its arguments,
   taken from argparse (what ``surfmod CMD --help`` prints).
@@ -33,6 +37,8 @@ CLI_MARKER = "<!-- surfmod-cli-reference -->"
 TOL_MARKER = "<!-- surfmod-tolerances -->"
 GALLERY_MARKER = "<!-- surfmod-gallery -->"
 MAP_MARKER = "<!-- surfmod-package-map -->"
+RANK_MARKER = "<!-- surfmod-rank-table -->"
+LAYERING_TEST = Path(__file__).resolve().parents[2] / "tests" / "test_layering.py"
 PACKAGE = Path(surfmod.__file__).resolve().parent
 GALLERY = Path(__file__).resolve().parent.parent / "gallery"
 
@@ -78,6 +84,11 @@ def _cell(text: str) -> str:
     return " ".join(str(text).split()).replace("|", "\\|")
 
 
+def _sentence(text: str) -> str:
+    text = _cell(text)
+    return (text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")) if text else ""
+
+
 def _argument_rows(sub: argparse.ArgumentParser):
     for a in sub._actions:
         if isinstance(a, argparse._HelpAction):
@@ -104,7 +115,7 @@ def cli_md() -> str:
     out = []
     for name, blurb, sub in sorted(_subcommands(parser)):
         usage = " ".join(sub.format_usage().split())
-        out += [f"### `surfmod {name}`", "", _cell(blurb).capitalize() + ".", "", "```text", usage, "```", "",
+        out += [f"### `surfmod {name}`", "", _sentence(blurb), "", "```text", usage, "```", "",
                 "| argument | required | default | meaning |", "|---|---|---|---|", *_argument_rows(sub), ""]
     return "\n".join(out)
 
@@ -145,15 +156,61 @@ def _first_sentence(path: Path) -> str:
     return paragraph if end < 0 else paragraph[: end + 1]
 
 
+def _imported_packages(path: Path, package: list[str]) -> set[str]:
+    """The surfmod packages (or top-level modules) that ``path`` imports anywhere in it,
+    function-level imports included, relative imports resolved."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package[: len(package) - (node.level - 1)]
+                names = [".".join(base + [node.module])] if node.module else [
+                    ".".join(base + [a.name]) for a in node.names]
+            else:
+                names = [node.module or ""]
+        elif isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        else:
+            continue
+        for name in names:
+            parts = name.split(".")
+            if parts[0] == "surfmod" and len(parts) > 1:
+                found.add(parts[1])
+    return found
+
+
 def package_map_md() -> str:
-    rows = ["| package | what it holds | modules |", "|---|---|---|"]
-    top = sorted(p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__")
-    rows.append(f"| `surfmod` | {_cell(_first_sentence(PACKAGE / '__init__.py'))} | "
-                + ", ".join(f"`{m}`" for m in top) + " |")
+    rows = ["| package | what it holds | modules | imports from surfmod |", "|---|---|---|---|"]
     for init in sorted(PACKAGE.glob("*/__init__.py")):
         pkg = init.parent
+        files = sorted(pkg.rglob("*.py"))
         modules = sorted(p.stem for p in pkg.glob("*.py") if p.stem != "__init__")
-        rows.append(f"| `{pkg.name}/` | {_cell(_first_sentence(init))} | " + ", ".join(f"`{m}`" for m in modules) + " |")
+        uses = set()
+        for f in files:
+            uses |= _imported_packages(f, list(f.relative_to(PACKAGE.parent).parts[:-1]))
+        uses.discard(pkg.name)
+        rows.append(f"| `{pkg.name}/` | {_cell(_first_sentence(init))} | " + ", ".join(f"`{m}`" for m in modules)
+                    + " | " + ", ".join(f"`{u}`" for u in sorted(uses)) + " |")
+    top = sorted(p for p in PACKAGE.glob("*.py") if p.stem != "__init__")
+    for f in top:
+        uses = _imported_packages(f, ["surfmod"]) - {f.stem}
+        rows.append(f"| `{f.name}` | {_cell(_first_sentence(f))} | | " + ", ".join(f"`{u}`" for u in sorted(uses)) + " |")
+    return "\n".join(rows)
+
+
+def rank_table_md(path: Path = LAYERING_TEST) -> str:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    ranks = next(ast.literal_eval(node.value) for node in tree.body if isinstance(node, ast.Assign)
+                 and any(isinstance(t, ast.Name) and t.id == "RANKS" for t in node.targets))
+    holds = {}
+    for line in (ast.get_docstring(tree) or "").splitlines():
+        head, _, rest = line.partition(" ")
+        if head.isdigit() and ":" in rest:
+            holds[int(head)] = rest.split(":", 1)[1].strip()
+    rows = ["| rank | packages / modules | holds |", "|---:|---|---|"]
+    for rank, names in enumerate(ranks):
+        rows.append(f"| {rank} | " + ", ".join(f"`{n}`" for n in names) + f" | {_cell(holds.get(rank, ''))} |")
+    rows.append(f"| {len(ranks)} | `surfmod` (its `__init__`) | the public names, resolved lazily |")
     return "\n".join(rows)
 
 
@@ -161,6 +218,8 @@ def _source_read(app, docname, source):
     text = source[0]
     if API_MARKER in text:
         text = text.replace(API_MARKER, api_rst())
+    if RANK_MARKER in text:
+        text = text.replace(RANK_MARKER, rank_table_md())
     if MAP_MARKER in text:
         text = text.replace(MAP_MARKER, package_map_md())
     if GALLERY_MARKER in text:

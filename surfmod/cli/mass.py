@@ -1,5 +1,8 @@
 """``surfmod mass FILE.step``: volume, area, centroid and inertia of a STEP solid, checked
-against ``BRepGProp``; a disagreement is never printed with exit code 0."""
+against ``BRepGProp``; a disagreement is never printed with exit code 0.
+
+The same concept as :mod:`surfmod.uses.mass`, one level up: the command over it.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +11,7 @@ import numpy as np
 from .. import tolerances
 from ..inputs import to_shape
 from ..uses.mass import boundary_ambiguity, mass_properties
+from tqdm import tqdm
 
 #: exit code when surfmod and BRepGProp differ by less than the model's own ambiguity
 EXIT_AMBIGUOUS = 3
@@ -25,8 +29,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from tqdm import tqdm
-
     with tqdm(total=3, desc="mass", unit="step", disable=args.no_progress) as bar:
         solid = to_shape(args.path, "path", solid=True)
         bar.update()

@@ -1,4 +1,7 @@
-"""``surfmod toolpath FILE.step --tool ball --radius R --scallop h --out path.nc``."""
+"""``surfmod toolpath FILE.step --tool ball --radius R --scallop h --out path.nc``.
+
+The same concept as :mod:`surfmod.cam.toolpath`, one level up: the command over it.
+"""
 
 from __future__ import annotations
 

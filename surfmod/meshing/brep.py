@@ -42,6 +42,7 @@ from .deviation import DENSE, project_distances, triangle_deviations
 from .facesurface import FaceSurface
 from .polymesh import Mesh, weld
 from .refine import refine_face
+from tqdm import tqdm
 
 #: Refuse tolerances that would need more triangles than this (checked before meshing).
 MAX_TRIANGLES = 5_000_000
@@ -283,8 +284,6 @@ def _measure_faces(fms: list, evaluators: dict, tolerance: float, desc: str, pro
     for the analytic faces and one compiled call for the B-spline nets (all faces of each
     kind at once), the other faces one by one; an isometric repeat of a face takes its
     first instance's figures."""
-    from tqdm import tqdm
-
     from . import analytic_distance
 
     first = [i for i, fm in enumerate(fms) if fm.repeats < 0]
@@ -411,8 +410,6 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     within each solid (and within the faces outside any solid), so every closed solid
     is a closed, manifold part of the mesh.
     """
-    from tqdm import tqdm
-
     from ..occ.mesh import brepmesh
 
     evaluators: dict = {}  # face hash -> FaceSurface (splines from the estimate, others when measured)

@@ -17,6 +17,12 @@ from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 from .guard import kernel
 from .topo import wrapped
+from OCP.BRepClass import BRepClass_FaceClassifier
+from OCP.BRepTools import BRepTools
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+from .topo import faces_of
 
 
 
@@ -61,10 +67,6 @@ def local_analysis(geom_a, uv_a: np.ndarray, geom_b, uv_b: np.ndarray, *, revers
 def _inside_sign(face, uv, direction, step) -> float:
     """+1 when ``uv + step * direction`` lies inside the face, -1 when the opposite side
     does (``BRepClass_FaceClassifier``); 0 when neither (a sliver)."""
-    from OCP.BRepClass import BRepClass_FaceClassifier
-    from OCP.gp import gp_Pnt2d
-    from OCP.TopAbs import TopAbs_IN
-
     for sign in (1.0, -1.0):
         p = uv + sign * step * direction
         state = BRepClass_FaceClassifier(face, gp_Pnt2d(float(p[0]), float(p[1])), 1e-9).State()
@@ -82,13 +84,6 @@ def shared_edges(shape, samples: int) -> list[dict]:
     derivative) and ``inward`` ``(samples, 2)``: the unit parameter-space normal of the
     p-curve pointing into that face.
     """
-    from OCP.BRepTools import BRepTools
-    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-    from OCP.TopExp import TopExp
-    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-
-    from .topo import faces_of
-
     s = wrapped(shape)
     all_faces = faces_of(s)
     records = []
@@ -125,9 +120,6 @@ def shared_edges(shape, samples: int) -> list[dict]:
 def face_edges_uv(face, samples: int) -> list:
     """Every non-degenerate edge of one face as ``(uv (samples, 2), tangent (samples, 2))``
     through its p-curve on that face."""
-    from OCP.TopAbs import TopAbs_EDGE
-    from OCP.TopExp import TopExp_Explorer
-
     f = TopoDS.Face_s(wrapped(face))
     out = []
     with kernel("face edges (BRepAdaptor_Curve2d)"):

@@ -22,6 +22,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Iterator
 from .binary import bspline_curves
 from .geom import read_bspline_curve
 from .guard import kernel
+from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 
 def _xy(p) -> np.ndarray:
@@ -199,8 +200,6 @@ def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
     >>> adaptor_d1(BRepAdaptor_Curve2d(edge, face), np.array([0.0])).round(12).tolist() == [[1, 0, 0, 1]]
     True
     """
-    from OCP.gp import gp_Pnt2d, gp_Vec2d
-
     p, d = gp_Pnt2d(), gp_Vec2d()
     out = np.empty((len(t), 4))
     with kernel("Geom2dAdaptor D1 (p-curve)"):

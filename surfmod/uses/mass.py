@@ -2,6 +2,8 @@
 faces, a build123d shape, a STEP path) and hands the faces read back to the quadrature
 pipeline of :mod:`surfmod.mass` (its module notes hold the method); ``method="occt"``
 returns OCCT's ``BRepGProp`` instead (the cross-check).
+
+The same concept as :mod:`surfmod.cli.mass` (the ``surfmod mass`` command over this).
 """
 
 from __future__ import annotations
