@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import DamagedFileError, KernelError, SurfmodError
+from .errors import DamagedFileError, KernelError, MissingExtraError, SurfmodError
 from .version import installed_version
 
 # public name -> module that defines it (relative to this package)
@@ -140,7 +140,7 @@ _EXPORTS = {
     "Fill": ".construct.fill",
 }
 
-__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError"])
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError"])
 
 
 def __getattr__(name: str):

@@ -58,6 +58,24 @@ def finite_result(out: np.ndarray, u: np.ndarray, v: np.ndarray, what: str) -> n
     )
 
 
+def model_size(*surfaces) -> float:
+    """The bounding-box diagonal of 9 x 9 samples of each surface (the scale that
+    tolerances are judged against).
+
+    >>> import surfmod as sm
+    >>> round(model_size(sm.plane((0, 0, 0), (3, 0, 0), (0, 4, 0))), 12)
+    5.0
+    """
+    pts = []
+    for s in surfaces:
+        (u0, u1), (v0, v1) = s.domain
+        pts.append(s._grid_derivatives(np.linspace(u0, u1, 9), np.linspace(v0, v1, 9), 0)[:, :, 0, 0].reshape(-1, 3))
+    pts = np.concatenate(pts)
+    with np.errstate(invalid="ignore", over="ignore"):
+        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    return size if np.isfinite(size) else 0.0
+
+
 class Surface(Immutable, abc.ABC):
     """Base of every parametric surface in surfmod.
 

@@ -7,7 +7,7 @@ level holds):
 rank  packages / modules
 ====  =========================================================================
 0     errors, tolerances, version: the error contract, the tolerance floors, the version
-1     checks: argument validation at the door of every public entry
+1     checks, extras: argument validation at every public door; the optional extras
 2     immutable, transforms, atomic: frozen arrays, affine maps, atomic writes
 3     eval: the NumPy/numba evaluation core (bases, kernels, frames)
 4     occ: the kernel door, the only package that imports OCP (plain data out)
@@ -57,7 +57,7 @@ PACKAGE = ROOT
 
 RANKS = [
     ["errors", "tolerances", "version"],
-    ["checks"],
+    ["checks", "extras"],
     ["immutable", "transforms", "atomic"],
     ["eval"],
     ["occ"],
@@ -89,10 +89,10 @@ LAZY = {
     "scipy": "its sparse solvers, k-d trees, csgraph: 0.25-1.1 s on top of numpy",
     "matplotlib": "2.5 s; sm.render, analysis pictures and section PNGs only",
     "mpl_toolkits": "matplotlib's 3-D axes, with matplotlib",
-    "trimesh": "optional extra 'trimesh' (2.1 s): Mesh.to_trimesh only",
-    "gmsh": "optional extra 'fem': sm.fe_mesh only",
-    "meshio": "optional extra 'fem': FE mesh files only",
-    "ezdxf": "optional extra 'dxf': sm.export_dxf only",
+    "trimesh": "2.1 s; Mesh.to_trimesh (surfmod mesh's watertight check)",
+    "gmsh": "optional extra 'fem' (surfmod.extras.require loads it)",
+    "meshio": "optional extra 'fem' (surfmod.extras.require loads it)",
+    "ezdxf": "0.6 s; DXF output only (surfmod.io.dxf loads it at its top)",
     "distributed": "optional extra 'cluster': --scheduler ADDRESS only",
     "dask": "optional extra 'cluster', with distributed",
     "geomdl": "optional extra 'interop'",
@@ -498,3 +498,17 @@ def test_no_subpackage_shadows_a_public_name():
         importlib.import_module(info.name)
     shadowed = [name for name in sm.__all__ if isinstance(getattr(sm, name), types.ModuleType)]
     assert not shadowed
+
+
+# --- the mass pipeline: each stage calls only the stages before it ---------------------------
+MASS_STAGES = ["rules", "breaks", "boundary", "nodes", "planes", "moments", "totals"]
+
+
+def test_mass_stages_call_only_earlier_stages():
+    bad = []
+    for i, stage in enumerate(MASS_STAGES):
+        for target, line, _ in EDGES[f"surfmod.mass.{stage}"]:
+            if target.startswith("surfmod.mass.") and target.rsplit(".", 1)[1] not in MASS_STAGES[:i]:
+                bad.append(f"surfmod.mass.{stage}:{line} imports {target}")
+    assert not bad, bad
+    assert sorted(MASS_STAGES) == sorted(n.rsplit(".", 1)[1] for n in MODULES if n.startswith("surfmod.mass."))
