@@ -36,6 +36,8 @@ import surfmod as sm
 from surfmod.eval.streaming import aligned_16, fence, stream_pair
 from surfmod.gallery.synthetic import wavy_net
 
+from .tables import Table, heading, note
+
 NET_SIZES = (4, 20, 100, 400, 1000)
 GRID = 1000
 SCATTERED = 10**6
@@ -282,24 +284,26 @@ def _x(a, b):
 
 
 def report(one: dict, every: dict) -> None:
-    print(f"threads of the compiled kernels: 1c {one['threads']}, all {every['threads']} "
-          f"(parallel variants, equal bit for bit; the machine has {os.cpu_count()} cores)\n")
-    print(f"{GRID}² grid of positions, rational bicubic net n x n (OCCT: per-point Value x 10^6)")
-    head = (f"{'net':>9} {'surfmod 1c':>11} {'into 1c':>8} {'surfmod all':>12} {'OCCT':>7} {'splipy 1c':>10} "
-            f"{'splipy all':>11} {'x OCCT':>7} {'into':>7} {'x splipy 1c':>12} {'x splipy all':>13}")
-    print(head)
-    print("-" * len(head))
+    note(f"threads of the compiled kernels: 1c {one['threads']}, all {every['threads']} "
+         f"(parallel variants, equal bit for bit; the machine has {os.cpu_count()} cores)")
+    note()
+    heading(f"{GRID}² grid of positions, rational bicubic net n x n (OCCT: per-point Value x 10^6)")
+    table = Table(("net", 9), ("surfmod 1c", 11), ("into 1c", 8), ("surfmod all", 12), ("OCCT", 7), ("splipy 1c", 10),
+                  ("splipy all", 11), ("x OCCT", 7), ("into", 7), ("x splipy 1c", 12), ("x splipy all", 13))
+    table.header()
     for n in map(str, NET_SIZES):
         a, b = one["net"][n], every["net"][n]
         occ = a["occt_d0"] * GRID**2
-        print(f"{n + 'x' + n:>9} {_f(a['ours']):>11} {_f(a['into']):>8} {_f(b['ours']):>12} {_f(occ, '.3f'):>7} "
-              f"{_f(a['splipy']):>10} {_f(b['splipy']):>11} {_x(occ, a['ours']):>7} {_x(occ, a['into']):>7} "
-              f"{_x(a['splipy'], a['ours']):>12} {_x(b['splipy'], b['ours']):>13}")
-    print("into = BSplineSurface.grid_into, writing into a preallocated array (x OCCT of that column)")
+        table.row(n + "x" + n, _f(a["ours"]), _f(a["into"]), _f(b["ours"]), _f(occ, ".3f"), _f(a["splipy"]),
+                  _f(b["splipy"]), _x(occ, a["ours"]), _x(occ, a["into"]), _x(a["splipy"], a["ours"]),
+                  _x(b["splipy"], b["ours"]))
+    note("into = BSplineSurface.grid_into, writing into a preallocated array (x OCCT of that column)")
     r, ra = one["rows"], every["rows"]
     d0_20, d2_20 = one["net"]["20"]["occt_d0"], one["net"]["20"]["occt_d2"]
-    print("\ncase (20x20 bicubic unless named)          surfmod 1c  surfmod all        OCCT     x OCCT    floor  x floor")
-    print("-" * 107)
+    note()
+    table = Table(("case (20x20 bicubic unless named)", 40), ("surfmod 1c", 11), ("surfmod all", 12), ("OCCT", 11),
+                  ("x OCCT", 10), ("floor", 8), ("x floor", 8), left_first=True)
+    table.header()
     lines = [
         ("1000² grid, rational NURBS", one["net"]["20"]["ours"], every["net"]["20"]["ours"], d0_20 * GRID**2, r["floor_d0"]),
         ("  into a preallocated array", one["net"]["20"]["into"], every["net"]["20"]["into"], d0_20 * GRID**2,
@@ -317,32 +321,36 @@ def report(one: dict, every: dict) -> None:
         ("10⁶ scattered, NURBS partials to 2", r["scattered_d2"], ra["scattered_d2"], d2_20 * SCATTERED, None),
     ]
     for name, t1, ta, occ, floor in lines:
-        print(f"{name:<40} {_f(t1):>11} {_f(ta):>12} {_f(occ, '.3f'):>11} {_x(occ, t1):>10} "
-              f"{_f(floor):>8} {_x(t1, floor):>8}")
-    print("partials to 2: OCCT D2 gives 6 vectors a point, surfmod the full 3x3 square (27 doubles);")
-    print("floor = allocate and fill the output array (for the \"into\" rows: fill the reused array);")
-    print("x floor = surfmod / floor (1 = at the floor).")
-    print(f"a compiled loop that only writes the reused array: {_f(r['floor_d0_numba'])} (positions), "
-          f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2);")
-    print(f"  with non-temporal stores, as surfmod writes partials to 2 into arrays past 16 MiB: {_f(r['floor_d2_stream'])} "
-          f"({_x(d2_20 * GRID**2, r['floor_d2_stream'])} OCCT D2 at most)")
-    print("\ngeomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
+        table.row(name, _f(t1), _f(ta), _f(occ, ".3f"), _x(occ, t1), _f(floor), _x(t1, floor))
+    note("partials to 2: OCCT D2 gives 6 vectors a point, surfmod the full 3x3 square (27 doubles);")
+    note("floor = allocate and fill the output array (for the \"into\" rows: fill the reused array);")
+    note("x floor = surfmod / floor (1 = at the floor).")
+    note(f"a compiled loop that only writes the reused array: {_f(r['floor_d0_numba'])} (positions), "
+         f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2);")
+    note(f"  with non-temporal stores, as surfmod writes partials to 2 into arrays past 16 MiB: {_f(r['floor_d2_stream'])} "
+         f"({_x(d2_20 * GRID**2, r['floor_d2_stream'])} OCCT D2 at most)")
+    note()
+    heading("geomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
+    table = Table(("net", 9), ("geomdl", 9), ("surfmod", 9), ("x geomdl", 10))
+    table.header()
     for n in (4, 20):
-        print(f"  {n}x{n}: geomdl {_f(r[f'geomdl{n}'], '.1f')}  surfmod {_f(r[f'poly{n}'])}  "
-              f"x geomdl {_x(r[f'geomdl{n}'], r[f'poly{n}'])}")
+        table.row(f"{n}x{n}", _f(r[f"geomdl{n}"], ".1f"), _f(r[f"poly{n}"]), _x(r[f"geomdl{n}"], r[f"poly{n}"]))
     npy = r["numpy"]
-    print("\nnumba kernels vs the pure-NumPy paths they replaced (1 core, rational bicubic):")
-    print(f"  1000² grid, 20x20 net:   NumPy {_f(npy['grid20'])}  numba {_f(one['net']['20']['ours'])}  "
-          f"{_x(npy['grid20'], one['net']['20']['ours'])}")
-    print(f"  1000² grid, 400x400 net: NumPy {_f(npy['grid400'])}  numba {_f(one['net']['400']['ours'])}  "
-          f"{_x(npy['grid400'], one['net']['400']['ours'])}")
-    print(f"  10⁶ scattered, 20x20:    NumPy {_f(npy['scattered'])}  numba {_f(r['scattered_d0'])}  "
-          f"{_x(npy['scattered'], r['scattered_d0'])}")
-    print("\nbounded memory (20x20 NURBS, reduced to a bounding box as it streams):")
+    note()
+    heading("numba kernels vs the pure-NumPy paths they replaced (1 core, rational bicubic):")
+    table = Table(("case", 24), ("NumPy", 9), ("numba", 9), ("speed-up", 9), left_first=True)
+    table.header()
+    table.row("1000² grid, 20x20 net", _f(npy["grid20"]), _f(one["net"]["20"]["ours"]),
+              _x(npy["grid20"], one["net"]["20"]["ours"]))
+    table.row("1000² grid, 400x400 net", _f(npy["grid400"]), _f(one["net"]["400"]["ours"]),
+              _x(npy["grid400"], one["net"]["400"]["ours"]))
+    table.row("10⁶ scattered, 20x20", _f(npy["scattered"]), _f(r["scattered_d0"]), _x(npy["scattered"], r["scattered_d0"]))
+    note()
+    heading("bounded memory (20x20 NURBS, reduced to a bounding box as it streams):")
     for key, what in (("grid", "grid via grid_chunks(max_points=2^21)"), ("scattered", "scattered in slices of 2^20")):
         count, secs, peak, whole = r["memory"][key]
-        print(f"  {count:.0e} points, {what}: {secs:.1f} s CPU (bounding box included), tracemalloc peak {peak:.0f} MiB "
-              f"(one array of the result: {whole:.0f} MiB)")
+        note(f"  {count:.0e} points, {what}: {secs:.1f} s CPU (bounding box included), tracemalloc peak {peak:.0f} MiB "
+             f"(one array of the result: {whole:.0f} MiB)")
 
 
 def main() -> None:

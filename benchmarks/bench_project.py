@@ -24,6 +24,8 @@ import numpy as np
 import surfmod as sm
 from surfmod.occ.ops import project_points
 
+from .tables import Table, note
+
 
 def _surface():
     rng = np.random.default_rng(0)
@@ -56,9 +58,9 @@ def _elementary():
 
 def analytic_table(n: int = 10_000) -> None:
     rng = np.random.default_rng(2)
-    head = f"{'surface':>9} {'points':>7} {'surfmod':>10} {'OCCT':>10} {'speed-up':>9} {'same':>6} {'ours closer':>12} {'OCCT closer':>12}"
-    print(head)
-    print("-" * len(head))
+    table = Table(("surface", 9), ("points", 7), ("surfmod", 10), ("OCCT", 10), ("speed-up", 9), ("same", 6),
+                  ("ours closer", 12), ("OCCT closer", 12))
+    table.header()
     for name, s in _elementary().items():
         (u0, u1), (v0, v1) = s.domain
         pts = rng.uniform(-6, 6, (n, 3))
@@ -67,17 +69,17 @@ def analytic_table(n: int = 10_000) -> None:
         found = np.isfinite(theirs[:, 2])
         diff = ours.distance - np.where(found, theirs[:, 2], np.inf)
         same = int(np.sum(np.abs(diff) <= 1e-9))
-        print(f"{name:>9} {n:>7} {t_ours / n * 1e6:>8.3f}us {t_occ / n * 1e6:>8.3f}us {t_occ / t_ours:>8.1f}x "
-              f"{same:>6} {int(np.sum(diff < -1e-9)):>12} {int(np.sum(found & (diff > 1e-9))):>12}")
+        table.row(name, f"{n}", f"{t_ours / n * 1e6:.3f}us", f"{t_occ / n * 1e6:.3f}us", f"{t_occ / t_ours:.1f}x",
+                  f"{same}", f"{int(np.sum(diff < -1e-9))}", f"{int(np.sum(found & (diff > 1e-9)))}")
 
 
 def main() -> None:
     s = _surface()
     (u0, u1), (v0, v1) = s.domain
     rng = np.random.default_rng(1)
-    head = f"{'points':>7} {'surfmod':>10} {'OCCT':>10} {'speed-up':>9} {'same':>6} {'ours closer':>12} {'OCCT closer':>12}"
-    print(head)
-    print("-" * len(head))
+    table = Table(("points", 7), ("surfmod", 10), ("OCCT", 10), ("speed-up", 9), ("same", 6), ("ours closer", 12),
+                  ("OCCT closer", 12))
+    table.header()
     for n in (1_000, 10_000):
         pts = np.c_[rng.uniform(-5, 45, n), rng.uniform(-5, 35, n), rng.uniform(-12, 12, n)]
         ours, t_ours = _best(sm.project, pts, s)
@@ -87,11 +89,10 @@ def main() -> None:
         same = int(np.sum(np.abs(diff) <= 1e-9))
         closer = int(np.sum(diff < -1e-9))
         worse = int(np.sum(found & (diff > 1e-9)))
-        print(f"{n:>7} {t_ours / n * 1e3:>8.3f}ms {t_occ / n * 1e3:>8.3f}ms {t_occ / t_ours:>8.1f}x "
-              f"{same:>6} {closer:>12} {worse:>12}")
-    print("CPU times per point (one core); 'ours closer' includes the points OCCT finds no orthogonal")
-    print("projection for.")
-    print()
+        table.row(f"{n}", f"{t_ours / n * 1e3:.3f}ms", f"{t_occ / n * 1e3:.3f}ms", f"{t_occ / t_ours:.1f}x",
+                  f"{same}", f"{closer}", f"{worse}")
+    note("CPU times per point (one core); 'ours closer' includes the points OCCT finds no orthogonal "
+         "projection for.")
     analytic_table()
 
 

@@ -46,7 +46,7 @@ print("G-code:", (OUT / "cam_part.nc").read_text().splitlines()[3:10])
 
 # 4. cutter locations on the exact faces: a 10 mm flat end mill dropped at a few points,
 #    its mesh heights polished by Newton on the faces themselves (rim or bottom contact)
-from surfmod.uses.toolpath import drop_cutter  # noqa: E402
+from surfmod.cam.toolpath import drop_cutter  # noqa: E402
 
 xy = np.array([[20.0, 15.0], [40.0, 30.0], [60.0, 45.0]])
 flat = sm.Tool("flat", 5.0)

@@ -13,9 +13,8 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import DamagedFileError, KernelError, SurfmodError
-
-__version__ = "0.1.0"
+from .errors import DamagedFileError, KernelError, MissingExtraError, SurfmodError
+from .version import installed_version
 
 # public name -> module that defines it (relative to this package)
 _EXPORTS = {
@@ -55,8 +54,8 @@ _EXPORTS = {
     "from_face": ".readback",
     "TrimmedFace": ".readback",
     "from_edge": ".construct.from_edge",
-    "crosscheck": ".verification",
-    "CrossCheck": ".verification",
+    "crosscheck": ".occt_crosscheck",
+    "CrossCheck": ".occt_crosscheck",
     "Mesh": ".meshing.grid",
     "mesh": ".meshing.grid",
     "export_step": ".io.step",
@@ -99,7 +98,7 @@ _EXPORTS = {
     "LimitSurface": ".subdiv.limit",
     "mass_properties": ".uses.mass",
     "boundary_ambiguity": ".uses.mass",
-    "MassProperties": ".uses.mass",
+    "MassProperties": ".mass.totals",
     "interference": ".uses.interference",
     "Interference": ".uses.interference",
     "section": ".uses.section",
@@ -109,11 +108,11 @@ _EXPORTS = {
     "fe_mesh": ".uses.femesh",
     "FEMesh": ".uses.femesh",
     "export_fe_mesh": ".uses.femesh",
-    "toolpath": ".uses.toolpath",
-    "Toolpath": ".uses.toolpath",
-    "Tool": ".uses.toolpath",
-    "export_gcode": ".io.gcode",
-    "make_solid": ".uses.inputs",
+    "toolpath": ".cam.toolpath",
+    "Toolpath": ".cam.toolpath",
+    "Tool": ".cam.tool",
+    "export_gcode": ".cam.gcode",
+    "make_solid": ".inputs",
     "coons": ".construct.coons",
     "CoonsSurface": ".construct.coons",
     "gordon": ".construct.gordon",
@@ -126,12 +125,12 @@ _EXPORTS = {
     "from_rhino": ".interop.rhino_io",
     "export_iges": ".io.iges",
     "import_iges": ".io.iges",
-    "fit": ".construct.scattered_fit",
-    "Fit": ".construct.scattered_fit",
+    "fit": ".ops.fit",
+    "Fit": ".ops.fit",
     "continuity": ".ops.continuity",
     "Continuity": ".ops.continuity",
-    "blend": ".construct.blend",
-    "BlendSurface": ".construct.blend",
+    "blend": ".ops.blend",
+    "BlendSurface": ".ops.blend",
     "analyze": ".meshing.analyze",
     "Analysis": ".meshing.analyze",
     "offset": ".construct.offset",
@@ -141,10 +140,13 @@ _EXPORTS = {
     "Fill": ".construct.fill",
 }
 
-__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError"])
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError"])
 
 
 def __getattr__(name: str):
+    if name == "__version__":
+        globals()[name] = value = installed_version()
+        return value
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'surfmod' has no attribute {name!r}")

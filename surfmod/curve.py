@@ -112,6 +112,13 @@ class Curve(Immutable, abc.ABC):
         t0, t1 = self.domain
         return edge_from_curve(self.geom(), t0, t1)
 
+    def _repr_png_(self) -> bytes | None:
+        """A picture for Jupyter: the curve as a line (see :func:`surfmod.meshing.render.png_bytes`)."""
+        # cycle: surfmod.curve <-> surfmod.meshing.render (the picture samples curves)
+        from .meshing.render import repr_png
+
+        return repr_png(self)
+
     @property
     def breaks(self) -> np.ndarray:
         """Parameters where the curve may lose smoothness (the domain ends; a B-spline adds

@@ -275,6 +275,13 @@ class Surface(Immutable, abc.ABC):
         (u0, u1), (v0, v1) = self.domain
         return face_from_surface(self.geom(), u0, u1, v0, v1)
 
+    def _repr_png_(self) -> bytes | None:
+        """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        # cycle: surfmod.surface <-> surfmod.meshing.render (the picture tessellates surfaces)
+        from .meshing.render import repr_png
+
+        return repr_png(self)
+
     # -- named transforms (all through ``transformed``) ----------------------------------
     def translated(self, vector) -> "Surface":
         """A copy moved by ``vector``."""

@@ -15,11 +15,11 @@ from toolpath_reference import ball_clearance, flat_cuts, gcode_positions
 
 import surfmod as sm
 from surfmod.cli import main as cli_main
-from surfmod.occ.cam import part_triangles
-from surfmod.uses import toolpath_moves
-from surfmod.uses.drop_cutter import TriangleGrid, drop
-from surfmod.uses.inputs import to_shape
-from surfmod.uses.toolpath import drop_cutter
+from surfmod.occ.triangulation import part_triangles
+from surfmod.cam import toolpath_moves
+from surfmod.cam.drop_cutter import TriangleGrid, drop
+from surfmod.inputs import to_shape
+from surfmod.cam.toolpath import drop_cutter
 
 CORPUS_PART = "trimesh_featuretype.STEP"
 # G-code writes 4 decimals: x, y rounded to nearest (a wall may come 5e-5·√2 closer)
@@ -185,7 +185,7 @@ def test_gcode_export(tmp_path):
 @pytest.mark.parametrize("make, arg", [
     (lambda: sm.Tool("ball", 0), "radius"),
     (lambda: sm.Tool("ball", -1), "radius"),
-    (lambda: sm.Tool("bull", 1), "kind"),
+    (lambda: sm.Tool("cone", 1), "kind"), (lambda: sm.Tool("bull", 1), "corner_radius"), (lambda: sm.Tool("bull", 1, 1), "corner_radius"),
     (lambda: sm.toolpath(bumpy(), sm.Tool("ball", 1), stepover=2.5), "stepover"),
     (lambda: sm.toolpath(bumpy(), sm.Tool("ball", 1), scallop=1.0), "scallop"),
     (lambda: sm.toolpath(bumpy(), sm.Tool("flat", 1), scallop=0.1), "scallop"),

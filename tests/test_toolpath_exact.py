@@ -9,7 +9,7 @@ import build123d as bd
 import numpy as np
 
 import surfmod as sm
-from surfmod.uses.toolpath import drop_cutter
+from surfmod.cam.toolpath import drop_cutter
 
 R_BALL = 1.5
 COARSE = 0.05  # mesh deflection 0.02: mesh heights miss by ~1e-2, exact ones must not

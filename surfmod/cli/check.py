@@ -8,7 +8,7 @@ from pathlib import Path
 from ..errors import SurfmodError
 from ..io.step import import_step
 from ..readback import from_face
-from ..verification import crosscheck_many
+from ..occt_crosscheck import crosscheck_many
 from .batch import RowSink, run_batch, step_files
 
 COLUMNS = [("file", "<36.36"), ("face", ">5d"), ("surface type", "<30.30"), ("max dev", ">10.2e"),
@@ -48,7 +48,7 @@ def check_file(path, samples: int = 24) -> list[tuple]:
     ``sampling="sufficient"``: at most ``samples`` values per direction (plus knots), fewer
     where fewer already prove agreement with OCCT over the whole face (elementary
     surfaces, B-splines with few spans; see
-    :func:`surfmod.verification.sufficient_parameters`).
+    :func:`surfmod.occt_crosscheck.sufficient_parameters`).
 
     >>> import surfmod as sm, build123d as bd, tempfile, os
     >>> path = os.path.join(tempfile.mkdtemp(), "box.step")

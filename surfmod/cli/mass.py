@@ -1,15 +1,19 @@
 """``surfmod mass FILE.step``: volume, area, centroid and inertia of a STEP solid, checked
 against ``BRepGProp``; exit 0 only when all four agree within ``MASS_AGREEMENT_RTOL`` (one
 line says so), 3 when the model itself is ambiguous (its edges leave the volume that open,
-or p-curves stray beyond their edges' tolerance: they are named), 4 otherwise."""
+or p-curves stray beyond their edges' tolerance: they are named), 4 otherwise.
+
+The same concept as :mod:`surfmod.uses.mass`, one level up: the command over it.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
 from .. import tolerances
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from ..uses.mass import boundary_ambiguity, mass_properties
+from tqdm import tqdm
 
 #: exit code when surfmod and BRepGProp differ by less than the model's own ambiguity
 EXIT_AMBIGUOUS = 3
@@ -27,8 +31,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from tqdm import tqdm
-
     with tqdm(total=3, desc="mass", unit="step", disable=args.no_progress) as bar:
         solid = to_shape(args.path, "path", solid=True)
         bar.update()

@@ -30,7 +30,7 @@ from ..surface import Surface
 from . import elementary_closest as closest
 from .conics import Arc
 from .curves import Line
-from .frames import cos_d, frame_transformed, make_frame, sin_d
+from .axes import cos_d, frame_transformed, make_frame, sin_d
 from .revolution import revolve_nurbs
 
 TWO_PI = 2.0 * math.pi

@@ -35,7 +35,7 @@ import numpy as np
 from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..ops.continuity import SIDES
+from ..sides import SIDES
 from ..surface import Surface
 from .fill_domain import polygon, side_blend
 from .fill_ribbons import Corner, Ribbon, check_corners, match_corners

@@ -16,6 +16,8 @@ Both return a :class:`FittedSurface` (a B-spline surface that *is* its OCCT twin
 ``Geom_BSplineSurface``) with the data parameters and the measured ``max_deviation``;
 :meth:`FittedSurface.occt_fit` builds OCCT's own fit (``GeomAPI_PointsToBSplineSurface``)
 of the same data for comparison.
+
+The same concept as :mod:`surfmod.occ.fitting`, its OCCT twin (``GeomAPI_PointsToBSplineSurface``) behind the kernel door.
 """
 
 from __future__ import annotations
@@ -49,8 +51,7 @@ class FittedSurface(BSplineSurface):
 
     @classmethod
     def _make(cls, net, degree, knots, data, params, kind, tolerance=None):
-        obj = cls._construct_fast()
-        BSplineSurface._set(obj, net, degree, knots, None)
+        obj = cls._trusted(net, degree, knots, None)
         obj.data = checks.frozen(data)
         obj.parameters = (checks.frozen(params[0]), checks.frozen(params[1]))
         obj.kind = kind

@@ -296,8 +296,7 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
         (1.0, skin_g, (pu, g_curves[0].degree), (ku, g_curves[0].knots)),
         (-1.0, tensor, (pu, qv), (ku, kv)),
     ])
-    obj = GordonSurface._construct_fast()
-    BSplineSurface._set(obj, net, deg, knots, None)
+    obj = GordonSurface._trusted(net, deg, knots, None)
     obj.profiles = tuple(prof)
     obj.guides = tuple(guid)
     obj.parameters = (checks.frozen(big_u), checks.frozen(big_v))

@@ -22,10 +22,10 @@ from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
 from ..nets.bspline import BSplineSurface
-from ..ops.continuity import side_params, SIDES
+from ..sides import SIDES, side_params
 from ..surface import Surface, model_size
-from ..uses.inputs import make_solid
-from .blend import as_bspline_surface
+from ..inputs import make_solid
+from ..nets.convert import as_bspline_surface
 from .offset_surface import OffsetSurface
 from .ruled import ruled
 

@@ -34,7 +34,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .basis import basis_derivatives, find_spans
+from . import vectorized
+from .basis import basis_derivatives, find_spans, reciprocal_table, span_buckets
 from .threads import running_on, threads_for
 
 #: doubles in the per-block row table of the grid stage (2 MiB): stays in L2
@@ -45,6 +46,13 @@ V_BLOCK = 1024
 GRID_MIN_BLOCK = 16
 #: blocks per thread (at least): threads that finish early take more of them
 BLOCKS_PER_THREAD = 8
+#: work (points times partials per point, ``(order + 1)^2``) from which scattered pairs
+#: go through the compiled kernels; less is done in NumPy (:mod:`surfmod.eval.vectorized`),
+#: which takes milliseconds there, while the first compiled call of a process loads numba
+#: and its kernels (about a second; minutes into an empty cache)
+COMPILED_SCATTERED = 1 << 15
+#: the same for grids, whose NumPy path costs less per point (one row stage for all u)
+COMPILED_GRID = 1 << 18
 #: bytes of a caller's output array from which grids of partials to order 2 are written
 #: into it with non-temporal stores (:mod:`surfmod.eval.streaming`): far beyond the L2
 #: caches, where writing through them only evicts everything else
@@ -115,13 +123,12 @@ class LocalNet(NamedTuple):
 def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
     """Tables for the kernels from full knot vectors, degrees and the homogeneous net
     ``(n, m, 3)`` (polynomial) or ``(n, m, 4)`` (rational)."""
-    k = _kernels()
     ku, kv = writable(knots_u), writable(knots_v)
     ctrl = homogeneous4(hctrl)
     n, m = ctrl.shape[:2]
     return LocalNet(ku, int(p), kv, int(q), ctrl, hctrl.shape[-1] == 4,
-                    k.reciprocal_table(ku, p, n), k.reciprocal_table(kv, q, m),
-                    k.span_buckets(ku, p, n), k.span_buckets(kv, q, m), {})
+                    reciprocal_table(ku, p, n), reciprocal_table(kv, q, m),
+                    span_buckets(ku, p, n), span_buckets(kv, q, m), {})
 
 
 def partials_finite(net: LocalNet, order: int) -> bool:
@@ -221,6 +228,12 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
     Many points on a small low-degree net go through per-span polynomial patches
     (:mod:`surfmod.eval.patches`), the others through the basis-function kernel."""
     u, v = _as_float(u), _as_float(v)
+    if u.size < COMPILED_SCATTERED:
+        h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, 0)[:, 0, 0]
+        if out is None:
+            return h
+        out[...] = h
+        return out
     if out is None:
         out = np.empty((u.size, 3))
     table = _patch_table(net, u.size)
@@ -243,8 +256,14 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     Partials to order 1 or 2 of many points on a small low-degree net go through the
     per-span patches (:mod:`surfmod.eval.patches`, as positions do), the others through
     the basis-function kernel."""
-    k = _kernels()
     u, v = _as_float(u), _as_float(v)
+    if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
+        h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, order)
+        if out is None:
+            return h
+        out[...] = h
+        return out
+    k = _kernels()
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
     table = _patch_table(net, u.size) if order in (1, 2) else None
@@ -392,9 +411,15 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     partials to order 2 in chunks of v-points held in L1, streamed past the caches into
     a caller's ``out`` of ``STREAM_BYTES`` or more (:mod:`surfmod.eval.partials_stage`).
     """
-    k = _kernels()
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
     us, vs = _as_float(us), _as_float(vs)
+    if us.size * vs.size * (order + 1) ** 2 < COMPILED_GRID:
+        h = vectorized.grid(knots_u, p, knots_v, q, ctrl, rational, us, vs, order)
+        if out is None:
+            return h
+        out[...] = h[:, :, 0, 0] if order == 0 else h
+        return out[:, :, None, None, :] if order == 0 else out
+    k = _kernels()
     n, m = ctrl.shape[:2]
     kk = order + 1
     dim = 4 if rational else 3

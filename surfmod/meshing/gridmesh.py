@@ -11,7 +11,7 @@ equidistributing a chordal-error bound, then *verified* and refined where it fai
    lines.
 2. **Verification.**  Every cell is sampled on a ``6 x 6`` lattice (the 25 sample points
    per triangle of :mod:`surfmod.meshing.deviation`, for either diagonal), evaluated as
-   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridkernel`).
+   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridmesh_kernels`).
    At each sample ``q = L(u, v)`` (the triangles' linear interpolation) the residual
    ``r = S(u, v) - q`` is split into its tangential part (a Gauss-Newton step
    ``J delta``, tangents by finite differences on the cell's lattice) and its normal
@@ -204,7 +204,7 @@ class GridMesh:
         (True: 00-11), the sagging of each cell's u- and v-sides (``eu``, ``ev``) and
         the vertices; returns the largest deviation (measured by projection at the
         samples over the tolerance or near the maximum, bounded elsewhere)."""
-        from . import gridkernel as gk
+        from . import gridmesh_kernels as gk
 
         us, vs = self.us, self.vs
         nu, nv = len(us) - 1, len(vs) - 1

@@ -42,6 +42,13 @@ class Mesh:
         fi.setflags(write=False)
         object.__setattr__(self, "faces", fi)
 
+    def _repr_png_(self) -> bytes | None:
+        """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        # cycle: surfmod.meshing.polymesh <-> surfmod.meshing.render (the picture draws meshes)
+        from .render import repr_png
+
+        return repr_png(self)
+
     def triangles(self) -> np.ndarray:
         """Faces as triangles (quads split along their 0-2 diagonal)."""
         if self.faces.shape[1] == 3:

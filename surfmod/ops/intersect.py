@@ -20,10 +20,11 @@ from ..construct.elementary import PlaneSurface
 from ..construct.plane import ThreePointPlane
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
-from ..readback.clip import as_face_surface, clip_curves
+from .clip import as_face_surface, clip_curves
 from ..surface import Surface
 from . import marching
 from .closest import closest_points, nearest_samples, seed_parameters
+from tqdm import tqdm
 
 # -- problems -------------------------------------------------------------------------------
 
@@ -351,7 +352,6 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
         seeds = _implicit_seeds(problem, a)
         o, x, y, _ = plane_frame(origin, normal)
         uv_b_of = lambda X, P: np.stack([(P - o) @ x, (P - o) @ y], axis=1)  # noqa: E731
-    from tqdm import tqdm
 
     with tqdm(total=len(seeds), desc="intersect", unit="seed", disable=not progress, leave=False) as bar:
         traced = marching.trace_all(problem, seeds, h, angle, bar)

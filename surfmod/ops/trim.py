@@ -9,13 +9,15 @@ the knot lines of the surface, so the integrand is smooth on every piece.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .. import checks
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
-from ..readback.clip import as_face_surface
+from .clip import as_face_surface
 from ..readback.trimmed import TrimmedFace
 from ..surface import Surface, model_size
 
@@ -234,8 +236,9 @@ def _curve_crossings(curve, ubreaks, vbreaks, per_span: int = 8, dense: int = 64
 def trimmed_area(s: Surface, boundary_curve_uv=None, order: int = 24) -> float:
     """Area of the trimmed region, by NumPy quadrature (Green's theorem in (u, v)).
 
-    Without ``boundary_curve_uv``, ``s`` is a face (build123d / OCP, or read back with
-    :func:`surfmod.from_face`) and its own boundary is used.
+    It is the NumPy side of :func:`trim` (same arguments), checked against the face it
+    builds.  Without ``boundary_curve_uv``, ``s`` is a face and its own boundary is used:
+    deprecated, that is ``sm.from_face(face).area()``.
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0))
@@ -246,6 +249,8 @@ def trimmed_area(s: Surface, boundary_curve_uv=None, order: int = 24) -> float:
         face = as_face_surface(s)
         if not isinstance(face, TrimmedFace):
             raise SurfmodError("boundary_curve_uv: needed unless s is a face (it carries its own boundary)")
+        # deprecated (one release): a face's area has one name, sm.from_face(face).area()
+        warnings.warn("trimmed_area(face) is deprecated: use sm.from_face(face).area()", DeprecationWarning, stacklevel=2)
         return face.area()
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")

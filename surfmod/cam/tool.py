@@ -1,0 +1,184 @@
+"""End mills (flat, ball, bull nose) and the tool table of a job.
+
+A tool is its cutting end (profile ``f(d)``: the height of the end above the tip at
+distance ``d`` from the axis) on a shank as wide as the end; ``flute_length`` is how deep
+it can cut.  The table (number, speeds and feeds of each tool) comes from a TOML or JSON
+file or from defaults.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+
+KINDS = ("flat", "ball", "bull")
+#: Default spindle speed (rpm) and feeds (mm/min): a 6 mm carbide end mill in aluminium,
+#: scaled by the diameter (surface speed and chip load held); the plunge/ramp feed a third.
+DEFAULT_SURFACE_SPEED = 200.0  # m/min
+DEFAULT_CHIP_LOAD = 0.04  # mm per tooth, two flutes
+MAX_SPINDLE = 24000.0
+
+
+@dataclass(frozen=True)
+class Tool:
+    """An end mill: ``kind`` ``"flat"``, ``"ball"`` or ``"bull"``, ``radius`` > 0, and for a
+    bull nose its ``corner_radius`` (``0 < corner_radius < radius``: a flat core of radius
+    ``radius - corner_radius`` rounded by a torus).  ``flute_length`` (default four
+    radii) bounds the depth it may cut; ``number`` (the T word), ``spindle`` (rpm),
+    ``feed`` and ``plunge_feed`` (mm/min) default from the diameter.
+
+    >>> import surfmod as sm
+    >>> t = sm.Tool("ball", 3.0)
+    >>> round(t.stepover_for_scallop(0.01), 6)
+    0.48949
+    >>> b = sm.Tool("bull", 4.0, 1.0)
+    >>> round(b.stepover_for_scallop(0.01), 6), b.profile(2.0), b.profile(4.0)
+    (6.282135, 0.0, 1.0)
+    """
+
+    kind: str
+    radius: float
+    corner_radius: float = 0.0
+    flute_length: float | None = None
+    number: int | None = None
+    spindle: float | None = None
+    feed: float | None = None
+    plunge_feed: float | None = None
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise SurfmodError(f"tool: kind must be 'flat', 'ball' or 'bull', got {self.kind!r}")
+        r = checks.positive(self.radius, "tool radius")
+        object.__setattr__(self, "radius", r)
+        c = float(self.corner_radius)
+        if self.kind == "bull":
+            if not 0.0 < c < r:
+                raise SurfmodError(f"corner_radius: a bull nose needs 0 < corner radius < radius {r:g}, got {c:g}")
+        elif c != 0.0 and not (self.kind == "ball" and c == r):
+            raise SurfmodError(f"corner_radius: a {self.kind} end mill has none, got {c:g}")
+        object.__setattr__(self, "corner_radius", c)
+        flute = 4.0 * r if self.flute_length is None else checks.positive(self.flute_length, "flute_length")
+        object.__setattr__(self, "flute_length", flute)
+        if self.number is not None:
+            object.__setattr__(self, "number", checks.count(self.number, "number", 1, 99999))
+        for name in ("spindle", "feed", "plunge_feed"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, checks.positive(getattr(self, name), name))
+
+    @property
+    def diameter(self) -> float:
+        return 2.0 * self.radius
+
+    @property
+    def corner(self) -> float:
+        """The radius of the rounded edge: the radius for a ball, 0 for a flat end."""
+        return {"ball": self.radius, "flat": 0.0}.get(self.kind, self.corner_radius)
+
+    @property
+    def core(self) -> float:
+        """Radius of the flat bottom (0 for a ball)."""
+        return self.radius - self.corner
+
+    def profile(self, d):
+        """Height of the cutting end above the tip at distance ``d`` from the axis (inf beyond
+        the radius)."""
+        d = np.asarray(d, dtype=float)
+        c, t = self.corner, np.maximum(d - self.core, 0.0)
+        out = np.where(d <= self.radius * (1 + 1e-15), c - np.sqrt(np.maximum(c * c - t * t, 0.0)), np.inf)
+        return float(out) if out.ndim == 0 else out
+
+    def stepover_for_scallop(self, scallop: float) -> float:
+        """Stepover leaving cusps of height ``scallop`` on flat ground: ``2 sqrt(2 c h − h²)``
+        for a ball of radius ``c``, plus the flat core's width ``2 (r − c)`` for a bull nose."""
+        h = checks.positive(scallop, "scallop")
+        if self.kind == "flat":
+            raise SurfmodError("scallop: a flat end mill leaves no scallop on flat ground; give stepover instead")
+        if h >= self.radius:
+            raise SurfmodError(f"scallop: must be smaller than the tool radius {self.radius:g}, got {h:g}")
+        c = self.corner
+        h = min(h, c)
+        return float(2.0 * self.core + 2.0 * np.sqrt(2.0 * c * h - h * h))
+
+    def scallop_for_stepover(self, stepover: float) -> float:
+        """Cusp height on flat ground for a given stepover (0 for a flat end mill, and for a
+        bull nose whose core spans the stepover)."""
+        if self.kind == "flat":
+            return 0.0
+        c, half = self.corner, stepover / 2.0 - self.core
+        if half <= 0:
+            return 0.0
+        return float(c - np.sqrt(max(c * c - half * half, 0.0)))
+
+    def with_defaults(self, number: int) -> "Tool":
+        """This tool with ``number`` (unless it has one) and speeds and feeds filled in."""
+        rpm = self.spindle or min(DEFAULT_SURFACE_SPEED * 1000.0 / (np.pi * self.diameter), MAX_SPINDLE)
+        feed = self.feed or 2 * DEFAULT_CHIP_LOAD * rpm * min(1.0, self.diameter / 6.0)
+        return replace(self, number=self.number or number, spindle=float(round(rpm)),
+                       feed=float(round(feed)), plunge_feed=self.plunge_feed or float(round(feed / 3)))
+
+    def __str__(self) -> str:
+        name = {"flat": "flat end mill", "ball": "ball end mill",
+                "bull": f"bull nose (corner r={self.corner_radius:g})"}[self.kind]
+        return f"T{self.number or '?'} {name} r={self.radius:g}"
+
+
+def parse_tool(text: str, name: str = "tool") -> Tool:
+    """``"flat:R"``, ``"ball:R"`` or ``"bull:R:r"`` (radius, corner radius in mm) as a Tool.
+
+    >>> parse_tool("bull:3:0.5")
+    Tool(kind='bull', radius=3.0, corner_radius=0.5, flute_length=12.0, number=None, spindle=None, feed=None, plunge_feed=None)
+    """
+    parts = str(text).split(":")
+    try:
+        numbers = [float(p) for p in parts[1:]]
+    except ValueError:
+        raise SurfmodError(f"{name}: expected flat:R, ball:R or bull:R:r, got {text!r}") from None
+    kind = parts[0]
+    if kind not in KINDS or len(numbers) != (2 if kind == "bull" else 1):
+        raise SurfmodError(f"{name}: expected flat:R, ball:R or bull:R:r, got {text!r}")
+    if not numbers[0] > 0:
+        raise SurfmodError(f"radius: {name} radius must be > 0, got {numbers[0]:g}")
+    return Tool(kind, numbers[0], numbers[1] if kind == "bull" else 0.0)
+
+
+def load_tool_table(path) -> dict[int, Tool]:
+    """Tools by number from a TOML (``[[tool]]`` tables) or JSON (``{"tool": [...]}``) file;
+    each entry has ``number``, ``kind``, ``radius`` and optionally ``corner_radius``,
+    ``flute_length``, ``spindle``, ``feed``, ``plunge_feed``.
+
+    >>> import tempfile, os
+    >>> p = os.path.join(tempfile.mkdtemp(), "tools.toml")
+    >>> _ = open(p, "w").write('[[tool]]\\nnumber = 3\\nkind = "ball"\\nradius = 2\\nspindle = 18000\\n')
+    >>> load_tool_table(p)[3].spindle
+    18000.0
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise SurfmodError(f"tools: no such file {str(path)!r}")
+    try:
+        data = tomllib.loads(p.read_text()) if p.suffix.lower() == ".toml" else json.loads(p.read_text())
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise SurfmodError(f"tools: {p.name} is not a tool table: {exc}") from None
+    entries = data.get("tool") if isinstance(data, dict) else None
+    if not isinstance(entries, list):
+        raise SurfmodError(f"tools: {p.name} has no list of [[tool]] entries")
+    known = {"number", "kind", "radius", "corner_radius", "flute_length", "spindle", "feed", "plunge_feed"}
+    table = {}
+    for k, entry in enumerate(entries):
+        if not isinstance(entry, dict) or "number" not in entry or not set(entry) <= known:
+            raise SurfmodError(f"tools: entry {k + 1} of {p.name} needs number, kind, radius and only {sorted(known)}")
+        try:
+            tool = Tool(**entry)
+        except TypeError as exc:
+            raise SurfmodError(f"tools: entry {k + 1} of {p.name}: {exc}") from None
+        if tool.number in table:
+            raise SurfmodError(f"tools: tool number {tool.number} appears twice in {p.name}")
+        table[tool.number] = tool
+    return table

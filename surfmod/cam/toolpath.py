@@ -1,0 +1,307 @@
+"""NC tool paths for continuous-path machining: drop-cutter zig-zag rasters that never gouge.
+
+The part is every face of the input (walls, undersides and trimmed faces included), meshed
+by OCCT's BRepMesh inside each face's trim at a chordal deflection of 40 % of the
+gouge ``tolerance``.  The end mill (ball, flat or bull nose, with a shank of its own radius up to
+infinity) is dropped onto that mesh in closed form (:mod:`surfmod.cam.drop_cutter`), so a
+cutter location touches but never enters the triangles; where BRepMesh reports a larger
+deflection than asked for (faces of real parts that cannot be meshed finer than their own
+tolerance) every height is lifted by the difference.
+
+Every straight G1 move between cutter locations is then checked along its length, not only
+at its ends (:mod:`surfmod.cam.toolpath_moves`): locations are inserted where a move would
+cut deeper than half the tolerance, steps at walls become vertical-level-vertical
+staircases, and a final check on other sample points must find every move within
+``tolerance - deflection``.  Moves the refinement cannot bring within it are lifted
+(:func:`~surfmod.cam.toolpath_moves.lift_moves`: material is left there, reported as
+``Toolpath.lifted``); a path that still cuts deeper raises ``SurfmodError``: gouging
+G-code is never returned.  The default tolerance is a tenth of the scallop height.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+from .gcode import gcode_text
+from ..meshing.render import Drawing, polyline_runs, repr_png
+from .drop_cutter import TriangleGrid, drop
+from ..inputs import to_shape
+from .toolpath_exact import exact_heights
+from .tool import Tool
+from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
+
+# Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
+# the refinement inserts a location (the rest is the margin between sample points).
+MESH_SHARE = 0.4
+REFINE_SHARE = 0.5
+# More cutter locations than this is a mistake in step/stepover, not a finishing path.
+MAX_LOCATIONS = 2_000_000
+
+
+@dataclass(frozen=True)
+class Toolpath:
+    """A continuous zig-zag tool path, verified move by move.
+
+    ``points`` ``(N, 3)``: cutter locations (tool tip) in machining order, one continuous
+    polyline (passes joined by links, refined where straight moves would cut, staircases
+    at walls); ``contacts`` ``(N, 3)``: where the dropped tool touches the part at each
+    location's (x, y) (NaN where it touches nothing); ``pass_index`` ``(N,)``: raster pass
+    of each point (-1 on links and staircases).  ``gouge``: the deepest any move was found
+    below the drop-cutter height (≤ 0: nowhere), ``deflection``: the mesh's chordal
+    deflection, ``tolerance``: the depth no move may cut (``gouge + deflection`` is within it),
+    ``lifted``: the most any location was raised above its drop-cutter height where
+    refining could not keep a move from cutting (0: nowhere; material is left there).
+
+    >>> import surfmod as sm
+    >>> flat = sm.plane((0, 0, 0), (10, 0, 0), (0, 10, 0))
+    >>> tp = sm.toolpath(flat, sm.Tool("ball", 1.0), stepover=1.0)
+    >>> float(tp.points[:, 2].min()), tp.gouge + tp.deflection <= tp.tolerance   # tip rides on z = 0
+    (0.0, True)
+    """
+
+    points: np.ndarray = field(repr=False)
+    contacts: np.ndarray = field(repr=False)
+    pass_index: np.ndarray = field(repr=False)
+    tool: Tool
+    stepover: float
+    step: float
+    scallop: float
+    direction: str
+    gouge: float
+    tolerance: float
+    deflection: float
+    lifted: float = 0.0
+
+    @property
+    def n_passes(self) -> int:
+        return int(self.pass_index.max()) + 1
+
+    @property
+    def length(self) -> float:
+        return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
+
+    def to_gcode(self, **kw) -> str:
+        """The G-code text (see :func:`surfmod.export_gcode`)."""
+        return gcode_text(self, **kw)
+
+    def drawing(self) -> list[Drawing]:
+        """The path as lines for :func:`surfmod.render`: raster passes in blue, links and
+        staircases (``pass_index`` -1) in orange."""
+        on_pass = (self.pass_index[1:] >= 0) & (self.pass_index[1:] == self.pass_index[:-1])
+        runs = polyline_runs(self.points, on_pass)
+        return [
+            Drawing(lines=runs.get(True, []), line_color=(0.1, 0.3, 0.8, 0.9), line_width=0.7),
+            Drawing(lines=runs.get(False, []), line_color=(0.95, 0.5, 0.1, 0.9), line_width=0.7),
+        ]
+
+    def _repr_png_(self) -> bytes | None:
+        """A picture of the moves for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        return repr_png(self)
+
+    def __str__(self) -> str:
+        return (
+            f"toolpath: {self.tool.kind} end mill r={self.tool.radius:g}"
+            + (f" corner r={self.tool.corner_radius:g}" if self.tool.kind == "bull" else "")
+            + f", {self.n_passes} passes along {self.direction}, "
+            f"{len(self.points)} points, stepover {self.stepover:.6g} (scallop {self.scallop:.3g} on flat ground), "
+            f"length {self.length:.6g}, every move checked: max gouge {max(self.gouge + self.deflection, 0.0):.2e} "
+            f"(tolerance {self.tolerance:.2e})"
+            + (f", moves lifted by up to {self.lifted:.3g} where refining could not follow the part (material left)"
+               if self.lifted > 0 else "")
+        )
+
+
+@dataclass(frozen=True)
+class _Part:
+    """The machined part for one tool: its mesh on a query grid, and the lift that covers
+    a mesh deflection larger than requested."""
+
+    grid: TriangleGrid
+    kind: str
+    corner: float
+    deflection: float
+    lift: float
+    box: np.ndarray
+    faces: list = field(default_factory=list, repr=False)  # OCCT faces, and the face of each triangle
+    owner: np.ndarray = field(default=None, repr=False)
+
+    def height(self, xy: np.ndarray) -> np.ndarray:
+        """Tip heights at ``xy`` (N, 2), NaN where the tool touches nothing."""
+        return drop(self.grid, self.kind, xy, corner=self.corner) + self.lift
+
+
+def _part(obj, tool: Tool, tolerance: float) -> _Part:
+    from ..occ.triangulation import part_triangles
+
+    shape = to_shape(obj, "obj")
+    requested = MESH_SHARE * tolerance
+    try:
+        triangles, measured, (faces, owner) = part_triangles(shape, requested, face_index=True)
+    except SurfmodError as exc:
+        raise NoSafePathError(f"toolpath: no safe path: {exc}") from None
+    points = triangles.reshape(-1, 3)
+    box = np.array([points.min(axis=0), points.max(axis=0)])
+    return _Part(TriangleGrid(triangles, tool.radius), tool.kind, tool.corner, max(measured, requested),
+                 max(measured - requested, 0.0), box, faces, owner)
+
+
+def _check_tool(tool) -> Tool:
+    if not isinstance(tool, Tool):
+        raise SurfmodError(f"tool: expected a surfmod Tool, got {type(tool).__name__}")
+    return tool
+
+
+def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: bool = False):
+    """Tool-tip heights ``(N,)`` and contact points ``(N, 3)`` of ``tool`` dropped onto
+    every face of ``obj`` at the (x, y) locations ``xy`` ``(N, 2)`` (NaN where the tool
+    touches nothing).  The faces are meshed to 40 % of ``tolerance`` (default
+    ``radius / 1000``); heights are exact for that mesh.
+
+    ``exact=True`` polishes each height on the exact face the tool rests on
+    (:mod:`surfmod.cam.toolpath_exact`: Newton on the face's own evaluator, inside its
+    trim: the ball's centre, a flat end's rim on a sloped face or its bottom on a
+    summit), so it is exact to rounding on the B-rep, contact points included; where the
+    tool rests on an edge or a vertex of the mesh the mesh height is kept, lifted as
+    above.
+
+    >>> import surfmod as sm
+    >>> from surfmod.cam.toolpath import drop_cutter
+    >>> z, contact = drop_cutter(sm.plane((0, 0, 2), (4, 0, 2), (0, 4, 2)), sm.Tool("ball", 1.0), [[1.0, 1.0]])
+    >>> z.tolist(), contact.tolist()
+    ([2.0], [[1.0, 1.0, 2.0]])
+    """
+    tool = _check_tool(tool)
+    cl = checks.finite_array(xy, "xy", ndim=2, last=2)
+    tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
+    part = _part(obj, tool, tolerance)
+    z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True, corner=part.corner)
+    z = z + part.lift
+    if exact:
+        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.kind, tool.radius,
+                                       tool.corner)
+    return z, contacts
+
+
+def _stepover(tool: Tool, stepover, scallop) -> float:
+    if stepover is not None and scallop is not None:
+        raise SurfmodError("stepover: give either stepover or scallop, not both")
+    if scallop is not None:
+        stepover = tool.stepover_for_scallop(scallop)
+    elif stepover is None:
+        raise SurfmodError("stepover: give stepover or scallop")
+    else:
+        stepover = checks.positive(stepover, "stepover")
+    if stepover > tool.diameter:
+        raise SurfmodError(f"stepover: {stepover:g} is larger than the tool diameter {tool.diameter:g}")
+    return stepover
+
+
+def _drop_repeats(points: np.ndarray, index: np.ndarray):
+    """Remove locations equal to their predecessor (zero-length moves of staircases)."""
+    keep = np.r_[True, np.any(points[1:] != points[:-1], axis=1)]
+    return points[keep], index[keep]
+
+
+def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float | None = None,
+             step: float | None = None, direction: str = "x", bounds=None, tolerance: float | None = None,
+             progress: bool = False, max_points: int = MAX_LOCATIONS) -> Toolpath:
+    """Zig-zag drop-cutter finishing path of ``tool`` over a part, every move gouge-checked.
+
+    ``obj``: a surfmod surface (or list of them), a build123d shape or a STEP path; all its
+    faces count (walls and trimmed faces included; the shank is as wide as the tool).
+    Give ``stepover`` (distance between passes, at most the tool diameter) or ``scallop``
+    (cusp height on flat ground for a ball cutter, stepover = 2·sqrt(2rh − h²)).  ``step``
+    is the spacing of locations along a pass (default ``radius / 4``); passes run along
+    ``direction`` ``"x"`` or ``"y"`` over the part's (x, y) bounding box or ``bounds =
+    ((xmin, ymin), (xmax, ymax))``.  ``tolerance``: the depth no move may cut (default a
+    tenth of the scallop height, or ``radius / 100`` when the stepover leaves none); a
+    path that cannot be made to respect it raises ``SurfmodError``.  ``progress`` shows a
+    tqdm bar over the stages.  More than ``max_points`` cutter locations (estimated from
+    the bounds, stepover and step before the part is meshed or anything is allocated)
+    are refused; raise ``max_points`` to allow them.
+
+    >>> import surfmod as sm, numpy as np
+    >>> s = sm.plane((0, 0, 1), (10, 0, 1), (0, 10, 1))
+    >>> tp = sm.toolpath(s, sm.Tool("ball", 2.0), scallop=0.05)
+    >>> bool(tp.stepover <= 2 * np.sqrt(2 * 2 * 0.05 - 0.05 ** 2)), float(np.abs(tp.points[:, 2] - 1).max()) < 1e-12
+    (True, True)
+    """
+    tool = _check_tool(tool)
+    stepover = _stepover(tool, stepover, scallop)
+    step = tool.radius / 4 if step is None else checks.positive(step, "step")
+    if direction not in ("x", "y"):
+        raise SurfmodError(f"direction: expected 'x' or 'y', got {direction!r}")
+    if tolerance is None:
+        cusp = tool.scallop_for_stepover(stepover)
+        tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
+    else:
+        tolerance = checks.positive(tolerance, "tolerance")
+    if bounds is not None:
+        box = checks.finite_array(bounds, "bounds")
+        if box.shape != (2, 2) or np.any(box[1] < box[0]):
+            raise SurfmodError(f"bounds: expected ((xmin, ymin), (xmax, ymax)), got {box.tolist()}")
+    from tqdm import tqdm
+
+    def estimate(lo, hi):
+        a, b = (0, 1) if direction == "x" else (1, 0)
+        passes = float(hi[b] - lo[b]) / stepover + 2
+        along = float(hi[a] - lo[a]) / step + 2
+        checks.work(passes * along + passes * stepover / step, max_points, "max_points",
+                    f"the raster of {passes:,.0f} passes x {along:,.0f} locations (use a larger step or stepover)")
+
+    shape = to_shape(obj, "obj")
+    if bounds is None:  # the shape's box (a little larger than the mesh's) sizes the raster up front
+        from ..occ.uses import bounding_box
+
+        outer = bounding_box(shape)
+        estimate(outer[0, :2], outer[1, :2])
+    else:
+        estimate(box[0], box[1])
+    with tqdm(total=4, desc="toolpath", unit="stage", disable=not progress) as bar:
+        part = _part(shape, tool, tolerance)
+        bar.update()
+        lo, hi = (part.box[0, :2], part.box[1, :2]) if bounds is None else (box[0], box[1])
+        xy, index, across = raster(lo, hi, stepover, step, direction)
+        z = part.height(xy)
+        if np.isnan(z).all():
+            raise SurfmodError("bounds: the tool touches no face inside these bounds")
+        floor = float(np.nanmin(z))  # where the tool touches nothing it stays at the lowest level
+        points = np.column_stack([xy, np.where(np.isnan(z), floor, z)])
+        bar.update()
+        allowed = tolerance - part.deflection + part.lift
+        if allowed <= 0:
+            raise SurfmodError(f"tolerance: {tolerance:.3g} is below the part's mesh deflection {part.deflection:.3g}")
+        min_length = min(tolerance, step / 64)
+        for _ in range(2):  # the refinement makes short steep moves at walls: staircase them too
+            points, index = staircase_steep(points, index)
+            points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor)
+        points, index = _drop_repeats(points, index)
+        bar.update()
+        depth = move_gouge(part.height, points)
+        if depth.max() > allowed:
+            # repair what the verdict's own sample points found, then judge again
+            points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor,
+                                         centred=True)
+            points, index = _drop_repeats(points, index)
+            depth = move_gouge(part.height, points)
+        lifted = 0.0
+        if len(depth) and depth.max() > allowed:
+            # the refinement could not follow the part here (walls meeting at a sliver of a
+            # face, say): lift those moves, which leaves material but never cuts
+            points, lift, depth = lift_moves(part.height, points, depth, REFINE_SHARE * allowed)
+            lifted = float(lift.max())
+        gouge = float(depth.max()) if len(depth) else 0.0
+        if gouge > allowed:
+            worst = int(np.argmax(depth))
+            raise NoSafePathError(
+                f"toolpath: no safe path: move {worst + 1} still cuts {gouge + part.deflection - part.lift:.3g} "
+                f"deep, more than the tolerance {tolerance:.3g}")
+        _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
+        bar.update()
+    actual = float(np.diff(across).max()) if len(across) > 1 else 0.0
+    return Toolpath(checks.frozen(points), checks.frozen(contacts), index, tool, actual, step,
+                    tool.scallop_for_stepover(actual), direction, gouge - part.lift, tolerance, part.deflection, lifted)
