@@ -32,6 +32,8 @@ def _note(result) -> str:
     parts = [f"{k} {v:.2e} > {lim:.1e}" for k, (v, lim) in details.get("failed", {}).items()]
     if not result.passed and not parts and "tolerance" in details:
         parts.append(f"deviation {result.max_deviation:.2e} > {details['tolerance']:.1e}")
+    if details.get("curvature_settled"):
+        parts.append(details["curvature_settled"])
     if details.get("knot_jump_points"):
         parts.append(f"{details['knot_jump_points']} samples on C1/C0 knot lines: derivatives the surface has not "
                      "got there skipped")
