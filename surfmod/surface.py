@@ -12,7 +12,7 @@ import abc
 
 import numpy as np
 
-from . import checks, tolerances
+from . import checks, pictures, tolerances
 from .errors import SurfmodError
 from .eval.differential import Curvatures, curvatures, degenerate_mask, unit_normals
 from .immutable import Immutable
@@ -56,6 +56,24 @@ def finite_result(out: np.ndarray, u: np.ndarray, v: np.ndarray, what: str) -> n
         f"u, v: the {what} at (u, v) = ({u[i]:.17g}, {v[i]:.17g}) are not finite "
         "(the surface is singular or overflows there)"
     )
+
+
+def model_size(*surfaces) -> float:
+    """The bounding-box diagonal of 9 x 9 samples of each surface (the scale that
+    tolerances are judged against).
+
+    >>> import surfmod as sm
+    >>> round(model_size(sm.plane((0, 0, 0), (3, 0, 0), (0, 4, 0))), 12)
+    5.0
+    """
+    pts = []
+    for s in surfaces:
+        (u0, u1), (v0, v1) = s.domain
+        pts.append(s._grid_derivatives(np.linspace(u0, u1, 9), np.linspace(v0, v1, 9), 0)[:, :, 0, 0].reshape(-1, 3))
+    pts = np.concatenate(pts)
+    with np.errstate(invalid="ignore", over="ignore"):
+        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    return size if np.isfinite(size) else 0.0
 
 
 class Surface(Immutable, abc.ABC):
@@ -259,10 +277,7 @@ class Surface(Immutable, abc.ABC):
 
     def _repr_png_(self) -> bytes | None:
         """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
-        # cycle: surfmod.surface <-> surfmod.meshing.render (the picture tessellates surfaces)
-        from .meshing.render import repr_png
-
-        return repr_png(self)
+        return pictures.repr_png(self)
 
     # -- named transforms (all through ``transformed``) ----------------------------------
     def translated(self, vector) -> "Surface":

@@ -211,7 +211,7 @@ def test_cam_part_toolpath_in_stock(tmp_path):
     and reported.  What issue 26 says is missing is asserted missing: the spindle is never
     started."""
     from surfmod.occ.triangulation import part_triangles
-    from surfmod.uses.inputs import to_shape
+    from surfmod.inputs import to_shape
 
     tri, deflection = part_triangles(to_shape(SAMPLES / "cam_part.step"), 0.001)
     prog = parse_canon(run_rs274(SAMPLES / "cam_part.nc", tmp_path / "cam.txt"))

@@ -13,6 +13,9 @@
   subpackages and top-level modules of surfmod, each with the first sentence of its
   docstring, its modules and the surfmod packages it imports (read with :mod:`ast`,
   nothing imported, function-level imports included).
+* ``design.md``: the marker ``<!-- surfmod-rank-table -->`` becomes the rank table of
+  ``tests/test_layering.py`` (its ``RANKS`` list, and what each rank holds from the table
+  in its docstring), so the page and the test cannot disagree.
 * ``cli.md``: the marker ``<!-- surfmod-cli-reference -->`` becomes one section per
   subcommand of the ``surfmod`` parser: its usage line and a table of its arguments,
   taken from argparse (what ``surfmod CMD --help`` prints).
@@ -34,6 +37,8 @@ CLI_MARKER = "<!-- surfmod-cli-reference -->"
 TOL_MARKER = "<!-- surfmod-tolerances -->"
 GALLERY_MARKER = "<!-- surfmod-gallery -->"
 MAP_MARKER = "<!-- surfmod-package-map -->"
+RANK_MARKER = "<!-- surfmod-rank-table -->"
+LAYERING_TEST = Path(__file__).resolve().parents[2] / "tests" / "test_layering.py"
 PACKAGE = Path(surfmod.__file__).resolve().parent
 GALLERY = Path(__file__).resolve().parent.parent / "gallery"
 
@@ -193,10 +198,28 @@ def package_map_md() -> str:
     return "\n".join(rows)
 
 
+def rank_table_md(path: Path = LAYERING_TEST) -> str:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    ranks = next(ast.literal_eval(node.value) for node in tree.body if isinstance(node, ast.Assign)
+                 and any(isinstance(t, ast.Name) and t.id == "RANKS" for t in node.targets))
+    holds = {}
+    for line in (ast.get_docstring(tree) or "").splitlines():
+        head, _, rest = line.partition(" ")
+        if head.isdigit() and ":" in rest:
+            holds[int(head)] = rest.split(":", 1)[1].strip()
+    rows = ["| rank | packages / modules | holds |", "|---:|---|---|"]
+    for rank, names in enumerate(ranks):
+        rows.append(f"| {rank} | " + ", ".join(f"`{n}`" for n in names) + f" | {_cell(holds.get(rank, ''))} |")
+    rows.append(f"| {len(ranks)} | `surfmod` (its `__init__`) | the public names, resolved lazily |")
+    return "\n".join(rows)
+
+
 def _source_read(app, docname, source):
     text = source[0]
     if API_MARKER in text:
         text = text.replace(API_MARKER, api_rst())
+    if RANK_MARKER in text:
+        text = text.replace(RANK_MARKER, rank_table_md())
     if MAP_MARKER in text:
         text = text.replace(MAP_MARKER, package_map_md())
     if GALLERY_MARKER in text:

@@ -6,7 +6,7 @@ The same concept as :mod:`surfmod.uses.femesh`, one level up: the command over i
 from __future__ import annotations
 
 from ..atomic import target_path
-from ..uses.femesh import fe_mesh, FORMATS
+from ..uses.femesh import FORMATS, export_fe_mesh, fe_mesh
 from tqdm import tqdm
 
 
@@ -26,7 +26,7 @@ def run(args) -> int:
     with tqdm(total=2, desc="femesh", unit="step", disable=args.no_progress) as bar:
         m = fe_mesh(args.path, args.size, args.order, args.kind)
         bar.update()
-        m.export(args.out)
+        export_fe_mesh(m, args.out)
         bar.update()
     print(m)
     print(f"wrote {args.out}")

@@ -144,7 +144,7 @@ def refine(uv: np.ndarray, tri: np.ndarray):
 def _face_samples(face, target: float, max_triangles: int = 20000):
     """OCCT's triangulation of the trimmed region, split until 3-D edges are <= ``target``."""
     from ..occ.topo import face_surface
-    from ..occ.uses import face_uv_triangles
+    from ..occ.mesh import face_uv_triangles
 
     s = from_face(face)
     _, _, reversed_ = face_surface(face)

@@ -274,6 +274,16 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
         return out
 
 
+def face_uv_triangles(face, deflection: float, angular: float = 0.1):
+    """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
+    face (the face's trimmed parameter region as a polygonal patchwork)."""
+    ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
+    if got is None or np.isnan(got.uv).any():
+        raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
+    uv, idx = got.uv, got.triangles
+    return uv, idx
+
+
 def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None,
              uv_bounds: dict | None = None) -> list[FaceMesh]:
     """Run ``BRepMesh_IncrementalMesh`` (after clearing old triangulations) and return the

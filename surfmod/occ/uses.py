@@ -12,14 +12,13 @@ from itertools import chain
 
 import numpy as np
 from OCP.BRep import BRep_Tool
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopoDS import TopoDS
 
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import check_done, kernel
-from .mesh import mesh_faces
-from .topo import explore as _explore, shells_of, solids_of
+from .topo import explore as _explore, shells_of, solids_of, wrapped
 from OCP.BRep import BRep_Builder
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Section
@@ -181,11 +180,19 @@ def vertex_mean(shape) -> np.ndarray:
     return np.repeat(pts.reshape(n, 3), np.maximum(visits, 1), axis=0).mean(axis=0)
 
 
-def bounding_box(shape) -> np.ndarray:
-    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` (optimal box)."""
-    with kernel("BRepBndLib.AddOptimal_s"):
+def bounding_box(shape, *, optimal: bool = True) -> np.ndarray:
+    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` of a ``TopoDS_Shape`` or build123d
+    shape: the tight box (``BRepBndLib.AddOptimal``), or with ``optimal=False`` OCCT's quick
+    box (from a stored triangulation, else the control points, enlarged by the shape
+    tolerance: a cheap upper bound).  The one bounding box of the kernel door."""
+    inner = wrapped(shape)
+    shape = shape if inner is None else inner
+    with kernel("BRepBndLib.AddOptimal_s" if optimal else "BRepBndLib.Add"):
         box = Bnd_Box()
-        BRepBndLib.AddOptimal_s(shape, box, False, False)
+        if optimal:
+            BRepBndLib.AddOptimal_s(shape, box, False, False)
+        else:
+            BRepBndLib.Add_s(shape, box, True)
         return np.array(box.Get()).reshape(2, 3)
 
 
@@ -249,35 +256,6 @@ def elementary_faces(faces) -> list:
 _PERIODIC = {"Geom_Plane": (False, False), "Geom_CylindricalSurface": (True, False),
              "Geom_ConicalSurface": (True, False), "Geom_SphericalSurface": (True, False),
              "Geom_ToroidalSurface": (True, True)}
-
-
-def is_rectangle(face, bounds) -> bool:
-    """True when every edge's p-curve lies on the border of the face's UV box (one wire)."""
-    if len(_explore(face, TopAbs_WIRE)) != 1:
-        return False
-    u0, u1, v0, v1 = bounds
-    tu, tv = 1e-7 * max(1.0, u1 - u0), 1e-7 * max(1.0, v1 - v0)
-    for e in _explore(face, TopAbs_EDGE):
-        edge = TopoDS.Edge_s(e)
-        pc = BRepAdaptor_Curve2d(edge, face)
-        f, l = pc.FirstParameter(), pc.LastParameter()
-        for t in f + (l - f) * np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0]):
-            p = pc.Value(float(t))
-            u, v = p.X(), p.Y()
-            on = min(abs(u - u0), abs(u - u1)) <= tu or min(abs(v - v0), abs(v - v1)) <= tv
-            if not on:
-                return False
-    return True
-
-
-def face_uv_triangles(face, deflection: float, angular: float = 0.1):
-    """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
-    face (the face's trimmed parameter region as a polygonal patchwork)."""
-    ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
-    if got is None or np.isnan(got.uv).any():
-        raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
-    uv, idx = got.uv, got.triangles
-    return uv, idx
 
 
 def edge_deviations(shape, samples: int = 23) -> np.ndarray:
@@ -412,6 +390,6 @@ def write_brep(shape, path) -> None:
 
 __all__ = [
     "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
-    "elementary_faces", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
+    "elementary_faces", "gprops", "min_distance", "section_edges",
     "model_tolerance", "planar_faces_on", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

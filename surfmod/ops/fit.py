@@ -327,7 +327,7 @@ def fit(points, tolerance: float, degree=(3, 3), *, smoothing: float = 1e-6, bas
     (True, True)
     """
     q = checks.finite_array(points, "points", ndim=2, last=3)
-    tol = checks.positive(tolerance, "tolerance")
+    tol = checks.tolerance(tolerance, "tolerance", float(np.linalg.norm(np.ptp(q, axis=0))) if len(q) else 0.0)
     try:
         p_u, p_v = degree
     except (TypeError, ValueError):

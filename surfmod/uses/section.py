@@ -199,7 +199,6 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     (1, [True], True)
     """
     from ..occ import uses as occ
-    from ..occ.triangulation import bounding_box as quick_box
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
@@ -208,7 +207,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     shape = to_shape(obj, "obj")
     # only a length scale for the on-face test: OCCT's quick box, not the optimal one
     # (which costs more than the section itself on B-spline parts)
-    box = quick_box(shape)
+    box = occ.bounding_box(shape, optimal=False)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
     on = planar_faces_in(shape, origin, normal, tol)
     if on:
