@@ -61,7 +61,7 @@ def run_and_judge_flat(part, tmp_path, capsys):
 #: the exact judge places the flat cutter along every move and asks OCCT for its distance
 #: to the part: on the largest part (11752, 1018 faces) that alone ran over eight minutes
 #: on the 2-core CI machine, so the flat-end sweep leaves out the two largest parts (with
-#: box_sides, 417 faces) and covers the other ten; the ball sweep below covers every file.
+#: box_sides, 417 faces) and covers the other ten; the ball sweep below covers every file of conftest.JUDGED.
 #: On Ventilator (9903 flat-end locations over 305 faces) the judge ran over 25 minutes:
 #: its moves are judged where the path was lifted (the test after the sweep)
 FLAT_TOO_SLOW_TO_JUDGE = {"pythonocc_11752.stp", "trimesh_box_sides.STEP", "pythonocc_Ventilator.stp"}
