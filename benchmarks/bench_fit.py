@@ -20,6 +20,8 @@ import numpy as np
 
 import surfmod as sm
 
+from .tables import Table
+
 
 def wave(x, y):
     return 0.3 * np.sin(3 * x) * np.cos(2 * y)
@@ -36,8 +38,11 @@ def _poles(geom):
     return f"{geom.NbUPoles()}x{geom.NbVPoles()}"
 
 
+TABLE = Table(("data", 26), ("method", 42, "<"), ("max dev", 9), ("rms", 9), ("poles", 9), ("time s", 7), left_first=True)
+
+
 def _row(name, method, dev, rms, poles, seconds):
-    print(f"| {name:<22} | {method:<34} | {dev:9.2e} | {rms:9.2e} | {poles:>9} | {seconds:7.2f} |")
+    TABLE.row(name, method, f"{dev:.2e}", f"{rms:.2e}", f"{poles}", f"{seconds:.2f}")
 
 
 def _ours(name, pts, tol, **kw):
@@ -83,8 +88,7 @@ def _plate(name, pts, tol):
 
 
 def main(argv=()) -> None:
-    print("| data                   | method                             |   max dev |       rms |     poles |  time s |")
-    print("|---|---|---:|---:|---:|---:|")
+    TABLE.header()
     rng = np.random.default_rng(0)
     tol = 1e-3
     # 1. a 60 x 60 grid of the wave: OCCT's grid fit applies

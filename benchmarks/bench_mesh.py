@@ -32,6 +32,8 @@ from surfmod.gallery.synthetic import wavy_net
 from surfmod.meshing.brep import DENSE, measure_face_meshes
 from surfmod.occ.mesh import brepmesh
 
+from .tables import Table, note
+
 
 def _nurbs_sphere(r: float = 5.0):
     s2 = np.sqrt(0.5)
@@ -164,34 +166,23 @@ def solid_rows(tolerances=(0.01, 0.001)):
 def main(only=(), solids: bool = True) -> None:
     """Print the tables (``only``: substrings of surface names; ``solids``: the solid
     table too)."""
-    head = (
-        f"| {'surface':<28} | {'tol':>6} | {'ours tris':>9} | {'ours dev':>9} | {'ours s':>7} "
-        f"| {'BRepMesh tris':>13} | {'BRepMesh dev':>12} | {'BRepMesh s':>10} | {'BRepMesh ok tris':>16} "
-        f"| {'ok dev':>9} | {'ok s':>7} | {'ours/ok tris':>12} | {'time ratio':>10} |"
-    )
-    print(head)
-    print("|" + "|".join("-" * (len(c)) for c in head.split("|")[1:-1]) + "|")
+    table = Table(("surface", 28), ("tol", 6), ("ours tris", 9), ("ours dev", 9), ("ours s", 7), ("BRepMesh tris", 13),
+                  ("BRepMesh dev", 12), ("BRepMesh s", 10), ("BRepMesh ok tris", 16), ("ok dev", 9), ("ok s", 7),
+                  ("ours/ok tris", 12), ("time ratio", 10), left_first=True)
+    table.header()
     for name, tol, n, dev, dt, n_b, dev_b, t_b, n_ok, dev_ok, t_ok in rows(only=only):
         flag = "" if dev_b <= tol else " (!)"
-        print(
-            f"| {name:<28} | {tol:>6g} | {n:>9d} | {dev:>9.3g} | {dt:>7.3f} | {n_b:>13d} | {dev_b:>8.3g}{flag:<4} "
-            f"| {t_b:>10.3f} | {n_ok:>16d} | {dev_ok:>9.3g} | {t_ok:>7.3f} | {n / n_ok:>12.2f} | {dt / t_b:>10.2f} |",
-            flush=True,
-        )
-    print("(!) BRepMesh's measured deviation exceeds the requested deflection\n")
+        table.row(name, f"{tol:g}", f"{n:d}", f"{dev:.3g}", f"{dt:.3f}", f"{n_b:d}", f"{dev_b:.3g}{flag}", f"{t_b:.3f}",
+                  f"{n_ok:d}", f"{dev_ok:.3g}", f"{t_ok:.3f}", f"{n / n_ok:.2f}", f"{dt / t_b:.2f}")
+    note("(!) BRepMesh's measured deviation exceeds the requested deflection")
+    note()
     if not solids:
         return
-    head2 = (
-        f"| {'solid':<22} | {'tol':>6} | {'tris':>7} | {'measured dev':>12} | {'time s':>6} "
-        f"| {'BRepMesh(defl=tol) tris':>23} | {'its dev':>9} | watertight |"
-    )
-    print(head2)
-    print("|" + "|".join("-" * (len(c)) for c in head2.split("|")[1:-1]) + "|")
+    table = Table(("solid", 22), ("tol", 6), ("tris", 7), ("measured dev", 12), ("time s", 6),
+                  ("BRepMesh(defl=tol) tris", 23), ("its dev", 9), ("watertight", 10), left_first=True)
+    table.header()
     for name, tol, n, dev, dt, n_b, dev_b, ok in solid_rows():
-        print(
-            f"| {name:<22} | {tol:>6g} | {n:>7d} | {dev:>12.3g} | {dt:>6.2f} | {n_b:>23d} | {dev_b:>9.3g} "
-            f"| {'yes' if ok else 'NO':>10} |"
-        )
+        table.row(name, f"{tol:g}", f"{n:d}", f"{dev:.3g}", f"{dt:.2f}", f"{n_b:d}", f"{dev_b:.3g}", "yes" if ok else "NO")
 
 
 if __name__ == "__main__":

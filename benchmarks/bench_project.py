@@ -7,17 +7,24 @@ OCCT's answers surfmod matches (to 1e-9), and how many points each side answers 
 closer: OCCT only returns orthogonal projections, while surfmod also finds the closest
 boundary points.
 
+The second table holds the elementary surfaces (closed forms on both sides: OCCT's
+``Extrema_ExtPElS``, surfmod's :mod:`surfmod.construct.elementary_closest`), 10,000
+points within ±6 around patches of size about 4, each over its own bounded domain.
+
 ``python -m benchmarks project``
 """
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
 
 import surfmod as sm
 from surfmod.occ.ops import project_points
+
+from .tables import Table, note
 
 
 def _surface():
@@ -39,13 +46,40 @@ def _best(fn, *args, repeat: int = 3):
     return result, best
 
 
+def _elementary():
+    return {
+        "plane": sm.PlaneSurface((1, 2, 3), (0.3, 0.2, 1), u_range=(-2, 3), v_range=(-1, 2)),
+        "cylinder": sm.CylindricalSurface(2.0, (1, 0, 0), (0.2, 0.3, 1), v_range=(-1, 3)),
+        "cone": sm.ConicalSurface(math.radians(30), 1.0, (0, 0, 0), (0, 0.2, 1), v_range=(-4, 3)),
+        "sphere": sm.sphere(2.0, center=(1, 0, 0)),
+        "torus": sm.torus(3.0, 1.0, (0, 1, 0), (1, 0, 1)),
+    }
+
+
+def analytic_table(n: int = 10_000) -> None:
+    rng = np.random.default_rng(2)
+    table = Table(("surface", 9), ("points", 7), ("surfmod", 10), ("OCCT", 10), ("speed-up", 9), ("same", 6),
+                  ("ours closer", 12), ("OCCT closer", 12))
+    table.header()
+    for name, s in _elementary().items():
+        (u0, u1), (v0, v1) = s.domain
+        pts = rng.uniform(-6, 6, (n, 3))
+        ours, t_ours = _best(sm.project, pts, s)
+        theirs, t_occ = _best(project_points, s.geom(), (u0, u1, v0, v1), pts)
+        found = np.isfinite(theirs[:, 2])
+        diff = ours.distance - np.where(found, theirs[:, 2], np.inf)
+        same = int(np.sum(np.abs(diff) <= 1e-9))
+        table.row(name, f"{n}", f"{t_ours / n * 1e6:.3f}us", f"{t_occ / n * 1e6:.3f}us", f"{t_occ / t_ours:.1f}x",
+                  f"{same}", f"{int(np.sum(diff < -1e-9))}", f"{int(np.sum(found & (diff > 1e-9)))}")
+
+
 def main() -> None:
     s = _surface()
     (u0, u1), (v0, v1) = s.domain
     rng = np.random.default_rng(1)
-    head = f"{'points':>7} {'surfmod':>10} {'OCCT':>10} {'speed-up':>9} {'same':>6} {'ours closer':>12} {'OCCT closer':>12}"
-    print(head)
-    print("-" * len(head))
+    table = Table(("points", 7), ("surfmod", 10), ("OCCT", 10), ("speed-up", 9), ("same", 6), ("ours closer", 12),
+                  ("OCCT closer", 12))
+    table.header()
     for n in (1_000, 10_000):
         pts = np.c_[rng.uniform(-5, 45, n), rng.uniform(-5, 35, n), rng.uniform(-12, 12, n)]
         ours, t_ours = _best(sm.project, pts, s)
@@ -55,10 +89,11 @@ def main() -> None:
         same = int(np.sum(np.abs(diff) <= 1e-9))
         closer = int(np.sum(diff < -1e-9))
         worse = int(np.sum(found & (diff > 1e-9)))
-        print(f"{n:>7} {t_ours / n * 1e3:>8.3f}ms {t_occ / n * 1e3:>8.3f}ms {t_occ / t_ours:>8.1f}x "
-              f"{same:>6} {closer:>12} {worse:>12}")
-    print("CPU times per point (one core); 'ours closer' includes the points OCCT finds no orthogonal")
-    print("projection for.")
+        table.row(f"{n}", f"{t_ours / n * 1e3:.3f}ms", f"{t_occ / n * 1e3:.3f}ms", f"{t_occ / t_ours:.1f}x",
+                  f"{same}", f"{closer}", f"{worse}")
+    note("CPU times per point (one core); 'ours closer' includes the points OCCT finds no orthogonal "
+         "projection for.")
+    analytic_table()
 
 
 if __name__ == "__main__":

@@ -30,6 +30,8 @@ import numpy as np
 
 import surfmod as sm
 
+from .tables import Table, note
+
 CORPUS = Path(__file__).resolve().parent.parent / "tests" / "data" / "step"
 REPEATS = 2
 
@@ -113,10 +115,10 @@ JOBS = ("read", "check", "mesh", "mass", "section")
 
 def _cell(ours, theirs) -> str:
     if isinstance(ours, str):
-        return f"{ours:>22}"
+        return ours
     if isinstance(theirs, str):
-        return f"{ours:8.3f} {'-':>6} {'-':>6}"
-    return f"{ours:8.3f} {theirs:6.3f} {ours / theirs:5.1f}x"
+        return f"{ours:.3f} / -"
+    return f"{ours:.3f} / {theirs:.3f} = {ours / theirs:.1f}x"
 
 
 def _options(argv):
@@ -144,10 +146,9 @@ def main(argv=None) -> None:
     if not files:
         print(f"no corpus file at {CORPUS}" + (f" matching {' '.join(words)}" if words else ""))
         return
-    print("seconds: surfmod, OCCT, ratio (surfmod / OCCT); mesh at 1e-3 of the bbox diagonal")
-    head = f"{'file':<44}" + "".join(f"{j:^23}" for j in jobs)
-    print(head)
-    print("-" * len(head))
+    note("seconds: surfmod / OCCT = ratio; mesh at 1e-3 of the bbox diagonal")
+    table = Table(("file", 43), *((job, 24) for job in jobs), left_first=True)
+    table.header()
     with tempfile.TemporaryDirectory() as tmp:
         out, occt_out = Path(tmp) / "part.stl", Path(tmp) / "occt.stl"
         for path in files:
@@ -157,10 +158,7 @@ def main(argv=None) -> None:
             centre = tuple(float(x) for x in (np.array(tuple(bb.min)) + np.array(tuple(bb.max))) / 2)
             ours = _surfmod_jobs(path, part, 1e-3 * diag, centre, out)
             theirs = _occt_jobs(path, _occt_read(path), 1e-3 * diag, centre, occt_out)
-            row = f"{path.name[:43]:<44}"
-            for job in jobs:
-                row += _cell(*_best_pair(ours[job], theirs[job], repeats)) + " "
-            print(row, flush=True)
+            table.row(path.name[:43], *(_cell(*_best_pair(ours[job], theirs[job], repeats)) for job in jobs))
 
 
 if __name__ == "__main__":

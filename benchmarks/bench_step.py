@@ -16,6 +16,8 @@ import surfmod as sm
 from surfmod.occ import isolated
 from surfmod.occ.exchange import read_step
 
+from .tables import Table, note
+
 CORPUS = Path(__file__).resolve().parent.parent / "tests" / "data" / "step"
 
 
@@ -28,8 +30,8 @@ def main() -> None:
     t = time.perf_counter()
     sm.import_step(files[0])
     start = time.perf_counter() - t
-    print(f"{'file':<44} {'MB':>6} {'in-process':>11} {'isolated':>9} {'overhead':>9}")
-    print("-" * 83)
+    table = Table(("file", 44), ("MB", 6), ("in-process", 11), ("isolated", 9), ("overhead", 9), left_first=True)
+    table.header()
     total_direct = total_isolated = 0.0
     for f in files:
         t = time.perf_counter()
@@ -40,11 +42,10 @@ def main() -> None:
         iso = time.perf_counter() - t
         total_direct += direct
         total_isolated += iso
-        print(f"{f.name:<44.44} {f.stat().st_size / 1e6:6.2f} {direct:10.3f}s {iso:8.3f}s {iso / direct:8.2f}x")
-    print("-" * 83)
-    print(f"{'corpus':<44} {'':>6} {total_direct:10.3f}s {total_isolated:8.3f}s "
-          f"{total_isolated / total_direct:8.2f}x")
-    print(f"worker start (first read, once per process): {start:.2f}s")
+        table.row(f.name[:44], f"{f.stat().st_size / 1e6:.2f}", f"{direct:.3f}s", f"{iso:.3f}s", f"{iso / direct:.2f}x")
+    table.rule()
+    table.row("corpus", "", f"{total_direct:.3f}s", f"{total_isolated:.3f}s", f"{total_isolated / total_direct:.2f}x")
+    note(f"worker start (first read, once per process): {start:.2f}s")
 
 
 if __name__ == "__main__":

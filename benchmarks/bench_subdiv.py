@@ -18,6 +18,8 @@ from trimesh.remesh import subdivide_loop
 
 import surfmod as sm
 
+from .tables import Table, note
+
 
 def _time(fn, repeat: int = 3):
     best, out = np.inf, None
@@ -56,19 +58,19 @@ def catmull_clark_rows():
 
 
 def main() -> None:
-    head = f"{'Loop':<14} {'triangles':>10} {'surfmod':>9} {'trimesh':>9} {'speed-up':>9} {'max |Δv|':>10}"
-    print(head)
-    print("-" * len(head))
+    table = Table(("Loop", 14), ("triangles", 10), ("surfmod", 9), ("trimesh", 9), ("speed-up", 9), ("max |Δv|", 10),
+                  left_first=True)
+    table.header()
     for levels, nf, t, t_tm, dev in loop_rows():
-        print(f"{'level ' + str(levels):<14} {nf:>10} {t:>8.4f}s {t_tm:>8.4f}s {t_tm / t:>8.1f}x {dev:>10.1e}")
-    print("icosphere with 642 vertices; max |Δv| compares the two vertex sets.\n")
-    head = f"{'Catmull–Clark':<14} {'faces':>10} {'surfmod':>9}"
-    print(head)
-    print("-" * len(head))
+        table.row(f"level {levels}", f"{nf}", f"{t:.4f}s", f"{t_tm:.4f}s", f"{t_tm / t:.1f}x", f"{dev:.1e}")
+    note("icosphere with 642 vertices; max |Δv| compares the two vertex sets.")
+    note()
+    table = Table(("Catmull–Clark", 14), ("faces", 10), ("surfmod", 9), left_first=True)
+    table.header()
     for levels, nf, t in catmull_clark_rows():
         label = "limit patches" if levels == "limit" else f"level {levels}"
-        print(f"{label:<14} {nf:>10} {t:>8.4f}s")
-    print("cube cage (8 vertices, 6 quads); 'limit patches' = sm.limit_surface, bicubic B-spline patches.")
+        table.row(label, f"{nf}", f"{t:.4f}s")
+    note("cube cage (8 vertices, 6 quads); 'limit patches' = sm.limit_surface, bicubic B-spline patches.")
 
 
 if __name__ == "__main__":

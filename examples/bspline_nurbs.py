@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 import surfmod as sm
+from surfmod.nets.bezier import bezier_patches
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 
@@ -31,7 +32,7 @@ for s in (bspline, nurbs):
 refined = nurbs.insert_knot(u=0.7, v=0.45)
 print("after knot insertion, same surface:", np.abs(refined.grid(np.linspace(0, 1, 9), np.linspace(0, 1, 9))
                                                     - nurbs.grid(np.linspace(0, 1, 9), np.linspace(0, 1, 9))).max())
-print("Bézier patches:", len(nurbs.bezier_patches()))
+print("Bézier patches:", len(bezier_patches(nurbs)))
 
 k = nurbs.curvatures(0.5, 0.45)
 print(f"at (0.5, 0.45): Gaussian {k.gaussian:.3e}, mean {k.mean:.3e}")

@@ -15,7 +15,7 @@ sm.export_step(part, OUT / "fe_part.step")
 tets = sm.fe_mesh(part, size=4.0, order=1, kind="volume", path=OUT / "fe_part.vtu")
 print(tets)
 print(f"mesh volume {tets.volume:.3f} vs solid {sm.mass_properties(part).volume:.3f}")
-tets.export(OUT / "fe_part.inp")
+sm.export_fe_mesh(tets, OUT / "fe_part.inp")
 
 tris = sm.fe_mesh(part, size=4.0, order=2, kind="surface", path=OUT / "fe_part_surface.msh")
 print(tris)

@@ -11,8 +11,8 @@ from pathlib import Path
 import build123d as bd
 
 import surfmod as sm
-from surfmod.construct.blend import occt_blend
-from surfmod.gallery.continuity import blend_report, nurbs_pair
+from surfmod.ops.blend import occt_blend
+from surfmod.gallery.beyond import blend_report, nurbs_pair
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 

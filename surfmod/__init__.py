@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import DamagedFileError, KernelError, SurfmodError
-
-__version__ = "0.1.0"
+from .errors import DamagedFileError, KernelError, MissingExtraError, SurfmodError
+from .pictures import install as _install_renderer
+from .version import installed_version
 
 # public name -> module that defines it (relative to this package)
 _EXPORTS = {
@@ -55,8 +55,8 @@ _EXPORTS = {
     "from_face": ".readback",
     "TrimmedFace": ".readback",
     "from_edge": ".construct.from_edge",
-    "crosscheck": ".verification",
-    "CrossCheck": ".verification",
+    "crosscheck": ".occt_crosscheck",
+    "CrossCheck": ".occt_crosscheck",
     "Mesh": ".meshing.grid",
     "mesh": ".meshing.grid",
     "export_step": ".io.step",
@@ -99,7 +99,7 @@ _EXPORTS = {
     "LimitSurface": ".subdiv.limit",
     "mass_properties": ".uses.mass",
     "boundary_ambiguity": ".uses.mass",
-    "MassProperties": ".uses.mass",
+    "MassProperties": ".mass.totals",
     "interference": ".uses.interference",
     "Interference": ".uses.interference",
     "section": ".uses.section",
@@ -118,7 +118,7 @@ _EXPORTS = {
     "Finish": ".cam.job",
     "Operation": ".cam.job",
     "export_gcode": ".cam.gcode",
-    "make_solid": ".uses.inputs",
+    "make_solid": ".inputs",
     "coons": ".construct.coons",
     "CoonsSurface": ".construct.coons",
     "gordon": ".construct.gordon",
@@ -131,12 +131,12 @@ _EXPORTS = {
     "from_rhino": ".interop.rhino_io",
     "export_iges": ".io.iges",
     "import_iges": ".io.iges",
-    "fit": ".construct.scattered_fit",
-    "Fit": ".construct.scattered_fit",
+    "fit": ".ops.fit",
+    "Fit": ".ops.fit",
     "continuity": ".ops.continuity",
     "Continuity": ".ops.continuity",
-    "blend": ".construct.blend",
-    "BlendSurface": ".construct.blend",
+    "blend": ".ops.blend",
+    "BlendSurface": ".ops.blend",
     "analyze": ".meshing.analyze",
     "Analysis": ".meshing.analyze",
     "offset": ".construct.offset",
@@ -146,16 +146,28 @@ _EXPORTS = {
     "Fill": ".construct.fill",
 }
 
-__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError"])
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError"])
 
 
 def __getattr__(name: str):
+    if name == "__version__":
+        globals()[name] = value = installed_version()
+        return value
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'surfmod' has no attribute {name!r}")
     value = getattr(importlib.import_module(module, __name__), name)
     globals()[name] = value
     return value
+
+
+def _repr_png(obj):
+    # the renderer ranks above the surfaces it draws; this package, at the top, hands it to
+    # them through surfmod.pictures, loaded (with matplotlib) on the first picture only
+    return importlib.import_module(".meshing.render", __name__).repr_png(obj)
+
+
+_install_renderer(_repr_png)
 
 
 def __dir__():

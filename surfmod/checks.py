@@ -164,6 +164,35 @@ def positive(value, name: str) -> float:
     return x
 
 
+#: tolerances below this fraction of the model size are round-off, not a request: refused
+TOLERANCE_FLOOR = 1e-12
+
+
+def tolerance(value, name: str, size: float) -> float:
+    """A tolerance for a model of size ``size`` (its bounding-box diagonal): a finite
+    number within ``[TOLERANCE_FLOOR * size, size]``.  Below the floor no double-precision
+    answer can be judged (iterations meant to reach it never stop); above the model size
+    every answer is within it.  ``size <= 0`` (a degenerate model) checks only ``> 0``.
+
+    >>> tolerance(1e-3, "tolerance", 10.0)
+    0.001
+    >>> tolerance(1e-300, "tolerance", 10.0)
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: tolerance: 1e-300 is below the floor 1e-11 (1e-12 of the model size 10)
+    """
+    tol = positive(value, name)
+    size = float(size)
+    if not (math.isfinite(size) and size > 0.0):
+        return tol
+    if tol < TOLERANCE_FLOOR * size:
+        raise SurfmodError(f"{name}: {tol:g} is below the floor {TOLERANCE_FLOOR * size:g} "
+                           f"({TOLERANCE_FLOOR:g} of the model size {size:g})")
+    if tol > size:
+        raise SurfmodError(f"{name}: {tol:g} exceeds the model size {size:g} (every answer would be within it)")
+    return tol
+
+
 def interval(value, name: str) -> tuple[float, float]:
     """A parameter or coordinate range ``(start, end)`` with finite ``start < end``.
 

@@ -11,7 +11,7 @@ import abc
 
 import numpy as np
 
-from . import checks
+from . import checks, pictures
 from .errors import SurfmodError
 from .immutable import Immutable
 from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
@@ -111,6 +111,10 @@ class Curve(Immutable, abc.ABC):
 
         t0, t1 = self.domain
         return edge_from_curve(self.geom(), t0, t1)
+
+    def _repr_png_(self) -> bytes | None:
+        """A picture for Jupyter: the curve as a line (see :func:`surfmod.meshing.render.png_bytes`)."""
+        return pictures.repr_png(self)
 
     @property
     def breaks(self) -> np.ndarray:

@@ -42,3 +42,15 @@ class DamagedFileError(KernelError):
     >>> issubclass(sm.DamagedFileError, sm.KernelError)
     True
     """
+
+
+class MissingExtraError(SurfmodError, ImportError):
+    """A call needs an optional package that is not installed; the message names the
+    package and the extra that brings it (``pip install "surfmod[fem]"``).  It is both a
+    :class:`SurfmodError` (the command line prints its one line and exits 1) and an
+    ``ImportError``.
+
+    >>> import surfmod as sm
+    >>> issubclass(sm.MissingExtraError, sm.SurfmodError) and issubclass(sm.MissingExtraError, ImportError)
+    True
+    """

@@ -12,7 +12,7 @@ import abc
 
 import numpy as np
 
-from . import checks, tolerances
+from . import checks, pictures, tolerances
 from .errors import SurfmodError
 from .eval.differential import Curvatures, curvatures, degenerate_mask, unit_normals
 from .immutable import Immutable
@@ -58,6 +58,24 @@ def finite_result(out: np.ndarray, u: np.ndarray, v: np.ndarray, what: str) -> n
     )
 
 
+def model_size(*surfaces) -> float:
+    """The bounding-box diagonal of 9 x 9 samples of each surface (the scale that
+    tolerances are judged against).
+
+    >>> import surfmod as sm
+    >>> round(model_size(sm.plane((0, 0, 0), (3, 0, 0), (0, 4, 0))), 12)
+    5.0
+    """
+    pts = []
+    for s in surfaces:
+        (u0, u1), (v0, v1) = s.domain
+        pts.append(s._grid_derivatives(np.linspace(u0, u1, 9), np.linspace(v0, v1, 9), 0)[:, :, 0, 0].reshape(-1, 3))
+    pts = np.concatenate(pts)
+    with np.errstate(invalid="ignore", over="ignore"):
+        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    return size if np.isfinite(size) else 0.0
+
+
 class Surface(Immutable, abc.ABC):
     """Base of every parametric surface in surfmod.
 
@@ -97,6 +115,12 @@ class Surface(Immutable, abc.ABC):
         """True when every partial up to ``order`` (0: positions) is finite by construction,
         so no pass over the output is needed; subclasses that can bound them override."""
         return False
+
+    def _closest_parameters(self, points: np.ndarray):
+        """``(u, v)`` of the closest points of the domain to ``(N, 3)`` points where the
+        surface has them in closed form (the elementary surfaces), else ``None``: then
+        :func:`surfmod.ops.closest.closest_points` seeds and iterates."""
+        return None
 
     def _grid_derivatives(self, us: np.ndarray, vs: np.ndarray, order: int) -> np.ndarray:
         """``(len(us), len(vs), K, K, 3)``; subclasses override with a faster tensor path."""
@@ -250,6 +274,10 @@ class Surface(Immutable, abc.ABC):
 
         (u0, u1), (v0, v1) = self.domain
         return face_from_surface(self.geom(), u0, u1, v0, v1)
+
+    def _repr_png_(self) -> bytes | None:
+        """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        return pictures.repr_png(self)
 
     # -- named transforms (all through ``transformed``) ----------------------------------
     def translated(self, vector) -> "Surface":

@@ -21,7 +21,7 @@
     different summation orders (de Boor vs. power-basis cache).
 ``CROSSCHECK_NORMAL_RTOL``
     Pass limit on the normal deviation converted back into the derivative difference
-    that explains it (see ``verification._normal_turns``): derivatives agree to about
+    that explains it (see ``occt_crosscheck._normal_turns``): derivatives agree to about
     ``DERIVATIVE_RTOL``; the cross product and normalization lose up to two digits more.
 ``CROSSCHECK_CURVATURE_RTOL``
     Pass limit on curvatures relative to the largest curvature: curvature divides

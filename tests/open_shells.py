@@ -19,7 +19,7 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS_Shell
 
-from surfmod.uses.inputs import to_shape
+from surfmod.inputs import to_shape
 
 
 def _explore(shape, kind):

@@ -1,4 +1,4 @@
-"""Closed-form distances (surfmod.meshing.analytic) equal OCCT's projection distance:
+"""Closed-form distances (surfmod.meshing.analytic_distance) equal OCCT's projection distance:
 planes, spheres, cylinders, cones and tori, and surfaces of revolution of a circle or a
 line lying in a plane through the axis (a torus, a sphere, a cone, a cylinder, a plane);
 a line skew to the axis (a hyperboloid) and an ellipse get no closed form."""
@@ -19,7 +19,7 @@ from OCP.Geom import (
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Elips, gp_Pnt
 
-from surfmod.meshing import analytic
+from surfmod.meshing import analytic_distance as analytic
 
 AXIS = gp_Ax1(gp_Pnt(0.5, -1.0, 0.2), gp_Dir(0.2, 0.3, 0.9))
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.construct.blend import occt_blend
+from surfmod.ops.blend import occt_blend
 
 
 def patch(seed, shift=(0.0, 0.0, 0.0), degree=(3, 3), knots=None, weights=False, shape=(6, 5)):

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 import reference as ref
 import surfmod as sm
 from strategies import bspline_surfaces, clamped_knots, parameters_with_knots
+from surfmod.nets.bezier import bezier_patches, bezier_pieces
 from surfmod.nets.knots import smooth_mask
 from surfmod.occ.sample import curve_d2, surface_d2, surface_props
 
@@ -126,7 +127,7 @@ def test_bezier_extraction_reproduces_the_surface(rng):
     ku = [0, 0, 0, 0, 0.25, 0.6, 1, 1, 1, 1]
     kv = [0, 0, 0, 0.5, 0.5, 1, 1, 1]
     s = sm.BSplineSurface(rng.uniform(-1, 1, (6, 5, 3)), (3, 2), (ku, kv))
-    patches = s.bezier_patches()
+    patches = bezier_patches(s)
     assert len(patches) == 3 * 2
     for (u0, u1), (v0, v1), patch in patches:
         a = np.linspace(0, 1, 5)
@@ -172,7 +173,7 @@ def test_curve_segment_and_bezier_pieces(rng):
     seg = c.segment(0.2, 0.9)
     t = np.linspace(0.2, 0.9, 13)
     np.testing.assert_allclose(seg.points(t), c.points(t), atol=1e-13)
-    pieces = c.bezier_pieces()
+    pieces = bezier_pieces(c)
     assert [span for span, _ in pieces] == [(0.0, 0.3), (0.3, 0.5), (0.5, 0.8), (0.8, 1.0)]
     for (t0, t1), piece in pieces:
         a = np.linspace(0, 1, 5)

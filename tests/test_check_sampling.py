@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.verification import crosscheck_many, sufficient_parameters
+from surfmod.occt_crosscheck import crosscheck_many, sufficient_parameters
 
 from conftest import CORPUS
 
@@ -135,7 +135,7 @@ def test_a_batch_returns_the_error_of_an_unreadable_object():
 
 def test_batches_are_bounded(monkeypatch):
     """More faces than one batch holds: every face is judged, in pieces."""
-    import surfmod.verification as v
+    import surfmod.occt_crosscheck as v
 
     monkeypatch.setattr(v, "BATCH_FACES", 2)
     objs = [sm.sphere(1.0 + i) for i in range(5)] + [_WideCylinder(100.0, v_range=(0, 5))]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import importlib.metadata
+import re
 import shutil
 import subprocess
 import sys
@@ -21,6 +23,29 @@ def test_help_lists_the_subcommands(capsys):
     out = capsys.readouterr().out
     for name in ("gallery", "check"):
         assert name in out
+
+
+def _pyproject_version() -> str:
+    text = (Path(__file__).resolve().parent.parent / "pyproject.toml").read_text()
+    # (tomllib is Python 3.11+; the project supports 3.10)
+    return re.search(r'^version = "([^"]+)"$', text, flags=re.MULTILINE).group(1)
+
+
+def test_version_comes_from_the_installed_metadata(capsys):
+    # one source (pyproject.toml) -> the metadata pip wrote -> sm.__version__ and --version
+    version = importlib.metadata.version("surfmod")
+    assert version == _pyproject_version() == sm.__version__
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out == f"surfmod {version}\n"
+
+
+def test_version_of_an_uninstalled_tree_says_so():
+    from surfmod.version import NOT_INSTALLED, installed_version
+
+    assert installed_version("surfmod-no-such-distribution") == NOT_INSTALLED
+    assert installed_version("numpy") == np.__version__
 
 
 def test_check_reports_every_face(tmp_path, capsys):
@@ -67,6 +92,8 @@ def test_console_script_runs_the_gallery(tmp_path):
     )
     assert out.returncode == 0, out.stderr
     assert "2 of 2 entities passed" in out.stdout
+    version = subprocess.run([_console_script(), "--version"], capture_output=True, text=True, check=True)
+    assert version.stdout.strip() == f"surfmod {sm.__version__}"
     for name in ("bezier", "hermite"):
         assert (tmp_path / f"{name}.step").stat().st_size > 0
         assert (tmp_path / f"{name}.stl").stat().st_size > 0

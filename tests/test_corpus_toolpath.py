@@ -13,12 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import CORPUS_FILES
+from conftest import JUDGED_FILES
 from toolpath_reference import ball_clearance, flat_cuts, gcode_positions, material
 
 from surfmod.cli import main as cli_main
 from surfmod.occ.triangulation import bounding_box
-from surfmod.uses.inputs import to_shape
+from surfmod.inputs import to_shape
 
 RADIUS_SHARE = 0.03
 SCALLOP_SHARE = 0.1
@@ -68,7 +68,7 @@ FLAT_TOO_SLOW_TO_JUDGE = {"pythonocc_11752.stp", "trimesh_box_sides.STEP", "pyth
 
 
 @pytest.mark.corpus
-@pytest.mark.parametrize("corpus_file", [p for p in CORPUS_FILES if p.name not in FLAT_TOO_SLOW_TO_JUDGE],
+@pytest.mark.parametrize("corpus_file", [p for p in JUDGED_FILES if p.name not in FLAT_TOO_SLOW_TO_JUDGE],
                          ids=lambda p: p.name)
 def test_corpus_flat_end_toolpath_never_gouges(corpus_file, tmp_path, capsys):
     run_and_judge_flat(corpus_file, tmp_path, capsys)
@@ -105,8 +105,24 @@ def test_ventilator_flat_end_path_is_lifted_where_refining_fails_and_those_moves
 
 
 @pytest.mark.corpus
+@pytest.mark.parametrize("corpus_file", JUDGED_FILES, ids=lambda p: p.name)
 def test_corpus_toolpath_never_gouges(corpus_file, tmp_path, capsys):
     run_and_judge(corpus_file, tmp_path, capsys)
+
+
+@pytest.mark.corpus
+def test_corpus_toolpath_runs_on_every_file(corpus_file, tmp_path, capsys):
+    """The cheap check on every file (the exact judge above runs on conftest's JUDGED):
+    the ball-end path is written or refused in one line, and its moves stay over the part
+    (within a tool radius of its box in x and y) and never a radius below its lowest point
+    (the lowest a ball can rest: on an edge, e.g. a through hole's bottom rim)."""
+    shape = to_shape(corpus_file)
+    radius = _radius(shape)
+    moves = _run(corpus_file, tmp_path, capsys, ["--radius", repr(radius), "--scallop", repr(SCALLOP_SHARE * radius)])
+    lo, hi = bounding_box(shape)
+    assert len(moves) > 1 and np.isfinite(moves).all()
+    assert (moves[:, :2] >= lo[:2] - radius - ROUNDING).all() and (moves[:, :2] <= hi[:2] + radius + ROUNDING).all()
+    assert moves[:, 2].min() >= lo[2] - radius - ROUNDING
 
 
 def test_one_corpus_toolpath_never_gouges(corpus_dir, tmp_path, capsys):

@@ -1,9 +1,11 @@
 """Every script in examples/ runs, writes readable STEP/STL files into step_samples/ and
 keeps the promises it prints: every cross-check it shows passes, every measured figure it
-sets beside a tolerance or a closed form agrees with it.
+sets beside a tolerance or a closed form agrees with it.  Every script prints at least one
+figure that is checked (a GENERIC one or one of its own PROMISES): a script whose output
+is never read would pass whatever it computed.
 
 Scripts run in-process (build123d is imported once) from a copy of the folder, so the
-repository's step_samples/ is left alone.
+repository's step_samples/ is left alone; the corpus (tests/data) is linked beside it.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import surfmod as sm
 from surfmod.cli.check import check_file
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+DATA = Path(__file__).resolve().parent / "data"
 SCRIPTS = sorted(p.name for p in EXAMPLES.glob("*.py"))
 
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
@@ -81,19 +84,58 @@ PROMISES = {
     "project_shadow.py": [(rf"max \|du\| {NUM}", lambda d: float(d) < 1e-12)],
     "interference.py": [(r"interference report: (\w+)", None)],
     "fe_mesh.py": [(rf"curved \(order 2\) surface area {NUM} vs exact {NUM}", lambda a, b: _close(a, b, 1e-4))],
+    "continuity_analysis.py": [
+        # a cylinder's quarter joined tangentially to a plane (G1), two halves of one surface (G2)
+        (r"^a\.u0 \| b\.v0 +\S+ +\S+ +\S+ +\S+ +(G\d)$", lambda level: level == "G1"),
+        (r"^a\.u1 \| b\.u0 +\S+ +\S+ +\S+ +\S+ +(G\d)$", lambda level: level == "G2"),
+        (rf"^max over 20 edges +{NUM}", lambda gap: float(gap) < 1e-7),
+    ],
+    "curvature_analysis.py": [
+        (rf"^(?:zebra|isophote) +range \[{NUM}, {NUM}\]", lambda a, b: 0 <= float(a) <= float(b) <= 1),
+        (rf"^max_abs +range \[{NUM}, {NUM}\]", lambda a, b: 0 <= float(a) <= float(b)),
+    ],
+    "fill_hole.py": [
+        (rf"sm\.fill G(\d) +gap +{NUM} +angle +{NUM} rad +curvature jump +{NUM} \({NUM} relative\)",
+         lambda level, gap, angle, _jump, rel: float(gap) < 1e-12 and float(angle) < 1e-12
+         and (level == "1" or float(rel) < 1e-10)),
+    ],
+    "g2_blend.py": [
+        (rf"^a\.(?:u1 \| b\.v0|v1 \| b\.u0) +{NUM} +{NUM} +\S+ +\S+ +(G\d)$",
+         lambda gap, angle, level: float(gap) < 1e-12 and float(angle) < 1e-12 and level == "G2"),
+    ],
+    "nurbs_exchange.py": [
+        # the neutral formats store doubles as text: equal to a few ulps, not bit for bit
+        (rf"^(\S+) +data identical: (\w+), max point difference {NUM}",
+         lambda fmt, same, d: float(d) < 1e-13 and (same == "True" or fmt in ("IGES", "STEP"))),
+    ],
+    "offset_thicken.py": [
+        (rf"^offset 0\.8: .*max deviation {NUM}", lambda d: float(d) <= 1e-5),
+        (rf"^thickened: volume {NUM} \(BRepGProp\), {NUM} \(NumPy quadrature\)", lambda a, b: _close(a, b, 1e-7)),
+    ],
+    "real_part_faces.py": [
+        (rf"area {NUM} \(40 x 30 - pi 5\^2 = {NUM}\)", lambda a, b: _close(a, 1200 - 25 * np.pi, 1e-10) and a == b),
+        (rf"in 2 pieces, {NUM} long \(30 - 10\)", lambda length: _close(length, 20, 1e-7)),
+    ],
+    "fit_scan.py": [
+        (rf"^fit: .*max deviation {NUM} \(OCCT projection of every point\).* converged (\w+)",
+         lambda d, converged: float(d) <= 0.005 and converged == "True"),
+    ],
 }
 
 
 def _kept_promises(script: str, output: str) -> list[str]:
     """Each printed figure that breaks its promise, as a readable line."""
-    broken = []
+    broken, checked = [], 0
     for pattern, holds in GENERIC + PROMISES.get(script, []):
         matches = list(re.finditer(pattern, output, flags=re.MULTILINE))
         if pattern in dict(PROMISES.get(script, [])) and not matches:
             broken.append(f"{script} no longer prints {pattern!r}")
         for m in matches:
+            checked += 1
             if holds is not None and not holds(*m.groups()):
                 broken.append(f"{script}: {m.group(0)!r}")
+    if not checked:
+        broken.append(f"{script} prints no figure that is checked (give it a PROMISES entry)")
     if script == "interference.py":
         kinds = re.findall(r"interference report: (\w+)", output)
         if kinds[:3] != ["CLEARANCE", "CONTACT", "INTERFERENCE"]:
@@ -105,12 +147,25 @@ def test_promise_checker_can_fail():
     out = "CrossCheck(parametric, 64 samples, max deviation 1e-3, FAILED)\nsphere area 1.0 vs 4 pi R^2 = 1.1\n"
     assert len(_kept_promises("quadrics.py", out)) == 2
     assert _kept_promises("trim.py", "")[0].startswith("trim.py no longer prints")
+    # a script without promises of its own that prints nothing checkable is broken too
+    assert _kept_promises("bezier_patch.py", "wrote bezier_patch.step\n") == [
+        "bezier_patch.py prints no figure that is checked (give it a PROMISES entry)"
+    ]
+    assert _kept_promises("bezier_patch.py", "CrossCheck(parametric, 9 samples, max deviation 0, passed)") == []
+    # every promise of every script can fail: each pattern's check rejects a wrong figure
+    bad = {"nurbs_exchange.py": "geomdl   data identical: False, max point difference 1.0e-03\n",
+           "real_part_faces.py": "  area 1121.5 (40 x 30 - pi 5^2 = 1121.5); untrimmed 1200\n",
+           "fill_hole.py": "hole, sm.fill G2     gap  2.9e-15  angle  1.6e-14 rad  curvature jump  2.4e-2 (3.9e-2 relative)"}
+    for script, out in bad.items():
+        assert any(line.startswith(f"{script}: ") for line in _kept_promises(script, out)), script
 
 
 @pytest.mark.parametrize("script", SCRIPTS)
 def test_example_runs_and_writes_samples(script, tmp_path, capsys):
     (tmp_path / "examples").mkdir()
     (tmp_path / "step_samples").mkdir()
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "data").symlink_to(DATA, target_is_directory=True)
     copy = tmp_path / "examples" / script
     shutil.copy(EXAMPLES / script, copy)
     runpy.run_path(str(copy), run_name="__main__")

@@ -11,7 +11,7 @@ from test_fill import corner_hole, four_sided_hole
 
 import surfmod as sm
 from surfmod.construct.fill import occt_fill
-from surfmod.occ.continuity import local_analysis
+from surfmod.occ.local_analysis import local_analysis
 
 SAMPLES = 60
 

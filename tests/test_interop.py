@@ -154,7 +154,7 @@ def test_analytic_surfaces_and_build123d_faces_are_converted():
                                       ("geomdl", "from_geomdl"), ("splipy", "from_splipy"), ("rhino3dm", "from_rhino")])
 def test_missing_library_names_the_extra(lib, call, monkeypatch):
     monkeypatch.setitem(sys.modules, lib, None)  # import now raises ImportError
-    with pytest.raises(sm.SurfmodError, match=r"pip install surfmod\[interop\]"):
+    with pytest.raises(sm.MissingExtraError, match=rf"{call} needs the optional package '{lib}': pip install \"surfmod\[interop\]\""):
         getattr(sm, call)(sm.BSplineCurve([(0, 0, 0), (1, 0, 0)], 1))
 
 

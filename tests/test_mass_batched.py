@@ -17,13 +17,14 @@ from surfmod.occ import uses as occ
 from surfmod.occ.pcurves import face_pcurves, faces_pcurves
 from surfmod.occ.topo import faces_of
 from surfmod.readback import from_face
-from surfmod.uses.inputs import to_shape
-from surfmod.uses.mass import _moments, _read_faces
-from surfmod.uses.mass_boundary import PcurveTable, pcurve_d1, taylor_pieces
-import surfmod.uses.mass_green as mg
-import surfmod.uses.mass_grid as mgrid
-from surfmod.uses.mass_green import face_nodes, mass_face, mass_faces
-from surfmod.uses.mass_plane import plane_moments
+from surfmod.inputs import to_shape
+from surfmod.mass.moments import _moments
+from surfmod.readback import from_faces as _read_faces
+from surfmod.mass.boundary import PcurveTable, pcurve_d1, taylor_pieces
+import surfmod.mass.nodes as mg
+import surfmod.mass.rules as mgrid
+from surfmod.mass.nodes import face_nodes, mass_face, mass_faces
+from surfmod.mass.planes import plane_moments
 
 def _rel(a, b):
     return abs(a - b) / abs(b)
@@ -294,7 +295,7 @@ def test_vertex_mean_weights_shared_vertices_by_their_visits():
 def test_moments_of_groups_equal_one_call_per_group(corpus_dir):
     # the integrands of both totals (exact and not) in one pass: each group's sums are the
     # ones its own call makes, bit for bit
-    from surfmod.uses.mass import _moments_of_groups
+    from surfmod.mass.moments import _moments_of_groups
 
     _, shapes = _part(corpus_dir / "occt_screw.step")
     read = _read_faces(shapes)
@@ -314,7 +315,7 @@ def test_lines_and_arcs_laid_directly_equal_the_boundary_pass(monkeypatch, cut):
     # plates with holes and rounded slots: their lines' and arcs' Gauss nodes laid without
     # boundaries() give its sums (to round-off: the nodes are the same), and the solids'
     # exact volumes
-    import surfmod.uses.mass_plane as mp
+    import surfmod.mass.planes as mp
 
     if cut == "disc":
         part, volume = bd.Cylinder(1.5, 2.0), math.pi * 1.5**2 * 2.0
@@ -373,8 +374,8 @@ def test_spline_pcurve_breaks_from_knots_equal_occt_intervals_on_the_corpus(corp
 def test_boundary_nodes_with_span_hints_equal_the_search(corpus_dir, monkeypatch):
     # the span of each piece's middle serves all its Gauss nodes: the same values as
     # searching every node's span (the screw's helical B-spline p-curves, bit for bit)
-    import surfmod.uses.mass_green as mg
-    from surfmod.uses.mass_boundary import PcurveTable, boundaries
+    import surfmod.mass.nodes as mg
+    from surfmod.mass.boundary import PcurveTable, boundaries
 
     _, shapes = _part(corpus_dir / "occt_screw.step")
     read = _read_faces(shapes)
@@ -412,7 +413,7 @@ def test_pcurve_table_subset_equals_a_table_of_those_records(corpus_dir, name):
 
 
 def test_elementary_degrees_by_type_equal_direction_degree():
-    import surfmod.uses.mass_green as mg
+    import surfmod.mass.nodes as mg
 
     solids = [bd.Box(1, 2, 3), bd.Cylinder(1, 2), bd.Cone(2, 1, 3), bd.Sphere(1), bd.Torus(3, 1)]
     kinds = set()

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-import surfmod.uses.mass_green as mg
-import surfmod.uses.mass_grid as mgrid
+import surfmod.mass.nodes as mg
+import surfmod.mass.rules as mgrid
 from surfmod.occ.pcurves import adaptor_d1, face_pcurves
 from surfmod.occ.topo import faces_of
-from surfmod.uses.mass import _moments, face_moments
+from surfmod.mass.moments import _moments, face_moments
 
 CORPUS_FILE = "pythonocc_face_recognition_sample_part.stp"
 

@@ -189,7 +189,7 @@ def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
 def test_analytic_faces_measured_at_once_equal_face_by_face(corpus_dir):
     """measure_analytic_faces (every plane, cylinder, cone and torus face of a part in
     one compiled pass) gives each face what measure_face gives it alone."""
-    from surfmod.meshing import analytic
+    from surfmod.meshing import analytic_distance as analytic
     from surfmod.meshing.brep import measure_analytic_faces
 
     shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")

@@ -18,7 +18,7 @@ from surfmod.cli import main as cli_main
 from surfmod.occ.triangulation import part_triangles
 from surfmod.cam import toolpath_moves
 from surfmod.cam.drop_cutter import TriangleGrid, drop
-from surfmod.uses.inputs import to_shape
+from surfmod.inputs import to_shape
 from surfmod.cam.toolpath import drop_cutter
 
 CORPUS_PART = "trimesh_featuretype.STEP"

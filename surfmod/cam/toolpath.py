@@ -26,9 +26,10 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from .gcode import gcode_text
+from ..inputs import to_shape
+from ..meshing.render import Drawing, polyline_runs, repr_png
 from .drop_cutter import TriangleGrid, drop
-from ..uses.inputs import to_shape
+from .gcode import gcode_text
 from .toolpath_exact import exact_heights
 from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
@@ -86,6 +87,20 @@ class Toolpath:
     def to_gcode(self, **kw) -> str:
         """The G-code text (see :func:`surfmod.export_gcode`)."""
         return gcode_text(self, **kw)
+
+    def drawing(self) -> list[Drawing]:
+        """The path as lines for :func:`surfmod.render`: raster passes in blue, links and
+        staircases (``pass_index`` -1) in orange."""
+        on_pass = (self.pass_index[1:] >= 0) & (self.pass_index[1:] == self.pass_index[:-1])
+        runs = polyline_runs(self.points, on_pass)
+        return [
+            Drawing(lines=runs.get(True, []), line_color=(0.1, 0.3, 0.8, 0.9), line_width=0.7),
+            Drawing(lines=runs.get(False, []), line_color=(0.95, 0.5, 0.1, 0.9), line_width=0.7),
+        ]
+
+    def _repr_png_(self) -> bytes | None:
+        """A picture of the moves for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        return repr_png(self)
 
     def __str__(self) -> str:
         return (

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 from ..errors import SurfmodError
+from ..version import installed_version
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -17,6 +18,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="surfmod",
         description="Surface-modeling toolbox on OpenCASCADE, cross-checked by NumPy.",
     )
+    parser.add_argument("--version", action="version", version=f"surfmod {installed_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
         module = importlib.import_module(f"{__name__}.{info.name}")

@@ -1,4 +1,7 @@
-"""``surfmod analyze PART.step --kind zebra --out z.png``: curvature analysis of a part."""
+"""``surfmod analyze PART.step --kind zebra --out z.png``: curvature analysis of a part.
+
+The same concept as :mod:`surfmod.meshing.analyze`, one level up: the command over it.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +9,7 @@ from ..errors import SurfmodError
 
 from ..meshing.analyze import analyze
 
-from ..uses.inputs import load_step
+from ..inputs import load_step
 
 
 def register(sub) -> None:

@@ -1,9 +1,13 @@
-"""``surfmod femesh FILE.step --size S --out mesh.msh``: gmsh FE mesh via meshio."""
+"""``surfmod femesh FILE.step --size S --out mesh.msh``: gmsh FE mesh via meshio.
+
+The same concept as :mod:`surfmod.uses.femesh`, one level up: the command over it.
+"""
 
 from __future__ import annotations
 
 from ..atomic import target_path
-from ..uses.femesh import fe_mesh, FORMATS
+from ..uses.femesh import FORMATS, export_fe_mesh, fe_mesh
+from tqdm import tqdm
 
 
 def register(sub) -> None:
@@ -18,13 +22,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from tqdm import tqdm
-
     target_path(args.out, "out", tuple(FORMATS))
     with tqdm(total=2, desc="femesh", unit="step", disable=args.no_progress) as bar:
         m = fe_mesh(args.path, args.size, args.order, args.kind)
         bar.update()
-        m.export(args.out)
+        export_fe_mesh(m, args.out)
         bar.update()
     print(m)
     print(f"wrote {args.out}")

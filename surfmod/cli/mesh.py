@@ -1,6 +1,9 @@
 """``surfmod mesh FILE.step --tolerance T --out part.stl [--strict]``: STL for CAM and
 slicers, measured against the B-rep; faces whose model is itself off by more than the
-tolerance are reported (or refused with ``--strict``)."""
+tolerance are reported (or refused with ``--strict``).
+
+The same concept as :mod:`surfmod.occ.mesh` (OCCT's BRepMesh) at the top: the command that meshes a B-rep.
+"""
 
 from __future__ import annotations
 

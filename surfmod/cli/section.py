@@ -1,4 +1,7 @@
-"""``surfmod section FILE.step --origin x y z --normal x y z --out file.dxf``."""
+"""``surfmod section FILE.step --origin x y z --normal x y z --out file.dxf``.
+
+The same concept as :mod:`surfmod.uses.section`, one level up: the command over it.
+"""
 
 from __future__ import annotations
 
@@ -6,8 +9,9 @@ from pathlib import Path
 
 from ..errors import SurfmodError
 from ..io.svg import export_svg
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from ..uses.section import section
+from tqdm import tqdm
 
 
 def register(sub) -> None:
@@ -22,8 +26,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from tqdm import tqdm
-
     from ..io.dxf import export_dxf
 
     suffix = Path(args.out).suffix.lower()

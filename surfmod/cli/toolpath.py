@@ -1,4 +1,7 @@
-"""``surfmod toolpath FILE.step --tool ball --radius R --scallop h --out path.nc``."""
+"""``surfmod toolpath FILE.step --tool ball --radius R --scallop h --out path.nc``.
+
+The same concept as :mod:`surfmod.cam.toolpath`, one level up: the command over it.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +9,7 @@ from __future__ import annotations
 from ..errors import SurfmodError
 from ..atomic import target_path
 from ..cam.gcode import export_gcode
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from ..cam.toolpath import Tool, toolpath
 
 GCODE_SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")

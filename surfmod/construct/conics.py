@@ -19,7 +19,7 @@ from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
-from .frames import cos_d, frame_transformed, make_frame, sin_d
+from .axes import cos_d, frame_transformed, make_frame, sin_d
 
 TWO_PI = 2.0 * math.pi
 

@@ -185,8 +185,7 @@ def coons(c0, c1, d0, d1, *, blend: str = "linear", tolerance: float = 1e-7) -> 
     pts, w = cartesian(net, rational)
     if w is not None and np.any(w <= 0):
         raise SurfmodError("c0: the blended weights are not positive; use boundaries with end weights 1")
-    obj = CoonsSurface._construct_fast()
-    BSplineSurface._set(obj, pts, (cu[0].degree, cv[0].degree), (cu[0].knots, cv[0].knots), w)
+    obj = CoonsSurface._trusted(pts, (cu[0].degree, cv[0].degree), (cu[0].knots, cv[0].knots), w)
     obj.boundaries = tuple(given)
     obj.blend = blend
     return obj

@@ -27,9 +27,10 @@ from .. import checks, transforms
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface
 from ..surface import Surface
+from . import elementary_closest as closest
 from .conics import Arc
 from .curves import Line
-from .frames import cos_d, frame_transformed, make_frame, sin_d
+from .axes import cos_d, frame_transformed, make_frame, sin_d
 from .revolution import revolve_nurbs
 
 TWO_PI = 2.0 * math.pi
@@ -90,6 +91,17 @@ class ElementarySurface(Surface):
         # separable: the trigonometry runs on the nu + nv parameters, not on nu x nv points
         return self._derivatives(us[:, None], vs[None, :], order)
 
+    def _closest_parameters(self, points):
+        return self._closest_in(points, self._domain)
+
+    def _closest_in(self, points, box):
+        """``(u, v)`` of the closest points of the parameter box ``box`` to ``(N, 3)``
+        points, in closed form (:mod:`surfmod.construct.elementary_closest`)."""
+        return self._closest_local(self._local(points), box)
+
+    def _closest_local(self, local, box):
+        raise NotImplementedError
+
     def geom(self):
         return self._twin(self._build_geom)
 
@@ -147,6 +159,9 @@ class PlaneSurface(ElementarySurface):
             fy[..., 0, 1] = 1.0
         return fx, fy, fz
 
+    def _closest_local(self, local, box):
+        return closest.plane(local, box)
+
     def _build_geom(self):
         from ..occ.analytic import plane
 
@@ -196,6 +211,9 @@ class CylindricalSurface(ElementarySurface):
         if order >= 1:
             fz[..., 0, 1] = 1.0
         return fx, fy, fz
+
+    def _closest_local(self, local, box):
+        return closest.cylinder(local, box)
 
     def _build_geom(self):
         from ..occ.analytic import cylinder
@@ -263,6 +281,9 @@ class ConicalSurface(ElementarySurface):
             fz[..., 0, 1] = ca
         return fx, fy, fz
 
+    def _closest_local(self, local, box):
+        return closest.cone(local, box, self.radius, self.semi_angle)
+
     def _build_geom(self):
         from ..occ.analytic import cone
 
@@ -325,6 +346,9 @@ class SphericalSurface(ElementarySurface):
             fz[..., 0, l] = r * sin_d(v, l)
         return fx, fy, fz
 
+    def _closest_local(self, local, box):
+        return closest.sphere(local, box)
+
     def _build_geom(self):
         from ..occ.analytic import sphere
 
@@ -383,6 +407,9 @@ class ToroidalSurface(ElementarySurface):
         for l in range(order + 1):
             fz[..., 0, l] = self.minor * sin_d(v, l)
         return fx, fy, fz
+
+    def _closest_local(self, local, box):
+        return closest.torus(local, box, self.major)
 
     def _build_geom(self):
         from ..occ.analytic import torus

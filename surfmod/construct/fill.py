@@ -35,7 +35,7 @@ import numpy as np
 from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..ops.continuity import SIDES
+from ..sides import SIDES
 from ..surface import Surface
 from .fill_domain import polygon, side_blend
 from .fill_ribbons import Corner, Ribbon, check_corners, match_corners
@@ -167,6 +167,7 @@ def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: f
     ribbons = [_ribbon(item, i) for i, item in enumerate(boundary)]
     ends = [rb.curve(np.array([0.0, 1.0]))[0] for rb in ribbons]
     size = max(float(np.ptp(np.concatenate(ends), axis=0).max()), 1e-300)
+    tolerance = checks.tolerance(tolerance, "tolerance", size)
     tol = 1e-6 * size
     # orient every side to start where the previous one ends
     if min(np.linalg.norm(ends[0][1] - ends[1][k]) for k in (0, 1)) > min(

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SurfmodError
-from ..ops.continuity import SIDES, side_params
+from ..sides import SIDES, side_params
 from .fill_domain import compose, distances, polygon, side_parameter
 
 

@@ -16,6 +16,8 @@ Both return a :class:`FittedSurface` (a B-spline surface that *is* its OCCT twin
 ``Geom_BSplineSurface``) with the data parameters and the measured ``max_deviation``;
 :meth:`FittedSurface.occt_fit` builds OCCT's own fit (``GeomAPI_PointsToBSplineSurface``)
 of the same data for comparison.
+
+The same concept as :mod:`surfmod.occ.fitting`, its OCCT twin (``GeomAPI_PointsToBSplineSurface``) behind the kernel door.
 """
 
 from __future__ import annotations
@@ -49,8 +51,7 @@ class FittedSurface(BSplineSurface):
 
     @classmethod
     def _make(cls, net, degree, knots, data, params, kind, tolerance=None):
-        obj = cls._construct_fast()
-        BSplineSurface._set(obj, net, degree, knots, None)
+        obj = cls._trusted(net, degree, knots, None)
         obj.data = checks.frozen(data)
         obj.parameters = (checks.frozen(params[0]), checks.frozen(params[1]))
         obj.kind = kind
@@ -291,7 +292,7 @@ def approximate(points, degree=(3, 3), tolerance: float | None = None, *, n_ctrl
     us, vs = _parameters_for(q, method, parameters)
     n, m = q.shape[:2]
     diag = float(np.linalg.norm(q.reshape(-1, 3).max(axis=0) - q.reshape(-1, 3).min(axis=0)))
-    tol = 1e-3 * max(diag, 1e-300) if tolerance is None else checks.positive(tolerance, "tolerance")
+    tol = 1e-3 * max(diag, 1e-300) if tolerance is None else checks.tolerance(tolerance, "tolerance", diag)
     if n_ctrl is not None:
         try:
             nu, nv = n_ctrl

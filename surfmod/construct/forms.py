@@ -249,7 +249,7 @@ def explicit(f, x_range, y_range, tolerance: float | None = None) -> ExplicitSur
     xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
     z0 = _call_f(f, xs[:, None], ys[None, :])
     size = max(x1 - x0, y1 - y0, float(z0.max() - z0.min()))
-    tol = 1e-3 * size if tolerance is None else checks.positive(tolerance, "tolerance")
+    tol = 1e-3 * size if tolerance is None else checks.tolerance(tolerance, "tolerance", size)
     while True:
         xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
         z = _call_f(f, xs[:, None], ys[None, :])

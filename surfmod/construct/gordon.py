@@ -239,6 +239,8 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
     tol = checks.positive(tolerance, "tolerance")
     prof = _curves(profiles, "profiles")
     guid = _curves(guides, "guides")
+    net = np.concatenate([c.control_points.reshape(-1, c.control_points.shape[-1])[:, :3] for c in prof + guid])
+    tol = checks.tolerance(tol, "tolerance", float(np.linalg.norm(np.ptp(net, axis=0))))
     u, v, gap = _crossings(prof, guid)
     if gap.max() > tol:
         i, j = np.unravel_index(int(gap.argmax()), gap.shape)
@@ -294,8 +296,7 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
         (1.0, skin_g, (pu, g_curves[0].degree), (ku, g_curves[0].knots)),
         (-1.0, tensor, (pu, qv), (ku, kv)),
     ])
-    obj = GordonSurface._construct_fast()
-    BSplineSurface._set(obj, net, deg, knots, None)
+    obj = GordonSurface._trusted(net, deg, knots, None)
     obj.profiles = tuple(prof)
     obj.guides = tuple(guid)
     obj.parameters = (checks.frozen(big_u), checks.frozen(big_v))

@@ -173,8 +173,7 @@ def loft(sections, *, ruled: bool = False) -> LoftSurface:
     net, w = cartesian(net_h, rational)
     if w is not None and np.any(w <= 0):
         raise SurfmodError("sections: the interpolated weights are not positive; use sections with equal weights")
-    obj = LoftSurface._construct_fast()
-    BSplineSurface._set(obj, net, (compat[0].degree, q), (compat[0].knots, kv), w)
+    obj = LoftSurface._trusted(net, (compat[0].degree, q), (compat[0].knots, kv), w)
     obj.sections = tuple(curves)
     obj.ruled = bool(ruled)
     obj.section_parameters = checks.frozen(v)

@@ -22,10 +22,10 @@ from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
 from ..nets.bspline import BSplineSurface
-from ..ops.continuity import side_params, SIDES
-from ..surface import Surface
-from ..uses.inputs import make_solid
-from .blend import as_bspline_surface
+from ..sides import SIDES, side_params
+from ..surface import Surface, model_size
+from ..inputs import make_solid
+from ..nets.convert import as_bspline_surface
 from .offset_surface import OffsetSurface
 from .ruled import ruled
 
@@ -186,7 +186,7 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
         raise SurfmodError(f"distance: expected a number, got {distance!r}") from None
     if not np.isfinite(d) or d == 0.0:
         raise SurfmodError(f"distance: must be finite and non-zero, got {distance!r}")
-    tol = checks.positive(tolerance, "tolerance")
+    tol = checks.tolerance(tolerance, "tolerance", model_size(s) + abs(d))
     max_rounds = checks.count(max_rounds, "max_rounds")
     precheck(s, d)
     exact = OffsetSurface(s, d)

@@ -36,8 +36,7 @@ class ThreePointPlane(BSplineSurface):
     def transformed(self, matrix) -> "ThreePointPlane":
         """An affine image of a plane is a plane: same class, mapped control points."""
         out = BSplineSurface.transformed(self, matrix)
-        obj = ThreePointPlane._construct_fast()
-        BSplineSurface._set(obj, out.control_points, out.degree, out.knots, None)
+        obj = ThreePointPlane._trusted(out.control_points, out.degree, out.knots, None)
         return obj
 
     def implicit(self, xyz) -> np.ndarray:
@@ -62,6 +61,5 @@ def plane(p0, p1, p2) -> ThreePointPlane:
         raise SurfmodError("p2: collinear with p0 and p1, the three points do not span a plane")
     net = np.array([[a, c], [b, b + e2]])
     k = np.array([0.0, 0.0, 1.0, 1.0])
-    obj = ThreePointPlane._construct_fast()
-    BSplineSurface._set(obj, net, (1, 1), (k, k), None)
+    obj = ThreePointPlane._trusted(net, (1, 1), (k, k), None)
     return obj

@@ -70,8 +70,7 @@ def ellipsoid(rx, ry, rz, center=(0.0, 0.0, 0.0)) -> Ellipsoid:
     radii = np.array([checks.positive(rx, "rx"), checks.positive(ry, "ry"), checks.positive(rz, "rz")])
     c = checks.point(center, "center")
     unit = SphericalSurface(1.0).to_nurbs()
-    obj = Ellipsoid._construct_fast()
-    BSplineSurface._set(obj, unit.control_points * radii + c, unit.degree, unit.knots, unit.weights)
+    obj = Ellipsoid._trusted(unit.control_points * radii + c, unit.degree, unit.knots, unit.weights)
     obj.radii = checks.frozen(radii)
     obj.center = checks.frozen(c)
     return obj

@@ -18,7 +18,7 @@ from ..curve import Curve
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..surface import Surface
-from .frames import cos_d, sin_d
+from .axes import cos_d, sin_d
 from .from_edge import as_curve
 
 

@@ -74,8 +74,7 @@ def ruled(g, q) -> RuledSurface:
     if wa is not None or wb is not None:
         n = a.control_points.shape[0]
         weights = np.stack([np.ones(n) if wa is None else wa, np.ones(n) if wb is None else wb], axis=1)
-    obj = RuledSurface._construct_fast()
-    BSplineSurface._set(obj, net, (a.degree, 1), (a.knots, np.array([0.0, 0.0, 1.0, 1.0])), weights)
+    obj = RuledSurface._trusted(net, (a.degree, 1), (a.knots, np.array([0.0, 0.0, 1.0, 1.0])), weights)
     obj.g, obj.q = a, b
     obj.inputs = tuple(curves)
     return obj

@@ -241,12 +241,20 @@ def _curve_error(angle_map, s, count, radius):
 
 
 def _count_for(angle_map, s, radius, tol, start):
+    """``(n, error)``: the samples of one direction whose cubic interpolant meets ``tol``
+    (at most about 15 trials, growing by half each), or ``_MAX_SAMPLES`` and the error
+    they leave."""
     n = start
-    while n < _MAX_SAMPLES:
-        if _curve_error(angle_map, s, n, radius) <= tol:
-            return n
+    while True:
+        error = _curve_error(angle_map, s, n, radius)
+        if error <= tol or n >= _MAX_SAMPLES:
+            return n, error
         n = min(_MAX_SAMPLES, int(n * 1.5) + 1)
-    return _MAX_SAMPLES
+
+
+#: the deviation check samples about 4.4 points per data point and direction (knots and
+#: parameters, 4 per span); 5 x 5 per sample bounds its grid before any fit is made
+_CHECK_POINTS_PER_SAMPLE = 25
 
 
 def superellipsoid(rx, ry, rz, s1, s2, *, tolerance: float | None = None) -> Superellipsoid:
@@ -270,15 +278,23 @@ def superellipsoid(rx, ry, rz, s1, s2, *, tolerance: float | None = None) -> Sup
         if not 0.05 <= value <= 5.0:
             raise SurfmodError(f"{name}: exponent must lie in [0.05, 5], got {value:g}")
     size = max(rx, ry, rz)
-    tol = 1e-3 * size if tolerance is None else checks.positive(tolerance, "tolerance")
+    tol = 1e-3 * size if tolerance is None else checks.tolerance(tolerance, "tolerance", size)
     if tol < 1e-7 * size:
         raise SurfmodError(f"tolerance: {tol:g} is below what a fitted bicubic can reach (1e-7 x size)")
     eta_map = _AngleMap(s1, -np.pi / 2, 2)
     omega_map = _AngleMap(s2, -np.pi, 4)
     # each direction to a share of the tolerance, then refine both until the surface meets it
-    n_u = _count_for(eta_map, s1, size, tol / 3, 9)
-    n_v = _count_for(omega_map, s2, size, tol / 3, 13)
+    (n_u, err_u), (n_v, err_v) = _count_for(eta_map, s1, size, tol / 3, 9), _count_for(omega_map, s2, size, tol / 3, 13)
+    # a profile the finest samples leave off by more than four times the tolerance: so is the
+    # surface (the profile's error, scaled by the largest radius, overstates it by up to ~1.5x)
+    if max(err_u, err_v) > 4 * tol:
+        raise SurfmodError(f"tolerance: {tol:g} needs more than {_MAX_SAMPLES} samples along "
+                           f"{'eta (s1)' if err_u > tol else 'omega (s2)'} (reached {max(err_u, err_v):.3g}); "
+                           "use a larger tolerance")
     while True:
+        if _CHECK_POINTS_PER_SAMPLE * n_u * n_v > checks.MAX_POINTS:
+            raise SurfmodError(f"tolerance: {tol:g} needs a fit of more than {n_u} x {n_v} samples, whose "
+                               f"check would exceed {checks.MAX_POINTS:,} points; use a larger tolerance")
         us, vs = np.linspace(0.0, 1.0, n_u), np.linspace(0.0, 1.0, n_v)
         ecs, wcs = eta_map.cos_sin(us[:, None]), omega_map.cos_sin(vs[None, :])
         pts = _points_cs(rx, ry, rz, s1, s2, ecs, wcs)

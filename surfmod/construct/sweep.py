@@ -27,6 +27,8 @@ auxiliary spine is traced from our own twisted frame), but approximates them, so
 ``exact_in_occt`` is False and the cross-check is geometric (distance from the NumPy
 points to the pipe-shell face).  Derivatives in ``u`` are exact; derivatives in ``v``
 are 5-point central differences (relative accuracy ~1e-9), up to second order.
+
+The same concept as :mod:`surfmod.occ.sweep`, its OCCT twin (the pipe shell) behind the kernel door.
 """
 
 from __future__ import annotations

@@ -98,3 +98,39 @@ def basis_matrix(knots: np.ndarray, degree: int, n_ctrl: int, t: np.ndarray, ord
     for k in range(order + 1):
         mat[k, rows, cols] = ders[:, k, :]
     return mat
+
+
+def reciprocal_table(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
+    """``inv[span, j, r] = 1 / (knots[span+r+1] - knots[span+r+1-j])`` for the spans of the
+    domain and ``r < j <= degree`` (other entries 0, as is an empty difference: the 0/0 = 0
+    convention): the divisors of the Cox-de Boor triangle, which the compiled kernels
+    multiply by instead of dividing.  Every such difference spans the non-empty knot
+    interval ``[knots[span], knots[span+1])``.
+
+    >>> reciprocal_table(np.array([0, 0, 1, 2, 2.0]), 1, 3)[1:, 1, 0].tolist()
+    [1.0, 1.0]
+    """
+    p = degree
+    inv = np.zeros((n_ctrl, p + 1, p + 1))
+    span, j, r = np.meshgrid(np.arange(p, n_ctrl), np.arange(1, p + 1), np.arange(p + 1), indexing="ij")
+    keep = r < j
+    span, j, r = span[keep], j[keep], r[keep]
+    diff = knots[span + r + 1] - knots[span + r + 1 - j]
+    with np.errstate(divide="ignore"):
+        inv[span, j, r] = np.where(diff > 0, 1.0 / diff, 0.0)
+    return inv
+
+
+def span_buckets(knots: np.ndarray, degree: int, n_ctrl: int, per_span: int = 4):
+    """``(t0, scale, table)`` for the compiled O(1) span search
+    (:func:`surfmod.eval.kernels.find_span_bucketed`): ``per_span`` buckets per knot span
+    over ``[knots[degree], knots[n_ctrl]]``, each holding the span of its start.
+
+    >>> span_buckets(np.array([0, 0, 1, 2, 2.0]), 1, 3, per_span=1)[2].tolist()
+    [1, 2]
+    """
+    t0, t1 = float(knots[degree]), float(knots[n_ctrl])
+    count = max(1, per_span * (n_ctrl - degree))
+    starts = t0 + (t1 - t0) * np.arange(count) / count
+    table = find_spans(knots, degree, n_ctrl, starts).astype(np.int64)
+    return t0, (count / (t1 - t0) if t1 > t0 else 0.0), table

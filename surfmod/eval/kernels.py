@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .basis import reciprocal_table, span_buckets  # noqa: F401  (the tables the kernels read)
+
 # unsigned index steps: unsigned offsets spare numba's negative-index wraparound (a
 # compare and a select per access), which otherwise keeps loops from vectorizing
 U1, U2, U3 = np.uint64(1), np.uint64(2), np.uint64(3)
@@ -60,27 +62,6 @@ def find_span_bucketed(knots, degree, n_ctrl, t, t0, scale, table):
     while span > degree and knots[span] > t:
         span -= 1
     return span
-
-
-def span_buckets(knots: np.ndarray, degree: int, n_ctrl: int, per_span: int = 4):
-    """``(t0, scale, table)`` for :func:`find_span_bucketed`: ``per_span`` buckets per
-    knot span over ``[knots[degree], knots[n_ctrl]]``, each holding the span of its start."""
-    t0, t1 = float(knots[degree]), float(knots[n_ctrl])
-    count = max(1, per_span * (n_ctrl - degree))
-    table = np.empty(count, np.int64)
-    _fill_buckets(knots, degree, n_ctrl, t0, t1, table)
-    return t0, (count / (t1 - t0) if t1 > t0 else 0.0), table
-
-
-@njit(cache=True, error_model="numpy")
-def _fill_buckets(knots, degree, n_ctrl, t0, t1, table):
-    """``table[k]``: the span holding ``t0 + (t1 - t0) k / count`` (compiled: one call per
-    surface direction costs less than the NumPy steps it replaces)."""
-    count = table.size
-    for k in range(count):
-        start = t0 + (t1 - t0) * k / count
-        span = np.searchsorted(knots, start, side="right") - 1
-        table[k] = min(max(span, degree), n_ctrl - 1)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -144,24 +125,6 @@ def quotient_point(h, binom, out):
                         v2 += binom[l, j] * h[i, j, 3] * out[k - i, l - j, d]
                     v -= binom[k, i] * v2
                 out[k, l, d] = v * inv_w
-
-
-def reciprocal_table(knots: np.ndarray, degree: int, n_ctrl: int) -> np.ndarray:
-    """``inv[span, j, r] = 1 / (knots[span+r+1] - knots[span+r+1-j])`` for the spans of the
-    domain (other entries 0): the divisors of the Cox-de Boor triangle.  Every such
-    difference spans the non-empty knot interval ``[knots[span], knots[span+1])``."""
-    inv = np.zeros((n_ctrl, degree + 1, degree + 1))
-    _fill_reciprocals(knots, degree, n_ctrl, inv)
-    return inv
-
-
-@njit(cache=True, error_model="numpy")
-def _fill_reciprocals(knots, p, n_ctrl, inv):
-    for span in range(p, n_ctrl):
-        for j in range(1, p + 1):
-            for r in range(j):
-                diff = knots[span + r + 1] - knots[span + r + 1 - j]
-                inv[span, j, r] = 1.0 / diff if diff > 0 else 0.0
 
 
 def binomials(order: int) -> np.ndarray:

@@ -34,7 +34,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .basis import basis_derivatives, find_spans
+from . import vectorized
+from .basis import basis_derivatives, find_spans, reciprocal_table, span_buckets
 from .threads import running_on, threads_for
 
 #: doubles in the per-block row table of the grid stage (2 MiB): stays in L2
@@ -45,10 +46,13 @@ V_BLOCK = 1024
 GRID_MIN_BLOCK = 16
 #: blocks per thread (at least): threads that finish early take more of them
 BLOCKS_PER_THREAD = 8
-#: bytes of a caller's output array from which grids of partials to order 2 are written
-#: into it with non-temporal stores (:mod:`surfmod.eval.streaming`): far beyond the L2
-#: caches, where writing through them only evicts everything else
-STREAM_BYTES = 1 << 24
+#: work (points times partials per point, ``(order + 1)^2``) from which scattered pairs
+#: go through the compiled kernels; less is done in NumPy (:mod:`surfmod.eval.vectorized`),
+#: which takes milliseconds there, while the first compiled call of a process loads numba
+#: and its kernels (about a second; minutes into an empty cache)
+COMPILED_SCATTERED = 1 << 15
+#: the same for grids, whose NumPy path costs less per point (one row stage for all u)
+COMPILED_GRID = 1 << 18
 
 
 def _kernels():
@@ -115,13 +119,12 @@ class LocalNet(NamedTuple):
 def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
     """Tables for the kernels from full knot vectors, degrees and the homogeneous net
     ``(n, m, 3)`` (polynomial) or ``(n, m, 4)`` (rational)."""
-    k = _kernels()
     ku, kv = writable(knots_u), writable(knots_v)
     ctrl = homogeneous4(hctrl)
     n, m = ctrl.shape[:2]
     return LocalNet(ku, int(p), kv, int(q), ctrl, hctrl.shape[-1] == 4,
-                    k.reciprocal_table(ku, p, n), k.reciprocal_table(kv, q, m),
-                    k.span_buckets(ku, p, n), k.span_buckets(kv, q, m), {})
+                    reciprocal_table(ku, p, n), reciprocal_table(kv, q, m),
+                    span_buckets(ku, p, n), span_buckets(kv, q, m), {})
 
 
 def partials_finite(net: LocalNet, order: int) -> bool:
@@ -221,6 +224,12 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
     Many points on a small low-degree net go through per-span polynomial patches
     (:mod:`surfmod.eval.patches`), the others through the basis-function kernel."""
     u, v = _as_float(u), _as_float(v)
+    if u.size < COMPILED_SCATTERED:
+        h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, 0)[:, 0, 0]
+        if out is None:
+            return h
+        out[...] = h
+        return out
     if out is None:
         out = np.empty((u.size, 3))
     table = _patch_table(net, u.size)
@@ -243,8 +252,14 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     Partials to order 1 or 2 of many points on a small low-degree net go through the
     per-span patches (:mod:`surfmod.eval.patches`, as positions do), the others through
     the basis-function kernel."""
-    k = _kernels()
     u, v = _as_float(u), _as_float(v)
+    if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
+        h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, order)
+        if out is None:
+            return h
+        out[...] = h
+        return out
+    k = _kernels()
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
     table = _patch_table(net, u.size) if order in (1, 2) else None
@@ -389,26 +404,25 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     len(vs), 3)`` for positions (``order == 0``), ``(len(us), len(vs), K, K, 3)`` for
     partials.  The partials are formed on cache-resident planes (every partial and
     coordinate a contiguous row of v) and each point's values are then stored together;
-    partials to order 2 in chunks of v-points held in L1, streamed past the caches into
-    a caller's ``out`` of ``STREAM_BYTES`` or more (:mod:`surfmod.eval.partials_stage`).
+    partials to order 2 in chunks of v-points held in L1 (:mod:`surfmod.eval.partials_stage`).
+    Small grids (under :data:`COMPILED_GRID` partials) are evaluated in NumPy
+    (:mod:`surfmod.eval.vectorized`).
     """
-    k = _kernels()
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
     us, vs = _as_float(us), _as_float(vs)
+    if us.size * vs.size * (order + 1) ** 2 < COMPILED_GRID:
+        h = vectorized.grid(knots_u, p, knots_v, q, ctrl, rational, us, vs, order)
+        if out is None:
+            return h
+        out[...] = h[:, :, 0, 0] if order == 0 else h
+        return out[:, :, None, None, :] if order == 0 else out
+    k = _kernels()
     n, m = ctrl.shape[:2]
     kk = order + 1
     dim = 4 if rational else 3
     su, bu = _basis(knots_u, p, n, us, order)
     sv, bv = _basis(knots_v, q, m, vs, order)
     binom = k.binomials(order)
-    # Streaming stores pay into a caller's big array, reused from call to call (its lines
-    # long out of the caches), not into a fresh one: the kernel zeroes each new page
-    # through the caches as it is first written, and plain stores then hit those lines
-    # (measured on 1000² partials: 55 ms plain, 74 ms streamed; reused: 38 ms vs 21 ms).
-    # They also need the doubles on 8-byte boundaries (a row then starts on or 8 bytes
-    # past a 16-byte one); a misaligned caller's array is written plainly.
-    stream = (order == 2 and out is not None and out.nbytes >= STREAM_BYTES
-              and out.ctypes.data % 8 == 0)
     if out is None:
         out = np.empty((us.size, vs.size, 3) if order == 0 else (us.size, vs.size, kk, kk, 3))
     run, count = _kernels_for(us.size * vs.size, grid=True)
@@ -428,8 +442,7 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             else:
                 blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
                 per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
-            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns,
-                     stream)
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns)
     if order == 0:
         return out[:, :, None, None, :]
     return out

@@ -1,6 +1,6 @@
 """The gallery: every lecture entity built, cross-checked against OCCT and exported.
 
-Each module in this package (one per area: synthetic, analytic, swept, …) lists its
+Each module in this package (one per area: synthetic, analytic_surfaces, swept, beyond, …) lists its
 entries with :func:`entry`; :func:`entries` collects them all in module order.  An entry
 is a small function that builds the object, so nothing is built at import time.
 """

@@ -10,8 +10,9 @@ from ..io.step import export_step
 from ..io.stl import export_stl
 from ..meshing.render import render
 from ..surface import Surface
-from ..verification import crosscheck
+from ..occt_crosscheck import crosscheck
 from . import Entry, entries
+from tqdm import tqdm
 
 
 @dataclass
@@ -53,8 +54,6 @@ def _render(obj, path: Path) -> None:
 
 def run_gallery(outdir, *, progress: bool = True, only=None) -> list[Row]:
     """Build, check and export every entry (or the named ones); one row each."""
-    from tqdm import tqdm
-
     items = entries()
     if only:
         unknown = sorted(set(only) - {e.name for e in items})

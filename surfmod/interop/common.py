@@ -3,8 +3,6 @@ objects, and building surfmod objects from plain arrays."""
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 
 from ..construct.from_edge import from_edge
@@ -13,21 +11,6 @@ from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..readback import from_face
 from ..surface import Surface
-
-EXTRA = "pip install surfmod[interop]"
-
-
-def require(module: str, purpose: str):
-    """Import an optional library or raise ``SurfmodError`` naming the extra.
-
-    >>> require("numpy", "arrays").__name__
-    'numpy'
-    """
-    try:
-        return importlib.import_module(module)
-    except ImportError:
-        raise SurfmodError(f"{purpose}: the optional library {module!r} is not installed ({EXTRA})") from None
-
 
 def nurbs_of(obj, name: str = "obj"):
     """The exact B-spline/NURBS form of a surfmod surface or curve (or build123d

@@ -14,7 +14,8 @@ import numpy as np
 
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from .common import from_homogeneous, homogeneous_of, nurbs_of, require
+from ..extras import require
+from .common import from_homogeneous, homogeneous_of, nurbs_of
 
 
 def to_geomdl(obj):
@@ -26,7 +27,7 @@ def to_geomdl(obj):
     >>> (g.degree_u, g.degree_v), np.allclose(g.evaluate_single((0.3, 0.6)), s.points(0.3, 0.6))
     ((2, 3), True)
     """
-    require("geomdl", "to_geomdl")
+    require("geomdl", "interop", "to_geomdl")
     from geomdl import NURBS, BSpline
 
     kind, b = nurbs_of(obj)
@@ -57,7 +58,7 @@ def from_geomdl(obj):
     >>> sm.from_geomdl(sm.to_geomdl(c)).control_points.tolist() == c.control_points.tolist()
     True
     """
-    require("geomdl", "from_geomdl")
+    require("geomdl", "interop", "from_geomdl")
     from geomdl import abstract
 
     rational = hasattr(obj, "ctrlptsw")

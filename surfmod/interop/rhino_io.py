@@ -16,7 +16,8 @@ import numpy as np
 from ..atomic import atomic_path, target_path
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from .common import from_homogeneous, nurbs_of, require
+from ..extras import require
+from .common import from_homogeneous, nurbs_of
 
 
 def to_rhino(obj, path=None):
@@ -33,7 +34,7 @@ def to_rhino(obj, path=None):
     """
     if path is not None:
         return export_3dm(obj, path)
-    r3 = require("rhino3dm", "to_rhino")
+    r3 = require("rhino3dm", "interop", "to_rhino")
     kind, b = nurbs_of(obj)
     if kind == "curve":
         n = len(b.control_points)
@@ -73,7 +74,7 @@ def from_rhino(obj):
     >>> sm.from_rhino(sm.to_rhino(c)).knots.tolist()
     [0.0, 0.0, 0.0, 1.0, 1.0, 1.0]
     """
-    r3 = require("rhino3dm", "from_rhino")
+    r3 = require("rhino3dm", "interop", "from_rhino")
     if isinstance(obj, (str, os.PathLike)):
         return read_3dm(obj)
 
@@ -109,7 +110,7 @@ def export_3dm(objects, path) -> list:
     >>> len(read_3dm(path))
     1
     """
-    r3 = require("rhino3dm", "export_3dm")
+    r3 = require("rhino3dm", "interop", "export_3dm")
 
     target = target_path(path, "path", (".3dm",))
     items = list(objects) if isinstance(objects, (list, tuple)) else [objects]
@@ -128,7 +129,7 @@ def export_3dm(objects, path) -> list:
 def read_3dm(path) -> list:
     """Every NURBS curve and surface of a ``.3dm`` file as surfmod objects (Breps give
     their faces' surfaces)."""
-    r3 = require("rhino3dm", "read_3dm")
+    r3 = require("rhino3dm", "interop", "read_3dm")
     if not os.path.isfile(os.fspath(path)):
         raise SurfmodError(f"path: no such file {path}")
     model = r3.File3dm.Read(os.fspath(path))

@@ -11,7 +11,8 @@ import numpy as np
 
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from .common import from_homogeneous, homogeneous_of, nurbs_of, require
+from ..extras import require
+from .common import from_homogeneous, homogeneous_of, nurbs_of
 
 
 def to_splipy(obj):
@@ -23,7 +24,7 @@ def to_splipy(obj):
     >>> sp.order(0), bool(np.allclose(sp(0.4), c.points(0.4)))
     (3, True)
     """
-    splipy = require("splipy", "to_splipy")
+    splipy = require("splipy", "interop", "to_splipy")
     kind, b = nurbs_of(obj)
     ctrl = homogeneous_of(b.control_points, b.weights) if b.rational else b.control_points
     if kind == "curve":
@@ -41,7 +42,7 @@ def from_splipy(obj):
     >>> s.rational, s.degree
     (True, (2, 2))
     """
-    splipy = require("splipy", "from_splipy")
+    splipy = require("splipy", "interop", "from_splipy")
 
     if not isinstance(obj, (splipy.Curve, splipy.Surface)):
         raise SurfmodError(f"obj: expected a splipy Curve or Surface, got {type(obj).__name__}")

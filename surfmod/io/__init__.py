@@ -1,1 +1,1 @@
-"""Exchange files: STEP, STL (and later DXF, SVG, G-code); every write is atomic."""
+"""Exchange files: STEP, IGES, STL, DXF and SVG; every write is atomic."""

@@ -1,6 +1,9 @@
 """IGES export/import of surfmod surfaces and build123d shapes (atomic writes), beside
 STEP (:mod:`surfmod.io.step`).  B-spline and NURBS surfaces travel as IGES entity 128
-with their degrees, knots, weights and poles unchanged."""
+with their degrees, knots, weights and poles unchanged.
+
+The same concept as :mod:`surfmod.occ.iges`: this is the user's door (atomic writes, checks), that the OCCT reader/writer.
+"""
 
 from __future__ import annotations
 

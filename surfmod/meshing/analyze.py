@@ -20,6 +20,8 @@ Fairness, per patch: ``bending = integral of (k1^2 + k2^2) dA`` (thin-plate ener
 ``variation = integral of |grad H|^2 dA`` (the squared surface gradient of the mean
 curvature: zero on spheres, cylinders and planes), both by the trapezoid rule on the
 triangles, so two designs can be compared by a number.
+
+The same concept as :mod:`surfmod.cli.analyze` (the ``surfmod analyze`` command over this).
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..ops.continuity import normal_curvature
+from ..sides import normal_curvature
 from ..readback import from_face
 from ..surface import Surface
 from .analyze_plot import write_png
@@ -142,7 +144,7 @@ def refine(uv: np.ndarray, tri: np.ndarray):
 def _face_samples(face, target: float, max_triangles: int = 20000):
     """OCCT's triangulation of the trimmed region, split until 3-D edges are <= ``target``."""
     from ..occ.topo import face_surface
-    from ..occ.uses import face_uv_triangles
+    from ..occ.mesh import face_uv_triangles
 
     s = from_face(face)
     _, _, reversed_ = face_surface(face)
@@ -252,7 +254,7 @@ def _combs(patches_src, count: int, samples: int, scale):
                 p, k, n = _comb_along(s, u, v, np.full_like(u, du), np.full_like(v, dv), sign)
                 raw.append((where, p, k, n))
         else:
-            from ..occ.continuity import face_edges_uv
+            from ..occ.local_analysis import face_edges_uv
 
             (a0, a1), (b0, b1) = s.domain
             for i, (uv, tangent) in enumerate(face_edges_uv(face, samples)):

@@ -7,7 +7,7 @@ once):
 
 * planes, cylinders, cones, spheres and tori, and surfaces of revolution that are one of
   those (a circle or line in a plane through the axis): the exact distance in closed
-  form (:mod:`surfmod.meshing.analytic`);
+  form (:mod:`surfmod.meshing.analytic_distance`);
 * B-spline faces, and extrusions of spline curves (exact B-spline nets over their
   box): the *UV-parametric error* ``|q - S(uv)|`` of each sample ``q`` of a triangle and
   its UV-interpolated parameter (an upper bound of the distance, ``S(uv)`` being a point
@@ -42,6 +42,7 @@ from .deviation import DENSE, project_distances, triangle_deviations
 from .facesurface import FaceSurface
 from .polymesh import Mesh, weld
 from .refine import refine_face
+from tqdm import tqdm
 
 #: Refuse tolerances that would need more triangles than this (checked before meshing).
 MAX_TRIANGLES = 5_000_000
@@ -85,9 +86,9 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
     Values at most ``tolerance / 2`` may be upper bounds; larger ones are projections.
     """
-    from . import analytic
+    from . import analytic_distance
 
-    params = analytic.parameters(fm.surface)
+    params = analytic_distance.parameters(fm.surface)
     if params is not None:  # closed forms
         return measure_analytic_faces([fm], [params], bary)[0]
     ev = FaceSurface(fm.surface, fm.bounds) if ev is None else ev
@@ -125,21 +126,21 @@ def _packed(evs: list):
 
 def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np.ndarray, float]]:
     """:func:`measure_face` of many plane, sphere, cylinder, cone and torus faces
-    (``params``: their :func:`surfmod.meshing.analytic.parameters`) in two compiled
+    (``params``: their :func:`surfmod.meshing.analytic_distance.parameters`) in two compiled
     calls: per face its triangles' deviations and its nodes' max deviation."""
-    from . import analytic
+    from . import analytic_distance
 
     kinds = np.array([k for k, _, _ in params])
     frames = np.array([f for _, f, _ in params], float).reshape(-1, 2, 3)
     sizes = np.array([z for _, _, z in params], float).reshape(-1, 2)
     nodes, triangles, node_at, tri_at = _concatenated(fms)
-    node = analytic.distances(kinds, frames, sizes, nodes, np.repeat(np.arange(len(fms)), np.diff(node_at)))
+    node = analytic_distance.distances(kinds, frames, sizes, nodes, np.repeat(np.arange(len(fms)), np.diff(node_at)))
     # planes are measured at their nodes (exact: the distance is linear on a triangle),
     # the others at their triangles' samples
-    curved = np.nonzero(kinds != analytic.PLANE)[0]
-    tri = analytic.triangle_distances(kinds, frames, sizes, nodes, triangles,
+    curved = np.nonzero(kinds != analytic_distance.PLANE)[0]
+    tri = analytic_distance.triangle_distances(kinds, frames, sizes, nodes, triangles,
                                       np.c_[curved, tri_at[curved], tri_at[curved + 1]], bary)
-    on_plane = np.repeat(kinds == analytic.PLANE, np.diff(tri_at))
+    on_plane = np.repeat(kinds == analytic_distance.PLANE, np.diff(tri_at))
     tri[on_plane] = node[triangles[on_plane]].max(axis=1, initial=0.0)
     return [(tri[tri_at[f]:tri_at[f + 1]], float(node[node_at[f]:node_at[f + 1]].max(initial=0.0)))
             for f in range(len(fms))]
@@ -283,12 +284,10 @@ def _measure_faces(fms: list, evaluators: dict, tolerance: float, desc: str, pro
     for the analytic faces and one compiled call for the B-spline nets (all faces of each
     kind at once), the other faces one by one; an isometric repeat of a face takes its
     first instance's figures."""
-    from tqdm import tqdm
-
-    from . import analytic
+    from . import analytic_distance
 
     first = [i for i, fm in enumerate(fms) if fm.repeats < 0]
-    params = {i: a for i in first if (a := analytic.parameters(fms[i].surface)) is not None}
+    params = {i: a for i in first if (a := analytic_distance.parameters(fms[i].surface)) is not None}
     evs = {i: _evaluator(evaluators, fms[i]) for i in first if i not in params}
     splines = [i for i, ev in evs.items() if ev is not None and ev.projector is not None and len(fms[i].nodes)]
     measured = {}
@@ -411,8 +410,6 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     within each solid (and within the faces outside any solid), so every closed solid
     is a closed, manifold part of the mesh.
     """
-    from tqdm import tqdm
-
     from ..occ.mesh import brepmesh
 
     evaluators: dict = {}  # face hash -> FaceSurface (splines from the estimate, others when measured)

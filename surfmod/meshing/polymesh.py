@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import checks
+from .. import checks, pictures
 from ..errors import SurfmodError
 
 
@@ -41,6 +41,10 @@ class Mesh:
         fi = np.array(f, dtype=np.int64, copy=True)
         fi.setflags(write=False)
         object.__setattr__(self, "faces", fi)
+
+    def _repr_png_(self) -> bytes | None:
+        """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
+        return pictures.repr_png(self)
 
     def triangles(self) -> np.ndarray:
         """Faces as triangles (quads split along their 0-2 diagonal)."""

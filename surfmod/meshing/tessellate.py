@@ -26,6 +26,7 @@ from .deviation import DENSE
 from .domain import _sides, _surface_size
 from .gridmesh import grid_tessellate
 from .polymesh import Mesh
+from tqdm import tqdm
 
 #: Tolerances below this fraction of the object size cannot be certified in float64.
 MIN_RELATIVE_TOLERANCE = 1e-10
@@ -86,8 +87,6 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
     >>> m.info["kind"], m.info["closed"], m.info["max_deviation"] <= 0.05
     ('grid', (True, True), True)
     """
-    from tqdm import tqdm
-
     if method not in ("auto", "grid", "adaptive"):
         raise SurfmodError(f"method: expected 'auto', 'grid' or 'adaptive', got {method!r}")
     size, estimate = _check_tolerance(s, tolerance, max_triangles)

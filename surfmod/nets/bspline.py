@@ -123,13 +123,6 @@ class BSplineCurve(Curve):
         pts, w = cartesian(h, self.rational)
         return BSplineCurve._trusted(pts, self.degree, knots, w)
 
-    def bezier_pieces(self):
-        """Bézier extraction: ``[((t0, t1), BezierCurve), ...]`` (see :func:`surfmod.nets.bezier.bezier_pieces`)."""
-        # cycle: surfmod.nets.bspline <-> surfmod.nets.bezier (BezierCurve subclasses BSplineCurve)
-        from .bezier import bezier_pieces
-
-        return bezier_pieces(self)
-
 
 def _ordered_range(rng, name, domain):
     try:
@@ -337,14 +330,6 @@ class BSplineSurface(Surface):
         us = [(u0, u1)] if u is None else [(u0, float(u)), (float(u), u1)]
         vs = [(v0, v1)] if v is None else [(v0, float(v)), (float(v), v1)]
         return [self.segment(ur, vr) for ur in us for vr in vs]
-
-    def bezier_patches(self):
-        """Bézier extraction: ``[((u0, u1), (v0, v1), BezierSurface), ...]`` (see
-        :func:`surfmod.nets.bezier.bezier_patches`)."""
-        # cycle: surfmod.nets.bspline <-> surfmod.nets.bezier (BezierSurface subclasses BSplineSurface)
-        from .bezier import bezier_patches
-
-        return bezier_patches(self)
 
     def isocurve(self, u: float | None = None, v: float | None = None) -> BSplineCurve:
         """The exact iso-parametric curve at constant ``u`` (a curve in v) or constant ``v``."""

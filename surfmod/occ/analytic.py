@@ -14,6 +14,12 @@ from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Trsf
 from ..errors import SurfmodError
 from .arrays import pnt, xyz
 from .guard import kernel
+from OCP.Geom import (Geom_Circle, Geom_ConicalSurface, Geom_CylindricalSurface, Geom_Ellipse, Geom_Hyperbola,
+    Geom_Line, Geom_OffsetSurface, Geom_Parabola, Geom_Plane, Geom_RectangularTrimmedSurface, Geom_SphericalSurface,
+    Geom_SurfaceOfLinearExtrusion, Geom_SurfaceOfRevolution, Geom_ToroidalSurface, Geom_TrimmedCurve)
+from OCP.GeomFill import GeomFill
+from OCP.gp import gp_Circ, gp_Elips, gp_Hypr, gp_Lin, gp_Parab
+from .geom import bezier_curve, read_bspline_curve
 
 
 def _dir(v) -> gp_Dir:
@@ -48,48 +54,31 @@ def read_ax3(pos) -> tuple:
 
 # -- curves ---------------------------------------------------------------------------------
 def circle(origin, normal, x_dir, radius):
-    from OCP.Geom import Geom_Circle
-    from OCP.gp import gp_Circ
-
     with kernel("Geom_Circle"):
         return Geom_Circle(gp_Circ(ax2(origin, normal, x_dir), float(radius)))
 
 
 def ellipse(origin, normal, x_dir, major, minor):
-    from OCP.Geom import Geom_Ellipse
-    from OCP.gp import gp_Elips
-
     with kernel("Geom_Ellipse"):
         return Geom_Ellipse(gp_Elips(ax2(origin, normal, x_dir), float(major), float(minor)))
 
 
 def parabola(origin, normal, x_dir, focal):
-    from OCP.Geom import Geom_Parabola
-    from OCP.gp import gp_Parab
-
     with kernel("Geom_Parabola"):
         return Geom_Parabola(gp_Parab(ax2(origin, normal, x_dir), float(focal)))
 
 
 def hyperbola(origin, normal, x_dir, major, minor):
-    from OCP.Geom import Geom_Hyperbola
-    from OCP.gp import gp_Hypr
-
     with kernel("Geom_Hyperbola"):
         return Geom_Hyperbola(gp_Hypr(ax2(origin, normal, x_dir), float(major), float(minor)))
 
 
 def infinite_line(origin, direction):
-    from OCP.Geom import Geom_Line
-    from OCP.gp import gp_Lin
-
     with kernel("Geom_Line"):
         return Geom_Line(gp_Lin(pnt(origin), _dir(direction)))
 
 
 def trimmed(curve, t0, t1):
-    from OCP.Geom import Geom_TrimmedCurve
-
     with kernel("Geom_TrimmedCurve"):
         return Geom_TrimmedCurve(curve, float(t0), float(t1))
 
@@ -106,7 +95,6 @@ def read_curve(curve) -> dict:
     trimmed curves are unwrapped (the caller keeps the parameter range).
     """
 
-    from .geom import read_bspline_curve
 
     name = curve_type(curve)
     with kernel(f"reading {name}"):
@@ -138,36 +126,26 @@ def read_curve(curve) -> dict:
 
 # -- elementary surfaces ----------------------------------------------------------------------
 def plane(frame):
-    from OCP.Geom import Geom_Plane
-
     with kernel("Geom_Plane"):
         return Geom_Plane(ax3(frame))
 
 
 def cylinder(frame, radius):
-    from OCP.Geom import Geom_CylindricalSurface
-
     with kernel("Geom_CylindricalSurface"):
         return Geom_CylindricalSurface(ax3(frame), float(radius))
 
 
 def cone(frame, semi_angle, ref_radius):
-    from OCP.Geom import Geom_ConicalSurface
-
     with kernel("Geom_ConicalSurface"):
         return Geom_ConicalSurface(ax3(frame), float(semi_angle), float(ref_radius))
 
 
 def sphere(frame, radius):
-    from OCP.Geom import Geom_SphericalSurface
-
     with kernel("Geom_SphericalSurface"):
         return Geom_SphericalSurface(ax3(frame), float(radius))
 
 
 def torus(frame, major, minor):
-    from OCP.Geom import Geom_ToroidalSurface
-
     with kernel("Geom_ToroidalSurface"):
         return Geom_ToroidalSurface(ax3(frame), float(major), float(minor))
 
@@ -190,15 +168,11 @@ def read_elementary(surf) -> dict:
 
 # -- swept analytic surfaces --------------------------------------------------------------------
 def revolution(basis_curve, origin, direction):
-    from OCP.Geom import Geom_SurfaceOfRevolution
-
     with kernel("Geom_SurfaceOfRevolution"):
         return Geom_SurfaceOfRevolution(basis_curve, gp_Ax1(pnt(origin), _dir(direction)))
 
 
 def extrusion(basis_curve, direction):
-    from OCP.Geom import Geom_SurfaceOfLinearExtrusion
-
     with kernel("Geom_SurfaceOfLinearExtrusion"):
         return Geom_SurfaceOfLinearExtrusion(basis_curve, _dir(direction))
 
@@ -215,8 +189,6 @@ def read_extrusion(surf) -> dict:
 
 
 def offset_surface(basis, distance):
-    from OCP.Geom import Geom_OffsetSurface
-
     with kernel("Geom_OffsetSurface"):
         return Geom_OffsetSurface(basis, float(distance))
 
@@ -233,8 +205,6 @@ def read_trimmed_surface(surf) -> dict:
 
 def ruled(curve1, curve2):
     """OCCT's ruled surface between two curves (``GeomFill::Surface``)."""
-    from OCP.GeomFill import GeomFill
-
     with kernel("GeomFill::Surface"):
         return GeomFill.Surface_s(curve1, curve2)
 
@@ -257,13 +227,9 @@ def transformed(geom, matrix):
 
 def rectangular_trimmed(basis, u0, u1, v0, v1):
     """``Geom_RectangularTrimmedSurface`` of ``basis`` over ``[u0, u1] x [v0, v1]``."""
-    from OCP.Geom import Geom_RectangularTrimmedSurface
-
     with kernel("Geom_RectangularTrimmedSurface"):
         return Geom_RectangularTrimmedSurface(basis, float(u0), float(u1), float(v0), float(v1))
 
 
 def bezier_curve_geom(points, weights=None):
-    from .geom import bezier_curve
-
     return bezier_curve(np.asarray(points, float), None if weights is None else np.asarray(weights, float))

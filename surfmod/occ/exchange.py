@@ -9,6 +9,13 @@ from OCP.Message import Message, Message_Gravity
 from ..errors import SurfmodError
 from .fullprecision import write_step_full
 from .guard import kernel
+from OCP.BRep import BRep_Builder
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.STEPControl import STEPControl_Reader
+from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shell, TopoDS_Solid
 
 
 def _quiet_messages() -> None:
@@ -22,9 +29,6 @@ _quiet_messages()
 
 def compound(shapes):
     """One TopoDS_Compound of the given TopoDS shapes."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
-
     builder = BRep_Builder()
     comp = TopoDS_Compound()
     builder.MakeCompound(comp)
@@ -33,18 +37,87 @@ def compound(shapes):
     return comp
 
 
+def _solid_shells_forward(solid):
+    """``solid`` (as stored) with each REVERSED shell replaced by :func:`_forward_shell`,
+    or ``solid`` itself when none is reversed."""
+    children, changed = [], False
+    it = TopoDS_Iterator(solid, False, False)  # the shells as the solid holds them
+    while it.More():
+        child = it.Value()
+        if child.ShapeType() == TopAbs_SHELL and child.Orientation() == TopAbs_REVERSED:
+            child, changed = _forward_shell(child), True
+        children.append(child)
+        it.Next()
+    if not changed:
+        return solid
+    builder = BRep_Builder()
+    out = TopoDS_Solid()
+    builder.MakeSolid(out)
+    for child in children:
+        builder.Add(out, child)
+    out.Location(solid.Location())
+    out.Orientation(solid.Orientation())
+    return out
+
+
+def _forward_shell(shell):
+    """The same faces in a FORWARD shell: each face's orientation composed with the
+    shell's (and its location with the shell's), so the faces face the same way."""
+    builder = BRep_Builder()
+    out = TopoDS_Shell()
+    builder.MakeShell(out)
+    it = TopoDS_Iterator(shell, True, True)  # faces with the shell's orientation and location applied
+    while it.More():
+        builder.Add(out, it.Value())
+        it.Next()
+    out.Closed(shell.Closed())
+    return out
+
+
+def map_solids(shape, fn):
+    """``shape`` with each solid ``s`` in it replaced by ``fn(s)`` (``fn`` returns ``s``
+    itself to keep it); compounds that hold a replaced solid are rebuilt with their own
+    location and orientation, everything else is shared.  ``shape`` itself when nothing
+    changes."""
+    kind = shape.ShapeType()
+    if kind == TopAbs_SOLID:
+        return fn(shape)
+    if kind not in (TopAbs_COMPOUND, TopAbs_COMPSOLID):
+        return shape
+    children, changed = [], False
+    it = TopoDS_Iterator(shape, False, False)  # children as stored, relative to ``shape``
+    while it.More():
+        child = map_solids(it.Value(), fn)
+        changed |= not child.IsSame(it.Value()) or child.Orientation() != it.Value().Orientation()
+        children.append(child)
+        it.Next()
+    if not changed:
+        return shape
+    builder = BRep_Builder()
+    out = TopoDS_Compound() if kind == TopAbs_COMPOUND else TopoDS_CompSolid()
+    (builder.MakeCompound if kind == TopAbs_COMPOUND else builder.MakeCompSolid)(out)
+    for child in children:
+        builder.Add(out, child)
+    out.Location(shape.Location())
+    out.Orientation(shape.Orientation())
+    return out
+
+
 def write_step(shape, path: str) -> None:
     """Write a TopoDS shape as AP214 STEP to ``path`` (the caller makes this atomic), reals
     with 17 significant digits so every pole and weight survives the text bit for bit
-    (OCCT's default 12 digits move poles by up to ~5e-13 relative)."""
-    write_step_full(shape, path)
+    (OCCT's default 12 digits move poles by up to ~5e-13 relative).
+
+    A solid whose shell is used REVERSED (OCCT's reader makes one of a file's inside-out
+    closed shell) is written as a FORWARD shell of its faces reversed: the same solid, and
+    the file holds every face the way it faces, for any reader (a STEP CLOSED_SHELL has
+    no orientation of its own)."""
+    write_step_full(map_solids(shape, _solid_shells_forward), path)
 
 
 def read_with(reader, kind: str, path: str):
     """One TopoDS shape from ``path`` through an OCCT ``XSControl_Reader`` subclass
     instance (STEP, IGES); unreadable files raise ``SurfmodError`` naming ``kind``."""
-    from OCP.IFSelect import IFSelect_RetDone
-
     with kernel(f"{type(reader).__name__}"):
         if reader.ReadFile(str(path)) != IFSelect_RetDone:
             raise SurfmodError(f"path: {path} is not a readable {kind} file")
@@ -55,8 +128,27 @@ def read_with(reader, kind: str, path: str):
     return shape
 
 
-def read_step(path: str):
-    """Read a STEP file into one TopoDS shape; unreadable files raise ``SurfmodError``."""
-    from OCP.STEPControl import STEPControl_Reader
+def outward_solids(shape):
+    """``shape`` with every solid whose enclosed volume is negative (its faces point
+    inwards) reversed, so each solid's faces point out of its material.
 
-    return read_with(STEPControl_Reader(), "STEP", path)
+    OCCT's reader orients a closed shell by classifying a point at infinity
+    (``ShapeFix_Solid``), which on some valid parts answers IN whatever the faces say:
+    stepcode_HEAD_BACK.stp (edges 6.9e-2 off its spheres) reads outward from its
+    inside-out file, and that correct solid, written and read again, comes back inside
+    out.  The sign of the volume (the divergence theorem over the faces as oriented)
+    decides instead.
+    """
+    def outward(solid):
+        props = GProp_GProps()
+        BRepGProp.VolumeProperties_s(solid, props)
+        return solid.Reversed() if props.Mass() < 0.0 else solid
+
+    with kernel("BRepGProp.VolumeProperties_s"):
+        return map_solids(shape, outward)
+
+
+def read_step(path: str):
+    """Read a STEP file into one TopoDS shape, its solids :func:`outward_solids`;
+    unreadable files raise ``SurfmodError``."""
+    return outward_solids(read_with(STEPControl_Reader(), "STEP", path))

@@ -8,16 +8,20 @@ import numpy as np
 
 from .guard import check_done, kernel
 from .topo import wrapped
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeFilling
+from OCP.Geom import Geom_RectangularTrimmedSurface
+from OCP.GeomAbs import GeomAbs_C0, GeomAbs_G1, GeomAbs_G2
+from OCP.GeomConvert import GeomConvert
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+from .geom import read_bspline_surface
 
 
 def bspline_over(geom, bounds) -> dict:
     """Exact B-spline data of ``geom`` restricted to ``bounds = (u0, u1, v0, v1)``
     (``GeomConvert`` on a ``Geom_RectangularTrimmedSurface``)."""
-    from OCP.Geom import Geom_RectangularTrimmedSurface
-    from OCP.GeomConvert import GeomConvert
-
-    from .geom import read_bspline_surface
-
     u0, u1, v0, v1 = (float(x) for x in bounds)
     with kernel("GeomConvert.SurfaceToBSplineSurface_s"):
         trimmed = Geom_RectangularTrimmedSurface(geom, u0, u1, v0, v1)
@@ -26,11 +30,6 @@ def bspline_over(geom, bounds) -> dict:
 
 def nearest_edge(face, point):
     """The edge of ``face`` whose midpoint is closest to ``point`` (a TopoDS_Edge)."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve
-    from OCP.TopAbs import TopAbs_EDGE
-    from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
-
     best, best_d = None, np.inf
     explorer = TopExp_Explorer(wrapped(face), TopAbs_EDGE)
     with kernel("BRepAdaptor_Curve"):
@@ -52,9 +51,6 @@ def make_filling(constraints, *, degree: int = 3, points_on_curve: int = 15, ite
     (with ``"G2"`` OCCT's builder fails, "The continuity is not G0 G1 or G2", which the
     guard turns into ``KernelError``).  Returns the filling face (build123d ``Face``)."""
     import build123d as bd
-    from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeFilling
-    from OCP.GeomAbs import GeomAbs_C0, GeomAbs_G1, GeomAbs_G2
-    from OCP.TopoDS import TopoDS
 
     orders = {"C0": GeomAbs_C0, "G1": GeomAbs_G1, "G2": GeomAbs_G2}
     with kernel("BRepOffsetAPI_MakeFilling"):

@@ -14,15 +14,15 @@ import numpy as np
 
 from ..errors import KernelError
 from .guard import kernel
+from OCP.Extrema import Extrema_GenLocateExtPS
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+from OCP.GeomAdaptor import GeomAdaptor_Surface
+from OCP.GeomPlate import GeomPlate_BuildPlateSurface, GeomPlate_MakeApprox, GeomPlate_PointConstraint
+from OCP.gp import gp_Pnt
 
 
 def project_points(surf, points: np.ndarray, u: np.ndarray, v: np.ndarray):
     """Distances ``(N,)`` and OCCT foot parameters ``(u, v)`` of ``points`` on ``surf``."""
-    from OCP.Extrema import Extrema_GenLocateExtPS
-    from OCP.GeomAdaptor import GeomAdaptor_Surface
-    from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
-    from OCP.gp import gp_Pnt
-
     n = len(points)
     dist = np.empty(n)
     uo, vo = np.empty(n), np.empty(n)
@@ -59,9 +59,6 @@ def project_points(surf, points: np.ndarray, u: np.ndarray, v: np.ndarray):
 def plate_through_points(points: np.ndarray, degree: int = 3, max_segments: int = 9, tolerance: float = 1e-3):
     """OCCT's ``GeomPlate`` surface constrained by points (``GeomPlate_BuildPlateSurface``
     with ``GeomPlate_PointConstraint``s, approximated by ``GeomPlate_MakeApprox``)."""
-    from OCP.GeomPlate import GeomPlate_BuildPlateSurface, GeomPlate_MakeApprox, GeomPlate_PointConstraint
-    from OCP.gp import gp_Pnt
-
     with kernel("GeomPlate_BuildPlateSurface"):
         build = GeomPlate_BuildPlateSurface(degree, 15, 2)
         for x, y, z in np.asarray(points, dtype=float).tolist():

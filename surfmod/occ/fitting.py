@@ -1,4 +1,7 @@
-"""OCCT's own surface fitting (``GeomAPI_PointsToBSplineSurface``), for comparisons."""
+"""OCCT's own surface fitting (``GeomAPI_PointsToBSplineSurface``), for comparisons.
+
+The same concept as :mod:`surfmod.construct.fitting`, of which this is the OCCT twin.
+"""
 
 from __future__ import annotations
 

@@ -12,6 +12,10 @@ import io
 
 from ..errors import KernelError
 from .guard import kernel
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.Interface import Interface_Static
+from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+from OCP.StepData import StepData_StepWriter
 
 #: printf format of reals: 17 significant digits, the round-trip precision of a double
 FLOAT_FORMAT = "%.16E"
@@ -24,11 +28,6 @@ def write_bytes(path: str, data: bytes) -> None:
 
 def step_text(shape) -> bytes:
     """AP214 STEP of a TopoDS shape with full-precision reals (``StepData_StepWriter``)."""
-    from OCP.IFSelect import IFSelect_RetDone
-    from OCP.Interface import Interface_Static
-    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
-    from OCP.StepData import StepData_StepWriter
-
     with kernel("StepData_StepWriter"):
         writer = STEPControl_Writer()
         Interface_Static.SetCVal_s("write.step.schema", "AP214IS")

@@ -9,6 +9,7 @@ from OCP.Geom import Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Ge
 from . import arrays
 from .binary import bspline_curves, spline_surface
 from .guard import kernel
+import OCP.Geom as G
 
 
 def bspline_surface(net, degree, knots, weights=None) -> Geom_BSplineSurface:
@@ -118,8 +119,6 @@ def surface_type(surf) -> str:
 
 def downcast_surface(surf):
     """The most derived Python wrapper of a ``Geom_Surface`` handle."""
-    import OCP.Geom as G
-
     cls = getattr(G, surface_type(surf), None)
     if cls is None or not hasattr(cls, "DownCast"):
         return surf

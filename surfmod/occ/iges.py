@@ -2,6 +2,8 @@
 
 Reals are written with 17 significant digits (:mod:`surfmod.occ.fullprecision`), so
 B-spline poles, weights and knots come back bit for bit; OCCT's own ``Write`` prints 10.
+
+The same concept as :mod:`surfmod.io.iges`, whose OCCT side (``IGESControl``) this is.
 """
 
 from __future__ import annotations
@@ -12,17 +14,16 @@ from ..errors import KernelError
 from .exchange import read_with
 from .fullprecision import FLOAT_FORMAT, write_bytes
 from .guard import kernel
+from OCP.IGESControl import IGESControl_Controller, IGESControl_Reader, IGESControl_Writer
+from OCP.IGESData import IGESData_IGESWriter
+from OCP.IGESSelect import IGESSelect_WorkLibrary
+from OCP.Interface import Interface_Static
 
 
 def iges_text(shape, *, brep: bool = False) -> bytes:
     """IGES 5.3 text of a TopoDS shape.  ``brep=False`` writes faces as trimmed surfaces
     (entity 144 over 128 B-splines), what most NURBS tools read; ``brep=True`` writes
     MSBO B-rep solids (entity 186)."""
-    from OCP.IGESControl import IGESControl_Controller, IGESControl_Writer
-    from OCP.IGESData import IGESData_IGESWriter
-    from OCP.IGESSelect import IGESSelect_WorkLibrary
-    from OCP.Interface import Interface_Static
-
     with kernel("IGESControl_Writer"):
         IGESControl_Controller.Init_s()
         Interface_Static.SetIVal_s("write.iges.brep.mode", 1 if brep else 0)
@@ -46,6 +47,4 @@ def write_iges(shape, path: str, *, brep: bool = False) -> None:
 
 def read_iges(path: str):
     """Read an IGES file into one TopoDS shape; unreadable files raise ``SurfmodError``."""
-    from OCP.IGESControl import IGESControl_Reader
-
     return read_with(IGESControl_Reader(), "IGES", path)

@@ -4,6 +4,8 @@ the figures needed to estimate a triangle count before meshing.
 
 The plain Python loops here run over OCCT calls (one per node or per sample); they are
 the kernel boundary and the measurement side, not a NumPy evaluation path.
+
+The same concept as :mod:`surfmod.cli.mesh` at the kernel door (the command meshes with surfmod's own tessellator, checked against this).
 """
 
 from __future__ import annotations
@@ -18,6 +20,23 @@ import numpy as np
 
 from ..errors import SurfmodError
 from .guard import kernel
+from OCP.BRep import BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepMesh import BRepMesh_IncrementalMesh
+from OCP.BRepTools import BRepTools
+from OCP.BinTools import BinTools_ShapeSet
+from OCP.Bnd import Bnd_Box
+from OCP.GeomLProp import GeomLProp_SLProps
+from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
+from OCP.TColStd import TColStd_Array1OfReal
+from OCP.TColgp import TColgp_Array1OfPnt
+from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_SOLID
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopLoc import TopLoc_Location
+from OCP.gp import gp_Pnt, gp_Vec
+from .arrays import pnts_to_numpy_1d, to_numpy_1d
+from .geom import read_bezier_surface, read_bspline_curve, read_bspline_surface, surface_type
+from .topo import faces_of, wrapped
 
 
 @dataclass
@@ -46,8 +65,6 @@ class FaceMesh:
     def bounds(self) -> tuple:
         """The face's UV box ``(u0, u1, v0, v1)`` (``BRepTools.UVBounds``)."""
         if self.uv_box is None:
-            from OCP.BRepTools import BRepTools
-
             with kernel("BRepTools.UVBounds"):
                 self.uv_box = tuple(float(b) for b in BRepTools.UVBounds_s(self.face))
         return self.uv_box
@@ -55,18 +72,12 @@ class FaceMesh:
 
 def clean(shape) -> None:
     """Drop any triangulation stored on ``shape`` so the next BRepMesh starts afresh."""
-    from OCP.BRepTools import BRepTools
-
-    from .topo import wrapped
-
     with kernel("BRepTools.Clean"):
         BRepTools.Clean_s(wrapped(shape))
 
 
 def basis_surface(surf):
     """The surface under ``Geom_RectangularTrimmedSurface`` wrappers (same parametrization)."""
-    from .geom import surface_type
-
     while surface_type(surf) == "Geom_RectangularTrimmedSurface":
         surf = surf.BasisSurface()
     return surf
@@ -74,9 +85,6 @@ def basis_surface(surf):
 
 def _face_solids(shp) -> dict:
     """``{face hash: solid index}`` for the faces that belong to a solid."""
-    from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
-    from OCP.TopExp import TopExp_Explorer
-
     owner = {}
     solids = TopExp_Explorer(shp, TopAbs_SOLID)
     k = 0
@@ -128,9 +136,6 @@ _GROUPS = count()
 def _local_triangulation(face):
     """``(nodes in the face's own frame, uv or None, triangles, deflection)`` of one
     face's stored triangulation, read node by node, or ``None``."""
-    from OCP.BRep import BRep_Tool
-    from OCP.TopLoc import TopLoc_Location
-
     tri = BRep_Tool.Triangulation_s(face, TopLoc_Location())
     if tri is None:
         return None
@@ -184,10 +189,6 @@ def _triangulation_table(faces: list) -> list | None:
     costs a Python call per node.  Located instances of one face share one entry
     (the same tuple object).  ``None`` when the buffer cannot be matched to the faces
     (an unexpected layout, or two faces sharing one triangulation object)."""
-    from OCP.BinTools import BinTools_ShapeSet
-    from OCP.BRep import BRep_Tool
-    from OCP.TopLoc import TopLoc_Location
-
     table = BinTools_ShapeSet()
     table.SetWithTriangles(True)
     buckets: dict = {}  # hash of the unlocated face -> [(unlocated face, slot)]
@@ -215,8 +216,6 @@ def _triangulation_table(faces: list) -> list | None:
 
 def _face_triangles(face, got, with_uv: bool, with_nodes: bool, group: int) -> FaceTriangles | None:
     """:class:`FaceTriangles` of ``face`` from its local triangulation ``got``."""
-    from OCP.TopAbs import TopAbs_REVERSED
-
     if got is None or len(got[2]) == 0:
         return None
     nodes, uv, idx, deflection = got
@@ -256,10 +255,6 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
     >>> [(k, len(t.triangles)) for k, _, t in mesh_faces(bd.Box(1, 1, 1), 0.1)][:2]
     [(0, 2), (1, 2)]
     """
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
-
-    from .topo import faces_of, wrapped
-
     shp = wrapped(shape)
     if shp is None:
         raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
@@ -279,6 +274,16 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
         return out
 
 
+def face_uv_triangles(face, deflection: float, angular: float = 0.1):
+    """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
+    face (the face's trimmed parameter region as a polygonal patchwork)."""
+    ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
+    if got is None or np.isnan(got.uv).any():
+        raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
+    uv, idx = got.uv, got.triangles
+    return uv, idx
+
+
 def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, missing: list | None = None,
              uv_bounds: dict | None = None) -> list[FaceMesh]:
     """Run ``BRepMesh_IncrementalMesh`` (after clearing old triangulations) and return the
@@ -286,11 +291,6 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
     share an edge coincide bit for bit.  Faces BRepMesh left without triangles are
     skipped; their indices are appended to ``missing`` when a list is given.
     ``uv_bounds``: faces' UV boxes already known (by face hash, from :func:`shape_figures`)."""
-    from OCP.BRep import BRep_Tool
-
-    from .geom import surface_type
-    from .topo import wrapped
-
     shp = wrapped(shape)
     surfaces = {}
 
@@ -328,8 +328,6 @@ def surface_info(surf) -> dict:
     NumPy-readable ``bspline`` data (B-spline/Bezier surfaces, ``None`` otherwise) and
     per direction whether it is ``periodic`` with its ``period`` and parameter
     ``range``."""
-    from .geom import read_bezier_surface, read_bspline_surface, surface_type
-
     name = surface_type(surf)
     with kernel(f"{name} parameters"):
         u0, u1, v0, v1 = surf.Bounds()
@@ -353,8 +351,6 @@ def curve_info(curve) -> dict:
     ``{"name", "bspline"|"bezier" (reader dicts), "line": (origin, direction),
     "conic": (centre, x axis, y axis, a, b) for circles and ellipses}``; trimmed-curve
     wrappers are removed (same parametrization).  Other types give only ``name``."""
-    from .geom import read_bspline_curve
-
     name = curve.DynamicType().Name()
     with kernel(f"{name} parameters"):
         while name == "Geom_TrimmedCurve":
@@ -364,11 +360,6 @@ def curve_info(curve) -> dict:
         if name == "Geom_BSplineCurve":
             info["bspline"] = read_bspline_curve(curve)
         elif name == "Geom_BezierCurve":
-            from OCP.TColgp import TColgp_Array1OfPnt
-            from OCP.TColStd import TColStd_Array1OfReal
-
-            from .arrays import pnts_to_numpy_1d, to_numpy_1d
-
             poles = TColgp_Array1OfPnt(1, curve.NbPoles())
             curve.Poles(poles)
             weights = None
@@ -392,8 +383,6 @@ def curve_info(curve) -> dict:
 def swept_info(surf) -> dict | None:
     """Axis/direction and basis curve of a surface of revolution (``"axis": (origin,
     direction)``) or of linear extrusion (``"direction"``); ``None`` for other types."""
-    from .geom import surface_type
-
     name = surface_type(surf)
     if name not in ("Geom_SurfaceOfRevolution", "Geom_SurfaceOfLinearExtrusion"):
         return None
@@ -410,8 +399,6 @@ def swept_info(surf) -> dict | None:
 def surface_d1(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``(N, 2, 2, 3)`` position and first partials of a ``Geom_Surface`` from ``D1``
     (entry ``[1, 1]`` is left zero)."""
-    from OCP.gp import gp_Pnt, gp_Vec
-
     out = np.zeros((len(u), 2, 2, 3))
     p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
     with kernel("Geom_Surface.D1"):
@@ -427,10 +414,8 @@ def elementary_parameters(surf) -> tuple | None:
     """``(type name, origin, axis, sizes)`` of a plane, sphere, cylinder, cone or torus:
     its placement's location and direction and ``(0, 0)``, ``(radius, 0)``, ``(radius,
     0)``, ``(reference radius, semi-angle)`` or ``(major, minor radius)``; ``None`` for
-    any other surface type (:func:`surfmod.meshing.analytic.parameters` turns these
+    any other surface type (:func:`surfmod.meshing.analytic_distance.parameters` turns these
     into closed-form distances)."""
-    from .geom import surface_type
-
     name = surface_type(surf)
     if name not in ANALYTIC:
         return None
@@ -479,12 +464,6 @@ def shape_figures(shape, samples: int = 5, sample_face=None, uv_bounds: dict | N
     fills in after this returns, to sample all its faces at once), or ``None`` to leave
     the face to ``GeomLProp`` here.  ``uv_bounds``, a dict, receives each sampled face's
     ``BRepTools.UVBounds`` by face hash (for :func:`brepmesh`)."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-    from OCP.TopLoc import TopLoc_Location
-
-    from .topo import faces_of, wrapped
-
     shp = wrapped(shape)
     with kernel("shape figures (Bnd_Box, GeomLProp)"):
         box = Bnd_Box()
@@ -513,12 +492,6 @@ def shape_figures(shape, samples: int = 5, sample_face=None, uv_bounds: dict | N
 
 def _face_figure(face, samples: int, floor: float, sample_face, uv_bounds: dict | None = None):
     """:func:`shape_figures`' figure of one face, or ``False`` for a plane."""
-    from OCP.BRep import BRep_Tool
-    from OCP.BRepTools import BRepTools
-    from OCP.GeomLProp import GeomLProp_SLProps
-
-    from .geom import surface_type
-
     surf = basis_surface(BRep_Tool.Surface_s(face))
     name = surface_type(surf)
     if name == "Geom_Plane":
@@ -572,9 +545,5 @@ def _face_figure(face, samples: int, floor: float, sample_face, uv_bounds: dict 
 def max_tolerance(shape) -> float:
     """Largest vertex/edge/face tolerance stored in a shape (how far OCCT allows its
     topology to stray from the geometry)."""
-    from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
-
-    from .topo import wrapped
-
     with kernel("ShapeAnalysis_ShapeTolerance"):
         return float(ShapeAnalysis_ShapeTolerance().Tolerance(wrapped(shape), 1))

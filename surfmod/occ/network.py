@@ -8,14 +8,14 @@ import numpy as np
 
 from ..errors import KernelError
 from .guard import kernel
+from OCP.GeomFill import GeomFill_BSplineCurves, GeomFill_FillingStyle
+from .sample import distances_to_surface
 
 
 def bspline_curves_fill(c1, c2, c3, c4, style: str = "coons"):
     """``GeomFill_BSplineCurves(c1, c2, c3, c4, style)``: four ``Geom_BSplineCurve``
     handles forming a closed loop (OCCT arranges and orients them); returns the
     ``Geom_BSplineSurface``."""
-    from OCP.GeomFill import GeomFill_BSplineCurves, GeomFill_FillingStyle
-
     styles = {
         "coons": GeomFill_FillingStyle.GeomFill_CoonsStyle,
         "stretch": GeomFill_FillingStyle.GeomFill_StretchStyle,
@@ -46,8 +46,6 @@ def gordon_face(profiles, guides, tolerance: float):
 def curve_to_surface_distances(surf, bounds, curve, samples: int) -> np.ndarray:
     """Distances from ``samples`` points along a ``Geom_Curve`` (uniform in its
     parameter) to a bounded ``Geom_Surface``, by OCCT point projection."""
-    from .sample import distances_to_surface
-
     with kernel("Geom_Curve.Value"):
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
         pts = np.array([curve.Value(float(t)).Coord() for t in np.linspace(t0, t1, samples)])

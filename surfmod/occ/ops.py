@@ -17,6 +17,27 @@ from ..errors import SurfmodError
 from . import arrays
 from .geom import downcast_surface
 from .guard import check_done, kernel
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepLib import BRepLib
+from OCP.GCE2d import GCE2d_MakeSegment
+from OCP.GCPnts import GCPnts_AbscissaPoint
+from OCP.GProp import GProp_GProps
+from OCP.Geom import Geom_Line, Geom_Plane, Geom_RectangularTrimmedSurface
+from OCP.Geom2d import Geom2d_BSplineCurve
+from OCP.GeomAPI import GeomAPI_IntCS, GeomAPI_IntSS, GeomAPI_ProjectPointOnSurf
+from OCP.GeomAdaptor import GeomAdaptor_Curve
+from OCP.HLRAlgo import HLRAlgo_Projector
+from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
+from OCP.ShapeFix import ShapeFix_Face
+from OCP.TColgp import TColgp_Array1OfPnt2d
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+from OCP.gp import gp_Pnt2d
+from .sample import distances_to_face
 
 # -- transforms ---------------------------------------------------------------------------
 
@@ -107,11 +128,6 @@ def _pcurves(loop):
     ``BRepGProp`` integrates such an edge inaccurately: 3e-4 relative area error on a
     curved NURBS, where per-side segments agree with quadrature to 1e-11.)
     """
-    from OCP.GCE2d import GCE2d_MakeSegment
-    from OCP.Geom2d import Geom2d_BSplineCurve
-    from OCP.gp import gp_Pnt2d
-    from OCP.TColgp import TColgp_Array1OfPnt2d
-
     if loop[0] == "polyline":
         pts = np.asarray(loop[1], dtype=float)
         return [
@@ -136,9 +152,6 @@ def trimmed_face(surf, loops, tolerance: float = 1e-7):
     rebuilt from the p-curves with ``BRepLib.BuildCurves3d_s``.
     """
     import build123d as bd
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
-    from OCP.BRepLib import BRepLib
-    from OCP.ShapeFix import ShapeFix_Face
 
     with kernel("trimmed face (BRepBuilderAPI_MakeFace with p-curve wires)"):
         wires = []
@@ -164,9 +177,6 @@ def trimmed_face(surf, loops, tolerance: float = 1e-7):
 
 def face_area(face, eps: float = 1e-10) -> float:
     """Area of a face/shape by ``BRepGProp.SurfaceProperties_s`` at relative accuracy ``eps``."""
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
     props = GProp_GProps()
     with kernel("BRepGProp.SurfaceProperties_s"):
         BRepGProp.SurfaceProperties_s(getattr(face, "wrapped", face), props, eps, False)
@@ -175,8 +185,6 @@ def face_area(face, eps: float = 1e-10) -> float:
 
 def face_is_valid(face) -> bool:
     """``BRepCheck_Analyzer`` verdict."""
-    from OCP.BRepCheck import BRepCheck_Analyzer
-
     with kernel("BRepCheck_Analyzer"):
         return bool(BRepCheck_Analyzer(getattr(face, "wrapped", face)).IsValid())
 
@@ -186,8 +194,6 @@ def face_is_valid(face) -> bool:
 
 def bounded(surf, bounds):
     """``Geom_RectangularTrimmedSurface`` over ``bounds = (u0, u1, v0, v1)``."""
-    from OCP.Geom import Geom_RectangularTrimmedSurface
-
     u0, u1, v0, v1 = map(float, bounds)
     with kernel("Geom_RectangularTrimmedSurface"):
         return Geom_RectangularTrimmedSurface(surf, u0, u1, v0, v1)
@@ -195,17 +201,12 @@ def bounded(surf, bounds):
 
 def infinite_plane(origin, normal):
     """``Geom_Plane`` through ``origin`` with ``normal``."""
-    from OCP.Geom import Geom_Plane
-
     with kernel("Geom_Plane"):
         return Geom_Plane(arrays.pnt(origin), gp_Dir(*map(float, normal)))
 
 
 def curve_length(curve, t0: float, t1: float, tol: float = 1e-10) -> float:
     """Arc length by ``GCPnts_AbscissaPoint.Length_s``."""
-    from OCP.GCPnts import GCPnts_AbscissaPoint
-    from OCP.GeomAdaptor import GeomAdaptor_Curve
-
     with kernel("GCPnts_AbscissaPoint.Length_s"):
         return float(GCPnts_AbscissaPoint.Length_s(GeomAdaptor_Curve(curve, t0, t1), tol))
 
@@ -218,8 +219,6 @@ def sample_curve(curve, t0: float, t1: float, count: int) -> np.ndarray:
 
 def intersect_surfaces(s1, s2, tolerance: float = 1e-7, samples: int = 200):
     """``GeomAPI_IntSS``: list of ``(points (samples, 3), length)`` per intersection curve."""
-    from OCP.GeomAPI import GeomAPI_IntSS
-
     out = []
     with kernel("GeomAPI_IntSS"):
         inter = GeomAPI_IntSS(s1, s2, float(tolerance))
@@ -234,9 +233,6 @@ def intersect_surfaces(s1, s2, tolerance: float = 1e-7, samples: int = 200):
 
 def intersect_line(surf, origin, direction) -> np.ndarray:
     """``GeomAPI_IntCS`` of the line ``origin + w * unit(direction)``: ``(k, 3)`` rows ``(u, v, w)``."""
-    from OCP.Geom import Geom_Line
-    from OCP.GeomAPI import GeomAPI_IntCS
-
     with kernel("GeomAPI_IntCS"):
         line = Geom_Line(gp_Lin(arrays.pnt(origin), gp_Dir(*map(float, direction))))
         inter = GeomAPI_IntCS(line, surf)
@@ -249,8 +245,6 @@ def intersect_line(surf, origin, direction) -> np.ndarray:
 def project_points(surf, bounds, points) -> np.ndarray:
     """``GeomAPI_ProjectPointOnSurf`` lower-distance solution per point: ``(N, 3)`` rows
     ``(u, v, distance)``; NaN where OCCT finds no orthogonal projection."""
-    from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
-
     u0, u1, v0, v1 = map(float, bounds)
     out = np.full((len(points), 3), np.nan)
     with kernel("GeomAPI_ProjectPointOnSurf"):
@@ -265,8 +259,6 @@ def project_points(surf, bounds, points) -> np.ndarray:
 
 def face_distances(face, points) -> np.ndarray:
     """Distance from each point to a face (``BRepExtrema_DistShapeShape``), boundaries included."""
-    from .sample import distances_to_face
-
     return distances_to_face(getattr(face, "wrapped", face), np.asarray(points, dtype=float))
 
 
@@ -279,13 +271,6 @@ def hlr_outline(face, direction, samples_per_edge: int = 60):
     polylines in the projector frame ``frame = (origin, xdir, ydir)``; ``outline`` holds
     the silhouette (outline) edges, ``sharp`` the projected face boundary, visible and
     hidden alike."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve
-    from OCP.HLRAlgo import HLRAlgo_Projector
-    from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
-    from OCP.TopAbs import TopAbs_EDGE
-    from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
-
     d = np.asarray(direction, dtype=float)
     with kernel("HLRBRep_Algo"):
         ax = gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(*map(float, d)))

@@ -5,7 +5,7 @@ the face (``-1`` for a reversed edge), the breaks of its ``GeomAbs_CN`` interval
 the 2-D curve itself -- a line (origin, direction), a circle (centre, axes, radius), a
 B-spline (poles, weights, flat knots, degree) or any other type, which
 :func:`adaptor_d1` samples point by point through the record's OCCT ``adaptor``.  Lines, circles and B-splines are then
-evaluated for all Gauss nodes at once (:mod:`surfmod.uses.mass_boundary`), instead of one
+evaluated for all Gauss nodes at once (:mod:`surfmod.mass.boundary`), instead of one
 ``Geom2dAdaptor.D1`` call per node; :func:`faces_pcurves` reads the B-spline p-curves
 of many faces through one binary table.
 """
@@ -22,6 +22,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Iterator
 from .binary import bspline_curves
 from .geom import read_bspline_curve
 from .guard import kernel
+from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 
 def _xy(p) -> np.ndarray:
@@ -199,8 +200,6 @@ def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
     >>> adaptor_d1(BRepAdaptor_Curve2d(edge, face), np.array([0.0])).round(12).tolist() == [[1, 0, 0, 1]]
     True
     """
-    from OCP.gp import gp_Pnt2d, gp_Vec2d
-
     p, d = gp_Pnt2d(), gp_Vec2d()
     out = np.empty((len(t), 4))
     with kernel("Geom2dAdaptor D1 (p-curve)"):

@@ -16,6 +16,10 @@ from __future__ import annotations
 from ..errors import KernelError
 from .guard import kernel
 from .topo import explore, solids_of, wrapped
+from OCP.BOPAlgo import BOPAlgo_MakerVolume
+from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
+from OCP.TopTools import TopTools_ListOfShape
+from .uses import gprops
 
 #: The regions' BRepGProp volumes must add up to the solid's within this relative error
 #: (both at eps 1e-9): anything else means a region was misclassified or lost.
@@ -35,12 +39,6 @@ def material_regions(solid) -> list:
     >>> [round(gprops(r)["volume"], 9) for r in material_regions(hollow.wrapped)]
     [56.0]
     """
-    from OCP.BOPAlgo import BOPAlgo_MakerVolume
-    from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
-    from OCP.TopTools import TopTools_ListOfShape
-
-    from .uses import gprops
-
     solid = wrapped(solid)
     with kernel("BOPAlgo_MakerVolume (material regions)"):
         maker = BOPAlgo_MakerVolume()

@@ -12,6 +12,8 @@ from OCP.GeomLProp import GeomLProp_SLProps
 
 from .arrays import xyz
 from .guard import kernel
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+from .topo import closest_on_face
 
 
 def surface_d2(surf, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -58,16 +60,12 @@ def curve_d2(curve, t: np.ndarray) -> np.ndarray:
 def distances_to_face(face_shape, points: np.ndarray) -> np.ndarray:
     """Distance from each point to a TopoDS face, boundary included
     (``BRepExtrema_DistShapeShape``; see :func:`surfmod.occ.topo.closest_on_face`)."""
-    from .topo import closest_on_face
-
     return closest_on_face(face_shape, np.asarray(points, dtype=float).reshape(-1, 3))[0]
 
 
 def distances_to_surface(surf, points: np.ndarray, bounds) -> np.ndarray:
     """Distance from each point to a bounded ``Geom_Surface`` (``GeomAPI_ProjectPointOnSurf``),
     falling back to the face distance when projection finds no extremum (e.g. at borders)."""
-    from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
-
     u0, u1, v0, v1 = bounds
     out = np.empty(len(points))
     with kernel("GeomAPI_ProjectPointOnSurf"):

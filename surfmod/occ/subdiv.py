@@ -11,6 +11,12 @@ from OCP.TopoDS import TopoDS
 from ..errors import KernelError
 from .guard import check_done, kernel
 from .topo import shells_of, wrapped
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
+from OCP.TopExp import TopExp
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+from OCP.gp import gp_Pnt, gp_Vec
 
 
 def sew(faces, tolerance: float):
@@ -67,13 +73,6 @@ def edge_continuity(shape, samples: int = 17):
     between their outward normals (face orientation applied).  Returns ``(max_gap,
     max_angle_deg, edges)``; a per-edge loop (a check, not an evaluation path).
     """
-    from OCP.BRep import BRep_Tool
-    from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
-    from OCP.gp import gp_Pnt, gp_Vec
-    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
-    from OCP.TopExp import TopExp
-    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-
     s = wrapped(shape)
     gap, angle, count = 0.0, 0.0, 0
     with kernel("edge continuity (BRepAdaptor_Curve2d)"):

@@ -1,5 +1,8 @@
 """OCCT's swept and lofted shells: ``BRepOffsetAPI_MakePipeShell`` and
-``BRepOffsetAPI_ThruSections``, built from OCCT curves (``Geom_Curve`` + range)."""
+``BRepOffsetAPI_ThruSections``, built from OCCT curves (``Geom_Curve`` + range).
+
+The same concept as :mod:`surfmod.construct.sweep`, of which this is the OCCT twin.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +14,12 @@ from OCP.TopoDS import TopoDS
 from ..errors import KernelError
 from .guard import check_done, kernel
 from .topo import faces_of
+from OCP.BRepFill import BRepFill_TypeOfContact
+from OCP.Law import Law_Interpol
+from OCP.TColgp import TColgp_Array1OfPnt2d
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopExp import TopExp_Explorer
+from OCP.gp import gp_Pnt2d
 
 
 def _wire(curve, t0, t1):
@@ -34,8 +43,6 @@ def pipe_shell(profiles, path, *, mode: str = "frenet", auxiliary=None, contact:
     spine (``SetLaw`` with a ``Law_Interpol``).  Returns the shell (``TopoDS_Shape``) and
     its faces.
     """
-    from OCP.BRepFill import BRepFill_TypeOfContact
-
     with kernel("BRepOffsetAPI_MakePipeShell"):
         spine = _wire(*path)
         first, last = TopoDS.Vertex_s(TopExp.FirstVertex_s(_edge_of(spine))), TopoDS.Vertex_s(
@@ -88,10 +95,6 @@ def _faces(shape, maker: str):
 
 
 def _interpolated_law(params, values):
-    from OCP.gp import gp_Pnt2d
-    from OCP.Law import Law_Interpol
-    from OCP.TColgp import TColgp_Array1OfPnt2d
-
     arr = TColgp_Array1OfPnt2d(1, len(params))
     for i, (a, b) in enumerate(zip(params, values), start=1):
         arr.SetValue(i, gp_Pnt2d(float(a), float(b)))
@@ -101,8 +104,5 @@ def _interpolated_law(params, values):
 
 
 def _edge_of(wire):
-    from OCP.TopAbs import TopAbs_EDGE
-    from OCP.TopExp import TopExp_Explorer
-
     explorer = TopExp_Explorer(wire, TopAbs_EDGE)
     return TopoDS.Edge_s(explorer.Current())

@@ -10,6 +10,20 @@ from OCP.TopoDS import TopoDS
 from .. import transforms
 from ..errors import SurfmodError
 from .guard import check_done, kernel
+from OCP import TopAbs
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.BRepBuilderAPI import BRepBuilderAPI_GTransform, BRepBuilderAPI_MakeVertex, BRepBuilderAPI_Transform
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
+from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
+from OCP.Geom import Geom_TrimmedCurve
+from OCP.GeomConvert import GeomConvert, GeomConvert_CompCurveToBSplineCurve
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_OUT, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS_Shape
+from OCP.gp import gp_GTrsf, gp_Mat, gp_Pnt, gp_Pnt2d, gp_XYZ
+from .analytic import trsf
+from .arrays import xyz
 
 FACE_TOLERANCE = 1e-7
 
@@ -36,16 +50,12 @@ def edge_from_curve(curve, t0, t1):
 
 def wrapped(obj):
     """The ``TopoDS_Shape`` inside a build123d object, the shape itself, or None."""
-    from OCP.TopoDS import TopoDS_Shape
-
     shape = getattr(obj, "wrapped", obj)
     return shape if isinstance(shape, TopoDS_Shape) else None
 
 
 def _single(obj, kind: str):
     """The ``TopoDS_Shape`` of a build123d or OCP ``kind`` ("Face", "Edge"), else SurfmodError."""
-    from OCP import TopAbs
-
     shape = wrapped(obj)
     if shape is None or shape.IsNull() or shape.ShapeType() != getattr(TopAbs, f"TopAbs_{kind.upper()}"):
         raise SurfmodError(f"{kind.lower()}: expected a build123d {kind} or TopoDS_{kind}, got {type(obj).__name__}")
@@ -60,9 +70,6 @@ def single_face(face):
 def face_surface(face):
     """``(Geom_Surface, (u0, u1, v0, v1), reversed)`` of a build123d or OCP face (the
     surface with the face's location applied)."""
-    from OCP.BRepTools import BRepTools
-    from OCP.TopAbs import TopAbs_REVERSED
-
     shape = _single(face, "Face")
     with kernel("BRep_Tool.Surface_s"):
         f = TopoDS.Face_s(shape)
@@ -85,8 +92,6 @@ def curve_of_edge(edge):
 
 def explore(shape, kind):
     """Sub-shapes of one ``TopAbs`` kind, in exploration order (with repeats, as OCCT)."""
-    from OCP.TopExp import TopExp_Explorer
-
     out = []
     explorer = TopExp_Explorer(shape, kind)
     while explorer.More():
@@ -97,8 +102,6 @@ def explore(shape, kind):
 
 def faces_of(shape):
     """All faces of a shape (build123d object or TopoDS_Shape), in exploration order."""
-    from OCP.TopAbs import TopAbs_FACE
-
     shp = wrapped(shape)
     if shp is None:
         raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
@@ -106,25 +109,16 @@ def faces_of(shape):
 
 
 def solids_of(shape):
-    from OCP.TopAbs import TopAbs_SOLID
-
     return [TopoDS.Solid_s(s) for s in explore(shape, TopAbs_SOLID)]
 
 
 def shells_of(shape):
-    from OCP.TopAbs import TopAbs_SHELL
-
     return [TopoDS.Shell_s(s) for s in explore(shape, TopAbs_SHELL)]
 
 
 def transformed_face(face, matrix):
     """A face mapped by a 4x4 affine matrix: ``BRepBuilderAPI_Transform`` for
     similarities (the surface type is kept), ``BRepBuilderAPI_GTransform`` otherwise."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_GTransform, BRepBuilderAPI_Transform
-    from OCP.gp import gp_GTrsf, gp_Mat, gp_XYZ
-
-    from .analytic import trsf
-
     m = transforms.affine(matrix)
     shape = single_face(face)
     with kernel("BRepBuilderAPI_Transform"):
@@ -139,10 +133,6 @@ def transformed_face(face, matrix):
 def classify_uv(face, u, v, tolerance=None):
     """Boolean array: ``(u[i], v[i])`` inside the face or on its boundary
     (``BRepTopAdaptor_FClass2d`` at ``tolerance``, default the face's own tolerance)."""
-    from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
-    from OCP.gp import gp_Pnt2d
-    from OCP.TopAbs import TopAbs_OUT
-
     f = single_face(face)
     with kernel("BRepTopAdaptor_FClass2d"):
         tol = BRep_Tool.Tolerance_s(f) if tolerance is None else float(tolerance)
@@ -154,12 +144,6 @@ def classify_uv(face, u, v, tolerance=None):
 def closest_on_face(face, points):
     """``(distances (N,), points (N, 3))``: closest points on a trimmed face (or any
     shape of faces: shell, compound), boundary included (``BRepExtrema_DistShapeShape``)."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-    from OCP.gp import gp_Pnt
-
-    from .arrays import xyz
-
     f = wrapped(face)
     if f is None or f.IsNull():
         raise SurfmodError(f"face: expected a build123d shape or TopoDS_Shape, got {type(face).__name__}")
@@ -181,10 +165,6 @@ def closest_on_face(face, points):
 def face_wires_uv(face, samples: int):
     """The face's wires as ``(N, 2)`` arrays in ``(u, v)`` (outer wire first), each edge
     sampled at ``samples`` points of its p-curve in the wire's order."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-    from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
-    from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
-
     f = single_face(face)
     out = []
     with kernel("BRepAdaptor_Curve2d (face wires)"):
@@ -211,11 +191,6 @@ def face_wires_uv(face, samples: int):
 def shape_bspline(shape):
     """The exact B-spline form of an edge's or a wire's 3-D curve (wires are joined
     edge by edge with ``GeomConvert_CompCurveToBSplineCurve``)."""
-    from OCP.Geom import Geom_TrimmedCurve
-    from OCP.GeomConvert import GeomConvert, GeomConvert_CompCurveToBSplineCurve
-    from OCP.TopAbs import TopAbs_EDGE, TopAbs_WIRE
-    from OCP.BRepTools import BRepTools_WireExplorer
-
     s = wrapped(shape)
     if s is None or s.IsNull() or s.ShapeType() not in (TopAbs_EDGE, TopAbs_WIRE):
         raise SurfmodError(f"expected a build123d Edge or Wire, got {type(shape).__name__}")
@@ -232,7 +207,6 @@ def shape_bspline(shape):
         for e in edges:
             curve, t0, t1 = curve_of_edge(e)
             piece = GeomConvert.CurveToBSplineCurve_s(Geom_TrimmedCurve(curve, t0, t1))
-            from OCP.TopAbs import TopAbs_REVERSED
 
             if e.Orientation() == TopAbs_REVERSED:
                 piece.Reverse()

@@ -12,22 +12,41 @@ from itertools import chain
 
 import numpy as np
 from OCP.BRep import BRep_Tool
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopoDS import TopoDS
 
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import check_done, kernel
-from .mesh import mesh_faces
-from .topo import explore as _explore, shells_of, solids_of
+from .topo import explore as _explore, shells_of, solids_of, wrapped
+from OCP.BRep import BRep_Builder
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Section
+from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepLib import BRepLib
+from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
+from OCP.Bnd import Bnd_Box
+from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_QuasiUniformDeflection
+from OCP.GProp import GProp_GProps
+from OCP.GeomAbs import GeomAbs_Plane
+from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds, ShapeAnalysis_ShapeTolerance
+from OCP.TopAbs import TopAbs_VERTEX
+from OCP.TopExp import TopExp
+from OCP.TopTools import TopTools_HSequenceOfShape, TopTools_IndexedDataMapOfShapeListOfShape
+from OCP.TopoDS import TopoDS_Shell
+from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+from .exchange import compound
+from .topo import faces_of
+import OCP.Geom as G
 
 SEW_TOLERANCE = 1e-6
 
 
 def model_tolerance(shape) -> float:
     """The largest edge tolerance of ``shape`` (what the writing system vouched for)."""
-    from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
-
     with kernel("ShapeAnalysis_ShapeTolerance"):
         return float(ShapeAnalysis_ShapeTolerance().Tolerance(shape, 1, TopAbs_EDGE))
 
@@ -37,9 +56,6 @@ def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
 
     Raises ``SurfmodError`` when the faces do not close up.
     """
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
-    from OCP.BRepLib import BRepLib
-
     with kernel("BRepBuilderAPI_Sewing"):
         sewing = BRepBuilderAPI_Sewing(tolerance)
         for f in face_shapes:
@@ -63,9 +79,6 @@ def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
 def _solid_of_shell(shell, what: str):
     """A solid bounded by one shell; an open shell is sewn at the model's own tolerance
     first (loose faces that OCCT sewing joins), and refused only if it stays open."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
-    from OCP.BRepLib import BRepLib
-
     if not BRep_Tool.IsClosed_s(shell):
         tol = max(SEW_TOLERANCE, model_tolerance(shell))
         try:
@@ -82,8 +95,6 @@ def _solid_of_shell(shell, what: str):
 def closed_solid(shape):
     """A closed solid (or compound of them) for volume work; open shells are sewn at the
     model's tolerance and refused if they stay open."""
-    from .exchange import compound
-
     solids = solids_of(shape)
     if solids:
         out = []
@@ -106,8 +117,6 @@ def closed_solid(shape):
         raise SurfmodError("obj: has no faces, so no solid to measure")
     # faces that already share their edges (e.g. one periodic face: a full sphere or
     # torus closed by its own seam and poles) form a closed shell without sewing
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Shell
 
     builder = BRep_Builder()
     shell = TopoDS_Shell()
@@ -125,9 +134,6 @@ def gprops(shape, eps: float = 1e-9) -> dict:
     Returns volume, area, centroid and the inertia matrix about the centroid
     (OCCT's ``MatrixOfInertia``: diagonal ``∫(y²+z²)``, off-diagonal ``−∫xy``).
     """
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
     with kernel("BRepGProp.VolumeProperties_s"):
         vp = GProp_GProps()
         verr = BRepGProp.VolumeProperties_s(shape, vp, float(eps), False, False)
@@ -161,10 +167,6 @@ def vertex_mean(shape) -> np.ndarray:
     >>> vertex_mean(bd.Box(2, 4, 6).wrapped).round(12).tolist()  # 8 corners, 6 visits each
     [0.0, 0.0, 0.0]
     """
-    from OCP.TopAbs import TopAbs_VERTEX
-    from OCP.TopExp import TopExp
-    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-
     with kernel("TopExp.MapShapesAndAncestors_s"):
         ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
         TopExp.MapShapesAndAncestors_s(shape, TopAbs_VERTEX, TopAbs_EDGE, ancestors)
@@ -178,14 +180,19 @@ def vertex_mean(shape) -> np.ndarray:
     return np.repeat(pts.reshape(n, 3), np.maximum(visits, 1), axis=0).mean(axis=0)
 
 
-def bounding_box(shape) -> np.ndarray:
-    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` (optimal box)."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-
-    with kernel("BRepBndLib.AddOptimal_s"):
+def bounding_box(shape, *, optimal: bool = True) -> np.ndarray:
+    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` of a ``TopoDS_Shape`` or build123d
+    shape: the tight box (``BRepBndLib.AddOptimal``), or with ``optimal=False`` OCCT's quick
+    box (from a stored triangulation, else the control points, enlarged by the shape
+    tolerance: a cheap upper bound).  The one bounding box of the kernel door."""
+    inner = wrapped(shape)
+    shape = shape if inner is None else inner
+    with kernel("BRepBndLib.AddOptimal_s" if optimal else "BRepBndLib.Add"):
         box = Bnd_Box()
-        BRepBndLib.AddOptimal_s(shape, box, False, False)
+        if optimal:
+            BRepBndLib.AddOptimal_s(shape, box, False, False)
+        else:
+            BRepBndLib.Add_s(shape, box, True)
         return np.array(box.Get()).reshape(2, 3)
 
 
@@ -205,9 +212,6 @@ def elementary_faces(faces) -> list:
     >>> [(d[0], d[5]) for d in elementary_faces([f.wrapped for f in bd.Cylinder(1, 2).faces()])]
     [('Geom_CylindricalSurface', (1.0,)), ('Geom_Plane', ()), ('Geom_Plane', ())]
     """
-    import OCP.Geom as G
-    from OCP.BRepTools import BRepTools
-
     surface_of, uv_bounds = BRep_Tool.Surface_s, BRepTools.UVBounds_s
     reversed_ = TopAbs_REVERSED
     out, frames = [], []
@@ -254,48 +258,11 @@ _PERIODIC = {"Geom_Plane": (False, False), "Geom_CylindricalSurface": (True, Fal
              "Geom_ToroidalSurface": (True, True)}
 
 
-def is_rectangle(face, bounds) -> bool:
-    """True when every edge's p-curve lies on the border of the face's UV box (one wire)."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
-
-    if len(_explore(face, TopAbs_WIRE)) != 1:
-        return False
-    u0, u1, v0, v1 = bounds
-    tu, tv = 1e-7 * max(1.0, u1 - u0), 1e-7 * max(1.0, v1 - v0)
-    for e in _explore(face, TopAbs_EDGE):
-        edge = TopoDS.Edge_s(e)
-        pc = BRepAdaptor_Curve2d(edge, face)
-        f, l = pc.FirstParameter(), pc.LastParameter()
-        for t in f + (l - f) * np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0]):
-            p = pc.Value(float(t))
-            u, v = p.X(), p.Y()
-            on = min(abs(u - u0), abs(u - u1)) <= tu or min(abs(v - v0), abs(v - v1)) <= tv
-            if not on:
-                return False
-    return True
-
-
-def face_uv_triangles(face, deflection: float, angular: float = 0.1):
-    """UV nodes ``(M, 2)`` and triangles ``(T, 3)`` of a BRepMesh triangulation of one
-    face (the face's trimmed parameter region as a polygonal patchwork)."""
-    ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
-    if got is None or np.isnan(got.uv).any():
-        raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
-    uv, idx = got.uv, got.triangles
-    return uv, idx
-
-
 def edge_deviations(shape, samples: int = 23) -> np.ndarray:
     """``(E, 2)``: per edge of ``shape`` the largest distance between its 3-D curve and the
     image of its p-curve on each of its faces (``samples`` points, as ``BRepCheck`` does),
     and the edge's length.  A model whose edges are off their faces this far bounds a
     region only up to that distance."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-    from OCP.TopExp import TopExp
-    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-
     out = []
     with kernel("edge deviations"):
         emap = TopTools_IndexedDataMapOfShapeListOfShape()
@@ -324,8 +291,6 @@ def edge_deviations(shape, samples: int = 23) -> np.ndarray:
 # -- interference -----------------------------------------------------------------------
 def common_volume(a, b, eps: float = 1e-9) -> float:
     """Volume of ``BRepAlgoAPI_Common(a, b)`` (0 when the parts do not overlap)."""
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
-
     with kernel("BRepAlgoAPI_Common"):
         op = BRepAlgoAPI_Common(a, b)
         if not op.IsDone():
@@ -338,8 +303,6 @@ def common_volume(a, b, eps: float = 1e-9) -> float:
 
 def min_distance(a, b):
     """``(distance, point_on_a, point_on_b, inner)`` from ``BRepExtrema_DistShapeShape``."""
-    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-
     with kernel("BRepExtrema_DistShapeShape"):
         d = BRepExtrema_DistShapeShape(a, b)
         if not d.IsDone() or d.NbSolution() == 0:
@@ -352,10 +315,6 @@ def section_edges(shape, origin, normal):
     """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
     end to end with ``ShapeAnalysis_FreeBounds``)."""
     import build123d as bd
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
-    from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
-    from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
-    from OCP.TopTools import TopTools_HSequenceOfShape
 
     with kernel("BRepAlgoAPI_Section"):
         pln = gp_Pln(gp_Pnt(*map(float, origin)), gp_Dir(*map(float, normal)))
@@ -380,11 +339,6 @@ def planar_faces_on(shape, origin, normal, tol: float) -> list[int]:
     """Exploration indices of the planar faces of ``shape`` that lie in the plane
     ``(origin, normal)`` (parallel within 1e-9, offset within ``tol``): OCCT's plane of
     each face, with the face's location applied (``BRepAdaptor_Surface``)."""
-    from OCP.BRepAdaptor import BRepAdaptor_Surface
-    from OCP.GeomAbs import GeomAbs_Plane
-
-    from .topo import faces_of
-
     origin, normal = np.asarray(origin, dtype=float), np.asarray(normal, dtype=float)
     out = []
     with kernel("BRepAdaptor_Surface (planar faces)"):
@@ -401,8 +355,6 @@ def planar_faces_on(shape, origin, normal, tol: float) -> list[int]:
 
 def wire_edges(wire):
     """The edges of a wire in connection order."""
-    from OCP.BRepTools import BRepTools_WireExplorer
-
     out = []
     ex = BRepTools_WireExplorer(TopoDS.Wire_s(getattr(wire, "wrapped", wire)))
     while ex.More():
@@ -414,9 +366,6 @@ def wire_edges(wire):
 def edge_points(edge, deflection: float) -> np.ndarray:
     """Points along an edge (in its orientation) whose chords stay within ``deflection``
     of the curve (``GCPnts_QuasiUniformDeflection``)."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve
-    from OCP.GCPnts import GCPnts_QuasiUniformDeflection
-
     with kernel("GCPnts_QuasiUniformDeflection"):
         c = BRepAdaptor_Curve(edge)
         algo = GCPnts_QuasiUniformDeflection(c, float(deflection), c.FirstParameter(), c.LastParameter())
@@ -428,17 +377,12 @@ def edge_points(edge, deflection: float) -> np.ndarray:
 
 def edge_length(edge) -> float:
     """Length of an edge (``GCPnts_AbscissaPoint``, OCCT's own)."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve
-    from OCP.GCPnts import GCPnts_AbscissaPoint
-
     with kernel("GCPnts_AbscissaPoint.Length_s"):
         return float(GCPnts_AbscissaPoint.Length_s(BRepAdaptor_Curve(edge), 1e-12))
 
 
 # -- files ------------------------------------------------------------------------------
 def write_brep(shape, path) -> None:
-    from OCP.BRepTools import BRepTools
-
     with kernel("BRepTools.Write_s"):
         if not BRepTools.Write_s(shape, str(path)):
             raise SurfmodError(f"path: could not write BREP {path}")
@@ -446,6 +390,6 @@ def write_brep(shape, path) -> None:
 
 __all__ = [
     "bounding_box", "closed_solid", "vertex_mean", "common_volume", "edge_deviations", "edge_length", "edge_points",
-    "elementary_faces", "face_uv_triangles", "gprops", "is_rectangle", "min_distance", "section_edges",
+    "elementary_faces", "gprops", "min_distance", "section_edges",
     "model_tolerance", "planar_faces_on", "sew_solid", "shells_of", "solids_of", "wire_edges", "write_brep",
 ]

@@ -20,10 +20,11 @@ from ..construct.elementary import PlaneSurface
 from ..construct.plane import ThreePointPlane
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
-from ..readback.clip import as_face_surface, clip_curves
+from .clip import as_face_surface, clip_curves
 from ..surface import Surface
 from . import marching
 from .closest import closest_points, nearest_samples, seed_parameters
+from tqdm import tqdm
 
 # -- problems -------------------------------------------------------------------------------
 
@@ -338,6 +339,8 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
         raise SurfmodError(f"{'b' if swap else 'a'}: expected a surfmod Surface, got {type(a).__name__}")
     plane = None if isinstance(b, Surface) else as_plane(b, "a" if swap else "b")
     problem = SurfaceSurface(a, b, tol) if plane is None else SurfacePlane(a, *plane, tol)
+    # below the floor Newton's stop test is never met and coincidence never detected
+    tol = problem.tolerance = checks.tolerance(tol, "tolerance", problem.scale)
     h = checks.positive(step, "step") if step is not None else problem.scale / 40
     checks.work(10.0 * problem.scale / h, max_points, "max_points", f"tracing with step {h:.3g} on a model of size {problem.scale:.3g}")
     _refuse_coincident(a, b, plane, tol, ("b", "a") if swap else ("a", "b"))  # before any seed is solved
@@ -349,7 +352,6 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
         seeds = _implicit_seeds(problem, a)
         o, x, y, _ = plane_frame(origin, normal)
         uv_b_of = lambda X, P: np.stack([(P - o) @ x, (P - o) @ y], axis=1)  # noqa: E731
-    from tqdm import tqdm
 
     with tqdm(total=len(seeds), desc="intersect", unit="seed", disable=not progress, leave=False) as bar:
         traced = marching.trace_all(problem, seeds, h, angle, bar)
@@ -375,7 +377,7 @@ def intersect_line(s: Surface, origin, direction, *, tolerance: float = 1e-9) ->
         raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
     o = checks.point(origin, "origin")
     d = checks.direction(direction, "direction")
-    tol = checks.positive(tolerance, "tolerance")
+    tol = checks.tolerance(tolerance, "tolerance", _size(s))
     problem = SurfaceLine(s, o, d, tol)
     _, _, uu, vv, pts, cell = _grid(s)
     rel = pts - o

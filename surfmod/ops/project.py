@@ -10,10 +10,11 @@ import numpy as np
 from .. import checks
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..readback.clip import as_face_surface, project_on_face
+from .clip import as_face_surface, project_on_face
 from ..readback.trimmed import TrimmedFace
 from ..surface import Surface, require_surface
 from .closest import closest_points
+from tqdm import tqdm
 
 
 class Projection(NamedTuple):
@@ -83,8 +84,6 @@ def project(points_or_curve, s: Surface, *, samples: int = 65, seeds: int = 8,
     checks.work(len(flat), max_points, "max_points", f"projecting {len(flat):,} points")
     blocks = range(0, len(flat), _BLOCK)
     if progress or (progress is None and len(blocks) > 1):
-        from tqdm import tqdm
-
         blocks = tqdm(blocks, desc="project", unit="block")
     parts = [closest_points(s, flat[b0 : b0 + _BLOCK], seeds) for b0 in blocks]
     u, v, p, d = (np.concatenate(a) for a in zip(*parts))

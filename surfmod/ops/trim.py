@@ -9,15 +9,20 @@ the knot lines of the surface, so the integrand is smooth on every piece.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .. import checks
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
-from ..readback.clip import as_face_surface
+from .clip import as_face_surface
 from ..readback.trimmed import TrimmedFace
-from ..surface import Surface
+from ..surface import Surface, model_size
+
+#: OCCT's ``Precision::Confusion()``: the smallest distance its topology tells apart
+OCCT_CONFUSION = 1e-7
 
 #: Closing gap allowed between the first and last point of a loop, relative to the domain.
 CLOSURE_RTOL = 1e-9
@@ -145,7 +150,13 @@ def trim(s: Surface, boundary_curve_uv, *, tolerance: float = 1e-7):
     """
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
-    tol = checks.positive(tolerance, "tolerance")
+    tol = checks.tolerance(tolerance, "tolerance", model_size(s))
+    # the 3-D edges are approximated from the p-curves to this tolerance (BRepLib
+    # BuildCurves3d): below OCCT's confusion tolerance it only multiplies segments (1e-11
+    # on a unit square took 22 s) and OCCT's own checks cannot tell the difference
+    if tol < OCCT_CONFUSION:
+        raise SurfmodError(f"tolerance: {tol:g} is below OCCT's confusion tolerance {OCCT_CONFUSION:g} "
+                           "(Precision::Confusion), the finest edge OCCT builds")
     loops = boundary_loops(s, boundary_curve_uv)
     from ..occ.ops import trimmed_face
 
@@ -225,8 +236,9 @@ def _curve_crossings(curve, ubreaks, vbreaks, per_span: int = 8, dense: int = 64
 def trimmed_area(s: Surface, boundary_curve_uv=None, order: int = 24) -> float:
     """Area of the trimmed region, by NumPy quadrature (Green's theorem in (u, v)).
 
-    Without ``boundary_curve_uv``, ``s`` is a face (build123d / OCP, or read back with
-    :func:`surfmod.from_face`) and its own boundary is used.
+    It is the NumPy side of :func:`trim` (same arguments), checked against the face it
+    builds.  Without ``boundary_curve_uv``, ``s`` is a face and its own boundary is used:
+    deprecated, that is ``sm.from_face(face).area()``.
 
     >>> import surfmod as sm
     >>> s = sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0))
@@ -237,6 +249,8 @@ def trimmed_area(s: Surface, boundary_curve_uv=None, order: int = 24) -> float:
         face = as_face_surface(s)
         if not isinstance(face, TrimmedFace):
             raise SurfmodError("boundary_curve_uv: needed unless s is a face (it carries its own boundary)")
+        # deprecated (one release): a face's area has one name, sm.from_face(face).area()
+        warnings.warn("trimmed_area(face) is deprecated: use sm.from_face(face).area()", DeprecationWarning, stacklevel=2)
         return face.area()
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")

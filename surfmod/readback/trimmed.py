@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks
+from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface, ToroidalSurface
+from ..mass.moments import face_moments
 from ..surface import Surface
 from .readers import read_surface
 
@@ -87,6 +89,11 @@ class TrimmedFace(Surface):
     def _grid_derivatives(self, us, vs, order):
         return self.surface._grid_derivatives(self._wrap(us, 0), self._wrap(vs, 1), order)
 
+    def _closest_parameters(self, points):
+        # closed forms of the untrimmed surface, over the face's own parameter box
+        closed_form = getattr(self.surface, "_closest_in", None)
+        return None if closed_form is None else closed_form(points, self._domain)
+
     def geom(self):
         """The face's own OCCT surface (located), the file's exact geometry."""
         return self._geom
@@ -136,9 +143,6 @@ class TrimmedFace(Surface):
     def area(self) -> float:
         """Area of the trimmed face (Gauss quadrature on the NumPy evaluator; Green's
         theorem over the exact p-curves for trimmed faces)."""
-        # cycle: surfmod.readback.trimmed <-> surfmod.uses.mass (area() delegates up to uses/)
-        from ..uses.mass import face_moments
-
         return float(face_moments(self)[0])
 
 
@@ -173,3 +177,37 @@ def from_face(face) -> TrimmedFace:
     geom = downcast_surface(geom)
     surface = read_surface(geom, bounds)
     return TrimmedFace(surface, shape, geom, bounds, _periods(geom, surface), reversed_)
+
+
+_ELEMENTARY = {
+    "Geom_Plane": PlaneSurface, "Geom_CylindricalSurface": CylindricalSurface, "Geom_ConicalSurface": ConicalSurface,
+    "Geom_SphericalSurface": SphericalSurface, "Geom_ToroidalSurface": ToroidalSurface,
+}
+
+
+def from_faces(shapes: list) -> list:
+    """:func:`surfmod.from_face` of every face of a part: the same ``TrimmedFace``, the
+    elementary ones (planes, cylinders, cones, spheres, tori: most faces of real parts)
+    built from one pass over their OCCT data (:func:`surfmod.occ.uses.elementary_faces`)."""
+    from ..occ.uses import elementary_faces
+
+    out = []
+    for shape, data in zip(shapes, elementary_faces(shapes)):
+        if data is None:
+            out.append(from_face(shape))
+            continue
+        name, geom, bounds, reversed_, frame, radii, periodic = data
+        u0, u1, v0, v1 = bounds
+        surface = _ELEMENTARY[name]._trusted(frame, radii, (u0, u1), (v0, v1))
+        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(periodic, bounds), reversed_))
+    return out
+
+
+def _elementary_periods(periodic, bounds) -> tuple:
+    """readback's ``_periods`` of an elementary surface over ``bounds`` (``periodic``: per
+    direction whether OCCT's surface is periodic; the period is then 2π): 2π where the
+    direction is periodic and the face spans one whole period, else None."""
+    period = 2 * np.pi
+    spans = (bounds[1] - bounds[0], bounds[3] - bounds[2])
+    return tuple(period if periodic and abs(span - period) <= 1e-9 * period else None
+                 for periodic, span in zip(periodic, spans))

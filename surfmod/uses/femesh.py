@@ -1,20 +1,26 @@
-"""Finite element meshes of parts with a target element size (gmsh), written via meshio."""
+"""Finite element meshes of parts with a target element size (gmsh), written via meshio.
+
+The same concept as :mod:`surfmod.cli.femesh` (the ``surfmod femesh`` command over this).
+"""
 
 from __future__ import annotations
 
 import tempfile
 import threading
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from .. import checks
 from ..atomic import atomic_path, target_path
 from ..errors import KernelError, SurfmodError
+from ..extras import require
 from ..meshing.brep import tessellate_shape
-from .inputs import to_shape
+from ..inputs import to_shape
 
 _GMSH_LOCK = threading.Lock()  # gmsh keeps global state: one mesh at a time
 
@@ -94,7 +100,9 @@ class FEMesh:
         return float(np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum() / 2)
 
     def export(self, path) -> None:
-        """Same as :func:`export_fe_mesh`."""
+        """Deprecated (one release): :func:`surfmod.export_fe_mesh`, the one name, beside
+        ``export_step``/``export_stl``."""
+        warnings.warn("FEMesh.export is deprecated: use sm.export_fe_mesh(mesh, path)", DeprecationWarning, stacklevel=2)
         export_fe_mesh(self, path)
 
     def __str__(self) -> str:
@@ -176,9 +184,7 @@ def min_triangle_angles(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
 
 
 def _gmsh():
-    import gmsh  # a declared dependency, heavy: loaded on the first FE mesh only
-
-    return gmsh
+    return require("gmsh", "fem", "sm.fe_mesh")  # the optional extra 'fem', loaded on the first FE mesh only
 
 
 #: gmsh's OCC healing, tried when a part does not mesh as read (real STEP parts: tiny or
@@ -401,7 +407,7 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     >>> round(m.volume, 9), m.cell_type, m.quality["gamma"]["min"] > 0.2
     (8.0, 'tetra', True)
     """
-    import meshio
+    meshio = require("meshio", "fem", "sm.fe_mesh")
 
     from ..occ import uses as occ
 
@@ -426,7 +432,6 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     checks.work(estimate, max_elements, "max_elements", f"a {kind} mesh with element size {size:g} of a part of extent {extent:.4g}")
     cell = _CELLS[(kind, order)]
     failures = []
-    from tqdm import tqdm
 
     with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp, \
             tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:
@@ -548,7 +553,7 @@ def export_fe_mesh(mesh, path) -> None:
     >>> meshio.read(p).cells[0].type
     'triangle'
     """
-    import meshio
+    meshio = require("meshio", "fem", "sm.fe_mesh")
 
     target = target_path(path, "path", tuple(FORMATS))
     m = mesh.mesh if isinstance(mesh, FEMesh) else mesh

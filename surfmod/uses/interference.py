@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import checks
-from .inputs import to_shape
+from ..inputs import to_shape
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,7 @@
-"""Cross-section views: planar sections of a part as curves, in 3-D and in the plane's frame."""
+"""Cross-section views: planar sections of a part as curves, in 3-D and in the plane's frame.
+
+The same concept as :mod:`surfmod.cli.section` (the ``surfmod section`` command over this).
+"""
 
 from __future__ import annotations
 
@@ -15,7 +18,7 @@ from ..construct.from_edge import from_edge
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
 from ..readback import read_curve
-from .inputs import to_shape
+from ..inputs import to_shape
 
 
 def plane_frame(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray]:
@@ -196,7 +199,6 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     (1, [True], True)
     """
     from ..occ import uses as occ
-    from ..occ.triangulation import bounding_box as quick_box
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
@@ -205,7 +207,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     shape = to_shape(obj, "obj")
     # only a length scale for the on-face test: OCCT's quick box, not the optimal one
     # (which costs more than the section itself on B-spline parts)
-    box = quick_box(shape)
+    box = occ.bounding_box(shape, optimal=False)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
     on = planar_faces_in(shape, origin, normal, tol)
     if on:

@@ -1,0 +1,118 @@
+"""Closest points on the OCCT elementary surfaces in closed form, over a parameter box.
+
+The counterpart of OCCT's ``Extrema_ExtPElS``, but for the bounded patch (the box
+``[u0, u1] x [v0, v1]`` of the surface's own parametrization) rather than the infinite
+surface: every function returns the parameters of the closest point of the box, which is
+the orthogonal foot when that lies inside and a boundary or corner point otherwise.
+
+All five distances separate.  In the frame of the surface write the point as
+``(rho cos t, rho sin t, z)``.  On a cylinder, sphere or ring torus the squared distance
+is ``g(v) - 2 rho w(v) cos(u - t)`` with a weight ``w(v) >= 0`` (the radius, ``R cos v``,
+``R + r cos v``), so for every ``v`` the best ``u`` is the angle of the box closest to
+``t``, the same for all ``v``; what is left is one-dimensional: a clipped line parameter
+(plane, cylinder), or the angle of the box closest to the direction of the point in the
+meridian half-plane (sphere, torus).  On a cone the weight ``R + v sin a`` changes sign
+at the apex, so each nappe gets its own best ``u`` (towards ``t`` or away from it) and the
+squared distance is a convex quadratic in ``v`` there: two candidates, the nearer wins
+(a box always holds one of them: at least one side of the apex is not empty).
+
+Points on the axis (or at the centre, or on a torus' core circle) are equally far from a
+whole circle of points: the angle chosen is the one closest to 0 in the box, a valid
+closest point like any other.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+TWO_PI = 2.0 * math.pi
+
+
+def closest_angle(theta: np.ndarray, a0: float, a1: float) -> np.ndarray:
+    """The angle of ``[a0, a1]`` nearest to ``theta`` on the circle (``theta`` taken mod 2 pi).
+
+    >>> closest_angle(np.array([0.5, 3.0, -0.1, 6.0]), 0.0, 1.0).tolist()
+    [0.5, 1.0, 0.0, 0.0]
+    """
+    t = a0 + np.mod(theta - a0, TWO_PI)  # in [a0, a0 + 2 pi)
+    if a1 - a0 >= TWO_PI:
+        return t
+    # outside the arc: the nearer end going either way round (both gaps add to 2 pi - span)
+    return np.where(t <= a1, t, np.where(t - a1 <= a0 + TWO_PI - t, a1, a0))
+
+
+def _polar(local: np.ndarray):
+    x, y, z = local[:, 0], local[:, 1], local[:, 2]
+    return np.hypot(x, y), np.arctan2(y, x), z
+
+
+def plane(local, box):
+    """``(u, v)`` on ``O + u X + v Y``: the in-plane coordinates clipped to the box."""
+    (u0, u1), (v0, v1) = box
+    return np.clip(local[:, 0], u0, u1), np.clip(local[:, 1], v0, v1)
+
+
+def cylinder(local, box):
+    """``(u, v)`` on ``O + R (cos u X + sin u Y) + v Z``."""
+    (u0, u1), (v0, v1) = box
+    _, theta, z = _polar(local)
+    return closest_angle(theta, u0, u1), np.clip(z, v0, v1)
+
+
+def sphere(local, box):
+    """``(u, v)`` on ``O + R cos v (cos u X + sin u Y) + R sin v Z``, ``v`` in ``[-pi/2, pi/2]``.
+
+    With ``u`` fixed the distance falls as ``w cos v + z sin v`` grows (``w = rho cos(u - t)``),
+    a cosine of ``v - atan2(z, w)``: the latitude of the box closest to that angle wins.
+    """
+    (u0, u1), (v0, v1) = box
+    rho, theta, z = _polar(local)
+    u = closest_angle(theta, u0, u1)
+    return u, closest_angle(np.arctan2(z, rho * np.cos(u - theta)), v0, v1)
+
+
+def torus(local, box, major: float):
+    """``(u, v)`` on ``O + (R + r cos v)(cos u X + sin u Y) + r sin v Z`` (``r < R``).
+
+    With ``u`` fixed the point seen in the meridian half-plane is ``(w, z)``,
+    ``w = rho cos(u - t)``; the closest point of the tube circle around ``(R, 0)`` is in
+    the direction ``atan2(z, w - R)``, the closest angle of the box to it wins.
+    """
+    (u0, u1), (v0, v1) = box
+    rho, theta, z = _polar(local)
+    u = closest_angle(theta, u0, u1)
+    w = rho * np.cos(u - theta)
+    return u, closest_angle(np.arctan2(z, w - major), v0, v1)
+
+
+def cone(local, box, radius: float, semi_angle: float):
+    """``(u, v)`` on ``O + (R + v sin a)(cos u X + sin u Y) + v cos a Z``.
+
+    One candidate per nappe of the box (``R + v sin a >= 0``, the best ``u`` facing the
+    point, and ``<= 0``, facing away); the nearer one is returned.
+    """
+    (u0, u1), (v0, v1) = box
+    rho, theta, z = _polar(local)
+    sa, ca = math.sin(semi_angle), math.cos(semi_angle)
+    apex = -radius / sa
+    # the v-intervals of the box on either side of the apex: (R + v sin a) >= 0, then <= 0
+    ahead = (max(v0, apex), v1) if sa > 0 else (v0, min(v1, apex))
+    behind = (v0, min(v1, apex)) if sa > 0 else (max(v0, apex), v1)
+    best = None
+    for (lo, hi), facing in ((ahead, theta), (behind, theta + math.pi)):
+        if lo > hi:
+            continue
+        u = closest_angle(facing, u0, u1)
+        c, s = np.cos(u - theta), np.sin(u - theta)
+        # |S - P|^2 = v^2 + 2 v (R sin a - rho cos(u - t) sin a - z cos a) + const
+        v = np.clip(rho * c * sa + z * ca - radius * sa, lo, hi)
+        # the squared distance as a sum of squares (no cancellation near the surface)
+        d2 = (radius + v * sa - rho * c) ** 2 + (rho * s) ** 2 + (v * ca - z) ** 2
+        if best is None:
+            best = (u, v, d2)
+        else:
+            nearer = d2 < best[2]
+            best = (np.where(nearer, u, best[0]), np.where(nearer, v, best[1]), np.minimum(d2, best[2]))
+    return best[0], best[1]

@@ -1,0 +1,79 @@
+"""Turn whatever the user hands to a "use" into an OCCT shape.
+
+Accepted: a surfmod ``Surface`` (its face), a list/tuple of surfaces or faces (sewn into
+a closed solid when ``solid=True``), any build123d shape, an OCP ``TopoDS_Shape``, or the
+path of a STEP file.
+"""
+
+from __future__ import annotations
+
+import os
+
+from .errors import SurfmodError
+from .surface import Surface
+
+
+def load_step(path, name: str = "obj"):
+    """The TopoDS shape in a STEP file, read in the isolated reader process
+    (:func:`surfmod.import_step`); unreadable or damaged files raise ``SurfmodError``."""
+    from .occ.isolated import read_step_file
+
+    return read_step_file(path, name)
+
+
+def _single(item, name):
+    if isinstance(item, Surface):
+        return item.face().wrapped
+    shape = getattr(item, "wrapped", item)
+    if type(shape).__module__.startswith("OCP") and hasattr(shape, "IsNull"):
+        if shape.IsNull():
+            raise SurfmodError(f"{name}: is an empty shape")
+        return shape
+    raise SurfmodError(
+        f"{name}: expected a surfmod surface, a list of them, a build123d shape or a STEP path, "
+        f"got {type(item).__name__}"
+    )
+
+
+def to_shape(obj, name: str = "obj", *, solid: bool = False):
+    """The OCCT shape for ``obj``; with ``solid=True`` a closed, outward-oriented solid
+    (open shells raise ``SurfmodError``)."""
+    from .occ import uses as occ
+
+    if isinstance(obj, (str, os.PathLike)):
+        shape = load_step(obj, name)
+    elif isinstance(obj, (list, tuple)):
+        if not obj:
+            raise SurfmodError(f"{name}: empty list of surfaces")
+        faces = [_single(o, name) for o in obj]
+        if solid:
+            return occ.sew_solid(faces)
+        from .occ.exchange import compound
+
+        shape = compound(faces)
+    else:
+        shape = _single(obj, name)
+    if solid:
+        try:
+            return occ.closed_solid(shape)
+        except SurfmodError as exc:
+            msg = str(exc)
+            raise SurfmodError(msg if msg.startswith(name) else f"{name}: {msg}") from None
+    return shape
+
+
+def make_solid(surfaces):
+    """A build123d ``Solid`` bounded by surfmod surfaces (and/or faces) that close up:
+    they are sewn (``BRepBuilderAPI_Sewing``) and oriented outwards.  Faces that leave
+    free edges raise ``SurfmodError``.
+
+    >>> import surfmod as sm, build123d as bd
+    >>> cube = sm.make_solid(bd.Box(1, 2, 3).faces())
+    >>> round(cube.volume, 12)
+    6.0
+    """
+    import build123d as bd
+
+    if not isinstance(surfaces, (list, tuple)) or not surfaces:
+        raise SurfmodError("surfaces: expected a non-empty list of surfaces or faces")
+    return bd.Solid(to_shape(list(surfaces), "surfaces", solid=True))

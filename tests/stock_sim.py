@@ -1,0 +1,545 @@
+"""An independent stock simulation for the CAM tests (written for the tests: it shares no
+code with ``surfmod.cam`` / ``surfmod.uses`` and reads only what a controller reads).
+
+The program is read back as LinuxCNC's own interpreter executes it: ``rs274 -g IN.ngc
+OUT.txt`` prints the canonical machine commands (``STRAIGHT_TRAVERSE``, ``STRAIGHT_FEED``,
+``ARC_FEED``, ``CHANGE_TOOL``, ``START_SPINDLE_CLOCKWISE`` …), parsed by
+:func:`parse_canon`.  :func:`parse_gcode` is a second, much smaller reader of the G-code
+text itself (G0/G1/G2/G3 in absolute millimetres on the XY plane) for programs without
+an interpreter at hand.
+
+The stock is a height field (dexels along Z) on a regular (x, y) grid: at each node the
+top of the material left.  Each move sweeps the tool (an end mill with a shank of its own
+radius: ``flat``, ``ball`` or ``bull`` = flat core of radius ``R - r`` then a torus of
+corner radius ``r``) along the straight segment between its end points, and the stock
+becomes the minimum of itself and the swept tool's lower envelope.  That envelope is
+exact at every node: closed forms for a ball (the lowest point of the capsule the sphere
+sweeps) and a flat end (the lowest disc position over the node), and for a bull on a
+sloped move a golden-section search of the convex function ``t -> z(t) + f(d(t))``
+(``f`` the tool profile's height at radius ``d``) on the interval where the tool covers
+the node.  Arcs are replaced by chords whose sagitta is at most ``ARC_CHORD``.
+
+Work and memory are bounded: nodes are visited per move inside the move's box grown by
+the tool radius, moves are batched up to ``PAIRS_PER_BATCH`` (node, move) pairs, and long
+moves are split into pieces of at most ``PIECE`` tool radii.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+RS274 = shutil.which("rs274") or ("/usr/bin/rs274" if Path("/usr/bin/rs274").exists() else None)
+PAIRS_PER_BATCH = 2_000_000
+PIECE = 4.0  # tool radii per piece of a long move
+ARC_CHORD = 1e-6  # mm, sagitta of the chords replacing an arc
+GOLDEN_STEPS = 64  # 0.618**64 ~ 4e-14 of the covered parameter interval
+
+
+@dataclass(frozen=True)
+class Cutter:
+    """A tool's shape: ``kind`` flat/ball/bull, ``radius`` R, ``corner`` r (bull only)."""
+
+    kind: str
+    radius: float
+    corner: float = 0.0
+
+    def __post_init__(self):
+        if self.kind == "ball":
+            object.__setattr__(self, "corner", float(self.radius))
+        elif self.kind == "flat":
+            object.__setattr__(self, "corner", 0.0)
+        elif self.kind != "bull" or not 0 < self.corner < self.radius:
+            raise ValueError(f"cutter: bad shape {self.kind} R={self.radius} r={self.corner}")
+
+    def profile(self, d: np.ndarray) -> np.ndarray:
+        """Height above the tip of the tool's lower surface at radius ``d`` (inf beyond R)."""
+        d = np.asarray(d, dtype=float)
+        core = self.radius - self.corner
+        r = self.corner
+        out = np.full(d.shape, np.inf)
+        inside = d <= self.radius
+        out[inside & (d <= core)] = 0.0
+        ring = inside & (d > core)
+        out[ring] = r - np.sqrt(np.maximum(r * r - (d[ring] - core) ** 2, 0.0))
+        return out
+
+
+@dataclass
+class Move:
+    """One straight piece of the program: ``rapid`` or feed, from ``a`` to ``b`` (tip
+    points), with the tool number and spindle state it ran with and its source line."""
+
+    a: np.ndarray
+    b: np.ndarray
+    rapid: bool
+    tool: int
+    spindle: bool
+    line: int
+
+
+@dataclass
+class Program:
+    moves: list[Move]
+    tool_changes: list[int] = field(default_factory=list)
+    length_offsets: list[int] = field(default_factory=list)  # tool whose G43 was active at each change
+    spindle_starts: list[tuple[int, float]] = field(default_factory=list)  # (tool, speed)
+    comments: list[str] = field(default_factory=list)
+    ended: bool = False
+
+
+def run_rs274(ngc: Path, out: Path | None = None, tool_table: Path | None = None) -> str:
+    """The canonical commands LinuxCNC's interpreter prints for ``ngc`` (raises if
+    rs274 is missing or reports an error)."""
+    if RS274 is None:
+        raise FileNotFoundError("rs274 (Debian package linuxcnc-uspace) is not installed")
+    out = Path(out) if out is not None else Path(ngc).with_suffix(".canon")
+    cmd = [RS274] + (["-t", str(tool_table)] if tool_table else []) + ["-g", str(ngc), str(out)]
+    done = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=600)
+    text = out.read_text() if out.exists() else ""
+    if done.returncode != 0 or "PROGRAM_END" not in text and "PROGRAM_STOP" not in text:
+        raise RuntimeError(f"rs274 failed ({done.returncode}): {done.stdout[-500:]} {done.stderr[-500:]}")
+    return text
+
+
+_CALL = re.compile(r"^\s*\d+\s+N\S*\s+([A-Z_]+)\((.*)\)\s*$")
+
+
+def _numbers(args: str) -> list[float]:
+    return [float(v) for v in re.split(r"[,\s]+", args.strip()) if v]
+
+
+def _arc_points(start, end_xy, centre, rotation: int, z_end: float) -> np.ndarray:
+    """Chord end points of an XY arc from ``start`` (3,) to ``end_xy`` round ``centre``
+    (CCW for rotation > 0, |rotation| - 1 extra full turns), Z linear in the angle."""
+    r0 = math.hypot(start[0] - centre[0], start[1] - centre[1])
+    a0 = math.atan2(start[1] - centre[1], start[0] - centre[0])
+    a1 = math.atan2(end_xy[1] - centre[1], end_xy[0] - centre[0])
+    turns = abs(rotation) - 1
+    if rotation > 0:
+        sweep = (a1 - a0) % (2 * math.pi) or 2 * math.pi * (turns == 0 and np.allclose(start[:2], end_xy))
+        sweep += 2 * math.pi * turns
+    else:
+        sweep = -((a0 - a1) % (2 * math.pi)) or -2 * math.pi * (turns == 0 and np.allclose(start[:2], end_xy))
+        sweep -= 2 * math.pi * turns
+    step = 2 * math.acos(max(1 - ARC_CHORD / max(r0, 1e-12), -1.0)) if r0 > ARC_CHORD else math.pi
+    n = max(1, math.ceil(abs(sweep) / max(step, 1e-9)))
+    if n > 10_000_000:
+        raise ValueError("arc: too many chords")
+    ang = a0 + sweep * np.arange(1, n + 1) / n
+    pts = np.column_stack([centre[0] + r0 * np.cos(ang), centre[1] + r0 * np.sin(ang),
+                           start[2] + (z_end - start[2]) * np.arange(1, n + 1) / n])
+    pts[-1, :2] = end_xy
+    return pts
+
+
+def parse_canon(text: str) -> Program:
+    """The moves, tool changes and spindle starts of rs274's canonical output."""
+    prog = Program([])
+    pos = None
+    tool, spindle, offset_tool = 0, False, None
+    pending_tool = 0
+    for i, line in enumerate(text.splitlines()):
+        m = _CALL.match(line)
+        if not m:
+            continue
+        name, args = m.groups()
+        if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"):
+            p = np.array(_numbers(args)[:3])
+            if pos is not None and np.any(p != pos):
+                prog.moves.append(Move(pos, p, name == "STRAIGHT_TRAVERSE", tool, spindle, i + 1))
+            pos = p
+        elif name == "ARC_FEED":
+            v = _numbers(args)
+            if pos is None:
+                raise ValueError(f"line {i + 1}: arc before any position")
+            pts = _arc_points(pos, (v[0], v[1]), (v[2], v[3]), int(v[4]), v[5])
+            for q in pts:
+                prog.moves.append(Move(pos, q, False, tool, spindle, i + 1))
+                pos = q
+        elif name == "SELECT_TOOL":
+            pending_tool = int(_numbers(args)[0])
+        elif name == "CHANGE_TOOL":
+            tool = int(_numbers(args)[0]) if args.strip() else pending_tool
+            prog.tool_changes.append(tool)
+            offset_tool = None
+        elif name == "USE_TOOL_LENGTH_OFFSET":
+            offset_tool = tool
+            prog.length_offsets.append(tool)
+        elif name in ("START_SPINDLE_CLOCKWISE", "START_SPINDLE_COUNTERCLOCKWISE"):
+            spindle = True
+        elif name == "SET_SPINDLE_SPEED":
+            prog.spindle_starts.append((tool, _numbers(args)[-1]))
+        elif name == "STOP_SPINDLE_TURNING":
+            spindle = False
+        elif name == "COMMENT":
+            prog.comments.append(args.strip().strip('"'))
+        elif name in ("PROGRAM_END", "PROGRAM_STOP"):
+            prog.ended = True
+    del offset_tool
+    return prog
+
+
+_WORD = re.compile(r"([A-Z])\s*([-+]?\d*\.?\d+)")
+
+
+def parse_gcode(text: str) -> Program:
+    """A second reader of the G-code text itself: G0/G1/G2/G3 (I, J or R arcs) with
+    X Y Z words, absolute millimetres in the XY plane, T/M6, M3/M4/M5, M2/M30."""
+    prog = Program([])
+    pos = np.zeros(3)
+    known = False
+    motion, tool, spindle = 0, 0, False
+    for i, raw in enumerate(text.splitlines()):
+        line = re.sub(r"\(.*?\)|;.*$", "", raw.upper())
+        words = _WORD.findall(line)
+        if not words:
+            continue
+        g = [float(v) for k, v in words if k == "G"]
+        mcodes = [int(float(v)) for k, v in words if k == "M"]
+        vals = {k: float(v) for k, v in words if k not in "GM"}
+        for code in g:
+            if code in (0, 1, 2, 3):
+                motion = int(code)
+            elif code in (20, 91):
+                raise ValueError(f"line {i + 1}: G{code:g} (inches / incremental) is not read here")
+        if "T" in vals and 6 in mcodes:
+            tool = int(vals["T"])
+            prog.tool_changes.append(tool)
+        if 3 in mcodes or 4 in mcodes:
+            spindle = True
+            prog.spindle_starts.append((tool, vals.get("S", 0.0)))
+        if 5 in mcodes or 6 in mcodes:
+            spindle = False if 5 in mcodes else spindle
+        if 2 in mcodes or 30 in mcodes:
+            prog.ended = True
+        if not any(k in vals for k in "XYZ"):
+            continue
+        new = pos.copy()
+        for j, k in enumerate("XYZ"):
+            if k in vals:
+                new[j] = vals[k]
+        if motion in (0, 1):
+            if known and np.any(new != pos):
+                prog.moves.append(Move(pos, new, motion == 0, tool, spindle, i + 1))
+        else:
+            if "R" in vals:
+                chord = new[:2] - pos[:2]
+                half = np.linalg.norm(chord) / 2
+                rr = vals["R"]
+                h = math.sqrt(max(rr * rr - half * half, 0.0))
+                left = np.array([-chord[1], chord[0]]) / (2 * half)
+                # G2 with R > 0 takes the short arc: the centre lies right of the chord
+                side = -1.0 if (motion == 2) == (rr > 0) else 1.0
+                centre = pos[:2] + chord / 2 + side * h * left
+            else:
+                centre = pos[:2] + np.array([vals.get("I", 0.0), vals.get("J", 0.0)])
+            start = pos
+            for q in _arc_points(pos, new[:2], centre, 1 if motion == 3 else -1, new[2]):
+                prog.moves.append(Move(start, q, False, tool, spindle, i + 1))
+                start = q
+        pos, known = new, True
+    return prog
+
+
+# ----------------------------------------------------------------------------------------------
+# swept tool envelopes: lowest point of the tool over nodes (qx, qy) along a -> b (tip points)
+
+def _cover(qx, qy, a, b, R):
+    """Parameter interval [t0, t1] (clipped to [0, 1]) where the axis is within R of each
+    node, and a mask of nodes covered at all."""
+    wx, wy = qx - a[0], qy - a[1]
+    vx, vy = b[0] - a[0], b[1] - a[1]
+    vv = vx * vx + vy * vy
+    ww = wx * wx + wy * wy - R * R
+    if vv == 0:
+        ok = ww <= 0
+        return np.zeros_like(qx), np.ones_like(qx), ok
+    wv = wx * vx + wy * vy
+    disc = wv * wv - vv * ww
+    ok = disc >= 0
+    root = np.sqrt(np.where(ok, disc, 0.0))
+    t0, t1 = (wv - root) / vv, (wv + root) / vv
+    ok &= (t1 >= 0) & (t0 <= 1)
+    return np.clip(t0, 0, 1), np.clip(t1, 0, 1), ok
+
+
+def envelope(cutter: Cutter, qx: np.ndarray, qy: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Lowest height of the tool swept straight from tip ``a`` to tip ``b`` over each node
+    (inf where the tool never covers it)."""
+    shape = np.shape(qx)
+    return _envelope(cutter, np.ravel(qx).astype(float), np.ravel(qy).astype(float), a, b).reshape(shape)
+
+
+def _envelope(cutter, qx, qy, a, b):
+    R = cutter.radius
+    t0, t1, ok = _cover(qx, qy, a, b, R)
+    out = np.full(qx.shape, np.inf)
+    dz = b[2] - a[2]
+    if cutter.kind == "flat":
+        t = np.where(dz > 0, t0, t1)
+        out[ok] = a[2] + t[ok] * dz
+        return out
+    if cutter.kind == "ball":
+        return np.where(ok, _ball_envelope(qx, qy, a, b, R), np.inf)
+    # bull: on a level move the closest axis point is lowest; else minimise the convex
+    # z(t) + f(d(t)) over the covered interval
+    vx, vy = b[0] - a[0], b[1] - a[1]
+    idx = np.flatnonzero(ok)
+    qx, qy, lo, hi = qx[idx], qy[idx], t0[idx], t1[idx]
+
+    def height(t):
+        d = np.hypot(qx - a[0] - t * vx, qy - a[1] - t * vy)
+        return a[2] + t * dz + cutter.profile(np.minimum(d, R))
+
+    if dz == 0:
+        vv = vx * vx + vy * vy
+        t = np.clip(((qx - a[0]) * vx + (qy - a[1]) * vy) / vv, 0, 1) if vv > 0 else np.zeros_like(qx)
+        out[idx] = height(t)
+        return out
+    g = (math.sqrt(5) - 1) / 2
+    x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+    f1, f2 = height(x1), height(x2)
+    for _ in range(GOLDEN_STEPS):
+        left = f1 <= f2  # the minimum lies in [lo, x2]
+        hi = np.where(left, x2, hi)
+        lo = np.where(left, lo, x1)
+        keep_x, keep_f = np.where(left, x1, x2), np.where(left, f1, f2)
+        fresh = np.where(left, hi - g * (hi - lo), lo + g * (hi - lo))
+        fresh_f = height(fresh)
+        x1, x2 = np.where(left, fresh, keep_x), np.where(left, keep_x, fresh)
+        f1, f2 = np.where(left, fresh_f, keep_f), np.where(left, keep_f, fresh_f)
+    out[idx] = np.minimum.reduce([height(lo), height(hi), f1, f2])
+    return out
+
+
+def _ball_envelope(qx, qy, a, b, R):
+    """Lowest point over each node of the capsule swept by the ball's centre (a, b tips)."""
+    wx, wy = qx - a[0], qy - a[1]
+    ex, ey, ez = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    m = wx * wx + wy * wy
+    out = np.full(qx.shape, np.inf)
+    for p, mm in ((a, m), (b, (qx - b[0]) ** 2 + (qy - b[1]) ** 2)):
+        out = np.minimum(out, np.where(mm <= R * R, p[2] + R - np.sqrt(np.maximum(R * R - mm, 0.0)), np.inf))
+    A = ex * ex + ey * ey
+    if A <= 1e-24:
+        return out
+    L2 = A + ez * ez
+    k = wx * ex + wy * ey
+    disc = k * k * ez * ez - A * (m * L2 - k * k - R * R * L2)
+    ok = disc >= 0
+    s = (k * ez - np.sqrt(np.where(ok, disc, 0.0))) / A  # lower root: centre height offset
+    u = (k + s * ez) / L2
+    ok &= (u >= 0) & (u <= 1)
+    # the centre sits at a_z + R + s over the node: the capsule's lowest point is R below
+    # the cylinder's lower crossing, i.e. the crossing itself (s measured from a's centre)
+    return np.minimum(out, np.where(ok, a[2] + R + s, np.inf))
+
+
+# ----------------------------------------------------------------------------------------------
+
+@dataclass
+class Report:
+    """What the simulation found.  Depths in mm, positive = the fault happened."""
+
+    gouge: float = -np.inf  # deepest cut below the part's height field
+    gouge_at: tuple = ()
+    rapid_cut: float = -np.inf  # most material a rapid removed at one node
+    rapid_cut_lines: list = field(default_factory=list)
+    rapid_part: float = -np.inf  # deepest a rapid's tool came below the part's top
+    cut_without_spindle: int = 0  # feed moves that removed material with the spindle stopped
+    unknown_tools: set = field(default_factory=set)
+    moves: int = 0
+    cutting_moves: int = 0
+
+    def __str__(self):
+        return (f"{self.moves} moves ({self.cutting_moves} cutting): gouge {self.gouge:.3g} at {self.gouge_at}, "
+                f"rapid through stock {self.rapid_cut:.3g} (lines {self.rapid_cut_lines[:5]}), "
+                f"rapid into part {self.rapid_part:.3g}, cuts with spindle off {self.cut_without_spindle}")
+
+
+class Stock:
+    """Height-field stock on the grid ``x0 + h i``, ``y0 + h j`` (i < nx, j < ny).
+
+    ``top`` starts at the stock's top over the stock's (x, y) box and -inf outside it (no
+    material there), so cuts off the stock remove nothing."""
+
+    def __init__(self, box, h: float, *, origin=None):
+        (x0, y0, z0), (x1, y1, z1) = np.asarray(box, dtype=float)
+        self.box = np.array([[x0, y0, z0], [x1, y1, z1]])
+        self.h = float(h)
+        ox, oy = (x0, y0) if origin is None else origin
+        # the grid's nodes inside the stock's (x, y) box
+        self.x = ox + h * np.arange(math.ceil((x0 - ox) / h - 1e-9), math.floor((x1 - ox) / h + 1e-9) + 1)
+        self.y = oy + h * np.arange(math.ceil((y0 - oy) / h - 1e-9), math.floor((y1 - oy) / h + 1e-9) + 1)
+        if self.x.size * self.y.size > 40_000_000:
+            raise ValueError("stock grid: too many nodes; choose a coarser h")
+        X, Y = np.meshgrid(self.x, self.y, indexing="ij")
+        inside = (X >= x0 - 1e-12) & (X <= x1 + 1e-12) & (Y >= y0 - 1e-12) & (Y <= y1 + 1e-12)
+        self.top = np.where(inside, z1, -np.inf)
+        self.bottom = z0
+
+    def nodes(self):
+        return np.meshgrid(self.x, self.y, indexing="ij")
+
+    def _window(self, a, b, R):
+        lo = np.minimum(a[:2], b[:2]) - R
+        hi = np.maximum(a[:2], b[:2]) + R
+        i0, i1 = np.searchsorted(self.x, lo[0], "left"), np.searchsorted(self.x, hi[0], "right")
+        j0, j1 = np.searchsorted(self.y, lo[1], "left"), np.searchsorted(self.y, hi[1], "right")
+        return i0, i1, j0, j1
+
+    def sweep(self, cutter: Cutter, a, b):
+        """(window slices, lowest tool height there) of one straight move, without cutting."""
+        i0, i1, j0, j1 = self._window(a, b, cutter.radius)
+        if i0 >= i1 or j0 >= j1:
+            return None, None
+        qx, qy = np.meshgrid(self.x[i0:i1], self.y[j0:j1], indexing="ij")
+        return (slice(i0, i1), slice(j0, j1)), envelope(cutter, qx, qy, a, b)
+
+
+def _pieces(a, b, R):
+    n = max(1, math.ceil(np.linalg.norm(b[:2] - a[:2]) / (PIECE * R)))
+    if n > 10_000_000:
+        raise ValueError("move too long for the grid")
+    t = np.linspace(0, 1, n + 1)[:, None]
+    pts = a + t * (b - a)
+    return list(zip(pts[:-1], pts[1:]))
+
+
+def simulate(program: Program, cutters: dict[int, Cutter], stock: Stock, part_top: np.ndarray | None = None,
+             *, eps: float = 1e-9) -> Report:
+    """Run every move of ``program`` through ``stock`` (cut in place) with the tool of
+    each move's number in ``cutters``; ``part_top`` (the part's height field on the stock
+    grid, -inf where no part) is checked against every move's tool."""
+    rep = Report()
+    floor = np.full(stock.top.shape, -np.inf) if part_top is None else part_top
+    lowest = np.full(stock.top.shape, np.inf)  # lowest any feed move's tool came
+    for mv in program.moves:
+        rep.moves += 1
+        cutter = cutters.get(mv.tool)
+        if cutter is None:
+            rep.unknown_tools.add(mv.tool)
+            continue
+        removed = 0.0
+        for a, b in _pieces(mv.a, mv.b, cutter.radius):
+            win, env = stock.sweep(cutter, a, b)
+            if win is None:
+                continue
+            depth = stock.top[win] - env
+            removed = max(removed, float(depth.max(initial=-np.inf)))
+            into_part = float((floor[win] - env).max(initial=-np.inf))
+            if mv.rapid:
+                if depth.max(initial=-np.inf) > eps:
+                    rep.rapid_cut_lines.append(mv.line)
+                rep.rapid_cut = max(rep.rapid_cut, float(depth.max(initial=-np.inf)))
+                rep.rapid_part = max(rep.rapid_part, into_part)
+            np.minimum(lowest[win], env, out=lowest[win])
+            np.minimum(stock.top[win], env, out=stock.top[win])
+        if removed > eps and not mv.rapid:
+            rep.cutting_moves += 1
+            if not mv.spindle:
+                rep.cut_without_spindle += 1
+    gap = floor - lowest
+    k = np.unravel_index(np.argmax(gap), gap.shape)
+    rep.gouge = float(gap[k])
+    rep.gouge_at = (float(stock.x[k[0]]), float(stock.y[k[1]]))
+    return rep
+
+
+# ----------------------------------------------------------------------------------------------
+# the part as a height field, and the surface a tool can reach
+
+def part_height(triangles: np.ndarray, x: np.ndarray, y: np.ndarray, *, block: int = 2_000_000) -> np.ndarray:
+    """Top of the triangles over each grid node ``(len(x), len(y))`` (-inf where none):
+    a vertical ray from above, exact on the triangles."""
+    tri = np.asarray(triangles, dtype=float)
+    top = np.full((len(x), len(y)), -np.inf)
+    h = (x[1] - x[0]) if len(x) > 1 else 1.0
+    lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
+    i0 = np.searchsorted(x, lo[:, 0] - 1e-12, "left")
+    i1 = np.searchsorted(x, hi[:, 0] + 1e-12, "right")
+    j0 = np.searchsorted(y, lo[:, 1] - 1e-12, "left")
+    j1 = np.searchsorted(y, hi[:, 1] + 1e-12, "right")
+    ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
+    counts = ni * nj
+    del h
+    edges = np.r_[0, np.cumsum(counts)]
+    starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
+    for s0, s1 in zip(starts[:-1], starts[1:]):
+        if s1 <= s0:
+            continue
+        ids = np.arange(s0, min(s1, len(counts)))
+        c = counts[ids]
+        t = np.repeat(ids, c)
+        local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
+        ii = i0[t] + local // np.maximum(nj[t], 1)
+        jj = j0[t] + local % np.maximum(nj[t], 1)
+        px, py = x[ii], y[jj]
+        A, B, C = tri[t, 0], tri[t, 1], tri[t, 2]
+        v0, v1 = B - A, C - A
+        den = v0[:, 0] * v1[:, 1] - v1[:, 0] * v0[:, 1]
+        good = np.abs(den) > 1e-300
+        den = np.where(good, den, 1.0)
+        wx, wy = px - A[:, 0], py - A[:, 1]
+        l1 = (wx * v1[:, 1] - v1[:, 0] * wy) / den
+        l2 = (v0[:, 0] * wy - wx * v0[:, 1]) / den
+        slack = 1e-12
+        inside = good & (l1 >= -slack) & (l2 >= -slack) & (l1 + l2 <= 1 + slack)
+        z = A[:, 2] + l1 * v0[:, 2] + l2 * v1[:, 2]
+        np.maximum.at(top, (ii[inside], jj[inside]), z[inside])
+    return top
+
+
+def _disc_offsets(cutter: Cutter, h: float):
+    n = int(math.floor(cutter.radius / h))
+    di, dj = np.mgrid[-n:n + 1, -n:n + 1]
+    d = h * np.hypot(di, dj)
+    keep = d <= cutter.radius
+    return di[keep], dj[keep], cutter.profile(d[keep])
+
+
+def _shifted(a: np.ndarray, di: int, dj: int, fill: float) -> np.ndarray:
+    """``a`` read at (i + di, j + dj), ``fill`` outside."""
+    out = np.full_like(a, fill)
+    nx, ny = a.shape
+    si = slice(max(di, 0), nx + min(di, 0))
+    sj = slice(max(dj, 0), ny + min(dj, 0))
+    ti = slice(max(-di, 0), nx + min(-di, 0))
+    tj = slice(max(-dj, 0), ny + min(-dj, 0))
+    out[ti, tj] = a[si, sj]
+    return out
+
+
+def cutter_locations(top: np.ndarray, cutter: Cutter, h: float) -> np.ndarray:
+    """Drop-cutter tip heights on the grid against the height field ``top`` (the dilation
+    of the part's subgraph by the tool's lower surface, sampled on the same grid)."""
+    cl = np.full(top.shape, -np.inf)
+    for di, dj, f in zip(*_disc_offsets(cutter, h)):
+        np.maximum(cl, _shifted(top, int(di), int(dj), -np.inf) - f, out=cl)
+    return cl
+
+
+def reachable(top: np.ndarray, cutter: Cutter, h: float, cl: np.ndarray | None = None) -> np.ndarray:
+    """The surface the tool can reach: the opening of the part's height field ``top`` by
+    the tool's lower surface (lowest tool surface over each node among all tool positions
+    resting on the part).  ``reachable - top`` is the rest the tool cannot cut."""
+    cl = cutter_locations(top, cutter, h) if cl is None else cl
+    out = np.full(top.shape, np.inf)
+    for di, dj, f in zip(*_disc_offsets(cutter, h)):
+        np.minimum(out, _shifted(cl, int(di), int(dj), np.inf) + f, out=out)
+    return out
+
+
+def normal_residual(top: np.ndarray, surface: np.ndarray, h: float) -> np.ndarray:
+    """Stock above ``surface`` measured along the surface's normal (vertical residual
+    times cos of the slope, from central differences), NaN where either is undefined."""
+    gx, gy = np.gradient(np.where(np.isfinite(surface), surface, np.nan), h)
+    res = (top - surface) / np.sqrt(1 + gx * gx + gy * gy)
+    return np.where(np.isfinite(res), res, np.nan)

@@ -1,0 +1,125 @@
+"""The README and the documentation site agree with the code and with CI.
+
+The site's generated parts (API reference, command-line reference, package map, the named
+tolerances) come from ``docs/_ext/generated.py``; these tests run that generator without
+Sphinx, so a broken page fails the default suite, not only the docs build.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+import sys
+from pathlib import Path
+
+import surfmod
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = ROOT / "docs"
+
+
+def _generated():
+    sys.path.insert(0, str(DOCS))
+    try:
+        return importlib.import_module("_ext.generated")
+    finally:
+        sys.path.remove(str(DOCS))
+
+
+def test_api_reference_documents_every_public_name_once():
+    rst = _generated().api_rst()
+    documented = re.findall(r"^\.\. auto(?:class|function):: (\w+)$", rst, flags=re.M)
+    assert sorted(documented) == sorted(surfmod.__all__)
+
+
+def test_cli_reference_lists_every_subcommand_and_flag():
+    from surfmod.cli import build_parser
+
+    md = _generated().cli_md()
+    sub = next(a for a in build_parser()._actions if a.__class__.__name__ == "_SubParsersAction")
+    for name, parser in sub.choices.items():
+        assert f"### `surfmod {name}`" in md
+        for action in parser._actions:
+            for flag in action.option_strings:
+                if flag not in ("-h", "--help"):
+                    assert f"`{flag}" in md or f", {flag}" in md, (name, flag)
+
+
+def test_package_map_names_every_subpackage():
+    md = _generated().package_map_md()
+    for init in (ROOT / "surfmod").glob("*/__init__.py"):
+        assert f"| `{init.parent.name}/` |" in md
+
+
+def test_named_tolerances_table_reads_the_module():
+    from surfmod import tolerances
+
+    md = _generated().tolerances_md()
+    assert f"| `EXACT_RTOL` | {tolerances.EXACT_RTOL:g} |" in md
+
+
+def test_readme_is_short_and_gives_the_commands_ci_runs():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    assert len(readme.splitlines()) <= 200
+    for command in ('pip install -e ".[test,bench]" && surfmod gallery out/', "python -m pytest -q"):
+        assert command in readme and command in ci
+    assert "../shared" not in readme
+
+
+def test_readme_links_point_at_files_of_the_repository():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    targets = re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", readme)
+    assert targets
+    missing = [t for t in targets if not t.startswith("http") and not (ROOT / t).exists()]
+    assert not missing, missing
+
+
+def test_benchmark_tables_print_markdown(capsys):
+    from benchmarks import tables
+
+    table = tables.Table(("net", 9), ("max |dv|", 8), ("note", 6, "<"))
+    try:
+        tables.MARKDOWN = True
+        table.header()
+        table.row("4x4", "1e-16", "ok")
+    finally:
+        tables.MARKDOWN = False
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines == ["| net | max \\|dv\\| | note |", "|---:|---:|---|", "| 4x4 | 1e-16 | ok |"]
+
+
+def test_design_page_rank_table_is_the_layering_tests():
+    import test_layering
+
+    md = _generated().rank_table_md()
+    for rank, names in enumerate(test_layering.RANKS):
+        assert f"| {rank} | " + ", ".join(f"`{n}`" for n in names) + " |" in md
+
+
+def _pages():
+    return [ROOT / "README.md", *sorted(DOCS.glob("*.md")), *sorted((DOCS / "guide").glob("*.md"))]
+
+
+def test_pages_name_only_modules_and_functions_that_exist():
+    # a module moved or renamed must take its mentions in the manual with it
+    missing = []
+    for page in _pages():
+        text = page.read_text(encoding="utf-8")
+        for path in set(re.findall(r"surfmod/[a-z_/]+\.py", text)):
+            if not (ROOT / path).exists():
+                missing.append(f"{page.name}: {path}")
+        for dotted in set(re.findall(r"\bsurfmod(?:\.[A-Za-z_]+)+", text)):
+            parts = dotted.split(".")
+            for cut in range(len(parts), 0, -1):
+                base = ROOT.joinpath(*parts[:cut])
+                source = base.with_suffix(".py") if base.with_suffix(".py").exists() else base / "__init__.py"
+                if source.exists():
+                    rest = parts[cut:]
+                    if rest and not re.search(rf"^\s*(?:def|class) {rest[0]}\b|^{rest[0]}\s*[:=]",
+                                              source.read_text(encoding="utf-8"), flags=re.M):
+                        missing.append(f"{page.name}: {dotted}")
+                    break
+            else:
+                missing.append(f"{page.name}: {dotted}")
+    assert not missing, missing
