@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 from .roughing import FEED, PLUNGE, RAPID, RAMP_ANGLE, Motion, offset_tool, rough
 from .tool import Tool
 from .toolpath import _part, toolpath
