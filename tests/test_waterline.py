@@ -1,0 +1,197 @@
+"""Waterline contours (surfmod/cam/waterline.py): exact offsets of a plate, a tilted
+plate and a pyramid for flat, ball and bull ends (textbook distances), loops closed and
+oriented, the work bounded, bad input refused; then OpenCAMLib's ``Waterline`` on a
+corpus part: every point OCL puts on its loops lies on ours within 1e-6 of the part's
+size (OCL's weave leaves rare spikes off the contour; those are shown to be off it by
+OCL's own drop-cutter)."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from ocl_reference import drop as ocl_drop
+from ocl_reference import polyline_distance
+from ocl_reference import waterline as ocl_waterline
+
+from surfmod.cam.waterline import waterline
+from surfmod.errors import SurfmodError
+
+CORPUS_PART = "trimesh_featuretype.STEP"
+
+
+def tool(kind, R, r=0.0):
+    return SimpleNamespace(kind=kind, radius=R, corner_radius=r)
+
+
+def radius_at(kind, R, r, h):
+    """Textbook radius of the tool's profile at height h above the tip."""
+    if kind == "flat" or h >= (R if kind == "ball" else r):
+        return R
+    if kind == "ball":
+        return math.sqrt(R * R - (R - h) ** 2)
+    return R - r + math.sqrt(r * r - (r - h) ** 2)
+
+
+def square(size=10.0, z=0.0):
+    s = size
+    return np.array([[[0, 0, z], [s, 0, z], [s, s, z]], [[0, 0, z], [s, s, z], [0, s, z]]], float)
+
+
+def box_distance(xy, lo, hi):
+    dx = np.maximum(np.maximum(lo[0] - xy[:, 0], xy[:, 0] - hi[0]), 0)
+    dy = np.maximum(np.maximum(lo[1] - xy[:, 1], xy[:, 1] - hi[1]), 0)
+    return np.hypot(dx, dy)
+
+
+def signed_area(loop):
+    x, y = loop[:, 0], loop[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+@pytest.mark.parametrize("kind, R, r", [("flat", 1.0, 0.0), ("ball", 1.0, 0.0), ("bull", 1.5, 0.5)])
+@pytest.mark.parametrize("h", [0.05, 0.2, 0.45, 2.0])
+def test_plate_offset_is_the_profile_radius(kind, R, r, h):
+    """A level square plate h above the tip: the contour is the square grown by the
+    tool's radius at height h, corners rounded, counter-clockwise."""
+    (loop,), = waterline(square(), tool(kind, R, r), [-h])
+    rho = radius_at(kind, R, r, h)
+    d = box_distance(loop[:, :2], (0, 0), (10, 10))
+    assert np.abs(d - rho).max() < 1e-12
+    assert np.all(loop[:, 2] == -h)
+    # the rounded square's area, up to the chords' shortfall on the corner arcs
+    exact = 100 + 40 * rho + math.pi * rho * rho
+    assert signed_area(loop[:, :2]) == pytest.approx(exact, rel=1e-5)
+    assert signed_area(loop[:, :2]) < exact
+
+
+def test_plate_above_the_tool_is_not_seen_and_below_it_is_the_shank():
+    """Above the plate's height nothing is cut; far below it the shank (radius R) meets it."""
+    assert waterline(square(), tool("ball", 1.0), [0.1]) == [[]]
+    (loop,), = waterline(square(), tool("ball", 1.0), [-50.0])
+    assert np.abs(box_distance(loop[:, :2], (0, 0), (10, 10)) - 1.0).max() < 1e-12
+
+
+@pytest.mark.parametrize("kind, R, r", [("flat", 2.0, 0.0), ("ball", 2.0, 0.0), ("bull", 2.0, 0.7)])
+def test_tilted_plate_facet_contact(kind, R, r):
+    """A plane z = s·x (slope s, unit normal n): on the downhill side (x < 0 edge far away)
+    the contour is where the tool's support point along -n touches the plane: the line
+    x = x*(z) from the textbook contact of each profile."""
+    s = 0.5
+    big = 40.0
+    tri = np.array([[[-big, -big, -s * big], [big, -big, s * big], [big, big, s * big]],
+                    [[-big, -big, -s * big], [big, big, s * big], [-big, big, -s * big]]])
+    z = 0.0
+    (loop,), = waterline(tri, tool(kind, R, r), [z], sampling=0.5)
+    n = np.array([-s, 0.0, 1.0]) / math.hypot(s, 1.0)
+    # tip at (x, 0, z); support point along -n: ball: centre - R n; flat: rim uphill; bull: both
+    if kind == "ball":
+        off = np.array([0.0, 0.0, R]) - R * n
+    elif kind == "flat":
+        off = np.array([R, 0.0, 0.0])
+    else:
+        off = np.array([R - r, 0.0, r]) - r * n
+    # the support point on the plane: z + off_z = s (x + off_x)
+    x_star = (z + off[2]) / s - off[0]
+    mid = np.abs(loop[:, 1]) < big / 2
+    left = loop[mid & (loop[:, 0] < 0), 0] if x_star < 0 else loop[mid & (loop[:, 0] < big / 2), 0]
+    assert np.abs(left - x_star).min() < 1e-9
+    assert np.abs(left - x_star).max() < 1e-9
+
+
+def test_pyramid_edge_contact_ball():
+    """A square pyramid (apex up): at a tip height the ball's contour on a diagonal lies at
+    the textbook distance from the edge line (sphere centre at R from the edge)."""
+    a, top = 10.0, 8.0
+    base = np.array([[-a, -a, 0], [a, -a, 0], [a, a, 0], [-a, a, 0]], float)
+    apex = np.array([0.0, 0.0, top])
+    tri = np.array([[base[k], base[(k + 1) % 4], apex] for k in range(4)])
+    R, z = 1.5, 3.0
+    (loop,), = waterline(tri, tool("ball", R), [z], sampling=0.4, tolerance=1e-9)
+    # on the diagonal direction u = (1, 1)/√2, the ball's centre (t u, z + R) at distance R
+    # from the edge line apex -> base corner (a, a, 0)
+    e = np.array([a, a, -top]) / np.linalg.norm([a, a, -top])
+    u = np.array([1.0, 1.0]) / math.sqrt(2)
+    along = loop[:, :2] @ u
+    across = loop[:, :2] @ np.array([-u[1], u[0]])
+    k = np.argmin(np.abs(across) + (along < 0) * 1e9)
+    t = along[k]
+    c = np.array([t * u[0], t * u[1], z + R]) - apex
+    dist = np.linalg.norm(c - (c @ e) * e)
+    assert abs(across[k]) < 0.05 and dist == pytest.approx(R, abs=1e-7)
+
+
+def test_loops_are_closed_oriented_and_nested():
+    """A frame (a square ring): an outer loop counter-clockwise round the material and an
+    inner loop clockwise (the material on the left of travel), both at the textbook offset."""
+    outer, inner = square(20.0), square(10.0)
+    inner[..., :2] += 5
+    # the ring as 8 triangles between the two squares
+    o = np.array([[0, 0], [20, 0], [20, 20], [0, 20]], float)
+    i = o / 2 + 5
+    tri = []
+    for k in range(4):
+        a, b, c, d = o[k], o[(k + 1) % 4], i[(k + 1) % 4], i[k]
+        tri += [[[*a, 0], [*b, 0], [*c, 0]], [[*a, 0], [*c, 0], [*d, 0]]]
+    loops, = waterline(np.array(tri, float), tool("flat", 1.0), [0.0], sampling=0.3)
+    assert len(loops) == 2
+    areas = sorted(signed_area(lp[:, :2]) for lp in loops)
+    assert areas[0] == pytest.approx(-(8 * 8), abs=1e-6)  # the hole shrunk by R: square corners, met to the tolerance
+    assert areas[1] == pytest.approx(400 + 80 + math.pi, rel=1e-5)
+
+
+def test_bad_input_and_bounds():
+    with pytest.raises(SurfmodError, match="tool"):
+        waterline(square(), tool("drill", 1.0), [0.0])
+    with pytest.raises(SurfmodError, match="radius"):
+        waterline(square(), tool("ball", 0.0), [0.0])
+    with pytest.raises(SurfmodError, match="corner"):
+        waterline(square(), tool("bull", 1.0, 1.0), [0.0])
+    with pytest.raises(SurfmodError, match="part"):
+        waterline(np.zeros((3, 3)), tool("ball", 1.0), [0.0])
+    with pytest.raises(SurfmodError, match="z_levels"):
+        waterline(square(), tool("ball", 1.0), [np.nan])
+    with pytest.raises(SurfmodError, match="sampling"):
+        waterline(square(), tool("ball", 1.0), [0.0], sampling=-1)
+    with pytest.raises(SurfmodError, match="sampling"):  # the work estimate refuses before starting
+        waterline(square(1000.0), tool("ball", 1.0), np.zeros(50), sampling=1e-3)
+
+
+# --- OpenCAMLib ---------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def corpus_triangles(corpus_dir):
+    from surfmod.occ.triangulation import part_triangles
+    from surfmod.inputs import to_shape
+
+    tri, _ = part_triangles(to_shape(corpus_dir / CORPUS_PART), 0.05)
+    return tri
+
+
+@pytest.mark.parametrize("kind, R, r", [("ball", 3.0, 0.0), ("flat", 3.0, 0.0), ("bull", 3.0, 1.0)])
+def test_equals_opencamlib_waterline(tmp_path, corpus_triangles, kind, R, r):
+    tri = corpus_triangles
+    pts = tri.reshape(-1, 3)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    size = float((hi - lo).max())
+    z = float(lo[2] + 0.4 * (hi[2] - lo[2]))
+    sampling = 0.5
+    (ours,) = waterline(tri, tool(kind, R, r), [z], sampling=sampling)
+    theirs, _ = ocl_waterline(tmp_path, tri, kind, R, r, z, sampling)
+    real = [lp for lp in theirs if len(lp) >= 3]
+    assert len(ours) == len(real)
+    for lp in ours:
+        assert len(lp) >= 3 and np.all(lp[:, 2] == z)
+    pts_ocl = np.vstack(theirs)
+    d = polyline_distance(pts_ocl, ours)
+    off = d > 1e-6 * size
+    assert off.mean() < 0.01, f"{off.sum()} of {len(d)} OCL points off our contour"
+    if off.any():
+        # OCL's stray points are not on the contour: its own drop-cutter finds the tool
+        # clear of the part (tip able to go below z) at and round each of them
+        ring = pts_ocl[off, None, :2] + 0.2 * sampling * np.array(
+            [[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]])[None]
+        heights, _ = ocl_drop(tmp_path, tri, kind, R, r, ring.reshape(-1, 2), float(lo[2]) - 100)
+        assert np.all(heights < z - 1e-3)
