@@ -12,11 +12,15 @@ all-core times are wall times.  OCCT per-point rates
 ``gp_Vec``, no conversion) are measured on 100² points through OCP and scaled to the point
 count.  The memory-write floor is the time to allocate and fill the output array
 ("fresh"), or to fill an array that already exists ("reused"), and, for comparison, a
-compiled loop that only writes every double of the reused array, with ordinary and with
-non-temporal stores (surfmod streams grids of partials to order 2 into a caller's array
-of 16 MiB and more, :mod:`surfmod.eval.streaming`); the "into" rows write
+compiled loop that only writes every double of the reused array; the "into" rows write
 into a preallocated array with ``BSplineSurface.grid_into`` (as OCCT's side writes into
 preallocated points), the others allocate their result.
+
+Start-up (issue 23) is measured in fresh processes (:func:`cold_start`): the README's
+first example (a 5x4 net: ``grid``, ``points``, ``derivatives``, ``normals``,
+``curvatures``, import included) with ``NUMBA_CACHE_DIR`` pointed at an empty folder and
+again with the cache that run filled, and the first against the second call of
+``tessellate``, ``project`` and ``mass_properties`` in one process.
 
 ``python -m benchmarks eval``
 """
@@ -27,13 +31,13 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 import tracemalloc
 
 import numpy as np
 
 import surfmod as sm
-from surfmod.eval.streaming import aligned_16, fence, stream_pair
 from surfmod.gallery.synthetic import wavy_net
 
 from .tables import Table, heading, note
@@ -138,27 +142,6 @@ def numba_write_floor():
     return njit(_write_every)
 
 
-def _stream_every(out):
-    flat = out.reshape(-1)
-    start = 0 if aligned_16(flat, 0) else 1
-    if start:
-        flat[0] = 0.0
-    for i in range(start, flat.size - 1, 2):
-        stream_pair(flat, i, float(i), float(i + 1))
-    if (flat.size - start) % 2:
-        flat[flat.size - 1] = 0.0
-    fence()
-
-
-def numba_stream_floor():
-    """:func:`numba_write_floor` with non-temporal 16-byte stores
-    (:mod:`surfmod.eval.streaming`), as surfmod writes large grids of partials to order 2:
-    no read for ownership, so about half the memory traffic."""
-    from numba import njit
-
-    return njit(_stream_every)
-
-
 def measure(single: bool) -> dict:
     """Every timing of the tables, in seconds, for this process's thread setting."""
     out = {"net": {}, "rows": {}}
@@ -194,9 +177,6 @@ def measure(single: bool) -> dict:
     write = numba_write_floor()
     write(buf2[:1])
     rows["floor_d2_numba"] = _time(lambda: write(buf2), single, 5)
-    stream = numba_stream_floor()
-    stream(buf2[:1])
-    rows["floor_d2_stream"] = _time(lambda: stream(buf2), single, 5)
     rows["floor_d0_numba"] = _time(lambda: write(buf), single, 5)
     del buf2
     rng = np.random.default_rng(3)
@@ -219,20 +199,16 @@ def measure(single: bool) -> dict:
 
 
 def numpy_paths(grid, u, v) -> dict:
-    """The pure-NumPy evaluators of the first round (dense basis matrices and two GEMMs
-    for grids, cache-blocked gathers for scattered points, NumPy quotient rule), timed
-    on the same cases as the compiled local-support kernels that replaced them."""
-    from surfmod.eval.rational import surface_quotient
-    from surfmod.eval.tensor import rational_grid_positions, surface_derivatives
+    """The NumPy local-support paths (:mod:`surfmod.eval.vectorized`, which small work
+    takes), timed on the large cases the compiled kernels take, for comparison."""
+    from surfmod.eval import vectorized
 
     res = {}
     for n in (20, 400):
-        s = nurbs(n)
-        (p, q), (ku, kv) = s.degree, s.knots
-        res[f"grid{n}"] = _time(lambda: rational_grid_positions(ku, p, kv, q, s._homogeneous, grid, grid), True, 2)
-    s = nurbs(20)
-    (p, q), (ku, kv) = s.degree, s.knots
-    res["scattered"] = _time(lambda: surface_quotient(surface_derivatives(ku, p, kv, q, s._homogeneous, u, v, 0)), True, 1)
+        net = nurbs(n)._local_net()
+        res[f"grid{n}"] = _time(lambda: vectorized.grid(*net[:4], net.ctrl, True, grid, grid, 0), True, 2)
+    net = nurbs(20)._local_net()
+    res["scattered"] = _time(lambda: vectorized.scattered(*net[:4], net.ctrl, True, u, v, 0), True, 1)
     return res
 
 
@@ -261,6 +237,84 @@ def memory(grid_n: int = 10_000, scattered_n: int = 10**7, chunk: int = 1 << 20)
                         scattered_n * 24 / 2**20)
     tracemalloc.stop()
     return res
+
+
+#: the README's first example, in a fresh process: seconds from before the import to the end
+README_FIRST = """
+import time
+t0 = time.perf_counter()
+import numpy as np, surfmod as sm
+x, y = np.meshgrid(np.linspace(0, 30, 5), np.linspace(0, 20, 4), indexing="ij")
+net = np.stack([x, y, 3 * np.sin(x / 8) * np.cos(y / 6)], axis=-1)
+s = sm.BSplineSurface(net, degree=(3, 2), weights=np.ones((5, 4)))
+u, v = np.linspace(0, 1, 200), np.linspace(0, 1, 100)
+s.grid(u, v)
+s.points(0.3, 0.6)
+s.derivatives(0.3, 0.6, 2)
+s.normals(u[:50], v[:50])
+s.curvatures(u[:50], v[:50])
+print(time.perf_counter() - t0)
+"""
+
+#: first and second call of a process (two different objects, so nothing is reused)
+FIRST_SECOND = """
+import sys, time
+import numpy as np, surfmod as sm, build123d as bd
+from surfmod.gallery.synthetic import wavy_net
+rng = np.random.default_rng(1)
+pts = np.c_[rng.uniform(0, 10, 500), rng.uniform(0, 8, 500), rng.uniform(-1, 2, 500)]
+calls = {
+    "tessellate": lambda k: sm.tessellate(sm.BSplineSurface(wavy_net(8, 8, 0.6 - 0.1 * k), (3, 3)), 0.05),
+    "project": lambda k: sm.project(pts, sm.BSplineSurface(wavy_net(8, 8, 0.6 - 0.1 * k), (3, 3)), progress=False),
+    "mass_properties": lambda k: sm.mass_properties(bd.Sphere(1 + k) - bd.Box(1, 1, 1)),
+}
+times = []
+for k in range(2):
+    t = time.perf_counter()
+    calls[sys.argv[1]](k)
+    times.append(time.perf_counter() - t)
+print(*times)
+"""
+
+
+def _fresh(script: str, cache: str, *args) -> list[float]:
+    """Run ``script`` in a fresh one-core process with numba's cache in ``cache``; its
+    last line of output as floats."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    for var in THREAD_VARS:
+        env[var] = "1"
+    done = subprocess.run([sys.executable, "-c", script, *args], env=env, capture_output=True, text=True, check=True)
+    return [float(x) for x in done.stdout.strip().splitlines()[-1].split()]
+
+
+def cold_start() -> dict:
+    """Start-up costs in fresh processes (wall seconds, one core): the README's first
+    example into an empty numba cache and then with that cache filled; the first and
+    second call of tessellate, project and mass_properties, cold and warm."""
+    out = {}
+    with tempfile.TemporaryDirectory() as cache:
+        out["readme_cold"] = _fresh(README_FIRST, cache)[0]
+        out["readme_warm"] = min(_fresh(README_FIRST, cache)[0] for _ in range(3))
+        for name in ("tessellate", "project", "mass_properties"):
+            out[f"{name}_cold"] = _fresh(FIRST_SECOND, cache, name)
+            out[f"{name}_warm"] = min(_fresh(FIRST_SECOND, cache, name) for _ in range(2))
+    return out
+
+
+def report_cold_start(r: dict) -> None:
+    heading("start-up in fresh processes (wall seconds, 1 core; the targets of issue 23)")
+    table = Table(("case", 44, "<"), ("first", 8), ("second", 8), ("first - second", 15), ("target", 24, "<"))
+    table.header()
+    table.row("README first example, empty numba cache", f"{r['readme_cold']:.2f}", "—", "—", "<= 5 s")
+    table.row("README first example, warm cache", f"{r['readme_warm']:.2f}", "—", "—", "<= 1 s, import included")
+    for name in ("tessellate", "project", "mass_properties"):
+        for kind in ("cold", "warm"):
+            first, second = r[f"{name}_{kind}"]
+            table.row(f"{name}, {'empty' if kind == 'cold' else 'warm'} cache", f"{first:.3f}", f"{second:.3f}",
+                      f"{first - second:+.3f}", "<= +0.5 s")
+    note("README example: import, a 200x100 grid, points, derivatives, normals, curvatures of a 5x4 net;")
+    note("tessellate: a wavy 8x8 NURBS at 0.05; project: 500 points on it; mass_properties: sphere minus box.")
+    note()
 
 
 def _run_worker(single: bool) -> dict:
@@ -326,9 +380,7 @@ def report(one: dict, every: dict) -> None:
     note("floor = allocate and fill the output array (for the \"into\" rows: fill the reused array);")
     note("x floor = surfmod / floor (1 = at the floor).")
     note(f"a compiled loop that only writes the reused array: {_f(r['floor_d0_numba'])} (positions), "
-         f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2);")
-    note(f"  with non-temporal stores, as surfmod writes partials to 2 into arrays past 16 MiB: {_f(r['floor_d2_stream'])} "
-         f"({_x(d2_20 * GRID**2, r['floor_d2_stream'])} OCCT D2 at most)")
+         f"{_f(r['floor_d2_numba'])} (partials to 2: {_x(d2_20 * GRID**2, r['floor_d2_numba'])} OCCT D2).")
     note()
     heading("geomdl (pure Python, timed on 100², scaled to 1000²), polynomial bicubic:")
     table = Table(("net", 9), ("geomdl", 9), ("surfmod", 9), ("x geomdl", 10))
@@ -337,7 +389,7 @@ def report(one: dict, every: dict) -> None:
         table.row(f"{n}x{n}", _f(r[f"geomdl{n}"], ".1f"), _f(r[f"poly{n}"]), _x(r[f"geomdl{n}"], r[f"poly{n}"]))
     npy = r["numpy"]
     note()
-    heading("numba kernels vs the pure-NumPy paths they replaced (1 core, rational bicubic):")
+    heading("numba kernels vs the NumPy paths of small work (eval/vectorized.py; 1 core, rational bicubic):")
     table = Table(("case", 24), ("NumPy", 9), ("numba", 9), ("speed-up", 9), left_first=True)
     table.header()
     table.row("1000² grid, 20x20 net", _f(npy["grid20"]), _f(one["net"]["20"]["ours"]),
@@ -354,6 +406,7 @@ def report(one: dict, every: dict) -> None:
 
 
 def main() -> None:
+    report_cold_start(cold_start())
     one, every = _run_worker(True), _run_worker(False)
     report(one, every)
 
@@ -361,5 +414,7 @@ def main() -> None:
 if __name__ == "__main__":
     if len(sys.argv) > 2 and sys.argv[1] == "--worker":
         print(json.dumps(measure(sys.argv[2] == "single")))
+    elif sys.argv[1:] == ["--cold"]:  # the start-up rows only
+        report_cold_start(cold_start())
     else:
         main()

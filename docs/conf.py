@@ -12,7 +12,6 @@ generated from the ``surfmod`` argument parser itself.
 
 from __future__ import annotations
 
-import inspect
 import sys
 from pathlib import Path
 
@@ -21,8 +20,6 @@ sys.path.insert(0, str(HERE.parent))  # the checkout's surfmod, also without an 
 sys.path.insert(0, str(HERE))
 
 import surfmod  # noqa: E402
-
-from _ext import api_groups  # noqa: E402
 
 project = "surfmod"
 author = "the surfmod developers"
@@ -58,6 +55,3 @@ html_theme = "furo"
 html_title = f"surfmod {release}"
 html_static_path = []
 
-# the groups of the API page; a public name in no group is listed under "Other public names"
-API_GROUPS = api_groups.GROUPS
-del inspect

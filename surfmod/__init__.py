@@ -14,6 +14,7 @@ from __future__ import annotations
 import importlib
 
 from .errors import DamagedFileError, KernelError, MissingExtraError, SurfmodError
+from .pictures import install as _install_renderer
 from .version import installed_version
 
 # public name -> module that defines it (relative to this package)
@@ -153,6 +154,15 @@ def __getattr__(name: str):
     value = getattr(importlib.import_module(module, __name__), name)
     globals()[name] = value
     return value
+
+
+def _repr_png(obj):
+    # the renderer ranks above the surfaces it draws; this package, at the top, hands it to
+    # them through surfmod.pictures, loaded (with matplotlib) on the first picture only
+    return importlib.import_module(".meshing.render", __name__).repr_png(obj)
+
+
+_install_renderer(_repr_png)
 
 
 def __dir__():

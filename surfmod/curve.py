@@ -11,7 +11,7 @@ import abc
 
 import numpy as np
 
-from . import checks
+from . import checks, pictures
 from .errors import SurfmodError
 from .immutable import Immutable
 from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
@@ -114,10 +114,7 @@ class Curve(Immutable, abc.ABC):
 
     def _repr_png_(self) -> bytes | None:
         """A picture for Jupyter: the curve as a line (see :func:`surfmod.meshing.render.png_bytes`)."""
-        # cycle: surfmod.curve <-> surfmod.meshing.render (the picture samples curves)
-        from .meshing.render import repr_png
-
-        return repr_png(self)
+        return pictures.repr_png(self)
 
     @property
     def breaks(self) -> np.ndarray:

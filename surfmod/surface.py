@@ -12,7 +12,7 @@ import abc
 
 import numpy as np
 
-from . import checks, tolerances
+from . import checks, pictures, tolerances
 from .errors import SurfmodError
 from .eval.differential import Curvatures, curvatures, degenerate_mask, unit_normals
 from .immutable import Immutable
@@ -277,10 +277,7 @@ class Surface(Immutable, abc.ABC):
 
     def _repr_png_(self) -> bytes | None:
         """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
-        # cycle: surfmod.surface <-> surfmod.meshing.render (the picture tessellates surfaces)
-        from .meshing.render import repr_png
-
-        return repr_png(self)
+        return pictures.repr_png(self)
 
     # -- named transforms (all through ``transformed``) ----------------------------------
     def translated(self, vector) -> "Surface":

@@ -95,3 +95,31 @@ def test_design_page_rank_table_is_the_layering_tests():
     md = _generated().rank_table_md()
     for rank, names in enumerate(test_layering.RANKS):
         assert f"| {rank} | " + ", ".join(f"`{n}`" for n in names) + " |" in md
+
+
+def _pages():
+    return [ROOT / "README.md", *sorted(DOCS.glob("*.md")), *sorted((DOCS / "guide").glob("*.md"))]
+
+
+def test_pages_name_only_modules_and_functions_that_exist():
+    # a module moved or renamed must take its mentions in the manual with it
+    missing = []
+    for page in _pages():
+        text = page.read_text(encoding="utf-8")
+        for path in set(re.findall(r"surfmod/[a-z_/]+\.py", text)):
+            if not (ROOT / path).exists():
+                missing.append(f"{page.name}: {path}")
+        for dotted in set(re.findall(r"\bsurfmod(?:\.[A-Za-z_]+)+", text)):
+            parts = dotted.split(".")
+            for cut in range(len(parts), 0, -1):
+                base = ROOT.joinpath(*parts[:cut])
+                source = base.with_suffix(".py") if base.with_suffix(".py").exists() else base / "__init__.py"
+                if source.exists():
+                    rest = parts[cut:]
+                    if rest and not re.search(rf"^\s*(?:def|class) {rest[0]}\b|^{rest[0]}\s*[:=]",
+                                              source.read_text(encoding="utf-8"), flags=re.M):
+                        missing.append(f"{page.name}: {dotted}")
+                    break
+            else:
+                missing.append(f"{page.name}: {dotted}")
+    assert not missing, missing

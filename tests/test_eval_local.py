@@ -12,10 +12,12 @@ import pytest
 from hypothesis import given, settings
 
 import reference as ref
+from dense_eval import surface_grid
 import surfmod as sm
 from strategies import bspline_surfaces, parameters_with_knots
 from surfmod.eval import kernels, local
 from surfmod.eval.basis import find_spans
+from surfmod.eval.rational import surface_quotient
 from surfmod.nets.knots import smooth_mask
 from surfmod.occ.sample import surface_d2
 
@@ -239,10 +241,8 @@ def test_empty_inputs():
 @settings(max_examples=25, deadline=None)
 @given(s=bspline_surfaces())
 def test_local_kernels_equal_the_dense_blas_path(s):
-    """An independent algorithm: dense basis matrices and two GEMMs (eval/tensor.py) with
-    the NumPy quotient rule (eval/rational.py)."""
-    from surfmod.eval.rational import surface_quotient
-    from surfmod.eval.tensor import surface_grid
+    """An independent algorithm: dense basis matrices and two GEMMs (tests/dense_eval.py)
+    with the NumPy quotient rule (eval/rational.py)."""
 
     us, vs = parameters_with_knots(s, 6)
     (p, q), (ku, kv) = s.degree, s.knots

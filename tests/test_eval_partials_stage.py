@@ -1,6 +1,6 @@
 """The grid's stage for partials to order 2 (surfmod/eval/partials_stage.py): equal to
-the general stage to rounding for every degree, chunk tail, alignment and v-offset,
-streamed or not; and through the public API on a grid large enough to stream."""
+the general stage to rounding for every degree, chunk tail, alignment and v-offset; and
+through the public API on grids of one and two v-blocks."""
 
 import numpy as np
 import pytest
@@ -40,79 +40,53 @@ def _general(bu, first, p, w, rational, b0, shape):
 @pytest.mark.parametrize("p", [1, 2, 3, 4, 5])
 @pytest.mark.parametrize("rational", [False, True])
 @pytest.mark.parametrize("nv", [1, 2, CHUNK - 1, CHUNK, 2 * CHUNK + 3])
-def test_stage_equals_the_general_path_streamed_or_not(p, rational, nv):
+def test_stage_equals_the_general_path(p, rational, nv):
     rng = np.random.default_rng(100 * p + nv + rational)
     w, bu, first = _table(rng, p, rational, 3, nv)
     for b0 in (0, 1, 2):  # the rows start on, and 8 bytes past, a 16-byte boundary
         shape = (3, nv + b0 + 1, 3, 3, 3)
         expected = _general(bu, first, p, w, rational, b0, shape)
-        got = {}
-        for stream in (False, True):
-            out = np.full(shape, np.nan)
-            order2_block(bu, first, p, w, rational, b0, out, stream)
-            got[stream] = out
-        np.testing.assert_array_equal(got[True], got[False])  # the same values, only stored differently
+        got = np.full(shape, np.nan)
+        order2_block(bu, first, p, w, rational, b0, got)
         # points outside [b0, b0 + nv) are untouched; inside, the general path's values
         # to rounding (fused multiply-adds; a few ulps after the quotient rule's differences)
-        assert np.isnan(got[True][:, :b0]).all() and np.isnan(got[True][:, b0 + nv:]).all()
-        _assert_within(got[True][:, b0 : b0 + nv], expected[:, b0 : b0 + nv], 5e-14)
+        assert np.isnan(got[:, :b0]).all() and np.isnan(got[:, b0 + nv:]).all()
+        _assert_within(got[:, b0 : b0 + nv], expected[:, b0 : b0 + nv], 5e-14)
 
 
-@pytest.mark.parametrize("nu", [1, 2, 5])
-def test_pipelined_columns_equal_the_plain_chunks(nu):
-    """Streamed rational chunks overlap their stores with the next u-point's quotient
-    rule (column by column, two sets of planes): for one u-point (only the last flush),
-    two, and an odd count, whole chunks and a partial one, the plain path's values."""
-    rng = np.random.default_rng(nu)
-    nv = 3 * CHUNK + 5
-    w, bu, first = _table(rng, 3, True, nu, nv)
-    shape = (nu, nv + 1, 3, 3, 3)  # rows of an even number of points: every row 16-byte aligned
-    streamed, plain = np.full(shape, np.nan), np.full(shape, np.nan)
-    order2_block(bu, first, 3, w, True, 0, streamed, True)
-    order2_block(bu, first, 3, w, True, 0, plain, False)
-    np.testing.assert_array_equal(streamed, plain)
-    assert np.isnan(streamed[:, nv:]).all()
-    _assert_within(streamed[:, :nv], _general(bu, first, 3, w, True, 0, shape)[:, :nv], 5e-14)
-
-
-def test_an_empty_block_is_streamed_as_nothing():
-    """A block of no u-points (the overlapped path starts from u-point 0) leaves the
-    rest of the array alone."""
+def test_an_empty_block_writes_nothing():
     w, bu, first = _table(np.random.default_rng(3), 3, True, 0, 2 * CHUNK)
     out = np.full((2, 2 * CHUNK, 3, 3, 3), np.nan)
-    order2_block(bu, first, 3, w, True, 0, out[:0], True)
+    order2_block(bu, first, 3, w, True, 0, out[:0])
     assert np.isnan(out).all()
 
 
 def test_stage_writes_a_misaligned_array():
     """A caller's array whose rows start 8 bytes past a 16-byte boundary (a view one
-    double into a buffer) is written from its first 16-byte boundary on, the same values."""
+    double into a buffer) gets the same values."""
     rng = np.random.default_rng(5)
     w, bu, first = _table(rng, 3, True, 4, 2 * CHUNK + 1)
     buffer = np.full(1 + 4 * w.shape[3] * 27, np.nan)
     shifted = buffer[1:].reshape(4, w.shape[3], 3, 3, 3)
     aligned = np.full(shifted.shape, np.nan)
-    order2_block(bu, first, 3, w, True, 0, shifted, True)
-    order2_block(bu, first, 3, w, True, 0, aligned, True)
+    order2_block(bu, first, 3, w, True, 0, shifted)
+    order2_block(bu, first, 3, w, True, 0, aligned)
     np.testing.assert_array_equal(shifted, aligned)
     assert np.isnan(buffer[0])
 
 
 @pytest.mark.parametrize("nu, nv", [(300, 300), (90, 1100), (80, 1101)])
-def test_a_streamed_grid_equals_the_plain_one_and_scattered_partials(monkeypatch, nu, nv):
-    """Partials to order 2 past ``STREAM_BYTES`` (19-21 MB; one v-block, or two with the
-    second starting at point 1024, rows of an even or an odd number of points: every row
-    16-byte aligned, or every other one): streamed into a caller's array they equal the
-    plain stores bit for bit, and the scattered kernel's partials (a different
-    algorithm) to 1e-13 of each partial's size."""
+def test_a_grid_into_a_callers_array_equals_the_grid_and_scattered_partials(nu, nv):
+    """Partials to order 2 of grids of one v-block or two (the second starting at point
+    1024; rows of an even or an odd number of points) through the compiled stage: into a
+    caller's array they equal ``grid_derivatives`` bit for bit, and the scattered
+    kernel's partials (a different algorithm) to 1e-13 of each partial's size."""
     rng = np.random.default_rng(11)
     s = sm.BSplineSurface(wavy_net(9, 8), (3, 2), weights=10 ** rng.uniform(-1, 1, (9, 8)))
     us, vs = np.linspace(0, 1, nu), np.sort(rng.uniform(0, 1, nv))
-    assert nu * nv * 27 * 8 >= local.STREAM_BYTES
-    streamed = s.grid_into(us, vs, np.empty((nu, nv, 3, 3, 3)), order=2)
-    monkeypatch.setattr(local, "STREAM_BYTES", 1 << 62)
-    plain = s.grid_into(us, vs, np.empty((nu, nv, 3, 3, 3)), order=2)
-    np.testing.assert_array_equal(streamed, plain)
+    assert nu * nv * 9 >= local.COMPILED_GRID  # the compiled stage, not NumPy
+    into = s.grid_into(us, vs, np.empty((nu, nv, 3, 3, 3)), order=2)
+    np.testing.assert_array_equal(into, s.grid_derivatives(us, vs, 2))
     uu, vv = np.meshgrid(us, vs, indexing="ij")
-    scattered = s.derivatives(uu.ravel(), vv.ravel(), 2).reshape(streamed.shape)
-    _assert_within(streamed, scattered, 1e-13)
+    scattered = s.derivatives(uu.ravel(), vv.ravel(), 2).reshape(into.shape)
+    _assert_within(into, scattered, 1e-13)

@@ -18,6 +18,16 @@ from surfmod.eval import grid_kernels, local, row_stage, sliding, threads
 from surfmod.occ.sample import surface_d2
 
 
+@pytest.fixture(autouse=True, scope="module")
+def compiled_kernels():
+    """These tests are of the compiled kernels: every call goes through them, however
+    small (by default small work is done in NumPy, eval/vectorized.py)."""
+    saved = local.COMPILED_SCATTERED, local.COMPILED_GRID
+    local.COMPILED_SCATTERED = local.COMPILED_GRID = 0
+    yield
+    local.COMPILED_SCATTERED, local.COMPILED_GRID = saved
+
+
 def _uniform_surface(n, m, p, q, rational, seed=0):
     """A net with uniform knots (so evenly spaced parameters fall one a span) and a
     wavy height."""

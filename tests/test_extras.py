@@ -49,7 +49,7 @@ def test_every_library_the_code_imports_is_declared():
 
 def test_every_hard_dependency_is_used():
     used = _third_party_imports()
-    # llvmlite: numba's own binding, imported by eval/streaming.py; OCP through build123d too
+    # every hard dependency is imported by surfmod itself (OCP through build123d too)
     assert HARD - used == set(), HARD - used
 
 

@@ -257,6 +257,96 @@ def operation_case(rng, tmp: Path):
     return "translated/scaled/mirrored", lambda: (s.translated(a[0]), s.scaled(a[2]), s.mirrored(a[0], a[1]))
 
 
+# -- tolerances, analytic projection, coincident surfaces ----------------------------------
+# tolerances far below the floor (1e-12 of the model size), around it, ordinary, huge and
+# not numbers: each must be refused with the argument's name or answered in bounded time
+TOLERANCES = [5e-324, 1e-300, 1e-20, 1e-15, 2e-12, 1e-11, 1e-6, 1e-3, 0.5, 1e3, 1e20, 1e300, math.nan, math.inf,
+              -math.inf, -1e-6, 0.0]
+#: the tolerances an operation runs with for real (not refused): those that bound slow work
+WORKING = [1e-6, 1e-3, 0.5]
+
+
+def _elementary_surfaces():
+    return [
+        sm.sphere(2.0, center=(1, 0, 0)),
+        sm.SphericalSurface(2.0, u_range=(0.5, 2.0), v_range=(-0.3, 0.9)),
+        sm.torus(3.0, 1.0, (0, 1, 0), (1, 0, 1)),
+        sm.ToroidalSurface(3.0, 1.0, u_range=(1, 2.5), v_range=(4, 7)),
+        sm.ConicalSurface(-0.4, 1.0, u_range=(2, 4), v_range=(-5, 1)),
+        sm.CylindricalSurface(2.0, u_range=(5, 8), v_range=(0, 1)),
+        sm.PlaneSurface((1, 2, 3), (0.3, 0.2, 1), u_range=(-2, 3), v_range=(-1, 2)),
+    ]
+
+
+ELEMENTARY = _elementary_surfaces()
+_rational = sm.BSplineSurface(np.random.default_rng(11).uniform(-1, 1, (5, 5, 3)) + np.stack(np.meshgrid(
+    np.arange(5.0), np.arange(5.0), [0.0], indexing="ij"), -1)[:, :, 0], (3, 3),
+    weights=np.random.default_rng(12).uniform(0.5, 2.0, (5, 5)))
+
+
+def _grid_points(n=8):
+    x, y = np.meshgrid(np.linspace(0, 2, n), np.linspace(0, 1, n), indexing="ij")
+    return np.stack([x, y, np.sin(x) * np.cos(2 * y)], -1)
+
+
+def tolerance_case(rng, tmp: Path):
+    k = rng.integers(16)
+    tol = TOLERANCES[rng.integers(len(TOLERANCES))]
+    if k == 0:  # 1e5 points onto an elementary surface: closed forms, never a search
+        s = ELEMENTARY[rng.integers(len(ELEMENTARY))]
+        pts = rng.uniform(-8, 8, (100_000, 3))
+        if rng.random() < 0.3:  # on the axis, at the centre
+            pts[: 1000] = 0.0
+        return f"project 1e5 onto {type(s).__name__}", lambda: sm.project(pts, s)
+    if k == 1:  # identical rational B-splines, any tolerance
+        return "intersect identical", lambda: sm.intersect(_rational, _rational, tol)
+    if k == 2:  # nearly identical: moved or one pole nudged by 1e-15 .. 1e-4
+        gap = float(10.0 ** rng.uniform(-15, -4))
+        b = _rational.translated((0, 0, gap)) if rng.random() < 0.5 else _nudged(_rational, gap)
+        t = tol if rng.random() < 0.5 else WORKING[rng.integers(len(WORKING))]
+        return "intersect nearly identical", lambda: sm.intersect(_rational, b, t)
+    s = SURFACES[rng.integers(len(SURFACES))]
+    if k == 3:
+        return "intersect plane tol", lambda: sm.intersect(s, ((0.1, 0.2, 0.3), (0.3, 0.1, 1.0)), tol)
+    if k == 4:
+        return "intersect_line tol", lambda: sm.intersect_line(s, (0.1, 0.2, 0.3), (0.3, 0.1, 1.0), tolerance=tol)
+    if k == 5:
+        return "tessellate tol", lambda: sm.tessellate(s, tol)
+    if k == 6:
+        return "export_stl tol", lambda: sm.export_stl(s, tmp / "t.stl", tolerance=tol)
+    if k == 7:
+        return "offset tol", lambda: sm.offset(_rational, 0.2, tol)
+    if k == 8:
+        pts = _grid_points().reshape(-1, 3)
+        return "fit tol", lambda: sm.fit(pts, tol)
+    if k == 9:
+        return "approximate tol", lambda: sm.approximate(_grid_points(), tolerance=tol)
+    if k == 10:
+        p = [sm.Line((0, y, 0), (3, y, 0)) for y in (0, 1, 2)]
+        g = [sm.Line((x, 0, 0), (x, 2, 0)) for x in (0, 1.5, 3)]
+        return "gordon tol", lambda: sm.gordon(p, g, tol)
+    if k == 11:
+        return "explicit tol", lambda: sm.explicit(lambda x, y: np.sin(x) * y, (0, 2), (0, 1), tol)
+    if k == 12:
+        return "superellipsoid tol", lambda: sm.superellipsoid(1.0, 1.5, 2.0, 0.5, 2.0, tolerance=tol)
+    if k == 13:
+        square = [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75), (0.25, 0.25)]
+        return "trim tol", lambda: sm.trim(sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0)), square, tolerance=tol)
+    if k == 14:
+        c = [sm.Line((0, 0, 0), (1, 0, 0)), sm.Line((0, 1, 0), (1, 1, 0)), sm.Line((0, 0, 0), (0, 1, 0)),
+             sm.Line((1, 0, 0), (1, 1, 0))]
+        return "coons tol", lambda: sm.coons(*c, tolerance=tol)
+    sides = [sm.Line((0, 0, 0), (1, 0, 0)), sm.Line((1, 0, 0), (1, 1, 0)), sm.Line((1, 1, 0), (0, 1, 0)),
+             sm.Line((0, 1, 0), (0, 0, 0))]
+    return "fill tol", lambda: sm.fill(sides, "G0", tolerance=tol)
+
+
+def _nudged(s, gap):
+    net = np.array(s.control_points, dtype=float)
+    net[2, 2, 2] += gap
+    return sm.BSplineSurface(net, s.degree, s.knots, s.weights)
+
+
 # -- checking -------------------------------------------------------------------------------
 def _finite(value) -> bool:
     if isinstance(value, np.ndarray):
@@ -313,15 +403,19 @@ def _report(failures, count, seed):
     return f"{len(failures)} of {count} cases broke the contract (seed {seed}):\n" + "\n".join(failures[:40])
 
 
-@pytest.mark.parametrize("group, count", [("constructors", 900), ("evaluation", 900), ("operations", 260)])
+GROUPS = [("constructors", 900), ("evaluation", 900), ("operations", 260), ("tolerances", 160)]
+
+
+@pytest.mark.parametrize("group, count", GROUPS)
 def test_api_fuzz(group, count, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # relative export paths land in the test's folder
     count *= SCALE
-    seed = SEED + ["constructors", "evaluation", "operations"].index(group)
+    seed = SEED + [g for g, _ in GROUPS].index(group)
     make = {
         "constructors": constructor_case,
         "evaluation": evaluation_case,
         "operations": lambda rng: operation_case(rng, tmp_path),
+        "tolerances": lambda rng: tolerance_case(rng, tmp_path),
     }[group]
     failures = run_cases(make, count, seed)
     assert not failures, _report(failures, count, seed)
@@ -329,7 +423,7 @@ def test_api_fuzz(group, count, tmp_path, monkeypatch):
 
 def test_fuzz_runs_at_least_2000_cases():
     """The CI run covers at least 2,000 API cases, the explore run at least 10,000."""
-    total = sum(c for _, c in [("constructors", 900), ("evaluation", 900), ("operations", 260)]) * SCALE
+    total = sum(c for _, c in GROUPS) * SCALE
     assert total >= (10_000 if EXPLORE else 2_000)
 
 

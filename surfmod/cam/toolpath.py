@@ -26,10 +26,10 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from .gcode import gcode_text
+from ..inputs import to_shape
 from ..meshing.render import Drawing, polyline_runs, repr_png
 from .drop_cutter import TriangleGrid, drop
-from ..inputs import to_shape
+from .gcode import gcode_text
 from .toolpath_exact import exact_heights
 from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep

@@ -32,6 +32,11 @@ def _note(result) -> str:
     parts = [f"{k} {v:.2e} > {lim:.1e}" for k, (v, lim) in details.get("failed", {}).items()]
     if not result.passed and not parts and "tolerance" in details:
         parts.append(f"deviation {result.max_deviation:.2e} > {details['tolerance']:.1e}")
+    if details.get("curvature_settled"):
+        parts.append(details["curvature_settled"])
+    if details.get("knot_jump_points"):
+        parts.append(f"{details['knot_jump_points']} samples on C1/C0 knot lines: derivatives the surface has not "
+                     "got there skipped")
     if details.get("short_span_points"):
         parts.append(f"{details['short_span_points']} samples on round-off-wide knot spans: position only")
     return "; ".join(parts)
@@ -76,7 +81,32 @@ def check_file(path, samples: int = 24) -> list[tuple]:
             rows[i] = (name, i, kind, float("nan"), False, str(r))
         else:
             rows[i] = (name, i, kind, r.max_deviation, r.passed, _note(r))
+    for i, note in _stray_notes(shape).items():
+        if i in rows:
+            f, j, kind, dev, ok, old = rows[i]
+            rows[i] = (f, j, kind, dev, ok, "; ".join(x for x in (old, note) if x))
     return [rows[i] for i in sorted(rows)]
+
+
+def _stray_notes(shape) -> dict:
+    """Per face index a note on its edges whose p-curves stray from the 3-D curve (or
+    from each other) beyond the edge's own tolerance: there the model is ambiguous."""
+    from ..occ.strays import edge_strays
+
+    try:
+        strays = [e for e in edge_strays(shape, samples=9) if e.ambiguous]
+    except SurfmodError:
+        return {}
+    per_face: dict = {}
+    for e in strays:
+        for i in e.faces:
+            per_face.setdefault(i, []).append(e)
+    notes = {}
+    for i, edges in per_face.items():
+        worst = max(edges, key=lambda e: max(e.stray, e.gap) / max(e.tolerance, 1e-300))
+        notes[i] = (f"ambiguous: {len(edges)} edge(s) whose p-curves stray beyond their tolerance, worst edge "
+                    f"{worst.edge}: {max(worst.stray, worst.gap):.2e} > tol {worst.tolerance:.1e}")
+    return notes
 
 
 def _kind_of(face) -> str:

@@ -19,8 +19,7 @@ from .row_stage import contract_rows, row_points
 
 
 @njit(cache=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns,
-         stream):
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns):
     """The grid ``us x vs[b0:b0+n_v]`` into ``out`` (point-major: ``(n_u, N_v, 3)`` for
     positions, ``(n_u, N_v, K, K, 3)`` for partials, ``K = bu.shape[1]``), block by block
     of u-points (:func:`grid_block_positions`, :func:`grid_block_derivatives`); block
@@ -29,16 +28,14 @@ def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts,
     first row among them; ``scratch[0]`` holds a block's row table (reused: a fresh
     table per block would be paged in again and again).  ``vruns`` is ``(bplan, planes,
     run_starts, run_kinds)`` for the vector loops of :func:`surfmod.eval.row_stage.contract_rows`,
-    or empty arrays (no run kinds) for the one-point-at-a-time stage :func:`grid_rows`.
-    ``stream``: partials to order 2 go to ``out`` with non-temporal stores
-    (:mod:`surfmod.eval.partials_stage`), for outputs far larger than the caches."""
+    or empty arrays (no run kinds) for the one-point-at-a-time stage :func:`grid_rows`."""
     for blk in range(starts.size - 1):
         if out.ndim == 3:
             grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,
                                  first, blk, vruns)
         else:
             grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[0], starts, rows,
-                                   row_starts, first, blk, vruns, stream)
+                                   row_starts, first, blk, vruns)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -74,12 +71,12 @@ def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, 
 
 @njit(cache=True, error_model="numpy")
 def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows, row_starts,
-                           first, blk, vruns, stream):
+                           first, blk, vruns):
     """One block of :func:`grid` for partials: to order 2 by
     :func:`surfmod.eval.partials_stage.order2_block`, other orders by :func:`grid_derivatives`."""
     table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns)
     if bu.shape[1] == 3:
-        order2_block(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1], stream)
+        order2_block(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1])
     else:
         grid_derivatives(bu[a0:a1], first[a0:a1], p, table, rational, binom, b0, out[a0:a1])
 

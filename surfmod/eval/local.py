@@ -53,10 +53,6 @@ BLOCKS_PER_THREAD = 8
 COMPILED_SCATTERED = 1 << 15
 #: the same for grids, whose NumPy path costs less per point (one row stage for all u)
 COMPILED_GRID = 1 << 18
-#: bytes of a caller's output array from which grids of partials to order 2 are written
-#: into it with non-temporal stores (:mod:`surfmod.eval.streaming`): far beyond the L2
-#: caches, where writing through them only evicts everything else
-STREAM_BYTES = 1 << 24
 
 
 def _kernels():
@@ -408,8 +404,9 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     len(vs), 3)`` for positions (``order == 0``), ``(len(us), len(vs), K, K, 3)`` for
     partials.  The partials are formed on cache-resident planes (every partial and
     coordinate a contiguous row of v) and each point's values are then stored together;
-    partials to order 2 in chunks of v-points held in L1, streamed past the caches into
-    a caller's ``out`` of ``STREAM_BYTES`` or more (:mod:`surfmod.eval.partials_stage`).
+    partials to order 2 in chunks of v-points held in L1 (:mod:`surfmod.eval.partials_stage`).
+    Small grids (under :data:`COMPILED_GRID` partials) are evaluated in NumPy
+    (:mod:`surfmod.eval.vectorized`).
     """
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
     us, vs = _as_float(us), _as_float(vs)
@@ -426,14 +423,6 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     su, bu = _basis(knots_u, p, n, us, order)
     sv, bv = _basis(knots_v, q, m, vs, order)
     binom = k.binomials(order)
-    # Streaming stores pay into a caller's big array, reused from call to call (its lines
-    # long out of the caches), not into a fresh one: the kernel zeroes each new page
-    # through the caches as it is first written, and plain stores then hit those lines
-    # (measured on 1000² partials: 55 ms plain, 74 ms streamed; reused: 38 ms vs 21 ms).
-    # They also need the doubles on 8-byte boundaries (a row then starts on or 8 bytes
-    # past a 16-byte one); a misaligned caller's array is written plainly.
-    stream = (order == 2 and out is not None and out.nbytes >= STREAM_BYTES
-              and out.ctypes.data % 8 == 0)
     if out is None:
         out = np.empty((us.size, vs.size, 3) if order == 0 else (us.size, vs.size, kk, kk, 3))
     run, count = _kernels_for(us.size * vs.size, grid=True)
@@ -453,8 +442,7 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             else:
                 blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
                 per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
-            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns,
-                     stream)
+            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns)
     if order == 0:
         return out[:, :, None, None, :]
     return out

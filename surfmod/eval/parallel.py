@@ -19,8 +19,7 @@ from .patches import derivatives_chunk, positions_chunk
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns,
-         stream):
+def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns):
     """:func:`surfmod.eval.grid_kernels.grid`, a block of u-points per task; each thread
     builds its blocks' row tables in its own row of ``scratch``."""
     for blk in prange(starts.size - 1):
@@ -30,7 +29,7 @@ def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts,
                                  first, blk, vruns)
         else:
             grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows,
-                                   row_starts, first, blk, vruns, stream)
+                                   row_starts, first, blk, vruns)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

@@ -5,25 +5,15 @@ For each u-point and chunk: its p+1 rows of the row table are combined into 36 p
 (partial ``(k, l)``, coordinate ``d``; each row window loaded once for all three ``k``),
 the quotient rule runs over the chunk with each point's weights and their multiples
 loaded once for the three coordinates, and each pair of points (54 doubles) goes to the
-output as 27 aligned 16-byte stores, non-temporal when the caller asks for streaming
-(:mod:`surfmod.eval.streaming`).  Done plane by plane over a whole v-row (the general
-path of :func:`surfmod.eval.grid_kernels.grid_derivatives`), the same work moves every
-plane through L2 three times; here only the row table is read from L2, and when
-streaming not even that: the chunks then go column by column, so each chunk's row
-windows stay in L1 for every u-point.
-
-Streamed rational grids at degree <= 3 also overlap the computing with the writing
-(:func:`_streamed_rational`): the 27 doubles a point leave the core far faster than
-memory takes them, so a chunk's stores, issued all at once, wait for memory while the
-arithmetic waits for them.  Each chunk's stores are issued instead while the next chunk
-goes through the quotient rule, four points after every four points, from a second set
-of planes.
+output as 27 16-byte pairs of doubles.  Done plane by plane over a whole v-row (the
+general path of :func:`surfmod.eval.grid_kernels.grid_derivatives`), the same work moves
+every plane through L2 three times; here only the row table is read from L2.
 
 Every value is the same sum, in the same order, as in the general path, compiled with
 fused multiply-adds (``fastmath={"contract"}``, nothing else): one rounding per term
 instead of two, so the results equal the general path's to rounding (a few ulps of each
-partial's size, ``tests/test_eval_partials_stage.py``) and are deterministic (the same
-streamed or not, on one thread or several, for any blocking).
+partial's size, ``tests/test_eval_partials_stage.py``) and are deterministic (the same on
+one thread or several, for any blocking).
 """
 
 from __future__ import annotations
@@ -32,57 +22,39 @@ import numpy as np
 from numba import literally, njit, uint64
 
 from .kernels import quotient_order2
-from .streaming import aligned_16, fence, stream_pair
 
 #: v-points per chunk: 36 planes of 16 doubles (4.6 KiB) beside the row windows in L1
 CHUNK = 16
 #: doubles of one chunk's planes: plane ``(k, l, d)`` at ``((3 k + l) 4 + d) CHUNK``
 PLANES = 36 * CHUNK
-#: points the pipelined quotient rule takes between two of the last chunk's stores
-STEP = 4
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
-def order2_block(bu, first, p, w, rational, b0, out, stream):
+def order2_block(bu, first, p, w, rational, b0, out):
     """Partials to order 2 of a block of u-points: ``out[a, b0:b0+n_v]`` from the row
     table ``w (rows, 3, dim, n_v)``, ``first[a]`` the place of u-point ``a``'s first row
     in it, ``bu (n_u, 3, p+1)`` the u-basis with its derivatives."""
-    # one compiled chunk loop per combine, and the overlapped one on its own: each holds
-    # only its own hot loop (measured: with two in one function, LLVM compiled them to
-    # half the speed)
-    planes = np.empty(2 * PLANES)
-    if stream and p <= 3 and rational:
-        _streamed_rational(bu, first, p, w, b0, out, planes)
-    elif p <= 3:
-        _chunks(bu, first, p, w, rational, b0, out, planes, 0, stream, False)
+    # one compiled chunk loop per combine: each holds only its own hot loop (measured:
+    # with two in one function, LLVM compiled them to half the speed)
+    planes = np.empty(PLANES)
+    if p <= 3:
+        _chunks(bu, first, p, w, rational, b0, out, planes, False)
     else:
-        _chunks(bu, first, p, w, rational, b0, out, planes, 0, stream, True)
-    if stream:
-        fence()
+        _chunks(bu, first, p, w, rational, b0, out, planes, True)
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _chunks(bu, first, p, w, rational, b0, out, planes, v_first, stream, high_degree):
-    """The chunk loop of :func:`order2_block` from v-point ``v_first`` on, one chunk at a
-    time in ``planes[:PLANES]``; ``high_degree`` is a compile-time constant
-    (``literally``).
-
-    Streamed, the chunks go column by column: all u-points of one chunk of v-points,
-    then the next chunk.  The row windows of a chunk (a few KiB for every row of the
-    table) then stay in L1 while every u-point combines them, where row by row each
-    u-point reads its rows' windows from L2; non-temporal stores write whole lines
-    whatever their order (1000² partials of a 20x20 NURBS: 17-18 ms against 19-20 ms).
-    Plain stores go row by row, along the output, since each of them first reads its
-    line (column by column: 41 ms against 36 ms)."""
+def _chunks(bu, first, p, w, rational, b0, out, planes, high_degree):
+    """The chunk loop of :func:`order2_block`, one chunk at a time in ``planes``, row by
+    row along the output; ``high_degree`` is a compile-time constant (``literally``)."""
     literally(high_degree)
     flat = out.reshape(-1)
     stride = out.shape[1] * 27
     nv, dim = w.shape[3], 4 if rational else 3
-    chunks = (nv - v_first + CHUNK - 1) // CHUNK
-    outer, inner = (chunks, bu.shape[0]) if stream else (bu.shape[0], chunks)
-    for i in range(outer):
-        for j in range(inner):
-            a, c0 = (j, v_first + i * CHUNK) if stream else (i, v_first + j * CHUNK)
+    chunks = (nv + CHUNK - 1) // CHUNK
+    for a in range(bu.shape[0]):
+        for j in range(chunks):
+            c0 = j * CHUNK
             n = min(CHUNK, nv - c0)
             if high_degree:
                 _combine_high(bu, a, first[a], p, w, dim, c0, n, planes, 0)
@@ -90,46 +62,7 @@ def _chunks(bu, first, p, w, rational, b0, out, planes, v_first, stream, high_de
                 _combine(bu, a, first[a], p, w, dim, c0, n, planes, 0)
             if rational:
                 _quotient(planes, 0, 0, n)
-            _store_points(planes, 0, n, flat, a * stride + 27 * (b0 + c0), stream)
-
-
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _streamed_rational(bu, first, p, w, b0, out, planes):
-    """:func:`_chunks` streamed, rational, degree <= 3, with the stores of each chunk
-    overlapping the next one's quotient rule (:func:`_column`), column by column over the
-    whole chunks when every row of ``out`` starts on a 16-byte boundary; the last
-    partial chunk, misaligned rows and an empty block as :func:`_chunks` does them."""
-    flat = out.reshape(-1)
-    stride = out.shape[1] * 27
-    whole = w.shape[3] // CHUNK
-    if bu.shape[0] == 0 or stride % 2 or not aligned_16(flat, 27 * b0):
-        whole = 0
-    for c in range(whole):
-        _column(bu, first, p, w, planes, flat, 27 * (b0 + c * CHUNK), stride, c * CHUNK)
-    if whole * CHUNK < w.shape[3]:
-        _chunks(bu, first, p, w, True, b0, out, planes, whole * CHUNK, True, False)
-
-
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _column(bu, first, p, w, planes, flat, o, stride, c0):
-    """One whole chunk ``c0:c0+CHUNK`` of every u-point, u-point ``a``'s at
-    ``flat[o + a stride:]`` (16-byte aligned): u-point ``a`` is combined into one half
-    of ``planes``, and while its quotient rule runs :data:`STEP` points at a time, the
-    other half (u-point ``a - 1``, done) goes to memory as many points after each step."""
-    _combine(bu, 0, first[0], p, w, 4, c0, CHUNK, planes, 0)
-    _quotient(planes, 0, 0, CHUNK)
-    for a in range(1, bu.shape[0]):
-        mine = (a % 2) * PLANES
-        done = PLANES - mine
-        t = o + (a - 1) * stride
-        _combine(bu, a, first[a], p, w, 4, c0, CHUNK, planes, mine)
-        for b in range(0, CHUNK, STEP):
-            _quotient(planes, mine, b, b + STEP)
-            for e in range(b, b + STEP, 2):
-                _store_pair(planes, done + e, flat, t + 27 * e, True)
-    last = ((bu.shape[0] - 1) % 2) * PLANES
-    for e in range(0, CHUNK, 2):
-        _store_pair(planes, last + e, flat, o + (bu.shape[0] - 1) * stride + 27 * e, True)
+            _store_points(planes, 0, n, flat, a * stride + 27 * (b0 + c0))
 
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
@@ -208,12 +141,9 @@ def _quotient(planes, base, lo, hi):
 
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
-def _pair(row, i, x0, x1, stream):
-    if stream:
-        stream_pair(row, i, x0, x1)
-    else:
-        row[i] = x0
-        row[i + uint64(1)] = x1
+def _two(row, i, x0, x1):
+    row[i] = x0
+    row[i + uint64(1)] = x1
 
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
@@ -225,9 +155,9 @@ def _store_point(planes, q, row, o):
 
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
-def _store_pair(planes, q, row, t, stream):
+def _store_pair(planes, q, row, t):
     """The points at ``planes[q]`` and ``planes[q + 1]`` (plane offsets from there) to
-    ``row[t:t+54]``, ``row[t]`` on a 16-byte boundary, as 27 16-byte stores.  A pair's
+    ``row[t:t+54]``, as 27 pairs of doubles (which LLVM may store 16 bytes at a time).  A pair's
     54 doubles are the first point's 27 then the second's, so the pairs are ``(f, f+1)``
     of the first for even ``f < 26``, then ``(26 of the first, 0 of the second)``, then
     ``(f, f+1)`` of the second for odd ``f``; the loops take two entries ``m = 3k + l``
@@ -238,31 +168,28 @@ def _store_pair(planes, q, row, t, stream):
     for mm in range(4):  # entries m = 2 mm and 2 mm + 1 of the first point: doubles 6 mm .. 6 mm + 5
         e = uint64(2 * mm) * d4 + b
         u = s + uint64(6 * mm)
-        _pair(row, u, planes[e], planes[e + d1], stream)
-        _pair(row, u + uint64(2), planes[e + d2], planes[e + d4], stream)
-        _pair(row, u + uint64(4), planes[e + d4 + d1], planes[e + d4 + d2], stream)
-    _pair(row, s + uint64(24), planes[last + b], planes[last + d1 + b], stream)
-    _pair(row, s + uint64(26), planes[last + d2 + b], planes[b + one], stream)
+        _two(row, u, planes[e], planes[e + d1])
+        _two(row, u + uint64(2), planes[e + d2], planes[e + d4])
+        _two(row, u + uint64(4), planes[e + d4 + d1], planes[e + d4 + d2])
+    _two(row, s + uint64(24), planes[last + b], planes[last + d1 + b])
+    _two(row, s + uint64(26), planes[last + d2 + b], planes[b + one])
     s += uint64(27)
     for mm in range(4):  # doubles 6 mm + 1 .. 6 mm + 6 of the second point
         e = uint64(2 * mm) * d4 + b + one
         u = s + uint64(6 * mm)
-        _pair(row, u + one, planes[e + d1], planes[e + d2], stream)
-        _pair(row, u + uint64(3), planes[e + d4], planes[e + d4 + d1], stream)
-        _pair(row, u + uint64(5), planes[e + d4 + d2], planes[e + d4 + d4], stream)
-    _pair(row, s + uint64(25), planes[last + d1 + b + one], planes[last + d2 + b + one], stream)
+        _two(row, u + one, planes[e + d1], planes[e + d2])
+        _two(row, u + uint64(3), planes[e + d4], planes[e + d4 + d1])
+        _two(row, u + uint64(5), planes[e + d4 + d2], planes[e + d4 + d4])
+    _two(row, s + uint64(25), planes[last + d1 + b + one], planes[last + d2 + b + one])
 
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
-def _store_points(planes, base, n, row, o, stream):
-    """Points ``0..n-1`` of the chunk at ``planes[base:]`` point-major into ``row[o:]``:
-    pairs of points (:func:`_store_pair`) from the first 16-byte boundary on."""
+def _store_points(planes, base, n, row, o):
+    """Points ``0..n-1`` of the chunk at ``planes[base:]`` point-major into ``row[o:]``,
+    in pairs of points (:func:`_store_pair`)."""
     b = 0
-    if n > 0 and not aligned_16(row, o):
-        _store_point(planes, base, row, o)
-        b = 1
     while b + 1 < n:
-        _store_pair(planes, base + b, row, o + 27 * b, stream)
+        _store_pair(planes, base + b, row, o + 27 * b)
         b += 2
     if b < n:
         _store_point(planes, base + b, row, o + 27 * b)

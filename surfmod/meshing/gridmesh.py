@@ -37,12 +37,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
+from . import gridbounds
 from .deviation import project_distances
 
 #: lattice divisions per cell side for verification (6: DENSE's 25 samples per triangle)
 K = 6
 #: lattice points per verification block (bounded memory)
 BLOCK_POINTS = 1 << 18
+#: lattice points from which a block is bounded by the compiled loops (gridmesh_kernels.py);
+#: smaller ones in NumPy (gridbounds.py, the same values), which spares the first mesh
+#: of a process numba's import and load
+COMPILED_LATTICE = 1 << 16
 #: refinement passes before giving up
 MAX_PASSES = 40
 #: verification passes spent on coarsening after the first passing grid
@@ -204,8 +209,6 @@ class GridMesh:
         (True: 00-11), the sagging of each cell's u- and v-sides (``eu``, ``ev``) and
         the vertices; returns the largest deviation (measured by projection at the
         samples over the tolerance or near the maximum, bounded elsewhere)."""
-        from . import gridmesh_kernels as gk
-
         us, vs = self.us, self.vs
         nu, nv = len(us) - 1, len(vs) - 1
         self.err, self.eu, self.ev = np.zeros((nu, nv)), np.zeros((nu, nv)), np.zeros((nu, nv))
@@ -220,10 +223,17 @@ class GridMesh:
             S = np.ascontiguousarray(self.s._grid_derivatives(lat_u, lat_v, 0)[:, :, 0, 0])
             self.verts[i0 : i1 + 1] = S[::K, ::K]
             diag = self.diag[i0:i1]
-            gk.diagonals(S, K, diag)
-            est = np.empty(S.shape[:2])
-            Q = np.empty_like(S)
-            gk.estimates(S, K, diag, self.kmax, est, Q)
+            compiled = S.shape[0] * S.shape[1] >= COMPILED_LATTICE
+            if compiled:
+                from . import gridmesh_kernels as gk  # numba: loaded on the first large lattice
+
+                gk.diagonals(S, K, diag)
+                est = np.empty(S.shape[:2])
+                Q = np.empty_like(S)
+                gk.estimates(S, K, diag, self.kmax, est, Q)
+            else:
+                diag[...] = gridbounds.diagonals(S, K, diag.shape)
+                est, Q = gridbounds.estimates(S, K, diag, self.kmax)
             top = max(top, float(est.max()))
             # candidates for projection: over the tolerance or near the running maximum
             idx = np.flatnonzero(est > min(self.tol, 0.9 * top))
@@ -232,7 +242,14 @@ class GridMesh:
             blocks.append((i0, i1, est))
         self._project(blocks, cand, top)
         for i0, i1, est in blocks:
-            gk.cell_maxima(est, K, self.err[i0:i1], self.eu[i0:i1], self.ev[i0:i1])
+            parts = self.err[i0:i1], self.eu[i0:i1], self.ev[i0:i1]
+            if est.size >= COMPILED_LATTICE:
+                from . import gridmesh_kernels as gk
+
+                gk.cell_maxima(est, K, *parts)
+            else:
+                for part, value in zip(parts, gridbounds.cell_maxima(est, K, parts[0].shape)):
+                    part[...] = value
         return float(self.err.max(initial=0.0))
 
     def _project(self, blocks, cand, top: float) -> None:

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import checks
+from .. import checks, pictures
 from ..errors import SurfmodError
 
 
@@ -44,10 +44,7 @@ class Mesh:
 
     def _repr_png_(self) -> bytes | None:
         """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
-        # cycle: surfmod.meshing.polymesh <-> surfmod.meshing.render (the picture draws meshes)
-        from .render import repr_png
-
-        return repr_png(self)
+        return pictures.repr_png(self)
 
     def triangles(self) -> np.ndarray:
         """Faces as triangles (quads split along their 0-2 diagonal)."""

@@ -16,6 +16,14 @@ from __future__ import annotations
 import numpy as np
 
 from ..surface import Surface
+from . import nearest
+
+#: point-cell pairs from which the seeds are searched by the compiled branch and bound
+#: (ops/seeding.py); fewer in NumPy (ops/nearest.py, every triangle), which spares a
+#: small projection numba's import and load
+COMPILED_SEED_PAIRS = 1 << 17
+#: Newton starts from which B-spline projections iterate in the compiled loop (ops/newton.py)
+COMPILED_NEWTON_STARTS = 1 << 10
 
 
 def seed_parameters(s: Surface, direction: int, per_span: int = 4, minimum: int = 24, maximum: int = 96) -> np.ndarray:
@@ -106,7 +114,7 @@ def _newton_in_boxes(s: Surface, points, u, v, box, iterations: int):
     (du0, du1), (dv0, dv1) = s.domain
     spanu, spanv = du1 - du0, dv1 - dv0
     u, v = u.copy(), v.copy()
-    if hasattr(s, "_local_net"):  # B-spline / NURBS: the same iteration, compiled
+    if hasattr(s, "_local_net") and u.size >= COMPILED_NEWTON_STARTS:  # B-spline / NURBS: the same iteration, compiled
         from ..eval.kernels import binomials
         from .newton import newton_boxes
 
@@ -221,14 +229,16 @@ def seed_starts(points, us, vs, g, seeds: int) -> np.ndarray:
     compiled branch and bound of :mod:`surfmod.ops.seeding` (cells whose nearest corner
     is farther than the current ``seeds``-th foot plus the cell's diameter are skipped).
     """
-    from .seeding import row_diameters, seed_kernel, triangle_tables  # numba, loaded on first use
-
-    e, gram, cross, diam = triangle_tables(g)
+    e, gram, cross, diam = nearest.triangle_tables(g)
     n_basins = max(2, seeds // 2)
+    if len(points) * diam.size < COMPILED_SEED_PAIRS:  # small work: NumPy, no numba to load
+        return nearest.seed_starts(points, us, vs, g, e, gram, cross, int(seeds), int(n_basins))
+    from .seeding import seed_kernel  # numba, loaded on the first large projection
+
     out = np.empty((len(points), seeds + n_basins, 2))
     seed_kernel(np.require(points, float, ["C", "W"]), np.require(g, float, ["C", "W"]),
                 np.require(us, float, ["C", "W"]), np.require(vs, float, ["C", "W"]),
-                e, gram, cross, diam, row_diameters(diam), int(seeds), int(n_basins), out)
+                e, gram, cross, diam, nearest.row_diameters(diam), int(seeds), int(n_basins), out)
     return out
 
 

@@ -16,29 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-
-def triangle_tables(g: np.ndarray):
-    """Per-cell data of the grid ``g (nu, nv, 3)``: corners, edges and the 2x2 Gram
-    matrices of the two triangles ``(i,j),(i+1,j),(i+1,j+1)`` and ``(i,j),(i+1,j+1),(i,j+1)``,
-    and the cell diameters.  Arrays are ``(nu-1, nv-1, ...)``."""
-    p00, p10, p11, p01 = g[:-1, :-1], g[1:, :-1], g[1:, 1:], g[:-1, 1:]
-    e = np.stack([p10 - p00, p11 - p00, p11 - p00, p01 - p00], axis=2)  # (.., 4, 3): e0,e1 of tri 0, of tri 1
-    gram = np.einsum("...ad,...ad->...a", e[..., [0, 1, 2, 3], :], e[..., [0, 1, 2, 3], :])
-    cross = np.stack([np.einsum("...d,...d->...", e[..., 0, :], e[..., 1, :]),
-                      np.einsum("...d,...d->...", e[..., 2, :], e[..., 3, :])], axis=-1)
-    corners = (p00, p10, p11, p01)
-    diam2 = np.zeros(p00.shape[:2])
-    for a in range(4):
-        for b in range(a + 1, 4):
-            diff = corners[a] - corners[b]
-            diam2 = np.maximum(diam2, np.einsum("...d,...d->...", diff, diff))
-    return (np.ascontiguousarray(e), np.ascontiguousarray(gram), np.ascontiguousarray(cross),
-            np.sqrt(diam2))
-
-
-def row_diameters(diam: np.ndarray) -> np.ndarray:
-    """The largest cell diameter of each row of cells (prunes whole rows at once)."""
-    return np.ascontiguousarray(diam.max(axis=1))
+from .nearest import row_diameters, triangle_tables  # noqa: F401  (the kernel's tables, in NumPy)
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -21,6 +21,9 @@ from .clip import as_face_surface
 from ..readback.trimmed import TrimmedFace
 from ..surface import Surface, model_size
 
+#: OCCT's ``Precision::Confusion()``: the smallest distance its topology tells apart
+OCCT_CONFUSION = 1e-7
+
 #: Closing gap allowed between the first and last point of a loop, relative to the domain.
 CLOSURE_RTOL = 1e-9
 
@@ -148,6 +151,12 @@ def trim(s: Surface, boundary_curve_uv, *, tolerance: float = 1e-7):
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
     tol = checks.tolerance(tolerance, "tolerance", model_size(s))
+    # the 3-D edges are approximated from the p-curves to this tolerance (BRepLib
+    # BuildCurves3d): below OCCT's confusion tolerance it only multiplies segments (1e-11
+    # on a unit square took 22 s) and OCCT's own checks cannot tell the difference
+    if tol < OCCT_CONFUSION:
+        raise SurfmodError(f"tolerance: {tol:g} is below OCCT's confusion tolerance {OCCT_CONFUSION:g} "
+                           "(Precision::Confusion), the finest edge OCCT builds")
     loops = boundary_loops(s, boundary_curve_uv)
     from ..occ.ops import trimmed_face
 
