@@ -273,5 +273,6 @@ def test_corpus_finishing_path_in_stock(tmp_path, corpus_dir, name, kind):
     rep = simulate(prog, {0: cutter}, stock, top)
     print(name, kind, rep)
     assert rep.gouge < tp.tolerance + deflection + 2e-4, str(rep)
-    assert rep.rapid_cut <= 1e-9 and rep.rapid_part < 0, str(rep)
+    # a retract straight up from a contact starts touching the part: not below it
+    assert rep.rapid_cut <= 1e-9 and rep.rapid_part <= 1e-9, str(rep)
     assert rep.cutting_moves > 0
