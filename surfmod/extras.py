@@ -1,8 +1,8 @@
 """The optional extras: which call needs which package, and the one way to load one.
 
 surfmod's hard dependencies (NumPy, SciPy, numba, OCP, build123d, matplotlib, trimesh,
-tqdm, joblib, ezdxf) serve the public API and every command's default path; these come with an
-extra of ``pyproject.toml`` and serve one call each:
+tqdm, joblib, ezdxf, mpmath) serve the public API and every command's default path;
+these come with an extra of ``pyproject.toml`` and serve one call each:
 
 ========  ======================  ====================================================
 extra     packages                needed by

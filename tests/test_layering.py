@@ -99,6 +99,7 @@ LAZY = {
     "splipy": "optional extra 'interop'",
     "rhino3dm": "optional extra 'interop'",
     "opencamlib": "optional, the CAM cross-check and benchmarks",
+    "importlib": "importlib.metadata, 0.19 s; sm.__version__ and surfmod --version only",
     "ocl": "opencamlib's module name",
 }
 

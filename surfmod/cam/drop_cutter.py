@@ -32,6 +32,7 @@ cell, every triangle whose (x, y) box grown by ``r`` meets it.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from ..errors import SurfmodError
 
@@ -220,25 +221,43 @@ def _bull_profile(d, a: float, c: float):
     return f, slope
 
 
+@njit(cache=True, error_model="numpy")
+def _bull_edge_kernel(dx, dy, ex, ey, ez, A, B, lo, hi, a, c, steps, u):
+    """Bisection per pair on the sign of ``ez - f'(d(u)) d'(u)`` (decreasing in ``u``)."""
+    for i in range(len(u)):
+        left, right = lo[i], hi[i]
+        for _ in range(steps):
+            mid = 0.5 * (left + right)
+            px, py = dx[i] + mid * ex[i], dy[i] + mid * ey[i]
+            d = np.sqrt(px * px + py * py)
+            t = d - a
+            if t <= 0.0 or d == 0.0:
+                rising = ez[i] > 0.0
+            else:
+                root2 = c * c - t * t
+                if root2 <= 0.0:
+                    rate = (mid * A[i] + B[i]) / d
+                    rising = rate < 0.0 or (rate == 0.0 and ez[i] > 0.0)
+                else:
+                    rising = ez[i] > t / np.sqrt(root2) * (mid * A[i] + B[i]) / d
+            if rising:
+                left = mid
+            else:
+                right = mid
+        u[i] = 0.5 * (left + right)
+
+
 def _bull_edge_argmax(rows, default, lo, hi, dx, dy, ex, ey, ez, A, B, a: float, c: float):
     """Edge parameter ``u`` in ``[lo, hi]`` maximizing the concave ``u ez - f(d(u))`` at
-    ``rows`` (``default`` elsewhere): bisection on the sign of the decreasing derivative."""
+    ``rows`` (``default`` elsewhere): bisection on the sign of the decreasing derivative
+    (compiled: a scalar loop per pair)."""
     u = default.copy()
     if not rows.size:
         return u
-    dx, dy, ex, ey, ez, A, B = (w[rows] for w in (dx, dy, ex, ey, ez, A, B))
-    left, right = lo[rows], hi[rows]
-    for _ in range(BULL_EDGE_STEPS):
-        mid = 0.5 * (left + right)
-        ddx, ddy = dx + mid * ex, dy + mid * ey
-        d = np.sqrt(ddx * ddx + ddy * ddy)
-        _, slope = _bull_profile(d, a, c)
-        rate = (mid * A + B) / np.where(d > 0, d, 1.0)  # d'(u)
-        with np.errstate(invalid="ignore"):
-            up = ez > np.where(rate == 0, 0.0, slope * rate)
-        left = np.where(up, mid, left)
-        right = np.where(up, right, mid)
-    u[rows] = 0.5 * (left + right)
+    got = np.empty(rows.size)
+    _bull_edge_kernel(*(np.ascontiguousarray(w[rows], dtype=np.float64) for w in (dx, dy, ex, ey, ez, A, B, lo, hi)),
+                      float(a), float(c), BULL_EDGE_STEPS, got)
+    u[rows] = got
     return u
 
 
@@ -293,7 +312,7 @@ def _features(kind: str, corner: float):
     return lambda qx, qy, t, r: _bull_features(qx, qy, t, r, corner)
 
 
-def _reach(grid: TriangleGrid, kind: str, q: np.ndarray, ti: np.ndarray) -> np.ndarray:
+def _reach(grid: TriangleGrid, kind: str, q: np.ndarray, ti: np.ndarray, corner: float = 0.0) -> np.ndarray:
     """Upper bound of the tip height each triangle can give: its highest vertex, lifted
     (ball) by how far the ball can rise over the nearest point of its (x, y) box."""
     gap = np.maximum(np.maximum(grid.lo[ti] + grid.radius - q, q - grid.hi[ti] + grid.radius), 0.0)
@@ -301,6 +320,9 @@ def _reach(grid: TriangleGrid, kind: str, q: np.ndarray, ti: np.ndarray) -> np.n
     r2 = grid.radius**2
     if kind == "ball":
         return np.where(d2 <= r2, grid.top[ti] + np.sqrt(np.maximum(r2 - d2, 0.0)) - grid.radius, -np.inf)
+    if kind == "bull":  # no point nearer than the box can lift the tip more than the profile there
+        f, _ = _bull_profile(np.sqrt(d2), grid.radius - corner, corner)
+        return np.where(d2 <= r2, grid.top[ti] - np.minimum(f, corner), -np.inf)
     return np.where(d2 <= r2, grid.top[ti], -np.inf)
 
 
@@ -328,7 +350,7 @@ def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop
     for s0, s1 in zip(starts, np.r_[starts[1:], len(xy)]):
         q_block = xy[s0:s1]
         qi, ti = grid.pairs(q_block, start[s0:s1], stop[s0:s1])
-        reach = _reach(grid, kind, q_block[qi], ti)
+        reach = _reach(grid, kind, q_block[qi], ti, corner)
         live = np.isfinite(reach)
         qi, ti, reach = qi[live], ti[live], reach[live]
         if not len(qi):

@@ -7,6 +7,7 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..atomic import atomic_path, target_path
+from .post import export_job
 
 
 def _is_toolpath(obj) -> bool:
@@ -83,9 +84,14 @@ def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = Non
     return "\n".join(lines)
 
 
-def export_gcode(toolpath, path, *, feed: float = 600.0, safe_height: float | None = None, **kw) -> None:
+def export_gcode(toolpath, path, *, feed: float = 600.0, safe_height: float | None = None, post: str | None = None,
+                 **kw):
     """Write a tool path as G-code: G21/G90, ``G0`` rapid to ``safe_height``, ``G1``
     moves at ``feed`` (mm/min), retract and ``M2``.  Atomic.
+
+    A machining :class:`~surfmod.Job` goes through a post-processor instead
+    (:mod:`surfmod.cam.post`): ``post="linuxcnc"`` (default, one RS274NGC program with
+    tool changes) or ``"grbl"`` (one program per tool); the paths written are returned.
 
     >>> import surfmod as sm, tempfile, os
     >>> tp = sm.toolpath(sm.plane((0, 0, 0), (4, 0, 0), (0, 4, 0)), sm.Tool("flat", 1.0), stepover=1.5)
@@ -94,6 +100,10 @@ def export_gcode(toolpath, path, *, feed: float = 600.0, safe_height: float | No
     >>> open(p).read().splitlines()[-3:]
     ['G0 Z10.0000', 'M2', '%']
     """
+    if hasattr(toolpath, "operations"):
+        return export_job(toolpath, path, post or "linuxcnc", **kw)
+    if post is not None:
+        raise SurfmodError("post: a post-processor applies to a machining Job (sm.machine), not to a Toolpath")
     target = target_path(path, "path", (".nc", ".gcode", ".ngc", ".tap", ".cnc"))
     text = gcode_text(toolpath, feed=feed, safe_height=safe_height, **kw)
     with atomic_path(target) as tmp:

@@ -30,8 +30,8 @@ MAX_SPINDLE = 24000.0
 class Tool:
     """An end mill: ``kind`` ``"flat"``, ``"ball"`` or ``"bull"``, ``radius`` > 0, and for a
     bull nose its ``corner_radius`` (``0 < corner_radius < radius``: a flat core of radius
-    ``radius - corner_radius`` rounded by a torus).  ``flute_length`` (default four
-    radii) bounds the depth it may cut; ``number`` (the T word), ``spindle`` (rpm),
+    ``radius - corner_radius`` rounded by a torus).  ``flute_length`` (default three
+    diameters) bounds the depth it may cut; ``number`` (the T word), ``spindle`` (rpm),
     ``feed`` and ``plunge_feed`` (mm/min) default from the diameter.
 
     >>> import surfmod as sm
@@ -64,7 +64,7 @@ class Tool:
         elif c != 0.0 and not (self.kind == "ball" and c == r):
             raise SurfmodError(f"corner_radius: a {self.kind} end mill has none, got {c:g}")
         object.__setattr__(self, "corner_radius", c)
-        flute = 4.0 * r if self.flute_length is None else checks.positive(self.flute_length, "flute_length")
+        flute = 6.0 * r if self.flute_length is None else checks.positive(self.flute_length, "flute_length")
         object.__setattr__(self, "flute_length", flute)
         if self.number is not None:
             object.__setattr__(self, "number", checks.count(self.number, "number", 1, 99999))
@@ -133,7 +133,7 @@ def parse_tool(text: str, name: str = "tool") -> Tool:
     """``"flat:R"``, ``"ball:R"`` or ``"bull:R:r"`` (radius, corner radius in mm) as a Tool.
 
     >>> parse_tool("bull:3:0.5")
-    Tool(kind='bull', radius=3.0, corner_radius=0.5, flute_length=12.0, number=None, spindle=None, feed=None, plunge_feed=None)
+    Tool(kind='bull', radius=3.0, corner_radius=0.5, flute_length=18.0, number=None, spindle=None, feed=None, plunge_feed=None)
     """
     parts = str(text).split(":")
     try:

@@ -1,0 +1,229 @@
+"""A machining job: a part, a block of stock and operations in order (roughing, finishing).
+
+>>> import surfmod as sm, build123d as bd
+>>> part = bd.Box(20, 20, 5) + bd.Pos(0, 0, 4) * bd.Cylinder(5, 3)
+>>> job = sm.machine(part, 2.0, [sm.Rough(sm.Tool("flat", 3.0), stepdown=2.0, allowance=0.3),
+...                              sm.Finish(sm.Tool("ball", 1.5), scallop=0.05)])
+>>> [op.name for op in job.operations], [op.tool.number for op in job.operations]
+(['roughing', 'finishing'], [1, 2])
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+from ..inputs import to_shape
+from .roughing import FEED, PLUNGE, RAPID, RAMP_ANGLE, Motion, offset_tool, rough
+from .tool import Tool
+from .toolpath import _part, toolpath
+
+#: Rapid traverse (mm/min) and tool change time (s) of the time estimate.
+RAPID_RATE = 5000.0
+TOOL_CHANGE_TIME = 8.0
+#: Clearance of links and retracts above the stock (mm).
+CLEARANCE = 5.0
+
+
+@dataclass(frozen=True)
+class Rough:
+    """Z-level roughing with ``tool``: levels ``stepdown`` apart (default the tool radius),
+    down to the part plus ``allowance``; rings ``stepover`` apart (default 40 % of the
+    diameter: the radial engagement)."""
+
+    tool: Tool
+    stepdown: float | None = None
+    allowance: float = 0.5
+    stepover: float | None = None
+
+
+@dataclass(frozen=True)
+class Finish:
+    """Drop-cutter zig-zag finishing with ``tool`` leaving cusps of ``scallop`` on flat
+    ground (or passes ``stepover`` apart)."""
+
+    tool: Tool
+    scallop: float | None = None
+    stepover: float | None = None
+    direction: str = "x"
+
+
+@dataclass(frozen=True)
+class Operation:
+    """One operation of a :class:`Job`: its ``name``, ``tool`` (numbered, with speeds and
+    feeds), ``motion`` (cutter locations and how the tool moves to each), machining
+    ``time_estimate`` (s) and a ``report`` (levels, scallop, rest left...)."""
+
+    name: str
+    tool: Tool
+    motion: Motion = field(repr=False)
+    time_estimate: float
+    report: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def moves(self) -> np.ndarray:
+        return self.motion.points
+
+    @property
+    def length(self) -> float:
+        """Length of the cutting moves (feed and plunge), mm."""
+        seg = np.linalg.norm(np.diff(self.motion.points, axis=0), axis=1)
+        return float(seg[self.motion.kind[1:] != RAPID].sum())
+
+    def __str__(self) -> str:
+        m, s = divmod(self.time_estimate, 60)
+        return f"{self.name}: {self.tool}, cutting length {self.length:.0f} mm, time {int(m)} min {s:04.1f} s"
+
+
+@dataclass(frozen=True)
+class Job:
+    """The operations of a part machined from ``stock`` (``[[x0, y0, z0], [x1, y1, z1]]``)."""
+
+    part: object = field(repr=False)
+    stock: np.ndarray
+    operations: tuple
+    safe_height: float
+
+    @property
+    def time_estimate(self) -> float:
+        return float(sum(op.time_estimate for op in self.operations))
+
+    def __str__(self) -> str:
+        lo, hi = self.stock
+        head = (f"job: stock {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} x {hi[2] - lo[2]:g} mm at "
+                f"({lo[0]:g}, {lo[1]:g}, {lo[2]:g}), {len(self.operations)} operations, "
+                f"total time {self.time_estimate / 60:.1f} min")
+        return "\n".join([head] + [f"  {op}" for op in self.operations])
+
+    def _repr_png_(self) -> bytes:
+        from .picture import job_png
+
+        return job_png(self)
+
+
+def motion_time(motion: Motion, tool: Tool) -> float:
+    """Seconds: rapids at ``RAPID_RATE``, cuts at the tool's feed, ramps at its plunge feed."""
+    if len(motion.points) < 2:
+        return 0.0
+    seg = np.linalg.norm(np.diff(motion.points, axis=0), axis=1)
+    kind = motion.kind[1:]
+    rate = np.where(kind == RAPID, RAPID_RATE, np.where(kind == FEED, tool.feed, tool.plunge_feed))
+    return float((seg / rate).sum() * 60.0)
+
+
+def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
+    """The stock: a margin (the part's box grown on the four sides and on top, its bottom
+    at the part's bottom) or an explicit box, which must hold the part."""
+    if np.ndim(stock) == 0:
+        m = float(stock)
+        if not np.isfinite(m) or m < 0:
+            raise SurfmodError(f"stock_margin: must be >= 0, got {stock!r}")
+        return np.array([part_box[0] - [m, m, 0.0], part_box[1] + [m, m, m]])
+    box = checks.finite_array(stock, "stock").reshape(-1)
+    if box.shape != (6,):
+        raise SurfmodError(f"stock: expected X0 Y0 Z0 X1 Y1 Z1, got {np.asarray(stock).tolist()}")
+    box = np.sort(box.reshape(2, 3), axis=0)
+    slack = 1e-6 * float(np.ptp(part_box, axis=0).max())
+    if np.any(box[0] > part_box[0] + slack) or np.any(box[1] < part_box[1] - slack):
+        raise SurfmodError(f"stock: the box {box.ravel().tolist()} is smaller than the part "
+                           f"{np.round(part_box.ravel(), 4).tolist()}")
+    return box
+
+
+def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest_above: float, progress):
+    path = toolpath(shape, tool, op.stepover, scallop=op.scallop, direction=op.direction, progress=progress)
+    pts = path.points
+    top = float(min(pts[0, 2] + rest_above + 1.0, safe))
+    moves, kinds = [[pts[0, 0], pts[0, 1], safe]], [RAPID]
+    if tool.kind == "ball" or top <= pts[0, 2]:
+        moves.append([pts[0, 0], pts[0, 1], top])
+        kinds.append(RAPID)
+        moves.append(pts[0])
+        kinds.append(PLUNGE)
+    else:  # a flat or bull end enters by a helix of half its radius onto the first location
+        part = _part(shape, tool, path.tolerance)
+        rho = tool.radius / 2
+        turns = max(1, int(np.ceil((top - pts[0, 2]) / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * rho))))
+        t = np.linspace(0, 1, 48 * turns + 1)
+        helix = pts[0, :2] + rho * np.column_stack([np.cos(2 * np.pi * turns * t) - 1, np.sin(2 * np.pi * turns * t)])
+        hz = np.maximum(top - (top - pts[0, 2]) * t, np.nan_to_num(part.height(helix), nan=-np.inf))
+        moves.append([helix[0, 0], helix[0, 1], max(top, hz[0])])
+        kinds.append(RAPID)
+        moves += list(np.column_stack([helix, hz]))
+        kinds += [PLUNGE] * len(helix)
+    moves += list(pts[1:])
+    kinds += [FEED] * (len(pts) - 1)
+    moves.append([pts[-1, 0], pts[-1, 1], safe])
+    kinds.append(RAPID)
+    report = {"stepover": path.stepover, "scallop": path.scallop, "gouge": path.gouge, "lifted": path.lifted,
+              "tolerance": path.tolerance, "toolpath": path}
+    return Motion(np.array(moves, float), np.array(kinds, np.int8)), report
+
+
+def machine(part, stock, operations, *, progress: bool = False) -> Job:
+    """Machine ``part`` (a build123d shape, STEP path or surfmod surfaces) from ``stock``
+    (a margin in mm, or a box ``[[x0, y0, z0], [x1, y1, z1]]`` holding the part) by
+    ``operations`` in order (:class:`Rough`, :class:`Finish`); tools without a number get
+    1, 2, ... in that order, and speeds and feeds from their diameter.  Roughing clears the
+    stock down to the part plus its allowance (:mod:`surfmod.cam.roughing`); finishing is
+    the gouge-checked drop-cutter path (:func:`surfmod.toolpath`).  Raises
+    ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut."""
+    from tqdm import tqdm
+
+    from ..occ.uses import bounding_box
+
+    shape = to_shape(part, "part")
+    ops = list(operations) if isinstance(operations, (list, tuple)) else [operations]
+    if not ops or not all(isinstance(o, (Rough, Finish)) for o in ops):
+        raise SurfmodError("operations: expected a list of sm.Rough / sm.Finish")
+    box = bounding_box(shape.wrapped if hasattr(shape, "wrapped") else shape)
+    if not np.all(np.isfinite(box)) or np.any(box[1] - box[0] <= 0):
+        raise SurfmodError("part: has no solid extent to machine")
+    stock = stock_box(box, stock)
+    safe = float(stock[1, 2] + CLEARANCE)
+    done, rest_above = [], float(stock[1, 2] - box[0, 2])
+    numbers = {}
+    with tqdm(total=2 * len(ops), desc="machine", unit="stage", disable=not progress) as bar:
+        for k, op in enumerate(ops):
+            if not isinstance(op.tool, Tool):
+                raise SurfmodError(f"tool: expected a surfmod Tool, got {type(op.tool).__name__}")
+            tool = op.tool.with_defaults(k + 1)
+            if numbers.setdefault(tool.number, tool) != tool:
+                raise SurfmodError(f"tool: number {tool.number} is given to two different tools")
+            if isinstance(op, Rough):
+                stepdown = tool.radius if op.stepdown is None else checks.positive(op.stepdown, "stepdown")
+                stepover = 0.8 * tool.radius if op.stepover is None else checks.positive(op.stepover, "stepover")
+                if stepover >= tool.radius:
+                    raise SurfmodError(f"stepover: roughing needs a stepover below the tool radius {tool.radius:g}")
+                allowance = float(op.allowance)
+                if not np.isfinite(allowance) or allowance < 0:
+                    raise SurfmodError(f"allowance: must be >= 0, got {op.allowance!r}")
+                grown = offset_tool(tool, allowance)
+                tolerance = max(min(allowance / 4, 0.05), 0.005) if allowance > 0 else 0.01
+                p = _part(shape, grown, tolerance)
+                bar.update()
+                motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover, CLEARANCE)
+                cut_depth = float(stock[1, 2] - report["low"]) if report["levels"] else 0.0
+                if cut_depth > tool.flute_length + 1e-9:
+                    raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the roughing cuts "
+                                       f"{cut_depth:.4g} mm deep")
+                report.update(allowance=allowance, stepdown=stepdown, stepover=stepover)
+                rest_above = min(rest_above, allowance + stepdown)
+                name = "roughing"
+            else:
+                if op.scallop is not None:
+                    tool.stepover_for_scallop(op.scallop)  # scallop >= radius etc. raise here
+                bar.update()
+                motion, report = _finish(shape, op, tool, stock, safe, rest_above, False)
+                # after roughing the finishing tool works below the part's top
+                low = float(report["toolpath"].points[:, 2].min())
+                if box[1, 2] - low > tool.flute_length + 1e-9:
+                    raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the finishing "
+                                       f"goes {box[1, 2] - low:.4g} mm below the part's top")
+                name = "finishing"
+            bar.update()
+            done.append(Operation(name, tool, motion, motion_time(motion, tool) + TOOL_CHANGE_TIME, report))
+    return Job(shape, stock, tuple(done), safe)

@@ -1,0 +1,118 @@
+"""Post-processors: a :class:`~surfmod.cam.job.Job` as G-code a controller runs.
+
+Both posts write millimetres, absolute, in part coordinates; retracts are plain ``G0 Z``
+moves to the job's clearance height (no ``G28``/``G30``/``G53`` machine-coordinate moves,
+no ``G5`` splines).  Heights are rounded up to the written digits (the tool never sits
+lower than the verified path).
+
+- ``"linuxcnc"``: one RS274NGC program; per operation a comment naming it and its tool,
+  ``T n M6`` and ``G43 H n`` (tool length offset), ``S… M3`` before the first cut, ``M5``
+  after it; ``M30`` at the end.
+- ``"grbl"``: no tool changer, so one program per tool (``NAME_T1.nc``, ``NAME_T2.nc``…),
+  each with its spindle start and stop and no ``M6``/``G43``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..atomic import atomic_path, target_path
+from ..errors import SurfmodError
+from .roughing import FEED, RAPID
+
+POSTS = ("linuxcnc", "grbl")
+SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")
+
+
+def _up(values: np.ndarray, digits: int) -> np.ndarray:
+    scale = 10.0**digits
+    return np.ceil(np.round(values * scale, 6)) / scale
+
+
+def _moves(op, digits: int) -> list[str]:
+    """G0/G1 lines of an operation's motion, feeds modal (written when they change)."""
+    pts = np.array(op.motion.points, float)
+    pts[:, 2] = _up(pts[:, 2], digits)
+    kind = op.motion.kind
+    fmt = f"%.{digits}f"
+    cols = [np.char.mod(fmt, pts[:, k]) for k in range(3)]
+    lines, last, feed_now = [], (None, None, None), None
+    for i in range(len(pts)):
+        xyz = (cols[0][i], cols[1][i], cols[2][i])
+        if xyz == last:
+            continue
+        words = " ".join(f"{a}{v}" for a, v, w in zip("XYZ", xyz, last) if v != w)
+        if kind[i] == RAPID:
+            lines.append(f"G0 {words}")
+        else:
+            f = op.tool.feed if kind[i] == FEED else op.tool.plunge_feed
+            if f != feed_now:
+                words += f" F{f:g}"
+                feed_now = f
+            lines.append(f"G1 {words}")
+        last = xyz
+    return lines
+
+
+def _operation(op, job, post: str, digits: int, coolant: bool) -> list[str]:
+    t = op.tool
+    safe = f"{_up(np.array([job.safe_height]), digits)[0]:.{digits}f}"
+    out = [f"(operation: {op.name}, tool {t.number}: {t}, flute length {t.flute_length:g} mm)",
+           f"(estimated time {op.time_estimate:.0f} s, cutting length {op.length:.0f} mm)"]
+    if post == "linuxcnc":
+        out += [f"T{t.number} M6", f"G43 H{t.number}"]
+    out += [f"G0 Z{safe}", f"S{t.spindle:.0f} M3"]
+    if coolant:
+        out.append("M8")
+    out += _moves(op, digits)
+    out += [f"G0 Z{safe}"] + (["M9"] if coolant else []) + ["M5"]
+    return out
+
+
+def _header(job, title: str) -> list[str]:
+    lo, hi = job.stock
+    return ["%", f"({title})",
+            f"(stock X{lo[0]:g}..{hi[0]:g} Y{lo[1]:g}..{hi[1]:g} Z{lo[2]:g}..{hi[2]:g} mm, part coordinates)",
+            "G21 G90 G17 G94 (mm, absolute, XY plane, feed per minute)", "G40 G49 G80 (no compensation, no offset)"]
+
+
+def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = False) -> list[str]:
+    """The program texts of ``job``: one for ``"linuxcnc"``, one per tool for ``"grbl"``."""
+    if post not in POSTS:
+        raise SurfmodError(f"post: expected one of {', '.join(POSTS)}, got {post!r}")
+    if int(digits) != digits or not 1 <= digits <= 6:
+        raise SurfmodError(f"digits: expected an integer 1..6, got {digits!r}")
+    if post == "linuxcnc":
+        body = _header(job, f"surfmod job: {len(job.operations)} operations, LinuxCNC")
+        for op in job.operations:
+            body += _operation(op, job, post, digits, coolant)
+        return ["\n".join(body + ["M30", "%", ""])]
+    texts = []
+    for number in dict.fromkeys(op.tool.number for op in job.operations):
+        ops = [op for op in job.operations if op.tool.number == number]
+        body = _header(job, f"surfmod job, GRBL program for tool {number}: {ops[0].tool}; change the tool, "
+                            f"set its length, then run")
+        for op in ops:
+            body += _operation(op, job, post, digits, coolant)
+        texts.append("\n".join(body + ["M30", "%", ""]))
+    return texts
+
+
+def program_paths(path, job, post: str) -> list:
+    """Where :func:`export_job` writes: ``path`` (LinuxCNC), ``STEM_T<n>SUFFIX`` per tool (GRBL)."""
+    target = target_path(path, "path", SUFFIXES)
+    if post != "grbl":
+        return [target]
+    numbers = dict.fromkeys(op.tool.number for op in job.operations)
+    return [target.with_name(f"{target.stem}_T{n}{target.suffix}") for n in numbers]
+
+
+def export_job(job, path, post: str = "linuxcnc", **kw) -> list:
+    """Write the program(s) of ``job`` atomically; returns the paths written.  All texts
+    are made before the first file is written, so bad input writes nothing."""
+    texts = programs(job, post, **kw)
+    paths = program_paths(path, job, post)
+    for p, text in zip(paths, texts):
+        with atomic_path(p) as tmp:
+            tmp.write_text(text, encoding="ascii")
+    return paths

@@ -1,0 +1,82 @@
+"""``surfmod machine PART.step --out JOB.ngc --stock-margin M --rough flat:R --finish ball:R --scallop S``."""
+
+from __future__ import annotations
+
+from ..atomic import target_path
+from ..cam.job import Finish, Rough, machine
+from ..cam.post import POSTS, SUFFIXES, export_job, program_paths, programs
+from ..cam.tool import load_tool_table, parse_tool
+from ..errors import SurfmodError
+from ..inputs import to_shape
+
+
+def register(sub) -> None:
+    p = sub.add_parser("machine", help="machine a STEP part from stock: z-level roughing, drop-cutter finishing, "
+                                       "a LinuxCNC or GRBL program")
+    p.add_argument("path", help="STEP file (the part, a solid)")
+    p.add_argument("--out", required=True, help="output program .ngc/.nc (GRBL: one file per tool, NAME_T<n>)")
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--stock-margin", type=float, help="stock = part box grown by M on the sides and on top (mm)")
+    g.add_argument("--stock", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"),
+                   help="stock box in part coordinates")
+    p.add_argument("--rough", required=True, help="roughing tool flat:R, ball:R or bull:R:r (tool 1)")
+    p.add_argument("--finish", required=True, help="finishing tool flat:R, ball:R or bull:R:r (tool 2)")
+    p.add_argument("--scallop", type=float, required=True, help="finishing scallop height (mm)")
+    p.add_argument("--stepdown", type=float, help="roughing level spacing (default the rough tool radius)")
+    p.add_argument("--allowance", type=float, default=0.5, help="material roughing leaves on the part (mm)")
+    p.add_argument("--post", default="linuxcnc", help=f"post-processor: {', '.join(POSTS)}")
+    p.add_argument("--tools", help="tool table (TOML or JSON) giving tool 1 and 2 their flutes, speeds, feeds")
+    p.add_argument("--png", help="picture of the moves over the shaded part")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.set_defaults(run=run)
+
+
+def _tool(text: str, number: int, table: dict, name: str):
+    tool = parse_tool(text, name)
+    entry = table.get(number)
+    if entry is None:
+        return tool
+    if (entry.kind, entry.radius, entry.corner_radius) != (tool.kind, tool.radius, tool.corner_radius):
+        raise SurfmodError(f"{name}: {text} is not tool {number} of the tool table ({entry})")
+    return entry
+
+
+def run(args) -> int:
+    """Check every argument before any work, machine, write the program(s) and print the
+    summary; on bad input one line and exit 1, nothing written."""
+    if args.post not in POSTS:
+        raise SurfmodError(f"post: expected one of {', '.join(POSTS)}, got {args.post!r}")
+    target_path(args.out, "out", SUFFIXES)
+    if args.png:
+        target_path(args.png, "png", (".png",))
+    table = load_tool_table(args.tools) if args.tools else {}
+    rough_tool = _tool(args.rough, 1, table, "rough")
+    finish_tool = _tool(args.finish, 2, table, "finish")
+    if args.stepdown is not None and not args.stepdown > 0:
+        raise SurfmodError(f"stepdown: must be > 0, got {args.stepdown:g}")
+    if not args.scallop > 0:
+        raise SurfmodError(f"scallop: must be > 0, got {args.scallop:g}")
+    if args.scallop >= finish_tool.radius:
+        raise SurfmodError(f"scallop: {args.scallop:g} must be smaller than the finishing tool radius "
+                           f"{finish_tool.radius:g}")
+    if not args.allowance >= 0:
+        raise SurfmodError(f"allowance: must be >= 0, got {args.allowance:g}")
+    if args.stock_margin is not None and not args.stock_margin >= 0:
+        raise SurfmodError(f"stock_margin: must be >= 0, got {args.stock_margin:g}")
+    shape = to_shape(args.path, "path", solid=True)
+    stock = args.stock_margin if args.stock is None else [args.stock[:3], args.stock[3:]]
+    job = machine(shape, stock, [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
+                                 Finish(finish_tool, scallop=args.scallop)], progress=not args.no_progress)
+    programs(job, args.post)  # any refusal before a file is written
+    program_paths(args.out, job, args.post)
+    written = export_job(job, args.out, args.post)
+    if args.png:
+        from ..cam.picture import write_png
+
+        write_png(job, args.png)
+    print(job)
+    for op in job.operations:
+        print(f"  {op.name}: length {op.length:.1f} mm, time estimate {op.time_estimate:.1f} s, tool {op.tool}")
+    for p in written + ([args.png] if args.png else []):
+        print(f"wrote {p}")
+    return 0

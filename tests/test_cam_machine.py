@@ -1,0 +1,249 @@
+"""Machining from stock: a part with a pocket and a boss roughed and finished, the program
+read back by LinuxCNC's own interpreter (``rs274 -g``), the moves checked against the part
+by an independent sampling of the tool over the part's mesh points."""
+
+import re
+import shutil
+import subprocess
+
+import build123d as bd
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+import surfmod as sm
+from surfmod.cli import main
+from surfmod.cam.roughing import FEED, MAX_RAMP_ANGLE, RAPID
+from surfmod.occ.triangulation import part_triangles
+
+RS274 = shutil.which("rs274")
+needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")
+
+
+def pocket_part():
+    part = bd.Box(24, 16, 6) - bd.Pos(3, 0, 2) * bd.Box(10, 8, 3)
+    return part + bd.Pos(-7, 0, 4) * bd.Cylinder(2.5, 2)
+
+
+@pytest.fixture(scope="module")
+def part_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cam") / "pocket.step"
+    bd.export_step(pocket_part(), str(path))
+    return path
+
+
+@pytest.fixture(scope="module")
+def job(part_file):
+    return sm.machine(str(part_file), 2.0, [sm.Rough(sm.Tool("flat", 2.0), stepdown=1.5, allowance=0.3),
+                                            sm.Finish(sm.Tool("ball", 1.0), scallop=0.05)])
+
+
+def canon(path):
+    """The canonical machine commands rs274 reads from ``path``: (name, numbers) tuples."""
+    out = path.with_suffix(".canon")
+    run = subprocess.run([RS274, "-g", str(path), str(out)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout + run.stderr
+    text = out.read_text()
+    assert "error" not in (run.stdout + run.stderr).lower(), run.stdout + run.stderr
+    cmds = []
+    for line in text.splitlines():
+        m = re.match(r"\s*\d+\s+N\.+\s+([A-Z_0-9]+)\((.*)\)", line)
+        if m:
+            nums = [float(v) for v in re.findall(r"-?\d+\.\d+|-?\d+", m.group(2))] if m.group(1) != "COMMENT" else []
+            cmds.append((m.group(1), nums))
+    return cmds
+
+
+def program_moves(job, digits=4):
+    """The job's moves as written (heights rounded up), consecutive repeats dropped."""
+    out = []
+    for op in job.operations:
+        p = op.motion.points.copy()
+        p[:, 2] = np.ceil(np.round(p[:, 2] * 10**digits, 6)) / 10**digits
+        p[:, :2] = np.round(p[:, :2], digits)
+        for q in p:
+            if not out or np.any(np.abs(out[-1] - q) > 1e-9):
+                out.append(q)
+    return np.array(out)
+
+
+@needs_rs274
+def test_linuxcnc_program_runs_in_rs274(job, tmp_path):
+    path = tmp_path / "job.ngc"
+    sm.export_gcode(job, path, post="linuxcnc")
+    text = path.read_text()
+    assert not re.search(r"\bG(28|30|53|5)\b", text)
+    cmds = canon(path)
+    names = [c[0] for c in cmds]
+    assert names.count("CHANGE_TOOL") == 2
+    assert [c[1][0] for c in cmds if c[0] == "CHANGE_TOOL"] == [1, 2]
+    assert names[-3:].count("PROGRAM_END") == 1 or "PROGRAM_END" in names
+    # per tool: change, length offset, spindle on before the first feed, spindle off after the last
+    spindle, tool = False, None
+    for name, nums in cmds:
+        if name == "CHANGE_TOOL":
+            tool, offset_seen = int(nums[0]), False
+        elif name == "USE_TOOL_LENGTH_OFFSET" and tool is not None:
+            offset_seen = True
+        elif name == "START_SPINDLE_CLOCKWISE":
+            spindle = True
+        elif name == "STOP_SPINDLE_TURNING":
+            spindle = False
+        elif name in ("STRAIGHT_FEED", "ARC_FEED"):
+            assert spindle and tool is not None and offset_seen, "a cut without spindle, tool or G43"
+    assert not spindle
+    # the moves read back are the job's moves
+    moves = np.array([c[1][:3] for c in cmds if c[0] in ("STRAIGHT_FEED", "STRAIGHT_TRAVERSE")])
+    ref = program_moves(job)
+    assert len(moves) >= len(ref) - 2
+    tree = cKDTree(moves)
+    d, _ = tree.query(ref)
+    assert d.max() < 2e-4
+
+
+@needs_rs274
+def test_grbl_one_program_per_tool(job, tmp_path):
+    paths = sm.export_gcode(job, tmp_path / "job.nc", post="grbl")
+    assert [p.name for p in paths] == ["job_T1.nc", "job_T2.nc"]
+    for p in paths:
+        text = p.read_text()
+        assert "M6" not in text and "G43" not in text and "M3" in text and "M30" in text
+        names = [c[0] for c in canon(p)]
+        assert names.index("START_SPINDLE_CLOCKWISE") < names.index("STRAIGHT_FEED")
+
+
+def part_points(job):
+    tri, _ = part_triangles(job.part, 0.01)
+    pts = np.concatenate([tri.reshape(-1, 3), tri.mean(axis=1)])
+    return np.unique(np.round(pts, 9), axis=0)
+
+
+def sample_moves(points, spacing):
+    seg = np.diff(points, axis=0)
+    n = np.maximum(np.ceil(np.linalg.norm(seg[:, :2], axis=1) / spacing).astype(int), 1)
+    t = np.concatenate([np.arange(k) / k for k in n])
+    return np.vstack([np.repeat(points[:-1], n, axis=0) + np.repeat(seg, n, axis=0) * t[:, None], points[-1:]])
+
+
+def deepest_cut(tool, locations, pts, allowance):
+    """Deepest any part point lies inside the tool grown by ``allowance`` (> 0: a gouge)."""
+    tree = cKDTree(pts[:, :2])
+    reach = tool.radius + allowance
+    worst = -np.inf
+    for q, near in zip(locations, tree.query_ball_point(locations[:, :2], reach)):
+        if not near:
+            continue
+        p = pts[near]
+        d = np.hypot(p[:, 0] - q[0], p[:, 1] - q[1])
+        # the tool grown by the allowance: the profile of the tool, widened by it, dropped by it
+        r = np.maximum(d - allowance, 0.0)
+        lift = tool.profile(np.minimum(r, tool.radius))
+        worst = max(worst, float((p[:, 2] - (q[2] - allowance + lift)).max()))
+    return worst
+
+
+def test_roughing_never_enters_the_allowance(job):
+    rough = job.operations[0]
+    pts = part_points(job)
+    cuts = sample_moves(rough.motion.points, 0.2)
+    # the grown flat end: a point at horizontal d > R lies beside the tool, within A of its rim
+    depth = deepest_cut(rough.tool, cuts, pts, 0.0)
+    assert depth <= 1e-3  # the mesh's chordal deflection
+    # and the allowance itself: no part point under the flat end grown by A (a wall point
+    # at exactly R + A beside the axis is where the grown rim touches it)
+    tree = cKDTree(pts[:, :2])
+    worst = -np.inf
+    for q, near in zip(cuts, tree.query_ball_point(cuts[:, :2], rough.tool.radius + 0.3 - 1e-3)):
+        if near:
+            worst = max(worst, float((pts[near, 2] - q[2]).max()))
+    assert worst <= -0.3 + 1e-3
+
+
+def test_finishing_never_gouges(job):
+    fin = job.operations[1]
+    cuts = sample_moves(fin.motion.points, 0.05)
+    depth = deepest_cut(fin.tool, cuts, part_points(job), 0.0)
+    assert depth <= fin.report["tolerance"] + 1e-6
+
+
+def test_entries_and_links(job):
+    safe = job.safe_height
+    for op in job.operations:
+        p, kind = op.motion.points, op.motion.kind
+        seg = np.diff(p, axis=0)
+        rapid = kind[1:] == RAPID
+        level = np.hypot(seg[:, 0], seg[:, 1]) > 1e-9
+        # rapids across run at the clearance height; others are vertical
+        assert np.all(np.abs(p[1:][rapid & level, 2] - safe) < 1e-9)
+        assert np.all(np.abs(p[:-1][rapid & level, 2] - safe) < 1e-9)
+        if op.tool.kind != "ball":
+            # no straight plunge of a flat end below the stock top, ramps no steeper than the limit
+            # (descents of cutting moves below 0.05 mm are lifts onto the exact height where the
+            # grid put a ring a fraction of a cell into the allowance)
+            cut = ~rapid & (seg[:, 2] < -0.05) & (p[1:, 2] < job.stock[1, 2])
+            slope = -seg[cut, 2] / np.maximum(np.hypot(seg[cut, 0], seg[cut, 1]), 1e-300)
+            assert np.all(slope <= np.tan(np.radians(MAX_RAMP_ANGLE)) + 1e-9)
+    assert job.operations[0].motion.kind.tolist().count(FEED) > 100
+
+
+def test_roughing_clears_to_the_allowance(job):
+    """Over the open floor beside the part the roughing reaches the stock bottom, and over the
+    pocket floor its lowest level stands on floor + allowance."""
+    p = job.operations[0].motion.points
+    assert abs(p[:, 2].min() - job.stock[0, 2]) < 1e-9
+    in_pocket = (np.abs(p[:, 0] - 3) < 5 - 2 - 0.3 - 1e-6) & (np.abs(p[:, 1]) < 4 - 2 - 0.3 - 1e-6)
+    assert abs(p[in_pocket, 2].min() - (0.5 + 0.3)) < 1e-6
+
+
+def test_summary_and_times(job):
+    text = str(job)
+    assert "roughing" in text and "finishing" in text and "T1" in text and "T2" in text
+    for op in job.operations:
+        assert op.time_estimate > 0 and op.length > 0
+
+
+def test_cli_machine(part_file, tmp_path, capsys):
+    out = tmp_path / "job.ngc"
+    png = tmp_path / "job.png"
+    assert main(["machine", str(part_file), "--out", str(out), "--stock-margin", "2", "--rough", "flat:2",
+                 "--finish", "ball:1", "--scallop", "0.08", "--stepdown", "2", "--allowance", "0.3",
+                 "--png", str(png), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "roughing" in text and "time estimate" in text and out.is_file()
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    assert "T1 M6" in out.read_text() and "T2 M6" in out.read_text()
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--rough", "flat:0"], "radius"),
+    (["--rough", "bull:2:2"], "corner_radius"),
+    (["--stepdown", "0"], "stepdown"),
+    (["--scallop", "1"], "scallop"),
+    (["--post", "fanuc"], "post"),
+    (["--stock", "-1", "-1", "-1", "1", "1", "1"], "stock"),
+    (["--rough", "flat:1"], "flute_length"),
+])
+def test_cli_bad_input(part_file, tmp_path, capsys, args, word):
+    out = tmp_path / "bad.ngc"
+    base = {"--rough": ["flat:2"], "--finish": ["ball:1"], "--scallop": ["0.08"], "--stock-margin": ["2"]}
+    for k in range(len(args)):
+        if args[k].startswith("--"):
+            base.pop(args[k], None)
+            if args[k] == "--stock":
+                base.pop("--stock-margin", None)
+    argv = ["machine", str(part_file), "--out", str(out), "--no-progress"]
+    for k, v in base.items():
+        argv += [k, *v]
+    argv += args
+    assert main(argv) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and word in err[0]
+    assert not out.exists()
+
+
+def test_no_solid(tmp_path, capsys):
+    path = tmp_path / "face.step"
+    bd.export_step(bd.Face.make_rect(10, 10), str(path))
+    assert main(["machine", str(path), "--out", str(tmp_path / "x.ngc"), "--stock-margin", "2", "--rough",
+                 "flat:2", "--finish", "ball:1", "--scallop", "0.05", "--no-progress"]) == 1
+    assert not (tmp_path / "x.ngc").exists()
