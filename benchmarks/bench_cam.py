@@ -10,9 +10,11 @@ parts, the same triangles on both sides (BRepMesh at 0.05 mm), one core each
 * drop-cutter: ``surfmod.cam.drop_cutter.drop`` (grid build included) at ``POINTS``
   random (x, y) over the part, against OCL's ``BatchDropCutter``.
 
-``ratio`` is OCL's time over ours (≥ 1: not slower than OCL's C++).  The largest
-difference in height (drop-cutter) and the largest distance of an OCL waterline point
-from our loops (relative to the part's size) are printed beside the times.
+``ratio`` is OCL's time over ours (≥ 1: not slower than OCL's C++).  Beside the times:
+the largest difference in height over the part's size (drop-cutter), and the share of
+OCL's waterline points that lie on our loops within 1e-6 of the part's size (OCL's weave
+leaves some stray points off the true contour on small loops; tests/test_waterline.py
+shows them off it with OCL's own drop-cutter).
 
 ``python -m benchmarks cam``
 """
@@ -87,7 +89,7 @@ def rows():
             t0 = time.perf_counter()
             ours = waterline(tri, tool, levels, sampling=SAMPLING)
             t_ours = time.perf_counter() - t0
-            t_ocl, worst = 0.0, 0.0
+            t_ocl, on, total = 0.0, 0, 0
             for z, loops in zip(levels, ours):
                 wl = ocl.Waterline()
                 wl.setSTL(surf)
@@ -101,15 +103,17 @@ def rows():
                 theirs = [np.array([[p.x, p.y] for p in loop]) for loop in wl.getLoops()]
                 if theirs and loops:
                     d = _polyline_distance(np.vstack(theirs), loops)
-                    worst = max(worst, float(np.percentile(d, 99)) / size)
+                    on += int(np.sum(d <= 1e-6 * size))
+                    total += len(d)
             n_pts = sum(len(lp) for loops in ours for lp in loops)
-            yield name, kind, "waterline", f"{LEVELS} levels, {n_pts} pts", t_ours, t_ocl, f"{worst:.1e} (99%)"
+            share = f"{on / total:.2%} on ours" if total else "no loops"
+            yield name, kind, "waterline", f"{LEVELS} levels, {n_pts} pts", t_ours, t_ocl, share
             # drop-cutter
             try:
                 t0 = time.perf_counter()
-                z_ours = drop(TriangleGrid(tri, R), kind, xy)
+                z_ours = drop(TriangleGrid(tri, R), kind, xy, corner=r)
                 t_ours = time.perf_counter() - t0
-            except SurfmodError:
+            except (SurfmodError, TypeError):  # a kind this surfmod.cam does not drop yet
                 yield name, kind, "drop-cutter", "not in surfmod.cam yet", float("nan"), float("nan"), ""
                 continue
             bdc = ocl.BatchDropCutter()
@@ -130,7 +134,7 @@ def rows():
 
 def main() -> None:
     table = Table(("part", 40, "<"), ("tool", 5), ("kernel", 11), ("size", 24), ("ours s", 8), ("OCL s", 8),
-                  ("ratio", 6), ("max diff / size", 15))
+                  ("ratio", 6), ("agreement", 18))
     table.header()
     for name, kind, op, what, t_ours, t_ocl, diff in rows():
         ratio = t_ocl / t_ours if t_ours == t_ours else float("nan")

@@ -236,3 +236,43 @@ def test_cam_part_toolpath_in_stock(tmp_path):
           f"99.5% {np.percentile(r, 99.5):.4f}, share above 0.05: {np.mean(r > 0.05):.3%}")
     assert r.min() > -0.02  # the grid's own reach error stays small
     assert r.max() < 0.08
+
+
+# --- today's finishing paths on corpus parts ---------------------------------------------------
+
+CORPUS_PARTS = ["trimesh_featuretype.STEP", "pythonocc_face_recognition_sample_part.stp",
+                "trimesh_box_sides.STEP", "cadquery_red_cube_blue_cylinder.step"]
+
+
+@needs_rs274
+@pytest.mark.corpus
+@pytest.mark.parametrize("name", CORPUS_PARTS)
+@pytest.mark.parametrize("kind", ["ball", "bull"])
+def test_corpus_finishing_path_in_stock(tmp_path, corpus_dir, name, kind):
+    """``sm.toolpath`` on a corpus part, written by ``sm.export_gcode``, read back by rs274 and
+    run through the stock simulation on the part's box (1 mm of stock on top): no cut
+    below the part's mesh deeper than the path's tolerance (plus the G-code's 4 decimals),
+    no rapid through stock or part."""
+    import surfmod as sm
+    from surfmod.inputs import to_shape
+    from surfmod.occ.triangulation import part_triangles
+
+    shape = to_shape(corpus_dir / name)
+    tool = sm.Tool("ball", 3.0) if kind == "ball" else sm.Tool("bull", 3.0, 1.0)
+    tp = sm.toolpath(shape, tool, stepover=2.5, step=1.0, tolerance=0.02)
+    path = tmp_path / "finish.ngc"
+    tri, deflection = part_triangles(shape, 0.01)
+    lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
+    sm.export_gcode(tp, path, feed=1200, safe_height=float(hi[2]) + 10)
+    prog = parse_canon(run_rs274(path, tmp_path / "finish.txt"))
+    assert len(prog.moves) >= len(tp.points) - 1
+    h = 0.25
+    stock = Stock([lo, hi + [0, 0, 1.0]], h)
+    top = part_height(tri, stock.x, stock.y)
+    cutter = Cutter(kind, 3.0, 1.0 if kind == "bull" else 0.0)
+    rep = simulate(prog, {0: cutter}, stock, top)
+    print(name, kind, rep)
+    assert rep.gouge < tp.tolerance + deflection + 2e-4, str(rep)
+    # a retract straight up from a contact starts touching the part: not below it
+    assert rep.rapid_cut <= 1e-9 and rep.rapid_part <= 1e-9, str(rep)
+    assert rep.cutting_moves > 0
