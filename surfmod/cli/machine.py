@@ -7,7 +7,7 @@ from ..cam.job import Finish, Rough, machine
 from ..cam.post import POSTS, SUFFIXES, export_job, program_paths, programs
 from ..cam.tool import load_tool_table, parse_tool
 from ..errors import SurfmodError
-from ..uses.inputs import to_shape
+from ..inputs import to_shape
 
 
 def register(sub) -> None:
