@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from tqdm import tqdm
 
 from .. import checks
 from ..errors import SurfmodError
@@ -171,8 +172,6 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
     stock down to the part plus its allowance (:mod:`surfmod.cam.roughing`); finishing is
     the gouge-checked drop-cutter path (:func:`surfmod.toolpath`).  Raises
     ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut."""
-    from tqdm import tqdm
-
     from ..occ.uses import bounding_box
 
     shape = to_shape(part, "part")

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import contourpy
 import numpy as np
 from scipy import ndimage
 
@@ -168,8 +169,6 @@ def rough(part_grid: TriangleGrid, lift: float, grown: Tool, tool: Tool, allowan
     out = _Builder()
     out.add([[stock[0, 0], stock[0, 1], safe]], RAPID)
     in_box = (X >= lo_box[0]) & (X <= hi_box[0]) & (Y >= lo_box[1]) & (Y <= hi_box[1])
-    import contourpy
-
     previous = top
     ramps, max_angle = 0, 0.0
     for z in levels:
