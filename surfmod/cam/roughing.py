@@ -183,7 +183,8 @@ def rough(part_grid: TriangleGrid, lift: float, grown: Tool, tool: Tool, allowan
             dist = ndimage.distance_transform_edt(free) * cell
             order = -1
         top_d = float(dist[in_box & free].max())
-        rings_at = 0.5 * cell + stepover * np.arange(int((top_d - 0.5 * cell) / stepover) + 1)
+        # the first ring a cell inside where the tool may stand (half a cell can lie beyond it)
+        rings_at = cell + stepover * np.arange(int(max(top_d - cell, 0.0) / stepover) + 1)
         if order < 0:
             rings_at = rings_at[::-1]
         gen = contourpy.contour_generator(xs, ys, dist.T, line_type=contourpy.LineType.Separate)
