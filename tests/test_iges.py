@@ -102,7 +102,10 @@ def test_corpus_bspline_faces_survive_iges_and_the_libraries(corpus_file, tmp_pa
         assert np.abs(b.points(uu, vv) - s.points(uu, vv)).max() <= 1e-13 * size
         for to, frm in ((sm.to_geomdl, sm.from_geomdl), (sm.to_splipy, sm.from_splipy), (sm.to_rhino, sm.from_rhino)):
             r = frm(to(s))
-            assert r.degree == s.degree and all(np.array_equal(a, c) for a, c in zip(r.knots, s.knots))
+            # OpenNURBS keeps no superfluous end knot: an unclamped vector (stepcode_dm1-id-214's
+            # periodic faces) comes back with its neighbours repeated there, the surface unchanged
+            ends = slice(1, -1) if to is sm.to_rhino else slice(None)
+            assert r.degree == s.degree and all(np.array_equal(a[ends], c[ends]) for a, c in zip(r.knots, s.knots))
             assert np.abs(r.points(uu, vv) - s.points(uu, vv)).max() <= 1e-13 * size
 
 
