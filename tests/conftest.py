@@ -55,6 +55,17 @@ def corpus_file(request):
     return request.param
 
 
+@pytest.fixture(params=JUDGED_FILES or [None], ids=lambda p: p.name if p else "missing")
+def judged_file(request):
+    """Each file of :data:`JUDGED` in turn: for the slow judges that compare two whole
+    evaluations of a part (dense against sampled check, node by node against closed form,
+    OCCT's continuity and normals at every sample, gmsh's tetrahedra); the commands
+    themselves run on every file through ``corpus_file``."""
+    if request.param is None:
+        pytest.fail(f"the judged files of the corpus are missing: {CORPUS}")
+    return request.param
+
+
 @pytest.fixture(scope="session")
 def corpus_dir():
     if not CORPUS_FILES:

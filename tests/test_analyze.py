@@ -169,5 +169,5 @@ def test_one_corpus_file_normals(corpus_dir):
 
 
 @pytest.mark.corpus
-def test_corpus_normals_against_occt(corpus_file):
-    _normals_against_occt(corpus_file)
+def test_corpus_normals_against_occt(judged_file):
+    _normals_against_occt(judged_file)

@@ -170,5 +170,5 @@ def test_check_file_agrees_with_the_dense_check():
 
 
 @pytest.mark.corpus
-def test_check_file_agrees_with_the_dense_check_on_the_corpus(corpus_file):
-    _check_agrees_with_the_dense_check(corpus_file)
+def test_check_file_agrees_with_the_dense_check_on_the_corpus(judged_file):
+    _check_agrees_with_the_dense_check(judged_file)

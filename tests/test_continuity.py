@@ -140,5 +140,5 @@ def test_one_corpus_file_against_occt(corpus_dir):
 
 
 @pytest.mark.corpus
-def test_corpus_continuity_against_occt(corpus_file):
-    _check_against_occt(corpus_file)
+def test_corpus_continuity_against_occt(judged_file):
+    _check_against_occt(judged_file)

@@ -164,15 +164,15 @@ def test_two_solid_assembly_has_no_inverted_tet():
 
 
 @pytest.mark.corpus
-def test_no_inverted_tet_on_any_corpus_solid(corpus_file):
+def test_no_inverted_tet_on_any_corpus_solid(judged_file):
     """Every corpus part volume-meshes with no inverted tetrahedron, and the tetrahedra
     fill the solids: their volume is BRepGProp's within the chordal error of their
     boundary: the measured triangulation's bound where fe_mesh filled a triangulation
     (pythonocc_11752.stp), the sampled chord bound where gmsh meshed the B-rep."""
     from surfmod.occ.uses import gprops, solids_of
 
-    m, vol = _corpus_fe_mesh(corpus_file)
-    reference = sum(abs(gprops(s)["volume"]) for s in solids_of(sm.import_step(corpus_file).wrapped))
+    m, vol = _corpus_fe_mesh(judged_file)
+    reference = sum(abs(gprops(s)["volume"]) for s in solids_of(sm.import_step(judged_file).wrapped))
     bound = m.quality["surface" if "surface" in m.quality else "chordal"]["volume_bound"]
     assert abs(vol.sum() - reference) <= bound
     if "surface" in m.quality:

@@ -141,8 +141,8 @@ def test_trimmed_planes_in_closed_form_equal_node_by_node(corpus_dir):
 
 
 @pytest.mark.corpus
-def test_trimmed_planes_in_closed_form_equal_node_by_node_on_the_corpus(corpus_file):
-    _planes_equal_node_by_node(corpus_file)
+def test_trimmed_planes_in_closed_form_equal_node_by_node_on_the_corpus(judged_file):
+    _planes_equal_node_by_node(judged_file)
 
 
 def _box_minus_cylinder_inertia(a, b, c, r, h, d):

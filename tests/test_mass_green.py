@@ -209,10 +209,10 @@ def test_green_grid_on_a_holed_plate_is_exact(monkeypatch):
 
 
 @pytest.mark.corpus
-def test_green_grid_equals_node_by_node_on_the_corpus(monkeypatch, corpus_file):
+def test_green_grid_equals_node_by_node_on_the_corpus(monkeypatch, judged_file):
     # every trimmed face of every file: the moment integrals (volume, first and second
     # moments) of both routes agree at order 16, where node-by-node Gauss has converged
-    for face in faces_of(sm.import_step(corpus_file).wrapped):
+    for face in faces_of(sm.import_step(judged_file).wrapped):
         mf = mg.mass_face(sm.from_face(face))
         if mf.natural:
             continue
