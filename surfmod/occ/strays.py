@@ -19,7 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepGProp import BRepGProp
 from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
 from OCP.GProp import GProp_GProps
@@ -30,6 +30,7 @@ from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_Ind
 
 from .arrays import pnt, xyz
 from .guard import kernel
+from .topo import pcurve_points
 
 
 class EdgeStray(NamedTuple):
@@ -87,10 +88,7 @@ def edge_strays(shape, samples: int = 17) -> list[EdgeStray]:
                 if index in faces:  # a seam edge: the same face twice (two p-curves)
                     continue
                 faces.append(index)
-                pc = BRepAdaptor_Curve2d(edge, face)
-                surf = BRepAdaptor_Surface(face, False)
-                t = np.linspace(pc.FirstParameter(), pc.LastParameter(), samples)
-                pts = np.array([xyz(surf.Value(q.X(), q.Y())) for q in (pc.Value(float(x)) for x in t)])
+                t, pts = pcurve_points(edge, face, samples)
                 images.append(pts)
                 tolerance = BRep_Tool.Tolerance_s(edge)
                 # at equal parameters (BRepCheck's view): a bound on the true distance that,

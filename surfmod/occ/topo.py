@@ -11,7 +11,7 @@ from .. import transforms
 from ..errors import SurfmodError
 from .guard import check_done, kernel
 from OCP import TopAbs
-from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.BRepBuilderAPI import BRepBuilderAPI_GTransform, BRepBuilderAPI_MakeVertex, BRepBuilderAPI_Transform
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
@@ -215,3 +215,13 @@ def shape_bspline(shape):
             elif not joined.Add(piece, 1e-6, True):
                 raise SurfmodError("wire: edges are not connected end to end")
         return joined.BSplineCurve()
+
+
+def pcurve_points(edge, face, samples: int):
+    """The parameters of ``samples`` equally spaced points of ``edge``'s p-curve on ``face``
+    and their images on the face's surface, ``(t, (samples, 3) points)``: what an edge's
+    3-D curve is measured against (``BRepCheck`` samples the same way)."""
+    pc = BRepAdaptor_Curve2d(edge, face)
+    surf = BRepAdaptor_Surface(face, False)
+    t = np.linspace(pc.FirstParameter(), pc.LastParameter(), samples)
+    return t, np.array([xyz(surf.Value(q.X(), q.Y())) for q in (pc.Value(float(x)) for x in t)])

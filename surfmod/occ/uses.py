@@ -18,9 +18,9 @@ from OCP.TopoDS import TopoDS
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import check_done, kernel
-from .topo import explore as _explore, shells_of, solids_of, wrapped
+from .topo import explore as _explore, pcurve_points, shells_of, solids_of, wrapped
 from OCP.BRep import BRep_Builder
-from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Section
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
@@ -277,10 +277,7 @@ def edge_deviations(shape, samples: int = 23) -> np.ndarray:
             dev = 0.0
             for f in emap.FindFromIndex(k):
                 face = TopoDS.Face_s(f)
-                pc = BRepAdaptor_Curve2d(edge, face)
-                surf = BRepAdaptor_Surface(face, False)
-                tp = np.linspace(pc.FirstParameter(), pc.LastParameter(), samples)
-                ps = np.array([xyz(surf.Value(q.X(), q.Y())) for q in (pc.Value(float(x)) for x in tp)])
+                _, ps = pcurve_points(edge, face, samples)
                 dev = max(dev, float(np.linalg.norm(ps - p3, axis=1).max()))
             props = GProp_GProps()
             BRepGProp.LinearProperties_s(edge, props)
