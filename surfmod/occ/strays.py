@@ -23,14 +23,13 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepGProp import BRepGProp
 from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
 from OCP.GProp import GProp_GProps
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp
-from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
+from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from .arrays import pnt, xyz
 from .guard import kernel
-from .topo import pcurve_points
+from .topo import geometric_edges, pcurve_points
 
 
 class EdgeStray(NamedTuple):
@@ -66,12 +65,7 @@ def edge_strays(shape, samples: int = 17) -> list[EdgeStray]:
     with kernel("edge strays (GeomAPI_ProjectPointOnCurve)"):
         fmap = TopTools_IndexedMapOfShape()
         TopExp.MapShapes_s(shape, TopAbs_FACE, fmap)
-        emap = TopTools_IndexedDataMapOfShapeListOfShape()
-        TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, emap)
-        for k in range(1, emap.Extent() + 1):
-            edge = TopoDS.Edge_s(emap.FindKey(k))
-            if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
-                continue
+        for edge_index, edge, edge_faces in geometric_edges(shape):
             range_ = BRepAdaptor_Curve(edge)
             first, last = range_.FirstParameter(), range_.LastParameter()
             curve = BRep_Tool.Curve_s(edge, first, last)  # a located copy of the 3-D curve
@@ -80,8 +74,7 @@ def edge_strays(shape, samples: int = 17) -> list[EdgeStray]:
             project = GeomAPI_ProjectPointOnCurve()
             project.Init(curve, first, last)
             images, faces, stray = [], [], 0.0
-            for f in emap.FindFromIndex(k):
-                face = TopoDS.Face_s(f)
+            for face in edge_faces:
                 if face.IsNull():
                     continue
                 index = fmap.FindIndex(face) - 1
@@ -109,5 +102,5 @@ def edge_strays(shape, samples: int = 17) -> list[EdgeStray]:
                 gap = float(max(np.linalg.norm(a - b, axis=1).max() for a in images for b in images))
             props = GProp_GProps()
             BRepGProp.LinearProperties_s(edge, props)
-            out.append(EdgeStray(k - 1, tuple(faces), float(BRep_Tool.Tolerance_s(edge)), stray, gap, props.Mass()))
+            out.append(EdgeStray(edge_index, tuple(faces), float(BRep_Tool.Tolerance_s(edge)), stray, gap, props.Mass()))
     return out

@@ -19,7 +19,8 @@ from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.Geom import Geom_TrimmedCurve
 from OCP.GeomConvert import GeomConvert, GeomConvert_CompCurveToBSplineCurve
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_OUT, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from OCP.TopoDS import TopoDS_Shape
 from OCP.gp import gp_GTrsf, gp_Mat, gp_Pnt, gp_Pnt2d, gp_XYZ
 from .analytic import trsf
@@ -225,3 +226,16 @@ def pcurve_points(edge, face, samples: int):
     surf = BRepAdaptor_Surface(face, False)
     t = np.linspace(pc.FirstParameter(), pc.LastParameter(), samples)
     return t, np.array([xyz(surf.Value(q.X(), q.Y())) for q in (pc.Value(float(x)) for x in t)])
+
+
+def geometric_edges(shape):
+    """``(index, edge, faces)`` for every edge of ``shape`` that has a 3-D curve and is not
+    degenerate: its index in ``TopExp``'s edge map (from 0) and the faces that hold it (a
+    seam's face twice), the edges whose curves can be measured against their p-curves."""
+    emap = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, emap)
+    for k in range(1, emap.Extent() + 1):
+        edge = TopoDS.Edge_s(emap.FindKey(k))
+        if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
+            continue
+        yield k - 1, edge, [TopoDS.Face_s(f) for f in emap.FindFromIndex(k)]

@@ -18,7 +18,7 @@ from OCP.TopoDS import TopoDS
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import check_done, kernel
-from .topo import explore as _explore, pcurve_points, shells_of, solids_of, wrapped
+from .topo import explore as _explore, geometric_edges, pcurve_points, shells_of, solids_of, wrapped
 from OCP.BRep import BRep_Builder
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Section
@@ -265,18 +265,12 @@ def edge_deviations(shape, samples: int = 23) -> np.ndarray:
     region only up to that distance."""
     out = []
     with kernel("edge deviations"):
-        emap = TopTools_IndexedDataMapOfShapeListOfShape()
-        TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, emap)
-        for k in range(1, emap.Extent() + 1):
-            edge = TopoDS.Edge_s(emap.FindKey(k))
-            if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
-                continue
+        for _, edge, edge_faces in geometric_edges(shape):
             c3 = BRepAdaptor_Curve(edge)
             t = np.linspace(c3.FirstParameter(), c3.LastParameter(), samples)
             p3 = np.array([xyz(c3.Value(float(x))) for x in t])
             dev = 0.0
-            for f in emap.FindFromIndex(k):
-                face = TopoDS.Face_s(f)
+            for face in edge_faces:
                 _, ps = pcurve_points(edge, face, samples)
                 dev = max(dev, float(np.linalg.norm(ps - p3, axis=1).max()))
             props = GProp_GProps()
