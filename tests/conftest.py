@@ -14,6 +14,8 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
+from surfmod.eval import local
+
 settings.register_profile("reproducible", derandomize=True, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "reproducible"))
@@ -71,3 +73,13 @@ def corpus_dir():
     if not CORPUS_FILES:
         pytest.fail(f"the real-parts corpus is missing: {CORPUS}")
     return CORPUS
+
+
+@pytest.fixture(scope="module")
+def compiled_kernels():
+    """Every evaluation goes through the compiled kernels, however small (by default small
+    work is done in NumPy, eval/vectorized.py): for the tests of the kernels themselves."""
+    saved = local.COMPILED_SCATTERED, local.COMPILED_GRID
+    local.COMPILED_SCATTERED = local.COMPILED_GRID = 0
+    yield
+    local.COMPILED_SCATTERED, local.COMPILED_GRID = saved

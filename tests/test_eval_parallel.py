@@ -13,14 +13,8 @@ import surfmod as sm
 from surfmod.eval import local, parallel, threads
 
 
-@pytest.fixture(autouse=True, scope="module")
-def compiled_kernels():
-    """These tests are of the compiled kernels: every call goes through them, however
-    small (by default small work is done in NumPy, eval/vectorized.py)."""
-    saved = local.COMPILED_SCATTERED, local.COMPILED_GRID
-    local.COMPILED_SCATTERED = local.COMPILED_GRID = 0
-    yield
-    local.COMPILED_SCATTERED, local.COMPILED_GRID = saved
+# the compiled kernels for every call, however small (conftest.compiled_kernels)
+pytestmark = pytest.mark.usefixtures("compiled_kernels")
 
 needs_two = pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="numba may start one thread only")
 

@@ -18,14 +18,8 @@ from surfmod.eval import grid_kernels, local, row_stage, sliding, threads
 from surfmod.occ.sample import surface_d2
 
 
-@pytest.fixture(autouse=True, scope="module")
-def compiled_kernels():
-    """These tests are of the compiled kernels: every call goes through them, however
-    small (by default small work is done in NumPy, eval/vectorized.py)."""
-    saved = local.COMPILED_SCATTERED, local.COMPILED_GRID
-    local.COMPILED_SCATTERED = local.COMPILED_GRID = 0
-    yield
-    local.COMPILED_SCATTERED, local.COMPILED_GRID = saved
+# the compiled kernels for every call, however small (conftest.compiled_kernels)
+pytestmark = pytest.mark.usefixtures("compiled_kernels")
 
 
 def _uniform_surface(n, m, p, q, rational, seed=0):
