@@ -16,12 +16,14 @@ from surfmod.cli import main
 from surfmod.uses import femesh
 
 
+def _refuse(*args, **kwargs):
+    raise femesh._GmshFailure("Invalid boundary mesh (overlapping facets) on surface 1 (forced)")
+
+
 @pytest.fixture
 def brep_fails(monkeypatch):
-    def refuse(*args, **kwargs):
-        raise femesh._GmshFailure("Invalid boundary mesh (overlapping facets) on surface 1 (forced)")
-
-    monkeypatch.setattr(femesh, "_run_gmsh", refuse)
+    # module level, not local: gmsh runs in a child process, which gets the function by name
+    monkeypatch.setattr(femesh, "_run_gmsh", _refuse)
 
 
 def test_cylinder_from_its_triangulation(brep_fails):

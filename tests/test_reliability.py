@@ -327,6 +327,18 @@ def test_11_nan_and_huge_coordinates_are_refused_before_any_use(tmp_path):
     assert len(sm.import_step(huge, max_coordinate=1e21).faces()) == 10  # the caller may raise the limit
     with pytest.raises(sm.DamagedFileError, match=r"^path: .*screw-inf\.step has NaN or infinite coordinates$"):
         sm.import_step(with_x(b"1.E300", "screw-inf.step"))
+    # a control point of inf inside a face: outside the box of edges and bounds, and a
+    # later evaluation of its span crashed OCCT (SIGSEGV in the mass integrator)
+    data = (CORPUS / "stepcode_HEAD_FRONT.stp").read_bytes()
+    old = b"#56=CARTESIAN_POINT('Control Point',(9.84251968504,"
+    assert data.count(old) == 1
+    pole = tmp_path / "head-inf-pole.stp"
+    pole.write_bytes(data.replace(old, b"#56=CARTESIAN_POINT('Control Point',(inf,"))
+    with pytest.raises(sm.DamagedFileError, match=r"^path: .*head-inf-pole\.stp has NaN, infinite or out-of-range "
+                                                  r"numbers in the geometry of (face|p-curve|edge) "):
+        sm.import_step(pole)
+    with pytest.raises(sm.DamagedFileError, match=r"^obj: .*head-inf-pole\.stp has NaN, infinite"):
+        sm.mass_properties(str(pole))
 
 
 # 12 ------------------------------------------------------------------------------------------

@@ -61,9 +61,12 @@ def curvatures(ders: np.ndarray) -> Curvatures:
     l_ = np.einsum("...i,...i->...", suu, n)
     m_ = np.einsum("...i,...i->...", suv, n)
     n_ = np.einsum("...i,...i->...", svv, n)
-    det = e * g - f * f
-    det = np.where(det > 0.0, det, np.finfo(float).tiny)
-    gauss = (l_ * n_ - m_ * m_) / det
-    mean = (e * n_ - 2.0 * f * m_ + g * l_) / (2.0 * det)
-    disc = np.sqrt(np.maximum(mean * mean - gauss, 0.0))
-    return Curvatures(gauss, mean, mean + disc, mean - disc)
+    # non-finite derivatives (a damaged part's geometry) give non-finite curvatures,
+    # which callers test for; numpy's warnings about them would only be noise on stderr
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        det = e * g - f * f
+        det = np.where(det > 0.0, det, np.finfo(float).tiny)
+        gauss = (l_ * n_ - m_ * m_) / det
+        mean = (e * n_ - 2.0 * f * m_ + g * l_) / (2.0 * det)
+        disc = np.sqrt(np.maximum(mean * mean - gauss, 0.0))
+        return Curvatures(gauss, mean, mean + disc, mean - disc)

@@ -34,6 +34,7 @@ import time
 from pathlib import Path
 
 from .. import checks
+from .finite import first_non_finite
 from ..errors import DamagedFileError, SurfmodError
 from .guard import kernel
 
@@ -90,6 +91,15 @@ def _read_and_check(path: str, max_coordinate: float) -> bytes:
         raise SurfmodError(
             f"path: {path} has coordinates up to {size:.3g}, beyond the limit {max_coordinate:.3g} "
             "(max_coordinate=)"
+        )
+    # the box is built from edges and bounds: a control point of inf inside a face is
+    # not in it, and evaluating that span later crashes OCCT
+    with kernel("geometry check"):
+        where = first_non_finite(shape, max_coordinate)
+    if where is not None:
+        raise SurfmodError(
+            f"path: {path} has NaN, infinite or out-of-range numbers in the geometry of {where} "
+            f"(limit {max_coordinate:.3g}, max_coordinate=)"
         )
     with kernel("BinTools.Write"):
         out = io.BytesIO()

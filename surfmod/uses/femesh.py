@@ -6,7 +6,7 @@ The same concept as :mod:`surfmod.cli.femesh` (the ``surfmod femesh`` command ov
 from __future__ import annotations
 
 import tempfile
-import threading
+import time
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -15,14 +15,13 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .. import checks
+from .. import checks, child
 from ..atomic import atomic_path, target_path
 from ..errors import KernelError, SurfmodError
 from ..extras import require
 from ..meshing.brep import tessellate_shape
 from ..inputs import to_shape
 
-_GMSH_LOCK = threading.Lock()  # gmsh keeps global state: one mesh at a time
 
 FORMATS = {".msh": "gmsh", ".vtu": "vtu", ".inp": "abaqus"}
 _CELLS = {("surface", 1): "triangle", ("surface", 2): "triangle6",
@@ -200,29 +199,29 @@ HEALING = {
 
 @contextmanager
 def _gmsh_model(name: str):
-    """gmsh, initialized (if no caller did) and holding one fresh model ``name``, under the
-    process-wide lock (gmsh is one global state).  gmsh's own exceptions become
-    ``_GmshFailure`` (retried healed, then reported); the model is removed afterwards."""
+    """gmsh, initialized (if no caller did) and holding one fresh model ``name`` (gmsh is
+    one global state, and each run has a child process of its own, :func:`_gmsh_in_child`).
+    gmsh's own exceptions become ``_GmshFailure`` (retried healed, then reported); the
+    model is removed afterwards."""
     gmsh = _gmsh()
-    with _GMSH_LOCK:
-        own = not gmsh.isInitialized()
-        if own:
-            gmsh.initialize(interruptible=False)
+    own = not gmsh.isInitialized()
+    if own:
+        gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add(name)
+        yield gmsh
+    except SurfmodError:
+        raise
+    except Exception as exc:
+        raise _GmshFailure(str(exc)) from exc
+    finally:
         try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            gmsh.model.add(name)
-            yield gmsh
-        except SurfmodError:
-            raise
-        except Exception as exc:
-            raise _GmshFailure(str(exc)) from exc
-        finally:
-            try:
-                gmsh.model.remove()
-            except Exception:  # pragma: no cover
-                pass
-            if own:
-                gmsh.finalize()
+            gmsh.model.remove()
+        except Exception:  # pragma: no cover
+            pass
+        if own:
+            gmsh.finalize()
 
 
 def _run_gmsh(brep: Path, msh: Path, dim: int, size: float, order: int, heal: bool) -> dict:
@@ -432,6 +431,9 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     checks.work(estimate, max_elements, "max_elements", f"a {kind} mesh with element size {size:g} of a part of extent {extent:.4g}")
     cell = _CELLS[(kind, order)]
     failures = []
+    # one time budget for all attempts, from the same estimate: gmsh makes well over
+    # GMSH_ELEMENTS_PER_SECOND elements a second on a busy machine; a run past it is stuck
+    deadline = time.monotonic() + GMSH_SECONDS + estimate / GMSH_ELEMENTS_PER_SECOND
 
     with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp, \
             tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:
@@ -441,12 +443,17 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
         # triangulation, of each solid and then of each solid's material regions
         attempts = ATTEMPTS[kind]
         for attempt in attempts:
+            if time.monotonic() >= deadline:
+                failures.append(f"{attempt}: not tried, the time budget was spent")
+                continue
             bar.set_postfix_str(attempt)
             try:
                 if attempt in ("triangulation", "regions"):
-                    quality, surface = _triangulation_attempt(shape, msh, size, order, regions=attempt == "regions")
+                    quality, surface = _triangulation_attempt(shape, msh, size, order, deadline,
+                                                              regions=attempt == "regions")
                 else:
-                    quality = _run_gmsh(brep, msh, 3 if kind == "volume" else 2, size, order, attempt == "healed")
+                    args = (brep, msh, 3 if kind == "volume" else 2, size, order, attempt == "healed")
+                    quality = _gmsh_in_child(_run_gmsh, args, deadline)
             except _GmshFailure as exc:
                 failures.append(f"{attempt}: {exc}")
                 continue
@@ -488,13 +495,27 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
 #: crossing at that curve, which gmsh's boundary recovery rejects).
 ATTEMPTS = {"volume": ("as read", "healed", "triangulation", "regions"), "surface": ("as read", "healed")}
 
+#: fe_mesh's time budget over all its attempts: this many seconds plus one per this many
+#: estimated elements (gmsh makes tens of thousands a second); past it gmsh is stuck
+GMSH_SECONDS = 60.0
+GMSH_ELEMENTS_PER_SECOND = 1000.0
+
 #: The fallback triangulation's chordal tolerance, as a share of the bounding-box diagonal
 #: (the STL standard of ``surfmod mesh``), and at most this share of the element size.
 TRIANGULATION_SHARE = 1e-3
 TRIANGULATION_SIZE_SHARE = 0.25
 
 
-def _triangulation_attempt(shape, msh: Path, size: float, order: int, *, regions: bool = False):
+def _gmsh_in_child(fn, args: tuple, deadline: float):
+    """``fn(*args)`` (a gmsh run) in a child process that must answer by ``deadline``
+    (``time.monotonic()``): gmsh can loop for ever on a damaged face, inside one C call."""
+    try:
+        return child.call(fn, args, max(deadline - time.monotonic(), 1.0), "gmsh")
+    except child.ChildFailure as exc:
+        raise _GmshFailure(str(exc)) from None
+
+
+def _triangulation_attempt(shape, msh: Path, size: float, order: int, deadline: float, *, regions: bool = False):
     """Volume-mesh every solid of ``shape`` from its watertight triangulation, measured
     against the exact faces (:func:`surfmod.meshing.brep.tessellate_shape`), for parts
     whose B-rep gmsh cannot mesh; with ``regions`` each solid is first split into its
@@ -527,7 +548,7 @@ def _triangulation_attempt(shape, msh: Path, size: float, order: int, *, regions
         dev = max(float(mesh.info["max_deviation"]), tolerance)
         deviation = max(deviation, dev)
         bound += mesh.area * dev
-    quality = _run_gmsh_triangulation(surfaces, msh, size, order)
+    quality = _gmsh_in_child(_run_gmsh_triangulation, (surfaces, msh, size, order), deadline)
     return quality, {"tolerance": tolerance, "max_deviation": deviation, "reference_volume": reference,
                      "volume_bound": bound, "regions": len(pieces)}
 

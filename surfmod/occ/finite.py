@@ -1,0 +1,128 @@
+"""Is every number of a shape's geometry finite?  (The STEP reader's last check.)
+
+A damaged STEP file can hold ``inf`` or ``nan`` in a control point that OCCT's reader
+accepts; the bounding box, built from edges and bounds, need not see it, and a later
+evaluation of that span crashes inside OCCT (SIGSEGV in ``BRepAdaptor``).  So the reader's
+worker looks at the numbers themselves: the poles and weights of every B-spline or Bézier
+surface, 3-D curve and p-curve, and a few evaluated points of every other surface and curve
+(an analytic surface's numbers are its placement and radii, which its points carry).
+"""
+
+from __future__ import annotations
+
+import math
+
+import OCP.Geom as G
+import OCP.Geom2d as G2
+from OCP.BRep import BRep_Tool
+from OCP.BRepTools import BRepTools
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+
+# where no B-spline form holds the numbers, these fractions of the range are evaluated
+_FRACTIONS = (0.0, 0.5, 1.0)
+
+
+def _downcast(geom, module):
+    cls = getattr(module, geom.DynamicType().Name(), None)
+    down = cls.DownCast(geom) if cls is not None and hasattr(cls, "DownCast") else None
+    return geom if down is None else down
+
+
+def _basis(geom, module, attribute: str):
+    """Through trimming and offset wrappers (``attribute``: ``BasisSurface`` or
+    ``BasisCurve``) to the geometry that holds the numbers."""
+    for _ in range(8):  # nesting is shallow in any file; bounded anyway
+        geom = _downcast(geom, module)
+        inner = getattr(geom, attribute, None)
+        if inner is None:
+            return geom
+        geom = inner()
+    return _downcast(geom, module)
+
+
+def _finite_xyz(p, limit: float) -> bool:
+    return all(math.isfinite(c) and abs(c) <= limit for c in p.Coord())
+
+
+def _poles_ok(geom, limit: float) -> bool:
+    """The control points (and weights) of a B-spline/Bézier curve or surface."""
+    if hasattr(geom, "NbUPoles"):
+        nu, nv = geom.NbUPoles(), geom.NbVPoles()
+        for i in range(1, nu + 1):
+            for j in range(1, nv + 1):
+                if not _finite_xyz(geom.Pole(i, j), limit) or not math.isfinite(geom.Weight(i, j)):
+                    return False
+        return True
+    for i in range(1, geom.NbPoles() + 1):
+        if not _finite_xyz(geom.Pole(i), limit) or not math.isfinite(geom.Weight(i)):
+            return False
+    return True
+
+
+def _has_poles(geom) -> bool:
+    return hasattr(geom, "NbUPoles") or hasattr(geom, "NbPoles")
+
+
+def _surface_ok(surf, bounds, limit: float) -> bool:
+    surf = _basis(surf, G, "BasisSurface")
+    if _has_poles(surf):
+        return _poles_ok(surf, limit)
+    # a swept surface (revolution, extrusion) carries the numbers of its profile curve
+    profile = getattr(surf, "BasisCurve", None)
+    if profile is not None:
+        curve = _basis(profile(), G, "BasisCurve")
+        if _has_poles(curve) and not _poles_ok(curve, limit):
+            return False
+    u0, u1, v0, v1 = bounds
+    if not all(math.isfinite(b) for b in bounds):
+        return False
+    return all(
+        _finite_xyz(surf.Value(u0 + a * (u1 - u0), v0 + b * (v1 - v0)), limit) for a in _FRACTIONS for b in _FRACTIONS
+    )
+
+
+def _curve_ok(curve, t0: float, t1: float, limit: float, module) -> bool:
+    curve = _basis(curve, module, "BasisCurve")
+    if _has_poles(curve):
+        return _poles_ok(curve, limit)
+    if not (math.isfinite(t0) and math.isfinite(t1)):
+        return False
+    return all(_finite_xyz(curve.Value(t0 + a * (t1 - t0)), limit) for a in _FRACTIONS)
+
+
+def first_non_finite(shape, limit: float) -> str | None:
+    """``None`` when every number is finite and within ``limit``, else what is not
+    (``"face 3"``, ``"edge 12"``, ``"p-curve of edge 4 on face 2"``)."""
+    faces = TopExp_Explorer(shape, TopAbs_FACE)
+    fi = 0
+    while faces.More():
+        fi += 1
+        face = TopoDS.Face_s(faces.Current())
+        faces.Next()
+        surf = BRep_Tool.Surface_s(face)
+        if surf is not None and not _surface_ok(surf, BRepTools.UVBounds_s(face), limit):
+            return f"face {fi}"
+        edges = TopExp_Explorer(face, TopAbs_EDGE)
+        ei = 0
+        while edges.More():
+            ei += 1
+            edge = TopoDS.Edge_s(edges.Current())
+            edges.Next()
+            pcurve, t0, t1 = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0), *BRep_Tool.Range_s(edge)
+            if pcurve is not None and not _curve_ok(pcurve, t0, t1, math.inf, G2):
+                return f"p-curve of edge {ei} on face {fi}"
+    edges = TopExp_Explorer(shape, TopAbs_EDGE)
+    ei = 0
+    while edges.More():
+        ei += 1
+        edge = TopoDS.Edge_s(edges.Current())
+        edges.Next()
+        if BRep_Tool.Degenerated_s(edge):
+            continue
+        curve = BRep_Tool.Curve_s(edge, 0.0, 0.0)
+        t0, t1 = BRep_Tool.Range_s(edge)
+        if curve is not None and not _curve_ok(curve, t0, t1, limit, G):
+            return f"edge {ei}"
+    return None
