@@ -8,7 +8,7 @@ rank  packages / modules
 ====  =========================================================================
 0     errors, tolerances, version: the error contract, the tolerance floors, the version
 1     checks, extras: argument validation at every public door; the optional extras
-2     immutable, transforms, atomic, pictures: frozen arrays, affine maps, atomic writes, the renderer's door
+2     immutable, transforms, atomic, pictures, child: frozen arrays, affine maps, atomic writes, the renderer's door, a foreign call in a child process
 3     eval: the NumPy/numba evaluation core (bases, kernels, frames)
 4     occ: the kernel door, the only package that imports OCP (plain data out)
 5     surface, curve: the two protocols every entity implements
@@ -58,7 +58,7 @@ PACKAGE = ROOT
 RANKS = [
     ["errors", "tolerances", "version"],
     ["checks", "extras"],
-    ["immutable", "transforms", "atomic", "pictures"],
+    ["immutable", "transforms", "atomic", "pictures", "child"],
     ["eval"],
     ["occ"],
     ["surface", "curve"],
