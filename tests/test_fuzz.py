@@ -462,9 +462,10 @@ class Driver:
         ready = select.select([self.proc.stdout], [], [], seconds)[0]
         line = self.proc.stdout.readline() if ready else ""
         if not line:
-            hung = self.proc.poll() is None
+            # readable with nothing to read is end of file: the child died (it may not be
+            # reaped yet, so poll() cannot tell a crash from a hang here)
             self.close()
-            return {"outcome": "hang" if hung else f"crash (exit {self.proc.returncode})"}
+            return {"outcome": f"crash (exit {self.proc.returncode})" if ready else "hang"}
         return json.loads(line)
 
     def close(self):
@@ -483,14 +484,15 @@ def driver():
     d.close()
 
 
-def mutants(files, per_file: int, seed: int, folder: Path):
-    """Damaged copies of ``files``: every mutation kind in turn, ``per_file`` each."""
+def mutants(files, per_file: int, seed: int, folder: Path, shift: int = 0):
+    """Damaged copies of ``files``: every mutation kind in turn (starting ``shift`` kinds
+    on), ``per_file`` each."""
     rng = np.random.default_rng(seed)
     out = []
     for f in files:
         data = f.read_bytes()
         for j in range(per_file):
-            kind = KINDS[(j + len(out)) % len(KINDS)]
+            kind = KINDS[(j + len(out) + shift) % len(KINDS)]
             path = folder / f"{f.stem[:24]}-{j:02d}-{kind}{f.suffix}"
             path.write_bytes(mutate(data, kind, rng))
             out.append(path)
@@ -524,10 +526,11 @@ def test_damaged_step_files_are_refused_cleanly(driver, tmp_path):
 
 
 @pytest.mark.corpus
-def test_damaged_step_files_whole_corpus(driver, tmp_path):
-    # every kind on every judged file (90 cases); each of the 222 of all 37 files is a child
-    # process with its own deadline, too many for CI's hour
-    paths = mutants(JUDGED_FILES, 6, SEED + 1, tmp_path)
+@pytest.mark.parametrize("index", range(len(JUDGED_FILES)), ids=[f.stem for f in JUDGED_FILES])
+def test_damaged_step_files_whole_corpus(driver, tmp_path, index):
+    # every kind on every judged file (90 cases, one test per file); each of the 222 of all
+    # 37 files is a read with its own deadline, too many for CI's hour
+    paths = mutants([JUDGED_FILES[index]], 6, SEED + 1 + index, tmp_path)
     failures = check_import(driver, paths)
     assert not failures, "\n".join(failures)
 
@@ -581,7 +584,11 @@ def test_damaged_step_files_through_the_commands(driver, tmp_path):
 
 
 @pytest.mark.corpus
-def test_damaged_step_files_through_the_commands_corpus(driver, tmp_path):
-    paths = mutants(SMALL, 12, SEED + 3, tmp_path)
+@pytest.mark.parametrize("index", range(len(SMALL)), ids=[f.stem for f in SMALL])
+def test_damaged_step_files_through_the_commands_corpus(driver, tmp_path, index):
+    """Every small corpus file, damaged once for each of the six commands; the mutation
+    kinds turn with the file, so over the files every (command, kind) pair comes three
+    times.  One test per file, so that the corpus run's workers share them out."""
+    paths = mutants([SMALL[index]], len(COMMANDS), SEED + 3 + index, tmp_path, shift=index)
     failures = check_cli(driver, paths, tmp_path)
     assert not failures, "\n".join(failures)
