@@ -17,7 +17,8 @@ exact at every node: closed forms for a ball (the lowest point of the capsule th
 sweeps) and a flat end (the lowest disc position over the node), and for a bull on a
 sloped move a golden-section search of the convex function ``t -> z(t) + f(d(t))``
 (``f`` the tool profile's height at radius ``d``) on the interval where the tool covers
-the node.  Arcs are replaced by chords whose sagitta is at most ``ARC_CHORD``.
+the node.  Arcs are replaced by chords whose sagitta is at most ``ARC_CHORD`` (or the
+readers' ``arc_chord``: the chords lie inside the arc by at most that).
 
 Work and memory are bounded: nodes are visited per move inside the move's box grown by
 the tool radius, moves are batched up to ``PAIRS_PER_BATCH`` (node, move) pairs, and long
@@ -115,7 +116,7 @@ def _numbers(args: str) -> list[float]:
     return [float(v) for v in re.split(r"[,\s]+", args.strip()) if v]
 
 
-def _arc_points(start, end_xy, centre, rotation: int, z_end: float) -> np.ndarray:
+def _arc_points(start, end_xy, centre, rotation: int, z_end: float, chord: float = ARC_CHORD) -> np.ndarray:
     """Chord end points of an XY arc from ``start`` (3,) to ``end_xy`` round ``centre``
     (CCW for rotation > 0, |rotation| - 1 extra full turns), Z linear in the angle."""
     r0 = math.hypot(start[0] - centre[0], start[1] - centre[1])
@@ -128,7 +129,7 @@ def _arc_points(start, end_xy, centre, rotation: int, z_end: float) -> np.ndarra
     else:
         sweep = -((a0 - a1) % (2 * math.pi)) or -2 * math.pi * (turns == 0 and np.allclose(start[:2], end_xy))
         sweep -= 2 * math.pi * turns
-    step = 2 * math.acos(max(1 - ARC_CHORD / max(r0, 1e-12), -1.0)) if r0 > ARC_CHORD else math.pi
+    step = 2 * math.acos(max(1 - chord / max(r0, 1e-12), -1.0)) if r0 > chord else math.pi
     n = max(1, math.ceil(abs(sweep) / max(step, 1e-9)))
     if n > 10_000_000:
         raise ValueError("arc: too many chords")
@@ -139,8 +140,9 @@ def _arc_points(start, end_xy, centre, rotation: int, z_end: float) -> np.ndarra
     return pts
 
 
-def parse_canon(text: str) -> Program:
-    """The moves, tool changes and spindle starts of rs274's canonical output."""
+def parse_canon(text: str, arc_chord: float = ARC_CHORD) -> Program:
+    """The moves, tool changes and spindle starts of rs274's canonical output (arcs as
+    chords of sagitta at most ``arc_chord``)."""
     prog = Program([])
     pos = None
     tool, spindle, offset_tool = 0, False, None
@@ -159,7 +161,7 @@ def parse_canon(text: str) -> Program:
             v = _numbers(args)
             if pos is None:
                 raise ValueError(f"line {i + 1}: arc before any position")
-            pts = _arc_points(pos, (v[0], v[1]), (v[2], v[3]), int(v[4]), v[5])
+            pts = _arc_points(pos, (v[0], v[1]), (v[2], v[3]), int(v[4]), v[5], arc_chord)
             for q in pts:
                 prog.moves.append(Move(pos, q, False, tool, spindle, i + 1))
                 pos = q
@@ -189,7 +191,7 @@ def parse_canon(text: str) -> Program:
 _WORD = re.compile(r"([A-Z])\s*([-+]?\d*\.?\d+)")
 
 
-def parse_gcode(text: str) -> Program:
+def parse_gcode(text: str, arc_chord: float = ARC_CHORD) -> Program:
     """A second reader of the G-code text itself: G0/G1/G2/G3 (I, J or R arcs) with
     X Y Z words, absolute millimetres in the XY plane, T/M6, M3/M4/M5, M2/M30."""
     prog = Program([])
@@ -241,7 +243,7 @@ def parse_gcode(text: str) -> Program:
             else:
                 centre = pos[:2] + np.array([vals.get("I", 0.0), vals.get("J", 0.0)])
             start = pos
-            for q in _arc_points(pos, new[:2], centre, 1 if motion == 3 else -1, new[2]):
+            for q in _arc_points(pos, new[:2], centre, 1 if motion == 3 else -1, new[2], arc_chord):
                 prog.moves.append(Move(start, q, False, tool, spindle, i + 1))
                 start = q
         pos, known = new, True

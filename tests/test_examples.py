@@ -116,6 +116,10 @@ PROMISES = {
         (rf"area {NUM} \(40 x 30 - pi 5\^2 = {NUM}\)", lambda a, b: _close(a, 1200 - 25 * np.pi, 1e-10) and a == b),
         (rf"in 2 pieces, {NUM} long \(30 - 10\)", lambda length: _close(length, 20, 1e-7)),
     ],
+    "cam_machining.py": [
+        (r"^cam_job\.ngc: \d+ lines, (\d+) tool changes", lambda n: int(n) == 2),
+        (r"^GRBL programs \['cam_job_pocket_T1\.nc', 'cam_job_pocket_T2\.nc'\], (\d+) arc words", lambda n: int(n) > 0),
+    ],
     "fit_scan.py": [
         (rf"^fit: .*max deviation {NUM} \(OCCT projection of every point\).* converged (\w+)",
          lambda d, converged: float(d) <= 0.005 and converged == "True"),

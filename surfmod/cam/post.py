@@ -18,6 +18,7 @@ import numpy as np
 
 from ..atomic import atomic_path, target_path
 from ..errors import SurfmodError
+from .arcs import find_arcs
 from .roughing import FEED, RAPID
 
 POSTS = ("linuxcnc", "grbl")
@@ -29,55 +30,79 @@ def _up(values: np.ndarray, digits: int) -> np.ndarray:
     return np.ceil(np.round(values * scale, 6)) / scale
 
 
-def _moves(op, digits: int) -> list[str]:
-    """G0/G1 lines of an operation's motion, feeds modal (written when they change)."""
+def _moves(op, digits: int, arcs: bool = True) -> list[str]:
+    """G0/G1 (and G2/G3) lines of an operation's motion, feeds modal (written when they
+    change).  Circular runs (:func:`surfmod.cam.arcs.find_arcs`, found on the heights as
+    written) become one arc word each, its centre ``I J`` from the written start."""
     pts = np.array(op.motion.points, float)
-    pts[:, 2] = _up(pts[:, 2], digits)
     kind = op.motion.kind
+    # arcs are found on the path itself: an arc between ends rounded up lies above it
+    found = find_arcs(pts, kind) if arcs else []
+    pts[:, 2] = _up(pts[:, 2], digits)
     fmt = f"%.{digits}f"
-    cols = [np.char.mod(fmt, pts[:, k]) for k in range(3)]
+    # rounded first and + 0.0: no "-0.0000" words
+    cols = [np.char.mod(fmt, np.round(pts[:, k], digits) + 0.0) for k in range(3)]
+    arc_at = {a.start: a for a in found if kind[a.start + 1] != RAPID}
     lines, last, feed_now = [], (None, None, None), None
-    for i in range(len(pts)):
+
+    def feed_word(k):
+        nonlocal feed_now
+        f = op.tool.feed if kind[k] == FEED else op.tool.plunge_feed
+        if f == feed_now:
+            return ""
+        feed_now = f
+        return f" F{f:g}"
+
+    i, n = 0, len(pts)
+    while i < n:
         xyz = (cols[0][i], cols[1][i], cols[2][i])
-        if xyz == last:
+        if xyz != last:
+            words = " ".join(f"{a}{v}" for a, v, w in zip("XYZ", xyz, last) if v != w)
+            lines.append(f"G0 {words}" if kind[i] == RAPID else f"G1 {words}{feed_word(i)}")
+            last = xyz
+        arc = arc_at.get(i)
+        if arc is None:
+            i += 1
             continue
-        words = " ".join(f"{a}{v}" for a, v, w in zip("XYZ", xyz, last) if v != w)
-        if kind[i] == RAPID:
-            lines.append(f"G0 {words}")
-        else:
-            f = op.tool.feed if kind[i] == FEED else op.tool.plunge_feed
-            if f != feed_now:
-                words += f" F{f:g}"
-                feed_now = f
-            lines.append(f"G1 {words}")
-        last = xyz
+        j = arc.end
+        end = (cols[0][j], cols[1][j], cols[2][j])
+        words = f"X{end[0]} Y{end[1]}" + (f" Z{end[2]}" if end[2] != last[2] else "")
+        ij = [fmt % (round(arc.centre[k] - float(last[k]), digits) + 0.0) for k in range(2)]
+        lines.append(f"{'G3' if arc.ccw else 'G2'} {words} I{ij[0]} J{ij[1]}{feed_word(j)}")
+        last, i = end, j  # a next arc may start where this one ends
     return lines
 
 
-def _operation(op, job, post: str, digits: int, coolant: bool) -> list[str]:
+def _operation(op, job, post: str, digits: int, coolant: bool, arcs: bool) -> list[str]:
     t = op.tool
     safe = f"{_up(np.array([job.safe_height]), digits)[0]:.{digits}f}"
-    out = [f"(operation: {op.name}, tool {t.number}: {t}, flute length {t.flute_length:g} mm)",
+    out = [_comment(f"operation: {op.name}, tool {t.number}: {t}, flute length {t.flute_length:g} mm"),
            f"(estimated time {op.time_estimate:.0f} s, cutting length {op.length:.0f} mm)"]
     if post == "linuxcnc":
         out += [f"T{t.number} M6", f"G43 H{t.number}"]
     out += [f"G0 Z{safe}", f"S{t.spindle:.0f} M3"]
     if coolant:
         out.append("M8")
-    out += _moves(op, digits)
+    out += _moves(op, digits, arcs)
     out += [f"G0 Z{safe}"] + (["M9"] if coolant else []) + ["M5"]
     return out
 
 
+def _comment(text: str) -> str:
+    """A comment: RS274NGC comments do not nest, so parentheses inside become brackets."""
+    return "(" + text.replace("(", "[").replace(")", "]") + ")"
+
+
 def _header(job, title: str) -> list[str]:
     lo, hi = job.stock
-    return ["%", f"({title})",
+    return ["%", _comment(title),
             f"(stock X{lo[0]:g}..{hi[0]:g} Y{lo[1]:g}..{hi[1]:g} Z{lo[2]:g}..{hi[2]:g} mm, part coordinates)",
             "G21 G90 G17 G94 (mm, absolute, XY plane, feed per minute)", "G40 G49 G80 (no compensation, no offset)"]
 
 
-def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = False) -> list[str]:
-    """The program texts of ``job``: one for ``"linuxcnc"``, one per tool for ``"grbl"``."""
+def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = False, arcs: bool = True) -> list[str]:
+    """The program texts of ``job``: one for ``"linuxcnc"``, one per tool for ``"grbl"``;
+    circular runs of the moves as ``G2``/``G3`` unless ``arcs=False`` (all ``G1``)."""
     if post not in POSTS:
         raise SurfmodError(f"post: expected one of {', '.join(POSTS)}, got {post!r}")
     if int(digits) != digits or not 1 <= digits <= 6:
@@ -85,7 +110,7 @@ def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = Fa
     if post == "linuxcnc":
         body = _header(job, f"surfmod job: {len(job.operations)} operations, LinuxCNC")
         for op in job.operations:
-            body += _operation(op, job, post, digits, coolant)
+            body += _operation(op, job, post, digits, coolant, bool(arcs))
         return ["\n".join(body + ["M30", "%", ""])]
     texts = []
     for number in dict.fromkeys(op.tool.number for op in job.operations):
@@ -93,7 +118,7 @@ def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = Fa
         body = _header(job, f"surfmod job, GRBL program for tool {number}: {ops[0].tool}; change the tool, "
                             f"set its length, then run")
         for op in ops:
-            body += _operation(op, job, post, digits, coolant)
+            body += _operation(op, job, post, digits, coolant, bool(arcs))
         texts.append("\n".join(body + ["M30", "%", ""]))
     return texts
 
