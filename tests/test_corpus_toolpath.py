@@ -58,18 +58,21 @@ def run_and_judge_flat(part, tmp_path, capsys):
     assert flat_cuts(material(shape), moves, radius, depth, moves[:, 2].max() + radius) == []
 
 
-#: the exact judge places the flat cutter along every move and asks OCCT for its distance
-#: to the part: on the largest part (11752, 1018 faces) that alone ran over eight minutes
-#: on the 2-core CI machine, so the flat-end sweep leaves out the two largest parts (with
-#: box_sides, 417 faces) and covers the other ten; the ball sweep below covers every file of conftest.JUDGED.
+#: the exact flat-end judge places the cutter at most r/20 apart along every move, closer
+#: still where the tip height changes (a quarter of the depth between placements), and asks
+#: OCCT for each placement's distance to the part: 50 s or less on these five files, but
+#: 21 and 19 minutes on axom_sliced_cylinder and nist_ftc_11 (their steep walls), 4 on
+#: linkrods and over 8 on 11752, on the 2-core CI machine.  So it judges this named subset
+#: (planes, cylinders, cones, B-splines, an assembly); the ball judge below covers every
+#: file of conftest.JUDGED, and the flat path's own check runs on every file.
 #: On Ventilator (9903 flat-end locations over 305 faces) the judge ran over 25 minutes:
-#: its moves are judged where the path was lifted (the test after the sweep)
-FLAT_TOO_SLOW_TO_JUDGE = {"pythonocc_11752.stp", "trimesh_box_sides.STEP", "pythonocc_Ventilator.stp"}
+#: its moves are judged where the path was lifted (the test after the sweep).
+FLAT_JUDGED = ("pythonocc_face_recognition_sample_part.stp", "cadquery_red_cube_blue_cylinder.step",
+               "pythonocc_as1-oc-214.stp", "pythonocc_as1_pe_203.stp", "occt_screw.step")
 
 
 @pytest.mark.corpus
-@pytest.mark.parametrize("corpus_file", [p for p in JUDGED_FILES if p.name not in FLAT_TOO_SLOW_TO_JUDGE],
-                         ids=lambda p: p.name)
+@pytest.mark.parametrize("corpus_file", [p for p in JUDGED_FILES if p.name in FLAT_JUDGED], ids=lambda p: p.name)
 def test_corpus_flat_end_toolpath_never_gouges(corpus_file, tmp_path, capsys):
     run_and_judge_flat(corpus_file, tmp_path, capsys)
 

@@ -106,7 +106,7 @@ def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float)
     """Indices of moves where the flat end, shrunk by ``depth``, meets the part.  Each
     cylinder is measured against the faces whose bounding boxes meet its own (the same
     distance as against the whole part, found faster)."""
-    faces, boxes = _face_boxes(getattr(part, "wrapped", part))
+    faces, boxes = face_boxes(getattr(part, "wrapped", part))
     rho = radius - depth
     bad = []
     for i in range(len(points) - 1):
@@ -118,7 +118,7 @@ def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float)
         near = np.nonzero(np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1))[0]
         if not len(near):
             continue
-        target = _compound(faces[k] for k in near)
+        target = compound(faces[k] for k in near)
         for t in np.linspace(0.0, 1.0, n + 1):
             p = a + t * (b - a)
             axis = gp_Ax2(gp_Pnt(float(p[0]), float(p[1]), float(p[2] + depth)), gp_Dir(0, 0, 1))
@@ -131,7 +131,7 @@ def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float)
     return bad
 
 
-def _compound(shapes):
+def compound(shapes):
     from OCP.BRep import BRep_Builder
     from OCP.TopoDS import TopoDS_Compound
 
@@ -142,7 +142,7 @@ def _compound(shapes):
     return compound
 
 
-def _face_boxes(part):
+def face_boxes(part):
     """The faces of ``part`` and their OCCT bounding boxes ``(F, 2, 3)``."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
