@@ -83,3 +83,24 @@ def compiled_kernels():
     local.COMPILED_SCATTERED = local.COMPILED_GRID = 0
     yield
     local.COMPILED_SCATTERED, local.COMPILED_GRID = saved
+
+
+#: Tests of a minute or more on the 2-core CI machine (the corpus judges), collected first:
+#: pytest-xdist's workers start on them and the short tests fill in behind, instead of one
+#: long test arriving last and leaving the other worker idle for its whole run.
+SLOW_FIRST = (
+    "test_corpus_toolpath.py::test_corpus_toolpath_never_gouges",
+    "test_corpus_toolpath.py::test_corpus_flat_end",
+    "test_corpus_toolpath.py::test_ventilator",
+    "test_stock_sim.py::test_corpus_finishing_path_in_stock",
+    "test_cam_job_proof.py::",
+    "test_fuzz.py::test_damaged_step_files_through_the_commands_corpus",
+    "test_open_shells.py::test_open_shells_of_corpus_parts",
+    "test_mass_green.py::test_green_grid_equals_node_by_node_on_the_corpus",
+    "test_femesh.py::test_no_inverted_tet_on_any_corpus_solid",
+    "test_femesh_fallback.py::test_11752",
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    items.sort(key=lambda item: not any(key in item.nodeid for key in SLOW_FIRST))  # stable
