@@ -1,0 +1,514 @@
+"""Finishing in a job: the drop-cutter raster over the whole part, waterline (constant-Z)
+contours on its steep regions, and a report of the rest the tool cannot reach.
+
+**The scallop rule.**  Passes of a ball (or a bull's corner, radius ``c``) a distance
+``s`` apart along the surface leave cusps ``c - sqrt(c² - (s/2)²)`` (convex and flat
+ground; concave ground of curvature radius ``ρ`` adds about ``s²/(8(ρ - c))``).  The raster's passes
+are ``s_xy`` apart in (x, y), ``s_xy / cos φ`` apart along ground that slopes by ``φ``
+across them, so its stepover is the scallop's ``s`` times ``cos φ_max``, ``φ_max`` the
+steepest cross slope of the part's triangles below the threshold ``steep_angle``.
+Waterline levels ``Δz`` apart lie ``Δz / sin θ`` apart along a wall of slope ``θ``, so
+``Δz = s · sin θ_min``, ``θ_min`` the least slope (at least the threshold) of the steep
+triangles near each level: on a vertical wall the levels stand ``s`` apart.  The raster
+runs everywhere (its cusps on the steep regions are cut again by the contours; its length
+there is the steep regions' small (x, y) footprint), the contours only on the steep
+pieces of each level's loops.  The scallop budget is the asked one less what exactness
+costs: the mesh's deflection and the lift over it (:mod:`surfmod.cam.toolpath`), and for
+the contours the margin they keep from the mesh.
+
+**Exact and gouge-free contours.**  The waterline (:func:`surfmod.cam.waterline.waterline`)
+is computed for the tool grown by ``g`` (its Minkowski sum with a ball of radius ``g``:
+ball ``R + g``, bull ``(R + g, c + g)``, a flat end the bull ``(R + g, g)``; tip ``g``
+lower), ``g`` the mesh's chordal deflection plus the contours' chord tolerance, so the
+real tool along every chord keeps at least the deflection from every triangle and never
+touches the faces themselves: on a wall of slope θ a mesh-deep gouge would be
+``1 / cos θ`` deeper measured vertically.  Every move is then judged like the raster's
+(:func:`~surfmod.cam.toolpath_moves.move_gouge` against the drop-cutter heights) and lifted
+where it would cut (never needed by construction; reported as ``lifted``).
+
+**Links** between contours run along the part when the straight move stays clear of it
+and is short (at most a tool radius across, no more than one level down); otherwise the
+tool goes up at the feed to above the stock the roughing can have left (:class:`Rest`),
+then rapidly to the clearance height, across, down to that height, and enters as the raster
+does (a ball plunges, a flat or bull end helixes).
+
+**Rest.**  On an (x, y) grid, the part's top (a vertical ray onto the triangles) and the
+opening of it by the tool's lower surface (the lowest the tool's surface comes over each
+node among all drop-cutter positions): where the opening stands more than the scallop
+above the part, the finishing tool cannot reach (corners and slots narrower than the
+tool, the fillet a ball leaves where a wall meets a floor).  Its area, deepest point and
+box are reported, not cut.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+from scipy import ndimage
+
+from ..errors import SurfmodError
+from .drop_cutter import TriangleGrid, drop
+from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Motion
+from .tool import Tool
+from .toolpath import REFINE_SHARE, _Part, raster_path
+from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
+from .waterline import waterline
+
+#: Steep regions: slopes within this many degrees below the threshold count too (the
+#: classification samples the drop-cutter surface, the raster's slope bound its triangles).
+STEEP_MARGIN = 1.0
+#: Clearance (mm) of entries and retracts above the highest stock the roughing can have left.
+REST_CLEARANCE = 1.0
+#: Grid spacing of the rest map: a tool radius over this, or the part's size over REST_CELLS.
+REST_PER_RADIUS = 8
+REST_CELLS = 500
+
+
+@dataclass(frozen=True)
+class Rest:
+    """What a roughing pass left: over any (x, y) column, stock at most ``above`` higher
+    than the part's highest point within ``reach`` of the column (the roughing tool's
+    radius plus its allowance: its grown tool stood at every column it could, levels
+    ``stepdown`` apart)."""
+
+    reach: float
+    above: float
+
+
+class _StockTop:
+    """The height above which no stock is left over the finishing tool's footprint."""
+
+    def __init__(self, part: _Part, tool: Tool, rest: Rest | None, stock: np.ndarray, safe: float):
+        self.part, self.rest, self.stock, self.safe = part, rest, stock, safe
+        self.grid = None if rest is None else TriangleGrid(part.grid.triangles, tool.radius + rest.reach)
+
+    def __call__(self, xy) -> np.ndarray:
+        xy = np.asarray(xy, float).reshape(-1, 2)
+        if self.grid is None:
+            return np.full(len(xy), min(float(self.stock[1, 2]) + REST_CLEARANCE, self.safe))
+        h = drop(self.grid, "flat", xy)  # the highest part point within the reach of the footprint
+        h = np.nan_to_num(h, nan=float(self.stock[0, 2])) + self.part.lift + self.rest.above + REST_CLEARANCE
+        return np.minimum(h, self.safe)
+
+
+class _Moves:
+    def __init__(self):
+        self.points, self.kinds = [], []
+
+    def add(self, pts, kind):
+        pts = np.atleast_2d(np.asarray(pts, float))
+        self.points.append(pts)
+        self.kinds.append(np.full(len(pts), kind, np.int8))
+
+    @property
+    def last(self):
+        return self.points[-1][-1] if self.points else None
+
+    def motion(self) -> Motion:
+        return Motion(np.concatenate(self.points), np.concatenate(self.kinds))
+
+
+def _enter(out: _Moves, p, top: float, part: _Part, tool: Tool, safe: float):
+    """From the clearance height over ``p``: rapid down to ``top`` (above any stock left),
+    then a ball plunges, a flat or bull end helixes (half its radius) onto ``p``."""
+    out.add([[p[0], p[1], safe]], RAPID)
+    if tool.kind == "ball" or top <= p[2]:
+        out.add([[p[0], p[1], max(top, p[2])]], RAPID)
+        out.add([p], PLUNGE)
+        return
+    rho = tool.radius / 2
+    turns = max(1, int(np.ceil((top - p[2]) / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * rho))))
+    t = np.linspace(0, 1, 48 * turns + 1)
+    helix = p[:2] + rho * np.column_stack([np.cos(2 * np.pi * turns * t) - 1, np.sin(2 * np.pi * turns * t)])
+    hz = np.maximum(top - (top - p[2]) * t, np.nan_to_num(part.height(helix), nan=-np.inf))
+    out.add([[helix[0, 0], helix[0, 1], max(top, hz[0])]], RAPID)
+    out.add(np.column_stack([helix, hz]), PLUNGE)
+    out.add([p], PLUNGE)
+
+
+def _leave(out: _Moves, top: float, safe: float):
+    """Up at the feed to above the stock left, then rapidly to the clearance height."""
+    p = out.last
+    if p[2] < top:
+        out.add([[p[0], p[1], top]], FEED)
+    out.add([[p[0], p[1], safe]], RAPID)
+
+
+def _normals(tri: np.ndarray) -> np.ndarray:
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n *= np.where(n[:, 2:3] < 0, -1.0, 1.0)
+    length = np.linalg.norm(n, axis=1)
+    return n / np.where(length > 0, length, 1.0)[:, None]
+
+
+def _circle_spacing(c: float, h: float) -> float:
+    """Distance between passes of a circle of radius ``c`` leaving cusps ``h``."""
+    h = min(h, c)
+    return 2.0 * math.sqrt(max(2.0 * c * h - h * h, 0.0))
+
+
+def _levels(tri, slope, steep, spacing, top, bottom, reach):
+    """Tip heights from ``top`` down to ``bottom``: each next one ``spacing · sin θ_min``
+    lower, ``θ_min`` the least slope of the steep triangles within the tool's reach of the
+    band; heights with no steep triangle near are skipped."""
+    lo_t, hi_t = tri[steep, :, 2].min(axis=1), tri[steep, :, 2].max(axis=1)
+    s_sl = np.sin(np.radians(slope[steep]))
+
+    def near(z):
+        return (hi_t >= z - spacing) & (lo_t <= z + reach + spacing)
+
+    out, z = [], top
+    while z > bottom:
+        here = near(z)
+        if here.any():
+            out.append(z)
+            z -= spacing * float(s_sl[here].min())
+        else:  # jump down to the next steep triangle
+            below = hi_t[hi_t < z - spacing]
+            if not len(below):
+                break
+            z = float(below.max()) + 0.5 * spacing
+    if z <= bottom and near(bottom).any() and (not out or out[-1] > bottom + 1e-9):
+        out.append(bottom)
+    return np.array(out, float)
+
+
+def _pieces(loop: np.ndarray, keep: np.ndarray):
+    """Runs of ``keep`` along a closed ``loop``, each grown by one point at either end;
+    the whole loop closed (first point repeated) when all of it is kept."""
+    n = len(loop)
+    if keep.all():
+        return [np.vstack([loop, loop[:1]])]
+    k0 = int(np.argmin(keep))
+    idx = np.roll(np.arange(n), -k0)
+    flags = keep[idx]
+    out, start = [], None
+    for i in range(n + 1):
+        on = flags[i] if i < n else False
+        if on and start is None:
+            start = i
+        elif not on and start is not None:
+            sel = idx[np.arange(start - 1, i + 1) % n]
+            out.append(loop[sel])
+            start = None
+    return out
+
+
+def _chord(part: _Part, tool: Tool, tolerance: float) -> float:
+    """Chord tolerance of the contours (their margin from the mesh is it plus the mesh's deflection)."""
+    return max(min(tolerance / 8, 1e-3 * tool.radius), 1e-7 * float(np.max(part.box[1] - part.box[0])))
+
+
+def _grown(tool: Tool, g: float):
+    if tool.kind == "ball":
+        return SimpleNamespace(kind="ball", radius=tool.radius + g)
+    return SimpleNamespace(kind="bull", radius=tool.radius + g, corner_radius=tool.corner + g)
+
+
+def _judge(part: _Part, pts: np.ndarray, allowed: float):
+    """Gouge-check one polyline; lift what would cut (returns points, lift)."""
+    if len(pts) < 2:
+        return pts, 0.0
+    depth = move_gouge(part.height, pts)
+    if depth.max() <= allowed:
+        return pts, 0.0
+    pts, lift, depth = lift_moves(part.height, pts, depth, REFINE_SHARE * allowed)
+    if depth.max() > allowed:
+        raise NoSafePathError(f"toolpath: no safe path: a waterline move still cuts {depth.max():.3g} deep")
+    return pts, float(lift.max())
+
+
+def waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float):
+    """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
+    the top of its steep triangles (slope ≥ ``steep_angle``) down to ``bottom``, ``spacing``
+    the distance of neighbouring levels along the walls.  Returns ``(pieces, info)``:
+    pieces per level (top first), each ``(N, 3)``, closed ones with their first point
+    repeated, and a report dict."""
+    tri = part.grid.triangles
+    n = _normals(tri)
+    slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
+    steep = slope >= steep_angle - STEEP_MARGIN
+    info = {"levels": 0, "z_spacing": (0.0, 0.0), "contours": 0, "length": 0.0, "spacing": spacing, "lifted": 0.0}
+    if not steep.any():
+        return [], info
+    chord = _chord(part, tool, tolerance)
+    g = chord + part.deflection  # the tool keeps the mesh's whole deflection from it (walls amplify any gouge)
+    reach = tool.corner if tool.kind != "flat" else 0.0
+    levels = _levels(tri, slope, steep, spacing, float(tri[steep, :, 2].max()), bottom, reach + tool.radius)
+    if not len(levels):
+        return [], info
+    grown = _grown(tool, g)
+    loops = waterline(tri, grown, levels - g, sampling=tool.radius / 2, tolerance=chord)
+    allowed = tolerance - part.deflection + part.lift
+    w = 0.25 * spacing
+    bottom_z = bottom
+    out, lifted, count, length = [], 0.0, 0, 0.0
+    for z, level in zip(levels, loops):
+        pieces = []
+        for loop in level:
+            xy = loop[:, :2]
+            tangent = np.roll(xy, -1, axis=0) - np.roll(xy, 1, axis=0)
+            tangent /= np.maximum(np.linalg.norm(tangent, axis=1), 1e-300)[:, None]
+            outward = np.column_stack([tangent[:, 1], -tangent[:, 0]])  # the material lies on the left
+            h_in = np.nan_to_num(part.height(xy - w * outward), nan=bottom_z)
+            h_out = np.nan_to_num(part.height(xy + w * outward), nan=bottom_z)
+            cl_slope = np.degrees(np.arctan2(np.maximum(h_in - h_out, 0.0), 2 * w))
+            keep = cl_slope >= steep_angle - STEEP_MARGIN
+            if not keep.any():
+                continue
+            for piece in _pieces(np.column_stack([xy, np.full(len(xy), z)]), keep):
+                if len(piece) < 2:
+                    continue
+                piece, lift = _judge(part, piece, allowed)
+                lifted = max(lifted, lift)
+                pieces.append(piece)
+                count += 1
+                length += float(np.linalg.norm(np.diff(piece, axis=0), axis=1).sum())
+        out.append(pieces)
+    gaps = -np.diff(levels)
+    info.update(levels=len(levels), z_spacing=(float(gaps.min()) if len(gaps) else 0.0,
+                                               float(gaps.max()) if len(gaps) else 0.0),
+                contours=count, length=length, lifted=lifted, top=float(levels[0]), bottom=float(levels[-1]),
+                margin=g)
+    return out, info
+
+
+def _link_clear(part: _Part, a, b, allowed: float, step: float) -> np.ndarray | None:
+    """The straight move a -> b sampled ``step`` apart, if it stays clear of the part."""
+    n = int(np.ceil(np.linalg.norm(b[:2] - a[:2]) / step)) + 1
+    pts = a + np.linspace(0, 1, n + 1)[:, None] * (b - a)
+    if move_gouge(part.height, pts).max() > REFINE_SHARE * allowed:
+        return None
+    return pts[1:]
+
+
+def order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
+                 max_down: float):
+    """Append the pieces level by level (top first), each level's nearest first, linked
+    along the part where short and clear, else up and over."""
+    allowed = tolerance - part.deflection + part.lift
+    links = 0
+    for pieces in levels:
+        todo = list(pieces)
+        while todo:
+            here = out.last
+            best, best_d, best_k = None, np.inf, 0
+            for j, pc in enumerate(todo):
+                closed = len(pc) > 2 and np.all(pc[0] == pc[-1])
+                cand = pc[:-1] if closed else pc[:1]
+                d = np.linalg.norm(cand[:, :2] - here[:2], axis=1)
+                k = int(np.argmin(d))
+                if d[k] < best_d:
+                    best, best_d, best_k = j, float(d[k]), k
+            pc = todo.pop(best)
+            if len(pc) > 2 and np.all(pc[0] == pc[-1]) and best_k:
+                pc = np.vstack([pc[best_k:-1], pc[:best_k + 1]])
+            drop_z = here[2] - pc[0, 2]
+            path = None
+            if here[2] < safe and best_d <= tool.radius and -1e-9 <= drop_z <= max_down:
+                path = _link_clear(part, here, pc[0], allowed, tool.radius / 8)
+            if path is not None:
+                out.add(path, PLUNGE if drop_z > 1e-9 else FEED)
+                links += 1
+            else:
+                if here[2] < safe:
+                    _leave(out, float(top(here[None, :2])[0]), safe)
+                _enter(out, pc[0], float(top(pc[:1, :2])[0]), part, tool, safe)
+            out.add(pc[1:], FEED)
+    return links
+
+
+def raster_stepover(part: _Part, tool: Tool, scallop: float, steep_angle: float | None, direction: str):
+    """The raster's stepover for cusps of ``scallop`` across ground sloping up to the
+    steepest cross slope of the part's triangles below ``steep_angle`` (all of them when
+    None); returns ``(stepover, that slope in degrees)``."""
+    tri = part.grid.triangles
+    n = _normals(tri)
+    slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
+    shallow = slope < (90.0 if steep_angle is None else steep_angle)
+    across = 1 if direction == "x" else 0
+    cross = np.degrees(np.arctan2(np.abs(n[shallow, across]), n[shallow, 2])) if shallow.any() else np.zeros(1)
+    phi = float(min(cross.max(), 89.0))
+    circ = _circle_spacing(tool.corner, scallop)
+    if tool.kind == "bull" and phi < 1.0:  # the flat core counts only on level ground
+        return 2.0 * tool.core + circ, phi
+    return circ * math.cos(math.radians(phi)), phi
+
+
+# ----------------------------------------------------------------------------------------------
+# rest
+
+def height_field(tri: np.ndarray, x: np.ndarray, y: np.ndarray, block: int = 2_000_000) -> np.ndarray:
+    """Highest triangle over each node of the grid ``x`` × ``y`` (-inf where none).
+
+    >>> tri = np.array([[[0, 0, 1], [2, 0, 1], [0, 2, 3]]], float)
+    >>> height_field(tri, np.array([0.5, 3.0]), np.array([0.5])).tolist()
+    [[1.5], [-inf]]
+    """
+    top = np.full((len(x), len(y)), -np.inf)
+    lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
+    i0, i1 = np.searchsorted(x, lo[:, 0] - 1e-12), np.searchsorted(x, hi[:, 0] + 1e-12, "right")
+    j0, j1 = np.searchsorted(y, lo[:, 1] - 1e-12), np.searchsorted(y, hi[:, 1] + 1e-12, "right")
+    ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
+    counts = ni * nj
+    edges = np.r_[0, np.cumsum(counts)]
+    s0 = 0
+    while s0 < len(counts):
+        # triangles in blocks of at most `block` (triangle, node) pairs
+        s_next = max(int(np.searchsorted(edges, edges[s0] + block, "right")) - 1, s0 + 1)
+        ids = np.arange(s0, min(s_next, len(counts)))
+        s0 = s_next
+        c = counts[ids]
+        t = np.repeat(ids, c)
+        local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
+        ii = i0[t] + local // np.maximum(nj[t], 1)
+        jj = j0[t] + local % np.maximum(nj[t], 1)
+        A, v0, v1 = tri[t, 0], tri[t, 1] - tri[t, 0], tri[t, 2] - tri[t, 0]
+        den = v0[:, 0] * v1[:, 1] - v1[:, 0] * v0[:, 1]
+        good = np.abs(den) > 1e-300
+        den = np.where(good, den, 1.0)
+        wx, wy = x[ii] - A[:, 0], y[jj] - A[:, 1]
+        l1 = (wx * v1[:, 1] - v1[:, 0] * wy) / den
+        l2 = (v0[:, 0] * wy - wx * v0[:, 1]) / den
+        inside = good & (l1 >= -1e-12) & (l2 >= -1e-12) & (l1 + l2 <= 1 + 1e-12)
+        z = A[:, 2] + l1 * v0[:, 2] + l2 * v1[:, 2]
+        np.maximum.at(top, (ii[inside], jj[inside]), z[inside])
+    return top
+
+
+def rest_left(part: _Part, tool: Tool, floor: float, threshold: float, spacing: float | None = None) -> dict:
+    """Where ``tool`` cannot reach the part's top-visible surface by more than
+    ``threshold``: ``area`` (mm²), ``max_depth`` (vertical, mm), ``box``
+    ``[[x0, y0], [x1, y1]]`` (None when nowhere), ``regions``, the grid ``spacing`` and
+    ``map`` ``(x, y, rest)``: the nodes and the height of the rest over each (NaN off the part).
+    ``floor``: the lowest the tool may go where it touches nothing (the stock's bottom)."""
+    tri = part.grid.triangles
+    lo, hi = part.box
+    h = float(spacing) if spacing else max(tool.radius / REST_PER_RADIUS, float(np.max(hi[:2] - lo[:2])) / REST_CELLS)
+    x = np.arange(lo[0], hi[0] + 0.5 * h, h)
+    y = np.arange(lo[1], hi[1] + 0.5 * h, h)
+    top = height_field(tri, x, y)
+    m = int(math.floor(tool.radius / h))
+    px = lo[0] + h * np.arange(-m, len(x) + m)
+    py = lo[1] + h * np.arange(-m, len(y) + m)
+    PX, PY = np.meshgrid(px, py, indexing="ij")
+    cl = part.height(np.column_stack([PX.ravel(), PY.ravel()])).reshape(PX.shape)
+    cl = np.maximum(np.nan_to_num(cl, nan=floor), floor)
+    reach = np.full(top.shape, np.inf)
+    di, dj = np.mgrid[-m:m + 1, -m:m + 1]
+    d = h * np.hypot(di, dj)
+    ok = d <= tool.radius
+    for a, b, f in zip(di[ok], dj[ok], tool.profile(d[ok])):
+        np.minimum(reach, cl[m + a:m + a + len(x), m + b:m + b + len(y)] + f, out=reach)
+    rest = np.where(np.isfinite(top), reach - top, -np.inf)
+    mask = rest > threshold
+    out = {"area": float(mask.sum() * h * h), "max_depth": float(rest[mask].max()) if mask.any() else 0.0,
+           "box": None, "regions": 0, "spacing": h, "threshold": threshold,
+           "map": (x, y, np.where(np.isfinite(rest), rest, np.nan))}
+    if mask.any():
+        ii, jj = np.nonzero(mask)
+        out["box"] = [[float(x[ii.min()]), float(y[jj.min()])], [float(x[ii.max()]), float(y[jj.max()])]]
+        out["regions"] = int(ndimage.label(mask, structure=np.ones((3, 3)))[1])
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+
+def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | None, direction: str,
+           steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Rest | None,
+           lowest: float | None = None):
+    """The finishing :class:`~surfmod.cam.roughing.Motion` (waterline pieces on the steep
+    regions, then the raster) and its report; contours no lower than ``lowest`` (where
+    the flutes end, default the stock's bottom)."""
+    margin = part.lift + part.deflection  # what exactness costs the scallop (see the module doc)
+    if scallop is not None:
+        budget = scallop - margin
+        if budget <= 0:
+            raise SurfmodError(f"scallop: {scallop:g} is not above the mesh's deflection and lift {margin:.3g}")
+        step_xy, phi = raster_stepover(part, tool, budget, steep_angle, direction)
+    else:
+        step_xy, phi = stepover, 0.0
+    if step_xy > tool.diameter:
+        step_xy = tool.diameter
+    top = _StockTop(part, tool, rest, stock, safe)
+    out = _Moves()
+    wl_info = None
+    if steep_angle is not None:
+        if scallop is not None:
+            # the contours keep a chord + the deflection from the mesh, give or take a chord,
+            # and the mesh lies within the deflection of the faces
+            wl_budget = scallop - 2 * part.deflection - 2 * _chord(part, tool, tolerance)
+            if wl_budget <= 0:
+                raise SurfmodError(f"scallop: {scallop:g} leaves no room for the waterline's margin")
+            spacing = _circle_spacing(tool.corner, wl_budget) if tool.kind != "flat" else stepover
+        else:
+            spacing = stepover
+        # no deeper than the flutes reach below the part's top (the raster's own depth is checked by the job)
+        bottom = float(stock[0, 2]) if lowest is None else max(float(stock[0, 2]), lowest)
+        levels, wl_info = waterline_pieces(part, tool, steep_angle, spacing, tolerance, bottom)
+        wl_info["flute_limited"] = bottom > float(stock[0, 2])
+        if any(levels):
+            first = next(p for lv in levels for p in lv)
+            out.add([[first[0, 0], first[0, 1], safe]], RAPID)
+            wl_info["links"] = order_pieces(out, levels, part, tool, top, safe, tolerance, 1.5 * spacing)
+            _leave(out, float(top(out.last[None, :2])[0]), safe)
+    # the contours' links, entries and retracts judged once more on the drop-cutter heights
+    # (the contours themselves and the raster were judged as they were made)
+    allowed = tolerance - part.deflection + part.lift
+    depth = np.full(1, -np.inf)
+    if out.points:
+        wl_motion = out.motion()
+        depth = move_gouge(part.height, wl_motion.points)
+        if depth.max() > allowed:
+            k = int(np.argmax(depth))
+            raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
+    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, None, tolerance)
+    pts = path.points
+    before = sum(len(q) for q in out.points)
+    _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe)
+    entry = np.concatenate(out.points)[max(before - 1, 0):]
+    if move_gouge(part.height, entry).max() > allowed:
+        raise NoSafePathError("toolpath: no safe path: the raster's entry cuts the part")
+    out.add(pts[1:], FEED)
+    _leave(out, float(top(pts[-1:, :2])[0]), safe)
+    motion = out.motion()
+    threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)
+    report = {"stepover": path.stepover, "scallop": scallop if scallop is not None else path.scallop,
+              "gouge": max(float(depth.max()) - part.lift, path.gouge),
+              "lifted": max(path.lifted, (wl_info or {}).get("lifted", 0.0)),
+              "tolerance": tolerance, "toolpath": path, "steep_angle": steep_angle,
+              "raster": {"stepover": path.stepover, "passes": path.n_passes, "length": path.length,
+                         "cross_slope": phi, "margin": margin},
+              "waterline": wl_info,
+              "rest": rest_left(part, tool, float(stock[0, 2]), threshold)}
+    return motion, report
+
+
+def summary_lines(report: dict) -> list[str]:
+    """The finishing report as lines for the ``surfmod machine`` summary."""
+    lines = []
+    r = report.get("raster")
+    if r:
+        lines.append(f"raster: {r['passes']} passes {r['stepover']:.4g} mm apart (cross slopes up to "
+                     f"{r['cross_slope']:.1f} deg), length {r['length']:.0f} mm")
+    w = report.get("waterline")
+    if w and w["levels"]:
+        lines.append(f"waterline on slopes >= {report['steep_angle']:g} deg: {w['levels']} levels "
+                     f"{w['z_spacing'][0]:.3g}-{w['z_spacing'][1]:.3g} mm apart (z {w['bottom']:.4g} to {w['top']:.4g}), "
+                     f"{w['contours']} contours, length {w['length']:.0f} mm"
+                     + (" (the flutes reach no lower)" if w.get("flute_limited") else ""))
+    elif w is not None:
+        lines.append(f"waterline: no slopes >= {report['steep_angle']:g} deg")
+    rest = report.get("rest")
+    if rest:
+        if rest["box"] is None:
+            lines.append(f"rest: the tool reaches everywhere within {rest['threshold']:.3g} mm")
+        else:
+            (x0, y0), (x1, y1) = rest["box"]
+            lines.append(f"rest not reached (more than {rest['threshold']:.3g} mm, left for a smaller tool): "
+                         f"area {rest['area']:.4g} mm^2, max depth {rest['max_depth']:.4g} mm, "
+                         f"{rest['regions']} region(s) in x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g}")
+    return lines
