@@ -43,7 +43,7 @@ box are reported, not cut.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -76,6 +76,19 @@ class Rest:
 
     reach: float
     above: float
+
+
+def clear_part(part: _Part, tool: Tool) -> _Part:
+    """``part`` for ``tool`` grown by the mesh's deflection ``δ`` (ball ``R + δ``, bull
+    ``(R + δ, c + δ)``, a flat end the bull ``(R + δ, δ)``; the tip ``δ`` lower): its
+    heights keep the tool ``δ`` from every triangle in every direction, so it never touches
+    the faces the mesh stands for.  (A vertical lift by ``δ`` would not do on a wall of
+    slope θ: there the mesh's ``δ`` is ``δ / cos θ`` deep measured vertically.)"""
+    d = part.deflection
+    grid = TriangleGrid(part.grid.triangles, tool.radius + d)
+    if tool.kind == "ball":
+        return replace(part, grid=grid, kind="ball", corner=tool.radius + d, lift=d)
+    return replace(part, grid=grid, kind="bull", corner=tool.corner + d, lift=d)
 
 
 class _StockTop:
@@ -321,21 +334,33 @@ def order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, s
     return links
 
 
-def raster_stepover(part: _Part, tool: Tool, scallop: float, steep_angle: float | None, direction: str):
-    """The raster's stepover for cusps of ``scallop`` across ground sloping up to the
-    steepest cross slope of the part's triangles below ``steep_angle`` (all of them when
-    None); returns ``(stepover, that slope in degrees)``."""
+def raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float | None, direction: str):
+    """Cross positions of the raster's passes for cusps of ``scallop`` across the ground
+    between them: each next pass ``s · cos φ`` further, ``φ`` the steepest cross slope of
+    the part's triangles below ``steep_angle`` (all of them when None) within the tool's
+    radius of the two passes.  Returns ``(positions, steepest φ in degrees)``."""
     tri = part.grid.triangles
     n = _normals(tri)
     slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
     shallow = slope < (90.0 if steep_angle is None else steep_angle)
-    across = 1 if direction == "x" else 0
-    cross = np.degrees(np.arctan2(np.abs(n[shallow, across]), n[shallow, 2])) if shallow.any() else np.zeros(1)
-    phi = float(min(cross.max(), 89.0))
+    axis = 1 if direction == "x" else 0
+    cross = np.minimum(np.degrees(np.arctan2(np.abs(n[shallow, axis]), n[shallow, 2])), 89.0)
+    t_lo, t_hi = tri[shallow, :, axis].min(axis=1), tri[shallow, :, axis].max(axis=1)
     circ = _circle_spacing(tool.corner, scallop)
-    if tool.kind == "bull" and phi < 1.0:  # the flat core counts only on level ground
-        return 2.0 * tool.core + circ, phi
-    return circ * math.cos(math.radians(phi)), phi
+    lo, hi = float(part.box[0, axis]), float(part.box[1, axis])
+    R = tool.radius
+    out, steepest = [lo], 0.0
+    while out[-1] < hi - 1e-9:
+        y = out[-1]
+        near = (t_hi >= y - R) & (t_lo <= y + circ + 2.0 * tool.core + R)
+        phi = float(cross[near].max()) if near.any() else 0.0
+        steepest = max(steepest, phi)
+        if tool.kind == "bull" and phi < 1.0:  # the flat core counts only on level ground
+            gap = 2.0 * tool.core + circ
+        else:
+            gap = circ * math.cos(math.radians(phi))
+        out.append(min(y + min(gap, tool.diameter), hi))
+    return np.array(out), steepest
 
 
 # ----------------------------------------------------------------------------------------------
@@ -428,11 +453,10 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         budget = scallop - margin
         if budget <= 0:
             raise SurfmodError(f"scallop: {scallop:g} is not above the mesh's deflection and lift {margin:.3g}")
-        step_xy, phi = raster_stepover(part, tool, budget, steep_angle, direction)
+        across, phi = raster_passes(part, tool, budget, steep_angle, direction)
+        step_xy = float(np.diff(across).max()) if len(across) > 1 else tool.radius
     else:
-        step_xy, phi = stepover, 0.0
-    if step_xy > tool.diameter:
-        step_xy = tool.diameter
+        across, step_xy, phi = None, stepover, 0.0
     top = _StockTop(part, tool, rest, stock, safe)
     out = _Moves()
     wl_info = None
@@ -465,7 +489,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         if depth.max() > allowed:
             k = int(np.argmax(depth))
             raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
-    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, None, tolerance)
+    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, None, tolerance, across=across)
     pts = path.points
     before = sum(len(q) for q in out.points)
     _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe)
@@ -480,11 +504,20 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
               "gouge": max(float(depth.max()) - part.lift, path.gouge),
               "lifted": max(path.lifted, (wl_info or {}).get("lifted", 0.0)),
               "tolerance": tolerance, "toolpath": path, "steep_angle": steep_angle,
-              "raster": {"stepover": path.stepover, "passes": path.n_passes, "length": path.length,
+              "raster": {"stepover": path.stepover, "least_stepover": float(np.diff(path_across(path)).min())
+                         if path.n_passes > 1 else 0.0, "passes": path.n_passes, "length": path.length,
                          "cross_slope": phi, "margin": margin},
               "waterline": wl_info,
               "rest": rest_left(part, tool, float(stock[0, 2]), threshold)}
     return motion, report
+
+
+def path_across(path) -> np.ndarray:
+    """The cross positions of a raster's passes."""
+    axis = 1 if path.direction == "x" else 0
+    on = path.pass_index >= 0
+    first = np.r_[True, path.pass_index[on][1:] != path.pass_index[on][:-1]]
+    return path.points[on][first, axis]
 
 
 def summary_lines(report: dict) -> list[str]:
@@ -492,8 +525,8 @@ def summary_lines(report: dict) -> list[str]:
     lines = []
     r = report.get("raster")
     if r:
-        lines.append(f"raster: {r['passes']} passes {r['stepover']:.4g} mm apart (cross slopes up to "
-                     f"{r['cross_slope']:.1f} deg), length {r['length']:.0f} mm")
+        lines.append(f"raster: {r['passes']} passes {r['least_stepover']:.4g}-{r['stepover']:.4g} mm apart (cross "
+                     f"slopes up to {r['cross_slope']:.1f} deg), length {r['length']:.0f} mm")
     w = report.get("waterline")
     if w and w["levels"]:
         lines.append(f"waterline on slopes >= {report['steep_angle']:g} deg: {w['levels']} levels "

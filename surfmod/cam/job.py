@@ -19,7 +19,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
 from .roughing import FEED, RAPID, Motion, offset_tool, rough
-from .finishing import Rest, finish
+from .finishing import Rest, clear_part, finish
 from .tool import Tool
 from .toolpath import _part
 
@@ -159,7 +159,7 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     else:
         cusp = tool.scallop_for_stepover(stepover)
         tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
-    part = _part(shape, tool, tolerance)
+    part = clear_part(_part(shape, tool, tolerance), tool)
     return finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction, steep_angle=steep,
                   tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
 

@@ -268,13 +268,14 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
 
 
 def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction: str, bounds, tolerance: float,
-                bar=None) -> Toolpath:
+                bar=None, across=None) -> Toolpath:
     """The verified zig-zag :class:`Toolpath` of ``tool`` over an already meshed ``part``
     (:func:`toolpath` after its checks; ``bounds`` ``((xmin, ymin), (xmax, ymax))`` or None
-    for the part's box; ``bar`` a tqdm bar advanced per stage)."""
+    for the part's box; ``bar`` a tqdm bar advanced per stage; ``across``: the passes'
+    cross positions instead of ``stepover``)."""
     tick = bar.update if bar is not None else (lambda: None)
     lo, hi = (part.box[0, :2], part.box[1, :2]) if bounds is None else (np.asarray(bounds[0]), np.asarray(bounds[1]))
-    xy, index, across = raster(lo, hi, stepover, step, direction)
+    xy, index, across = raster(lo, hi, stepover, step, direction, across)
     z = part.height(xy)
     if np.isnan(z).all():
         raise SurfmodError("bounds: the tool touches no face inside these bounds")
