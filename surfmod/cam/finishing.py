@@ -2,42 +2,45 @@
 contours on its steep regions, and a report of the rest the tool cannot reach.
 
 **The scallop rule.**  Passes of a ball (or a bull's corner, radius ``c``) a distance
-``s`` apart along the surface leave cusps ``c - sqrt(c² - (s/2)²)`` (convex and flat
-ground; concave ground of curvature radius ``ρ`` adds about ``s²/(8(ρ - c))``).  The raster's passes
-are ``s_xy`` apart in (x, y), ``s_xy / cos φ`` apart along ground that slopes by ``φ``
-across them, so its stepover is the scallop's ``s`` times ``cos φ_max``, ``φ_max`` the
-steepest cross slope of the part's triangles below the threshold ``steep_angle``.
-Waterline levels ``Δz`` apart lie ``Δz / sin θ`` apart along a wall of slope ``θ``, so
-``Δz = s · sin θ_min``, ``θ_min`` the least slope (at least the threshold) of the steep
-triangles near each level: on a vertical wall the levels stand ``s`` apart.  The raster
-runs everywhere (its cusps on the steep regions are cut again by the contours; its length
-there is the steep regions' small (x, y) footprint), the contours only on the steep
-pieces of each level's loops.  The scallop budget is the asked one less what exactness
-costs: the mesh's deflection and the lift over it (:mod:`surfmod.cam.toolpath`), and for
-the contours the margin they keep from the mesh.
+``s`` apart along the surface leave cusps ``c - sqrt(c² - (s/2)²)`` on flat and convex
+ground (concave ground of curvature radius ``ρ`` adds about ``s²/(8(ρ - c))``, not
+budgeted).  The raster's passes ``d`` apart in (x, y) stand ``d / cos φ`` apart along
+ground sloping by ``φ`` across them, so each next pass is placed ``s · cos φ`` further,
+``φ`` the steepest cross slope of the triangles below the threshold ``steep_angle``
+within the tool's radius of the two passes (``s`` apart over level ground, closer beside
+slopes).  Waterline levels ``Δz`` apart lie ``Δz / sin θ`` apart along a wall of slope
+``θ``, so ``Δz = s · sin θ_min``, ``θ_min`` the least slope (at least the threshold) of
+the steep triangles near each level: on a vertical wall the levels stand ``s`` apart.
+The raster runs everywhere (its cusps on the steep regions are cut again by the contours;
+its length there is the steep regions' small (x, y) footprint), the contours only on the
+steep pieces of each level's loops.  The budget ``s`` is computed for is the scallop asked
+for less what exactness costs: the tool keeps the mesh's deflection ``δ`` from the mesh,
+which lies within ``δ`` of the faces (``2 δ``), the contours also their chord tolerance.
 
-**Exact and gouge-free contours.**  The waterline (:func:`surfmod.cam.waterline.waterline`)
-is computed for the tool grown by ``g`` (its Minkowski sum with a ball of radius ``g``:
-ball ``R + g``, bull ``(R + g, c + g)``, a flat end the bull ``(R + g, g)``; tip ``g``
-lower), ``g`` the mesh's chordal deflection plus the contours' chord tolerance, so the
-real tool along every chord keeps at least the deflection from every triangle and never
-touches the faces themselves: on a wall of slope θ a mesh-deep gouge would be
-``1 / cos θ`` deeper measured vertically.  Every move is then judged like the raster's
-(:func:`~surfmod.cam.toolpath_moves.move_gouge` against the drop-cutter heights) and lifted
-where it would cut (never needed by construction; reported as ``lifted``).
+**Exact and gouge-free.**  All heights are drop-cutter heights of the tool grown by ``δ``
+(:func:`clear_part`): the tool never touches the faces the mesh stands for, in any
+direction (a vertical lift would not do: on a wall of slope θ the mesh's ``δ`` is
+``δ / cos θ`` deep measured vertically).  The waterline
+(:func:`surfmod.cam.waterline.waterline`) is computed for the tool grown by ``g`` = ``δ``
+plus the contours' chord tolerance (its Minkowski sum with a ball of radius ``g``: ball
+``R + g``, bull ``(R + g, c + g)``, a flat end the bull ``(R + g, g)``; tip ``g`` lower),
+so along every chord the real tool keeps at least ``δ`` from every triangle.  Every move
+is then judged like the raster's (:func:`~surfmod.cam.toolpath_moves.move_gouge` against
+the drop-cutter heights) and lifted where it would cut (not needed by construction;
+reported as ``lifted``).
 
 **Links** between contours run along the part when the straight move stays clear of it
-and is short (at most a tool radius across, no more than one level down); otherwise the
+and is short (at most a tool radius across, no more than 1.5 levels down); otherwise the
 tool goes up at the feed to above the stock the roughing can have left (:class:`Rest`),
 then rapidly to the clearance height, across, down to that height, and enters as the raster
 does (a ball plunges, a flat or bull end helixes).
 
 **Rest.**  On an (x, y) grid, the part's top (a vertical ray onto the triangles) and the
 opening of it by the tool's lower surface (the lowest the tool's surface comes over each
-node among all drop-cutter positions): where the opening stands more than the scallop
-above the part, the finishing tool cannot reach (corners and slots narrower than the
-tool, the fillet a ball leaves where a wall meets a floor).  Its area, deepest point and
-box are reported, not cut.
+node among all drop-cutter positions on the grid): where the opening stands more than the
+scallop above the part, the finishing tool cannot reach (corners and slots narrower than
+the tool, the fillet a ball leaves where a wall meets a floor).  Its area, deepest point
+and box are reported, not cut.
 """
 
 from __future__ import annotations
@@ -234,7 +237,7 @@ def _judge(part: _Part, pts: np.ndarray, allowed: float):
     return pts, float(lift.max())
 
 
-def waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float):
+def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float):
     """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
     the top of its steep triangles (slope ≥ ``steep_angle``) down to ``bottom``, ``spacing``
     the distance of neighbouring levels along the walls.  Returns ``(pieces, info)``:
@@ -298,7 +301,7 @@ def _link_clear(part: _Part, a, b, allowed: float, step: float) -> np.ndarray | 
     return pts[1:]
 
 
-def order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
+def _order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
                  max_down: float):
     """Append the pieces level by level (top first), each level's nearest first, linked
     along the part where short and clear, else up and over."""
@@ -334,11 +337,12 @@ def order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, s
     return links
 
 
-def raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float | None, direction: str):
+def _raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float | None, direction: str,
+                   lo: float, hi: float):
     """Cross positions of the raster's passes for cusps of ``scallop`` across the ground
     between them: each next pass ``s · cos φ`` further, ``φ`` the steepest cross slope of
     the part's triangles below ``steep_angle`` (all of them when None) within the tool's
-    radius of the two passes.  Returns ``(positions, steepest φ in degrees)``."""
+    radius of the two passes, from ``lo`` to ``hi``.  Returns ``(positions, steepest φ in degrees)``."""
     tri = part.grid.triangles
     n = _normals(tri)
     slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
@@ -347,9 +351,8 @@ def raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float | 
     cross = np.minimum(np.degrees(np.arctan2(np.abs(n[shallow, axis]), n[shallow, 2])), 89.0)
     t_lo, t_hi = tri[shallow, :, axis].min(axis=1), tri[shallow, :, axis].max(axis=1)
     circ = _circle_spacing(tool.corner, scallop)
-    lo, hi = float(part.box[0, axis]), float(part.box[1, axis])
     R = tool.radius
-    out, steepest = [lo], 0.0
+    out, steepest = [float(lo)], 0.0
     while out[-1] < hi - 1e-9:
         y = out[-1]
         near = (t_hi >= y - R) & (t_lo <= y + circ + 2.0 * tool.core + R)
@@ -453,7 +456,18 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         budget = scallop - margin
         if budget <= 0:
             raise SurfmodError(f"scallop: {scallop:g} is not above the mesh's deflection and lift {margin:.3g}")
-        across, phi = raster_passes(part, tool, budget, steep_angle, direction)
+    else:
+        budget = None
+    # the raster runs beyond the part's box until a pass's contact reaches the rim: on ground
+    # falling by θ towards it the tool touches its core plus c sin θ uphill of its axis
+    slope = np.degrees(np.arccos(np.clip(_normals(part.grid.triangles)[:, 2], -1, 1)))
+    shallow = slope[slope < (90.0 if steep_angle is None else steep_angle)]
+    theta = float(shallow.max()) if len(shallow) else 0.0
+    overhang = tool.core + tool.corner * math.sin(math.radians(theta)) if theta > 1e-6 else 0.0
+    bounds = (part.box[0, :2] - overhang, part.box[1, :2] + overhang)
+    if budget is not None:
+        axis = 1 if direction == "x" else 0
+        across, phi = _raster_passes(part, tool, budget, steep_angle, direction, bounds[0][axis], bounds[1][axis])
         step_xy = float(np.diff(across).max()) if len(across) > 1 else tool.radius
     else:
         across, step_xy, phi = None, stepover, 0.0
@@ -472,12 +486,12 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
             spacing = stepover
         # no deeper than the flutes reach below the part's top (the raster's own depth is checked by the job)
         bottom = float(stock[0, 2]) if lowest is None else max(float(stock[0, 2]), lowest)
-        levels, wl_info = waterline_pieces(part, tool, steep_angle, spacing, tolerance, bottom)
+        levels, wl_info = _waterline_pieces(part, tool, steep_angle, spacing, tolerance, bottom)
         wl_info["flute_limited"] = bottom > float(stock[0, 2])
         if any(levels):
             first = next(p for lv in levels for p in lv)
             out.add([[first[0, 0], first[0, 1], safe]], RAPID)
-            wl_info["links"] = order_pieces(out, levels, part, tool, top, safe, tolerance, 1.5 * spacing)
+            wl_info["links"] = _order_pieces(out, levels, part, tool, top, safe, tolerance, 1.5 * spacing)
             _leave(out, float(top(out.last[None, :2])[0]), safe)
     # the contours' links, entries and retracts judged once more on the drop-cutter heights
     # (the contours themselves and the raster were judged as they were made)
@@ -489,7 +503,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         if depth.max() > allowed:
             k = int(np.argmax(depth))
             raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
-    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, None, tolerance, across=across)
+    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, across=across)
     pts = path.points
     before = sum(len(q) for q in out.points)
     _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe)
@@ -504,15 +518,15 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
               "gouge": max(float(depth.max()) - part.lift, path.gouge),
               "lifted": max(path.lifted, (wl_info or {}).get("lifted", 0.0)),
               "tolerance": tolerance, "toolpath": path, "steep_angle": steep_angle,
-              "raster": {"stepover": path.stepover, "least_stepover": float(np.diff(path_across(path)).min())
+              "raster": {"stepover": path.stepover, "least_stepover": float(np.diff(_path_across(path)).min())
                          if path.n_passes > 1 else 0.0, "passes": path.n_passes, "length": path.length,
-                         "cross_slope": phi, "margin": margin},
+                         "cross_slope": phi, "margin": margin, "overhang": overhang},
               "waterline": wl_info,
               "rest": rest_left(part, tool, float(stock[0, 2]), threshold)}
     return motion, report
 
 
-def path_across(path) -> np.ndarray:
+def _path_across(path) -> np.ndarray:
     """The cross positions of a raster's passes."""
     axis = 1 if path.direction == "x" else 0
     on = path.pass_index >= 0
@@ -521,7 +535,11 @@ def path_across(path) -> np.ndarray:
 
 
 def summary_lines(report: dict) -> list[str]:
-    """The finishing report as lines for the ``surfmod machine`` summary."""
+    """The finishing report as lines for the ``surfmod machine`` summary.
+
+    >>> summary_lines({"rest": {"box": None, "threshold": 0.05}})
+    ['rest: the tool reaches everywhere within 0.05 mm']
+    """
     lines = []
     r = report.get("raster")
     if r:
