@@ -127,21 +127,27 @@ class _Moves:
         return Motion(np.concatenate(self.points), np.concatenate(self.kinds))
 
 
-def _enter(out: _Moves, p, top: float, part: _Part, tool: Tool, safe: float):
+def _enter(out: _Moves, p, top: float, part: _Part, tool: Tool, safe: float, allowed: float):
     """From the clearance height over ``p``: rapid down to ``top`` (above any stock left),
-    then a ball plunges, a flat or bull end helixes (half its radius) onto ``p``."""
+    then a ball plunges, a flat or bull end descends by a helix onto ``p`` (half its radius
+    wide, narrower where the part stands within it: the helix may not rise above the part's
+    drop heights and then fall onto ``p``; a plunge when even an eighth of the radius does)."""
     out.add([[p[0], p[1], safe]], RAPID)
-    if tool.kind == "ball" or top <= p[2]:
-        out.add([[p[0], p[1], max(top, p[2])]], RAPID)
-        out.add([p], PLUNGE)
-        return
-    rho = tool.radius / 2
-    turns = max(1, int(np.ceil((top - p[2]) / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * rho))))
-    t = np.linspace(0, 1, 48 * turns + 1)
-    helix = p[:2] + rho * np.column_stack([np.cos(2 * np.pi * turns * t) - 1, np.sin(2 * np.pi * turns * t)])
-    hz = np.maximum(top - (top - p[2]) * t, np.nan_to_num(part.height(helix), nan=-np.inf))
-    out.add([[helix[0, 0], helix[0, 1], max(top, hz[0])]], RAPID)
-    out.add(np.column_stack([helix, hz]), PLUNGE)
+    start = np.array([p[0], p[1], max(top, p[2])])
+    if tool.kind != "ball" and top > p[2]:
+        for rho in tool.radius / np.array([2.0, 4.0, 8.0]):
+            turns = max(1, int(np.ceil((top - p[2]) / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * rho))))
+            t = np.linspace(0, 1, 48 * turns + 1)
+            ang = 2 * np.pi * turns * t
+            helix = p[:2] + rho * np.column_stack([np.cos(ang) - 1, np.sin(ang)])
+            hz = np.maximum(top - (top - p[2]) * t, np.nan_to_num(part.height(helix), nan=-np.inf))
+            hz[-1] = p[2]
+            pts = np.column_stack([helix, hz])
+            if move_gouge(part.height, pts).max() <= REFINE_SHARE * allowed:
+                out.add([[helix[0, 0], helix[0, 1], max(top, hz[0])]], RAPID)
+                out.add(pts, PLUNGE)
+                return
+    out.add([start], RAPID)
     out.add([p], PLUNGE)
 
 
@@ -310,7 +316,8 @@ def _order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, 
     for pieces in levels:
         todo = list(pieces)
         while todo:
-            here = out.last
+            # the first piece is entered from the clearance height over its own start
+            here = out.last if out.points else np.array([todo[0][0, 0], todo[0][0, 1], safe])
             best, best_d, best_k = None, np.inf, 0
             for j, pc in enumerate(todo):
                 closed = len(pc) > 2 and np.all(pc[0] == pc[-1])
@@ -332,7 +339,7 @@ def _order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, 
             else:
                 if here[2] < safe:
                     _leave(out, float(top(here[None, :2])[0]), safe)
-                _enter(out, pc[0], float(top(pc[:1, :2])[0]), part, tool, safe)
+                _enter(out, pc[0], float(top(pc[:1, :2])[0]), part, tool, safe, allowed)
             out.add(pc[1:], FEED)
     return links
 
@@ -489,8 +496,6 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         levels, wl_info = _waterline_pieces(part, tool, steep_angle, spacing, tolerance, bottom)
         wl_info["flute_limited"] = bottom > float(stock[0, 2])
         if any(levels):
-            first = next(p for lv in levels for p in lv)
-            out.add([[first[0, 0], first[0, 1], safe]], RAPID)
             wl_info["links"] = _order_pieces(out, levels, part, tool, top, safe, tolerance, 1.5 * spacing)
             _leave(out, float(top(out.last[None, :2])[0]), safe)
     # the contours' links, entries and retracts judged once more on the drop-cutter heights
@@ -506,7 +511,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, across=across)
     pts = path.points
     before = sum(len(q) for q in out.points)
-    _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe)
+    _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe, allowed)
     entry = np.concatenate(out.points)[max(before - 1, 0):]
     if move_gouge(part.height, entry).max() > allowed:
         raise NoSafePathError("toolpath: no safe path: the raster's entry cuts the part")
