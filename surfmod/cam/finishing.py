@@ -553,7 +553,7 @@ def summary_lines(report: dict) -> list[str]:
     w = report.get("waterline")
     if w and w["levels"]:
         lines.append(f"waterline on slopes >= {report['steep_angle']:g} deg: {w['levels']} levels "
-                     f"{w['z_spacing'][0]:.3g}-{w['z_spacing'][1]:.3g} mm apart (z {w['bottom']:.4g} to {w['top']:.4g}), "
+                     f"{w['z_spacing'][0]:.3g}-{w['z_spacing'][1]:.3g} mm apart (z {round(w['bottom'], 3) + 0.0:g} to {round(w['top'], 3) + 0.0:g}), "
                      f"{w['contours']} contours, length {w['length']:.0f} mm"
                      + (" (the flutes reach no lower)" if w.get("flute_limited") else ""))
     elif w is not None:
