@@ -552,8 +552,9 @@ def summary_lines(report: dict) -> list[str]:
                      f"slopes up to {r['cross_slope']:.1f} deg), length {r['length']:.0f} mm")
     w = report.get("waterline")
     if w and w["levels"]:
+        z0, z1 = round(w["bottom"], 3) + 0.0, round(w["top"], 3) + 0.0  # no "-0"
         lines.append(f"waterline on slopes >= {report['steep_angle']:g} deg: {w['levels']} levels "
-                     f"{w['z_spacing'][0]:.3g}-{w['z_spacing'][1]:.3g} mm apart (z {round(w['bottom'], 3) + 0.0:g} to {round(w['top'], 3) + 0.0:g}), "
+                     f"{w['z_spacing'][0]:.3g}-{w['z_spacing'][1]:.3g} mm apart (z {z0:g} to {z1:g}), "
                      f"{w['contours']} contours, length {w['length']:.0f} mm"
                      + (" (the flutes reach no lower)" if w.get("flute_limited") else ""))
     elif w is not None:
