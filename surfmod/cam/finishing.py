@@ -52,7 +52,6 @@ from types import SimpleNamespace
 import numpy as np
 from scipy import ndimage
 
-from ..errors import SurfmodError
 from .drop_cutter import TriangleGrid, drop
 from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Motion
 from .tool import Tool
@@ -307,6 +306,19 @@ def _link_clear(part: _Part, a, b, allowed: float, step: float) -> np.ndarray | 
     return pts[1:]
 
 
+def _budget(scallop: float, margin: float):
+    """The cusp height passes are spaced for: the scallop less ``margin``, and whether that
+    holds the scallop (a mesh coarser than the scallop, as some faces of real parts cannot be
+    meshed finer than their own tolerance, gets a quarter of the scallop and no promise).
+
+    >>> [tuple(round(v, 6) for v in _budget(0.05, m)) for m in (0.02, 0.2)]
+    [(0.03, 1), (0.0125, 0)]
+    """
+    if scallop - margin >= scallop / 4:
+        return scallop - margin, True
+    return scallop / 4, False
+
+
 def _order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
                  max_down: float):
     """Append the pieces level by level (top first), each level's nearest first, linked
@@ -459,10 +471,9 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     regions, then the raster) and its report; contours no lower than ``lowest`` (where
     the flutes end, default the stock's bottom)."""
     margin = part.lift + part.deflection  # what exactness costs the scallop (see the module doc)
+    held = True
     if scallop is not None:
-        budget = scallop - margin
-        if budget <= 0:
-            raise SurfmodError(f"scallop: {scallop:g} is not above the mesh's deflection and lift {margin:.3g}")
+        budget, held = _budget(scallop, margin)
     else:
         budget = None
     # the raster runs beyond the part's box until a pass's contact reaches the rim: on ground
@@ -485,9 +496,8 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         if scallop is not None:
             # the contours keep a chord + the deflection from the mesh, give or take a chord,
             # and the mesh lies within the deflection of the faces
-            wl_budget = scallop - 2 * part.deflection - 2 * _chord(part, tool, tolerance)
-            if wl_budget <= 0:
-                raise SurfmodError(f"scallop: {scallop:g} leaves no room for the waterline's margin")
+            wl_budget, wl_held = _budget(scallop, 2 * part.deflection + 2 * _chord(part, tool, tolerance))
+            held = held and wl_held
             spacing = _circle_spacing(tool.corner, wl_budget) if tool.kind != "flat" else stepover
         else:
             spacing = stepover
@@ -520,6 +530,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     motion = out.motion()
     threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)
     report = {"stepover": path.stepover, "scallop": scallop if scallop is not None else path.scallop,
+              "scallop_held": held, "deflection": part.deflection,
               "gouge": max(float(depth.max()) - part.lift, path.gouge),
               "lifted": max(path.lifted, (wl_info or {}).get("lifted", 0.0)),
               "tolerance": tolerance, "toolpath": path, "steep_angle": steep_angle,
@@ -559,6 +570,9 @@ def summary_lines(report: dict) -> list[str]:
                      + (" (the flutes reach no lower)" if w.get("flute_limited") else ""))
     elif w is not None:
         lines.append(f"waterline: no slopes >= {report['steep_angle']:g} deg")
+    if not report.get("scallop_held", True):
+        lines.append(f"scallop not held: the mesh's deflection {report['deflection']:.3g} mm (the faces' own "
+                     f"tolerance) is too large for {report['scallop']:g}; passes spaced for a quarter of it")
     rest = report.get("rest")
     if rest:
         if rest["box"] is None:
