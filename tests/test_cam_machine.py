@@ -210,6 +210,9 @@ def test_cli_machine(part_file, tmp_path, capsys):
                  "--png", str(png), "--no-progress"]) == 0
     text = capsys.readouterr().out
     assert "roughing" in text and "time estimate" in text and out.is_file()
+    # the finishing passes and the rest left: levels, contours, the pocket's corners
+    assert "waterline on slopes >= 45 deg:" in text and "contours" in text and "raster:" in text
+    assert "rest not reached" in text and "max depth" in text
     assert png.read_bytes()[:4] == b"\x89PNG"
     assert "T1 M6" in out.read_text() and "T2 M6" in out.read_text()
 

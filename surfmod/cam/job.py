@@ -18,9 +18,10 @@ from tqdm import tqdm
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
-from .roughing import FEED, PLUNGE, RAPID, RAMP_ANGLE, Motion, offset_tool, rough
+from .roughing import FEED, RAPID, Motion, offset_tool, rough
+from .finishing import Rest, clear_part, finish
 from .tool import Tool
-from .toolpath import _part, toolpath
+from .toolpath import _part
 
 #: Rapid traverse (mm/min) and tool change time (s) of the time estimate.
 RAPID_RATE = 5000.0
@@ -43,13 +44,17 @@ class Rough:
 
 @dataclass(frozen=True)
 class Finish:
-    """Drop-cutter zig-zag finishing with ``tool`` leaving cusps of ``scallop`` on flat
-    ground (or passes ``stepover`` apart)."""
+    """Finishing with ``tool``: the drop-cutter zig-zag along ``direction`` over the whole
+    part plus waterline (constant-Z) contours on the regions steeper than ``steep_angle``
+    degrees (None: no contours), spaced so that the cusps measured along the surface stay
+    within ``scallop`` on every slope (or passes ``stepover`` apart, levels
+    ``stepover · sin(steep_angle)`` apart on the walls); see :mod:`surfmod.cam.finishing`."""
 
     tool: Tool
     scallop: float | None = None
     stepover: float | None = None
     direction: str = "x"
+    steep_angle: float | None = 45.0
 
 
 @dataclass(frozen=True)
@@ -134,34 +139,29 @@ def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
     return box
 
 
-def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest_above: float, progress):
-    path = toolpath(shape, tool, op.stepover, scallop=op.scallop, direction=op.direction, progress=progress)
-    pts = path.points
-    top = float(min(pts[0, 2] + rest_above + 1.0, safe))
-    moves, kinds = [[pts[0, 0], pts[0, 1], safe]], [RAPID]
-    if tool.kind == "ball" or top <= pts[0, 2]:
-        moves.append([pts[0, 0], pts[0, 1], top])
-        kinds.append(RAPID)
-        moves.append(pts[0])
-        kinds.append(PLUNGE)
-    else:  # a flat or bull end enters by a helix of half its radius onto the first location
-        part = _part(shape, tool, path.tolerance)
-        rho = tool.radius / 2
-        turns = max(1, int(np.ceil((top - pts[0, 2]) / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * rho))))
-        t = np.linspace(0, 1, 48 * turns + 1)
-        helix = pts[0, :2] + rho * np.column_stack([np.cos(2 * np.pi * turns * t) - 1, np.sin(2 * np.pi * turns * t)])
-        hz = np.maximum(top - (top - pts[0, 2]) * t, np.nan_to_num(part.height(helix), nan=-np.inf))
-        moves.append([helix[0, 0], helix[0, 1], max(top, hz[0])])
-        kinds.append(RAPID)
-        moves += list(np.column_stack([helix, hz]))
-        kinds += [PLUNGE] * len(helix)
-    moves += list(pts[1:])
-    kinds += [FEED] * (len(pts) - 1)
-    moves.append([pts[-1, 0], pts[-1, 1], safe])
-    kinds.append(RAPID)
-    report = {"stepover": path.stepover, "scallop": path.scallop, "gouge": path.gouge, "lifted": path.lifted,
-              "tolerance": path.tolerance, "toolpath": path}
-    return Motion(np.array(moves, float), np.array(kinds, np.int8)), report
+def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Rest | None, lowest: float):
+    if op.stepover is not None and op.scallop is not None:
+        raise SurfmodError("stepover: give either stepover or scallop, not both")
+    if op.scallop is None and op.stepover is None:
+        raise SurfmodError("stepover: give stepover or scallop")
+    stepover = None if op.stepover is None else checks.positive(op.stepover, "stepover")
+    if stepover is not None and stepover > tool.diameter:
+        raise SurfmodError(f"stepover: {stepover:g} is larger than the tool diameter {tool.diameter:g}")
+    if op.direction not in ("x", "y"):
+        raise SurfmodError(f"direction: expected 'x' or 'y', got {op.direction!r}")
+    steep = op.steep_angle
+    if steep is not None:
+        steep = float(steep)
+        if not 0.0 < steep <= 90.0:
+            raise SurfmodError(f"steep_angle: must be in (0, 90] degrees, got {op.steep_angle!r}")
+    if op.scallop is not None:
+        tolerance = op.scallop / 10
+    else:
+        cusp = tool.scallop_for_stepover(stepover)
+        tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
+    part = clear_part(_part(shape, tool, tolerance), tool)
+    return finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction, steep_angle=steep,
+                  tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
 
 
 def machine(part, stock, operations, *, progress: bool = False) -> Job:
@@ -170,7 +170,9 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
     ``operations`` in order (:class:`Rough`, :class:`Finish`); tools without a number get
     1, 2, ... in that order, and speeds and feeds from their diameter.  Roughing clears the
     stock down to the part plus its allowance (:mod:`surfmod.cam.roughing`); finishing is
-    the gouge-checked drop-cutter path (:func:`surfmod.toolpath`).  Raises
+    the gouge-checked drop-cutter path (:func:`surfmod.toolpath`) plus waterline contours on
+    the steep regions, with the rest it cannot reach reported
+    (:mod:`surfmod.cam.finishing`).  Raises
     ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut."""
     from ..occ.uses import bounding_box
 
@@ -183,7 +185,7 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
         raise SurfmodError("part: has no solid extent to machine")
     stock = stock_box(box, stock)
     safe = float(stock[1, 2] + CLEARANCE)
-    done, rest_above = [], float(stock[1, 2] - box[0, 2])
+    done, rest = [], None
     numbers = {}
     with tqdm(total=2 * len(ops), desc="machine", unit="stage", disable=not progress) as bar:
         for k, op in enumerate(ops):
@@ -210,15 +212,17 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
                     raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the roughing cuts "
                                        f"{cut_depth:.4g} mm deep")
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover)
-                rest_above = min(rest_above, allowance + stepdown)
+                rest = Rest(tool.radius + allowance, allowance + stepdown + p.lift)
                 name = "roughing"
             else:
                 if op.scallop is not None:
                     tool.stepover_for_scallop(op.scallop)  # scallop >= radius etc. raise here
                 bar.update()
-                motion, report = _finish(shape, op, tool, stock, safe, rest_above, False)
+                # the contours go no deeper than the flutes reach below the part's top
+                lowest = float(box[1, 2] - tool.flute_length) + 1e-9
+                motion, report = _finish(shape, op, tool, stock, safe, rest, lowest)
                 # after roughing the finishing tool works below the part's top
-                low = float(report["toolpath"].points[:, 2].min())
+                low = float(motion.points[motion.kind != RAPID, 2].min())
                 if box[1, 2] - low > tool.flute_length + 1e-9:
                     raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the finishing "
                                        f"goes {box[1, 2] - low:.4g} mm below the part's top")

@@ -264,44 +264,54 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     with tqdm(total=4, desc="toolpath", unit="stage", disable=not progress) as bar:
         part = _part(shape, tool, tolerance)
         bar.update()
-        lo, hi = (part.box[0, :2], part.box[1, :2]) if bounds is None else (box[0], box[1])
-        xy, index, across = raster(lo, hi, stepover, step, direction)
-        z = part.height(xy)
-        if np.isnan(z).all():
-            raise SurfmodError("bounds: the tool touches no face inside these bounds")
-        floor = float(np.nanmin(z))  # where the tool touches nothing it stays at the lowest level
-        points = np.column_stack([xy, np.where(np.isnan(z), floor, z)])
-        bar.update()
-        allowed = tolerance - part.deflection + part.lift
-        if allowed <= 0:
-            raise SurfmodError(f"tolerance: {tolerance:.3g} is below the part's mesh deflection {part.deflection:.3g}")
-        min_length = min(tolerance, step / 64)
-        for _ in range(2):  # the refinement makes short steep moves at walls: staircase them too
-            points, index = staircase_steep(points, index)
-            points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor)
+        return raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance, bar)
+
+
+def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction: str, bounds, tolerance: float,
+                bar=None, across=None) -> Toolpath:
+    """The verified zig-zag :class:`Toolpath` of ``tool`` over an already meshed ``part``
+    (:func:`toolpath` after its checks; ``bounds`` ``((xmin, ymin), (xmax, ymax))`` or None
+    for the part's box; ``bar`` a tqdm bar advanced per stage; ``across``: the passes'
+    cross positions instead of ``stepover``)."""
+    tick = bar.update if bar is not None else (lambda: None)
+    lo, hi = (part.box[0, :2], part.box[1, :2]) if bounds is None else (np.asarray(bounds[0]), np.asarray(bounds[1]))
+    xy, index, across = raster(lo, hi, stepover, step, direction, across)
+    z = part.height(xy)
+    if np.isnan(z).all():
+        raise SurfmodError("bounds: the tool touches no face inside these bounds")
+    floor = float(np.nanmin(z))  # where the tool touches nothing it stays at the lowest level
+    points = np.column_stack([xy, np.where(np.isnan(z), floor, z)])
+    tick()
+    allowed = tolerance - part.deflection + part.lift
+    if allowed <= 0:
+        raise SurfmodError(f"tolerance: {tolerance:.3g} is below the part's mesh deflection {part.deflection:.3g}")
+    min_length = min(tolerance, step / 64)
+    for _ in range(2):  # the refinement makes short steep moves at walls: staircase them too
+        points, index = staircase_steep(points, index)
+        points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor)
+    points, index = _drop_repeats(points, index)
+    tick()
+    depth = move_gouge(part.height, points)
+    if depth.max() > allowed:
+        # repair what the verdict's own sample points found, then judge again
+        points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor,
+                                     centred=True)
         points, index = _drop_repeats(points, index)
-        bar.update()
         depth = move_gouge(part.height, points)
-        if depth.max() > allowed:
-            # repair what the verdict's own sample points found, then judge again
-            points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor,
-                                         centred=True)
-            points, index = _drop_repeats(points, index)
-            depth = move_gouge(part.height, points)
-        lifted = 0.0
-        if len(depth) and depth.max() > allowed:
-            # the refinement could not follow the part here (walls meeting at a sliver of a
-            # face, say): lift those moves, which leaves material but never cuts
-            points, lift, depth = lift_moves(part.height, points, depth, REFINE_SHARE * allowed)
-            lifted = float(lift.max())
-        gouge = float(depth.max()) if len(depth) else 0.0
-        if gouge > allowed:
-            worst = int(np.argmax(depth))
-            raise NoSafePathError(
-                f"toolpath: no safe path: move {worst + 1} still cuts {gouge + part.deflection - part.lift:.3g} "
-                f"deep, more than the tolerance {tolerance:.3g}")
-        _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
-        bar.update()
+    lifted = 0.0
+    if len(depth) and depth.max() > allowed:
+        # the refinement could not follow the part here (walls meeting at a sliver of a
+        # face, say): lift those moves, which leaves material but never cuts
+        points, lift, depth = lift_moves(part.height, points, depth, REFINE_SHARE * allowed)
+        lifted = float(lift.max())
+    gouge = float(depth.max()) if len(depth) else 0.0
+    if gouge > allowed:
+        worst = int(np.argmax(depth))
+        raise NoSafePathError(
+            f"toolpath: no safe path: move {worst + 1} still cuts {gouge + part.deflection - part.lift:.3g} "
+            f"deep, more than the tolerance {tolerance:.3g}")
+    _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
+    tick()
     actual = float(np.diff(across).max()) if len(across) > 1 else 0.0
     return Toolpath(checks.frozen(points), checks.frozen(contacts), index, tool, actual, step,
                     tool.scallop_for_stepover(actual), direction, gouge - part.lift, tolerance, part.deflection, lifted)

@@ -28,11 +28,11 @@ REFINE_ROUNDS = 40
 STEEP_SLOPE = 2.0
 
 
-def raster(lo, hi, stepover: float, step: float, direction: str):
+def raster(lo, hi, stepover: float, step: float, direction: str, across=None):
     """Zig-zag cutter locations ``(N, 2)`` over the box ``lo``–``hi`` with passes along
-    ``direction`` (``"x"`` or ``"y"``) ``stepover`` apart and points ``step`` apart, joined
-    by links along the box side; the pass index of each location (-1 on links) and the
-    cross positions of the passes.
+    ``direction`` (``"x"`` or ``"y"``) ``stepover`` apart (or at the cross positions
+    ``across``, increasing) and points ``step`` apart, joined by links along the box side;
+    the pass index of each location (-1 on links) and the cross positions of the passes.
 
     >>> xy, index, across = raster((0, 0), (2, 1), 1.0, 1.0, "x")
     >>> xy.tolist(), index.tolist()
@@ -40,9 +40,11 @@ def raster(lo, hi, stepover: float, step: float, direction: str):
     """
     along_axis, across_axis = (0, 1) if direction == "x" else (1, 0)
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    n_pass = int(np.ceil((hi[across_axis] - lo[across_axis]) / stepover - 1e-9)) + 1
-    across = (np.linspace(lo[across_axis], hi[across_axis], max(n_pass, 2))
-              if hi[across_axis] > lo[across_axis] else np.array([lo[across_axis]]))
+    if across is None:
+        n_pass = int(np.ceil((hi[across_axis] - lo[across_axis]) / stepover - 1e-9)) + 1
+        across = (np.linspace(lo[across_axis], hi[across_axis], max(n_pass, 2))
+                  if hi[across_axis] > lo[across_axis] else np.array([lo[across_axis]]))
+    across = np.asarray(across, float)
     n_along = int(np.ceil((hi[along_axis] - lo[along_axis]) / step - 1e-9)) + 1
     along = np.linspace(lo[along_axis], hi[along_axis], max(n_along, 2))
     rows, index = [], []

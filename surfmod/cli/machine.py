@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..atomic import target_path
+from ..cam.finishing import summary_lines
 from ..cam.job import Finish, Rough, machine
 from ..cam.post import POSTS, SUFFIXES, export_job, program_paths, programs
 from ..cam.tool import load_tool_table, parse_tool
@@ -11,8 +12,8 @@ from ..inputs import to_shape
 
 
 def register(sub) -> None:
-    p = sub.add_parser("machine", help="machine a STEP part from stock: z-level roughing, drop-cutter finishing, "
-                                       "a LinuxCNC or GRBL program")
+    p = sub.add_parser("machine", help="machine a STEP part from stock: z-level roughing, drop-cutter and "
+                                       "waterline finishing, a LinuxCNC or GRBL program")
     p.add_argument("path", help="STEP file (the part, a solid)")
     p.add_argument("--out", required=True, help="output program .ngc/.nc (GRBL: one file per tool, NAME_T<n>)")
     g = p.add_mutually_exclusive_group(required=True)
@@ -77,6 +78,9 @@ def run(args) -> int:
     print(job)
     for op in job.operations:
         print(f"  {op.name}: length {op.length:.1f} mm, time estimate {op.time_estimate:.1f} s, tool {op.tool}")
+        if op.name == "finishing":
+            for line in summary_lines(op.report):
+                print(f"    {line}")
     for p in written + ([args.png] if args.png else []):
         print(f"wrote {p}")
     return 0

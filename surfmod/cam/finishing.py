@@ -1,0 +1,585 @@
+"""Finishing in a job: the drop-cutter raster over the whole part, waterline (constant-Z)
+contours on its steep regions, and a report of the rest the tool cannot reach.
+
+**The scallop rule.**  Passes of a ball (or a bull's corner, radius ``c``) a distance
+``s`` apart along the surface leave cusps ``c - sqrt(c² - (s/2)²)`` on flat and convex
+ground (concave ground of curvature radius ``ρ`` adds about ``s²/(8(ρ - c))``, not
+budgeted).  The raster's passes ``d`` apart in (x, y) stand ``d / cos φ`` apart along
+ground sloping by ``φ`` across them, so each next pass is placed ``s · cos φ`` further,
+``φ`` the steepest cross slope of the triangles below the threshold ``steep_angle``
+within the tool's radius of the two passes (``s`` apart over level ground, closer beside
+slopes).  Waterline levels ``Δz`` apart lie ``Δz / sin θ`` apart along a wall of slope
+``θ``, so ``Δz = s · sin θ_min``, ``θ_min`` the least slope (at least the threshold) of
+the steep triangles near each level: on a vertical wall the levels stand ``s`` apart.
+The raster runs everywhere (its cusps on the steep regions are cut again by the contours;
+its length there is the steep regions' small (x, y) footprint), the contours only on the
+steep pieces of each level's loops.  The budget ``s`` is computed for is the scallop asked
+for less what exactness costs: the tool keeps the mesh's deflection ``δ`` from the mesh,
+which lies within ``δ`` of the faces (``2 δ``), the contours also their chord tolerance.
+
+**Exact and gouge-free.**  All heights are drop-cutter heights of the tool grown by ``δ``
+(:func:`clear_part`): the tool never touches the faces the mesh stands for, in any
+direction (a vertical lift would not do: on a wall of slope θ the mesh's ``δ`` is
+``δ / cos θ`` deep measured vertically).  The waterline
+(:func:`surfmod.cam.waterline.waterline`) is computed for the tool grown by ``g`` = ``δ``
+plus the contours' chord tolerance (its Minkowski sum with a ball of radius ``g``: ball
+``R + g``, bull ``(R + g, c + g)``, a flat end the bull ``(R + g, g)``; tip ``g`` lower),
+so along every chord the real tool keeps at least ``δ`` from every triangle.  Every move
+is then judged like the raster's (:func:`~surfmod.cam.toolpath_moves.move_gouge` against
+the drop-cutter heights) and lifted where it would cut (not needed by construction;
+reported as ``lifted``).
+
+**Links** between contours run along the part when the straight move stays clear of it
+and is short (at most a tool radius across, no more than 1.5 levels down); otherwise the
+tool goes up at the feed to above the stock the roughing can have left (:class:`Rest`),
+then rapidly to the clearance height, across, down to that height, and enters as the raster
+does (a ball plunges, a flat or bull end helixes).
+
+**Rest.**  On an (x, y) grid, the part's top (a vertical ray onto the triangles) and the
+opening of it by the tool's lower surface (the lowest the tool's surface comes over each
+node among all drop-cutter positions on the grid): where the opening stands more than the
+scallop above the part, the finishing tool cannot reach (corners and slots narrower than
+the tool, the fillet a ball leaves where a wall meets a floor).  Its area, deepest point
+and box are reported, not cut.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from types import SimpleNamespace
+
+import numpy as np
+from scipy import ndimage
+
+from .drop_cutter import TriangleGrid, drop
+from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Motion
+from .tool import Tool
+from .toolpath import REFINE_SHARE, _Part, raster_path
+from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
+from .waterline import waterline
+
+#: Steep regions: slopes within this many degrees below the threshold count too (the
+#: classification samples the drop-cutter surface, the raster's slope bound its triangles).
+STEEP_MARGIN = 1.0
+#: Clearance (mm) of entries and retracts above the highest stock the roughing can have left.
+REST_CLEARANCE = 1.0
+#: Grid spacing of the rest map: a tool radius over this, or the part's size over REST_CELLS.
+REST_PER_RADIUS = 8
+REST_CELLS = 500
+
+
+@dataclass(frozen=True)
+class Rest:
+    """What a roughing pass left: over any (x, y) column, stock at most ``above`` higher
+    than the part's highest point within ``reach`` of the column (the roughing tool's
+    radius plus its allowance: its grown tool stood at every column it could, levels
+    ``stepdown`` apart)."""
+
+    reach: float
+    above: float
+
+
+def clear_part(part: _Part, tool: Tool) -> _Part:
+    """``part`` for ``tool`` grown by the mesh's deflection ``δ`` (ball ``R + δ``, bull
+    ``(R + δ, c + δ)``, a flat end the bull ``(R + δ, δ)``; the tip ``δ`` lower): its
+    heights keep the tool ``δ`` from every triangle in every direction, so it never touches
+    the faces the mesh stands for.  (A vertical lift by ``δ`` would not do on a wall of
+    slope θ: there the mesh's ``δ`` is ``δ / cos θ`` deep measured vertically.)"""
+    d = part.deflection
+    grid = TriangleGrid(part.grid.triangles, tool.radius + d)
+    if tool.kind == "ball":
+        return replace(part, grid=grid, kind="ball", corner=tool.radius + d, lift=d)
+    return replace(part, grid=grid, kind="bull", corner=tool.corner + d, lift=d)
+
+
+class _StockTop:
+    """The height above which no stock is left over the finishing tool's footprint."""
+
+    def __init__(self, part: _Part, tool: Tool, rest: Rest | None, stock: np.ndarray, safe: float):
+        self.part, self.rest, self.stock, self.safe = part, rest, stock, safe
+        self.grid = None if rest is None else TriangleGrid(part.grid.triangles, tool.radius + rest.reach)
+
+    def __call__(self, xy) -> np.ndarray:
+        xy = np.asarray(xy, float).reshape(-1, 2)
+        if self.grid is None:
+            return np.full(len(xy), min(float(self.stock[1, 2]) + REST_CLEARANCE, self.safe))
+        h = drop(self.grid, "flat", xy)  # the highest part point within the reach of the footprint
+        h = np.nan_to_num(h, nan=float(self.stock[0, 2])) + self.part.lift + self.rest.above + REST_CLEARANCE
+        return np.minimum(h, self.safe)
+
+
+class _Moves:
+    def __init__(self):
+        self.points, self.kinds = [], []
+
+    def add(self, pts, kind):
+        pts = np.atleast_2d(np.asarray(pts, float))
+        self.points.append(pts)
+        self.kinds.append(np.full(len(pts), kind, np.int8))
+
+    @property
+    def last(self):
+        return self.points[-1][-1] if self.points else None
+
+    def motion(self) -> Motion:
+        return Motion(np.concatenate(self.points), np.concatenate(self.kinds))
+
+
+def _enter(out: _Moves, p, top: float, part: _Part, tool: Tool, safe: float, allowed: float):
+    """From the clearance height over ``p``: rapid down to ``top`` (above any stock left),
+    then a ball plunges, a flat or bull end descends by a helix onto ``p`` (half its radius
+    wide, narrower where the part stands within it: the helix may not rise above the part's
+    drop heights and then fall onto ``p``; a plunge when even an eighth of the radius does)."""
+    out.add([[p[0], p[1], safe]], RAPID)
+    start = np.array([p[0], p[1], max(top, p[2])])
+    if tool.kind != "ball" and top > p[2]:
+        for rho in tool.radius / np.array([2.0, 4.0, 8.0]):
+            turns = max(1, int(np.ceil((top - p[2]) / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * rho))))
+            t = np.linspace(0, 1, 48 * turns + 1)
+            ang = 2 * np.pi * turns * t
+            helix = p[:2] + rho * np.column_stack([np.cos(ang) - 1, np.sin(ang)])
+            hz = np.maximum(top - (top - p[2]) * t, np.nan_to_num(part.height(helix), nan=-np.inf))
+            hz[-1] = p[2]
+            pts = np.column_stack([helix, hz])
+            if move_gouge(part.height, pts).max() <= REFINE_SHARE * allowed:
+                out.add([[helix[0, 0], helix[0, 1], max(top, hz[0])]], RAPID)
+                out.add(pts, PLUNGE)
+                return
+    out.add([start], RAPID)
+    out.add([p], PLUNGE)
+
+
+def _leave(out: _Moves, top: float, safe: float):
+    """Up at the feed to above the stock left, then rapidly to the clearance height."""
+    p = out.last
+    if p[2] < top:
+        out.add([[p[0], p[1], top]], FEED)
+    out.add([[p[0], p[1], safe]], RAPID)
+
+
+def _normals(tri: np.ndarray) -> np.ndarray:
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n *= np.where(n[:, 2:3] < 0, -1.0, 1.0)
+    length = np.linalg.norm(n, axis=1)
+    return n / np.where(length > 0, length, 1.0)[:, None]
+
+
+def _circle_spacing(c: float, h: float) -> float:
+    """Distance between passes of a circle of radius ``c`` leaving cusps ``h``."""
+    h = min(h, c)
+    return 2.0 * math.sqrt(max(2.0 * c * h - h * h, 0.0))
+
+
+def _levels(tri, slope, steep, spacing, top, bottom, reach):
+    """Tip heights from ``top`` down to ``bottom``: each next one ``spacing · sin θ_min``
+    lower, ``θ_min`` the least slope of the steep triangles within the tool's reach of the
+    band; heights with no steep triangle near are skipped."""
+    lo_t, hi_t = tri[steep, :, 2].min(axis=1), tri[steep, :, 2].max(axis=1)
+    s_sl = np.sin(np.radians(slope[steep]))
+
+    def near(z):
+        return (hi_t >= z - spacing) & (lo_t <= z + reach + spacing)
+
+    out, z = [], top
+    while z > bottom:
+        here = near(z)
+        if here.any():
+            out.append(z)
+            z -= spacing * float(s_sl[here].min())
+        else:  # jump down to the next steep triangle
+            below = hi_t[hi_t < z - spacing]
+            if not len(below):
+                break
+            z = float(below.max()) + 0.5 * spacing
+    if z <= bottom and near(bottom).any() and (not out or out[-1] > bottom + 1e-9):
+        out.append(bottom)
+    return np.array(out, float)
+
+
+def _pieces(loop: np.ndarray, keep: np.ndarray):
+    """Runs of ``keep`` along a closed ``loop``, each grown by one point at either end;
+    the whole loop closed (first point repeated) when all of it is kept."""
+    n = len(loop)
+    if keep.all():
+        return [np.vstack([loop, loop[:1]])]
+    k0 = int(np.argmin(keep))
+    idx = np.roll(np.arange(n), -k0)
+    flags = keep[idx]
+    out, start = [], None
+    for i in range(n + 1):
+        on = flags[i] if i < n else False
+        if on and start is None:
+            start = i
+        elif not on and start is not None:
+            sel = idx[np.arange(start - 1, i + 1) % n]
+            out.append(loop[sel])
+            start = None
+    return out
+
+
+def _chord(part: _Part, tool: Tool, tolerance: float) -> float:
+    """Chord tolerance of the contours (their margin from the mesh is it plus the mesh's deflection)."""
+    return max(min(tolerance / 8, 1e-3 * tool.radius), 1e-7 * float(np.max(part.box[1] - part.box[0])))
+
+
+def _grown(tool: Tool, g: float):
+    if tool.kind == "ball":
+        return SimpleNamespace(kind="ball", radius=tool.radius + g)
+    return SimpleNamespace(kind="bull", radius=tool.radius + g, corner_radius=tool.corner + g)
+
+
+def _judge(part: _Part, pts: np.ndarray, allowed: float):
+    """Gouge-check one polyline; lift what would cut (returns points, lift)."""
+    if len(pts) < 2:
+        return pts, 0.0
+    depth = move_gouge(part.height, pts)
+    if depth.max() <= allowed:
+        return pts, 0.0
+    pts, lift, depth = lift_moves(part.height, pts, depth, REFINE_SHARE * allowed)
+    if depth.max() > allowed:
+        raise NoSafePathError(f"toolpath: no safe path: a waterline move still cuts {depth.max():.3g} deep")
+    return pts, float(lift.max())
+
+
+def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float):
+    """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
+    the top of its steep triangles (slope ≥ ``steep_angle``) down to ``bottom``, ``spacing``
+    the distance of neighbouring levels along the walls.  Returns ``(pieces, info)``:
+    pieces per level (top first), each ``(N, 3)``, closed ones with their first point
+    repeated, and a report dict."""
+    tri = part.grid.triangles
+    n = _normals(tri)
+    slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
+    steep = slope >= steep_angle - STEEP_MARGIN
+    info = {"levels": 0, "z_spacing": (0.0, 0.0), "contours": 0, "length": 0.0, "spacing": spacing, "lifted": 0.0}
+    if not steep.any():
+        return [], info
+    chord = _chord(part, tool, tolerance)
+    g = chord + part.deflection  # the tool keeps the mesh's whole deflection from it (walls amplify any gouge)
+    reach = tool.corner if tool.kind != "flat" else 0.0
+    levels = _levels(tri, slope, steep, spacing, float(tri[steep, :, 2].max()), bottom, reach + tool.radius)
+    if not len(levels):
+        return [], info
+    grown = _grown(tool, g)
+    loops = waterline(tri, grown, levels - g, sampling=tool.radius / 2, tolerance=chord)
+    allowed = tolerance - part.deflection + part.lift
+    w = 0.25 * spacing
+    bottom_z = bottom
+    out, lifted, count, length = [], 0.0, 0, 0.0
+    for z, level in zip(levels, loops):
+        pieces = []
+        for loop in level:
+            xy = loop[:, :2]
+            tangent = np.roll(xy, -1, axis=0) - np.roll(xy, 1, axis=0)
+            tangent /= np.maximum(np.linalg.norm(tangent, axis=1), 1e-300)[:, None]
+            outward = np.column_stack([tangent[:, 1], -tangent[:, 0]])  # the material lies on the left
+            h_in = np.nan_to_num(part.height(xy - w * outward), nan=bottom_z)
+            h_out = np.nan_to_num(part.height(xy + w * outward), nan=bottom_z)
+            cl_slope = np.degrees(np.arctan2(np.maximum(h_in - h_out, 0.0), 2 * w))
+            keep = cl_slope >= steep_angle - STEEP_MARGIN
+            if not keep.any():
+                continue
+            for piece in _pieces(np.column_stack([xy, np.full(len(xy), z)]), keep):
+                if len(piece) < 2:
+                    continue
+                piece, lift = _judge(part, piece, allowed)
+                lifted = max(lifted, lift)
+                pieces.append(piece)
+                count += 1
+                length += float(np.linalg.norm(np.diff(piece, axis=0), axis=1).sum())
+        out.append(pieces)
+    gaps = -np.diff(levels)
+    info.update(levels=len(levels), z_spacing=(float(gaps.min()) if len(gaps) else 0.0,
+                                               float(gaps.max()) if len(gaps) else 0.0),
+                contours=count, length=length, lifted=lifted, top=float(levels[0]), bottom=float(levels[-1]),
+                margin=g)
+    return out, info
+
+
+def _link_clear(part: _Part, a, b, allowed: float, step: float) -> np.ndarray | None:
+    """The straight move a -> b sampled ``step`` apart, if it stays clear of the part."""
+    n = int(np.ceil(np.linalg.norm(b[:2] - a[:2]) / step)) + 1
+    pts = a + np.linspace(0, 1, n + 1)[:, None] * (b - a)
+    if move_gouge(part.height, pts).max() > REFINE_SHARE * allowed:
+        return None
+    return pts[1:]
+
+
+def _budget(scallop: float, margin: float):
+    """The cusp height passes are spaced for: the scallop less ``margin``, and whether that
+    holds the scallop (a mesh coarser than the scallop, as some faces of real parts cannot be
+    meshed finer than their own tolerance, gets half the scallop and no promise).
+
+    >>> [tuple(round(v, 6) for v in _budget(0.05, m)) for m in (0.02, 0.2)]
+    [(0.03, 1), (0.025, 0)]
+    """
+    if scallop - margin >= scallop / 4:
+        return scallop - margin, True
+    return scallop / 2, False  # no promise either way: not a raster ten times denser for nothing
+
+
+def _order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
+                 max_down: float):
+    """Append the pieces level by level (top first), each level's nearest first, linked
+    along the part where short and clear, else up and over."""
+    allowed = tolerance - part.deflection + part.lift
+    links = 0
+    for pieces in levels:
+        todo = list(pieces)
+        while todo:
+            # the first piece is entered from the clearance height over its own start
+            here = out.last if out.points else np.array([todo[0][0, 0], todo[0][0, 1], safe])
+            best, best_d, best_k = None, np.inf, 0
+            for j, pc in enumerate(todo):
+                closed = len(pc) > 2 and np.all(pc[0] == pc[-1])
+                cand = pc[:-1] if closed else pc[:1]
+                d = np.linalg.norm(cand[:, :2] - here[:2], axis=1)
+                k = int(np.argmin(d))
+                if d[k] < best_d:
+                    best, best_d, best_k = j, float(d[k]), k
+            pc = todo.pop(best)
+            if len(pc) > 2 and np.all(pc[0] == pc[-1]) and best_k:
+                pc = np.vstack([pc[best_k:-1], pc[:best_k + 1]])
+            drop_z = here[2] - pc[0, 2]
+            path = None
+            if here[2] < safe and best_d <= tool.radius and -1e-9 <= drop_z <= max_down:
+                path = _link_clear(part, here, pc[0], allowed, tool.radius / 8)
+            if path is not None:
+                out.add(path, PLUNGE if drop_z > 1e-9 else FEED)
+                links += 1
+            else:
+                if here[2] < safe:
+                    _leave(out, float(top(here[None, :2])[0]), safe)
+                _enter(out, pc[0], float(top(pc[:1, :2])[0]), part, tool, safe, allowed)
+            out.add(pc[1:], FEED)
+    return links
+
+
+def _raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float | None, direction: str,
+                   lo: float, hi: float):
+    """Cross positions of the raster's passes for cusps of ``scallop`` across the ground
+    between them: each next pass ``s · cos φ`` further, ``φ`` the steepest cross slope of
+    the part's triangles below ``steep_angle`` (all of them when None) within the tool's
+    radius of the two passes, from ``lo`` to ``hi``.  Returns ``(positions, steepest φ in degrees)``."""
+    tri = part.grid.triangles
+    n = _normals(tri)
+    slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
+    shallow = slope < (90.0 if steep_angle is None else steep_angle)
+    axis = 1 if direction == "x" else 0
+    cross = np.minimum(np.degrees(np.arctan2(np.abs(n[shallow, axis]), n[shallow, 2])), 89.0)
+    t_lo, t_hi = tri[shallow, :, axis].min(axis=1), tri[shallow, :, axis].max(axis=1)
+    circ = _circle_spacing(tool.corner, scallop)
+    R = tool.radius
+    out, steepest = [float(lo)], 0.0
+    while out[-1] < hi - 1e-9:
+        y = out[-1]
+        near = (t_hi >= y - R) & (t_lo <= y + circ + 2.0 * tool.core + R)
+        phi = float(cross[near].max()) if near.any() else 0.0
+        steepest = max(steepest, phi)
+        if tool.kind == "bull" and phi < 1.0:  # the flat core counts only on level ground
+            gap = 2.0 * tool.core + circ
+        else:
+            gap = circ * math.cos(math.radians(phi))
+        out.append(min(y + min(gap, tool.diameter), hi))
+    return np.array(out), steepest
+
+
+# ----------------------------------------------------------------------------------------------
+# rest
+
+def height_field(tri: np.ndarray, x: np.ndarray, y: np.ndarray, block: int = 2_000_000) -> np.ndarray:
+    """Highest triangle over each node of the grid ``x`` × ``y`` (-inf where none).
+
+    >>> tri = np.array([[[0, 0, 1], [2, 0, 1], [0, 2, 3]]], float)
+    >>> height_field(tri, np.array([0.5, 3.0]), np.array([0.5])).tolist()
+    [[1.5], [-inf]]
+    """
+    top = np.full((len(x), len(y)), -np.inf)
+    lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
+    i0, i1 = np.searchsorted(x, lo[:, 0] - 1e-12), np.searchsorted(x, hi[:, 0] + 1e-12, "right")
+    j0, j1 = np.searchsorted(y, lo[:, 1] - 1e-12), np.searchsorted(y, hi[:, 1] + 1e-12, "right")
+    ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
+    counts = ni * nj
+    edges = np.r_[0, np.cumsum(counts)]
+    s0 = 0
+    while s0 < len(counts):
+        # triangles in blocks of at most `block` (triangle, node) pairs
+        s_next = max(int(np.searchsorted(edges, edges[s0] + block, "right")) - 1, s0 + 1)
+        ids = np.arange(s0, min(s_next, len(counts)))
+        s0 = s_next
+        c = counts[ids]
+        t = np.repeat(ids, c)
+        local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
+        ii = i0[t] + local // np.maximum(nj[t], 1)
+        jj = j0[t] + local % np.maximum(nj[t], 1)
+        A, v0, v1 = tri[t, 0], tri[t, 1] - tri[t, 0], tri[t, 2] - tri[t, 0]
+        den = v0[:, 0] * v1[:, 1] - v1[:, 0] * v0[:, 1]
+        good = np.abs(den) > 1e-300
+        den = np.where(good, den, 1.0)
+        wx, wy = x[ii] - A[:, 0], y[jj] - A[:, 1]
+        l1 = (wx * v1[:, 1] - v1[:, 0] * wy) / den
+        l2 = (v0[:, 0] * wy - wx * v0[:, 1]) / den
+        inside = good & (l1 >= -1e-12) & (l2 >= -1e-12) & (l1 + l2 <= 1 + 1e-12)
+        z = A[:, 2] + l1 * v0[:, 2] + l2 * v1[:, 2]
+        np.maximum.at(top, (ii[inside], jj[inside]), z[inside])
+    return top
+
+
+def rest_left(part: _Part, tool: Tool, floor: float, threshold: float, spacing: float | None = None) -> dict:
+    """Where ``tool`` cannot reach the part's top-visible surface by more than
+    ``threshold``: ``area`` (mm²), ``max_depth`` (vertical, mm), ``box``
+    ``[[x0, y0], [x1, y1]]`` (None when nowhere), ``regions``, the grid ``spacing`` and
+    ``map`` ``(x, y, rest)``: the nodes and the height of the rest over each (NaN off the part).
+    ``floor``: the lowest the tool may go where it touches nothing (the stock's bottom)."""
+    tri = part.grid.triangles
+    lo, hi = part.box
+    h = float(spacing) if spacing else max(tool.radius / REST_PER_RADIUS, float(np.max(hi[:2] - lo[:2])) / REST_CELLS)
+    x = np.arange(lo[0], hi[0] + 0.5 * h, h)
+    y = np.arange(lo[1], hi[1] + 0.5 * h, h)
+    top = height_field(tri, x, y)
+    m = int(math.floor(tool.radius / h))
+    px = lo[0] + h * np.arange(-m, len(x) + m)
+    py = lo[1] + h * np.arange(-m, len(y) + m)
+    PX, PY = np.meshgrid(px, py, indexing="ij")
+    cl = part.height(np.column_stack([PX.ravel(), PY.ravel()])).reshape(PX.shape)
+    cl = np.maximum(np.nan_to_num(cl, nan=floor), floor)
+    reach = np.full(top.shape, np.inf)
+    di, dj = np.mgrid[-m:m + 1, -m:m + 1]
+    d = h * np.hypot(di, dj)
+    ok = d <= tool.radius
+    for a, b, f in zip(di[ok], dj[ok], tool.profile(d[ok])):
+        np.minimum(reach, cl[m + a:m + a + len(x), m + b:m + b + len(y)] + f, out=reach)
+    rest = np.where(np.isfinite(top), reach - top, -np.inf)
+    mask = rest > threshold
+    out = {"area": float(mask.sum() * h * h), "max_depth": float(rest[mask].max()) if mask.any() else 0.0,
+           "box": None, "regions": 0, "spacing": h, "threshold": threshold,
+           "map": (x, y, np.where(np.isfinite(rest), rest, np.nan))}
+    if mask.any():
+        ii, jj = np.nonzero(mask)
+        out["box"] = [[float(x[ii.min()]), float(y[jj.min()])], [float(x[ii.max()]), float(y[jj.max()])]]
+        out["regions"] = int(ndimage.label(mask, structure=np.ones((3, 3)))[1])
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+
+def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | None, direction: str,
+           steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Rest | None,
+           lowest: float | None = None):
+    """The finishing :class:`~surfmod.cam.roughing.Motion` (waterline pieces on the steep
+    regions, then the raster) and its report; contours no lower than ``lowest`` (where
+    the flutes end, default the stock's bottom)."""
+    margin = part.lift + part.deflection  # what exactness costs the scallop (see the module doc)
+    held = True
+    if scallop is not None:
+        budget, held = _budget(scallop, margin)
+    else:
+        budget = None
+    # the raster runs beyond the part's box until a pass's contact reaches the rim: on ground
+    # falling by θ towards it the tool touches its core plus c sin θ uphill of its axis
+    slope = np.degrees(np.arccos(np.clip(_normals(part.grid.triangles)[:, 2], -1, 1)))
+    shallow = slope[slope < (90.0 if steep_angle is None else steep_angle)]
+    theta = float(shallow.max()) if len(shallow) else 0.0
+    overhang = tool.core + tool.corner * math.sin(math.radians(theta)) if theta > 1e-6 else 0.0
+    bounds = (part.box[0, :2] - overhang, part.box[1, :2] + overhang)
+    if budget is not None:
+        axis = 1 if direction == "x" else 0
+        across, phi = _raster_passes(part, tool, budget, steep_angle, direction, bounds[0][axis], bounds[1][axis])
+        step_xy = float(np.diff(across).max()) if len(across) > 1 else tool.radius
+    else:
+        across, step_xy, phi = None, stepover, 0.0
+    top = _StockTop(part, tool, rest, stock, safe)
+    out = _Moves()
+    wl_info = None
+    if steep_angle is not None:
+        if scallop is not None:
+            # the contours keep a chord + the deflection from the mesh, give or take a chord,
+            # and the mesh lies within the deflection of the faces
+            wl_budget, wl_held = _budget(scallop, 2 * part.deflection + 2 * _chord(part, tool, tolerance))
+            held = held and wl_held
+            spacing = _circle_spacing(tool.corner, wl_budget) if tool.kind != "flat" else stepover
+        else:
+            spacing = stepover
+        # no deeper than the flutes reach below the part's top (the raster's own depth is checked by the job)
+        bottom = float(stock[0, 2]) if lowest is None else max(float(stock[0, 2]), lowest)
+        levels, wl_info = _waterline_pieces(part, tool, steep_angle, spacing, tolerance, bottom)
+        wl_info["flute_limited"] = bottom > float(stock[0, 2])
+        if any(levels):
+            wl_info["links"] = _order_pieces(out, levels, part, tool, top, safe, tolerance, 1.5 * spacing)
+            _leave(out, float(top(out.last[None, :2])[0]), safe)
+    # the contours' links, entries and retracts judged once more on the drop-cutter heights
+    # (the contours themselves and the raster were judged as they were made)
+    allowed = tolerance - part.deflection + part.lift
+    depth = np.full(1, -np.inf)
+    if out.points:
+        wl_motion = out.motion()
+        depth = move_gouge(part.height, wl_motion.points)
+        if depth.max() > allowed:
+            k = int(np.argmax(depth))
+            raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
+    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, across=across)
+    pts = path.points
+    before = sum(len(q) for q in out.points)
+    _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe, allowed)
+    entry = np.concatenate(out.points)[max(before - 1, 0):]
+    if move_gouge(part.height, entry).max() > allowed:
+        raise NoSafePathError("toolpath: no safe path: the raster's entry cuts the part")
+    out.add(pts[1:], FEED)
+    _leave(out, float(top(pts[-1:, :2])[0]), safe)
+    motion = out.motion()
+    threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)
+    report = {"stepover": path.stepover, "scallop": scallop if scallop is not None else path.scallop,
+              "scallop_held": held, "deflection": part.deflection,
+              "gouge": max(float(depth.max()) - part.lift, path.gouge),
+              "lifted": max(path.lifted, (wl_info or {}).get("lifted", 0.0)),
+              "tolerance": tolerance, "toolpath": path, "steep_angle": steep_angle,
+              "raster": {"stepover": path.stepover, "least_stepover": float(np.diff(_path_across(path)).min())
+                         if path.n_passes > 1 else 0.0, "passes": path.n_passes, "length": path.length,
+                         "cross_slope": phi, "margin": margin, "overhang": overhang},
+              "waterline": wl_info,
+              "rest": rest_left(part, tool, float(stock[0, 2]), threshold)}
+    return motion, report
+
+
+def _path_across(path) -> np.ndarray:
+    """The cross positions of a raster's passes."""
+    axis = 1 if path.direction == "x" else 0
+    on = path.pass_index >= 0
+    first = np.r_[True, path.pass_index[on][1:] != path.pass_index[on][:-1]]
+    return path.points[on][first, axis]
+
+
+def summary_lines(report: dict) -> list[str]:
+    """The finishing report as lines for the ``surfmod machine`` summary.
+
+    >>> summary_lines({"rest": {"box": None, "threshold": 0.05}})
+    ['rest: the tool reaches everywhere within 0.05 mm']
+    """
+    lines = []
+    r = report.get("raster")
+    if r:
+        lines.append(f"raster: {r['passes']} passes {r['least_stepover']:.4g}-{r['stepover']:.4g} mm apart (cross "
+                     f"slopes up to {r['cross_slope']:.1f} deg), length {r['length']:.0f} mm")
+    w = report.get("waterline")
+    if w and w["levels"]:
+        z0, z1 = round(w["bottom"], 3) + 0.0, round(w["top"], 3) + 0.0  # no "-0"
+        lines.append(f"waterline on slopes >= {report['steep_angle']:g} deg: {w['levels']} levels "
+                     f"{w['z_spacing'][0]:.3g}-{w['z_spacing'][1]:.3g} mm apart (z {z0:g} to {z1:g}), "
+                     f"{w['contours']} contours, length {w['length']:.0f} mm"
+                     + (" (the flutes reach no lower)" if w.get("flute_limited") else ""))
+    elif w is not None:
+        lines.append(f"waterline: no slopes >= {report['steep_angle']:g} deg")
+    if not report.get("scallop_held", True):
+        lines.append(f"scallop not held: the mesh's deflection {report['deflection']:.3g} mm (the faces' own "
+                     f"tolerance) is too large for {report['scallop']:g}; passes spaced for half of it")
+    rest = report.get("rest")
+    if rest:
+        if rest["box"] is None:
+            lines.append(f"rest: the tool reaches everywhere within {rest['threshold']:.3g} mm")
+        else:
+            (x0, y0), (x1, y1) = rest["box"]
+            lines.append(f"rest not reached (more than {rest['threshold']:.3g} mm, left for a smaller tool): "
+                         f"area {rest['area']:.4g} mm^2, max depth {rest['max_depth']:.4g} mm, "
+                         f"{rest['regions']} region(s) in x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g}")
+    return lines
