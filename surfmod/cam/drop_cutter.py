@@ -51,7 +51,8 @@ KINDS = {"ball": 0, "flat": 1, "bull": 2}
 class TriangleGrid:
     """Triangles ``(M, 3, 3)`` bucketed on an (x, y) grid for queries of tool radius ``radius``.
 
-    Each cell lists the triangles whose (x, y) box grown by the radius meets it.
+    Each cell lists the triangles whose (x, y) box grown by the radius meets it, highest
+    top first.
 
     >>> import numpy as np
     >>> tri = np.array([[[0, 0, 1], [4, 0, 1], [0, 4, 1]]], float)
@@ -86,7 +87,9 @@ class TriangleGrid:
         ix = i0[tri_id, 0] + local % nx[tri_id]
         iy = i0[tri_id, 1] + local // nx[tri_id]
         cell_id = ix * self.shape[1] + iy
-        order = np.argsort(cell_id, kind="stable")
+        # each cell's list from its highest triangle down: a drop stops at the first
+        # triangle whose top is below the height already found (no later one can beat it)
+        order = np.lexsort((-self.top[tri_id], cell_id))
         self._cells = cell_id[order]
         self._tris = tri_id[order]
 
@@ -325,30 +328,22 @@ def _reach(kind, qx, qy, lo, hi, top, r, c):
 def _drop_kernel(kind, xy, start, stop, tris, rows, lo, hi, top, r, c, z, touch, touched):
     """Per location: the highest tip height over its cell list, its contact and triangle.
 
-    First the triangles right under the location (its (x, y) inside their own box): their
-    best contact bounds from below what every other triangle must be able to beat, so a
-    triangle whose :func:`_reach` is lower is skipped without solving its contacts (most
-    of a list on a fine mesh).  Then the list in order, the first of equal heights winning."""
+    The list runs from the highest triangle top down, and no triangle lifts the tip above
+    its top (:func:`_reach`, a tighter bound, skips the rest before any contact is
+    solved), so the walk stops at the first top below the height found: on a fine mesh
+    most of a list is never read.  Of equal heights the first found wins."""
     contact = np.empty(3)
     for i in range(len(xy)):
         qx, qy = xy[i, 0], xy[i, 1]
-        bound = -np.inf
-        for k in range(start[i], stop[i]):
-            ti = tris[k]
-            if lo[ti, 0] + r <= qx <= hi[ti, 0] - r and lo[ti, 1] + r <= qy <= hi[ti, 1] - r:
-                bound = max(bound, _height(kind, qx, qy, rows[ti], r, c, contact))
         best, winner = -np.inf, -1
         for k in range(start[i], stop[i]):
             ti = tris[k]
+            if top[ti] < best:
+                break
             if not (lo[ti, 0] <= qx <= hi[ti, 0] and lo[ti, 1] <= qy <= hi[ti, 1]):
                 continue
-            under = lo[ti, 0] + r <= qx <= hi[ti, 0] - r and lo[ti, 1] + r <= qy <= hi[ti, 1] - r
-            # the triangles under the location always count: their height may exceed their
-            # own reach by a rounding, and the bound is one of them
-            if not under:
-                reach = _reach(kind, qx, qy, lo[ti], hi[ti], top[ti], r, c)
-                if reach == -np.inf or reach < bound or reach < best:
-                    continue
+            if _reach(kind, qx, qy, lo[ti], hi[ti], top[ti], r, c) < best:
+                continue
             h = _height(kind, qx, qy, rows[ti], r, c, contact)
             if h > best:
                 best, winner = h, ti
