@@ -244,7 +244,9 @@ def test_tiny_tolerance_and_huge_work_are_refused_before_the_work(tmp_path, monk
         raise AssertionError("BRepMesh ran before the refusal")
 
     monkeypatch.setattr(triangulation, "part_triangles", no_meshing)
-    for tol, why in ((1e-14, "below the floor"), (1e-7, "triangles, above the limit")):
+    monkeypatch.setattr(toolpath_module, "MAX_TRIANGLES", 100_000)  # the sphere at 1e-4: ~600,000 estimated
+    for tol, why in ((5e-324, "below the floor"), (1e-14, "below the floor"), (1e-5, "BRepMesh's time"),
+                     (1e-4, "triangles, above the limit")):
         with pytest.raises(sm.SurfmodError, match=f"^tolerance: .*{why}"):
             sm.toolpath(sphere, tool, stepover=1.0, tolerance=tol)
     monkeypatch.undo()
@@ -272,7 +274,7 @@ def test_tiny_tolerance_and_huge_work_are_refused_before_the_work(tmp_path, monk
     step = tmp_path / "sphere.step"
     sm.export_step(sphere, step)
     out = tmp_path / "p.nc"
-    code = cli_main(["toolpath", str(step), "--radius", "1", "--stepover", "1", "--tolerance", "1e-7",
+    code = cli_main(["toolpath", str(step), "--radius", "1", "--stepover", "1", "--tolerance", "1e-5",
                      "--out", str(out), "--no-progress"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1 and not out.exists() and len(err) == 1 and "tolerance:" in err[0]
