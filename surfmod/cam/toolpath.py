@@ -49,8 +49,10 @@ MAX_TRIANGLES = 2_000_000
 #: (ball of 3 % of the part, scallop 2 % of the ball) asks 5e-5
 TOLERANCE_FLOOR = 1e-6
 #: drop-cutter work one path may take, in triangle tests (cell-list entries a drop may
-#: walk, an upper bound: the walk stops early on most lists); about a minute of one core
-MAX_WORK = 10_000_000_000
+#: walk, an upper bound: the walk stops early on most lists).  The costliest corpus part
+#: at the documented setting (Ventilator, ball of 3 % of the part, scallop 2 % of the
+#: ball) takes 1.0e10 of them in 42 s of one core; the cap is about twice that
+MAX_WORK = 25_000_000_000
 #: drops per raster location a path costs at the least: two refinement passes of two
 #: samples per move, the verdict's four, a repair's two and its verdict's four, the contacts
 NOMINAL_DROPS = 17
