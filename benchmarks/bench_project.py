@@ -49,6 +49,7 @@ def _best(fn, *args, repeat: int = 3):
 def _elementary():
     return {
         "plane": sm.PlaneSurface((1, 2, 3), (0.3, 0.2, 1), u_range=(-2, 3), v_range=(-1, 2)),
+        "sm.plane": sm.plane((1, 2, 0.5), (4, 2.5, 1), (0.5, 5, 2)),  # the 3-point parallelogram (a B-spline)
         "cylinder": sm.CylindricalSurface(2.0, (1, 0, 0), (0.2, 0.3, 1), v_range=(-1, 3)),
         "cone": sm.ConicalSurface(math.radians(30), 1.0, (0, 0, 0), (0, 0.2, 1), v_range=(-4, 3)),
         "sphere": sm.sphere(2.0, center=(1, 0, 0)),

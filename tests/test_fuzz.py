@@ -27,12 +27,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+import build123d as bd
 import numpy as np
 import pytest
 from conftest import CORPUS_FILES, JUDGED_FILES
 from step_mutations import KINDS, mutate
 
 import surfmod as sm
+from surfmod.cam.toolpath import drop_cutter
 from surfmod.curve import Curve
 from surfmod.surface import Surface
 
@@ -275,10 +277,15 @@ def _elementary_surfaces():
         sm.ConicalSurface(-0.4, 1.0, u_range=(2, 4), v_range=(-5, 1)),
         sm.CylindricalSurface(2.0, u_range=(5, 8), v_range=(0, 1)),
         sm.PlaneSurface((1, 2, 3), (0.3, 0.2, 1), u_range=(-2, 3), v_range=(-1, 2)),
+        sm.plane((1, 2, 0.5), (4, 2.5, 1), (0.5, 5, 2)),  # sm.plane's skewed parallelogram: closed form too
     ]
 
 
 ELEMENTARY = _elementary_surfaces()
+#: a superellipsoid with creases (exponents near 2): its mesh needs 6-60x the curvature estimate
+CREASED = sm.superellipsoid(1, 1, 1, 1.8, 1.8)
+#: a small part for the tolerance of the tool path and the drop-cutter (a ball of 1 over it)
+BOSS = bd.Box(6, 4, 2) + bd.Pos(0, 0, 1.5) * bd.Cylinder(1.2, 1)
 _rational = sm.BSplineSurface(np.random.default_rng(11).uniform(-1, 1, (5, 5, 3)) + np.stack(np.meshgrid(
     np.arange(5.0), np.arange(5.0), [0.0], indexing="ij"), -1)[:, :, 0], (3, 3),
     weights=np.random.default_rng(12).uniform(0.5, 2.0, (5, 5)))
@@ -290,8 +297,10 @@ def _grid_points(n=8):
 
 
 def tolerance_case(rng, tmp: Path):
-    k = rng.integers(16)
+    k = rng.integers(21)
     tol = TOLERANCES[rng.integers(len(TOLERANCES))]
+    if k >= 16:
+        return _tolerance_case_more(rng, k, tol, tmp)
     if k == 0:  # 1e5 points onto an elementary surface: closed forms, never a search
         s = ELEMENTARY[rng.integers(len(ELEMENTARY))]
         pts = rng.uniform(-8, 8, (100_000, 3))
@@ -339,6 +348,22 @@ def tolerance_case(rng, tmp: Path):
     sides = [sm.Line((0, 0, 0), (1, 0, 0)), sm.Line((1, 0, 0), (1, 1, 0)), sm.Line((1, 1, 0), (0, 1, 0)),
              sm.Line((0, 1, 0), (0, 0, 0))]
     return "fill tol", lambda: sm.fill(sides, "G0", tolerance=tol)
+
+
+def _tolerance_case_more(rng, k, tol, tmp: Path):
+    """Issue 25's families: tool paths and drop-cutter heights, meshes of solids, the
+    creased superellipsoid, and a surface against a copy of itself or a hair away."""
+    if k == 16:
+        return "toolpath tol", lambda: sm.toolpath(BOSS, sm.Tool("ball", 1.0), stepover=1.0, tolerance=tol)
+    if k == 17:
+        return "drop_cutter tol", lambda: drop_cutter(BOSS, sm.Tool("flat", 1.0), [[0.0, 0.0], [2.5, 1.0]],
+                                                      tolerance=tol)
+    if k == 18:
+        return "export_stl solid tol", lambda: sm.export_stl(BOSS, tmp / "s.stl", tolerance=tol)
+    if k == 19:
+        return "tessellate creased tol", lambda: sm.tessellate(CREASED, tol)
+    s = SURFACES[rng.integers(len(SURFACES))]
+    return "intersect self tol", lambda: sm.intersect(s, s, tol)
 
 
 def _nudged(s, gap):

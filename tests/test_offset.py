@@ -112,3 +112,24 @@ def test_thicken_volumes():
         sm.thicken(cyl, -2.5)
     mid = sm.thicken(cyl, 0.5, tolerance=1e-7, symmetric=True)      # radii 1.75 .. 2.25
     assert gprops(mid.wrapped)["volume"] == pytest.approx(1.5 / 2 * (2.25**2 - 1.75**2) * 3, rel=1e-7)
+
+
+def test_tiny_tolerances_refused_before_the_big_fits(monkeypatch):
+    """Issue 25: offset(…, 1e-9) ran for minutes of ever larger fits whose error stalled
+    at the least-squares round-off (~4e-11 of the size).  Below FIT_FLOOR of the size it is
+    refused at once; above it, a tolerance whose h^4 span count passes MAX_SPANS is refused
+    before that fit is made."""
+    from surfmod.construct import offset as offset_module
+
+    s = wavy()
+    size = offset_module.model_size(s) + 0.5
+    fits = []
+    original = offset_module._fit
+    monkeypatch.setattr(offset_module, "_fit", lambda *a, **k: fits.append(a[1].size * a[2].size) or original(*a, **k))
+    with pytest.raises(sm.SurfmodError, match=r"^tolerance: .* below what a bicubic fit can reach"):
+        sm.offset(s, 0.5, 0.5 * offset_module.FIT_FLOOR * size)
+    assert fits == []
+    monkeypatch.setattr(offset_module, "MAX_SPANS", 400)
+    with pytest.raises(sm.SurfmodError, match=r"^tolerance: 1e-07 would need at least [\d,]+ bicubic spans"):
+        sm.offset(s, 0.5, 1e-7)
+    assert max(fits) <= 400 * 2  # breakpoints of every fit made stayed within the cap

@@ -135,3 +135,67 @@ def test_closest_angle_wraps_and_picks_the_nearer_end():
     assert closest_angle(np.array([0.5]), 5.0, 8.0)[0] == pytest.approx(0.5 + 2 * math.pi, abs=1e-15)
     # outside [0, 1]: 3.5 is nearer to 1 (2.5) than to 2 pi (2.78); 3.7 is nearer to 2 pi
     np.testing.assert_array_equal(closest_angle(np.array([3.5, 3.7]), 0.0, 1.0), [1.0, 0.0])
+
+
+# sm.plane's parallelogram P0 + u (P1 - P0) + v (P2 - P0) with skewed, unequal edges
+SKEWED = sm.plane((1, 2, 0.5), (4, 2.5, 1), (0.5, 5, 2))
+
+
+def test_three_point_plane_textbook_feet_and_distances():
+    pts = _points(20000, 6)
+    pr = sm.project(pts, SKEWED)
+    p0, p1, p2 = SKEWED.control_points[0, 0], SKEWED.control_points[1, 0], SKEWED.control_points[0, 1]
+    n = np.cross(p1 - p0, p2 - p0)
+    n /= np.linalg.norm(n)
+    height = (pts - p0) @ n
+    foot = pts - height[:, None] * n
+    # the foot's coordinates in the (skewed) edge basis, by least squares: inside the square, it is the answer
+    uv = np.linalg.lstsq(np.column_stack([p1 - p0, p2 - p0]), (foot - p0).T, rcond=None)[0].T
+    inside = np.all((uv >= 0) & (uv <= 1), axis=1)
+    assert 1000 < inside.sum() < len(pts) - 1000
+    np.testing.assert_allclose(pr.distance[inside], np.abs(height[inside]), atol=1e-12 * 8, rtol=0)
+    np.testing.assert_allclose(pr.point[inside], foot[inside], atol=1e-12 * 8, rtol=0)
+    np.testing.assert_allclose(np.c_[pr.u, pr.v][inside], uv[inside], atol=1e-12, rtol=0)
+    # outside, the closest point lies on the boundary and is no nearer than the foot
+    on_side = (np.isclose(pr.u, 0, atol=0) | np.isclose(pr.u, 1, atol=0) | np.isclose(pr.v, 0, atol=0)
+               | np.isclose(pr.v, 1, atol=0))
+    assert on_side[~inside].all() and (pr.distance[~inside] >= np.abs(height[~inside]) - 1e-12).all()
+
+
+def test_three_point_plane_matches_occt_feet_and_face_distance():
+    pts = _points(3000, 7)
+    pr = sm.project(pts, SKEWED)
+    assert SKEWED._closest_parameters(pts) is not None  # the closed form, not the search
+    theirs = occ.project_points(SKEWED.geom(), _bounds(SKEWED), pts)
+    found = np.isfinite(theirs[:, 2])
+    assert found.sum() > 1000
+    diff = pr.distance[found] - theirs[found, 2]
+    assert diff.max() <= 1e-12 * 8  # never farther than OCCT
+    same = np.abs(diff) <= 1e-12 * 8
+    assert same.sum() > 1000
+    np.testing.assert_allclose(np.c_[pr.u, pr.v][found][same], theirs[found][same, :2], atol=1e-11, rtol=0)
+    # the bounded patch, edges and corners included
+    np.testing.assert_allclose(pr.distance[:600], occ.face_distances(SKEWED.face(), pts[:600]), atol=1e-12 * 8,
+                               rtol=0)
+
+
+def test_three_point_plane_moved_and_reparametrized_and_not_a_parallelogram():
+    pts = _points(500, 8)
+    moved = SKEWED.rotated((1, 0, 0), (0.2, 1, 0.3), 41).scaled(1.7)
+    assert type(moved) is sm.ThreePointPlane and moved._closest_parameters(pts) is not None
+    np.testing.assert_allclose(sm.project(pts, moved).distance, occ.face_distances(moved.face(), pts),
+                               atol=1e-12 * 16, rtol=0)
+    # knots [2, 2, 5, 5] x [-1, -1, 0, 0]: the closed form maps back to the net's own parameters
+    net = SKEWED.control_points
+    k = (np.array([2.0, 2, 5, 5]), np.array([-1.0, -1, 0, 0]))
+    other = sm.ThreePointPlane(net, (1, 1), k)
+    pr = sm.project(pts, other)
+    np.testing.assert_allclose(other.points(pr.u, pr.v), pr.point, atol=1e-13)
+    np.testing.assert_allclose(pr.distance, sm.project(pts, SKEWED).distance, atol=1e-13, rtol=0)
+    # a bilinear net that is not a plane is given to the class directly: the search projects it
+    warped = net.copy()
+    warped[1, 1, 2] += 0.5
+    twisted = sm.ThreePointPlane(warped, (1, 1), SKEWED.knots)
+    assert twisted._closest_parameters(pts) is None
+    np.testing.assert_allclose(sm.project(pts[:200], twisted).distance, occ.face_distances(twisted.face(), pts[:200]),
+                               atol=1e-9, rtol=0)

@@ -10,6 +10,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
+from surfmod.meshing import tessellate as tessellate_module
 from surfmod.meshing.deviation import _barycentric
 
 
@@ -359,3 +360,38 @@ def test_auto_refines_locally_around_an_isolated_feature():
 def test_bad_method(method):
     with pytest.raises(sm.SurfmodError, match="method"):
         sm.tessellate(sm.sphere(1.0), 0.1, method=method)
+
+
+def test_tiny_tolerance_refused_before_meshing(monkeypatch):
+    """Issue 25: a creased superellipsoid at 3e-6 was refused only after ~28 s of
+    refinement; the curvature estimate times the fewest triangles any mesh took per
+    estimated one (MESH_OVERHEAD) refuses it before a grid or a cell is built."""
+    from surfmod.meshing import adaptive
+
+    def never(*args, **kwargs):
+        raise AssertionError("meshing started before the refusal")
+
+    monkeypatch.setattr(adaptive._Refiner, "run", never)
+    monkeypatch.setattr(tessellate_module, "grid_tessellate", never)
+    s = sm.superellipsoid(1, 1, 1, 1.8, 1.8)
+    with pytest.raises(sm.SurfmodError, match=r"^tolerance: 3e-06 would need about [\d,]+ triangles.*max_triangles=250,000"):
+        sm.tessellate(s, 3e-6)
+
+
+def test_refinement_refuses_as_soon_as_its_fewest_cells_pass_the_cap(monkeypatch):
+    """Before each split the refinement counts the fewest cells it can end with (a split
+    cuts a cell's sag at best fourfold): over the cap it refuses then, not once the cells
+    themselves are over it."""
+    from surfmod.meshing import adaptive
+
+    sizes = []
+    original = adaptive._Refiner.split
+
+    def split(self, cells):
+        sizes.append(self.x0.size)
+        return original(self, cells)
+
+    monkeypatch.setattr(adaptive._Refiner, "split", split)
+    with pytest.raises(sm.SurfmodError, match=r"^tolerance: 0.0001 needs more than [\d,]+ triangles.*found after"):
+        sm.tessellate(sm.superellipsoid(1, 1, 1, 1.8, 1.8), 1e-4, method="adaptive", max_triangles=20_000)
+    assert all(2 * n <= 20_000 for n in sizes)  # never built more cells than the cap allows

@@ -15,7 +15,9 @@ from toolpath_reference import ball_clearance, flat_cuts, gcode_positions
 
 import surfmod as sm
 from surfmod.cli import main as cli_main
+from surfmod.occ import triangulation
 from surfmod.occ.triangulation import part_triangles
+from surfmod.cam import toolpath as toolpath_module
 from surfmod.cam import toolpath_moves
 from surfmod.cam.drop_cutter import TriangleGrid, drop
 from surfmod.inputs import to_shape
@@ -228,6 +230,71 @@ def test_path_that_still_gouges_is_an_error(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1 and not out.exists()
     assert len(err) == 1 and err[0].startswith("surfmod toolpath: error:") and "no safe path" in err[0]
+
+
+def test_tiny_tolerance_and_huge_work_are_refused_before_the_work(tmp_path, monkeypatch, capsys):
+    """A tolerance below the part's floor or whose mesh would be too large is refused
+    before BRepMesh runs; drop-cutter work above ``max_work`` is refused from the raster
+    on the mesh before the first drop, and again before any later round would pass the
+    cap (the CLI: one line, exit 1, no file)."""
+    sphere = bd.Sphere(10.0)
+    tool = sm.Tool("ball", 1.0)
+
+    def no_meshing(*args, **kwargs):
+        raise AssertionError("BRepMesh ran before the refusal")
+
+    monkeypatch.setattr(triangulation, "part_triangles", no_meshing)
+    monkeypatch.setattr(toolpath_module, "MAX_TRIANGLES", 100_000)  # the sphere at 1e-4: ~600,000 estimated
+    for tol, why in ((5e-324, "below the floor"), (1e-14, "below the floor"), (1e-5, "BRepMesh's time"),
+                     (1e-4, "triangles, above the limit")):
+        with pytest.raises(sm.SurfmodError, match=f"^tolerance: .*{why}"):
+            sm.toolpath(sphere, tool, stepover=1.0, tolerance=tol)
+    monkeypatch.undo()
+    drops = []
+    monkeypatch.setattr(toolpath_module, "drop", lambda *a, **k: drops.append(1) or drop(*a, **k))
+    with pytest.raises(sm.SurfmodError, match=r"^max_work: the drop-cutter over [\d,]+ locations"):
+        sm.toolpath(sphere, tool, stepover=1.0, max_work=100_000)
+    assert drops == []  # refused from the estimate: nothing dropped
+    # a cap above the estimate but below what the refinement needs: refused between rounds
+    calls = []
+    original = toolpath_module._Meter.charge
+
+    def charge(self, work, what):
+        calls.append(self.used + work)
+        return original(self, work, what)
+
+    monkeypatch.setattr(toolpath_module._Meter, "charge", charge)
+    tp = sm.toolpath(sphere, tool, stepover=1.0)
+    cap = (calls[0] * toolpath_module.NOMINAL_DROPS + calls[-1]) // 2
+    assert calls[0] * toolpath_module.NOMINAL_DROPS < cap < calls[-1] and tp.gouge + tp.deflection <= tp.tolerance
+    calls.clear()
+    with pytest.raises(sm.SurfmodError, match=r"^max_work: the drop-cutter \(.*after [\d,]+ triangle tests\)"):
+        sm.toolpath(sphere, tool, stepover=1.0, max_work=cap)
+    assert max(calls[:-1]) <= cap < calls[-1]  # the refused round was charged, not dropped
+    step = tmp_path / "sphere.step"
+    sm.export_step(sphere, step)
+    out = tmp_path / "p.nc"
+    code = cli_main(["toolpath", str(step), "--radius", "1", "--stepover", "1", "--tolerance", "1e-5",
+                     "--out", str(out), "--no-progress"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and not out.exists() and len(err) == 1 and "tolerance:" in err[0]
+
+
+def test_progress_bar_counts_the_drop_cutter_work(monkeypatch):
+    """The bar's total is the estimate from the raster, its count every triangle test
+    charged (so it moves in every round), and it ends full."""
+    seen = []
+    original = toolpath_module._Meter.charge
+
+    def charge(self, work, what):
+        original(self, work, what)
+        seen.append((self.bar.n, self.bar.total, self.used))
+
+    monkeypatch.setattr(toolpath_module._Meter, "charge", charge)
+    sm.toolpath(bumpy(), sm.Tool("ball", 2.0), stepover=2.5, step=1.0, progress=True)
+    counts = [n for n, _, _ in seen]
+    assert len(seen) > 5 and counts == sorted(counts) and len(set(counts)) == len(counts)
+    assert all(n == used and n <= total for n, total, used in seen)
 
 
 def test_solid_top_faces_fillet_closed_form(tmp_path):

@@ -1,4 +1,4 @@
-"""Drop-cutter against a triangle soup, vectorized over (cutter location, triangle) pairs.
+"""Drop-cutter against a triangle soup, compiled: one scalar loop per cutter location over its candidate triangles.
 
 The tool is an end mill with an endless shank of its own radius above the tip: a ball
 end (sphere of radius ``r`` centred ``r`` above the tip), a flat end (a disc at the
@@ -26,7 +26,12 @@ facet is solved in closed form (as OpenCAMLib does), then the highest contact wi
   OpenCAMLib also solves it numerically).
 
 Candidate pairs come from a uniform (x, y) grid of cell size ~``r/2`` holding, for each
-cell, every triangle whose (x, y) box grown by ``r`` meets it.
+cell, every triangle whose (x, y) box grown by ``r`` meets it.  On a fine mesh under a
+large tool a location's list holds thousands of triangles of which a few dozen can win:
+a bound per triangle (its highest vertex, lifted by the ball over its box) against the
+best height found so far skips the rest before any contact is solved, which is why the
+loop is compiled rather than vectorized over pairs (the pairs' arrays alone cost a
+millisecond per location there).
 """
 
 from __future__ import annotations
@@ -36,17 +41,18 @@ from numba import njit
 
 from ..errors import SurfmodError
 
-# Pairs evaluated per block: bounds the memory of the (pairs, 7) candidate arrays.
-PAIRS_PER_BLOCK = 250_000
 # Barycentric slack for "contact inside the triangle": neighbouring triangles share the
 # edge anyway, so a hair of overlap never adds a wrong contact.
 INSIDE_SLACK = 1e-12
+#: tool kinds as the compiled kernel numbers them
+KINDS = {"ball": 0, "flat": 1, "bull": 2}
 
 
 class TriangleGrid:
     """Triangles ``(M, 3, 3)`` bucketed on an (x, y) grid for queries of tool radius ``radius``.
 
-    Each cell lists the triangles whose (x, y) box grown by the radius meets it.
+    Each cell lists the triangles whose (x, y) box grown by the radius meets it, highest
+    top first.
 
     >>> import numpy as np
     >>> tri = np.array([[[0, 0, 1], [4, 0, 1], [0, 4, 1]]], float)
@@ -59,9 +65,8 @@ class TriangleGrid:
     def __init__(self, triangles: np.ndarray, radius: float):
         self.triangles = np.ascontiguousarray(triangles, dtype=float)
         self.radius = float(radius)
-        # structure of arrays (12, M): a, b, c (x, y, z each), upward unit normal
-        self.soa = np.ascontiguousarray(np.vstack([self.triangles.reshape(-1, 9).T,
-                                                   _upward_normals(self.triangles).T]))
+        # one row of 12 per triangle for the compiled kernel: a, b, c (x, y, z each), upward unit normal
+        self.rows = np.ascontiguousarray(np.hstack([self.triangles.reshape(-1, 9), _upward_normals(self.triangles)]))
         self.top = self.triangles[:, :, 2].max(axis=1)
         lo = self.triangles[:, :, :2].min(axis=1) - self.radius
         hi = self.triangles[:, :, :2].max(axis=1) + self.radius
@@ -82,7 +87,9 @@ class TriangleGrid:
         ix = i0[tri_id, 0] + local % nx[tri_id]
         iy = i0[tri_id, 1] + local // nx[tri_id]
         cell_id = ix * self.shape[1] + iy
-        order = np.argsort(cell_id, kind="stable")
+        # each cell's list from its highest triangle down: a drop stops at the first
+        # triangle whose top is below the height already found (no later one can beat it)
+        order = np.lexsort((-self.top[tri_id], cell_id))
         self._cells = cell_id[order]
         self._tris = tri_id[order]
 
@@ -98,16 +105,11 @@ class TriangleGrid:
         stop = np.where(cell_id >= 0, np.searchsorted(self._cells, cell_id, "right"), start)
         return start, stop
 
-    def pairs(self, xy: np.ndarray, start: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(location index, triangle index)`` pairs of the list entries ``start:stop`` of
-        each location whose (x, y) box grown by the radius holds the location."""
-        n = np.maximum(stop - start, 0)
-        qi = np.repeat(np.arange(len(xy)), n)
-        offset = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
-        ti = self._tris[np.repeat(start, n) + offset]
-        p = xy[qi]
-        keep = np.all((p >= self.lo[ti]) & (p <= self.hi[ti]), axis=1)
-        return qi[keep], ti[keep]
+    def entries(self, xy: np.ndarray) -> int:
+        """How many cell-list entries the locations ``xy`` (N, 2) walk: the work of a drop
+        (each entry costs a box test, most of them nothing more), known before it is done."""
+        start, stop = self.segments(np.asarray(xy, dtype=float).reshape(-1, 2))
+        return int(np.maximum(stop - start, 0).sum())
 
 
 def _upward_normals(tri: np.ndarray) -> np.ndarray:
@@ -118,36 +120,47 @@ def _upward_normals(tri: np.ndarray) -> np.ndarray:
     return n / np.where(length > 0, length, 1.0)
 
 
+@njit(cache=True, inline="always", error_model="numpy")
 def _inside_xy(t, px, py):
-    """Is (px, py) inside the (x, y) projection of each triangle ``t`` (rows of the
-    structure-of-arrays gather, see :meth:`TriangleGrid.gather`)?"""
+    """Is (px, py) inside the (x, y) projection of the triangle row ``t``?"""
     ax, ay = t[0], t[1]
     v0x, v0y, v1x, v1y = t[3] - ax, t[4] - ay, t[6] - ax, t[7] - ay
     v2x, v2y = px - ax, py - ay
     den = v0x * v1y - v1x * v0y
-    ok = den != 0
-    den = np.where(ok, den, 1.0)
+    if den == 0.0:
+        return False
     l1 = (v2x * v1y - v1x * v2y) / den
     l2 = (v0x * v2y - v2x * v0y) / den
-    return ok & (l1 >= -INSIDE_SLACK) & (l2 >= -INSIDE_SLACK) & (l1 + l2 <= 1 + INSIDE_SLACK)
+    return l1 >= -INSIDE_SLACK and l2 >= -INSIDE_SLACK and l1 + l2 <= 1.0 + INSIDE_SLACK
 
 
+@njit(cache=True, inline="always", error_model="numpy")
 def _plane_z(t, px, py):
-    nz = np.where(t[11] > 0, t[11], 1.0)
+    nz = t[11] if t[11] > 0.0 else 1.0
     return t[2] - (t[9] * (px - t[0]) + t[10] * (py - t[1])) / nz
 
 
-def _ball_features(qx, qy, t, r: float):
-    """Tip heights of a ball at (qx, qy) against each triangle's 3 vertices, 3 edges and
-    facet (-inf where that feature is not touched), as 7 arrays, and the 7 contact points."""
-    heights, contacts = [], []
+@njit(cache=True, inline="always", error_model="numpy")
+def _keep(best, contact, h, x, y, z):
+    """Keep the feature ``h`` at ``(x, y, z)`` when it is strictly higher (the first of equals wins)."""
+    if h > best:
+        contact[0], contact[1], contact[2] = x, y, z
+        return h
+    return best
+
+
+@njit(cache=True, error_model="numpy")
+def _ball(qx, qy, t, r, contact):
+    """Tip height of a ball at (qx, qy) on the triangle row ``t`` (-inf if untouched), the
+    highest of its 3 vertices, 3 edges and facet; the contact point goes to ``contact``."""
+    best = -np.inf
     r2 = r * r
     for j in range(3):
         px, py, pz = t[3 * j], t[3 * j + 1], t[3 * j + 2]
         wx, wy = qx - px, qy - py
         m = wx * wx + wy * wy
-        heights.append(np.where(m <= r2, pz + np.sqrt(np.maximum(r2 - m, 0.0)) - r, -np.inf))
-        contacts.append((px, py, pz))
+        if m <= r2:
+            best = _keep(best, contact, pz + np.sqrt(max(r2 - m, 0.0)) - r, px, py, pz)
         # edge p -> p + e: centre (q, p_z + s) at distance r from the edge's line
         k3 = 3 * ((j + 1) % 3)
         ex, ey, ez = t[k3] - px, t[k3 + 1] - py, t[k3 + 2] - pz
@@ -155,54 +168,49 @@ def _ball_features(qx, qy, t, r: float):
         A = ex * ex + ey * ey
         L2 = A + ez * ez
         disc = k * k * ez * ez - A * (L2 * m - k * k - r2 * L2)
-        ok = (A > 1e-14 * L2) & (disc >= 0)
-        s = (k * ez + np.sqrt(np.where(ok, disc, 0.0))) / np.where(ok, A, 1.0)
-        u = (k + s * ez) / np.where(L2 > 0, L2, 1.0)
-        ok &= (u >= 0) & (u <= 1)
-        heights.append(np.where(ok, pz + s - r, -np.inf))
-        u = np.clip(u, 0, 1)
-        contacts.append((px + u * ex, py + u * ey, pz + u * ez))
+        if A > 1e-14 * L2 and disc >= 0.0:
+            s = (k * ez + np.sqrt(disc)) / A
+            u = (k + s * ez) / (L2 if L2 > 0.0 else 1.0)
+            if 0.0 <= u <= 1.0:
+                best = _keep(best, contact, pz + s - r, px + u * ex, py + u * ey, pz + u * ez)
     cx, cy = qx - r * t[9], qy - r * t[10]
-    z = _plane_z(t, cx, cy)
-    ok = (t[11] > 1e-12) & _inside_xy(t, cx, cy)
-    heights.append(np.where(ok, z + r * t[11] - r, -np.inf))
-    contacts.append((cx, cy, z))
-    return heights, contacts
+    if t[11] > 1e-12 and _inside_xy(t, cx, cy):
+        z = _plane_z(t, cx, cy)
+        best = _keep(best, contact, z + r * t[11] - r, cx, cy, z)
+    return best
 
 
-def _flat_features(qx, qy, t, r: float):
-    """As :func:`_ball_features` for a flat end of radius ``r`` (a disc at the tip)."""
-    heights, contacts = [], []
+@njit(cache=True, error_model="numpy")
+def _flat(qx, qy, t, r, contact):
+    """As :func:`_ball` for a flat end of radius ``r`` (a disc at the tip)."""
+    best = -np.inf
     r2 = r * r
     for j in range(3):
         px, py, pz = t[3 * j], t[3 * j + 1], t[3 * j + 2]
         dx, dy = px - qx, py - qy
         C = dx * dx + dy * dy - r2
-        heights.append(np.where(C <= 0, pz, -np.inf))
-        contacts.append((px, py, pz))
+        if C <= 0.0:
+            best = _keep(best, contact, pz, px, py, pz)
         # edge: the parameter interval inside the disc, |p_xy + u e_xy - q|² ≤ r²
         k3 = 3 * ((j + 1) % 3)
         ex, ey, ez = t[k3] - px, t[k3 + 1] - py, t[k3 + 2] - pz
         A = ex * ex + ey * ey
         B = ex * dx + ey * dy
         disc = B * B - A * C
-        ok = (A > 0) & (disc >= 0)
-        root = np.sqrt(np.where(ok, disc, 0.0))
-        Ad = np.where(ok, A, 1.0)
-        u0, u1 = (-B - root) / Ad, (-B + root) / Ad
-        ok &= (u1 >= 0) & (u0 <= 1)
-        u = np.clip(np.where(ez >= 0, u1, u0), 0, 1)  # the higher end of the piece inside the disc
-        heights.append(np.where(ok, pz + u * ez, -np.inf))
-        contacts.append((px + u * ex, py + u * ey, pz + u * ez))
-    slope = np.hypot(t[9], t[10])
+        if A > 0.0 and disc >= 0.0:
+            root = np.sqrt(disc)
+            u0, u1 = (-B - root) / A, (-B + root) / A
+            if u1 >= 0.0 and u0 <= 1.0:
+                u = min(max(u1 if ez >= 0.0 else u0, 0.0), 1.0)  # the higher end of the piece inside the disc
+                best = _keep(best, contact, pz + u * ez, px + u * ex, py + u * ey, pz + u * ez)
     # uphill direction of the plane is -n_xy; a level facet is touched under the axis
-    scale = np.where(slope > 1e-15, r / np.where(slope > 0, slope, 1.0), 0.0)
+    slope = np.hypot(t[9], t[10])
+    scale = r / slope if slope > 1e-15 else 0.0
     cx, cy = qx - scale * t[9], qy - scale * t[10]
-    z = _plane_z(t, cx, cy)
-    ok = (t[11] > 1e-12) & _inside_xy(t, cx, cy)
-    heights.append(np.where(ok, z, -np.inf))
-    contacts.append((cx, cy, z))
-    return heights, contacts
+    if t[11] > 1e-12 and _inside_xy(t, cx, cy):
+        z = _plane_z(t, cx, cy)
+        best = _keep(best, contact, z, cx, cy, z)
+    return best
 
 
 #: Bisection steps for the bull's edge contact: the parameter to 2^-36 of the edge, the
@@ -210,68 +218,53 @@ def _flat_features(qx, qy, t, r: float):
 BULL_EDGE_STEPS = 36
 
 
-def _bull_profile(d, a: float, c: float):
+@njit(cache=True, inline="always", error_model="numpy")
+def _bull_profile(d, a, c):
     """Height of the bull's surface above its tip at distance ``d`` from the axis (inf
-    beyond the radius), and its slope ``df/dd``."""
-    t = np.maximum(d - a, 0.0)
-    root = np.sqrt(np.maximum(c * c - t * t, 0.0))
-    inside = d <= a + c
-    f = np.where(inside, c - root, np.inf)
-    slope = np.where(t <= 0, 0.0, np.where(root > 0, t / np.where(root > 0, root, 1.0), np.inf))
-    return f, slope
+    beyond the radius)."""
+    if d > a + c:
+        return np.inf
+    t = max(d - a, 0.0)
+    return c - np.sqrt(max(c * c - t * t, 0.0))
 
 
 @njit(cache=True, error_model="numpy")
-def _bull_edge_kernel(dx, dy, ex, ey, ez, A, B, lo, hi, a, c, steps, u):
-    """Bisection per pair on the sign of ``ez - f'(d(u)) d'(u)`` (decreasing in ``u``)."""
-    for i in range(len(u)):
-        left, right = lo[i], hi[i]
-        for _ in range(steps):
-            mid = 0.5 * (left + right)
-            px, py = dx[i] + mid * ex[i], dy[i] + mid * ey[i]
-            d = np.sqrt(px * px + py * py)
-            t = d - a
-            if t <= 0.0 or d == 0.0:
-                rising = ez[i] > 0.0
+def _bull_edge_u(dx, dy, ex, ey, ez, A, B, left, right, a, c):
+    """Edge parameter in ``[left, right]`` maximizing the concave ``u ez - f(d(u))``:
+    bisection on the sign of its decreasing derivative ``ez - f'(d(u)) d'(u)``."""
+    for _ in range(BULL_EDGE_STEPS):
+        mid = 0.5 * (left + right)
+        px, py = dx + mid * ex, dy + mid * ey
+        d = np.sqrt(px * px + py * py)
+        t = d - a
+        if t <= 0.0 or d == 0.0:
+            rising = ez > 0.0
+        else:
+            root2 = c * c - t * t
+            if root2 <= 0.0:
+                rate = (mid * A + B) / d
+                rising = rate < 0.0 or (rate == 0.0 and ez > 0.0)
             else:
-                root2 = c * c - t * t
-                if root2 <= 0.0:
-                    rate = (mid * A[i] + B[i]) / d
-                    rising = rate < 0.0 or (rate == 0.0 and ez[i] > 0.0)
-                else:
-                    rising = ez[i] > t / np.sqrt(root2) * (mid * A[i] + B[i]) / d
-            if rising:
-                left = mid
-            else:
-                right = mid
-        u[i] = 0.5 * (left + right)
+                rising = ez > t / np.sqrt(root2) * (mid * A + B) / d
+        if rising:
+            left = mid
+        else:
+            right = mid
+    return 0.5 * (left + right)
 
 
-def _bull_edge_argmax(rows, default, lo, hi, dx, dy, ex, ey, ez, A, B, a: float, c: float):
-    """Edge parameter ``u`` in ``[lo, hi]`` maximizing the concave ``u ez - f(d(u))`` at
-    ``rows`` (``default`` elsewhere): bisection on the sign of the decreasing derivative
-    (compiled: a scalar loop per pair)."""
-    u = default.copy()
-    if not rows.size:
-        return u
-    got = np.empty(rows.size)
-    _bull_edge_kernel(*(np.ascontiguousarray(w[rows], dtype=np.float64) for w in (dx, dy, ex, ey, ez, A, B, lo, hi)),
-                      float(a), float(c), BULL_EDGE_STEPS, got)
-    u[rows] = got
-    return u
-
-
-def _bull_features(qx, qy, t, r: float, c: float):
-    """As :func:`_ball_features` for a bull nose of radius ``r`` and corner radius ``c``."""
+@njit(cache=True, error_model="numpy")
+def _bull(qx, qy, t, r, c, contact):
+    """As :func:`_ball` for a bull nose of radius ``r`` and corner radius ``c``."""
     a = r - c
-    heights, contacts = [], []
+    best = -np.inf
     r2 = r * r
     for j in range(3):
         px, py, pz = t[3 * j], t[3 * j + 1], t[3 * j + 2]
         dx, dy = px - qx, py - qy
-        f, _ = _bull_profile(np.sqrt(dx * dx + dy * dy), a, c)
-        heights.append(np.where(np.isfinite(f), pz - f, -np.inf))
-        contacts.append((px, py, pz))
+        f = _bull_profile(np.sqrt(dx * dx + dy * dy), a, c)
+        if f < np.inf:
+            best = _keep(best, contact, pz - f, px, py, pz)
         # edge p + u e: the piece inside the radius, then the maximum of the concave height
         k3 = 3 * ((j + 1) % 3)
         ex, ey, ez = t[k3] - px, t[k3 + 1] - py, t[k3 + 2] - pz
@@ -279,108 +272,84 @@ def _bull_features(qx, qy, t, r: float, c: float):
         B = ex * dx + ey * dy
         C = dx * dx + dy * dy - r2
         disc = B * B - A * C
-        ok = (A > 1e-14 * (A + ez * ez)) & (disc >= 0)
-        root = np.sqrt(np.where(ok, disc, 0.0))
-        Ad = np.where(ok, A, 1.0)
-        lo = np.clip((-B - root) / Ad, 0.0, 1.0)
-        hi = np.clip((-B + root) / Ad, 0.0, 1.0)
-        ok &= hi > lo
-        # a piece wholly on the core (d convex: both ends within a) is highest at an end
-        core = (np.hypot(dx + lo * ex, dy + lo * ey) <= a) & (np.hypot(dx + hi * ex, dy + hi * ey) <= a)
-        u = _bull_edge_argmax(np.flatnonzero(ok & ~core), np.where(ez > 0, hi, lo), lo, hi,
-                              dx, dy, ex, ey, ez, A, B, a, c)
-        ddx, ddy = dx + u * ex, dy + u * ey
-        f, _ = _bull_profile(np.sqrt(ddx * ddx + ddy * ddy), a, c)
-        heights.append(np.where(ok & np.isfinite(f), pz + u * ez - f, -np.inf))
-        contacts.append((px + u * ex, py + u * ey, pz + u * ez))
-    slope = np.hypot(t[9], t[10])
-    scale = np.where(slope > 1e-15, a / np.where(slope > 0, slope, 1.0), 0.0)
-    cx, cy = qx - scale * t[9] - c * t[9], qy - scale * t[10] - c * t[10]
-    z = _plane_z(t, cx, cy)
-    ok = (t[11] > 1e-12) & _inside_xy(t, cx, cy)
-    heights.append(np.where(ok, z + c * t[11] - c, -np.inf))
-    contacts.append((cx, cy, z))
-    return heights, contacts
-
-
-def _features(kind: str, corner: float):
-    """The feature function ``(qx, qy, t, r)`` of a tool kind."""
-    if kind == "ball":
-        return _ball_features
-    if kind == "flat":
-        return _flat_features
-    return lambda qx, qy, t, r: _bull_features(qx, qy, t, r, corner)
-
-
-def _reach(grid: TriangleGrid, kind: str, q: np.ndarray, ti: np.ndarray, corner: float = 0.0) -> np.ndarray:
-    """Upper bound of the tip height each triangle can give: its highest vertex, lifted
-    (ball) by how far the ball can rise over the nearest point of its (x, y) box."""
-    gap = np.maximum(np.maximum(grid.lo[ti] + grid.radius - q, q - grid.hi[ti] + grid.radius), 0.0)
-    d2 = (gap**2).sum(axis=1)
-    r2 = grid.radius**2
-    if kind == "ball":
-        return np.where(d2 <= r2, grid.top[ti] + np.sqrt(np.maximum(r2 - d2, 0.0)) - grid.radius, -np.inf)
-    if kind == "bull":  # no point nearer than the box can lift the tip more than the profile there
-        f, _ = _bull_profile(np.sqrt(d2), grid.radius - corner, corner)
-        return np.where(d2 <= r2, grid.top[ti] - np.minimum(f, corner), -np.inf)
-    return np.where(d2 <= r2, grid.top[ti], -np.inf)
-
-
-def _per_location_max(qi: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
-    """Max of ``values`` per location index ``qi`` (sorted), -inf where none."""
-    out = np.full(n, -np.inf)
-    if len(qi):
-        first = np.r_[0, np.nonzero(np.diff(qi))[0] + 1]
-        out[qi[first]] = np.maximum.reduceat(values, first)
-    return out
-
-
-def _best(grid: TriangleGrid, kind: str, xy: np.ndarray, start: np.ndarray, stop: np.ndarray, corner: float = 0.0):
-    """Highest tip height ``(N,)`` (-inf if none), its contact ``(N, 3)`` and the index of
-    the touched triangle ``(N,)`` (-1 if none) over the
-    cell-list entries ``start:stop`` of each location, in blocks of about
-    ``PAIRS_PER_BLOCK`` pairs.  Pairs whose upper bound (:func:`_reach`) is below a height
-    already reached at their location are skipped."""
-    features = _features(kind, corner)
-    z = np.full(len(xy), -np.inf)
-    touch = np.full((len(xy), 3), np.nan)
-    touched = np.full(len(xy), -1, dtype=np.int64)
-    block = np.cumsum(np.maximum(stop - start, 0)) // PAIRS_PER_BLOCK
-    starts = np.r_[0, np.nonzero(np.diff(block))[0] + 1]
-    for s0, s1 in zip(starts, np.r_[starts[1:], len(xy)]):
-        q_block = xy[s0:s1]
-        qi, ti = grid.pairs(q_block, start[s0:s1], stop[s0:s1])
-        reach = _reach(grid, kind, q_block[qi], ti, corner)
-        live = np.isfinite(reach)
-        qi, ti, reach = qi[live], ti[live], reach[live]
-        if not len(qi):
+        if not (A > 1e-14 * (A + ez * ez) and disc >= 0.0):
             continue
-        # first the triangles right under each location (its (x, y) inside their box): their
-        # best contact bounds from below what every other triangle must be able to beat
-        q = q_block[qi]
-        early = np.all((q >= grid.lo[ti] + grid.radius) & (q <= grid.hi[ti] - grid.radius), axis=1)
-        q = q[early]
-        heights, _ = features(q[:, 0], q[:, 1], grid.soa[:, ti[early]], grid.radius)
-        bound = _per_location_max(qi[early], np.max(heights, axis=0), len(q_block))
-        late = ~early & (reach >= bound[qi])
-        pick = early | late
-        qi, ti = qi[pick], ti[pick]
-        q = q_block[qi]
-        heights, _ = features(q[:, 0], q[:, 1], grid.soa[:, ti], grid.radius)
-        best = np.max(heights, axis=0)
-        top = _per_location_max(qi, best, len(q_block))
-        hit = np.flatnonzero(best == top[qi])
-        _, winner = np.unique(qi[hit], return_index=True)
-        winner = hit[winner]
-        rows = s0 + qi[winner]
-        z[rows] = best[winner]
-        # contacts of the winning pairs only
-        qw = q[winner]
-        heights, contacts = features(qw[:, 0], qw[:, 1], grid.soa[:, ti[winner]], grid.radius)
-        feature = np.argmax(heights, axis=0)
-        touch[rows] = np.array(contacts)[feature, :, np.arange(len(winner))]
-        touched[rows] = ti[winner]
-    return z, touch, touched
+        root = np.sqrt(disc)
+        lo = min(max((-B - root) / A, 0.0), 1.0)
+        hi = min(max((-B + root) / A, 0.0), 1.0)
+        if not hi > lo:
+            continue
+        # a piece wholly on the core (d convex: both ends within a) is highest at an end
+        if np.hypot(dx + lo * ex, dy + lo * ey) <= a and np.hypot(dx + hi * ex, dy + hi * ey) <= a:
+            u = hi if ez > 0.0 else lo
+        else:
+            u = _bull_edge_u(dx, dy, ex, ey, ez, A, B, lo, hi, a, c)
+        ddx, ddy = dx + u * ex, dy + u * ey
+        f = _bull_profile(np.sqrt(ddx * ddx + ddy * ddy), a, c)
+        if f < np.inf:
+            best = _keep(best, contact, pz + u * ez - f, px + u * ex, py + u * ey, pz + u * ez)
+    slope = np.hypot(t[9], t[10])
+    scale = a / slope if slope > 1e-15 else 0.0
+    cx, cy = qx - scale * t[9] - c * t[9], qy - scale * t[10] - c * t[10]
+    if t[11] > 1e-12 and _inside_xy(t, cx, cy):
+        z = _plane_z(t, cx, cy)
+        best = _keep(best, contact, z + c * t[11] - c, cx, cy, z)
+    return best
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _height(kind, qx, qy, t, r, c, contact):
+    if kind == 0:
+        return _ball(qx, qy, t, r, contact)
+    if kind == 1:
+        return _flat(qx, qy, t, r, contact)
+    return _bull(qx, qy, t, r, c, contact)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _reach(kind, qx, qy, lo, hi, top, r, c):
+    """Upper bound of the tip height a triangle can give at (qx, qy): its highest vertex,
+    lifted (ball) by how far the ball can rise over the nearest point of its (x, y) box
+    (``lo``, ``hi``: the box grown by ``r``); -inf when the box is out of reach."""
+    gx = max(max(lo[0] + r - qx, qx - hi[0] + r), 0.0)
+    gy = max(max(lo[1] + r - qy, qy - hi[1] + r), 0.0)
+    d2 = gx * gx + gy * gy
+    r2 = r * r
+    if d2 > r2:
+        return -np.inf
+    if kind == 0:
+        return top + np.sqrt(max(r2 - d2, 0.0)) - r
+    if kind == 2:  # no point nearer than the box can lift the tip more than the profile there
+        return top - min(_bull_profile(np.sqrt(d2), r - c, c), c)
+    return top
+
+
+@njit(cache=True, error_model="numpy")
+def _drop_kernel(kind, xy, start, stop, tris, rows, lo, hi, top, r, c, z, touch, touched):
+    """Per location: the highest tip height over its cell list, its contact and triangle.
+
+    The list runs from the highest triangle top down, and no triangle lifts the tip above
+    its top (:func:`_reach`, a tighter bound, skips the rest before any contact is
+    solved), so the walk stops at the first top below the height found: on a fine mesh
+    most of a list is never read.  Of equal heights the first found wins."""
+    contact = np.empty(3)
+    for i in range(len(xy)):
+        qx, qy = xy[i, 0], xy[i, 1]
+        best, winner = -np.inf, -1
+        for k in range(start[i], stop[i]):
+            ti = tris[k]
+            if top[ti] < best:
+                break
+            if not (lo[ti, 0] <= qx <= hi[ti, 0] and lo[ti, 1] <= qy <= hi[ti, 1]):
+                continue
+            if _reach(kind, qx, qy, lo[ti], hi[ti], top[ti], r, c) < best:
+                continue
+            h = _height(kind, qx, qy, rows[ti], r, c, contact)
+            if h > best:
+                best, winner = h, ti
+                touch[i, 0], touch[i, 1], touch[i, 2] = contact[0], contact[1], contact[2]
+        z[i] = best
+        touched[i] = winner
 
 
 def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = False, triangles: bool = False,
@@ -402,6 +371,9 @@ def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = Fals
         raise SurfmodError(f"corner_radius: must be > 0 and < the radius {grid.radius:g}, got {corner!r}")
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     start, stop = grid.segments(xy)
-    z, touch, touched = _best(grid, kind, xy, start, stop, corner)
+    z, touch = np.empty(len(xy)), np.full((len(xy), 3), np.nan)
+    touched = np.empty(len(xy), dtype=np.int64)
+    _drop_kernel(KINDS[kind], np.ascontiguousarray(xy), start, stop, grid._tris, grid.rows, grid.lo, grid.hi,
+                 grid.top, grid.radius, float(corner), z, touch, touched)
     z[~np.isfinite(z)] = np.nan
     return (z,) + ((touch,) if contacts else ()) + ((touched,) if triangles else ()) if contacts or triangles else z

@@ -40,6 +40,22 @@ MESH_SHARE = 0.4
 REFINE_SHARE = 0.5
 # More cutter locations than this is a mistake in step/stepover, not a finishing path.
 MAX_LOCATIONS = 2_000_000
+#: triangles the part's mesh may need by the curvature estimate (meshing/brep), checked
+#: before BRepMesh runs: the drop grid indexes each triangle in ~25 cells
+MAX_TRIANGLES = 2_000_000
+#: tolerances below this fraction of the part's diagonal are refused before meshing:
+#: BRepMesh's time is not in the curvature estimate there (a 6 x 4 x 3 boss at 1.3e-7 of
+#: its size: 15 s of BRepMesh for planes around one cylinder); the documented setting
+#: (ball of 3 % of the part, scallop 2 % of the ball) asks 5e-5
+TOLERANCE_FLOOR = 1e-6
+#: drop-cutter work one path may take, in triangle tests (cell-list entries a drop may
+#: walk, an upper bound: the walk stops early on most lists).  The costliest corpus part
+#: at the documented setting (Ventilator, ball of 3 % of the part, scallop 2 % of the
+#: ball) takes 1.0e10 of them in 42 s of one core; the cap is about twice that
+MAX_WORK = 25_000_000_000
+#: drops per raster location a path costs at the least: two refinement passes of two
+#: samples per move, the verdict's four, a repair's two and its verdict's four, the contacts
+NOMINAL_DROPS = 17
 
 
 @dataclass(frozen=True)
@@ -115,6 +131,24 @@ class Toolpath:
         )
 
 
+class _Meter:
+    """The drop-cutter work of one path against its cap, charged before each drop (so a
+    refusal comes before the work), shown on the progress bar."""
+
+    def __init__(self, cap: float = np.inf, bar=None):
+        self.used, self.cap, self.bar = 0, cap, bar
+
+    def charge(self, work: int, what: str) -> None:
+        if self.used + work > self.cap:
+            checks.work(self.used + work, int(self.cap), "max_work",
+                        f"the drop-cutter ({what}, after {self.used:,} triangle tests)")
+        self.used += work
+        if self.bar is not None:
+            if self.used > self.bar.total:  # more refinement than estimated: the bar grows, never stalls at 100 %
+                self.bar.total = int(self.used * 1.25)
+            self.bar.update(work)
+
+
 @dataclass(frozen=True)
 class _Part:
     """The machined part for one tool: its mesh on a query grid, and the lift that covers
@@ -128,17 +162,41 @@ class _Part:
     box: np.ndarray
     faces: list = field(default_factory=list, repr=False)  # OCCT faces, and the face of each triangle
     owner: np.ndarray = field(default=None, repr=False)
+    meter: _Meter = field(default_factory=_Meter, repr=False)
 
     def height(self, xy: np.ndarray) -> np.ndarray:
         """Tip heights at ``xy`` (N, 2), NaN where the tool touches nothing."""
+        self.meter.charge(self.grid.entries(xy), f"{len(xy):,} locations")
         return drop(self.grid, self.kind, xy, corner=self.corner) + self.lift
 
 
-def _part(obj, tool: Tool, tolerance: float) -> _Part:
+def _mesh_estimate(shape, tolerance: float) -> None:
+    """Refuse, before BRepMesh runs, a tolerance whose curvature estimate of the mesh
+    exceeds :data:`MAX_TRIANGLES` or whose tolerance lies below :data:`TOLERANCE_FLOOR`
+    of the part's size."""
+    from ..meshing.brep import _estimate
+    from ..occ.triangulation import bounding_box
+
+    box = bounding_box(shape)
+    diag = float(np.linalg.norm(box[1] - box[0]))
+    tolerance = checks.tolerance(tolerance, "tolerance", diag)
+    if tolerance < TOLERANCE_FLOOR * diag:
+        raise SurfmodError(f"tolerance: {tolerance:g} is below {TOLERANCE_FLOOR:g} x the part size {diag:.3g} "
+                           f"(BRepMesh's time grows without bound below it)")
+    deflection = MESH_SHARE * tolerance
+    estimate, _ = _estimate(shape, deflection)
+    if estimate > MAX_TRIANGLES:
+        raise SurfmodError(
+            f"tolerance: {tolerance:.3g} meshes the part at deflection {deflection:.3g}, about "
+            f"{estimate:,.0f} triangles, above the limit {MAX_TRIANGLES:,} (a larger tolerance or scallop)")
+
+
+def _part(obj, tool: Tool, tolerance: float, meter: _Meter | None = None) -> _Part:
     from ..occ.triangulation import part_triangles
 
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
+    _mesh_estimate(shape, tolerance)
     try:
         triangles, measured, (faces, owner) = part_triangles(shape, requested, face_index=True)
     except SurfmodError as exc:
@@ -146,7 +204,7 @@ def _part(obj, tool: Tool, tolerance: float) -> _Part:
     points = triangles.reshape(-1, 3)
     box = np.array([points.min(axis=0), points.max(axis=0)])
     return _Part(TriangleGrid(triangles, tool.radius), tool.kind, tool.corner, max(measured, requested),
-                 max(measured - requested, 0.0), box, faces, owner)
+                 max(measured - requested, 0.0), box, faces, owner, meter or _Meter())
 
 
 def _check_tool(tool) -> Tool:
@@ -208,7 +266,7 @@ def _drop_repeats(points: np.ndarray, index: np.ndarray):
 
 def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float | None = None,
              step: float | None = None, direction: str = "x", bounds=None, tolerance: float | None = None,
-             progress: bool = False, max_points: int = MAX_LOCATIONS) -> Toolpath:
+             progress: bool = False, max_points: int = MAX_LOCATIONS, max_work: int = MAX_WORK) -> Toolpath:
     """Zig-zag drop-cutter finishing path of ``tool`` over a part, every move gouge-checked.
 
     ``obj``: a surfmod surface (or list of them), a build123d shape or a STEP path; all its
@@ -220,9 +278,14 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     ((xmin, ymin), (xmax, ymax))``.  ``tolerance``: the depth no move may cut (default a
     tenth of the scallop height, or ``radius / 100`` when the stepover leaves none); a
     path that cannot be made to respect it raises ``SurfmodError``.  ``progress`` shows a
-    tqdm bar over the stages.  More than ``max_points`` cutter locations (estimated from
-    the bounds, stepover and step before the part is meshed or anything is allocated)
-    are refused; raise ``max_points`` to allow them.
+    tqdm bar of the drop-cutter's triangle tests, the stage beside it.  More than
+    ``max_points`` cutter locations (estimated from the bounds, stepover and step before
+    the part is meshed or anything is allocated) are refused; raise ``max_points`` to
+    allow them.  The work is bounded too, each bound checked before its work starts: a
+    mesh of more than ``MAX_TRIANGLES`` by the curvature estimate, or a tolerance below
+    the floor of the part's size (``tolerance:``), and more than ``max_work`` triangle
+    tests of the drop-cutter (about a minute of one core), estimated from the raster on
+    the mesh and charged again before each round of refinement (``max_work:``).
 
     >>> import surfmod as sm, numpy as np
     >>> s = sm.plane((0, 0, 1), (10, 0, 1), (0, 10, 1))
@@ -261,27 +324,40 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         estimate(outer[0, :2], outer[1, :2])
     else:
         estimate(box[0], box[1])
-    with tqdm(total=4, desc="toolpath", unit="stage", disable=not progress) as bar:
-        part = _part(shape, tool, tolerance)
-        bar.update()
-        return raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance, bar)
+    max_work = checks.count(max_work, "max_work")
+    # the bar counts triangle tests (estimated once the mesh is known), so it moves with
+    # every round of the refinement, the stage it is in beside it
+    with tqdm(total=1, desc="toolpath", unit=" tests", unit_scale=True, disable=not progress) as bar:
+        bar.set_postfix_str("meshing")
+        meter = _Meter(max_work, bar)
+        part = _part(shape, tool, tolerance, meter)
+        return raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
+                           bar, meter=meter, max_work=max_work)
 
 
 def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction: str, bounds, tolerance: float,
-                bar=None, across=None) -> Toolpath:
+                bar=None, across=None, meter=None, max_work: int | None = None) -> Toolpath:
     """The verified zig-zag :class:`Toolpath` of ``tool`` over an already meshed ``part``
     (:func:`toolpath` after its checks; ``bounds`` ``((xmin, ymin), (xmax, ymax))`` or None
-    for the part's box; ``bar`` a tqdm bar advanced per stage; ``across``: the passes'
-    cross positions instead of ``stepover``)."""
-    tick = bar.update if bar is not None else (lambda: None)
+    for the part's box; ``bar`` a tqdm bar counting triangle tests; ``across``: the passes'
+    cross positions instead of ``stepover``; ``meter``/``max_work``: the work bound)."""
+    stage = bar.set_postfix_str if bar is not None else (lambda text: None)
     lo, hi = (part.box[0, :2], part.box[1, :2]) if bounds is None else (np.asarray(bounds[0]), np.asarray(bounds[1]))
     xy, index, across = raster(lo, hi, stepover, step, direction, across)
+    if max_work is not None:
+        first = part.grid.entries(xy)
+        checks.work(NOMINAL_DROPS * first, max_work, "max_work",
+                    f"the drop-cutter over {len(xy):,} locations of {first / max(len(xy), 1):,.0f} triangle tests "
+                    f"each, {NOMINAL_DROPS} drops a location at the least (a larger tolerance, scallop or step)")
+        if bar is not None:
+            bar.total = NOMINAL_DROPS * first
+    stage("dropping")
     z = part.height(xy)
     if np.isnan(z).all():
         raise SurfmodError("bounds: the tool touches no face inside these bounds")
     floor = float(np.nanmin(z))  # where the tool touches nothing it stays at the lowest level
     points = np.column_stack([xy, np.where(np.isnan(z), floor, z)])
-    tick()
+    stage("refining")
     allowed = tolerance - part.deflection + part.lift
     if allowed <= 0:
         raise SurfmodError(f"tolerance: {tolerance:.3g} is below the part's mesh deflection {part.deflection:.3g}")
@@ -290,7 +366,7 @@ def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction
         points, index = staircase_steep(points, index)
         points, index = refine_moves(part.height, points, index, REFINE_SHARE * allowed, min_length, floor)
     points, index = _drop_repeats(points, index)
-    tick()
+    stage("checking every move")
     depth = move_gouge(part.height, points)
     if depth.max() > allowed:
         # repair what the verdict's own sample points found, then judge again
@@ -310,8 +386,12 @@ def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction
         raise NoSafePathError(
             f"toolpath: no safe path: move {worst + 1} still cuts {gouge + part.deflection - part.lift:.3g} "
             f"deep, more than the tolerance {tolerance:.3g}")
+    if meter is not None:
+        meter.charge(part.grid.entries(points[:, :2]), "the contacts")
     _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
-    tick()
+    if bar is not None and max_work is not None:
+        bar.total = bar.n
+    stage("done")
     actual = float(np.diff(across).max()) if len(across) > 1 else 0.0
     return Toolpath(checks.frozen(points), checks.frozen(contacts), index, tool, actual, step,
                     tool.scallop_for_stepover(actual), direction, gouge - part.lift, tolerance, part.deflection, lifted)

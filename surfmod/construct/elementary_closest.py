@@ -116,3 +116,42 @@ def cone(local, box, radius: float, semi_angle: float):
             nearer = d2 < best[2]
             best = (np.where(nearer, u, best[0]), np.where(nearer, v, best[1]), np.minimum(d2, best[2]))
     return best[0], best[1]
+
+
+def parallelogram(points: np.ndarray, origin: np.ndarray, e1: np.ndarray, e2: np.ndarray):
+    """``(s, t)`` in ``[0, 1]²`` of the closest points of ``origin + s e1 + t e2`` to ``(N, 3)`` points.
+
+    The foot on the carrier plane has the coordinates of the dual basis, ``s = d . f1``,
+    ``t = d . f2`` with ``f1 = (e2 x n) / (e1 . (e2 x n))`` (no normal equations: their
+    conditioning is the square of a skewed pair's); a foot outside the square means the
+    closest point is on the boundary (the squared distance is convex), the nearest of the
+    four edges' clipped feet.
+
+    >>> s, t = parallelogram(np.array([[0.5, 0.5, 3.0], [3.0, -1.0, 0.0]]), np.zeros(3), np.array([2.0, 0, 0]),
+    ...                      np.array([1.0, 1, 0]))
+    >>> s.tolist(), t.tolist()   # a foot inside; the corner (1, 0) nearest to a point beyond it
+    ([0.0, 1.0], [0.5, 0.0])
+    """
+    n = np.cross(e1, e2)
+    n /= np.linalg.norm(n)
+    f1, f2 = np.cross(e2, n), np.cross(n, e1)
+    f1, f2 = f1 / (e1 @ f1), f2 / (e2 @ f2)
+    d = points - origin
+    s, t = d @ f1, d @ f2
+    out = ~((s >= 0) & (s <= 1) & (t >= 0) & (t <= 1))
+    if out.any():
+        q = d[out]
+        best = np.full(len(q), np.inf)
+        bs, bt = np.empty(len(q)), np.empty(len(q))
+        # the edges t = 0, t = 1 (along e1) and s = 0, s = 1 (along e2), with the fixed side
+        for start, along, fixed, run_is_s in ((0, e1, 0.0, True), (e2, e1, 1.0, True),
+                                               (0, e2, 0.0, False), (e1, e2, 1.0, False)):
+            w = np.clip((q - start) @ along / (along @ along), 0.0, 1.0)
+            d2 = np.sum((start + w[:, None] * along - q) ** 2, axis=1)
+            nearer = d2 < best
+            best = np.where(nearer, d2, best)
+            bs = np.where(nearer, w if run_is_s else fixed, bs)
+            bt = np.where(nearer, fixed if run_is_s else w, bt)
+        s, t = s.copy(), t.copy()
+        s[out], t[out] = bs, bt
+    return s, t

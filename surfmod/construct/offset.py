@@ -147,10 +147,20 @@ def _span_errors(fit: Surface, exact: Surface, bu, bv):
     return err.reshape(bu.size - 1, 3, bv.size - 1, 3).max(axis=(1, 3))
 
 
+#: spans of a bicubic approximation (each fit is a least-squares solve on a tensor grid
+#: of 6 samples a span: 250 x 250 spans took 10 s of one core)
+MAX_SPANS = 65_536
+#: tolerances below this fraction of the model size are refused by ``offset``: the
+#: least-squares fit's own round-off is ~4e-11 of it (a random Bézier patch's offset
+#: stalled at 1.2e-9 on a 29 mm model, at 60,000 spans and 15 s)
+FIT_FLOOR = 1e-9
+
+
 def bicubic_approximation(exact: Surface, bu, bv, tol: float, mults=({}, {}), max_rounds: int = 10):
     """``(fit, max_deviation)``: a bicubic B-spline within ``tol`` of ``exact`` in its own
     parameters, starting from the breakpoints ``bu``, ``bv`` (with the interior knot
-    multiplicities ``mults``) and halving every span whose midpoint errors exceed ``tol``."""
+    multiplicities ``mults``) and halving every span whose midpoint errors exceed ``tol``.
+    Refused (``tolerance:``) before a fit of more than ``MAX_SPANS`` spans by the h^4 rate."""
     bu, bv = np.asarray(bu, float), np.asarray(bv, float)
     if bu.size < 3:
         bu = np.linspace(bu[0], bu[-1], 3)
@@ -162,6 +172,14 @@ def bicubic_approximation(exact: Surface, bu, bv, tol: float, mults=({}, {}), ma
         bad = err > tol
         if not np.any(bad):
             return fit, float(err.max())
+        worst = float(err.max())
+        # a bicubic's error falls at most 16-fold per halving (h^4): each span needs at least
+        # (err / tol)^(1/4) pieces along each direction, known before the larger fit is made
+        need = np.ceil((np.maximum(err, tol) / tol) ** 0.25)
+        spans = float(need.max(axis=1).sum()) * float(need.max(axis=0).sum())
+        if spans > MAX_SPANS:
+            raise SurfmodError(f"tolerance: {tol:g} would need at least {spans:,.0f} bicubic spans (error "
+                               f"{worst:.3g} with {err.size:,}), above the limit {MAX_SPANS:,}; loosen it")
         bu = np.union1d(bu, 0.5 * (bu[:-1] + bu[1:])[bad.any(axis=1)])
         bv = np.union1d(bv, 0.5 * (bv[:-1] + bv[1:])[bad.any(axis=0)])
     raise SurfmodError(f"tolerance: {tol:g} not reached after {max_rounds} refinements "
@@ -186,7 +204,11 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
         raise SurfmodError(f"distance: expected a number, got {distance!r}") from None
     if not np.isfinite(d) or d == 0.0:
         raise SurfmodError(f"distance: must be finite and non-zero, got {distance!r}")
-    tol = checks.tolerance(tolerance, "tolerance", model_size(s) + abs(d))
+    size = model_size(s) + abs(d)
+    tol = checks.tolerance(tolerance, "tolerance", size)
+    if tol < FIT_FLOOR * size:
+        raise SurfmodError(f"tolerance: {tol:g} is below what a bicubic fit can reach ({FIT_FLOOR:g} x the size "
+                           f"{size:.3g} of the surface and its offset)")
     max_rounds = checks.count(max_rounds, "max_rounds")
     precheck(s, d)
     exact = OffsetSurface(s, d)

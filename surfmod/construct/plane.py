@@ -7,6 +7,11 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface
+from .elementary_closest import parallelogram
+
+#: how far (relative to the net's size) the fourth control point may sit from the
+#: parallelogram of the other three for the closed-form projection (a rounding, no more)
+PARALLELOGRAM_SLACK = 1e-13
 
 
 class ThreePointPlane(BSplineSurface):
@@ -32,6 +37,22 @@ class ThreePointPlane(BSplineSurface):
     def normal(self) -> np.ndarray:
         n = np.cross(self.control_points[1, 0] - self.origin, self.control_points[0, 1] - self.origin)
         return n / np.linalg.norm(n)
+
+    def _closest_parameters(self, points):
+        """Closest points in closed form (:func:`~surfmod.construct.elementary_closest.parallelogram`)
+        when the net is the parallelogram :func:`plane` makes (``None`` otherwise: a net
+        given to the class directly is projected like any B-spline)."""
+        net = self.control_points
+        if net.shape[:2] != (2, 2) or self.degree != (1, 1) or (self.rational and np.ptp(self.weights) > 0):
+            return None
+        e1, e2 = net[1, 0] - net[0, 0], net[0, 1] - net[0, 0]
+        size = max(np.abs(e1).max(), np.abs(e2).max())
+        if (np.abs(net[1, 1] - net[1, 0] - e2).max() > PARALLELOGRAM_SLACK * size
+                or np.linalg.norm(np.cross(e1, e2)) <= 1e-12 * size * size):
+            return None
+        s, t = parallelogram(points, net[0, 0], e1, e2)
+        (u0, u1), (v0, v1) = self.domain
+        return u0 + s * (u1 - u0), v0 + t * (v1 - v0)
 
     def transformed(self, matrix) -> "ThreePointPlane":
         """An affine image of a plane is a plane: same class, mapped control points."""

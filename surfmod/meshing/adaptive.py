@@ -267,6 +267,19 @@ class _Refiner:
         self.sig = np.concatenate([self.sig[keep], np.full((added, 4), -1, dtype=np.int64)])
         return int(stuck.sum())
 
+    def _refuse_beyond_cap(self, bad: np.ndarray) -> None:
+        """Refuse before splitting when even the fewest cells the refinement can end with
+        exceed the cap: a split halves a cell's chords, so its sag falls at best fourfold
+        (a smooth surface; less at a crease), and a cell off by ``e`` becomes at least
+        ``2^ceil(log4(e / tol))`` cells."""
+        splits = np.ceil(np.log(np.maximum(self.err[bad] / self.tol, 1.0)) / np.log(4.0))
+        fewest = self.x0.size - bad.size + float(np.sum(2.0 ** np.maximum(splits, 1.0)))
+        if 2 * fewest > self.max_triangles:
+            raise SurfmodError(
+                f"tolerance: {self.tol:g} needs more than {2 * fewest:,.0f} triangles, above the limit "
+                f"max_triangles={self.max_triangles:,} (found after {self.iterations} refinement passes)"
+            )
+
     def run(self):
         stuck_total = 0
         dense_pass = False
@@ -300,6 +313,7 @@ class _Refiner:
                 dense_pass = True
                 continue
             dense_pass = False
+            self._refuse_beyond_cap(bad)
             stuck = self.split(bad)
             stuck_total = max(stuck_total, stuck)
             if stuck == bad.size:  # nothing could be split any more

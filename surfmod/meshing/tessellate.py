@@ -32,6 +32,14 @@ from tqdm import tqdm
 MIN_RELATIVE_TOLERANCE = 1e-10
 
 
+#: the fewest triangles a mesh within the tolerance took per triangle of the curvature
+#: estimate, measured on planes' neighbours to superellipsoids (cylinders 1.5: one
+#: curved direction; spheres, tori, B-splines 2-3, where a cell's diagonal sags more than
+#: its sides; creased superellipsoids 6-60): the estimate times this is a floor of the
+#: work, so a tolerance refused by it is refused before any meshing
+MESH_OVERHEAD = 1.4
+
+
 def estimate_triangles(s, tolerance: float, size: float) -> float:
     """Order-of-magnitude triangle count for ``tolerance`` from sampled principal curvatures:
     a chord of length ``h`` on curvature ``k`` deviates ``k h^2 / 8``."""
@@ -59,9 +67,9 @@ def _check_tolerance(s, tolerance: float, max_triangles: int) -> tuple[float, fl
             "deviations that small cannot be measured in double precision"
         )
     estimate = estimate_triangles(s, tolerance, size)
-    if estimate > max_triangles:
+    if MESH_OVERHEAD * estimate > max_triangles:
         raise SurfmodError(
-            f"tolerance: {tolerance:g} would need about {estimate:,.0f} triangles, above the limit "
+            f"tolerance: {tolerance:g} would need about {MESH_OVERHEAD * estimate:,.0f} triangles, above the limit "
             f"max_triangles={max_triangles:,}"
         )
     return size, estimate
