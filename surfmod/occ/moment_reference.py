@@ -140,9 +140,11 @@ class MomentReference:
     sweeps: tuple = field(default=(), repr=False)
 
 
-def _vertex_points(shape) -> np.ndarray:
-    pts = [xyz(BRep_Tool.Pnt_s(TopoDS.Vertex_s(v))) for v in explore(shape, TopAbs_VERTEX)]
-    return np.array(pts, dtype=float).reshape(-1, 3)
+def _vertex_points(shape):
+    """The vertices' points ``(n, 3)`` and tolerances ``(n,)``."""
+    vs = [TopoDS.Vertex_s(v) for v in explore(shape, TopAbs_VERTEX)]
+    pts = np.array([xyz(BRep_Tool.Pnt_s(v)) for v in vs], dtype=float).reshape(-1, 3)
+    return pts, np.array([BRep_Tool.Tolerance_s(v) for v in vs], dtype=float)
 
 
 def max_tolerance(shape) -> float:
@@ -153,8 +155,8 @@ def max_tolerance(shape) -> float:
 
 # -- critical levels -------------------------------------------------------------------
 def _edge_samples(shape):
-    """Per curved edge: ``(adaptor, parameters, first derivatives)`` on a sample wide
-    enough to bracket each extreme of ``C(t)·a`` (a few per smooth interval)."""
+    """Per curved edge: ``(adaptor, parameters, first derivatives, tolerance)`` on a
+    sample wide enough to bracket each extreme of ``C(t)·a`` (a few per smooth interval)."""
     out = []
     for _, edge, _faces in geometric_edges(shape):
         c = BRepAdaptor_Curve(edge)
@@ -168,16 +170,17 @@ def _edge_samples(shape):
         for k, tt in enumerate(t):
             c.D1(float(tt), p, d1)
             der[k] = d1.X(), d1.Y(), d1.Z()
-        out.append((c, t, der))
+        out.append((c, t, der, BRep_Tool.Tolerance_s(edge)))
     return out
 
 
 def _edge_levels(samples, a: np.ndarray) -> list:
     """Heights of the interior extremes of every sampled edge along ``a`` (Newton on
-    ``C'·a = 0`` inside each bracket where it changes sign, bisection when Newton leaves)."""
+    ``C'·a = 0`` inside each bracket where it changes sign, bisection when Newton leaves),
+    as ``(height, edge tolerance)`` pairs."""
     levels = []
     p, d1, d2 = gp_Pnt(), gp_Vec(), gp_Vec()
-    for c, t, der in samples:
+    for c, t, der, tol in samples:
         g = der @ a
         scale = np.abs(der).max() + 1e-300
         for k in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
@@ -198,7 +201,7 @@ def _edge_levels(samples, a: np.ndarray) -> list:
                 if hi - lo <= 1e-15 * (abs(t[-1]) + abs(t[0]) + 1):
                     break
             c.D0(float(x), p)
-            levels.append(p.X() * a[0] + p.Y() * a[1] + p.Z() * a[2])
+            levels.append((p.X() * a[0] + p.Y() * a[1] + p.Z() * a[2], tol))
     return levels
 
 
@@ -240,11 +243,12 @@ def _newton_critical(s, u, v, box, a, scale):
 
 
 def _face_levels(face_data, a: np.ndarray) -> tuple[list, int]:
-    """Heights of the interior critical points of every face along ``a``, and how many
-    grid cells held a sign change Newton could not settle (then the error estimate
-    shows whether it mattered)."""
-    levels, unresolved = [], 0
-    for kind, data in face_data:
+    """Heights of the interior critical points of every face along ``a`` as ``(height,
+    face tolerance)`` pairs, and how many grid cells held a sign change Newton could not
+    settle (then the error estimate shows whether it mattered)."""
+    out, unresolved = [], 0
+    for kind, data, tol in face_data:
+        levels = []
         if kind == "plane":
             n, p = data
             if abs(abs(n @ a) - 1) < 1e-12:
@@ -279,7 +283,8 @@ def _face_levels(face_data, a: np.ndarray) -> tuple[list, int]:
                     unresolved += 1
                 else:
                     levels.append(h)
-    return levels, unresolved
+        out += [(h, tol) for h in levels]
+    return out, unresolved
 
 
 def _faces_data(shape):
@@ -287,22 +292,23 @@ def _faces_data(shape):
     for face in faces_of(shape):
         s = BRepAdaptor_Surface(face, False)
         kind = s.GetType()
+        tol = BRep_Tool.Tolerance_s(face)
         if kind == GeomAbs_Plane:
             pl = s.Plane()
-            out.append(("plane", (xyz(pl.Axis().Direction()), xyz(pl.Location()))))
+            out.append(("plane", (xyz(pl.Axis().Direction()), xyz(pl.Location())), tol))
         elif kind == GeomAbs_Cylinder:
             cy = s.Cylinder()
-            out.append(("cylinder", (xyz(cy.Axis().Direction()), xyz(cy.Location()), cy.Radius())))
+            out.append(("cylinder", (xyz(cy.Axis().Direction()), xyz(cy.Location()), cy.Radius()), tol))
         elif kind == GeomAbs_Cone:
-            out.append(("cone", xyz(s.Cone().Apex())))
+            out.append(("cone", xyz(s.Cone().Apex()), tol))
         elif kind == GeomAbs_Sphere:
             sp = s.Sphere()
-            out.append(("sphere", (xyz(sp.Location()), sp.Radius())))
+            out.append(("sphere", (xyz(sp.Location()), sp.Radius()), tol))
         elif kind == GeomAbs_Torus:
             to = s.Torus()
-            out.append(("torus", (xyz(to.Axis().Direction()), xyz(to.Location()), to.MajorRadius(), to.MinorRadius())))
+            out.append(("torus", (xyz(to.Axis().Direction()), xyz(to.Location()), to.MajorRadius(), to.MinorRadius()), tol))
         else:
-            out.append(("grid", _surface_grid(face)))
+            out.append(("grid", _surface_grid(face), tol))
     return out
 
 
@@ -317,12 +323,22 @@ class _Levels:
             self.faces = _faces_data(shape)
         self.unresolved = 0
 
-    def along(self, a: np.ndarray) -> np.ndarray:
+    def along(self, a: np.ndarray, tolerances: bool = False):
+        """The sorted critical levels along ``a`` (distinct), and with ``tolerances`` the
+        largest tolerance of the sub-shapes at each (a vertex's, an edge's, a face's)."""
         with kernel("critical levels"):
             faces, unresolved = _face_levels(self.faces, a)
             self.unresolved += unresolved
-            levels = np.concatenate([self.vertices @ a, _edge_levels(self.edges, a), faces])
-        return np.unique(levels)
+            pairs = _edge_levels(self.edges, a) + faces
+            pts, vtol = self.vertices
+            levels = np.concatenate([pts @ a, [h for h, _ in pairs]])
+            tols = np.concatenate([vtol, [t for _, t in pairs]])
+        order = np.lexsort((-tols, levels))
+        levels, tols = levels[order], tols[order]
+        first = np.concatenate([[True], np.diff(levels) > 0])
+        # the largest tolerance at each distinct level: sorted by level, then by tolerance
+        # descending, the first of each run holds it
+        return (levels[first], tols[first]) if tolerances else levels[first]
 
 
 def critical_levels(shape, direction) -> np.ndarray:
@@ -339,14 +355,33 @@ def critical_levels(shape, direction) -> np.ndarray:
 
 
 # -- intervals and nodes ---------------------------------------------------------------
-def _intervals(levels: np.ndarray, min_length: float, pieces: int) -> np.ndarray:
-    """Interval ends from the critical levels: those closer than ``min_length`` to the
-    previous one merged, intervals longer than the extent / ``pieces`` split evenly."""
-    keep = [levels[0]]
-    for t in levels[1:-1]:
-        if t - keep[-1] >= min_length and levels[-1] - t >= min_length:
+def _intervals(levels: np.ndarray, min_length: float, pieces: int, tolerances=None) -> np.ndarray:
+    """Interval ends from the critical levels: each interval at least ``min_length`` long
+    and long enough that its first node after ψ stays twice the ``tolerances`` of its two
+    ends clear of them (a closer level is merged into the one before, which takes the
+    larger tolerance of the two); the last level is always kept, the one
+    before it dropped if too close.  Intervals longer than the extent / ``pieces`` are
+    split evenly.  ``SurfmodError`` when not even the whole extent leaves that room."""
+    tols = np.zeros(len(levels)) if tolerances is None else np.asarray(tolerances, dtype=float)
+
+    def need(t0, t1):
+        return max(min_length, 2 * max(t0, t1) / _FIRST_NODE)
+
+    keep, ktol = [levels[0]], [tols[0]]
+    for t, tol in zip(levels[1:-1], tols[1:-1]):
+        if t - keep[-1] >= need(ktol[-1], tol):
             keep.append(t)
-    keep.append(levels[-1])
+            ktol.append(tol)
+        else:
+            ktol[-1] = max(ktol[-1], tol)
+    last, ltol = levels[-1], tols[-1]
+    while len(keep) > 1 and last - keep[-1] < need(ktol[-1], ltol):
+        keep.pop()
+        ltol = max(ltol, ktol.pop())
+    if last - keep[-1] < need(ktol[-1], ltol):
+        raise SurfmodError(f"shape: its tolerances (up to {max(ltol, ktol[-1]):.1e}) leave no room for cuts clear of "
+                           f"its features along this direction (extent {last - keep[-1]:.3g})")
+    keep.append(last)
     ends = [keep[0]]
     longest = (keep[-1] - keep[0]) / pieces
     for b in keep[1:]:
@@ -428,25 +463,22 @@ def cut_volumes(shape, direction, heights, volume: float, origin, size: float, o
     return (below + above) / 2, float(slabs.sum() - volume), len(pieces)
 
 
-def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, tolerance: float = 0.0,
+def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, tolerances=None,
           pieces: int = 2, deadline: float = math.inf) -> Sweep:
     """``∫h dV`` and ``∫h² dV`` of ``shape`` along the unit ``direction``, ``h`` the height
     above the point ``origin`` (the part's centre), from ``V(t)`` at the Gauss–Kronrod nodes between the critical
-    ``levels`` (found when not given); ``volume`` is the solid's trusted volume,
-    ``size`` at least the part's half diagonal (the planes' half side), ``tolerance`` the
-    model's largest (nodes keep clear of levels by twice it); past ``deadline`` (a
+    ``levels`` (found when not given, with the ``tolerances`` of the sub-shapes there:
+    nodes keep clear of each level by twice its tolerance); ``volume`` is the solid's
+    trusted volume, ``size`` at least the part's half diagonal (the planes' half side); past ``deadline`` (a
     ``time.perf_counter`` value) the sweep stops with ``SurfmodError`` naming ``budget``."""
     a = np.asarray(direction, dtype=float)
-    levels = critical_levels(shape, a) if levels is None else np.asarray(levels, dtype=float)
+    if levels is None:
+        levels, tolerances = _Levels(shape).along(a, tolerances=True)
+    levels = np.asarray(levels, dtype=float)
     extent = levels[-1] - levels[0]
     if not extent > 0:
         raise SurfmodError("shape: has no extent along the sweep direction")
-    min_length = max(1e-6 * extent, 2 * tolerance / _FIRST_NODE)
-    if min_length > extent / 8:
-        raise SurfmodError(f"shape: its largest tolerance {tolerance:.1e} leaves no room for cuts clear of its "
-                           f"features (nodes within {_FIRST_NODE:.1e} of an interval from its ends; extent "
-                           f"{extent:.3g}): the moment reference needs a tolerance below {extent / 8 * _FIRST_NODE / 2:.1e}")
-    ends = _intervals(levels, min_length, pieces)
+    ends = _intervals(levels, 1e-6 * extent, pieces, tolerances)
     t, scale = _nodes(ends)
     origin = np.asarray(origin, dtype=float)
     centre = float(a @ origin)
@@ -514,15 +546,14 @@ def estimated_seconds(shape, pieces: int = 2) -> float:
     True
     """
     finder = _Levels(shape)
-    tol = max_tolerance(shape)
     planes = 0
     for d in DIRECTIONS:
-        lv = finder.along(d)
-        extent = lv[-1] - lv[0]
-        if 2 * tol / _FIRST_NODE > extent / 8:
+        lv, tols = finder.along(d, tolerances=True)
+        try:
+            planes += 21 * (len(_intervals(lv, 1e-6 * (lv[-1] - lv[0]), pieces, tols)) - 1)
+        except SurfmodError:
             return 0.0  # refused at once (see sweep)
-        planes += 21 * (len(_intervals(lv, max(1e-6 * extent, 2 * tol / _FIRST_NODE), pieces)) - 1)
-    simple = sum(kind in ("plane", "cylinder", "cone", "sphere") for kind, _ in finder.faces)
+    simple = sum(kind in ("plane", "cylinder", "cone", "sphere") for kind, *_ in finder.faces)
     hard = len(finder.faces) - simple
     return planes * (_COST[0] + _COST[1] * simple + _COST[2] * hard)
 
@@ -532,8 +563,8 @@ def moment_reference(shape, volume: float | None = None, *, pieces: int = 2,
     """Volume, centroid and inertia (about the centroid, ``Ixy = -∫xy``) of a solid from
     six volume sweeps (see the module notes), with error estimates.  ``volume`` is the
     trusted volume (BRepGProp's at eps 1e-12 when not given); ``pieces`` the fewest
-    intervals along each direction (longer ones are split).  Nodes keep clear of critical
-    levels by twice the model's largest tolerance.  ``budget`` bounds the seconds spent
+    intervals along each direction (longer ones are split).  Nodes keep clear of each
+    critical level by twice the tolerance of the sub-shapes there.  ``budget`` bounds the seconds spent
     (checked between cuts: ``SurfmodError`` naming ``budget`` when exceeded).
 
     >>> import build123d as bd
@@ -553,13 +584,12 @@ def moment_reference(shape, volume: float | None = None, *, pieces: int = 2,
         volume = props.Mass()
     volume = float(volume)
     finder = _Levels(shape)
-    tol = max_tolerance(shape)
-    levels = [finder.along(d) for d in DIRECTIONS]
+    levels = [finder.along(d, tolerances=True) for d in DIRECTIONS]
     # heights from the centre of the axes' extents (no cancellation against far origins)
-    centre = np.array([(lv[0] + lv[-1]) / 2 for lv in levels[:3]])
-    size = 0.6 * float(np.linalg.norm([lv[-1] - lv[0] for lv in levels[:3]])) + 10 * tol
-    sweeps = [sweep(shape, d, centre, volume, size, levels=lv, tolerance=tol, pieces=pieces, deadline=deadline)
-              for d, lv in zip(DIRECTIONS, levels)]
+    centre = np.array([(lv[0] + lv[-1]) / 2 for lv, _ in levels[:3]])
+    size = 0.6 * float(np.linalg.norm([lv[-1] - lv[0] for lv, _ in levels[:3]])) + 10 * max_tolerance(shape)
+    sweeps = [sweep(shape, d, centre, volume, size, levels=lv, tolerances=tl, pieces=pieces, deadline=deadline)
+              for d, (lv, tl) in zip(DIRECTIONS, levels)]
     s1 = np.array([s.first for s in sweeps[:3]])
     e1 = np.array([s.first_error for s in sweeps[:3]])
     second = np.diag([s.second for s in sweeps[:3]])
