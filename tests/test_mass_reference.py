@@ -88,21 +88,25 @@ def test_kronrod_rule_is_exact_to_degree_31_and_holds_the_gauss_rule():
 def test_nodes_integrate_a_square_root_end_exactly():
     # ψ(s) = 3s² - 2s³ turns (t - a)^(3/2) at an end into a polynomial in s
     ends = np.array([0.0, 1.0, 3.0])
-    t, scale = _nodes(ends)
+    t, scale = _nodes(ends, [True, True])
     f = np.where(t < 1, t ** 1.5, np.sqrt(3 - t))
     assert abs(((scale * f) @ KRONROD_W).sum() - (0.4 + 2 / 3 * 2 ** 1.5)) < 1e-14
 
 
 def test_intervals_merge_close_levels_and_split_long_ones():
-    ends = _intervals(np.array([0.0, 1e-9, 0.5, 4.0]), 1e-6, 2)
-    assert ends.tolist() == [0.0, 0.5, 2.25, 4.0]
-    # a level whose vertex tolerance would put the first node after ψ (1.4e-5 of the
-    # interval in) within twice that tolerance of it is merged; the last level stays
+    ends, mapped = _intervals(np.array([0.0, 1e-9, 0.5, 4.0]), 1e-6, 2)
+    assert ends.tolist() == [0.0, 0.5, 2.25, 4.0] and mapped.all()
+    # next to a vertex whose tolerance the first node after ψ (1.4e-5 of the interval in)
+    # would come within twice of, the interval is integrated plainly (first node 2.2e-3
+    # in); closer still, the level is merged; the last level stays
     levels = np.array([0.0, 1e-3, 0.5, 3.999, 4.0])
-    assert _intervals(levels, 1e-6, 1, [0, 1e-8, 0, 0, 0]).tolist() == [0.0, 0.5, 3.999, 4.0]
-    assert _intervals(levels, 1e-6, 1, [0, 0, 0, 0, 1e-8]).tolist() == [0.0, 1e-3, 0.5, 4.0]
+    ends, mapped = _intervals(levels, 1e-6, 1, [0, 1e-8, 0, 0, 0])
+    assert ends.tolist() == levels.tolist() and mapped.tolist() == [False, True, True, True]
+    ends, mapped = _intervals(levels, 1e-6, 1, [0, 2e-6, 0, 0, 0])
+    assert ends.tolist() == [0.0, 0.5, 3.999, 4.0] and mapped.tolist() == [True, True, True]
+    assert _intervals(levels, 1e-6, 1, [0, 0, 0, 0, 2e-6])[0].tolist() == [0.0, 1e-3, 0.5, 4.0]
     with pytest.raises(SurfmodError, match="shape: its tolerances"):
-        _intervals(levels, 1e-6, 1, [1e-4] * 5)
+        _intervals(levels, 1e-6, 1, [1e-2] * 5)
 
 
 def test_critical_levels_of_elementary_faces():

@@ -94,7 +94,8 @@ GAUSS_W[1::2] = np.concatenate([_WG, _WG[::-1]])
 #: the first Kronrod node's place after ψ, as a fraction of its interval: a node must stay
 #: this far from a critical level, so an interval shorter than (a few tolerances) / this
 #: is merged into its neighbour (the Boolean would take its nearest plane for a face)
-_FIRST_NODE = 3 * ((1 - _XK[0]) / 2) ** 2 - 2 * ((1 - _XK[0]) / 2) ** 3
+_FIRST_PLAIN = (1 - _XK[0]) / 2
+_FIRST_NODE = 3 * _FIRST_PLAIN ** 2 - 2 * _FIRST_PLAIN ** 3
 #: directions of the six sweeps: the axes, then the diagonals giving the products
 DIRECTIONS = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [1, 0, 1], [0, 1, 1]]) / np.sqrt(
     [[1], [1], [1], [2], [2], [2]])
@@ -355,17 +356,21 @@ def critical_levels(shape, direction) -> np.ndarray:
 
 
 # -- intervals and nodes ---------------------------------------------------------------
-def _intervals(levels: np.ndarray, min_length: float, pieces: int, tolerances=None) -> np.ndarray:
-    """Interval ends from the critical levels: each interval at least ``min_length`` long
-    and long enough that its first node after ψ stays twice the ``tolerances`` of its two
-    ends clear of them (a closer level is merged into the one before, which takes the
-    larger tolerance of the two); the last level is always kept, the one
+def _intervals(levels: np.ndarray, min_length: float, pieces: int, tolerances=None):
+    """Interval ends from the critical levels, and per interval whether it is mapped by ψ.
+
+    Each interval is at least ``min_length`` long, and its nodes stay twice the
+    ``tolerances`` of its two ends clear of them: mapped by ψ when its first node (1.4e-5
+    of the length in) does, else integrated by plain Gauss–Kronrod (first node 2.2e-3 in:
+    a short interval next to a loose vertex keeps its breakpoint, and its end behaviour
+    costs little for being short); a level too close even for that is merged into the one
+    before (which takes the larger tolerance).  The last level is always kept, the one
     before it dropped if too close.  Intervals longer than the extent / ``pieces`` are
     split evenly.  ``SurfmodError`` when not even the whole extent leaves that room."""
     tols = np.zeros(len(levels)) if tolerances is None else np.asarray(tolerances, dtype=float)
 
-    def need(t0, t1):
-        return max(min_length, 2 * max(t0, t1) / _FIRST_NODE)
+    def need(t0, t1, first=_FIRST_PLAIN):
+        return max(min_length, 2 * max(t0, t1) / first)
 
     keep, ktol = [levels[0]], [tols[0]]
     for t, tol in zip(levels[1:-1], tols[1:-1]):
@@ -382,20 +387,26 @@ def _intervals(levels: np.ndarray, min_length: float, pieces: int, tolerances=No
         raise SurfmodError(f"shape: its tolerances (up to {max(ltol, ktol[-1]):.1e}) leave no room for cuts clear of "
                            f"its features along this direction (extent {last - keep[-1]:.3g})")
     keep.append(last)
-    ends = [keep[0]]
+    ktol.append(ltol)
+    ends, mapped = [keep[0]], []
     longest = (keep[-1] - keep[0]) / pieces
-    for b in keep[1:]:
-        k = max(1, math.ceil((b - ends[-1]) / longest - 1e-9))
-        ends += list(np.linspace(ends[-1], b, k + 1)[1:])
-    return np.array(ends)
+    for k in range(1, len(keep)):
+        length = keep[k] - keep[k - 1]
+        n = max(1, math.ceil(length / longest - 1e-9))
+        ends += list(np.linspace(keep[k - 1], keep[k], n + 1)[1:])
+        mapped += [length >= need(ktol[k - 1], ktol[k], _FIRST_NODE)] * n
+    return np.array(ends), np.array(mapped, dtype=bool)
 
 
-def _nodes(ends: np.ndarray):
+def _nodes(ends: np.ndarray, mapped=None):
     """Nodes ``(m, 21)`` of the intervals between ``ends`` after ``t = a + (b - a) ψ(s)``
-    and the factors ``(b - a) ψ'(s) / 2`` that make ``∫ f dt`` the Kronrod (or Gauss)
-    sum of ``f`` times them."""
+    (or plainly where ``mapped`` is false) and the factors ``(b - a) ψ'(s) / 2`` that
+    make ``∫ f dt`` the Kronrod (or Gauss) sum of ``f`` times them."""
     s = (KRONROD_X + 1) / 2
     psi, dpsi = 3 * s * s - 2 * s ** 3, 6 * s * (1 - s)
+    mapped = np.ones(len(ends) - 1, dtype=bool) if mapped is None else np.asarray(mapped, dtype=bool)
+    psi = np.where(mapped[:, None], psi, s)
+    dpsi = np.where(mapped[:, None], dpsi, 1.0)
     length = np.diff(ends)[:, None]
     return ends[:-1, None] + length * psi, length * dpsi / 2
 
@@ -478,8 +489,8 @@ def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, 
     extent = levels[-1] - levels[0]
     if not extent > 0:
         raise SurfmodError("shape: has no extent along the sweep direction")
-    ends = _intervals(levels, 1e-6 * extent, pieces, tolerances)
-    t, scale = _nodes(ends)
+    ends, mapped = _intervals(levels, 1e-6 * extent, pieces, tolerances)
+    t, scale = _nodes(ends, mapped)
     origin = np.asarray(origin, dtype=float)
     centre = float(a @ origin)
     # one cut per interval: a piece the splitter loses (it happens, rarely, among a hundred
@@ -550,7 +561,7 @@ def estimated_seconds(shape, pieces: int = 2) -> float:
     for d in DIRECTIONS:
         lv, tols = finder.along(d, tolerances=True)
         try:
-            planes += 21 * (len(_intervals(lv, 1e-6 * (lv[-1] - lv[0]), pieces, tols)) - 1)
+            planes += 21 * len(_intervals(lv, 1e-6 * (lv[-1] - lv[0]), pieces, tols)[1])
         except SurfmodError:
             return 0.0  # refused at once (see sweep)
     simple = sum(kind in ("plane", "cylinder", "cone", "sphere") for kind, *_ in finder.faces)
