@@ -61,10 +61,10 @@ def revolution(rho2: P, z0: float, z1: float):
     return v, np.array([0, 0, zc]), np.diag([xx + zz, xx + zz, 2 * xx])
 
 
-def check(shape, volume, centroid, inertia, tol=1e-10, covered=False):
-    """The reference within ``tol`` (relative) of the closed form; with ``covered``, its
-    error within its own estimate, and that estimate within ``tol``."""
-    r = moment_reference(shape)
+def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None):
+    """The reference (``r``, or computed) within ``tol`` (relative) of the closed form; with
+    ``covered``, its error within its own estimate, and that estimate within ``tol``."""
+    r = moment_reference(shape) if r is None else r
     assert abs(r.volume - volume) / volume < 1e-12
     length = volume ** (1 / 3)
     big = np.abs(inertia).max()
@@ -119,8 +119,21 @@ def test_critical_levels_of_elementary_faces():
     assert len(critical_levels(box, (1, 0, 0))) == 4
 
 
-def test_box_with_an_off_centre_hole():
-    r2, cx, cy = 0.25, 0.7, 0.3
+HOLE = (0.7, 0.3)
+
+
+def holed_box():
+    return bd.Box(4, 3, 2) - bd.Cylinder(0.5, 3).translate((*HOLE, 0))
+
+
+@pytest.fixture(scope="module")
+def hole_reference():
+    """The reference of :func:`holed_box`, cut once for the tests that use it."""
+    return moment_reference(holed_box().wrapped)
+
+
+def test_box_with_an_off_centre_hole(hole_reference):
+    r2, (cx, cy) = 0.25, HOLE
     vh = math.pi * r2 * 2
     v = 24 - vh
     first = -vh * np.array([cx, cy, 0])
@@ -128,8 +141,7 @@ def test_box_with_an_off_centre_hole():
     second[0, 1] = second[1, 0] = -vh * cx * cy  # Steiner: the hole's ∫xy about its axis is 0
     g = first / v
     central = second - v * np.outer(g, g)
-    part = bd.Box(4, 3, 2) - bd.Cylinder(0.5, 3).translate((cx, cy, 0))
-    check(part.wrapped, v, g, np.trace(central) * np.eye(3) - central)
+    check(None, v, g, np.trace(central) * np.eye(3) - central, r=hole_reference)
 
 
 @pytest.mark.corpus  # 17 s on the busy 2-core machine
@@ -155,12 +167,10 @@ def test_a_solid_is_required():
         moment_reference(bd.Box(1, 1, 1).faces()[0].wrapped)
 
 
-_CACHE: dict = {}
-
-
 @pytest.mark.parametrize("moved_side, code, line", [
     ("occt", 0, "REFERENCE CONFIRMS SURFMOD"), ("numpy", 4, "REFERENCE CONFIRMS BREPGPROP")])
-def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, capsys, moved_side, code, line):
+def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, capsys, hole_reference,
+                                                        moved_side, code, line):
     import dataclasses
 
     import surfmod as sm
@@ -169,21 +179,17 @@ def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, c
     from surfmod.cli import main
 
     path = tmp_path / "hole.step"
-    sm.export_step(bd.Box(4, 3, 2) - bd.Cylinder(0.5, 3).translate((0.7, 0.3, 0)), path)
-    real, real_ref = mass.mass_properties, mr.moment_reference
+    sm.export_step(holed_box(), path)
+    real = mass.mass_properties
 
-    def one_side_off(solid, density=1.0, **kw):  # one side's centroid 1e-5 off
+    def one_side_off(solid, density=1.0, **kw):  # one side's centroid 1e-5 of the size off
         r = real(solid, density, **kw)
         side = kw.get("method", "numpy")
         return dataclasses.replace(r, centroid=np.asarray(r.centroid) + 3e-5) if side == moved_side else r
 
-    def cached(shape, *a, **k):  # the same solid in both cases: cut it once
-        if "r" not in _CACHE:
-            _CACHE["r"] = real_ref(shape, *a, **k)
-        return _CACHE["r"]
-
     monkeypatch.setattr(mass, "mass_properties", one_side_off)
-    monkeypatch.setattr(mr, "moment_reference", cached)
+    # the same solid as the fixture's (read back from STEP): its reference, cut once
+    monkeypatch.setattr(mr, "moment_reference", lambda *a, **k: hole_reference)
     assert main(["mass", str(path), "--no-progress"]) == code
     out = capsys.readouterr().out
     assert line in out and out.count("REFERENCE") == 1
