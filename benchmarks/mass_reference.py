@@ -60,7 +60,8 @@ def main(argv=None) -> int:
     p.add_argument("--budget", type=float, default=600.0, help="seconds per solid for the reference")
     p.add_argument("--max-faces", type=int, default=400, help="skip solids with more faces (stated)")
     args = p.parse_args(argv)
-    files = [Path(f) for f in args.files] or sorted(x for x in CORPUS.glob("*") if x.suffix.lower() in (".step", ".stp"))
+    files = [Path(f) for f in args.files] or sorted(
+        x for x in CORPUS.glob("*") if x.suffix.lower() in (".step", ".stp"))
     keys = None
     for path in files:
         for i, solid in enumerate(solids_of(sm.import_step(path).wrapped)):
@@ -80,8 +81,8 @@ def main(argv=None) -> int:
             if keys is None:
                 keys = list(row)
                 print("solid faces " + " ".join(keys), flush=True)
-            print(f"{name} {nf} " + " ".join(f"{row[k]:.2e}" if isinstance(row[k], float) else str(row[k]) for k in keys),
-                  flush=True)
+            cells = (f"{row[k]:.2e}" if isinstance(row[k], float) else str(row[k]) for k in keys)
+            print(f"{name} {nf} " + " ".join(cells), flush=True)
     return 0
 
 

@@ -122,9 +122,11 @@ def settle(solid, r, o, names, limit):
     detail = ", ".join(f"{k}: surfmod {diff[k](r):.2e}, BRepGProp {diff[k](o):.2e} (its error {est[k]:.1e})"
                        for k in names)
     if sides == {"surfmod"}:
-        return "surfmod", f"REFERENCE CONFIRMS SURFMOD: the independent moment reference agrees with surfmod, not BRepGProp ({detail})"
+        return "surfmod", ("REFERENCE CONFIRMS SURFMOD: the independent moment reference agrees with surfmod, "
+                           f"not BRepGProp ({detail})")
     if sides == {"occt"}:
-        return "occt", f"REFERENCE CONFIRMS BREPGPROP: the independent moment reference agrees with BRepGProp, not surfmod ({detail})"
+        return "occt", ("REFERENCE CONFIRMS BREPGPROP: the independent moment reference agrees with BRepGProp, "
+                        f"not surfmod ({detail})")
     return None, f"REFERENCE UNDECIDED: the independent moment reference cannot tell the two apart ({detail})"
 
 

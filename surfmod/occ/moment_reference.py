@@ -317,7 +317,8 @@ def _faces_data(shape):
             out.append(("sphere", (xyz(sp.Location()), sp.Radius()), tol))
         elif kind == GeomAbs_Torus:
             to = s.Torus()
-            out.append(("torus", (xyz(to.Axis().Direction()), xyz(to.Location()), to.MajorRadius(), to.MinorRadius()), tol))
+            frame = (xyz(to.Axis().Direction()), xyz(to.Location()), to.MajorRadius(), to.MinorRadius())
+            out.append(("torus", frame, tol))
         else:
             out.append(("grid", _surface_grid(face), tol))
     return out
