@@ -59,12 +59,13 @@ def main(argv=None) -> int:
     p.add_argument("files", nargs="*", help="STEP files (default: the corpus)")
     p.add_argument("--budget", type=float, default=600.0, help="seconds per solid for the reference")
     p.add_argument("--max-faces", type=int, default=400, help="skip solids with more faces (stated)")
+    p.add_argument("--solids", type=int, default=None, help="only the first N solids of each file")
     args = p.parse_args(argv)
     files = [Path(f) for f in args.files] or sorted(
         x for x in CORPUS.glob("*") if x.suffix.lower() in (".step", ".stp"))
     keys = None
     for path in files:
-        for i, solid in enumerate(solids_of(sm.import_step(path).wrapped)):
+        for i, solid in enumerate(solids_of(sm.import_step(path).wrapped)[:args.solids]):
             name = f"{path.name}#{i}"
             nf = len(faces_of(solid))
             if not BRepCheck_Analyzer(solid).IsValid():

@@ -553,10 +553,11 @@ def _cut_interval(shape, a, nodes, volume, origin, size):
     return min(best, split, key=lambda r: abs(r[1]))
 
 
-#: seconds per cutting plane: a constant, per face of an elementary surface the plane
-#: meets, per face of a free-form or toroidal one (their sections are walked and
-#: approximated); measured on the corpus (single core, idle machine)
-_COST = (5e-3, 8e-5, 0.15)
+#: seconds per cutting plane: a constant, per face of an elementary surface, per face of
+#: a free-form or toroidal one (their sections are walked and approximated); from the
+#: corpus (benchmarks/mass_reference.py: 5-36 ms a plane on 7-30 elementary faces, a
+#: rotated torus 0.35 s), an estimate for refusing early: the budget is what bounds
+_COST = (0.01, 5e-4, 0.15)
 
 
 def estimated_seconds(shape, pieces: int = 2) -> float:
