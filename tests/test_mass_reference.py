@@ -1,0 +1,275 @@
+"""The independent moment reference (:mod:`surfmod.occ.moment_reference`): centroid and
+inertia from volumes of cut solids only, against textbook closed forms (moments of a solid
+of revolution from its profile, Steiner's theorem for a hole, a rotation applied by
+Rodrigues' formula).
+
+Where every cut meets the faces in lines and circles whose p-curves are exact (the box
+with a hole) it holds 1e-10 of the part's size and of the largest inertia entry.  Where
+the cuts are oblique to curved faces OCCT's splitter gives the new edges approximated
+p-curves (an ellipse on a cylinder, a circle on a tilted sphere) and the pieces' volumes
+carry 1e-9..1e-8 of error: there the test asks that the reference's own error estimate
+covers its actual error and stays below 1e-7 (enough to settle the 1e-7..1e-5
+disagreements the mass command meets).  A torus (R 3, r 1) is not here: every cut
+of a torus is walked (rotated: 214 s on the busy machine); measured by hand, moved but
+not rotated (283 s): centroid 2.4e-10, inertia 4.3e-9, both within its own estimate."""
+
+from __future__ import annotations
+
+import math
+
+import build123d as bd
+import numpy as np
+import pytest
+from numpy.polynomial import Polynomial as P
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+
+from surfmod.errors import SurfmodError
+from surfmod.occ.moment_reference import (GAUSS_W, KRONROD_W, KRONROD_X, critical_levels, moment_reference,
+                                          _intervals, _nodes)
+
+AXIS, ANGLE, SHIFT = np.array([1.0, 2.0, 3.0]) / math.sqrt(14), 0.7, np.array([3.0, -2.0, 5.0])
+
+
+def rodrigues(axis, angle):
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k
+
+
+def moved(shape):
+    """``shape`` rotated by ANGLE about AXIS through the origin, then moved by SHIFT."""
+    rot, move = gp_Trsf(), gp_Trsf()
+    rot.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(*AXIS)), ANGLE)
+    move.SetTranslation(gp_Vec(*SHIFT))
+    return BRepBuilderAPI_Transform(shape, move.Multiplied(rot), True).Shape()
+
+
+def revolution(rho2: P, z0: float, z1: float):
+    """Volume, centroid and inertia (about the centroid) of the solid of revolution about
+    z with squared radius ``rho2(z)`` on ``[z0, z1]``: ``V = ∫π ρ²``, ``∫z = ∫π ρ² z``,
+    ``∫z² = ∫π ρ² z²``, ``∫x² = ∫y² = ∫π ρ⁴ / 4`` (discs), exactly (polynomials)."""
+    z = P([0, 1])
+
+    def integral(p):
+        q = p.integ()
+        return q(z1) - q(z0)
+
+    v = integral(math.pi * rho2)
+    zc = integral(math.pi * rho2 * z) / v
+    zz = integral(math.pi * rho2 * z * z) - v * zc * zc
+    xx = integral(math.pi * rho2 * rho2 / 4)
+    return v, np.array([0, 0, zc]), np.diag([xx + zz, xx + zz, 2 * xx])
+
+
+def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None):
+    """The reference (``r``, or computed) within ``tol`` (relative) of the closed form; with
+    ``covered``, its error within its own estimate, and that estimate within ``tol``."""
+    r = moment_reference(shape) if r is None else r
+    assert abs(r.volume - volume) / volume < 1e-12
+    length = volume ** (1 / 3)
+    big = np.abs(inertia).max()
+    dc = np.abs(r.centroid - centroid).max()
+    di = np.abs(r.inertia - inertia).max()
+    assert dc / length < tol and di / big < tol, (dc / length, di / big)
+    assert r.centroid_error / length < tol and r.inertia_error / big < tol and r.consistency < tol
+    if covered:
+        assert dc <= r.centroid_error and di <= r.inertia_error, (dc, r.centroid_error, di, r.inertia_error)
+    return r
+
+
+def test_kronrod_rule_is_exact_to_degree_31_and_holds_the_gauss_rule():
+    x, w = np.polynomial.legendre.leggauss(10)
+    assert np.allclose(KRONROD_X[1::2], x, rtol=0, atol=1e-15) and np.allclose(GAUSS_W[1::2], w, atol=1e-15)
+    for k in range(32):
+        assert abs(KRONROD_W @ KRONROD_X ** k - (1 - (-1) ** (k + 1)) / (k + 1)) < 1e-14
+    assert abs(KRONROD_W @ KRONROD_X ** 32 - 2 / 33) > 1e-13  # and no further: the rule is what it says
+
+
+def test_nodes_integrate_a_square_root_end_exactly():
+    # ψ(s) = 3s² - 2s³ turns (t - a)^(3/2) at an end into a polynomial in s
+    ends = np.array([0.0, 1.0, 3.0])
+    t, scale = _nodes(ends, [True, True])
+    f = np.where(t < 1, t ** 1.5, np.sqrt(3 - t))
+    assert abs(((scale * f) @ KRONROD_W).sum() - (0.4 + 2 / 3 * 2 ** 1.5)) < 1e-14
+
+
+def test_intervals_merge_close_levels_and_split_long_ones():
+    ends, mapped = _intervals(np.array([0.0, 1e-9, 0.5, 4.0]), 1e-6, 2)
+    assert ends.tolist() == [0.0, 0.5, 2.25, 4.0] and mapped.all()
+    # next to a vertex whose tolerance the first node after ψ (1.4e-5 of the interval in)
+    # would come within twice of, the interval is integrated plainly (first node 2.2e-3
+    # in); closer still, the level is merged; the last level stays
+    levels = np.array([0.0, 1e-3, 0.5, 3.999, 4.0])
+    ends, mapped = _intervals(levels, 1e-6, 1, [0, 1e-8, 0, 0, 0])
+    assert ends.tolist() == levels.tolist() and mapped.tolist() == [False, True, True, True]
+    ends, mapped = _intervals(levels, 1e-6, 1, [0, 2e-6, 0, 0, 0])
+    assert ends.tolist() == [0.0, 0.5, 3.999, 4.0] and mapped.tolist() == [True, True, True]
+    assert _intervals(levels, 1e-6, 1, [0, 0, 0, 0, 2e-6])[0].tolist() == [0.0, 1e-3, 0.5, 4.0]
+    with pytest.raises(SurfmodError, match="shape: its tolerances"):
+        _intervals(levels, 1e-6, 1, [1e-2] * 5)
+
+
+def test_critical_levels_of_elementary_faces():
+    assert critical_levels(bd.Cylinder(1, 4).wrapped, (1, 0, 0)).round(12).tolist() == [-1.0, 1.0]
+    assert critical_levels(bd.Cylinder(1, 4).wrapped, (0, 0, 1)).round(12).tolist() == [-2.0, 2.0]
+    torus = critical_levels(bd.Torus(3, 1).wrapped, (1, 0, 0)).round(12).tolist()
+    assert torus == [-4.0, -2.0, 2.0, 4.0]  # the inner equator's saddles too
+    # a tilted box has its vertices' levels only
+    box = bd.Box(1, 2, 3).rotate(bd.Axis.Z, 30).wrapped
+    assert len(critical_levels(box, (1, 0, 0))) == 4
+
+
+HOLE = (0.7, 0.3)
+
+
+def holed_box():
+    return bd.Box(4, 3, 2) - bd.Cylinder(0.5, 3).translate((*HOLE, 0))
+
+
+@pytest.fixture(scope="module")
+def hole_reference():
+    """The reference of :func:`holed_box`, cut once for the tests that use it."""
+    return moment_reference(holed_box().wrapped)
+
+
+def test_box_with_an_off_centre_hole(hole_reference):
+    r2, (cx, cy) = 0.25, HOLE
+    vh = math.pi * r2 * 2
+    v = 24 - vh
+    first = -vh * np.array([cx, cy, 0])
+    second = np.diag([32 - vh * (cx * cx + r2 / 4), 18 - vh * (cy * cy + r2 / 4), 8 - vh / 3])
+    second[0, 1] = second[1, 0] = -vh * cx * cy  # Steiner: the hole's ∫xy about its axis is 0
+    g = first / v
+    central = second - v * np.outer(g, g)
+    check(None, v, g, np.trace(central) * np.eye(3) - central, r=hole_reference)
+
+
+@pytest.mark.corpus  # 17 s on the busy 2-core machine
+def test_spherical_cap_moved_and_rotated():
+    radius, z0 = 2.0, 0.5
+    above = bd.Box(5, 5, 3, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)).translate((0, 0, z0))
+    cap = bd.Sphere(radius) & above
+    v, c, inertia = revolution(P([radius * radius, 0, -1]), z0, radius)
+    q = rodrigues(AXIS, ANGLE)
+    check(moved(cap.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-7, covered=True)
+
+
+@pytest.mark.corpus  # 22 s on the busy 2-core machine
+def test_cone_frustum_moved_and_rotated():
+    r1, r2, h = 2.0, 0.8, 3.0
+    cone = bd.Cone(r1, r2, h, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN))
+    v, c, inertia = revolution(P([r1, (r2 - r1) / h]) ** 2, 0.0, h)
+    q = rodrigues(AXIS, ANGLE)
+    check(moved(cone.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-7, covered=True)
+
+
+def test_a_solid_is_required():
+    with pytest.raises(SurfmodError, match="shape: "):
+        moment_reference(bd.Box(1, 1, 1).faces()[0].wrapped)
+
+
+@pytest.mark.parametrize("moved_side, code, line", [
+    ("occt", 0, "REFERENCE CONFIRMS SURFMOD"), ("numpy", 4, "REFERENCE CONFIRMS BREPGPROP")])
+def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, capsys, hole_reference,
+                                                        moved_side, code, line):
+    import dataclasses
+
+    import surfmod as sm
+    import surfmod.cli.mass as mass
+    import surfmod.occ.moment_reference as mr
+    from surfmod.cli import main
+
+    path = tmp_path / "hole.step"
+    sm.export_step(holed_box(), path)
+    real = mass.mass_properties
+
+    def one_side_off(solid, density=1.0, **kw):  # one side's centroid 1e-5 of the size off
+        r = real(solid, density, **kw)
+        side = kw.get("method", "numpy")
+        return dataclasses.replace(r, centroid=np.asarray(r.centroid) + 3e-5) if side == moved_side else r
+
+    monkeypatch.setattr(mass, "mass_properties", one_side_off)
+    # the same solid as the fixture's (read back from STEP): its reference, cut once
+    monkeypatch.setattr(mr, "moment_reference", lambda *a, **k: hole_reference)
+    assert main(["mass", str(path), "--no-progress"]) == code
+    out = capsys.readouterr().out
+    assert line in out and out.count("REFERENCE") == 1
+    assert ("DISAGREEMENT" in out) == (code == 4)
+
+
+def test_mass_command_skips_a_reference_over_budget(monkeypatch, tmp_path, capsys):
+    import dataclasses
+
+    import surfmod as sm
+    import surfmod.cli.mass as mass
+    from surfmod.cli import main
+
+    path = tmp_path / "box.step"
+    sm.export_step(bd.Box(1, 2, 3), path)
+    real = mass.mass_properties
+    monkeypatch.setattr(mass, "mass_properties", lambda s, d=1.0, **kw: (
+        dataclasses.replace(real(s, d, **kw), centroid=np.asarray(real(s, d, **kw).centroid) + 1e-4)
+        if "method" not in kw else real(s, d, **kw)))
+    monkeypatch.setattr(mass, "REFERENCE_BUDGET", 1e-6)
+    assert main(["mass", str(path), "--no-progress"]) == 4
+    out = capsys.readouterr().out
+    assert "REFERENCE SKIPPED: the independent moment reference would take about" in out and "DISAGREEMENT" in out
+
+
+# -- real parts (the corpus; benchmarks/mass_reference.py runs the reference on all) --------
+def _solid(corpus_dir, name, index):
+    import surfmod as sm
+    from surfmod.occ.topo import solids_of
+
+    return solids_of(sm.import_step(corpus_dir / name).wrapped)[index]
+
+
+def _against_reference(solid, budget=60.0):
+    """``(surfmod's centroid and inertia differences, BRepGProp's, the reference's
+    estimates, the reference)``, differences relative to the volume's cube root and the largest inertia entry."""
+    import surfmod as sm
+    from surfmod.occ import uses as occ
+
+    o = occ.gprops(solid, 1e-12)
+    ref = moment_reference(solid, o["volume"], budget=budget)
+    mine = sm.mass_properties(solid)
+    length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
+
+    def rel(c, i):
+        return np.abs(np.asarray(c) - ref.centroid).max() / length, np.abs(np.asarray(i) - ref.inertia).max() / big
+
+    estimates = ref.centroid_error / length, ref.inertia_error / big
+    return rel(mine.centroid, mine.inertia), rel(o["centroid"], o["inertia"]), estimates, ref
+
+
+@pytest.mark.corpus  # 2 s
+def test_brepgprop_product_of_inertia_quirk_on_a_plain_cylinder(corpus_dir):
+    # cadquery's blue cylinder (r 5, h 10, axis z through (10, 5)): by symmetry Ixy = 0.
+    # BRepGProp (eps 1e-12) gives -4.7e-5, 4e-9 of Ixx: an OCCT quirk; surfmod's and the
+    # reference's agree with the closed form
+    from surfmod.occ import uses as occ
+
+    solid = _solid(corpus_dir, "cadquery_red_cube_blue_cylinder.step", 0)
+    v = math.pi * 25 * 10
+    exact = np.diag([v * (3 * 25 + 100) / 12] * 2 + [v * 25 / 2])
+    (mc, mi), (oc, oi), (ec, ei), ref = _against_reference(solid)
+    assert np.abs(ref.inertia - exact).max() / exact.max() < 1e-10 and np.allclose(ref.centroid, (10, 5, 5), atol=1e-9)
+    assert mc < 1e-10 and mi < 1e-10 and ec < 1e-10 and ei < 1e-9
+    assert oi > 1e-9 and abs(occ.gprops(solid, 1e-12)["inertia"][0, 1]) / exact.max() > 1e-9  # the quirk
+
+
+REAL_SOLIDS = [
+    # 23 faces (17 planes, 6 cylinders), loose vertices (1e-5) beside 1e-7 faces: 2100 planes
+    ("pythonocc_face_recognition_sample_part.stp", 0),
+    ("pythonocc_as1_pe_203.stp", 3),  # a bolt of the assembly: 6 planes, 2 cylinders
+    ("cadquery_red_cube_blue_cylinder.step", 1),  # the red cube
+]
+
+
+@pytest.mark.corpus  # 97 s, 19 s and 2 s of the busy machine's wall time
+@pytest.mark.parametrize("name, index", REAL_SOLIDS, ids=[f"{n}#{i}" for n, i in REAL_SOLIDS])
+def test_surfmod_moments_match_the_reference_on_real_parts(corpus_dir, name, index):
+    (mc, mi), (oc, oi), (ec, ei), _ = _against_reference(_solid(corpus_dir, name, index), budget=300)
+    assert ec < 1e-10 and ei < 1e-10  # the reference is sure of itself here ...
+    assert mc < 1e-9 and mi < 1e-9  # ... and surfmod is within the issue's 1e-9 of it
+    assert oc < 1e-9 and oi < 1e-9  # (so is BRepGProp on these)
