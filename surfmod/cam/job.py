@@ -18,8 +18,8 @@ from tqdm import tqdm
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
-from .roughing import FEED, RAPID, Motion, offset_tool, rough
 from .finishing import Rest, clear_part, finish
+from .roughing import FEED, RAPID, Motion, left_summary, offset_tool, rough
 from .tool import Tool
 from .toolpath import _part
 
@@ -81,7 +81,9 @@ class Operation:
 
     def __str__(self) -> str:
         m, s = divmod(self.time_estimate, 60)
-        return f"{self.name}: {self.tool}, cutting length {self.length:.0f} mm, time {int(m)} min {s:04.1f} s"
+        text = f"{self.name}: {self.tool}, cutting length {self.length:.0f} mm, time {int(m)} min {s:04.1f} s"
+        left = left_summary(self.report.get("left")) if self.name == "roughing" else ""
+        return f"{text}; {left}" if left else text
 
 
 @dataclass(frozen=True)
@@ -206,7 +208,8 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
                 tolerance = max(min(allowance / 4, 0.05), 0.005) if allowance > 0 else 0.01
                 p = _part(shape, grown, tolerance)
                 bar.update()
-                motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover, CLEARANCE)
+                motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover, CLEARANCE,
+                                       deflection=p.deflection)
                 cut_depth = float(stock[1, 2] - report["low"]) if report["levels"] else 0.0
                 if cut_depth > tool.flute_length + 1e-9:
                     raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the roughing cuts "
