@@ -105,6 +105,18 @@ class TriangleGrid:
         stop = np.where(cell_id >= 0, np.searchsorted(self._cells, cell_id, "right"), start)
         return start, stop
 
+    def pairs(self, xy: np.ndarray, start: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(location index, triangle index)`` pairs of the list entries ``start:stop`` of
+        each location whose (x, y) box grown by the radius holds the location (the
+        waterline's fibers query the grid this way)."""
+        n = np.maximum(stop - start, 0)
+        qi = np.repeat(np.arange(len(xy)), n)
+        offset = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+        ti = self._tris[np.repeat(start, n) + offset]
+        p = xy[qi]
+        keep = np.all((p >= self.lo[ti]) & (p <= self.hi[ti]), axis=1)
+        return qi[keep], ti[keep]
+
     def entries(self, xy: np.ndarray) -> int:
         """How many cell-list entries the locations ``xy`` (N, 2) walk: the work of a drop
         (each entry costs a box test, most of them nothing more), known before it is done."""
