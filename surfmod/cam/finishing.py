@@ -53,7 +53,7 @@ import numpy as np
 from scipy import ndimage
 
 from .drop_cutter import TriangleGrid, drop
-from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Motion
+from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
 from .tool import Tool
 from .toolpath import REFINE_SHARE, _Part, raster_path
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
@@ -109,24 +109,7 @@ class _StockTop:
         return np.minimum(h, self.safe)
 
 
-class _Moves:
-    def __init__(self):
-        self.points, self.kinds = [], []
-
-    def add(self, pts, kind):
-        pts = np.atleast_2d(np.asarray(pts, float))
-        self.points.append(pts)
-        self.kinds.append(np.full(len(pts), kind, np.int8))
-
-    @property
-    def last(self):
-        return self.points[-1][-1] if self.points else None
-
-    def motion(self) -> Motion:
-        return Motion(np.concatenate(self.points), np.concatenate(self.kinds))
-
-
-def _enter(out: _Moves, p, top: float, part: _Part, tool: Tool, safe: float, allowed: float):
+def _enter(out: Moves, p, top: float, part: _Part, tool: Tool, safe: float, allowed: float):
     """From the clearance height over ``p``: rapid down to ``top`` (above any stock left),
     then a ball plunges, a flat or bull end descends by a helix onto ``p`` (half its radius
     wide, narrower where the part stands within it: the helix may not rise above the part's
@@ -150,7 +133,7 @@ def _enter(out: _Moves, p, top: float, part: _Part, tool: Tool, safe: float, all
     out.add([p], PLUNGE)
 
 
-def _leave(out: _Moves, top: float, safe: float):
+def _leave(out: Moves, top: float, safe: float):
     """Up at the feed to above the stock left, then rapidly to the clearance height."""
     p = out.last
     if p[2] < top:
@@ -319,7 +302,7 @@ def _budget(scallop: float, margin: float):
     return scallop / 2, False  # no promise either way: not a raster ten times denser for nothing
 
 
-def _order_pieces(out: _Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
+def _order_pieces(out: Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
                  max_down: float):
     """Append the pieces level by level (top first), each level's nearest first, linked
     along the part where short and clear, else up and over."""
@@ -490,7 +473,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     else:
         across, step_xy, phi = None, stepover, 0.0
     top = _StockTop(part, tool, rest, stock, safe)
-    out = _Moves()
+    out = Moves()
     wl_info = None
     if steep_angle is not None:
         if scallop is not None:

@@ -71,7 +71,10 @@ class Motion:
     kind: np.ndarray
 
 
-class _Builder:
+class Moves:
+    """Cutter locations gathered run by run with their move kinds, then one :class:`Motion`
+    (roughing and finishing both build their operations with it)."""
+
     def __init__(self):
         self.points, self.kinds = [], []
 
@@ -188,7 +191,7 @@ def rough(part_grid: TriangleGrid, lift: float, grown: Tool, tool: Tool, allowan
     if low >= top:
         levels = []
 
-    out = _Builder()
+    out = Moves()
     out.add([[stock[0, 0], stock[0, 1], safe]], RAPID)
     in_box = (X >= lo_box[0]) & (X <= hi_box[0]) & (Y >= lo_box[1]) & (Y <= hi_box[1])
     previous = top
@@ -390,7 +393,7 @@ class _Level:
                 "area": area, "ring": pts.copy()}
 
 
-def _cut_piece(out: _Builder, piece, closed: bool, lv: _Level):
+def _cut_piece(out: Moves, piece, closed: bool, lv: _Level):
     """Cut one ring (closed) or piece of a ring (open, its ends on the grown stock box);
     returns the report of the region when the tool cannot enter it without a plunge."""
     z, height = lv.z, lv.height
@@ -459,7 +462,7 @@ def _level_clear(height, a, b, z, step) -> bool:
     return bool(np.all(height(a + t * (b - a)) <= z + 1e-9))
 
 
-def _link(out: _Builder, target, safe):
+def _link(out: Moves, target, safe):
     """Up to the clearance height, across, (the caller goes down)."""
     last = out.last
     if last is not None and last[2] < safe:
