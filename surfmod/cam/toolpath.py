@@ -332,21 +332,21 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         meter = _Meter(max_work, bar)
         part = _part(shape, tool, tolerance, meter)
         return raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
-                           bar, meter=meter, max_work=max_work)
+                           bar, meter=meter)
 
 
 def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction: str, bounds, tolerance: float,
-                bar=None, across=None, meter=None, max_work: int | None = None) -> Toolpath:
+                bar=None, across=None, meter: _Meter | None = None) -> Toolpath:
     """The verified zig-zag :class:`Toolpath` of ``tool`` over an already meshed ``part``
     (:func:`toolpath` after its checks; ``bounds`` ``((xmin, ymin), (xmax, ymax))`` or None
     for the part's box; ``bar`` a tqdm bar counting triangle tests; ``across``: the passes'
-    cross positions instead of ``stepover``; ``meter``/``max_work``: the work bound)."""
+    cross positions instead of ``stepover``; ``meter``: the work bound, checked up front)."""
     stage = bar.set_postfix_str if bar is not None else (lambda text: None)
     lo, hi = (part.box[0, :2], part.box[1, :2]) if bounds is None else (np.asarray(bounds[0]), np.asarray(bounds[1]))
     xy, index, across = raster(lo, hi, stepover, step, direction, across)
-    if max_work is not None:
+    if meter is not None:
         first = part.grid.entries(xy)
-        checks.work(NOMINAL_DROPS * first, max_work, "max_work",
+        checks.work(NOMINAL_DROPS * first, int(meter.cap), "max_work",
                     f"the drop-cutter over {len(xy):,} locations of {first / max(len(xy), 1):,.0f} triangle tests "
                     f"each, {NOMINAL_DROPS} drops a location at the least (a larger tolerance, scallop or step)")
         if bar is not None:
@@ -389,7 +389,7 @@ def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction
     if meter is not None:
         meter.charge(part.grid.entries(points[:, :2]), "the contacts")
     _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
-    if bar is not None and max_work is not None:
+    if bar is not None and meter is not None:
         bar.total = bar.n
     stage("done")
     actual = float(np.diff(across).max()) if len(across) > 1 else 0.0
