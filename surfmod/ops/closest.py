@@ -15,15 +15,21 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..eval.local import COMPILED_SCATTERED
 from ..surface import Surface
 from . import nearest
 
 #: point-cell pairs from which the seeds are searched by the compiled branch and bound
-#: (ops/seeding.py); fewer in NumPy (ops/nearest.py, every triangle), which spares a
-#: small projection numba's import and load
-COMPILED_SEED_PAIRS = 1 << 17
-#: Newton starts from which B-spline projections iterate in the compiled loop (ops/newton.py)
-COMPILED_NEWTON_STARTS = 1 << 10
+#: (ops/seeding.py); fewer in NumPy (ops/nearest.py, every triangle, about 0.12 us a
+#: pair): below 2^21 pairs (500 points on a 40 x 40 seed grid) NumPy's 0.25 s is less
+#: than loading the compiled kernel from numba's cache (0.2-0.4 s) and far less than
+#: compiling it into an empty one (4-10 s)
+COMPILED_SEED_PAIRS = 1 << 21
+#: Newton starts from which B-spline projections iterate in the compiled loop
+#: (ops/newton.py, about 7 s to compile into an empty cache); below it NumPy's iteration
+#: (about 15 us a start), whose partials to order 2 (9 a start) then stay below
+#: eval.local.COMPILED_SCATTERED and so in NumPy too
+COMPILED_NEWTON_STARTS = COMPILED_SCATTERED // 9
 
 
 def seed_parameters(s: Surface, direction: int, per_span: int = 4, minimum: int = 24, maximum: int = 96) -> np.ndarray:
