@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ.ops import project_points
+from surfmod.occ.geomapi import project_points
 
 from .tables import Table, note
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import surfmod as sm
 from surfmod.occ import isolated
-from surfmod.occ.exchange import read_step
+from surfmod.occ.step import read_step
 
 from .tables import Table, note
 

@@ -21,7 +21,7 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 
 import surfmod as sm
 from surfmod.errors import SurfmodError
-from surfmod.occ import uses as occ
+from surfmod.occ.properties import gprops
 from surfmod.occ.moment_reference import moment_reference
 from surfmod.occ.topo import faces_of, solids_of
 from surfmod.uses.mass import mass_properties
@@ -33,7 +33,7 @@ def compare(solid, budget):
     t0 = time.perf_counter()
     mine = mass_properties(solid, estimate_error=False)
     t1 = time.perf_counter()
-    o = occ.gprops(solid, 1e-12)
+    o = gprops(solid, 1e-12)
     ref = moment_reference(solid, o["volume"], budget=budget)
     length = ref.volume ** (1 / 3)
     big = np.abs(ref.inertia).max()

@@ -8,7 +8,7 @@ import build123d as bd
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ import ops as occ
+from surfmod.occ.geomapi import intersect_line, intersect_surfaces
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 
@@ -19,7 +19,7 @@ x, y = np.meshgrid(np.linspace(-0.5, 4.5, 6), np.linspace(-0.5, 3.5, 6), indexin
 b = sm.BSplineSurface(np.stack([x, y, 0.3 * np.sin(x * 2) + 0.2 * y - 0.3], -1), (3, 3))
 
 curves = sm.intersect(a, b)
-theirs = occ.intersect_surfaces(a.geom(), b.geom())
+theirs = intersect_surfaces(a.geom(), b.geom())
 print(f"surface-surface: {len(curves)} curves (OCCT IntSS: {len(theirs)})")
 for c in curves:
     gap = np.abs(b.points(c.uv_b[:, 0], c.uv_b[:, 1]) - c.points).max()
@@ -32,7 +32,7 @@ for c in sm.intersect(a, plane):
     print(f"surface-plane: length {c.length:.8f}")
 
 hits = sm.intersect_line(a, (2, 1.5, 3), (0.1, 0.2, -1))
-print("line hits (u, v, t):", hits, "OCCT IntCS:", occ.intersect_line(a.geom(), (2, 1.5, 3), np.array((0.1, 0.2, -1)) / np.linalg.norm((0.1, 0.2, -1))))
+print("line hits (u, v, t):", hits, "OCCT IntCS:", intersect_line(a.geom(), (2, 1.5, 3), np.array((0.1, 0.2, -1)) / np.linalg.norm((0.1, 0.2, -1))))
 
 edges = [bd.Edge.make_spline([bd.Vector(*p) for p in c.points[:: max(1, len(c) // 60)]]) for c in curves if not c.closed]
 sm.export_step([a.face(), b.face(), *edges], OUT / "intersect.step")

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.occ.uses import gprops
+from surfmod.occ.properties import gprops
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 

@@ -9,7 +9,7 @@ import build123d as bd
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ import ops as occ
+from surfmod.occ.geomapi import project_points
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 
@@ -19,7 +19,7 @@ s = sm.BSplineSurface(np.stack([x, y, 1.5 * rng.uniform(-1, 1, (7, 6))], -1), (3
 
 pts = np.c_[rng.uniform(0.3, 3.7, 2000), rng.uniform(0.3, 2.7, 2000), rng.uniform(-2, 2, 2000)]
 pr = sm.project(pts, s)
-theirs = occ.project_points(s.geom(), (0, 1, 0, 1), pts[:200])
+theirs = project_points(s.geom(), (0, 1, 0, 1), pts[:200])
 same = np.abs(pr.distance[:200] - theirs[:, 2]) < 1e-9
 print(f"projected 2000 points; first 200 vs OCCT: {same.sum()} equal, max |du| {np.abs(pr.u[:200][same] - theirs[same, 0]).max():.1e}, "
       f"{(~same).sum()} closer boundary points (OCCT only gives orthogonal projections)")

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ import ops as occ
+from surfmod.occ.transformed import geom_gtransformed, geom_transformed, named_trsf
 from surfmod.occ.sample import surface_d0
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
@@ -20,19 +20,19 @@ patch = sm.BSplineSurface(np.stack([x, y, z], -1), (3, 2), None, w)
 
 uu, vv = (a.ravel() for a in np.meshgrid(np.linspace(0, 1, 9), np.linspace(0, 1, 9), indexing="ij"))
 cases = {
-    "translated": (patch.translated((50, 0, 0)), occ.named_trsf("translation", (50, 0, 0))),
-    "rotated": (patch.rotated((0, 0, 0), (0, 0, 1), 30), occ.named_trsf("rotation", (0, 0, 0), (0, 0, 1), 30)),
-    "mirrored": (patch.mirrored((0, 0, 0), (0, 1, 0)), occ.named_trsf("mirror", (0, 0, 0), (0, 1, 0))),
-    "scaled": (patch.scaled(0.5, (20, 15, 0)), occ.named_trsf("scale", (20, 15, 0), 0.5)),
+    "translated": (patch.translated((50, 0, 0)), named_trsf("translation", (50, 0, 0))),
+    "rotated": (patch.rotated((0, 0, 0), (0, 0, 1), 30), named_trsf("rotation", (0, 0, 0), (0, 0, 1), 30)),
+    "mirrored": (patch.mirrored((0, 0, 0), (0, 1, 0)), named_trsf("mirror", (0, 0, 0), (0, 1, 0))),
+    "scaled": (patch.scaled(0.5, (20, 15, 0)), named_trsf("scale", (20, 15, 0), 0.5)),
 }
 for name, (mine, trsf) in cases.items():
-    theirs = occ.geom_transformed(patch.geom(), trsf)
+    theirs = geom_transformed(patch.geom(), trsf)
     dev = np.abs(mine.points(uu, vv) - surface_d0(theirs, uu, vv)).max()
     print(f"{name:10s} max deviation from gp_Trsf: {dev:.2e}")
 
 m = np.diag([1.0, 2.0, 0.5, 1.0])
 stretched = patch.scaled((1.0, 2.0, 0.5))
-dev = np.abs(stretched.points(uu, vv) - surface_d0(occ.geom_gtransformed(patch.geom(), m), uu, vv)).max()
+dev = np.abs(stretched.points(uu, vv) - surface_d0(geom_gtransformed(patch.geom(), m), uu, vv)).max()
 print(f"non-uniform scale max deviation from gp_GTrsf: {dev:.2e}")
 
 pieces = patch.split(u=0.4, v=0.5)

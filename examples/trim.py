@@ -9,7 +9,7 @@ import build123d as bd
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ.ops import face_area
+from surfmod.occ.faces import face_area
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 

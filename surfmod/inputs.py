@@ -38,7 +38,7 @@ def _single(item, name):
 def to_shape(obj, name: str = "obj", *, solid: bool = False):
     """The OCCT shape for ``obj``; with ``solid=True`` a closed, outward-oriented solid
     (open shells raise ``SurfmodError``)."""
-    from .occ import uses as occ
+    from .occ.solids import closed_solid, sew_solid
 
     if isinstance(obj, (str, os.PathLike)):
         shape = load_step(obj, name)
@@ -47,15 +47,15 @@ def to_shape(obj, name: str = "obj", *, solid: bool = False):
             raise SurfmodError(f"{name}: empty list of surfaces")
         faces = [_single(o, name) for o in obj]
         if solid:
-            return occ.sew_solid(faces)
-        from .occ.exchange import compound
+            return sew_solid(faces)
+        from .occ.topo import compound
 
         shape = compound(faces)
     else:
         shape = _single(obj, name)
     if solid:
         try:
-            return occ.closed_solid(shape)
+            return closed_solid(shape)
         except SurfmodError as exc:
             msg = str(exc)
             raise SurfmodError(msg if msg.startswith(name) else f"{name}: {msg}") from None

@@ -20,7 +20,7 @@ from surfmod.cli import main
 from surfmod.meshing.brep import DENSE, measure_face
 from surfmod.occ.mesh import brepmesh, shape_figures
 from surfmod.occ.sample import distances_to_face
-from surfmod.occ.uses import solids_of
+from surfmod.occ.topo import solids_of
 
 SCREW = CORPUS / "occt_screw.step"
 

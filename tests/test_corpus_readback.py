@@ -13,7 +13,9 @@ import pytest
 
 import surfmod as sm
 from surfmod.cli import main
-from surfmod.occ import uses as occ
+from surfmod.occ.discretize import edge_length, wire_edges
+from surfmod.occ.properties import bounding_box, gprops
+from surfmod.occ.section import section_edges
 from surfmod.occ.sample import surface_d0, surface_d2
 from surfmod.occ.topo import face_from_surface, face_surface, faces_of, solids_of
 from surfmod.readback import from_face
@@ -145,7 +147,7 @@ def test_check_bad_paths_exit_1_in_one_line(tmp_path, capsys, make, msg):
 def _mass_agrees(path):
     for i, solid in enumerate(solids_of(sm.import_step(path).wrapped)):
         mine = mass_properties(solid).volume
-        ref = occ.gprops(solid, 1e-9)["volume"]
+        ref = gprops(solid, 1e-9)["volume"]
         rel = abs(mine - ref) / ref
         if rel > 1e-7:  # only where the file itself leaves the volume that open
             assert rel <= boundary_ambiguity(solid), (path.name, i, rel)
@@ -229,14 +231,14 @@ def dxf_length(path) -> float:
 
 def _sections_match(path, tmp_path):
     for i, solid in enumerate(solids_of(sm.import_step(path).wrapped)):
-        centre = occ.bounding_box(solid).mean(axis=0)
+        centre = bounding_box(solid).mean(axis=0)
         normal = np.array([0.0, 0.0, 1.0])
         try:
             sec = sm.section(solid, centre, normal)
         except sm.SurfmodError:  # the plane lies on a planar face: tilt it
             normal = np.array([0.1, 0.2, 1.0]) / math.sqrt(1.05)
             sec = sm.section(solid, centre, normal)
-        ref = sum(occ.edge_length(e) for w in occ.section_edges(solid, centre, normal) for e in occ.wire_edges(w))
+        ref = sum(edge_length(e) for w in section_edges(solid, centre, normal) for e in wire_edges(w))
         out = tmp_path / f"s{i}.dxf"
         sm.export_dxf(sec, out)
         assert abs(dxf_length(out) - ref) <= 1e-6 * ref, (path.name, i)

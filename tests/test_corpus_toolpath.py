@@ -17,7 +17,7 @@ from conftest import JUDGED_FILES
 from toolpath_reference import ball_clearance, flat_cuts, gcode_positions, material
 
 from surfmod.cli import main as cli_main
-from surfmod.occ.triangulation import bounding_box
+from surfmod.occ.properties import bounding_box
 from surfmod.inputs import to_shape
 
 RADIUS_SHARE = 0.03
@@ -37,7 +37,7 @@ def _run(part, tmp_path, capsys, options):
 
 
 def _radius(shape) -> float:
-    box = bounding_box(shape)
+    box = bounding_box(shape, optimal=False)
     return float(f"{RADIUS_SHARE * np.linalg.norm(box[1] - box[0]):.4g}")
 
 
@@ -122,7 +122,7 @@ def test_corpus_toolpath_runs_on_every_file(corpus_file, tmp_path, capsys):
     shape = to_shape(corpus_file)
     radius = _radius(shape)
     moves = _run(corpus_file, tmp_path, capsys, ["--radius", repr(radius), "--scallop", repr(SCALLOP_SHARE * radius)])
-    lo, hi = bounding_box(shape)
+    lo, hi = bounding_box(shape, optimal=False)
     assert len(moves) > 1 and np.isfinite(moves).all()
     assert (moves[:, :2] >= lo[:2] - radius - ROUNDING).all() and (moves[:, :2] <= hi[:2] + radius + ROUNDING).all()
     assert moves[:, 2].min() >= lo[2] - radius - ROUNDING

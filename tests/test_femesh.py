@@ -155,7 +155,7 @@ def _corpus_fe_mesh(path):
 def test_two_solid_assembly_has_no_inverted_tet():
     from conftest import CORPUS
 
-    from surfmod.occ.uses import gprops
+    from surfmod.occ.properties import gprops
 
     path = CORPUS / "cadquery_red_cube_blue_cylinder.step"
     m, vol = _corpus_fe_mesh(path)
@@ -169,7 +169,8 @@ def test_no_inverted_tet_on_any_corpus_solid(judged_file):
     fill the solids: their volume is BRepGProp's within the chordal error of their
     boundary: the measured triangulation's bound where fe_mesh filled a triangulation
     (pythonocc_11752.stp), the sampled chord bound where gmsh meshed the B-rep."""
-    from surfmod.occ.uses import gprops, solids_of
+    from surfmod.occ.properties import gprops
+    from surfmod.occ.topo import solids_of
 
     m, vol = _corpus_fe_mesh(judged_file)
     reference = sum(abs(gprops(s)["volume"]) for s in solids_of(sm.import_step(judged_file).wrapped))

@@ -76,7 +76,7 @@ def test_shells_of_a_hollow_triangulation():
 
 def test_material_regions_drop_the_void():
     from surfmod.occ.regions import material_regions
-    from surfmod.occ.uses import gprops
+    from surfmod.occ.properties import gprops
 
     hollow = (bd.Box(4, 4, 4) - bd.Box(2, 2, 2)).wrapped
     regions = material_regions(hollow)
@@ -91,7 +91,7 @@ def _boss_on_a_bore():
     from OCP.BRep import BRep_Builder
     from OCP.TopoDS import TopoDS_Solid
 
-    from surfmod.occ.uses import shells_of
+    from surfmod.occ.topo import shells_of
 
     centre = (bd.Align.CENTER, bd.Align.CENTER)
     outer = bd.Box(4, 4, 4, align=(*centre, bd.Align.MIN)) + bd.Cylinder(1, 1, align=(*centre, bd.Align.MAX))
@@ -105,7 +105,7 @@ def _boss_on_a_bore():
 
 def test_solid_touching_itself_meshes_from_its_material_regions():
     from surfmod.occ.regions import material_regions
-    from surfmod.occ.uses import gprops
+    from surfmod.occ.properties import gprops
 
     solid = _boss_on_a_bore()
     assert gprops(solid)["volume"] == pytest.approx(64.0, rel=1e-12)
@@ -133,7 +133,8 @@ def test_11752_meshes_from_its_material_regions(tmp_path):
     from conftest import CORPUS
 
     from surfmod.occ.regions import material_regions
-    from surfmod.occ.uses import gprops, shells_of, solids_of
+    from surfmod.occ.properties import gprops
+    from surfmod.occ.topo import shells_of, solids_of
 
     shape = sm.import_step(CORPUS / "pythonocc_11752.stp").wrapped
     (solid,) = solids_of(shape)

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ import ops as occ
+from surfmod.occ.faces import infinite_plane
+from surfmod.occ.geomapi import intersect_line, intersect_surfaces
 from surfmod.ops.intersect import as_plane
 from surfmod.ops.marching import segment_distances
 
@@ -44,7 +45,7 @@ def test_surface_plane_matches_intss():
     s = _nurbs()
     origin, normal = np.array([2, 1.5, 0.1]), np.array([0.3, 0.2, 1.0])
     curves = sm.intersect(s, (origin, normal))
-    theirs = occ.intersect_surfaces(s.geom(), occ.infinite_plane(origin, normal))
+    theirs = intersect_surfaces(s.geom(), infinite_plane(origin, normal))
     assert len(curves) == len(theirs) == 2
     n = normal / np.linalg.norm(normal)
     for c in curves:
@@ -63,7 +64,7 @@ def test_surface_plane_matches_intss():
 def test_surface_surface_matches_intss_and_finds_a_loop_occt_misses():
     a, b = _nurbs(), _wavy()
     curves = sm.intersect(a, b)
-    theirs = occ.intersect_surfaces(a.geom(), b.geom())
+    theirs = intersect_surfaces(a.geom(), b.geom())
     for c in curves:
         _on_surface(a, c.uv_a, c.points, 1e-15)
         _on_surface(b, c.uv_b, c.points, 1e-12)
@@ -126,7 +127,7 @@ def test_intersect_line_matches_intcs():
         origin = np.r_[rng.uniform(0.5, 3.5), rng.uniform(0.5, 2.5), 3.0]
         direction = np.r_[rng.uniform(-0.3, 0.3, 2), -1.0]
         mine = sm.intersect_line(s, origin, direction)
-        theirs = occ.intersect_line(s.geom(), origin, direction / np.linalg.norm(direction))
+        theirs = intersect_line(s.geom(), origin, direction / np.linalg.norm(direction))
         theirs = theirs[np.argsort(theirs[:, 2])]
         assert mine.shape == theirs.shape
         hits += len(mine)
@@ -140,7 +141,7 @@ def test_intersect_line_several_hits():
     """A line through the wavy surface along its waves crosses it several times."""
     w = _wavy()
     mine = sm.intersect_line(w, (-0.4, 1.0, -0.1), (1, 0, 0.02))
-    theirs = occ.intersect_line(w.geom(), (-0.4, 1.0, -0.1), np.array([1, 0, 0.02]) / np.linalg.norm([1, 0, 0.02]))
+    theirs = intersect_line(w.geom(), (-0.4, 1.0, -0.1), np.array([1, 0, 0.02]) / np.linalg.norm([1, 0, 0.02]))
     assert len(mine) == len(theirs) >= 2
     np.testing.assert_allclose(mine, theirs[np.argsort(theirs[:, 2])], atol=1e-9)
     assert np.all(np.diff(mine[:, 2]) > 0)
@@ -185,7 +186,7 @@ def test_quadrics_closed_forms():
     assert hits.shape == (2, 3)
     np.testing.assert_allclose(hits[:, 2], [3.0, 7.0], atol=1e-12)
     np.testing.assert_allclose(np.abs(hits[:, 1]), np.pi / 2, atol=1e-12)
-    theirs = occ.intersect_line(sphere.geom(), (0.3, 0.2, 5), np.array([0.1, 0, -1]) / np.linalg.norm([0.1, 0, -1]))
+    theirs = intersect_line(sphere.geom(), (0.3, 0.2, 5), np.array([0.1, 0, -1]) / np.linalg.norm([0.1, 0, -1]))
     mine = sm.intersect_line(sphere, (0.3, 0.2, 5), (0.1, 0, -1))
     np.testing.assert_allclose(mine, theirs[np.argsort(theirs[:, 2])], atol=1e-9)
 

@@ -111,23 +111,14 @@ OCC_LAZY = {
 
 #: the CAM helper's modules (issue 23's CAM item, issue 26): their function-level imports
 #: and names are its to settle; checked here once it has (then this is empty)
-CAM_BRANCH = ("surfmod.cam.toolpath", "surfmod.occ.triangulation")
+CAM_BRANCH = ()
 
 #: import cycles that another branch removes (each says which); empty once merged
-KNOWN_CYCLES: set[frozenset] = {
-    # eval/ is the evaluation core's to reshape (issue 23, its eval-core item)
-    frozenset({"surfmod.eval.patches", "surfmod.eval.parallel"}),
-}
+KNOWN_CYCLES: set[frozenset] = set()
 
 #: upward (or cyclic) function-level imports still to be removed, each with its reason;
 #: checked by every test here except that they may exist
-KNOWN_UPWARD: set[tuple[str, str]] = {
-    # notebook pictures (issue 24, the infra branch): _repr_png_ of surfaces, curves and meshes
-    # draws with the renderer above them; a display registry filled from meshing would remove these
-    ("surfmod.surface", "surfmod.meshing.render"),
-    ("surfmod.curve", "surfmod.meshing.render"),
-    ("surfmod.meshing.polymesh", "surfmod.meshing.render"),
-}
+KNOWN_UPWARD: set[tuple[str, str]] = set()
 
 
 def scan(package_root: Path):

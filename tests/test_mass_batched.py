@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ import uses as occ
+from surfmod.occ.elementary_faces import elementary_faces
+from surfmod.occ.properties import bounding_box, vertex_mean
 from surfmod.occ.pcurves import face_pcurves, faces_pcurves
 from surfmod.occ.topo import faces_of
 from surfmod.readback import from_face
@@ -101,7 +102,7 @@ def test_faces_pcurves_equal_face_by_face(corpus_dir):
 def test_elementary_faces_read_as_from_face(corpus_dir, name):
     _, shapes = _part(corpus_dir / name)
     fast, slow = _read_faces(shapes), [from_face(s) for s in shapes]
-    fast_faces = sum(d is not None for d in occ.elementary_faces(shapes))
+    fast_faces = sum(d is not None for d in elementary_faces(shapes))
     assert fast_faces >= 6
     if name.startswith("cadquery"):  # its cylinder is a Geom_RectangularTrimmedSurface: read fast too
         assert fast_faces == len(shapes) == 9
@@ -119,7 +120,7 @@ def test_elementary_faces_read_as_from_face(corpus_dir, name):
 def _planes_equal_node_by_node(path):
     shape = to_shape(sm.import_step(path), "obj")
     shapes = faces_of(shape)
-    ref = occ.vertex_mean(shape)
+    ref = vertex_mean(shape)
     read = _read_faces(shapes)
     records = faces_pcurves(shapes)
     taylor_pieces([r for recs in records for r in recs])
@@ -284,8 +285,8 @@ def test_vertex_mean_equals_the_explorers_visits(corpus_dir, name):
     # each distinct vertex weighted by its ancestor edges: the explorer's visits, to round-off
     solid, _ = _part(corpus_dir / name)
     want = _explorer_vertex_mean(solid)
-    size = np.ptp(occ.bounding_box(solid), axis=0).max()
-    assert np.abs(occ.vertex_mean(solid) - want).max() <= 1e-14 * size
+    size = np.ptp(bounding_box(solid), axis=0).max()
+    assert np.abs(vertex_mean(solid) - want).max() <= 1e-14 * size
 
 
 def test_vertex_mean_weights_shared_vertices_by_their_visits():
@@ -293,7 +294,7 @@ def test_vertex_mean_weights_shared_vertices_by_their_visits():
     # a plain mean of the distinct vertices would differ
     part = bd.Box(4, 4, 2) + bd.Cylinder(1, 3).translate((1, 0, 1))
     want = _explorer_vertex_mean(part.wrapped)
-    assert np.abs(occ.vertex_mean(part.wrapped) - want).max() <= 1e-15
+    assert np.abs(vertex_mean(part.wrapped) - want).max() <= 1e-15
     distinct = np.array([tuple(v) for v in part.vertices()]).mean(axis=0)
     assert np.abs(distinct - want).max() > 1e-3
 

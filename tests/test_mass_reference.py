@@ -228,9 +228,9 @@ def _against_reference(solid, budget=60.0):
     """``(surfmod's centroid and inertia differences, BRepGProp's, the reference's
     estimates, the reference)``, differences relative to the volume's cube root and the largest inertia entry."""
     import surfmod as sm
-    from surfmod.occ import uses as occ
+    from surfmod.occ.properties import gprops
 
-    o = occ.gprops(solid, 1e-12)
+    o = gprops(solid, 1e-12)
     ref = moment_reference(solid, o["volume"], budget=budget)
     mine = sm.mass_properties(solid)
     length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
@@ -247,7 +247,7 @@ def test_brepgprop_product_of_inertia_quirk_on_a_plain_cylinder(corpus_dir):
     # cadquery's blue cylinder (r 5, h 10, axis z through (10, 5)): by symmetry Ixy = 0.
     # BRepGProp (eps 1e-12) gives -4.7e-5, 4e-9 of Ixx: an OCCT quirk; surfmod's and the
     # reference's agree with the closed form
-    from surfmod.occ import uses as occ
+    from surfmod.occ.properties import gprops
 
     solid = _solid(corpus_dir, "cadquery_red_cube_blue_cylinder.step", 0)
     v = math.pi * 25 * 10
@@ -255,7 +255,7 @@ def test_brepgprop_product_of_inertia_quirk_on_a_plain_cylinder(corpus_dir):
     (mc, mi), (oc, oi), (ec, ei), ref = _against_reference(solid)
     assert np.abs(ref.inertia - exact).max() / exact.max() < 1e-10 and np.allclose(ref.centroid, (10, 5, 5), atol=1e-9)
     assert mc < 1e-10 and mi < 1e-10 and ec < 1e-10 and ei < 1e-9
-    assert oi > 1e-9 and abs(occ.gprops(solid, 1e-12)["inertia"][0, 1]) / exact.max() > 1e-9  # the quirk
+    assert oi > 1e-9 and abs(gprops(solid, 1e-12)["inertia"][0, 1]) / exact.max() > 1e-9  # the quirk
 
 
 REAL_SOLIDS = [

@@ -6,7 +6,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.occ.sample import distances_to_surface
-from surfmod.occ.uses import gprops
+from surfmod.occ.properties import gprops
 
 
 def wavy(seed=3, degree=(3, 3), knots=None):

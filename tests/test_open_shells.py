@@ -19,7 +19,9 @@ from test_corpus_toolpath import run_and_judge
 
 import surfmod as sm
 from surfmod.cli import main
-from surfmod.occ import uses as occ
+from surfmod.occ.discretize import edge_length, wire_edges
+from surfmod.occ.properties import bounding_box
+from surfmod.occ.section import section_edges
 
 QUICK = CORPUS / "cadquery_red_cube_blue_cylinder.step"
 SWEEP = ["occt_screw.step", "trimesh_featuretype.STEP", "pythonocc_face_recognition_sample_part.stp",
@@ -67,7 +69,7 @@ def check_mesh(path, tmp_path, capsys):
     """The STL is written, measured within the tolerance by OCCT's distance, open exactly
     along the missing faces (edges used once), and says it is not watertight."""
     shape = sm.import_step(path)
-    box = occ.bounding_box(shape.wrapped)
+    box = bounding_box(shape.wrapped)
     tol = 1e-3 * float(np.linalg.norm(box[1] - box[0]))
     out = tmp_path / "part.stl"
     capsys.readouterr()
@@ -84,11 +86,11 @@ def check_section(path, tmp_path, capsys):
     first plane (z, tilted, x, y) that OCCT finds crossing the shell is used (the faces
     taken out may be all the z plane met; a plane lying on a planar face is refused)."""
     shell = sm.import_step(path).wrapped
-    centre = occ.bounding_box(shell).mean(axis=0)
+    centre = bounding_box(shell).mean(axis=0)
     out = tmp_path / "part.dxf"
     tilted = np.array([0.1, 0.2, 1.0]) / math.sqrt(1.05)
     for normal in (np.array([0.0, 0.0, 1.0]), tilted, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])):
-        ref = sum(occ.edge_length(e) for w in occ.section_edges(shell, centre, normal) for e in occ.wire_edges(w))
+        ref = sum(edge_length(e) for w in section_edges(shell, centre, normal) for e in wire_edges(w))
         if ref == 0:
             continue
         capsys.readouterr()

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 import surfmod as sm
 from strategies import bspline_surfaces
-from surfmod.occ import ops as occ
+from surfmod.occ.geomapi import face_distances, project_points
 
 
 def _nurbs(seed=0):
@@ -29,7 +29,7 @@ def test_matches_occt_lower_distance_solution():
     rng = np.random.default_rng(1)
     pts = np.c_[rng.uniform(0.3, 3.7, 300), rng.uniform(0.3, 2.7, 300), rng.uniform(-1.5, 1.5, 300)]
     pr = sm.project(pts, s)
-    theirs = occ.project_points(s.geom(), _bounds(s), pts)
+    theirs = project_points(s.geom(), _bounds(s), pts)
     # OCCT returns orthogonal projections only; ours may be a closer boundary point
     assert np.all(pr.distance <= theirs[:, 2] + 1e-12)
     same = np.abs(pr.distance - theirs[:, 2]) <= 1e-9
@@ -51,7 +51,7 @@ def test_boundary_points_match_brepextrema_face_distance():
     s = _nurbs(2)
     pts = np.array([[-1.0, -1.0, 0.5], [5.0, 1.5, 0.0], [2.0, -2.0, 1.0], [4.5, 3.5, -1.0], [2.0, 4.0, 0.3], [-0.5, 1.2, 2.0]])
     pr = sm.project(pts, s)
-    np.testing.assert_allclose(pr.distance, occ.face_distances(s.face(), pts), atol=1e-9)
+    np.testing.assert_allclose(pr.distance, face_distances(s.face(), pts), atol=1e-9)
     on_edge = (pr.u == 0) | (pr.u == 1) | (pr.v == 0) | (pr.v == 1)
     assert on_edge.all()
 
@@ -76,7 +76,7 @@ def test_projecting_a_curve_samples_it():
     pr = sm.project(c, s, samples=21)
     assert pr.u.shape == (21,)
     pts = c.points(np.linspace(0, 1, 21))
-    theirs = occ.project_points(s.geom(), _bounds(s), pts)
+    theirs = project_points(s.geom(), _bounds(s), pts)
     interior = (pr.u > 0) & (pr.u < 1) & (pr.v > 0) & (pr.v < 1)
     assert interior.sum() >= 15
     np.testing.assert_allclose(pr.distance[interior], theirs[interior, 2], atol=1e-9)
@@ -106,7 +106,7 @@ def test_random_surfaces_never_worse_than_occt(s, seed):
     base = s.points(uv[:, 0], uv[:, 1])
     pts = base + s.normals(uv[:, 0], uv[:, 1]) * rng.uniform(-0.3, 0.3, (20, 1))
     pr = sm.project(pts, s)
-    theirs = occ.project_points(s.geom(), _bounds(s), pts)
+    theirs = project_points(s.geom(), _bounds(s), pts)
     ok = np.isfinite(theirs[:, 2])
     scale = max(1.0, float(np.abs(s.control_points).max()))
     assert np.all(pr.distance[ok] <= theirs[ok, 2] + 1e-9 * scale)
@@ -174,7 +174,7 @@ def test_stretched_parametrizations_find_the_global_minimum(seed):
     # (all in one flat valley), ended in a local minimum farther than OCCT's answer
     s, pts = _stretched_height_field(seed)
     pr = sm.project(pts, s)
-    theirs = occ.project_points(s.geom(), _bounds(s), pts)
+    theirs = project_points(s.geom(), _bounds(s), pts)
     ok = np.isfinite(theirs[:, 2])
     assert np.all(pr.distance[ok] <= theirs[ok, 2] + 1e-12)
 

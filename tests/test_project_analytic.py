@@ -12,7 +12,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.construct.elementary_closest import closest_angle
-from surfmod.occ import ops as occ
+from surfmod.occ.geomapi import face_distances, project_points
 
 FULL = {
     "plane": sm.PlaneSurface((1, 2, 3), (0.3, 0.2, 1), u_range=(-2, 3), v_range=(-1, 2)),
@@ -44,7 +44,7 @@ def test_never_farther_than_occt_and_same_feet(name):
     s = FULL[name]
     pts = _points(2000, 1)
     pr = sm.project(pts, s)
-    theirs = occ.project_points(s.geom(), _bounds(s), pts)
+    theirs = project_points(s.geom(), _bounds(s), pts)
     found = np.isfinite(theirs[:, 2])
     assert found.sum() > 150
     diff = pr.distance[found] - theirs[found, 2]
@@ -62,7 +62,7 @@ def test_bounded_patches_match_occt_face_distance(name):
     s = PATCHES[name]
     pts = _points(400, 2)
     pr = sm.project(pts, s)
-    d = occ.face_distances(s.face(), pts)
+    d = face_distances(s.face(), pts)
     np.testing.assert_allclose(pr.distance, d, atol=1e-12 * 6, rtol=0)
     (u0, u1), (v0, v1) = s.domain
     assert np.all((pr.u >= u0) & (pr.u <= u1) & (pr.v >= v0) & (pr.v <= v1))
@@ -116,7 +116,7 @@ def test_faces_read_back_use_their_own_parameter_box():
             f = sm.from_face(face)
             pts = _points(200, 4, 4.0)
             pr = sm.project(pts, f)
-            np.testing.assert_allclose(pr.distance, occ.face_distances(face, pts), atol=1e-12 * 4, rtol=0)
+            np.testing.assert_allclose(pr.distance, face_distances(face, pts), atol=1e-12 * 4, rtol=0)
 
 
 def test_indirect_frames_and_moved_copies():
@@ -126,7 +126,7 @@ def test_indirect_frames_and_moved_copies():
     for surf in (s, m):
         pts = _points(300, 5)
         pr = sm.project(pts, surf)
-        np.testing.assert_allclose(pr.distance, occ.face_distances(surf.face(), pts), atol=1e-12 * 12, rtol=0)
+        np.testing.assert_allclose(pr.distance, face_distances(surf.face(), pts), atol=1e-12 * 12, rtol=0)
 
 
 def test_closest_angle_wraps_and_picks_the_nearer_end():
@@ -166,7 +166,7 @@ def test_three_point_plane_matches_occt_feet_and_face_distance():
     pts = _points(3000, 7)
     pr = sm.project(pts, SKEWED)
     assert SKEWED._closest_parameters(pts) is not None  # the closed form, not the search
-    theirs = occ.project_points(SKEWED.geom(), _bounds(SKEWED), pts)
+    theirs = project_points(SKEWED.geom(), _bounds(SKEWED), pts)
     found = np.isfinite(theirs[:, 2])
     assert found.sum() > 1000
     diff = pr.distance[found] - theirs[found, 2]
@@ -175,7 +175,7 @@ def test_three_point_plane_matches_occt_feet_and_face_distance():
     assert same.sum() > 1000
     np.testing.assert_allclose(np.c_[pr.u, pr.v][found][same], theirs[found][same, :2], atol=1e-11, rtol=0)
     # the bounded patch, edges and corners included
-    np.testing.assert_allclose(pr.distance[:600], occ.face_distances(SKEWED.face(), pts[:600]), atol=1e-12 * 8,
+    np.testing.assert_allclose(pr.distance[:600], face_distances(SKEWED.face(), pts[:600]), atol=1e-12 * 8,
                                rtol=0)
 
 
@@ -183,7 +183,7 @@ def test_three_point_plane_moved_and_reparametrized_and_not_a_parallelogram():
     pts = _points(500, 8)
     moved = SKEWED.rotated((1, 0, 0), (0.2, 1, 0.3), 41).scaled(1.7)
     assert type(moved) is sm.ThreePointPlane and moved._closest_parameters(pts) is not None
-    np.testing.assert_allclose(sm.project(pts, moved).distance, occ.face_distances(moved.face(), pts),
+    np.testing.assert_allclose(sm.project(pts, moved).distance, face_distances(moved.face(), pts),
                                atol=1e-12 * 16, rtol=0)
     # knots [2, 2, 5, 5] x [-1, -1, 0, 0]: the closed form maps back to the net's own parameters
     net = SKEWED.control_points
@@ -197,5 +197,5 @@ def test_three_point_plane_moved_and_reparametrized_and_not_a_parallelogram():
     warped[1, 1, 2] += 0.5
     twisted = sm.ThreePointPlane(warped, (1, 1), SKEWED.knots)
     assert twisted._closest_parameters(pts) is None
-    np.testing.assert_allclose(sm.project(pts[:200], twisted).distance, occ.face_distances(twisted.face(), pts[:200]),
+    np.testing.assert_allclose(sm.project(pts[:200], twisted).distance, face_distances(twisted.face(), pts[:200]),
                                atol=1e-9, rtol=0)

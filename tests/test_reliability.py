@@ -136,7 +136,7 @@ def test_5_time_limit(tmp_path):
 
 
 def test_5_the_worker_is_reused_and_the_shape_is_exact():
-    from surfmod.occ.exchange import read_step
+    from surfmod.occ.step import read_step
 
     first = sm.import_step(SCREW)
     pid = isolated._WORKER._proc.pid

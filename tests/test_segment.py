@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 import surfmod as sm
 from strategies import bspline_surfaces
-from surfmod.occ import ops as occ
+from surfmod.occ.faces import segmented
 from surfmod.occ.geom import read_bezier_surface, read_bspline_surface
 from surfmod.occ.sample import surface_d0
 
@@ -20,7 +20,7 @@ def _size(s):
 
 def _assert_equal_to_occt_segment(s, ur, vr):
     mine = s.segment(ur, vr)
-    theirs = read_bspline_surface(occ.segmented(s.geom(), *ur, *vr))
+    theirs = read_bspline_surface(segmented(s.geom(), *ur, *vr))
     np.testing.assert_array_equal(mine.knots[0], theirs["knots"][0])
     np.testing.assert_array_equal(mine.knots[1], theirs["knots"][1])
     assert mine.degree == theirs["degree"]
@@ -58,12 +58,12 @@ def test_bezier_segment_is_exact_and_equals_occt_bezier_segment():
     rng = np.random.default_rng(2)
     b = sm.BezierSurface(rng.uniform(-1, 1, (4, 5, 3)), rng.uniform(0.5, 2, (4, 5)))
     piece = b.segment((0.2, 0.7), (0.1, 0.9))
-    theirs = read_bezier_surface(occ.segmented(b.geom(), 0.2, 0.7, 0.1, 0.9))
+    theirs = read_bezier_surface(segmented(b.geom(), 0.2, 0.7, 0.1, 0.9))
     # OCCT reparametrizes its Bézier segment to [0, 1]^2; the control net is the same
     np.testing.assert_allclose(piece.control_points, theirs["control_points"], atol=1e-14)
     np.testing.assert_allclose(piece.weights, theirs["weights"], rtol=1e-13)
     s, t = np.meshgrid(np.linspace(0, 1, 6), np.linspace(0, 1, 6), indexing="ij")
-    geom = occ.segmented(b.geom(), 0.2, 0.7, 0.1, 0.9)
+    geom = segmented(b.geom(), 0.2, 0.7, 0.1, 0.9)
     np.testing.assert_allclose(
         piece.points(0.2 + 0.5 * s, 0.1 + 0.8 * t).reshape(-1, 3), surface_d0(geom, s.ravel(), t.ravel()), atol=1e-14
     )

@@ -25,7 +25,7 @@ import pytest
 from conftest import CORPUS
 
 import surfmod as sm
-from surfmod.occ.exchange import map_solids, outward_solids
+from surfmod.occ.step import map_solids, outward_solids
 from surfmod.occ.topo import faces_of, solids_of
 
 #: file -> (largest relative change of a solid's volume or centroid, measured; the reason)

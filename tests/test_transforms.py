@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 import surfmod as sm
 from strategies import bspline_surfaces
 from surfmod import transforms
-from surfmod.occ import ops as occ
+from surfmod.occ.transformed import geom_gtransformed, geom_transformed, named_trsf, trsf_matrix
 from surfmod.occ.geom import surface_type
 from surfmod.occ.sample import surface_d0
 
@@ -71,7 +71,7 @@ def test_named_transforms_match_gp_trsf(subject, kind):
     apply, trsf_args = NAMED[kind]
     mine = apply(s)
     assert type(mine) is type(s)  # Hermite stays Hermite, Bezier stays Bezier
-    theirs = occ.geom_transformed(s.geom(), occ.named_trsf(*trsf_args))
+    theirs = geom_transformed(s.geom(), named_trsf(*trsf_args))
     assert surface_type(theirs) == surface_type(s.geom())
     _assert_same_surface(mine, theirs, 10 * _size(mine))
     # the geom() of the transformed surface is the transformed geom
@@ -93,7 +93,7 @@ def test_named_matrices_equal_gp_trsf_matrices(kind):
     spy = Spy.__new__(Spy)
     sm.BSplineSurface._set(spy, s.control_points, s.degree, s.knots, s.weights)
     apply(spy)
-    np.testing.assert_allclose(captured["m"], occ.trsf_matrix(occ.named_trsf(*trsf_args)), rtol=0, atol=1e-15 * 8)
+    np.testing.assert_allclose(captured["m"], trsf_matrix(named_trsf(*trsf_args)), rtol=0, atol=1e-15 * 8)
 
 
 @pytest.mark.parametrize("subject", sorted(SUBJECTS))
@@ -105,7 +105,7 @@ def test_nonuniform_scale_matches_gp_gtrsf(subject):
     m = np.eye(4)
     m[:3, :3] = np.diag(factor)
     m[:3, 3] = center * (1 - factor)
-    theirs = occ.geom_gtransformed(s.geom(), m)
+    theirs = geom_gtransformed(s.geom(), m)
     _assert_same_surface(mine, theirs, 10 * _size(mine))
     # and the point images: S'(u, v) = M S(u, v) (affine invariance of rational splines)
     u, v = _params(s)
@@ -142,11 +142,11 @@ coord = st.floats(-10, 10, allow_nan=False)
 def test_random_similarities_match_gp_trsf(s, axis, origin, degrees, shift, factor):
     axis = np.asarray(axis) / np.linalg.norm(axis)
     mine = s.rotated(origin, axis, degrees).translated(shift).mirrored(origin, axis).scaled(factor, shift)
-    t = occ.named_trsf("scale", shift, factor)
-    t.Multiply(occ.named_trsf("mirror", origin, axis))
-    t.Multiply(occ.named_trsf("translation", shift))
-    t.Multiply(occ.named_trsf("rotation", origin, axis, degrees))
-    theirs = occ.geom_transformed(s.geom(), t)
+    t = named_trsf("scale", shift, factor)
+    t.Multiply(named_trsf("mirror", origin, axis))
+    t.Multiply(named_trsf("translation", shift))
+    t.Multiply(named_trsf("rotation", origin, axis, degrees))
+    theirs = geom_transformed(s.geom(), t)
     scale = max(1.0, float(np.abs(mine.control_points).max()), 30 * abs(factor))
     _assert_same_surface(mine, theirs, 10 * scale)
 
@@ -161,7 +161,7 @@ def test_random_affine_maps_match_gp_gtrsf(s, seed):
     if abs(np.linalg.det(m[:3, :3])) < 1e-2:
         m[:3, :3] += 3 * np.eye(3)
     mine = s.transformed(m)
-    theirs = occ.geom_gtransformed(s.geom(), m)
+    theirs = geom_gtransformed(s.geom(), m)
     _assert_same_surface(mine, theirs, 10 * max(_size(mine), np.abs(m).max() * _size(s)))
     # the NumPy image of the points is the image of the NumPy points
     u, v = _params(s, 5)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ.ops import face_area, face_is_valid
+from surfmod.occ.faces import face_area, face_is_valid
 from surfmod.ops.trim import trimmed_area
 
 

@@ -176,7 +176,7 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
     the steep regions, with the rest it cannot reach reported
     (:mod:`surfmod.cam.finishing`).  Raises
     ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut."""
-    from ..occ.uses import bounding_box
+    from ..occ.properties import bounding_box
 
     shape = to_shape(part, "part")
     ops = list(operations) if isinstance(operations, (list, tuple)) else [operations]

@@ -1,5 +1,8 @@
 """NC tool paths for continuous-path machining: drop-cutter zig-zag rasters that never gouge.
 
+The same concept as :mod:`surfmod.cli.toolpath` (the ``surfmod toolpath`` command over it),
+one level down.
+
 The part is every face of the input (walls, undersides and trimmed faces included), meshed
 by OCCT's BRepMesh inside each face's trim at a chordal deflection of 40 % of the
 gouge ``tolerance``.  The end mill (ball, flat or bull nose, with a shank of its own radius up to
@@ -23,10 +26,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from tqdm import tqdm
 
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
+from ..meshing.brep import _estimate
 from ..meshing.render import Drawing, polyline_runs, repr_png
 from .drop_cutter import TriangleGrid, drop
 from .gcode import gcode_text
@@ -174,10 +179,9 @@ def _mesh_estimate(shape, tolerance: float) -> None:
     """Refuse, before BRepMesh runs, a tolerance whose curvature estimate of the mesh
     exceeds :data:`MAX_TRIANGLES` or whose tolerance lies below :data:`TOLERANCE_FLOOR`
     of the part's size."""
-    from ..meshing.brep import _estimate
-    from ..occ.triangulation import bounding_box
+    from ..occ.properties import bounding_box
 
-    box = bounding_box(shape)
+    box = bounding_box(shape, optimal=False)
     diag = float(np.linalg.norm(box[1] - box[0]))
     tolerance = checks.tolerance(tolerance, "tolerance", diag)
     if tolerance < TOLERANCE_FLOOR * diag:
@@ -307,8 +311,6 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         box = checks.finite_array(bounds, "bounds")
         if box.shape != (2, 2) or np.any(box[1] < box[0]):
             raise SurfmodError(f"bounds: expected ((xmin, ymin), (xmax, ymax)), got {box.tolist()}")
-    from tqdm import tqdm
-
     def estimate(lo, hi):
         a, b = (0, 1) if direction == "x" else (1, 0)
         passes = float(hi[b] - lo[b]) / stepover + 2
@@ -318,7 +320,7 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
 
     shape = to_shape(obj, "obj")
     if bounds is None:  # the shape's box (a little larger than the mesh's) sizes the raster up front
-        from ..occ.uses import bounding_box
+        from ..occ.properties import bounding_box
 
         outer = bounding_box(shape)
         estimate(outer[0, :2], outer[1, :2])

@@ -78,6 +78,22 @@ def _kernels_for(points: int, grid: bool = False):
     return _kernels(), 1
 
 
+def _run_patches(kernel: str, net, table, u, v, out) -> None:
+    """The per-span patch kernel ``kernel`` (:mod:`surfmod.eval.patches`) at the scattered
+    pairs ``(u, v)`` into ``out``, or its parallel variant (:mod:`surfmod.eval.parallel`)
+    when :mod:`surfmod.eval.threads` allows several threads, as :func:`_kernels_for`."""
+    from . import patches  # numba: compiled on first use, then from its disk cache
+
+    count = threads_for(u.size)
+    run = patches
+    if count > 1:
+        from . import parallel
+
+        run = parallel
+    with _on(count):
+        getattr(run, kernel)(*patches.arguments(net, table, u, v, out))
+
+
 def _on(count: int):
     """The ``with`` context that runs numba's parallel kernels on ``count`` threads."""
     return running_on(count) if count > 1 else nullcontext()
@@ -234,9 +250,7 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
         out = np.empty((u.size, 3))
     table = _patch_table(net, u.size)
     if table is not None:
-        from . import patches
-
-        patches.positions(net, table, u, v, out)
+        _run_patches("patch_positions", net, table, u, v, out)
         return out
     run, count = _kernels_for(u.size)
     with _on(count):
@@ -264,9 +278,7 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
         out = np.empty((u.size, order + 1, order + 1, 3))
     table = _patch_table(net, u.size) if order in (1, 2) else None
     if table is not None:
-        from . import patches
-
-        patches.derivatives(net, table, u, v, out)
+        _run_patches("patch_derivatives", net, table, u, v, out)
         return out
     run, count = _kernels_for(u.size)
     with _on(count):

@@ -11,9 +11,10 @@ where ``T[k, i] = N_i^(k)(mid) half^k / k!`` are the Taylor rows of the basis fu
 (computed by the same division-free Cox-de Boor triangle as every other kernel).  A
 point then costs a span search and a Horner scheme: no basis triangle, no knot look-ups;
 its partials, Horner schemes that carry their first two derivatives, the chain rule's
-factors ``(1 / half)^k`` and the quotient rule (:func:`derivatives`: about a third of
+factors ``(1 / half)^k`` and the quotient rule (:func:`patch_derivatives`: about a third of
 the basis-function kernel's time on a 20x20 bicubic NURBS).  OCCT's ``BSplSLib_Cache``
-evaluates the same kind of per-span polynomial.
+evaluates the same kind of per-span polynomial.  ``eval/local.py`` runs these kernels, or
+their parallel variants (:mod:`surfmod.eval.parallel`), with :func:`arguments`.
 
 The table holds ``(p+1)(q+1)`` homogeneous 4-vectors per span pair, so it is built only
 for small nets and degrees up to 3 (:func:`suits`), where the Taylor coefficients of a
@@ -24,9 +25,9 @@ level of the basis-function sums (agreement 1e-13 relative, tests/test_eval_loca
 >>> from surfmod.eval import local
 >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
 >>> knots = np.array([0, 0, 0, 0, 1, 1, 1, 1.0])
->>> table = build(local.prepare(knots, 3, knots, 3, net))
+>>> prepared = local.prepare(knots, 3, knots, 3, net)
 >>> out = np.empty((1, 3))
->>> positions(local.prepare(knots, 3, knots, 3, net), table, np.array([0.5]), np.array([0.25]), out)
+>>> patch_positions(*arguments(prepared, build(prepared), np.array([0.5]), np.array([0.25]), out))
 >>> out
 array([[1.5 , 0.75, 0.  ]])
 """
@@ -39,7 +40,6 @@ import numpy as np
 from numba import njit, uint64
 
 from .kernels import SCATTER_CHUNK, basis_ders_point, find_span_bucketed, quotient_order2
-from .threads import running_on, threads_for
 
 #: largest table built (bytes): 100 x 100 bicubic spans fit, the table stays cache-friendly
 MAX_TABLE_BYTES = 8 << 20
@@ -134,8 +134,10 @@ def _cubic_in_y(c, o, y):
 # Horner steps may fuse into FMAs ("contract"): one rounding instead of two, never a
 # reassociated sum, so the results stay within an ulp or so of the unfused ones.
 @njit(cache=True, error_model="numpy")
-def _positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-               bucket_u, bucket_v, u, v, out):
+def patch_positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                    bucket_u, bucket_v, u, v, out):
+    """Positions at scattered pairs into ``out (N, 3)``, chunk after chunk (the serial twin
+    of :func:`surfmod.eval.parallel.patch_positions`); arguments: :func:`arguments`."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
                         bucket_u, bucket_v, u, v, out, c)
@@ -236,8 +238,10 @@ def _patch_points(flat, p, q, base, xs, ys, rational, out, c0, c1):
 
 
 @njit(cache=True, error_model="numpy")
-def _derivatives(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                 bucket_u, bucket_v, u, v, out):
+def patch_derivatives(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                      bucket_u, bucket_v, u, v, out):
+    """Partials to order 1 or 2 at scattered pairs into ``out (N, K, K, 3)``, chunk after
+    chunk (the serial twin of :func:`surfmod.eval.parallel.patch_derivatives`)."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
                           bucket_u, bucket_v, u, v, out, c)
@@ -317,29 +321,10 @@ def _store_partials(h, rational, out, a, kk):
             out[a, 2, 0, d], out[a, 2, 1, d], out[a, 2, 2, d] = s20, s21, s22
 
 
-def positions(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-    """Positions at the scattered pairs ``(u[a], v[a])`` into ``out (N, 3)`` from ``table``
-    (flat float64 parameter arrays, in the domain)."""
-    _run(_positions, "patch_positions", net, table, u, v, out)
-
-
-def derivatives(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-    """Partials to order 1 or 2 at the scattered pairs ``(u[a], v[a])`` into ``out (N, K, K,
-    3)`` from ``table`` (flat float64 parameter arrays, in the domain)."""
-    _run(_derivatives, "patch_derivatives", net, table, u, v, out)
-
-
-def _run(serial, parallel_name: str, net, table: PatchTable, u, v, out) -> None:
-    """``serial``, or its variant ``parallel_name`` of :mod:`surfmod.eval.parallel` when
-    :mod:`surfmod.eval.threads` allows several threads, on the patch table's arrays."""
+def arguments(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> tuple:
+    """The arguments of :func:`patch_positions` and :func:`patch_derivatives` (and of their
+    parallel variants) for ``net``'s table at the scattered pairs ``(u[a], v[a])`` (flat
+    float64 arrays, in the domain), writing ``out``."""
     n, m = net.ctrl.shape[:2]
-    args = (net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u, table.mid_v,
+    return (net.knots_u, net.p, net.knots_v, net.q, n, m, table.coeffs, table.mid_u, table.scale_u, table.mid_v,
             table.scale_v, net.rational, net.bucket_u, net.bucket_v, u, v, out)
-    count = threads_for(u.size)
-    if count > 1:
-        from . import parallel
-
-        with running_on(count):
-            getattr(parallel, parallel_name)(*args)
-        return
-    serial(*args)

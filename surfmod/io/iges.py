@@ -27,7 +27,7 @@ def export_iges(objects, path, *, brep: bool = False) -> None:
     >>> len(sm.import_iges(path).faces())
     1
     """
-    from ..occ.exchange import compound
+    from ..occ.topo import compound
     from ..occ.iges import write_iges
 
     target = target_path(path, "path", SUFFIXES)

@@ -1,4 +1,8 @@
-"""STEP export/import of surfmod surfaces and build123d shapes (atomic writes)."""
+"""STEP export/import of surfmod surfaces and build123d shapes (atomic writes).
+
+The same concept as :mod:`surfmod.occ.step`, one level up: the public doors over OCCT's
+reader and writer.
+"""
 
 from __future__ import annotations
 
@@ -37,7 +41,8 @@ def export_step(objects, path) -> None:
     >>> d = tempfile.mkdtemp()
     >>> sm.export_step(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), os.path.join(d, "p.step"))
     """
-    from ..occ.exchange import compound, write_step
+    from ..occ.step import write_step
+    from ..occ.topo import compound
 
     target = target_path(path, "path", (".step", ".stp"))
     shapes = [to_shape(o) for o in _as_list(objects)]

@@ -174,7 +174,7 @@ def _items(obj, name: str):
             continue
         if wrapped(item) is None:
             raise SurfmodError(f"{name}: expected a surfmod surface, a face or a shape, got {type(item).__name__}")
-        from ..occ.uses import solids_of
+        from ..occ.topo import solids_of
 
         kind = "solid face" if solids_of(wrapped(item)) else "face"
         out.extend((kind, f) for f in faces_of(item))
@@ -307,8 +307,8 @@ def analyze(obj, kind: str, out=None, *, light=None, stripes: int = 8, resolutio
     items = _items(obj, "obj")
     target = None
     if any(what != "surface" for what, _ in items):
-        from ..occ.uses import bounding_box
-        from ..occ.exchange import compound
+        from ..occ.properties import bounding_box
+        from ..occ.topo import compound
 
         box = bounding_box(compound([f for what, f in items if what != "surface"]))
         target = float(np.linalg.norm(box[1] - box[0])) / resolution

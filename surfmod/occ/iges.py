@@ -1,4 +1,4 @@
-"""IGES read/write through OCCT's ``IGESControl`` (the STEP side is ``exchange.py``).
+"""IGES read/write through OCCT's ``IGESControl`` (the STEP side is ``step.py``).
 
 Reals are written with 17 significant digits (:mod:`surfmod.occ.fullprecision`), so
 B-spline poles, weights and knots come back bit for bit; OCCT's own ``Write`` prints 10.
@@ -11,7 +11,7 @@ from __future__ import annotations
 import io
 
 from ..errors import KernelError
-from .exchange import read_with
+from .step import read_with
 from .fullprecision import FLOAT_FORMAT, write_bytes
 from .guard import kernel
 from OCP.IGESControl import IGESControl_Controller, IGESControl_Reader, IGESControl_Writer

@@ -75,7 +75,7 @@ def _read_and_check(path: str, max_coordinate: float) -> bytes:
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
-    from .exchange import read_step
+    from .step import read_step
 
     shape = read_step(path)
     with kernel("BRepBndLib"):
@@ -113,7 +113,7 @@ def _worker_main() -> None:
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # OCCT prints banners to stdout: keep them off the protocol
     requests = sys.stdin.buffer.fileno()
-    from . import exchange  # noqa: F401  (load OCCT before the first request)
+    from . import step  # noqa: F401  (load OCCT before the first request)
 
     _send(reply, ("ready", os.getpid()))
     while True:

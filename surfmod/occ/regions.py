@@ -19,7 +19,7 @@ from .topo import explore, solids_of, wrapped
 from OCP.BOPAlgo import BOPAlgo_MakerVolume
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 from OCP.TopTools import TopTools_ListOfShape
-from .uses import gprops
+from .properties import gprops
 
 #: The regions' BRepGProp volumes must add up to the solid's within this relative error
 #: (both at eps 1e-9): anything else means a region was misclassified or lost.
@@ -34,7 +34,7 @@ def material_regions(solid) -> list:
     ``KernelError`` when OCCT fails or the kept volumes do not add up to the solid's.
 
     >>> import build123d as bd
-    >>> from surfmod.occ.uses import gprops
+    >>> from surfmod.occ.properties import gprops
     >>> hollow = bd.Box(4, 4, 4) - bd.Box(2, 2, 2)  # a solid with an inner void shell
     >>> [round(gprops(r)["volume"], 9) for r in material_regions(hollow.wrapped)]
     [56.0]

@@ -104,3 +104,24 @@ def edge_strays(shape, samples: int = 17) -> list[EdgeStray]:
             BRepGProp.LinearProperties_s(edge, props)
             out.append(EdgeStray(edge_index, tuple(faces), float(BRep_Tool.Tolerance_s(edge)), stray, gap, props.Mass()))
     return out
+
+
+def edge_deviations(shape, samples: int = 23) -> np.ndarray:
+    """``(E, 2)``: per edge of ``shape`` the largest distance between its 3-D curve and the
+    image of its p-curve on each of its faces (``samples`` points, as ``BRepCheck`` does),
+    and the edge's length.  A model whose edges are off their faces this far bounds a
+    region only up to that distance."""
+    out = []
+    with kernel("edge deviations"):
+        for _, edge, edge_faces in geometric_edges(shape):
+            c3 = BRepAdaptor_Curve(edge)
+            t = np.linspace(c3.FirstParameter(), c3.LastParameter(), samples)
+            p3 = np.array([xyz(c3.Value(float(x))) for x in t])
+            dev = 0.0
+            for face in edge_faces:
+                _, ps = pcurve_points(edge, face, samples)
+                dev = max(dev, float(np.linalg.norm(ps - p3, axis=1).max()))
+            props = GProp_GProps()
+            BRepGProp.LinearProperties_s(edge, props)
+            out.append((dev, props.Mass()))
+    return np.array(out).reshape(-1, 2)

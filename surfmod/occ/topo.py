@@ -3,28 +3,32 @@
 from __future__ import annotations
 
 import numpy as np
-from OCP.BRep import BRep_Tool
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace
-from OCP.TopoDS import TopoDS
-
-from .. import transforms
-from ..errors import SurfmodError
-from .guard import check_done, kernel
 from OCP import TopAbs
+from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
-from OCP.BRepBuilderAPI import BRepBuilderAPI_GTransform, BRepBuilderAPI_MakeVertex, BRepBuilderAPI_Transform
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_GTransform,
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakeVertex,
+    BRepBuilderAPI_Transform,
+)
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.Geom import Geom_TrimmedCurve
 from OCP.GeomConvert import GeomConvert, GeomConvert_CompCurveToBSplineCurve
+from OCP.gp import gp_GTrsf, gp_Mat, gp_Pnt, gp_Pnt2d, gp_XYZ
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_OUT, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-from OCP.TopoDS import TopoDS_Shape
-from OCP.gp import gp_GTrsf, gp_Mat, gp_Pnt, gp_Pnt2d, gp_XYZ
+
+from .. import transforms
+from ..errors import SurfmodError
 from .analytic import trsf
 from .arrays import xyz
+from .guard import check_done, kernel
 
 FACE_TOLERANCE = 1e-7
 
@@ -239,3 +243,13 @@ def geometric_edges(shape):
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             continue
         yield k - 1, edge, [TopoDS.Face_s(f) for f in emap.FindFromIndex(k)]
+
+
+def compound(shapes):
+    """One TopoDS_Compound of the given TopoDS shapes."""
+    builder = BRep_Builder()
+    comp = TopoDS_Compound()
+    builder.MakeCompound(comp)
+    for shape in shapes:
+        builder.Add(comp, shape)
+    return comp

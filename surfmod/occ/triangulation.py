@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
-from .guard import kernel
 from .mesh import mesh_faces
 from .topo import wrapped
 
@@ -47,16 +46,3 @@ def part_triangles(shape, deflection: float, angular: float = 0.35, *, face_inde
     if face_index:
         return np.concatenate(blocks), measured, (faces, np.concatenate(owners))
     return np.concatenate(blocks), measured
-
-
-def bounding_box(shape) -> np.ndarray:
-    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` of ``shape``: OCCT's quick box (from a
-    stored triangulation, else from the control points, enlarged by the shape tolerance)."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-
-    with kernel("BRepBndLib.Add"):
-        box = Bnd_Box()
-        BRepBndLib.Add_s(wrapped(shape), box, True)
-        x0, y0, z0, x1, y1, z1 = box.Get()
-    return np.array([[x0, y0, z0], [x1, y1, z1]])

@@ -324,7 +324,7 @@ def continuity(a, b=None, samples: int = 50, *, edge=None, occt: bool = False) -
         parts = _shell(a, samples, occt)
         return _combined(f"shell ({len(parts)} edges)", parts)
     if not isinstance(a, Surface) and not isinstance(b, Surface) and _is_shape(a) and _is_shape(b):
-        from ..occ.exchange import compound
+        from ..occ.topo import compound
         from ..occ.topo import wrapped
 
         parts = _shell(compound([wrapped(a), wrapped(b)]), samples, occt, only_faces=(0, 1))

@@ -158,7 +158,7 @@ def trim(s: Surface, boundary_curve_uv, *, tolerance: float = 1e-7):
         raise SurfmodError(f"tolerance: {tol:g} is below OCCT's confusion tolerance {OCCT_CONFUSION:g} "
                            "(Precision::Confusion), the finest edge OCCT builds")
     loops = boundary_loops(s, boundary_curve_uv)
-    from ..occ.ops import trimmed_face
+    from ..occ.faces import trimmed_face
 
     return trimmed_face(s.geom(), [loop.occ_spec() for loop in loops], tol)
 

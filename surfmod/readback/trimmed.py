@@ -188,8 +188,8 @@ _ELEMENTARY = {
 def from_faces(shapes: list) -> list:
     """:func:`surfmod.from_face` of every face of a part: the same ``TrimmedFace``, the
     elementary ones (planes, cylinders, cones, spheres, tori: most faces of real parts)
-    built from one pass over their OCCT data (:func:`surfmod.occ.uses.elementary_faces`)."""
-    from ..occ.uses import elementary_faces
+    built from one pass over their OCCT data (:func:`surfmod.occ.elementary_faces.elementary_faces`)."""
+    from ..occ.elementary_faces import elementary_faces
 
     out = []
     for shape, data in zip(shapes, elementary_faces(shapes)):

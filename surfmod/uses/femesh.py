@@ -408,7 +408,9 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     """
     meshio = require("meshio", "fem", "sm.fe_mesh")
 
-    from ..occ import uses as occ
+    from ..occ.properties import bounding_box
+    from ..occ.step import write_brep
+    from ..occ.topo import solids_of
 
     size = checks.positive(size, "size")
     if order not in (1, 2):
@@ -417,9 +419,9 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
         raise SurfmodError(f"kind: expected 'surface' or 'volume', got {kind!r}")
     shape = to_shape(obj, "obj")
     if kind == "volume":
-        if not occ.solids_of(shape):
+        if not solids_of(shape):
             shape = to_shape(obj, "obj", solid=True)
-    box = occ.bounding_box(shape)
+    box = bounding_box(shape)
     extent = float(np.max(box[1] - box[0]))
     if size > 10 * extent:
         raise SurfmodError(f"size: {size:g} is far larger than the part (extent {extent:.4g})")
@@ -438,7 +440,7 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp, \
             tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:
         brep, msh = Path(tmp) / "part.brep", Path(tmp) / "part.msh"
-        occ.write_brep(shape, brep)
+        write_brep(shape, brep)
         # as read, healed by gmsh, then (volumes) from surfmod's measured closed
         # triangulation, of each solid and then of each solid's material regions
         attempts = ATTEMPTS[kind]
@@ -525,13 +527,14 @@ def _triangulation_attempt(shape, msh: Path, size: float, order: int, deadline: 
     "volume_bound", "regions" (pieces meshed)}``: every boundary point lies within
     ``max_deviation`` of the part, so the tetrahedra's volume is within ``volume_bound`` =
     area x deviation of the part's."""
-    from ..occ import uses as occ
+    from ..occ.properties import bounding_box, gprops
+    from ..occ.topo import solids_of
     from ..occ.regions import material_regions
 
-    box = occ.bounding_box(shape)
+    box = bounding_box(shape)
     tolerance = min(TRIANGULATION_SHARE * float(np.linalg.norm(box[1] - box[0])), TRIANGULATION_SIZE_SHARE * size)
-    solids = occ.solids_of(shape)
-    reference = sum(abs(occ.gprops(solid)["volume"]) for solid in solids)
+    solids = solids_of(shape)
+    reference = sum(abs(gprops(solid)["volume"]) for solid in solids)
     pieces = solids
     if regions:
         try:

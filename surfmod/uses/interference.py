@@ -1,4 +1,8 @@
-"""Interference between mating parts: overlap volume, minimum distance, contact."""
+"""Interference between mating parts: overlap volume, minimum distance, contact.
+
+The same concept as :mod:`surfmod.occ.interference` (its OCCT Boolean and distance), one
+level up.
+"""
 
 from __future__ import annotations
 
@@ -70,15 +74,16 @@ def interference(a, b, tolerance: float = 1e-6) -> Interference:
     >>> round(r.distance, 9), r.status
     (1.0, 'clearance')
     """
-    from ..occ import uses as occ
+    from ..occ.interference import common_volume, min_distance
+    from ..occ.properties import gprops
 
     tolerance = checks.positive(tolerance, "tolerance")
     sa = to_shape(a, "a", solid=True)
     sb = to_shape(b, "b", solid=True)
-    va = occ.gprops(sa)["volume"]
-    vb = occ.gprops(sb)["volume"]
-    overlap = occ.common_volume(sa, sb)
-    dist, pa, pb, _inner = occ.min_distance(sa, sb)
+    va = gprops(sa)["volume"]
+    vb = gprops(sb)["volume"]
+    overlap = common_volume(sa, sb)
+    dist, pa, pb, _inner = min_distance(sa, sb)
     interferes = overlap > tolerance * min(va, vb)
     if interferes:
         dist = 0.0

@@ -41,7 +41,7 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
     >>> [round(float(x), 12) for x in r.inertia.diagonal()]
     [50.0, 40.0, 26.0]
     """
-    from ..occ import uses as occ
+    from ..occ.properties import gprops, vertex_mean
 
     density = checks.positive(density, "density")
     order = checks.count(order, "order", minimum=2)
@@ -49,14 +49,14 @@ def mass_properties(obj, density: float = 1.0, *, order: int = 12, method: str =
         raise SurfmodError(f"method: expected 'numpy' or 'occt', got {method!r}")
     solid = to_shape(obj, "obj", solid=True)
     if method == "occt":
-        g = occ.gprops(solid, eps)
+        g = gprops(solid, eps)
         return MassProperties(g["volume"], g["area"], g["centroid"], density * g["inertia"], density,
                               method=f"occt BRepGProp eps={eps:g}", _error=float(g["volume_error"]))
     # the reference point of the surface integrals: the mean of the vertices, as BRepGProp
     # takes it.  On a boundary that closes exactly any point gives the same result; on a
     # real file whose faces leave gaps (edges off their faces) the integrals depend on it
     # by (shift . closure defect) / 3, so the same point makes the two comparable.
-    ref = occ.vertex_mean(solid)
+    ref = vertex_mean(solid)
 
     if isinstance(obj, Surface):
         return integrate(obj, ref, density, order, estimate_error)
@@ -78,11 +78,12 @@ def boundary_ambiguity(obj) -> float:
     >>> sm.boundary_ambiguity(bd.Box(1, 2, 3)) < 1e-12
     True
     """
-    from ..occ import uses as occ
+    from ..occ.properties import bounding_box, gprops
+    from ..occ.strays import edge_deviations
 
     solid = to_shape(obj, "obj", solid=True)
-    box = occ.bounding_box(solid)
+    box = bounding_box(solid)
     r = float(np.linalg.norm(box[1] - box[0])) / 2
-    volume = occ.gprops(solid, 1e-6)["volume"]
-    dev = occ.edge_deviations(solid)
+    volume = gprops(solid, 1e-6)["volume"]
+    dev = edge_deviations(solid)
     return float(np.sum(dev[:, 0] * dev[:, 1]) * r / 3 / volume) if len(dev) else 0.0

@@ -1,6 +1,7 @@
 """Cross-section views: planar sections of a part as curves, in 3-D and in the plane's frame.
 
-The same concept as :mod:`surfmod.cli.section` (the ``surfmod section`` command over this).
+The same concept as :mod:`surfmod.cli.section` (the ``surfmod section`` command over this)
+and :mod:`surfmod.occ.section` (the OCCT section it reads, one level down).
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ class Section:
 
     @cached_property
     def polylines(self) -> list[np.ndarray]:
-        from ..occ.uses import wire_edges
+        from ..occ.discretize import wire_edges
 
         def sampled(edge):  # from_edge follows the edge's orientation
             curve = from_edge(edge)
@@ -94,7 +95,7 @@ class Section:
         (OCCT ``GCPnts_QuasiUniformDeflection``)."""
         if tolerance is None:
             return [self.to_plane(p) for p in self.polylines]
-        from ..occ.uses import edge_points, wire_edges
+        from ..occ.discretize import edge_points, wire_edges
 
         tol = checks.positive(tolerance, "tolerance")
         return [self.to_plane(_chained([edge_points(e, tol) for e in wire_edges(w)])) for w in self.wires]
@@ -106,7 +107,7 @@ class Section:
         ``("spline", degree, control_points (N, 2), knots, weights or None)``; B-splines
         keep their knots and weights, every other curve type is converted to its exact
         B-spline form."""
-        from ..occ.uses import wire_edges
+        from ..occ.discretize import wire_edges
 
         return [[_edge_entity(self, e) for e in wire_edges(w)] for w in self.wires]
 
@@ -181,7 +182,7 @@ def planar_faces_in(shape, origin, normal, tol: float) -> list[int]:
     >>> planar_faces_in(bd.Box(2, 2, 2), np.array([0, 0, 1.0]), np.array([0, 0, -1.0]), 1e-9)
     [5]
     """
-    from ..occ.uses import planar_faces_on
+    from ..occ.section import planar_faces_on
 
     return planar_faces_on(shape, origin, normal, tol)
 
@@ -198,7 +199,8 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     >>> len(s.wires), s.closed, round(s.length, 12) == round(2 * 3.141592653589793 * 3 ** 0.5, 12)
     (1, [True], True)
     """
-    from ..occ import uses as occ
+    from ..occ.properties import bounding_box
+    from ..occ.section import section_edges
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
@@ -207,7 +209,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     shape = to_shape(obj, "obj")
     # only a length scale for the on-face test: OCCT's quick box, not the optimal one
     # (which costs more than the section itself on B-spline parts)
-    box = occ.bounding_box(shape, optimal=False)
+    box = bounding_box(shape, optimal=False)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
     on = planar_faces_in(shape, origin, normal, tol)
     if on:
@@ -215,6 +217,6 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
             f"plane_normal: the section plane is parallel to planar face(s) {on} of obj and lies on them; "
             "move plane_origin off the face or tilt the plane"
         )
-    wires = occ.section_edges(shape, origin, normal)
+    wires = section_edges(shape, origin, normal)
     return Section(checks.frozen(origin), checks.frozen(normal), checks.frozen(xa), checks.frozen(ya),
                    wires, [bool(w.is_closed) for w in wires], samples)

@@ -1,21 +1,24 @@
-"""STEP read/write of TopoDS shapes (in process; files from users go through
-:mod:`surfmod.occ.isolated`, which runs :func:`read_step` in a child process)."""
+"""STEP read/write of TopoDS shapes, and OCCT's native BREP files (for gmsh).
+
+In process; files from users go through :mod:`surfmod.occ.isolated`, which runs
+:func:`read_step` in a child process.  The same concept as :mod:`surfmod.io.step`, one
+level down: that module is the public ``import_step``/``export_step`` over this one."""
 
 from __future__ import annotations
 
-# loaded at import: the module silences OCCT's STEP banners once, on import
+from OCP.BRep import BRep_Builder
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepTools import BRepTools
+from OCP.GProp import GProp_GProps
+from OCP.IFSelect import IFSelect_RetDone
 from OCP.Message import Message, Message_Gravity
+from OCP.STEPControl import STEPControl_Reader
+from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shell, TopoDS_Solid
 
 from ..errors import SurfmodError
 from .fullprecision import write_step_full
 from .guard import kernel
-from OCP.BRep import BRep_Builder
-from OCP.BRepGProp import BRepGProp
-from OCP.GProp import GProp_GProps
-from OCP.IFSelect import IFSelect_RetDone
-from OCP.STEPControl import STEPControl_Reader
-from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
-from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shell, TopoDS_Solid
 
 
 def _quiet_messages() -> None:
@@ -25,16 +28,6 @@ def _quiet_messages() -> None:
 
 
 _quiet_messages()
-
-
-def compound(shapes):
-    """One TopoDS_Compound of the given TopoDS shapes."""
-    builder = BRep_Builder()
-    comp = TopoDS_Compound()
-    builder.MakeCompound(comp)
-    for shape in shapes:
-        builder.Add(comp, shape)
-    return comp
 
 
 def _solid_shells_forward(solid):
@@ -152,3 +145,11 @@ def read_step(path: str):
     """Read a STEP file into one TopoDS shape, its solids :func:`outward_solids`;
     unreadable files raise ``SurfmodError``."""
     return outward_solids(read_with(STEPControl_Reader(), "STEP", path))
+
+
+def write_brep(shape, path) -> None:
+    """``shape`` as an OCCT native BREP file at ``path`` (what gmsh reads without a STEP
+    translation of its own)."""
+    with kernel("BRepTools.Write_s"):
+        if not BRepTools.Write_s(shape, str(path)):
+            raise SurfmodError(f"path: could not write BREP {path}")

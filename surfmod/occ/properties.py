@@ -1,0 +1,90 @@
+"""Global properties of shapes: ``BRepGProp`` volume, area, centroid and inertia, the
+vertex mean BRepGProp refers its integrals to, and the one bounding box of the kernel
+door (``BRepBndLib``)."""
+
+from __future__ import annotations
+
+from itertools import chain
+
+import numpy as np
+from OCP.Bnd import Bnd_Box
+from OCP.BRep import BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
+from OCP.TopExp import TopExp
+from OCP.TopoDS import TopoDS
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+from .arrays import xyz
+from .guard import kernel
+from .topo import wrapped
+
+
+def gprops(shape, eps: float = 1e-9) -> dict:
+    """``BRepGProp`` volume and surface properties at relative tolerance ``eps``.
+
+    Returns volume, area, centroid and the inertia matrix about the centroid
+    (OCCT's ``MatrixOfInertia``: diagonal ``∫(y²+z²)``, off-diagonal ``−∫xy``).
+    """
+    with kernel("BRepGProp.VolumeProperties_s"):
+        vp = GProp_GProps()
+        verr = BRepGProp.VolumeProperties_s(shape, vp, float(eps), False, False)
+        sp = GProp_GProps()
+        serr = BRepGProp.SurfaceProperties_s(shape, sp, float(eps), False)
+        c = vp.CentreOfMass()
+        m = vp.MatrixOfInertia()
+        inertia = np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)])
+    return {
+        "volume": vp.Mass(),
+        "area": sp.Mass(),
+        "centroid": xyz(c),
+        "inertia": inertia,
+        "volume_error": verr,
+        "area_error": serr,
+    }
+
+
+def vertex_mean(shape) -> np.ndarray:
+    """Mean of the shape's vertex points, visited with repeats as ``TopExp_Explorer`` does
+    (BRepGProp's rough barycentre, the reference point of its integrals); the bounding
+    box centre when the shape has no vertex (one periodic face: a full sphere).
+
+    The explorer meets a vertex once per occurrence under an edge occurrence (an edge
+    once per face that holds it), which is the length of its ancestor list in
+    ``TopExp::MapShapesAndAncestors(VERTEX, EDGE)`` (one entry per such occurrence): each
+    distinct vertex is read once and repeated that many times (a vertex under no edge,
+    once), instead of one OCCT call chain per visit.
+
+    >>> import build123d as bd
+    >>> vertex_mean(bd.Box(2, 4, 6).wrapped).round(12).tolist()  # 8 corners, 6 visits each
+    [0.0, 0.0, 0.0]
+    """
+    with kernel("TopExp.MapShapesAndAncestors_s"):
+        ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
+        TopExp.MapShapesAndAncestors_s(shape, TopAbs_VERTEX, TopAbs_EDGE, ancestors)
+        n = ancestors.Extent()
+        if not n:
+            return bounding_box(shape).mean(axis=0)
+        pnt, vertex, key, edges = BRep_Tool.Pnt_s, TopoDS.Vertex_s, ancestors.FindKey, ancestors.FindFromIndex
+        # one flat fromiter over Coord() tuples (no array per vertex)
+        pts = np.fromiter(chain.from_iterable(pnt(vertex(key(i))).Coord() for i in range(1, n + 1)), float, 3 * n)
+        visits = np.fromiter((edges(i).Size() for i in range(1, n + 1)), int, n)
+    return np.repeat(pts.reshape(n, 3), np.maximum(visits, 1), axis=0).mean(axis=0)
+
+
+def bounding_box(shape, *, optimal: bool = True) -> np.ndarray:
+    """``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` of a ``TopoDS_Shape`` or build123d
+    shape: the tight box (``BRepBndLib.AddOptimal``), or with ``optimal=False`` OCCT's quick
+    box (from a stored triangulation, else the control points, enlarged by the shape
+    tolerance: a cheap upper bound).  The one bounding box of the kernel door."""
+    inner = wrapped(shape)
+    shape = shape if inner is None else inner
+    with kernel("BRepBndLib.AddOptimal_s" if optimal else "BRepBndLib.Add"):
+        box = Bnd_Box()
+        if optimal:
+            BRepBndLib.AddOptimal_s(shape, box, False, False)
+        else:
+            BRepBndLib.Add_s(shape, box, True)
+        return np.array(box.Get()).reshape(2, 3)

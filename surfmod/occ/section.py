@@ -1,0 +1,63 @@
+"""Plane sections of shapes (``BRepAlgoAPI_Section``, edges chained into wires) and the
+planar faces lying in a plane: the same concept as :mod:`surfmod.uses.section`, one level
+down (that module turns these wires into section curves and areas)."""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
+from OCP.GeomAbs import GeomAbs_Plane
+from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopoDS import TopoDS
+from OCP.TopTools import TopTools_HSequenceOfShape
+
+from ..errors import SurfmodError
+from .arrays import xyz
+from .guard import kernel
+from .topo import explore as _explore
+from .topo import faces_of
+
+
+def section_edges(shape, origin, normal):
+    """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
+    end to end with ``ShapeAnalysis_FreeBounds``)."""
+    import build123d as bd
+
+    with kernel("BRepAlgoAPI_Section"):
+        pln = gp_Pln(gp_Pnt(*map(float, origin)), gp_Dir(*map(float, normal)))
+        op = BRepAlgoAPI_Section(shape, pln, False)
+        op.Approximation(False)
+        op.ComputePCurveOn1(False)
+        op.Build()
+        if not op.IsDone():
+            raise SurfmodError("obj: OCCT could not section this shape")
+        edges = _explore(op.Shape(), TopAbs_EDGE)
+        if not edges:
+            return []
+        seq = TopTools_HSequenceOfShape()
+        for e in edges:
+            seq.Append(e)
+        wires = TopTools_HSequenceOfShape()
+        ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(seq, 1e-6, False, wires)
+        return [bd.Wire(TopoDS.Wire_s(wires.Value(i))) for i in range(1, wires.Length() + 1)]
+
+
+def planar_faces_on(shape, origin, normal, tol: float) -> list[int]:
+    """Exploration indices of the planar faces of ``shape`` that lie in the plane
+    ``(origin, normal)`` (parallel within 1e-9, offset within ``tol``): OCCT's plane of
+    each face, with the face's location applied (``BRepAdaptor_Surface``)."""
+    origin, normal = np.asarray(origin, dtype=float), np.asarray(normal, dtype=float)
+    out = []
+    with kernel("BRepAdaptor_Surface (planar faces)"):
+        for i, face in enumerate(faces_of(shape)):
+            adaptor = BRepAdaptor_Surface(face, False)
+            if adaptor.GetType() != GeomAbs_Plane:
+                continue
+            ax = adaptor.Plane().Axis()
+            z, o = xyz(ax.Direction()), xyz(ax.Location())
+            if abs(abs(float(z @ normal)) - 1.0) < 1e-9 and abs(float((o - origin) @ normal)) < tol:
+                out.append(i)
+    return out

@@ -1,0 +1,101 @@
+"""Closed solids from faces and shells (``BRepBuilderAPI_Sewing``, ``BRepBuilderAPI_MakeSolid``):
+what volume work (mass properties, FE meshes, interference) is given to measure."""
+
+from __future__ import annotations
+
+from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+from OCP.BRepLib import BRepLib
+from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+from OCP.TopoDS import TopoDS_Shell
+
+from ..errors import SurfmodError
+from .guard import check_done, kernel
+from .topo import compound, shells_of, solids_of
+from .topo import explore as _explore
+
+SEW_TOLERANCE = 1e-6
+
+
+def model_tolerance(shape) -> float:
+    """The largest edge tolerance of ``shape`` (what the writing system vouched for)."""
+    with kernel("ShapeAnalysis_ShapeTolerance"):
+        return float(ShapeAnalysis_ShapeTolerance().Tolerance(shape, 1, TopAbs_EDGE))
+
+
+def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
+    """Sew faces into a closed shell and make an outward-oriented solid.
+
+    Raises ``SurfmodError`` when the faces do not close up.
+    """
+    with kernel("BRepBuilderAPI_Sewing"):
+        sewing = BRepBuilderAPI_Sewing(tolerance)
+        for f in face_shapes:
+            sewing.Add(f)
+        sewing.Perform()
+        sewed = sewing.SewedShape()
+    shells = shells_of(sewed)
+    if len(shells) != 1 or not BRep_Tool.IsClosed_s(shells[0]):
+        raise SurfmodError(
+            f"obj: the {len(face_shapes)} faces do not sew into one closed shell at tolerance {tolerance:.3g} "
+            f"(got {len(shells)} shell(s), free edges remain): volume needs a closed boundary"
+        )
+    with kernel("BRepBuilderAPI_MakeSolid"):
+        maker = BRepBuilderAPI_MakeSolid(shells[0])
+        check_done(maker, "BRepBuilderAPI_MakeSolid")
+        solid = maker.Solid()
+        BRepLib.OrientClosedSolid_s(solid)
+    return solid
+
+
+def _solid_of_shell(shell, what: str):
+    """A solid bounded by one shell; an open shell is sewn at the model's own tolerance
+    first (loose faces that OCCT sewing joins), and refused only if it stays open."""
+    if not BRep_Tool.IsClosed_s(shell):
+        tol = max(SEW_TOLERANCE, model_tolerance(shell))
+        try:
+            return sew_solid(_explore(shell, TopAbs_FACE), tol)
+        except SurfmodError:
+            raise SurfmodError(f"obj: {what} is not closed (free edges remain after sewing at the model's tolerance "
+                               f"{tol:.3g}): volume needs a closed boundary") from None
+    with kernel("BRepBuilderAPI_MakeSolid"):
+        solid = BRepBuilderAPI_MakeSolid(shell).Solid()
+        BRepLib.OrientClosedSolid_s(solid)
+    return solid
+
+
+def closed_solid(shape):
+    """A closed solid (or compound of them) for volume work; open shells are sewn at the
+    model's tolerance and refused if they stay open."""
+    solids = solids_of(shape)
+    if solids:
+        out = []
+        for i, s in enumerate(solids):
+            shells = shells_of(s)
+            if all(BRep_Tool.IsClosed_s(sh) for sh in shells):
+                out.append(s)
+            elif len(shells) == 1:
+                out.append(_solid_of_shell(shells[0], f"solid {i}"))
+            else:
+                raise SurfmodError(f"obj: solid {i} has an open shell among {len(shells)} (free edges): "
+                                   "volume needs a closed boundary")
+        return out[0] if len(out) == 1 else compound(out)
+    shells = shells_of(shape)
+    if shells:
+        out = [_solid_of_shell(sh, f"shell {i}") for i, sh in enumerate(shells)]
+        return out[0] if len(out) == 1 else compound(out)
+    faces = _explore(shape, TopAbs_FACE)
+    if not faces:
+        raise SurfmodError("obj: has no faces, so no solid to measure")
+    # faces that already share their edges (e.g. one periodic face: a full sphere or
+    # torus closed by its own seam and poles) form a closed shell without sewing
+
+    builder = BRep_Builder()
+    shell = TopoDS_Shell()
+    builder.MakeShell(shell)
+    for f in faces:
+        builder.Add(shell, f)
+    if BRep_Tool.IsClosed_s(shell):
+        return _solid_of_shell(shell, "the shell of its faces")
+    return sew_solid(faces, max(SEW_TOLERANCE, model_tolerance(shape)))
