@@ -144,6 +144,28 @@ def test_loops_are_closed_oriented_and_nested():
     assert areas[1] == pytest.approx(400 + 80 + math.pi, rel=1e-5)
 
 
+@pytest.mark.parametrize("kind, R, r", [("ball", 1.5, 0.0), ("bull", 1.5, 0.5), ("flat", 1.5, 0.0)])
+def test_levels_together_equal_levels_alone(kind, R, r):
+    """Several levels in one call (unsorted) give each level's loops of a call of its own:
+    the triangles wholly above a level's corner height, met once and carried down the
+    levels, forbid what they forbid when met at that level.  A pyramid and, beside it, a
+    shelf at z = 6 whose band joins the pyramid's offset at the low levels."""
+    a, top = 10.0, 8.0
+    base = np.array([[-a, -a, 0], [a, -a, 0], [a, a, 0], [-a, a, 0]], float)
+    tri = [[base[k], base[(k + 1) % 4], [0.0, 0.0, top]] for k in range(4)]
+    shelf = square(6.0, z=6.0)
+    shelf[..., 0] += a + 0.5
+    tri = np.concatenate([np.array(tri), shelf])
+    levels = [1.0, 5.5, 3.0, 0.2, 6.2]
+    together = waterline(tri, tool(kind, R, r), levels, sampling=0.4)
+    for z, loops in zip(levels, together):
+        (alone,) = waterline(tri, tool(kind, R, r), [z], sampling=0.4)
+        assert len(loops) == len(alone) >= 1
+        assert (max(lp[:, 0].max() for lp in loops) > 16.5) == (z < 6.0)  # the shelf's band
+        for p, q in zip(loops, alone):
+            assert p.shape == q.shape and np.abs(p - q).max() < 1e-12
+
+
 def test_bad_input_and_bounds():
     with pytest.raises(SurfmodError, match="tool"):
         waterline(square(), tool("drill", 1.0), [0.0])

@@ -53,6 +53,18 @@ def _tool_shape(tool):
 # ----------------------------------------------------------------------------------------------
 # fibers against the mesh
 
+class _Shank:
+    """Per grid line of one direction, the merged intervals forbidden by the triangles
+    wholly above ``floor``.  A triangle above a level's corner height z + rc meets the tool
+    with the shank alone, in the band within R of its (x, y) shadow: the same at every
+    lower level, so it is met once and carried down (on a part that is mostly above the
+    level, most triangles are), not once per level."""
+
+    def __init__(self):
+        self.floor = np.inf
+        self.comp = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+
+
 class _Fibers:
     """The part's triangles for fiber queries at one tool: bucketed for short fibers."""
 
@@ -60,33 +72,44 @@ class _Fibers:
         self.tri = triangles
         self.kind, self.R, self.rc = kind, R, rc
         self.top = triangles[:, :, 2].max(axis=1)
+        self.bottom = triangles[:, :, 2].min(axis=1)
         self.grid = TriangleGrid(triangles, R + reach)
         self.lo = triangles[:, :, :2].min(axis=1)
         self.hi = triangles[:, :, :2].max(axis=1)
 
-    def lines(self, at, axis: int, z):
+    def lines(self, at, axis: int, z, shank: "_Shank"):
         """Merged components ``(start, end)`` along each grid line: the lines
         ``coordinate[axis] = at[k]``, running along the other axis (positions measured
-        along it)."""
-        other = 1 - axis
-        tri = self.tri
-        lo = tri[:, :, axis].min(axis=1) - self.R
-        hi = tri[:, :, axis].max(axis=1) + self.R
-        live = np.flatnonzero(self.top >= z)
-        k0 = np.searchsorted(at, lo[live], "left")
-        k1 = np.searchsorted(at, hi[live], "right")
+        along it).  ``shank`` carries the components of the triangles wholly above
+        ``z + rc`` from the level above (levels must come top first); only the triangles
+        new to it and those reaching into [z, z + rc) are met here."""
+        corner = z + self.rc
+        joined = np.flatnonzero((self.bottom >= corner) & (self.bottom < shank.floor))
+        shank.floor = corner
+        if len(joined):
+            shank.comp = _components(*(np.concatenate(pair) for pair in zip(shank.comp, self._hits(at, axis, z, joined))))
+        band = np.flatnonzero((self.top >= z) & (self.bottom < corner))
+        c_line, c_lo, c_hi = _components(*(np.concatenate(pair) for pair in zip(shank.comp, self._hits(at, axis, z, band))))
+        bounds = np.searchsorted(c_line, np.arange(len(at) + 1))
+        return [(c_lo[bounds[k]:bounds[k + 1]], c_hi[bounds[k]:bounds[k + 1]]) for k in range(len(at))]
+
+    def _hits(self, at, axis: int, z, which):
+        """``(line, t0, t1)`` of every grid line that the triangles ``which`` forbid an
+        interval of (the lines within R of a triangle's box)."""
+        lo = self.lo[which, axis] - self.R
+        hi = self.hi[which, axis] + self.R
+        k0 = np.searchsorted(at, lo, "left")
+        k1 = np.searchsorted(at, hi, "right")
         n = np.maximum(k1 - k0, 0)
-        ti = np.repeat(live, n)
+        ti = np.repeat(which, n)
         li = np.repeat(k0, n) + np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
         o = np.zeros((len(ti), 2))
         o[:, axis] = at[li]
         d = np.zeros((len(ti), 2))
-        d[:, other] = 1.0
+        d[:, 1 - axis] = 1.0
         t0, t1 = pair_intervals(self.grid.rows, ti, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, self.kind, self.R, self.rc)
         hit = t0 <= t1
-        c_line, c_lo, c_hi = _components(li[hit], t0[hit], t1[hit])
-        bounds = np.searchsorted(c_line, np.arange(len(at) + 1))
-        return [(c_lo[bounds[k]:bounds[k + 1]], c_hi[bounds[k]:bounds[k + 1]]) for k in range(len(at))]
+        return li[hit], t0[hit], t1[hit]
 
     def query(self, o, d, z, reach):
         """Per fiber (the segment ``o ± reach d``: origin (F, 2), unit direction (F, 2),
@@ -171,11 +194,12 @@ def _line_crossings(t, state, c_lo, c_hi):
     return out
 
 
-def _grid_contours(fib: _Fibers, z, x, y):
-    """Closed loops (arrays of (x, y)) of the forbidden region's boundary found on the grid."""
+def _grid_contours(fib: _Fibers, z, x, y, shanks):
+    """Closed loops (arrays of (x, y)) of the forbidden region's boundary found on the grid
+    (``shanks``: the rows' and the columns' :class:`_Shank`, levels top first)."""
     nx, ny = len(x), len(y)
-    rows = fib.lines(y, 1, z)  # per row j: components along x
-    cols = fib.lines(x, 0, z)  # per column i: components along y
+    rows = fib.lines(y, 1, z, shanks[0])  # per row j: components along x
+    cols = fib.lines(x, 0, z, shanks[1])  # per column i: components along y
     state = np.zeros((nx, ny), bool)
     for j, (c_lo, c_hi) in enumerate(rows):
         if len(c_lo):
@@ -329,10 +353,12 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     if per_level * len(levels) > MAX_PAIRS:
         raise SurfmodError(f"sampling: {sampling} gives ~{per_level * len(levels):.3g} fiber-triangle pairs "
                            f"over {len(levels)} levels (limit {MAX_PAIRS:.0e}); choose a coarser sampling")
-    out = []
-    for z in levels:
-        loops = _grid_contours(fib, z, x, y)
+    out = [None] * len(levels)
+    shanks = (_Shank(), _Shank())
+    for k in np.argsort(-levels, kind="stable"):  # top first: the shank intervals carry down
+        z = levels[k]
+        loops = _grid_contours(fib, z, x, y, shanks)
         if loops:
             loops = _refine(fib, z, loops, tol, 1.5 * h)
-        out.append([np.column_stack([p, np.full(len(p), z)]) for p in loops])
+        out[k] = [np.column_stack([p, np.full(len(p), z)]) for p in loops]
     return out
