@@ -188,8 +188,10 @@ def main() -> None:
     table.row(f"cam_part.step ({hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} x {hi[2] - lo[2]:.3g} mm stock)", ops,
               f"{t_job:.2f}", f"{t_post:.2f}", str(lines), str(sum(len(op.motion.points) for op in job.operations)),
               "< 60 s")
-    note("machine s includes reading the STEP file, meshing, roughing (height field, rings, every move checked) "
-         "and finishing (drop-cutter zig-zag, every move checked); post s is the LinuxCNC program with its arcs.")
+    note("machine s (the first work of the process: it includes loading the compiled kernels from numba's cache) "
+         "covers reading the STEP file, meshing, roughing (height field, rings, every move checked) and finishing "
+         "(waterline contours on the steep slopes and the drop-cutter zig-zag, every move checked); post s is the "
+         "LinuxCNC program with its arcs.")
     heading("waterline and drop-cutter beside OpenCAMLib (one core each side)")
     table = Table(("part", 40, "<"), ("tool", 5), ("kernel", 11), ("size", 24), ("ours s", 8), ("OCL s", 8),
                   ("ratio", 6), ("agreement", 18))

@@ -16,6 +16,8 @@ from ocl_reference import drop as ocl_drop
 from ocl_reference import polyline_distance
 from ocl_reference import waterline as ocl_waterline
 
+from surfmod.cam.drop_cutter import TriangleGrid, drop
+from surfmod.cam.fiber_contact import intervals
 from surfmod.cam.waterline import waterline
 from surfmod.errors import SurfmodError
 
@@ -142,6 +144,28 @@ def test_loops_are_closed_oriented_and_nested():
     assert areas[1] == pytest.approx(400 + 80 + math.pi, rel=1e-5)
 
 
+@pytest.mark.parametrize("kind, R, r", [("ball", 1.5, 0.0), ("bull", 1.5, 0.5), ("flat", 1.5, 0.0)])
+def test_levels_together_equal_levels_alone(kind, R, r):
+    """Several levels in one call (unsorted) give each level's loops of a call of its own:
+    the triangles wholly above a level's corner height, met once and carried down the
+    levels, forbid what they forbid when met at that level.  A pyramid and, beside it, a
+    shelf at z = 6 whose band joins the pyramid's offset at the low levels."""
+    a, top = 10.0, 8.0
+    base = np.array([[-a, -a, 0], [a, -a, 0], [a, a, 0], [-a, a, 0]], float)
+    tri = [[base[k], base[(k + 1) % 4], [0.0, 0.0, top]] for k in range(4)]
+    shelf = square(6.0, z=6.0)
+    shelf[..., 0] += a + 0.5
+    tri = np.concatenate([np.array(tri), shelf])
+    levels = [1.0, 5.5, 3.0, 0.2, 6.2]
+    together = waterline(tri, tool(kind, R, r), levels, sampling=0.4)
+    for z, loops in zip(levels, together):
+        (alone,) = waterline(tri, tool(kind, R, r), [z], sampling=0.4)
+        assert len(loops) == len(alone) >= 1
+        assert (max(lp[:, 0].max() for lp in loops) > 16.5) == (z < 6.0)  # the shelf's band
+        for p, q in zip(loops, alone):
+            assert p.shape == q.shape and np.abs(p - q).max() < 1e-12
+
+
 def test_bad_input_and_bounds():
     with pytest.raises(SurfmodError, match="tool"):
         waterline(square(), tool("drill", 1.0), [0.0])
@@ -157,6 +181,44 @@ def test_bad_input_and_bounds():
         waterline(square(), tool("ball", 1.0), [0.0], sampling=-1)
     with pytest.raises(SurfmodError, match="sampling"):  # the work estimate refuses before starting
         waterline(square(1000.0), tool("ball", 1.0), np.zeros(50), sampling=1e-3)
+
+
+@pytest.mark.parametrize("kind, R, r", [("ball", 1.5, 1.5), ("flat", 1.5, 0.0), ("bull", 1.5, 0.6)])
+def test_fiber_intervals_are_where_the_dropped_tool_reaches_z(kind, R, r):
+    """Per (fiber, triangle) pair the interval is exactly where the tool at tip height z
+    meets the triangle, i.e. where the drop-cutter (an independent solver: its bull edge is
+    a bisection on the height's derivative, the waterline's an ellipse offset) stops at or
+    above z: along the fiber the dropped tip is above z inside the interval and below
+    outside, up to the ends.  Random triangles, some with a level edge, each placed
+    in its own 20 mm cell so that one grid drops on all of them."""
+    rng = np.random.default_rng(11)
+    side = 40
+    n = side * side
+    tri = rng.random((n, 3, 3)) * 6 - 3
+    tri[: n // 4, 1, 2] = tri[: n // 4, 0, 2]
+    cell = 20.0 * np.column_stack([np.arange(n) % side, np.arange(n) // side])
+    tri[:, :, :2] += cell[:, None, :]
+    ang = rng.random(n) * 2 * np.pi
+    d = np.column_stack([np.cos(ang), np.sin(ang)])
+    o = cell + rng.random((n, 2)) * 6 - 3 - 5 * d
+    z = -0.5
+    t0, t1 = intervals(tri, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, kind, R, r)
+    grid = TriangleGrid(tri, R)
+    hit = t0 <= t1
+    assert 0.3 < hit.mean() < 0.9
+    # just inside each end the dropped tip is at or above z, just outside at or below it
+    # (a shank-bounded end is a jump, a profile-bounded one a square-root slope)
+    step = 1e-9
+    for t, inward in ((t0[hit], 1.0), (t1[hit], -1.0)):
+        h_in = drop(grid, kind, o[hit] + (t + inward * step)[:, None] * d[hit], corner=r)
+        h_out = np.nan_to_num(drop(grid, kind, o[hit] + (t - inward * step)[:, None] * d[hit], corner=r), nan=-np.inf)
+        assert h_in.min() > z - 1e-4 and h_out.max() < z + 1e-4
+    ts = np.linspace(-1.0, 11.0, 49)
+    h = drop(grid, kind, (o[:, None, :] + ts[None, :, None] * d[:, None, :]).reshape(-1, 2), corner=r)
+    h = np.nan_to_num(h, nan=-np.inf).reshape(n, len(ts))
+    inside = (ts[None, :] >= t0[:, None]) & (ts[None, :] <= t1[:, None])
+    assert not np.any(inside & (h < z - 1e-9))
+    assert not np.any(~inside & (h > z + 1e-9))
 
 
 # --- OpenCAMLib ---------------------------------------------------------------------------------

@@ -65,8 +65,7 @@ class TriangleGrid:
     def __init__(self, triangles: np.ndarray, radius: float):
         self.triangles = np.ascontiguousarray(triangles, dtype=float)
         self.radius = float(radius)
-        # one row of 12 per triangle for the compiled kernel: a, b, c (x, y, z each), upward unit normal
-        self.rows = np.ascontiguousarray(np.hstack([self.triangles.reshape(-1, 9), _upward_normals(self.triangles)]))
+        self.rows = triangle_rows(self.triangles)
         self.top = self.triangles[:, :, 2].max(axis=1)
         lo = self.triangles[:, :, :2].min(axis=1) - self.radius
         hi = self.triangles[:, :, :2].max(axis=1) + self.radius
@@ -122,6 +121,17 @@ class TriangleGrid:
         (each entry costs a box test, most of them nothing more), known before it is done."""
         start, stop = self.segments(np.asarray(xy, dtype=float).reshape(-1, 2))
         return int(np.maximum(stop - start, 0).sum())
+
+
+def triangle_rows(tri: np.ndarray) -> np.ndarray:
+    """One row of 12 per triangle for the compiled kernels: a, b, c (x, y, z each), then
+    the upward unit normal.
+
+    >>> triangle_rows(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 1]]], float))[0, 9:].round(4).tolist()
+    [0.0, -0.7071, 0.7071]
+    """
+    tri = np.asarray(tri, dtype=float)
+    return np.ascontiguousarray(np.hstack([tri.reshape(-1, 9), _upward_normals(tri)]))
 
 
 def _upward_normals(tri: np.ndarray) -> np.ndarray:

@@ -5,24 +5,10 @@ flat, ball, or bull = flat core of radius ``R - r`` rounded by a torus of corner
 ``r``) may stand at the (x, y) positions where it meets no triangle; the waterline is
 the boundary of the positions where it does.  That set is, per triangle, convex (the
 tool and the triangle are convex), so along any horizontal line ("fiber") each triangle
-forbids one interval of positions, whose ends are solved in closed form from the
-triangle's features, as OpenCAMLib's push-cutter does:
+forbids one interval of positions, whose ends :mod:`surfmod.cam.fiber_contact` solves in
+closed form from the triangle's features, as OpenCAMLib's push-cutter does.
 
-* a vertex (or a point where an edge crosses height ``z`` or ``z + r``) forbids a disc
-  of the tool's radius at that height;
-* an edge's part above ``z + r`` (r the corner radius; the whole edge above ``z`` for a
-  flat end) forbids the band within ``R`` of its (x, y) projection: the fiber meets the
-  two offset lines;
-* an edge's part between ``z`` and ``z + r`` is touched by the ball (the centre line
-  meets the cylinder of radius ``R`` round the edge: a quadratic) or by the torus (the
-  core circle's centre meets the ellipse where that cylinder of radius ``r`` cuts the
-  plane ``z + r``, offset by ``R - r``: roots bracketed on the ellipse's angle, then
-  bisected);
-* a facet is touched by the tool's support point along its normal (linear in the
-  position along the fiber), kept when that point falls inside the triangle.
-
-Every candidate is a position where the tool touches the triangle, so the interval is
-the smallest and largest of them.  The contours come from a grid of fibers of spacing
+The contours come from a grid of fibers of spacing
 ``sampling``: node states (inside or outside) and the exact crossing on every grid edge
 whose nodes differ, joined cell by cell (marching squares, the material kept on the
 left) into closed loops; then every chord whose midpoint lies farther than
@@ -36,17 +22,15 @@ after ``MAX_REFINE`` rounds (each halves the chord error's scale).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..errors import SurfmodError
 from .drop_cutter import TriangleGrid
+from .fiber_contact import pair_intervals
 
 MAX_PAIRS = 200_000_000  # (fiber, triangle) pairs over all levels: beyond this, coarsen sampling
 PAIRS_PER_BLOCK = 400_000
 MAX_REFINE = 30
-TORUS_SAMPLES = 48  # angle samples bracketing the torus-edge roots (at most 4 per edge)
 
 
 def _tool_shape(tool):
@@ -67,259 +51,19 @@ def _tool_shape(tool):
 
 
 # ----------------------------------------------------------------------------------------------
-# per (fiber, triangle) pair: the interval of positions where the tool meets the triangle
-
-def _profile_radius(h, R, rc):
-    """Tool radius at height ``h`` ≥ 0 above the tip (R above the corner)."""
-    core = R - rc
-    hc = np.clip(h, 0.0, rc)
-    return np.where(h >= rc, R, core + np.sqrt(np.maximum(rc * rc - (rc - hc) ** 2, 0.0)))
-
-
-class _Span:
-    """Running min / max of candidate positions per pair."""
-
-    def __init__(self, n):
-        self.lo = np.full(n, np.inf)
-        self.hi = np.full(n, -np.inf)
-
-    def add(self, t, ok):
-        t = np.where(ok, t, np.nan)
-        self.lo = np.fmin(self.lo, t)
-        self.hi = np.fmax(self.hi, t)
-
-
-def _disc(span, px, py, radius, ok, ox, oy, dx, dy):
-    wx, wy = px - ox, py - oy
-    along = wx * dx + wy * dy
-    off = wx * dy - wy * dx
-    g = radius * radius - off * off
-    ok = ok & (g >= 0)
-    root = np.sqrt(np.where(ok, g, 0.0))
-    span.add(along - root, ok)
-    span.add(along + root, ok)
-
-
-def intervals(tri, ox, oy, dx, dy, z, kind: str, R: float, rc: float):
-    """``(t0, t1)`` per pair: positions ``o + t d`` along each pair's fiber (unit ``d``,
-    horizontal, tip height ``z``) where the tool meets the pair's triangle ``tri``
-    ``(P, 3, 3)``; ``t0 = inf, t1 = -inf`` where it never does."""
-    n = len(ox)
-    span = _Span(n)
-    core = R - rc
-    for j in range(3):
-        p, q = tri[:, j], tri[:, (j + 1) % 3]
-        h0 = p[:, 2] - z
-        _disc(span, p[:, 0], p[:, 1], _profile_radius(h0, R, rc), h0 >= 0, ox, oy, dx, dy)
-        e = q - p
-        ez = e[:, 2]
-        flat_edge = np.abs(ez) < 1e-300
-        safe_ez = np.where(flat_edge, 1.0, ez)
-        # crossings of the heights z and z + rc: points whose disc is the profile's there
-        for level, radius in ((0.0, core), (rc, R)) if rc > 0 else ((0.0, R),):
-            u = (level - h0) / safe_ez
-            ok = ~flat_edge & (u > 0) & (u < 1)
-            _disc(span, p[:, 0] + u * e[:, 0], p[:, 1] + u * e[:, 1], radius, ok, ox, oy, dx, dy)
-        # the edge's parameter range above z + rc (cylinder) and within [z, z + rc) (end)
-        ua, ub = _above(h0, ez, flat_edge, rc)
-        _offset_lines(span, p, e, ua, ub, R, ox, oy, dx, dy)
-        if rc > 0:
-            uc, ud = _between(h0, ez, flat_edge, rc)
-            if kind == "ball":
-                _ball_edge(span, p, e, uc, ud, z, R, ox, oy, dx, dy)
-            else:
-                _torus_edge(span, p, e, uc, ud, z, R, rc, ox, oy, dx, dy)
-    _facet(span, tri, z, kind, R, rc, ox, oy, dx, dy)
-    return span.lo, span.hi
-
-
-def _above(h0, ez, flat_edge, level):
-    """Parameter range ``[ua, ub]`` of each edge where its height above z is ≥ level
-    (empty: ua > ub)."""
-    safe = np.where(flat_edge, 1.0, ez)
-    u = (level - h0) / safe
-    ua = np.where(flat_edge, np.where(h0 >= level, 0.0, 2.0), np.where(ez > 0, np.maximum(u, 0), 0.0))
-    ub = np.where(flat_edge, np.where(h0 >= level, 1.0, -1.0), np.where(ez > 0, 1.0, np.minimum(u, 1)))
-    return ua, ub
-
-
-def _between(h0, ez, flat_edge, rc):
-    a0, b0 = _above(h0, ez, flat_edge, 0.0)
-    a1, b1 = _above(h0, ez, flat_edge, rc)
-    # [z, z + rc) is the range above 0 minus the range above rc: one piece since the edge is straight
-    lo = np.where(ez > 0, a0, np.where(ez < 0, np.maximum(a0, b1), a0))
-    hi = np.where(ez > 0, np.minimum(b0, a1), np.where(ez < 0, b0, np.where(flat_edge & (h0 >= rc), -1.0, b0)))
-    return lo, hi
-
-
-def _offset_lines(span, p, e, ua, ub, R, ox, oy, dx, dy):
-    ex, ey = e[:, 0], e[:, 1]
-    L = np.hypot(ex, ey)
-    ok0 = (ub >= ua) & (L > 0)
-    Ls = np.where(L > 0, L, 1.0)
-    nx, ny = -ey / Ls, ex / Ls
-    det = -dx * ey + ex * dy  # of [d, -e] (columns)
-    ok0 &= np.abs(det) > 1e-14 * Ls
-    det = np.where(ok0, det, 1.0)
-    for side in (1.0, -1.0):
-        bx = p[:, 0] + side * R * nx - ox
-        by = p[:, 1] + side * R * ny - oy
-        t = (bx * -ey + ex * by) / det
-        u = (dx * by - dy * bx) / det
-        span.add(t, ok0 & (u >= ua) & (u <= ub))
-
-
-def _ball_edge(span, p, e, uc, ud, z, R, ox, oy, dx, dy):
-    Le = np.linalg.norm(e, axis=1)
-    ok0 = (ud >= uc) & (Le > 0)
-    L = np.where(Le > 0, Le, 1.0)
-    ux, uy, uz = e[:, 0] / L, e[:, 1] / L, e[:, 2] / L
-    wx, wy, wz = ox - p[:, 0], oy - p[:, 1], z + R - p[:, 2]
-    De = dx * ux + dy * uy
-    we = wx * ux + wy * uy + wz * uz
-    a = 1.0 - De * De
-    b = wx * dx + wy * dy - we * De
-    c = wx * wx + wy * wy + wz * wz - we * we - R * R
-    disc = b * b - a * c
-    ok0 &= (a > 1e-14) & (disc >= 0)
-    a = np.where(ok0, a, 1.0)
-    root = np.sqrt(np.where(ok0, disc, 0.0))
-    for t in ((-b - root) / a, (-b + root) / a):
-        u = (we + t * De) / L
-        span.add(t, ok0 & (u >= uc) & (u <= ud))
-
-
-def _torus_edge(span, p, e, uc, ud, z, R, rc, ox, oy, dx, dy):
-    """Torus end against the edge's part between z and z + rc: the core circle's centre
-    (at height z + rc) lies at distance R - rc from the ellipse in which the cylinder of
-    radius rc round the edge's line cuts that plane.  Roots of the fiber's offset from
-    that ellipse's offset curve are bracketed on the ellipse angle and bisected."""
-    ok0 = ud >= uc
-    _torus_level_edge(span, p, e, uc, ud, z, R, rc, ox, oy, dx, dy, ok0)
-    idx = np.flatnonzero(ok0 & (np.abs(e[:, 2]) > 1e-12 * np.linalg.norm(e, axis=1)))
-    if not len(idx):
-        return
-    P, E = p[idx], e[idx]
-    Ox, Oy, Dx, Dy = ox[idx], oy[idx], dx[idx], dy[idx]
-    L = np.linalg.norm(E, axis=1)
-    a = E / L[:, None]
-    # the edge line meets the plane z + rc at the ellipse centre
-    s0 = (z + rc - P[:, 2]) / a[:, 2]
-    cx, cy = P[:, 0] + s0 * a[:, 0], P[:, 1] + s0 * a[:, 1]
-    # ellipse: semi-axis rc across the line's horizontal direction, rc / |a_z| along it
-    hxy = np.hypot(a[:, 0], a[:, 1])
-    tilted = hxy > 1e-15
-    ux = np.where(tilted, a[:, 0] / np.where(tilted, hxy, 1.0), 1.0)
-    uy = np.where(tilted, a[:, 1] / np.where(tilted, hxy, 1.0), 0.0)
-    A = rc / np.abs(a[:, 2])  # along (ux, uy)
-    B = np.full_like(A, rc)  # along (-uy, ux)
-    core = R - rc
-
-    th = np.linspace(0.0, 2 * np.pi, TORUS_SAMPLES + 1)[None, :].repeat(len(idx), 0)
-    f = _curve_at(th, *(k[:, None] for k in (cx, cy, A, B, ux, uy, Ox, Oy, Dx, Dy)), core)[0]
-    sign = np.signbit(f)
-    cross = sign[:, :-1] != sign[:, 1:]
-    rows, cols = np.nonzero(cross)
-    if not len(rows):
-        return
-    lo, hi = th[rows, cols], th[rows, cols + 1]
-    sub = idx[rows]
-
-    def curve_rows(t):
-        keep = (cx, cy, A, B, ux, uy, Ox, Oy, Dx, Dy)
-        return _curve_at(t, *(k[rows] for k in keep), core)
-
-    flo = curve_rows(lo)[0]
-    for _ in range(44):  # 2π/48 / 2^44: 1e-14 rad
-        mid = 0.5 * (lo + hi)
-        fm = curve_rows(mid)[0]
-        same = np.signbit(fm) == np.signbit(flo)
-        lo = np.where(same, mid, lo)
-        flo = np.where(same, fm, flo)
-        hi = np.where(same, hi, mid)
-    _, t, qx, qy = curve_rows(0.5 * (lo + hi))
-    # the contact's edge parameter: the ellipse point's foot on the edge line
-    Pr, ar = P[rows], a[rows]
-    foot = ((qx - Pr[:, 0]) * ar[:, 0] + (qy - Pr[:, 1]) * ar[:, 1] + (z + rc - Pr[:, 2]) * ar[:, 2]) / L[rows]
-    good = (foot >= uc[sub]) & (foot <= ud[sub])
-    # scatter into the span of the pairs (several roots per pair: fmin/fmax per root)
-    lo_t = np.full(len(span.lo), np.inf)
-    hi_t = np.full(len(span.lo), -np.inf)
-    np.minimum.at(lo_t, sub[good], t[good])
-    np.maximum.at(hi_t, sub[good], t[good])
-    span.lo = np.minimum(span.lo, lo_t)
-    span.hi = np.maximum(span.hi, hi_t)
-
-
-def _curve_at(th, cx, cy, A, B, ux, uy, Ox, Oy, Dx, Dy, core):
-    c, s = np.cos(th), np.sin(th)
-    qx = cx + A * c * ux - B * s * uy
-    qy = cy + A * c * uy + B * s * ux
-    gx, gy = c / A, s / B
-    g = np.hypot(gx, gy)
-    nx = (gx * ux - gy * uy) / g
-    ny = (gx * uy + gy * ux) / g
-    fx, fy = qx + core * nx - Ox, qy + core * ny - Oy
-    return fx * Dy - fy * Dx, fx * Dx + fy * Dy, qx, qy
-
-
-def _torus_level_edge(span, p, e, uc, ud, z, R, rc, ox, oy, dx, dy, ok0):
-    """A level edge at height h in [0, rc): the band within the profile's radius there
-    of its (x, y) projection (offset lines of that radius)."""
-    level = ok0 & (np.abs(e[:, 2]) <= 1e-12 * np.linalg.norm(e, axis=1))
-    if not level.any():
-        return
-    h = p[:, 2] - z
-    rho = _profile_radius(h, R, rc)
-    ex, ey = e[:, 0], e[:, 1]
-    Ls = np.where(np.hypot(ex, ey) > 0, np.hypot(ex, ey), 1.0)
-    nx, ny = -ey / Ls, ex / Ls
-    det = -dx * ey + ex * dy
-    ok = level & (np.abs(det) > 1e-14 * Ls)
-    det = np.where(ok, det, 1.0)
-    for side in (1.0, -1.0):
-        bx = p[:, 0] + side * rho * nx - ox
-        by = p[:, 1] + side * rho * ny - oy
-        t = (bx * -ey + ex * by) / det
-        u = (dx * by - dy * bx) / det
-        span.add(t, ok & (u >= 0) & (u <= 1))
-
-
-def _facet(span, tri, z, kind, R, rc, ox, oy, dx, dy):
-    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
-    n = np.cross(b - a, c - a)
-    n *= np.where(n[:, 2:3] < 0, -1.0, 1.0)
-    ln = np.linalg.norm(n, axis=1)
-    n = n / np.where(ln > 0, ln, 1.0)[:, None]
-    nx, ny, nz = n[:, 0], n[:, 1], n[:, 2]
-    sxy = np.hypot(nx, ny)
-    ok = (nz > 1e-12) & (sxy > 1e-15)
-    sx = np.where(ok, nx / np.where(sxy > 0, sxy, 1.0), 0.0)
-    sy = np.where(ok, ny / np.where(sxy > 0, sxy, 1.0), 0.0)
-    # support point of the tool along -n, relative to the tip at (o + t d, z)
-    if kind == "ball":
-        px, py, pz = -R * nx, -R * ny, R - R * nz
-    elif kind == "flat":
-        px, py, pz = -R * sx, -R * sy, np.zeros_like(nz)
-    else:
-        px, py, pz = -(R - rc) * sx - rc * nx, -(R - rc) * sy - rc * ny, rc - rc * nz
-    rate = nx * dx + ny * dy
-    ok &= np.abs(rate) > 1e-15
-    s0x, s0y, s0z = ox + px - a[:, 0], oy + py - a[:, 1], z + pz - a[:, 2]
-    t = -(nx * s0x + ny * s0y + nz * s0z) / np.where(ok, rate, 1.0)
-    cx, cy = ox + t * dx + px, oy + t * dy + py
-    v0x, v0y, v1x, v1y = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1], c[:, 0] - a[:, 0], c[:, 1] - a[:, 1]
-    den = v0x * v1y - v1x * v0y
-    ok &= den != 0
-    den = np.where(ok, den, 1.0)
-    wx, wy = cx - a[:, 0], cy - a[:, 1]
-    l1 = (wx * v1y - v1x * wy) / den
-    l2 = (v0x * wy - wx * v0y) / den
-    span.add(t, ok & (l1 >= 0) & (l2 >= 0) & (l1 + l2 <= 1))
-
-
-# ----------------------------------------------------------------------------------------------
 # fibers against the mesh
+
+class _Shank:
+    """Per grid line of one direction, the merged intervals forbidden by the triangles
+    wholly above ``floor``.  A triangle above a level's corner height z + rc meets the tool
+    with the shank alone, in the band within R of its (x, y) shadow: the same at every
+    lower level, so it is met once and carried down (on a part that is mostly above the
+    level, most triangles are), not once per level."""
+
+    def __init__(self):
+        self.floor = np.inf
+        self.comp = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+
 
 class _Fibers:
     """The part's triangles for fiber queries at one tool: bucketed for short fibers."""
@@ -328,37 +72,44 @@ class _Fibers:
         self.tri = triangles
         self.kind, self.R, self.rc = kind, R, rc
         self.top = triangles[:, :, 2].max(axis=1)
+        self.bottom = triangles[:, :, 2].min(axis=1)
         self.grid = TriangleGrid(triangles, R + reach)
         self.lo = triangles[:, :, :2].min(axis=1)
         self.hi = triangles[:, :, :2].max(axis=1)
 
-    def lines(self, at, axis: int, z):
+    def lines(self, at, axis: int, z, shank: "_Shank"):
         """Merged components ``(start, end)`` along each grid line: the lines
         ``coordinate[axis] = at[k]``, running along the other axis (positions measured
-        along it)."""
-        other = 1 - axis
-        tri = self.tri
-        lo = tri[:, :, axis].min(axis=1) - self.R
-        hi = tri[:, :, axis].max(axis=1) + self.R
-        live = np.flatnonzero(self.top >= z)
-        k0 = np.searchsorted(at, lo[live], "left")
-        k1 = np.searchsorted(at, hi[live], "right")
+        along it).  ``shank`` carries the components of the triangles wholly above
+        ``z + rc`` from the level above (levels must come top first); only the triangles
+        new to it and those reaching into [z, z + rc) are met here."""
+        corner = z + self.rc
+        joined = np.flatnonzero((self.bottom >= corner) & (self.bottom < shank.floor))
+        shank.floor = corner
+        if len(joined):
+            shank.comp = _components(*(np.concatenate(pair) for pair in zip(shank.comp, self._hits(at, axis, z, joined))))
+        band = np.flatnonzero((self.top >= z) & (self.bottom < corner))
+        c_line, c_lo, c_hi = _components(*(np.concatenate(pair) for pair in zip(shank.comp, self._hits(at, axis, z, band))))
+        bounds = np.searchsorted(c_line, np.arange(len(at) + 1))
+        return [(c_lo[bounds[k]:bounds[k + 1]], c_hi[bounds[k]:bounds[k + 1]]) for k in range(len(at))]
+
+    def _hits(self, at, axis: int, z, which):
+        """``(line, t0, t1)`` of every grid line that the triangles ``which`` forbid an
+        interval of (the lines within R of a triangle's box)."""
+        lo = self.lo[which, axis] - self.R
+        hi = self.hi[which, axis] + self.R
+        k0 = np.searchsorted(at, lo, "left")
+        k1 = np.searchsorted(at, hi, "right")
         n = np.maximum(k1 - k0, 0)
-        ti = np.repeat(live, n)
+        ti = np.repeat(which, n)
         li = np.repeat(k0, n) + np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
         o = np.zeros((len(ti), 2))
         o[:, axis] = at[li]
         d = np.zeros((len(ti), 2))
-        d[:, other] = 1.0
-        t0, t1 = np.empty(len(ti)), np.empty(len(ti))
-        for s0 in range(0, len(ti), PAIRS_PER_BLOCK):
-            s1 = s0 + PAIRS_PER_BLOCK
-            t0[s0:s1], t1[s0:s1] = intervals(tri[ti[s0:s1]], o[s0:s1, 0], o[s0:s1, 1], d[s0:s1, 0], d[s0:s1, 1],
-                                             z, self.kind, self.R, self.rc)
+        d[:, 1 - axis] = 1.0
+        t0, t1 = pair_intervals(self.grid.rows, ti, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, self.kind, self.R, self.rc)
         hit = t0 <= t1
-        c_line, c_lo, c_hi = _components(li[hit], t0[hit], t1[hit])
-        bounds = np.searchsorted(c_line, np.arange(len(at) + 1))
-        return [(c_lo[bounds[k]:bounds[k + 1]], c_hi[bounds[k]:bounds[k + 1]]) for k in range(len(at))]
+        return li[hit], t0[hit], t1[hit]
 
     def query(self, o, d, z, reach):
         """Per fiber (the segment ``o ± reach d``: origin (F, 2), unit direction (F, 2),
@@ -374,7 +125,8 @@ class _Fibers:
             ext = np.abs(d[qg]) * reach[qg, None] + self.R
             keep = (self.top[ti] >= z) & np.all((o[qg] + ext >= self.lo[ti]) & (o[qg] - ext <= self.hi[ti]), axis=1)
             qg, ti = qg[keep], ti[keep]
-            lo, hi = intervals(self.tri[ti], o[qg, 0], o[qg, 1], d[qg, 0], d[qg, 1], z, self.kind, self.R, self.rc)
+            lo, hi = pair_intervals(self.grid.rows, ti, o[qg, 0], o[qg, 1], d[qg, 0], d[qg, 1], z,
+                                    self.kind, self.R, self.rc)
             hit = lo <= hi
             out_q.append(qg[hit]), out_lo.append(lo[hit]), out_hi.append(hi[hit])
         return np.concatenate(out_q), np.concatenate(out_lo), np.concatenate(out_hi)
@@ -442,11 +194,12 @@ def _line_crossings(t, state, c_lo, c_hi):
     return out
 
 
-def _grid_contours(fib: _Fibers, z, x, y):
-    """Closed loops (arrays of (x, y)) of the forbidden region's boundary found on the grid."""
+def _grid_contours(fib: _Fibers, z, x, y, shanks):
+    """Closed loops (arrays of (x, y)) of the forbidden region's boundary found on the grid
+    (``shanks``: the rows' and the columns' :class:`_Shank`, levels top first)."""
     nx, ny = len(x), len(y)
-    rows = fib.lines(y, 1, z)  # per row j: components along x
-    cols = fib.lines(x, 0, z)  # per column i: components along y
+    rows = fib.lines(y, 1, z, shanks[0])  # per row j: components along x
+    cols = fib.lines(x, 0, z, shanks[1])  # per column i: components along y
     state = np.zeros((nx, ny), bool)
     for j, (c_lo, c_hi) in enumerate(rows):
         if len(c_lo):
@@ -600,10 +353,12 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     if per_level * len(levels) > MAX_PAIRS:
         raise SurfmodError(f"sampling: {sampling} gives ~{per_level * len(levels):.3g} fiber-triangle pairs "
                            f"over {len(levels)} levels (limit {MAX_PAIRS:.0e}); choose a coarser sampling")
-    out = []
-    for z in levels:
-        loops = _grid_contours(fib, z, x, y)
+    out = [None] * len(levels)
+    shanks = (_Shank(), _Shank())
+    for k in np.argsort(-levels, kind="stable"):  # top first: the shank intervals carry down
+        z = levels[k]
+        loops = _grid_contours(fib, z, x, y, shanks)
         if loops:
             loops = _refine(fib, z, loops, tol, 1.5 * h)
-        out.append([np.column_stack([p, np.full(len(p), z)]) for p in loops])
+        out[k] = [np.column_stack([p, np.full(len(p), z)]) for p in loops]
     return out
