@@ -75,6 +75,10 @@ def interference(a, b, tolerance: float = 1e-6) -> Interference:
     tolerance = checks.positive(tolerance, "tolerance")
     sa = to_shape(a, "a", solid=True)
     sb = to_shape(b, "b", solid=True)
+    box = np.concatenate([occ.bounding_box(sa, optimal=False), occ.bounding_box(sb, optimal=False)])
+    # a contact distance below round-off of the pair's size is no request (the volume
+    # share uses the same number: at most 1, since the overlap is at most the smaller part)
+    checks.tolerance(tolerance, "tolerance", float(np.linalg.norm(np.ptp(box, axis=0))))
     va = occ.gprops(sa)["volume"]
     vb = occ.gprops(sb)["volume"]
     overlap = occ.common_volume(sa, sb)
