@@ -12,7 +12,8 @@ from ..errors import SurfmodError
 from .guard import check_done, kernel
 from OCP import TopAbs
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
-from OCP.BRepBuilderAPI import BRepBuilderAPI_GTransform, BRepBuilderAPI_MakeVertex, BRepBuilderAPI_Transform
+from OCP.BRepBuilderAPI import (BRepBuilderAPI_Copy, BRepBuilderAPI_GTransform, BRepBuilderAPI_MakeVertex,
+                                BRepBuilderAPI_Transform)
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
@@ -151,6 +152,11 @@ def closest_on_face(face, points):
     dist = np.empty(len(points))
     near = np.empty((len(points), 3))
     with kernel("BRepExtrema_DistShapeShape"):
+        # BRepExtrema prunes faces by boxes taken from a stored triangulation when there is
+        # one; a coarse one (BRepMesh at 10x a tolerance) boxes a curved face too tightly
+        # and the closest face is skipped: distances came out 3x too large.  A copy without
+        # the mesh (geometry shared) is boxed from the exact surfaces.
+        f = BRepBuilderAPI_Copy(f, False, False).Shape()
         ext = BRepExtrema_DistShapeShape()
         ext.LoadS1(f)
         for i, q in enumerate(points):
