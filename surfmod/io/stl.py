@@ -33,13 +33,20 @@ def merged(meshes: list[Mesh]) -> Mesh:
 
 
 def facet_normals(tri: np.ndarray) -> np.ndarray:
-    """Unit normals of triangles ``(T, 3, 3)`` as an STL reader recomputes them: from the
-    vertices rounded to float32 (what the file holds), in float32 arithmetic, so a
-    sliver triangle's written normal agrees with the one admesh & co. check it against."""
-    t = np.asarray(tri, dtype=np.float32)
+    """Unit normals (float32) of triangles ``(T, 3, 3)``: the exact normal of the triangle
+    the file holds, i.e. from the vertices rounded to float32, in float64 arithmetic, so
+    a sliver triangle's written normal agrees with the one admesh & co. check it against.
+    float32 arithmetic was not enough: on a sliver of pythonocc_Ventilator.stp (a 1e-5
+    edge beside 4.9 ones) its cross product lost digits and admesh "fixed" the normal
+    (1.4e-3 off, its limit is 1e-3).
+
+    >>> facet_normals(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]])).tolist()
+    [[0.0, 0.0, 1.0]]
+    """
+    t = np.asarray(tri, dtype=np.float32).astype(np.float64)
     n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     norm = np.linalg.norm(n, axis=1, keepdims=True)
-    return n / np.where(norm > 0, norm, np.float32(1.0))
+    return (n / np.where(norm > 0, norm, 1.0)).astype(np.float32)
 
 
 def write_binary(fh, tri: np.ndarray) -> None:
