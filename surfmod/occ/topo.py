@@ -152,10 +152,10 @@ def closest_on_face(face, points):
     dist = np.empty(len(points))
     near = np.empty((len(points), 3))
     with kernel("BRepExtrema_DistShapeShape"):
-        # BRepExtrema prunes faces by boxes taken from a stored triangulation when there is
-        # one; a coarse one (BRepMesh at 10x a tolerance) boxes a curved face too tightly
-        # and the closest face is skipped: distances came out 3x too large.  A copy without
-        # the mesh (geometry shared) is boxed from the exact surfaces.
+        # BRepExtrema answers from a stored triangulation when the face has one: after a
+        # coarse BRepMesh (10x a tolerance) it put a point inside a face's trim 0.0038 off
+        # it, judging it outside by a hole's chords (test_occt_quirks).  A copy without the
+        # mesh (geometry shared) is measured against the exact face.
         f = BRepBuilderAPI_Copy(f, False, False).Shape()
         ext = BRepExtrema_DistShapeShape()
         ext.LoadS1(f)
