@@ -3,9 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+from conftest import CORPUS
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.gp import gp_Pnt, gp_Vec
 
 import surfmod as sm
+from surfmod.occ.mesh import brepmesh, clean
+from surfmod.occ.topo import closest_on_face, faces_of
 
 
 def test_high_degree_derivatives_lose_digits_at_span_end():
@@ -38,13 +43,6 @@ def test_brepextrema_answers_from_a_stored_coarse_triangulation():
     point outside the trim by the hole's chords.  Clean, it says 0.  ``closest_on_face``
     (the corpus STL judge's distance) measures a copy without the triangulation; before
     that the judge said 2x the tolerance for an STL that was within half of it."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-
-    from conftest import CORPUS
-    from surfmod.occ.mesh import brepmesh, clean
-    from surfmod.occ.topo import closest_on_face, faces_of
-
     shape = sm.import_step(CORPUS / "cadquery_red_cube_blue_cylinder.step").wrapped
     face = next(iter(faces_of(shape)))
     p = (10.0, 9.996224721272787, 0.0)
