@@ -129,12 +129,18 @@ def crosscheck(obj, samples: int = 64, tolerance: float | None = None, *, sampli
     25
     """
     samples = checks.count(samples, "samples", minimum=2)
+    if tolerance is not None:
+        tolerance = checks.positive(tolerance, "tolerance")
     if sampling not in SAMPLINGS:
         raise SurfmodError(f"sampling: expected one of {', '.join(SAMPLINGS)}, got {sampling!r}")
     if isinstance(obj, Curve):
         return _check_curve(obj, samples)
     if not isinstance(obj, Surface):
         obj = from_face(obj)
+    if tolerance is not None:  # a pass threshold below round-off of the surface's size could never pass
+        (u0, u1), (v0, v1) = obj.domain
+        grid = obj.grid(np.linspace(u0, u1, 5), np.linspace(v0, v1, 5)).reshape(-1, 3)
+        tolerance = checks.tolerance(tolerance, "tolerance", float(np.linalg.norm(np.ptp(grid, axis=0))))
     if obj.exact_in_occt:
         return _check_parametric(obj, samples, sampling == "sufficient")
     return _check_geometric(obj, samples, tolerance)

@@ -286,6 +286,10 @@ ELEMENTARY = _elementary_surfaces()
 CREASED = sm.superellipsoid(1, 1, 1, 1.8, 1.8)
 #: a small part for the tolerance of the tool path and the drop-cutter (a ball of 1 over it)
 BOSS = bd.Box(6, 4, 2) + bd.Pos(0, 0, 1.5) * bd.Cylinder(1.2, 1)
+#: a surface OCCT only approximates (cross-checked geometrically, against a tolerance)
+OFFSET = sm.offset(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), 0.1, 1e-4)
+#: a section of BOSS through its boss: lines and a circle
+SECTION = sm.section(BOSS, (0, 0, 1.5), (0, 1, 0))
 _rational = sm.BSplineSurface(np.random.default_rng(11).uniform(-1, 1, (5, 5, 3)) + np.stack(np.meshgrid(
     np.arange(5.0), np.arange(5.0), [0.0], indexing="ij"), -1)[:, :, 0], (3, 3),
     weights=np.random.default_rng(12).uniform(0.5, 2.0, (5, 5)))
@@ -297,7 +301,7 @@ def _grid_points(n=8):
 
 
 def tolerance_case(rng, tmp: Path):
-    k = rng.integers(21)
+    k = rng.integers(24)
     tol = TOLERANCES[rng.integers(len(TOLERANCES))]
     if k >= 16:
         return _tolerance_case_more(rng, k, tol, tmp)
@@ -362,6 +366,12 @@ def _tolerance_case_more(rng, k, tol, tmp: Path):
         return "export_stl solid tol", lambda: sm.export_stl(BOSS, tmp / "s.stl", tolerance=tol)
     if k == 19:
         return "tessellate creased tol", lambda: sm.tessellate(CREASED, tol)
+    if k == 21:  # the pass threshold of a geometric cross-check
+        return "crosscheck tol", lambda: sm.crosscheck(OFFSET, samples=4, tolerance=tol)
+    if k == 22:
+        return "interference tol", lambda: sm.interference(BOSS, bd.Pos(7, 0, 0) * bd.Box(1, 1, 1), tolerance=tol)
+    if k == 23:  # chords of a section: 1e-12 of its size took 70 s before the floor and the point estimate
+        return "export_svg tol", lambda: sm.export_svg(SECTION, tmp / "s.svg", tolerance=tol)
     s = SURFACES[rng.integers(len(SURFACES))]
     return "intersect self tol", lambda: sm.intersect(s, s, tol)
 

@@ -242,6 +242,7 @@ def test_8_touching_is_not_coinciding():
 
 
 # 9 -------------------------------------------------------------------------------------------
+@pytest.mark.filterwarnings("error")  # a far point must not overflow anywhere on its way (inf, then clipped)
 def test_9_far_points():
     e = sm.ellipsoid(1, 2, 3)
     with pytest.raises(sm.SurfmodError, match=r"^points_or_curve: magnitude 1e\+300 exceeds the limit 1e\+70$"):

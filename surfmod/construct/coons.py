@@ -150,6 +150,8 @@ def coons(c0, c1, d0, d1, *, blend: str = "linear", tolerance: float = 1e-7) -> 
 
     tolerance = checks.positive(tolerance, "tolerance")
     given = [as_curve(c, name) for c, name in zip((c0, c1, d0, d1), NAMES)]
+    ends = np.concatenate([c.points(np.array(c.domain)) for c in given])
+    tolerance = checks.tolerance(tolerance, "tolerance", float(np.linalg.norm(np.ptp(ends, axis=0))))
     _corner_check(given, tolerance)
 
     # as OCCT's SetSameDistribution: the longer interval wins, ties go to c0 and to d1

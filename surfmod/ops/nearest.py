@@ -49,6 +49,19 @@ def row_diameters(diam: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(diam.max(axis=1))
 
 
+def _unit_quotient(num, det):
+    """``clip(num / det, 0, 1)`` for ``det > 0``, forming only the quotients inside
+    ``(0, 1)``: a degenerate triangle (a pole's collapsed edge, ``det`` at its 1e-300
+    floor) seen from a far point (1e60) would otherwise overflow to inf before the clip.
+
+    >>> _unit_quotient(np.array([-1.0, 0.5, 1e60]), np.array([1.0, 1.0, 1e-300])).tolist()
+    [0.0, 0.5, 1.0]
+    """
+    inside = (num > 0.0) & (num < det)
+    q = np.divide(num, det, out=np.zeros(np.broadcast_shapes(np.shape(num), np.shape(det))), where=inside)
+    return np.where(num >= det, 1.0, q)
+
+
 def _feet(a, e0, e1, d00, d11, d01):
     """Squared distances and clipped barycentric ``(beta, gamma)`` of the feet of the
     points ``a`` (relative to each triangle's first corner, ``(B, C, 3)``) on the triangles
@@ -56,8 +69,8 @@ def _feet(a, e0, e1, d00, d11, d01):
     r0 = a[..., 0] * e0[:, 0] + a[..., 1] * e0[:, 1] + a[..., 2] * e0[:, 2]
     r1 = a[..., 0] * e1[:, 0] + a[..., 1] * e1[:, 1] + a[..., 2] * e1[:, 2]
     det = np.maximum(d00 * d11 - d01 * d01, 1e-300)
-    beta = np.clip((d11 * r0 - d01 * r1) / det, 0.0, 1.0)
-    gamma = np.clip((d00 * r1 - d01 * r0) / det, 0.0, 1.0)
+    beta = _unit_quotient(d11 * r0 - d01 * r1, det)
+    gamma = _unit_quotient(d00 * r1 - d01 * r0, det)
     over = np.maximum(beta + gamma, 1.0)
     beta, gamma = beta / over, gamma / over
     f = [beta * e0[:, d] + gamma * e1[:, d] - a[..., d] for d in range(3)]

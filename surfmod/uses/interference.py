@@ -75,11 +75,15 @@ def interference(a, b, tolerance: float = 1e-6) -> Interference:
     (1.0, 'clearance')
     """
     from ..occ.interference import common_volume, min_distance
-    from ..occ.properties import gprops
+    from ..occ.properties import bounding_box, gprops
 
     tolerance = checks.positive(tolerance, "tolerance")
     sa = to_shape(a, "a", solid=True)
     sb = to_shape(b, "b", solid=True)
+    box = np.concatenate([bounding_box(sa, optimal=False), bounding_box(sb, optimal=False)])
+    # a contact distance below round-off of the pair's size is no request (the volume
+    # share uses the same number: at most 1, since the overlap is at most the smaller part)
+    checks.tolerance(tolerance, "tolerance", float(np.linalg.norm(np.ptp(box, axis=0))))
     va = gprops(sa)["volume"]
     vb = gprops(sb)["volume"]
     overlap = common_volume(sa, sb)

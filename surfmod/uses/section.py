@@ -39,6 +39,36 @@ def plane_frame(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray
     return x, np.cross(normal, x)
 
 
+#: the most points :meth:`Section.polylines_2d` discretizes the section edges into (estimated
+#: first): OCCT's GCPnts takes ~20 us a point, so about 4 s
+MAX_CHORD_POINTS = 200_000
+
+
+def chord_points(polylines, tolerance: float) -> float:
+    """Points a chordal ``tolerance`` needs along curves sampled as ``polylines``: a chord
+    ``h`` on curvature ``k`` sags ``k h^2 / 8``, so a stretch ``h`` turning by ``theta``
+    (curvature ``theta / h``) needs ``sqrt(theta h / (8 tolerance))`` chords; exact for a
+    circle sampled evenly.
+
+    >>> t = np.linspace(0, 2 * np.pi, 65)
+    >>> exact = 2 * np.pi * np.sqrt(1 / 8e-6)  # a unit circle's chords, plus the 65 samples
+    >>> bool(exact < chord_points([np.c_[np.cos(t), np.sin(t), 0 * t]], 1e-6) < exact + 65)
+    True
+    """
+    total = 0.0
+    for p in polylines:
+        seg = np.diff(np.asarray(p, float), axis=0)
+        h = np.linalg.norm(seg, axis=1)
+        seg, h = seg[h > 0], h[h > 0]
+        total += len(p)
+        if len(seg) < 2:
+            continue
+        cos = np.einsum("ij,ij->i", seg[:-1], seg[1:]) / (h[:-1] * h[1:])
+        theta = np.arccos(np.clip(cos, -1.0, 1.0))
+        total += float(np.sqrt(theta * 0.5 * (h[:-1] + h[1:]) / (8 * tolerance)).sum())
+    return total
+
+
 @dataclass(frozen=True)
 class Section:
     """Section curves of a part by a plane.
@@ -97,7 +127,13 @@ class Section:
             return [self.to_plane(p) for p in self.polylines]
         from ..occ.discretize import edge_points, wire_edges
 
-        tol = checks.positive(tolerance, "tolerance")
+        pts = np.concatenate(self.polylines) if self.polylines else np.zeros((0, 3))
+        size = float(np.linalg.norm(np.ptp(pts, axis=0))) if len(pts) else 0.0
+        tol = checks.tolerance(tolerance, "tolerance", size)
+        need = chord_points(self.polylines, tol)
+        if need > MAX_CHORD_POINTS:  # GCPnts takes ~20 us a point: 1e-12 of a sphere's section ran 70 s
+            raise SurfmodError(f"tolerance: {tol:g} would need about {need:,.0f} points along the section, above "
+                               f"{MAX_CHORD_POINTS:,}")
         return [self.to_plane(_chained([edge_points(e, tol) for e in wire_edges(w)])) for w in self.wires]
 
     def entities_2d(self) -> list[list[tuple]]:
