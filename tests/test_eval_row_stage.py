@@ -6,6 +6,8 @@ run) agree with the scattered kernel, the textbook and OCCT."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from itertools import pairwise
 
 import numba
@@ -114,7 +116,7 @@ def test_grid_on_a_big_net_through_the_vector_paths(p, q, rational, monkeypatch)
     grid = s.grid(us, vs)
     ders = s.grid_derivatives(us[::3], vs, 2)
     assert "planes" in s._local_net().cache
-    monkeypatch.setattr(local, "_vector_runs", lambda *args: local._NO_RUNS)
+    monkeypatch.setattr(local, "_vector_runs", lambda *args: None)
     np.testing.assert_array_equal(grid, s.grid(us, vs))
     np.testing.assert_array_equal(ders, s.grid_derivatives(us[::3], vs, 2))
     uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
@@ -185,8 +187,25 @@ def test_interleaved_stages_over_several_v_chunks(rational, monkeypatch):
     assert np.count_nonzero(kinds == row_stage.NEXT_SPAN) >= 2 and np.any(kinds == row_stage.SCALAR)
     grid = s.grid(us, vs)
     assert "planes" in s._local_net().cache
-    monkeypatch.setattr(local, "_vector_runs", lambda *args: local._NO_RUNS)
+    monkeypatch.setattr(local, "_vector_runs", lambda *args: None)
     np.testing.assert_array_equal(grid, s.grid(us, vs))
     uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
     np.testing.assert_allclose(grid.reshape(-1, 3), s.points(uu, vv), rtol=0,
                                atol=1e-13 * np.abs(s.control_points).max())
+
+
+def test_a_grid_on_a_small_net_compiles_no_vector_stage():
+    """The vector row stage and the sliding ring are compiled only for grids that use them
+    (numba prunes the ``vruns is None`` branches): a grid on a 20 x 20 net, in a fresh
+    process, leaves both without a signature."""
+    script = (
+        "import numpy as np, surfmod as sm\n"
+        "from surfmod.gallery.synthetic import wavy_net\n"
+        "from surfmod.eval import row_stage, sliding\n"
+        "u = np.linspace(0, 1, 700)\n"
+        "s = sm.BSplineSurface(wavy_net(20, 20), (3, 3))\n"
+        "s.grid(u, u); s.grid_derivatives(u[:300], u[:300], 2)\n"
+        "print(len(row_stage.contract_rows.signatures), len(sliding.block_positions.signatures))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert done.stdout.split() == ["0", "0"]

@@ -2,8 +2,8 @@
 the net rows the u-points need contracted with the v-basis once (:func:`grid_rows`),
 then p+1 rows combined per u-point with the v-points on the vector axis
 (:func:`grid_positions`, :func:`grid_derivatives`), block by block of u-points
-(:func:`grid`).  Conventions as in :mod:`surfmod.eval.kernels`; the multi-threaded
-variant of :func:`grid` is in :mod:`surfmod.eval.parallel`.
+(:func:`positions_grid`, :func:`partials_grid`).  Conventions as in :mod:`surfmod.eval.kernels`; the multi-threaded
+variants are in :mod:`surfmod.eval.parallel`.
 """
 
 from __future__ import annotations
@@ -19,52 +19,65 @@ from .row_stage import contract_rows, row_points
 
 
 @njit(cache=True, error_model="numpy")
-def grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first, vruns):
-    """The grid ``us x vs[b0:b0+n_v]`` into ``out`` (point-major: ``(n_u, N_v, 3)`` for
-    positions, ``(n_u, N_v, K, K, 3)`` for partials, ``K = bu.shape[1]``), block by block
-    of u-points (:func:`grid_block_positions`, :func:`grid_block_derivatives`); block
-    ``k`` is u-points ``starts[k]:starts[k+1]``, its net rows
-    ``rows[row_starts[k]:row_starts[k+1]]``, ``first[a]`` the place of u-point ``a``'s
-    first row among them; ``scratch[0]`` holds a block's row table (reused: a fresh
-    table per block would be paged in again and again).  ``vruns`` is ``(bplan, planes,
-    run_starts, run_kinds)`` for the vector loops of :func:`surfmod.eval.row_stage.contract_rows`,
-    or empty arrays (no run kinds) for the one-point-at-a-time stage :func:`grid_rows`."""
+def positions_grid(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch, starts, rows, row_starts, first, vruns):
+    """The grid of positions ``us x vs[b0:b0+n_v]`` into ``out`` (point-major ``(n_u, N_v,
+    3)``), block by block of u-points (:func:`grid_block_positions`); block ``k`` is
+    u-points ``starts[k]:starts[k+1]``, its net rows ``rows[row_starts[k]:row_starts[k+1]]``,
+    ``first[a]`` the place of u-point ``a``'s first row among them; ``scratch[0]`` holds a
+    block's row table (reused: a fresh table per block would be paged in again and again).
+    ``vruns`` is ``(bplan, planes, run_starts, run_kinds)`` for the vector loops of
+    :func:`surfmod.eval.row_stage.contract_rows`, or ``None`` for the one-point-at-a-time
+    stage :func:`grid_rows`.
+
+    Only the stages a call can reach are compiled: numba prunes the ``vruns is None``
+    branches by the argument's type, so a grid on a small net (no vector runs) compiles
+    neither the vector row stage nor the sliding ring (a quarter of the compile time of
+    all of them: 48 s against 178 s into an empty cache on the loaded 2-core machine).
+    For the same reason positions and partials are two entries."""
     for blk in range(starts.size - 1):
-        if out.ndim == 3:
-            grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,
-                                 first, blk, vruns)
-        else:
-            grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[0], starts, rows,
-                                   row_starts, first, blk, vruns)
+        grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,
+                             first, blk, vruns)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
+def partials_grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first,
+                  vruns):
+    """The grid of partials ``(n_u, N_v, K, K, 3)``, ``K = bu.shape[1]``, as
+    :func:`positions_grid` (:func:`grid_block_derivatives` per block)."""
+    for blk in range(starts.size - 1):
+        grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[0], starts, rows,
+                               row_starts, first, blk, vruns)
+
+
+@njit(cache=True, error_model="numpy")
 def _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns):
-    """A block's net rows contracted with the v-basis (:func:`grid_rows`) into a table in
-    ``space`` (its thread's scratch), and its u-range.  Blocks share nothing but the
-    read-only inputs, so the parallel variant (:mod:`surfmod.eval.parallel`) runs them
+    """A block's net rows contracted with the v-basis (:func:`grid_rows`, or the vector
+    loops of :func:`surfmod.eval.row_stage.contract_rows` when ``vruns`` is given) into a
+    table in ``space`` (its thread's scratch), and its u-range.  Blocks share nothing but
+    the read-only inputs, so the parallel variant (:mod:`surfmod.eval.parallel`) runs them
     on several threads."""
     mine = rows[row_starts[blk] : row_starts[blk + 1]]
     kk, nv = bv.shape[1], sv.size
     table = space[: mine.size * kk * dim * nv].reshape((mine.size, kk, dim, nv))
-    bplan, planes, run_starts, run_kinds = vruns
-    if run_kinds.size:
-        contract_rows(bv, bplan, sv, q, ctrl, planes, mine, dim, table, run_starts, run_kinds)
-    else:
+    if vruns is None:
         grid_rows(bv, sv, q, ctrl, mine, dim, table)
+    else:
+        bplan, planes, run_starts, run_kinds = vruns
+        contract_rows(bv, bplan, sv, q, ctrl, planes, mine, dim, table, run_starts, run_kinds)
     return table, starts[blk], starts[blk + 1]
 
 
 @njit(cache=True, error_model="numpy")
 def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, starts, rows, row_starts, first,
                          blk, vruns):
-    """One block of :func:`grid` for positions (on a big net with the stages interleaved,
+    """One block of :func:`positions_grid` (on a big net with the stages interleaved,
     :mod:`surfmod.eval.sliding`, when it suits)."""
     a0, a1 = starts[blk], starts[blk + 1]
-    if sliding.suits(p, first, a0, a1, space, dim, sv.size, vruns[3]):
-        sliding.block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space,
-                                rows[row_starts[blk] : row_starts[blk + 1]], a0, a1, first, vruns)
-        return
+    if vruns is not None:
+        if sliding.suits(p, first, a0, a1, space, dim, sv.size, vruns[3]):
+            sliding.block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space,
+                                    rows[row_starts[blk] : row_starts[blk + 1]], a0, a1, first, vruns)
+            return
     table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns)
     grid_positions(bu[a0:a1], first[a0:a1], p, table, rational, b0, out[a0:a1])
 
@@ -72,7 +85,7 @@ def grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, space, 
 @njit(cache=True, error_model="numpy")
 def grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, space, starts, rows, row_starts,
                            first, blk, vruns):
-    """One block of :func:`grid` for partials: to order 2 by
+    """One block of :func:`partials_grid`: to order 2 by
     :func:`surfmod.eval.partials_stage.order2_block`, other orders by :func:`grid_derivatives`."""
     table, a0, a1 = _block_table(bv, sv, q, ctrl, dim, space, starts, rows, row_starts, blk, vruns)
     if bu.shape[1] == 3:

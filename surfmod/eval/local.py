@@ -326,7 +326,7 @@ def _numba_threads() -> int:
 
 def _row_blocks(su, p, n, per_row, threads=1):
     """Blocks of u-points whose net rows fit the row table, as the arrays of
-    :func:`surfmod.eval.grid_kernels.grid`: ``(starts, rows, row_starts, first)``.  With
+    :func:`surfmod.eval.grid_kernels.positions_grid` and ``partials_grid``: ``(starts, rows, row_starts, first)``.  With
     several threads there are :data:`BLOCKS_PER_THREAD` blocks a thread or more (rows at
     a boundary between blocks are contracted by both; the values do not depend on the
     blocking)."""
@@ -383,13 +383,11 @@ def _sorted_block_rows(su, p, n, starts):
     return rows.astype(np.int64), row_starts.astype(np.int64), first.astype(np.int64)
 
 
-_NO_RUNS = (np.empty((0, 0, 0)), np.empty((0, 4, 0)), np.zeros(1, dtype=np.int64), np.empty(0, dtype=np.int64))
-
-
 def _vector_runs(net: LocalNet, sv, bv, rows: int):
     """The arguments of the grid's vector row stage (:mod:`surfmod.eval.row_stage`) for
     v-points with spans ``sv`` and basis ``bv`` when ``rows`` net rows are contracted:
-    ``(bplan, planes, run_starts, run_kinds)``, or no runs (one point at a time).
+    ``(bplan, planes, run_starts, run_kinds)``, or ``None`` (one point at a time, and the
+    vector stages are then not compiled).
 
     Vector loops need runs of v-points in consecutive spans (a net with about as many
     spans as points) and the net as coordinate planes, built once per surface, and only
@@ -399,10 +397,10 @@ def _vector_runs(net: LocalNet, sv, bv, rows: int):
 
     n = net.ctrl.shape[0]
     if rows < max(64, n // 4):
-        return _NO_RUNS
+        return None
     starts, kinds = row_stage.runs(sv)
     if not np.any(kinds == row_stage.NEXT_SPAN):
-        return _NO_RUNS
+        return None
     planes = net.cache.get("planes")
     if planes is None:
         planes = net.cache["planes"] = row_stage.net_planes(net.ctrl)
@@ -444,7 +442,7 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
         for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
             svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
             vruns = _vector_runs(net, svb, bvb, needed)
-            if order == 0 and p <= 3 and vruns[3].size and ordered:
+            if order == 0 and p <= 3 and vruns is not None and ordered:
                 # the stages interleave in a ring (eval/sliding.py): no row table, so the
                 # blocks need not be cut to its size (only shared among the threads)
                 from .sliding import CHUNK, RING
@@ -454,7 +452,11 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             else:
                 blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
                 per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
-            run.grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, _scratch(count, per_slot), *blocks, vruns)
+            scratch = _scratch(count, per_slot)
+            if order == 0:
+                run.positions_grid(bvb, svb, q, ctrl, dim, bu, p, rational, b0, out, scratch, *blocks, vruns)
+            else:
+                run.partials_grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, *blocks, vruns)
     if order == 0:
         return out[:, :, None, None, :]
     return out
