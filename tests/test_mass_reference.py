@@ -5,13 +5,14 @@ Rodrigues' formula).
 
 Where every cut meets the faces in lines and circles whose p-curves are exact (the box
 with a hole) it holds 1e-10 of the part's size and of the largest inertia entry.  Where
-the cuts are oblique to curved faces OCCT's splitter gives the new edges approximated
-p-curves (an ellipse on a cylinder, a circle on a tilted sphere) and the pieces' volumes
-carry 1e-9..1e-8 of error: there the test asks that the reference's own error estimate
-covers its actual error and stays below 1e-7 (enough to settle the 1e-7..1e-5
-disagreements the mass command meets).  A torus (R 3, r 1) is not here: every cut
-of a torus is walked (rotated: 214 s on the busy machine); measured by hand, moved but
-not rotated (283 s): centroid 2.4e-10, inertia 4.3e-9, both within its own estimate."""
+the cuts are oblique to curved faces OCCT gives the new edges approximated p-curves (an
+ellipse on a cylinder, a circle on a tilted sphere); the reference weighs fluxes through
+the solid's own faces, on which those p-curves cost only their error squared: the
+rotated spherical cap holds 4e-12 / 3e-11, the cone frustum 4e-11 / 5e-9 (two cuts the
+splitter botches next to a fold of the base circle).  A rotated torus or rounded box is
+tested here through ``sm.mass_properties`` and BRepGProp only: the reference cuts their
+sections by walking (torus, pieces=1: more than 900 s on the busy machine) or at every
+one of their many vertex levels (rounded box: 6426 planes, 590 s)."""
 
 from __future__ import annotations
 
@@ -158,9 +159,10 @@ def test_brepgprop_plane_volume_measures_heights_from_the_mirrored_plane():
     assert math.isclose(flux(box, 2), 6, rel_tol=1e-14)  # a closed shell's volume does not care
 
 
-def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None):
-    """The reference (``r``, or computed) within ``tol`` (relative) of the closed form; with
-    ``covered``, its error within its own estimate, and that estimate within ``tol``."""
+def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None, estimate=None):
+    """The reference (``r``, or computed) within ``tol`` (relative) of the closed form, its
+    estimates within ``estimate`` (default ``tol``); with ``covered``, its error within
+    its own estimate."""
     r = moment_reference(shape) if r is None else r
     assert abs(r.volume - volume) / volume < 1e-12
     length = volume ** (1 / 3)
@@ -168,7 +170,8 @@ def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None):
     dc = np.abs(r.centroid - centroid).max()
     di = np.abs(r.inertia - inertia).max()
     assert dc / length < tol and di / big < tol, (dc / length, di / big)
-    assert r.centroid_error / length < tol and r.inertia_error / big < tol and r.consistency < tol
+    estimate = tol if estimate is None else estimate
+    assert r.centroid_error / length < estimate and r.inertia_error / big < estimate and r.consistency < tol
     if covered:
         assert dc <= r.centroid_error and di <= r.inertia_error, (dc, r.centroid_error, di, r.inertia_error)
     return r
@@ -241,23 +244,29 @@ def test_box_with_an_off_centre_hole(hole_reference):
     check(None, v, g, np.trace(central) * np.eye(3) - central, r=hole_reference)
 
 
-@pytest.mark.corpus  # 17 s on the busy 2-core machine
+@pytest.mark.corpus  # 18 s on the busy 2-core machine
 def test_spherical_cap_moved_and_rotated():
+    # every cut but those along z meets the sphere obliquely: approximated p-curves,
+    # which cost the volumes of slabs 1e-8 (centroid 9.5e-9, inertia 1.3e-8) and the
+    # fluxes 3.8e-12 and 3.4e-11; QUADPACK's estimate stays cautious (1.5e-8)
     radius, z0 = 2.0, 0.5
     above = bd.Box(5, 5, 3, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)).translate((0, 0, z0))
     cap = bd.Sphere(radius) & above
     v, c, inertia = revolution(P([radius * radius, 0, -1]), z0, radius)
     q = rodrigues(AXIS, ANGLE)
-    check(moved(cap.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-7, covered=True)
+    check(moved(cap.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, covered=True, estimate=1e-7)
 
 
-@pytest.mark.corpus  # 22 s on the busy 2-core machine
+@pytest.mark.corpus  # 14 s on the busy 2-core machine
 def test_cone_frustum_moved_and_rotated():
+    # centroid 4e-11; the inertia 5e-9: two intervals' cuts, next to a fold of the base
+    # circle, lose 2e-7 of the volume whichever way they are tried (the splitter's
+    # failure, counted in the estimate)
     r1, r2, h = 2.0, 0.8, 3.0
     cone = bd.Cone(r1, r2, h, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN))
     v, c, inertia = revolution(P([r1, (r2 - r1) / h]) ** 2, 0.0, h)
     q = rodrigues(AXIS, ANGLE)
-    check(moved(cone.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-7, covered=True)
+    check(moved(cone.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-8, covered=True, estimate=1e-6)
 
 
 def test_a_solid_is_required():
