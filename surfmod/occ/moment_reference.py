@@ -55,7 +55,9 @@ axes' for free).
 What it does not see: an error in a face piece's flux that its neighbour's cancels
 (none is known: the shared p-curves make the pieces tile each face exactly).  Measured
 (tests/test_mass_reference.py, against closed forms, rotated and moved solids): a box with
-a hole, a spherical cap, a cone frustum to 1e-11 of the part.  Cost: 21 planes per
+a hole and a spherical cap to 1e-11 of the part (centroid) and 4e-11 (inertia), a cone
+frustum 4e-11 and 5e-9 (two cuts the splitter botches next to a fold of its base circle,
+within the estimate).  Cost: 21 planes per
 interval, six directions, seconds per hundred planes on prismatic parts and far more where
 sections are walked (tori, B-splines); :func:`estimated_seconds` says how long before
 cutting anything.
