@@ -141,7 +141,7 @@ def test_mass_properties_of_a_rotated_and_moved_torus_and_rounded_box(name):
 
 
 def test_brepgprop_plane_volume_measures_heights_from_the_mirrored_plane():
-    # the OCCT 7.7 quirk the reference's fluxes work around (moment_reference._flux): the
+    # the OCCT 7.9 quirk the reference's fluxes work around (moment_reference._flux): the
     # "volume between the faces and the plane z = 2" of a box's faces is ∫(z + 2) n_z dA,
     # not ∫(z - 2) n_z dA; through the origin the two agree
     box = bd.Box(1, 2, 3).translate((0.3, 0.1, 0.2))  # z from -1.3 to 1.7, top and bottom of area 2

@@ -461,7 +461,7 @@ def _flux(shape, shift, a) -> float:
     """``∫ (a·(x - shift)) (a·n) dA`` over the faces of ``shape``: BRepGProp's volume
     "between the faces and a plane", for the plane through the origin normal to ``a``
     after moving the faces by ``-shift``.  (Moved rather than given a plane through
-    ``shift``: OCCT 7.7's plane variant measures heights from the plane's mirror image
+    ``shift``: OCCT 7.9's plane variant measures heights from the plane's mirror image
     about the origin, ``a·x + d`` for the plane ``a·x = d``; through the origin the two
     agree, tests/test_mass_reference.py pins it.)"""
     move = gp_Trsf()
