@@ -5,13 +5,14 @@ Rodrigues' formula).
 
 Where every cut meets the faces in lines and circles whose p-curves are exact (the box
 with a hole) it holds 1e-10 of the part's size and of the largest inertia entry.  Where
-the cuts are oblique to curved faces OCCT's splitter gives the new edges approximated
-p-curves (an ellipse on a cylinder, a circle on a tilted sphere) and the pieces' volumes
-carry 1e-9..1e-8 of error: there the test asks that the reference's own error estimate
-covers its actual error and stays below 1e-7 (enough to settle the 1e-7..1e-5
-disagreements the mass command meets).  A torus (R 3, r 1) is not here: every cut
-of a torus is walked (rotated: 214 s on the busy machine); measured by hand, moved but
-not rotated (283 s): centroid 2.4e-10, inertia 4.3e-9, both within its own estimate."""
+the cuts are oblique to curved faces OCCT gives the new edges approximated p-curves (an
+ellipse on a cylinder, a circle on a tilted sphere); the reference weighs fluxes through
+the solid's own faces, on which those p-curves cost only their error squared: the
+rotated spherical cap holds 4e-12 / 3e-11, the cone frustum 4e-11 / 5e-9 (two cuts the
+splitter botches next to a fold of the base circle).  A rotated torus or rounded box is
+tested here through ``sm.mass_properties`` and BRepGProp only: the reference cuts their
+sections by walking (torus, pieces=1: more than 900 s on the busy machine) or at every
+one of their many vertex levels (rounded box: 6426 planes, 590 s)."""
 
 from __future__ import annotations
 
@@ -22,11 +23,15 @@ import numpy as np
 import pytest
 from numpy.polynomial import Polynomial as P
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
-from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+from OCP.gp import gp_Ax1, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 
+import surfmod as sm
 from surfmod.errors import SurfmodError
-from surfmod.occ.moment_reference import (GAUSS_W, KRONROD_W, KRONROD_X, critical_levels, moment_reference,
-                                          _intervals, _nodes)
+from surfmod.occ import uses as occ
+from surfmod.occ.moment_reference import (GAUSS_W, KRONROD_W, KRONROD_X, critical_levels, cut_volumes,
+                                          moment_reference, _intervals, _nodes)
 
 AXIS, ANGLE, SHIFT = np.array([1.0, 2.0, 3.0]) / math.sqrt(14), 0.7, np.array([3.0, -2.0, 5.0])
 
@@ -61,9 +66,103 @@ def revolution(rho2: P, z0: float, z1: float):
     return v, np.array([0, 0, zc]), np.diag([xx + zz, xx + zz, 2 * xx])
 
 
-def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None):
-    """The reference (``r``, or computed) within ``tol`` (relative) of the closed form; with
-    ``covered``, its error within its own estimate, and that estimate within ``tol``."""
+def torus_moments(big, small):
+    """Pappus for the volume; the textbook inertia of a solid torus about its centre."""
+    v = 2 * math.pi ** 2 * big * small * small
+    across, along = v * (big * big / 2 + 5 * small * small / 8), v * (big * big + 3 * small * small / 4)
+    return v, np.zeros(3), np.diag([across, across, along])
+
+
+#: a point segment, quarter disc and ball octant of radius ρ: their measure and the first
+#: and second moments of one coordinate (u ≥ 0 from the flat side)
+def _rounded_pieces(rho):
+    return {1: (rho, rho ** 2 / 2, rho ** 3 / 3),
+            2: (math.pi * rho ** 2 / 4, rho ** 3 / 3, math.pi * rho ** 4 / 16),
+            3: (math.pi * rho ** 3 / 6, math.pi * rho ** 4 / 16, math.pi * rho ** 5 / 30)}
+
+
+def rounded_box_moments(sides, rho):
+    """Volume, centroid and inertia of a box of ``sides`` centred at the origin with every
+    edge filleted by ``rho`` (the core box grown by a ball): 27 pieces, one per choice of
+    below / inside / above the core along each axis; a piece outside the core along k axes
+    is the core's cross-section times a segment, quarter disc or ball octant."""
+    half = np.asarray(sides, dtype=float) / 2 - rho
+    pieces = _rounded_pieces(rho)
+    v, sq = 0.0, np.zeros(3)
+    for where in np.ndindex(3, 3, 3):
+        out = [w != 1 for w in where]
+        k = sum(out)
+        m0 = pieces[k][0] if k else 1.0
+        v += m0 * math.prod(2 * half[i] for i in range(3) if not out[i])
+        for i in range(3):
+            rest = math.prod(2 * half[j] for j in range(3) if not out[j] and j != i)
+            if out[i]:  # x = ±(half + u): ∫(half + u)² over the rounded piece
+                _, m1, m2 = pieces[k]
+                sq[i] += (half[i] ** 2 * m0 + 2 * half[i] * m1 + m2) * rest
+            else:
+                sq[i] += 2 * half[i] ** 3 / 3 * rest * m0
+    return v, np.zeros(3), np.diag([sq[1] + sq[2], sq[0] + sq[2], sq[0] + sq[1]])
+
+
+def rounded_box(sides, rho):
+    return bd.fillet(bd.Box(*sides).edges(), rho)
+
+
+def test_closed_forms_of_the_torus_and_rounded_box_hold_for_simple_cases():
+    # the rounded box's 27 pieces: with ρ → 0 a box, with the core → 0 a ball
+    v, _, inertia = rounded_box_moments((4, 3, 2), 1e-300)
+    assert math.isclose(v, 24, rel_tol=1e-15) and np.allclose(np.diag(inertia), [26, 40, 50], rtol=1e-15)
+    v, _, inertia = rounded_box_moments((2, 2, 2), 1.0)
+    assert math.isclose(v, 4 * math.pi / 3, rel_tol=1e-15)
+    assert np.allclose(np.diag(inertia), 2 / 5 * v, rtol=1e-15)
+    # the torus against OCCT's own volume of it (a closed form of its own, 1e-15)
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(bd.Torus(3, 1).wrapped, props, 1e-12, False, False)
+    assert math.isclose(props.Mass(), torus_moments(3, 1)[0], rel_tol=1e-14)
+
+
+@pytest.mark.parametrize("name", ["torus", "rounded box"])
+def test_mass_properties_of_a_rotated_and_moved_torus_and_rounded_box(name):
+    # surfmod's own integration and BRepGProp against the closed forms, 1e-10 of the
+    # part's size (centroid) and of the largest inertia entry; 0.2 s
+    shape, (v, c, inertia) = {"torus": (bd.Torus(3, 1).wrapped, torus_moments(3, 1)),
+                              "rounded box": (rounded_box((4, 3, 2), 0.5).wrapped,
+                                              rounded_box_moments((4, 3, 2), 0.5))}[name]
+    q = rodrigues(AXIS, ANGLE)
+    c, inertia = q @ c + SHIFT, q @ inertia @ q.T
+    solid = moved(shape)
+    mine, theirs = sm.mass_properties(solid), occ.gprops(solid, 1e-12)
+    length, big = v ** (1 / 3), np.abs(inertia).max()
+    for got_v, got_c, got_i in ((mine.volume, mine.centroid, mine.inertia),
+                                (theirs["volume"], theirs["centroid"], theirs["inertia"])):
+        assert abs(got_v - v) / v < 1e-12
+        assert np.abs(np.asarray(got_c) - c).max() / length < 1e-10
+        assert np.abs(np.asarray(got_i) - inertia).max() / big < 1e-10
+
+
+def test_brepgprop_plane_volume_measures_heights_from_the_mirrored_plane():
+    # the OCCT 7.9 quirk the reference's fluxes work around (moment_reference._flux): the
+    # "volume between the faces and the plane z = 2" of a box's faces is ∫(z + 2) n_z dA,
+    # not ∫(z - 2) n_z dA; through the origin the two agree
+    box = bd.Box(1, 2, 3).translate((0.3, 0.1, 0.2))  # z from -1.3 to 1.7, top and bottom of area 2
+    faces = box.faces().sort_by(bd.Axis.Z)
+    bottom, top, box = faces[0].wrapped, faces[-1].wrapped, box.wrapped
+
+    def flux(shape, z):
+        props = GProp_GProps()
+        BRepGProp.VolumePropertiesGK_s(shape, props, gp_Pln(gp_Pnt(0, 0, z), gp_Dir(0, 0, 1)), 1e-12)
+        return props.Mass()
+
+    assert math.isclose(flux(top, 0), 2 * 1.7, rel_tol=1e-14) and math.isclose(flux(bottom, 0), 2 * 1.3, rel_tol=1e-14)
+    assert math.isclose(flux(top, 2), 2 * (1.7 + 2), rel_tol=1e-14)  # the quirk: (1.7 - 2) * 2 expected
+    assert math.isclose(flux(bottom, 2), -2 * (-1.3 + 2), rel_tol=1e-14)
+    assert math.isclose(flux(box, 2), 6, rel_tol=1e-14)  # a closed shell's volume does not care
+
+
+def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None, estimate=None):
+    """The reference (``r``, or computed) within ``tol`` (relative) of the closed form, its
+    estimates within ``estimate`` (default ``tol``); with ``covered``, its error within
+    its own estimate."""
     r = moment_reference(shape) if r is None else r
     assert abs(r.volume - volume) / volume < 1e-12
     length = volume ** (1 / 3)
@@ -71,7 +170,8 @@ def check(shape, volume, centroid, inertia, tol=1e-10, covered=False, r=None):
     dc = np.abs(r.centroid - centroid).max()
     di = np.abs(r.inertia - inertia).max()
     assert dc / length < tol and di / big < tol, (dc / length, di / big)
-    assert r.centroid_error / length < tol and r.inertia_error / big < tol and r.consistency < tol
+    estimate = tol if estimate is None else estimate
+    assert r.centroid_error / length < estimate and r.inertia_error / big < estimate and r.consistency < tol
     if covered:
         assert dc <= r.centroid_error and di <= r.inertia_error, (dc, r.centroid_error, di, r.inertia_error)
     return r
@@ -119,6 +219,22 @@ def test_critical_levels_of_elementary_faces():
     assert len(critical_levels(box, (1, 0, 0))) == 4
 
 
+def test_cut_volumes_of_a_sphere_cut_obliquely_are_exact_caps():
+    # every plane meets the sphere's parameter lines obliquely, so OCCT approximates the
+    # p-curves of the section circles: weighed as slabs' volumes V(t) was 1.3e-11..4.7e-11
+    # of the sphere off the cap formula; as fluxes through the sphere's own face, below
+    # 6e-13 (1 s)
+    radius, centre = 2.0, np.array([0.3, -0.2, 0.5])
+    sphere = bd.Sphere(radius).translate(tuple(centre)).wrapped
+    a = np.array([1.0, 2.0, 3.0]) / math.sqrt(14)
+    heights = a @ centre + np.array([-1.7, -0.9, -0.2, 0.4, 1.1, 1.8])
+    v = 4 / 3 * math.pi * radius ** 3
+    vt, defect, pieces = cut_volumes(sphere, a, heights, v, centre, 3.0)
+    depth = heights - (a @ centre - radius)
+    assert pieces == 7 and abs(defect) / v < 1e-12
+    assert np.abs(vt - math.pi * depth ** 2 * (3 * radius - depth) / 3).max() / v < 2e-12
+
+
 HOLE = (0.7, 0.3)
 
 
@@ -144,23 +260,29 @@ def test_box_with_an_off_centre_hole(hole_reference):
     check(None, v, g, np.trace(central) * np.eye(3) - central, r=hole_reference)
 
 
-@pytest.mark.corpus  # 17 s on the busy 2-core machine
+@pytest.mark.corpus  # 18 s on the busy 2-core machine
 def test_spherical_cap_moved_and_rotated():
+    # every cut but those along z meets the sphere obliquely: approximated p-curves,
+    # which cost the volumes of slabs 1e-8 (centroid 9.5e-9, inertia 1.3e-8) and the
+    # fluxes 3.8e-12 and 3.4e-11; QUADPACK's estimate stays cautious (1.5e-8)
     radius, z0 = 2.0, 0.5
     above = bd.Box(5, 5, 3, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)).translate((0, 0, z0))
     cap = bd.Sphere(radius) & above
     v, c, inertia = revolution(P([radius * radius, 0, -1]), z0, radius)
     q = rodrigues(AXIS, ANGLE)
-    check(moved(cap.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-7, covered=True)
+    check(moved(cap.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, covered=True, estimate=1e-7)
 
 
-@pytest.mark.corpus  # 22 s on the busy 2-core machine
+@pytest.mark.corpus  # 14 s on the busy 2-core machine
 def test_cone_frustum_moved_and_rotated():
+    # centroid 4e-11; the inertia 5e-9: two intervals' cuts, next to a fold of the base
+    # circle, lose 2e-7 of the volume whichever way they are tried (the splitter's
+    # failure, counted in the estimate)
     r1, r2, h = 2.0, 0.8, 3.0
     cone = bd.Cone(r1, r2, h, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN))
     v, c, inertia = revolution(P([r1, (r2 - r1) / h]) ** 2, 0.0, h)
     q = rodrigues(AXIS, ANGLE)
-    check(moved(cone.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-7, covered=True)
+    check(moved(cone.wrapped), v, q @ c + SHIFT, q @ inertia @ q.T, tol=1e-8, covered=True, estimate=1e-6)
 
 
 def test_a_solid_is_required():

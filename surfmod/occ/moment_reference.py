@@ -25,13 +25,24 @@ feature): an interval too short for that after ψ is integrated without ψ, a sh
 merged.
 
 Each interval's 21 levels are cut at once: ``BRepAlgoAPI_Splitter`` cuts the solid by
-their planes into slabs, each slab's pieces are weighed (``BRepGProp`` volume only, at
-relative tolerance 1e-12; its centre of mass only tells which slab a piece is in), and
-``V`` at a node is the sum of the slabs below it, averaged with ``V`` minus the slabs
-above.  The sum of all slabs against the solid's volume is that cut's *defect*, what the
-Boolean lost: a cut with a defect above 1e-10 is tried again (axis-aligned boxes instead
-of oriented ones, then the odd and even nodes apart), and the defect enters the error
-estimate as a volume misplaced over the interval.
+their planes into slabs, and ``V(t)`` is not weighed as the volume of the slabs below
+``t`` but as the flux of ``F = (a·x - t) a`` (divergence 1) through the solid's *own*
+faces below ``t`` (their pieces, per slab, by ``BRepGProp``'s adaptive Gauss–Kronrod rule
+at relative tolerance 1e-12).  The planar section faces drop out (``F`` vanishes on the
+plane at ``t``, and the sections below are shared by two slabs with opposite normals);
+the pieces of one curved face share the p-curves of the new edges between them, so only
+the p-curve at ``t`` bounds a domain, and there ``F·n`` vanishes: a p-curve that OCCT
+approximated ``δ`` off the true section (an ellipse on a cylinder cut obliquely, a circle
+on a tilted sphere, any section of a torus or B-spline; ``δ ~ 1e-7``) moves ``V`` by
+``δ²``, where the slabs' volumes moved by ``δ`` (1e-9..1e-8 of the part).  ``V`` at a
+node is that sum below it, averaged with ``V`` minus the sum above.  The total flux of
+all pieces against the solid's volume is that cut's *defect*, what the Boolean lost (each
+piece is put in its slab by its centre of mass): a cut with a defect above 1e-10 is
+tried again (axis-aligned boxes instead of oriented ones, then the odd and even nodes
+apart), and the defect enters the error estimate as a volume misplaced over the interval.
+A piece the splitter leaves uncut across a plane (seen on a rotated torus) moves volume
+between slabs without a defect; ``V(t)`` is then no longer smooth there, and the
+Gauss–Kronrod estimate is what shows it.
 
 Second moments about a point: the three axes give ``∫h_i`` and ``∫h_i²``; the products
 ``∫h_i h_j`` come from three more sweeps along the diagonals ``(e_i + e_j)/√2``:
@@ -41,14 +52,15 @@ the ``(s, t)`` plane no tensor rule follows; six one-dimensional sweeps are exac
 levels, and the diagonals' first moments, which must equal ``(∫h_i + ∫h_j)/√2``, check the
 axes' for free).
 
-What it does not see: a piece's volume error that its neighbour's cancels in the slabs'
-sum (an approximated p-curve of a new edge moves volume from one slab to the next).
-Where the cuts meet curved faces obliquely (an ellipse on a cylinder, a circle on a
-tilted sphere, any section of a torus or B-spline) OCCT approximates those p-curves, and
-the reference is good to about 1e-9..1e-8 of the part instead of 1e-11
-(tests/test_mass_reference.py).  Cost: 21 planes per interval, six directions, seconds
-per hundred planes on prismatic parts and far more where sections are walked (tori,
-B-splines); :func:`estimated_seconds` says how long before cutting anything.
+What it does not see: an error in a face piece's flux that its neighbour's cancels
+(none is known: the shared p-curves make the pieces tile each face exactly).  Measured
+(tests/test_mass_reference.py, against closed forms, rotated and moved solids): a box with
+a hole and a spherical cap to 1e-11 of the part (centroid) and 4e-11 (inertia), a cone
+frustum 4e-11 and 5e-9 (two cuts the splitter botches next to a fold of its base circle,
+within the estimate).  Cost: 21 planes per
+interval, six directions, seconds per hundred planes on prismatic parts and far more where
+sections are walked (tori, B-splines); :func:`estimated_seconds` says how long before
+cutting anything.
 """
 
 from __future__ import annotations
@@ -58,7 +70,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from OCP.BRep import BRep_Tool
+from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Splitter
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
@@ -70,8 +82,9 @@ from OCP.GeomAbs import (GeomAbs_C2, GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Lin
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_SHAPE, TopAbs_VERTEX
 from OCP.TopTools import TopTools_ListOfShape
-from OCP.TopoDS import TopoDS
-from OCP.gp import gp_Dir, gp_Pln, gp_Pnt, gp_Vec
+from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS, TopoDS_Compound
+from OCP.gp import gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 
 from ..errors import SurfmodError
 from .arrays import xyz
@@ -423,16 +436,9 @@ def _nodes(ends: np.ndarray, mapped=None):
 
 
 # -- cutting ---------------------------------------------------------------------------
-#: BRepGProp's relative tolerance for the pieces: its fixed-order rule leaves 5e-9 of the
-#: volume of slabs whose edges are approximated (an ellipse's p-curve on a cylinder cut
-#: obliquely); the adaptive one at 1e-12 leaves 1e-12
+#: BRepGProp's relative tolerance for the fluxes of the pieces' faces (its adaptive
+#: Gauss–Kronrod rule; it reaches 1e-15 on elementary faces)
 PIECE_EPS = 1e-12
-
-
-def _volume(shape):
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, props, PIECE_EPS, False, False)
-    return props.Mass(), props.CentreOfMass()
 
 
 def _quad_error(f: np.ndarray, scale: np.ndarray) -> np.ndarray:
@@ -451,19 +457,68 @@ def _quad_error(f: np.ndarray, scale: np.ndarray) -> np.ndarray:
     return np.maximum(err, 50 * np.finfo(float).eps * (np.abs(g) @ KRONROD_W))
 
 
+def _flux(shape, shift, a) -> float:
+    """``∫ (a·(x - shift)) (a·n) dA`` over the faces of ``shape``: BRepGProp's volume
+    "between the faces and a plane", for the plane through the origin normal to ``a``
+    after moving the faces by ``-shift``.  (Moved rather than given a plane through
+    ``shift``: OCCT 7.9's plane variant measures heights from the plane's mirror image
+    about the origin, ``a·x + d`` for the plane ``a·x = d``; through the origin the two
+    agree, tests/test_mass_reference.py pins it.)"""
+    move = gp_Trsf()
+    move.SetTranslation(gp_Vec(*(-np.asarray(shift, dtype=float))))
+    props = GProp_GProps()
+    BRepGProp.VolumePropertiesGK_s(shape.Moved(TopLoc_Location(move)), props,
+                                   gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(*a)), PIECE_EPS)
+    return props.Mass()
+
+
+def _slab_of(piece, heights, a) -> int:
+    """The slab (0 below the first height ... ``len(heights)`` above the last) holding a
+    piece of the split solid, from its centre of mass.  (Not from its vertices: next to
+    a fold of an edge the Boolean gives new vertices tolerances of 1e-5 and merges a
+    sliver into its neighbour, and vertices then name slabs the volume is not in.)"""
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(piece, props, PIECE_EPS, False, False)
+    return int(np.searchsorted(heights, a @ xyz(props.CentreOfMass())))
+
+
+def _is_cut_face(face, a, heights, span) -> bool:
+    """Whether ``face`` lies on one of the cutting planes (a plane normal to ``a`` at one
+    of ``heights``: the nodes keep clear of the solid's own faces normal to ``a``)."""
+    s = BRepAdaptor_Surface(face, False)
+    if s.GetType() != GeomAbs_Plane:
+        return False
+    pl = s.Plane()
+    if abs(abs(xyz(pl.Axis().Direction()) @ a) - 1) > 1e-12:
+        return False
+    return bool(np.abs(heights - xyz(pl.Location()) @ a).min() <= 1e-9 * span)
+
+
 def cut_volumes(shape, direction, heights, volume: float, origin, size: float, obb: bool = True):
-    """``V(t)`` at each of the sorted ``heights`` along ``direction``: the solid split by
-    all their planes at once (``BRepAlgoAPI_Splitter``), each piece weighed and put in
-    the slab its centre lies in; returns ``(V, defect, pieces)`` with ``defect`` the sum
-    of the slabs less ``volume``.  The planes are squares of half side ``size`` about
-    ``origin``'s projections (the part's centre: they need only cover it)."""
+    """``V(t)`` at each of the sorted ``heights`` along ``direction``, returned as ``(V,
+    defect, pieces)``.
+
+    The solid is split by all their planes at once (``BRepAlgoAPI_Splitter``); then
+    ``V(t)`` is the flux of ``F = (a·x - t) a`` (divergence 1) through the solid's own
+    boundary below ``t``: the cut faces drop out (``F`` vanishes on the plane ``t`` and
+    the faces of the planes below are shared by two slabs with opposite normals), and
+    the pieces of one original face share the p-curves of the new edges between them, so
+    only the p-curve at ``t`` itself bounds a domain, where ``F·n`` vanishes: a p-curve
+    ``δ`` off (OCCT approximates them, ``δ ~ 1e-7``) moves ``V`` by ``δ²``, not ``δ``.
+    Per slab (the slab of each piece, from its centre) the flux ``W`` about ``origin``
+    and the projected area ``M = ∫a·n dA`` give ``V(t) = Σ_below (W - (t - c) M)``,
+    averaged with ``V`` minus the same sum above.  ``defect`` is the total flux less
+    ``volume`` (a piece the splitter lost or broke).  The planes are squares of half
+    side ``size`` about ``origin``'s projections (the part's centre: they need only cover it)."""
     a = np.asarray(direction, dtype=float)
     heights = np.asarray(heights, dtype=float)
+    origin = np.asarray(origin, dtype=float)
+    centre = float(a @ origin)
+    span = float(heights[-1] - heights[0]) if len(heights) > 1 else size
     with kernel("BRepAlgoAPI_Splitter"):
         tools = TopTools_ListOfShape()
-        origin = np.asarray(origin, dtype=float)
         for h in heights:
-            plane = gp_Pln(gp_Pnt(*(origin + a * (h - a @ origin))), gp_Dir(*a))
+            plane = gp_Pln(gp_Pnt(*(origin + a * (h - centre))), gp_Dir(*a))
             tools.Append(BRepBuilderAPI_MakeFace(plane, -size, size, -size, size).Face())
         args = TopTools_ListOfShape()
         args.Append(shape)
@@ -472,17 +527,31 @@ def cut_volumes(shape, direction, heights, volume: float, origin, size: float, o
         splitter.SetTools(tools)
         splitter.SetRunParallel(False)
         splitter.SetUseOBB(obb)
+        # the caller's solid stays as it was (the Boolean may otherwise raise the
+        # tolerances of its sub-shapes in place)
+        splitter.SetNonDestructive(True)
         splitter.Build()
         if not splitter.IsDone():
             raise SurfmodError("shape: OCCT's splitter failed to cut the solid into slabs")
         pieces = solids_of(splitter.Shape())
-        slabs = np.zeros(len(heights) + 1)
+        builder = BRep_Builder()
+        slabs = [TopoDS_Compound() for _ in range(len(heights) + 1)]
+        for c in slabs:
+            builder.MakeCompound(c)
         for piece in pieces:
-            v, c = _volume(piece)
-            slabs[np.searchsorted(heights, a @ xyz(c))] += v
-    below = np.cumsum(slabs)[:-1]
-    above = volume - np.cumsum(slabs[::-1])[::-1][1:]
-    return (below + above) / 2, float(slabs.sum() - volume), len(pieces)
+            slab = slabs[_slab_of(piece, heights, a)]
+            for face in faces_of(piece):
+                if not _is_cut_face(face, a, heights, span):
+                    builder.Add(slab, face)
+        # the second reference level a half side away: M from the difference of two
+        # fluxes loses only log10(size / slab) digits
+        w = np.array([_flux(c, origin, a) for c in slabs])
+        m = (w - np.array([_flux(c, origin + size * a, a) for c in slabs])) / size
+    h = heights - centre
+    below = np.cumsum(w)[:-1] - h * np.cumsum(m)[:-1]
+    w_above, m_above = np.cumsum(w[::-1])[::-1][1:], np.cumsum(m[::-1])[::-1][1:]
+    above = volume - (w_above - h * m_above)
+    return (below + above) / 2, float(w.sum() - volume), len(pieces)
 
 
 def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, tolerances=None,
