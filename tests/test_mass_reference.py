@@ -29,7 +29,7 @@ from OCP.gp import gp_Ax1, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 
 import surfmod as sm
 from surfmod.errors import SurfmodError
-from surfmod.occ import uses as occ
+from surfmod.occ.properties import gprops
 from surfmod.occ.moment_reference import (GAUSS_W, KRONROD_W, KRONROD_X, critical_levels, cut_volumes,
                                           moment_reference, _intervals, _nodes)
 
@@ -131,7 +131,7 @@ def test_mass_properties_of_a_rotated_and_moved_torus_and_rounded_box(name):
     q = rodrigues(AXIS, ANGLE)
     c, inertia = q @ c + SHIFT, q @ inertia @ q.T
     solid = moved(shape)
-    mine, theirs = sm.mass_properties(solid), occ.gprops(solid, 1e-12)
+    mine, theirs = sm.mass_properties(solid), gprops(solid, 1e-12)
     length, big = v ** (1 / 3), np.abs(inertia).max()
     for got_v, got_c, got_i in ((mine.volume, mine.centroid, mine.inertia),
                                 (theirs["volume"], theirs["centroid"], theirs["inertia"])):
@@ -350,8 +350,6 @@ def _against_reference(solid, budget=60.0):
     """``(surfmod's centroid and inertia differences, BRepGProp's, the reference's
     estimates, the reference)``, differences relative to the volume's cube root and the largest inertia entry."""
     import surfmod as sm
-    from surfmod.occ.properties import gprops
-
     o = gprops(solid, 1e-12)
     ref = moment_reference(solid, o["volume"], budget=budget)
     mine = sm.mass_properties(solid)
@@ -369,8 +367,6 @@ def test_brepgprop_product_of_inertia_quirk_on_a_plain_cylinder(corpus_dir):
     # cadquery's blue cylinder (r 5, h 10, axis z through (10, 5)): by symmetry Ixy = 0.
     # BRepGProp (eps 1e-12) gives -4.7e-5, 4e-9 of Ixx: an OCCT quirk; surfmod's and the
     # reference's agree with the closed form
-    from surfmod.occ.properties import gprops
-
     solid = _solid(corpus_dir, "cadquery_red_cube_blue_cylinder.step", 0)
     v = math.pi * 25 * 10
     exact = np.diag([v * (3 * 25 + 100) / 12] * 2 + [v * 25 / 2])
