@@ -6,7 +6,6 @@ The same concept as :mod:`surfmod.cli.femesh` (the ``surfmod femesh`` command ov
 from __future__ import annotations
 
 import tempfile
-import time
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -433,9 +432,12 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     checks.work(estimate, max_elements, "max_elements", f"a {kind} mesh with element size {size:g} of a part of extent {extent:.4g}")
     cell = _CELLS[(kind, order)]
     failures = []
-    # one time budget for all attempts, from the same estimate: gmsh makes well over
-    # GMSH_ELEMENTS_PER_SECOND elements a second on a busy machine; a run past it is stuck
-    deadline = time.monotonic() + GMSH_SECONDS + estimate / GMSH_ELEMENTS_PER_SECOND
+    # each gmsh run has a time budget from the same estimate: gmsh makes well over
+    # GMSH_ELEMENTS_PER_SECOND elements a second on a busy machine, so a run past it is
+    # stuck.  One budget per run, not one for all attempts: surfmod's own triangulation
+    # of the later attempts, and a loaded machine, must not leave gmsh a second to mesh
+    # in; the whole wait is bounded by len(attempts) budgets
+    seconds = GMSH_SECONDS + estimate / GMSH_ELEMENTS_PER_SECOND
 
     with tempfile.TemporaryDirectory(prefix="surfmod-gmsh-") as tmp, \
             tqdm(total=2, desc="fe_mesh", unit="step", disable=not progress, leave=False) as bar:
@@ -445,17 +447,14 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
         # triangulation, of each solid and then of each solid's material regions
         attempts = ATTEMPTS[kind]
         for attempt in attempts:
-            if time.monotonic() >= deadline:
-                failures.append(f"{attempt}: not tried, the time budget was spent")
-                continue
             bar.set_postfix_str(attempt)
             try:
                 if attempt in ("triangulation", "regions"):
-                    quality, surface = _triangulation_attempt(shape, msh, size, order, deadline,
+                    quality, surface = _triangulation_attempt(shape, msh, size, order, seconds,
                                                               regions=attempt == "regions")
                 else:
                     args = (brep, msh, 3 if kind == "volume" else 2, size, order, attempt == "healed")
-                    quality = _gmsh_in_child(_run_gmsh, args, deadline)
+                    quality = _gmsh_in_child(_run_gmsh, args, seconds)
             except _GmshFailure as exc:
                 failures.append(f"{attempt}: {exc}")
                 continue
@@ -497,7 +496,7 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
 #: crossing at that curve, which gmsh's boundary recovery rejects).
 ATTEMPTS = {"volume": ("as read", "healed", "triangulation", "regions"), "surface": ("as read", "healed")}
 
-#: fe_mesh's time budget over all its attempts: this many seconds plus one per this many
+#: the time budget of each gmsh run of fe_mesh: this many seconds plus one per this many
 #: estimated elements (gmsh makes tens of thousands a second); past it gmsh is stuck
 GMSH_SECONDS = 60.0
 GMSH_ELEMENTS_PER_SECOND = 1000.0
@@ -508,21 +507,22 @@ TRIANGULATION_SHARE = 1e-3
 TRIANGULATION_SIZE_SHARE = 0.25
 
 
-def _gmsh_in_child(fn, args: tuple, deadline: float):
-    """``fn(*args)`` (a gmsh run) in a child process that must answer by ``deadline``
-    (``time.monotonic()``): gmsh can loop for ever on a damaged face, inside one C call."""
+def _gmsh_in_child(fn, args: tuple, seconds: float):
+    """``fn(*args)`` (a gmsh run) in a child process that must answer within ``seconds``:
+    gmsh can loop for ever on a damaged face, inside one C call."""
     try:
-        return child.call(fn, args, max(deadline - time.monotonic(), 1.0), "gmsh")
+        return child.call(fn, args, seconds, "gmsh")
     except child.ChildFailure as exc:
         raise _GmshFailure(str(exc)) from None
 
 
-def _triangulation_attempt(shape, msh: Path, size: float, order: int, deadline: float, *, regions: bool = False):
+def _triangulation_attempt(shape, msh: Path, size: float, order: int, seconds: float, *, regions: bool = False):
     """Volume-mesh every solid of ``shape`` from its watertight triangulation, measured
     against the exact faces (:func:`surfmod.meshing.brep.tessellate_shape`), for parts
     whose B-rep gmsh cannot mesh; with ``regions`` each solid is first split into its
     material regions (:func:`surfmod.occ.regions.material_regions`), each triangulated and
-    filled on its own.  Returns gmsh's qualities and what the boundary is:
+    filled on its own (gmsh has ``seconds`` for that).  Returns gmsh's qualities and what
+    the boundary is:
     ``{"tolerance", "max_deviation", "reference_volume" (BRepGProp of the solids),
     "volume_bound", "regions" (pieces meshed)}``: every boundary point lies within
     ``max_deviation`` of the part, so the tetrahedra's volume is within ``volume_bound`` =
@@ -551,7 +551,7 @@ def _triangulation_attempt(shape, msh: Path, size: float, order: int, deadline: 
         dev = max(float(mesh.info["max_deviation"]), tolerance)
         deviation = max(deviation, dev)
         bound += mesh.area * dev
-    quality = _gmsh_in_child(_run_gmsh_triangulation, (surfaces, msh, size, order), deadline)
+    quality = _gmsh_in_child(_run_gmsh_triangulation, (surfaces, msh, size, order), seconds)
     return quality, {"tolerance": tolerance, "max_deviation": deviation, "reference_volume": reference,
                      "volume_bound": bound, "regions": len(pieces)}
 
