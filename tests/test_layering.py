@@ -109,10 +109,6 @@ OCC_LAZY = {
     "surfmod.occ.isolated": "read_step_file overlaps its own OCCT import with the reader process's",
 }
 
-#: the CAM helper's modules (issue 23's CAM item, issue 26): their function-level imports
-#: and names are its to settle; checked here once it has (then this is empty)
-CAM_BRANCH = ()
-
 #: import cycles that another branch removes (each says which); empty once merged
 KNOWN_CYCLES: set[frozenset] = set()
 
@@ -301,8 +297,6 @@ def needless_lazy_imports(modules, edges) -> list[str]:
     heavy = heavy_modules(modules, edges)
     bad = []
     for name, found in edges.items():
-        if name in CAM_BRANCH:
-            continue
         in_occ = _in_occ(name)
         for target, line, in_function in found:
             if not in_function or (name, target) in KNOWN_UPWARD:
@@ -350,8 +344,6 @@ def test_module_names_are_unique_or_the_same_concept():
     bad = []
     for names in by_name.values():
         for name in names if len(names) > 1 else ():
-            if name in CAM_BRANCH:
-                continue
             doc = ast.get_docstring(ast.parse(MODULES[name].read_text())) or ""
             if "same concept" not in " ".join(doc.split()):
                 bad.append(f"{name} (also {', '.join(n for n in names if n != name)})")

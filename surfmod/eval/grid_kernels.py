@@ -2,8 +2,8 @@
 the net rows the u-points need contracted with the v-basis once (:func:`grid_rows`),
 then p+1 rows combined per u-point with the v-points on the vector axis
 (:func:`grid_positions`, :func:`grid_derivatives`), block by block of u-points
-(:func:`positions_grid`, :func:`partials_grid`).  Conventions as in :mod:`surfmod.eval.kernels`; the multi-threaded
-variants are in :mod:`surfmod.eval.parallel`.
+(:func:`positions_grid`, :func:`partials_grid`).  Conventions as in
+:mod:`surfmod.eval.kernels`; the multi-threaded variants are in :mod:`surfmod.eval.parallel`.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ def positions_grid(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch, star
     Only the stages a call can reach are compiled: numba prunes the ``vruns is None``
     branches by the argument's type, so a grid on a small net (no vector runs) compiles
     neither the vector row stage nor the sliding ring (a quarter of the compile time of
-    all of them: 48 s against 178 s into an empty cache on the loaded 2-core machine).
+    all of them: 40 s against 178 s into an empty cache on the loaded 2-core machine).
     For the same reason positions and partials are two entries."""
     for blk in range(starts.size - 1):
         grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[0], starts, rows, row_starts,

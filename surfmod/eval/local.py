@@ -326,10 +326,10 @@ def _numba_threads() -> int:
 
 def _row_blocks(su, p, n, per_row, threads=1):
     """Blocks of u-points whose net rows fit the row table, as the arrays of
-    :func:`surfmod.eval.grid_kernels.positions_grid` and ``partials_grid``: ``(starts, rows, row_starts, first)``.  With
-    several threads there are :data:`BLOCKS_PER_THREAD` blocks a thread or more (rows at
-    a boundary between blocks are contracted by both; the values do not depend on the
-    blocking)."""
+    :func:`surfmod.eval.grid_kernels.positions_grid` and ``partials_grid``: ``(starts,
+    rows, row_starts, first)``.  With several threads there are :data:`BLOCKS_PER_THREAD`
+    blocks a thread or more (rows at a boundary between blocks are contracted by both; the
+    values do not depend on the blocking)."""
     max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
     step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
     most = su.size  # u-points per block at most: with threads, several blocks each
