@@ -197,3 +197,20 @@ def test_cam_part_job_scallop_in_stock(tmp_path):
     lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
     beside = ~np.isfinite(top) & (np.maximum(np.maximum(lo[0] - X, X - hi[0]), np.maximum(lo[1] - Y, Y - hi[1])) > 0.2)
     assert stock.top[beside].max() <= job.stock[0, 2] + 3.0 + 1e-6
+
+
+@pytest.mark.corpus
+def test_featuretype_waterline_follows_notches_instead_of_lifting(corpus_dir):
+    """On trimesh_featuretype some waterline chords (1.5 mm, the fiber grid's) have their
+    middle on the contour of a wall while a small feature near the top of the wall pushes
+    the contour across the chord between: the drop-cutter check finds the chord cutting
+    down to the feature's top (22.4 mm deep at z = 0, 27 pieces over 1 mm).  Such chords
+    are split at exact contour points until they follow it, so nothing is lifted (before:
+    ``lifted`` 22.44 mm), the moves still judged against the drop-cutter heights."""
+    job = sm.machine(corpus_dir / "trimesh_featuretype.STEP", 2.0,
+                     [sm.Finish(sm.Tool("ball", 3.0, flute_length=80), scallop=0.15)])
+    rep = job.operations[0].report
+    wl = rep["waterline"]
+    assert wl["split"] > 0  # the notches are there: pieces had gouging chords
+    assert rep["lifted"] <= rep["tolerance"] and wl["lifted"] <= rep["tolerance"], rep["lifted"]
+    assert rep["gouge"] + rep["deflection"] <= rep["tolerance"]
