@@ -333,9 +333,13 @@ class ContourPoints:
         along the fiber normal to it (the middle itself where none lies within the chord's
         length, or ``reach``, of it)."""
         pts = np.asarray(pts, float)
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise SurfmodError(f"pts: expected (N, 2) points, got shape {pts.shape}")
         which = np.unique(np.asarray(which, np.int64))
         if not len(which):
             return pts
+        if which[0] < 0 or which[-1] >= len(pts) - 1:
+            raise SurfmodError(f"which: chord indices must lie in [0, {len(pts) - 2}], got {which[0]}..{which[-1]}")
         a, b = pts[which], pts[which + 1]
         mid, chord = 0.5 * (a + b), b - a
         length = np.linalg.norm(chord, axis=1)
