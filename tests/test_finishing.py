@@ -197,3 +197,50 @@ def test_cam_part_job_scallop_in_stock(tmp_path):
     lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
     beside = ~np.isfinite(top) & (np.maximum(np.maximum(lo[0] - X, X - hi[0]), np.maximum(lo[1] - Y, Y - hi[1])) > 0.2)
     assert stock.top[beside].max() <= job.stock[0, 2] + 3.0 + 1e-6
+
+
+def test_waterline_chord_across_a_notch_is_split_not_lifted():
+    """A 20 mm box with a nub 0.01 mm proud of its +x wall (0.02 wide, z 8-10): below it
+    the ball's (r = 3) waterline bulges 0.01 outward over 0.5 mm, placed a quarter of the
+    way along one of the fiber grid's 1.5 mm chords (the grid's rows at -1.0079 + 1.5 k),
+    so the chord's middle lies on the wall's contour and its refinement misses the bulge;
+    the drop-cutter check finds the chord cutting down to the nub (before issue 26's fix
+    those moves were lifted, by up to 7.18 mm).  Now they are split at exact contour
+    points: nothing lifted, and no move below the nub comes nearer its footprint than the
+    radius (sampled every 0.01 mm).  Runs in about 0.5 s."""
+    R, p, yc = 3.0, 0.01, 0.117
+    body = bd.Box(20, 20, 10, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN))
+    job = sm.machine(body + bd.Pos(10 + p / 2, yc, 9) * bd.Box(p, 0.02, 2), 1.0,
+                     [sm.Finish(sm.Tool("ball", R), scallop=0.15)])
+    rep = job.operations[0].report
+    assert rep["waterline"]["split"] > 0  # the notch is there: pieces had chords cutting into it
+    assert rep["lifted"] <= rep["tolerance"], rep["lifted"]
+    pts = job.operations[0].moves
+    a, b = pts[:-1], pts[1:]
+    low = (a[:, 2] < 8) & (b[:, 2] < 8)
+    a, b = a[low], b[low]
+    n = np.ceil(np.linalg.norm(b - a, axis=1) / 0.01).astype(int) + 1
+    owner = np.repeat(np.arange(len(a)), n)
+    t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    q = a[owner] + t[:, None] * (b[owner] - a[owner])
+    dx = np.maximum(np.maximum(10 - q[:, 0], q[:, 0] - (10 + p)), 0)
+    dy = np.maximum(np.abs(q[:, 1] - yc) - 0.01, 0)
+    near = np.hypot(dx, dy)
+    assert low.sum() > 100 and near.min() >= R - rep["tolerance"], near.min()
+
+
+@pytest.mark.corpus
+def test_featuretype_waterline_follows_notches_instead_of_lifting(corpus_dir):
+    """On trimesh_featuretype some waterline chords (1.5 mm, the fiber grid's) have their
+    middle on the contour of a wall while a small feature near the top of the wall pushes
+    the contour across the chord between: the drop-cutter check finds the chord cutting
+    down to the feature's top (22.4 mm deep at z = 0, 27 pieces over 1 mm).  Such chords
+    are split at exact contour points until they follow it, so nothing is lifted (before:
+    ``lifted`` 22.44 mm), the moves still judged against the drop-cutter heights."""
+    job = sm.machine(corpus_dir / "trimesh_featuretype.STEP", 2.0,
+                     [sm.Finish(sm.Tool("ball", 3.0, flute_length=80), scallop=0.15)])
+    rep = job.operations[0].report
+    wl = rep["waterline"]
+    assert wl["split"] > 0  # the notches are there: pieces had gouging chords
+    assert rep["lifted"] <= rep["tolerance"] and wl["lifted"] <= rep["tolerance"], rep["lifted"]
+    assert rep["gouge"] + rep["deflection"] <= rep["tolerance"]

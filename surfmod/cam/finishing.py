@@ -26,8 +26,11 @@ plus the contours' chord tolerance (its Minkowski sum with a ball of radius ``g`
 ``R + g``, bull ``(R + g, c + g)``, a flat end the bull ``(R + g, g)``; tip ``g`` lower),
 so along every chord the real tool keeps at least ``δ`` from every triangle.  Every move
 is then judged like the raster's (:func:`~surfmod.cam.toolpath_moves.move_gouge` against
-the drop-cutter heights) and lifted where it would cut (not needed by construction;
-reported as ``lifted``).
+the drop-cutter heights).  The waterline checks a chord at its middle only, so a chord
+can cross a notch of the contour whose middle lies on it: such a chord is split at the
+exact contour point near its middle (:class:`~surfmod.cam.waterline.ContourPoints`),
+again and again (:func:`_follow`; ``split`` counts the pieces), and only a move that still
+cuts after that is lifted (reported as ``lifted``).
 
 **Links** between contours run along the part when the straight move stays clear of it
 and is short (at most a tool radius across, no more than 1.5 levels down); otherwise the
@@ -57,7 +60,7 @@ from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
 from .tool import Tool
 from .toolpath import REFINE_SHARE, _Part, raster_path
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
-from .waterline import waterline
+from .waterline import ContourPoints, waterline
 
 #: Steep regions: slopes within this many degrees below the threshold count too (the
 #: classification samples the drop-cutter surface, the raster's slope bound its triangles).
@@ -67,6 +70,9 @@ REST_CLEARANCE = 1.0
 #: Grid spacing of the rest map: a tool radius over this, or the part's size over REST_CELLS.
 REST_PER_RADIUS = 8
 REST_CELLS = 500
+#: Rounds of splitting a gouging waterline chord beyond the halvings that bring the longest
+#: chord to the chord tolerance (a split lands near, not at, the middle).
+SPLIT_SLACK = 3
 
 
 @dataclass(frozen=True)
@@ -212,17 +218,41 @@ def _grown(tool: Tool, g: float):
     return SimpleNamespace(kind="bull", radius=tool.radius + g, corner_radius=tool.corner + g)
 
 
-def _judge(part: _Part, pts: np.ndarray, allowed: float):
-    """Gouge-check one polyline; lift what would cut (returns points, lift)."""
+def _judge(part: _Part, pts: np.ndarray, allowed: float, depth: np.ndarray | None = None):
+    """Gouge-check one polyline (``depth`` its per-move depth when known); lift what would
+    cut (returns points, lift)."""
     if len(pts) < 2:
         return pts, 0.0
-    depth = move_gouge(part.height, pts)
+    if depth is None:
+        depth = move_gouge(part.height, pts)
     if depth.max() <= allowed:
         return pts, 0.0
     pts, lift, depth = lift_moves(part.height, pts, depth, REFINE_SHARE * allowed)
     if depth.max() > allowed:
         raise NoSafePathError(f"toolpath: no safe path: a waterline move still cuts {depth.max():.3g} deep")
     return pts, float(lift.max())
+
+
+def _follow(part: _Part, contour: ContourPoints, z: float, piece: np.ndarray, depth: np.ndarray, allowed: float,
+            shortest: float):
+    """``piece`` (tip height ``z`` + the contours' margin above the waterline's own ``z``)
+    with every chord cutting deeper than ``allowed`` split at the exact contour point
+    near its middle, round after round, so a chord whose middle lay on the contour while
+    the contour left it between (a notch) follows it.  Chords no longer than ``shortest``
+    are not split; the rounds are bounded before they start by the halvings that bring
+    the longest chord down to ``shortest`` (plus ``SPLIT_SLACK``).  Returns the piece and
+    its per-move depth."""
+    longest = float(np.linalg.norm(np.diff(piece[:, :2], axis=0), axis=1).max())
+    rounds = math.ceil(math.log2(max(longest / shortest, 1.0))) + SPLIT_SLACK
+    for _ in range(rounds):
+        length = np.linalg.norm(np.diff(piece[:, :2], axis=0), axis=1)
+        bad = np.flatnonzero((depth > allowed) & (length > shortest))
+        if not len(bad):
+            break
+        xy = contour.split(z, piece[:, :2], bad)
+        piece = np.column_stack([xy, np.full(len(xy), piece[0, 2])])
+        depth = move_gouge(part.height, piece)
+    return piece, depth
 
 
 def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float):
@@ -245,11 +275,13 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     if not len(levels):
         return [], info
     grown = _grown(tool, g)
-    loops = waterline(tri, grown, levels - g, sampling=tool.radius / 2, tolerance=chord)
+    sampling = tool.radius / 2
+    loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord)
+    contour = None  # built at the first gouging chord (most parts have none)
     allowed = tolerance - part.deflection + part.lift
     w = 0.25 * spacing
     bottom_z = bottom
-    out, lifted, count, length = [], 0.0, 0, 0.0
+    out, lifted, count, length, split = [], 0.0, 0, 0.0, 0
     for z, level in zip(levels, loops):
         pieces = []
         for loop in level:
@@ -266,7 +298,13 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
             for piece in _pieces(np.column_stack([xy, np.full(len(xy), z)]), keep):
                 if len(piece) < 2:
                     continue
-                piece, lift = _judge(part, piece, allowed)
+                depth = move_gouge(part.height, piece)
+                if depth.max() > allowed:  # a chord crosses a notch its middle missed: follow the contour
+                    if contour is None:
+                        contour = ContourPoints(tri, grown, 1.5 * sampling)
+                    piece, depth = _follow(part, contour, z - g, piece, depth, allowed, chord)
+                    split += 1
+                piece, lift = _judge(part, piece, allowed, depth)
                 lifted = max(lifted, lift)
                 pieces.append(piece)
                 count += 1
@@ -275,7 +313,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     gaps = -np.diff(levels)
     info.update(levels=len(levels), z_spacing=(float(gaps.min()) if len(gaps) else 0.0,
                                                float(gaps.max()) if len(gaps) else 0.0),
-                contours=count, length=length, lifted=lifted, top=float(levels[0]), bottom=float(levels[-1]),
+                contours=count, length=length, lifted=lifted, split=split, top=float(levels[0]), bottom=float(levels[-1]),
                 margin=g)
     return out, info
 

@@ -13,7 +13,9 @@ The contours come from a grid of fibers of spacing
 whose nodes differ, joined cell by cell (marching squares, the material kept on the
 left) into closed loops; then every chord whose midpoint lies farther than
 ``tolerance`` from the true contour (measured along a fiber normal to the chord) gets
-that exact point inserted, until none does.
+that exact point inserted, until none does.  A chord can still cross a notch of the
+contour whose middle it misses; :class:`ContourPoints` splits given chords at exact
+contour points (finishing does it where the drop-cutter check finds a chord cutting).
 
 Work is bounded before it starts: the number of (fiber, triangle) pairs from the grid
 and the triangles' boxes is estimated and refused above ``MAX_PAIRS``; refinement stops
@@ -301,6 +303,54 @@ def _refine(fib: _Fibers, z, loops, tolerance, reach):
             k += size
         loops, done = out, flags
     return loops
+
+
+class ContourPoints:
+    """Exact waterline points of one tool round a part, to split chords of its contours
+    (e.g. where a drop-cutter check finds a chord crossing a notch of the contour that its
+    midpoint missed).  ``reach``: how far from a chord's middle a point is looked for.
+
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> box = np.array([[[0, 0, 0], [10, 0, 0], [10, 10, 0]], [[0, 0, 0], [10, 10, 0], [0, 10, 0]]], float)
+    >>> cp = ContourPoints(box, SimpleNamespace(kind="flat", radius=1.0), 6.0)
+    >>> cp.split(0.0, np.array([[-1.0, 5.0], [5.0, -1.0]]), np.array([0])).round(6).tolist()  # cuts a corner
+    [[-1.0, 5.0], [-0.707107, -0.707107], [5.0, -1.0]]
+    """
+
+    def __init__(self, part, tool, reach: float):
+        kind, R, rc = _tool_shape(tool)
+        tri = np.asarray(part, dtype=float)
+        if tri.ndim != 3 or tri.shape[1:] != (3, 3) or not len(tri):
+            raise SurfmodError(f"part: expected triangles (M, 3, 3), got shape {tri.shape}")
+        if not reach > 0:
+            raise SurfmodError(f"reach: must be > 0, got {reach}")
+        self.fib, self.reach = _Fibers(tri, kind, R, rc, float(reach)), float(reach)
+
+    def split(self, z: float, pts: np.ndarray, which: np.ndarray) -> np.ndarray:
+        """The polyline ``pts`` (N, 2) with each chord ``i`` in ``which`` (from ``pts[i]`` to
+        ``pts[i + 1]``) split at the contour point at tip height ``z`` nearest its middle
+        along the fiber normal to it (the middle itself where none lies within the chord's
+        length, or ``reach``, of it)."""
+        pts = np.asarray(pts, float)
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise SurfmodError(f"pts: expected (N, 2) points, got shape {pts.shape}")
+        which = np.unique(np.asarray(which, np.int64))
+        if not len(which):
+            return pts
+        if which[0] < 0 or which[-1] >= len(pts) - 1:
+            raise SurfmodError(f"which: chord indices must lie in [0, {len(pts) - 2}], got {which[0]}..{which[-1]}")
+        a, b = pts[which], pts[which + 1]
+        mid, chord = 0.5 * (a + b), b - a
+        length = np.linalg.norm(chord, axis=1)
+        normal = np.column_stack([-chord[:, 1], chord[:, 0]]) / np.where(length > 0, length, 1.0)[:, None]
+        span = np.minimum(np.maximum(length, 1e-12), self.reach)
+        qi, lo, hi = self.fib.query(mid, normal, z, span)
+        seen = (lo <= span[qi]) & (hi >= -span[qi])
+        qi, lo, hi = qi[seen], np.maximum(lo[seen], -span[qi[seen]]), np.minimum(hi[seen], span[qi[seen]])
+        best = _union_nearest(len(which), qi, lo, hi)
+        off = np.where(np.isfinite(best) & (np.abs(best) < span), best, 0.0)
+        return np.insert(pts, which + 1, mid + off[:, None] * normal, axis=0)
 
 
 def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance: float | None = None):
