@@ -70,7 +70,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Splitter
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
@@ -83,13 +83,13 @@ from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_SHAPE, TopAbs_VERTEX
 from OCP.TopTools import TopTools_ListOfShape
 from OCP.TopLoc import TopLoc_Location
-from OCP.TopoDS import TopoDS, TopoDS_Compound
+from OCP.TopoDS import TopoDS
 from OCP.gp import gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import kernel
-from .topo import explore, faces_of, geometric_edges, solids_of
+from .topo import compound, explore, faces_of, geometric_edges, solids_of
 
 # Gauss–Kronrod 10/21 on [-1, 1] (QUADPACK's qk21): Kronrod nodes from the end inwards,
 # the Gauss nodes every second one (odd indices), the centre last
@@ -534,15 +534,11 @@ def cut_volumes(shape, direction, heights, volume: float, origin, size: float, o
         if not splitter.IsDone():
             raise SurfmodError("shape: OCCT's splitter failed to cut the solid into slabs")
         pieces = solids_of(splitter.Shape())
-        builder = BRep_Builder()
-        slabs = [TopoDS_Compound() for _ in range(len(heights) + 1)]
-        for c in slabs:
-            builder.MakeCompound(c)
+        slab_faces = [[] for _ in range(len(heights) + 1)]
         for piece in pieces:
-            slab = slabs[_slab_of(piece, heights, a)]
-            for face in faces_of(piece):
-                if not _is_cut_face(face, a, heights, span):
-                    builder.Add(slab, face)
+            slab_faces[_slab_of(piece, heights, a)].extend(
+                face for face in faces_of(piece) if not _is_cut_face(face, a, heights, span))
+        slabs = [compound(faces) for faces in slab_faces]
         # the second reference level a half side away: M from the difference of two
         # fluxes loses only log10(size / slab) digits
         w = np.array([_flux(c, origin, a) for c in slabs])
