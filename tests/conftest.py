@@ -8,6 +8,8 @@ with ``HYPOTHESIS_PROFILE=explore``.
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +33,15 @@ def rng():
 # ``python -m pytest -q -m corpus``; the default run (``-m "not corpus"`` in pyproject)
 # keeps the quick per-file cases.
 CORPUS = Path(__file__).resolve().parent / "data" / "step"
+
+
+def fresh_python(script: str) -> list[str]:
+    """The words ``script`` prints when run in a fresh interpreter (nothing imported yet,
+    numba's cache as configured): what a first call of a process loads and compiles."""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    return done.stdout.split()
+
+
 CORPUS_FILES = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
 
 

@@ -6,13 +6,12 @@ run) agree with the scattered kernel, the textbook and OCCT."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from itertools import pairwise
 
 import numba
 import numpy as np
 import pytest
+from conftest import fresh_python
 import reference as ref
 
 import surfmod as sm
@@ -207,5 +206,4 @@ def test_a_grid_on_a_small_net_compiles_no_vector_stage():
         "s.grid(u, u); s.grid_derivatives(u[:300], u[:300], 2)\n"
         "print(len(row_stage.contract_rows.signatures), len(sliding.block_positions.signatures))\n"
     )
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
-    assert done.stdout.split() == ["0", "0"]
+    assert fresh_python(script) == ["0", "0"]

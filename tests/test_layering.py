@@ -49,6 +49,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import fresh_python
 
 import surfmod
 
@@ -470,8 +471,7 @@ def test_every_entity_evaluates_with_the_kernel_blocked():
 def test_import_surfmod_loads_no_kernel():
     # (its time is measured by the benchmarks, not asserted here)
     code = "import sys, surfmod; print('OCP' in sys.modules, 'build123d' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
-    assert out == ["False", "False"], "import surfmod must not load OCP/build123d"
+    assert fresh_python(code) == ["False", "False"], "import surfmod must not load OCP/build123d"
 
 
 def test_no_subpackage_shadows_a_public_name():

@@ -3,11 +3,9 @@ branch and bound (ops/seeding.py), and projections that do not depend on which r
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
+from conftest import fresh_python
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
@@ -63,5 +61,4 @@ def test_a_small_projection_takes_the_numpy_paths():
         "r = sm.project(pts, sm.BSplineSurface(wavy_net(8, 8), (3, 3)), progress=False)\n"
         "print(len(r.distance), 'numba' in sys.modules)\n"
     )
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
-    assert done.stdout.split() == ["500", "False"]
+    assert fresh_python(script) == ["500", "False"]
