@@ -51,8 +51,12 @@ BLOCKS_PER_THREAD = 8
 #: which takes milliseconds there, while the first compiled call of a process loads numba
 #: and its kernels (about a second; minutes into an empty cache)
 COMPILED_SCATTERED = 1 << 15
-#: the same for grids, whose NumPy path costs less per point (one row stage for all u)
-COMPILED_GRID = 1 << 18
+#: the same for grids, whose NumPy path costs less per point (one row stage for all u):
+#: below 3 * 2^18 partials it takes at most about 70 ms (50 ms for a bicubic 103 x 633
+#: grid to order 2), less than loading the grid kernels from a warm cache and a small
+#: fraction of compiling them (12-25 s each); the meshers' and the gallery's grids (up
+#: to 640k partials) stay below it, so a first `surfmod gallery` compiles no grid stage
+COMPILED_GRID = 3 << 18
 
 
 def _kernels():
