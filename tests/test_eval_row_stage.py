@@ -207,3 +207,21 @@ def test_a_grid_on_a_small_net_compiles_no_vector_stage():
         "print(len(row_stage.contract_rows.signatures), len(sliding.block_positions.signatures))\n"
     )
     assert fresh_python(script) == ["0", "0"]
+
+
+def test_the_meshers_mid_sized_grids_stay_in_numpy():
+    """Grids below ``COMPILED_GRID`` partials (the structured mesher's 103 x 633 grid to
+    order 2, the superellipsoid's 406 x 813 positions) are evaluated in NumPy: in a fresh
+    process they import neither the grid kernels nor numba, so a first ``surfmod gallery``
+    compiles no grid stage."""
+    script = (
+        "import sys, numpy as np, surfmod as sm\n"
+        "from surfmod.gallery.synthetic import wavy_net\n"
+        "from surfmod.eval.local import COMPILED_GRID\n"
+        "assert 103 * 633 * 9 < COMPILED_GRID\n"
+        "s = sm.BSplineSurface(wavy_net(8, 8), (3, 3))\n"
+        "s.grid_derivatives(np.linspace(0, 1, 103), np.linspace(0, 1, 633), 2)\n"
+        "s.grid(np.linspace(0, 1, 406), np.linspace(0, 1, 813))\n"
+        "print(int('surfmod.eval.grid_kernels' in sys.modules), int('numba' in sys.modules))\n"
+    )
+    assert fresh_python(script) == ["0", "0"]
