@@ -200,16 +200,16 @@ def test_every_degree_matches_occt(p, rational):
 
 # -- the machinery -------------------------------------------------------------------------
 def test_grid_blocks_and_preallocated_output_agree():
-    """A net large enough that the u-points go in several row blocks; ``grid_into`` writes
-    the same numbers into the caller's buffer."""
+    """A grid whose v-points go in several chunks of the ring; ``grid_into`` writes the
+    same numbers into the caller's buffer."""
     s = _surface(300, 40, 3, 3, True, seed=9, repeat=False)
     us, vs = np.linspace(0, 1, 701), np.linspace(0, 1, 3000)
-    old = local.ROW_TABLE
+    old = local.CHUNK
     try:
-        local.ROW_TABLE = 1 << 15  # force many blocks
+        local.CHUNK = 128  # force many chunks
         blocked = s.grid(us, vs)
     finally:
-        local.ROW_TABLE = old
+        local.CHUNK = old
     np.testing.assert_array_equal(blocked, s.grid(us, vs))
     buf = np.empty((us.size, vs.size, 3))
     assert s.grid_into(us, vs, buf) is buf

@@ -50,10 +50,10 @@ def _both(fn, monkeypatch):
 @pytest.mark.parametrize("rational", [False, True])
 def test_parallel_grid_equals_serial_bit_for_bit(p, q, rational, monkeypatch):
     s = _surface(60, 45, p, q, rational, seed=p + q)
-    us, vs = np.linspace(0, 1, 301), np.r_[np.linspace(0, 1, 1500), 0.25, 0.0]  # two v-blocks, unsorted tail
-    monkeypatch.setattr(local, "ROW_TABLE", 1 << 14)  # several row blocks
+    us, vs = np.linspace(0, 1, 301), np.r_[np.linspace(0, 1, 1500), 0.25, 0.0]  # unsorted tail
+    monkeypatch.setattr(local, "CHUNK", 256)  # several chunks of v-points
     serial, threaded = _both(lambda: (s.grid(us, vs), s.grid_derivatives(us[::7], vs[::5], 2)), monkeypatch)
-    assert parallel.positions_grid.signatures and parallel.partials_grid.signatures  # both ran threaded
+    assert parallel.grid.signatures  # ran threaded
     np.testing.assert_array_equal(threaded[0], serial[0])
     np.testing.assert_array_equal(threaded[1], serial[1])
     buf = np.empty((us.size, vs.size, 3))
@@ -108,16 +108,15 @@ def test_numba_thread_count_is_restored(monkeypatch):
 
 @pytest.mark.parametrize("rational", [False, True])
 def test_grid_rows_do_not_depend_on_order_or_blocking(rational, monkeypatch):
-    """Sorted u-points go in blocks as large as the row table allows, shuffled ones in
-    smaller blocks: every point's values are the same bit for bit, in any order."""
+    """Shuffled u-points are sorted for the ring and put back; every point's values are
+    the same bit for bit, in any order and for any chunk of v-points."""
     s = _surface(120, 50, 3, 3, rational, seed=4)
-    us, vs = np.linspace(0, 1, 400), np.linspace(0, 1, 90)
+    us, vs = np.linspace(0, 1, 400), np.linspace(0, 1, 900)
     perm = np.random.default_rng(0).permutation(us.size)
-    monkeypatch.setattr(local, "ROW_TABLE", 1 << 13)
     with threads.limit(1):
         for order in (0, 2):
             ordered = s.grid_derivatives(us, vs, order)
             np.testing.assert_array_equal(s.grid_derivatives(us[perm], vs, order), ordered[perm])
-            monkeypatch.setattr(local, "ROW_TABLE", 1 << 19)  # one block
+            monkeypatch.setattr(local, "CHUNK", 100)  # nine chunks
             np.testing.assert_array_equal(s.grid_derivatives(us, vs, order), ordered)
-            monkeypatch.setattr(local, "ROW_TABLE", 1 << 13)
+            monkeypatch.setattr(local, "CHUNK", 1024)

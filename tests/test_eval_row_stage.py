@@ -1,12 +1,12 @@
-"""The grid's vector row stage (surfmod/eval/row_stage.py) and the paired position stage
-(surfmod/eval/position_stage.py): runs of v-points in consecutive spans go through vector
-loops over the net's coordinate planes and give the one-point-at-a-time sums bit for bit,
-at every degree and order; grids on nets with about one point a span (where those paths
-run) agree with the scattered kernel, the textbook and OCCT."""
+"""The compiled grid (surfmod/eval/grid_kernels.py), its row stage (surfmod/eval/row_stage.py)
+and its paired position stage (surfmod/eval/position_stage.py): runs of v-points in
+consecutive spans go through vector loops over the net's coordinate planes and give the
+one-point-at-a-time sums bit for bit, at every degree and order; grids on nets with about
+one point a span (where those loops run) agree with the scattered kernel, the textbook and
+OCCT; the values do not depend on the chunks of the ring; positions and partials of every
+order are one compiled function."""
 
 from __future__ import annotations
-
-from itertools import pairwise
 
 import numba
 import numpy as np
@@ -15,7 +15,7 @@ from conftest import fresh_python
 import reference as ref
 
 import surfmod as sm
-from surfmod.eval import grid_kernels, local, row_stage, sliding, threads
+from surfmod.eval import local, row_stage, threads
 from surfmod.occ.sample import surface_d2
 
 
@@ -89,10 +89,13 @@ def test_vector_row_stage_equals_the_scalar_one_bit_for_bit(q, order, rational):
     dim = 4 if rational else 3
     scalar = np.full((rows.size, order + 1, dim, vs.size), np.nan)
     vector = np.full_like(scalar, np.nan)
-    grid_kernels.grid_rows(bv, sv, q, net.ctrl, rows, dim, scalar)
-    bplan = np.ascontiguousarray(bv.transpose(1, 2, 0))
-    row_stage.contract_rows(bv, bplan, sv, q, net.ctrl, row_stage.net_planes(net.ctrl), rows, dim, vector,
-                            starts, kinds)
+    for plan, dst in ((local._scalar_plan(net, sv, bv), scalar),
+                      ((np.ascontiguousarray(bv.transpose(1, 2, 0)), row_stage.net_planes(net.ctrl), starts, kinds),
+                       vector)):
+        bplan, planes, run_starts, run_kinds = plan
+        for k, r in enumerate(rows):
+            row_stage.contract_row(bv, bplan, sv, q, net.ctrl[r], planes[r], dim, dst[k].reshape(-1), 0, vs.size,
+                                   run_starts, run_kinds, 0, vs.size)
     np.testing.assert_array_equal(vector, scalar)
     # and the sums are the textbook's: net rows contracted with the v-basis
     dense = np.zeros((vs.size, order + 1, m))
@@ -115,7 +118,7 @@ def test_grid_on_a_big_net_through_the_vector_paths(p, q, rational, monkeypatch)
     grid = s.grid(us, vs)
     ders = s.grid_derivatives(us[::3], vs, 2)
     assert "planes" in s._local_net().cache
-    monkeypatch.setattr(local, "_vector_runs", lambda *args: None)
+    monkeypatch.setattr(local, "_row_stage_plan", lambda net, sv, bv, rows: local._scalar_plan(net, sv, bv))
     np.testing.assert_array_equal(grid, s.grid(us, vs))
     np.testing.assert_array_equal(ders, s.grid_derivatives(us[::3], vs, 2))
     uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
@@ -143,7 +146,7 @@ def test_a_few_rows_of_a_big_net_skip_the_planes():
 def test_parallel_vector_paths_equal_serial_bit_for_bit(rational, monkeypatch):
     s = _uniform_surface(200, 180, 3, 3, rational, seed=5)
     us, vs = np.linspace(0, 1, 401), np.linspace(0, 1, 180)
-    monkeypatch.setattr(local, "ROW_TABLE", 1 << 15)  # several row blocks
+    monkeypatch.setattr(local, "GRID_MIN_BLOCK", 3)  # many blocks of u-points, a ring each
     with threads.limit(1):
         serial = s.grid(us, vs), s.grid_derivatives(us[::5], vs, 2)
     monkeypatch.setattr(threads, "PARALLEL_MIN_POINTS", 1)
@@ -153,60 +156,55 @@ def test_parallel_vector_paths_equal_serial_bit_for_bit(rational, monkeypatch):
     np.testing.assert_array_equal(threaded[1], serial[1])
 
 
-@pytest.mark.parametrize("seed", range(5))
-def test_sorted_block_rows_are_each_blocks_needed_rows(seed):
-    """The rows of each block of sorted u-points, found without a pass per block, are the
-    sorted union of its points' p+1 rows, and ``first`` places each point's lowest."""
-    rng = np.random.default_rng(seed)
-    p = int(rng.integers(1, 6))
-    n = int(rng.integers(p + 2, 900))
-    su = np.sort(rng.integers(p, n, int(rng.integers(2, 2000))))
-    for per_row in (1, 400, 4000):
-        starts, rows, row_starts, first = local._row_blocks(su, p, n, per_row)
-        for k, (a0, a1) in enumerate(pairwise(starts)):
-            block = rows[row_starts[k] : row_starts[k + 1]]
-            expected = np.unique((su[a0:a1, None] - p + np.arange(p + 1)).ravel())
-            np.testing.assert_array_equal(block, expected)
-            np.testing.assert_array_equal(block[first[a0:a1]], su[a0:a1] - p)
-
-
 @pytest.mark.parametrize("rational", [False, True])
-def test_interleaved_stages_over_several_v_chunks(rational, monkeypatch):
-    """More v-points than a chunk of the ring (surfmod/eval/sliding.py; v-blocks made
-    longer than a chunk, which is as long as a v-block), u-points skipping spans, pairs
-    and single points: the same bits as the two-stage path, and the points of the
-    scattered kernel."""
-    monkeypatch.setattr(local, "V_BLOCK", 4 * sliding.CHUNK)
+def test_the_ring_over_several_v_chunks(rational, monkeypatch):
+    """More v-points than a chunk of the ring, u-points skipping spans (rows no u-point
+    reads are not contracted), pairs and single points, unsorted u-points: the same bits
+    as with one chunk and as the one-point-at-a-time row stage, and the points of the
+    scattered kernel; partials to orders 1 and 3 likewise."""
     s = _uniform_surface(90, 2200, 3, 3, rational, seed=11)
     us = np.sort(np.r_[np.linspace(0, 1, 60), np.linspace(0.2, 0.3, 25), 0.5, 0.5])
     spans = 2200 - 3
     vs = np.sort(np.r_[(np.arange(spans) + 0.5) / spans, 0.25, 0.25, 1.0])  # one a span, and a few more
-    assert 2 * sliding.CHUNK < vs.size <= local.V_BLOCK
+    assert 2 * local.CHUNK < vs.size
     _, kinds = row_stage.runs(local._basis(s.knots[1], 3, 700, vs, 0)[0])
     assert np.count_nonzero(kinds == row_stage.NEXT_SPAN) >= 2 and np.any(kinds == row_stage.SCALAR)
     grid = s.grid(us, vs)
+    ders = {order: s.grid_derivatives(us[::4], vs, order) for order in (1, 3)}
     assert "planes" in s._local_net().cache
-    monkeypatch.setattr(local, "_vector_runs", lambda *args: None)
+    monkeypatch.setattr(local, "CHUNK", 1 << 20)
     np.testing.assert_array_equal(grid, s.grid(us, vs))
+    for order, d in ders.items():
+        np.testing.assert_array_equal(d, s.grid_derivatives(us[::4], vs, order))
+    monkeypatch.setattr(local, "_row_stage_plan", lambda net, sv, bv, rows: local._scalar_plan(net, sv, bv))
+    np.testing.assert_array_equal(grid, s.grid(us, vs))
+    perm = np.random.default_rng(2).permutation(us.size)
+    np.testing.assert_array_equal(s.grid(us[perm], vs), grid[perm])
     uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
     np.testing.assert_allclose(grid.reshape(-1, 3), s.points(uu, vv), rtol=0,
                                atol=1e-13 * np.abs(s.control_points).max())
+    uu, vv = (a.ravel() for a in np.meshgrid(us[::4], vs[::37], indexing="ij"))
+    for order, d in ders.items():
+        np.testing.assert_allclose(d[:, ::37].reshape(uu.size, -1), s.derivatives(uu, vv, order).reshape(uu.size, -1),
+                                   rtol=1e-12, atol=1e-10 * np.abs(d).max())
 
 
-def test_a_grid_on_a_small_net_compiles_no_vector_stage():
-    """The vector row stage and the sliding ring are compiled only for grids that use them
-    (numba prunes the ``vruns is None`` branches): a grid on a 20 x 20 net, in a fresh
-    process, leaves both without a signature."""
+def test_positions_and_partials_are_one_compiled_grid():
+    """One compiled path for grids: positions and partials of every order, polynomial and
+    rational, on small and big nets, in a fresh process, compile ``grid_kernels.grid``
+    once (one signature)."""
     script = (
         "import numpy as np, surfmod as sm\n"
         "from surfmod.gallery.synthetic import wavy_net\n"
-        "from surfmod.eval import row_stage, sliding\n"
-        "u = np.linspace(0, 1, 700)\n"
-        "s = sm.BSplineSurface(wavy_net(20, 20), (3, 3))\n"
-        "s.grid(u, u); s.grid_derivatives(u[:300], u[:300], 2)\n"
-        "print(len(row_stage.contract_rows.signatures), len(sliding.block_positions.signatures))\n"
+        "from surfmod.eval import grid_kernels, threads\n"
+        "threads.set_threads(1)\n"
+        "u = np.linspace(0, 1, 1000)\n"
+        "for n, w in ((20, None), (300, np.full((300, 300), 2.0))):\n"
+        "    s = sm.BSplineSurface(wavy_net(n, n), (3, 3), weights=w)\n"
+        "    s.grid(u, u); s.grid_derivatives(u, u[:500], 1); s.grid_derivatives(u, u[:400], 2)\n"
+        "print(len(grid_kernels.grid.signatures))\n"
     )
-    assert fresh_python(script) == ["0", "0"]
+    assert fresh_python(script) == ["1"]
 
 
 def test_the_meshers_mid_sized_grids_stay_in_numpy():

@@ -4,7 +4,7 @@ Every point touches only its ``(p+1) x (q+1)`` poles, so the cost depends on the
 of points and the degrees, never on the size of the control net.  The kernels are
 imported lazily (``import surfmod`` never imports numba) and compiled once into numba's
 on-disk cache (``cache=True``).  Every sizeable array they write (outputs, the grid's
-row tables) is allocated by the NumPy caller, so ``tracemalloc`` sees the memory and the
+ring of rows) is allocated by the NumPy caller, so ``tracemalloc`` sees the memory and the
 caller decides the blocking; inside there are only per-chunk scratch planes of a few
 hundred KiB at most.  The grid kernels are in :mod:`surfmod.eval.grid_kernels`, the multi-threaded variants
 in :mod:`surfmod.eval.parallel`.

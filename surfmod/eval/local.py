@@ -5,10 +5,10 @@ size of the control net (a 1000 x 1000 net costs what a 4 x 4 one does).
 Scattered pairs run one compiled loop over the points (span search, basis derivatives,
 local contraction, quotient rule); many positions on a small net of degree <= 3 use
 per-span Taylor patches instead (:mod:`surfmod.eval.patches`: a span search and a Horner
-scheme per point).  Grids run in two stages: the net rows that the u-points need are
-contracted with the v-basis once (``W[i, l, :, b]``), then each u-point combines its p+1
-rows with the v-points on the contiguous axis.  The u-points go in blocks so that the
-row table stays a few MiB whatever the grid or the net.  Results are written point-major,
+scheme per point).  Grids run in two interleaved stages: each net row that the sorted
+u-points need is contracted with the v-basis once a chunk of v-points, into a ring of
+rows that stays in L2 whatever the grid or the net, and each u-point combines its p+1
+rows with the v-points on the contiguous axis.  Results are written point-major,
 into a caller's array when given.  :func:`partials_finite` bounds the partials once per
 net, so callers need not rescan large outputs for NaN or infinity.
 
@@ -28,7 +28,6 @@ from __future__ import annotations
 import threading
 import warnings
 from contextlib import nullcontext
-from itertools import pairwise
 from math import comb
 from typing import NamedTuple
 
@@ -38,10 +37,16 @@ from . import vectorized
 from .basis import basis_derivatives, find_spans, reciprocal_table, span_buckets
 from .threads import running_on, threads_for
 
-#: doubles in the per-block row table of the grid stage (2 MiB): stays in L2
-ROW_TABLE = 1 << 18
-#: v-points per block of the grid: the rows a u-point combines stay in cache
-V_BLOCK = 1024
+#: rows in the ring of contracted net rows at least: a pass reads at most five (a cubic
+#: pair of positions on rows shifted by one), a u-point of degree p reads p + 1
+RING_ROWS = 8
+#: v-points a chunk of the ring covers at most: each net row's coordinate planes are
+#: then read in long contiguous stretches, which the hardware prefetchers follow from
+#: memory (chunks of 256 made 1000² positions on a 1000 x 1000 net 20 % slower)
+CHUNK = 1024
+#: the same for partials (or positions above degree 3), whose ring rows hold K planes
+#: each: the ring stays within 1 MiB (order 2, rational: 8 x 3 x 4 x 1024 doubles, 768 KiB)
+RING_DOUBLES = 1 << 17
 #: fewest u-points per block when blocks are split among threads
 GRID_MIN_BLOCK = 16
 #: blocks per thread (at least): threads that finish early take more of them
@@ -312,9 +317,9 @@ _workspace = threading.local()
 
 
 def _scratch(count: int, per_slot: int) -> np.ndarray:
-    """``(slots, per_slot)`` scratch for the grid's row tables, one slot per thread that
-    may run (numba's thread ids when ``count > 1``), kept per calling thread and reused:
-    a fresh multi-MiB table per call would be paged in each time."""
+    """``(slots, per_slot)`` scratch for the grid's rings, one slot per thread that may
+    run (numba's thread ids when ``count > 1``), kept per calling thread and reused: a
+    fresh ring per call would be paged in each time."""
     slots = 1 if count == 1 else _numba_threads()
     buf = getattr(_workspace, "rows", None)
     if buf is None or buf.size < slots * per_slot:
@@ -328,87 +333,43 @@ def _numba_threads() -> int:
     return int(numba.config.NUMBA_NUM_THREADS)
 
 
-def _row_blocks(su, p, n, per_row, threads=1):
-    """Blocks of u-points whose net rows fit the row table, as the arrays of
-    :func:`surfmod.eval.grid_kernels.positions_grid` and ``partials_grid``: ``(starts,
-    rows, row_starts, first)``.  With several threads there are :data:`BLOCKS_PER_THREAD`
-    blocks a thread or more (rows at a boundary between blocks are contracted by both; the
-    values do not depend on the blocking)."""
-    max_rows = max(p + 1, ROW_TABLE // max(1, per_row))
-    step = max(1, su.size) if n <= max_rows else max(1, max_rows // (p + 1))
-    most = su.size  # u-points per block at most: with threads, several blocks each
-    if threads > 1:
-        most = max(GRID_MIN_BLOCK, -(-su.size // (BLOCKS_PER_THREAD * threads)))
-        step = min(step, most)
-    ordered = su.size > 1 and bool(np.all(su[1:] >= su[:-1]))
-    if n > max_rows and ordered:
-        # sorted u (the usual grid): a block takes u-points while its rows fit, not
-        # max_rows / (p+1) of them (which assumes p+1 new rows per u-point)
-        cuts = [0]
-        while cuts[-1] < su.size:  # loop over memory blocks, not points
-            a0 = cuts[-1]
-            a1 = int(np.searchsorted(su, su[a0] + max_rows - p - 1, side="right"))
-            cuts.append(min(max(a1, a0 + 1), a0 + most))
-        starts = np.array(cuts)
-    else:
-        starts = np.arange(0, su.size + step, step).clip(max=su.size)
-        starts = starts[np.r_[True, np.diff(starts) > 0]]
-    if ordered:
-        return (starts.astype(np.int64),) + _sorted_block_rows(su, p, n, starts)
-    rows, row_starts, first = [], [0], np.empty(su.size, dtype=np.int64)
-    for a0, a1 in pairwise(starts):  # loop over memory blocks, not points
-        s = su[a0:a1]
-        block = np.unique((s[:, None] - p + np.arange(p + 1)).ravel())
-        first[a0:a1] = np.searchsorted(block, s - p)
-        rows.append(block)
-        row_starts.append(row_starts[-1] + block.size)
-    rows = np.concatenate(rows) if rows else np.empty(0, dtype=np.int64)
-    return starts.astype(np.int64), rows.astype(np.int64), np.array(row_starts, dtype=np.int64), first
+def _u_blocks(n_u: int, threads: int) -> np.ndarray:
+    """Starts of the blocks of (sorted) u-points that the threads share: at least
+    :data:`BLOCKS_PER_THREAD` a thread, of :data:`GRID_MIN_BLOCK` u-points or more."""
+    step = max(GRID_MIN_BLOCK, -(-n_u // (BLOCKS_PER_THREAD * threads)))
+    return np.r_[np.arange(0, n_u, step), n_u].astype(np.int64)
 
 
-def _needed_rows(su, p, n):
-    """Which of the ``n`` net rows the u-points of spans ``su`` read (a mask)."""
-    needed = np.zeros(n, dtype=bool)
-    needed[(su[:, None] - p + np.arange(p + 1)).ravel()] = True
-    return needed
-
-
-def _sorted_block_rows(su, p, n, starts):
-    """``(rows, row_starts, first)`` of :func:`_row_blocks` for sorted spans ``su``,
-    without a pass per block: the rows a block needs are all the needed rows from its
-    first point's lowest to its last point's highest (a needed row in between belongs to
-    a point in between), so each block's rows are a slice of the sorted needed rows."""
-    every = np.flatnonzero(_needed_rows(su, p, n))
-    lo = np.searchsorted(every, su[starts[:-1]] - p)
-    hi = np.searchsorted(every, su[starts[1:] - 1], side="right")
-    row_starts = np.r_[0, np.cumsum(hi - lo)]
-    rows = every[np.arange(row_starts[-1]) - np.repeat(row_starts[:-1] - lo, hi - lo)]
-    first = np.searchsorted(every, su - p) - np.repeat(lo, np.diff(starts))
-    return rows.astype(np.int64), row_starts.astype(np.int64), first.astype(np.int64)
-
-
-def _vector_runs(net: LocalNet, sv, bv, rows: int):
-    """The arguments of the grid's vector row stage (:mod:`surfmod.eval.row_stage`) for
+def _row_stage_plan(net: LocalNet, sv, bv, rows: int):
+    """The vector loops of the grid's row stage (:mod:`surfmod.eval.row_stage`) for
     v-points with spans ``sv`` and basis ``bv`` when ``rows`` net rows are contracted:
-    ``(bplan, planes, run_starts, run_kinds)``, or ``None`` (one point at a time, and the
-    vector stages are then not compiled).
+    ``(bplan, planes, run_starts, run_kinds)``.
 
     Vector loops need runs of v-points in consecutive spans (a net with about as many
     spans as points) and the net as coordinate planes, built once per surface, and only
     when the stage reads a quarter of the net or more (a few rows of a big net are not
-    worth a copy of all of it)."""
+    worth a copy of all of it).  Otherwise every v-point goes one at a time
+    (:func:`_scalar_plan`)."""
     from . import row_stage
 
     n = net.ctrl.shape[0]
-    if rows < max(64, n // 4):
-        return None
-    starts, kinds = row_stage.runs(sv)
-    if not np.any(kinds == row_stage.NEXT_SPAN):
-        return None
-    planes = net.cache.get("planes")
-    if planes is None:
-        planes = net.cache["planes"] = row_stage.net_planes(net.ctrl)
-    return np.ascontiguousarray(bv.transpose(1, 2, 0)), planes, starts, kinds
+    if rows >= max(64, n // 4):
+        starts, kinds = row_stage.runs(sv)
+        if np.any(kinds == row_stage.NEXT_SPAN):
+            planes = net.cache.get("planes")
+            if planes is None:
+                planes = net.cache["planes"] = row_stage.net_planes(net.ctrl)
+            return np.ascontiguousarray(bv.transpose(1, 2, 0)), planes, starts, kinds
+    return _scalar_plan(net, sv, bv)
+
+
+def _scalar_plan(net: LocalNet, sv, bv):
+    """The row stage's plan without vector loops: every v-point one at a time (one
+    :data:`~surfmod.eval.row_stage.SCALAR` run), empty planes."""
+    from . import row_stage
+
+    return (np.empty((bv.shape[1], bv.shape[2], 0)), np.empty((net.ctrl.shape[0], 4, 0)),
+            np.array([0, sv.size]), np.array([row_stage.SCALAR]))
 
 
 def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
@@ -416,11 +377,12 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
 
     Everything is written point-major (C order), into ``out`` when given: ``(len(us),
     len(vs), 3)`` for positions (``order == 0``), ``(len(us), len(vs), K, K, 3)`` for
-    partials.  The partials are formed on cache-resident planes (every partial and
-    coordinate a contiguous row of v) and each point's values are then stored together;
-    partials to order 2 in chunks of v-points held in L1 (:mod:`surfmod.eval.partials_stage`).
-    Small grids (under :data:`COMPILED_GRID` partials) are evaluated in NumPy
-    (:mod:`surfmod.eval.vectorized`).
+    partials.  Small grids (under :data:`COMPILED_GRID` partials) are evaluated in NumPy
+    (:mod:`surfmod.eval.vectorized`), the others by the compiled grid
+    (:mod:`surfmod.eval.grid_kernels`: each net row the u-points need is contracted with
+    the v-basis once per chunk of v-points into a ring, then each u-point combines its
+    rows), the u-points in ascending order (unsorted ones are sorted, and their rows
+    put back in place).
     """
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
     us, vs = _as_float(us), _as_float(vs)
@@ -430,37 +392,42 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
             return h
         out[...] = h[:, :, 0, 0] if order == 0 else h
         return out[:, :, None, None, :] if order == 0 else out
-    k = _kernels()
-    n, m = ctrl.shape[:2]
     kk = order + 1
-    dim = 4 if rational else 3
-    su, bu = _basis(knots_u, p, n, us, order)
-    sv, bv = _basis(knots_v, q, m, vs, order)
-    binom = k.binomials(order)
+    shape = (us.size, vs.size, kk, kk, 3)
     if out is None:
-        out = np.empty((us.size, vs.size, 3) if order == 0 else (us.size, vs.size, kk, kk, 3))
-    run, count = _kernels_for(us.size * vs.size, grid=True)
-    ordered = bool(np.all(su[1:] >= su[:-1]))
-    needed = int(np.count_nonzero(_needed_rows(su, p, n)))
-    with _on(count):
-        for b0 in range(0, vs.size, V_BLOCK):  # loop over cache blocks, not points
-            svb, bvb = sv[b0 : b0 + V_BLOCK], bv[b0 : b0 + V_BLOCK]
-            vruns = _vector_runs(net, svb, bvb, needed)
-            if order == 0 and p <= 3 and vruns is not None and ordered:
-                # the stages interleave in a ring (eval/sliding.py): no row table, so the
-                # blocks need not be cut to its size (only shared among the threads)
-                from .sliding import CHUNK, RING
-
-                blocks = _row_blocks(su, p, n, 1, count)
-                per_slot = RING * dim * min(svb.size, CHUNK)
-            else:
-                blocks = _row_blocks(su, p, n, kk * dim * svb.size, count)
-                per_slot = int(np.diff(blocks[2]).max(initial=0)) * kk * dim * svb.size
-            scratch = _scratch(count, per_slot)
-            if order == 0:
-                run.positions_grid(bvb, svb, q, ctrl, dim, bu, p, rational, b0, out, scratch, *blocks, vruns)
-            else:
-                run.partials_grid(bvb, svb, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, *blocks, vruns)
+        out = np.empty((us.size, vs.size, 3) if order == 0 else shape)
+    if bool(np.all(us[1:] >= us[:-1])):
+        _grid_sorted(net, us, vs, order, out.reshape(shape))
+    else:  # sorted for the ring, the rows put back in place
+        rank = np.argsort(us, kind="stable")
+        in_order = np.empty(shape)
+        _grid_sorted(net, us[rank], vs, order, in_order)
+        out.reshape(shape)[rank] = in_order
     if order == 0:
         return out[:, :, None, None, :]
     return out
+
+
+def _grid_sorted(net: LocalNet, us, vs, order: int, out) -> None:
+    """:func:`surface_grid` through the compiled grid, ``us`` ascending, ``out`` the
+    point-major ``(n_u, n_v, K, K, 3)``."""
+    k = _kernels()
+    knots_u, p, knots_v, q, ctrl, rational = net[:6]
+    n, m = ctrl.shape[:2]
+    kk, dim = order + 1, 4 if rational else 3
+    su, bu = _basis(knots_u, p, n, us, order)
+    sv, bv = _basis(knots_v, q, m, vs, order)
+    first = (su - p).astype(np.int64)
+    needed = np.unique(first[:, None] + np.arange(p + 1)).size
+    plan = _row_stage_plan(net, sv, bv, needed)
+    ring_rows = max(RING_ROWS, p + 1)
+    chunk = min(vs.size, CHUNK, max(16, RING_DOUBLES // (ring_rows * kk * dim)))
+    run, count = _kernels_for(us.size * vs.size, grid=True)
+    scratch = _scratch(count, ring_rows * kk * dim * chunk)
+    head = (bv, plan[0], sv, q, ctrl, plan[1], dim, bu, p, rational, k.binomials(order), out)
+    tail = (ring_rows, chunk, first, plan[2], plan[3])
+    if count == 1:
+        run.grid(*head, scratch[0], *tail)
+        return
+    with _on(count):
+        run.grid(*head, scratch, *tail, _u_blocks(us.size, count))

@@ -13,27 +13,20 @@ from __future__ import annotations
 
 from numba import get_thread_id, njit, prange
 
-from .grid_kernels import grid_block_derivatives, grid_block_positions
+from .grid_kernels import grid_block
 from .kernels import SCATTER_CHUNK, scattered_derivatives_chunk, scattered_positions_chunk
 from .patches import derivatives_chunk, positions_chunk
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def positions_grid(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch, starts, rows, row_starts, first, vruns):
-    """:func:`surfmod.eval.grid_kernels.positions_grid`, a block of u-points per task; each
-    thread builds its blocks' row tables in its own row of ``scratch``."""
+def grid(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, scratch, ring_rows, chunk, first,
+         run_starts, run_kinds, starts):
+    """:func:`surfmod.eval.grid_kernels.grid`, a block of u-points ``starts[k]:starts[k+1]``
+    per task; each thread keeps its blocks' ring in its own row of ``scratch`` (rows at a
+    boundary between blocks are contracted by both)."""
     for blk in prange(starts.size - 1):
-        grid_block_positions(bv, sv, q, ctrl, dim, bu, p, rational, b0, out, scratch[get_thread_id()], starts, rows,
-                             row_starts, first, blk, vruns)
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def partials_grid(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch, starts, rows, row_starts, first,
-                  vruns):
-    """:func:`surfmod.eval.grid_kernels.partials_grid`, a block of u-points per task."""
-    for blk in prange(starts.size - 1):
-        grid_block_derivatives(bv, sv, q, ctrl, dim, bu, p, rational, binom, b0, out, scratch[get_thread_id()],
-                               starts, rows, row_starts, first, blk, vruns)
+        grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, scratch[get_thread_id()],
+                   ring_rows, chunk, first, run_starts, run_kinds, starts[blk], starts[blk + 1])
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

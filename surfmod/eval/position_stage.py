@@ -1,5 +1,5 @@
-"""The second stage of the grid (:mod:`surfmod.eval.grid_kernels`) for positions at
-degrees up to 3 in u: each u-point combines its rows of the row table with the v-points
+"""The combine stage of the grid (:mod:`surfmod.eval.grid_kernels`) for positions at
+degrees up to 3 in u: each u-point combines its rows of the ring with the v-points
 on the vector axis, divides by the weight and stores its points interleaved, all in one
 loop with everything in registers (the four row terms are written out; missing ones get
 weight 0 on a valid row).
@@ -18,17 +18,6 @@ from .kernels import U1, U2, U3
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def positions_low_degree(bu, first, p, w, rational, b0, out):
-    """``out[a, b0 + b] = sum_i bu[a, 0, i] w[first[a] + i, 0, :3, b]`` (divided by the
-    weight row ``d = 3`` when ``rational``) for degrees ``p <= 3``; ``w`` is the row
-    table ``(rows, 1, dim, n_v)``, ``out`` the point-major ``(n_u, N_v, 3)``, pass by
-    pass (:func:`positions_pass`)."""
-    a = 0
-    while a < bu.shape[0]:
-        a += positions_pass(bu, first, p, w, rational, b0, out, a, bu.shape[0], w.shape[0], w.shape[3])
-
-
-@njit(cache=True, inline="always", error_model="numpy")
 def pass_extent(first, p, a, a_end):
     """The u-points of the pass at ``a`` (1 or 2) and the highest row it reads: a pair on
     the same rows, a cubic pair on rows shifted by one, or one point."""
@@ -41,11 +30,11 @@ def pass_extent(first, p, a, a_end):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def positions_pass(bu, first, p, w, rational, b0, out, a, a_end, modulus, count):
-    """One pass of :func:`positions_low_degree` at u-point ``a`` (u-points up to
-    ``a_end``): row ``r`` of the u-points is row ``r % modulus`` of the table (a ring of
-    rows, :mod:`surfmod.eval.sliding`; ``modulus`` = the row count for a whole table),
-    v-points ``0:count`` of the table go to ``out[:, b0:b0+count]``.  Returns the number
-    of u-points done."""
+    """One pass at u-point ``a`` (u-points up to ``a_end``): ``out[a, b0 + b] = sum_i
+    bu[a, 0, i] w[(first[a] + i) % modulus, 0, :3, b]`` (divided by the weight row ``d =
+    3`` when ``rational``) for ``b < count``, ``w`` the ring ``(modulus, 1, dim, chunk)``,
+    ``out`` point-major; a second u-point too when it shares rows (:func:`pass_extent`).
+    Returns the number of u-points done."""
     done, _ = pass_extent(first, p, a, a_end)
     if done == 2 and first[a + 1] == first[a]:  # two u-points on the same rows
         _low_degree_pair(bu, first, p, w, rational, b0, out, a, modulus, count)
@@ -85,7 +74,7 @@ def positions_pass(bu, first, p, w, rational, b0, out, a, a_end, modulus, count)
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _low_degree_pair(bu, first, p, w, rational, b0, out, a, modulus, count):
-    """u-points ``a`` and ``a + 1`` of :func:`positions_low_degree` when they share their
+    """u-points ``a`` and ``a + 1`` of :func:`positions_pass` when they share their
     rows (same span): one pass loads each row value once for both (the arithmetic of
     each point is that of the single pass, so the values are the same)."""
     f = first[a]
@@ -136,7 +125,7 @@ def _shifted_pair(bu, first, w, rational, b0, out, a, modulus, count):
     """Cubic u-points ``a`` (rows ``r..r+3``) and ``a + 1`` (rows ``r+1..r+4``) in one
     pass: five rows loaded for both instead of eight (each point's sums are those of the
     one-point pass, term for term).  The rows are read through one flat view of the
-    table by offsets: twenty views would need more runtime alias checks than LLVM allows
+    ring by offsets: twenty views would need more runtime alias checks than LLVM allows
     a vectorized loop."""
     c0, c1, c2, c3 = bu[a, 0, 0], bu[a, 0, 1], bu[a, 0, 2], bu[a, 0, 3]
     e0, e1, e2, e3 = bu[a + 1, 0, 0], bu[a + 1, 0, 1], bu[a + 1, 0, 2], bu[a + 1, 0, 3]

@@ -1,5 +1,5 @@
-"""The first stage of the grid (:mod:`surfmod.eval.grid_kernels`) in vector loops: the net
-rows the u-points need, contracted with the v-basis.
+"""The row stage of the grid (:mod:`surfmod.eval.grid_kernels`): a net row the u-points
+need, contracted with the v-basis, in vector loops where the v-points allow.
 
 Each v-point's window of q+1 poles starts at its own column, so a loop over the v-points
 reads the net at data-dependent places, which LLVM compiles to scalar loads and
@@ -14,7 +14,8 @@ values are the same whatever the runs (no reduction is reordered).  The other po
 one at a time with the same arithmetic (on a small net many points share a span, and
 the stage costs little anyway).
 
-:func:`runs` splits the v-points; :func:`contract_rows` is the stage itself.
+:func:`runs` splits the v-points; :func:`contract_row` (and :func:`contract_row_pair`, two
+rows at once) is the stage itself, for one net row.
 
 >>> import numpy as np
 >>> runs(np.array([3, 3, 3, 4, 5, 6, 7, 8, 10]), min_run=4)
@@ -66,7 +67,7 @@ def runs(sv, min_run=MIN_RUN):
 
 def net_planes(ctrl: np.ndarray) -> np.ndarray:
     """The homogeneous net ``(n, m, 4)`` as coordinate planes ``(n, 4, m)``: each net row's
-    x, y, z and w contiguous, as the vector loops of :func:`contract_rows` read them.
+    x, y, z and w contiguous, as the vector loops of :func:`contract_row` read them.
 
     >>> import numpy as np
     >>> net_planes(np.arange(8.0).reshape(1, 2, 4))[0]
@@ -76,20 +77,6 @@ def net_planes(ctrl: np.ndarray) -> np.ndarray:
            [3., 7.]])
     """
     return np.ascontiguousarray(ctrl.transpose(0, 2, 1))
-
-
-@njit(cache=True, error_model="numpy")
-def contract_rows(bv, bplan, sv, q, ctrl, planes, rows, dim, out, starts, kinds):
-    """``out[r, l, d, b] = sum_j bv[b, l, j] ctrl[rows[r], sv[b]-q+j, d]`` for ``d < dim``,
-    run by run (:func:`runs`: ``starts``, ``kinds``): points of a :data:`NEXT_SPAN` run
-    in vector loops over ``bplan`` (the v-basis ``(K, q+1, n_v)``, v-points on the last
-    axis) and ``planes`` (the net as coordinate planes, :func:`net_planes`), the others
-    one at a time (:func:`row_points`).  Every entry is the sum of the scalar loop (first
-    term first, then one term at a time), so the values do not depend on the runs."""
-    nv = sv.size
-    for r in range(rows.size):
-        contract_row(bv, bplan, sv, q, ctrl[rows[r]], planes[rows[r]], dim, out[r].reshape(-1), 0, nv, starts, kinds,
-                     0, nv)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
