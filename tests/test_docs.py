@@ -62,7 +62,7 @@ def test_readme_is_short_and_gives_the_commands_ci_runs():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
     assert len(readme.splitlines()) <= 200
-    for command in ('pip install -e ".[test,bench]" && surfmod gallery out/', "python -m pytest -q"):
+    for command in ('pip install -e ".[test,bench]" && surfmod gallery out/', "python -m pytest -q -n auto\n"):
         assert command in readme and command in ci
     assert "../shared" not in readme
 
