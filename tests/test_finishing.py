@@ -214,6 +214,7 @@ def test_waterline_chord_across_a_notch_is_split_not_lifted():
                      [sm.Finish(sm.Tool("ball", R), scallop=0.15)])
     rep = job.operations[0].report
     assert rep["waterline"]["split"] > 0  # the notch is there: pieces had chords cutting into it
+    assert any(f"{rep['waterline']['split']} chords split at the contour" in line for line in summary_lines(rep))
     assert rep["lifted"] <= rep["tolerance"], rep["lifted"]
     pts = job.operations[0].moves
     a, b = pts[:-1], pts[1:]

@@ -588,6 +588,8 @@ def summary_lines(report: dict) -> list[str]:
         lines.append(f"waterline on slopes >= {report['steep_angle']:g} deg: {w['levels']} levels "
                      f"{w['z_spacing'][0]:.3g}-{w['z_spacing'][1]:.3g} mm apart (z {z0:g} to {z1:g}), "
                      f"{w['contours']} contours, length {w['length']:.0f} mm"
+                     + (f", {w['split']} chords split at the contour where they would cut the part"
+                        if w.get("split") else "")
                      + (" (the flutes reach no lower)" if w.get("flute_limited") else ""))
     elif w is not None:
         lines.append(f"waterline: no slopes >= {report['steep_angle']:g} deg")
