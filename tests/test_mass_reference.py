@@ -290,6 +290,25 @@ def test_a_solid_is_required():
         moment_reference(bd.Box(1, 1, 1).faces()[0].wrapped)
 
 
+def test_a_run_over_budget_stops_at_the_pace_of_its_first_cuts():
+    """A box with six holes: 111 intervals, 2331 planes, about a minute of cutting (the
+    static estimate says 37 s).  With a budget of 2 s the run stops within its first
+    sweep, as soon as the pace of the cuts so far says it would end past the budget, and
+    says so (before, it cut until the deadline, then past it for the rest of a cut)."""
+    import re
+
+    part = bd.Box(40, 30, 10)
+    for i in range(6):
+        part = part - bd.Pos(-15 + 6 * i, 3 * (i % 3) - 3, 0) * bd.Cylinder(1.5 + 0.1 * i, 20)
+    with pytest.raises(SurfmodError, match="budget: ") as info:
+        moment_reference(part.wrapped, budget=2.0)
+    found = re.search(r"at the pace of its cuts \((\d+) intervals along \[1.0, 0.0, 0.0\], (\d+) cut, (\d+) more",
+                      str(info.value))
+    assert found, str(info.value)
+    intervals, cut, later = map(int, found.groups())
+    assert 1 <= cut < intervals and intervals + later > 100
+
+
 @pytest.mark.parametrize("moved_side, code, line", [
     ("occt", 0, "REFERENCE CONFIRMS SURFMOD"), ("numpy", 4, "REFERENCE CONFIRMS BREPGPROP")])
 def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, capsys, hole_reference,

@@ -551,13 +551,17 @@ def cut_volumes(shape, direction, heights, volume: float, origin, size: float, o
 
 
 def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, tolerances=None,
-          pieces: int = 2, deadline: float = math.inf) -> Sweep:
+          pieces: int = 2, deadline: float = math.inf, later: int = 0) -> Sweep:
     """``∫h dV`` and ``∫h² dV`` of ``shape`` along the unit ``direction``, ``h`` the height
     above the point ``origin`` (the part's centre), from ``V(t)`` at the Gauss–Kronrod nodes between the critical
     ``levels`` (found when not given, with the ``tolerances`` of the sub-shapes there:
     nodes keep clear of each level by twice its tolerance); ``volume`` is the solid's
-    trusted volume, ``size`` at least the part's half diagonal (the planes' half side); past ``deadline`` (a
-    ``time.perf_counter`` value) the sweep stops with ``SurfmodError`` naming ``budget``."""
+    trusted volume, ``size`` at least the part's half diagonal (the planes' half side).  The
+    sweep stops with ``SurfmodError`` naming ``budget`` past ``deadline`` (a
+    ``time.perf_counter`` value), or as soon as the pace of its cuts so far says that this
+    sweep and the ``later`` intervals of the sweeps after it would end past it (the cost of
+    a cut varies far more between solids than :func:`estimated_seconds` can foresee: the
+    splitter's retries, sections it walks)."""
     a = np.asarray(direction, dtype=float)
     if levels is None:
         levels, tolerances = _Levels(shape).along(a, tolerances=True)
@@ -574,10 +578,14 @@ def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, 
     vt = np.empty_like(t)
     defects = np.empty(len(t))
     n_pieces = 0
+    began = time.perf_counter()
     for k, nodes in enumerate(t):
-        if time.perf_counter() > deadline:
-            raise SurfmodError(f"budget: the moment reference ran out of time on this solid ({len(t)} intervals "
-                               f"along {np.round(a, 3).tolist()}, {k} cut)")
+        now = time.perf_counter()
+        ends_at = now + (now - began) / k * (len(t) - k + later) if k else now
+        if ends_at > deadline:
+            raise SurfmodError(f"budget: the moment reference would end about {ends_at - deadline:.0f} s past its "
+                               f"budget on this solid, at the pace of its cuts ({len(t)} intervals along "
+                               f"{np.round(a, 3).tolist()}, {k} cut, {later} more in the sweeps after it)")
         vt[k], defects[k], n = _cut_interval(shape, a, nodes, volume, origin, size)
         n_pieces += n
     h = t - centre
@@ -621,8 +629,17 @@ def _cut_interval(shape, a, nodes, volume, origin, size):
 #: seconds per cutting plane: a constant, per face of an elementary surface, per face of
 #: a free-form or toroidal one (their sections are walked and approximated); from the
 #: corpus (benchmarks/mass_reference.py: 5-36 ms a plane on 7-30 elementary faces, a
-#: rotated torus 0.35 s), an estimate for refusing early: the budget is what bounds
+#: rotated torus 0.35 s), an estimate for refusing early; the pace of the cuts (see
+#: sweep) is what bounds a run
 _COST = (0.01, 5e-4, 0.15)
+
+
+def _interval_count(levels, tolerances, pieces: int) -> int:
+    """How many intervals :func:`sweep` cuts along levels ``levels`` (0 where it refuses)."""
+    try:
+        return len(_intervals(levels, 1e-6 * (levels[-1] - levels[0]), pieces, tolerances)[1])
+    except SurfmodError:
+        return 0
 
 
 def estimated_seconds(shape, pieces: int = 2) -> float:
@@ -636,11 +653,10 @@ def estimated_seconds(shape, pieces: int = 2) -> float:
     finder = _Levels(shape)
     planes = 0
     for d in DIRECTIONS:
-        lv, tols = finder.along(d, tolerances=True)
-        try:
-            planes += 21 * len(_intervals(lv, 1e-6 * (lv[-1] - lv[0]), pieces, tols)[1])
-        except SurfmodError:
+        count = _interval_count(*finder.along(d, tolerances=True), pieces)
+        if not count:
             return 0.0  # refused at once (see sweep)
+        planes += 21 * count
     simple = sum(kind in ("plane", "cylinder", "cone", "sphere") for kind, *_ in finder.faces)
     hard = len(finder.faces) - simple
     return planes * (_COST[0] + _COST[1] * simple + _COST[2] * hard)
@@ -653,7 +669,8 @@ def moment_reference(shape, volume: float | None = None, *, pieces: int = 2,
     trusted volume (BRepGProp's at eps 1e-12 when not given); ``pieces`` the fewest
     intervals along each direction (longer ones are split).  Nodes keep clear of each
     critical level by twice the tolerance of the sub-shapes there.  ``budget`` bounds the seconds spent
-    (checked between cuts: ``SurfmodError`` naming ``budget`` when exceeded).
+    (checked between cuts, against the pace of the cuts so far: ``SurfmodError`` naming
+    ``budget`` as soon as the run would exceed it).
 
     >>> import build123d as bd
     >>> r = moment_reference(bd.Box(2, 3, 4).translate((1, 0, 0)).wrapped)
@@ -676,8 +693,10 @@ def moment_reference(shape, volume: float | None = None, *, pieces: int = 2,
     # heights from the centre of the axes' extents (no cancellation against far origins)
     centre = np.array([(lv[0] + lv[-1]) / 2 for lv, _ in levels[:3]])
     size = 0.6 * float(np.linalg.norm([lv[-1] - lv[0] for lv, _ in levels[:3]])) + 10 * max_tolerance(shape)
-    sweeps = [sweep(shape, d, centre, volume, size, levels=lv, tolerances=tl, pieces=pieces, deadline=deadline)
-              for d, (lv, tl) in zip(DIRECTIONS, levels)]
+    counts = [_interval_count(lv, tl, pieces) for lv, tl in levels]
+    sweeps = [sweep(shape, d, centre, volume, size, levels=lv, tolerances=tl, pieces=pieces, deadline=deadline,
+                    later=sum(counts[i + 1:]))
+              for i, (d, (lv, tl)) in enumerate(zip(DIRECTIONS, levels))]
     s1 = np.array([s.first for s in sweeps[:3]])
     e1 = np.array([s.first_error for s in sweeps[:3]])
     second = np.diag([s.second for s in sweeps[:3]])
