@@ -550,6 +550,10 @@ def cut_volumes(shape, direction, heights, volume: float, origin, size: float, o
     return (below + above) / 2, float(w.sum() - volume), len(pieces)
 
 
+#: cuts of a sweep after which their pace may stop a run that would go past its budget
+PACE_CUTS = 3
+
+
 def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, tolerances=None,
           pieces: int = 2, deadline: float = math.inf, later: int = 0) -> Sweep:
     """``∫h dV`` and ``∫h² dV`` of ``shape`` along the unit ``direction``, ``h`` the height
@@ -581,7 +585,8 @@ def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, 
     began = time.perf_counter()
     for k, nodes in enumerate(t):
         now = time.perf_counter()
-        ends_at = now + (now - began) / k * (len(t) - k + later) if k else now
+        # the pace of three cuts or more (one may have been a slow retry)
+        ends_at = now + (now - began) / k * (len(t) - k + later) if k >= PACE_CUTS else now
         if ends_at > deadline:
             raise SurfmodError(f"budget: the moment reference would end about {ends_at - deadline:.0f} s past its "
                                f"budget on this solid, at the pace of its cuts ({len(t)} intervals along "
