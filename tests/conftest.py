@@ -35,10 +35,12 @@ def rng():
 CORPUS = Path(__file__).resolve().parent / "data" / "step"
 
 
-def fresh_python(script: str) -> list[str]:
+def fresh_python(script: str, env: dict | None = None) -> list[str]:
     """The words ``script`` prints when run in a fresh interpreter (nothing imported yet,
-    numba's cache as configured): what a first call of a process loads and compiles."""
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    numba's cache as configured, or as ``env`` sets it): what a first call of a process
+    loads and compiles."""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True,
+                          env=None if env is None else {**os.environ, **env})
     return done.stdout.split()
 
 

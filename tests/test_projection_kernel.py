@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import fresh_python
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
@@ -99,3 +100,31 @@ def test_packed_segments_equal_one_call_per_net():
     got = project_segments(pk, np.array(boxes), np.concatenate(pts), np.concatenate(guesses), np.array(segments),
                            np.array(start), np.array(stop))
     np.testing.assert_array_equal(got, np.concatenate(expected))
+
+
+def test_the_meshers_projections_compile_one_signature(tmp_path):
+    """The B-rep mesher's deviation judge calls the Gauss-Newton kernel from the packed
+    kernels (triangles, nodes) and per face (``FaceSurface.projector``): every call passes
+    the same argument types (``start`` included), so a first mesh of a B-spline part
+    compiles it once, not once per caller (each compile took 5-6 s of a cold
+    `surfmod mesh`).  Counted in a fresh process with an empty numba cache (a kernel whose
+    caller is loaded from the cache is not compiled, and has no signature)."""
+    script = (
+        "import numpy as np, surfmod as sm\n"
+        "from surfmod.gallery.synthetic import wavy_net\n"
+        "from surfmod.eval import packed, projection_kernel\n"
+        "from surfmod.meshing.facesurface import FaceSurface\n"
+        "from surfmod.occ.topo import face_surface\n"
+        "s = sm.BSplineSurface(wavy_net(5, 4), (3, 2))\n"
+        "ev = FaceSurface(face_surface(s.face())[0])\n"
+        "pk = packed.pack([s._local_net()], *(np.array([ev.parameter_map[k]]) for k in range(4)))\n"
+        "box = np.array([[0, 1, 0, 1.0]])\n"
+        "uv = np.array([[0.2, 0.2], [0.8, 0.2], [0.5, 0.8]])\n"
+        "pts = s.points(uv[:, 0], uv[:, 1]) + 0.01\n"
+        "packed.triangle_deviations(pk, box, pts, uv, np.array([[0, 1, 2]]), np.array([[0, 0, 1]]),\n"
+        "                           np.array([[1 / 3] * 3]), np.zeros(1))\n"
+        "packed.project_segments(pk, box, pts, uv, np.array([[0, 0, 3]]), np.zeros(1), np.zeros(1))\n"
+        "ev.projector(pts, uv, (0, 1, 0, 1), 0.0)\n"
+        "print(len(projection_kernel.project_distances.signatures))\n"
+    )
+    assert fresh_python(script, env={"NUMBA_CACHE_DIR": str(tmp_path)}) == ["1"]

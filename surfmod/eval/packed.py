@@ -200,7 +200,7 @@ def _triangle_deviations(pk, boxes, nodes, uv, triangles, faces, bary, threshold
                     guess[at, c] = w0 * uv[i, c] + w1 * uv[j, c] + w2 * uv[k, c]
                 at += 1
         project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, pk.lo[f], pk.hi[f], pk.period[f],
-                          pk.periodic[f], boxes[f], pts, guess, threshold[f], dist)
+                          pk.periodic[f], boxes[f], pts, guess, threshold[f], dist, threshold[f])
         at = 0
         for t in range(a, b):
             worst = 0.0

@@ -59,14 +59,15 @@ def _first_partials(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket
 
 @njit(cache=True, error_model="numpy")
 def project_distances(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, lo, hi, period, periodic, box,
-                      points, uv, threshold, out, start=None):
+                      points, uv, threshold, out, start):
     """Distance bounds from ``points (N, 3)`` to the surface into ``out (N,)``, from the
     guesses ``uv (N, 2)`` clipped to ``box = (u0, u1, v0, v1)``; parameters are mapped as
     OCCT evaluates them (``lo``/``hi``/``period``/``periodic`` per direction).  Every
     iterate is a point of the surface, so the least distance seen is an upper bound.
-    Points whose first bound is at most ``start`` (default: ``threshold``) are not
-    iterated; the others iterate until their bound is within ``threshold``."""
-    first_stop = threshold if start is None else start
+    Points whose first bound is at most ``start`` are not iterated; the others iterate
+    until their bound is within ``threshold``.  ``start`` is always given (``threshold``
+    when no other), so that every caller compiles the one signature."""
+    first_stop = start
     ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
     lu, ru, tu = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
     lv, rv, tv = np.empty(q + 1), np.empty(q + 1), np.empty(q + 1)

@@ -168,7 +168,8 @@ class FaceSurface:
         projection_kernel.project_distances(
             net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v, net.bucket_u,
             net.bucket_v, *self.parameter_map, np.array(bounds, float),
-            np.ascontiguousarray(points, float), np.ascontiguousarray(uv, float), float(threshold), out)
+            np.ascontiguousarray(points, float), np.ascontiguousarray(uv, float), float(threshold), out,
+            float(threshold))
         return out
 
     def d0(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
