@@ -22,12 +22,19 @@ from numba import njit
 
 from .basis import reciprocal_table, span_buckets  # noqa: F401  (the tables the kernels read)
 
+# The per-point helpers below are plain compiled functions, not ``inline="always"``:
+# numba's own inlining copies a helper into every caller and types it again there (a
+# first `surfmod mesh` of a B-spline part compiled 24 s of kernels with it, 19 s
+# without), while LLVM still inlines them where it pays (the run times are the same,
+# benchmarks/bench_eval.py).  quotient_order2 stays inlined: it must take its caller's
+# floating-point flags.
+
 # unsigned index steps: unsigned offsets spare numba's negative-index wraparound (a
 # compare and a select per access), which otherwise keeps loops from vectorizing
 U1, U2, U3 = np.uint64(1), np.uint64(2), np.uint64(3)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def find_span(knots, degree, n_ctrl, t):
     """The largest ``i`` with ``knots[i] <= t``, clipped to the domain.  A branch-free
     binary search (the halving step compiles to a conditional move): random parameters
@@ -46,7 +53,7 @@ def find_span(knots, degree, n_ctrl, t):
     return span
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def find_span_bucketed(knots, degree, n_ctrl, t, t0, scale, table):
     """:func:`find_span` in O(1): a uniform bucket grid over the domain gives a span at or
     just before the answer (see :func:`span_buckets`), then a short, well-predicted walk.
@@ -64,7 +71,7 @@ def find_span_bucketed(knots, degree, n_ctrl, t, t0, scale, table):
     return span
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders):
     """The p+1 non-zero basis functions at ``t`` and their derivatives: ``ders[k, r]`` is
     the k-th derivative of ``N_{span-p+r}`` for ``k <= order`` (zero above the degree).
@@ -105,7 +112,7 @@ def basis_ders_point(knots, p, span, t, order, inv, ndu, left, right, tmp, ders)
             ders[k, r] = tmp[r]
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def quotient_point(h, binom, out):
     """Rational quotient rule (A4.4) at one point for the partials with ``k + l < K``
     (the triangle a Newton or curvature step needs): homogeneous ``h (K, K, 4)`` ->
@@ -219,7 +226,7 @@ def scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom
                         out[a0 + b, k, l, d] = h[k, l, d, b]
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u, v, lu, ru, nu_, lv, rv, nv_):
     """``(x, y, z)`` at one pair: bucketed span search, the A2.2 triangle in each
     direction and the ``(p+1) x (q+1)`` sum kept in registers (``lu``... ``nv_``: the
@@ -273,7 +280,7 @@ def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, 
         out[a, 2] = z
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _basis_funs(knots, p, span, t, inv, left, right, out):
     """Piegl & Tiller A2.2: the p+1 non-zero basis functions at ``t``.  The denominators
     ``right[r+1] + left[j-r]`` are knot differences independent of ``t``; their
@@ -291,7 +298,7 @@ def _basis_funs(knots, p, span, t, inv, left, right, out):
         out[j] = saved
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def quotient_planes(acc, binom):
     """The quotient rule in place on planes ``acc (K, K, 4, n)``: coordinates 0..2 of
     every entry become Cartesian, entry by entry in rising order (each needs only lower
@@ -322,7 +329,7 @@ def quotient_planes(acc, binom):
                     dst[b] *= inv_w[b]
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _quotient_planes_order2(acc):
     """:func:`quotient_planes` for partials to order 2, written out: one pass over the
     points per coordinate with all nine entries in registers (the general version makes
