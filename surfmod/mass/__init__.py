@@ -16,13 +16,19 @@ boundary pieces → nodes and rules → moments → totals.  :func:`surfmod.mass
 (:mod:`surfmod.uses.mass`) reads its input and calls :func:`~surfmod.mass.totals.integrate`;
 ``TrimmedFace.area()`` calls :func:`~surfmod.mass.moments.face_moments`.
 
-For a solid bounded by faces with outward normal ``n``::
+For a solid bounded by faces with outward normal ``n`` (``x`` from the reference point)::
 
-    V        = 1/3 ∮ x·n dA
-    ∫ x_i dV = 1/2 ∮ x_i² n_i dA
-    ∫ x_i² dV = 1/3 ∮ x_i³ n_i dA,   ∫ x_i x_j dV = 1/2 ∮ x_i² x_j n_i dA  (i ≠ j)
+    V            = 1/3 ∮ (x·n) dA
+    ∫ x_i dV     = 1/4 ∮ x_i (x·n) dA
+    ∫ x_i x_j dV = 1/5 ∮ x_i x_j (x·n) dA
 
-with ``n dA = ± (S_u × S_v) du dv``.  Each face is integrated in its own parameter
+with ``n dA = ± (S_u × S_v) du dv``: the radial fields ``x^k x / (3 + k)``, whose
+divergence is the monomial ``x^k``.  They are BRepGProp's, and they turn with the part:
+on a boundary that closes every divergence-free field adds nothing, but on a real file
+whose edges leave gaps the result depends on the fields, and per-axis ones
+(``x_i² n_i / 2``) make it depend on the orientation of the coordinate frame (on
+axom_boxed_sphere.step a rotation moved their inertia by 3e-3, where the radial fields
+give the same tensor turned, to round-off).  Each face is integrated in its own parameter
 domain:
 
 * a face whose boundary is its parameter rectangle (the usual case for surfmod

@@ -34,20 +34,15 @@ def _moments_of_groups(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray, b
     n[1] = su[2] * sv[0] - su[0] * sv[2]
     n[2] = su[0] * sv[1] - su[1] * sv[0]
     area = weights * np.sqrt(np.sum(n * n, axis=0))
-    vol = weights * np.sum(x * n, axis=0)
-    a = weights * x**2 * n  # w x_i^2 n_i, (3, N)
-    ax = a * x
-    cross = a[:, None, :] * x[None, :, :]  # w x_i^2 n_i x_j, (3, 3, N)
+    vol = weights * np.sum(x * n, axis=0)  # w x·n: the radial fields below all carry it
+    first = vol * x  # w x_i (x·n), (3, N)
+    second = first[:, None, :] * x[None, :, :]  # w x_i x_j (x·n), (3, 3, N)
     out = np.empty((len(bounds) - 1, 14))
     for g, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:])):
-        m = np.sum(cross[:, :, lo:hi], axis=2)  # sum w x_i^2 n_i x_j
-        # off the diagonal: symmetric average of the two equivalent divergence forms
-        second = (m + m.T) / 4.0
-        second[np.diag_indices(3)] = np.sum(ax[:, lo:hi], axis=1) / 3.0
         out[g, 0] = float(np.sum(area[lo:hi]))
         out[g, 1] = float(np.sum(vol[lo:hi])) / 3.0
-        out[g, 2:5] = np.sum(a[:, lo:hi], axis=1) / 2.0
-        out[g, 5:] = second.ravel()
+        out[g, 2:5] = np.sum(first[:, lo:hi], axis=1) / 4.0
+        out[g, 5:] = np.sum(second[:, :, lo:hi], axis=2).ravel() / 5.0
     return out
 
 

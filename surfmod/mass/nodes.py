@@ -1,7 +1,7 @@
 """Stage four of the mass pipeline (:mod:`surfmod.mass`): faces prepared for quadrature and their nodes, face by face.
 
 A face contributes ``∫∫_D g(u, v) du dv`` over its parameter region ``D`` for the
-integrands ``g`` of the divergence theorem (``x·n``, ``x_i² n_i``, ``x_i³ n_i``, ...).
+integrands ``g`` of the divergence theorem (``x·n``, ``x_i (x·n)``, ``x_i x_j (x·n)``).
 :func:`face_nodes` returns the surface partials at the nodes and their weights:
 
 * a face whose boundary is its parameter rectangle: tensor Gauss–Legendre on every span;

@@ -1,9 +1,10 @@
 """Stage five of the mass pipeline (:mod:`surfmod.mass`): trimmed planar faces in closed form, their mass integrals from boundary integrals alone.
 
-On a plane ``S = O + u X + v Y`` every integrand of :mod:`surfmod.mass` is a
-polynomial of degree at most 3 in ``(u, v)`` (``x_i² x_j n_i`` with ``x`` affine and ``n``
-constant), so a face's share is fixed by the ten moments ``M_pq = ∫∫_D a^p b^q`` of its
-parameter region ``D`` (``p + q ≤ 3``, ``a, b`` the parameters shifted to the foot of the
+On a plane ``S = O + u X + v Y`` the normal ``n`` and the height ``x·n`` of the reference
+point are constant, so every integrand of :mod:`surfmod.mass` (``x_i x_j (x·n)``, ``x``
+affine) is that height times a polynomial of degree at most 2 in ``(u, v)``, and a face's
+share is fixed by the six moments ``M_pq = ∫∫_D a^p b^q`` of its parameter region ``D``
+(``p + q ≤ 2``, ``a, b`` the parameters shifted to the foot of the
 reference point: no cancellation).  Green's theorem turns each into a boundary integral
 with the inner antiderivative written out,
 
@@ -30,9 +31,9 @@ from .nodes import face_boundary, is_conic  # noqa: F401 (is_conic re-exported)
 from .boundary import _FRACTIONS, PIECES  # noqa: F401
 from .rules import gauss
 
-# the ten monomials a^p b^q (p + q <= 3) and, for the basis e = (1, a, b), the moment each
-# product e_i e_j e_k is (T3[i, j, k] = M[_CUBE[i, j, k]]), likewise for fewer factors
-_POWERS = [(p, q) for p in range(4) for q in range(4 - p)]
+# the six monomials a^p b^q (p + q <= 2) and, for the basis e = (1, a, b), the moment each
+# product e_i e_j is (T2[i, j] = M[_SQUARE[i, j]]), likewise for one factor
+_POWERS = [(p, q) for p in range(3) for q in range(3 - p)]
 _INDEX = {pq: i for i, pq in enumerate(_POWERS)}
 
 
@@ -40,13 +41,12 @@ def _product_index(*axes: int) -> int:
     return _INDEX[(axes.count(1), axes.count(2))]
 
 
-_CUBE = np.array([[[_product_index(i, j, k) for k in range(3)] for j in range(3)] for i in range(3)])
 _SQUARE = np.array([[_product_index(i, j) for j in range(3)] for i in range(3)])
 _LINE = np.array([_product_index(i) for i in range(3)])
 
 
 def _region_moments(faces: list, foot: np.ndarray, order: int):
-    """Per face: the ten moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
+    """Per face: the six moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
     is positive) about its ``foot`` ``(uc, vc)``, and whether every boundary rule was exact."""
     parts, owners, exact = [], [], np.ones(len(faces), bool)
     lines, arcs = [], []  # of the faces bounded by lines and circles, all at once
@@ -55,7 +55,7 @@ def _region_moments(faces: list, foot: np.ndarray, order: int):
             lines.extend((i, rec) for rec in mf.pcurves if rec["kind"] == "line")
             arcs.extend((i, rec) for rec in mf.pcurves if rec["kind"] == "circle")
             continue
-        # 3 Gauss nodes per straight piece: the integrands are of degree 4 along it, exact
+        # 3 Gauss nodes per straight piece: the integrands are of degree 3 along it, exact
         P, dP, wt, exact[i] = face_boundary(mf, order)
         parts.append((P, wt * dP[:, 1]))
         owners.append(np.full(len(wt), i))
@@ -80,11 +80,11 @@ def _region_moments(faces: list, foot: np.ndarray, order: int):
         d = P[:, 0] - u0
         # ∫_{u0}^{u} (s - uc)^p ds = (A^(p+1) - B^(p+1)) / (p + 1) = d Σ_k A^k B^(p-k) / (p + 1)
         sums = [np.ones_like(A)]
-        for p in range(1, 4):
+        for p in range(1, 3):
             sums.append(sums[-1] * B + A**p)  # Σ_{k=0}^{p} A^k B^(p-k), Horner in B
-        inner = [wb * d * sums[p] / (p + 1) for p in range(4)]
-        b_pow = [np.ones_like(b), b, b * b, b * b * b]
-        values = np.stack([inner[p] * b_pow[q] for p, q in _POWERS], axis=1)  # (N, 10)
+        inner = [wb * d * sums[p] / (p + 1) for p in range(3)]
+        b_pow = [np.ones_like(b), b, b * b]
+        values = np.stack([inner[p] * b_pow[q] for p, q in _POWERS], axis=1)  # (N, 6)
         starts = np.concatenate([[0], np.cumsum(count)[:-1]])
         live = count > 0
         moments[live] = np.add.reduceat(values, starts[live], axis=0)
@@ -159,20 +159,15 @@ def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]
     frame = np.stack([c, ex, ey], axis=2)  # (F, 3 coordinates, 3 basis functions)
     sign = np.array([mf.sign for mf in faces])
     n = sign[:, None] * np.cross(ex, ey)
-    T1, T2, T3 = M[:, _LINE], M[:, _SQUARE], M[:, _CUBE]
+    T1, T2 = M[:, _LINE], M[:, _SQUARE]
     X1 = (frame @ T1[:, :, None])[:, :, 0]  # ∫ x_i
-    X2 = np.sum((frame @ T2) * frame, axis=2)  # ∫ x_i² = Σ_pq F_ip F_iq T2_pq
-    # ∫ x_i² x_j = Σ_pqr F_ip F_iq F_jr T3_pqr, as three batched products
-    Y = T3 @ frame.transpose(0, 2, 1)[:, None]  # (F, p, q, j)
-    Z = (frame @ Y.reshape(len(faces), 3, 9)).reshape(len(faces), 3, 3, 3)  # (F, i, q, j)
-    X3 = np.sum(frame[:, :, :, None] * Z, axis=2)  # (F, i, j)
+    X2 = frame @ T2 @ frame.transpose(0, 2, 1)  # ∫ x_i x_j = Σ_pq F_ip F_jq T2_pq
+    # x·n is constant on a plane (the height of the reference point above it): each
+    # radial integrand x_i x_j (x·n) is that height times a moment of the region
+    height = np.sum(n * c, axis=1)
     out = np.empty((len(faces), 14))
     out[:, 0] = np.linalg.norm(np.cross(ex, ey), axis=1) * M[:, 0]
-    out[:, 1] = np.sum(n * X1, axis=1) / 3.0
-    out[:, 2:5] = n * X2 / 2.0
-    m = n[:, :, None] * X3  # Σ w x_i² n_i x_j
-    second = (m + m.transpose(0, 2, 1)) / 4.0
-    idx = np.arange(3)
-    second[:, idx, idx] = n * X3[:, idx, idx] / 3.0
-    out[:, 5:] = second.reshape(len(faces), 9)
+    out[:, 1] = height * M[:, 0] / 3.0
+    out[:, 2:5] = height[:, None] * X1 / 4.0
+    out[:, 5:] = (height[:, None, None] * X2).reshape(len(faces), 9) / 5.0
     return out, exact
