@@ -2,7 +2,11 @@
 breaks into pieces that Gauss–Legendre integrates to round-off.
 
 Knots of splines and of the basis curves of swept surfaces, eighth turns on angular
-(trigonometric) directions, one piece on polynomial directions.  Faces are those read
+(trigonometric) directions, one piece on polynomial directions.  A rational direction's
+spans are split further by its weights (:func:`rational_pieces`): the integrands carry
+powers of the weight function in their denominators, whose complex zeros come nearer the
+span as the weights part, and Gauss–Legendre slows with them (a semicircle as one cubic
+span, weights 1, 1/3, 1/3, 1: 3e-10 of the volume at 12 nodes, round-off at two pieces).  Faces are those read
 back by :func:`surfmod.from_face`: a ``TrimmedFace`` (which ranks above this package and
 calls it for its ``area()``) is recognized by the OCCT face it carries (:func:`is_face`).
 
@@ -82,8 +86,53 @@ def direction_breaks(surface, direction: int):
     return "angular"  # unknown analytic: keep pieces short
 
 
+#: the most pieces a rational span is split into (a weight ratio of 2^16)
+MAX_RATIONAL_PIECES = 16
+
+
+def _weights_along(surface, direction: int):
+    """The weights of the rational spline behind ``direction`` of ``surface``, as lines
+    along that direction (rows), or None where it is not rational."""
+    if isinstance(surface, OffsetSurface):
+        return _weights_along(surface.base, direction)
+    if isinstance(surface, TabulatedCylinder):  # the swept curve's weights along u
+        w = getattr(surface.curve, "weights", None) if direction == 0 else None
+        return None if w is None else np.asarray(w, dtype=float)[None, :]
+    if isinstance(surface, RevolutionSurface):  # the profile's along v
+        w = getattr(surface.profile, "weights", None) if direction == 1 else None
+        return None if w is None else np.asarray(w, dtype=float)[None, :]
+    w = getattr(surface, "weights", None)
+    return None if w is None else np.moveaxis(np.asarray(w, dtype=float), direction, -1)
+
+
+def rational_pieces(surface, direction: int) -> int:
+    """Pieces per knot span along ``direction`` of a rational spline (a NURBS surface, the
+    curve of an extrusion, the profile of a revolution): ``⌈log2 r⌉`` (at least 1, at most
+    :data:`MAX_RATIONAL_PIECES`), ``r`` the largest ratio of two weights on one line of
+    control points along it (1 where the weights do not vary that way).
+
+    >>> import numpy as np, surfmod as sm
+    >>> w = np.array([[1, 1 / 3, 1 / 3, 1]] * 2)
+    >>> s = sm.BSplineSurface(np.zeros((2, 4, 3)), degree=(1, 3), weights=w)
+    >>> rational_pieces(s, 0), rational_pieces(s, 1)
+    (1, 2)
+    """
+    if is_face(surface):
+        surface = surface.surface
+    lines = _weights_along(surface, direction)
+    if lines is None:
+        return 1
+    lines = np.abs(lines)
+    ratio = float((lines.max(axis=-1) / np.maximum(lines.min(axis=-1), 1e-300)).max())
+    return int(min(MAX_RATIONAL_PIECES, max(1, np.ceil(np.log2(ratio) - 1e-9))))
+
+
 def _patch_breaks(surface, lo, hi, direction, period):
     b = direction_breaks(surface, direction)
     if isinstance(b, str):
         return _breaks(lo, hi, None, ANGULAR_PIECE)
-    return _breaks(lo, hi, b, None, period)
+    out = _breaks(lo, hi, b, None, period)
+    pieces = rational_pieces(surface, direction)
+    if pieces > 1:  # each span in equal pieces
+        out = np.concatenate([out[:1]] + [np.linspace(a, c, pieces + 1)[1:] for a, c in zip(out[:-1], out[1:])])
+    return out
