@@ -1,12 +1,16 @@
-"""surfmod's mass properties against the independent moment reference
-(:mod:`surfmod.occ.moment_reference`) and BRepGProp on every valid solid of the corpus:
-``python -m benchmarks.mass_reference [--budget S] [FILE ...]`` prints one row per solid.
+"""surfmod's mass properties against an independent reference and BRepGProp on every valid
+solid of the corpus: ``python -m benchmarks.mass_reference [--reference refined|cuts]
+[--budget S] [FILE ...]`` prints one row per solid.
 
-A script, not a test: the reference cuts each solid by hundreds of planes (seconds to
-minutes per solid).  Columns: centroid differences relative to volume^(1/3), inertia
-differences relative to its largest entry, for surfmod-vs-reference (``sm``),
-BRepGProp-vs-reference (``occ``, eps 1e-12) and surfmod-vs-BRepGProp (``sm-occ``); the
-reference's own error estimates (``est``), its largest cut defect and diagonal check.
+``refined`` (default) is :mod:`surfmod.occ.refined_props` (BRepGProp on the faces split
+until it converges, seconds per solid; ``tests/test_mass_reference.py`` runs it on every
+corpus solid), ``cuts`` is :mod:`surfmod.occ.moment_reference` (the solid cut by hundreds
+of planes, seconds to minutes per solid, a script's work rather than a test's).  Columns:
+centroid differences relative to volume^(1/3), inertia differences relative to its
+largest entry, for surfmod-vs-reference (``sm``), BRepGProp-vs-reference (``occ``, eps
+1e-12) and surfmod-vs-BRepGProp (``sm-occ``); the reference's own error estimates
+(``est``); for ``cuts`` its largest cut defect, diagonal check and planes, for ``refined``
+its last split.
 """
 
 from __future__ import annotations
@@ -23,20 +27,28 @@ import surfmod as sm
 from surfmod.errors import SurfmodError
 from surfmod.occ.properties import gprops
 from surfmod.occ.moment_reference import moment_reference
+from surfmod.occ.refined_props import refined_props
 from surfmod.occ.topo import faces_of, solids_of
 from surfmod.uses.mass import mass_properties
 
 CORPUS = Path(__file__).resolve().parent.parent / "tests" / "data" / "step"
 
 
-def compare(solid, budget):
+def compare(solid, budget, reference="refined"):
     t0 = time.perf_counter()
     mine = mass_properties(solid, estimate_error=False)
     t1 = time.perf_counter()
     o = gprops(solid, 1e-12)
-    ref = moment_reference(solid, o["volume"], budget=budget)
-    length = ref.volume ** (1 / 3)
-    big = np.abs(ref.inertia).max()
+    if reference == "refined":
+        ref = refined_props(solid, budget=budget)
+        length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
+        c_est, i_est = ref.changes["centroid"], ref.changes["inertia"]
+        extra = {"splits": ref.splits}
+    else:
+        ref = moment_reference(solid, o["volume"], budget=budget)
+        length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
+        c_est, i_est = ref.centroid_error / length, ref.inertia_error / big
+        extra = {"defect": ref.defect, "check": ref.consistency, "planes": ref.planes}
 
     def dc(c):
         return float(np.abs(np.asarray(c) - ref.centroid).max()) / length
@@ -46,17 +58,17 @@ def compare(solid, budget):
 
     return {
         "vol sm-occ": abs(mine.volume - o["volume"]) / o["volume"],
-        "c sm": dc(mine.centroid), "c occ": dc(o["centroid"]), "c est": ref.centroid_error / length,
+        "c sm": dc(mine.centroid), "c occ": dc(o["centroid"]), "c est": c_est,
         "c sm-occ": float(np.abs(np.asarray(mine.centroid) - o["centroid"]).max()) / length,
-        "I sm": di(mine.inertia), "I occ": di(o["inertia"]), "I est": ref.inertia_error / big,
-        "defect": ref.defect, "check": ref.consistency, "planes": ref.planes,
-        "t sm": t1 - t0, "t ref": ref.seconds,
+        "I sm": di(mine.inertia), "I occ": di(o["inertia"]), "I est": i_est,
+        **extra, "t sm": t1 - t0, "t ref": ref.seconds,
     }
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("files", nargs="*", help="STEP files (default: the corpus)")
+    p.add_argument("--reference", choices=("refined", "cuts"), default="refined", help="which reference (default refined)")
     p.add_argument("--budget", type=float, default=600.0, help="seconds per solid for the reference")
     p.add_argument("--max-faces", type=int, default=400, help="skip solids with more faces (stated)")
     p.add_argument("--solids", type=int, default=None, help="only the first N solids of each file")
@@ -75,7 +87,7 @@ def main(argv=None) -> int:
                 print(f"{name}: skipped, {nf} faces > --max-faces {args.max_faces}", flush=True)
                 continue
             try:
-                row = compare(solid, args.budget)
+                row = compare(solid, args.budget, args.reference)
             except SurfmodError as exc:
                 print(f"{name}: {nf} faces, no reference: {exc}", flush=True)
                 continue

@@ -169,8 +169,10 @@ def test_mass_command_says_when_the_model_is_ambiguous(capsys):
     assert "AMBIGUOUS MODEL" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("ambiguity, code, word", [(1e-5, 3, "AMBIGUOUS MODEL"), (1e-9, 4, "DISAGREEMENT")])
-def test_mass_command_never_prints_a_disagreement_with_exit_0(monkeypatch, capsys, ambiguity, code, word):
+@pytest.mark.parametrize("ambiguity, decided, code, word", [
+    (1e-5, False, 3, "AMBIGUOUS MODEL"), (1e-9, False, 4, "DISAGREEMENT"),
+    (1e-5, True, 4, "REFERENCE CONFIRMS BREPGPROP")])
+def test_mass_command_never_prints_a_disagreement_with_exit_0(monkeypatch, capsys, ambiguity, decided, code, word):
     import dataclasses
 
     import surfmod.cli.mass as mass  # the command's own names are the ones it calls
@@ -183,6 +185,8 @@ def test_mass_command_never_prints_a_disagreement_with_exit_0(monkeypatch, capsy
 
     monkeypatch.setattr(mass, "mass_properties", off_by_1e6)
     monkeypatch.setattr(mass, "boundary_ambiguity", lambda solid: ambiguity)
+    if not decided:  # the reference cannot tell: the model's ambiguity decides between 3 and 4
+        monkeypatch.setattr(mass, "settle", lambda *a: (None, "REFERENCE UNDECIDED: (test)"))
     assert main(["mass", str(CORPUS / "cadquery_red_cube_blue_cylinder.step"), "--no-progress"]) == code
     assert word in capsys.readouterr().out
 

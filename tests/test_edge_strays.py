@@ -86,10 +86,12 @@ def test_mass_names_the_edges_and_exits_3(monkeypatch, tmp_path, capsys):
 
     monkeypatch.setattr(mass, "mass_properties", centroid_off)
     monkeypatch.setattr(mass, "boundary_ambiguity", lambda s: 0.0)  # only the strays explain it
+    monkeypatch.setattr(mass, "settle", lambda *a: (None, "REFERENCE UNDECIDED: (test)"))  # nor can it tell
     assert main(["mass", str(path), "--no-progress"]) == 3
     out = capsys.readouterr().out
     assert "AMBIGUOUS MODEL: centroid differs" in out and "1 edge(s) have p-curves straying" in out
     assert f"edge {edge} of faces" in out
+    assert out.count(f"edge {edge} of faces") == 2 and "NOTE: 1 edge(s) have p-curves straying" in out
 
 
 def test_mass_exit_0_says_all_four_agree(tmp_path, capsys):

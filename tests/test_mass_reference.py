@@ -16,6 +16,7 @@ one of their many vertex levels (rounded box: 6426 planes, 590 s)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import build123d as bd
@@ -311,13 +312,11 @@ def test_a_run_over_budget_stops_at_the_pace_of_its_first_cuts():
 
 @pytest.mark.parametrize("moved_side, code, line", [
     ("occt", 0, "REFERENCE CONFIRMS SURFMOD"), ("numpy", 4, "REFERENCE CONFIRMS BREPGPROP")])
-def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, capsys, hole_reference,
-                                                        moved_side, code, line):
+def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, capsys, moved_side, code, line):
     import dataclasses
 
     import surfmod as sm
     import surfmod.cli.mass as mass
-    import surfmod.occ.moment_reference as mr
     from surfmod.cli import main
 
     path = tmp_path / "hole.step"
@@ -330,11 +329,9 @@ def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, c
         return dataclasses.replace(r, centroid=np.asarray(r.centroid) + 3e-5) if side == moved_side else r
 
     monkeypatch.setattr(mass, "mass_properties", one_side_off)
-    # the same solid as the fixture's (read back from STEP): its reference, cut once
-    monkeypatch.setattr(mr, "moment_reference", lambda *a, **k: hole_reference)
     assert main(["mass", str(path), "--no-progress"]) == code
     out = capsys.readouterr().out
-    assert line in out and out.count("REFERENCE") == 1
+    assert line in out and out.count("REFERENCE") == 1 and "BRepGProp on the faces split 2 x 2" in out
     assert ("DISAGREEMENT" in out) == (code == 4)
 
 
@@ -354,7 +351,7 @@ def test_mass_command_skips_a_reference_over_budget(monkeypatch, tmp_path, capsy
     monkeypatch.setattr(mass, "REFERENCE_BUDGET", 1e-6)
     assert main(["mass", str(path), "--no-progress"]) == 4
     out = capsys.readouterr().out
-    assert "REFERENCE SKIPPED: the independent moment reference would take about" in out and "DISAGREEMENT" in out
+    assert "REFERENCE SKIPPED: budget: refining the faces 2 x 2 would take about" in out and "DISAGREEMENT" in out
 
 
 # -- real parts (the corpus; benchmarks/mass_reference.py runs the reference on all) --------
@@ -410,3 +407,87 @@ def test_surfmod_moments_match_the_reference_on_real_parts(corpus_dir, name, ind
     assert ec < 1e-10 and ei < 1e-10  # the reference is sure of itself here ...
     assert mc < 1e-9 and mi < 1e-9  # ... and surfmod is within the issue's 1e-9 of it
     assert oc < 1e-9 and oi < 1e-9  # (so is BRepGProp on these)
+
+
+# -- the refined reference (surfmod.occ.refined_props) ----------------------------------
+def test_refined_reference_settles_brepgprop_on_a_torus_fillet(corpus_dir):
+    """nist_ftc_11, a washer with two torus beads: BRepGProp's inertia at eps 1e-13 is 5e-7
+    off the closed form from its profile (its adaptive rule converges the volume only); on
+    faces split 2 x 2 and 4 x 4 it converges to it, as surfmod's is."""
+    import mpmath as mp
+
+    from surfmod.occ.refined_props import refined_props
+
+    mp.mp.dps = 30
+    h, rr = mp.mpf("0.425"), mp.mpf("1.5")
+    t2 = mp.asin(h / rr)
+    # the profile in the (r, z) half plane, counter-clockwise: outer wall, outer bead, top,
+    # inner bead, inner wall (the bottom and top lines carry no dz)
+    def region(a, b):  # ∫∫ r^a z^b dA = ∮ r^(a+1) / (a+1) z^b dz
+        f = lambda r, z: r ** (a + 1) / (a + 1) * z ** b  # noqa: E731
+        arc = lambda c: lambda t: f(c + rr * mp.cos(t), rr * mp.sin(t)) * rr * mp.cos(t)  # noqa: E731
+        return (mp.quad(lambda z: f(mp.mpf("31.5"), z), [-1.5, 0]) + mp.quad(arc(30), [0, mp.pi / 2, mp.pi - t2])
+                + mp.quad(arc(mp.mpf("17.5")), [t2, mp.pi / 2, mp.pi]) + mp.quad(lambda z: f(16, z), [0, -1.5]))
+    v = 2 * mp.pi * region(1, 0)
+    zc = 2 * mp.pi * region(1, 1) / v
+    xx, zz = mp.pi * region(3, 0), 2 * mp.pi * region(1, 2) - v * zc ** 2
+    washer = _solid(corpus_dir, "nist_ftc_11_asme1_rb.stp", 0)
+    exact = np.diag([float(xx + zz)] * 2 + [float(2 * xx)])
+    big = exact.max()
+    occ = gprops(washer, 1e-13)
+    assert abs(occ["volume"] / float(v) - 1) < 1e-12
+    assert np.abs(occ["inertia"] - exact).max() / big > 1e-7  # the quirk
+    ref = refined_props(washer)
+    assert ref.converged and ref.splits >= 2
+    assert abs(ref.volume / float(v) - 1) < 1e-13 and abs(ref.centroid[2] - float(zc)) < 1e-13 * 32
+    assert np.abs(ref.inertia - exact).max() / big < 1e-11
+    mine = sm.mass_properties(washer)
+    assert np.abs(mine.inertia - exact).max() / big < 1e-12
+
+
+def test_refined_reference_keeps_the_reference_point_and_refuses_past_its_budget():
+    from surfmod.occ.properties import vertex_mean
+    from surfmod.occ.refined_props import gprops_about, refined_props
+
+    part = (bd.Box(4, 3, 2) - bd.Cylinder(0.5, 3).translate((*HOLE, 0))).wrapped
+    g, o = gprops_about(part, vertex_mean(part)), gprops(part, 1e-13)  # BRepGProp's loop, face by face
+    assert g.Mass() == pytest.approx(o["volume"], rel=1e-15)
+    ref = refined_props(part)
+    assert np.allclose(ref.location, vertex_mean(part), rtol=0, atol=0) and ref.converged
+    with pytest.raises(SurfmodError, match="budget: refining the faces 2 x 2"):
+        refined_props(part, budget=0.0)
+    with pytest.raises(SurfmodError, match="shape: "):
+        refined_props(bd.Box(1, 1, 1).faces()[0].wrapped)
+
+
+@pytest.mark.corpus  # 1-100 s per file (the refinements of the faces)
+def test_surfmod_matches_the_refined_reference_on_every_corpus_solid(corpus_file):
+    """On every solid of the corpus: where the refined reference has settled (its last
+    refinement moved volume, centroid and inertia by less than 1e-10), surfmod's are within
+    1e-9 of it (the issue's goal), whatever plain BRepGProp says.  Where it has not (the
+    split changes the solid: ShapeUpgrade fits p-curves again on files whose p-curves
+    stray, build123d's screw thread, axom's B-spline sphere), surfmod must be within 1e-9
+    plus the reference's own estimate of it, or within 1e-9 or what the file leaves open
+    (its boundary ambiguity) of plain BRepGProp (the same fields about the same point).
+    The unsettled solids (occt_linkrods, the CATIA MAINBODY parts, stepcode_dm1's B-spline
+    solids, pythonocc_11752, ...) are where the issue's proof is still owed."""
+    from surfmod.occ.refined_props import refined_props
+    from surfmod.occ.topo import solids_of
+    from surfmod.uses.mass import boundary_ambiguity
+
+    def off(ref, mine):
+        length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
+        return max(abs(mine.volume - ref.volume) / ref.volume, np.abs(mine.centroid - ref.centroid).max() / length,
+                   np.abs(mine.inertia - ref.inertia).max() / big)
+
+    for i, solid in enumerate(solids_of(sm.import_step(corpus_file).wrapped)):
+        ref = refined_props(solid, budget=300)
+        mine = sm.mass_properties(solid, estimate_error=False)
+        estimate = max(ref.changes[k] for k in ("volume", "centroid", "inertia"))
+        if estimate < 1e-10:
+            assert off(ref, mine) < 1e-9, (corpus_file.name, i, off(ref, mine))
+            continue
+        o = gprops(solid, 1e-13)
+        plain = dataclasses.replace(ref, volume=o["volume"], centroid=o["centroid"], inertia=o["inertia"])
+        assert off(ref, mine) < 1e-9 + 2 * estimate or off(plain, mine) < max(1e-9, boundary_ambiguity(solid)), (
+            corpus_file.name, i, off(ref, mine), estimate, off(plain, mine))
