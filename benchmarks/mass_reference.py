@@ -39,14 +39,13 @@ def compare(solid, budget, reference="refined"):
     mine = mass_properties(solid, estimate_error=False)
     t1 = time.perf_counter()
     o = gprops(solid, 1e-12)
+    ref = (refined_props(solid, budget=budget) if reference == "refined"
+           else moment_reference(solid, o["volume"], budget=budget))
+    length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
     if reference == "refined":
-        ref = refined_props(solid, budget=budget)
-        length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
         c_est, i_est = ref.changes["centroid"], ref.changes["inertia"]
         extra = {"splits": ref.splits}
     else:
-        ref = moment_reference(solid, o["volume"], budget=budget)
-        length, big = ref.volume ** (1 / 3), np.abs(ref.inertia).max()
         c_est, i_est = ref.centroid_error / length, ref.inertia_error / big
         extra = {"defect": ref.defect, "check": ref.consistency, "planes": ref.planes}
 

@@ -16,8 +16,6 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
-
 from .. import tolerances
 from ..errors import SurfmodError
 from ..inputs import to_shape
@@ -52,6 +50,9 @@ def run(args) -> int:
         o = mass_properties(solid, args.density, method="occt", eps=args.eps)
         bar.update()
     print(r)
+    from ..occ.properties import relative_differences
+    from ..occ.strays import edge_strays
+
     limit = tolerances.MASS_AGREEMENT_RTOL
     diffs = relative_differences(r, o)
     print(f"BRepGProp (eps={args.eps:g}) relative differences: " + ", ".join(f"{k} {v:.2e}" for k, v in diffs.items())
@@ -66,8 +67,6 @@ def run(args) -> int:
         diffs = relative_differences(r, o)
         print(f"BRepGProp (eps={fine:g}) relative differences: " + ", ".join(f"{k} {v:.2e}" for k, v in diffs.items()))
         off = {k: v for k, v in diffs.items() if not v <= limit}
-    from ..occ.strays import edge_strays
-
     strays = sorted((e for e in edge_strays(solid) if e.ambiguous), key=lambda e: -max(e.stray, e.gap))
     named = ", ".join(f"edge {e.edge} of faces {'/'.join(map(str, e.faces))} ({max(e.stray, e.gap):.2e} > tol "
                       f"{e.tolerance:.1e})" for e in strays[:5]) + (" ..." if len(strays) > 5 else "")
@@ -104,6 +103,7 @@ def settle(solid, r, o, names, limit, density: float = 1.0):
     error estimate; ``"occt"`` the other way round; ``None`` (with the reason) when it
     cannot tell or would take more than ``REFERENCE_BUDGET`` seconds (``density`` scales
     the reference's inertia as it scales theirs)."""
+    from ..occ.properties import relative_differences
     from ..occ.refined_props import refined_props
 
     try:
@@ -130,14 +130,3 @@ def settle(solid, r, o, names, limit, density: float = 1.0):
         return "occt", f"REFERENCE CONFIRMS BREPGPROP: {how} agrees with plain BRepGProp, not surfmod ({detail})"
     return None, f"REFERENCE UNDECIDED: {how} cannot tell the two apart ({detail})"
 
-
-def relative_differences(r, o) -> dict:
-    """Mass properties ``r`` against ``o`` (surfmod's, BRepGProp's, the reference's): volume and area relative,
-    the centroid relative to the volume's cube root, the inertia to its largest entry."""
-    length = max(abs(o.volume), 1e-300) ** (1 / 3)
-    return {
-        "volume": abs(r.volume - o.volume) / max(abs(o.volume), 1e-300),
-        "area": abs(r.area - o.area) / max(abs(o.area), 1e-300),
-        "centroid": float(np.abs(np.asarray(r.centroid) - np.asarray(o.centroid)).max()) / length,
-        "inertia": float(np.abs(np.asarray(r.inertia) - np.asarray(o.inertia)).max()) / max(abs(np.asarray(o.inertia)).max(), 1e-300),
-    }

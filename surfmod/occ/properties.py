@@ -1,6 +1,6 @@
-"""Global properties of shapes: ``BRepGProp`` volume, area, centroid and inertia, the
-vertex mean BRepGProp refers its integrals to, and the one bounding box of the kernel
-door (``BRepBndLib``)."""
+"""Global properties of shapes: ``BRepGProp`` volume, area, centroid and inertia, how far
+two sets of them differ, the vertex mean BRepGProp refers its integrals to, and the one
+bounding box of the kernel door (``BRepBndLib``)."""
 
 from __future__ import annotations
 
@@ -33,16 +33,41 @@ def gprops(shape, eps: float = 1e-9) -> dict:
         verr = BRepGProp.VolumeProperties_s(shape, vp, float(eps), False, False)
         sp = GProp_GProps()
         serr = BRepGProp.SurfaceProperties_s(shape, sp, float(eps), False)
-        c = vp.CentreOfMass()
-        m = vp.MatrixOfInertia()
-        inertia = np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)])
     return {
         "volume": vp.Mass(),
         "area": sp.Mass(),
-        "centroid": xyz(c),
-        "inertia": inertia,
+        "centroid": xyz(vp.CentreOfMass()),
+        "inertia": inertia_matrix(vp),
         "volume_error": verr,
         "area_error": serr,
+    }
+
+
+def inertia_matrix(props: GProp_GProps) -> np.ndarray:
+    """``props.MatrixOfInertia()`` as a ``(3, 3)`` array (about the centre of mass)."""
+    m = props.MatrixOfInertia()
+    return np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)])
+
+
+def relative_differences(r, o) -> dict:
+    """Mass properties ``r`` against ``o`` (anything with ``volume``, ``area``, ``centroid``
+    and ``inertia``: surfmod's, BRepGProp's, a reference's): volume and area relative, the
+    centroid relative to the volume's cube root, the inertia to its largest entry, all of
+    ``o``.
+
+    >>> from types import SimpleNamespace as P
+    >>> a = P(volume=8.0, area=24.0, centroid=(0, 0, 0), inertia=[[1.0, 0], [0, 2.0]])
+    >>> b = P(volume=8.0, area=24.0, centroid=(0, 0, 2e-6), inertia=[[1.0, 0], [0, 2.0]])
+    >>> {k: float(v) for k, v in relative_differences(b, a).items()}
+    {'volume': 0.0, 'area': 0.0, 'centroid': 1e-06, 'inertia': 0.0}
+    """
+    length = max(abs(o.volume), 1e-300) ** (1 / 3)
+    big = max(float(np.abs(np.asarray(o.inertia)).max()), 1e-300)
+    return {
+        "volume": abs(r.volume - o.volume) / max(abs(o.volume), 1e-300),
+        "area": abs(r.area - o.area) / max(abs(o.area), 1e-300),
+        "centroid": float(np.abs(np.asarray(r.centroid) - np.asarray(o.centroid)).max()) / length,
+        "inertia": float(np.abs(np.asarray(r.inertia) - np.asarray(o.inertia)).max()) / big,
     }
 
 

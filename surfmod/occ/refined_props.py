@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from OCP.BRepGProp import BRepGProp, BRepGProp_Domain, BRepGProp_Face, BRepGProp_Vinert
@@ -45,7 +46,7 @@ from OCP.gp import gp_Pnt
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import kernel
-from .properties import vertex_mean
+from .properties import inertia_matrix, relative_differences, vertex_mean
 from .topo import faces_of, solids_of
 
 #: the pieces per face direction, coarsest first
@@ -115,16 +116,21 @@ def gprops_about(shape, location, eps: float = 1e-13) -> GProp_GProps:
     return total
 
 
-def _props(shape, location, eps):
-    """``(volume, area, centroid, inertia)`` of ``shape`` by BRepGProp, the volume integrals
+class _Props(NamedTuple):
+    volume: float
+    area: float
+    centroid: np.ndarray
+    inertia: np.ndarray
+
+
+def _props(shape, location, eps) -> _Props:
+    """BRepGProp's volume, area, centroid and inertia of ``shape``, the volume integrals
     about ``location`` (the area is the same about any point)."""
     g = gprops_about(shape, location, eps)
-    m = g.MatrixOfInertia()
     area = GProp_GProps()
     with kernel("BRepGProp.SurfaceProperties_s"):
         BRepGProp.SurfaceProperties_s(shape, area, float(eps), False)
-    return (g.Mass(), area.Mass(), xyz(g.CentreOfMass()),
-            np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)]))
+    return _Props(g.Mass(), area.Mass(), xyz(g.CentreOfMass()), inertia_matrix(g))
 
 
 def refined_props(shape, *, location=None, eps: float = 1e-13, budget: float = 60.0) -> RefinedProps:
@@ -151,15 +157,11 @@ def refined_props(shape, *, location=None, eps: float = 1e-13, budget: float = 6
             raise SurfmodError(f"budget: refining the faces {k} x {k} would take about {4 * last:.0f} s, more than the "
                                f"{start + budget - now:.0f} s left of {budget:g} s")
         split = split_faces(shape, k)
-        volume, area, centroid, inertia = _props(split, location, eps)
+        current = _props(split, location, eps)
         last = time.perf_counter() - now
         if previous is not None:
-            v0, a0, c0, i0 = previous
-            changes = {"volume": abs(volume - v0) / abs(volume), "area": abs(area - a0) / abs(area),
-                       "centroid": float(np.abs(centroid - c0).max()) / abs(volume) ** (1 / 3),
-                       "inertia": float(np.abs(inertia - i0).max()) / float(np.abs(inertia).max())}
+            changes = relative_differences(previous, current)
             if max(changes.values()) <= CONVERGED:
                 break
-        previous = volume, area, centroid, inertia
-    return RefinedProps(volume, area, centroid, inertia, location, k, len(faces_of(split)), changes,
-                        time.perf_counter() - start)
+        previous = current
+    return RefinedProps(*current, location, k, len(faces_of(split)), changes, time.perf_counter() - start)
