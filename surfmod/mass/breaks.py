@@ -127,12 +127,18 @@ def rational_pieces(surface, direction: int) -> int:
     return int(min(MAX_RATIONAL_PIECES, max(1, np.ceil(np.log2(ratio) - 1e-9))))
 
 
+def knot_breaks(surface, lo: float, hi: float, knots, direction: int, period: float | None = None) -> np.ndarray:
+    """:func:`_breaks` at the ``knots`` of a spline direction of ``surface`` (a face read
+    back or a surface), each span then split in :func:`rational_pieces` equal pieces."""
+    out = _breaks(lo, hi, knots, None, period)
+    pieces = rational_pieces(surface, direction)
+    if pieces > 1:
+        out = np.concatenate([out[:1]] + [np.linspace(a, c, pieces + 1)[1:] for a, c in zip(out[:-1], out[1:])])
+    return out
+
+
 def _patch_breaks(surface, lo, hi, direction, period):
     b = direction_breaks(surface, direction)
     if isinstance(b, str):
         return _breaks(lo, hi, None, ANGULAR_PIECE)
-    out = _breaks(lo, hi, b, None, period)
-    pieces = rational_pieces(surface, direction)
-    if pieces > 1:  # each span in equal pieces
-        out = np.concatenate([out[:1]] + [np.linspace(a, c, pieces + 1)[1:] for a, c in zip(out[:-1], out[1:])])
-    return out
+    return knot_breaks(surface, lo, hi, b, direction, period)

@@ -44,7 +44,7 @@ from ..construct.elementary import (ConicalSurface, CylindricalSurface, Elementa
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from .breaks import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks, is_face
+from .breaks import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks, is_face, knot_breaks
 from .boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
 from .rules import (GridJob, exact_order, gauss, green_layout, grid_nodes, grids_nodes, inner_nodes,  # noqa: F401
                         interpolation_points)
@@ -330,7 +330,8 @@ def surface_mass_face(surf) -> MassFace:
     for direction, (lo, hi) in enumerate(surf.domain):
         b = direction_breaks(surf, direction)
         # analytic directions without knots: eight pieces keep Gauss converged
-        breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None else _breaks(lo, hi, b, None))
+        breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None
+                      else knot_breaks(surf, lo, hi, b, direction))
     (u0, u1), (v0, v1) = surf.domain
     evaluate, grid_evaluate = evaluators(surf)
     return MassFace(evaluate, (u0, u1, v0, v1), tuple(breaks), 1.0,
