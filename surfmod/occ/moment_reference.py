@@ -59,8 +59,8 @@ a hole and a spherical cap to 1e-11 of the part (centroid) and 4e-11 (inertia), 
 frustum 4e-11 and 5e-9 (two cuts the splitter botches next to a fold of its base circle,
 within the estimate).  Cost: 21 planes per
 interval, six directions, seconds per hundred planes on prismatic parts and far more where
-sections are walked (tori, B-splines); :func:`estimated_seconds` says how long before
-cutting anything.
+sections are walked (tori, B-splines); a ``budget`` stops a run at the pace of its first
+cuts (see :func:`sweep`).
 """
 
 from __future__ import annotations
@@ -564,7 +564,7 @@ def sweep(shape, direction, origin, volume: float, size: float, *, levels=None, 
     sweep stops with ``SurfmodError`` naming ``budget`` past ``deadline`` (a
     ``time.perf_counter`` value), or as soon as the pace of its cuts so far says that this
     sweep and the ``later`` intervals of the sweeps after it would end past it (the cost of
-    a cut varies far more between solids than :func:`estimated_seconds` can foresee: the
+    a cut varies far more between solids than any count of planes and faces foresees: the
     splitter's retries, sections it walks)."""
     a = np.asarray(direction, dtype=float)
     if levels is None:
@@ -631,40 +631,12 @@ def _cut_interval(shape, a, nodes, volume, origin, size):
     return min(best, split, key=lambda r: abs(r[1]))
 
 
-#: seconds per cutting plane: a constant, per face of an elementary surface, per face of
-#: a free-form or toroidal one (their sections are walked and approximated); from the
-#: corpus (benchmarks/mass_reference.py: 5-36 ms a plane on 7-30 elementary faces, a
-#: rotated torus 0.35 s), an estimate for refusing early; the pace of the cuts (see
-#: sweep) is what bounds a run
-_COST = (0.01, 5e-4, 0.15)
-
-
 def _interval_count(levels, tolerances, pieces: int) -> int:
     """How many intervals :func:`sweep` cuts along levels ``levels`` (0 where it refuses)."""
     try:
         return len(_intervals(levels, 1e-6 * (levels[-1] - levels[0]), pieces, tolerances)[1])
     except SurfmodError:
         return 0
-
-
-def estimated_seconds(shape, pieces: int = 2) -> float:
-    """What :func:`moment_reference` would take on ``shape``, from its planes (found from
-    the critical levels, as it would) and its faces, before cutting anything.
-
-    >>> import build123d as bd
-    >>> 0 < estimated_seconds(bd.Box(1, 2, 3).wrapped) < 10
-    True
-    """
-    finder = _Levels(shape)
-    planes = 0
-    for d in DIRECTIONS:
-        count = _interval_count(*finder.along(d, tolerances=True), pieces)
-        if not count:
-            return 0.0  # refused at once (see sweep)
-        planes += 21 * count
-    simple = sum(kind in ("plane", "cylinder", "cone", "sphere") for kind, *_ in finder.faces)
-    hard = len(finder.faces) - simple
-    return planes * (_COST[0] + _COST[1] * simple + _COST[2] * hard)
 
 
 def moment_reference(shape, volume: float | None = None, *, pieces: int = 2,
