@@ -77,3 +77,36 @@ def test_c1_knot_of_a_trimmed_bspline_in_a_file(tmp_path):
     [(_, _, kind, dev, ok, note)] = check_file(path, 24)
     assert ok and dev < 1e-12, note
     assert "C1/C0 knot lines" in note
+
+
+def _periodic_c1_at_the_seam():
+    """:func:`_periodic_c1` with its seam knot 0 doubled too: C1 across the seam."""
+    mults = [2] + MULTS_U[1:-1] + [2]
+    rng = np.random.default_rng(5)
+    nu, nv = sum(mults[:-1]), 4
+    poles = TColgp_Array2OfPnt(1, nu, 1, nv)
+    for i in range(nu):
+        a = 2 * math.pi * i / nu
+        for j in range(nv):
+            r = 2 + 0.3 * rng.uniform(-1, 1)
+            poles.SetValue(i + 1, j + 1, gp_Pnt(r * math.cos(a), r * math.sin(a), j + 0.2 * rng.uniform(-1, 1)))
+    uk, um = TColStd_Array1OfReal(1, len(KNOTS_U)), TColStd_Array1OfInteger(1, len(KNOTS_U))
+    for i, (k, m) in enumerate(zip(KNOTS_U, mults)):
+        uk.SetValue(i + 1, k)
+        um.SetValue(i + 1, m)
+    vk, vm = TColStd_Array1OfReal(1, 2), TColStd_Array1OfInteger(1, 2)
+    vk.SetValue(1, 0.0), vk.SetValue(2, 1.0), vm.SetValue(1, 4), vm.SetValue(2, 4)
+    return Geom_BSplineSurface(poles, uk, vk, um, vm, 3, 3, True, False)
+
+
+@pytest.mark.parametrize("sampling", ["dense", "sufficient"])
+def test_a_c1_seam_knot_at_the_face_edge_is_no_false_alarm(sampling):
+    # a face whose trim starts an ulp below the seam (as read from a file: v0 = -4.4e-16 on
+    # a PlanetCAD part): surfmod's knot vector of the periodic spline runs on past the
+    # seam, so it took the span below while OCCT snaps onto the knot; d2_rel was 0.3 there
+    g = _periodic_c1_at_the_seam()
+    assert _second_derivative_jump(g, 0.0) > 0.1  # the seam is a real C1 knot
+    trimmed = Geom_RectangularTrimmedSurface(g, 0.0, math.pi, 0.0, 1.0)  # as the file has it
+    face = sm.from_face(BRepBuilderAPI_MakeFace(trimmed, -4.440892098500626e-16, math.pi, 0.0, 1.0, 1e-7).Face())
+    r = sm.crosscheck(face, sampling=sampling)
+    assert r.passed, r.details["failed"]

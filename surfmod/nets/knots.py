@@ -60,16 +60,23 @@ def segment(knots: np.ndarray, degree: int, ctrl: np.ndarray, a: float, b: float
 
 
 def smooth_mask(knots: np.ndarray, degree: int, t: np.ndarray, order: int) -> np.ndarray:
-    """False where ``t`` is (within a few ulps of) an interior knot across which the
-    ``order``-th derivative jumps (multiplicity > degree - order).  There the derivative is
-    two-valued: surfmod returns the one of the span ``t`` falls in, while OCCT's span
-    search (``BSplCLib::LocateParameter``) snaps a parameter that close to the knot onto
-    it, so comparisons skip such parameters.
+    """False where ``t`` is (within a few ulps of) a knot with spans on both sides across
+    which the ``order``-th derivative jumps (multiplicity > degree - order).  There the
+    derivative is two-valued: surfmod returns the one of the span ``t`` falls in, while
+    OCCT's span search (``BSplCLib::LocateParameter``) snaps a parameter that close to the
+    knot onto it, so comparisons skip such parameters.  Such knots are the interior ones,
+    and the ends of the domain of an unclamped vector (a periodic spline's seam: its spans
+    run on past it, so a parameter an ulp below the seam falls in the span before).
 
     >>> smooth_mask(np.array([0, 0, 0.6000000000000001, 3, 3]), 1, np.array([0.3, 0.6, 0.6000000000000001]), 1)
     array([ True, False, False])
+    >>> periodic = np.array([-1.0, 0, 0, 1, 1, 2, 2, 3])  # degree 2, double knots: C0
+    >>> smooth_mask(periodic, 2, np.array([-4.4e-16, 0.5, 2.0]), 1)
+    array([False,  True, False])
     """
-    inner = knots[(knots > knots[degree]) & (knots < knots[-degree - 1])]
+    # strictly inside the whole vector: on a clamped one the ends of the domain repeat
+    # degree + 1 times and drop out, on an unclamped one they are knots like the others
+    inner = knots[(knots > knots[0]) & (knots < knots[-1])]
     values, mult = np.unique(inner, return_counts=True)
     jumps = values[mult > degree - order]
     if not jumps.size:
