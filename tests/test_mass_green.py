@@ -287,3 +287,48 @@ def test_a_quintic_pcurve_is_split_at_its_knots_not_at_occts_intervals():
     assert _rel(face_moments(sm.from_face(face))[0], area) < 1e-13
     assert _rel(sm.mass_properties(bd.extrude(face, 2.0)).volume, 2 * area) < 1e-13
 
+
+def test_a_pcurve_below_the_surfaces_knot_range_continues_its_end_span():
+    """A bilinear B-spline patch over [0, 1]², trimmed by a wire whose bottom edge dips to
+    v = -0.01 (OCCT continues the end span there; its UV bounds stop at v = 0): Green's
+    inner integral along v took no part of the sliver below v = 0 (the V of the face was
+    1e-3 off, on soarm_Motor1_holder a face's area 5e-4); now exact.  BRepGProp is 3.4e-7
+    off here."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
+    from OCP.BRepLib import BRepLib
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.Geom2d import Geom2d_Line
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d
+
+    poles = TColgp_Array2OfPnt(1, 4, 1, 2)  # x = 2u, y = 3v, z = 0.9uv; three spans in u
+    for i in range(4):
+        for j in (0, 1):
+            poles.SetValue(i + 1, j + 1, gp_Pnt(2.0 * i / 3, 3.0 * j, 0.3 * i * j))
+    ku, mu = TColStd_Array1OfReal(1, 4), TColStd_Array1OfInteger(1, 4)
+    for i, (a, b) in enumerate(zip([0, 1 / 3, 2 / 3, 1], [2, 1, 1, 2]), start=1):
+        ku.SetValue(i, a), mu.SetValue(i, b)
+    kv, mv = TColStd_Array1OfReal(1, 2), TColStd_Array1OfInteger(1, 2)
+    kv.SetValue(1, 0.0), kv.SetValue(2, 1.0), mv.SetValue(1, 2), mv.SetValue(2, 2)
+    surf = Geom_BSplineSurface(poles, ku, kv, mu, mv, 1, 1)
+    corners = [(0, -0.01), (1, 0.2), (1, 1), (0, 1)]
+    wire = BRepBuilderAPI_MakeWire()
+    for (a, b), (c, d) in zip(corners, corners[1:] + corners[:1]):
+        line = Geom2d_Line(gp_Pnt2d(a, b), gp_Dir2d(c - a, d - b))
+        wire.Add(BRepBuilderAPI_MakeEdge(line, surf, 0.0, float(np.hypot(c - a, d - b))).Edge())
+    face = BRepBuilderAPI_MakeFace(surf, wire.Wire(), True).Face()
+    BRepLib.BuildCurves3d_s(face)
+    read = sm.from_face(face)
+    assert read.domain[1][0] == 0.0  # the face box stops at the knot range
+    # the region: u in [0, 1], v from -0.01 + 0.21 u to 1; V = ∫∫ (x - c)·(Su × Sv) / 3,
+    # a polynomial: Gauss–Legendre on v = l(u) + (1 - l(u)) t is exact
+    c = np.array([0.5, -1.0, 2.0])
+    x, w = np.polynomial.legendre.leggauss(8)
+    u, t = np.meshgrid((x + 1) / 2, (x + 1) / 2, indexing="ij")
+    low = -0.01 + 0.21 * u
+    v = low + (1 - low) * t
+    pos = np.stack([2 * u, 3 * v, 0.9 * u * v], -1) - c
+    n = np.stack([-2.7 * v, -1.8 * u, np.full_like(u, 6.0)], -1)  # Su x Sv
+    exact = float(np.einsum("i,j,ij->", w / 2, w / 2, np.sum(pos * n, -1) / 3 * (1 - low)))
+    assert _rel(face_moments(read, c)[1], exact) < 1e-13

@@ -525,6 +525,9 @@ def _green_plan(mf: MassFace, order: int, orders, exacts) -> _GreenPlan:
     # beyond the face box, where a short end span must not be extrapolated far)
     obr = mf.breaks[1 - k]
     on_grid = np.abs(2 * P[:, 1 - k] - obr[q] - obr[q + 1]) <= (1 + GRID_REACH) * (obr[q + 1] - obr[q])
+    # and inside the inner breaks: beyond them the end span is continued node by node
+    br = mf.breaks[k]
+    on_grid &= (P[:, k] >= br[0]) & (P[:, k] <= br[-1])
     counts = [interpolation_points(mf.degrees[d], order) for d in (k, 1 - k)]
     deepest = np.zeros(len(obr) - 1, int)  # per outer span, the inner spans its nodes reach
     np.maximum.at(deepest, q[on_grid], (full + partial)[on_grid])
