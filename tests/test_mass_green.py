@@ -288,12 +288,13 @@ def test_a_quintic_pcurve_is_split_at_its_knots_not_at_occts_intervals():
     assert _rel(sm.mass_properties(bd.extrude(face, 2.0)).volume, 2 * area) < 1e-13
 
 
-def test_a_pcurve_below_the_surfaces_knot_range_continues_its_end_span():
+def test_a_pcurve_below_the_surfaces_knot_range_is_integrated_as_brepgprop_does():
     """A bilinear B-spline patch over [0, 1]², trimmed by a wire whose bottom edge dips to
-    v = -0.01 (OCCT continues the end span there; its UV bounds stop at v = 0): Green's
-    inner integral along v took no part of the sliver below v = 0 (the V of the face was
-    1e-3 off, on soarm_Motor1_holder a face's area 5e-4); now exact.  BRepGProp is 3.4e-7
-    off here."""
+    v = -0.01 (OCCT continues the end span there; its UV bounds stop at v = 0).  Green's
+    inner integral ends at the face box, so the direction decides whether the sliver
+    below v = 0 counts: along v (cheaper here, three spans in u) it did not (the face's V
+    1e-3 off, on soarm_Motor1_holder a face's area 5e-4); along u, BRepGProp's direction,
+    the outer integral follows the p-curve out and it does (exact; BRepGProp 3.4e-7 off)."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
     from OCP.BRepLib import BRepLib
     from OCP.Geom import Geom_BSplineSurface

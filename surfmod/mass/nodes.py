@@ -417,6 +417,17 @@ def _largest_gap(mf: MassFace) -> float:
     return float(d.min(axis=1).max())
 
 
+def _reaches_beyond(mf: MassFace, P: np.ndarray) -> bool:
+    """Whether boundary nodes ``P`` lie beyond the ends of the face's breaks in either
+    direction by more than ``CLOSURE_RTOL`` of its extent (not the round-off of a seam)."""
+    for d in (0, 1):
+        lo, hi = mf.breaks[d][0], mf.breaks[d][-1]
+        reach = CLOSURE_RTOL * max(hi - lo, 1e-300)
+        if np.any(P[:, d] < lo - reach) or np.any(P[:, d] > hi + reach):
+            return True
+    return False
+
+
 def is_conic(mf) -> bool:
     """Whether a trimmed planar face is bounded by straight and circular p-curves only
     (holes, slots, rounded pockets): its boundary's Gauss nodes are then laid directly
@@ -505,9 +516,13 @@ def _green_plan(mf: MassFace, order: int, orders, exacts) -> _GreenPlan:
     plan = _GreenPlan()
     P, dP, wt, exact = face_boundary(mf, order)
     # inner direction: the one with fewer inner nodes per boundary node, where the
-    # p-curves close up.  Where they leave a gap (a model whose edges are off its faces)
-    # the result depends on the direction, and BRepGProp's is u from the box's left edge.
-    closed = _largest_gap(mf) <= CLOSURE_RTOL
+    # p-curves close up within the face box.  Where they leave a gap (a model whose edges
+    # are off its faces), or reach beyond the box (a p-curve a hair outside the surface's
+    # knot range, where OCCT's UV bounds stop), the result depends on the direction:
+    # the inner integral ends at the box, the outer one follows the p-curve out, and
+    # BRepGProp's direction is u from the box's left edge (soarm_Motor1_holder: inner v
+    # dropped a sliver below the v range, 5e-4 of a face's area, where BRepGProp keeps it)
+    closed = not _reaches_beyond(mf, P) and _largest_gap(mf) <= CLOSURE_RTOL
     cost = [(len(mf.breaks[d]) - 1) * orders[d] for d in (0, 1)]
     k = 1 if closed and cost[1] < cost[0] else 0
     m_in = orders[k]
@@ -525,9 +540,6 @@ def _green_plan(mf: MassFace, order: int, orders, exacts) -> _GreenPlan:
     # beyond the face box, where a short end span must not be extrapolated far)
     obr = mf.breaks[1 - k]
     on_grid = np.abs(2 * P[:, 1 - k] - obr[q] - obr[q + 1]) <= (1 + GRID_REACH) * (obr[q + 1] - obr[q])
-    # and inside the inner breaks: beyond them the end span is continued node by node
-    br = mf.breaks[k]
-    on_grid &= (P[:, k] >= br[0]) & (P[:, k] <= br[-1])
     counts = [interpolation_points(mf.degrees[d], order) for d in (k, 1 - k)]
     deepest = np.zeros(len(obr) - 1, int)  # per outer span, the inner spans its nodes reach
     np.maximum.at(deepest, q[on_grid], (full + partial)[on_grid])

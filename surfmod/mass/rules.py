@@ -151,15 +151,12 @@ def interpolation_points(degree, order: int) -> tuple[int, bool]:
 
 def green_layout(mf, k: int, P: np.ndarray):
     """Per boundary node: the inner spans wholly below it (``full``), whether the next one
-    is partial, and its outer span ``q``.  A node beyond the breaks (a p-curve a hair
-    outside the surface's knot range, where OCCT continues the end span) has the end span
-    continued to it as its partial one: ``[br[0], u]`` (backwards) below, ``[br[-1], u]``
-    above, integrated node by node (:func:`inner_nodes`)."""
+    is partial, and its outer span ``q``."""
     br, obr = mf.breaks[k], mf.breaks[1 - k]
     n_spans = len(br) - 1
     u = P[:, k]
     full = np.searchsorted(br[1:], u, side="right")  # br[i + 1] <= u
-    partial = ((full < n_spans) & (br[np.minimum(full, n_spans - 1)] < u)) | (u < br[0]) | (u > br[-1])
+    partial = (full < n_spans) & (br[np.minimum(full, n_spans - 1)] < u)
     q = np.clip(np.searchsorted(obr, P[:, 1 - k], side="right") - 1, 0, len(obr) - 2)
     return full, partial, q
 
