@@ -30,6 +30,7 @@ from OCP.gp import gp_Ax1, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 
 import surfmod as sm
 from surfmod.errors import SurfmodError
+from surfmod.tolerances import MASS_AGREEMENT_RTOL
 from surfmod.occ.properties import gprops
 from surfmod.occ.moment_reference import (GAUSS_W, KRONROD_W, KRONROD_X, PACE_CUTS, critical_levels, cut_volumes,
                                           moment_reference, _intervals, _nodes)
@@ -460,6 +461,10 @@ def test_refined_reference_keeps_the_reference_point_and_refuses_past_its_budget
         refined_props(bd.Box(1, 1, 1).faces()[0].wrapped)
 
 
+#: corpus solids whose own data leaves surfmod and BRepGProp more than 1e-7 apart
+AMBIGUOUS = {("pythonocc_Ventilator.stp", 0)}
+
+
 @pytest.mark.corpus  # 1-100 s per file (the refinements of the faces)
 def test_surfmod_matches_the_refined_reference_on_every_corpus_solid(corpus_file):
     """On every solid of the corpus: where the refined reference has settled (its last
@@ -467,8 +472,9 @@ def test_surfmod_matches_the_refined_reference_on_every_corpus_solid(corpus_file
     1e-9 of it (the issue's goal), whatever plain BRepGProp says.  Where it has not (the
     split changes the solid: ShapeUpgrade fits p-curves again on files whose p-curves
     stray, build123d's screw thread, axom's B-spline sphere), surfmod must be within 1e-9
-    plus the reference's own estimate of it, or within 1e-9 or what the file leaves open
-    (its boundary ambiguity) of plain BRepGProp (the same fields about the same point).
+    plus the reference's own estimate of it, or within the command's 1e-7 of plain
+    BRepGProp (the same fields about the same point; on the Ventilator within what the file
+    leaves open, its boundary ambiguity).
     The unsettled solids (occt_linkrods, the CATIA MAINBODY parts, stepcode_dm1's B-spline
     solids, pythonocc_11752, ...) are where the issue's proof is still owed."""
     from surfmod.occ.properties import relative_differences
@@ -489,5 +495,9 @@ def test_surfmod_matches_the_refined_reference_on_every_corpus_solid(corpus_file
             continue
         o = gprops(solid, 1e-13)
         plain = dataclasses.replace(ref, volume=o["volume"], area=o["area"], centroid=o["centroid"], inertia=o["inertia"])
-        assert off(ref, mine) < 1e-9 + 2 * estimate or off(plain, mine) < max(1e-9, boundary_ambiguity(solid)), (
+        # against plain BRepGProp: the command's own limit, beyond it only where the file's
+        # straying edges leave that much open (the Ventilator, 1.2e-6: surfmod mass exit 3)
+        limit = max(MASS_AGREEMENT_RTOL, boundary_ambiguity(solid)) if (corpus_file.name, i) in AMBIGUOUS else (
+            MASS_AGREEMENT_RTOL)
+        assert off(ref, mine) < 1e-9 + 2 * estimate or off(plain, mine) < limit, (
             corpus_file.name, i, off(ref, mine), estimate, off(plain, mine))
