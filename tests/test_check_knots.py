@@ -23,9 +23,11 @@ KNOTS_U = [0.0, 0.7, 1.3, 2.9, 3.1, 4.4, 2 * math.pi]
 MULTS_U = [1, 1, 2, 1, 1, 1, 1]  # 1.3 is a double knot of a cubic: C1 there
 
 
-def _periodic_c1():
-    rng = np.random.default_rng(4)
-    nu, nv = sum(MULTS_U[:-1]), 4
+def _periodic_c1(mults=MULTS_U, seed=4):
+    """A periodic bicubic over the knots ``KNOTS_U`` with multiplicities ``mults`` (random
+    radii from ``seed``), clamped in v."""
+    rng = np.random.default_rng(seed)
+    nu, nv = sum(mults[:-1]), 4
     poles = TColgp_Array2OfPnt(1, nu, 1, nv)
     for i in range(nu):
         a = 2 * math.pi * i / nu
@@ -33,7 +35,7 @@ def _periodic_c1():
             r = 2 + 0.3 * rng.uniform(-1, 1)
             poles.SetValue(i + 1, j + 1, gp_Pnt(r * math.cos(a), r * math.sin(a), j + 0.2 * rng.uniform(-1, 1)))
     uk, um = TColStd_Array1OfReal(1, len(KNOTS_U)), TColStd_Array1OfInteger(1, len(KNOTS_U))
-    for i, (k, m) in enumerate(zip(KNOTS_U, MULTS_U)):
+    for i, (k, m) in enumerate(zip(KNOTS_U, mults)):
         uk.SetValue(i + 1, k)
         um.SetValue(i + 1, m)
     vk, vm = TColStd_Array1OfReal(1, 2), TColStd_Array1OfInteger(1, 2)
@@ -81,22 +83,7 @@ def test_c1_knot_of_a_trimmed_bspline_in_a_file(tmp_path):
 
 def _periodic_c1_at_the_seam():
     """:func:`_periodic_c1` with its seam knot 0 doubled too: C1 across the seam."""
-    mults = [2] + MULTS_U[1:-1] + [2]
-    rng = np.random.default_rng(5)
-    nu, nv = sum(mults[:-1]), 4
-    poles = TColgp_Array2OfPnt(1, nu, 1, nv)
-    for i in range(nu):
-        a = 2 * math.pi * i / nu
-        for j in range(nv):
-            r = 2 + 0.3 * rng.uniform(-1, 1)
-            poles.SetValue(i + 1, j + 1, gp_Pnt(r * math.cos(a), r * math.sin(a), j + 0.2 * rng.uniform(-1, 1)))
-    uk, um = TColStd_Array1OfReal(1, len(KNOTS_U)), TColStd_Array1OfInteger(1, len(KNOTS_U))
-    for i, (k, m) in enumerate(zip(KNOTS_U, mults)):
-        uk.SetValue(i + 1, k)
-        um.SetValue(i + 1, m)
-    vk, vm = TColStd_Array1OfReal(1, 2), TColStd_Array1OfInteger(1, 2)
-    vk.SetValue(1, 0.0), vk.SetValue(2, 1.0), vm.SetValue(1, 4), vm.SetValue(2, 4)
-    return Geom_BSplineSurface(poles, uk, vk, um, vm, 3, 3, True, False)
+    return _periodic_c1([2] + MULTS_U[1:-1] + [2], seed=5)
 
 
 @pytest.mark.parametrize("sampling", ["dense", "sufficient"])
