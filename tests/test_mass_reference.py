@@ -461,43 +461,75 @@ def test_refined_reference_keeps_the_reference_point_and_refuses_past_its_budget
         refined_props(bd.Box(1, 1, 1).faces()[0].wrapped)
 
 
-#: corpus solids whose own data leaves surfmod and BRepGProp more than 1e-7 apart
-AMBIGUOUS = {("pythonocc_Ventilator.stp", 0)}
+#: corpus solids whose integrators disagree by more than 1e-9 because the file itself
+#: leaves those digits open (p-curves straying from their edges: boundary_ambiguity 2e-4 to
+#: 4e-3), with surfmod's distance from the Gauss-Kronrod rule measured when they were
+#: named; surfmod's own digits there are settled (order 12, 16, 24 agree to 1e-16)
+AMBIGUOUS = {
+    ("occt_linkrods.step", 0): 1.9e-9,
+    ("stepcode_MAINBODY_BACK.stp", 0): 1.6e-5,
+    ("stepcode_MAINBODY_FRONT.stp", 0): 7.5e-6,
+    ("pythonocc_11752.stp", 0): 6.2e-8,
+    ("pythonocc_Ventilator.stp", 0): 2.5e-8,
+}
 
 
-@pytest.mark.corpus  # 1-100 s per file (the refinements of the faces)
-def test_surfmod_matches_the_refined_reference_on_every_corpus_solid(corpus_file):
-    """On every solid of the corpus: where the refined reference has settled (its last
-    refinement moved volume, centroid and inertia by less than 1e-10), surfmod's are within
-    1e-9 of it (the issue's goal), whatever plain BRepGProp says.  Where it has not (the
-    split changes the solid: ShapeUpgrade fits p-curves again on files whose p-curves
-    stray, build123d's screw thread, axom's B-spline sphere), surfmod must be within 1e-9
-    plus the reference's own estimate of it, or within the command's 1e-7 of plain
-    BRepGProp (the same fields about the same point; on the Ventilator within what the file
-    leaves open, its boundary ambiguity).
-    The unsettled solids (occt_linkrods, the CATIA MAINBODY parts, stepcode_dm1's B-spline
-    solids, pythonocc_11752, ...) are where the issue's proof is still owed."""
+def _off(ref, mine):
     from surfmod.occ.properties import relative_differences
+
+    d = relative_differences(mine, ref)
+    return max(d["volume"], d["centroid"], d["inertia"])
+
+
+@pytest.mark.corpus  # 1-100 s per file (the refinements of the faces, the Gauss-Kronrod rule)
+def test_surfmod_matches_an_independent_reference_on_every_corpus_solid(corpus_file):
+    """On every solid of the corpus surfmod's volume, centroid and inertia are within 1e-9
+    (the issue's goal) of an independent reference, whatever plain BRepGProp says:
+
+    * the refined reference, where it has settled (its last refinement moved every
+      quantity by less than 1e-10);
+    * where it has not (its split changes the solid: ShapeUpgrade fits p-curves again on
+      stepcode_dm1's B-spline solids, stepcode_TAIL_TURBINE, build123d's screw thread,
+      axom's B-spline sphere, nist_ctc_05), BRepGProp's Gauss-Kronrod rule with the
+      moments converged, its own error estimate below 1e-9;
+    * on the solids named in :data:`AMBIGUOUS` the file leaves more than 1e-9 open: there
+      surfmod is within the command's 1e-7 of plain BRepGProp (the Ventilator within its
+      boundary ambiguity), and a new one fails here until it is named."""
+    from surfmod.occ.kronrod_props import kronrod_props
     from surfmod.occ.refined_props import refined_props
     from surfmod.occ.topo import solids_of
     from surfmod.uses.mass import boundary_ambiguity
 
-    def off(ref, mine):
-        d = relative_differences(mine, ref)
-        return max(d["volume"], d["centroid"], d["inertia"])
-
     for i, solid in enumerate(solids_of(sm.import_step(corpus_file).wrapped)):
-        ref = refined_props(solid, budget=300)
+        key = (corpus_file.name, i)
         mine = sm.mass_properties(solid, estimate_error=False)
+        ref = refined_props(solid, budget=300)
         estimate = max(ref.changes[k] for k in ("volume", "centroid", "inertia"))
         if estimate < 1e-10:
-            assert off(ref, mine) < 1e-9, (corpus_file.name, i, off(ref, mine))
+            assert _off(ref, mine) < 1e-9, (key, _off(ref, mine))
+            continue
+        if key not in AMBIGUOUS:
+            gk = kronrod_props(solid, 1e-10)
+            assert gk.error < 1e-9 and _off(gk, mine) < 1e-9, (key, _off(gk, mine), gk.error, estimate)
             continue
         o = gprops(solid, 1e-13)
         plain = dataclasses.replace(ref, volume=o["volume"], area=o["area"], centroid=o["centroid"], inertia=o["inertia"])
-        # against plain BRepGProp: the command's own limit, beyond it only where the file's
-        # straying edges leave that much open (the Ventilator, 1.2e-6: surfmod mass exit 3)
-        limit = max(MASS_AGREEMENT_RTOL, boundary_ambiguity(solid)) if (corpus_file.name, i) in AMBIGUOUS else (
+        limit = max(MASS_AGREEMENT_RTOL, boundary_ambiguity(solid)) if key == ("pythonocc_Ventilator.stp", 0) else (
             MASS_AGREEMENT_RTOL)
-        assert off(ref, mine) < 1e-9 + 2 * estimate or off(plain, mine) < limit, (
-            corpus_file.name, i, off(ref, mine), estimate, off(plain, mine))
+        assert _off(plain, mine) < limit, (key, _off(plain, mine))
+
+
+def test_brepgprop_inertia_quirk_on_a_b_spline_solid_settled_by_gauss_kronrod(corpus_dir):
+    """An OCCT quirk, pinned: on stepcode_dm1's solid 4 (B-spline faces, edges that close to
+    1e-13) plain BRepGProp's inertia is 6e-9 of its largest entry off, at eps 1e-13 as at
+    1e-9 (its adaptive rule converges only the volume), where its own Gauss-Kronrod rule
+    with the moments converged and surfmod agree to 1e-12."""
+    from surfmod.occ.kronrod_props import kronrod_props
+
+    solid = _solid(corpus_dir, "stepcode_dm1-id-214.stp", 4)
+    mine = sm.mass_properties(solid, estimate_error=False)
+    gk = kronrod_props(solid, 1e-10)
+    o = gprops(solid, 1e-13)
+    plain = dataclasses.replace(gk, volume=o["volume"], centroid=o["centroid"], inertia=o["inertia"])
+    assert gk.error < 1e-11 and _off(gk, mine) < 1e-11
+    assert _off(gk, plain) > 3e-9

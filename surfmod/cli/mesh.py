@@ -42,6 +42,14 @@ def run(args) -> int:
     print(f"{out}: {len(mesh.faces)} triangles, {len(mesh.vertices)} vertices, "
           f"watertight {tm.is_watertight}, winding consistent {tm.is_winding_consistent}"
           + (f", measured max deviation {dev:.3g}" if dev is not None else ""))
+    skipped = mesh.info.get("faces_not_meshed", [])
+    if skipped:
+        print(f"NOTE: {len(skipped)} face(s) of open shells BRepMesh cannot triangulate are left out: faces "
+              f"{', '.join(map(str, skipped[:10]))}{' ...' if len(skipped) > 10 else ''} (--strict refuses them)")
+    opened = mesh.info.get("open_faces", 0) - len(skipped)
+    if opened:
+        print(f"NOTE: {opened} face(s) lie in no closed shell (open shells or loose faces): "
+              "the STL stays open along their free edges, as the model is")
     report = mesh.info.get("faces_over_tolerance", [])
     if report:
         print(f"{len(report)} face(s) deviate more than {args.tolerance:g} and a finer mesh does not bring them "

@@ -29,6 +29,7 @@ def merged(meshes: list[Mesh]) -> Mesh:
     if devs:
         info["max_deviation"] = max(devs)
     info["faces_over_tolerance"] = [r for m in meshes for r in m.info.get("faces_over_tolerance", [])]
+    info["open_faces"] = sum(m.info.get("open_faces", 0) for m in meshes)
     return Mesh(np.concatenate(verts), np.concatenate(faces), info)
 
 

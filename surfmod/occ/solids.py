@@ -65,6 +65,35 @@ def _solid_of_shell(shell, what: str):
     return solid
 
 
+def _faces_outside(shape, owners) -> list[int]:
+    inside = {f.__hash__() for owner in owners for f in _explore(owner, TopAbs_FACE)}
+    return [k for k, f in enumerate(_explore(shape, TopAbs_FACE)) if f.__hash__() not in inside]
+
+
+def left_out_faces(shape) -> list[int]:
+    """Indices (``faces_of`` order) of the faces :func:`closed_solid` leaves out: those
+    outside every solid when the shape has solids (open shells and loose faces beside
+    them: they enclose no volume), outside every shell when it has shells but no solid.
+
+    >>> import build123d as bd
+    >>> left_out_faces(bd.Compound([bd.Box(1, 1, 1), bd.Face.make_rect(1, 1)]).wrapped)
+    [6]
+    """
+    owners = solids_of(shape) or shells_of(shape)
+    return _faces_outside(shape, owners) if owners else []
+
+
+def open_faces(shape) -> list[int]:
+    """Indices (``faces_of`` order) of the faces in no closed shell: open shells and loose
+    faces, whose free edges a mesh of the shape cannot close.
+
+    >>> import build123d as bd
+    >>> open_faces(bd.Compound([bd.Box(1, 1, 1), bd.Face.make_rect(1, 1)]).wrapped)
+    [6]
+    """
+    return _faces_outside(shape, [s for s in shells_of(shape) if BRep_Tool.IsClosed_s(s)])
+
+
 def closed_solid(shape):
     """A closed solid (or compound of them) for volume work; open shells are sewn at the
     model's tolerance and refused if they stay open."""
