@@ -32,6 +32,10 @@ from surfmod.occ.topo import faces_of, solids_of
 OCCT_REBUILDS = {
     "axom_boxed_sphere.step": (0.00719, "measured 0.00575: Rhino B-spline faces, 2 solids"),
     "build123d_M6-1x12-countersunk-screw.step": (2e-08, "measured 1.6e-08: B-spline thread"),
+    "koch_Follower_Gripper_Static_Part.STEP": (1.3e-08, "measured 1.04e-08: SolidWorks 2024 quintic trims; plain "
+                                                        "STEPControl write and read: the same change (checked)"),
+    "soarm_Motor1_holder.step": (1.91e-06, "measured 1.52e-06: Fusion 360, p-curves past a B-spline's knot range; "
+                                           "plain STEPControl write and read: the same change (checked)"),
     "nist_ctc_04_asme1_rd.stp": (4.97e-10, "measured 3.98e-10: cones, tori, spheres"),
     "nist_ctc_05_asme1_rd.stp": (2.27e-07, "measured 1.82e-07: B-spline faces"),
     "nist_ftc_07_asme1_rd.stp": (4.18e-07, "measured 3.34e-07: B-spline faces; fixes off: same change (checked)"),
