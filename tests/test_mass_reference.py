@@ -336,6 +336,34 @@ def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, c
     assert ("DISAGREEMENT" in out) == (code == 4)
 
 
+@pytest.mark.parametrize("moved_side, code, line", [
+    ("occt", 0, "REFERENCE CONFIRMS SURFMOD"), ("numpy", 4, "REFERENCE CONFIRMS BREPGPROP")])
+def test_mass_command_asks_gauss_kronrod_when_the_split_cannot_tell(monkeypatch, tmp_path, capsys, moved_side, code,
+                                                                    line):
+    import surfmod.cli.mass as mass
+    import surfmod.occ.refined_props as refined
+    from surfmod.cli import main
+
+    path = tmp_path / "hole.step"
+    sm.export_step(holed_box(), path)
+    real = mass.mass_properties
+
+    def one_side_off(solid, density=1.0, **kw):
+        r = real(solid, density, **kw)
+        return dataclasses.replace(r, centroid=np.asarray(r.centroid) + 3e-5) if kw.get(
+            "method", "numpy") == moved_side else r
+
+    def unsettled(solid, budget=60.0, **kw):  # as on a file whose split is not exact
+        raise SurfmodError("budget: refining the faces 2 x 2 (test)")
+
+    monkeypatch.setattr(mass, "mass_properties", one_side_off)
+    monkeypatch.setattr(refined, "refined_props", unsettled)
+    assert main(["mass", str(path), "--no-progress"]) == code
+    out = capsys.readouterr().out
+    assert "REFERENCE SKIPPED: budget: refining the faces 2 x 2 (test)" in out
+    assert f"{line}: BRepGProp's Gauss-Kronrod rule agrees with" in out
+
+
 def test_mass_command_skips_a_reference_over_budget(monkeypatch, tmp_path, capsys):
     import dataclasses
 
@@ -353,6 +381,7 @@ def test_mass_command_skips_a_reference_over_budget(monkeypatch, tmp_path, capsy
     assert main(["mass", str(path), "--no-progress"]) == 4
     out = capsys.readouterr().out
     assert "REFERENCE SKIPPED: budget: refining the faces 2 x 2 would take about" in out and "DISAGREEMENT" in out
+    assert "REFERENCE SKIPPED: budget: no time left for the Gauss-Kronrod reference" in out
 
 
 # -- real parts (the corpus; benchmarks/mass_reference.py runs the reference on all) --------

@@ -7,8 +7,9 @@ about the same point, within ``REFERENCE_BUDGET`` seconds) confirms surfmod's va
 line says which side it confirms); 4 when it confirms BRepGProp's, or cannot tell on a
 model whose edges close; 3 when it cannot tell and the model itself is ambiguous (its edges
 leave the volume open by more than the disagreement, or p-curves stray beyond their
-edges' tolerance: they are named).  Edges that stray are named in a note whatever the verdict, and so are the faces
-left out (open shells or loose faces beside the solids enclose no volume).
+edges' tolerance: they are named).  Edges that stray are named in a note whatever the
+verdict, and so are the faces left out (open shells or loose faces beside the solids
+enclose no volume).
 
 The same concept as :mod:`surfmod.uses.mass`, one level up: the command over it.
 """
@@ -136,9 +137,9 @@ def settle(solid, r, o, names, limit, density: float = 1.0):
             lines.append(f"REFERENCE SKIPPED: {exc}")
             continue
         side, line = _verdict(dataclasses.replace(ref, inertia=density * ref.inertia), r, o, names, limit, how, errors)
-        if side is not None:
-            return side, line
         lines.append(line)
+        if side is not None:  # the lines of the references that could not tell come first
+            return side, "\n".join(lines)
     return None, "\n".join(lines)
 
 

@@ -490,7 +490,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     opened = open_faces(wrapped(shape))
     # a face of a closed shell left out would open the mesh: refused; one of an open shell
     # (the model is open there anyway, e.g. Alias's slivers in trj3_s1-al-214) is reported
-    closing = [k for k in missing if k not in set(opened)]
+    closing = sorted(set(missing) - set(opened))
     if closing or (strict and missing):
         raise SurfmodError(
             f"shape: BRepMesh could not triangulate face{'s' if len(missing) > 1 else ''} "

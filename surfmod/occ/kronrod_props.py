@@ -98,6 +98,8 @@ def kronrod_props_within(shape, seconds: float, eps: float = 1e-10) -> KronrodPr
     >>> round(kronrod_props_within(bd.Box(1, 2, 3).wrapped, 60).volume, 12)
     6.0
     """
+    if not seconds > 0:
+        raise SurfmodError("budget: no time left for the Gauss-Kronrod reference")
     with kernel("BinTools.Write"):
         out = io.BytesIO()
         BinTools.Write_s(shape, out)
