@@ -92,6 +92,7 @@ def test_mass_names_the_edges_and_exits_3(monkeypatch, tmp_path, capsys):
     assert "AMBIGUOUS MODEL: centroid differs" in out and "1 edge(s) have p-curves straying" in out
     assert f"edge {edge} of faces" in out
     assert out.count(f"edge {edge} of faces") == 2 and "NOTE: 1 edge(s) have p-curves straying" in out
+    assert "the file's edges leave its volume open by up to" in out
 
 
 def test_mass_exit_0_says_all_four_agree(tmp_path, capsys):

@@ -83,8 +83,12 @@ def run(args) -> int:
                     key=lambda e: -max(e.stray, e.gap))
     named = ", ".join(f"edge {e.edge} of faces {'/'.join(map(str, e.faces))} ({max(e.stray, e.gap):.2e} > tol "
                       f"{e.tolerance:.1e})" for e in strays[:5]) + (" ..." if len(strays) > 5 else "")
+    amb = None
     if strays:  # whatever the verdict: the digits below the strays are the file's, not the part's
-        print(f"NOTE: {len(strays)} edge(s) have p-curves straying beyond their own tolerance: {named}")
+        amb = boundary_ambiguity(solid)
+        print(f"NOTE: {len(strays)} edge(s) have p-curves straying beyond their own tolerance: {named}; the file's "
+              f"edges leave its volume open by up to {amb:.2e} (relative): digits beyond that are the file's, not "
+              "the part's")
     if not off:
         print(f"AGREE: volume, area, centroid and inertia all agree with BRepGProp within {limit:g}")
         return 0
@@ -95,7 +99,7 @@ def run(args) -> int:
         return 0
     differ = f"{', '.join(off)} differ{'s' if len(off) == 1 else ''} from BRepGProp by up to {worst:.2e}"
     if side is None:
-        amb = boundary_ambiguity(solid)
+        amb = boundary_ambiguity(solid) if amb is None else amb
         if strays or amb >= worst:
             print(f"AMBIGUOUS MODEL: {differ} (more than {limit:g}); the model's edges leave its volume open by up to "
                   f"{amb:.2e} (relative) and {len(strays)} edge(s) have p-curves straying beyond their own tolerance"
