@@ -23,6 +23,17 @@ def xyz(p) -> np.ndarray:
     return np.array([p.X(), p.Y(), p.Z()])
 
 
+def xyz_many(points, n: int) -> np.ndarray:
+    """``n`` gp_Pnt/gp_Vec from an iterable as an ``(n, 3)`` array, in one ``fromiter``
+    over their ``Coord()`` tuples (no array per point: a third of the time of
+    ``np.array([xyz(p) ...])`` on an edge's samples).
+
+    >>> xyz_many((gp_Pnt(i, 0, 1) for i in range(2)), 2).tolist()
+    [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0]]
+    """
+    return np.fromiter(chain.from_iterable(p.Coord() for p in points), float, 3 * n).reshape(n, 3)
+
+
 def points_1d(points: np.ndarray) -> TColgp_Array1OfPnt:
     arr = TColgp_Array1OfPnt(1, len(points))
     for i, p in enumerate(points, start=1):

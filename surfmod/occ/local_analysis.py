@@ -10,20 +10,18 @@ from __future__ import annotations
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.BRepClass import BRepClass_FaceClassifier
+from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_G2
 from OCP.LocalAnalysis import LocalAnalysis_SurfaceContinuity
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN
+from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 from .guard import kernel
-from .topo import wrapped
-from OCP.BRepClass import BRepClass_FaceClassifier
-from OCP.BRepTools import BRepTools
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN
-from OCP.TopExp import TopExp, TopExp_Explorer
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-from .topo import faces_of
-
+from .topo import faces_of, shape_list, wrapped
 
 
 def _pcurve_samples(edge, face, samples: int):
@@ -92,7 +90,7 @@ def shared_edges(shape, samples: int) -> list[dict]:
         TopExp.MapShapesAndAncestors_s(s, TopAbs_EDGE, TopAbs_FACE, amap)
         for i in range(1, amap.Extent() + 1):
             ancestors = []
-            for f in amap.FindFromIndex(i):
+            for f in shape_list(amap.FindFromIndex(i)):
                 if not any(f.IsSame(g) for g in ancestors):
                     ancestors.append(f)
             edge = TopoDS.Edge_s(amap.FindKey(i))

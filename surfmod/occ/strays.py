@@ -27,7 +27,7 @@ from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
-from .arrays import pnt, xyz
+from .arrays import pnt, xyz, xyz_many
 from .guard import kernel
 from .topo import geometric_edges, pcurve_points
 
@@ -86,7 +86,7 @@ def edge_strays(shape, samples: int = 17) -> list[EdgeStray]:
                 tolerance = BRep_Tool.Tolerance_s(edge)
                 # at equal parameters (BRepCheck's view): a bound on the true distance that,
                 # within the tolerance, already clears the edge; beyond it project each point
-                same = np.array([xyz(curve.Value(float(x))) for x in t])
+                same = xyz_many((curve.Value(x) for x in t.tolist()), len(t))
                 bound = float(np.linalg.norm(pts - same, axis=1).max())
                 if bound <= tolerance:
                     stray = max(stray, bound)
@@ -116,7 +116,7 @@ def edge_deviations(shape, samples: int = 23) -> np.ndarray:
         for _, edge, edge_faces in geometric_edges(shape):
             c3 = BRepAdaptor_Curve(edge)
             t = np.linspace(c3.FirstParameter(), c3.LastParameter(), samples)
-            p3 = np.array([xyz(c3.Value(float(x))) for x in t])
+            p3 = xyz_many((c3.Value(x) for x in t.tolist()), samples)
             dev = 0.0
             for face in edge_faces:
                 _, ps = pcurve_points(edge, face, samples)

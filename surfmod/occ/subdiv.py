@@ -10,7 +10,7 @@ from OCP.TopoDS import TopoDS
 
 from ..errors import KernelError
 from .guard import check_done, kernel
-from .topo import shells_of, wrapped
+from .topo import shape_list, shells_of, wrapped
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
@@ -79,7 +79,7 @@ def edge_continuity(shape, samples: int = 17):
         amap = TopTools_IndexedDataMapOfShapeListOfShape()
         TopExp.MapShapesAndAncestors_s(s, TopAbs_EDGE, TopAbs_FACE, amap)
         for i in range(1, amap.Extent() + 1):
-            faces = list(amap.FindFromIndex(i))
+            faces = shape_list(amap.FindFromIndex(i))
             if len(faces) != 2:
                 continue
             edge = TopoDS.Edge_s(amap.FindKey(i))
