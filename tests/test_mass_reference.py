@@ -491,9 +491,15 @@ def test_refined_reference_keeps_the_reference_point_and_refuses_past_its_budget
 
 
 #: corpus solids whose integrators disagree by more than 1e-9 because the file itself
-#: leaves those digits open (p-curves straying from their edges: boundary_ambiguity 2e-4 to
-#: 4e-3), with surfmod's distance from the Gauss-Kronrod rule measured when they were
-#: named; surfmod's own digits there are settled (order 12, 16, 24 agree to 1e-16)
+#: leaves those digits open (boundary_ambiguity 2e-4 to 4e-3), with surfmod's distance from
+#: the Gauss-Kronrod rule measured when they were named; surfmod's own digits there are
+#: settled (order 12, 16, 24 agree to 1e-16).  Face by face (BRepGProp_Vinert against
+#: BRepGProp_VinertGK about the same point) the difference sits on faces whose boundary
+#: does not close: on the MAINBODY parts three B-spline faces whose p-curve loops leave
+#: 2-D gaps of 1.7e-3 to 2.1e-3 between consecutive edges; on pythonocc_11752 and
+#: occt_linkrods B-spline faces whose edges stray 2e-4 to 3e-3 off them (some trimmed past
+#: the surface's knot range), so the two faces of an edge meet nowhere and the fields each
+#: integrator takes through the gap give it other digits
 AMBIGUOUS = {
     ("occt_linkrods.step", 0): 1.9e-9,
     ("stepcode_MAINBODY_BACK.stp", 0): 1.6e-5,
