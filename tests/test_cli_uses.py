@@ -49,6 +49,13 @@ def test_section(part, tmp_path, capsys):
     assert main(["section", str(path), "--origin", "0", "0", "-2.5", "--normal", "0", "0", "1",
                  "--out", str(bad), "--no-progress"]) == 1
     assert "parallel" in capsys.readouterr().err and not bad.exists()
+    # a plane that misses the part: one error line naming the argument and the file (it
+    # printed the empty section on stdout, and damaged files met it in the fuzz run)
+    assert main(["section", str(path), "--origin", "0", "0", "50", "--normal", "0", "0", "1",
+                 "--out", str(bad), "--no-progress"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("surfmod section: error: origin: the plane through (0.0, 0.0, 50.0)") and "misses" in err
+    assert len(err.splitlines()) == 1 and path.name in err and not bad.exists()
 
 
 def test_femesh(part, tmp_path, capsys):

@@ -36,9 +36,9 @@ def run(args) -> int:
         bar.update()
         s = section(shape, args.origin, args.normal)
         bar.update()
-        if s.empty:
-            print(s)
-            return 1
+        if s.empty:  # bad input like any other: one line on stderr, exit 1, no file
+            raise SurfmodError(f"origin: the plane through {tuple(args.origin)} with normal {tuple(args.normal)} "
+                               "misses the part: the section is empty")
         (export_dxf if suffix == ".dxf" else export_svg)(s, args.out)
         if args.png:
             s.preview(args.png)
