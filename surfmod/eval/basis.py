@@ -20,6 +20,24 @@ def find_spans(knots: np.ndarray, degree: int, n_ctrl: int, t: np.ndarray) -> np
     return np.clip(spans, degree, n_ctrl - 1)
 
 
+def knots_inside(knots, lo: float, hi: float, period: float | None = None) -> np.ndarray:
+    """The distinct values of ``knots`` strictly inside ``(lo, hi)``, sorted; with a
+    ``period`` (a periodic spline) repeated every period first, so a range past the knot
+    vector's ends still meets every knot it crosses.  Where a spline is no smoother than
+    ``C^(p-1)``: the breaks of a quadrature.
+
+    >>> knots_inside([0, 0, 1, 2, 2], 0.5, 2.0).tolist()
+    [1.0]
+    >>> knots_inside([0, 1, 2], -1.5, 1.5, period=2.0).tolist()
+    [-1.0, 0.0, 1.0]
+    """
+    k = np.unique(np.asarray(knots, dtype=float))
+    if period is not None and len(k):
+        shifts = np.arange(np.floor((lo - k[-1]) / period), np.ceil((hi - k[0]) / period) + 1)
+        k = np.unique((k[None, :] + period * shifts[:, None]).ravel())
+    return k[(k > lo) & (k < hi)]
+
+
 def basis_derivatives(knots: np.ndarray, degree: int, spans: np.ndarray, t: np.ndarray, order: int) -> np.ndarray:
     """Non-zero basis functions and their derivatives.
 

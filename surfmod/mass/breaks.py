@@ -24,6 +24,7 @@ from ..construct.conics import Conic
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.offset_surface import OffsetSurface
 from ..construct.revolution import RevolutionSurface
+from ..eval.basis import knots_inside
 from ..surface import Surface
 
 # Gauss–Legendre converges on cos/sin within a quarter turn; pieces on angular directions
@@ -41,11 +42,7 @@ def _breaks(lo: float, hi: float, knots, periodic_piece: float | None, period: f
     ``period`` when the direction wraps) and pieces of at most ``periodic_piece``."""
     pts = [lo, hi]
     if knots is not None and len(knots):
-        k = np.unique(np.asarray(knots, dtype=float))
-        if period is not None:
-            shifts = np.arange(np.floor((lo - k[-1]) / period), np.ceil((hi - k[0]) / period) + 1)
-            k = (k[None, :] + period * shifts[:, None]).ravel()
-        pts.extend(k[(k > lo) & (k < hi)])
+        pts.extend(knots_inside(knots, lo, hi, period))
     if periodic_piece is not None:
         n = int(np.ceil((hi - lo) / periodic_piece - 1e-9))
         pts.extend(np.linspace(lo, hi, max(n, 1) + 1))

@@ -18,11 +18,12 @@ from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAb
 from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS, TopoDS_Iterator
+from OCP.gp import gp_Pnt2d, gp_Vec2d
 
+from ..eval.basis import knots_inside
 from .binary import bspline_curves
 from .geom import read_bspline_curve
 from .guard import kernel
-from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 
 def _xy(p) -> np.ndarray:
@@ -155,11 +156,8 @@ def _periodic_knot_breaks(b, f: float, l: float) -> np.ndarray:
     """The breaks of a periodic B-spline p-curve ``b`` over ``[f, l]``: its knots, repeated
     every period, strictly inside, between the ends (see :func:`_spline_breaks` for why
     not OCCT's intervals)."""
-    knots = np.array([b.Knot(i) for i in range(1, b.NbKnots() + 1)])
-    period = b.LastParameter() - b.FirstParameter()
-    shifts = np.arange(np.floor((f - knots[-1]) / period), np.ceil((l - knots[0]) / period) + 1)
-    every = np.unique((knots[None, :] + period * shifts[:, None]).ravel())
-    return np.concatenate([[f], every[(every > f) & (every < l)], [l]])
+    knots = [b.Knot(i) for i in range(1, b.NbKnots() + 1)]
+    return np.concatenate([[f], knots_inside(knots, f, l, b.LastParameter() - b.FirstParameter()), [l]])
 
 
 def _spline_breaks(records: list) -> None:
