@@ -491,8 +491,9 @@ def test_refined_reference_keeps_the_reference_point_and_refuses_past_its_budget
 
 
 #: corpus solids whose integrators disagree by more than 1e-9 because the file itself
-#: leaves those digits open (boundary_ambiguity 2e-4 to 4e-3), with surfmod's distance from
-#: the Gauss-Kronrod rule measured when they were named; surfmod's own digits there are
+#: leaves those digits open (boundary_ambiguity 2e-4 to 4e-3), each with surfmod's distance
+#: from the Gauss-Kronrod rule measured when it was named (a record: the test does not run
+#: the rule on them, which would add two and a half minutes); surfmod's own digits there are
 #: settled (order 12, 16, 24 agree to 1e-16).  Face by face (BRepGProp_Vinert against
 #: BRepGProp_VinertGK about the same point) the difference sits on faces whose boundary
 #: does not close: on the MAINBODY parts three B-spline faces whose p-curve loops leave
