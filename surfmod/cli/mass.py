@@ -79,7 +79,8 @@ def run(args) -> int:
         off = {k: v for k, v in diffs.items() if not v <= limit}
     # measured on the file's shape, so edges and faces carry the file's numbers, as the
     # faces left out do; edges of those faces bound no volume and do not count
-    strays = sorted((e for e in edge_strays(shape) if e.ambiguous and not set(e.faces) & set(left)),
+    outside = set(left)
+    strays = sorted((e for e in edge_strays(shape) if e.ambiguous and outside.isdisjoint(e.faces)),
                     key=lambda e: -max(e.stray, e.gap))
     named = ", ".join(f"edge {e.edge} of faces {'/'.join(map(str, e.faces))} ({max(e.stray, e.gap):.2e} > tol "
                       f"{e.tolerance:.1e})" for e in strays[:5]) + (" ..." if len(strays) > 5 else "")
@@ -123,20 +124,11 @@ def settle(solid, r, o, names, limit, density: float = 1.0):
     (:func:`surfmod.occ.kronrod_props.kronrod_props_within`, for solids whose split is not
     exact), both about the solid's vertex mean, the point surfmod takes (``density`` scales
     the references' inertia as it scales theirs)."""
-    from ..occ.kronrod_props import kronrod_props_within
-    from ..occ.refined_props import refined_props
-
     start = time.perf_counter()
     lines = []
-    for reference in ("split", "kronrod"):
-        left = REFERENCE_BUDGET - (time.perf_counter() - start)
+    for reference in (_split_reference, _kronrod_reference):
         try:
-            if reference == "split":
-                ref = refined_props(solid, budget=left)
-                how, errors = f"BRepGProp on the faces split {ref.splits} x {ref.splits}", ref.changes
-            else:
-                ref = kronrod_props_within(solid, left)
-                how, errors = "BRepGProp's Gauss-Kronrod rule", dict.fromkeys(names, ref.error)
+            ref, how, errors = reference(solid, names, REFERENCE_BUDGET - (time.perf_counter() - start))
         except SurfmodError as exc:
             lines.append(f"REFERENCE SKIPPED: {exc}")
             continue
@@ -145,6 +137,22 @@ def settle(solid, r, o, names, limit, density: float = 1.0):
         if side is not None:  # the lines of the references that could not tell come first
             return side, "\n".join(lines)
     return None, "\n".join(lines)
+
+
+def _split_reference(solid, names, seconds):
+    """``(reference, how it is named, its error per quantity)``: the faces split."""
+    from ..occ.refined_props import refined_props
+
+    ref = refined_props(solid, budget=seconds)
+    return ref, f"BRepGProp on the faces split {ref.splits} x {ref.splits}", ref.changes
+
+
+def _kronrod_reference(solid, names, seconds):
+    """The same for the Gauss-Kronrod rule: one error estimate for every quantity."""
+    from ..occ.kronrod_props import kronrod_props_within
+
+    ref = kronrod_props_within(solid, seconds)
+    return ref, "BRepGProp's Gauss-Kronrod rule", dict.fromkeys(names, ref.error)
 
 
 def _verdict(ref, r, o, names, limit, how, errors):

@@ -46,7 +46,7 @@ _LINE = np.array([_product_index(i) for i in range(3)])
 
 
 def _region_moments(faces: list, foot: np.ndarray, order: int):
-    """Per face: the six moments ``M_pq`` (rows of ``(F, 10)``, oriented so that the area
+    """Per face: the six moments ``M_pq`` (rows of ``(F, 6)``, oriented so that the area
     is positive) about its ``foot`` ``(uc, vc)``, and whether every boundary rule was exact."""
     parts, owners, exact = [], [], np.ones(len(faces), bool)
     lines, arcs = [], []  # of the faces bounded by lines and circles, all at once
