@@ -123,6 +123,7 @@ _EXPORTS = {
     "CoonsSurface": ".construct.coons",
     "gordon": ".construct.gordon",
     "GordonSurface": ".construct.gordon",
+    "to_build123d": ".io.viewer",
     "to_geomdl": ".interop.geomdl_io",
     "from_geomdl": ".interop.geomdl_io",
     "to_splipy": ".interop.splipy_io",

@@ -13,8 +13,8 @@ import pytest
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.Geom import Geom_BSplineSurface, Geom_RectangularTrimmedSurface
 from OCP.gp import gp_Pnt
-from OCP.TColgp import TColgp_Array2OfPnt
-from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+from surfmod.occ.bindings import TColgp_Array2OfPnt
+from surfmod.occ.bindings import TColStd_Array1OfInteger, TColStd_Array1OfReal
 
 import surfmod as sm
 from surfmod.cli.check import check_file

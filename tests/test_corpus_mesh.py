@@ -19,6 +19,7 @@ import surfmod as sm
 from surfmod.cli import main
 from surfmod.meshing.brep import DENSE, measure_face
 from surfmod.occ.mesh import brepmesh, shape_figures
+from surfmod.occ.bindings import OCCT_VERSION
 from surfmod.occ.sample import distances_to_face
 from surfmod.occ.topo import solids_of
 
@@ -125,11 +126,12 @@ def test_strict_refuses_and_writes_nothing(tmp_path, monkeypatch, capsys):
     out = tmp_path / "t.stl"
     assert main(["mesh", "part.step", "--tolerance", "0.01", "--out", str(out), "--no-progress"]) == 0
     text = capsys.readouterr().out
-    assert "watertight True" in text and "1 face(s) deviate more than 0.01" in text
+    n = 2 if OCCT_VERSION >= (8, 0) else 1  # OCCT 8.0's boolean leaves two such corners
+    assert "watertight True" in text and f"{n} face(s) deviate more than 0.01" in text
     assert "(SphericalSurface): measured 0.0251" in text and "model tolerance 0.056" in text
     out.unlink()
     assert main(["mesh", "part.step", "--tolerance", "0.01", "--out", str(out), "--strict", "--no-progress"]) != 0
-    assert "not met on 1 face" in capsys.readouterr().err
+    assert f"not met on {n} face" in capsys.readouterr().err
     assert not out.exists()
 
 

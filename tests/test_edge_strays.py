@@ -15,7 +15,7 @@ from OCP.gp import gp_Vec2d
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_IndexedMapOfShape
+from surfmod.occ.bindings import TopTools_IndexedMapOfShape
 
 import surfmod as sm
 from surfmod.cli import main
@@ -32,8 +32,8 @@ def _displaced(shift=SHIFT):
     faces, edges = TopTools_IndexedMapOfShape(), TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(solid, TopAbs_FACE, faces)
     TopExp.MapShapes_s(solid, TopAbs_EDGE, edges)
-    face = TopoDS.Face_s(faces.FindKey(1))
-    edge = TopoDS.Edge_s(_first_edge(face))
+    face = TopoDS.Face(faces.FindKey(1))
+    edge = TopoDS.Edge(_first_edge(face))
     c2d = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 1.0)
     moved = c2d.Translated(gp_Vec2d(shift, shift))
     BRep_Builder().UpdateEdge(edge, moved, face, BRep_Tool.Tolerance_s(edge))

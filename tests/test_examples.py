@@ -120,6 +120,7 @@ PROMISES = {
         (r"^cam_job\.ngc: \d+ lines, (\d+) tool changes", lambda n: int(n) == 2),
         (r"^GRBL programs \['cam_job_pocket_T1\.nc', 'cam_job_pocket_T2\.nc'\], (\d+) arc words", lambda n: int(n) > 0),
     ],
+    "cam_job_viewer.py": [(r"^moves shown (\d+) of (\d+)$", lambda shown, made: int(shown) == int(made) > 0)],
     "fit_scan.py": [
         (rf"^fit: .*max deviation {NUM} \(OCCT projection of every point\).* converged (\w+)",
          lambda d, converged: float(d) <= 0.005 and converged == "True"),

@@ -143,8 +143,8 @@ def _rational_semicircle():
     """The upper half of the unit circle as one rational cubic span (weights 1, 1/3, 1/3, 1)."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
     from OCP.Geom import Geom_BSplineCurve
-    from OCP.TColgp import TColgp_Array1OfPnt
-    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from surfmod.occ.bindings import TColgp_Array1OfPnt
+    from surfmod.occ.bindings import TColStd_Array1OfInteger, TColStd_Array1OfReal
     from OCP.gp import gp_Pnt
 
     poles, weights = TColgp_Array1OfPnt(1, 4), TColStd_Array1OfReal(1, 4)
@@ -189,7 +189,7 @@ def test_moments_of_an_open_boundary_turn_with_the_part():
 
     solid = BRepBuilderAPI_Copy(bd.Box(10, 20, 30).wrapped).Shape()
     face = faces_of(solid)[0]
-    edge = TopoDS.Edge_s(TopExp_Explorer(face, TopAbs_EDGE).Current())
+    edge = TopoDS.Edge(TopExp_Explorer(face, TopAbs_EDGE).Current())
     moved = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 1.0).Translated(gp_Vec2d(0.05, 0.05))
     BRep_Builder().UpdateEdge(edge, moved, face, BRep_Tool.Tolerance_s(edge))
     axis, angle = np.array([1.0, 2.0, 3.0]) / math.sqrt(14), 0.7

@@ -264,7 +264,7 @@ def test_face_records_visit_edges_as_the_explorer_does(corpus_dir, name):
         want = []
         for w, wire in enumerate(explore(face, TopAbs_WIRE)):
             for e in explore(wire, TopAbs_EDGE):
-                edge = TopoDS.Edge_s(e)
+                edge = TopoDS.Edge(e)
                 pc = BRepAdaptor_Curve2d(edge, face)
                 want.append((w, (pc.FirstParameter(), pc.LastParameter()), -1.0 if edge.Orientation() == TopAbs_REVERSED else 1.0))
         assert [(r["wire"], r["range"], r["sign"]) for r in records] == want
@@ -277,7 +277,7 @@ def _explorer_vertex_mean(shape):
 
     from surfmod.occ.topo import explore
 
-    return np.array([BRep_Tool.Pnt_s(TopoDS.Vertex_s(v)).Coord() for v in explore(shape, TopAbs_VERTEX)]).mean(axis=0)
+    return np.array([BRep_Tool.Pnt_s(TopoDS.Vertex(v)).Coord() for v in explore(shape, TopAbs_VERTEX)]).mean(axis=0)
 
 
 @pytest.mark.parametrize("name", QUICK + ("cadquery_red_cube_blue_cylinder.step", "pythonocc_Ventilator.stp"))

@@ -254,8 +254,8 @@ def _quintic_pcurve_plate():
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
     from OCP.Geom import Geom_BSplineCurve
     from OCP.GeomAbs import GeomAbs_CN
-    from OCP.TColgp import TColgp_Array1OfPnt
-    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from surfmod.occ.bindings import TColgp_Array1OfPnt
+    from surfmod.occ.bindings import TColStd_Array1OfInteger, TColStd_Array1OfReal
     from OCP.gp import gp_Pnt
 
     knots, mults = [0.0, 0.1, 0.2, 0.3, 0.35], [6, 1, 1, 1, 6]
@@ -299,8 +299,8 @@ def test_a_pcurve_below_the_surfaces_knot_range_is_integrated_as_brepgprop_does(
     from OCP.BRepLib import BRepLib
     from OCP.Geom import Geom_BSplineSurface
     from OCP.Geom2d import Geom2d_Line
-    from OCP.TColgp import TColgp_Array2OfPnt
-    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from surfmod.occ.bindings import TColgp_Array2OfPnt
+    from surfmod.occ.bindings import TColStd_Array1OfInteger, TColStd_Array1OfReal
     from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d
 
     poles = TColgp_Array2OfPnt(1, 4, 1, 2)  # x = 2u, y = 3v, z = 0.9uv; three spans in u

@@ -47,7 +47,7 @@ def _pcurves(shape):
     out = []
     for face in faces_of(shape):
         for e in explore(face, TopAbs_EDGE):
-            pc = BRepAdaptor_Curve2d(TopoDS.Edge_s(e), face)
+            pc = BRepAdaptor_Curve2d(TopoDS.Edge(e), face)
             if pc.GetType() == GeomAbs_BSplineCurve:
                 out.append(pc.BSpline())
     return out

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import CORPUS
+from test_occt_quirks import quirk_holds
 
 import surfmod as sm
 from surfmod import atomic, checks
@@ -335,6 +336,12 @@ def test_11_nan_and_huge_coordinates_are_refused_before_any_use(tmp_path):
     assert data.count(old) == 1
     pole = tmp_path / "head-inf-pole.stp"
     pole.write_bytes(data.replace(old, b"#56=CARTESIAN_POINT('Control Point',(inf,"))
+    if quirk_holds("test_reliability.py::test_11_nan_and_huge_coordinates_are_refused_before_any_use"):
+        # OCCT 8.0's reader loops on the inf pole (over 240 s where the file reads in 3 s):
+        # the reader process is stopped at the timeout and the file named
+        with pytest.raises(sm.DamagedFileError, match=r"^path: reading .*head-inf-pole\.stp did not finish within"):
+            sm.import_step(pole, timeout=3)
+        return
     with pytest.raises(sm.DamagedFileError, match=r"^path: .*head-inf-pole\.stp has NaN, infinite or out-of-range "
                                                   r"numbers in the geometry of (face|p-curve|edge) "):
         sm.import_step(pole)

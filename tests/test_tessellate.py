@@ -12,6 +12,7 @@ import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
 from surfmod.meshing import tessellate as tessellate_module
 from surfmod.meshing.deviation import _barycentric
+from surfmod.occ.bindings import OCCT_VERSION
 
 
 def _independent_max_distance(s, mesh, per_triangle=3, limit=1500, seed=0):
@@ -186,9 +187,10 @@ def test_mesh_is_refused():
 
 def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_reported_or_refused_when_strict():
     """A near-tangent boolean leaves edges with 0.056 tolerance: BRepMesh discretizes no
-    edge finer than that, so one face stays 0.025 off whatever the deflection.  The mesh
-    is written (watertight) and that face is reported with its own tolerance; ``strict``
-    refuses instead."""
+    edge finer than that, so a spherical corner stays 0.025 off whatever the deflection
+    (one on OCCT 7.9; OCCT 8.0's boolean leaves two such corners).  The mesh is written
+    (watertight) and those faces are reported with their own tolerance; ``strict`` refuses
+    instead."""
     import build123d as bd
 
     from surfmod.meshing.brep import DENSE, measure_face
@@ -199,9 +201,12 @@ def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_reported_or_refu
     solid = bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 2) - bd.Solid.make_cylinder(2, 10)
     m = sm.tessellate(solid, 0.01)
     assert m.to_trimesh().is_watertight
-    (face,) = m.info["faces_over_tolerance"]
-    assert face["surface"] == "SphericalSurface"
-    assert 0.01 < face["deviation"] <= face["model_tolerance"] and face["model_tolerance"] > 0.05
+    over = m.info["faces_over_tolerance"]
+    assert len(over) == (2 if OCCT_VERSION >= (8, 0) else 1)
+    for face in over:
+        assert face["surface"] == "SphericalSurface"
+        assert 0.01 < face["deviation"] <= face["model_tolerance"] and face["model_tolerance"] > 0.05
+    face = max(over, key=lambda f: f["deviation"])
     assert m.info["max_deviation"] == face["deviation"]
     # the reported deviation is real: OCCT's distance from the worst triangle's samples
     # to that face (BRepExtrema) agrees with the measurement
@@ -210,7 +215,8 @@ def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_reported_or_refu
     worst = fm.nodes[fm.triangles[np.argmax(per_triangle)]]
     occt = distances_to_face(faces_of(solid)[face["face"]], DENSE @ worst)
     assert occt.max() == pytest.approx(face["deviation"], rel=1e-6)
-    with pytest.raises(sm.SurfmodError, match=r"(?s)tolerance: 0.01 is not met on 1 face.*strict.*model tolerance 0.056"):
+    with pytest.raises(sm.SurfmodError, match=rf"(?s)tolerance: 0.01 is not met on {len(over)} faces?.*strict.*model "
+                                              r"tolerance 0.056"):
         sm.tessellate(solid, 0.01, strict=True)
 
 

@@ -24,6 +24,9 @@ from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
 from OCP.Extrema import Extrema_ExtFlag_MIN
 from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 
+from surfmod.occ.bindings import box_limits
+
+
 def material(shape):
     """The faces of ``shape`` as one compound: free edges and vertices of a STEP file
     (construction wires) are not material a tool can cut."""
@@ -155,7 +158,7 @@ def face_boxes(part):
         face = explorer.Current()
         box = Bnd_Box()
         BRepBndLib.Add_s(face, box, False)  # from the geometry, not a stored triangulation
-        x0, y0, z0, x1, y1, z1 = box.Get()
+        x0, y0, z0, x1, y1, z1 = box_limits(box)
         faces.append(face)
         boxes.append([[x0, y0, z0], [x1, y1, z1]])
         explorer.Next()

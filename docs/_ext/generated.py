@@ -16,6 +16,9 @@
 * ``design.md``: the marker ``<!-- surfmod-rank-table -->`` becomes the rank table of
   ``tests/test_layering.py`` (its ``RANKS`` list, and what each rank holds from the table
   in its docstring), so the page and the test cannot disagree.
+* ``guide/stacks.md``: the marker ``<!-- surfmod-quirk-table -->`` becomes the table of
+  OCCT quirks by release, read from the ``QUIRKS`` dict of ``tests/test_occt_quirks.py``
+  (which asserts each one on the release it runs on).
 * ``cli.md``: the marker ``<!-- surfmod-cli-reference -->`` becomes one section per
   subcommand of the ``surfmod`` parser: its usage line and a table of its arguments,
   taken from argparse (what ``surfmod CMD --help`` prints).
@@ -38,7 +41,9 @@ TOL_MARKER = "<!-- surfmod-tolerances -->"
 GALLERY_MARKER = "<!-- surfmod-gallery -->"
 MAP_MARKER = "<!-- surfmod-package-map -->"
 RANK_MARKER = "<!-- surfmod-rank-table -->"
+QUIRK_MARKER = "<!-- surfmod-quirk-table -->"
 LAYERING_TEST = Path(__file__).resolve().parents[2] / "tests" / "test_layering.py"
+QUIRKS_TEST = Path(__file__).resolve().parents[2] / "tests" / "test_occt_quirks.py"
 PACKAGE = Path(surfmod.__file__).resolve().parent
 GALLERY = Path(__file__).resolve().parent.parent / "gallery"
 
@@ -214,6 +219,20 @@ def rank_table_md(path: Path = LAYERING_TEST) -> str:
     return "\n".join(rows)
 
 
+def _literal(path: Path, name: str):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return next(ast.literal_eval(node.value) for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))
+                and any(isinstance(t, ast.Name) and t.id == name
+                        for t in (node.targets if isinstance(node, ast.Assign) else [node.target])))
+
+
+def quirk_table_md(path: Path = QUIRKS_TEST) -> str:
+    rows = ["| quirk | OCCT 7.9 | OCCT 8.0 | test |", "|---|---|---|---|"]
+    for test, (what, *holds) in _literal(path, "QUIRKS").items():
+        rows.append(f"| {_cell(what)} | " + " | ".join("holds" if h else "fixed" for h in holds) + f" | `{test}` |")
+    return "\n".join(rows)
+
+
 def _source_read(app, docname, source):
     text = source[0]
     if API_MARKER in text:
@@ -226,6 +245,8 @@ def _source_read(app, docname, source):
         text = text.replace(GALLERY_MARKER, gallery_md())
     if TOL_MARKER in text:
         text = text.replace(TOL_MARKER, tolerances_md())
+    if QUIRK_MARKER in text:
+        text = text.replace(QUIRK_MARKER, quirk_table_md())
     if CLI_MARKER in text:
         text = text.replace(CLI_MARKER, cli_md())
     source[0] = text

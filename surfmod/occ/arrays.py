@@ -6,8 +6,14 @@ from itertools import chain
 
 import numpy as np
 from OCP.gp import gp_Pnt, gp_Vec
-from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
-from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
+
+from .bindings import (
+    TColgp_Array1OfPnt,
+    TColgp_Array2OfPnt,
+    TColStd_Array1OfInteger,
+    TColStd_Array1OfReal,
+    TColStd_Array2OfReal,
+)
 
 
 def pnt(p) -> gp_Pnt:

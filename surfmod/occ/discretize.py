@@ -19,7 +19,7 @@ from .guard import kernel
 def wire_edges(wire):
     """The edges of a wire in connection order."""
     out = []
-    ex = BRepTools_WireExplorer(TopoDS.Wire_s(getattr(wire, "wrapped", wire)))
+    ex = BRepTools_WireExplorer(TopoDS.Wire(getattr(wire, "wrapped", wire)))
     while ex.More():
         out.append(ex.Current())
         ex.Next()

@@ -8,17 +8,16 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace,
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
-from OCP.GCE2d import GCE2d_MakeSegment
 from OCP.Geom import Geom_Plane, Geom_RectangularTrimmedSurface
 from OCP.Geom2d import Geom2d_BSplineCurve
 from OCP.gp import gp_Dir, gp_Pnt2d
 from OCP.GProp import GProp_GProps
 from OCP.ShapeFix import ShapeFix_Face
-from OCP.TColgp import TColgp_Array1OfPnt2d
 
 from . import arrays
 from .geom import downcast_surface
 from .guard import check_done, kernel
+from .bindings import MakeSegment2d, TColgp_Array1OfPnt2d
 
 
 def segmented(surf, u0: float, u1: float, v0: float, v1: float):
@@ -41,7 +40,7 @@ def _pcurves(loop):
     if loop[0] == "polyline":
         pts = np.asarray(loop[1], dtype=float)
         return [
-            GCE2d_MakeSegment(gp_Pnt2d(float(a[0]), float(a[1])), gp_Pnt2d(float(b[0]), float(b[1]))).Value()
+            MakeSegment2d(gp_Pnt2d(float(a[0]), float(a[1])), gp_Pnt2d(float(b[0]), float(b[1]))).Value()
             for a, b in zip(pts[:-1], pts[1:])
         ]
     _, p2, degree, knots, weights = loop

@@ -34,7 +34,7 @@ def nearest_edge(face, point):
     explorer = TopExp_Explorer(wrapped(face), TopAbs_EDGE)
     with kernel("BRepAdaptor_Curve"):
         while explorer.More():
-            e = TopoDS.Edge_s(explorer.Current())
+            e = TopoDS.Edge(explorer.Current())
             c = BRepAdaptor_Curve(e)
             p = c.Value(0.5 * (c.FirstParameter() + c.LastParameter()))
             d = float(np.linalg.norm(np.array([p.X(), p.Y(), p.Z()]) - point))
@@ -57,12 +57,12 @@ def make_filling(constraints, *, degree: int = 3, points_on_curve: int = 15, ite
         maker = BRepOffsetAPI_MakeFilling(degree, points_on_curve, iterations, False, 1e-5, 1e-5, 1e-4, 1e-2,
                                           max_degree, max_segments)
         for edge, face, order in constraints:
-            e = TopoDS.Edge_s(wrapped(edge))
+            e = TopoDS.Edge(wrapped(edge))
             if face is None:
                 maker.Add(e, orders[order], True)
             else:
-                maker.Add(e, TopoDS.Face_s(wrapped(face)), orders[order], True)
+                maker.Add(e, TopoDS.Face(wrapped(face)), orders[order], True)
         maker.Build()
         check_done(maker, "BRepOffsetAPI_MakeFilling")
-        return bd.Face(TopoDS.Face_s(maker.Shape()))
+        return bd.Face(TopoDS.Face(maker.Shape()))
 

@@ -99,7 +99,7 @@ def first_non_finite(shape, limit: float) -> str | None:
     fi = 0
     while faces.More():
         fi += 1
-        face = TopoDS.Face_s(faces.Current())
+        face = TopoDS.Face(faces.Current())
         faces.Next()
         surf = BRep_Tool.Surface_s(face)
         if surf is not None and not _surface_ok(surf, BRepTools.UVBounds_s(face), limit):
@@ -108,7 +108,7 @@ def first_non_finite(shape, limit: float) -> str | None:
         ei = 0
         while edges.More():
             ei += 1
-            edge = TopoDS.Edge_s(edges.Current())
+            edge = TopoDS.Edge(edges.Current())
             edges.Next()
             pcurve, t0, t1 = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0), *BRep_Tool.Range_s(edge)
             if pcurve is not None and not _curve_ok(pcurve, t0, t1, math.inf, G2):
@@ -117,7 +117,7 @@ def first_non_finite(shape, limit: float) -> str | None:
     ei = 0
     while edges.More():
         ei += 1
-        edge = TopoDS.Edge_s(edges.Current())
+        edge = TopoDS.Edge(edges.Current())
         edges.Next()
         if BRep_Tool.Degenerated_s(edge):
             continue

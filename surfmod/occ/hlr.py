@@ -44,7 +44,7 @@ def hlr_outline(face, direction, samples_per_edge: int = 60):
                     continue
                 explorer = TopExp_Explorer(shape, TopAbs_EDGE)
                 while explorer.More():
-                    curve = BRepAdaptor_Curve(TopoDS.Edge_s(explorer.Current()))
+                    curve = BRepAdaptor_Curve(TopoDS.Edge(explorer.Current()))
                     ts = np.linspace(curve.FirstParameter(), curve.LastParameter(), samples_per_edge)
                     polylines.append(np.array([arrays.xyz(curve.Value(float(t)))[:2] for t in ts]))
                     explorer.Next()

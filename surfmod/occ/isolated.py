@@ -75,6 +75,7 @@ def _read_and_check(path: str, max_coordinate: float) -> bytes:
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
+    from .bindings import box_limits
     from .step import read_step
 
     shape = read_step(path)
@@ -83,7 +84,7 @@ def _read_and_check(path: str, max_coordinate: float) -> bytes:
         BRepBndLib.Add_s(shape, box, False)  # from the geometry, not a triangulation
         if box.IsVoid():
             raise SurfmodError(f"path: {path} contains no geometry")
-        corners = box.Get()
+        corners = box_limits(box)
     if not all(math.isfinite(c) for c in corners):
         raise SurfmodError(f"path: {path} has NaN or infinite coordinates")
     size = max(abs(c) for c in corners)

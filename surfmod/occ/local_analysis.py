@@ -17,11 +17,11 @@ from OCP.LocalAnalysis import LocalAnalysis_SurfaceContinuity
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 from .guard import kernel
 from .topo import faces_of, shape_list, wrapped
+from .bindings import TopTools_IndexedDataMapOfShapeListOfShape
 
 
 def _pcurve_samples(edge, face, samples: int):
@@ -93,12 +93,12 @@ def shared_edges(shape, samples: int) -> list[dict]:
             for f in shape_list(amap.FindFromIndex(i)):
                 if not any(f.IsSame(g) for g in ancestors):
                     ancestors.append(f)
-            edge = TopoDS.Edge_s(amap.FindKey(i))
+            edge = TopoDS.Edge(amap.FindKey(i))
             if len(ancestors) != 2 or BRep_Tool.Degenerated_s(edge):
                 continue  # free edges, seams (one face twice), non-manifold edges
             rec = {"edge": i - 1, "faces": [], "face_shapes": [], "uv": [], "tangent": [], "inward": []}
             for f in ancestors:
-                face = TopoDS.Face_s(f)
+                face = TopoDS.Face(f)
                 rec["faces"].append(next((k for k, g in enumerate(all_faces) if g.IsSame(face)), -1))
                 rec["face_shapes"].append(face)
                 uv, tangent = _pcurve_samples(edge, face, samples)
@@ -118,12 +118,12 @@ def shared_edges(shape, samples: int) -> list[dict]:
 def face_edges_uv(face, samples: int) -> list:
     """Every non-degenerate edge of one face as ``(uv (samples, 2), tangent (samples, 2))``
     through its p-curve on that face."""
-    f = TopoDS.Face_s(wrapped(face))
+    f = TopoDS.Face(wrapped(face))
     out = []
     with kernel("face edges (BRepAdaptor_Curve2d)"):
         explorer = TopExp_Explorer(f, TopAbs_EDGE)
         while explorer.More():
-            edge = TopoDS.Edge_s(explorer.Current())
+            edge = TopoDS.Edge(explorer.Current())
             explorer.Next()
             if BRep_Tool.Degenerated_s(edge):
                 continue

@@ -28,8 +28,6 @@ from OCP.BinTools import BinTools_ShapeSet
 from OCP.Bnd import Bnd_Box
 from OCP.GeomLProp import GeomLProp_SLProps
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
-from OCP.TColStd import TColStd_Array1OfReal
-from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
@@ -37,6 +35,7 @@ from OCP.gp import gp_Pnt, gp_Vec
 from .arrays import pnts_to_numpy_1d, to_numpy_1d
 from .geom import read_bezier_surface, read_bspline_curve, read_bspline_surface, surface_type
 from .topo import faces_of, wrapped
+from .bindings import box_limits, TColgp_Array1OfPnt, TColStd_Array1OfReal
 
 
 @dataclass
@@ -470,7 +469,7 @@ def shape_figures(shape, samples: int = 5, sample_face=None, uv_bounds: dict | N
         BRepBndLib.Add_s(shp, box)
         if box.IsVoid():
             raise SurfmodError("shape: is empty")
-        x0, y0, z0, x1, y1, z1 = box.Get()
+        x0, y0, z0, x1, y1, z1 = box_limits(box)
         diag = float(np.linalg.norm([x1 - x0, y1 - y0, z1 - z0]))
         floor = 1.0 / max(diag, 1e-300)
         figures = []

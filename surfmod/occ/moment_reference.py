@@ -81,7 +81,6 @@ from OCP.GeomAbs import (GeomAbs_C2, GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Lin
                          GeomAbs_Sphere, GeomAbs_Torus)
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_SHAPE, TopAbs_VERTEX
-from OCP.TopTools import TopTools_ListOfShape
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from OCP.gp import gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
@@ -90,6 +89,7 @@ from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import kernel
 from .topo import compound, explore, faces_of, geometric_edges, solids_of
+from .bindings import TopTools_ListOfShape
 
 # Gauss–Kronrod 10/21 on [-1, 1] (QUADPACK's qk21): Kronrod nodes from the end inwards,
 # the Gauss nodes every second one (odd indices), the centre last
@@ -166,7 +166,7 @@ class MomentReference:
 
 def _vertex_points(shape):
     """The vertices' points ``(n, 3)`` and tolerances ``(n,)``."""
-    vs = [TopoDS.Vertex_s(v) for v in explore(shape, TopAbs_VERTEX)]
+    vs = [TopoDS.Vertex(v) for v in explore(shape, TopAbs_VERTEX)]
     pts = np.array([xyz(BRep_Tool.Pnt_s(v)) for v in vs], dtype=float).reshape(-1, 3)
     return pts, np.array([BRep_Tool.Tolerance_s(v) for v in vs], dtype=float)
 

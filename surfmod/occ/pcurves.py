@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAbs_Line
-from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS, TopoDS_Iterator
 from OCP.gp import gp_Pnt2d, gp_Vec2d
@@ -24,6 +23,7 @@ from ..eval.basis import knots_inside
 from .binary import bspline_curves
 from .geom import read_bspline_curve
 from .guard import kernel
+from .bindings import TColStd_Array1OfReal
 
 
 def _xy(p) -> np.ndarray:
@@ -97,7 +97,7 @@ def _face_records(face, splines: list, lines: list) -> list[dict]:
     are appended to ``splines`` as ``(record, curve)``, straight ones to ``lines`` as
     ``(record, (origin, direction, range))``, for the caller to read in bulk."""
     out = []
-    to_edge = TopoDS.Edge_s
+    to_edge = TopoDS.Edge
     # the face's wires and their edges as TopExp_Explorer visits them (children in order,
     # orientations composed), by TopoDS_Iterator: no explorer stack per wire
     wires = TopoDS_Iterator(face)

@@ -15,11 +15,11 @@ from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from .arrays import xyz
 from .guard import kernel
 from .topo import wrapped
+from .bindings import box_limits, TopTools_IndexedDataMapOfShapeListOfShape
 
 
 def gprops(shape, eps: float = 1e-9) -> dict:
@@ -92,7 +92,7 @@ def vertex_mean(shape) -> np.ndarray:
         n = ancestors.Extent()
         if not n:
             return bounding_box(shape).mean(axis=0)
-        pnt, vertex, key, edges = BRep_Tool.Pnt_s, TopoDS.Vertex_s, ancestors.FindKey, ancestors.FindFromIndex
+        pnt, vertex, key, edges = BRep_Tool.Pnt_s, TopoDS.Vertex, ancestors.FindKey, ancestors.FindFromIndex
         # one flat fromiter over Coord() tuples (no array per vertex)
         pts = np.fromiter(chain.from_iterable(pnt(vertex(key(i))).Coord() for i in range(1, n + 1)), float, 3 * n)
         visits = np.fromiter((edges(i).Size() for i in range(1, n + 1)), int, n)
@@ -112,4 +112,4 @@ def bounding_box(shape, *, optimal: bool = True) -> np.ndarray:
             BRepBndLib.AddOptimal_s(shape, box, False, False)
         else:
             BRepBndLib.Add_s(shape, box, True)
-        return np.array(box.Get()).reshape(2, 3)
+        return np.array(box_limits(box)).reshape(2, 3)

@@ -18,8 +18,8 @@ from .guard import kernel
 from .topo import explore, solids_of, wrapped
 from OCP.BOPAlgo import BOPAlgo_MakerVolume
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
-from OCP.TopTools import TopTools_ListOfShape
 from .properties import gprops
+from .bindings import TopTools_ListOfShape
 
 #: The regions' BRepGProp volumes must add up to the solid's within this relative error
 #: (both at eps 1e-9): anything else means a region was misclassified or lost.

@@ -12,13 +12,13 @@ from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
 from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_HSequenceOfShape
 
 from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import kernel
 from .topo import explore as _explore
 from .topo import faces_of
+from .bindings import TopTools_HSequenceOfShape
 
 
 def section_edges(shape, origin, normal):
@@ -42,7 +42,7 @@ def section_edges(shape, origin, normal):
             seq.Append(e)
         wires = TopTools_HSequenceOfShape()
         ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(seq, 1e-6, False, wires)
-        return [bd.Wire(TopoDS.Wire_s(wires.Value(i))) for i in range(1, wires.Length() + 1)]
+        return [bd.Wire(TopoDS.Wire(wires.Value(i))) for i in range(1, wires.Length() + 1)]
 
 
 def planar_faces_on(shape, origin, normal, tol: float) -> list[int]:

@@ -25,11 +25,11 @@ from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
 from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp
-from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from .arrays import pnt, xyz, xyz_many
 from .guard import kernel
 from .topo import geometric_edges, pcurve_points
+from .bindings import TopTools_IndexedMapOfShape
 
 
 class EdgeStray(NamedTuple):

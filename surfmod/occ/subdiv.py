@@ -5,18 +5,18 @@ from __future__ import annotations
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.BRepLib import BRepLib
+from OCP.gp import gp_Pnt, gp_Vec
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
+from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 
 from ..errors import KernelError
+from .bindings import TopTools_IndexedDataMapOfShapeListOfShape
 from .guard import check_done, kernel
 from .topo import shape_list, shells_of, wrapped
-from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
-from OCP.TopExp import TopExp
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-from OCP.gp import gp_Pnt, gp_Vec
 
 
 def sew(faces, tolerance: float):
@@ -55,7 +55,7 @@ def solid(faces, tolerance: float):
     if info["free_edges"]:
         raise KernelError(f"BRepBuilderAPI_Sewing: {info['free_edges']} free edges left, the shell is not closed")
     with kernel("BRepBuilderAPI_MakeSolid"):
-        maker = BRepBuilderAPI_MakeSolid(TopoDS.Shell_s(sh.wrapped))
+        maker = BRepBuilderAPI_MakeSolid(TopoDS.Shell(sh.wrapped))
         check_done(maker, "BRepBuilderAPI_MakeSolid")
         s = maker.Solid()
         BRepLib.OrientClosedSolid_s(s)
@@ -82,13 +82,13 @@ def edge_continuity(shape, samples: int = 17):
             faces = shape_list(amap.FindFromIndex(i))
             if len(faces) != 2:
                 continue
-            edge = TopoDS.Edge_s(amap.FindKey(i))
+            edge = TopoDS.Edge(amap.FindKey(i))
             if BRep_Tool.Degenerated_s(edge):
                 continue
             count += 1
             pts, nrm = [], []
             for f in faces:
-                face = TopoDS.Face_s(f)
+                face = TopoDS.Face(f)
                 pcurve = BRepAdaptor_Curve2d(edge, face)
                 t0, t1 = pcurve.FirstParameter(), pcurve.LastParameter()
                 surf = BRepAdaptor_Surface(face, False)

@@ -7,19 +7,18 @@ The same concept as :mod:`surfmod.construct.sweep`, of which this is the OCCT tw
 from __future__ import annotations
 
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+from OCP.BRepFill import BRepFill_TypeOfContact
 from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell, BRepOffsetAPI_ThruSections
-from OCP.TopExp import TopExp
+from OCP.gp import gp_Pnt2d
+from OCP.Law import Law_Interpol
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 from ..errors import KernelError
+from .bindings import TColgp_Array1OfPnt2d
 from .guard import check_done, kernel
 from .topo import faces_of
-from OCP.BRepFill import BRepFill_TypeOfContact
-from OCP.Law import Law_Interpol
-from OCP.TColgp import TColgp_Array1OfPnt2d
-from OCP.TopAbs import TopAbs_EDGE
-from OCP.TopExp import TopExp_Explorer
-from OCP.gp import gp_Pnt2d
 
 
 def _wire(curve, t0, t1):
@@ -45,7 +44,7 @@ def pipe_shell(profiles, path, *, mode: str = "frenet", auxiliary=None, contact:
     """
     with kernel("BRepOffsetAPI_MakePipeShell"):
         spine = _wire(*path)
-        first, last = TopoDS.Vertex_s(TopExp.FirstVertex_s(_edge_of(spine))), TopoDS.Vertex_s(
+        first, last = TopoDS.Vertex(TopExp.FirstVertex_s(_edge_of(spine))), TopoDS.Vertex(
             TopExp.LastVertex_s(_edge_of(spine))
         )
         maker = BRepOffsetAPI_MakePipeShell(spine)
@@ -105,4 +104,4 @@ def _interpolated_law(params, values):
 
 def _edge_of(wire):
     explorer = TopExp_Explorer(wire, TopAbs_EDGE)
-    return TopoDS.Edge_s(explorer.Current())
+    return TopoDS.Edge(explorer.Current())

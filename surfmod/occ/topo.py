@@ -16,20 +16,19 @@ from OCP.BRepBuilderAPI import (
 )
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
-from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.Geom import Geom_TrimmedCurve
 from OCP.GeomConvert import GeomConvert, GeomConvert_CompCurveToBSplineCurve
 from OCP.gp import gp_GTrsf, gp_Mat, gp_Pnt, gp_Pnt2d, gp_XYZ
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_OUT, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_ListOfShape
 
 from .. import transforms
 from ..errors import SurfmodError
 from .analytic import trsf
 from .arrays import xyz, xyz_many
 from .guard import check_done, kernel
+from .bindings import IntTools_FClass2d, TopTools_IndexedDataMapOfShapeListOfShape, TopTools_ListOfShape
 
 FACE_TOLERANCE = 1e-7
 
@@ -70,7 +69,7 @@ def _single(obj, kind: str):
 
 def single_face(face):
     """The ``TopoDS_Face`` of a build123d or OCP face; anything else raises ``SurfmodError``."""
-    return TopoDS.Face_s(_single(face, "Face"))
+    return TopoDS.Face(_single(face, "Face"))
 
 
 def face_surface(face):
@@ -78,7 +77,7 @@ def face_surface(face):
     surface with the face's location applied)."""
     shape = _single(face, "Face")
     with kernel("BRep_Tool.Surface_s"):
-        f = TopoDS.Face_s(shape)
+        f = TopoDS.Face(shape)
         surf = BRep_Tool.Surface_s(f)
         u0, u1, v0, v1 = BRepTools.UVBounds_s(f)
         return surf, (u0, u1, v0, v1), f.Orientation() == TopAbs_REVERSED
@@ -88,7 +87,7 @@ def curve_of_edge(edge):
     """``(Geom_Curve, t0, t1)`` of a build123d or OCP edge."""
     shape = _single(edge, "Edge")
     with kernel("BRep_Tool.Curve_s"):
-        e = TopoDS.Edge_s(shape)
+        e = TopoDS.Edge(shape)
         curve = BRep_Tool.Curve_s(e, 0.0, 0.0)  # located copy; OCP returns only the curve
         if curve is None:
             raise SurfmodError("edge: has no 3-D curve")
@@ -111,15 +110,15 @@ def faces_of(shape):
     shp = wrapped(shape)
     if shp is None:
         raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
-    return [TopoDS.Face_s(f) for f in explore(shp, TopAbs_FACE)]
+    return [TopoDS.Face(f) for f in explore(shp, TopAbs_FACE)]
 
 
 def solids_of(shape):
-    return [TopoDS.Solid_s(s) for s in explore(shape, TopAbs_SOLID)]
+    return [TopoDS.Solid(s) for s in explore(shape, TopAbs_SOLID)]
 
 
 def shells_of(shape):
-    return [TopoDS.Shell_s(s) for s in explore(shape, TopAbs_SHELL)]
+    return [TopoDS.Shell(s) for s in explore(shape, TopAbs_SHELL)]
 
 
 def transformed_face(face, matrix):
@@ -133,16 +132,16 @@ def transformed_face(face, matrix):
         else:
             g = gp_GTrsf(gp_Mat(*map(float, m[:3, :3].ravel())), gp_XYZ(*map(float, m[:3, 3])))
             out = BRepBuilderAPI_GTransform(shape, g, True).Shape()
-        return TopoDS.Face_s(out)
+        return TopoDS.Face(out)
 
 
 def classify_uv(face, u, v, tolerance=None):
     """Boolean array: ``(u[i], v[i])`` inside the face or on its boundary
-    (``BRepTopAdaptor_FClass2d`` at ``tolerance``, default the face's own tolerance)."""
+    (``IntTools_FClass2d`` at ``tolerance``, default the face's own tolerance)."""
     f = single_face(face)
-    with kernel("BRepTopAdaptor_FClass2d"):
+    with kernel("IntTools_FClass2d"):
         tol = BRep_Tool.Tolerance_s(f) if tolerance is None else float(tolerance)
-        classifier = BRepTopAdaptor_FClass2d(f, tol)
+        classifier = IntTools_FClass2d(f, tol)
         return np.array([classifier.Perform(gp_Pnt2d(float(a), float(b)), False) != TopAbs_OUT for a, b in zip(u, v)],
                         dtype=bool)
 
@@ -180,7 +179,7 @@ def face_wires_uv(face, samples: int):
     out = []
     with kernel("BRepAdaptor_Curve2d (face wires)"):
         outer = BRepTools.OuterWire_s(f)
-        wires = [TopoDS.Wire_s(w) for w in explore(f, TopAbs_WIRE)]
+        wires = [TopoDS.Wire(w) for w in explore(f, TopAbs_WIRE)]
         wires.sort(key=lambda w: not w.IsSame(outer))
         for w in wires:
             pts = []
@@ -206,10 +205,10 @@ def shape_bspline(shape):
     if s is None or s.IsNull() or s.ShapeType() not in (TopAbs_EDGE, TopAbs_WIRE):
         raise SurfmodError(f"expected a build123d Edge or Wire, got {type(shape).__name__}")
     if s.ShapeType() == TopAbs_EDGE:
-        edges = [TopoDS.Edge_s(s)]
+        edges = [TopoDS.Edge(s)]
     else:
         edges = []
-        explorer = BRepTools_WireExplorer(TopoDS.Wire_s(s))
+        explorer = BRepTools_WireExplorer(TopoDS.Wire(s))
         while explorer.More():
             edges.append(explorer.Current())
             explorer.Next()
@@ -245,7 +244,7 @@ def shape_list(shapes) -> list:
     made a map of every edge's faces half of ``surfmod check``'s time on a 417-face part.
 
     >>> import build123d as bd
-    >>> from OCP.TopTools import TopTools_ListOfShape
+    >>> from surfmod.occ.bindings import TopTools_ListOfShape
     >>> faces, lst = bd.Box(1, 1, 1).faces()[:3], TopTools_ListOfShape()
     >>> for f in faces:
     ...     _ = lst.Append(f.wrapped)
@@ -271,10 +270,10 @@ def geometric_edges(shape):
     emap = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, emap)
     for k in range(1, emap.Extent() + 1):
-        edge = TopoDS.Edge_s(emap.FindKey(k))
+        edge = TopoDS.Edge(emap.FindKey(k))
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             continue
-        yield k - 1, edge, [TopoDS.Face_s(f) for f in shape_list(emap.FindFromIndex(k))]
+        yield k - 1, edge, [TopoDS.Face(f) for f in shape_list(emap.FindFromIndex(k))]
 
 
 def compound(shapes):
