@@ -139,17 +139,57 @@ class LocalNet(NamedTuple):
     bucket_u: tuple  # span search buckets (kernels.span_buckets)
     bucket_v: tuple
     cache: dict  # tables built on first need (the per-span patches of eval/patches.py)
+    origin: np.ndarray | None = None  # the point the evaluated net is taken about (see prepare)
 
 
-def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray) -> LocalNet:
+#: a net whose centre lies farther from the origin than this many times its radius is
+#: evaluated about its centre (see :func:`prepare`)
+FAR_NET = 1.0
+
+
+def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray, points=None, weights=None) -> LocalNet:
     """Tables for the kernels from full knot vectors, degrees and the homogeneous net
-    ``(n, m, 3)`` (polynomial) or ``(n, m, 4)`` (rational)."""
+    ``(n, m, 3)`` (polynomial) or ``(n, m, 4)`` (rational).
+
+    Given the Cartesian ``points`` (and ``weights``) of a net far from the origin (its
+    centre more than :data:`FAR_NET` radii away), the evaluators take the net less its
+    centre and add the centre back to the positions.  A derivative is a sum of poles
+    weighted by basis derivatives that cancel (they sum to zero), so it carries a
+    rounding error of ``eps`` times the poles' magnitude: a 100 mm face 1e6 mm from the
+    origin lost four digits of its partials (OCCT loses them too).  About the centre the
+    magnitude is the net's radius.  ``ctrl`` stays the net itself (the projection and
+    Newton kernels compare it with points in space); the centred copy is in ``cache``.
+    """
     ku, kv = writable(knots_u), writable(knots_v)
     ctrl = homogeneous4(hctrl)
     n, m = ctrl.shape[:2]
-    return LocalNet(ku, int(p), kv, int(q), ctrl, hctrl.shape[-1] == 4,
-                    reciprocal_table(ku, p, n), reciprocal_table(kv, q, m),
-                    span_buckets(ku, p, n), span_buckets(kv, q, m), {})
+    net = LocalNet(ku, int(p), kv, int(q), ctrl, hctrl.shape[-1] == 4,
+                   reciprocal_table(ku, p, n), reciprocal_table(kv, q, m),
+                   span_buckets(ku, p, n), span_buckets(kv, q, m), {})
+    if points is not None:
+        pts = np.asarray(points, dtype=float)
+        lo, hi = pts.reshape(-1, 3).min(axis=0), pts.reshape(-1, 3).max(axis=0)
+        with np.errstate(over="ignore", invalid="ignore"):  # nets near the float range stay as they are
+            centre = 0.5 * lo + 0.5 * hi
+            far = np.abs(centre).max() > FAR_NET * 0.5 * (hi - lo).max()
+        if far:
+            moved = pts - centre  # from the Cartesian poles: w * P - w * c would keep P's rounding
+            if weights is not None:
+                w = np.asarray(weights, dtype=float)[..., None]
+                moved = np.concatenate([moved * w, w], axis=-1)
+            net.cache["centred"] = net._replace(ctrl=homogeneous4(moved), cache={}, origin=centre)
+    return net
+
+
+def _centred(net: LocalNet) -> LocalNet:
+    """The net the evaluators take: about its centre when :func:`prepare` moved it."""
+    return net.cache.get("centred", net)
+
+
+def _add_origin(net: LocalNet, positions: np.ndarray) -> None:
+    """Positions of a centred net back in place (nothing for a net left where it was)."""
+    if net.origin is not None:
+        positions += net.origin
 
 
 def partials_finite(net: LocalNet, order: int) -> bool:
@@ -249,22 +289,25 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
     Many points on a small low-degree net go through per-span polynomial patches
     (:mod:`surfmod.eval.patches`), the others through the basis-function kernel."""
     u, v = _as_float(u), _as_float(v)
+    net = _centred(net)
     if u.size < COMPILED_SCATTERED:
         h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, 0)[:, 0, 0]
         if out is None:
-            return h
-        out[...] = h
-        return out
-    if out is None:
-        out = np.empty((u.size, 3))
-    table = _patch_table(net, u.size)
-    if table is not None:
-        _run_patches("patch_positions", net, table, u, v, out)
-        return out
-    run, count = _kernels_for(u.size)
-    with _on(count):
-        run.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
-                                net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
+            out = h
+        else:
+            out[...] = h
+    else:
+        if out is None:
+            out = np.empty((u.size, 3))
+        table = _patch_table(net, u.size)
+        if table is not None:
+            _run_patches("patch_positions", net, table, u, v, out)
+        else:
+            run, count = _kernels_for(u.size)
+            with _on(count):
+                run.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
+                                        net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
+    _add_origin(net, out)
     return out
 
 
@@ -276,11 +319,14 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     per-span patches (:mod:`surfmod.eval.patches`, as positions do), the others through
     the basis-function kernel."""
     u, v = _as_float(u), _as_float(v)
+    net = _centred(net)
     if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
         h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, order)
         if out is None:
-            return h
-        out[...] = h
+            out = h
+        else:
+            out[...] = h
+        _add_origin(net, out[:, 0, 0])
         return out
     k = _kernels()
     if out is None:
@@ -288,12 +334,13 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     table = _patch_table(net, u.size) if order in (1, 2) else None
     if table is not None:
         _run_patches("patch_derivatives", net, table, u, v, out)
-        return out
-    run, count = _kernels_for(u.size)
-    with _on(count):
-        run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),
-                                  net.rational, k.binomials(order), net.inv_u, net.inv_v, net.bucket_u,
-                                  net.bucket_v, out)
+    else:
+        run, count = _kernels_for(u.size)
+        with _on(count):
+            run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),
+                                      net.rational, k.binomials(order), net.inv_u, net.inv_v, net.bucket_u,
+                                      net.bucket_v, out)
+    _add_origin(net, out[:, 0, 0])
     return out
 
 
@@ -384,27 +431,29 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     rows), the u-points in ascending order (unsorted ones are sorted, and their rows
     put back in place).
     """
+    net = _centred(net)
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
     us, vs = _as_float(us), _as_float(vs)
+    kk = order + 1
+    shape = (us.size, vs.size, kk, kk, 3)
     if us.size * vs.size * (order + 1) ** 2 < COMPILED_GRID:
         h = vectorized.grid(knots_u, p, knots_v, q, ctrl, rational, us, vs, order)
         if out is None:
-            return h
-        out[...] = h[:, :, 0, 0] if order == 0 else h
-        return out[:, :, None, None, :] if order == 0 else out
-    kk = order + 1
-    shape = (us.size, vs.size, kk, kk, 3)
-    if out is None:
-        out = np.empty((us.size, vs.size, 3) if order == 0 else shape)
-    if bool(np.all(us[1:] >= us[:-1])):
-        _grid_sorted(net, us, vs, order, out.reshape(shape))
-    else:  # sorted for the ring, the rows put back in place
-        rank = np.argsort(us, kind="stable")
-        in_order = np.empty(shape)
-        _grid_sorted(net, us[rank], vs, order, in_order)
-        out.reshape(shape)[rank] = in_order
-    if order == 0:
-        return out[:, :, None, None, :]
+            out = h
+        else:
+            out[...] = h[:, :, 0, 0] if order == 0 else h
+    else:
+        if out is None:
+            out = np.empty((us.size, vs.size, 3) if order == 0 else shape)
+        if bool(np.all(us[1:] >= us[:-1])):
+            _grid_sorted(net, us, vs, order, out.reshape(shape))
+        else:  # sorted for the ring, the rows put back in place
+            rank = np.argsort(us, kind="stable")
+            in_order = np.empty(shape)
+            _grid_sorted(net, us[rank], vs, order, in_order)
+            out.reshape(shape)[rank] = in_order
+    out = out.reshape(shape)
+    _add_origin(net, out[:, :, 0, 0])
     return out
 
 

@@ -225,7 +225,8 @@ class BSplineSurface(Surface):
         cached = self.__dict__.get("_local")
         if cached is None:
             (p, q), (ku, kv) = self.degree, self.knots
-            cached = self._local = local.prepare(ku, p, kv, q, self._homogeneous)
+            cached = self._local = local.prepare(ku, p, kv, q, self._homogeneous, self.control_points,
+                                                    self.weights)
         return cached
 
     def _finite_partials(self, order: int) -> bool:
