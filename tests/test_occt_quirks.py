@@ -106,3 +106,26 @@ def test_brepextrema_answers_from_a_stored_coarse_triangulation():
     # the quirk; where it is gone, OCCT stopped using the mesh here
     assert (occt() > 3e-3) == quirk_holds("test_occt_quirks.py::test_brepextrema_answers_from_a_stored_coarse_triangulation")
     assert closest_on_face(face, np.array([p]))[0][0] < 1e-12
+
+
+def test_high_degree_bezier_derivatives_lose_digits_inside():
+    """Inside a degree 12 x 25 Bézier patch too, OCCT's ``D2`` loses digits: its first and
+    second partials are ~1e-7 relative off the 40-digit value (its curvatures ~1e-6),
+    where surfmod's are within 1e-13 (tests/test_eval_precision.py holds surfmod to
+    max(OCCT's error, 1e-12) on such a patch, so this bar follows OCCT)."""
+    from surfmod.nets import mp_reference
+    from surfmod.occ.sample import surface_d2
+
+    rng = np.random.default_rng(12)
+    x, y = np.meshgrid(np.linspace(0, 100, 13), np.linspace(0, 60, 26), indexing="ij")
+    net = np.stack([x, y, 8 * np.sin(x / 20) * np.cos(y / 18) + rng.normal(0, 0.8, x.shape)], -1)
+    s = sm.BezierSurface(net)
+    u, v = rng.uniform(0.1, 0.9, 4), rng.uniform(0.1, 0.9, 4)
+    ref = np.array([[[[float(c) for c in d[k, l]] for l in range(3 - k)] + [[np.nan] * 3] * k for k in range(3)]
+                    for d in (mp_reference.partials(net, None, s.degree, s.knots, a, b) for a, b in zip(u, v))])
+    occ, ours = surface_d2(s.geom(), u, v), s.derivatives(u, v, 2)
+    for k, l in ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2)):
+        scale = np.abs(ref[:, k, l]).max()
+        assert np.abs(ours[:, k, l] - ref[:, k, l]).max() < 1e-13 * scale
+    occ_err = max(np.abs(occ[:, k, l] - ref[:, k, l]).max() / np.abs(ref[:, k, l]).max() for k, l in ((0, 1), (0, 2)))
+    assert occ_err > 1e-10  # the quirk; if this fails OCCT got better (the degree-25 direction is v)
