@@ -46,6 +46,23 @@ def _both(fn, monkeypatch):
 
 
 @needs_two
+def test_parallel_grid_of_a_far_net_equals_serial_bit_for_bit(monkeypatch):
+    """A net far from the origin is evaluated about its centre, which the grid kernel adds
+    back to the positions (local.prepare): the same on one thread and on two, and the
+    same surface as the net at home moved."""
+    s = _surface(30, 20, 3, 3, True, seed=4)
+    far = sm.BSplineSurface(s.control_points + 1e4, s.degree, s.knots, s.weights)
+    assert far._local_net().cache["centred"].origin is not None
+    us, vs = np.linspace(0, 1, 101), np.linspace(0, 1, 700)
+    serial, threaded = _both(lambda: (far.grid(us, vs), far.grid_derivatives(us[::3], vs[::3], 2)), monkeypatch)
+    np.testing.assert_array_equal(threaded[0], serial[0])
+    np.testing.assert_array_equal(threaded[1], serial[1])
+    np.testing.assert_allclose(serial[0], s.grid(us, vs) + 1e4, rtol=0, atol=1e-11)
+    home = s.grid_derivatives(us[::3], vs[::3], 2)
+    np.testing.assert_allclose(serial[1][..., 1:, :, :], home[..., 1:, :, :], rtol=0, atol=1e-12 * np.abs(home).max())
+
+
+@needs_two
 @pytest.mark.parametrize("p, q", [(3, 3), (2, 1), (5, 4)])
 @pytest.mark.parametrize("rational", [False, True])
 def test_parallel_grid_equals_serial_bit_for_bit(p, q, rational, monkeypatch):

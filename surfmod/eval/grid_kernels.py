@@ -41,27 +41,30 @@ PLANE_POINTS = 64
 
 
 @njit(cache=True, error_model="numpy")
-def grid(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, space, ring_rows, chunk, first,
+def grid(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk, first,
          run_starts, run_kinds):
     """The grid ``us x vs`` into ``out`` (point-major ``(n_u, N_v, K, K, 3)``,
     ``K = bu.shape[1]``; positions are ``K = 1``): :func:`grid_block` on all u-points."""
-    grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, space, ring_rows, chunk, first,
-               run_starts, run_kinds, 0, bu.shape[0])
+    grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk,
+               first, run_starts, run_kinds, 0, bu.shape[0])
 
 
 @njit(cache=True, error_model="numpy")
-def grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, space, ring_rows, chunk, first,
-               run_starts, run_kinds, a0, a1):
+def grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk,
+               first, run_starts, run_kinds, a0, a1):
     """u-points ``a0:a1`` of the grid, in ascending order: ``first[a]`` is u-point ``a``'s
     lowest net row (its span minus ``p``), ``bu (n_u, K, p+1)`` its basis and derivatives;
     ``bv (n_v, K, q+1)`` and ``sv`` the v-basis and spans, ``bplan``/``planes``/``run_*``
     the vector loops of the row stage (:mod:`surfmod.eval.row_stage`; an empty ``planes``
     when there are no runs of consecutive spans).  ``space`` holds the ring: ``ring_rows``
-    rows of ``(K, dim, chunk)``."""
+    rows of ``(K, dim, chunk)``.  ``origin`` (3 values) is added to the positions: the
+    net is taken about it (:func:`surfmod.eval.local.prepare`); it is added to each
+    u-point's chunk just after it is written, while that is still in cache."""
     kk, nv = bu.shape[1], sv.size
     ring = space[: ring_rows * kk * dim * chunk].reshape((ring_rows, kk, dim, chunk))
     flat = ring.reshape(-1)
     fast = kk == 1 and p <= 3
+    moved = origin[0] != 0.0 or origin[1] != 0.0 or origin[2] != 0.0
     width = min(chunk, PLANE_POINTS)
     acc = np.ones((kk, kk, 4, width))  # ones: the weights of lanes a short last piece leaves
     gather = np.empty(3 * kk * kk, dtype=np.uint64)  # where each value of a point is in `acc`
@@ -88,7 +91,11 @@ def grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out,
                              (ready % ring_rows) * kk * dim * chunk - c0, chunk, run_starts, run_kinds, c0, c1)
                 ready += 1
             if fast:
-                a += positions_pass(bu, first, p, ring, rational, c0, out, a, a1, ring_rows, c1 - c0)
+                done = positions_pass(bu, first, p, ring, rational, c0, out, a, a1, ring_rows, c1 - c0)
+                if moved:
+                    for b in range(a, a + done):
+                        _add_origin(out[b], c0, c1, origin)
+                a += done
                 continue
             for s0 in range(0, c1 - c0, width):  # planes of `width` points: they stay in L1
                 n = min(width, c1 - c0 - s0)
@@ -96,7 +103,20 @@ def grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out,
                 if rational:
                     quotient_planes(acc, binom)
                 _store(acc, out[a], c0 + s0, n, gather)
+            if moved:
+                _add_origin(out[a], c0, c1, origin)
             a += 1
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _add_origin(points, c0, c1, origin):
+    """``origin`` added to the positions of ``points[c0:c1]`` (``(N_v, K, K, 3)``)."""
+    flat, size = points.reshape(-1), points[0].size
+    for b in range(c0, c1):
+        t = b * size
+        flat[t] += origin[0]
+        flat[t + 1] += origin[1]
+        flat[t + 2] += origin[2]
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -438,23 +438,21 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     shape = (us.size, vs.size, kk, kk, 3)
     if us.size * vs.size * (order + 1) ** 2 < COMPILED_GRID:
         h = vectorized.grid(knots_u, p, knots_v, q, ctrl, rational, us, vs, order)
+        _add_origin(net, h[:, :, 0, 0])
         if out is None:
-            out = h
-        else:
-            out[...] = h[:, :, 0, 0] if order == 0 else h
-    else:
-        if out is None:
-            out = np.empty((us.size, vs.size, 3) if order == 0 else shape)
-        if bool(np.all(us[1:] >= us[:-1])):
-            _grid_sorted(net, us, vs, order, out.reshape(shape))
-        else:  # sorted for the ring, the rows put back in place
-            rank = np.argsort(us, kind="stable")
-            in_order = np.empty(shape)
-            _grid_sorted(net, us[rank], vs, order, in_order)
-            out.reshape(shape)[rank] = in_order
-    out = out.reshape(shape)
-    _add_origin(net, out[:, :, 0, 0])
-    return out
+            return h
+        out[...] = h[:, :, 0, 0] if order == 0 else h
+        return out.reshape(shape)
+    if out is None:
+        out = np.empty((us.size, vs.size, 3) if order == 0 else shape)
+    if bool(np.all(us[1:] >= us[:-1])):  # the compiled grid adds the origin itself, while in cache
+        _grid_sorted(net, us, vs, order, out.reshape(shape))
+    else:  # sorted for the ring, the rows put back in place
+        rank = np.argsort(us, kind="stable")
+        in_order = np.empty(shape)
+        _grid_sorted(net, us[rank], vs, order, in_order)
+        out.reshape(shape)[rank] = in_order
+    return out.reshape(shape)
 
 
 def _grid_sorted(net: LocalNet, us, vs, order: int, out) -> None:
@@ -473,7 +471,8 @@ def _grid_sorted(net: LocalNet, us, vs, order: int, out) -> None:
     chunk = min(vs.size, CHUNK, max(16, RING_DOUBLES // (ring_rows * kk * dim)))
     run, count = _kernels_for(us.size * vs.size, grid=True)
     scratch = _scratch(count, ring_rows * kk * dim * chunk)
-    head = (bv, plan[0], sv, q, ctrl, plan[1], dim, bu, p, rational, k.binomials(order), out)
+    origin = np.zeros(3) if net.origin is None else net.origin  # added in the kernel, while in cache
+    head = (bv, plan[0], sv, q, ctrl, plan[1], dim, bu, p, rational, k.binomials(order), out, origin)
     tail = (ring_rows, chunk, first, plan[2], plan[3])
     if count == 1:
         run.grid(*head, scratch[0], *tail)

@@ -19,13 +19,13 @@ from .patches import derivatives_chunk, positions_chunk
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def grid(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, scratch, ring_rows, chunk, first,
+def grid(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, scratch, ring_rows, chunk, first,
          run_starts, run_kinds, starts):
     """:func:`surfmod.eval.grid_kernels.grid`, a block of u-points ``starts[k]:starts[k+1]``
     per task; each thread keeps its blocks' ring in its own row of ``scratch`` (rows at a
     boundary between blocks are contracted by both)."""
     for blk in prange(starts.size - 1):
-        grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, scratch[get_thread_id()],
+        grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, scratch[get_thread_id()],
                    ring_rows, chunk, first, run_starts, run_kinds, starts[blk], starts[blk + 1])
 
 
