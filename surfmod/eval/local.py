@@ -166,19 +166,37 @@ def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray, points=None, we
     net = LocalNet(ku, int(p), kv, int(q), ctrl, hctrl.shape[-1] == 4,
                    reciprocal_table(ku, p, n), reciprocal_table(kv, q, m),
                    span_buckets(ku, p, n), span_buckets(kv, q, m), {})
-    if points is not None:
-        pts = np.asarray(points, dtype=float)
-        lo, hi = pts.reshape(-1, 3).min(axis=0), pts.reshape(-1, 3).max(axis=0)
-        with np.errstate(over="ignore", invalid="ignore"):  # nets near the float range stay as they are
-            centre = 0.5 * lo + 0.5 * hi
-            far = np.abs(centre).max() > FAR_NET * 0.5 * (hi - lo).max()
-        if far:
-            moved = pts - centre  # from the Cartesian poles: w * P - w * c would keep P's rounding
-            if weights is not None:
-                w = np.asarray(weights, dtype=float)[..., None]
-                moved = np.concatenate([moved * w, w], axis=-1)
-            net.cache["centred"] = net._replace(ctrl=homogeneous4(moved), cache={}, origin=centre)
+    centre = None if points is None else far_centre(points)
+    if centre is not None:
+        net.cache["centred"] = net._replace(ctrl=homogeneous4(moved_homogeneous(points, weights, centre)), cache={},
+                                            origin=centre)
     return net
+
+
+def far_centre(points) -> np.ndarray | None:
+    """The centre of the bounding box of ``points`` (``(..., 3)``) when it lies farther
+    from the origin than :data:`FAR_NET` times the box's half size (a net whose
+    derivatives lose digits to its distance, see :func:`prepare`), else None.
+
+    >>> far_centre([(1e6, 0, 0), (1e6 + 2, 2, 0)]).tolist(), far_centre([(-1, 0, 0), (2, 1, 0)])
+    ([1000001.0, 1.0, 0.0], None)
+    """
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    with np.errstate(over="ignore", invalid="ignore"):  # nets near the float range stay as they are
+        centre = 0.5 * lo + 0.5 * hi
+        far = np.abs(centre).max() > FAR_NET * 0.5 * (hi - lo).max()
+    return centre if far else None
+
+
+def moved_homogeneous(points, weights, centre) -> np.ndarray:
+    """The homogeneous net of ``points - centre`` (with ``weights``, if any), made from the
+    Cartesian poles: ``w P - w c`` would keep the rounding of ``w P``."""
+    moved = np.asarray(points, dtype=float) - centre
+    if weights is None:
+        return moved
+    w = np.asarray(weights, dtype=float)[..., None]
+    return np.concatenate([moved * w, w], axis=-1)
 
 
 def _centred(net: LocalNet) -> LocalNet:

@@ -69,6 +69,10 @@ class BSplineCurve(Curve):
         self.knots = checks.frozen(k)
         self.weights = None if w is None else checks.frozen(w)
         self._homogeneous = homogeneous(self.control_points, self.weights)
+        # a curve far from the origin is evaluated about its centre (eval.local.prepare)
+        centre = local.far_centre(self.control_points)
+        self._centred = (None if centre is None else
+                         (centre, local.moved_homogeneous(self.control_points, self.weights, centre)))
 
     @classmethod
     def _trusted(cls, pts, p, k, w=None):
@@ -91,8 +95,12 @@ class BSplineCurve(Curve):
         return np.unique(self.knots[self.degree : len(self.control_points) + 1])
 
     def _derivatives(self, t, order):
-        h = curve_derivatives(self.knots, self.degree, self._homogeneous, t, order)
-        return curve_quotient(h) if self.rational else h
+        centre, net = self._centred or (None, self._homogeneous)
+        h = curve_derivatives(self.knots, self.degree, net, t, order)
+        out = curve_quotient(h) if self.rational else h
+        if centre is not None:
+            out[:, 0] += centre
+        return out
 
     def geom(self):
         from ..occ.geom import bspline_curve
