@@ -4,8 +4,10 @@ on a stress family built here, and against OCCT's own error on it (issue 35).
 Every path is held to the same bar: the NumPy twin (``eval/vectorized.py``), the compiled
 scattered kernel, the per-span patches, the compiled and the NumPy grids.  Positions,
 partials to order 2, normals and curvatures stay within ``max(OCCT's error, 1e-12)``
-relative of the reference (each order relative to its largest reference magnitude over
-the case, curvatures to the larger principal curvature at the point).  Nothing is cached:
+relative of the reference, the bar of issue 35 (each order relative to its largest
+reference magnitude over the case, curvatures to the larger principal curvature at the
+point); surfmod in fact keeps 1e-12 on every case, also where OCCT does not (the
+high-degree Béziers, the far NURBS curve), and that is what is asserted.  Nothing is cached:
 the reference costs a few milliseconds a point, so a case takes a dozen points.
 """
 
@@ -74,6 +76,9 @@ def _surfaces():
         "NURBS, weights 1 to 1e4": sm.BSplineSurface(
             _wavy(rng, 7, 6), (3, 2), (_clamped([0.25, 0.5, 0.75], 3, 0, 1), _clamped([0.3, 0.6, 0.61], 2, 0, 1)),
             weights=w),
+        "NURBS, weights 1 to 1e3 (per-span patches)": sm.BSplineSurface(
+            _wavy(rng, 7, 6), (3, 2), (_clamped([0.25, 0.5, 0.75], 3, 0, 1), _clamped([0.3, 0.6, 0.61], 2, 0, 1)),
+            weights=np.exp(rng.uniform(0, np.log(1e3), (7, 6)))),
         "1e6 from the origin": sm.BSplineSurface(
             _wavy(rng, 8, 8, origin=(1e6, -1e6, 5e5)), (3, 3),
             (_clamped([0.2, 0.4, 0.6, 0.8], 3, 0, 1), _clamped([0.2, 0.4, 0.6, 0.8], 3, 0, 1))),
@@ -157,24 +162,23 @@ def test_surface_within_occt_and_reference(name):
     v = _parameters(s.domain[1], s.knots[1], rng)
     ref = _reference(s.control_points, s.weights, s.degree, s.knots, u, v)
     geom = s.geom()
-    bar = np.maximum(_errors(surface_values_d2(geom, u, v), ref), REL)
+    occ = _errors(surface_values_d2(geom, u, v), ref)
     paths, positions = _paths(s, u, v)
     for path, ders in paths.items():
         errs = _errors(ders, ref)
-        assert np.all(errs <= bar), f"{path}: errors {errs} above max(OCCT's, 1e-12) {bar}"
+        assert np.all(np.array(errs) <= REL), f"{path}: errors {errs} per order (OCCT's {occ})"
     pos_scale = np.abs(ref[:, 0, 0]).max()
-    assert np.abs(positions - ref[None, :, 0, 0]).max() <= max(bar[0], 4e-16) * pos_scale
+    assert np.abs(positions - ref[None, :, 0, 0]).max() <= 1e-14 * pos_scale  # a few ulps
     if name == "collapsed pole row":
         return  # normals and curvatures are judged where they are defined: the cases below
     normals, k_occ = surface_props(geom, u, v)
     k_ref = np.array([mp_reference.curvatures(s.control_points, s.weights, s.degree, s.knots, a, b)
                       for a, b in zip(u, v)])
     n_ref = unit_normals(ref)
-    k_bar = max(_curvature_error(k_occ, k_ref), REL)
-    n_bar = max(np.abs(normals - n_ref).max(), REL)
+    k_occ, n_occ = _curvature_error(k_occ, k_ref), np.abs(normals - n_ref).max()
     for path, ders in paths.items():
-        assert np.abs(unit_normals(ders) - n_ref).max() <= n_bar, path
-        assert _curvature_error(np.stack(curvatures(ders), axis=1), k_ref) <= k_bar, path
+        assert np.abs(unit_normals(ders) - n_ref).max() <= REL, (path, n_occ)
+        assert _curvature_error(np.stack(curvatures(ders), axis=1), k_ref) <= REL, (path, k_occ)
 
 
 def test_principal_curvatures_keep_their_digits_near_an_umbilic():
@@ -225,4 +229,4 @@ def test_curve_within_occt_and_reference(name):
     for k in range(3):
         scale = np.abs(ref[:, k]).max()
         err = np.abs(c.derivatives(t, 2)[:, k] - ref[:, k]).max() / scale
-        assert err <= max(np.abs(occ[:, k] - ref[:, k]).max() / scale, REL), (k, err)
+        assert err <= REL, (k, err, np.abs(occ[:, k] - ref[:, k]).max() / scale)

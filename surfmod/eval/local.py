@@ -294,7 +294,7 @@ def _patch_table(net: LocalNet, count: int):
         return None
     from . import patches
 
-    if not patches.suits(net.p, net.q, n, m):
+    if not patches.suits(net.p, net.q, n, m, net.ctrl[..., 3] if net.rational else None):
         return None
     table = net.cache["patches"] = patches.build(net)
     return table

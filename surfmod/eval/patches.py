@@ -45,6 +45,11 @@ from .kernels import SCATTER_CHUNK, basis_ders_point, find_span_bucketed, quotie
 MAX_TABLE_BYTES = 8 << 20
 #: highest degree in either direction (see the module docstring on rounding)
 MAX_DEGREE = 3
+#: largest ratio of a rational net's weights: where the weight varies by orders of
+#: magnitude across a span, the power-basis sums cancel (Horner from the midpoint of a span
+#: whose weights run from 1 to 8e3: partials 1e-12 relative off, the basis kernel 2e-15;
+#: OCCT's cache loses 2e-11), so such nets take the basis-function kernel
+MAX_WEIGHT_RATIO = 1e3
 #: points located per pass of the patch kernel (see :func:`positions_chunk`)
 LOCATE_BLOCK = 128
 # unsigned offset steps (an unsigned plus a signed integer would be typed float64)
@@ -61,10 +66,13 @@ class PatchTable(NamedTuple):
     scale_v: np.ndarray
 
 
-def suits(p: int, q: int, n: int, m: int) -> bool:
-    """Whether a table for degrees ``(p, q)`` and an ``n x m`` net is worth building."""
+def suits(p: int, q: int, n: int, m: int, weights=None) -> bool:
+    """Whether a table for degrees ``(p, q)`` and an ``n x m`` net (with ``weights``, if
+    rational) is worth building and keeps the kernels' precision."""
     size = (n - p) * (m - q) * (p + 1) * (q + 1) * 4 * 8
-    return max(p, q) <= MAX_DEGREE and size <= MAX_TABLE_BYTES
+    if max(p, q) > MAX_DEGREE or size > MAX_TABLE_BYTES:
+        return False
+    return weights is None or bool(weights.max() <= MAX_WEIGHT_RATIO * weights.min())
 
 
 @njit(cache=True, error_model="numpy")
