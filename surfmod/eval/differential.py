@@ -80,9 +80,10 @@ def curvatures(ders: np.ndarray) -> Curvatures:
         gauss = (l_ * n_ - m_ * m_) / det
         mean = (e * n_ - 2.0 * f * m_ + g * l_) / (2.0 * det)
         # the shape operator in the frame (e1, e2): a = L / E, b, c the normal curvature along e2
-        e_ = np.where(e > 0.0, e, np.finfo(float).tiny)
-        a = l_ / e_
-        b = (m_ * e - l_ * f) / (e_ * np.sqrt(det))
-        c = (l_ * f * f - 2.0 * m_ * f * e + n_ * e * e) / (e_ * det)
+        # (written with F / E: no fourth powers of the partials, which overflow at 1e70)
+        slant = f / np.where(e > 0.0, e, np.finfo(float).tiny)
+        a = l_ / np.where(e > 0.0, e, np.finfo(float).tiny)
+        b = (m_ - l_ * slant) / np.sqrt(det)
+        c = (l_ * f * slant - 2.0 * m_ * f + n_ * e) / det
         disc = np.hypot(0.5 * (a - c), b)
         return Curvatures(gauss, mean, mean + disc, mean - disc)
