@@ -46,20 +46,32 @@ def _both(fn, monkeypatch):
 
 
 @needs_two
-def test_parallel_grid_of_a_far_net_equals_serial_bit_for_bit(monkeypatch):
-    """A net far from the origin is evaluated about its centre, which the grid kernel adds
-    back to the positions (local.prepare): the same on one thread and on two, and the
+def test_parallel_far_net_equals_serial_bit_for_bit(monkeypatch):
+    """A net far from the origin is evaluated about its centre, which the kernels add back
+    to the positions as they store them (local.prepare): grids, scattered points through
+    the patches and through the basis kernel, the same on one thread and on two, and the
     same surface as the net at home moved."""
     s = _surface(30, 20, 3, 3, True, seed=4)
     far = sm.BSplineSurface(s.control_points + 1e4, s.degree, s.knots, s.weights)
     assert far._local_net().cache["centred"].origin is not None
     us, vs = np.linspace(0, 1, 101), np.linspace(0, 1, 700)
-    serial, threaded = _both(lambda: (far.grid(us, vs), far.grid_derivatives(us[::3], vs[::3], 2)), monkeypatch)
-    np.testing.assert_array_equal(threaded[0], serial[0])
-    np.testing.assert_array_equal(threaded[1], serial[1])
-    np.testing.assert_allclose(serial[0], s.grid(us, vs) + 1e4, rtol=0, atol=1e-11)
-    home = s.grid_derivatives(us[::3], vs[::3], 2)
-    np.testing.assert_allclose(serial[1][..., 1:, :, :], home[..., 1:, :, :], rtol=0, atol=1e-12 * np.abs(home).max())
+    u, v = np.random.default_rng(5).uniform(0, 1, (2, 5000))  # scattered: patches (order <= 2) and basis kernel
+
+    def run(surface):
+        return (surface.grid(us, vs), surface.grid_derivatives(us[::3], vs[::3], 2), surface.points(u, v),
+                surface.derivatives(u, v, 2), surface.derivatives(u, v, 3))
+
+    serial, threaded = _both(lambda: run(far), monkeypatch)
+    assert "patches" in far._local_net().cache["centred"].cache
+    home = run(s)
+    for k, (got, one, at_home) in enumerate(zip(threaded, serial, home)):
+        np.testing.assert_array_equal(got, one)
+        if k in (0, 2):  # positions
+            np.testing.assert_allclose(one, at_home + 1e4, rtol=0, atol=1e-11)
+            continue
+        np.testing.assert_allclose(one[..., 0, 0, :], at_home[..., 0, 0, :] + 1e4, rtol=0, atol=1e-11)
+        np.testing.assert_allclose(one[..., 1:, :, :], at_home[..., 1:, :, :], rtol=0,
+                                   atol=1e-11 * np.abs(at_home).max())  # two roundings of a derivative
 
 
 @needs_two

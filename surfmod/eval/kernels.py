@@ -152,21 +152,24 @@ POINT_BLOCK = 128
 SCATTER_CHUNK = 4096
 
 @njit(cache=True, error_model="numpy")
-def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
+def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out,
+                          origin=None):
     """Mixed partials at scattered pairs into ``out (N, K, K, 3)`` (Cartesian).
 
     ``ctrl`` is ``(n, m, 4)``: homogeneous for a rational net, the weight column unused
     otherwise.  Points go in blocks: per point the spans, the basis derivatives and a
     gather of the local ``(p+1) x (q+1)`` net into planes; then the contraction and the
-    quotient rule run over the block with the points on the contiguous (vector) axis."""
+    quotient rule run over the block with the points on the contiguous (vector) axis.
+    ``origin`` (3 values, or None) is added to the positions as they are stored: the
+    point a far net is taken about (:func:`surfmod.eval.local.prepare`)."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v,
-                                    bucket_u, bucket_v, out, c)
+                                    bucket_u, bucket_v, out, c, origin)
 
 
 @njit(cache=True, error_model="numpy")
 def scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u,
-                                bucket_v, out, chunk):
+                                bucket_v, out, chunk, origin=None):
     """Points ``chunk * SCATTER_CHUNK`` onwards (one chunk) of :func:`scattered_derivatives`,
     with their own scratch planes: chunks are independent."""
     n, m = ctrl.shape[0], ctrl.shape[1]
@@ -224,6 +227,9 @@ def scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom
                 for l in range(kk):
                     for d in range(3):
                         out[a0 + b, k, l, d] = h[k, l, d, b]
+            if origin is not None:
+                for d in range(3):
+                    out[a0 + b, 0, 0, d] += origin[d]
 
 
 @njit(cache=True, error_model="numpy")
@@ -258,16 +264,18 @@ def position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, 
 
 
 @njit(cache=True, error_model="numpy")
-def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out):
+def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, origin=None):
     """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
     :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
-    sums kept in registers."""
+    sums kept in registers (``origin`` added, if given)."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
-        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c)
+        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c,
+                                  origin)
 
 
 @njit(cache=True, error_model="numpy")
-def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, chunk):
+def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, chunk,
+                              origin=None):
     """One chunk of :func:`scattered_positions` (points ``chunk * SCATTER_CHUNK`` on)."""
     nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
     lu, ru = np.empty(p + 1), np.empty(p + 1)
@@ -275,6 +283,8 @@ def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, 
     for a in range(chunk * SCATTER_CHUNK, min(u.size, (chunk + 1) * SCATTER_CHUNK)):
         x, y, z = position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u[a], v[a],
                               lu, ru, nu_, lv, rv, nv_)
+        if origin is not None:
+            x, y, z = x + origin[0], y + origin[1], z + origin[2]
         out[a, 0] = x
         out[a, 1] = y
         out[a, 2] = z

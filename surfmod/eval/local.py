@@ -100,7 +100,7 @@ def _run_patches(kernel: str, net, table, u, v, out) -> None:
 
         run = parallel
     with _on(count):
-        getattr(run, kernel)(*patches.arguments(net, table, u, v, out))
+        getattr(run, kernel)(*patches.arguments(net, table, u, v, out), net.origin)
 
 
 def _on(count: int):
@@ -310,22 +310,21 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
     net = _centred(net)
     if u.size < COMPILED_SCATTERED:
         h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, 0)[:, 0, 0]
+        _add_origin(net, h)
         if out is None:
-            out = h
-        else:
-            out[...] = h
-    else:
-        if out is None:
-            out = np.empty((u.size, 3))
-        table = _patch_table(net, u.size)
-        if table is not None:
-            _run_patches("patch_positions", net, table, u, v, out)
-        else:
-            run, count = _kernels_for(u.size)
-            with _on(count):
-                run.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
-                                        net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out)
-    _add_origin(net, out)
+            return h
+        out[...] = h
+        return out
+    if out is None:
+        out = np.empty((u.size, 3))
+    table = _patch_table(net, u.size)  # the kernels add the origin as they store
+    if table is not None:
+        _run_patches("patch_positions", net, table, u, v, out)
+        return out
+    run, count = _kernels_for(u.size)
+    with _on(count):
+        run.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
+                                net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out, net.origin)
     return out
 
 
@@ -340,25 +339,23 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     net = _centred(net)
     if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
         h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, order)
+        _add_origin(net, h[:, 0, 0])
         if out is None:
-            out = h
-        else:
-            out[...] = h
-        _add_origin(net, out[:, 0, 0])
+            return h
+        out[...] = h
         return out
     k = _kernels()
     if out is None:
         out = np.empty((u.size, order + 1, order + 1, 3))
     table = _patch_table(net, u.size) if order in (1, 2) else None
-    if table is not None:
+    if table is not None:  # the kernels add the origin as they store
         _run_patches("patch_derivatives", net, table, u, v, out)
-    else:
-        run, count = _kernels_for(u.size)
-        with _on(count):
-            run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),
-                                      net.rational, k.binomials(order), net.inv_u, net.inv_v, net.bucket_u,
-                                      net.bucket_v, out)
-    _add_origin(net, out[:, 0, 0])
+        return out
+    run, count = _kernels_for(u.size)
+    with _on(count):
+        run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),
+                                  net.rational, k.binomials(order), net.inv_u, net.inv_v, net.bucket_u,
+                                  net.bucket_v, out, net.origin)
     return out
 
 

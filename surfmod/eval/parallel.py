@@ -30,33 +30,35 @@ def grid(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origi
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out):
+def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, origin=None):
     """:func:`surfmod.eval.kernels.scattered_positions`, a chunk of points per task."""
     for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
-        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c)
+        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c,
+                                  origin)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out):
+def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out,
+                          origin=None):
     """:func:`surfmod.eval.kernels.scattered_derivatives`, a chunk of points per task."""
     for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v,
-                                    bucket_u, bucket_v, out, c)
+                                    bucket_u, bucket_v, out, c, origin)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def patch_positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
-                    u, v, out):
+                    u, v, out, origin=None):
     """The per-span patch kernel of :mod:`surfmod.eval.patches`, a chunk of points per task."""
     for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
-                        u, v, out, c)
+                        u, v, out, c, origin)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def patch_derivatives(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
-                      u, v, out):
+                      u, v, out, origin=None):
     """The patch kernel for partials of :mod:`surfmod.eval.patches`, a chunk of points per task."""
     for c in prange((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational, bucket_u, bucket_v,
-                          u, v, out, c)
+                          u, v, out, c, origin)

@@ -143,17 +143,18 @@ def _cubic_in_y(c, o, y):
 # reassociated sum, so the results stay within an ulp or so of the unfused ones.
 @njit(cache=True, error_model="numpy")
 def patch_positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                    bucket_u, bucket_v, u, v, out):
+                    bucket_u, bucket_v, u, v, out, origin=None):
     """Positions at scattered pairs into ``out (N, 3)``, chunk after chunk (the serial twin
-    of :func:`surfmod.eval.parallel.patch_positions`); arguments: :func:`arguments`."""
+    of :func:`surfmod.eval.parallel.patch_positions`); arguments: :func:`arguments`, and
+    the ``origin`` added to the positions (a far net's centre), if any."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                        bucket_u, bucket_v, u, v, out, c)
+                        bucket_u, bucket_v, u, v, out, c, origin)
 
 
 @njit(cache=True, error_model="numpy")
 def positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                    bucket_u, bucket_v, u, v, out, chunk):
+                    bucket_u, bucket_v, u, v, out, chunk, origin=None):
     """Points ``chunk * SCATTER_CHUNK`` onwards (one chunk) of :func:`positions`; the
     parallel variant (:mod:`surfmod.eval.parallel`) runs the chunks on several threads.
 
@@ -176,6 +177,10 @@ def positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, 
             _bicubic_points(flat, coeffs.shape[-1], base, xs, ys, rational, out, c0, c1)
         else:
             _patch_points(flat, p, q, base, xs, ys, rational, out, c0, c1)
+        if origin is not None:  # while the block is in cache
+            for i in range(c0, c1):
+                for d in range(3):
+                    out[i, d] += origin[d]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -247,17 +252,17 @@ def _patch_points(flat, p, q, base, xs, ys, rational, out, c0, c1):
 
 @njit(cache=True, error_model="numpy")
 def patch_derivatives(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                      bucket_u, bucket_v, u, v, out):
+                      bucket_u, bucket_v, u, v, out, origin=None):
     """Partials to order 1 or 2 at scattered pairs into ``out (N, K, K, 3)``, chunk after
     chunk (the serial twin of :func:`surfmod.eval.parallel.patch_derivatives`)."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                          bucket_u, bucket_v, u, v, out, c)
+                          bucket_u, bucket_v, u, v, out, c, origin)
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
 def derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                      bucket_u, bucket_v, u, v, out, chunk):
+                      bucket_u, bucket_v, u, v, out, chunk, origin=None):
     """Partials to order 1 or 2 (``out (N, K, K, 3)``, ``K = 2, 3``) of the points of
     one chunk from their patches: per point, Horner schemes with their first two
     derivatives, in y over each x-power's row, then in x over the results; the chain
@@ -303,6 +308,9 @@ def derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v
                 for d in range(dim):
                     h[k, l, d] *= sl
         _store_partials(h, rational, out, a, kk)
+        if origin is not None:
+            for d in range(3):
+                out[a, 0, 0, d] += origin[d]
 
 
 @njit(cache=True, inline="always", error_model="numpy", fastmath={"contract"})
