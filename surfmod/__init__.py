@@ -145,6 +145,8 @@ _EXPORTS = {
     "OffsetApproximation": ".construct.offset",
     "fill": ".construct.fill",
     "Fill": ".construct.fill",
+    "conformance": ".conform",
+    "Conformance": ".conform",
 }
 
 __all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError"])

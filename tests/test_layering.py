@@ -23,7 +23,7 @@ rank  packages / modules
 14    uses, cam: mass, sections, FE meshes, interference; tool paths
 15    io: STEP, STL, IGES, DXF, SVG, G-code writers and readers
 16    interop, occt_crosscheck: other libraries' objects; the cross-check with OCCT
-17    gallery: the lecture entities built, checked and pictured
+17    gallery, conform: the lecture entities built, checked and pictured; evaluators held against OCCT
 18    cli: the command line
 19    surfmod (the package itself: the public names, resolved lazily)
 ====  =========================================================================
@@ -74,7 +74,7 @@ RANKS = [
     ["uses", "cam"],
     ["io"],
     ["interop", "occt_crosscheck"],
-    ["gallery"],
+    ["gallery", "conform"],
     ["cli"],
 ]
 RANK = {name: rank for rank, names in enumerate(RANKS) for name in names}

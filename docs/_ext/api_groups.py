@@ -20,8 +20,9 @@ GROUPS = [
      ["interpolate", "approximate", "FittedSurface", "fit", "Fit", "coons", "CoonsSurface",
       "gordon", "GordonSurface", "blend", "BlendSurface", "fill", "Fill", "offset", "thicken",
       "OffsetApproximation", "OffsetSurface"]),
-    ("Real parts and checking", "Faces of STEP files read back into NumPy, and the cross-check against OCCT.",
-     ["import_step", "from_face", "TrimmedFace", "crosscheck", "CrossCheck"]),
+    ("Real parts and checking", "Faces of STEP files read back into NumPy, the cross-check against OCCT, and "
+     "any evaluator held against OCCT and a 40-digit reference.",
+     ["import_step", "from_face", "TrimmedFace", "crosscheck", "CrossCheck", "conformance", "Conformance"]),
     ("Meshing and display", "Grid meshes, verified tessellation, iso-curves, shaded pictures.",
      ["Mesh", "mesh", "tessellate", "isocurves", "IsoCurves", "IsoCurve", "render", "export_stl"]),
     ("Subdivision", "Catmull–Clark and Loop subdivision, limit points, limit surfaces as CAD patches.",

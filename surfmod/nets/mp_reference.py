@@ -123,6 +123,35 @@ def partials(control_points, weights, degree, knots, u: float, v: float, dps: in
         return d
 
 
+def curve_partials(points, weights, degree: int, knots, t: float, dps: int = 40):
+    """``d[k]`` (``k <= 2``): position, first and second derivative of the curve at ``t``
+    as mpf 3-vectors (the quotient rule on the homogeneous derivatives when weighted)."""
+    with mp.workdps(dps):
+        pts = np.asarray(points, dtype=float)
+        w = np.ones(len(pts)) if weights is None else np.asarray(weights, dtype=float)
+        k = [mp.mpf(float(x)) for x in knots]
+        tt = mp.mpf(float(t))
+        i = _span(k, degree, len(pts), tt)
+        b = _basis_ders(k, degree, i, tt, 2)
+        hom = []
+        for order in range(3):
+            a, wt = [mp.mpf(0)] * 3, mp.mpf(0)
+            for r in range(degree + 1):
+                ww = mp.mpf(float(w[i - degree + r])) * b[order][r]
+                wt += ww
+                for c in range(3):
+                    a[c] += ww * mp.mpf(float(pts[i - degree + r, c]))
+            hom.append((a, wt))
+        d = []
+        for order in range(3):
+            val = list(hom[order][0])
+            for j in range(1, order + 1):
+                coef = mp.binomial(order, j) * hom[j][1]
+                val = [x - coef * y for x, y in zip(val, d[order - j])]
+            d.append([x / hom[0][1] for x in val])
+        return d
+
+
 def curvatures(control_points, weights, degree, knots, u: float, v: float, dps: int = 40):
     """``(gaussian, mean, k1, k2)`` at ``(u, v)`` against the normal ``Su x Sv``, as floats.
 

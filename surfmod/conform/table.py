@@ -1,0 +1,143 @@
+"""``sm.conformance``: an evaluator and OCCT against the 40-digit reference, case by case.
+
+The error of an order is the largest, over the case's samples and the partials of that
+order, of the distance to the reference divided by the reference's size there: the
+largest of those partials at the sample, and never less than a millionth of the case's
+own scale of that order (its largest partial of the order, or its largest position over
+the domain width to the order), so a vanishing partial (a plane's second derivatives)
+is measured against its surface and not against zero.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from tqdm import tqdm
+
+from ..errors import MissingExtraError, SurfmodError
+from . import adapters
+from .cases import Case, resolve
+from .reference import reference
+
+#: the stated limit: an evaluator within max(OCCT's error, LIMIT) of the reference conforms
+LIMIT = 1e-12
+
+
+class Row(NamedTuple):
+    """One case at one order: the evaluator's worst relative error, OCCT's, who is right
+    (which of the two is within :data:`LIMIT`: ``"both"``, ``"evaluator"``, ``"OCCT"`` or
+    ``"neither"``), whether the evaluator conforms, and a note."""
+
+    case: str
+    order: int
+    error: float
+    occt_error: float
+    right: str
+    ok: bool
+    note: str = ""
+
+
+class Conformance(NamedTuple):
+    """The table of :func:`conformance`: ``evaluator`` (its name), ``rows`` and ``passed``."""
+
+    evaluator: str
+    rows: list
+    passed: bool
+    limit: float = LIMIT
+
+    def markdown(self) -> str:
+        """The rows as a Markdown table, with a line saying how many conform."""
+        lines = ["| case | order | evaluator | OCCT | right | conforms |", "|---|---:|---:|---:|---|---|"]
+        for r in self.rows:
+            lines.append(f"| {r.case} | {r.order} | {r.error:.1e} | {r.occt_error:.1e} | {r.right} | "
+                         f"{'yes' if r.ok else '**no**'}{' — ' + r.note if r.note else ''} |")
+        return "\n".join(lines) + "\n\n" + self.summary() + "\n"
+
+    def summary(self) -> str:
+        bad = sorted({r.case for r in self.rows if not r.ok})
+        cases = len({r.case for r in self.rows})
+        return (f"{self.evaluator}: {cases - len(bad)} of {cases} cases within max(OCCT, {self.limit:.0e}) of the "
+                f"40-digit reference" + (f"; worse than OCCT on: {', '.join(bad)}" if bad else ""))
+
+
+def _entries(case: Case, order: int):
+    """Index tuples of the partials of exactly ``order`` in a case's partials array."""
+    if case.is_curve:
+        return [(order,)] if order <= 2 else []
+    return [(k, order - k) for k in range(order + 1)]
+
+
+def errors(case: Case, values: np.ndarray, ref: np.ndarray, order: int) -> float:
+    """The relative error of ``values`` at ``order`` (see the module notes)."""
+    idx = _entries(case, order)
+    got = np.stack([values[(slice(None), *i)] for i in idx], axis=1)   # (N, E, 3)
+    want = np.stack([ref[(slice(None), *i)] for i in idx], axis=1)
+    size = np.linalg.norm(want, axis=-1).max(axis=1)                    # (N,)
+    width = float(np.ptp(np.array(case.obj.domain, dtype=float).reshape(-1, 2), axis=1).max())
+    scale0 = np.linalg.norm(ref[(slice(None), *_entries(case, 0)[0])], axis=-1).max()
+    floor = 1e-6 * max(size.max(), scale0 / max(width, 1e-300) ** order, 1e-300)
+    return float((np.linalg.norm(got - want, axis=-1).max(axis=1) / np.maximum(size, floor)).max())
+
+
+def _judge(error: float, occt: float) -> tuple[str, bool]:
+    """Who is right (within :data:`LIMIT`: ``"both"``, ``"evaluator"``, ``"OCCT"`` or
+    ``"neither"``) and whether the evaluator conforms (within ``max(OCCT, LIMIT)``)."""
+    mine, theirs = bool(error <= LIMIT), bool(occt <= LIMIT)  # NaN: not right
+    right = {(True, True): "both", (True, False): "evaluator", (False, True): "OCCT"}.get((mine, theirs), "neither")
+    return right, bool(error <= max(occt, LIMIT))
+
+
+def conformance(evaluator, cases="stress", orders: int = 2, progress: bool = False) -> Conformance:
+    """Hold ``evaluator`` against OCCT and the 40-digit reference on ``cases``.
+
+    ``evaluator`` is an adapter name (``"surfmod"``, ``"surfmod-numpy"``, ``"occt"``,
+    ``"geomdl"``, ``"splipy"``, ``"rhino3dm"``), ``"MODULE:FUNCTION"``, or a callable:
+    with ``orders=0`` called as ``f(surface, u, v)`` returning positions ``(N, 3)``, else
+    as ``f(surface, u, v, order)`` returning partials ``(N, order + 1, order + 1, 3)``,
+    ``[..., k, l, :]`` = d^(k+l)S/du^k dv^l.  ``surface`` is the case as a surfmod
+    ``BSplineSurface``/``BezierSurface`` (``control_points``, ``degree``, ``knots``,
+    ``weights`` or None); ``u``, ``v`` are flat arrays.  ``cases`` is ``"stress"``,
+    ``"lecture"``, ``"corpus"``, a STEP path, or a list of surfmod B-spline/Bézier surfaces
+    and curves (a callable is held against the surfaces only).  ``orders`` is 0, 1 or 2.
+
+    Returns a :class:`Conformance`: one :class:`Row` per case and order with the
+    evaluator's worst relative error, OCCT's and who is right; ``passed`` is False when
+    the evaluator is worse than ``max(OCCT's error, 1e-12)`` on any row.  An adapter's
+    missing package raises :class:`~surfmod.errors.MissingExtraError`; a callable that
+    raises, returns the wrong shape or NaN raises :class:`~surfmod.errors.SurfmodError`.
+
+    >>> import numpy as np, surfmod as sm
+    >>> net = np.zeros((3, 3, 3)); net[..., 0], net[..., 1] = np.mgrid[0:3, 0:3]
+    >>> s = sm.BezierSurface(net)
+    >>> t = sm.conformance(lambda s, u, v: s.points(u, v), cases=[s], orders=0)
+    >>> t.passed, t.rows[0].right
+    (True, 'both')
+    """
+    if isinstance(orders, bool) or not isinstance(orders, (int, np.integer)) or not 0 <= orders <= 2:
+        raise SurfmodError(f"orders: expected 0, 1 or 2, got {orders!r}")
+    if isinstance(evaluator, str):
+        reason = adapters.missing(evaluator)
+        if reason:
+            raise MissingExtraError(f"evaluator: {reason}")
+        adapter = adapters.load(evaluator)
+    elif callable(evaluator):
+        adapter = adapters.wrap_callable(evaluator, getattr(evaluator, "__name__", "the callable"))
+    else:
+        raise SurfmodError(f"evaluator: expected an adapter name or a callable, got {type(evaluator).__name__}")
+    held = [c for c in resolve(cases) if adapter.curves or not c.is_curve]
+    if not held:
+        raise SurfmodError("cases: no surface among them for a callable evaluator")
+    rows = []
+    for case in tqdm(held, desc="conformance", unit="case", disable=not progress):
+        top = min(orders, adapter.curve_order if case.is_curve else adapter.max_order)
+        ref = reference(case)
+        occt = adapters.partials(adapters.ADAPTERS["occt"], case, top)
+        note = ""
+        mine = adapters.partials(adapter, case, top)
+        for order in range(top + 1):
+            err, occt_err = errors(case, mine, ref, order), errors(case, occt, ref, order)
+            right, ok = _judge(err, occt_err)
+            rows.append(Row(case.name, order, err, occt_err, right, ok, note))
+    name = evaluator if isinstance(evaluator, str) else adapter.name
+    return Conformance(name, rows, all(r.ok for r in rows))
