@@ -121,6 +121,10 @@ PROMISES = {
         (r"^GRBL programs \['cam_job_pocket_T1\.nc', 'cam_job_pocket_T2\.nc'\], (\d+) arc words", lambda n: int(n) > 0),
     ],
     "cam_job_viewer.py": [(r"^moves shown (\d+) of (\d+)$", lambda shown, made: int(shown) == int(made) > 0)],
+    "conformance_own_evaluator.py": [
+        (r"own de Boor conforms: (\w+) ; off by 1e-9 conforms: (\w+)", lambda own, off: own == "True" and off == "False"),
+        (rf"^worst case .*: own error {NUM}, OCCT {NUM}", lambda own, occt: float(own) <= max(float(occt), 1e-12)),
+    ],
     "fit_scan.py": [
         (rf"^fit: .*max deviation {NUM} \(OCCT projection of every point\).* converged (\w+)",
          lambda d, converged: float(d) <= 0.005 and converged == "True"),
