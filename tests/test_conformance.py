@@ -186,3 +186,19 @@ def test_cli_bad_input_is_one_line_and_no_file(tmp_path, capsys, argv, message):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"surfmod conformance: error: {message}")
     assert not csv.exists()
+
+
+def test_a_shipped_library_failing_on_a_case_is_a_failing_row(stress, monkeypatch):
+    def broken(obj, u, v, order):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setitem(adapters.ADAPTERS, "geomdl", adapters.Adapter("geomdl", broken))
+    table = sm.conformance("geomdl", _few(stress, "crowded 1e-05 bicubic"), orders=1)
+    assert not table.passed and all(np.isnan(r.error) and not r.ok for r in table.rows)
+    assert table.rows[0].note == "geomdl raised ZeroDivisionError: float division by zero"
+
+
+def test_reference_work_beyond_the_cap_is_refused_before_it_starts(stress):
+    fresh = stress["Bezier degree 25 x 3"].obj.transformed(np.diag([2.0, 1, 1, 1]))  # not in the cache
+    with pytest.raises(sm.SurfmodError, match=r"^cases: their 40-digit reference would sum 3\.74e\+03 basis terms.*max_terms=1e\+03"):
+        sm.conformance("occt", [fresh], max_terms=1e3)
