@@ -14,7 +14,7 @@ def register(sub) -> None:
     p = sub.add_parser("conformance", help="hold an evaluator of B-spline/NURBS surfaces and curves against OCCT "
                                            "and a 40-digit reference")
     p.add_argument("--evaluator", required=True, metavar="NAME|MODULE:FUNCTION",
-                   help="surfmod, surfmod-numpy, occt, geomdl, splipy, rhino3dm, or MODULE:FUNCTION, a function "
+                   help="surfmod, surfmod-patches, surfmod-numpy, occt, geomdl, splipy, rhino3dm, or MODULE:FUNCTION, a function "
                         "f(surface, u, v, order) returning partials (N, order+1, order+1, 3) "
                         "(f(surface, u, v) returning positions with --orders 0)")
     p.add_argument("--cases", default="stress", metavar="stress|lecture|corpus|PATH.step",

@@ -40,6 +40,8 @@ class Adapter(NamedTuple):
 
 
 def _surfmod_compiled(obj, u, v, order):
+    """surfmod's compiled basis-function kernel (what scattered points beyond a few
+    thousand use), whatever the number of points."""
     if v is None:
         return obj.derivatives(u, order)  # curves have one path, NumPy
     net = obj._local_net()
@@ -48,6 +50,24 @@ def _surfmod_compiled(obj, u, v, order):
     k.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, local.writable(u),
                             local.writable(v), int(order), net.rational, k.binomials(order), net.inv_u,
                             net.inv_v, net.bucket_u, net.bucket_v, out)
+    return out
+
+
+def _surfmod_patches(obj, u, v, order):
+    """surfmod's compiled per-span Taylor patches (:mod:`surfmod.eval.patches`: many points
+    on a small net of degree <= 3); the basis kernel where surfmod never uses them."""
+    from ..eval import patches  # numba: compiled on first use, then from its disk cache
+
+    if v is None:
+        return _surfmod_compiled(obj, u, v, order)
+    net = obj._local_net()
+    n, m = net.ctrl.shape[:2]
+    if not patches.suits(net.p, net.q, n, m):
+        return _surfmod_compiled(obj, u, v, order)  # where surfmod never uses patches
+    table = patches.build(net)
+    out = np.empty((u.size, 3) if order == 0 else (u.size, order + 1, order + 1, 3))
+    kernel = patches.patch_positions if order == 0 else patches.patch_derivatives
+    kernel(*patches.arguments(net, table, local.writable(u), local.writable(v), out))
     return out
 
 
@@ -101,6 +121,7 @@ def _rhino3dm(obj, u, v, order):
 
 ADAPTERS = {
     "surfmod": Adapter("surfmod", _surfmod_compiled),
+    "surfmod-patches": Adapter("surfmod-patches", _surfmod_patches),
     "surfmod-numpy": Adapter("surfmod-numpy", _surfmod_numpy),
     "occt": Adapter("occt", _occt),
     "geomdl": Adapter("geomdl", _geomdl),

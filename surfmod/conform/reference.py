@@ -59,9 +59,13 @@ def _cache() -> dict:
 
 
 def reference(case: Case) -> np.ndarray:
-    """:func:`compute` of ``case``, from the cache when it holds the case."""
-    cached = _cache().get(case.fingerprint())
-    return cached if cached is not None else compute(case)
+    """:func:`compute` of ``case``, from the cache when it holds the case; a case computed
+    here is kept for the rest of the process (a second evaluator held against the same
+    STEP file does not pay for it again)."""
+    key = case.fingerprint()
+    if key not in _cache():
+        _cache()[key] = compute(case)
+    return _cache()[key]
 
 
 def cached(case: Case) -> bool:

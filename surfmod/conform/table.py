@@ -98,24 +98,46 @@ def conformance(evaluator, cases="stress", orders: int = 2, progress: bool = Fal
                 max_terms: float = MAX_TERMS) -> Conformance:
     """Hold ``evaluator`` against OCCT and the 40-digit reference on ``cases``.
 
-    ``evaluator`` is an adapter name (``"surfmod"``, ``"surfmod-numpy"``, ``"occt"``,
-    ``"geomdl"``, ``"splipy"``, ``"rhino3dm"``), ``"MODULE:FUNCTION"``, or a callable:
-    with ``orders=0`` called as ``f(surface, u, v)`` returning positions ``(N, 3)``, else
-    as ``f(surface, u, v, order)`` returning partials ``(N, order + 1, order + 1, 3)``,
-    ``[..., k, l, :]`` = d^(k+l)S/du^k dv^l.  ``surface`` is the case as a surfmod
-    ``BSplineSurface``/``BezierSurface`` (``control_points``, ``degree``, ``knots``,
-    ``weights`` or None); ``u``, ``v`` are flat arrays.  ``cases`` is ``"stress"``,
-    ``"lecture"``, ``"corpus"``, a STEP path, or a list of surfmod B-spline/Bézier surfaces
-    and curves (a callable is held against the surfaces only).  ``orders`` is 0, 1 or 2.
-    The 40-digit reference of cases not in the cache is computed first; its work (samples
-    times basis terms) is estimated before and refused above ``max_terms``.
+    Parameters
+    ----------
+    evaluator : str or callable
+        An adapter name (``"surfmod"``, the compiled basis kernel; ``"surfmod-patches"``,
+        the compiled per-span Taylor patches; ``"surfmod-numpy"``; ``"occt"``;
+        ``"geomdl"``; ``"splipy"``; ``"rhino3dm"``), ``"MODULE:FUNCTION"``, or a callable: with
+        ``orders=0`` called as ``f(surface, u, v)`` returning positions ``(N, 3)``, else as
+        ``f(surface, u, v, order)`` returning partials ``(N, order + 1, order + 1, 3)``,
+        ``[..., k, l, :]`` = d^(k+l)S/du^k dv^l.  ``surface`` is the case as a surfmod
+        ``BSplineSurface``/``BezierSurface`` (``control_points``, ``degree``, ``knots``,
+        ``weights`` or None); ``u``, ``v`` are flat arrays.  A callable is held against
+        the surface cases only.
+    cases : str, path or list
+        ``"stress"``, ``"lecture"``, ``"corpus"``, a STEP path, or a list of surfmod
+        B-spline/Bézier surfaces and curves.
+    orders : int
+        The highest derivative order held: 0, 1 or 2.
+    progress : bool
+        Show a tqdm bar over the cases.
+    max_terms : float
+        Cap on the 40-digit work of the cases not in the cache (samples times basis
+        terms), estimated before it starts.
 
-    Returns a :class:`Conformance`: one :class:`Row` per case and order with the
-    evaluator's worst relative error, OCCT's and who is right; ``passed`` is False when
-    the evaluator is worse than ``max(OCCT's error, 1e-12)`` on any row.  An adapter's
-    missing package raises :class:`~surfmod.errors.MissingExtraError`; a callable that
-    raises, returns the wrong shape or NaN raises :class:`~surfmod.errors.SurfmodError`.
+    Returns
+    -------
+    Conformance
+        One :class:`Row` per case and order with the evaluator's worst relative error,
+        OCCT's and who is right; ``passed`` is False when the evaluator is worse than
+        ``max(OCCT's error, 1e-12)`` on any row.
 
+    Raises
+    ------
+    MissingExtraError
+        The named adapter's library is not installed.
+    SurfmodError
+        Bad arguments, or a callable that raises, returns another shape or NaN (the
+        message names the case).
+
+    Examples
+    --------
     >>> import numpy as np, surfmod as sm
     >>> net = np.zeros((3, 3, 3)); net[..., 0], net[..., 1] = np.mgrid[0:3, 0:3]
     >>> s = sm.BezierSurface(net)
