@@ -22,13 +22,12 @@ from surfmod.nets import mp_reference
 #: stress cases where surfmod's own evaluator is still worse than OCCT, per path: first and
 #: second derivatives of nets 1e6 from the origin (the sum of basis derivatives times far
 #: poles cancels; OCCT differences the poles first); the per-span Taylor patches also on
-#: crowded knots (up to 3e-12 in positions and second derivatives).  Issue 35's part A
-#: fixes them in surfmod/eval; these sets then empty.
+#: crowded knots (second derivatives).  Issue 35's part A fixes them in surfmod/eval;
+#: these sets then empty.
 OPEN_IN_SURFMOD = {
     "surfmod": {"1e6 from the origin, crowded", "curve, 1e6 from the origin"},
     "surfmod-patches": {"1e6 from the origin, crowded", "curve, 1e6 from the origin", "crowded 1e-04 bicubic",
-                        "crowded 1e-05 bicubic", "crowded 1e-06 bicubic", "NURBS, weights 1..1e4, crowded",
-                        "21 x 4 bicubic, crowded u, domain below 0"},
+                        "crowded 1e-05 bicubic", "crowded 1e-06 bicubic"},
 }
 
 
@@ -128,7 +127,7 @@ def test_a_sloppy_evaluator_fails_and_occt_is_named_right(stress):
     table = sm.conformance(sloppy, _few(stress, "crowded 1e-05 bicubic"))
     assert not table.passed
     assert [(r.order, r.right, r.ok) for r in table.rows] == [(0, "OCCT", False), (1, "OCCT", False), (2, "OCCT", False)]
-    assert all(r.error == pytest.approx(1e-9, rel=1e-3) for r in table.rows)
+    assert all(r.error == pytest.approx(1e-9, rel=0.05) for r in table.rows)  # positions: against the extent
     assert "**no**" in table.markdown() and "worse than OCCT on: crowded 1e-05 bicubic" in table.markdown()
 
 

@@ -1,11 +1,14 @@
 """``sm.conformance``: an evaluator and OCCT against the 40-digit reference, case by case.
 
 The error of an order is the largest, over the case's samples and the partials of that
-order, of the distance to the reference divided by the reference's size there: the
-largest of those partials at the sample, and never less than a millionth of the case's
-own scale of that order (its largest partial of the order, or its largest position over
-the domain width to the order), so a vanishing partial (a plane's second derivatives)
-is measured against its surface and not against zero.
+order, of the distance to the reference divided by a scale.  Positions are measured
+against the case's size (its largest position, or the extent of its samples if larger):
+their round-off grows with the coordinates, wherever the origin is.  A partial is measured against its own size at
+the sample (the largest partial of that order there), so a span where the derivatives are
+small is not judged against the large ones of a crowded span nearby; never against less
+than :data:`LOCAL_FLOOR` of the case's scale of that order (its largest partial of the
+order, or the extent of its samples over the domain width to the order), so a partial
+passing through zero is not judged against zero.
 """
 
 from __future__ import annotations
@@ -22,6 +25,10 @@ from .reference import cached, reference
 
 #: the stated limit: an evaluator within max(OCCT's error, LIMIT) of the reference conforms
 LIMIT = 1e-12
+#: a partial is measured against its own size at the sample, never less than this fraction
+#: of its case's scale (positions against the case's scale: their error grows with the
+#: coordinates, not with the distance from the origin)
+LOCAL_FLOOR = 1e-3
 #: the 40-digit reference costs about this much per sample and basis term ((p+1)(q+1) of a
 #: surface) on one core
 SECONDS_PER_TERM = 5e-4
@@ -81,9 +88,11 @@ def errors(case: Case, values: np.ndarray, ref: np.ndarray, order: int) -> float
     want = np.stack([ref[(slice(None), *i)] for i in idx], axis=1)
     size = np.linalg.norm(want, axis=-1).max(axis=1)                    # (N,)
     width = float(np.ptp(np.array(case.obj.domain, dtype=float).reshape(-1, 2), axis=1).max())
-    scale0 = np.linalg.norm(ref[(slice(None), *_entries(case, 0)[0])], axis=-1).max()
-    floor = 1e-6 * max(size.max(), scale0 / max(width, 1e-300) ** order, 1e-300)
-    return float((np.linalg.norm(got - want, axis=-1).max(axis=1) / np.maximum(size, floor)).max())
+    positions = ref[(slice(None), *_entries(case, 0)[0])]
+    extent = float(np.linalg.norm(np.ptp(positions, axis=0)))  # the object's size, not its distance
+    scale = max(size.max(), extent / max(width, 1e-300) ** order, 1e-300)
+    denominator = scale if order == 0 else np.maximum(size, LOCAL_FLOOR * scale)
+    return float((np.linalg.norm(got - want, axis=-1).max(axis=1) / denominator).max())
 
 
 def _judge(error: float, occt: float) -> tuple[str, bool]:
