@@ -180,7 +180,7 @@ def conformance(evaluator, cases="stress", orders: int = 2, progress: bool = Fal
         try:
             mine, note = adapters.partials(adapter, case, top), ""
         except Exception as exc:  # a shipped library failing on one case is a row, not the end
-            if adapter.name not in adapters.ADAPTERS or isinstance(exc, MissingExtraError):
+            if adapters.ADAPTERS.get(adapter.name) is not adapter or isinstance(exc, MissingExtraError):
                 raise
             mine, note = np.full_like(occt, np.nan), f"{adapter.name} raised {type(exc).__name__}: {exc}"
         for order in range(top + 1):
