@@ -19,16 +19,10 @@ from surfmod.cli import main
 from surfmod.conform import adapters, cases, reference
 from surfmod.nets import mp_reference
 
-#: stress cases where surfmod's own evaluator is still worse than OCCT, per path: first and
-#: second derivatives of nets 1e6 from the origin (the sum of basis derivatives times far
-#: poles cancels; OCCT differences the poles first); the per-span Taylor patches also on
-#: crowded knots (second derivatives).  Issue 35's part A fixes them in surfmod/eval;
-#: these sets then empty.
-OPEN_IN_SURFMOD = {
-    "surfmod": {"1e6 from the origin, crowded", "curve, 1e6 from the origin"},
-    "surfmod-patches": {"1e6 from the origin, crowded", "curve, 1e6 from the origin", "crowded 1e-04 bicubic",
-                        "crowded 1e-05 bicubic", "crowded 1e-06 bicubic"},
-}
+#: surfmod's evaluation paths: each must be within max(OCCT's error, 1e-12) of the 40-digit
+#: reference on every stress case (nets 1e6 from the origin are evaluated about their
+#: centre, crowded knots keep the patches away: surfmod/eval/local.prepare, patches.suits)
+SURFMOD_PATHS = ("surfmod", "surfmod-patches", "surfmod-numpy")
 
 
 @pytest.fixture(scope="module")
@@ -101,11 +95,10 @@ def test_every_shipped_adapter_conforms_on_ordinary_cases(stress, name):
     assert all(r.error <= 1e-12 and r.right == "both" for r in table.rows)
 
 
-@pytest.mark.parametrize("name", sorted(OPEN_IN_SURFMOD))
-def test_surfmod_conforms_on_the_stress_family_but_the_open_cases(stress, name):
+@pytest.mark.parametrize("name", SURFMOD_PATHS)
+def test_surfmod_conforms_on_the_whole_stress_family(stress, name):
     table = sm.conformance(name, list(stress.values()))
-    worse = {r.case for r in table.rows if not r.ok}
-    assert worse <= OPEN_IN_SURFMOD[name], table.markdown()
+    assert table.passed, table.markdown()
 
 
 def test_occt_loses_digits_on_a_degree_25_bezier_where_surfmod_keeps_them(stress):

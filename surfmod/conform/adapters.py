@@ -44,12 +44,24 @@ def _surfmod_compiled(obj, u, v, order):
     thousand use), whatever the number of points."""
     if v is None:
         return obj.derivatives(u, order)  # curves have one path, NumPy
-    net = obj._local_net()
+    net = _net(obj)
     k = local._kernels()  # the compiled scattered kernel, whatever the number of points
     out = np.empty((u.size, order + 1, order + 1, 3))
     k.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, local.writable(u),
                             local.writable(v), int(order), net.rational, k.binomials(order), net.inv_u,
                             net.inv_v, net.bucket_u, net.bucket_v, out)
+    return _placed(net, out)
+
+
+def _net(obj):
+    """The net surfmod's evaluators take: about its centre when it lies far from the origin
+    (:func:`surfmod.eval.local.prepare`), as every path of surfmod evaluates it."""
+    return local._centred(obj._local_net())
+
+
+def _placed(net, out):
+    """Partials of a centred net with the positions moved back in place."""
+    local._add_origin(net, out[..., 0, 0, :] if out.ndim == 4 else out)
     return out
 
 
@@ -60,22 +72,23 @@ def _surfmod_patches(obj, u, v, order):
 
     if v is None:
         return _surfmod_compiled(obj, u, v, order)
-    net = obj._local_net()
+    net = _net(obj)
     n, m = net.ctrl.shape[:2]
-    if not patches.suits(net.p, net.q, n, m):
+    if not patches.suits(net.p, net.q, n, m, net.ctrl[..., 3] if net.rational else None, (net.knots_u, net.knots_v)):
         return _surfmod_compiled(obj, u, v, order)  # where surfmod never uses patches
     table = patches.build(net)
     out = np.empty((u.size, 3) if order == 0 else (u.size, order + 1, order + 1, 3))
     kernel = patches.patch_positions if order == 0 else patches.patch_derivatives
     kernel(*patches.arguments(net, table, local.writable(u), local.writable(v), out))
-    return out
+    return _placed(net, out)
 
 
 def _surfmod_numpy(obj, u, v, order):
     if v is None:
         return obj.derivatives(u, order)
-    net = obj._local_net()
-    return vectorized.scattered(*net[:4], net.ctrl, net.rational, local.writable(u), local.writable(v), order)
+    net = _net(obj)
+    out = vectorized.scattered(*net[:4], net.ctrl, net.rational, local.writable(u), local.writable(v), order)
+    return _placed(net, out)
 
 
 def _occt(obj, u, v, order):

@@ -294,7 +294,7 @@ def _patch_table(net: LocalNet, count: int):
         return None
     from . import patches
 
-    if not patches.suits(net.p, net.q, n, m, net.ctrl[..., 3] if net.rational else None):
+    if not patches.suits(net.p, net.q, n, m, net.ctrl[..., 3] if net.rational else None, (net.knots_u, net.knots_v)):
         return None
     table = net.cache["patches"] = patches.build(net)
     return table

@@ -50,6 +50,12 @@ MAX_DEGREE = 3
 #: whose weights run from 1 to 8e3: partials 1e-12 relative off, the basis kernel 2e-15;
 #: OCCT's cache loses 2e-11), so such nets take the basis-function kernel
 MAX_WEIGHT_RATIO = 1e3
+#: largest ratio of a direction's longest knot span to its shortest: the Taylor rows of a
+#: span 1e-5 of the domain beside spans 1e3x longer carry its neighbours' poles scaled by
+#: half-width powers, and their sums kept second partials 2.8e-12 relative where the basis
+#: kernel and OCCT keep 3e-15 (sm.conformance's crowded bicubics), so such nets take the
+#: basis-function kernel
+MAX_SPAN_RATIO = 1e3
 #: points located per pass of the patch kernel (see :func:`positions_chunk`)
 LOCATE_BLOCK = 128
 # unsigned offset steps (an unsigned plus a signed integer would be typed float64)
@@ -66,12 +72,18 @@ class PatchTable(NamedTuple):
     scale_v: np.ndarray
 
 
-def suits(p: int, q: int, n: int, m: int, weights=None) -> bool:
+def suits(p: int, q: int, n: int, m: int, weights=None, knots=()) -> bool:
     """Whether a table for degrees ``(p, q)`` and an ``n x m`` net (with ``weights``, if
-    rational) is worth building and keeps the kernels' precision."""
+    rational, and its ``knots`` vectors, if given) is worth building and keeps the kernels'
+    precision."""
     size = (n - p) * (m - q) * (p + 1) * (q + 1) * 4 * 8
     if max(p, q) > MAX_DEGREE or size > MAX_TABLE_BYTES:
         return False
+    for vector in knots:
+        spans = np.diff(vector)
+        spans = spans[spans > 0]
+        if spans.size and spans.max() > MAX_SPAN_RATIO * spans.min():
+            return False
     return weights is None or bool(weights.max() <= MAX_WEIGHT_RATIO * weights.min())
 
 
