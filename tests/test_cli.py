@@ -131,3 +131,85 @@ def test_gallery_table_keeps_long_names_whole():
     assert long in lines[2] and lines[2].endswith("yes")
     assert lines[3].endswith("NO")
     assert lines[2].index("Solid") == lines[3].index("Geom_SphericalSurface") == lines[0].index("OCCT construct")
+
+
+# -- negative numbers in any notation are values, on every command -------------------------------
+NEGATIVES = ["-3.2e+04", "-1E-3", "-.5", "-5.", "-1_000.25", "-7", "-2.5E+0"]
+
+
+def _float_flags():
+    """Every float-typed flag of every subcommand, read from the parser itself."""
+    import argparse
+
+    from surfmod.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    for name, parser in sub.choices.items():
+        for action in parser._actions:
+            if action.type is float and action.option_strings:
+                yield name, action
+
+
+@pytest.mark.parametrize("text", NEGATIVES)
+def test_every_float_flag_takes_a_negative_number(text):
+    """Parse-level, every command: the flag gets ``float(text)`` (argparse's own pattern
+    knew only -12 and -1.5 and took the rest for options)."""
+    import argparse
+
+    from surfmod.cli import build_parser
+
+    flags = list(_float_flags())
+    assert {"section", "machine", "mesh", "toolpath", "femesh", "mass"} <= {n for n, _ in flags}
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    for name, action in flags:
+        parser = sub.choices[name]
+        # the flag alone: the other required flags let go, a dummy for each positional
+        for a in parser._actions:
+            a.required = False
+        for g in parser._mutually_exclusive_groups:
+            g.required = False
+        positionals = ["x"] * sum(1 for a in parser._actions if not a.option_strings and a.nargs != "?")
+        count = action.nargs if isinstance(action.nargs, int) else 1
+        values = parser.parse_args([*positionals, action.option_strings[0], *[text] * count])
+        got = getattr(values, action.dest)
+        assert (got if isinstance(got, list) else [got]) == [float(text)] * count, (name, action.dest)
+
+
+def test_section_origin_in_exponent_notation(tmp_path, capsys):
+    """A part far on the negative side, cut through ``--origin -3.2e+04 …``: the square of
+    side 2 (perimeter 8) in the DXF."""
+    import build123d as bd
+    from test_corpus_readback import dxf_length
+
+    path, out = tmp_path / "far.step", tmp_path / "far.dxf"
+    sm.export_step(bd.Pos(-32000, -0.1, 1e-3) * bd.Box(2, 2, 2), path)
+    code = main(["section", str(path), "--origin", "-3.2e+04", "-1E-1", "-.5", "--normal", "-1e0", "0", "-0.",
+                 "--out", str(out), "--no-progress"])
+    assert code == 0, capsys.readouterr().err
+    assert dxf_length(out) == pytest.approx(8.0, rel=1e-12)
+
+
+def test_machine_stock_in_exponent_notation(tmp_path, capsys):
+    """``--stock`` in exponent notation reaches the stock check (a box beside the part is
+    refused naming ``stock``), not argparse's "expected 6 arguments"."""
+    import build123d as bd
+
+    path, out = tmp_path / "part.step", tmp_path / "job.ngc"
+    sm.export_step(bd.Box(10, 10, 5), path)
+    code = main(["machine", str(path), "--out", str(out), "--stock", "-4e+01", "-4E+01", "-3e1", "-3.5e+01", "-3.5e1",
+                 "-2.5e+01", "--rough", "flat:3", "--finish", "ball:1", "--scallop", "1e-2", "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 1 and err.startswith("surfmod machine: error: stock:") and err.count("\n") == 1, err
+    assert "[-40.0, -40.0, -30.0, -35.0, -35.0, -25.0]" in err
+    assert not out.exists()
+
+
+def test_mesh_negative_tolerance_is_named(tmp_path, capsys):
+    import build123d as bd
+
+    path = tmp_path / "part.step"
+    sm.export_step(bd.Box(1, 1, 1), path)
+    assert main(["mesh", str(path), "--tolerance", "-1e-3", "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("surfmod mesh: error: tolerance") and err.count("\n") == 1, err
+    assert not (tmp_path / "part.stl").exists()

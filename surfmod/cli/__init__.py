@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import pkgutil
+import re
 import sys
 from pathlib import Path
 
@@ -13,8 +14,30 @@ from ..errors import SurfmodError
 from ..version import installed_version
 
 
+#: every spelling ``float()`` takes for a negative number: argparse's own pattern knows only
+#: ``-12`` and ``-1.5``, so ``--origin -3.2e+04 1 2`` was read as an unknown option and the
+#: flag as short of values
+NEGATIVE_NUMBER = re.compile(r"^-(?:(?:\d[\d_]*(?:\.[\d_]*)?|\.\d[\d_]*)(?:[eE][+-]?\d[\d_]*)?|inf(?:inity)?|nan)$",
+                             re.IGNORECASE)
+
+
+class Parser(argparse.ArgumentParser):
+    """An ``ArgumentParser`` that takes a negative number in any notation as a value,
+    never as an option.  Subcommand parsers are of the same class (argparse makes them
+    with ``type(parent)``), so the whole command line gets it at once.
+
+    >>> p = Parser(prog="x"); _ = p.add_argument("--origin", nargs=3, type=float)
+    >>> p.parse_args(["--origin", "-3.2e+04", "-.5", "-1E-3"]).origin
+    [-32000.0, -0.5, -0.001]
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="surfmod",
         description="Surface-modeling toolbox on OpenCASCADE, cross-checked by NumPy.",
     )
