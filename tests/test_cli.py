@@ -213,3 +213,17 @@ def test_mesh_negative_tolerance_is_named(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("surfmod mesh: error: tolerance") and err.count("\n") == 1, err
     assert not (tmp_path / "part.stl").exists()
+
+
+def test_section_on_a_planar_face_draws_its_outline(tmp_path, capsys):
+    """``--origin`` on the top face of a box with a hole: exit 0, the DXF is the face's
+    outline (square 8 + circle pi), and the command names the face."""
+    import build123d as bd
+    from test_corpus_readback import dxf_length
+
+    path, out = tmp_path / "part.step", tmp_path / "top.dxf"
+    sm.export_step(bd.Box(2, 2, 2) - bd.Cylinder(0.5, 3), path)
+    assert main(["section", str(path), "--origin", "0", "0", "1", "--normal", "0", "0", "1", "--out", str(out),
+                 "--no-progress"]) == 0
+    assert "lies on planar face(s) [2]: their outline included" in capsys.readouterr().out
+    assert dxf_length(out) == pytest.approx(8 + np.pi, rel=1e-12)

@@ -69,9 +69,70 @@ def test_plane_missing_part_is_empty(tmp_path):
     assert not (tmp_path / "e.dxf").exists()
 
 
-def test_plane_on_planar_face_is_refused():
-    with pytest.raises(sm.SurfmodError, match="plane_normal: .*parallel"):
-        sm.section(bd.Box(2, 2, 2), (0, 0, 1), (0, 0, -1))
+def _occt_length(shape, origin, normal) -> float:
+    """BRepAlgoAPI_Section's length, edge by edge (GCPnts on OCCT's own edges)."""
+    from surfmod.occ.discretize import edge_length, wire_edges
+    from surfmod.occ.section import section_edges
+
+    shape = getattr(shape, "wrapped", shape)
+    return sum(edge_length(e) for w in section_edges(shape, np.array(origin, float), np.array(normal, float))
+               for e in wire_edges(w))
+
+
+def _outline(shape, faces) -> float:
+    """Length of the boundaries of ``faces`` (exploration indices), each edge once."""
+    from surfmod.occ.topo import faces_of
+
+    edges = {}
+    for i in faces:
+        for e in bd.Face(faces_of(getattr(shape, "wrapped", shape))[i]).edges():
+            edges[hash(e)] = e.length  # the same TopoDS edge hashes alike, orientation aside
+    return sum(edges.values())
+
+
+STEPPED = (bd.Box(4, 4, 1, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN))
+           + bd.Box(2, 2, 2, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)))
+
+
+@pytest.mark.parametrize("part, z, closed_form", [
+    (bd.Box(2, 2, 2) - bd.Cylinder(0.5, 3), 1.0, 8 + math.pi),   # the top face: square and hole
+    (bd.Box(2, 2, 2) - bd.Cylinder(0.5, 3), -1.0, 8 + math.pi),  # the bottom face
+    (STEPPED, 1.0, 16 + 8),                                       # the annulus of a step: both squares
+    (STEPPED, 0.0, 16),
+])
+@pytest.mark.parametrize("flip", [1.0, -1.0])
+def test_plane_on_planar_face_gives_its_outline(part, z, closed_form, flip, tmp_path):
+    """As a CAD system draws it: the outline of the face the plane lies on, equal to the
+    closed form, to the face's own edges and to BRepAlgoAPI_Section; the DXF says the same."""
+    from test_corpus_readback import dxf_length
+
+    s = sm.section(part, (0.3, -0.2, z), (0, 0, flip))
+    assert len(s.faces_on) == 1 and "lies on planar face(s)" in str(s)
+    assert s.length == pytest.approx(closed_form, rel=1e-12)
+    assert _outline(part, s.faces_on) == pytest.approx(closed_form, rel=1e-12)
+    assert s.length == pytest.approx(_occt_length(part, (0.3, -0.2, z), (0, 0, flip)), rel=1e-12)
+    assert all(s.closed)
+    sm.export_dxf(s, tmp_path / "top.dxf")
+    assert dxf_length(tmp_path / "top.dxf") == pytest.approx(closed_form, rel=1e-12)
+
+
+def test_plane_on_planar_faces_of_a_corpus_part(tmp_path):
+    """trimesh_featuretype: its bottom face alone (the section is its outline) and eight
+    faces at z = 19.05 whose outlines are all in the section; the DXF's length is
+    BRepAlgoAPI_Section's."""
+    from conftest import CORPUS
+    from test_corpus_readback import dxf_length
+
+    part = sm.import_step(CORPUS / "trimesh_featuretype.STEP")
+    for z, faces in ((0.0, 1), (19.05, 8)):
+        s = sm.section(part, (0, 0, z), (0, 0, 1))
+        assert len(s.faces_on) == faces
+        outline = _outline(part, s.faces_on)
+        assert s.length >= outline * (1 - 1e-12)
+        if faces == 1:
+            assert s.length == pytest.approx(outline, rel=1e-12)
+        sm.export_dxf(s, tmp_path / "s.dxf")
+        assert dxf_length(tmp_path / "s.dxf") == pytest.approx(_occt_length(part, (0, 0, z), (0, 0, 1)), rel=1e-9)
 
 
 @pytest.mark.parametrize("kw, arg", [({"plane_normal": (0, 0, 0)}, "plane_normal"),

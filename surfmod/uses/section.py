@@ -79,7 +79,9 @@ class Section:
     array per wire, computed on first use; ``closed`` says which wires close up.  The
     plane frame is ``origin`` with axes ``x_axis``, ``y_axis`` and ``normal``;
     :meth:`polylines_2d` gives the curves in it.
-    An empty section (the plane misses the part) has no wires.
+    An empty section (the plane misses the part) has no wires.  ``faces_on`` are the
+    indices of the planar faces lying in the plane: their outlines are part of the
+    section, as a CAD system draws it.
 
     >>> import surfmod as sm, build123d as bd
     >>> sec = sm.section(bd.Box(2, 2, 2), (0, 0, 0), (0, 0, 1))
@@ -94,6 +96,7 @@ class Section:
     wires: list = field(repr=False)
     closed: list
     samples: int = field(default=64, repr=False)
+    faces_on: tuple = ()
 
     @cached_property
     def polylines(self) -> list[np.ndarray]:
@@ -178,7 +181,8 @@ class Section:
     def __str__(self) -> str:
         if self.empty:
             return "section: empty (the plane misses the part)"
-        return f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}"
+        on = f"; the plane lies on planar face(s) {list(self.faces_on)}: their outline included" if self.faces_on else ""
+        return f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}{on}"
 
 
 def _chained(pieces: list[np.ndarray]) -> np.ndarray:
@@ -227,13 +231,18 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     """Planar section of a part (or of surfaces): curves where the plane cuts it.
 
     ``obj``: a build123d shape, surfmod surface(s) or a STEP path.  A plane that misses
-    the part gives an empty :class:`Section`; a plane lying on a planar face of the
-    part is ambiguous (the "section" would be the face) and raises ``SurfmodError``.
+    the part gives an empty :class:`Section`; a plane lying on planar faces of the part
+    gives their outlines (``BRepAlgoAPI_Section`` returns the boundary of the common
+    part), with the curves where it crosses the other faces, and names the faces in
+    ``faces_on``.
 
     >>> import surfmod as sm, build123d as bd
     >>> s = sm.section(bd.Sphere(2), (0, 0, 1), (0, 0, 1))
     >>> len(s.wires), s.closed, round(s.length, 12) == round(2 * 3.141592653589793 * 3 ** 0.5, 12)
     (1, [True], True)
+    >>> top = sm.section(bd.Box(2, 2, 2) - bd.Cylinder(0.5, 3), (0, 0, 1), (0, 0, 1))
+    >>> top.faces_on, round(top.length, 12) == round(8 + 3.141592653589793, 12)
+    ((2,), True)
     """
     from ..occ.properties import bounding_box
     from ..occ.section import section_edges
@@ -247,12 +256,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     # (which costs more than the section itself on B-spline parts)
     box = bounding_box(shape, optimal=False)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
-    on = planar_faces_in(shape, origin, normal, tol)
-    if on:
-        raise SurfmodError(
-            f"plane_normal: the section plane is parallel to planar face(s) {on} of obj and lies on them; "
-            "move plane_origin off the face or tilt the plane"
-        )
+    on = tuple(planar_faces_in(shape, origin, normal, tol))
     wires = section_edges(shape, origin, normal)
     return Section(checks.frozen(origin), checks.frozen(normal), checks.frozen(xa), checks.frozen(ya),
-                   wires, [bool(w.is_closed) for w in wires], samples)
+                   wires, [bool(w.is_closed) for w in wires], samples, on)
