@@ -182,3 +182,131 @@ def test_mesh_leaves_out_faces_of_open_shells_brepmesh_cannot_triangulate(tmp_pa
     assert main(["mesh", str(path), "--out", str(out), "--no-progress"]) == 1
     err = capsys.readouterr().err
     assert "could not triangulate face 0" in err and "open shells" not in err and not out.exists()
+
+
+# -- per-face commands: a face OCCT cannot triangulate or intersect is named, the rest done -------
+def loose_bspline_faces(tmp_path):
+    """A surface model of six loose bicubic B-spline faces (a 3 x 2 patchwork, not sewn):
+    the kind of model of the issue whose face OCCT could not triangulate."""
+    faces = []
+    for i in range(3):
+        for j in range(2):
+            x, y = np.meshgrid(np.linspace(10 * i, 10 * i + 10, 5), np.linspace(10 * j, 10 * j + 10, 5), indexing="ij")
+            net = np.stack([x, y, 2 * np.sin(x / 7) * np.cos(y / 5)], -1)
+            faces.append(sm.BSplineSurface(net, degree=(3, 3)).face())
+    path = tmp_path / "loose.step"
+    sm.export_step(faces, path)
+    return path
+
+
+def _is_last_patch(face) -> bool:
+    """The face over x in [20, 30], y in [10, 20] (the one made to fail)."""
+    lo = bounding_box(face)[0]
+    return lo[0] > 19 and lo[1] > 9
+
+
+def test_analyze_skips_a_face_brepmesh_cannot_triangulate(tmp_path, monkeypatch, capsys):
+    """BRepMesh's failure on one face is simulated (the public parts where it happens are
+    not in the corpus): the picture of the other five is written, the face named, exit 3."""
+    import surfmod.occ.mesh as occ_mesh
+
+    path, out = loose_bspline_faces(tmp_path), tmp_path / "z.png"
+    assert main(["analyze", str(path), "--out", str(out), "--resolution", "20"]) == 0
+    assert "6 patch(es)" in capsys.readouterr().out
+    out.unlink()
+    real = occ_mesh.face_uv_triangles
+
+    def failing(face, *a, **kw):
+        if _is_last_patch(face):
+            raise sm.SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
+        return real(face, *a, **kw)
+
+    monkeypatch.setattr(occ_mesh, "face_uv_triangles", failing)
+    assert main(["analyze", str(path), "--out", str(out), "--resolution", "20"]) == 3
+    printed = capsys.readouterr().out
+    assert "analysis zebra: 5 patch(es)" in printed
+    assert "face 5 skipped: obj: OCCT could not triangulate" in printed
+    assert "partial: 1 of 6 face(s) skipped" in printed
+    assert out.read_bytes()[:4] == b"\x89PNG"
+    # nothing drawable: the error, exit 1, no file
+    out.unlink()
+    monkeypatch.setattr(occ_mesh, "face_uv_triangles", lambda *a, **kw: (_ for _ in ()).throw(sm.SurfmodError("obj: no")))
+    assert main(["analyze", str(path), "--out", str(out), "--resolution", "20"]) == 1
+    assert capsys.readouterr().err.startswith("surfmod analyze: error:") and not out.exists()
+
+
+def test_section_goes_on_past_a_face_occt_cannot_intersect(tmp_path, monkeypatch, capsys):
+    """BRepAlgoAPI_Section's failure on the whole model and on one face is simulated: the
+    plane x = 25 crosses faces 4 and 5; face 5 is named, the DXF holds face 4's curve
+    (its length BRepAlgoAPI_Section's of that face alone), exit 3."""
+    import surfmod.occ.section as occ_section
+    from OCP.TopAbs import TopAbs_FACE
+
+    path, out = loose_bspline_faces(tmp_path), tmp_path / "s.dxf"
+    faces = sm.import_step(path).faces()
+    origin, normal = np.array([25.0, 0, 0]), np.array([1.0, 0, 0])
+    per_face = [sum(edge_length(e) for w in section_edges(f.wrapped, origin, normal) for e in wire_edges(w))
+                for f in faces]
+    assert [x > 0 for x in per_face] == [False] * 4 + [True] * 2
+    real = occ_section._cut
+
+    def failing(shape, pln):
+        if shape.ShapeType() != TopAbs_FACE or _is_last_patch(shape):
+            raise sm.SurfmodError("obj: OCCT could not section this shape")
+        return real(shape, pln)
+
+    monkeypatch.setattr(occ_section, "_cut", failing)
+    with pytest.raises(sm.SurfmodError, match="could not section"):
+        sm.section(path, origin, normal)
+    assert main(["section", str(path), "--origin", "25", "0", "0", "--normal", "1", "0", "0", "--out", str(out),
+                 "--no-progress"]) == 3
+    printed = capsys.readouterr().out
+    assert "face 5 skipped: obj: OCCT could not section this shape" in printed
+    assert "partial: 1 of 6 face(s) skipped" in printed and "1 face(s) OCCT could not intersect left out: [5]" in printed
+    assert dxf_length(out) == pytest.approx(per_face[4], rel=1e-9)
+    # the plane crosses only the face OCCT cannot intersect: nothing to write
+    out.unlink()
+    assert main(["section", str(path), "--origin", "24", "24", "0", "--normal", "1", "1", "0", "--out", str(out),
+                 "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("surfmod section: error: obj: the plane crosses no face but [5]") and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_check_names_a_face_it_cannot_check_and_exits_3(tmp_path, monkeypatch, capsys):
+    """A face whose read-back fails (simulated) is a row "skip" naming the reason, the
+    other five are checked and pass: exit 3 with the count.  A face failing its
+    cross-check still makes exit 1."""
+    import surfmod.cli.check as cli_check
+
+    path = loose_bspline_faces(tmp_path)
+    real = cli_check.from_face
+
+    def failing(face):
+        if _is_last_patch(face):
+            raise sm.SurfmodError("face: OCCT could not evaluate this face")
+        return real(face)
+
+    monkeypatch.setattr(cli_check, "from_face", failing)
+    assert main(["check", str(path), "--no-progress"]) == 3
+    printed = capsys.readouterr().out
+    rows = [line.split() for line in printed.splitlines() if line.startswith("loose.step")]
+    assert [r[4] for r in rows] == ["yes"] * 5 + ["skip"] and "not checked: face: OCCT could not evaluate" in printed
+    assert "5 of 6 faces passed" in printed and "partial: 1 of 6 face(s) could not be checked: loose.step face 5" in printed
+    csv_path = tmp_path / "rows.csv"
+    assert main(["check", str(path), "--csv", str(csv_path), "--no-progress"]) == 3
+    assert csv_path.read_text().count(",skip,") == 1
+
+    monkeypatch.setattr(cli_check, "from_face", real)
+    real_many = cli_check.crosscheck_many
+
+    def one_fails(surfaces, **kw):  # the last face's cross-check fails by 1e-3
+        results = real_many(surfaces, **kw)
+        r = results[-1]
+        results[-1] = type(r)(1e-3, r.mode, r.samples, False)
+        results[-1].details = {"tolerance": 1e-9}
+        return results
+
+    monkeypatch.setattr(cli_check, "crosscheck_many", one_fails)
+    assert main(["check", str(path), "--no-progress"]) == 1
+    assert "5 of 6 faces passed" in capsys.readouterr().out

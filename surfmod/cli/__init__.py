@@ -14,6 +14,10 @@ from ..errors import SurfmodError
 from ..version import installed_version
 
 
+#: exit status of a command that wrote its output for part of the model only (faces OCCT
+#: could not triangulate or intersect are named on the lines before)
+EXIT_PARTIAL = 3
+
 #: every spelling ``float()`` takes for a negative number: argparse's own pattern knows only
 #: ``-12`` and ``-1.5``, so ``--origin -3.2e+04 1 2`` was read as an unknown option and the
 #: flag as short of values

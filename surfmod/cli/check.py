@@ -1,5 +1,9 @@
 """``surfmod check PATH...``: read every face of STEP files (or folders of them) back and
-cross-check it against OCCT; one row per face, streamed, or ``--csv FILE``."""
+cross-check it against OCCT; one row per face, streamed, or ``--csv FILE``.
+
+Exit 1 when a face fails its cross-check or a file cannot be read; 3 (partial) when every
+face checked passes but some could not be checked (surfmod could not read them back or
+OCCT could not sample them): those are named, with their count."""
 
 from __future__ import annotations
 
@@ -9,6 +13,7 @@ from ..errors import SurfmodError
 from ..io.step import import_step
 from ..readback import from_face
 from ..occt_crosscheck import crosscheck_many
+from . import EXIT_PARTIAL
 from .batch import RowSink, run_batch, step_files
 
 COLUMNS = [("file", "<36.36"), ("face", ">5d"), ("surface type", "<30.30"), ("max dev", ">10.2e"),
@@ -44,7 +49,8 @@ def _note(result) -> str:
 
 def check_file(path, samples: int = 24) -> list[tuple]:
     """``[(file, face index, surface type, max deviation, passed, note), ...]`` for one
-    STEP file; an unreadable file is one row with face index -1.
+    STEP file; an unreadable file is one row with face index -1.  ``passed`` is None for
+    a face that could not be checked (its note starts with "not checked:" and the reason).
 
     Each face is read back once (:func:`surfmod.from_face`) and cross-checked with
     ``sampling="sufficient"``: at most ``samples`` values per direction (plus knots), fewer
@@ -72,13 +78,13 @@ def check_file(path, samples: int = 24) -> list[tuple]:
         try:
             reads[i] = from_face(face)
         except SurfmodError as exc:
-            rows[i] = (name, i, _kind_of(face), float("nan"), False, str(exc))
+            rows[i] = (name, i, _kind_of(face), float("nan"), None, f"not checked: {exc}")
     # one batch: OCCT sampled face by face, the comparison vectorized over all faces
     results = crosscheck_many(list(reads.values()), samples=samples, sampling="sufficient")
     for (i, read), r in zip(reads.items(), results):
         kind = surface_type(read.geom())
         if isinstance(r, SurfmodError):
-            rows[i] = (name, i, kind, float("nan"), False, str(r))
+            rows[i] = (name, i, kind, float("nan"), None, f"not checked: {r}")
         else:
             rows[i] = (name, i, kind, r.max_deviation, r.passed, _note(r))
     for i, note in _stray_notes(shape).items():
@@ -124,12 +130,20 @@ def run(args) -> int:
     files = step_files(args.paths)
     sink = RowSink(COLUMNS, args.csv)
     faces = bad = 0
+    unchecked = []
     for chunk in run_batch(check_file, files, options={"samples": args.samples}, scheduler=args.scheduler,
                            jobs=args.jobs, progress=not args.no_progress, desc="check"):
         for f, i, kind, dev, ok, note in chunk:
-            sink.add((Path(f).name if not args.csv else f, i, kind, dev, "yes" if ok else "NO", note))
+            sink.add((Path(f).name if not args.csv else f, i, kind, dev, "skip" if ok is None else "yes" if ok else "NO",
+                      note))
             faces += 1
-            bad += not ok
+            bad += ok is False
+            if ok is None:
+                unchecked.append(f"{Path(f).name} face {i}")
     sink.close()
-    print(f"{faces - bad} of {faces} faces passed in {len(files)} file(s)" + (f"; rows in {args.csv}" if args.csv else ""))
-    return 1 if bad else 0
+    passed = faces - bad - len(unchecked)
+    print(f"{passed} of {faces} faces passed in {len(files)} file(s)" + (f"; rows in {args.csv}" if args.csv else ""))
+    if unchecked:
+        shown = ", ".join(unchecked[:20]) + (f" and {len(unchecked) - 20} more" if len(unchecked) > 20 else "")
+        print(f"partial: {len(unchecked)} of {faces} face(s) could not be checked: {shown}")
+    return 1 if bad else EXIT_PARTIAL if unchecked else 0

@@ -1,6 +1,8 @@
 """``surfmod section FILE.step --origin x y z --normal x y z --out file.dxf``.
 
-The same concept as :mod:`surfmod.uses.section`, one level up: the command over it.
+The same concept as :mod:`surfmod.uses.section`, one level up: the command over it.  A
+part OCCT cannot section whole is sectioned face by face: the faces it cannot intersect
+are named, the others' curves written, and the command exits 3 (partial).
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from ..errors import SurfmodError
 from ..io.svg import export_svg
 from ..inputs import to_shape
 from ..uses.section import section
+from . import EXIT_PARTIAL
 from tqdm import tqdm
 
 
@@ -34,8 +37,11 @@ def run(args) -> int:
     with tqdm(total=3, desc="section", unit="step", disable=args.no_progress) as bar:
         shape = to_shape(args.path, "path")
         bar.update()
-        s = section(shape, args.origin, args.normal)
+        s = section(shape, args.origin, args.normal, partial=True)
         bar.update()
+        if s.empty and s.faces_skipped:
+            raise SurfmodError(f"obj: the plane crosses no face but {sorted(s.faces_skipped)}, which OCCT could not "
+                               "intersect: nothing to write")
         if s.empty:  # bad input like any other: one line on stderr, exit 1, no file
             raise SurfmodError(f"origin: the plane through {tuple(args.origin)} with normal {tuple(args.normal)} "
                                "misses the part: the section is empty")
@@ -44,5 +50,14 @@ def run(args) -> int:
             s.preview(args.png)
         bar.update()
     print(s)
-    print(f"wrote {args.out}" + (f" and {args.png}" if args.png else ""))
+    wrote = f"wrote {args.out}" + (f" and {args.png}" if args.png else "")
+    if s.faces_skipped:
+        from ..occ.topo import faces_of
+
+        for i, reason in sorted(s.faces_skipped.items()):
+            print(f"face {i} skipped: {reason}")
+        print(f"partial: {len(s.faces_skipped)} of {len(faces_of(shape))} face(s) skipped (OCCT could not intersect "
+              f"them); {wrote} with the curves of the others")
+        return EXIT_PARTIAL
+    print(wrote)
     return 0

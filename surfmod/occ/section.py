@@ -21,22 +21,47 @@ from .topo import faces_of
 from .bindings import TopTools_HSequenceOfShape
 
 
-def section_edges(shape, origin, normal):
-    """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
-    end to end with ``ShapeAnalysis_FreeBounds``)."""
-    import build123d as bd
-
+def _cut(shape, pln) -> list:
+    """The edges of ``BRepAlgoAPI_Section`` of ``shape`` by the plane ``pln``;
+    ``SurfmodError`` when OCCT fails."""
     with kernel("BRepAlgoAPI_Section"):
-        pln = gp_Pln(gp_Pnt(*map(float, origin)), gp_Dir(*map(float, normal)))
         op = BRepAlgoAPI_Section(shape, pln, False)
         op.Approximation(False)
         op.ComputePCurveOn1(False)
         op.Build()
         if not op.IsDone():
             raise SurfmodError("obj: OCCT could not section this shape")
-        edges = _explore(op.Shape(), TopAbs_EDGE)
-        if not edges:
-            return []
+        return _explore(op.Shape(), TopAbs_EDGE)
+
+
+def section_edges(shape, origin, normal, skipped: dict | None = None):
+    """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
+    end to end with ``ShapeAnalysis_FreeBounds``).
+
+    When OCCT cannot section the whole shape and ``skipped`` is a dict, the shape is
+    sectioned face by face (one Boolean a face): the faces OCCT cannot intersect go into
+    ``skipped`` as ``{index: reason}`` and the others' curves are returned; without
+    ``skipped``, or when no face can be sectioned, the failure is raised."""
+    import build123d as bd
+
+    pln = gp_Pln(gp_Pnt(*map(float, origin)), gp_Dir(*map(float, normal)))
+    try:
+        edges = _cut(shape, pln)
+    except SurfmodError:
+        if skipped is None:
+            raise
+        faces, edges, lost = faces_of(shape), [], {}
+        for i, face in enumerate(faces):
+            try:
+                edges.extend(_cut(face, pln))
+            except SurfmodError as exc:
+                lost[i] = " ".join(str(exc).split())
+        if len(lost) == len(faces):
+            raise
+        skipped.update(lost)
+    if not edges:
+        return []
+    with kernel("ShapeAnalysis_FreeBounds (section wires)"):
         seq = TopTools_HSequenceOfShape()
         for e in edges:
             seq.Append(e)

@@ -81,7 +81,9 @@ class Section:
     :meth:`polylines_2d` gives the curves in it.
     An empty section (the plane misses the part) has no wires.  ``faces_on`` are the
     indices of the planar faces lying in the plane: their outlines are part of the
-    section, as a CAD system draws it.
+    section, as a CAD system draws it.  ``faces_skipped`` (``{index: reason}``, only
+    with ``section(..., partial=True)``) are the faces OCCT could not intersect: their
+    curves are missing.
 
     >>> import surfmod as sm, build123d as bd
     >>> sec = sm.section(bd.Box(2, 2, 2), (0, 0, 0), (0, 0, 1))
@@ -97,6 +99,7 @@ class Section:
     closed: list
     samples: int = field(default=64, repr=False)
     faces_on: tuple = ()
+    faces_skipped: dict = field(default_factory=dict)
 
     @cached_property
     def polylines(self) -> list[np.ndarray]:
@@ -182,7 +185,10 @@ class Section:
         if self.empty:
             return "section: empty (the plane misses the part)"
         on = f"; the plane lies on planar face(s) {list(self.faces_on)}: their outline included" if self.faces_on else ""
-        return f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}{on}"
+        skipped = (f"; {len(self.faces_skipped)} face(s) OCCT could not intersect left out: "
+                   f"{sorted(self.faces_skipped)}" if self.faces_skipped else "")
+        return (f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}"
+                f"{on}{skipped}")
 
 
 def _chained(pieces: list[np.ndarray]) -> np.ndarray:
@@ -227,14 +233,16 @@ def planar_faces_in(shape, origin, normal, tol: float) -> list[int]:
     return planar_faces_on(shape, origin, normal, tol)
 
 
-def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) -> Section:
+def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, partial: bool = False) -> Section:
     """Planar section of a part (or of surfaces): curves where the plane cuts it.
 
     ``obj``: a build123d shape, surfmod surface(s) or a STEP path.  A plane that misses
     the part gives an empty :class:`Section`; a plane lying on planar faces of the part
     gives their outlines (``BRepAlgoAPI_Section`` returns the boundary of the common
     part), with the curves where it crosses the other faces, and names the faces in
-    ``faces_on``.
+    ``faces_on``.  When OCCT cannot section the whole part it raises ``SurfmodError``;
+    with ``partial=True`` the part is then sectioned face by face, and the faces OCCT
+    cannot intersect are left out and named in ``faces_skipped``.
 
     >>> import surfmod as sm, build123d as bd
     >>> s = sm.section(bd.Sphere(2), (0, 0, 1), (0, 0, 1))
@@ -257,6 +265,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None) 
     box = bounding_box(shape, optimal=False)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
     on = tuple(planar_faces_in(shape, origin, normal, tol))
-    wires = section_edges(shape, origin, normal)
+    skipped: dict = {}
+    wires = section_edges(shape, origin, normal, skipped if partial else None)
     return Section(checks.frozen(origin), checks.frozen(normal), checks.frozen(xa), checks.frozen(ya),
-                   wires, [bool(w.is_closed) for w in wires], samples, on)
+                   wires, [bool(w.is_closed) for w in wires], samples, on, skipped)
