@@ -5,11 +5,24 @@ A job is a plain module-level function ``job(path, **options) -> list of row tup
 it must catch its own per-file errors and report them as rows, so one bad file never
 stops a run of thousands.  Memory per worker stays bounded because a worker holds one
 file at a time and only rows travel back.
+
+What a run of ten thousand files needs besides:
+
+* each file's rows go to the CSV when the file completes, in one write, flushed: a crash
+  or Ctrl-C loses nothing finished, and ``--resume`` skips the files already there;
+* local workers (loky) watch the client and exit when it is gone, so a killed client
+  leaves no orphan process behind;
+* on a cluster each task runs in a child process of its worker (:func:`surfmod.child.call`)
+  within a time and a memory budget (``--task-seconds``, ``--task-memory``): a file over
+  budget is named and skipped, the worker lives on, and the file's shapes die with the
+  child; a task that kills its worker (Dask gives up after its ``allowed-failures``) is
+  named and skipped too, never retried for ever.
 """
 
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import os
 import sys
@@ -18,12 +31,16 @@ from pathlib import Path
 from joblib import Parallel, delayed
 from tqdm import tqdm
 
+from .. import child
 from ..errors import SurfmodError
-from ..atomic import atomic_path, target_path
+from ..atomic import target_path
 from ..io.step import import_step
 from ..io.stl import export_stl
 
 STEP_SUFFIXES = (".step", ".stp")
+#: default budget of one file's task on a cluster: seconds, and GiB resident
+TASK_SECONDS = 1800.0
+TASK_MEMORY_GIB = 8.0
 
 
 def step_files(paths) -> list[Path]:
@@ -54,12 +71,27 @@ def step_files(paths) -> list[Path]:
     return out
 
 
+def _watch_client(client_pid: int) -> None:
+    """In a local worker process: end it as soon as its client (the process that started
+    the run) is gone (:func:`surfmod.child.die_with`); nothing in the client itself (a
+    run of one job stays in the client)."""
+    if os.getpid() != client_pid:
+        child.die_with(client_pid)
+
+
+def _watched(job, client_pid, path, options):
+    _watch_client(client_pid)
+    return job(path, **options)
+
+
 def _local(job, files, options, jobs):
     n_jobs = jobs if len(files) > 1 else 1
-    return Parallel(n_jobs=n_jobs, return_as="generator")(delayed(job)(f, **options) for f in files)
+    # rows as each file completes, not in file order: a slow file holds back nobody's rows
+    return Parallel(n_jobs=n_jobs, return_as="generator_unordered")(
+        delayed(_watched)(job, os.getpid(), f, options) for f in files)
 
 
-def _dask(job, files, options, address):
+def _dask(job, files, options, address, failed_row, seconds, memory):
     try:
         from distributed import Client, as_completed
     except ImportError:  # pragma: no cover - the extra is declared in pyproject
@@ -70,24 +102,49 @@ def _dask(job, files, options, address):
         raise SurfmodError(f"scheduler: cannot reach the Dask scheduler at {address} ({exc})") from None
     try:
         # pure=False: a file may change between runs; one task per file keeps memory bounded
-        futures = [client.submit(job, str(f), pure=False, **options) for f in files]
+        futures = {client.submit(budgeted, job, str(f), options, seconds, memory, failed_row, pure=False): f
+                   for f in files}
         for future in as_completed(futures):
-            yield future.result()
+            try:
+                yield future.result()
+            except Exception as exc:  # noqa: BLE001 - KilledWorker, a lost connection: the file, not the run
+                yield [failed_row(str(futures[future]), f"skipped: {type(exc).__name__}: {' '.join(str(exc).split())}")]
             future.release()  # rows are in hand: let the cluster forget the task
     finally:
         client.close()
 
 
-def run_batch(job, files, *, options=None, scheduler=None, jobs=-1, progress=True, desc="files"):
-    """Yield the row lists of ``job(path, **options)`` for every file, as they finish
-    (joblib in file order locally; completion order on a Dask cluster).
+def budgeted(job, path, options, seconds, memory, failed_row):
+    """``job(path, **options)`` in a child process of this (worker) process within
+    ``seconds`` and ``memory`` bytes; over budget (or dead), the file's one row from
+    ``failed_row(path, message)`` naming the budget.
 
-    >>> rows = list(run_batch(_example_job, ["a.step", "b.step"], jobs=1, progress=False))
+    >>> budgeted(_example_job, "a.step", {}, 60.0, None, lambda p, m: [(p, m)])
+    [('a.step', 1)]
+    """
+    try:
+        return child.call(functools.partial(job, **options), (path,), seconds, f"the task of {path}", memory)
+    except child.ChildFailure as exc:
+        return [failed_row(path, f"skipped: {exc}")]
+
+
+def run_batch(job, files, *, options=None, scheduler=None, jobs=-1, progress=True, desc="files", failed_row=None,
+              task_seconds=TASK_SECONDS, task_memory=TASK_MEMORY_GIB * 2**30):
+    """Yield the row lists of ``job(path, **options)`` for every file, as they finish
+    (completion order).  On a Dask cluster each task runs within ``task_seconds`` and
+    ``task_memory`` bytes; a file over budget or whose task killed its workers gives the
+    one row ``failed_row(path, message)``.
+
+    >>> rows = sorted(run_batch(_example_job, ["a.step", "b.step"], jobs=1, progress=False))
     >>> rows
     [[('a.step', 1)], [('b.step', 1)]]
     """
     options = options or {}
-    chunks = _dask(job, files, options, scheduler) if scheduler else _local(job, files, options, jobs)
+    failed_row = failed_row or (lambda path, message: (path, message))
+    if scheduler:
+        chunks = _dask(job, files, options, scheduler, failed_row, task_seconds, task_memory)
+    else:
+        chunks = _local(job, files, options, jobs)
     yield from tqdm(chunks, total=len(files), desc=desc, unit="file", disable=not progress, file=sys.stderr)
 
 
@@ -96,11 +153,15 @@ def _example_job(path, **_):
 
 
 class RowSink:
-    """Where rows go: printed as a fixed-width table as they arrive, or collected for a
-    CSV file written atomically at the end (no partial file if the run fails).
+    """Where rows go: printed as a fixed-width table as they arrive, or to a CSV file,
+    each file's rows in one write when :meth:`flush` is called (after each file), so a
+    run that stops midway keeps every row of every file it finished.  The CSV file is
+    created with the first rows: a run that fails before any file finishes writes none.
 
     ``columns`` are ``(name, spec)`` pairs; ``spec`` is a format spec such as ``"<40.40"``
-    or ``">10.2e"`` used for the table (the CSV holds the raw values).
+    or ``">10.2e"`` used for the table (the CSV holds the raw values).  With ``resume``
+    an existing CSV file of the same columns is kept (a last line cut off by a crash is
+    dropped) and appended to; its rows are in :attr:`previous`.
 
     >>> sink = RowSink([("file", "<6.6"), ("dev", ">8.1e")])
     file         dev
@@ -108,14 +169,37 @@ class RowSink:
     a.step   5.0e-01
     """
 
-    def __init__(self, columns, csv_path=None, out=None):
+    def __init__(self, columns, csv_path=None, out=None, resume=False):
         self.names = [c for c, _ in columns]
         self.specs = [spec for _, spec in columns]
         self.csv_target = target_path(csv_path, "csv", (".csv",)) if csv_path else None
         self.out = out or sys.stdout
-        self.rows = []
+        self.pending, self.previous, self.stream = [], [], None
+        if resume and self.csv_target is None:
+            raise SurfmodError("resume: needs --csv, the file whose rows it keeps")
+        if resume and self.csv_target.exists():
+            self.previous = self._kept_rows()
+            self.stream = self.csv_target.open("a", newline="", encoding="utf-8")
         if self.csv_target is None:
             print("  ".join(self._cell(n, spec, header=True) for n, spec in zip(self.names, self.specs)), file=self.out)
+
+    def _kept_rows(self) -> list:
+        """The rows of the existing CSV file, after cutting off a last line left
+        unfinished (no newline) by a run that died while writing it."""
+        raw = self.csv_target.read_bytes()
+        if raw and not raw.endswith(b"\n"):
+            raw = raw[: raw.rfind(b"\n") + 1]
+            with self.csv_target.open("r+b") as f:
+                f.truncate(len(raw))
+        rows = list(csv.reader(io.StringIO(raw.decode("utf-8"), newline="")))
+        if rows and rows[0] != self.names:
+            raise SurfmodError(f"csv: {self.csv_target} has the columns {', '.join(rows[0])}, not "
+                               f"{', '.join(self.names)}: not a file of this command to resume")
+        return rows[1:]
+
+    def done_files(self) -> set:
+        """Absolute paths of the files whose rows the resumed CSV file holds."""
+        return {os.path.abspath(r[0]) for r in self.previous if r}
 
     @staticmethod
     def _cell(value, spec, header=False):
@@ -125,32 +209,86 @@ class RowSink:
         return format(value, spec)
 
     def add(self, row) -> None:
-        self.rows.append(tuple(row))
         if self.csv_target is None:
             print("  ".join(self._cell(v, spec) for v, spec in zip(row, self.specs)), file=self.out, flush=True)
+        else:
+            self.pending.append(tuple(row))
 
-    def close(self) -> None:
-        """Write the CSV file (atomic) when one was asked for."""
-        if self.csv_target is None:
+    def flush(self) -> None:
+        """Write the rows added since the last flush to the CSV file, in one write."""
+        if self.csv_target is None or not self.pending:
             return
         buf = io.StringIO()
         writer = csv.writer(buf)
-        writer.writerow(self.names)
-        writer.writerows(self.rows)
-        with atomic_path(self.csv_target) as tmp:
-            Path(tmp).write_text(buf.getvalue(), encoding="utf-8")
+        if self.stream is None:
+            self.stream = self.csv_target.open("w", newline="", encoding="utf-8")
+            writer.writerow(self.names)
+        writer.writerows(self.pending)
+        self.pending = []
+        self.stream.write(buf.getvalue())
+        self.stream.flush()
+
+    def close(self) -> None:
+        """Write what is left and close the CSV file."""
+        self.flush()
+        if self.stream is not None:
+            self.stream.close()
+            self.stream = None
 
 
 # -- plumbing shared by the commands that take many files ---------------------------------------
-def add_batch_arguments(parser) -> None:
-    """``--csv``, ``--scheduler`` and ``--jobs`` for a command taking ``PATH...``."""
+def add_batch_arguments(parser, rows: str = "one row per file") -> None:
+    """``--csv``, ``--resume``, ``--scheduler``, ``--jobs`` and the task budgets for a
+    command taking ``PATH...``."""
     parser.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     parser.add_argument("--scheduler", help="run on the Dask distributed scheduler at this address (tcp://host:8786)")
-    parser.add_argument("--csv", help="write one row per file to this CSV file instead of printing the table")
+    parser.add_argument("--csv", help=f"write {rows} to this CSV file, each file's rows as it completes, instead of "
+                                      "printing the table")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep the rows already in --csv and skip their files (after a crash or Ctrl-C)")
+    parser.add_argument("--task-seconds", type=float, default=TASK_SECONDS,
+                        help=f"with --scheduler: a file's task is skipped after this many seconds (default {TASK_SECONDS:g})")
+    parser.add_argument("--task-memory", type=float, default=TASK_MEMORY_GIB,
+                        help=f"with --scheduler: a file's task is skipped above this many GiB resident (default "
+                             f"{TASK_MEMORY_GIB:g})")
+
+
+def batch_run(args, job, options, columns, desc, failed_row, record=tuple):
+    """Run ``job`` over ``args.files`` for a command: each row as ``record(row)`` makes
+    it to the CSV file (flushed after each file) or the table (file names only there),
+    ``--resume`` honoured (``args.skipped`` says how many files it skipped).  Yields
+    ``(recorded row, fresh)`` for every row, the resumed CSV's rows first (``fresh``
+    False, their cells as read), then this run's."""
+    files = args.files
+    for name, limit in (("task_seconds", args.task_seconds), ("task_memory", args.task_memory)):
+        if not limit > 0:
+            raise SurfmodError(f"{name.replace('_', '-')}: must be > 0, got {limit}")
+    sink = RowSink(columns, args.csv, resume=args.resume)
+    done = sink.done_files()
+    todo = [f for f in files if os.path.abspath(f) not in done]
+    args.skipped = len(files) - len(todo)
+    for row in sink.previous:
+        yield row, False
+    try:
+        for chunk in run_batch(job, todo, options=options, scheduler=args.scheduler, jobs=args.jobs,
+                               progress=not getattr(args, "no_progress", False), desc=desc, failed_row=failed_row,
+                               task_seconds=args.task_seconds, task_memory=args.task_memory * 2**30):
+            for row in chunk:
+                row = record(row)
+                sink.add(row if args.csv else (Path(row[0]).name, *row[1:]))
+                yield row, True
+            sink.flush()
+    finally:
+        sink.close()
 
 
 MESH_COLUMNS = [("file", "<36.36"), ("triangles", ">10d"), ("watertight", "<10.10"), ("max dev", ">10.2e"),
                 ("stl", "<")]
+
+
+def mesh_failed(path, message) -> tuple:
+    """The one row of a file ``surfmod mesh`` could not mesh."""
+    return (str(path), 0, "-", float("nan"), f"error: {message}")
 
 
 def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None, strict: bool = False) -> list[tuple]:
@@ -162,7 +300,7 @@ def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None, strict:
     try:
         mesh = export_stl(import_step(p), out, tolerance=tolerance, ascii=ascii, strict=strict, progress=False)
     except SurfmodError as exc:
-        return [(str(p), 0, "-", float("nan"), f"error: {' '.join(str(exc).split())}")]
+        return [mesh_failed(p, " ".join(str(exc).split()))]
     dev = mesh.info.get("max_deviation")
     return [(str(p), len(mesh.faces), "yes" if mesh.to_trimesh().is_watertight else "NO",
              float("nan") if dev is None else float(dev), str(out))]
@@ -170,23 +308,20 @@ def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None, strict:
 
 def run_mesh(args) -> int:
     """``surfmod mesh PATH...`` over files and folders: one row per file."""
-    files = step_files(args.step)
+    args.files = step_files(args.step)
     out_dir = None
     if args.out:
         out_dir = Path(args.out)
         if not out_dir.is_dir():
             raise SurfmodError(f"out: with several files or folders --out must be an existing folder, got {out_dir}")
-    sink = RowSink(MESH_COLUMNS, args.csv)
-    bad = 0
+    bad = total = 0
     options = {"tolerance": args.tolerance, "ascii": args.ascii, "out_dir": None if out_dir is None else str(out_dir),
                "strict": bool(getattr(args, "strict", False))}
-    for chunk in run_batch(mesh_file, files, options=options, scheduler=args.scheduler, jobs=args.jobs,
-                           progress=not getattr(args, "no_progress", False), desc="mesh"):
-        for row in chunk:
-            sink.add((Path(row[0]).name if not args.csv else row[0], *row[1:]))
-            bad += row[4].startswith("error") or row[2] != "yes"
-    sink.close()
-    print(f"{len(files) - bad} of {len(files)} file(s) meshed watertight" + (f"; rows in {args.csv}" if args.csv else ""))
+    for row, _ in batch_run(args, mesh_file, options, MESH_COLUMNS, "mesh", mesh_failed):
+        total += 1
+        bad += str(row[4]).startswith("error") or row[2] != "yes"
+    resumed = f" ({args.skipped} already in {args.csv})" if args.skipped else ""
+    print(f"{total - bad} of {total} file(s) meshed watertight{resumed}" + (f"; rows in {args.csv}" if args.csv else ""))
     return 1 if bad else 0
 
 

@@ -14,7 +14,7 @@ from ..io.step import import_step
 from ..readback import from_face
 from ..occt_crosscheck import crosscheck_many
 from . import EXIT_PARTIAL
-from .batch import RowSink, run_batch, step_files
+from .batch import add_batch_arguments, batch_run, step_files
 
 COLUMNS = [("file", "<36.36"), ("face", ">5d"), ("surface type", "<30.30"), ("max dev", ">10.2e"),
            ("pass", "<4.4"), ("note", "<")]
@@ -24,9 +24,7 @@ def register(sub) -> None:
     p = sub.add_parser("check", help="cross-check every face of STEP files (or folders of them) against OCCT")
     p.add_argument("paths", nargs="+", help="STEP files or folders (searched recursively for .step/.stp)")
     p.add_argument("--samples", type=int, default=24, help="samples per parameter direction (default 24)")
-    p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
-    p.add_argument("--scheduler", help="run on the Dask distributed scheduler at this address (tcp://host:8786)")
-    p.add_argument("--csv", help="write the rows to this CSV file instead of printing the table")
+    add_batch_arguments(p, "the rows (one per face)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(run=run)
 
@@ -126,23 +124,30 @@ def _kind_of(face) -> str:
         return "-"
 
 
+def check_failed(path, message) -> tuple:
+    """The one row of a file whose task was skipped (over its budget, or it killed its
+    workers): face index -1, not checked (exit 3, partial)."""
+    return (str(path), -1, "-", float("nan"), None, message)
+
+
+def _recorded(row) -> tuple:
+    f, i, kind, dev, ok, note = row
+    return (f, i, kind, dev, "skip" if ok is None else "yes" if ok else "NO", note)
+
+
 def run(args) -> int:
-    files = step_files(args.paths)
-    sink = RowSink(COLUMNS, args.csv)
+    args.files = files = step_files(args.paths)
     faces = bad = 0
     unchecked = []
-    for chunk in run_batch(check_file, files, options={"samples": args.samples}, scheduler=args.scheduler,
-                           jobs=args.jobs, progress=not args.no_progress, desc="check"):
-        for f, i, kind, dev, ok, note in chunk:
-            sink.add((Path(f).name if not args.csv else f, i, kind, dev, "skip" if ok is None else "yes" if ok else "NO",
-                      note))
-            faces += 1
-            bad += ok is False
-            if ok is None:
-                unchecked.append(f"{Path(f).name} face {i}")
-    sink.close()
+    for (f, i, _, _, ok, _), _fresh in batch_run(args, check_file, {"samples": args.samples}, COLUMNS, "check",
+                                                 check_failed, _recorded):
+        faces += 1
+        bad += ok == "NO"
+        if ok == "skip":
+            unchecked.append(f"{Path(f).name} face {i}")
     passed = faces - bad - len(unchecked)
-    print(f"{passed} of {faces} faces passed in {len(files)} file(s)" + (f"; rows in {args.csv}" if args.csv else ""))
+    resumed = f" ({args.skipped} already in {args.csv})" if args.skipped else ""
+    print(f"{passed} of {faces} faces passed in {len(files)} file(s){resumed}" + (f"; rows in {args.csv}" if args.csv else ""))
     if unchecked:
         shown = ", ".join(unchecked[:20]) + (f" and {len(unchecked) - 20} more" if len(unchecked) > 20 else "")
         print(f"partial: {len(unchecked)} of {faces} face(s) could not be checked: {shown}")
