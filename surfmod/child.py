@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import os
 import pickle
+import select
+import struct
 import subprocess
 import sys
 import threading
@@ -82,7 +84,7 @@ def call(fn, args: tuple, seconds: float, what: str, memory: float | None = None
         except subprocess.TimeoutExpired:
             request = None
             if time.monotonic() >= deadline:
-                failure = f"{what} did not finish within {seconds:.0f} s"
+                failure = f"{what} did not finish within {seconds:g} s"
             elif memory and resident_bytes(proc.pid) > memory:
                 failure = f"{what} held more than {memory / 2**30:.3g} GiB"
             else:
@@ -98,23 +100,117 @@ def call(fn, args: tuple, seconds: float, what: str, memory: float | None = None
     return value
 
 
+class Server:
+    """One child process that runs calls one after another, so that many short calls pay
+    the child's start (imports, compiled kernels loaded) once, not once each; a call
+    over its budget kills the child, and the next call starts a fresh one.  A child left
+    holding more than half the memory budget after a call is retired too, so what one
+    file's shapes leave behind never reaches the next file's budget.  Not shared between
+    threads (give each thread its own).
+
+    >>> server = Server()
+    >>> server.call(divmod, (7, 2), 60.0, "divmod"), server.call(divmod, (9, 4), 60.0, "divmod")
+    ((3, 1), (2, 1))
+    >>> server.close()
+    """
+
+    def __init__(self):
+        self.proc = None
+
+    def _start(self) -> None:
+        self.proc = subprocess.Popen([sys.executable, "-m", "surfmod.child", "--serve"], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        self.proc.stdin.write(_framed(pickle.dumps(list(sys.path))))
+
+    def close(self) -> None:
+        """End the child (it is killed: it may be inside a call that never returns)."""
+        if self.proc is not None:
+            self.proc.kill()
+            self.proc.wait()
+            self.proc = None
+
+    def call(self, fn, args: tuple, seconds: float, what: str, memory: float | None = None):
+        """:func:`call`'s contract, in the one child."""
+        if self.proc is None or self.proc.poll() is not None:
+            self._start()
+        try:
+            self.proc.stdin.write(_framed(pickle.dumps((fn, args))))
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            self.close()
+            raise ChildFailure(f"{what}: the child died before the call") from None
+        fd, deadline = self.proc.stdout.fileno(), time.monotonic() + seconds
+        while not select.select([fd], [], [], max(min(deadline - time.monotonic(), MEMORY_POLL), 0.0))[0]:
+            if time.monotonic() >= deadline:
+                failure = f"{what} did not finish within {seconds:g} s"
+            elif memory and resident_bytes(self.proc.pid) > memory:
+                failure = f"{what} held more than {memory / 2**30:.3g} GiB"
+            else:
+                continue
+            self.close()
+            raise ChildFailure(failure)
+        blob = _read_framed(fd)
+        if blob is None:
+            code = self.proc.wait()
+            self.proc = None
+            raise ChildFailure(f"{what} died (exit code {code})")
+        held = resident_bytes(self.proc.pid) if memory else 0.0
+        if held > memory / 2 if memory else False:
+            self.close()
+        if held > memory if memory else False:  # between two looks, or at the end: over all the same
+            raise ChildFailure(f"{what} held more than {memory / 2**30:.3g} GiB")
+        kind, value = pickle.loads(blob)
+        if kind == "raised":
+            raise value
+        return value
+
+
+def _framed(blob: bytes) -> bytes:
+    return struct.pack("<Q", len(blob)) + blob
+
+
+def _read_exact(fd, n: int) -> bytes | None:
+    parts, left = [], n
+    while left:
+        part = os.read(fd, min(left, 1 << 20)) if isinstance(fd, int) else fd.read(left)
+        if not part:
+            return None
+        parts.append(part)
+        left -= len(part)
+    return b"".join(parts)
+
+
+def _read_framed(fd) -> bytes | None:
+    """One length-prefixed message from a descriptor or a binary stream; None at its end."""
+    header = _read_exact(fd, 8)
+    return None if header is None else _read_exact(fd, struct.unpack("<Q", header)[0])
+
+
+def _answer(fn, args) -> bytes:
+    try:
+        value = ("ok", fn(*args))
+    except BaseException as exc:  # noqa: BLE001 - sent to the parent, which re-raises it
+        value = ("raised", exc)
+    try:
+        return pickle.dumps(value)
+    except (pickle.PicklingError, TypeError, AttributeError) as exc:
+        return pickle.dumps(("raised", RuntimeError(f"{type(value[1]).__name__}: {value[1]} ({exc})")))
+
+
 def _main() -> None:
     die_with(os.getppid())  # a caller killed (or a Dask worker) takes its child with it
     # the reply goes to a private copy of stdout: a library may write to descriptor 1
     reply = os.fdopen(os.dup(1), "wb")
     os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
     stream = sys.stdin.buffer
+    if sys.argv[1:] == ["--serve"]:  # Server: framed calls until the parent closes the pipe
+        sys.path[:] = pickle.loads(_read_framed(stream))
+        while (request := _read_framed(stream)) is not None:
+            reply.write(_framed(_answer(*pickle.loads(request))))
+            reply.flush()
+        return
     sys.path[:] = pickle.load(stream)
-    fn, args = pickle.load(stream)
-    try:
-        value = ("ok", fn(*args))
-    except BaseException as exc:  # noqa: BLE001 - sent to the parent, which re-raises it
-        value = ("raised", exc)
-    try:
-        blob = pickle.dumps(value)
-    except (pickle.PicklingError, TypeError, AttributeError) as exc:
-        blob = pickle.dumps(("raised", RuntimeError(f"{type(value[1]).__name__}: {value[1]} ({exc})")))
-    reply.write(blob)
+    reply.write(_answer(*pickle.load(stream)))
     reply.flush()
 
 

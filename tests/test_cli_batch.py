@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import shutil
+import time
 from pathlib import Path
 
 import pytest
@@ -98,3 +99,102 @@ def test_resume_needs_the_csv_of_the_same_command(tmp_path, capsys):
     assert main(["check", str(folder), "--csv", str(rows_path), "--resume", "--no-progress"]) == 1
     err = capsys.readouterr().err
     assert "not a file of this command to resume" in err and err.count("\n") == 1
+
+
+def _cli(*args):
+    """``surfmod ARGS`` as a separate process (the client a test can kill)."""
+    import subprocess
+    import sys
+
+    code = "import sys; from surfmod.cli import main; sys.exit(main(sys.argv[1:]))"
+    return subprocess.Popen([sys.executable, "-c", code, *map(str, args)], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+
+
+def _rows_on_disk(path) -> list:
+    return list(csv.DictReader(path.open())) if path.exists() else []
+
+
+def test_killed_client_leaves_no_worker_and_keeps_its_rows(tmp_path):
+    """``surfmod check DIR --jobs 2`` killed (SIGKILL) once its first file's rows are on
+    disk: its loky workers exit (they watch the client), and the rows of every file it
+    finished stay in the CSV, whole."""
+    import signal
+
+    psutil = pytest.importorskip("psutil")
+    folder, rows_path = _copies(tmp_path, 12), tmp_path / "rows.csv"
+    client = _cli("check", folder, "--jobs", 2, "--csv", rows_path, "--no-progress")
+    try:
+        # waits on the first file (counted in polls; the bound is a last resort for a stuck run)
+        for _ in range(3000):
+            if _rows_on_disk(rows_path) or client.poll() is not None:
+                break
+            time.sleep(0.1)
+        workers = psutil.Process(client.pid).children(recursive=True)
+        assert client.poll() is None and len(workers) >= 2
+    finally:
+        client.send_signal(signal.SIGKILL)
+        client.wait()
+    gone, alive = psutil.wait_procs(workers, timeout=60)
+    assert not alive, f"{len(alive)} worker(s) outlived their client: {[p.cmdline()[:3] for p in alive]}"
+    rows = _rows_on_disk(rows_path)
+    per_file = {}
+    for r in rows:
+        per_file[r["file"]] = per_file.get(r["file"], 0) + 1
+    assert 1 <= len(per_file) < 12 and set(per_file.values()) == {9}
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A local Dask cluster of 2 worker processes, one thread each."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
+        yield c
+
+
+def test_a_worker_killed_mid_run_loses_no_other_file(tmp_path, cluster):
+    """``surfmod check DIR --scheduler`` on 2 workers; one worker is killed (SIGKILL) once
+    the first file's rows are on disk and before the last: Dask runs its task again on
+    the other, and every file's 9 rows end in the CSV, all passing, exit 0."""
+    import os
+    import signal
+
+    import distributed
+
+    folder, rows_path = _copies(tmp_path, 8), tmp_path / "rows.csv"
+    with distributed.Client(cluster.scheduler_address) as c:
+        pids = list(c.run(os.getpid).values())
+    client = _cli("check", folder, "--scheduler", cluster.scheduler_address, "--csv", rows_path, "--no-progress")
+    try:
+        for _ in range(6000):  # polls until the first file is on disk (a last-resort bound)
+            if _rows_on_disk(rows_path) or client.poll() is not None:
+                break
+            time.sleep(0.05)
+        finished_at_kill = {r["file"] for r in _rows_on_disk(rows_path)}
+        os.kill(pids[0], signal.SIGKILL)
+        code = client.wait(timeout=600)
+    finally:
+        if client.poll() is None:
+            client.kill()
+    assert 1 <= len(finished_at_kill) < 8
+    rows = _rows_on_disk(rows_path)
+    per_file = {}
+    for r in rows:
+        per_file[Path(r["file"]).name] = per_file.get(Path(r["file"]).name, 0) + 1
+    assert per_file == {f"part{i:02d}.step": 9 for i in range(8)} and all(r["pass"] == "yes" for r in rows)
+    assert code == 0
+
+
+@pytest.mark.parametrize("flag, value, why", [("--task-seconds", "0.001", "did not finish within 0.001 s"),
+                                              ("--task-memory", "0.001", "held more than 0.001 GiB")])
+def test_a_task_over_budget_is_named_and_skipped(tmp_path, cluster, capsys, flag, value, why):
+    """On a cluster a file whose task goes over its time or memory budget is one row
+    naming the file and the budget (its child process killed, the worker spared, no
+    retry); the run ends, exit 3 (partial)."""
+    folder, rows_path = _copies(tmp_path, 2), tmp_path / "rows.csv"
+    assert main(["check", str(folder), "--scheduler", cluster.scheduler_address, flag, value, "--csv", str(rows_path),
+                 "--no-progress"]) == 3
+    rows = _rows_on_disk(rows_path)
+    assert len(rows) == 2 and all(r["face"] == "-1" and r["pass"] == "skip" for r in rows)
+    assert all(r["note"] == f"skipped: the task of {r['file']} {why}" for r in rows), rows
+    assert "partial: 2 of 2 face(s) could not be checked" in capsys.readouterr().out

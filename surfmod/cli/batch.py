@@ -12,8 +12,8 @@ What a run of ten thousand files needs besides:
   or Ctrl-C loses nothing finished, and ``--resume`` skips the files already there;
 * local workers (loky) watch the client and exit when it is gone, so a killed client
   leaves no orphan process behind;
-* on a cluster each task runs in a child process of its worker (:func:`surfmod.child.call`)
-  within a time and a memory budget (``--task-seconds``, ``--task-memory``): a file over
+* on a cluster each task runs in a child process of its worker thread (one child serves
+  the thread's tasks in turn, :class:`surfmod.child.Server`) within a time and a memory budget (``--task-seconds``, ``--task-memory``): a file over
   budget is named and skipped, the worker lives on, and the file's shapes die with the
   child; a task that kills its worker (Dask gives up after its ``allowed-failures``) is
   named and skipped too, never retried for ever.
@@ -26,6 +26,7 @@ import functools
 import io
 import os
 import sys
+import threading
 from pathlib import Path
 
 from joblib import Parallel, delayed
@@ -114,16 +115,22 @@ def _dask(job, files, options, address, failed_row, seconds, memory):
         client.close()
 
 
+_servers = threading.local()
+
+
 def budgeted(job, path, options, seconds, memory, failed_row):
-    """``job(path, **options)`` in a child process of this (worker) process within
+    """``job(path, **options)`` in a child process of this (worker) thread, within
     ``seconds`` and ``memory`` bytes; over budget (or dead), the file's one row from
-    ``failed_row(path, message)`` naming the budget.
+    ``failed_row(path, message)`` naming the budget.  The child serves the thread's
+    tasks one after another (:class:`surfmod.child.Server`): its start is paid once.
 
     >>> budgeted(_example_job, "a.step", {}, 60.0, None, lambda p, m: [(p, m)])
     [('a.step', 1)]
     """
+    server = getattr(_servers, "server", None) or child.Server()
+    _servers.server = server
     try:
-        return child.call(functools.partial(job, **options), (path,), seconds, f"the task of {path}", memory)
+        return server.call(functools.partial(job, **options), (path,), seconds, f"the task of {path}", memory)
     except child.ChildFailure as exc:
         return [failed_row(path, f"skipped: {exc}")]
 
