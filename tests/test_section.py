@@ -181,3 +181,56 @@ def test_failed_export_keeps_existing_file(tmp_path):
     with pytest.raises(sm.SurfmodError, match="path"):
         sm.export_dxf([np.zeros((3, 2))], tmp_path / "x.txt")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.dxf"]
+
+
+# -- the command judges its own DXF: its length is BRepAlgoAPI_Section's ---------------------------
+def _section_command(path, tmp_path, normal=(0.1, 0.2, 1.0)):
+    """``surfmod section`` through the part's box centre; (exit code, stdout, DXF path)."""
+    from surfmod.cli import main
+    from surfmod.occ.properties import bounding_box
+
+    centre = bounding_box(sm.import_step(path).wrapped).mean(axis=0)
+    out = tmp_path / "s.dxf"
+    code = main(["section", str(path), "--origin", *map(repr, map(float, centre)), "--normal", *map(str, normal),
+                 "--out", str(out), "--no-progress"])
+    return code, out, centre
+
+
+def test_section_command_exit_0_only_on_a_dxf_as_long_as_occts(tmp_path, monkeypatch, capsys):
+    """A DXF that lost one entity on the way out (simulated after the writer) is caught by
+    the command's own judge: exit 3 naming both lengths; the intact DXF exits 0 and its
+    length (independent reader, tests' own) is BRepAlgoAPI_Section's to 1e-12."""
+    import ezdxf
+    import surfmod.io.dxf as io_dxf
+    from conftest import CORPUS
+    from test_corpus_readback import dxf_length
+
+    path = CORPUS / "nist_ctc_01_asme1_rd.stp"
+    code, out, centre = _section_command(path, tmp_path)
+    assert code == 0 and "DXF NOT EQUAL" not in capsys.readouterr().out
+    normal = np.array([0.1, 0.2, 1.0])
+    assert dxf_length(out) == pytest.approx(_occt_length(sm.import_step(path), centre, normal / np.linalg.norm(normal)),
+                                            rel=1e-12)
+    real = io_dxf.export_dxf
+
+    def losing(curves, target, **kw):
+        written = real(curves, target, **kw)
+        doc = ezdxf.readfile(target)
+        doc.modelspace().delete_entity(list(doc.modelspace())[-1])
+        doc.saveas(target)
+        return written
+
+    monkeypatch.setattr(io_dxf, "export_dxf", losing)
+    code, out, _ = _section_command(path, tmp_path)
+    printed = capsys.readouterr().out
+    assert code == 3 and "DXF NOT EQUAL TO THE SECTION: its entities are" in printed, printed
+
+
+@pytest.mark.corpus
+def test_section_command_judges_every_corpus_file(corpus_file, tmp_path, capsys):
+    """Exit 0 (the judge passed: DXF length = BRepAlgoAPI_Section's within 1e-11) or 1 for
+    a plane missing the part, on every corpus file."""
+    code, out, _ = _section_command(corpus_file, tmp_path)
+    assert code in (0, 1), capsys.readouterr()
+    if code == 1:
+        assert "misses the part" in capsys.readouterr().err
