@@ -198,3 +198,34 @@ def test_a_task_over_budget_is_named_and_skipped(tmp_path, cluster, capsys, flag
     assert len(rows) == 2 and all(r["face"] == "-1" and r["pass"] == "skip" for r in rows)
     assert all(r["note"] == f"skipped: the task of {r['file']} {why}" for r in rows), rows
     assert "partial: 2 of 2 face(s) could not be checked" in capsys.readouterr().out
+
+
+def test_mass_folder_rows_and_resume(tmp_path, capsys):
+    """``surfmod mass DIR``: one row per file with the volume (a box with a hole: closed
+    form) and the verdict; an unreadable file is its own row (exit 1); ``--resume`` keeps
+    the rows and measures nothing again."""
+    import math
+
+    import build123d as bd
+
+    import surfmod as sm
+
+    folder, rows_path = tmp_path / "parts", tmp_path / "mass.csv"
+    folder.mkdir()
+    sm.export_step(bd.Box(4, 3, 2) - bd.Cylinder(1, 3), folder / "a.step")
+    sm.export_step(bd.Pos(10, 0, 0) * bd.Box(1, 2, 3), folder / "b.step")
+    args = ["mass", str(folder), "--csv", str(rows_path), "--jobs", "1", "--no-progress"]
+    assert main(args) == 0
+    rows = {Path(r["file"]).name: r for r in csv.DictReader(rows_path.open())}
+    assert float(rows["a.step"]["volume"]) == pytest.approx(24 - 2 * math.pi, rel=1e-12)
+    assert float(rows["b.step"]["cx"]) == pytest.approx(10, rel=1e-12) and float(rows["b.step"]["volume"]) == pytest.approx(6)
+    assert all(r["exit"] == "0" and r["verdict"].startswith("AGREE") for r in rows.values())
+    assert "2 of 2 file(s) settled (exit 0)" in capsys.readouterr().out
+    (folder / "c.step").write_text("ISO-10303-21; broken")
+    assert main([*args, "--resume"]) == 1
+    rows = {Path(r["file"]).name: r for r in csv.DictReader(rows_path.open())}
+    assert len(rows) == 3 and rows["c.step"]["exit"] == "1" and rows["c.step"]["verdict"].startswith("error:")
+    assert "2 of 3 file(s) settled (exit 0) (2 already in" in capsys.readouterr().out
+    # one file, no folder: the command as before
+    assert main(["mass", str(folder / "a.step"), "--no-progress"]) == 0
+    assert "AGREE" in capsys.readouterr().out
