@@ -59,6 +59,11 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.run(args) or 0)
+    except KeyboardInterrupt:
+        # Ctrl-C: what was finished is written (a folder's CSV holds every finished file's
+        # rows); one line and the shell's status for SIGINT, not a traceback
+        print(f"surfmod {args.command}: interrupted", file=sys.stderr)
+        return 130
     except SurfmodError as exc:
         # one line, no traceback: bad input is the user's to fix, not a crash; a message
         # about a part that does not say which file it read gets the file appended
