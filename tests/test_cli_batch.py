@@ -111,6 +111,16 @@ def _cli(*args):
                             stderr=subprocess.DEVNULL)
 
 
+def _command_line(process) -> str:
+    """A psutil process's command line, "" once it has gone (it may end while listed)."""
+    import psutil
+
+    try:
+        return " ".join(process.cmdline())
+    except psutil.Error:
+        return ""
+
+
 def _rows_on_disk(path) -> list:
     return list(csv.DictReader(path.open())) if path.exists() else []
 
@@ -136,7 +146,7 @@ def test_killed_client_leaves_no_worker_and_keeps_its_rows(tmp_path):
         client.send_signal(signal.SIGKILL)
         client.wait()
     gone, alive = psutil.wait_procs(workers, timeout=60)
-    assert not alive, f"{len(alive)} worker(s) outlived their client: {[p.cmdline()[:3] for p in alive]}"
+    assert not alive, f"{len(alive)} worker(s) outlived their client: {[_command_line(p) for p in alive]}"
     rows = _rows_on_disk(rows_path)
     per_file = {}
     for r in rows:
@@ -229,3 +239,44 @@ def test_mass_folder_rows_and_resume(tmp_path, capsys):
     # one file, no folder: the command as before
     assert main(["mass", str(folder / "a.step"), "--no-progress"]) == 0
     assert "AGREE" in capsys.readouterr().out
+
+
+LOCAL_CLUSTER_CLIENT = """
+import sys, distributed
+from surfmod.cli import main
+if __name__ == "__main__":
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
+        sys.exit(main(["check", sys.argv[1], "--scheduler", c.scheduler_address, "--csv", sys.argv[2], "--no-progress"]))
+"""
+
+
+def test_killed_client_of_its_own_local_cluster_leaves_no_process(tmp_path):
+    """A script that starts a local Dask cluster and runs ``surfmod check`` on it, killed
+    (SIGKILL) once the first file's rows are on disk: its nannies, workers and the
+    workers' surfmod children all end (Dask's nannies watch their parent, surfmod's
+    children watch theirs); the finished files' rows stay."""
+    import signal
+    import subprocess
+    import sys
+
+    psutil = pytest.importorskip("psutil")
+    pytest.importorskip("distributed")
+    folder, rows_path = _copies(tmp_path, 12), tmp_path / "rows.csv"
+    script = tmp_path / "client.py"
+    script.write_text(LOCAL_CLUSTER_CLIENT)
+    client = subprocess.Popen([sys.executable, str(script), str(folder), str(rows_path)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    try:
+        for _ in range(6000):  # polls until the first file is on disk (a last-resort bound)
+            if _rows_on_disk(rows_path) or client.poll() is not None:
+                break
+            time.sleep(0.05)
+        below = psutil.Process(client.pid).children(recursive=True)
+        assert client.poll() is None
+        assert sum("surfmod.child" in _command_line(p) for p in below) >= 1  # a worker's child is serving
+    finally:
+        client.send_signal(signal.SIGKILL)
+        client.wait()
+    gone, alive = psutil.wait_procs(below, timeout=60)
+    assert not alive, f"{len(alive)} process(es) outlived their client: {[_command_line(p) for p in alive]}"
+    assert 1 <= len({r["file"] for r in _rows_on_disk(rows_path)}) < 12
