@@ -85,7 +85,8 @@ def test_check_csv_keeps_finished_files_and_resumes(tmp_path, monkeypatch, capsy
     assert seen == ["part02.step", "part03.step"]
     assert "36 of 36 faces passed in 4 file(s) (2 already in" in capsys.readouterr().out
     rows = list(csv.DictReader(rows_path.open()))
-    assert len(rows) == 4 * 9 and len({(r["file"], r["face"]) for r in rows}) == 36 and all(r["pass"] == "yes" for r in rows)
+    assert len(rows) == 4 * 9 and len({(r["file"], r["face"]) for r in rows}) == 36
+    assert all(r["pass"] == "yes" for r in rows)
     # a resumed run with nothing left to do checks nothing
     seen.clear()
     assert main([*args, "--resume"]) == 0 and seen == []
@@ -228,7 +229,8 @@ def test_mass_folder_rows_and_resume(tmp_path, capsys):
     assert main(args) == 0
     rows = {Path(r["file"]).name: r for r in csv.DictReader(rows_path.open())}
     assert float(rows["a.step"]["volume"]) == pytest.approx(24 - 2 * math.pi, rel=1e-12)
-    assert float(rows["b.step"]["cx"]) == pytest.approx(10, rel=1e-12) and float(rows["b.step"]["volume"]) == pytest.approx(6)
+    assert float(rows["b.step"]["cx"]) == pytest.approx(10, rel=1e-12)
+    assert float(rows["b.step"]["volume"]) == pytest.approx(6, rel=1e-12)
     assert all(r["exit"] == "0" and r["verdict"].startswith("AGREE") for r in rows.values())
     assert "2 of 2 file(s) settled (exit 0)" in capsys.readouterr().out
     (folder / "c.step").write_text("ISO-10303-21; broken")
@@ -246,7 +248,8 @@ import sys, distributed
 from surfmod.cli import main
 if __name__ == "__main__":
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
-        sys.exit(main(["check", sys.argv[1], "--scheduler", c.scheduler_address, "--csv", sys.argv[2], "--no-progress"]))
+        sys.exit(main(["check", sys.argv[1], "--scheduler", c.scheduler_address, "--csv", sys.argv[2],
+                       "--no-progress"]))
 """
 
 

@@ -13,10 +13,11 @@ What a run of ten thousand files needs besides:
 * local workers (loky) watch the client and exit when it is gone, so a killed client
   leaves no orphan process behind;
 * on a cluster each task runs in a child process of its worker thread (one child serves
-  the thread's tasks in turn, :class:`surfmod.child.Server`) within a time and a memory budget (``--task-seconds``, ``--task-memory``): a file over
-  budget is named and skipped, the worker lives on, and the file's shapes die with the
-  child; a task that kills its worker (Dask gives up after its ``allowed-failures``) is
-  named and skipped too, never retried for ever.
+  the thread's tasks in turn, :class:`surfmod.child.Server`) within a time and a memory
+  budget (``--task-seconds``, ``--task-memory``): a file over budget is named and
+  skipped, the worker lives on, and the child goes with the file's shapes; a task that
+  kills its worker (Dask gives up after its ``allowed-failures``) is named and skipped
+  too, never retried for ever.
 """
 
 from __future__ import annotations
@@ -254,7 +255,8 @@ def add_batch_arguments(parser, rows: str = "one row per file") -> None:
     parser.add_argument("--resume", action="store_true",
                         help="keep the rows already in --csv and skip their files (after a crash or Ctrl-C)")
     parser.add_argument("--task-seconds", type=float, default=TASK_SECONDS,
-                        help=f"with --scheduler: a file's task is skipped after this many seconds (default {TASK_SECONDS:g})")
+                        help="with --scheduler: a file's task is skipped after this many seconds "
+                             f"(default {TASK_SECONDS:g})")
     parser.add_argument("--task-memory", type=float, default=TASK_MEMORY_GIB,
                         help=f"with --scheduler: a file's task is skipped above this many GiB resident (default "
                              f"{TASK_MEMORY_GIB:g})")
@@ -328,7 +330,8 @@ def run_mesh(args) -> int:
         total += 1
         bad += str(row[4]).startswith("error") or row[2] != "yes"
     resumed = f" ({args.skipped} already in {args.csv})" if args.skipped else ""
-    print(f"{total - bad} of {total} file(s) meshed watertight{resumed}" + (f"; rows in {args.csv}" if args.csv else ""))
+    print(f"{total - bad} of {total} file(s) meshed watertight{resumed}"
+          + (f"; rows in {args.csv}" if args.csv else ""))
     return 1 if bad else 0
 
 

@@ -147,7 +147,8 @@ def run(args) -> int:
             unchecked.append(f"{Path(f).name} face {i}")
     passed = faces - bad - len(unchecked)
     resumed = f" ({args.skipped} already in {args.csv})" if args.skipped else ""
-    print(f"{passed} of {faces} faces passed in {len(files)} file(s){resumed}" + (f"; rows in {args.csv}" if args.csv else ""))
+    print(f"{passed} of {faces} faces passed in {len(files)} file(s){resumed}"
+          + (f"; rows in {args.csv}" if args.csv else ""))
     if unchecked:
         shown = ", ".join(unchecked[:20]) + (f" and {len(unchecked) - 20} more" if len(unchecked) > 20 else "")
         print(f"partial: {len(unchecked)} of {faces} face(s) could not be checked: {shown}")

@@ -184,7 +184,8 @@ class Section:
     def __str__(self) -> str:
         if self.empty:
             return "section: empty (the plane misses the part)"
-        on = f"; the plane lies on planar face(s) {list(self.faces_on)}: their outline included" if self.faces_on else ""
+        on = (f"; the plane lies on planar face(s) {list(self.faces_on)}: their outline included"
+              if self.faces_on else "")
         skipped = (f"; {len(self.faces_skipped)} face(s) OCCT could not intersect left out: "
                    f"{sorted(self.faces_skipped)}" if self.faces_skipped else "")
         return (f"section: {len(self.wires)} curve(s), {sum(self.closed)} closed, total length {self.length:.9g}"
