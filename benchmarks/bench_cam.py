@@ -32,11 +32,11 @@ import os
 import sys
 import time
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
 import surfmod as sm
+from surfmod.cam.cutters import CUTTERS
 from surfmod.cam.drop_cutter import TriangleGrid, drop
 from surfmod.cam.waterline import waterline
 from surfmod.errors import SurfmodError
@@ -109,7 +109,7 @@ def rows():
         levels = lo[2] + (hi[2] - lo[2]) * (np.arange(LEVELS) + 0.5) / LEVELS
         xy = lo[:2] + np.random.default_rng(7).random((POINTS, 2)) * (hi - lo)[:2]
         for kind, R, r in TOOLS:
-            tool = SimpleNamespace(kind=kind, radius=R, corner_radius=r)
+            tool = CUTTERS[kind](R, r)
             cutter = _ocl_cutter(ocl, kind, R, r)
             # waterline
             t0 = time.perf_counter()
@@ -139,7 +139,7 @@ def rows():
             # drop-cutter
             try:
                 t0 = time.perf_counter()
-                z_ours = drop(TriangleGrid(tri, R), kind, xy, corner=r)
+                z_ours = drop(TriangleGrid(tri, R), tool, xy)
                 t_ours = time.perf_counter() - t0
             except (SurfmodError, TypeError):  # a kind this surfmod.cam does not drop yet
                 yield name, kind, "drop-cutter", "not in surfmod.cam yet", float("nan"), float("nan"), ""

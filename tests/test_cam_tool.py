@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
+from surfmod.cam.cutters import Ball, Bull, Flat
 from surfmod.cam.drop_cutter import TriangleGrid, drop
 from surfmod.cam.tool import load_tool_table, parse_tool
 from surfmod.cam.toolpath import drop_cutter
@@ -38,7 +39,7 @@ def test_bull_drop_brute_force():
     tri = rng.uniform(-3, 3, (3, 3, 3))
     R, c = 1.5, 0.5
     xy = rng.uniform(-2.5, 2.5, (12, 2))
-    z = drop(TriangleGrid(tri, R), "bull", xy, corner=c)
+    z = drop(TriangleGrid(tri, R), Bull(R, c), xy)
     for q, zq in zip(xy, z):
         ref = brute_bull(tri, q, R, c)
         if np.isfinite(ref):
@@ -51,9 +52,9 @@ def test_bull_limits_are_ball_and_flat():
     tri = rng.uniform(-4, 4, (20, 3, 3))
     xy = rng.uniform(-4, 4, (500, 2))
     grid = TriangleGrid(tri, 2.0)
-    ball, flat = drop(grid, "ball", xy), drop(grid, "flat", xy)
-    near_ball = drop(grid, "bull", xy, corner=2.0 * (1 - 1e-9))
-    near_flat = drop(grid, "bull", xy, corner=1e-9)
+    ball, flat = drop(grid, Ball(2.0), xy), drop(grid, Flat(2.0), xy)
+    near_ball = drop(grid, Bull(2.0, 2.0 * (1 - 1e-9)), xy)
+    near_flat = drop(grid, Bull(2.0, 1e-9), xy)
     assert np.nanmax(np.abs(near_ball - ball)) < 1e-6
     assert np.nanmax(np.abs(near_flat - flat)) < 1e-6
 
@@ -88,7 +89,7 @@ def test_bull_equals_opencamlib(tmp_path):
     subprocess.run([sys.executable, "-c", OCL_SCRIPT, str(tmp_path / "in.npz"), str(tmp_path / "out.npy")],
                    check=True, timeout=300)
     ref = np.load(tmp_path / "out.npy")
-    z = drop(TriangleGrid(tri, R), "bull", xy, corner=c)
+    z = drop(TriangleGrid(tri, R), Bull(R, c), xy)
     z = np.where(np.isnan(z), -100, z)
     assert (ref > -100).sum() > 1500
     # OCL solves the torus-edge contact iteratively to ~1e-10

@@ -503,3 +503,53 @@ def test_mass_stages_call_only_earlier_stages():
                 bad.append(f"surfmod.mass.{stage}:{line} imports {target}")
     assert not bad, bad
     assert sorted(MASS_STAGES) == sorted(n.rsplit(".", 1)[1] for n in MODULES if n.startswith("surfmod.mass."))
+
+
+# --- cutters: each cutter is a class of surfmod.cam.cutters; nothing else switches on its kind ----
+#: at most this many places (functions) of surfmod/cam choose by a cutter's kind: the compiled
+#: drop and push (their routines cannot be objects) and one spare
+MAX_KIND_SWITCHES = 3
+CUTTER_KINDS = {"ball", "bull", "flat"}
+
+
+def kind_switches(cam: Path) -> list[str]:
+    """``module:function`` of every place under ``cam`` that chooses by a cutter's kind: a
+    comparison with a kind's name or a compiled code (``BALL``, ``FLAT``, ``BULL``, ``.code``),
+    a dict keyed by kinds' names, or an ``isinstance`` on a cutter class."""
+
+    def marks(node) -> bool:
+        return ((isinstance(node, ast.Constant) and node.value in CUTTER_KINDS)
+                or (isinstance(node, ast.Name) and node.id in {"BALL", "FLAT", "BULL"})
+                or (isinstance(node, ast.Attribute) and node.attr == "code"))
+
+    def switches(node) -> bool:
+        if isinstance(node, ast.Compare):
+            return any(marks(n) for n in [node.left, *node.comparators])
+        if isinstance(node, ast.Dict):
+            return any(marks(k) for k in node.keys if k is not None)
+        return (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "isinstance"
+                and any(isinstance(n, ast.Name) and n.id in {"Ball", "Flat", "Bull"} for n in ast.walk(node.args[1])))
+
+    places = set()
+    for path in sorted(cam.rglob("*.py")):
+        def walk(node, where):
+            for child in ast.iter_child_nodes(node):
+                inner = child.name if isinstance(child, (ast.FunctionDef, ast.ClassDef)) else where
+                if switches(child):
+                    places.add(f"{path.stem}:{inner}")
+                walk(child, inner)
+
+        walk(ast.parse(path.read_text()), "<module>")
+    return sorted(places)
+
+
+def test_cutter_kind_is_chosen_in_few_places():
+    places = kind_switches(PACKAGE / "cam")
+    assert len(places) <= MAX_KIND_SWITCHES, places
+
+
+def test_a_kind_switch_is_found(tmp_path):
+    (tmp_path / "a.py").write_text('def f(tool):\n    return 1 if tool.kind == "ball" else 2\n'
+                                   'def g(code):\n    return {"flat": 0}.get(code) if code == BALL else 3\n'
+                                   'class C:\n    def h(self, c):\n        return isinstance(c, (Bull, int))\n')
+    assert kind_switches(tmp_path) == ["a:f", "a:g", "a:h"]

@@ -19,6 +19,7 @@ from surfmod.occ import triangulation
 from surfmod.occ.triangulation import part_triangles
 from surfmod.cam import toolpath as toolpath_module
 from surfmod.cam import toolpath_moves
+from surfmod.cam.cutters import CUTTERS, Ball, Flat
 from surfmod.cam.drop_cutter import TriangleGrid, drop
 from surfmod.inputs import to_shape
 from surfmod.cam.toolpath import drop_cutter
@@ -84,12 +85,12 @@ def test_triangle_features_closed_forms():
     tri = np.array([[[0, 0, 0], [10, 0, 0], [0, 10, 10]]], float)  # plane z = y
     grid = TriangleGrid(tri, 1.0)
     q = np.array([[3.0, 3.0], [5.0, -0.9], [-0.6, -0.8]])
-    ball = drop(grid, "ball", q)
+    ball = drop(grid, Ball(1.0), q)
     # facet: centre r along the normal (0, -1, 1)/√2: tip = y + r√2 − r; at y = -0.9 the
     # facet contact would lie outside, the level edge y = z = 0 holds the ball:
     # tip = sqrt(r² − 0.9²) − r; vertex at the origin, d = 1: tip = −r
     assert ball == pytest.approx([3 + math.sqrt(2) - 1, math.sqrt(1 - 0.81) - 1, -1.0], abs=1e-14)
-    flat = drop(grid, "flat", q)
+    flat = drop(grid, Flat(1.0), q)
     # flat: the rim point uphill (y + r) on the facet; at (-0.6, -0.8) only the vertex at
     # distance exactly r touches
     assert flat == pytest.approx([4.0, 0.1, 0.0], abs=1e-14)
@@ -141,7 +142,7 @@ def test_opencamlib_cross_check_on_corpus_part(corpus_dir, tmp_path, kind):
     r = 3.0
     lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
     xy = lo[:2] + np.random.default_rng(1).random((1500, 2)) * (hi - lo)[:2]
-    z = drop(TriangleGrid(tri, r), kind, xy)
+    z = drop(TriangleGrid(tri, r), CUTTERS[kind](r), xy)
     stl = tmp_path / "part.stl"
     facets = "".join("facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x!r} {y!r} {w!r}\n" for x, y, w in t.tolist())
                      + "endloop\nendfacet\n" for t in tri.astype(np.float32))

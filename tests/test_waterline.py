@@ -8,7 +8,6 @@ OCL's own drop-cutter)."""
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -16,8 +15,9 @@ from ocl_reference import drop as ocl_drop
 from ocl_reference import polyline_distance
 from ocl_reference import waterline as ocl_waterline
 
-from surfmod.cam.drop_cutter import TriangleGrid, drop
-from surfmod.cam.fiber_contact import intervals
+from surfmod.cam.cutters import cutter
+from surfmod.cam.drop_cutter import TriangleGrid, drop, triangle_rows
+from surfmod.cam.fiber_contact import pair_intervals
 from surfmod.cam.waterline import waterline
 from surfmod.errors import SurfmodError
 
@@ -25,7 +25,7 @@ CORPUS_PART = "trimesh_featuretype.STEP"
 
 
 def tool(kind, R, r=0.0):
-    return SimpleNamespace(kind=kind, radius=R, corner_radius=r)
+    return cutter(kind, R, r)
 
 
 def radius_at(kind, R, r, h):
@@ -183,6 +183,12 @@ def test_bad_input_and_bounds():
         waterline(square(1000.0), tool("ball", 1.0), np.zeros(50), sampling=1e-3)
 
 
+def intervals(tri, ox, oy, dx, dy, z, shape):
+    """``(t0, t1)`` per pair: where ``shape`` pushed along the pair's fiber ``o + t d`` at
+    tip height ``z`` meets the pair's triangle ``tri`` ``(P, 3, 3)``."""
+    return pair_intervals(triangle_rows(tri), np.arange(len(tri)), ox, oy, dx, dy, z, shape)
+
+
 @pytest.mark.parametrize("kind, R, r", [("ball", 1.5, 1.5), ("flat", 1.5, 0.0), ("bull", 1.5, 0.6)])
 def test_fiber_intervals_are_where_the_dropped_tool_reaches_z(kind, R, r):
     """Per (fiber, triangle) pair the interval is exactly where the tool at tip height z
@@ -202,7 +208,7 @@ def test_fiber_intervals_are_where_the_dropped_tool_reaches_z(kind, R, r):
     d = np.column_stack([np.cos(ang), np.sin(ang)])
     o = cell + rng.random((n, 2)) * 6 - 3 - 5 * d
     z = -0.5
-    t0, t1 = intervals(tri, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, kind, R, r)
+    t0, t1 = intervals(tri, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, cutter(kind, R, r))
     grid = TriangleGrid(tri, R)
     hit = t0 <= t1
     assert 0.3 < hit.mean() < 0.9
@@ -210,11 +216,12 @@ def test_fiber_intervals_are_where_the_dropped_tool_reaches_z(kind, R, r):
     # (a shank-bounded end is a jump, a profile-bounded one a square-root slope)
     step = 1e-9
     for t, inward in ((t0[hit], 1.0), (t1[hit], -1.0)):
-        h_in = drop(grid, kind, o[hit] + (t + inward * step)[:, None] * d[hit], corner=r)
-        h_out = np.nan_to_num(drop(grid, kind, o[hit] + (t - inward * step)[:, None] * d[hit], corner=r), nan=-np.inf)
+        h_in = drop(grid, cutter(kind, R, r), o[hit] + (t + inward * step)[:, None] * d[hit])
+        h_out = np.nan_to_num(drop(grid, cutter(kind, R, r), o[hit] + (t - inward * step)[:, None] * d[hit]),
+                              nan=-np.inf)
         assert h_in.min() > z - 1e-4 and h_out.max() < z + 1e-4
     ts = np.linspace(-1.0, 11.0, 49)
-    h = drop(grid, kind, (o[:, None, :] + ts[None, :, None] * d[:, None, :]).reshape(-1, 2), corner=r)
+    h = drop(grid, cutter(kind, R, r), (o[:, None, :] + ts[None, :, None] * d[:, None, :]).reshape(-1, 2))
     h = np.nan_to_num(h, nan=-np.inf).reshape(n, len(ts))
     inside = (ts[None, :] >= t0[:, None]) & (ts[None, :] <= t1[:, None])
     assert not np.any(inside & (h < z - 1e-9))
@@ -263,13 +270,11 @@ def test_equals_opencamlib_waterline(tmp_path, corpus_triangles, kind, R, r):
 def test_drop_cutter_equals_opencamlib(tmp_path, corpus_triangles, kind, R, r):
     """surfmod.cam's drop-cutter heights (the waterline's companion for the tool's other
     direction) equal OCL's BatchDropCutter on the same triangles, ball, flat and bull."""
-    from surfmod.cam.drop_cutter import TriangleGrid, drop
-
     tri = corpus_triangles
     pts = tri.reshape(-1, 3)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     xy = lo[:2] + np.random.default_rng(3).random((2000, 2)) * (hi - lo)[:2]
-    ours = drop(TriangleGrid(tri, R), kind, xy, corner=r)
+    ours = drop(TriangleGrid(tri, R), cutter(kind, R, r), xy)
     floor = float(lo[2]) - 100.0
     theirs, _ = ocl_drop(tmp_path, tri, kind, R, r, xy, floor)
     miss = np.isnan(ours)

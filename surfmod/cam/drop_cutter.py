@@ -40,12 +40,12 @@ import numpy as np
 from numba import njit
 
 from ..errors import SurfmodError
+from .cutters import Ball, Cutter, Flat
 
 # Barycentric slack for "contact inside the triangle": neighbouring triangles share the
 # edge anyway, so a hair of overlap never adds a wrong contact.
 INSIDE_SLACK = 1e-12
-#: tool kinds as the compiled kernel numbers them
-KINDS = {"ball": 0, "flat": 1, "bull": 2}
+BALL, FLAT = Ball.code, Flat.code  # the cutters' numbers, globals frozen into the compiled code
 
 
 class TriangleGrid:
@@ -320,38 +320,33 @@ def _bull(qx, qy, t, r, c, contact):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _height(kind, qx, qy, t, r, c, contact):
-    if kind == 0:
-        return _ball(qx, qy, t, r, contact)
-    if kind == 1:
-        return _flat(qx, qy, t, r, contact)
-    return _bull(qx, qy, t, r, c, contact)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _reach(kind, qx, qy, lo, hi, top, r, c):
-    """Upper bound of the tip height a triangle can give at (qx, qy): its highest vertex,
-    lifted (ball) by how far the ball can rise over the nearest point of its (x, y) box
-    (``lo``, ``hi``: the box grown by ``r``); -inf when the box is out of reach."""
+def _drop_triangle(code, qx, qy, rows, ti, lo, hi, top, r, c, best, contact):
+    """Tip height of the cutter ``code`` at (qx, qy) on the triangle ``rows[ti]`` (the one
+    choice of a cutter's routine here), or -inf when it cannot beat ``best``: no higher
+    than the triangle's top, lifted (ball) or lowered (bull) by the profile over the
+    nearest point of its (x, y) box (``lo``, ``hi``: the box grown by ``r``)."""
     gx = max(max(lo[0] + r - qx, qx - hi[0] + r), 0.0)
     gy = max(max(lo[1] + r - qy, qy - hi[1] + r), 0.0)
     d2 = gx * gx + gy * gy
     r2 = r * r
-    if d2 > r2:
-        return -np.inf
-    if kind == 0:
-        return top + np.sqrt(max(r2 - d2, 0.0)) - r
-    if kind == 2:  # no point nearer than the box can lift the tip more than the profile there
-        return top - min(_bull_profile(np.sqrt(d2), r - c, c), c)
-    return top
+    reach = -np.inf if d2 > r2 else top
+    if code == BALL:
+        if d2 <= r2:
+            reach = top + np.sqrt(max(r2 - d2, 0.0)) - r
+        return -np.inf if reach < best else _ball(qx, qy, rows[ti], r, contact)
+    if code == FLAT:
+        return -np.inf if reach < best else _flat(qx, qy, rows[ti], r, contact)
+    if d2 <= r2:  # no point nearer than the box can lift the tip more than the profile there
+        reach = top - min(_bull_profile(np.sqrt(d2), r - c, c), c)
+    return -np.inf if reach < best else _bull(qx, qy, rows[ti], r, c, contact)
 
 
 @njit(cache=True, error_model="numpy")
-def _drop_kernel(kind, xy, start, stop, tris, rows, lo, hi, top, r, c, z, touch, touched):
+def _drop_kernel(code, xy, start, stop, tris, rows, lo, hi, top, r, c, z, touch, touched):
     """Per location: the highest tip height over its cell list, its contact and triangle.
 
     The list runs from the highest triangle top down, and no triangle lifts the tip above
-    its top (:func:`_reach`, a tighter bound, skips the rest before any contact is
+    its top (:func:`_drop_triangle`'s tighter bound skips the rest before any contact is
     solved), so the walk stops at the first top below the height found: on a fine mesh
     most of a list is never read.  Of equal heights the first found wins."""
     contact = np.empty(3)
@@ -364,9 +359,7 @@ def _drop_kernel(kind, xy, start, stop, tris, rows, lo, hi, top, r, c, z, touch,
                 break
             if not (lo[ti, 0] <= qx <= hi[ti, 0] and lo[ti, 1] <= qy <= hi[ti, 1]):
                 continue
-            if _reach(kind, qx, qy, lo[ti], hi[ti], top[ti], r, c) < best:
-                continue
-            h = _height(kind, qx, qy, rows[ti], r, c, contact)
+            h = _drop_triangle(code, qx, qy, rows, ti, lo[ti], hi[ti], top[ti], r, c, best, contact)
             if h > best:
                 best, winner = h, ti
                 touch[i, 0], touch[i, 1], touch[i, 2] = contact[0], contact[1], contact[2]
@@ -374,28 +367,25 @@ def _drop_kernel(kind, xy, start, stop, tris, rows, lo, hi, top, r, c, z, touch,
         touched[i] = winner
 
 
-def drop(grid: TriangleGrid, kind: str, xy: np.ndarray, *, contacts: bool = False, triangles: bool = False,
-         corner: float = 0.0):
-    """Tip heights ``(N,)`` (NaN where the tool touches nothing) of the ``kind`` (``"ball"``,
-    ``"flat"`` or ``"bull"`` of corner radius ``corner``) end mill of the grid's radius
-    dropped at ``xy`` (N, 2); with
-    ``contacts`` also the contact points ``(N, 3)``, with ``triangles`` also the index of
-    the touched triangle ``(N,)`` (-1 where none).
+def drop(grid: TriangleGrid, cutter: Cutter, xy: np.ndarray, *, contacts: bool = False, triangles: bool = False):
+    """Tip heights ``(N,)`` (NaN where the tool touches nothing) of ``cutter`` (of the
+    grid's radius) dropped at ``xy`` (N, 2); with ``contacts`` also the contact points
+    ``(N, 3)``, with ``triangles`` also the index of the touched triangle ``(N,)`` (-1
+    where none).
 
     >>> import numpy as np
+    >>> from surfmod.cam.cutters import Ball
     >>> tri = np.array([[[-5, -5, 2], [5, -5, 2], [0, 5, 2]]], float)
-    >>> drop(TriangleGrid(tri, 1.0), "ball", np.array([[0.0, 0.0], [20.0, 0.0]])).tolist()
+    >>> drop(TriangleGrid(tri, 1.0), Ball(1.0), np.array([[0.0, 0.0], [20.0, 0.0]])).tolist()
     [2.0, nan]
     """
-    if kind not in ("ball", "flat", "bull"):
-        raise SurfmodError(f"tool: kind must be 'ball', 'flat' or 'bull', got {kind!r}")
-    if kind == "bull" and not 0.0 < corner < grid.radius:
-        raise SurfmodError(f"corner_radius: must be > 0 and < the radius {grid.radius:g}, got {corner!r}")
+    if cutter.radius != grid.radius:
+        raise SurfmodError(f"cutter: radius {cutter.radius:g} differs from the grid's {grid.radius:g}")
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     start, stop = grid.segments(xy)
     z, touch = np.empty(len(xy)), np.full((len(xy), 3), np.nan)
     touched = np.empty(len(xy), dtype=np.int64)
-    _drop_kernel(KINDS[kind], np.ascontiguousarray(xy), start, stop, grid._tris, grid.rows, grid.lo, grid.hi,
-                 grid.top, grid.radius, float(corner), z, touch, touched)
+    _drop_kernel(cutter.code, np.ascontiguousarray(xy), start, stop, grid._tris, grid.rows, grid.lo, grid.hi,
+                 grid.top, grid.radius, cutter.corner, z, touch, touched)
     z[~np.isfinite(z)] = np.nan
     return (z,) + ((touch,) if contacts else ()) + ((touched,) if triangles else ()) if contacts or triangles else z

@@ -26,9 +26,9 @@ A ball of radius 1 along the x axis under a level triangle 1 above its tip: the
 triangle's x range [0, 1] grown by the radius.
 
 >>> import numpy as np
->>> tri = np.array([[[0, -1, 1], [0, 1, 1], [1, 0, 1]]], float)
->>> t0, t1 = intervals(tri, np.array([0.0]), np.array([0.0]), np.array([1.0]), np.array([0.0]), 0.0,
-...                    "ball", 1.0, 1.0)
+>>> from surfmod.cam.cutters import Ball
+>>> rows = triangle_rows(np.array([[[0, -1, 1], [0, 1, 1], [1, 0, 1]]], float))
+>>> t0, t1 = pair_intervals(rows, [0], [0.0], [0.0], [1.0], [0.0], 0.0, Ball(1.0))
 >>> float(t0[0]), float(t1[0])
 (-1.0, 2.0)
 """
@@ -40,7 +40,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .drop_cutter import KINDS, triangle_rows
+from .cutters import Cutter
+from .drop_cutter import BALL, triangle_rows
 
 #: Bound on the regula falsi (Illinois) steps of the torus contact: it takes about ten;
 #: bisection alone would take an angle bracket of π to rounding in ~55.
@@ -243,21 +244,16 @@ def _torus_edge(span, px, py, pz, ex, ey, ez, uc, ud, z, R, rc, ox, oy, dx, dy):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _facet(span, row, z, kind, R, rc, ox, oy, dx, dy):
-    """The tool's support point along the facet's upward normal on its plane, kept when
-    it falls inside the triangle."""
+def _facet(span, row, z, R, rc, ox, oy, dx, dy):
+    """The tool's support point along the facet's upward normal on its plane (the core's rim
+    uphill pushed out by ``rc`` along it), kept when it falls inside the triangle."""
     nx, ny, nz = row[9], row[10], row[11]
     sxy = math.hypot(nx, ny)
     if not (nz > 1e-12 and sxy > 1e-15):
         return
     sx, sy = nx / sxy, ny / sxy
     # support point of the tool along -n, relative to the tip at (o + t d, z)
-    if kind == 0:
-        qx, qy, qz = -R * nx, -R * ny, R - R * nz
-    elif kind == 1:
-        qx, qy, qz = -R * sx, -R * sy, 0.0
-    else:
-        qx, qy, qz = -(R - rc) * sx - rc * nx, -(R - rc) * sy - rc * ny, rc - rc * nz
+    qx, qy, qz = -(R - rc) * sx - rc * nx, -(R - rc) * sy - rc * ny, rc - rc * nz
     rate = nx * dx + ny * dy
     if not abs(rate) > 1e-15:
         return
@@ -276,8 +272,9 @@ def _facet(span, row, z, kind, R, rc, ox, oy, dx, dy):
 
 
 @njit(cache=True, error_model="numpy")
-def _pair(span, row, ox, oy, dx, dy, z, kind, R, rc):
-    """The interval of one (fiber, triangle) pair into ``span`` (inf, -inf if none)."""
+def _pair(span, row, ox, oy, dx, dy, z, code, R, rc):
+    """The interval of one (fiber, triangle) pair into ``span`` (inf, -inf if none) for the
+    cutter ``code`` (the one choice of a cutter's routine here: its rounded end's edge)."""
     span[0], span[1] = np.inf, -np.inf
     core = R - rc
     for j in range(3):
@@ -301,38 +298,30 @@ def _pair(span, row, ox, oy, dx, dy, z, kind, R, rc):
         _offset_lines(span, px, py, ex, ey, ua, ub, R, ox, oy, dx, dy)
         if rc > 0.0:
             uc, ud = _between(h0, ez, rc)
-            if kind == 0:
+            if code == BALL:
                 _ball_edge(span, px, py, pz, ex, ey, ez, uc, ud, z, R, ox, oy, dx, dy)
             else:
                 _torus_edge(span, px, py, pz, ex, ey, ez, uc, ud, z, R, rc, ox, oy, dx, dy)
-    _facet(span, row, z, kind, R, rc, ox, oy, dx, dy)
+    _facet(span, row, z, R, rc, ox, oy, dx, dy)
 
 
 @njit(cache=True, error_model="numpy")
-def _pairs_kernel(rows, ti, ox, oy, dx, dy, z, kind, R, rc, t0, t1):
+def _pairs_kernel(rows, ti, ox, oy, dx, dy, z, code, R, rc, t0, t1):
     span = np.empty(2)
     for i in range(len(ti)):
-        _pair(span, rows[ti[i]], ox[i], oy[i], dx[i], dy[i], z, kind, R, rc)
+        _pair(span, rows[ti[i]], ox[i], oy[i], dx[i], dy[i], z, code, R, rc)
         t0[i], t1[i] = span[0], span[1]
 
 
-def pair_intervals(rows, ti, ox, oy, dx, dy, z, kind: str, R: float, rc: float):
+def pair_intervals(rows, ti, ox, oy, dx, dy, z, cutter: Cutter):
     """``(t0, t1)`` per pair: the triangle ``rows[ti]`` (rows of
     :class:`~surfmod.cam.drop_cutter.TriangleGrid`: vertices and upward unit normal) against
-    the fiber ``o + t d`` (unit horizontal ``d``) at tip height ``z``; ``t0 = inf, t1 = -inf``
-    where the tool never meets the triangle.  ``rc``: the corner radius (R for a ball,
-    0 for a flat end)."""
+    ``cutter`` pushed along the fiber ``o + t d`` (unit horizontal ``d``) at tip height
+    ``z``; ``t0 = inf, t1 = -inf`` where it never meets the triangle."""
     n = len(ti)
     t0, t1 = np.empty(n), np.empty(n)
     f = np.ascontiguousarray
     _pairs_kernel(rows, f(ti, dtype=np.int64), f(ox, dtype=float), f(oy, dtype=float), f(dx, dtype=float),
-                  f(dy, dtype=float), float(z), KINDS[kind], float(R), float(rc), t0, t1)
+                  f(dy, dtype=float), float(z), cutter.code, cutter.radius, cutter.corner, t0, t1)
     return t0, t1
 
-
-def intervals(tri, ox, oy, dx, dy, z, kind: str, R: float, rc: float):
-    """``(t0, t1)`` per pair: positions ``o + t d`` along each pair's fiber (unit ``d``,
-    horizontal, tip height ``z``) where the tool meets the pair's triangle ``tri``
-    ``(P, 3, 3)``; ``t0 = inf, t1 = -inf`` where it never does."""
-    tri = np.asarray(tri, dtype=float)
-    return pair_intervals(triangle_rows(tri), np.arange(len(tri)), ox, oy, dx, dy, z, kind, R, rc)

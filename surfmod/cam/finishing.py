@@ -22,15 +22,14 @@ which lies within ``δ`` of the faces (``2 δ``), the contours also their chord 
 direction (a vertical lift would not do: on a wall of slope θ the mesh's ``δ`` is
 ``δ / cos θ`` deep measured vertically).  The waterline
 (:func:`surfmod.cam.waterline.waterline`) is computed for the tool grown by ``g`` = ``δ``
-plus the contours' chord tolerance (its Minkowski sum with a ball of radius ``g``: ball
-``R + g``, bull ``(R + g, c + g)``, a flat end the bull ``(R + g, g)``; tip ``g`` lower),
-so along every chord the real tool keeps at least ``δ`` from every triangle.  Every move
-is then judged like the raster's (:func:`~surfmod.cam.toolpath_moves.move_gouge` against
-the drop-cutter heights).  The waterline checks a chord at its middle only, so a chord
-can cross a notch of the contour whose middle lies on it: such a chord is split at the
-exact contour point near its middle (:class:`~surfmod.cam.waterline.ContourPoints`),
-again and again (:func:`_follow`; ``split`` counts the pieces), and only a move that still
-cuts after that is lifted (reported as ``lifted``).
+plus the contours' chord tolerance (:meth:`~surfmod.cam.cutters.Cutter.grown`), so along
+every chord the real tool keeps at least ``δ`` from every triangle.  Every move is then
+judged like the raster's (:func:`~surfmod.cam.toolpath_moves.move_gouge` against the
+drop-cutter heights).  The waterline checks a chord at its middle only, so a chord can
+cross a notch of the contour whose middle lies on it: such a chord is split at the exact
+contour point near its middle (:class:`~surfmod.cam.waterline.ContourPoints`), again and
+again (:func:`_follow`; ``split`` counts the pieces), and only a move that still cuts
+after that is lifted (reported as ``lifted``).
 
 **Links** between contours run along the part when the straight move stays clear of it
 and is short (at most a tool radius across, no more than 1.5 levels down); otherwise the
@@ -50,11 +49,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from types import SimpleNamespace
 
 import numpy as np
 from scipy import ndimage
 
+from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
 from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
 from .tool import Tool
@@ -87,16 +86,13 @@ class Rest:
 
 
 def clear_part(part: _Part, tool: Tool) -> _Part:
-    """``part`` for ``tool`` grown by the mesh's deflection ``δ`` (ball ``R + δ``, bull
-    ``(R + δ, c + δ)``, a flat end the bull ``(R + δ, δ)``; the tip ``δ`` lower): its
-    heights keep the tool ``δ`` from every triangle in every direction, so it never touches
-    the faces the mesh stands for.  (A vertical lift by ``δ`` would not do on a wall of
-    slope θ: there the mesh's ``δ`` is ``δ / cos θ`` deep measured vertically.)"""
+    """``part`` for ``tool`` grown by the mesh's deflection ``δ``
+    (:meth:`~surfmod.cam.cutters.Cutter.grown`): its heights keep the tool ``δ`` from
+    every triangle in every direction, so it never touches the faces the mesh stands for.
+    (A vertical lift by ``δ`` would not do on a wall of slope θ: there the mesh's ``δ`` is
+    ``δ / cos θ`` deep measured vertically.)"""
     d = part.deflection
-    grid = TriangleGrid(part.grid.triangles, tool.radius + d)
-    if tool.kind == "ball":
-        return replace(part, grid=grid, kind="ball", corner=tool.radius + d, lift=d)
-    return replace(part, grid=grid, kind="bull", corner=tool.corner + d, lift=d)
+    return replace(part, grid=TriangleGrid(part.grid.triangles, tool.radius + d), cutter=tool.cutter.grown(d), lift=d)
 
 
 class _StockTop:
@@ -110,7 +106,7 @@ class _StockTop:
         xy = np.asarray(xy, float).reshape(-1, 2)
         if self.grid is None:
             return np.full(len(xy), min(float(self.stock[1, 2]) + REST_CLEARANCE, self.safe))
-        h = drop(self.grid, "flat", xy)  # the highest part point within the reach of the footprint
+        h = drop(self.grid, Flat(self.grid.radius), xy)  # the highest part point within the reach of the footprint
         h = np.nan_to_num(h, nan=float(self.stock[0, 2])) + self.part.lift + self.rest.above + REST_CLEARANCE
         return np.minimum(h, self.safe)
 
@@ -122,7 +118,7 @@ def _enter(out: Moves, p, top: float, part: _Part, tool: Tool, safe: float, allo
     drop heights and then fall onto ``p``; a plunge when even an eighth of the radius does)."""
     out.add([[p[0], p[1], safe]], RAPID)
     start = np.array([p[0], p[1], max(top, p[2])])
-    if tool.kind != "ball" and top > p[2]:
+    if not tool.cutter.plunges and top > p[2]:
         for rho in tool.radius / np.array([2.0, 4.0, 8.0]):
             turns = max(1, int(np.ceil((top - p[2]) / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * rho))))
             t = np.linspace(0, 1, 48 * turns + 1)
@@ -152,12 +148,6 @@ def _normals(tri: np.ndarray) -> np.ndarray:
     n *= np.where(n[:, 2:3] < 0, -1.0, 1.0)
     length = np.linalg.norm(n, axis=1)
     return n / np.where(length > 0, length, 1.0)[:, None]
-
-
-def _circle_spacing(c: float, h: float) -> float:
-    """Distance between passes of a circle of radius ``c`` leaving cusps ``h``."""
-    h = min(h, c)
-    return 2.0 * math.sqrt(max(2.0 * c * h - h * h, 0.0))
 
 
 def _levels(tri, slope, steep, spacing, top, bottom, reach):
@@ -212,12 +202,6 @@ def _chord(part: _Part, tool: Tool, tolerance: float) -> float:
     return max(min(tolerance / 8, 1e-3 * tool.radius), 1e-7 * float(np.max(part.box[1] - part.box[0])))
 
 
-def _grown(tool: Tool, g: float):
-    if tool.kind == "ball":
-        return SimpleNamespace(kind="ball", radius=tool.radius + g)
-    return SimpleNamespace(kind="bull", radius=tool.radius + g, corner_radius=tool.corner + g)
-
-
 def _judge(part: _Part, pts: np.ndarray, allowed: float, depth: np.ndarray | None = None):
     """Gouge-check one polyline (``depth`` its per-move depth when known); lift what would
     cut (returns points, lift)."""
@@ -270,11 +254,10 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
         return [], info
     chord = _chord(part, tool, tolerance)
     g = chord + part.deflection  # the tool keeps the mesh's whole deflection from it (walls amplify any gouge)
-    reach = tool.corner if tool.kind != "flat" else 0.0
-    levels = _levels(tri, slope, steep, spacing, float(tri[steep, :, 2].max()), bottom, reach + tool.radius)
+    levels = _levels(tri, slope, steep, spacing, float(tri[steep, :, 2].max()), bottom, tool.corner + tool.radius)
     if not len(levels):
         return [], info
-    grown = _grown(tool, g)
+    grown = tool.cutter.grown(g)
     sampling = tool.radius / 2
     loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord)
     contour = None  # built at the first gouging chord (most parts have none)
@@ -390,7 +373,7 @@ def _raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float |
     axis = 1 if direction == "x" else 0
     cross = np.minimum(np.degrees(np.arctan2(np.abs(n[shallow, axis]), n[shallow, 2])), 89.0)
     t_lo, t_hi = tri[shallow, :, axis].min(axis=1), tri[shallow, :, axis].max(axis=1)
-    circ = _circle_spacing(tool.corner, scallop)
+    circ = tool.cutter.cusp_spacing(scallop)
     R = tool.radius
     out, steepest = [float(lo)], 0.0
     while out[-1] < hi - 1e-9:
@@ -398,10 +381,7 @@ def _raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float |
         near = (t_hi >= y - R) & (t_lo <= y + circ + 2.0 * tool.core + R)
         phi = float(cross[near].max()) if near.any() else 0.0
         steepest = max(steepest, phi)
-        if tool.kind == "bull" and phi < 1.0:  # the flat core counts only on level ground
-            gap = 2.0 * tool.core + circ
-        else:
-            gap = circ * math.cos(math.radians(phi))
+        gap = tool.cutter.pass_gap(circ, phi)
         out.append(min(y + min(gap, tool.diameter), hi))
     return np.array(out), steepest
 
@@ -519,7 +499,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
             # and the mesh lies within the deflection of the faces
             wl_budget, wl_held = _budget(scallop, 2 * part.deflection + 2 * _chord(part, tool, tolerance))
             held = held and wl_held
-            spacing = _circle_spacing(tool.corner, wl_budget) if tool.kind != "flat" else stepover
+            spacing = tool.cutter.cusp_spacing(wl_budget) if tool.corner > 0 else stepover
         else:
             spacing = stepover
         # no deeper than the flutes reach below the part's top (the raster's own depth is checked by the job)

@@ -12,11 +12,11 @@ from .post import export_job
 
 def _is_toolpath(obj) -> bool:
     """Duck typing (no import of ``toolpath``, which imports this writer): a tool path has
-    ``(N, 3)`` points and a tool with a kind and a radius."""
+    ``(N, 3)`` points and a tool with a cutter and a radius."""
     points = getattr(obj, "points", None)
     tool = getattr(obj, "tool", None)
     return (isinstance(points, np.ndarray) and points.ndim == 2 and points.shape[1] == 3 and len(points) > 0
-            and hasattr(tool, "kind") and hasattr(tool, "radius") and hasattr(obj, "stepover"))
+            and hasattr(tool, "cutter") and hasattr(tool, "radius") and hasattr(obj, "stepover"))
 
 
 def _up(values: np.ndarray, digits: int) -> np.ndarray:
@@ -56,7 +56,7 @@ def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = Non
     tool = toolpath.tool
     lines = [
         "%",
-        f"(surfmod drop-cutter zig-zag: {tool.kind} end mill radius {tool.radius:g} mm)",
+        f"(surfmod drop-cutter zig-zag: {tool.cutter.comment})",
         f"(stepover {toolpath.stepover:.6g} mm, scallop {toolpath.scallop:.4g} mm, {len(points)} points)",
     ]
     tolerance = getattr(toolpath, "tolerance", None)

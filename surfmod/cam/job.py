@@ -19,7 +19,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
 from .finishing import Rest, clear_part, finish
-from .roughing import FEED, RAPID, Motion, left_summary, offset_tool, rough
+from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import _part
 
@@ -161,7 +161,7 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     else:
         cusp = tool.scallop_for_stepover(stepover)
         tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
-    part = clear_part(_part(shape, tool, tolerance), tool)
+    part = clear_part(_part(shape, tool.cutter, tolerance), tool)
     return finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction, steep_angle=steep,
                   tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
 
@@ -204,7 +204,7 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
                 allowance = float(op.allowance)
                 if not np.isfinite(allowance) or allowance < 0:
                     raise SurfmodError(f"allowance: must be >= 0, got {op.allowance!r}")
-                grown = offset_tool(tool, allowance)
+                grown = tool.cutter.roughing_offset(allowance) if allowance > 0 else tool.cutter
                 tolerance = max(min(allowance / 4, 0.05), 0.005) if allowance > 0 else 0.01
                 p = _part(shape, grown, tolerance)
                 bar.update()

@@ -1,17 +1,17 @@
 """Z-level roughing: clearing a block of stock down to the part plus an allowance.
 
 The part grown by the allowance is bounded by the drop-cutter surface of the tool grown by
-it (:func:`offset_tool`; its tip is ``A`` below the real one), sampled on an (x, y) grid
-over the stock: ``h(x, y)`` is the lowest tip height that keeps the tool ``A`` clear of
-the part.  At a level ``z`` the tool may stand wherever ``h ≤ z``.  Every region of that
-set is cleared by contour-parallel rings: its boundary itself (the grid's isolines of
-``h`` moved onto the exact boundary by bisection with the exact drop height, then a
-hair inside: material within ``R`` of the boundary is cut however near the part it
-lies), and inside it the isolines of the grid's distance to the boundary, ``stepover``
-apart (each point of the region lies within ``stepover`` of a ring, so the tool, wider
-than that, sweeps it all; each ring engages about ``stepover`` of material radially
-beside the one before, up to a grid cell more).  Rings are clipped to the stock grown
-by ``radius + stepover / 2`` and cut from the far side inwards towards the part; open
+it (:meth:`~surfmod.cam.cutters.Cutter.roughing_offset`; its tip is ``A`` below the real
+one), sampled on an (x, y) grid over the stock: ``h(x, y)`` is the lowest tip height that
+keeps the tool ``A`` clear of the part.  At a level ``z`` the tool may stand wherever
+``h ≤ z``.  Every region of that set is cleared by contour-parallel rings: its boundary
+itself (the grid's isolines of ``h`` moved onto the exact boundary by bisection with the
+exact drop height, then a hair inside: material within ``R`` of the boundary is cut
+however near the part it lies), and inside it the isolines of the grid's distance to the
+boundary, ``stepover`` apart (each point of the region lies within ``stepover`` of a
+ring, so the tool, wider than that, sweeps it all; each ring engages about ``stepover``
+of material radially beside the one before, up to a grid cell more).  Rings are clipped
+to the stock grown by ``radius + stepover / 2`` and cut from the far side inwards towards the part; open
 stock is entered from the air, sideways; a closed ring from the end of the ring before
 at the level when that is near, else by a ramp along itself from the level above, or
 (a ring too short to ramp along) by a helix round its centre as wide as the region
@@ -36,6 +36,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import SurfmodError
+from .cutters import Cutter
 from .drop_cutter import TriangleGrid, drop
 from .tool import Tool
 from .toolpath_moves import lift_moves, move_gouge
@@ -93,20 +94,6 @@ class Moves:
         return Motion(np.concatenate(self.points), np.concatenate(self.kinds))
 
 
-def offset_tool(tool: Tool, allowance: float) -> Tool:
-    """A tool holding the tool grown by ``allowance``: its drop height, plus the allowance,
-    keeps the real tool at least that far from the part.  A ball grows into the ball
-    ``R + A`` (exact); a flat or bull end into the flat end ``R + A``, which holds the
-    exact offset (the bull ``R + A`` with corner ``c + A``) and drops an order of magnitude
-    faster: on a slope of angle θ it stays up to ``A (sin θ + cos θ - 1)`` further away
-    (at most 0.41 A, at 45°), material the finishing pass removes."""
-    if allowance <= 0:
-        return tool
-    if tool.kind == "ball":
-        return Tool("ball", tool.radius + allowance)
-    return Tool("flat", tool.radius + allowance)
-
-
 def _resample(line: np.ndarray, step: float, closed: bool) -> np.ndarray:
     """Points along ``line`` at most ``step`` apart (its own vertices kept)."""
     if closed and np.any(line[0] != line[-1]):
@@ -140,7 +127,7 @@ def _clip(line: np.ndarray, lo: np.ndarray, hi: np.ndarray):
     return [p for p in pieces if len(p) >= 2], False
 
 
-def rough(part_grid: TriangleGrid, lift: float, grown: Tool, tool: Tool, allowance: float, stock: np.ndarray,
+def rough(part_grid: TriangleGrid, lift: float, grown: Cutter, tool: Tool, allowance: float, stock: np.ndarray,
           stepdown: float, stepover: float, clearance: float, step: float | None = None, progress=None,
           deflection: float = 0.0):
     """The roughing :class:`Motion` of ``tool`` over ``part_grid`` (the part's triangles
@@ -154,7 +141,7 @@ def rough(part_grid: TriangleGrid, lift: float, grown: Tool, tool: Tool, allowan
     bottom = float(stock[0, 2])
 
     def height(xy):
-        h = drop(part_grid, grown.kind, np.asarray(xy, float).reshape(-1, 2), corner=grown.corner)
+        h = drop(part_grid, grown, np.asarray(xy, float).reshape(-1, 2))
         return np.maximum(np.where(np.isnan(h), bottom, h + lift + allowance), bottom)
 
     # rings reach a radius beyond the stock (the outermost cuts air, each next one at most

@@ -17,13 +17,14 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from .cutters import CUTTERS, cutter
 
-KINDS = ("flat", "ball", "bull")
 #: Default spindle speed (rpm) and feeds (mm/min): a 6 mm carbide end mill in aluminium,
 #: scaled by the diameter (surface speed and chip load held); the plunge/ramp feed a third.
 DEFAULT_SURFACE_SPEED = 200.0  # m/min
 DEFAULT_CHIP_LOAD = 0.04  # mm per tooth, two flutes
 MAX_SPINDLE = 24000.0
+SHAPE = frozenset({"corner", "core", "profile", "stepover_for_scallop", "scallop_for_stepover"})  # its cutter's
 
 
 @dataclass(frozen=True)
@@ -32,7 +33,11 @@ class Tool:
     bull nose its ``corner_radius`` (``0 < corner_radius < radius``: a flat core of radius
     ``radius - corner_radius`` rounded by a torus).  ``flute_length`` (default three
     diameters) bounds the depth it may cut; ``number`` (the T word), ``spindle`` (rpm),
-    ``feed`` and ``plunge_feed`` (mm/min) default from the diameter.
+    ``feed`` and ``plunge_feed`` (mm/min) default from the diameter.  Its shape is
+    ``cutter``, a :class:`~surfmod.cam.cutters.Cutter`, which also answers for the tool
+    ``corner`` (the corner radius: the radius for a ball, 0 for a flat end), ``core`` (the
+    flat bottom's radius), ``profile(d)``, ``stepover_for_scallop(h)`` and
+    ``scallop_for_stepover(s)``.
 
     >>> import surfmod as sm
     >>> t = sm.Tool("ball", 3.0)
@@ -53,18 +58,10 @@ class Tool:
     plunge_feed: float | None = None
 
     def __post_init__(self):
-        if self.kind not in KINDS:
-            raise SurfmodError(f"tool: kind must be 'flat', 'ball' or 'bull', got {self.kind!r}")
-        r = checks.positive(self.radius, "tool radius")
-        object.__setattr__(self, "radius", r)
-        c = float(self.corner_radius)
-        if self.kind == "bull":
-            if not 0.0 < c < r:
-                raise SurfmodError(f"corner_radius: a bull nose needs 0 < corner radius < radius {r:g}, got {c:g}")
-        elif c != 0.0 and not (self.kind == "ball" and c == r):
-            raise SurfmodError(f"corner_radius: a {self.kind} end mill has none, got {c:g}")
-        object.__setattr__(self, "corner_radius", c)
-        flute = 6.0 * r if self.flute_length is None else checks.positive(self.flute_length, "flute_length")
+        object.__setattr__(self, "cutter", cutter(self.kind, self.radius, self.corner_radius))
+        object.__setattr__(self, "radius", self.cutter.radius)
+        object.__setattr__(self, "corner_radius", float(self.corner_radius))
+        flute = 6.0 * self.radius if self.flute_length is None else checks.positive(self.flute_length, "flute_length")
         object.__setattr__(self, "flute_length", flute)
         if self.number is not None:
             object.__setattr__(self, "number", checks.count(self.number, "number", 1, 99999))
@@ -76,45 +73,10 @@ class Tool:
     def diameter(self) -> float:
         return 2.0 * self.radius
 
-    @property
-    def corner(self) -> float:
-        """The radius of the rounded edge: the radius for a ball, 0 for a flat end."""
-        return {"ball": self.radius, "flat": 0.0}.get(self.kind, self.corner_radius)
-
-    @property
-    def core(self) -> float:
-        """Radius of the flat bottom (0 for a ball)."""
-        return self.radius - self.corner
-
-    def profile(self, d):
-        """Height of the cutting end above the tip at distance ``d`` from the axis (inf beyond
-        the radius)."""
-        d = np.asarray(d, dtype=float)
-        c, t = self.corner, np.maximum(d - self.core, 0.0)
-        out = np.where(d <= self.radius * (1 + 1e-15), c - np.sqrt(np.maximum(c * c - t * t, 0.0)), np.inf)
-        return float(out) if out.ndim == 0 else out
-
-    def stepover_for_scallop(self, scallop: float) -> float:
-        """Stepover leaving cusps of height ``scallop`` on flat ground: ``2 sqrt(2 c h − h²)``
-        for a ball of radius ``c``, plus the flat core's width ``2 (r − c)`` for a bull nose."""
-        h = checks.positive(scallop, "scallop")
-        if self.kind == "flat":
-            raise SurfmodError("scallop: a flat end mill leaves no scallop on flat ground; give stepover instead")
-        if h >= self.radius:
-            raise SurfmodError(f"scallop: must be smaller than the tool radius {self.radius:g}, got {h:g}")
-        c = self.corner
-        h = min(h, c)
-        return float(2.0 * self.core + 2.0 * np.sqrt(2.0 * c * h - h * h))
-
-    def scallop_for_stepover(self, stepover: float) -> float:
-        """Cusp height on flat ground for a given stepover (0 for a flat end mill, and for a
-        bull nose whose core spans the stepover)."""
-        if self.kind == "flat":
-            return 0.0
-        c, half = self.corner, stepover / 2.0 - self.core
-        if half <= 0:
-            return 0.0
-        return float(c - np.sqrt(max(c * c - half * half, 0.0)))
+    def __getattr__(self, name):
+        if name in SHAPE:
+            return getattr(self.cutter, name)
+        raise AttributeError(f"'Tool' object has no attribute {name!r}")
 
     def with_defaults(self, number: int) -> "Tool":
         """This tool with ``number`` (unless it has one) and speeds and feeds filled in."""
@@ -124,9 +86,7 @@ class Tool:
                        feed=float(round(feed)), plunge_feed=self.plunge_feed or float(round(feed / 3)))
 
     def __str__(self) -> str:
-        name = {"flat": "flat end mill", "ball": "ball end mill",
-                "bull": f"bull nose (corner r={self.corner_radius:g})"}[self.kind]
-        return f"T{self.number or '?'} {name} r={self.radius:g}"
+        return f"T{self.number or '?'} {self.cutter.name} r={self.radius:g}"
 
 
 def parse_tool(text: str, name: str = "tool") -> Tool:
@@ -140,12 +100,12 @@ def parse_tool(text: str, name: str = "tool") -> Tool:
         numbers = [float(p) for p in parts[1:]]
     except ValueError:
         raise SurfmodError(f"{name}: expected flat:R, ball:R or bull:R:r, got {text!r}") from None
-    kind = parts[0]
-    if kind not in KINDS or len(numbers) != (2 if kind == "bull" else 1):
+    shape = CUTTERS.get(parts[0])
+    if shape is None or len(numbers) != shape.numbers:
         raise SurfmodError(f"{name}: expected flat:R, ball:R or bull:R:r, got {text!r}")
     if not numbers[0] > 0:
         raise SurfmodError(f"radius: {name} radius must be > 0, got {numbers[0]:g}")
-    return Tool(kind, numbers[0], numbers[1] if kind == "bull" else 0.0)
+    return Tool(parts[0], *numbers)
 
 
 def load_tool_table(path) -> dict[int, Tool]:

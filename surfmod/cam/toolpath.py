@@ -33,6 +33,7 @@ from ..errors import SurfmodError
 from ..inputs import to_shape
 from ..meshing.brep import _estimate
 from ..meshing.render import Drawing, polyline_runs, repr_png
+from .cutters import Cutter
 from .drop_cutter import TriangleGrid, drop
 from .gcode import gcode_text
 from .toolpath_exact import exact_heights
@@ -125,9 +126,7 @@ class Toolpath:
 
     def __str__(self) -> str:
         return (
-            f"toolpath: {self.tool.kind} end mill r={self.tool.radius:g}"
-            + (f" corner r={self.tool.corner_radius:g}" if self.tool.kind == "bull" else "")
-            + f", {self.n_passes} passes along {self.direction}, "
+            f"toolpath: {self.tool.cutter.summary}, {self.n_passes} passes along {self.direction}, "
             f"{len(self.points)} points, stepover {self.stepover:.6g} (scallop {self.scallop:.3g} on flat ground), "
             f"length {self.length:.6g}, every move checked: max gouge {max(self.gouge + self.deflection, 0.0):.2e} "
             f"(tolerance {self.tolerance:.2e})"
@@ -160,8 +159,7 @@ class _Part:
     a mesh deflection larger than requested."""
 
     grid: TriangleGrid
-    kind: str
-    corner: float
+    cutter: Cutter  # of the grid's radius
     deflection: float
     lift: float
     box: np.ndarray
@@ -172,7 +170,7 @@ class _Part:
     def height(self, xy: np.ndarray) -> np.ndarray:
         """Tip heights at ``xy`` (N, 2), NaN where the tool touches nothing."""
         self.meter.charge(self.grid.entries(xy), f"{len(xy):,} locations")
-        return drop(self.grid, self.kind, xy, corner=self.corner) + self.lift
+        return drop(self.grid, self.cutter, xy) + self.lift
 
 
 def _mesh_estimate(shape, tolerance: float) -> None:
@@ -195,7 +193,7 @@ def _mesh_estimate(shape, tolerance: float) -> None:
             f"{estimate:,.0f} triangles, above the limit {MAX_TRIANGLES:,} (a larger tolerance or scallop)")
 
 
-def _part(obj, tool: Tool, tolerance: float, meter: _Meter | None = None) -> _Part:
+def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None) -> _Part:
     from ..occ.triangulation import part_triangles
 
     shape = to_shape(obj, "obj")
@@ -207,7 +205,7 @@ def _part(obj, tool: Tool, tolerance: float, meter: _Meter | None = None) -> _Pa
         raise NoSafePathError(f"toolpath: no safe path: {exc}") from None
     points = triangles.reshape(-1, 3)
     box = np.array([points.min(axis=0), points.max(axis=0)])
-    return _Part(TriangleGrid(triangles, tool.radius), tool.kind, tool.corner, max(measured, requested),
+    return _Part(TriangleGrid(triangles, cutter.radius), cutter, max(measured, requested),
                  max(measured - requested, 0.0), box, faces, owner, meter or _Meter())
 
 
@@ -239,12 +237,11 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     tool = _check_tool(tool)
     cl = checks.finite_array(xy, "xy", ndim=2, last=2)
     tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
-    part = _part(obj, tool, tolerance)
-    z, contacts, touched = drop(part.grid, part.kind, cl, contacts=True, triangles=True, corner=part.corner)
+    part = _part(obj, tool.cutter, tolerance)
+    z, contacts, touched = drop(part.grid, part.cutter, cl, contacts=True, triangles=True)
     z = z + part.lift
     if exact:
-        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.kind, tool.radius,
-                                       tool.corner)
+        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.radius, tool.corner)
     return z, contacts
 
 
@@ -332,7 +329,7 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     with tqdm(total=1, desc="toolpath", unit=" tests", unit_scale=True, disable=not progress) as bar:
         bar.set_postfix_str("meshing")
         meter = _Meter(max_work, bar)
-        part = _part(shape, tool, tolerance, meter)
+        part = _part(shape, tool.cutter, tolerance, meter)
         return raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
                            bar, meter=meter)
 
@@ -390,7 +387,7 @@ def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction
             f"deep, more than the tolerance {tolerance:.3g}")
     if meter is not None:
         meter.charge(part.grid.entries(points[:, :2]), "the contacts")
-    _, contacts = drop(part.grid, part.kind, points[:, :2], contacts=True, corner=part.corner)
+    _, contacts = drop(part.grid, part.cutter, points[:, :2], contacts=True)
     if bar is not None and meter is not None:
         bar.total = bar.n
     stage("done")

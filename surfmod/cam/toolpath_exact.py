@@ -1,23 +1,16 @@
 """Drop-cutter heights on the exact faces, polished from the mesh's (ball, flat and bull
-nose end mills).
+nose end mills: one set of equations, the ball and the flat end its limits).
 
 The mesh drop (:mod:`surfmod.cam.drop_cutter`) is exact for BRepMesh's triangles, which
 are chords of the faces.  Where the tool touches a face inside its trim, the exact cutter
 location solves two equations in the face's ``(u, v)``, with ``S`` the face point, ``N``
-its upward unit normal and ``(x, y)`` the tool axis:
-
-- ball of radius ``r``: the ball centre is ``S`` pushed out by ``r`` along ``N``, so
-  ``(S + r N)_xy = (x, y)``, and the tip height is ``(S + r N)_z - r``;
-- flat end of radius ``R``, touching with its rim (a sloped face): the rim point lies
-  ``R`` from the axis, towards where the face rises, and the rim is tangent to the face
-  there, so ``S_xy + R N_xy / |N_xy| = (x, y)``, and the tip height is ``S_z``;
-- flat end touching with its bottom (a summit of the face under the disc): ``N_xy = 0``
-  at a point within ``R`` of the axis, and the tip height is ``S_z`` there;
-- bull nose of radius ``R`` and corner ``c`` touching with its torus: the tube's centre
-  ``S + c N`` lies on the ring of radius ``a = R - c``, ``a`` uphill of the axis, so
-  ``(S + c N)_xy + a N_xy / |N_xy| = (x, y)``, and the tip height is ``(S + c N)_z - c``
-  (the ball's equations for ``a = 0``, the rim's for ``c = 0``); with its core on a summit,
-  as a flat end of radius ``a``.
+its upward unit normal and ``(x, y)`` the tool axis.  An end mill of radius ``R`` and
+corner radius ``c`` touching with its rounded end: the corner's centre ``S + c N`` lies on
+the ring of radius ``a = R - c``, ``a`` uphill of the axis, so
+``(S + c N)_xy + a N_xy / |N_xy| = (x, y)``, and the tip height is ``(S + c N)_z - c``
+(a ball, ``c = R``: its centre ``S + R N`` on the axis; a flat end, ``c = 0``: its rim
+tangent to the face, which rises towards the axis).  Touching with its flat core (a
+summit of the face within ``a`` of the axis): ``N_xy = 0``, and the tip height is ``S_z``.
 
 Newton's method solves them for every location at once (per face, vectorized), started
 from the projection of the mesh contact onto the face; the Jacobian comes from central
@@ -49,20 +42,6 @@ def _frames(face, u, v):
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
     n *= np.where(n[..., 2:3] < 0, -1.0, 1.0)
     return d[..., 0, 0, :], n
-
-
-def _ball_centre(face, u, v, radius: float):
-    """``(S + r N)_xy``: where the axis of a ball resting on the face at ``(u, v)`` is."""
-    s, n = _frames(face, u, v)
-    return (s + radius * n)[..., :2]
-
-
-def _rim_axis(face, u, v, radius: float):
-    """``S_xy + R N_xy / |N_xy|``: where the axis of a flat end whose rim touches the face
-    at ``(u, v)`` is (the face rises towards the axis)."""
-    s, n = _frames(face, u, v)
-    level = np.linalg.norm(n[..., :2], axis=-1, keepdims=True)
-    return s[..., :2] + radius * n[..., :2] / np.where(level > 0, level, 1.0)
 
 
 def _torus_axis(face, u, v, radius: float, corner: float):
@@ -118,64 +97,26 @@ def _start(face, contacts: np.ndarray):
     return proj.u.astype(float), proj.v.astype(float)
 
 
-def polish_ball(face, xy: np.ndarray, contacts: np.ndarray, radius: float):
-    """Exact tip heights ``(N,)`` of a ball of ``radius`` at ``xy`` ``(N, 2)`` touching
-    the trimmed face ``face`` (a :class:`surfmod.TrimmedFace`) near ``contacts``
-    ``(N, 3)``, the exact contact points ``(N, 3)``, and a mask ``(N,)`` of the
-    locations where the exact contact lies inside the face (elsewhere NaN).
+def polish(face, xy: np.ndarray, contacts: np.ndarray, radius: float, corner: float):
+    """Exact tip heights ``(N,)`` of an end mill of ``radius`` and ``corner`` radius
+    (``radius`` for a ball, 0 for a flat end) at ``xy`` ``(N, 2)`` touching the trimmed
+    face ``face`` (a :class:`surfmod.TrimmedFace`) near ``contacts`` ``(N, 3)``, the exact
+    contact points ``(N, 3)``, and a mask ``(N,)`` of the locations where the exact
+    contact lies inside the face (elsewhere NaN): the rounded end's contact where the
+    mesh contact lies on it (a ball's everywhere, a flat end's rim), the core's (a
+    summit) where it lies within the flat core.
 
     >>> import surfmod as sm, build123d as bd, numpy as np
     >>> face = sm.from_face(bd.Sphere(5.0).faces()[0])
-    >>> z, contact, ok = polish_ball(face, np.array([[1.0, 2.0]]), np.array([[1.0, 2.0, 4.5]]), 1.0)
-    >>> bool(ok[0]), bool(abs(z[0] - (np.sqrt(36.0 - 5.0) - 1.0)) < 1e-12)
-    (True, True)
-    """
-    u, v, on = _solve(face, _ball_centre, xy, *_start(face, contacts), radius, radius)
-    p, n = _frames(face, u, v)
-    on &= n[:, 2] > 0  # a normal that is level (a wall) cannot hold the ball from below
-    return _inside(face, u, v, on, p[:, 2] + radius * n[:, 2] - radius, p)
-
-
-def polish_flat(face, xy: np.ndarray, contacts: np.ndarray, radius: float):
-    """:func:`polish_ball` for a flat end mill of ``radius``: the rim's contact where the
-    mesh contact lies on the rim, the bottom's (a summit of the face) where it lies
-    inside the disc.
-
-    >>> import surfmod as sm, build123d as bd, numpy as np
-    >>> face = sm.from_face(bd.Sphere(5.0).faces()[0])
-    >>> z, contact, ok = polish_flat(face, np.array([[3.0, 0.0]]), np.array([[2.0, 0.0, 4.58]]), 1.0)
-    >>> bool(ok[0]), bool(abs(z[0] - np.sqrt(25.0 - 4.0)) < 1e-12)
-    (True, True)
-    """
-    u, v = _start(face, contacts)
-    z, touch = np.full(len(xy), np.nan), np.full((len(xy), 3), np.nan)
-    on = np.zeros(len(xy), bool)
-    rim = np.linalg.norm(contacts[:, :2] - xy, axis=1) >= radius * (1.0 - 1e-6)
-    rows = np.flatnonzero(rim)
-    if rows.size:  # the rim on a sloped face, seen from above
-        ur, vr, hit = _solve(face, _rim_axis, xy[rows], u[rows], v[rows], radius, radius)
-        p, n = _frames(face, ur, vr)
-        hit &= (n[:, 2] > 0) & (np.linalg.norm(n[:, :2], axis=1) > 0)
-        z[rows], touch[rows], on[rows] = _inside(face, ur, vr, hit, p[:, 2], p)
-    rows = np.flatnonzero(~rim)
-    if rows.size:  # the bottom on a summit under the disc
-        ur, vr, hit = _solve(face, _slope, np.zeros((rows.size, 2)), u[rows], v[rows], radius, 1.0)
-        p = _frames(face, ur, vr)[0]
-        hit &= np.linalg.norm(p[:, :2] - xy[rows], axis=1) <= radius
-        z[rows], touch[rows], on[rows] = _inside(face, ur, vr, hit, p[:, 2], p)
-    return z, touch, on
-
-
-def polish_bull(face, xy: np.ndarray, contacts: np.ndarray, radius: float, corner: float):
-    """:func:`polish_ball` for a bull nose of ``radius`` and ``corner`` radius: the torus's
-    contact where the mesh contact lies on it, the core's (a summit) where it lies within
-    the flat core.
-
-    >>> import surfmod as sm, build123d as bd, numpy as np
-    >>> face = sm.from_face(bd.Sphere(5.0).faces()[0])
-    >>> z, contact, ok = polish_bull(face, np.array([[3.0, 0.0]]), np.array([[2.0, 0.0, 4.58]]), 1.0, 0.5)
+    >>> z, contact, ok = polish(face, np.array([[3.0, 0.0]]), np.array([[2.0, 0.0, 4.58]]), 1.0, 0.5)
     >>> # the tube centre on the sphere of radius 5.5 at x = 3 - 0.5: tip = sqrt(5.5² - 2.5²) - 0.5
     >>> bool(ok[0]), bool(abs(z[0] - (np.sqrt(5.5**2 - 2.5**2) - 0.5)) < 1e-12)
+    (True, True)
+    >>> z, contact, ok = polish(face, np.array([[1.0, 2.0]]), np.array([[1.0, 2.0, 4.5]]), 1.0, 1.0)  # a ball
+    >>> bool(ok[0]), bool(abs(z[0] - (np.sqrt(36.0 - 5.0) - 1.0)) < 1e-12)
+    (True, True)
+    >>> z, contact, ok = polish(face, np.array([[3.0, 0.0]]), np.array([[2.0, 0.0, 4.58]]), 1.0, 0.0)  # a flat end
+    >>> bool(ok[0]), bool(abs(z[0] - np.sqrt(25.0 - 4.0)) < 1e-12)
     (True, True)
     """
     core = radius - corner
@@ -191,7 +132,9 @@ def polish_bull(face, xy: np.ndarray, contacts: np.ndarray, radius: float, corne
 
         ur, vr, hit = _solve(face, axis, xy[rows], u[rows], v[rows], radius, radius)
         p, n = _frames(face, ur, vr)
-        hit &= (n[:, 2] > 0) & (np.linalg.norm(n[:, :2], axis=1) > 0)
+        # a level normal (a wall) cannot hold the end from below, nor (but for a ball, whose
+        # contact needs no uphill direction) one at a summit
+        hit &= (n[:, 2] > 0) & ((np.linalg.norm(n[:, :2], axis=1) > 0) | (core == 0.0))
         z[rows], touch[rows], on[rows] = _inside(face, ur, vr, hit, p[:, 2] + corner * n[:, 2] - corner, p)
     rows = np.flatnonzero(~torus)
     if rows.size:  # the core on a summit
@@ -211,19 +154,13 @@ def _inside(face, u, v, on, z, p):
 
 
 def exact_heights(faces, owner: np.ndarray, xy: np.ndarray, z: np.ndarray, contacts: np.ndarray,
-                  touched: np.ndarray, kind: str, radius: float, corner: float = 0.0):
-    """Mesh heights ``z`` of a ``kind`` (``"ball"``, ``"flat"`` or ``"bull"`` with its
-    ``corner`` radius) end mill polished on
-    the exact faces: ``faces`` (OCCT faces), ``owner`` (face index of each mesh
-    triangle), ``touched`` (triangle the tool rests on, -1 for none).  Returns the
-    heights, the contact points (exact where polished) and a mask of the locations
-    polished (the others keep their mesh height: the tool rests on an edge or vertex, or
-    touches nothing)."""
-    if kind == "bull":
-        def polish(face, xy, contacts, radius):
-            return polish_bull(face, xy, contacts, radius, corner)
-    else:
-        polish = polish_ball if kind == "ball" else polish_flat
+                  touched: np.ndarray, radius: float, corner: float):
+    """Mesh heights ``z`` of an end mill of ``radius`` and ``corner`` radius (see
+    :func:`polish`) polished on the exact faces: ``faces`` (OCCT faces), ``owner`` (face
+    index of each mesh triangle), ``touched`` (triangle the tool rests on, -1 for none).
+    Returns the heights, the contact points (exact where polished) and a mask of the
+    locations polished (the others keep their mesh height: the tool rests on an edge or
+    vertex, or touches nothing)."""
     z = np.array(z, dtype=float)
     contacts = np.array(contacts, dtype=float)
     polished = np.zeros(len(z), bool)
@@ -231,7 +168,7 @@ def exact_heights(faces, owner: np.ndarray, xy: np.ndarray, z: np.ndarray, conta
     face_of = np.where(hit, owner[np.where(hit, touched, 0)], -1)
     for k in np.unique(face_of[hit]):  # one vectorized solve per touched face
         rows = np.flatnonzero(face_of == k)
-        exact, touch, on = polish(from_face(faces[k]), xy[rows], contacts[rows], radius)
+        exact, touch, on = polish(from_face(faces[k]), xy[rows], contacts[rows], radius, corner)
         z[rows[on]] = exact[on]
         contacts[rows[on]] = touch[on]
         polished[rows[on]] = True

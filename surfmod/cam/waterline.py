@@ -27,29 +27,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
+from .cutters import Cutter
 from .drop_cutter import TriangleGrid
 from .fiber_contact import pair_intervals
 
 MAX_PAIRS = 200_000_000  # (fiber, triangle) pairs over all levels: beyond this, coarsen sampling
 PAIRS_PER_BLOCK = 400_000
 MAX_REFINE = 30
-
-
-def _tool_shape(tool):
-    kind = getattr(tool, "kind", None)
-    if kind not in ("ball", "flat", "bull"):
-        raise SurfmodError(f"tool: kind must be 'ball', 'flat' or 'bull', got {kind!r}")
-    R = float(getattr(tool, "radius", float("nan")))
-    if not R > 0:
-        raise SurfmodError(f"tool: radius must be > 0, got {R}")
-    if kind == "ball":
-        return kind, R, R
-    if kind == "flat":
-        return kind, R, 0.0
-    r = float(getattr(tool, "corner_radius", 0.0))
-    if not 0 < r < R:
-        raise SurfmodError(f"tool: corner radius must be in (0, radius {R:g}), got {r}")
-    return kind, R, r
 
 
 # ----------------------------------------------------------------------------------------------
@@ -70,12 +54,12 @@ class _Shank:
 class _Fibers:
     """The part's triangles for fiber queries at one tool: bucketed for short fibers."""
 
-    def __init__(self, triangles, kind, R, rc, reach):
+    def __init__(self, triangles, cutter: Cutter, reach):
         self.tri = triangles
-        self.kind, self.R, self.rc = kind, R, rc
+        self.cutter, self.R, self.rc = cutter, cutter.radius, cutter.corner
         self.top = triangles[:, :, 2].max(axis=1)
         self.bottom = triangles[:, :, 2].min(axis=1)
-        self.grid = TriangleGrid(triangles, R + reach)
+        self.grid = TriangleGrid(triangles, self.R + reach)
         self.lo = triangles[:, :, :2].min(axis=1)
         self.hi = triangles[:, :, :2].max(axis=1)
 
@@ -109,7 +93,7 @@ class _Fibers:
         o[:, axis] = at[li]
         d = np.zeros((len(ti), 2))
         d[:, 1 - axis] = 1.0
-        t0, t1 = pair_intervals(self.grid.rows, ti, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, self.kind, self.R, self.rc)
+        t0, t1 = pair_intervals(self.grid.rows, ti, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, self.cutter)
         hit = t0 <= t1
         return li[hit], t0[hit], t1[hit]
 
@@ -127,8 +111,7 @@ class _Fibers:
             ext = np.abs(d[qg]) * reach[qg, None] + self.R
             keep = (self.top[ti] >= z) & np.all((o[qg] + ext >= self.lo[ti]) & (o[qg] - ext <= self.hi[ti]), axis=1)
             qg, ti = qg[keep], ti[keep]
-            lo, hi = pair_intervals(self.grid.rows, ti, o[qg, 0], o[qg, 1], d[qg, 0], d[qg, 1], z,
-                                    self.kind, self.R, self.rc)
+            lo, hi = pair_intervals(self.grid.rows, ti, o[qg, 0], o[qg, 1], d[qg, 0], d[qg, 1], z, self.cutter)
             hit = lo <= hi
             out_q.append(qg[hit]), out_lo.append(lo[hit]), out_hi.append(hi[hit])
         return np.concatenate(out_q), np.concatenate(out_lo), np.concatenate(out_hi)
@@ -311,21 +294,21 @@ class ContourPoints:
     midpoint missed).  ``reach``: how far from a chord's middle a point is looked for.
 
     >>> import numpy as np
-    >>> from types import SimpleNamespace
+    >>> from surfmod.cam.cutters import Flat
     >>> box = np.array([[[0, 0, 0], [10, 0, 0], [10, 10, 0]], [[0, 0, 0], [10, 10, 0], [0, 10, 0]]], float)
-    >>> cp = ContourPoints(box, SimpleNamespace(kind="flat", radius=1.0), 6.0)
+    >>> cp = ContourPoints(box, Flat(1.0), 6.0)
     >>> cp.split(0.0, np.array([[-1.0, 5.0], [5.0, -1.0]]), np.array([0])).round(6).tolist()  # cuts a corner
     [[-1.0, 5.0], [-0.707107, -0.707107], [5.0, -1.0]]
     """
 
     def __init__(self, part, tool, reach: float):
-        kind, R, rc = _tool_shape(tool)
+        cutter = getattr(tool, "cutter", tool)
         tri = np.asarray(part, dtype=float)
         if tri.ndim != 3 or tri.shape[1:] != (3, 3) or not len(tri):
             raise SurfmodError(f"part: expected triangles (M, 3, 3), got shape {tri.shape}")
         if not reach > 0:
             raise SurfmodError(f"reach: must be > 0, got {reach}")
-        self.fib, self.reach = _Fibers(tri, kind, R, rc, float(reach)), float(reach)
+        self.fib, self.reach = _Fibers(tri, cutter, float(reach)), float(reach)
 
     def split(self, z: float, pts: np.ndarray, which: np.ndarray) -> np.ndarray:
         """The polyline ``pts`` (N, 2) with each chord ``i`` in ``which`` (from ``pts[i]`` to
@@ -360,20 +343,21 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     (counter-clockwise round islands, clockwise inside pockets).
 
     ``part``: triangles ``(M, 3, 3)`` (e.g. from :func:`surfmod.occ.triangulation.part_triangles`);
-    ``tool``: anything with ``kind`` (``"ball"``, ``"flat"``, ``"bull"``), ``radius`` and
-    (bull) ``corner_radius``, such as :class:`surfmod.Tool`.  ``sampling``: spacing of the
-    fiber grid that finds the loops (default a quarter of the radius; features of the
-    tool-offset narrower than it may be missed); ``tolerance``: how far a chord's middle
-    may lie from the exact contour (default 1e-6 of the part's size).
+    ``tool``: a :class:`surfmod.Tool` or a :class:`~surfmod.cam.cutters.Cutter`.
+    ``sampling``: spacing of the fiber grid that finds the loops (default a quarter of the
+    radius; features of the tool-offset narrower than it may be missed); ``tolerance``:
+    how far a chord's middle may lie from the exact contour (default 1e-6 of the part's
+    size).
 
     >>> import numpy as np
-    >>> from types import SimpleNamespace
+    >>> from surfmod.cam.cutters import Flat
     >>> box = np.array([[[0, 0, 0], [10, 0, 0], [10, 10, 0]], [[0, 0, 0], [10, 10, 0], [0, 10, 0]]], float)
-    >>> (loop,), = waterline(box, SimpleNamespace(kind="flat", radius=1.0), [0.0])
+    >>> (loop,), = waterline(box, Flat(1.0), [0.0])
     >>> bool(np.allclose(loop[:, :2].min(axis=0), -1.0, atol=1e-9)), float(loop[0, 2])
     (True, 0.0)
     """
-    kind, R, rc = _tool_shape(tool)
+    cutter = getattr(tool, "cutter", tool)
+    R = cutter.radius
     tri = np.asarray(part, dtype=float)
     if tri.ndim != 3 or tri.shape[1:] != (3, 3) or not len(tri):
         raise SurfmodError(f"part: expected triangles (M, 3, 3), got shape {tri.shape}")
@@ -395,7 +379,7 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     # the grid: the part's box grown by the radius and two cells, all outside
     x = np.arange(lo[0] - R - 2 * h, hi[0] + R + 2 * h + h, h)
     y = np.arange(lo[1] - R - 2 * h, hi[1] + R + 2 * h + h, h)
-    fib = _Fibers(tri, kind, R, rc, 1.5 * h)
+    fib = _Fibers(tri, cutter, 1.5 * h)
     # bound the work: each triangle meets the grid lines within R of its box (both
     # directions); refinement fibers add about as many again
     span = np.maximum(tri[:, :, :2].max(axis=1) - tri[:, :, :2].min(axis=1), 0) + 2 * R
