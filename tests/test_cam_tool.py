@@ -149,3 +149,21 @@ def test_tool_table(tmp_path):
         load_tool_table(js)
     filled = sm.Tool("flat", 3.0).with_defaults(1)
     assert filled.number == 1 and filled.spindle > 0 and filled.feed > filled.plunge_feed > 0
+
+
+@pytest.mark.parametrize("shape", [Ball(2.0), Flat(2.0), Bull(2.0, 0.5)])
+@pytest.mark.parametrize("g", [0.01, 0.3])
+def test_grown_cutter_is_the_cutters_offset(shape, g):
+    """Every point of the grown cutter's end (its tip ``g`` below the cutter's) lies ``g``
+    from the cutter's end, in closed form: from its flat core (the segment of height ``g``
+    out to ``a = R - c``) or its corner (the quarter circle of radius ``c`` round
+    ``(a, g + c)``); the roughing's stand-in holds the grown cutter."""
+    grown = shape.grown(g)
+    d = np.linspace(0.0, grown.radius, 401)
+    z = grown.profile(d)
+    a, c = shape.core, shape.corner
+    to_core = np.hypot(np.maximum(d - a, 0.0), z - g)
+    on_corner = (d >= a) & (z <= g + c)  # where the nearest corner point lies on its quarter
+    to_corner = np.where(on_corner, np.abs(np.hypot(d - a, z - g - c) - c), np.inf)
+    assert np.abs(np.minimum(to_core, to_corner) - g).max() < 1e-12
+    assert grown.radius == shape.radius + g and np.all(shape.roughing_offset(g).profile(d) <= z)
