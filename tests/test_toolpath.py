@@ -134,6 +134,7 @@ def test_flat_end_walls_exact(tmp_path):
 def test_opencamlib_cross_check_on_corpus_part(corpus_dir, tmp_path, kind):
     """Cutter-location heights equal OpenCAMLib's BatchDropCutter on the same triangles
     (written to STL in float32, which both then read exactly)."""
+    pytest.importorskip("opencamlib", reason="OpenCAMLib is the bench extra (pip install -e '.[bench]')")
     shape = to_shape(corpus_dir / CORPUS_PART)
     tri, _ = part_triangles(shape, 0.02)
     tri = tri.astype(np.float32).astype(float)
