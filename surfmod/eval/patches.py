@@ -51,11 +51,12 @@ MAX_DEGREE = 3
 #: OCCT's cache loses 2e-11), so such nets take the basis-function kernel
 MAX_WEIGHT_RATIO = 1e3
 #: largest ratio of a direction's longest knot span to its shortest: the Taylor rows of a
-#: span 1e-5 of the domain beside spans 1e3x longer carry its neighbours' poles scaled by
-#: half-width powers, and their sums kept second partials 2.8e-12 relative where the basis
-#: kernel and OCCT keep 3e-15 (sm.conformance's crowded bicubics), so such nets take the
-#: basis-function kernel
-MAX_SPAN_RATIO = 1e3
+#: span beside much longer ones carry its neighbours' poles scaled by half-width powers,
+#: and their sums lose digits of the second partials (crowded bicubics, spans 1e-4..1e-6 of
+#: the domain: 2.8e-12 relative where the basis kernel and OCCT keep 3e-15; nist_ctc_05's
+#: rational faces, span ratios 21..37: 1.8e-12..3.1e-12 where OCCT keeps 4.5e-13..7.3e-13),
+#: so such nets take the basis-function kernel (sm.conformance, cases stress and corpus)
+MAX_SPAN_RATIO = 10.0
 #: points located per pass of the patch kernel (see :func:`positions_chunk`)
 LOCATE_BLOCK = 128
 # unsigned offset steps (an unsigned plus a signed integer would be typed float64)
