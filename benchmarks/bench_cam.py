@@ -27,9 +27,6 @@ shows them off it with OCL's own drop-cutter).
 
 from __future__ import annotations
 
-import contextlib
-import os
-import sys
 import time
 from pathlib import Path
 
@@ -43,7 +40,7 @@ from surfmod.errors import SurfmodError
 from surfmod.inputs import to_shape
 from surfmod.occ.triangulation import part_triangles
 
-from .tables import Table, heading, note
+from .tables import Table, captured_stdout, heading, note
 
 CORPUS = Path(__file__).resolve().parent.parent / "tests" / "data" / "step"
 JOB_PART = Path(__file__).resolve().parent.parent / "step_samples" / "cam_part.step"
@@ -53,21 +50,6 @@ LEVELS = 3
 SAMPLING = 0.5
 POINTS = 20_000
 DEFLECTION = 0.05
-
-
-@contextlib.contextmanager
-def _quiet_stdout():
-    """OpenCAMLib's C++ prints diagnostics ("facetPush() ... error!?") on file descriptor 1:
-    sent to /dev/null while it runs, so the tables (and the generated Markdown) stay clean."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    with open(os.devnull, "w") as null:
-        os.dup2(null.fileno(), 1)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 1)
-            os.close(saved)
 
 
 def _ocl_surface(ocl, tri):
@@ -123,7 +105,7 @@ def rows():
                 wl.setZ(float(z))
                 wl.setSampling(SAMPLING)
                 wl.setThreads(1)
-                with _quiet_stdout():
+                with captured_stdout():  # OpenCAMLib's facetPush() diagnostics: not the table's
                     t0 = time.perf_counter()
                     wl.run()
                     t_ocl += time.perf_counter() - t0
@@ -151,7 +133,7 @@ def rows():
             floor = float(lo[2]) - 100.0
             for x, y in xy:
                 bdc.appendPoint(ocl.CLPoint(float(x), float(y), floor))
-            with _quiet_stdout():
+            with captured_stdout():  # OpenCAMLib's facetPush() diagnostics: not the table's
                 t0 = time.perf_counter()
                 bdc.run()
                 t_ocl = time.perf_counter() - t0

@@ -13,7 +13,16 @@ so the Markdown files under ``docs/benchmarks/`` are the benchmark's own output.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import re
+import sys
+import tempfile
+
 MARKDOWN = False
+
+#: a terminal colour code (OCCT colours its log lines)
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 
 class Table:
@@ -79,3 +88,26 @@ def heading(text: str) -> None:
         print(f"\n**{text.strip()}**")
     else:
         print(text)
+
+
+@contextlib.contextmanager
+def captured_stdout():
+    """Whatever C++ code (OCCT's log, OpenCAMLib's diagnostics) prints on file descriptor 1
+    while the block runs, kept apart from the tables: yields a list that holds the
+    printed lines, colour codes stripped and blank lines dropped, once the block ends.
+    A benchmark says in a note what it needs of them, so a generated page holds only
+    its tables and notes."""
+    sys.stdout.flush()
+    lines: list[str] = []
+    saved = os.dup(1)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 1)
+        try:
+            yield lines
+        finally:
+            sys.stdout.flush()
+            os.dup2(saved, 1)
+            os.close(saved)
+            sink.seek(0)
+            text = _ANSI.sub("", sink.read().decode("utf-8", "replace"))
+            lines.extend(line.strip() for line in text.splitlines() if line.strip())

@@ -123,3 +123,36 @@ def test_pages_name_only_modules_and_functions_that_exist():
             else:
                 missing.append(f"{page.name}: {dotted}")
     assert not missing, missing
+
+
+#: a line OCCT's message system prints (``*** ERR StepReaderData : …``, ``**** WARN …``)
+_OCCT_LOG = re.compile(r"^\s*\*{3,}\s*(?:ERR|FAIL|WARN|INFO|TRACE)\b")
+
+
+def stray_lines(text: str) -> list[str]:
+    """The lines of a Markdown page that no page means to hold: a terminal's colour codes,
+    an OCCT log line, or a line inside a table that is not a row of it (a program's output
+    that leaked into a generated table)."""
+    stray, in_table = [], False
+    for number, line in enumerate(text.splitlines(), 1):
+        is_row = line.lstrip().startswith("|")
+        if "\x1b" in line or _OCCT_LOG.match(line) or (in_table and line.strip() and not is_row):
+            stray.append(f"line {number}: {line!r}")
+        in_table = is_row or (in_table and bool(line.strip()))
+    return stray
+
+
+def test_stray_lines_are_found():
+    table = "| a | b |\n|---|---:|\n| x | 1 |\n"
+    assert stray_lines(table + "\nA note.\n") == []
+    log = "\x1b[32;1m*** ERR StepReaderData : Unresolved Reference : Fails Count : 16 ***\x1b[0m"
+    assert len(stray_lines(table + log + "\n| y | 2 |\n")) == 1
+    assert len(stray_lines(table + "\n*** ERR StepReaderData : Unresolved Reference ***\n")) == 1
+    assert len(stray_lines("| a |\n|---|\nsome output\n| b |\n")) == 1
+
+
+def test_pages_hold_no_stray_line():
+    # a generated page (docs/benchmarks/) holds only the tables and notes it claims
+    pages = [*_pages(), *sorted((DOCS / "benchmarks").glob("*.md"))]
+    found = {page.name: lines for page in pages if (lines := stray_lines(page.read_text(encoding="utf-8")))}
+    assert not found, found
