@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import DamagedFileError, KernelError, MissingExtraError, SurfmodError
+from .errors import DamagedFileError, KernelError, MissingExtraError, RoundTripWarning, SurfmodError
 from .pictures import install as _install_renderer
 from .version import installed_version
 
@@ -149,7 +149,7 @@ _EXPORTS = {
     "Conformance": ".conform",
 }
 
-__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError"])
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError", "RoundTripWarning"])
 
 
 def __getattr__(name: str):

@@ -54,3 +54,15 @@ class MissingExtraError(SurfmodError, ImportError):
     >>> issubclass(sm.MissingExtraError, sm.SurfmodError) and issubclass(sm.MissingExtraError, ImportError)
     True
     """
+
+
+class RoundTripWarning(UserWarning):
+    """A file was written, but reading it back gives a shape that differs from the one
+    given (a solid lost or turned, faces lost, a volume or centroid moved); the message
+    names what changed and by how much.  ``strict=True`` raises :class:`SurfmodError`
+    instead and writes nothing.
+
+    >>> import surfmod as sm
+    >>> issubclass(sm.RoundTripWarning, UserWarning)
+    True
+    """
