@@ -72,7 +72,7 @@ def relative_differences(r, o) -> dict:
     }
 
 
-def _solid_figures(solid):
+def solid_figures(solid):
     """Volume and centroid of one solid by BRepGProp's fixed Gauss rule (the same digits
     for the same geometry, so a change is the geometry's)."""
     vp = GProp_GProps()
@@ -113,7 +113,7 @@ def shape_changes(given, again, rtol: float = 1e-12) -> list[str]:
             if nx != ny:
                 changes.append(f"solid {i}: faces {nx} -> {ny}")
                 continue
-            (va, ca), (vb, cb) = _solid_figures(x), _solid_figures(y)
+            (va, ca), (vb, cb) = solid_figures(x), solid_figures(y)
             if (va < 0) != (vb < 0):
                 changes.append(f"solid {i}: enclosed volume {va:.6g} -> {vb:.6g} (turned "
                                f"{'inside out' if vb < 0 else 'outward'})")

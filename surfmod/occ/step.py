@@ -14,7 +14,7 @@ from OCP.IFSelect import IFSelect_RetDone
 from OCP.Message import Message, Message_Gravity
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
-from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shell, TopoDS_Solid
+from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shape, TopoDS_Shell, TopoDS_Solid
 
 from ..errors import SurfmodError
 from .fullprecision import write_step_full
@@ -153,3 +153,15 @@ def write_brep(shape, path) -> None:
     with kernel("BRepTools.Write_s"):
         if not BRepTools.Write_s(shape, str(path)):
             raise SurfmodError(f"path: could not write BREP {path}")
+
+
+def read_brep(path):
+    """The shape of an OCCT native BREP file at ``path`` (as :func:`write_brep` writes
+    it: every tolerance, orientation and p-curve as in memory, nothing healed); a file
+    that is not one raises ``SurfmodError`` naming it."""
+    shape = TopoDS_Shape()
+    with kernel("BRepTools.Read_s"):
+        ok = BRepTools.Read_s(shape, str(path), BRep_Builder())
+    if not ok or shape.IsNull():
+        raise SurfmodError(f"path: {path} is not a readable BREP file")
+    return shape
