@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import DamagedFileError, KernelError, MissingExtraError, RoundTripWarning, SurfmodError
+from .errors import DamagedFileError, InsideOutWarning, KernelError, MissingExtraError, RoundTripWarning, SurfmodError
 from .pictures import install as _install_renderer
 from .version import installed_version
 
@@ -149,7 +149,8 @@ _EXPORTS = {
     "Conformance": ".conform",
 }
 
-__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError", "RoundTripWarning"])
+__all__ = sorted([*_EXPORTS, "SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError", "RoundTripWarning",
+                  "InsideOutWarning"])
 
 
 def __getattr__(name: str):

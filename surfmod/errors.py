@@ -66,3 +66,15 @@ class RoundTripWarning(UserWarning):
     >>> issubclass(sm.RoundTripWarning, UserWarning)
     True
     """
+
+
+class InsideOutWarning(UserWarning):
+    """A solid encloses a negative volume (its faces point into its material): the
+    message names the solid and the volume.  Readers and meshing turn such a solid
+    outward by the sign of its enclosed volume (never face by face) and say so with this
+    warning; the command line prints it as one line.
+
+    >>> import surfmod as sm
+    >>> issubclass(sm.InsideOutWarning, UserWarning)
+    True
+    """

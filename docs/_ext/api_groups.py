@@ -43,5 +43,6 @@ GROUPS = [
      ["export_step", "export_iges", "import_iges", "to_geomdl", "from_geomdl", "to_splipy",
       "from_splipy", "to_rhino", "from_rhino"]),
     ("Errors and settings", "The exceptions of the error contract, and the thread cap of the kernels.",
-     ["SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError", "RoundTripWarning", "set_threads"]),
+     ["SurfmodError", "KernelError", "DamagedFileError", "MissingExtraError", "RoundTripWarning", "InsideOutWarning",
+      "set_threads"]),
 ]

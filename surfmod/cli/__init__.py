@@ -8,9 +8,10 @@ import importlib
 import pkgutil
 import re
 import sys
+import warnings
 from pathlib import Path
 
-from ..errors import SurfmodError
+from ..errors import InsideOutWarning, RoundTripWarning, SurfmodError
 from ..version import installed_version
 
 
@@ -57,8 +58,18 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+
+    def one_line(message, category, *_args, **_kwargs):
+        # a warning of surfmod's (an inside-out solid, a file that reads back changed) is
+        # one line naming the command, like its errors, not Python's two-line form
+        print(f"surfmod {args.command}: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
     try:
-        return int(args.run(args) or 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", InsideOutWarning)
+            warnings.simplefilter("always", RoundTripWarning)
+            warnings.showwarning = one_line
+            return int(args.run(args) or 0)
     except KeyboardInterrupt:
         # Ctrl-C: what was finished is written (a folder's CSV holds every finished file's
         # rows); one line and the shell's status for SIGINT, not a traceback

@@ -6,7 +6,8 @@ Every write is checked by reading the file back: exit 0 when it gives back what 
 (the number of solids, of faces and of faces in no solid, each solid's orientation,
 volume and centroid to 1e-12 relative; for an STL, a closed outward mesh of every solid),
 3 when it was written but does not (the lines before say what, and where), 1 on bad input
-with nothing written.  ``--check`` also prints the comparison, solid by solid.
+with nothing written (an STL that is not closed and outward: ``BROKEN:`` lines name the
+solids and faces).  ``--check`` also prints the comparison, solid by solid.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import warnings
 from pathlib import Path
 
 from ..atomic import atomic_path, target_path
-from ..errors import RoundTripWarning, SurfmodError
+from ..errors import InsideOutWarning, RoundTripWarning, SurfmodError
 from ..io.iges import SUFFIXES as IGES_SUFFIXES
 from ..io.iges import export_iges, import_iges
 from ..io.step import export_step, import_step
@@ -80,7 +81,9 @@ def _write(shape, out: str, kind: str, tolerance: float):
         with atomic_path(target_path(out, "output", (".brep",))) as tmp:
             write_brep(shape, tmp)
     else:
-        return export_stl(shape, out, tolerance)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RoundTripWarning)  # said by the caller, one line per problem
+            return export_stl(shape, out, tolerance)
     return None
 
 
@@ -108,8 +111,12 @@ def run(args) -> int:
     mesh = _write(shape, args.output, kind_out, tolerance)
     if mesh is not None:  # export_stl has read its STL back and judged it
         print(f"{args.output}: {len(mesh.faces)} triangles")
-        return 0
-    again = read_part(args.output, kind_out)
+        for line in mesh.info["stl_problems"]:
+            print(f"BROKEN: {line}")
+        return EXIT_CHANGED if mesh.info["stl_problems"] else 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", InsideOutWarning)  # an orientation change is one of the changes below
+        again = read_part(args.output, kind_out)
     if args.check:
         _report(shape, again)
     changes = shape_changes(shape, again)

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .. import checks
-from ..errors import SurfmodError
+from ..errors import RoundTripWarning, SurfmodError
+from ..meshing.closure import judge_stl
 from ..meshing.polymesh import Mesh
 from ..meshing.tessellate import tessellate
 from ..atomic import atomic_path, target_path
@@ -30,6 +33,13 @@ def merged(meshes: list[Mesh]) -> Mesh:
         info["max_deviation"] = max(devs)
     info["faces_over_tolerance"] = [r for m in meshes for r in m.info.get("faces_over_tolerance", [])]
     info["open_faces"] = sum(m.info.get("open_faces", 0) for m in meshes)
+    # what each run of triangles promises (a solid's: to close), in file order; a mesh or
+    # a surface promises nothing of the kind
+    info["stl_groups"] = [
+        (name if name is None or len(meshes) == 1 else f"object {k}, {name}", count, faces)
+        for k, m in enumerate(meshes, 1)
+        for name, count, faces in m.info.get("stl_groups", [(None, len(m.triangles()), None)])
+    ]
     return Mesh(np.concatenate(verts), np.concatenate(faces), info)
 
 
@@ -90,6 +100,16 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
     tolerance); ``strict=True`` refuses them instead and writes nothing.  ``progress``
     shows a tqdm bar while meshing.  Returns the mesh that was written.
 
+    The file written is read back and judged (:mod:`surfmod.meshing.closure`): the
+    triangles of every solid whose shells are closed must be closed, 2-manifold,
+    consistently and outward oriented, without a degenerate facet (0 admesh repairs).
+    Faces in no closed shell promise nothing of the kind (``info["open_faces"]``).  A
+    solid that breaks the promise, and a face whose triangles stray from it farther than
+    its nodes and its model tolerance explain (a meshing failure, not the model's), are
+    listed in ``info["stl_problems"]`` and said in a
+    :class:`~surfmod.errors.RoundTripWarning` naming the solids and faces; ``strict=True``
+    raises instead and writes nothing.
+
     >>> import surfmod as sm, tempfile, os
     >>> d = tempfile.mkdtemp()
     >>> m = sm.export_stl(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), os.path.join(d, "p.stl"))
@@ -103,6 +123,18 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
         raise SurfmodError("objects: nothing to export")
     mesh = merged([_mesh_of(o, tolerance, strict, progress) for o in items])
     tri = mesh.vertices[mesh.triangles()]
-    with atomic_path(target) as tmp, open(tmp, "wb") as fh:
-        (write_ascii if ascii else write_binary)(fh, tri)
+    with atomic_path(target) as tmp:
+        with open(tmp, "wb") as fh:
+            (write_ascii if ascii else write_binary)(fh, tri)
+        problems = judge_stl(tmp, mesh.info["stl_groups"]) + [
+            f"face {r['face']} ({r['surface']}): triangles {r['deviation']:.3g} off the face while its nodes are "
+            f"{r['node_deviation']:.3g} off and its model tolerance is {r['model_tolerance']:.3g}: a meshing failure"
+            for r in mesh.info["faces_over_tolerance"] if r.get("cause") == "mesh"]
+        if problems and strict:
+            raise SurfmodError("objects: the STL read back breaks its promise (strict=True writes nothing): "
+                               + "; ".join(problems))
+    mesh.info["stl_problems"] = problems
+    if problems:
+        warnings.warn(f"{target.name} read back breaks its promise: " + "; ".join(problems), RoundTripWarning,
+                      stacklevel=2)
     return mesh

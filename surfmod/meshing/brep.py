@@ -37,7 +37,7 @@ from functools import partial
 
 import numpy as np
 
-from ..errors import SurfmodError
+from ..errors import InsideOutWarning, SurfmodError
 from ..eval.differential import curvatures, degenerate_mask, raw_normals
 from .deviation import DENSE, project_distances, triangle_deviations
 from .facesurface import FaceSurface
@@ -390,12 +390,17 @@ def _faces_report(fms, dev, node_dev, tolerance):
     out = []
     for i in np.nonzero(dev > tolerance)[0]:
         fm = fms[i]
+        declared = max_tolerance(fm.face)
         out.append({
             "face": fm.index,
             "surface": surface_type(fm.surface).removeprefix("Geom_"),
             "deviation": float(dev[i]),
             "node_deviation": float(node_dev[i]),
-            "model_tolerance": max_tolerance(fm.face),
+            "model_tolerance": declared,
+            # the model explains a deviation its nodes (on the edges' curves) or its
+            # declared tolerance reach; triangles that stray farther while the nodes lie
+            # on the face are the meshing's failure, not the model's
+            "cause": "model" if dev[i] <= max(declared, float(allowed_deviation(node_dev[i], tolerance))) else "mesh",
         })
     return out
 
@@ -502,14 +507,31 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
         raise SurfmodError(
             f"tolerance: {tolerance:g} is not met on {len(report)} face(s) (strict):\n" + describe_faces(report)
         )
-    verts, tris = [], []
+    verts, tris, groups, inside_out = [], [], [], []
+    in_open_shell = set(opened)
     for solid in sorted({fm.solid for fm in fms}):
         part = [fm for fm in fms if fm.solid == solid]
         offsets = np.cumsum([0] + [len(fm.nodes) for fm in part])
-        v, t = weld(np.concatenate([fm.nodes for fm in part]),
-                    np.concatenate([fm.triangles + o for fm, o in zip(part, offsets)]))
+        nodes = np.concatenate([fm.nodes for fm in part])
+        joined = np.concatenate([fm.triangles + o for fm, o in zip(part, offsets)])
+        labels = np.concatenate([np.full(len(fm.triangles), fm.index) for fm in part])
+        v, t = weld(nodes, joined)
+        corner = nodes[joined]  # weld drops the triangles with two equal corners: so do the labels
+        kept = ~(np.all(corner[:, 0] == corner[:, 1], axis=1) | np.all(corner[:, 1] == corner[:, 2], axis=1)
+                 | np.all(corner[:, 0] == corner[:, 2], axis=1))
+        # a solid of closed shells promises a closed, outward STL (judged when written)
+        closes = solid >= 0 and not any(fm.index in in_open_shell for fm in part)
+        if closes:
+            c = v[t]
+            volume = float(np.einsum("ij,ij->i", c[:, 0], np.cross(c[:, 1], c[:, 2])).sum() / 6.0)
+            if volume < 0:  # the whole solid's faces point inwards: turned as one, by its volume
+                t = t[:, ::-1].copy()
+                inside_out.append((solid + 1, volume))
+                warnings.warn(f"solid {solid + 1} is inside out (enclosed volume {volume:.6g}): meshed outward",
+                              InsideOutWarning, stacklevel=3)
         tris.append(t + sum(len(x) for x in verts))
         verts.append(v)
+        groups.append((f"solid {solid + 1}" if closes else None, len(t), labels[kept]))
     info = {
         "kind": "brepmesh",
         "tolerance": tolerance,
@@ -523,5 +545,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
         "faces_over_tolerance": report,
         "faces_not_meshed": list(missing),
         "open_faces": len(opened),
+        "stl_groups": groups,
+        "inside_out_solids": inside_out,
     }
     return Mesh(np.concatenate(verts), np.concatenate(tris), info)

@@ -31,11 +31,12 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 from pathlib import Path
 
 from .. import checks
 from .finite import first_non_finite
-from ..errors import DamagedFileError, SurfmodError
+from ..errors import DamagedFileError, InsideOutWarning, SurfmodError
 from .guard import kernel
 
 _HEADER = struct.Struct("!Q")
@@ -69,8 +70,9 @@ def _recv(fd: int, deadline: float | None):
 
 
 # -- the worker side ------------------------------------------------------------------------
-def _read_and_check(path: str, max_coordinate: float) -> bytes:
-    """Read ``path`` with OCCT, check its coordinates, return the shape as BinTools bytes."""
+def _read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
+    """Read ``path`` with OCCT, check its coordinates, return the shape as BinTools bytes
+    and the solids inside out in the file, read outward (:func:`~surfmod.occ.step.outward_solids`)."""
     from OCP.BinTools import BinTools
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
@@ -78,7 +80,8 @@ def _read_and_check(path: str, max_coordinate: float) -> bytes:
     from .bindings import box_limits
     from .step import read_step
 
-    shape = read_step(path)
+    turned: list = []  # the solids inside out in the file, turned outward
+    shape = read_step(path, turned)
     with kernel("BRepBndLib"):
         box = Bnd_Box()
         BRepBndLib.Add_s(shape, box, False)  # from the geometry, not a triangulation
@@ -105,7 +108,7 @@ def _read_and_check(path: str, max_coordinate: float) -> bytes:
     with kernel("BinTools.Write"):
         out = io.BytesIO()
         BinTools.Write_s(shape, out)
-    return out.getvalue()
+    return out.getvalue(), turned
 
 
 def _worker_main() -> None:
@@ -123,7 +126,7 @@ def _worker_main() -> None:
         except EOFError:
             return
         try:
-            _send(reply, ("ok", _read_and_check(path, max_coordinate)))
+            _send(reply, ("ok", *_read_and_check(path, max_coordinate)))
         except SurfmodError as exc:
             msg = str(exc)  # every refusal names the file (a kernel failure names its operation)
             _send(reply, ("error", type(exc).__name__, msg if path in msg else f"path: {path}: {msg}"))
@@ -198,7 +201,7 @@ class _Worker:
                 pass
             self._kill(proc)
 
-    def read(self, path: str, timeout: float, max_coordinate: float) -> bytes:
+    def read(self, path: str, timeout: float, max_coordinate: float) -> tuple[bytes, list]:
         with self._lock:
             if self._owner != os.getpid():  # a forked child must not share the parent's worker
                 self._proc, self._owner = None, os.getpid()
@@ -227,7 +230,7 @@ class _Worker:
                     f"path: OCCT crashed reading {path} ({how}); the file is damaged"
                 ) from None
         if answer[0] == "ok":
-            return answer[1]
+            return answer[1], answer[2]
         raise DamagedFileError(answer[2])  # answer = ("error", exception type, message)
 
 
@@ -277,13 +280,16 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     from OCP.TopoDS import TopoDS_Shape
 
     try:
-        data = _WORKER.read(str(p), timeout, max_coordinate)
+        data, turned = _WORKER.read(str(p), timeout, max_coordinate)
     except DamagedFileError as exc:
         msg = str(exc)
         raise DamagedFileError(msg if msg.startswith(f"{name}:") else f"{name}: {msg.removeprefix('path: ')}") from None
     with kernel("BinTools.Read"):
         shape = TopoDS_Shape()
         BinTools.Read_s(shape, io.BytesIO(data))
+    for number, volume in turned:
+        warnings.warn(f"{p.name}: solid {number} is inside out in the file (enclosed volume {volume:.6g}): "
+                      "read outward", InsideOutWarning, stacklevel=3)
     return shape
 
 

@@ -121,7 +121,17 @@ def read_with(reader, kind: str, path: str):
     return shape
 
 
-def outward_solids(shape):
+def _shell_sign(solid) -> float:
+    """-1 when OCCT's reader uses the solid's shell REVERSED, else 1."""
+    it = TopoDS_Iterator(solid, False, False)
+    while it.More():
+        if it.Value().ShapeType() == TopAbs_SHELL and it.Value().Orientation() == TopAbs_REVERSED:
+            return -1.0
+        it.Next()
+    return 1.0
+
+
+def outward_solids(shape, inside_out: list | None = None):
     """``shape`` with every solid whose enclosed volume is negative (its faces point
     inwards) reversed, so each solid's faces point out of its material.
 
@@ -131,20 +141,32 @@ def outward_solids(shape):
     inside-out file, and that correct solid, written and read again, comes back inside
     out.  The sign of the volume (the divergence theorem over the faces as oriented)
     decides instead.
+
+    ``inside_out``, a list, receives ``(number, volume)`` of each solid of a freshly
+    read ``shape`` that is inside out *in the file* (numbered from 1 in explorer order),
+    with its enclosed volume as the file has it: STEP's closed shell has no orientation,
+    the reader builds it FORWARD as the file's faces point and may use it REVERSED, so
+    the file's orientation is the volume's sign with a REVERSED shell counted FORWARD.
     """
+    met = [0]
+
     def outward(solid):
+        met[0] += 1
         props = GProp_GProps()
         BRepGProp.VolumeProperties_s(solid, props)
+        if inside_out is not None and _shell_sign(solid) * props.Mass() < 0.0:
+            inside_out.append((met[0], _shell_sign(solid) * props.Mass()))
         return solid.Reversed() if props.Mass() < 0.0 else solid
 
     with kernel("BRepGProp.VolumeProperties_s"):
         return map_solids(shape, outward)
 
 
-def read_step(path: str):
-    """Read a STEP file into one TopoDS shape, its solids :func:`outward_solids`;
-    unreadable files raise ``SurfmodError``."""
-    return outward_solids(read_with(STEPControl_Reader(), "STEP", path))
+def read_step(path: str, inside_out: list | None = None):
+    """Read a STEP file into one TopoDS shape, its solids :func:`outward_solids` (those
+    inside out in the file added to ``inside_out``); unreadable files raise
+    ``SurfmodError``."""
+    return outward_solids(read_with(STEPControl_Reader(), "STEP", path), inside_out)
 
 
 def write_brep(shape, path) -> None:

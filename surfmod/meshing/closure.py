@@ -1,0 +1,148 @@
+"""The judge of a written STL, independent of how it was meshed: the file read back, and
+every solid's triangles closed, 2-manifold, consistently and outward oriented, without a
+degenerate facet (what admesh would otherwise repair, and what a slicer needs).
+
+The triangles are read from the file (float32, as any reader sees them); vertices are
+the same where their float32 coordinates are equal, which is how admesh and slicers join
+facets.  Per group of triangles (one solid):
+
+* an edge met once is *open*, an edge met three or more times is *non-manifold*;
+* an edge met twice in the same direction joins two facets of opposite orientation
+  (*inconsistent* winding);
+* a facet with two equal corners is *degenerate*;
+* the enclosed volume (the divergence theorem over the facets) must be positive: a
+  negative one is a solid meshed inside out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import SurfmodError
+
+#: binary STL: 80-byte header, uint32 count, then 50-byte records
+_RECORD = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+
+
+def read_stl(path) -> np.ndarray:
+    """The facets of an STL file (binary or ASCII) as float32 corners ``(T, 3, 3)``.
+
+    >>> import os, tempfile
+    >>> p = os.path.join(tempfile.mkdtemp(), "t.stl")
+    >>> _ = open(p, "w").write("solid t\\n facet normal 0 0 1\\n  outer loop\\n   vertex 0 0 0\\n"
+    ...                        "   vertex 1 0 0\\n   vertex 0 1 0\\n  endloop\\n endfacet\\nendsolid t\\n")
+    >>> read_stl(p).tolist()
+    [[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]
+    """
+    with open(path, "rb") as fh:
+        data = fh.read()
+    if len(data) >= 84:
+        (count,) = np.frombuffer(data, "<u4", 1, 80)
+        if 84 + int(count) * _RECORD.itemsize == len(data):
+            return np.frombuffer(data, _RECORD, int(count), 84)["v"].copy()
+    words = data.split()
+    at = [i for i, w in enumerate(words) if w == b"vertex"]
+    if not data.lstrip().startswith(b"solid") or not at:
+        raise SurfmodError(f"path: {path} is neither a binary nor an ASCII STL")
+    try:
+        corners = np.array([[float(words[i + k]) for k in (1, 2, 3)] for i in at], dtype=np.float32)
+    except (ValueError, IndexError):
+        raise SurfmodError(f"path: {path} has a vertex line that is not three numbers") from None
+    if len(corners) % 3:
+        raise SurfmodError(f"path: {path} has {len(corners)} vertex lines, not three per facet")
+    return corners.reshape(-1, 3, 3)
+
+
+@dataclass(frozen=True)
+class Closure:
+    """What one group of facets (a solid) is, read back: counts of ``open``,
+    ``non_manifold`` and ``inconsistent`` edges and ``degenerate`` facets, the enclosed
+    ``volume``, and ``faces``: the B-rep faces whose facets touch a bad edge (or are
+    degenerate), sorted."""
+
+    open: int
+    non_manifold: int
+    inconsistent: int
+    degenerate: int
+    volume: float
+    faces: tuple
+
+    @property
+    def sound(self) -> bool:
+        """Closed, 2-manifold, consistently outward, no degenerate facet."""
+        return not (self.open or self.non_manifold or self.inconsistent or self.degenerate) and self.volume > 0
+
+    def describe(self) -> str:
+        """The problems in words (empty when sound)."""
+        said = [f"{n} {what}" for n, what in ((self.open, "open edge(s)"), (self.non_manifold, "non-manifold edge(s)"),
+                                             (self.inconsistent, "edge(s) joining facets of opposite orientation"),
+                                             (self.degenerate, "degenerate facet(s)")) if n]
+        if self.volume <= 0:
+            said.append(f"enclosed volume {self.volume:.6g} (inside out or not closed)")
+        if self.faces:
+            shown = ", ".join(map(str, self.faces[:10])) + (" ..." if len(self.faces) > 10 else "")
+            said.append(f"along face(s) {shown}")
+        return "; ".join(said)
+
+
+def closure(corners: np.ndarray, faces: np.ndarray | None = None) -> Closure:
+    """Judge facets ``(T, 3, 3)`` as one closed solid; ``faces`` (``T`` ints) names the
+    B-rep face of each facet.
+
+    >>> box = np.array([[[0, 0, 0], [0, 1, 0], [1, 0, 0]], [[0, 0, 0], [1, 0, 0], [0, 0, 1]],
+    ...                 [[0, 0, 0], [0, 0, 1], [0, 1, 0]], [[1, 0, 0], [0, 1, 0], [0, 0, 1]]], np.float32)
+    >>> c = closure(box)   # a tetrahedron, outward
+    >>> c.sound, c.volume
+    (True, 0.16666666666666666)
+    >>> closure(box[:3]).describe()
+    '3 open edge(s); enclosed volume 0 (inside out or not closed)'
+    >>> closure(box[:, ::-1]).describe()
+    'enclosed volume -0.166667 (inside out or not closed)'
+    """
+    corners = np.asarray(corners, np.float32)
+    flat = corners.reshape(-1, 3)
+    _, index = np.unique(flat, axis=0, return_inverse=True)
+    tri = index.reshape(-1, 3)
+    degenerate = (tri[:, 0] == tri[:, 1]) | (tri[:, 1] == tri[:, 2]) | (tri[:, 0] == tri[:, 2])
+    good = tri[~degenerate]
+    directed = np.concatenate([good[:, [0, 1]], good[:, [1, 2]], good[:, [2, 0]]])
+    owner = np.tile(np.nonzero(~degenerate)[0], 3)
+    undirected = np.sort(directed, axis=1)
+    keys, inverse, counts = np.unique(undirected, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    # per undirected edge met twice: the two uses must run opposite ways
+    forward = (directed[:, 0] < directed[:, 1]).astype(np.int64)
+    ways = np.bincount(inverse, weights=forward, minlength=len(keys))
+    bad_edge = (counts == 1) | (counts > 2) | ((counts == 2) & (ways != 1))
+    c = corners.astype(np.float64)
+    volume = float(np.einsum("ij,ij->i", c[:, 0], np.cross(c[:, 1], c[:, 2])).sum() / 6.0)
+    named: tuple = ()
+    if faces is not None:
+        faces = np.asarray(faces)
+        hit = np.union1d(owner[bad_edge[inverse]], np.nonzero(degenerate)[0])
+        named = tuple(int(f) for f in np.unique(faces[hit]))
+    return Closure(open=int((counts == 1).sum()), non_manifold=int((counts > 2).sum()),
+                   inconsistent=int(((counts == 2) & (ways != 1)).sum()), degenerate=int(degenerate.sum()),
+                   volume=volume, faces=named)
+
+
+def judge_stl(path, groups: list) -> list[str]:
+    """The problems of the STL at ``path``, one line per group that is not sound.
+    ``groups`` are ``(name, count, faces)`` in file order: ``count`` facets named
+    ``name`` (e.g. ``"solid 2"``) that must close, ``faces`` their B-rep face indices;
+    ``None`` for a name skips facets that make no such promise (faces in no closed
+    shell).  The facet counts must add up to the file's."""
+    corners = read_stl(path)
+    total = sum(count for _, count, _ in groups)
+    if total != len(corners):
+        return [f"{path}: {len(corners)} facets read back, {total} written"]
+    problems, start = [], 0
+    for name, count, faces in groups:
+        if name is not None:
+            verdict = closure(corners[start:start + count], faces)
+            if not verdict.sound:
+                problems.append(f"{name}: {verdict.describe()}")
+        start += count
+    return problems
