@@ -132,3 +132,53 @@ def test_convert_to_stl_exits_3_naming_an_inconsistent_solid(tmp_path, capsys):
     assert main(["convert", str(brep), str(tmp_path / "f.stl"), "--tolerance", "0.01"]) == 3
     out = capsys.readouterr().out
     assert "BROKEN: solid 1: 4 edge(s) joining facets of opposite orientation; along face(s) 0, 1, 2, 4, 5" in out
+
+
+def _fake_mesher(monkeypatch, open_until: float, flipped: bool = False):
+    """``export_stl``'s mesher replaced: the box, open (a facet missing) at tolerances
+    above ``open_until``, closed at or below it; inside out when ``flipped``.  Returns
+    the tolerances asked for."""
+    import surfmod.io.stl as stl
+
+    asked = []
+
+    def mesh_of(obj, tolerance, strict, progress):
+        asked.append(tolerance)
+        corners, faces = _box_facets()
+        if flipped:
+            corners = corners[:, ::-1]
+        if tolerance > open_until:
+            corners, faces = corners[1:], faces[1:]
+        v = corners.reshape(-1, 3)
+        info = {"stl_groups": [("solid 1", len(corners), faces)], "faces_over_tolerance": []}
+        return sm.Mesh(v, np.arange(len(v)).reshape(-1, 3), info)
+
+    monkeypatch.setattr(stl, "_mesh_of", mesh_of)
+    return asked
+
+
+@needs_admesh
+def test_an_open_stl_is_meshed_again_finer_until_it_closes(tmp_path, monkeypatch):
+    asked = _fake_mesher(monkeypatch, open_until=0.005)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", sm.RoundTripWarning)
+        mesh = sm.export_stl("part", tmp_path / "box.stl", 0.01)
+    assert asked == [0.01, 0.005] and mesh.info["stl_problems"] == []
+    assert mesh.info["remeshed"] == ("solid 1: 3 open edge(s); along face(s) 0, 2, 5 at tolerance 0.01: closed "
+                                     "meshed again at 0.005")
+    stats = admesh_stats(tmp_path / "box.stl")
+    assert stats["Number of facets"] == 12 and all(stats[k] == 0 for k in ADMESH_REPAIRS)
+
+
+def test_an_stl_that_stays_open_is_said_and_the_first_mesh_kept(tmp_path, monkeypatch):
+    asked = _fake_mesher(monkeypatch, open_until=0.0)
+    with pytest.warns(sm.RoundTripWarning, match=r"^box.stl read back breaks its promise: solid 1: 3 open edge"):
+        mesh = sm.export_stl("part", tmp_path / "box.stl", 0.01)
+    assert asked == [0.01, 0.005, 0.0025] and len(read_stl(tmp_path / "box.stl")) == len(mesh.faces) == 11
+
+
+def test_orientation_is_not_meshed_again(tmp_path, monkeypatch):
+    asked = _fake_mesher(monkeypatch, open_until=1.0, flipped=True)
+    with pytest.warns(sm.RoundTripWarning, match=r"solid 1: enclosed volume -6 \(inside out or not closed\)$"):
+        sm.export_stl("part", tmp_path / "box.stl", 0.01)
+    assert asked == [0.01]

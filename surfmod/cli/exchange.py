@@ -111,6 +111,8 @@ def run(args) -> int:
     mesh = _write(shape, args.output, kind_out, tolerance)
     if mesh is not None:  # export_stl has read its STL back and judged it
         print(f"{args.output}: {len(mesh.faces)} triangles")
+        if mesh.info.get("remeshed"):
+            print(f"NOTE: {mesh.info['remeshed']}")
         for line in mesh.info["stl_problems"]:
             print(f"BROKEN: {line}")
         return EXIT_CHANGED if mesh.info["stl_problems"] else 0

@@ -65,6 +65,8 @@ def run(args) -> int:
               f"closer: the model's own error (its nodes or its tolerance are that far off); --strict refuses "
               f"such parts")
         print(describe_faces(report))
+    if mesh.info.get("remeshed"):
+        print(f"NOTE: {mesh.info['remeshed']}")
     # the STL read back: every solid closed, 2-manifold, outward; no meshing failure
     problems = mesh.info.get("stl_problems", [])
     for line in problems:

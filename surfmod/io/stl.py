@@ -9,6 +9,10 @@ import numpy as np
 from .. import checks
 from ..errors import RoundTripWarning, SurfmodError
 from ..meshing.closure import judge_stl
+
+#: fractions of the tolerance at which a part whose STL does not close is meshed again
+#: (each within the tolerance asked for; about 4x and 16x the triangles at most)
+REMESH = (0.5, 0.25)
 from ..meshing.polymesh import Mesh
 from ..meshing.tessellate import tessellate
 from ..atomic import atomic_path, target_path
@@ -108,7 +112,10 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
     its nodes and its model tolerance explain (a meshing failure, not the model's), are
     listed in ``info["stl_problems"]`` and said in a
     :class:`~surfmod.errors.RoundTripWarning` naming the solids and faces; ``strict=True``
-    raises instead and writes nothing.
+    raises instead and writes nothing.  Before that, a part with an open or non-manifold
+    edge, a degenerate facet or a mis-meshed face is meshed again at the finer
+    tolerances of :data:`REMESH` (within ``tolerance`` still); the first mesh that
+    passes is written and ``info["remeshed"]`` says why.
 
     >>> import surfmod as sm, tempfile, os
     >>> d = tempfile.mkdtemp()
@@ -122,14 +129,28 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
     if not items:
         raise SurfmodError("objects: nothing to export")
     mesh = merged([_mesh_of(o, tolerance, strict, progress) for o in items])
-    tri = mesh.vertices[mesh.triangles()]
+    meshed = any(not isinstance(o, Mesh) for o in items)
     with atomic_path(target) as tmp:
-        with open(tmp, "wb") as fh:
-            (write_ascii if ascii else write_binary)(fh, tri)
-        problems = judge_stl(tmp, mesh.info["stl_groups"]) + [
-            f"face {r['face']} ({r['surface']}): triangles {r['deviation']:.3g} off the face while its nodes are "
-            f"{r['node_deviation']:.3g} off and its model tolerance is {r['model_tolerance']:.3g}: a meshing failure"
-            for r in mesh.info["faces_over_tolerance"] if r.get("cause") == "mesh"]
+        problems, finer_may_close = _written(tmp, mesh, ascii)
+        held = mesh  # what the file holds
+        # repair: the whole part meshed again, finer (still within ``tolerance``), while
+        # a solid is open or a face was mis-meshed; orientation is not the mesh's to fix
+        for fraction in REMESH if problems and finer_may_close and meshed else ():
+            try:
+                finer = merged([_mesh_of(o, tolerance * fraction, strict, progress) for o in items])
+            except SurfmodError:  # past max_triangles: the first mesh stays, reported
+                break
+            left, finer_may_close = _written(tmp, finer, ascii)
+            held = finer
+            if not left:
+                finer.info["remeshed"] = (f"{'; '.join(problems)} at tolerance {tolerance:g}: closed meshed again "
+                                          f"at {tolerance * fraction:g}")
+                mesh, problems = finer, []
+                break
+            if not finer_may_close:
+                break
+        if held is not mesh:
+            _written(tmp, mesh, ascii)
         if problems and strict:
             raise SurfmodError("objects: the STL read back breaks its promise (strict=True writes nothing): "
                                + "; ".join(problems))
@@ -138,3 +159,18 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
         warnings.warn(f"{target.name} read back breaks its promise: " + "; ".join(problems), RoundTripWarning,
                       stacklevel=2)
     return mesh
+
+
+def _written(tmp, mesh: Mesh, ascii: bool) -> tuple[list[str], bool]:
+    """Write ``mesh`` to ``tmp``, read it back and judge it: the broken promises, one line
+    each, and whether a finer mesh may mend them (an open or non-manifold edge, a
+    degenerate facet, a face BRepMesh mis-meshed)."""
+    with open(tmp, "wb") as fh:
+        (write_ascii if ascii else write_binary)(fh, mesh.vertices[mesh.triangles()])
+    failing = judge_stl(tmp, mesh.info["stl_groups"])
+    mis_meshed = [r for r in mesh.info["faces_over_tolerance"] if r.get("cause") == "mesh"]
+    problems = [f"{name}: {verdict.describe()}" for name, verdict in failing] + [
+        f"face {r['face']} ({r['surface']}): triangles {r['deviation']:.3g} off the face while its nodes are "
+        f"{r['node_deviation']:.3g} off and its model tolerance is {r['model_tolerance']:.3g}: a meshing failure"
+        for r in mis_meshed]
+    return problems, bool(mis_meshed) or any(v.open or v.non_manifold or v.degenerate for _, v in failing)

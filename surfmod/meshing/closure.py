@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SurfmodError
+from ..errors import KernelError, SurfmodError
 
 #: binary STL: 80-byte header, uint32 count, then 50-byte records
 _RECORD = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
@@ -128,21 +128,22 @@ def closure(corners: np.ndarray, faces: np.ndarray | None = None) -> Closure:
                    volume=volume, faces=named)
 
 
-def judge_stl(path, groups: list) -> list[str]:
-    """The problems of the STL at ``path``, one line per group that is not sound.
+def judge_stl(path, groups: list) -> list[tuple[str, Closure]]:
+    """The groups of the STL at ``path`` that are not sound, as ``(name, verdict)``.
     ``groups`` are ``(name, count, faces)`` in file order: ``count`` facets named
     ``name`` (e.g. ``"solid 2"``) that must close, ``faces`` their B-rep face indices;
     ``None`` for a name skips facets that make no such promise (faces in no closed
-    shell).  The facet counts must add up to the file's."""
+    shell).  A file that does not hold as many facets as the groups raises
+    ``KernelError`` (the writer failed)."""
     corners = read_stl(path)
     total = sum(count for _, count, _ in groups)
     if total != len(corners):
-        return [f"{path}: {len(corners)} facets read back, {total} written"]
-    problems, start = [], 0
+        raise KernelError(f"STL writer: {len(corners)} facets read back from {path}, {total} written")
+    failing, start = [], 0
     for name, count, faces in groups:
         if name is not None:
             verdict = closure(corners[start:start + count], faces)
             if not verdict.sound:
-                problems.append(f"{name}: {verdict.describe()}")
+                failing.append((name, verdict))
         start += count
-    return problems
+    return failing
