@@ -95,13 +95,24 @@ def _one_face_flipped():
     return solid
 
 
-def test_export_stl_says_an_inconsistent_solid_and_strict_refuses(tmp_path):
-    with pytest.warns(sm.RoundTripWarning, match=r"solid 1: 4 edge\(s\) joining facets of opposite orientation"):
-        mesh = sm.export_stl(_one_face_flipped(), tmp_path / "f.stl", 0.01)
-    assert mesh.info["stl_problems"] and (tmp_path / "f.stl").exists()
-    with pytest.raises(sm.SurfmodError, match=r"^objects: the STL read back breaks its promise"):
-        sm.export_stl(_one_face_flipped(), tmp_path / "g.stl", 0.01, strict=True)
-    assert not (tmp_path / "g.stl").exists()
+@needs_admesh
+def test_export_stl_turns_the_faces_at_odds_with_their_neighbours(tmp_path):
+    # a solid whose faces disagree: made consistent from the connectivity (face 2 turned
+    # to agree with its four neighbours), outward from the enclosed volume
+    with pytest.warns(sm.InsideOutWarning, match=r"^solid 1: face\(s\) 2 point against their neighbours"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", sm.RoundTripWarning)
+            mesh = sm.export_stl(_one_face_flipped(), tmp_path / "f.stl", 0.01)
+    assert mesh.info["faces_turned"] == [(1, [2])] and mesh.info["inside_out_solids"] == []
+    stats = admesh_stats(tmp_path / "f.stl")
+    assert all(stats[k] == 0 for k in ADMESH_REPAIRS) and stats["Volume"] == pytest.approx(6.0, rel=1e-6)
+
+
+def test_strict_refuses_an_stl_that_breaks_its_promise(tmp_path, monkeypatch):
+    _fake_mesher(monkeypatch, open_until=0.0)
+    with pytest.raises(sm.SurfmodError, match=r"^objects: the STL read back breaks its promise .*3 open edge"):
+        sm.export_stl("part", tmp_path / "g.stl", 0.01, strict=True)
+    assert not list(tmp_path.iterdir())
 
 
 def test_export_stl_of_an_open_shell_promises_no_closure(tmp_path):
@@ -124,14 +135,15 @@ def test_mesh_command_says_an_inside_out_file_solid_in_one_line(tmp_path, capsys
     assert "BROKEN" not in captured.out
 
 
-def test_convert_to_stl_exits_3_naming_an_inconsistent_solid(tmp_path, capsys):
+def test_convert_to_stl_exits_3_naming_a_solid_left_open(tmp_path, capsys, monkeypatch):
     from surfmod.occ.step import write_brep
 
     brep = tmp_path / "f.brep"
     write_brep(_one_face_flipped(), brep)
+    _fake_mesher(monkeypatch, open_until=0.0)
     assert main(["convert", str(brep), str(tmp_path / "f.stl"), "--tolerance", "0.01"]) == 3
     out = capsys.readouterr().out
-    assert "BROKEN: solid 1: 4 edge(s) joining facets of opposite orientation; along face(s) 0, 1, 2, 4, 5" in out
+    assert "BROKEN: solid 1: 3 open edge(s); along face(s) 0, 2, 5" in out and (tmp_path / "f.stl").exists()
 
 
 def _fake_mesher(monkeypatch, open_until: float, flipped: bool = False):
@@ -182,3 +194,15 @@ def test_orientation_is_not_meshed_again(tmp_path, monkeypatch):
     with pytest.warns(sm.RoundTripWarning, match=r"solid 1: enclosed volume -6 \(inside out or not closed\)$"):
         sm.export_stl("part", tmp_path / "box.stl", 0.01)
     assert asked == [0.01]
+
+
+def test_faces_are_turned_only_where_whole_faces_can_agree():
+    from surfmod.meshing.closure import faces_against_neighbours
+
+    tet = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
+    odd = np.vstack([tet[:3], tet[3, ::-1]])
+    assert faces_against_neighbours(odd, np.arange(4)) == [3]
+    assert faces_against_neighbours(odd, np.array([0, 1, 2, 2])) == []  # face 2 at odds with itself
+    assert faces_against_neighbours(odd[:, ::-1], np.arange(4)) == [3]  # the fewer triangles turn
+    two = np.vstack([odd, tet + 4])  # two tetrahedra (one solid of two shells): each set by itself
+    assert faces_against_neighbours(two, np.array([0, 1, 2, 3, 4, 5, 6, 7])) == [3]

@@ -39,6 +39,7 @@ import numpy as np
 
 from ..errors import InsideOutWarning, SurfmodError
 from ..eval.differential import curvatures, degenerate_mask, raw_normals
+from .closure import faces_against_neighbours
 from .deviation import DENSE, project_distances, triangle_deviations
 from .facesurface import FaceSurface
 from .polymesh import Mesh, weld
@@ -507,7 +508,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
         raise SurfmodError(
             f"tolerance: {tolerance:g} is not met on {len(report)} face(s) (strict):\n" + describe_faces(report)
         )
-    verts, tris, groups, inside_out = [], [], [], []
+    verts, tris, groups, inside_out, faces_turned = [], [], [], [], []
     in_open_shell = set(opened)
     for solid in sorted({fm.solid for fm in fms}):
         part = [fm for fm in fms if fm.solid == solid]
@@ -522,6 +523,15 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
         # a solid of closed shells promises a closed, outward STL (judged when written)
         closes = solid >= 0 and not any(fm.index in in_open_shell for fm in part)
         if closes:
+            turn = faces_against_neighbours(t, labels[kept])
+            if turn:  # faces at odds with their neighbours: turned to agree, by the connectivity
+                flip = np.isin(labels[kept], turn)
+                t = t.copy()
+                t[flip] = t[flip][:, ::-1]
+                faces_turned.append((solid + 1, turn))
+                warnings.warn(f"solid {solid + 1}: face(s) {', '.join(map(str, turn[:10]))}"
+                              f"{' ...' if len(turn) > 10 else ''} point against their neighbours: meshed turned "
+                              "to agree with them", InsideOutWarning, stacklevel=3)
             c = v[t]
             volume = float(np.einsum("ij,ij->i", c[:, 0], np.cross(c[:, 1], c[:, 2])).sum() / 6.0)
             if volume < 0:  # the whole solid's faces point inwards: turned as one, by its volume
@@ -547,5 +557,6 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
         "open_faces": len(opened),
         "stl_groups": groups,
         "inside_out_solids": inside_out,
+        "faces_turned": faces_turned,
     }
     return Mesh(np.concatenate(verts), np.concatenate(tris), info)

@@ -128,6 +128,63 @@ def closure(corners: np.ndarray, faces: np.ndarray | None = None) -> Closure:
                    volume=volume, faces=named)
 
 
+def faces_against_neighbours(tri: np.ndarray, labels: np.ndarray) -> list[int]:
+    """The faces to turn so that every face of one closed solid agrees with its
+    neighbours, from the connectivity alone: ``tri`` its welded triangles ``(T, 3)``,
+    ``labels`` the face of each.  Two faces disagree across an edge their triangles both
+    run the same way; faces are turned (the fewer of two consistent colourings, counted
+    in triangles) so none disagrees.  Empty when they already agree, or when no turning
+    of whole faces makes them agree (a face at odds with itself, a non-manifold edge):
+    the judge then names them.
+
+    >>> tri = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])   # a tetrahedron
+    >>> faces_against_neighbours(tri, np.arange(4))
+    []
+    >>> faces_against_neighbours(np.vstack([tri[:3], tri[3, ::-1]]), np.arange(4))
+    [3]
+    """
+    tri = np.asarray(tri)
+    labels = np.asarray(labels)
+    directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    owner = np.tile(labels, 3)
+    key = np.sort(directed, axis=1)
+    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    if (counts > 2).any():
+        return []
+    order = np.argsort(inverse, kind="stable")
+    pairs = order[counts[inverse[order]] == 2].reshape(-1, 2)  # the two uses of each edge met twice
+    fa, fb = owner[pairs[:, 0]], owner[pairs[:, 1]]
+    same_way = directed[pairs[:, 0], 0] == directed[pairs[:, 1], 0]
+    if not same_way.any() or (same_way & (fa == fb)).any():
+        return []  # all agree; or a face at odds with itself, which no turning of whole faces mends
+    links = np.unique(np.stack([fa, fb, same_way.astype(int)], axis=1)[fa != fb], axis=0)
+    neighbours: dict = {}
+    for a, b, odd in links.tolist():
+        neighbours.setdefault(a, []).append((b, odd))
+        neighbours.setdefault(b, []).append((a, odd))
+    sizes = dict(zip(*np.unique(labels, return_counts=True)))
+    colour: dict = {}
+    for start in sorted(sizes, key=lambda f: -sizes[f]):  # each connected set of faces from its largest
+        if start in colour:
+            continue
+        colour[start], todo, part = 0, [start], [start]
+        while todo:
+            f = todo.pop()
+            for g, odd in neighbours.get(f, ()):
+                want = colour[f] ^ odd
+                if g not in colour:
+                    colour[g] = want
+                    todo.append(g)
+                    part.append(g)
+                elif colour[g] != want:
+                    return []  # no consistent colouring
+        if sum(sizes[f] for f in part if colour[f]) > sum(sizes[f] for f in part) / 2:
+            for f in part:
+                colour[f] ^= 1
+    return sorted(int(f) for f, c in colour.items() if c)
+
+
 def judge_stl(path, groups: list) -> list[tuple[str, Closure]]:
     """The groups of the STL at ``path`` that are not sound, as ``(name, verdict)``.
     ``groups`` are ``(name, count, faces)`` in file order: ``count`` facets named
