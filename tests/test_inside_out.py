@@ -66,3 +66,15 @@ def test_every_command_that_reads_solids_says_so_in_one_line(inside_out_step, tm
     assert code == 0
     err = capsys.readouterr().err.splitlines()
     assert [line for line in err if "inside out" in line] == [f"surfmod {command}: {LINE}"]
+
+
+def test_faces_at_odds_are_found_from_the_model():
+    import build123d as bd
+    from test_stl_verify import _one_face_flipped
+
+    from surfmod.occ.solids import faces_at_odds
+
+    # face 2 reversed in the shell: its four edges run the same way as in its neighbours
+    assert faces_at_odds(_one_face_flipped()) == [(1, 4, [0, 1, 2, 4, 5])]
+    assert faces_at_odds(bd.Solid.make_box(1, 2, 3).wrapped.Reversed()) == []  # inside out, but consistent
+    assert faces_at_odds(sm.import_step(CORPUS / "occt_linkrods.step").wrapped) == []

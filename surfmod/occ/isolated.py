@@ -72,16 +72,20 @@ def _recv(fd: int, deadline: float | None):
 # -- the worker side ------------------------------------------------------------------------
 def _read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
     """Read ``path`` with OCCT, check its coordinates, return the shape as BinTools bytes
-    and the solids inside out in the file, read outward (:func:`~surfmod.occ.step.outward_solids`)."""
+    and what the model says of its solids' orientation: those inside out in the file,
+    read outward (:func:`~surfmod.occ.step.outward_solids`), and those whose faces
+    disagree (:func:`~surfmod.occ.solids.faces_at_odds`)."""
     from OCP.BinTools import BinTools
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
     from .bindings import box_limits
+    from .solids import faces_at_odds
     from .step import read_step
 
     turned: list = []  # the solids inside out in the file, turned outward
     shape = read_step(path, turned)
+    at_odds = faces_at_odds(shape)  # solids whose faces disagree: said, left to mesh and mass
     with kernel("BRepBndLib"):
         box = Bnd_Box()
         BRepBndLib.Add_s(shape, box, False)  # from the geometry, not a triangulation
@@ -108,7 +112,7 @@ def _read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
     with kernel("BinTools.Write"):
         out = io.BytesIO()
         BinTools.Write_s(shape, out)
-    return out.getvalue(), turned
+    return out.getvalue(), (turned, at_odds)
 
 
 def _worker_main() -> None:
@@ -280,7 +284,7 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     from OCP.TopoDS import TopoDS_Shape
 
     try:
-        data, turned = _WORKER.read(str(p), timeout, max_coordinate)
+        data, (turned, at_odds) = _WORKER.read(str(p), timeout, max_coordinate)
     except DamagedFileError as exc:
         msg = str(exc)
         raise DamagedFileError(msg if msg.startswith(f"{name}:") else f"{name}: {msg.removeprefix('path: ')}") from None
@@ -290,6 +294,10 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     for number, volume in turned:
         warnings.warn(f"{p.name}: solid {number} is inside out in the file (enclosed volume {volume:.6g}): "
                       "read outward", InsideOutWarning, stacklevel=3)
+    for number, edges, faces in at_odds:
+        warnings.warn(f"{p.name}: solid {number} is inconsistently oriented: {edges} edge(s) run the same way in "
+                      f"both their faces (faces {', '.join(map(str, faces[:10]))}{' ...' if len(faces) > 10 else ''})",
+                      InsideOutWarning, stacklevel=3)
     return shape
 
 

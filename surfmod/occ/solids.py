@@ -70,6 +70,31 @@ def _faces_outside(shape, owners) -> list[int]:
     return [k for k, f in enumerate(_explore(shape, TopAbs_FACE)) if f.__hash__() not in inside]
 
 
+def faces_at_odds(shape) -> list[tuple[int, int, list[int]]]:
+    """The solids of ``shape`` whose faces disagree, from the model's topology:
+    ``(solid number from 1, edges, faces)`` for each solid in which some edge shared by
+    two faces runs the same way in both (in a consistently oriented shell each edge runs
+    one way in one face and the other way in the other), with the faces (``faces_of``
+    order) along such edges.  Seams (an edge used twice by one face) are not judged.
+
+    >>> import build123d as bd
+    >>> faces_at_odds(bd.Solid.make_box(1, 2, 3).wrapped)
+    []
+    """
+    index = {f.__hash__(): k for k, f in reversed(list(enumerate(_explore(shape, TopAbs_FACE))))}
+    out = []
+    with kernel("TopExp_Explorer"):
+        for number, solid in enumerate(solids_of(shape), 1):
+            uses: dict = {}  # edge -> [(face, orientation as the face runs it)]
+            for face in _explore(solid, TopAbs_FACE):
+                for edge in _explore(face, TopAbs_EDGE):  # orientation composed with the face's
+                    uses.setdefault(edge.__hash__(), []).append((index.get(face.__hash__(), -1), edge.Orientation()))
+            odd = [u for u in uses.values() if len(u) == 2 and u[0][0] != u[1][0] and u[0][1] == u[1][1]]
+            if odd:
+                out.append((number, len(odd), sorted({f for u in odd for f, _ in u})))
+    return out
+
+
 def left_out_faces(shape) -> list[int]:
     """Indices (``faces_of`` order) of the faces :func:`closed_solid` leaves out: those
     outside every solid when the shape has solids (open shells and loose faces beside
