@@ -78,3 +78,17 @@ def test_faces_at_odds_are_found_from_the_model():
     assert faces_at_odds(_one_face_flipped()) == [(1, 4, [0, 1, 2, 4, 5])]
     assert faces_at_odds(bd.Solid.make_box(1, 2, 3).wrapped.Reversed()) == []  # inside out, but consistent
     assert faces_at_odds(sm.import_step(CORPUS / "occt_linkrods.step").wrapped) == []
+
+
+@pytest.mark.parametrize("case", ["inside out", "one face at odds"])
+def test_mass_orients_a_solid_from_the_model_and_says_so(case):
+    import build123d as bd
+    from test_stl_verify import _one_face_flipped
+
+    solid = bd.Solid.make_box(1, 2, 3).wrapped.Reversed() if case == "inside out" else _one_face_flipped()
+    said = r"solid 1 is inside out \(enclosed volume -6\): turned outward" if case == "inside out" else \
+        r"solid 1: face\(s\) 2 of its shell point against their neighbours: turned to agree with them"
+    with pytest.warns(sm.InsideOutWarning, match=said):
+        r = sm.mass_properties(solid)
+    assert r.volume == pytest.approx(6.0, rel=1e-12)  # the 1 x 2 x 3 box, not 4 or -6
+    assert r.centroid == pytest.approx([0.5, 1.0, 1.5], abs=1e-12)

@@ -159,30 +159,9 @@ def faces_against_neighbours(tri: np.ndarray, labels: np.ndarray) -> list[int]:
     if not same_way.any() or (same_way & (fa == fb)).any():
         return []  # all agree; or a face at odds with itself, which no turning of whole faces mends
     links = np.unique(np.stack([fa, fb, same_way.astype(int)], axis=1)[fa != fb], axis=0)
-    neighbours: dict = {}
-    for a, b, odd in links.tolist():
-        neighbours.setdefault(a, []).append((b, odd))
-        neighbours.setdefault(b, []).append((a, odd))
-    sizes = dict(zip(*np.unique(labels, return_counts=True)))
-    colour: dict = {}
-    for start in sorted(sizes, key=lambda f: -sizes[f]):  # each connected set of faces from its largest
-        if start in colour:
-            continue
-        colour[start], todo, part = 0, [start], [start]
-        while todo:
-            f = todo.pop()
-            for g, odd in neighbours.get(f, ()):
-                want = colour[f] ^ odd
-                if g not in colour:
-                    colour[g] = want
-                    todo.append(g)
-                    part.append(g)
-                elif colour[g] != want:
-                    return []  # no consistent colouring
-        if sum(sizes[f] for f in part if colour[f]) > sum(sizes[f] for f in part) / 2:
-            for f in part:
-                colour[f] ^= 1
-    return sorted(int(f) for f, c in colour.items() if c)
+    from ..occ.solids import consistent_turns
+
+    return consistent_turns(links.tolist(), dict(zip(*np.unique(labels, return_counts=True))))
 
 
 def judge_stl(path, groups: list) -> list[tuple[str, Closure]]:

@@ -3,14 +3,18 @@ what volume work (mass properties, FE meshes, interference) is given to measure.
 
 from __future__ import annotations
 
+import warnings
+
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepLib import BRepLib
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-from OCP.TopoDS import TopoDS_Shell
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
 
-from ..errors import SurfmodError
+from ..errors import InsideOutWarning, SurfmodError
 from .guard import check_done, kernel
 from .topo import compound, shells_of, solids_of
 from .topo import explore as _explore
@@ -70,6 +74,87 @@ def _faces_outside(shape, owners) -> list[int]:
     return [k for k, f in enumerate(_explore(shape, TopAbs_FACE)) if f.__hash__() not in inside]
 
 
+def consistent_turns(links, sizes: dict) -> list:
+    """The faces to turn so that no two neighbours disagree: ``links`` are ``(a, b,
+    odd)`` for faces ``a`` and ``b`` sharing an edge (``odd`` true where the edge runs the
+    same way in both: they disagree), ``sizes`` each face's weight (triangles, or 1).  Of
+    the two consistent colourings of each connected set of faces the lighter one turns;
+    ``[]`` when no colouring is consistent (a non-orientable or self-contradicting set).
+
+    >>> consistent_turns([(0, 1, 0), (1, 2, 1), (0, 2, 1)], {0: 5, 1: 5, 2: 1})
+    [2]
+    """
+    neighbours: dict = {}
+    for a, b, odd in links:
+        neighbours.setdefault(a, []).append((b, int(odd)))
+        neighbours.setdefault(b, []).append((a, int(odd)))
+    colour: dict = {}
+    for start in sorted(sizes, key=lambda f: -sizes[f]):  # each connected set from its largest face
+        if start in colour:
+            continue
+        colour[start], todo, part = 0, [start], [start]
+        while todo:
+            f = todo.pop()
+            for g, odd in neighbours.get(f, ()):
+                if g not in colour:
+                    colour[g] = colour[f] ^ odd
+                    todo.append(g)
+                    part.append(g)
+                elif colour[g] != colour[f] ^ odd:
+                    return []
+        if sum(sizes[f] for f in part if colour[f]) > sum(sizes[f] for f in part) / 2:
+            for f in part:
+                colour[f] ^= 1
+    return sorted(int(f) for f, c in colour.items() if c)
+
+
+def _edge_uses(solid) -> tuple[list, dict]:
+    """The faces of ``solid`` (distinct, explorer order) and, per edge, the
+    ``(face position, orientation as the face runs it)`` of its uses."""
+    faces, position, uses = [], {}, {}
+    for face in _explore(solid, TopAbs_FACE):
+        k = position.setdefault(face.__hash__(), len(faces))
+        if k == len(faces):
+            faces.append(face)
+        for edge in _explore(face, TopAbs_EDGE):  # orientation composed with the face's
+            uses.setdefault(edge.__hash__(), []).append((k, edge.Orientation()))
+    return faces, uses
+
+
+def oriented_solid(solid):
+    """``solid`` with its faces made to agree (:func:`consistent_turns` over the edges
+    they share, for a solid of one shell) and then turned outward as a whole by the sign
+    of its enclosed volume; returns ``(solid, faces turned (positions in explorer
+    order), enclosed volume before)``.  ``solid`` itself when nothing needed turning.
+
+    >>> import build123d as bd
+    >>> s, turned, volume = oriented_solid(bd.Solid.make_box(1, 2, 3).wrapped.Reversed())
+    >>> turned, round(volume, 12)
+    ([], -6.0)
+    """
+    turned: list = []
+    shells = shells_of(solid)
+    with kernel("BRep_Builder"):
+        if len(shells) == 1:
+            faces, uses = _edge_uses(solid)
+            links = {(u[0][0], u[1][0], u[0][1] == u[1][1]) for u in uses.values()
+                     if len(u) == 2 and u[0][0] != u[1][0]}
+            if any(odd for _, _, odd in links):
+                turned = consistent_turns(sorted(links), {k: 1 for k in range(len(faces))})
+            if turned:
+                builder, shell, out = BRep_Builder(), TopoDS_Shell(), TopoDS_Solid()
+                builder.MakeShell(shell)
+                for k, face in enumerate(faces):
+                    builder.Add(shell, face.Reversed() if k in turned else face)
+                shell.Closed(True)
+                builder.MakeSolid(out)
+                builder.Add(out, shell)
+                solid = out
+        props = GProp_GProps()
+        BRepGProp.VolumeProperties_s(solid, props)
+    return (solid.Reversed() if props.Mass() < 0 else solid), turned, props.Mass()
+
+
 def faces_at_odds(shape) -> list[tuple[int, int, list[int]]]:
     """The solids of ``shape`` whose faces disagree, from the model's topology:
     ``(solid number from 1, edges, faces)`` for each solid in which some edge shared by
@@ -85,13 +170,10 @@ def faces_at_odds(shape) -> list[tuple[int, int, list[int]]]:
     out = []
     with kernel("TopExp_Explorer"):
         for number, solid in enumerate(solids_of(shape), 1):
-            uses: dict = {}  # edge -> [(face, orientation as the face runs it)]
-            for face in _explore(solid, TopAbs_FACE):
-                for edge in _explore(face, TopAbs_EDGE):  # orientation composed with the face's
-                    uses.setdefault(edge.__hash__(), []).append((index.get(face.__hash__(), -1), edge.Orientation()))
+            faces, uses = _edge_uses(solid)
             odd = [u for u in uses.values() if len(u) == 2 and u[0][0] != u[1][0] and u[0][1] == u[1][1]]
             if odd:
-                out.append((number, len(odd), sorted({f for u in odd for f, _ in u})))
+                out.append((number, len(odd), sorted({index.get(faces[k].__hash__(), -1) for u in odd for k, _ in u})))
     return out
 
 
@@ -128,7 +210,17 @@ def closed_solid(shape):
         for i, s in enumerate(solids):
             shells = shells_of(s)
             if all(BRep_Tool.IsClosed_s(sh) for sh in shells):
-                out.append(s)
+                # volume work needs faces that agree and point out: turned from the model
+                # (shared edges, then the sign of the enclosed volume), never face by face
+                oriented, turned, volume = oriented_solid(s)
+                if turned:
+                    warnings.warn(f"solid {i + 1}: face(s) {', '.join(map(str, turned[:10]))}"
+                                  f"{' ...' if len(turned) > 10 else ''} of its shell point against their "
+                                  "neighbours: turned to agree with them", InsideOutWarning, stacklevel=3)
+                if volume < 0:
+                    warnings.warn(f"solid {i + 1} is inside out (enclosed volume {volume:.6g}): turned outward",
+                                  InsideOutWarning, stacklevel=3)
+                out.append(oriented)
             elif len(shells) == 1:
                 out.append(_solid_of_shell(shells[0], f"solid {i}"))
             else:
