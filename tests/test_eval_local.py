@@ -82,9 +82,15 @@ def _net(n, m, rng):
     return np.stack([x, y, rng.uniform(-1, 1, (n, m))], axis=-1)
 
 
-def _knots(n, p, rng, repeat=True):
-    """Clamped non-uniform knots; with ``repeat`` a few interior knots of multiplicity p."""
-    inner = np.sort(rng.uniform(0.02, 0.98, n - p - 1))
+def _knots(n, p, rng, repeat=True, ratio=None):
+    """Clamped non-uniform knots; with ``repeat`` a few interior knots of multiplicity p;
+    with ``ratio`` non-empty spans within that factor of each other (the patch path takes
+    only such nets: ``patches.MAX_SPAN_RATIO``)."""
+    if ratio is None:
+        inner = np.sort(rng.uniform(0.02, 0.98, n - p - 1))
+    else:
+        spans = rng.uniform(1, ratio, n - p)
+        inner = np.cumsum(spans)[:-1] / spans.sum()
     if repeat and n - p - 1 >= 2 * p and p > 1:
         for start in rng.choice(np.arange(0, n - p - 1 - p, p), size=min(3, (n - p - 1) // (2 * p)), replace=False):
             inner[start : start + p] = inner[start]
@@ -92,10 +98,11 @@ def _knots(n, p, rng, repeat=True):
     return np.concatenate([np.zeros(p + 1), inner, np.ones(p + 1)])
 
 
-def _surface(n, m, p, q, rational, seed=0, repeat=True):
+def _surface(n, m, p, q, rational, seed=0, repeat=True, ratio=None):
     rng = np.random.default_rng(seed)
     w = 10.0 ** rng.uniform(-1, 1, (n, m)) if rational else None
-    return sm.BSplineSurface(_net(n, m, rng), (p, q), (_knots(n, p, rng, repeat), _knots(m, q, rng, repeat)), w)
+    knots = _knots(n, p, rng, repeat, ratio), _knots(m, q, rng, repeat, ratio)
+    return sm.BSplineSurface(_net(n, m, rng), (p, q), knots, w)
 
 
 def _sample_params(s, count, rng):
@@ -259,7 +266,7 @@ def test_patch_positions_match_basis_kernel_and_textbook(p, q, rational, compile
     """Many scattered points on a small net go through the per-span Taylor patches; they
     agree with the basis-function kernel everywhere and with the textbook sums on a
     sample, including knots (repeated ones too) and both domain ends."""
-    s = _surface(11, 9, p, q, rational, seed=p * 10 + q)
+    s = _surface(11, 9, p, q, rational, seed=p * 10 + q, ratio=3.0)
     rng = np.random.default_rng(4)
     u, v = _sample_params(s, 3000, rng)
     net = s._local_net()
@@ -287,7 +294,7 @@ def test_patch_partials_match_basis_kernel_and_textbook(p, q, rational, order, c
     (Horner schemes with their derivatives, the chain rule, the quotient rule): they
     agree with the basis-function kernel everywhere and with the textbook on a sample,
     knots and domain ends included."""
-    s = _surface(11, 9, p, q, rational, seed=p * 10 + q)
+    s = _surface(11, 9, p, q, rational, seed=p * 10 + q, ratio=3.0)
     u, v = _sample_params(s, 3000, np.random.default_rng(6))
     net = s._local_net()
     net.cache.clear()
