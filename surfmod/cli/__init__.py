@@ -59,10 +59,16 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
 
+    said = set()
+
     def one_line(message, category, *_args, **_kwargs):
         # a warning of surfmod's (an inside-out solid, a file that reads back changed) is
-        # one line naming the command, like its errors, not Python's two-line form
-        print(f"surfmod {args.command}: warning: {' '.join(str(message).split())}", file=sys.stderr)
+        # one line naming the command, like its errors, not Python's two-line form; said
+        # once, though a command may meet the same solid in several passes
+        text = " ".join(str(message).split())
+        if text not in said:
+            said.add(text)
+            print(f"surfmod {args.command}: warning: {text}", file=sys.stderr)
 
     try:
         with warnings.catch_warnings():
