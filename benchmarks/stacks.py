@@ -1,12 +1,12 @@
 """The same benchmark on the two OCCT stacks, side by side: which ratios OCCT 8.0 moved.
 
-``python -m benchmarks.stacks eval mesh > docs/benchmarks/stacks.md`` reads each named
+``python -m benchmarks.stacks eval mesh real > docs/benchmarks/stacks.md`` reads each named
 benchmark's page generated on OCCT 8.0 (``docs/benchmarks/NAME.md``) and on OCCT 7.9
 (``docs/benchmarks/NAME_occt79.md``, the same command run in a venv of the ``cadquery``
 extra), pairs their table rows by table and first cell, and prints, per benchmark, its
 first ratio row on both stacks and every row where a ratio (a cell ``12.3x``) moved by
-more than :data:`CHANGED` between them (``12.3x``, or a number under a header that says
-ratio).  Both pages should come from one sitting on one
+more than :data:`CHANGED` between them (``12.3x``, ``a / b = 12.3x``, or a number under a
+header that says ratio).  Both pages should come from one sitting on one
 machine: ratios of two runs on a shared machine differ by their noise too.
 """
 
@@ -19,7 +19,7 @@ from pathlib import Path
 PAGES = Path(__file__).resolve().parent.parent / "docs" / "benchmarks"
 #: a ratio that moved by more than this fraction between the stacks is named
 CHANGED = 0.20
-_RATIO = re.compile(r"^([0-9.]+)x$")
+_RATIO = re.compile(r"(?:^|= )([0-9.]+)x$")  # "12.3x", or real's "0.275 / 0.160 = 1.7x"
 
 
 def tables(text: str) -> list[tuple[list[str], dict[str, list[str]]]]:
@@ -49,7 +49,7 @@ def _ratios(cells: list[str], header: list[str]) -> dict[int, float]:
     """The ratio cells of a row: ``12.3x``, or any number under a header that says ratio."""
     out = {}
     for i, c in enumerate(cells):
-        if m := _RATIO.match(c):
+        if m := _RATIO.search(c):
             out[i] = float(m.group(1))
         elif i < len(header) and "ratio" in header[i]:
             try:
