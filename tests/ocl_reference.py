@@ -5,6 +5,7 @@ test run down).  Triangles go over as ``.npy`` in float64 and are built with
 
 from __future__ import annotations
 
+import importlib.util
 import subprocess
 import sys
 import textwrap
@@ -12,6 +13,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
+
+#: the tests that ask OpenCAMLib skip, with the reason, where the bench extra is not installed
+needs_opencamlib = pytest.mark.skipif(importlib.util.find_spec("opencamlib") is None,
+                                      reason="OpenCAMLib is the bench extra (pip install -e '.[bench]')")
 
 _PRELUDE = """
 import sys, time, numpy as np, opencamlib as ocl

@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 from ocl_reference import drop as ocl_drop
+from ocl_reference import needs_opencamlib
 from ocl_reference import polyline_distance
 from ocl_reference import waterline as ocl_waterline
 
@@ -239,6 +240,7 @@ def corpus_triangles(corpus_dir):
     return tri
 
 
+@needs_opencamlib
 @pytest.mark.parametrize("kind, R, r", [("ball", 3.0, 0.0), ("flat", 3.0, 0.0), ("bull", 3.0, 1.0)])
 def test_equals_opencamlib_waterline(tmp_path, corpus_triangles, kind, R, r):
     tri = corpus_triangles
@@ -266,6 +268,7 @@ def test_equals_opencamlib_waterline(tmp_path, corpus_triangles, kind, R, r):
         assert np.all(heights < z - 1e-3)
 
 
+@needs_opencamlib
 @pytest.mark.parametrize("kind, R, r", [("ball", 3.0, 0.0), ("flat", 3.0, 0.0), ("bull", 3.0, 1.0)])
 def test_drop_cutter_equals_opencamlib(tmp_path, corpus_triangles, kind, R, r):
     """surfmod.cam's drop-cutter heights (the waterline's companion for the tool's other
