@@ -22,25 +22,25 @@ CHANGED = 0.20
 _RATIO = re.compile(r"(?:^|= )([0-9.]+)x$")  # "12.3x", or real's "0.275 / 0.160 = 1.7x"
 
 
+def _keyed(rows: list[list[str]]) -> dict[str, list[str]]:
+    """Rows keyed by their first cell, and by the second too where the first repeats (mesh:
+    one row per surface and tolerance)."""
+    firsts = [r[0] for r in rows]
+    return {(r[0] if firsts.count(r[0]) == 1 else f"{r[0]} / {r[1]}"): r for r in rows}
+
+
 def tables(text: str) -> list[tuple[list[str], dict[str, list[str]]]]:
-    """The Markdown tables of a page: each its header cells and its rows keyed by first cell."""
-    out, header, rows = [], None, {}
+    """The Markdown tables of a page: each its header cells and its keyed rows."""
+    out, header, rows = [], None, []
     for line in text.splitlines() + [""]:
         if line.startswith("|"):
             cells = [c.strip() for c in line.strip().strip("|").split("|")]
             if header is None:
-                header, rows = cells, {}
+                header, rows = cells, []
             elif not set(line) <= set("|-: "):
-                # rows are keyed by their first cell, and by the second too where the first
-                # repeats (mesh: one row per surface and tolerance)
-                key = cells[0] if cells[0] not in rows and not any(k.startswith(cells[0] + " / ") for k in rows) \
-                    else f"{cells[0]} / {cells[1]}"
-                if key != cells[0] and cells[0] in rows:
-                    first = rows.pop(cells[0])
-                    rows[f"{first[0]} / {first[1]}"] = first
-                rows[key] = cells
+                rows.append(cells)
         elif header is not None:
-            out.append((header, rows))
+            out.append((header, _keyed(rows)))
             header = None
     return out
 

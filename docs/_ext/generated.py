@@ -203,10 +203,17 @@ def package_map_md() -> str:
     return "\n".join(rows)
 
 
+def _literal(path: Path, name: str):
+    """The value of the module-level literal ``name`` assigned in the Python file ``path``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return next(ast.literal_eval(node.value) for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))
+                and any(isinstance(t, ast.Name) and t.id == name
+                        for t in (node.targets if isinstance(node, ast.Assign) else [node.target])))
+
+
 def rank_table_md(path: Path = LAYERING_TEST) -> str:
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    ranks = next(ast.literal_eval(node.value) for node in tree.body if isinstance(node, ast.Assign)
-                 and any(isinstance(t, ast.Name) and t.id == "RANKS" for t in node.targets))
+    ranks = _literal(path, "RANKS")
     holds = {}
     for line in (ast.get_docstring(tree) or "").splitlines():
         head, _, rest = line.partition(" ")
@@ -217,13 +224,6 @@ def rank_table_md(path: Path = LAYERING_TEST) -> str:
         rows.append(f"| {rank} | " + ", ".join(f"`{n}`" for n in names) + f" | {_cell(holds.get(rank, ''))} |")
     rows.append(f"| {len(ranks)} | `surfmod` (its `__init__`) | the public names, resolved lazily |")
     return "\n".join(rows)
-
-
-def _literal(path: Path, name: str):
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    return next(ast.literal_eval(node.value) for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))
-                and any(isinstance(t, ast.Name) and t.id == name
-                        for t in (node.targets if isinstance(node, ast.Assign) else [node.target])))
 
 
 def quirk_table_md(path: Path = QUIRKS_TEST) -> str:

@@ -48,15 +48,22 @@ def polyline(points: np.ndarray, *, color=None, label: str = "") -> bd.Wire | No
     """One wire through ``points`` ``(N, 3)``, or None when fewer than two distinct points
     remain.  A point within OCCT's confusion distance (1e-7) of the one before it adds no
     edge: ``BRepBuilderAPI_MakePolygon`` skips it."""
-    pts = np.asarray(points, dtype=float)
     with kernel("BRepBuilderAPI_MakePolygon"):
-        poly = BRepBuilderAPI_MakePolygon()
-        for x, y, z in pts.tolist():
-            poly.Add(gp_Pnt(x, y, z))
+        poly = _polygon(np.asarray(points, dtype=float).tolist())
         if not poly.IsDone():  # fewer than two distinct points
             return None
         wire = bd.Wire(poly.Wire())
     return dress(wire, color, label)
+
+
+def _polygon(points: list, closed: bool = False) -> BRepBuilderAPI_MakePolygon:
+    """OCCT's polygon through ``points`` (a list of ``(x, y, z)``), closed if asked."""
+    poly = BRepBuilderAPI_MakePolygon()
+    for x, y, z in points:
+        poly.Add(gp_Pnt(x, y, z))
+    if closed:
+        poly.Close()
+    return poly
 
 
 def triangles(vertices: np.ndarray, faces: np.ndarray, *, color=None, label: str = "",
@@ -73,10 +80,7 @@ def triangles(vertices: np.ndarray, faces: np.ndarray, *, color=None, label: str
     builder.MakeCompound(out)
     with kernel("BRepBuilderAPI_MakeFace"):
         for corners in v[f].tolist():
-            poly = BRepBuilderAPI_MakePolygon()
-            for x, y, z in corners:
-                poly.Add(gp_Pnt(x, y, z))
-            poly.Close()
+            poly = _polygon(corners, closed=True)
             if not poly.IsDone():
                 continue
             face = BRepBuilderAPI_MakeFace(poly.Wire(), True)
