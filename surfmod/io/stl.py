@@ -8,7 +8,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import RoundTripWarning, SurfmodError
-from ..meshing.closure import judge_stl
+from ..meshing.closure import STL_RECORD, judge_stl
 
 #: fractions of the tolerance at which a part whose STL does not close is meshed again
 #: (each within the tolerance asked for; about 4x and 16x the triangles at most)
@@ -70,7 +70,7 @@ def facet_normals(tri: np.ndarray) -> np.ndarray:
 
 
 def write_binary(fh, tri: np.ndarray) -> None:
-    record = np.zeros(len(tri), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    record = np.zeros(len(tri), dtype=STL_RECORD)
     record["n"] = facet_normals(tri)
     record["v"] = tri
     header = b"surfmod binary STL".ljust(80, b" ")

@@ -22,8 +22,8 @@ import numpy as np
 
 from ..errors import KernelError, SurfmodError
 
-#: binary STL: 80-byte header, uint32 count, then 50-byte records
-_RECORD = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+#: binary STL: 80-byte header, uint32 count, then 50-byte records (io/stl.py writes them)
+STL_RECORD = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
 
 
 def read_stl(path) -> np.ndarray:
@@ -40,8 +40,8 @@ def read_stl(path) -> np.ndarray:
         data = fh.read()
     if len(data) >= 84:
         (count,) = np.frombuffer(data, "<u4", 1, 80)
-        if 84 + int(count) * _RECORD.itemsize == len(data):
-            return np.frombuffer(data, _RECORD, int(count), 84)["v"].copy()
+        if 84 + int(count) * STL_RECORD.itemsize == len(data):
+            return np.frombuffer(data, STL_RECORD, int(count), 84)["v"].copy()
     words = data.split()
     at = [i for i, w in enumerate(words) if w == b"vertex"]
     if not data.lstrip().startswith(b"solid") or not at:
