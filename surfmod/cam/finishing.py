@@ -64,6 +64,8 @@ from .waterline import ContourPoints, waterline
 #: Steep regions: slopes within this many degrees below the threshold count too (the
 #: classification samples the drop-cutter surface, the raster's slope bound its triangles).
 STEEP_MARGIN = 1.0
+#: triangles within this slope (degrees) of level are floors: a waterline level runs just above each
+FLOOR_SLOPE = 0.5
 #: Clearance (mm) of entries and retracts above the highest stock the roughing can have left.
 REST_CLEARANCE = 1.0
 #: Grid spacing of the rest map: a tool radius over this, or the part's size over REST_CELLS.
@@ -176,6 +178,22 @@ def _levels(tri, slope, steep, spacing, top, bottom, reach):
     return np.array(out, float)
 
 
+def _with_floors(levels: np.ndarray, tri: np.ndarray, slope: np.ndarray, bottom: float, above: float) -> np.ndarray:
+    """``levels`` plus a level ``above`` each flat floor (triangles within ``FLOOR_SLOPE``
+    of level) between the lowest and the highest level: the contour along a wall's foot.
+    Levels spaced along the wall rarely fall on a floor, and the raster's passes across
+    the fillet the tool leaves there are too far apart on its slope (a ring of 0.1-0.3 mm
+    round a boss or a pocket wall, for a scallop of 0.03-0.08)."""
+    if not len(levels):
+        return levels
+    flat = slope < FLOOR_SLOPE
+    floors = np.unique(np.round(tri[flat, :, 2].mean(axis=1), 9)) + above
+    floors = floors[(floors >= max(bottom, levels.min())) & (floors <= levels.max())]
+    merged = np.unique(np.concatenate([levels, floors]))[::-1]
+    keep = np.r_[True, -np.diff(merged) > 1e-6]
+    return merged[keep]
+
+
 def _pieces(loop: np.ndarray, keep: np.ndarray):
     """Runs of ``keep`` along a closed ``loop``, each grown by one point at either end;
     the whole loop closed (first point repeated) when all of it is kept."""
@@ -255,6 +273,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     chord = _chord(part, tool, tolerance)
     g = chord + part.deflection  # the tool keeps the mesh's whole deflection from it (walls amplify any gouge)
     levels = _levels(tri, slope, steep, spacing, float(tri[steep, :, 2].max()), bottom, tool.corner + tool.radius)
+    levels = _with_floors(levels, tri, slope, bottom, g + 0.5 * tolerance)
     if not len(levels):
         return [], info
     grown = tool.cutter.grown(g)

@@ -10,7 +10,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from tqdm import tqdm
@@ -21,6 +21,7 @@ from ..inputs import to_shape
 from .finishing import Rest, clear_part, finish
 from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
+from .verify import verify_job
 from .toolpath import _part
 
 #: Rapid traverse (mm/min) and tool change time (s) of the time estimate.
@@ -94,6 +95,8 @@ class Job:
     stock: np.ndarray
     operations: tuple
     safe_height: float
+    #: what :func:`surfmod.cam.verify.verify_job` found in its LinuxCNC program (None: not verified)
+    verification: object = field(default=None, repr=False)
 
     @property
     def time_estimate(self) -> float:
@@ -104,7 +107,10 @@ class Job:
         head = (f"job: stock {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} x {hi[2] - lo[2]:g} mm at "
                 f"({lo[0]:g}, {lo[1]:g}, {lo[2]:g}), {len(self.operations)} operations, "
                 f"total time {self.time_estimate / 60:.1f} min")
-        return "\n".join([head] + [f"  {op}" for op in self.operations])
+        lines = [head] + [f"  {op}" for op in self.operations]
+        if self.verification is not None:
+            lines += [f"  {line}" for line in self.verification.lines()]
+        return "\n".join(lines)
 
     def _repr_png_(self) -> bytes:
         from .picture import job_png
@@ -166,7 +172,7 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
                   tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
 
 
-def machine(part, stock, operations, *, progress: bool = False) -> Job:
+def machine(part, stock, operations, *, progress: bool = False, verify: bool = True) -> Job:
     """Machine ``part`` (a build123d shape, STEP path or surfmod surfaces) from ``stock``
     (a margin in mm, or a box ``[[x0, y0, z0], [x1, y1, z1]]`` holding the part) by
     ``operations`` in order (:class:`Rough`, :class:`Finish`); tools without a number get
@@ -175,7 +181,12 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
     the gouge-checked drop-cutter path (:func:`surfmod.toolpath`) plus waterline contours on
     the steep regions, with the rest it cannot reach reported
     (:mod:`surfmod.cam.finishing`).  Raises
-    ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut."""
+    ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut.
+
+    With ``verify`` (the default) the job's LinuxCNC program is read back and judged
+    against the exact part and the stock (:func:`surfmod.cam.verify.verify_job`: gouge,
+    rapids through stock or part, the scallop left); ``job.verification`` holds what it
+    found, ``job.verification.ok`` whether every promise holds."""
     from ..occ.properties import bounding_box
 
     shape = to_shape(part, "part")
@@ -214,7 +225,7 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
                 if cut_depth > tool.flute_length + 1e-9:
                     raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the roughing cuts "
                                        f"{cut_depth:.4g} mm deep")
-                report.update(allowance=allowance, stepdown=stepdown, stepover=stepover)
+                report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance)
                 rest = Rest(tool.radius + allowance, allowance + stepdown + p.lift)
                 name = "roughing"
             else:
@@ -232,4 +243,7 @@ def machine(part, stock, operations, *, progress: bool = False) -> Job:
                 name = "finishing"
             bar.update()
             done.append(Operation(name, tool, motion, motion_time(motion, tool) + TOOL_CHANGE_TIME, report))
-    return Job(shape, stock, tuple(done), safe)
+    job = Job(shape, stock, tuple(done), safe)
+    if verify:
+        job = replace(job, verification=verify_job(job))
+    return job

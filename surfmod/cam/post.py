@@ -93,22 +93,24 @@ def _comment(text: str) -> str:
     return "(" + text.replace("(", "[").replace(")", "]") + ")"
 
 
-def _header(job, title: str) -> list[str]:
+def _header(job, title: str, note: str | None) -> list[str]:
     lo, hi = job.stock
-    return ["%", _comment(title),
+    return ["%", _comment(title)] + ([_comment(note)] if note else []) + [
             f"(stock X{lo[0]:g}..{hi[0]:g} Y{lo[1]:g}..{hi[1]:g} Z{lo[2]:g}..{hi[2]:g} mm, part coordinates)",
             "G21 G90 G17 G94 (mm, absolute, XY plane, feed per minute)", "G40 G49 G80 (no compensation, no offset)"]
 
 
-def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = False, arcs: bool = True) -> list[str]:
+def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = False, arcs: bool = True,
+             note: str | None = None) -> list[str]:
     """The program texts of ``job``: one for ``"linuxcnc"``, one per tool for ``"grbl"``;
-    circular runs of the moves as ``G2``/``G3`` unless ``arcs=False`` (all ``G1``)."""
+    circular runs of the moves as ``G2``/``G3`` unless ``arcs=False`` (all ``G1``);
+    ``note``: a comment line under the title (what the verification found)."""
     if post not in POSTS:
         raise SurfmodError(f"post: expected one of {', '.join(POSTS)}, got {post!r}")
     if int(digits) != digits or not 1 <= digits <= 6:
         raise SurfmodError(f"digits: expected an integer 1..6, got {digits!r}")
     if post == "linuxcnc":
-        body = _header(job, f"surfmod job: {len(job.operations)} operations, LinuxCNC")
+        body = _header(job, f"surfmod job: {len(job.operations)} operations, LinuxCNC", note)
         for op in job.operations:
             body += _operation(op, job, post, digits, coolant, bool(arcs))
         return ["\n".join(body + ["M30", "%", ""])]
@@ -116,7 +118,7 @@ def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = Fa
     for number in dict.fromkeys(op.tool.number for op in job.operations):
         ops = [op for op in job.operations if op.tool.number == number]
         body = _header(job, f"surfmod job, GRBL program for tool {number}: {ops[0].tool}; change the tool, "
-                            f"set its length, then run")
+                            f"set its length, then run", note)
         for op in ops:
             body += _operation(op, job, post, digits, coolant, bool(arcs))
         texts.append("\n".join(body + ["M30", "%", ""]))

@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import sys
+from dataclasses import replace
+
 from ..atomic import target_path
 from ..cam.finishing import summary_lines
 from ..cam.job import Finish, Rough, machine
 from ..cam.post import POSTS, SUFFIXES, export_job, program_paths, programs
 from ..cam.tool import load_tool_table, parse_tool
+from ..cam.verify import verify_job
 from ..errors import SurfmodError
 from ..inputs import to_shape
+from . import EXIT_PARTIAL
 
 
 def register(sub) -> None:
@@ -28,6 +33,9 @@ def register(sub) -> None:
     p.add_argument("--post", default="linuxcnc", help=f"post-processor: {', '.join(POSTS)}")
     p.add_argument("--tools", help="tool table (TOML or JSON) giving tool 1 and 2 their flutes, speeds, feeds")
     p.add_argument("--png", help="picture of the moves over the shaded part")
+    p.add_argument("--no-verify", action="store_true",
+                   help="skip reading the program back and judging it against the exact part and the stock "
+                        "(faster; the program's header says it was not verified)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(run=run)
 
@@ -43,8 +51,11 @@ def _tool(text: str, number: int, table: dict, name: str):
 
 
 def run(args) -> int:
-    """Check every argument before any work, machine, write the program(s) and print the
-    summary; on bad input one line and exit 1, nothing written."""
+    """Check every argument before any work, machine, judge the program(s) as written
+    (:func:`~surfmod.cam.verify.verify_job`, unless ``--no-verify``), write them and print
+    the summary with the verdict.  Exit 0 when every promise holds, 3 when the program
+    is written but a promise is broken (the lines before say which and where); on bad
+    input one line and exit 1, nothing written."""
     if args.post not in POSTS:
         raise SurfmodError(f"post: expected one of {', '.join(POSTS)}, got {args.post!r}")
     target_path(args.out, "out", SUFFIXES)
@@ -67,10 +78,18 @@ def run(args) -> int:
     shape = to_shape(args.path, "path", solid=True)
     stock = args.stock_margin if args.stock is None else [args.stock[:3], args.stock[3:]]
     job = machine(shape, stock, [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
-                                 Finish(finish_tool, scallop=args.scallop)], progress=not args.no_progress)
-    programs(job, args.post)  # any refusal before a file is written
+                                 Finish(finish_tool, scallop=args.scallop)], progress=not args.no_progress,
+                  verify=False)
+    texts = programs(job, args.post)  # any refusal before a file is written
     program_paths(args.out, job, args.post)
-    written = export_job(job, args.out, args.post)
+    if args.no_verify:
+        note = "not verified (--no-verify): no check against the exact part or the stock"
+    else:
+        # the program as written, read back and judged; the verdict goes into its header
+        job = replace(job, verification=verify_job(job, args.post, texts))
+        note = ("verified: " if job.verification.ok else "VERIFICATION FAILED: ") + "; ".join(
+            str(f) for f in job.verification.findings)
+    written = export_job(job, args.out, args.post, note=note)
     if args.png:
         from ..cam.picture import write_png
 
@@ -83,4 +102,8 @@ def run(args) -> int:
                 print(f"    {line}")
     for p in written + ([args.png] if args.png else []):
         print(f"wrote {p}")
+    if job.verification is not None and not job.verification.ok:
+        broken = [f.what for f in job.verification.findings if not f.ok]
+        print(f"the program breaks a promise ({', '.join(broken)}): written, exit 3", file=sys.stderr)
+        return EXIT_PARTIAL
     return 0

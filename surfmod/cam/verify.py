@@ -1,0 +1,406 @@
+"""Every program judged before it leaves: the G-code read back, swept through a stock
+model and held against the exact part.
+
+The judge shares nothing with how the moves were made (the drop-cutter on BRepMesh
+triangles, :mod:`surfmod.cam.drop_cutter`):
+
+- **the program** is read back from its text (:mod:`surfmod.cam.program`): the rounded
+  coordinates, the arcs and the tool in the spindle are the machine's;
+- **the part** is points on its exact faces and edges: each face read back
+  (:func:`surfmod.from_face`), evaluated on a parameter grid a ``spacing`` apart on the
+  surface and kept inside its trim; every edge that bounds a face sampled as finely.
+  Edges bounding no face (construction wires) are not material and are left out.
+  Between points a surface can come nearer a tool by at most ``spacing² (1/c + κ)/8``
+  (``c`` the tool's corner radius, ``κ`` the surface's curvature): ``spacing`` is chosen
+  so that this stays within half the limit judged.  Where a ball cuts deepest, the
+  depth is measured once more by OCCT's exact distance (``BRepExtrema``);
+- **gouge**: every move of an operation, probed at points ``spacing`` apart along it, may
+  bring no point of the part deeper into the tool than the operation's limit: its
+  tolerance for finishing; for roughing the tool grown by its allowance, so that it
+  stays the allowance away less its tolerance.  Rapids may touch nothing;
+- **stock**: a height field over the stock box, a cell a quarter of the finishing
+  stepover wide, from which each feed removes what the tool's lower surface sweeps, in
+  the program's order.  A rapid whose tool goes below the stock's top there runs through
+  material;
+- **residual**: after the last finishing, the stock left above the lowest the finishing
+  tool can reach (the part's closing by the tool, from its drop onto the part's points),
+  measured normal to that surface, is at most the scallop plus the tolerance wherever the
+  tool reaches.  A height field cannot see a wall: nodes steeper than ``WALL_SLOPE`` and a
+  band one cell wide at the part's outline are counted, not judged.
+
+Each finding keeps its maximum and where it is.  The work is estimated before it starts
+(points on the part, probes, nodes) and refused above its bound with a line naming the
+option that lowers it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import checks
+from ..errors import SurfmodError
+from ..readback.trimmed import from_face
+from . import verify_kernels as K
+from .program import ProgramMoves, concatenate, read_program
+
+#: points on the part, probes along the moves and stock nodes one verification may take
+MAX_SAMPLES = 30_000_000
+MAX_PROBES = 60_000_000
+MAX_NODES = 30_000_000
+#: nodes of the stock steeper than this (degrees) are walls the height field cannot judge
+WALL_SLOPE = 80.0
+#: how many of the deepest ball probes OCCT's exact distance measures again
+EXACT_PROBES = 16
+#: grid points per face direction, at most (a face this fine is sampled coarser, and says so)
+MAX_FACE_GRID = 4000
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One promise measured: ``worst`` (mm) against ``limit``, ``where`` the worst is
+    (x, y, z), ``count`` moves or nodes beyond the limit, ``line`` the program line of the
+    worst move (0: none)."""
+
+    what: str
+    worst: float
+    limit: float
+    where: tuple | None = None
+    count: int = 0
+    line: int = 0
+
+    @property
+    def ok(self) -> bool:
+        return not self.worst > self.limit
+
+    def __str__(self) -> str:
+        at = "" if self.where is None else " at ({:.4g}, {:.4g}, {:.4g})".format(*self.where)
+        line = f" (line {self.line})" if self.line else ""
+        worst = "nothing inside the tool" if not self.worst > 0 else f"max {self.worst:.3g} mm"
+        verdict = "ok" if self.ok else f"BROKEN: {self.count} beyond it"
+        return f"{self.what}: {worst}{at}{line}, limit {self.limit:.3g} mm, {verdict}"
+
+
+@dataclass(frozen=True)
+class Verification:
+    """What :func:`verify_job` / :func:`verify_toolpath` found: the ``findings`` (gouge per
+    operation, rapids, residual), and the work: points on the part, probes along the moves,
+    stock nodes, and the wall nodes the height field counted but could not judge."""
+
+    findings: tuple
+    samples: int
+    probes: int
+    nodes: int = 0
+    walls: int = 0
+    spacing: float = 0.0
+    notes: tuple = field(default=())
+
+    @property
+    def ok(self) -> bool:
+        return all(f.ok for f in self.findings)
+
+    def lines(self) -> list[str]:
+        head = (f"verified against the exact part: {self.samples:,} points {self.spacing:.3g} mm apart, "
+                f"{self.probes:,} probes along the moves"
+                + (f", stock of {self.nodes:,} nodes ({self.walls:,} on walls not judged)" if self.nodes else ""))
+        return [head] + [str(f) for f in self.findings] + list(self.notes)
+
+    def __str__(self) -> str:
+        return "\n".join(self.lines())
+
+
+# -- the part as points ---------------------------------------------------------------------
+@dataclass(frozen=True)
+class PartPoints:
+    """Points of the exact part bucketed on an (x, y) grid of ``cell``: ``points`` sorted
+    by cell, highest first in each; ``starts`` the cells' offsets (``nx * ny + 1``)."""
+
+    points: np.ndarray
+    starts: np.ndarray
+    origin: tuple
+    cell: float
+    shape: tuple
+
+    @classmethod
+    def bucket(cls, points: np.ndarray, cell: float) -> "PartPoints":
+        lo = points[:, :2].min(axis=0) - cell
+        nx, ny = (np.floor((points[:, :2].max(axis=0) - lo) / cell).astype(np.int64) + 2)
+        ij = np.floor((points[:, :2] - lo) / cell).astype(np.int64)
+        cid = ij[:, 0] * ny + ij[:, 1]
+        order = np.lexsort((-points[:, 2], cid))
+        starts = np.searchsorted(cid[order], np.arange(nx * ny + 1))
+        return cls(np.ascontiguousarray(points[order]), starts.astype(np.int64), (float(lo[0]), float(lo[1])),
+                   float(cell), (int(nx), int(ny)))
+
+    def deepest(self, probes: np.ndarray, radius: float, corner: float):
+        return K.deepest(self.starts, self.points, *self.origin, self.cell, *self.shape,
+                         np.ascontiguousarray(probes, dtype=float), radius, corner)
+
+    def drop(self, xy: np.ndarray, radius: float, corner: float) -> np.ndarray:
+        return K.drop_heights(self.starts, self.points, *self.origin, self.cell, *self.shape,
+                              np.ascontiguousarray(xy, dtype=float), radius, corner)
+
+
+def _face_grid(face, spacing: float):
+    """A face's parameter grid ``spacing`` apart on the surface (from its largest
+    derivatives on a 9 x 9 grid), at most ``MAX_FACE_GRID`` a side."""
+    (u0, u1), (v0, v1) = face.domain
+    uu, vv = np.meshgrid(np.linspace(u0, u1, 9), np.linspace(v0, v1, 9), indexing="ij")
+    d = face.derivatives(uu.ravel(), vv.ravel(), 1)
+    su = float(np.linalg.norm(d[:, 1, 0], axis=1).max()) * (u1 - u0)
+    sv = float(np.linalg.norm(d[:, 0, 1], axis=1).max()) * (v1 - v0)
+    nu = int(min(MAX_FACE_GRID, max(2, math.ceil(su / spacing) + 1)))
+    nv = int(min(MAX_FACE_GRID, max(2, math.ceil(sv / spacing) + 1)))
+    return np.linspace(u0, u1, nu), np.linspace(v0, v1, nv)
+
+
+def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES) -> np.ndarray:
+    """Points ``(N, 3)`` on every face of ``shape`` inside its trim and on every edge that
+    bounds a face, about ``spacing`` apart; more than ``max_samples`` (counted on the
+    faces' parameter grids before any is evaluated) raises ``SurfmodError``."""
+    from ..occ.discretize import edge_length, sample_curve
+    from ..occ.topo import curve_of_edge, faces_of, geometric_edges, wrapped
+
+    spacing = checks.positive(spacing, "spacing")
+    faces = [from_face(f) for f in faces_of(shape)]
+    grids = [_face_grid(f, spacing) for f in faces]
+    edges = [e for _, e, owners in geometric_edges(wrapped(shape)) if owners]
+    counts = [max(2, math.ceil(edge_length(e) / spacing) + 1) for e in edges]
+    total = sum(len(a) * len(b) for a, b in grids) + sum(counts)
+    checks.work(total, max_samples, "max_samples",
+                f"the verification's {total:,} points on the part, {spacing:.3g} mm apart "
+                f"(a larger scallop or tolerance, or no verification)")
+    out = []
+    for face, (us, vs) in zip(faces, grids):
+        uu, vv = np.meshgrid(us, vs, indexing="ij")
+        inside = face.contains(uu.ravel(), vv.ravel())
+        if inside.any():
+            out.append(face.points(uu.ravel()[inside], vv.ravel()[inside], max_points=max_samples))
+    for edge, n in zip(edges, counts):
+        curve, t0, t1 = curve_of_edge(edge)
+        out.append(sample_curve(curve, t0, t1, n))
+    if not out:
+        raise SurfmodError("part: has no faces to verify against")
+    return np.concatenate(out)
+
+
+def spacing_for(limit: float, radius: float, corner: float) -> float:
+    """Point spacing on the part for judging a tool of ``radius``/``corner`` to ``limit``:
+    the gap a surface can close between points, ``spacing² / (8 c)``, at most half of it."""
+    c = max(corner, limit)
+    return float(min(2.0 * math.sqrt(limit * c), radius / 4))
+
+
+# -- probes along moves ---------------------------------------------------------------------
+def _probes(start: np.ndarray, end: np.ndarray, spacing: float, max_probes: int):
+    """Points ``spacing`` apart along each move (both ends included) and each one's move."""
+    length = np.linalg.norm(end - start, axis=1)
+    n = np.ceil(length / spacing).astype(np.int64) + 1
+    total = int(n.sum())
+    checks.work(total, max_probes, "max_probes",
+                f"the verification's {total:,} probes along the moves (a larger scallop or tolerance, "
+                f"or no verification)")
+    move = np.repeat(np.arange(len(start)), n)
+    first = np.r_[0, np.cumsum(n)[:-1]]
+    t = (np.arange(total) - np.repeat(first, n)) / np.maximum(np.repeat(n - 1, n), 1)
+    pts = start[move] + t[:, None] * (end - start)[move]
+    return pts, move
+
+
+def _gouge(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, radius: float, corner: float, limit: float,
+           spacing: float, what: str, max_probes: int, exact_shape=None):
+    """The deepest any point of the part comes into the tool along the picked moves."""
+    if not pick.any():
+        return Finding(what, -np.inf, limit), 0
+    idx = np.flatnonzero(pick)
+    probes, move = _probes(moves.start[idx], moves.end[idx], spacing, max_probes)
+    depth, which = part.deepest(probes, radius, corner)
+    if exact_shape is not None and corner == radius and depth.max() > 0:
+        # the deepest ball probes measured by OCCT's exact distance from the centre
+        from ..occ.topo import closest_on_face
+
+        top = np.argsort(depth)[-EXACT_PROBES:]
+        top = top[depth[top] > 0]
+        dist, _ = closest_on_face(exact_shape, probes[top] + [0.0, 0.0, radius])
+        depth[top] = np.maximum(depth[top], radius - dist)
+    k = int(np.argmax(depth))
+    if depth[k] <= 0:
+        return Finding(what, float(depth[k]), limit), len(probes)
+    bad = np.unique(move[depth > limit])
+    where = tuple(float(v) for v in part.points[which[k]]) if which[k] >= 0 else tuple(probes[k])
+    return Finding(what, float(depth[k]), limit, where, len(bad), int(moves.line[idx[move[k]]])), len(probes)
+
+
+# -- the job --------------------------------------------------------------------------------
+def _program_moves(job, texts: list[str], post: str) -> tuple[ProgramMoves, np.ndarray]:
+    """The programs' moves in the order the machine runs them, and each move's operation."""
+    if post == "linuxcnc":
+        groups = [(texts[0], list(range(len(job.operations))), 0)]
+    else:
+        numbers = list(dict.fromkeys(op.tool.number for op in job.operations))
+        if len(numbers) != len(texts):
+            raise SurfmodError(f"programs: expected {len(numbers)} GRBL programs (one per tool), got {len(texts)}")
+        groups = [(text, [k for k, op in enumerate(job.operations) if op.tool.number == n], n)
+                  for text, n in zip(texts, numbers)]
+    parts, owners = [], []
+    for text, ops, tool in groups:
+        moves = read_program(text, tool=tool)
+        # the posts open each operation with its comment: count them along the text
+        marks = [i for i, line in enumerate(text.splitlines(), start=1) if line.startswith("(operation:")]
+        if len(marks) != len(ops):
+            raise SurfmodError(f"programs: {len(marks)} operations in the text, the job has {len(ops)}")
+        local = np.searchsorted(np.array(marks), moves.line, side="right") - 1
+        if np.any(local < 0):
+            raise SurfmodError("programs: a move before the first operation")
+        parts.append(moves)
+        owners.append(np.asarray(ops)[local])
+    return concatenate(parts), np.concatenate(owners)
+
+
+def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, max_samples: int = MAX_SAMPLES,
+               max_probes: int = MAX_PROBES, max_nodes: int = MAX_NODES) -> Verification:
+    """Judge the program(s) of ``job`` (as :func:`surfmod.cam.post.programs` writes them
+    for ``post``, or the given ``texts``) against the exact part and the stock: gouge per
+    operation, rapids through stock or part, the scallop left (see the module).
+
+    >>> import surfmod as sm, build123d as bd
+    >>> job = sm.machine(bd.Box(20, 20, 5), 1.0, [sm.Rough(sm.Tool("flat", 3.0), allowance=0.3),
+    ...                                          sm.Finish(sm.Tool("ball", 2.0), scallop=0.05)], verify=False)
+    >>> v = verify_job(job)
+    >>> v.ok, [f.what for f in v.findings]
+    (True, ['gouge, roughing (tool 1)', 'gouge, finishing (tool 2)', 'rapids', 'residual'])
+    """
+    from .post import programs
+
+    texts = programs(job, post) if texts is None else list(texts)
+    moves, owner = _program_moves(job, texts, post)
+    digits = 1e-4  # the posts' 4 decimals: x and y rounded to the nearest, z up
+    plans = []
+    for k, op in enumerate(job.operations):
+        tool = op.tool
+        if op.name == "roughing":
+            a = float(op.report.get("allowance", 0.0))
+            cutter = tool.cutter.grown(a) if a > 0 else tool.cutter
+            limit = float(op.report["tolerance"]) + digits
+        else:
+            cutter, limit = tool.cutter, float(op.report["tolerance"]) + digits
+        plans.append((k, op, cutter, limit))
+    spacing = min(spacing_for(limit / 2, c.radius, c.corner) for _, _, c, limit in plans)
+    points = part_points(job.part, spacing, max_samples)
+    part = PartPoints.bucket(points, max(c.radius for _, _, c, _ in plans))
+    findings, probes = [], 0
+    for k, op, cutter, limit in plans:
+        found, n = _gouge(part, moves, (owner == k) & ~moves.rapid, cutter.radius, cutter.corner, limit, spacing,
+                          f"gouge, {op.name} (tool {op.tool.number})", max_probes - probes, job.part)
+        findings.append(found)
+        probes += n
+    # rapids: no point of the part inside the tool, and (below) no stock under it
+    rapid_part, n = Finding("rapids", -np.inf, 0.0), 0
+    for k, op, _, _ in plans:
+        found, m = _gouge(part, moves, (owner == k) & moves.rapid, op.tool.radius, op.tool.corner, 0.0, spacing,
+                          "rapids", max_probes - probes - n)
+        n += m
+        if found.worst > rapid_part.worst:
+            rapid_part = found
+    probes += n
+    finishing = [p for p in plans if p[1].name == "finishing"]
+    stepover = min((float(p[1].report.get("stepover") or p[1].tool.radius) for p in finishing),
+                   default=min(op.tool.radius for op in job.operations))
+    cell = max(stepover / 4, 1e-3)
+    lo, hi = np.asarray(job.stock, float)
+    nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
+    checks.work(nx * ny, max_nodes, "max_nodes",
+                f"the verification's stock of {nx:,} x {ny:,} nodes (a larger scallop, or no verification)")
+    top = np.full((nx, ny), float(hi[2]))
+    radii = np.array([job.operations[k].tool.radius for k in owner], float)
+    corners = np.array([job.operations[k].tool.corner for k in owner], float)
+    into, node = K.sweep(top, float(lo[0]), float(lo[1]), cell, moves.start, moves.end, moves.rapid, radii, corners,
+                         cell / 2)
+    through = np.where(moves.rapid, into, -np.inf)
+    stock_hit = 1e-6  # a rapid grazing the top it just cut is no collision
+    k = int(np.argmax(through)) if len(through) else 0
+    if len(through) and through[k] > stock_hit:
+        i, j = divmod(int(node[k]), ny)
+        where = (float(lo[0] + i * cell), float(lo[1] + j * cell), float(top[i, j]))
+        stock = Finding("rapids", float(through[k]), 0.0, where, int((through > stock_hit).sum()), int(moves.line[k]))
+    else:
+        stock = Finding("rapids", -np.inf, 0.0)
+    findings.append(max(stock, rapid_part, key=lambda f: f.worst))
+    uncut = ~moves.rapid & ~moves.spindle & (np.linalg.norm(moves.end - moves.start, axis=1) > 0)
+    notes = []
+    if uncut.any():
+        findings.append(Finding("cuts with the spindle stopped", float(uncut.sum()), 0.0, None, int(uncut.sum()),
+                                int(moves.line[np.argmax(uncut)])))
+    walls = 0
+    if finishing:
+        k, op, cutter, limit = finishing[-1]
+        found, walls = _residual(part, top, lo, cell, op, cutter, limit)
+        findings.append(found)
+    return Verification(tuple(findings), len(points), probes, nx * ny, walls, spacing, tuple(notes))
+
+
+def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):
+    """The stock left above the finishing tool's reach, normal to it, where it reaches."""
+    nx, ny = top.shape
+    gx, gy = np.meshgrid(lo[0] + cell * np.arange(nx), lo[1] + cell * np.arange(ny), indexing="ij")
+    xy = np.column_stack([gx.ravel(), gy.ravel()])
+    tips = part.drop(xy, cutter.radius, cutter.corner).reshape(nx, ny)
+    reach = K.closing(tips, cell, cutter.radius, cutter.corner)
+    # the part under each node (the highest of its points within the node's cell), and the
+    # outline: a node whose neighbours are not all over the part is not judged
+    under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
+    on = np.isfinite(under)
+    inner = on.copy()
+    inner[1:] &= on[:-1]
+    inner[:-1] &= on[1:]
+    inner[:, 1:] &= on[:, :-1]
+    inner[:, :-1] &= on[:, 1:]
+    inner &= np.isfinite(reach)
+    # on the grid the closing can fall below the part at the rim of a wall (the tool just
+    # across it): the tool never reaches below the part under the node
+    reach = np.maximum(reach, under)
+    gxr, gyr = np.gradient(np.where(np.isfinite(reach), reach, np.nan), cell)
+    theta = np.degrees(np.arctan(np.hypot(gxr, gyr)))
+    steep = inner & ~(np.nan_to_num(theta, nan=90.0) < WALL_SLOPE)
+    judged = inner & ~steep
+    left = (top - reach) * np.cos(np.radians(np.nan_to_num(theta, nan=90.0)))
+    # the stamped sweep lies above the true one by the profile's sag over a quarter cell
+    sag = (cell / 4) ** 2 / (2 * max(cutter.corner, cell))
+    scallop = float(op.report.get("scallop") or 0.0)
+    bound = scallop + limit + sag
+    what = f"residual after {op.name} (tool {op.tool.number}, normal to the reachable surface)"
+    if not judged.any():
+        return Finding(what, -np.inf, bound), int(steep.sum())
+    vals = np.where(judged, left, -np.inf)
+    i, j = np.unravel_index(int(np.argmax(vals)), vals.shape)
+    worst = float(vals[i, j])
+    return Finding(what, worst, bound, (float(gx[i, j]), float(gy[i, j]), float(top[i, j])),
+                   int((vals > bound).sum())), int(steep.sum())
+
+
+def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MAX_SAMPLES,
+                    max_probes: int = MAX_PROBES) -> Verification:
+    """Judge a :class:`~surfmod.cam.toolpath.Toolpath`'s G-code (``text``, default
+    ``path.to_gcode()``) against the exact faces of ``obj``: no move may bring a point of
+    a face deeper into the tool than the path's tolerance (plus the 4 decimals written).
+
+    >>> import surfmod as sm
+    >>> s = sm.plane((0, 0, 1), (10, 0, 1), (0, 10, 1))
+    >>> tp = sm.toolpath(s, sm.Tool("ball", 2.0), scallop=0.05)
+    >>> verify_toolpath(tp, s).ok
+    True
+    """
+    from ..inputs import to_shape
+
+    shape = to_shape(obj, "obj")
+    moves = read_program(path.to_gcode() if text is None else text, tool=0)
+    limit = float(path.tolerance) + 1e-4
+    cutter = path.tool.cutter
+    spacing = spacing_for(limit / 2, cutter.radius, cutter.corner)
+    points = part_points(shape, spacing, max_samples)
+    part = PartPoints.bucket(points, cutter.radius)
+    found, n = _gouge(part, moves, ~moves.rapid, cutter.radius, cutter.corner, limit, spacing, "gouge", max_probes,
+                      shape)
+    return Verification((found,), len(points), n, spacing=spacing)

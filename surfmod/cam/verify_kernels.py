@@ -1,0 +1,172 @@
+"""The verification's compiled loops: points of the exact part inside the tool, and the
+height-field stock swept by the tool (see :mod:`surfmod.cam.verify`).
+
+A tool is an end mill of radius ``R`` with corner radius ``c`` (ball: ``c = R``, flat:
+``c = 0``) on an endless shank of its own radius.  In the meridian half-plane of a point
+(``d`` from the axis, ``h`` above the tip) its lower surface is the flat core ``d <= R - c``
+at ``h = 0`` and the corner's quarter circle round ``(R - c, c)``, its side the line
+``d = R``.  A point is inside when ``d < R`` and ``h`` lies above the profile; how deep is
+its distance to that boundary, the least of the three pieces' distances (the nearest
+point of a surface of revolution lies in the point's own meridian plane).
+
+Points are bucketed on an (x, y) grid, each cell's list from its highest point down, so a
+probe stops reading a cell at the first point below its tip: nothing lower can be inside.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def profile(d, radius, corner):
+    """Height of the tool's lower surface above the tip at ``d`` from the axis."""
+    core = radius - corner
+    if d <= core:
+        return 0.0
+    t = d - core
+    return corner - math.sqrt(max(corner * corner - t * t, 0.0))
+
+
+@njit(cache=True, inline="always")
+def inside_depth(d, h, radius, corner):
+    """Distance of a point (``d``, ``h``) inside the tool to its boundary; -1 outside."""
+    if d >= radius or h <= profile(d, radius, corner):
+        return -1.0
+    core = radius - corner
+    side = radius - d
+    t = max(d - core, 0.0)
+    floor = math.sqrt(t * t + h * h)
+    vx, vz = d - core, h - corner
+    if vx >= 0.0 and vz <= 0.0:
+        ring = abs(corner - math.sqrt(vx * vx + vz * vz))
+    else:
+        ring = min(math.sqrt(vx * vx + h * h), math.sqrt((radius - d) ** 2 + vz * vz))
+    return min(side, floor, ring)
+
+
+@njit(cache=True)
+def deepest(starts, points, x0, y0, cell, nx, ny, probes, radius, corner):
+    """For each probe (tip point) the deepest bucketed point inside the tool and its index
+    (-1 and -1 where none is)."""
+    n = probes.shape[0]
+    depth = np.full(n, -1.0)
+    which = np.full(n, -1, np.int64)
+    for k in range(n):
+        px, py, pz = probes[k, 0], probes[k, 1], probes[k, 2]
+        i0 = max(int(math.floor((px - radius - x0) / cell)), 0)
+        i1 = min(int(math.floor((px + radius - x0) / cell)), nx - 1)
+        j0 = max(int(math.floor((py - radius - y0) / cell)), 0)
+        j1 = min(int(math.floor((py + radius - y0) / cell)), ny - 1)
+        best, arg = -1.0, -1
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                c = i * ny + j
+                for m in range(starts[c], starts[c + 1]):
+                    h = points[m, 2] - pz
+                    if h <= 0.0:
+                        break  # the cell's list runs from its highest point down
+                    dx, dy = points[m, 0] - px, points[m, 1] - py
+                    dep = inside_depth(math.sqrt(dx * dx + dy * dy), h, radius, corner)
+                    if dep > best:
+                        best, arg = dep, m
+        depth[k] = best
+        which[k] = arg
+    return depth, which
+
+
+@njit(cache=True)
+def drop_heights(starts, points, x0, y0, cell, nx, ny, xy, radius, corner):
+    """Tip heights of the tool dropped onto the bucketed points at each ``xy`` (the highest
+    ``z - profile(d)`` of the points within the radius; -inf where there is none)."""
+    n = xy.shape[0]
+    out = np.full(n, -np.inf)
+    for k in range(n):
+        px, py = xy[k, 0], xy[k, 1]
+        i0 = max(int(math.floor((px - radius - x0) / cell)), 0)
+        i1 = min(int(math.floor((px + radius - x0) / cell)), nx - 1)
+        j0 = max(int(math.floor((py - radius - y0) / cell)), 0)
+        j1 = min(int(math.floor((py + radius - y0) / cell)), ny - 1)
+        best = -np.inf
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                c = i * ny + j
+                for m in range(starts[c], starts[c + 1]):
+                    if points[m, 2] <= best:
+                        break  # nothing lower in this cell can lift the tool more
+                    dx, dy = points[m, 0] - px, points[m, 1] - py
+                    d = math.sqrt(dx * dx + dy * dy)
+                    if d < radius:
+                        z = points[m, 2] - profile(d, radius, corner)
+                        if z > best:
+                            best = z
+        out[k] = best
+    return out
+
+
+@njit(cache=True)
+def closing(tips, cell, radius, corner):
+    """The lowest the tool's lower surface reaches over each node: the least of
+    ``tips[node'] + profile(|node - node'|)`` over the nodes within the radius (the
+    part's closing by the tool, on the grid; inf where no tip stands in reach)."""
+    nx, ny = tips.shape
+    out = np.full((nx, ny), np.inf)
+    n = int(radius / cell)
+    for di in range(-n, n + 1):
+        for dj in range(-n, n + 1):
+            d = cell * math.sqrt(di * di + dj * dj)
+            if d >= radius:
+                continue
+            f = profile(d, radius, corner)
+            for i in range(max(0, -di), min(nx, nx - di)):
+                for j in range(max(0, -dj), min(ny, ny - dj)):
+                    v = tips[i + di, j + dj] + f
+                    if v < out[i, j]:
+                        out[i, j] = v
+    return out
+
+
+@njit(cache=True)
+def sweep(top, x0, y0, cell, starts, ends, rapid, radii, corners, step):
+    """Run the moves over the stock's height field ``top`` (nx, ny) in order: a feed
+    lowers every node to the tool's lower surface, a rapid cuts nothing and is measured.
+    Each move is stamped at points at most ``step`` apart in (x, y).  Returns, per move,
+    how far the tool's lower surface went below the stock's top (the deepest, -inf where
+    it covered no stock) and that node's flat index."""
+    nx, ny = top.shape
+    m = starts.shape[0]
+    into = np.full(m, -np.inf)
+    node = np.full(m, -1, np.int64)
+    for k in range(m):
+        ax, ay, az = starts[k, 0], starts[k, 1], starts[k, 2]
+        bx, by, bz = ends[k, 0], ends[k, 1], ends[k, 2]
+        radius, corner = radii[k], corners[k]
+        length = math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+        pieces = max(1, int(math.ceil(length / step)))
+        if length == 0.0:
+            pieces = 0  # a vertical move: its lowest end is stamped alone
+        for s in range(pieces + 1):
+            t = s / pieces if pieces else (1.0 if bz < az else 0.0)
+            cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
+            i0 = max(int(math.ceil((cx - radius - x0) / cell)), 0)
+            i1 = min(int(math.floor((cx + radius - x0) / cell)), nx - 1)
+            j0 = max(int(math.ceil((cy - radius - y0) / cell)), 0)
+            j1 = min(int(math.floor((cy + radius - y0) / cell)), ny - 1)
+            for i in range(i0, i1 + 1):
+                dx = x0 + i * cell - cx
+                for j in range(j0, j1 + 1):
+                    dy = y0 + j * cell - cy
+                    d = math.sqrt(dx * dx + dy * dy)
+                    if d >= radius:
+                        continue
+                    z = cz + profile(d, radius, corner)
+                    gap = top[i, j] - z
+                    if rapid[k]:
+                        if gap > into[k]:
+                            into[k], node[k] = gap, i * ny + j
+                    elif gap > 0.0:
+                        top[i, j] = z
+    return into, node
