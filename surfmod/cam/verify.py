@@ -39,6 +39,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .. import checks
 from ..errors import SurfmodError
@@ -54,8 +55,10 @@ MAX_NODES = 30_000_000
 WALL_SLOPE = 80.0
 #: how many of the deepest ball probes OCCT's exact distance measures again
 EXACT_PROBES = 16
-#: grid points per face direction, at most (a face this fine is sampled coarser, and says so)
+#: grid points per face direction, at most
 MAX_FACE_GRID = 4000
+#: samples per edge of the boundary loops that settle the points far from the trim
+BOUNDARY_SAMPLES = 64
 
 
 @dataclass(frozen=True)
@@ -156,6 +159,56 @@ def _face_grid(face, spacing: float):
     return np.linspace(u0, u1, nu), np.linspace(v0, v1, nv)
 
 
+def _crossings(loops: list, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
+    """Even-odd inside of the closed polylines ``loops`` on the grid ``us x vs``: per grid
+    line ``v``, the polylines' crossings left of each ``u`` counted (half-open in v)."""
+    segs = np.concatenate([np.stack([lp, np.roll(lp, -1, axis=0)], axis=1) for lp in loops])
+    (au, av), (bu, bv) = segs[:, 0].T, segs[:, 1].T
+    out = np.zeros((len(us), len(vs)), bool)
+    for j, v in enumerate(vs):
+        hit = (av <= v) != (bv <= v)
+        if not hit.any():
+            continue
+        a_u, a_v, b_u, b_v = au[hit], av[hit], bu[hit], bv[hit]
+        cross = np.sort(a_u + (v - a_v) * (b_u - a_u) / (b_v - a_v))
+        out[:, j] = np.searchsorted(cross, us, side="right") % 2 == 1
+    return out
+
+
+def _inside(face, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
+    """The grid ``us x vs`` classified against the face's trim.  The boundary loops are
+    sampled from the exact p-curves; the polylines (even-odd over the loops) settle every
+    point farther from them than their sagitta (estimated from the samples halfway) plus
+    a grid diagonal, in grid steps; OCCT's classifier the points nearer the boundary."""
+    uu, vv = np.meshgrid(us, vs, indexing="ij")
+    pts = np.column_stack([uu.ravel(), vv.ravel()])
+    # an odd count per edge puts every joint of two edges at an even index: each odd
+    # sample is its edge's p-curve at the parameter halfway between its neighbours
+    loops = [lp for lp in face.boundary_loops(2 * BOUNDARY_SAMPLES + 1) if len(lp) >= 5]
+    if not loops or len(us) < 2 or len(vs) < 2:
+        return face.contains(pts[:, 0], pts[:, 1]).reshape(uu.shape)
+    inside = _crossings(loops, us, vs).ravel()
+    # distances in grid steps (u and v differ in units and scale)
+    scale = np.array([us[1] - us[0], vs[1] - vs[0]])
+    grid_loops = [lp / scale for lp in loops]
+    # the halfway samples' distance from their neighbours' chords bounds the sagitta of
+    # the polylines above (halving a chord quarters it)
+    sag = max(float(np.linalg.norm(lp[1:-1:2] - 0.5 * (lp[:-2:2] + lp[2::2]), axis=1).max(initial=0.0))
+              for lp in grid_loops)
+    dense = []
+    for lp in grid_loops:  # samples along the polylines at most a grid step apart
+        seg = np.diff(lp, axis=0)
+        n = np.maximum(np.ceil(np.linalg.norm(seg, axis=1)).astype(np.int64), 1)
+        k = np.repeat(np.arange(len(seg)), n)
+        t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+        dense.append(lp[k] + t[:, None] * seg[k])
+    dist, _ = cKDTree(np.concatenate(dense)).query(pts / scale, distance_upper_bound=sag + 2.0)
+    ask = np.isfinite(dist)
+    if ask.any():
+        inside[ask] = face.contains(pts[ask, 0], pts[ask, 1])
+    return inside.reshape(uu.shape)
+
+
 def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     """Points ``(N, 3)`` on every face of ``shape`` inside its trim and on every edge that
     bounds a face, about ``spacing`` apart; more than ``max_samples`` (counted on the
@@ -175,7 +228,7 @@ def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES) -> np.nda
     out = []
     for face, (us, vs) in zip(faces, grids):
         uu, vv = np.meshgrid(us, vs, indexing="ij")
-        inside = face.contains(uu.ravel(), vv.ravel())
+        inside = _inside(face, us, vs).ravel()
         if inside.any():
             out.append(face.points(uu.ravel()[inside], vv.ravel()[inside], max_points=max_samples))
     for edge, n in zip(edges, counts):
@@ -191,6 +244,12 @@ def spacing_for(limit: float, radius: float, corner: float) -> float:
     the gap a surface can close between points, ``spacing² / (8 c)``, at most half of it."""
     c = max(corner, limit)
     return float(min(2.0 * math.sqrt(limit * c), radius / 4))
+
+
+def _cell(spacing: float, radius: float) -> float:
+    """Bucket size: a quarter of the smallest tool radius (a probe reads about 80 cells,
+    most of them cut short by their nearest distance), at least a few points wide."""
+    return max(radius / 4, 3 * spacing)
 
 
 # -- probes along moves ---------------------------------------------------------------------
@@ -289,7 +348,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         plans.append((k, op, cutter, limit))
     spacing = min(spacing_for(limit / 2, c.radius, c.corner) for _, _, c, limit in plans)
     points = part_points(job.part, spacing, max_samples)
-    part = PartPoints.bucket(points, max(c.radius for _, _, c, _ in plans))
+    part = PartPoints.bucket(points, _cell(spacing, min(c.radius for _, _, c, _ in plans)))
     findings, probes = [], 0
     for k, op, cutter, limit in plans:
         found, n = _gouge(part, moves, (owner == k) & ~moves.rapid, cutter.radius, cutter.corner, limit, spacing,
@@ -400,7 +459,7 @@ def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MA
     cutter = path.tool.cutter
     spacing = spacing_for(limit / 2, cutter.radius, cutter.corner)
     points = part_points(shape, spacing, max_samples)
-    part = PartPoints.bucket(points, cutter.radius)
+    part = PartPoints.bucket(points, _cell(spacing, cutter.radius))
     found, n = _gouge(part, moves, ~moves.rapid, cutter.radius, cutter.corner, limit, spacing, "gouge", max_probes,
                       shape)
     return Verification((found,), len(points), n, spacing=spacing)

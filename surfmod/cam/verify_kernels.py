@@ -48,10 +48,20 @@ def inside_depth(d, h, radius, corner):
     return min(side, floor, ring)
 
 
+@njit(cache=True, inline="always")
+def _gap(px, py, i, j, x0, y0, cell):
+    """Horizontal distance from (px, py) to cell (i, j) (0 inside it)."""
+    gx = max(x0 + i * cell - px, px - (x0 + (i + 1) * cell), 0.0)
+    gy = max(y0 + j * cell - py, py - (y0 + (j + 1) * cell), 0.0)
+    return math.sqrt(gx * gx + gy * gy)
+
+
 @njit(cache=True)
 def deepest(starts, points, x0, y0, cell, nx, ny, probes, radius, corner):
     """For each probe (tip point) the deepest bucketed point inside the tool and its index
-    (-1 and -1 where none is)."""
+    (-1 and -1 where none is).  A cell's list is read from its highest point down while a
+    point could still lie above the tool's lower surface there (its profile at the cell's
+    nearest distance)."""
     n = probes.shape[0]
     depth = np.full(n, -1.0)
     which = np.full(n, -1, np.int64)
@@ -64,11 +74,15 @@ def deepest(starts, points, x0, y0, cell, nx, ny, probes, radius, corner):
         best, arg = -1.0, -1
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
+                near = _gap(px, py, i, j, x0, y0, cell)
+                if near >= radius:
+                    continue
+                floor = profile(near, radius, corner)
                 c = i * ny + j
                 for m in range(starts[c], starts[c + 1]):
                     h = points[m, 2] - pz
-                    if h <= 0.0:
-                        break  # the cell's list runs from its highest point down
+                    if h <= floor:
+                        break  # the list runs from its highest point down
                     dx, dy = points[m, 0] - px, points[m, 1] - py
                     dep = inside_depth(math.sqrt(dx * dx + dy * dy), h, radius, corner)
                     if dep > best:
@@ -81,28 +95,40 @@ def deepest(starts, points, x0, y0, cell, nx, ny, probes, radius, corner):
 @njit(cache=True)
 def drop_heights(starts, points, x0, y0, cell, nx, ny, xy, radius, corner):
     """Tip heights of the tool dropped onto the bucketed points at each ``xy`` (the highest
-    ``z - profile(d)`` of the points within the radius; -inf where there is none)."""
+    ``z - profile(d)`` of the points within the radius; -inf where there is none).  The
+    location's own cell is read first; a cell's list stops where even its nearest
+    distance's profile cannot beat the best height found."""
     n = xy.shape[0]
     out = np.full(n, -np.inf)
     for k in range(n):
         px, py = xy[k, 0], xy[k, 1]
+        ic = int(math.floor((px - x0) / cell))
+        jc = int(math.floor((py - y0) / cell))
         i0 = max(int(math.floor((px - radius - x0) / cell)), 0)
         i1 = min(int(math.floor((px + radius - x0) / cell)), nx - 1)
         j0 = max(int(math.floor((py - radius - y0) / cell)), 0)
         j1 = min(int(math.floor((py + radius - y0) / cell)), ny - 1)
         best = -np.inf
-        for i in range(i0, i1 + 1):
-            for j in range(j0, j1 + 1):
-                c = i * ny + j
-                for m in range(starts[c], starts[c + 1]):
-                    if points[m, 2] <= best:
-                        break  # nothing lower in this cell can lift the tool more
-                    dx, dy = points[m, 0] - px, points[m, 1] - py
-                    d = math.sqrt(dx * dx + dy * dy)
-                    if d < radius:
-                        z = points[m, 2] - profile(d, radius, corner)
-                        if z > best:
-                            best = z
+        for pass_ in range(2):
+            for i in range(i0, i1 + 1):
+                for j in range(j0, j1 + 1):
+                    own = i == ic and j == jc
+                    if own != (pass_ == 0):
+                        continue
+                    near = _gap(px, py, i, j, x0, y0, cell)
+                    if near >= radius:
+                        continue
+                    lift = profile(near, radius, corner)
+                    c = i * ny + j
+                    for m in range(starts[c], starts[c + 1]):
+                        if points[m, 2] - lift <= best:
+                            break  # nothing lower in this cell can lift the tool more
+                        dx, dy = points[m, 0] - px, points[m, 1] - py
+                        d = math.sqrt(dx * dx + dy * dy)
+                        if d < radius:
+                            z = points[m, 2] - profile(d, radius, corner)
+                            if z > best:
+                                best = z
         out[k] = best
     return out
 
