@@ -83,7 +83,7 @@ def run(args) -> int:
     texts = programs(job, args.post)  # any refusal before a file is written
     program_paths(args.out, job, args.post)
     if args.no_verify:
-        note = "not verified (--no-verify): no check against the exact part or the stock"
+        note = "not verified: --no-verify, no check against the exact part or the stock"
     else:
         # the program as written, read back and judged; the verdict goes into its header
         job = replace(job, verification=verify_job(job, args.post, texts))
