@@ -57,8 +57,10 @@ WALL_SLOPE = 80.0
 EXACT_PROBES = 16
 #: grid points per face direction, at most
 MAX_FACE_GRID = 4000
-#: samples per edge of the boundary loops that settle the points far from the trim
+#: samples per edge of the boundary loops that settle the points far from the trim, and
+#: the grids small enough to classify point by point instead
 BOUNDARY_SAMPLES = 64
+SMALL_FACE = 4096
 
 
 @dataclass(frozen=True)
@@ -182,6 +184,8 @@ def _inside(face, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
     a grid diagonal, in grid steps; OCCT's classifier the points nearer the boundary."""
     uu, vv = np.meshgrid(us, vs, indexing="ij")
     pts = np.column_stack([uu.ravel(), vv.ravel()])
+    if len(pts) <= SMALL_FACE:  # fewer points than its boundary samples: ask them all
+        return face.contains(pts[:, 0], pts[:, 1]).reshape(uu.shape)
     # an odd count per edge puts every joint of two edges at an even index: each odd
     # sample is its edge's p-curve at the parameter halfway between its neighbours
     loops = [lp for lp in face.boundary_loops(2 * BOUNDARY_SAMPLES + 1) if len(lp) >= 5]
