@@ -216,3 +216,35 @@ def test_cli_machine_exit_3_and_header_on_a_broken_promise(tmp_path, capsys, mon
     captured = capsys.readouterr()
     assert out.is_file() and "(VERIFICATION FAILED: gouge, finishing [tool 2]: max 0.3 mm" in out.read_text()
     assert "BROKEN: 4 beyond it" in captured.out and "exit 3" in captured.err
+
+
+# -- the repair ----------------------------------------------------------------------------------
+def test_a_low_rib_along_the_raster_is_recut_and_both_judges_agree():
+    """A rib 1 mm high running along the raster: the ball rolls over its edges, and the
+    passes along x stand too far apart on the slopes it leaves there (0.16 mm of cusps for
+    a 0.05 scallop).  The verifier finds the strips, cross passes re-cut them, the job is
+    judged again, and the tests' own simulation measures the same."""
+    from scipy import ndimage
+    from stock_sim import Cutter, Stock, parse_gcode, part_height, reachable, simulate
+
+    from surfmod.occ.triangulation import part_triangles
+
+    part = bd.Box(40, 30, 5) + bd.Pos(0, 4, 3.0) * bd.Box(40, 6, 1.0)
+    job = sm.machine(part, 1.0, [sm.Rough(sm.Tool("flat", 4.0), allowance=0.3),
+                                 sm.Finish(sm.Tool("ball", 3.0), scallop=0.05)])
+    fin = job.operations[1]
+    residual = _finding(job.verification, "residual")
+    assert fin.report["recut"]["before"] > 2 * residual.limit and fin.report["recut"]["passes"] > 10
+    assert job.verification.ok, str(job.verification)
+
+    stock = Stock(job.stock, 0.1)
+    tri, _ = part_triangles(job.part, 0.002)
+    top = part_height(tri, stock.x, stock.y)
+    simulate(parse_gcode(programs(job)[0]), {1: Cutter("flat", 4.0), 2: Cutter("ball", 3.0)}, stock, top)
+    reach = np.maximum(reachable(np.where(np.isfinite(top), top, job.stock[0, 2]), Cutter("ball", 3.0), 0.1), top)
+    gx, gy = np.gradient(reach, 0.1)
+    cos = 1 / np.sqrt(1 + gx * gx + gy * gy)
+    judged = ndimage.binary_erosion(np.isfinite(top), iterations=2) & (cos > math.cos(math.radians(80)))
+    simulated = float(((stock.top - reach) * cos)[judged].max())
+    assert simulated <= residual.limit + 0.005, simulated
+    assert abs(simulated - residual.worst) < 0.01, (simulated, residual.worst)

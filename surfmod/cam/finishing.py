@@ -53,6 +53,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import ndimage
 
+from ..errors import SurfmodError
 from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
 from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
@@ -64,6 +65,8 @@ from .waterline import ContourPoints, waterline
 #: Steep regions: slopes within this many degrees below the threshold count too (the
 #: classification samples the drop-cutter surface, the raster's slope bound its triangles).
 STEEP_MARGIN = 1.0
+#: cross passes of a repair stand this share of the finishing's stepover apart (cos 45°)
+RECUT_SHARE = math.cos(math.radians(45.0))
 #: triangles within this slope (degrees) of level are floors: a waterline level runs just above each
 FLOOR_SLOPE = 0.5
 #: Clearance (mm) of entries and retracts above the highest stock the roughing can have left.
@@ -560,6 +563,60 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
               "waterline": wl_info,
               "rest": rest_left(part, tool, float(stock[0, 2]), threshold)}
     return motion, report
+
+
+def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, tolerance: float,
+          stock: np.ndarray, safe: float, rest: Rest | None):
+    """Cross passes over the regions a finishing left too much on: a drop-cutter raster
+    across ``direction`` over each box ``(x0, y0, x1, y1)`` grown by the tool radius, each
+    entered and left as the finishing's raster is.  Returns the :class:`Motion` (from and
+    back to the clearance height) and the number of passes; a box the tool touches nowhere
+    is skipped.  Walls and the fillets a tool leaves along them that run parallel to the
+    raster are crossed by these passes, so their cusps stand a stepover apart across them."""
+    other = "y" if direction == "x" else "x"
+    top = _StockTop(part, tool, rest, stock, safe)
+    allowed = tolerance - part.deflection + part.lift
+    out, passes = Moves(), 0
+    for x0, y0, x1, y1 in _merged(np.asarray(boxes, float).reshape(-1, 4), tool.radius):
+        bounds = np.array([[x0, y0], [x1, y1]])
+        try:
+            # passes closer by cos 45°: the cusps hold on slopes across them up to the
+            # waterline's threshold (the finishing's raster adapts its spacing; these do not)
+            path = raster_path(part, tool, stepover * RECUT_SHARE, tool.radius / 4, other, bounds, tolerance)
+        except SurfmodError as exc:
+            if str(exc).startswith("bounds:"):
+                continue  # the tool touches no face there
+            raise
+        pts = path.points
+        before = sum(len(q) for q in out.points)
+        _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe, allowed)
+        entry = np.concatenate(out.points)[max(before - 1, 0):]
+        if move_gouge(part.height, entry).max() > allowed:
+            raise NoSafePathError("toolpath: no safe path: a cross pass's entry cuts the part")
+        out.add(pts[1:], FEED)
+        _leave(out, float(top(pts[-1:, :2])[0]), safe)
+        passes += path.n_passes
+    return out.motion(), passes
+
+
+def _merged(boxes: np.ndarray, grow: float) -> list:
+    """The boxes grown by ``grow``, overlapping ones merged into their common box until
+    none overlap (each merge removes a box, so at most ``len(boxes)`` rounds)."""
+    out = [b + [-grow, -grow, grow, grow] for b in boxes]
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(out)):
+            for j in range(i + 1, len(out)):
+                a, b = out[i], out[j]
+                if a[0] <= b[2] and b[0] <= a[2] and a[1] <= b[3] and b[1] <= a[3]:
+                    out[i] = np.r_[np.minimum(a[:2], b[:2]), np.maximum(a[2:], b[2:])]
+                    del out[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return out
 
 
 def _path_across(path) -> np.ndarray:

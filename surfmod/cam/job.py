@@ -18,7 +18,7 @@ from tqdm import tqdm
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
-from .finishing import Rest, clear_part, finish
+from .finishing import Rest, clear_part, finish, recut
 from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .verify import verify_job
@@ -168,8 +168,34 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
         cusp = tool.scallop_for_stepover(stepover)
         tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
     part = clear_part(_part(shape, tool.cutter, tolerance), tool)
-    return finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction, steep_angle=steep,
-                  tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
+    motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
+                            steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
+    return motion, report, part
+
+
+def _recut(job: Job, finishing: dict) -> Job:
+    """One round of repair: where the verification found the last finishing's scallop
+    broken, cross passes over those regions (:func:`surfmod.cam.finishing.recut`) are
+    added to it, and the job is judged again.  Passes that would reach deeper than the
+    tool's flutes are not added; the verdict then stands."""
+    found = next((f for f in job.verification.findings if f.what.startswith("residual") and not f.ok), None)
+    if found is None or not found.boxes or not finishing:
+        return job
+    k = max(finishing)
+    op, (spec, part, rest) = job.operations[k], finishing[k]
+    extra, passes = recut(part, op.tool, found.boxes, stepover=float(op.report["stepover"]), direction=spec.direction,
+                          tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest)
+    cutting = extra.points[extra.kind != RAPID, 2]
+    if passes == 0 or float(job.stock[1, 2]) - float(cutting.min()) > op.tool.flute_length + 1e-9:
+        return job
+    motion = Motion(np.concatenate([op.motion.points, extra.points]), np.concatenate([op.motion.kind, extra.kind]))
+    seg = np.linalg.norm(np.diff(extra.points, axis=0), axis=1)
+    report = dict(op.report, recut={"regions": len(found.boxes), "passes": passes, "before": found.worst,
+                                    "length": float(seg[extra.kind[1:] != RAPID].sum())})
+    ops = list(job.operations)
+    ops[k] = replace(op, motion=motion, time_estimate=motion_time(motion, op.tool) + TOOL_CHANGE_TIME, report=report)
+    job = replace(job, operations=tuple(ops))
+    return replace(job, verification=verify_job(job))
 
 
 def machine(part, stock, operations, *, progress: bool = False, verify: bool = True) -> Job:
@@ -185,8 +211,10 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
 
     With ``verify`` (the default) the job's LinuxCNC program is read back and judged
     against the exact part and the stock (:func:`surfmod.cam.verify.verify_job`: gouge,
-    rapids through stock or part, the scallop left); ``job.verification`` holds what it
-    found, ``job.verification.ok`` whether every promise holds."""
+    rapids through stock or part, the scallop left); where the scallop is broken, cross
+    passes over those regions are added to the finishing (its ``report["recut"]``) and the
+    job is judged again.  ``job.verification`` holds what was found last,
+    ``job.verification.ok`` whether every promise holds."""
     from ..occ.properties import bounding_box
 
     shape = to_shape(part, "part")
@@ -198,7 +226,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
         raise SurfmodError("part: has no solid extent to machine")
     stock = stock_box(box, stock)
     safe = float(stock[1, 2] + CLEARANCE)
-    done, rest = [], None
+    done, rest, finishing = [], None, {}
     numbers = {}
     with tqdm(total=2 * len(ops), desc="machine", unit="stage", disable=not progress) as bar:
         for k, op in enumerate(ops):
@@ -234,7 +262,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 # the contours go no deeper than the flutes reach below the part's top
                 lowest = float(box[1, 2] - tool.flute_length) + 1e-9
-                motion, report = _finish(shape, op, tool, stock, safe, rest, lowest)
+                motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest)
+                finishing[k] = (op, finish_part, rest)
                 # after roughing the finishing tool works below the part's top
                 low = float(motion.points[motion.kind != RAPID, 2].min())
                 if box[1, 2] - low > tool.flute_length + 1e-9:
@@ -245,5 +274,5 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
             done.append(Operation(name, tool, motion, motion_time(motion, tool) + TOOL_CHANGE_TIME, report))
     job = Job(shape, stock, tuple(done), safe)
     if verify:
-        job = replace(job, verification=verify_job(job))
+        job = _recut(replace(job, verification=verify_job(job)), finishing)
     return job

@@ -39,6 +39,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from .. import checks
@@ -75,6 +76,8 @@ class Finding:
     where: tuple | None = None
     count: int = 0
     line: int = 0
+    #: the (x, y) boxes ``(x0, y0, x1, y1)`` of the connected regions beyond the limit
+    boxes: tuple = ()
 
     @property
     def ok(self) -> bool:
@@ -439,8 +442,12 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
     vals = np.where(judged, left, -np.inf)
     i, j = np.unravel_index(int(np.argmax(vals)), vals.shape)
     worst = float(vals[i, j])
-    return Finding(what, worst, bound, (float(gx[i, j]), float(gy[i, j]), float(top[i, j])),
-                   int((vals > bound).sum())), int(steep.sum())
+    over = vals > bound
+    labels, _ = ndimage.label(over)
+    boxes = tuple((float(gx[a.start, 0]), float(gy[0, b.start]), float(gx[a.stop - 1, 0]), float(gy[0, b.stop - 1]))
+                  for a, b in ndimage.find_objects(labels))
+    return Finding(what, worst, bound, (float(gx[i, j]), float(gy[i, j]), float(top[i, j])), int(over.sum()),
+                   boxes=boxes), int(steep.sum())
 
 
 def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MAX_SAMPLES,
