@@ -210,7 +210,7 @@ def test_cli_machine_exit_3_and_header_on_a_broken_promise(tmp_path, capsys, mon
         bad = V.Finding("gouge, finishing (tool 2)", 0.3, 0.0051, (1.0, 2.0, 2.5), 4, 123)
         return V.Verification((bad,) + v.findings[2:], v.samples, v.probes, v.nodes, v.walls, v.spacing)
 
-    monkeypatch.setattr("surfmod.cli.machine.verify_job", broken)
+    monkeypatch.setattr("surfmod.cam.job.verify_job", broken)
     out = tmp_path / "c.ngc"
     assert main(args + ["--out", str(out)]) == 3
     captured = capsys.readouterr()

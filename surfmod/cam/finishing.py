@@ -652,6 +652,10 @@ def summary_lines(report: dict) -> list[str]:
     if not report.get("scallop_held", True):
         lines.append(f"scallop not held: the mesh's deflection {report['deflection']:.3g} mm (the faces' own "
                      f"tolerance) is too large for {report['scallop']:g}; passes spaced for half of it")
+    again = report.get("recut")
+    if again:
+        lines.append(f"re-cut: the scallop was broken in {again['regions']} region(s) (up to {again['before']:.3g} mm): "
+                     f"{again['passes']} cross passes, length {again['length']:.0f} mm")
     rest = report.get("rest")
     if rest:
         if rest["box"] is None:

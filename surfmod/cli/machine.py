@@ -51,9 +51,9 @@ def _tool(text: str, number: int, table: dict, name: str):
 
 
 def run(args) -> int:
-    """Check every argument before any work, machine, judge the program(s) as written
-    (:func:`~surfmod.cam.verify.verify_job`, unless ``--no-verify``), write them and print
-    the summary with the verdict.  Exit 0 when every promise holds, 3 when the program
+    """Check every argument before any work, machine (the job's program judged and, where
+    the scallop is broken, re-cut: :func:`~surfmod.cam.job.machine`; GRBL's programs judged
+    as written), write them with the verdict in their header and print the summary.  Exit 0 when every promise holds, 3 when the program
     is written but a promise is broken (the lines before say which and where); on bad
     input one line and exit 1, nothing written."""
     if args.post not in POSTS:
@@ -79,14 +79,14 @@ def run(args) -> int:
     stock = args.stock_margin if args.stock is None else [args.stock[:3], args.stock[3:]]
     job = machine(shape, stock, [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
                                  Finish(finish_tool, scallop=args.scallop)], progress=not args.no_progress,
-                  verify=False)
+                  verify=not args.no_verify)
     texts = programs(job, args.post)  # any refusal before a file is written
     program_paths(args.out, job, args.post)
     if args.no_verify:
         note = "not verified: --no-verify, no check against the exact part or the stock"
     else:
-        # the program as written, read back and judged; the verdict goes into its header
-        job = replace(job, verification=verify_job(job, args.post, texts))
+        if args.post != "linuxcnc":  # the program as this post writes it, read back and judged
+            job = replace(job, verification=verify_job(job, args.post, texts))
         note = ("verified: " if job.verification.ok else "VERIFICATION FAILED: ") + "; ".join(
             str(f) for f in job.verification.findings)
     written = export_job(job, args.out, args.post, note=note)
