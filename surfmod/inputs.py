@@ -35,9 +35,11 @@ def _single(item, name):
     )
 
 
-def to_shape(obj, name: str = "obj", *, solid: bool = False):
+def to_shape(obj, name: str = "obj", *, solid: bool = False, outward: bool = True):
     """The OCCT shape for ``obj``; with ``solid=True`` a closed, outward-oriented solid
-    (open shells raise ``SurfmodError``)."""
+    (open shells raise ``SurfmodError``); ``outward=False`` leaves turning each solid by
+    the sign of its volume to a caller that integrates it anyway
+    (:func:`surfmod.occ.solids.closed_solid`)."""
     from .occ.solids import closed_solid, sew_solid
 
     if isinstance(obj, (str, os.PathLike)):
@@ -55,7 +57,7 @@ def to_shape(obj, name: str = "obj", *, solid: bool = False):
         shape = _single(obj, name)
     if solid:
         try:
-            return closed_solid(shape)
+            return closed_solid(shape, outward)
         except SurfmodError as exc:
             msg = str(exc)
             raise SurfmodError(msg if msg.startswith(name) else f"{name}: {msg}") from None

@@ -92,3 +92,23 @@ def test_mass_orients_a_solid_from_the_model_and_says_so(case):
         r = sm.mass_properties(solid)
     assert r.volume == pytest.approx(6.0, rel=1e-12)  # the 1 x 2 x 3 box, not 4 or -6
     assert r.centroid == pytest.approx([0.5, 1.0, 1.5], abs=1e-12)
+
+
+@pytest.mark.parametrize("method", ["numpy", "occt"])
+def test_mass_turns_each_solid_of_a_compound_by_its_own_measured_volume(method):
+    """The volume that orients a solid is the one measured (no BRepGProp pass first): in
+    a compound of a box and a box inside out beside it only the second is turned, named,
+    and both count outward."""
+    import build123d as bd
+
+    from surfmod.occ.topo import compound
+
+    first = bd.Solid.make_box(1, 2, 3).wrapped
+    second = bd.Solid.make_box(1, 2, 3).moved(bd.Location((10, 0, 0))).wrapped.Reversed()
+    with pytest.warns(sm.InsideOutWarning) as said:
+        r = sm.mass_properties(compound([first, second]), method=method)
+    assert [str(w.message) for w in said] == ["solid 2 is inside out (enclosed volume -6): turned outward"]
+    assert r.volume == pytest.approx(12.0, rel=1e-12)
+    assert r.centroid == pytest.approx([5.5, 1.0, 1.5], abs=1e-12)
+    alone = sm.mass_properties(first, method=method)  # about its own centroid; the pair's adds 2 x 6 x 5^2 in y, z
+    assert r.inertia.diagonal() == pytest.approx(2 * alone.inertia.diagonal() + [0, 300, 300], rel=1e-12)

@@ -91,11 +91,18 @@ def _finish(total: np.ndarray, ref: np.ndarray, density: float):
     return float(vol), float(area), ref + c, inertia
 
 
-def integrate(obj, ref: np.ndarray, density: float = 1.0, order: int = 12, estimate_error: bool = True) -> MassProperties:
+def integrate(obj, ref: np.ndarray, density: float = 1.0, order: int = 12, estimate_error: bool = True, *,
+              solids=None, inside_out: list | None = None) -> MassProperties:
     """:class:`MassProperties` of one closed surfmod surface ``obj`` (its NumPy evaluator
     over its domain), or of the faces of a closed solid read back (a list of
     ``TrimmedFace``, :func:`surfmod.readback.from_faces`), integrated about the point
-    ``ref`` (see :func:`surfmod.mass_properties` for ``order`` and ``estimate_error``)."""
+    ``ref`` (see :func:`surfmod.mass_properties` for ``order`` and ``estimate_error``).
+
+    ``solids`` gives the solid (numbered from 0) of each face read back: each solid's
+    moments are summed apart, and a solid whose enclosed volume comes out negative (its
+    faces point into its material) counts turned outward as a whole, its ``(number from
+    1, volume)`` appended to ``inside_out`` (a list).  So the volume that orients a solid
+    is the one measured, computed once.  Without ``solids`` the faces are one solid."""
     # the p-curves' reader is in the kernel door, loaded on the first call that needs OCP
     from ..occ.pcurves import faces_pcurves
 
@@ -111,39 +118,59 @@ def integrate(obj, ref: np.ndarray, density: float = 1.0, order: int = 12, estim
         taylor_pieces([rec for pcs in pcurves for rec in pcs])  # all B-spline p-curves at once
         faces = mass_faces(read, pcurves)
         prepare_boundaries(faces, order)  # the p-curves of all trimmed faces in one pass
+    number = np.zeros(len(faces), dtype=int) if solids is None or isinstance(obj, Surface) else np.asarray(solids)
+    if len(number) != len(faces):
+        raise SurfmodError(f"solids: {len(number)} solid numbers for {len(faces)} faces")
+    count = int(number.max(initial=0)) + 1
+    solid_of = {id(f): int(n) for f, n in zip(faces, number)}
     # faces whose every rule is exact by degree give the same sums at any order: the
-    # lower-order pass behind the error estimate only re-integrates the others
-    # two totals: faces whose every rule is exact by degree (0) and the others (1)
-    sums = _Accumulator(ref, groups=2)
+    # lower-order pass behind the error estimate only re-integrates the others.  Two
+    # totals per solid: faces whose every rule is exact by degree (2 s) and the others (2 s + 1)
+    sums = _Accumulator(ref, groups=2 * count)
     inexact = []
     planes = [f for f in faces if f.plane and f.natural and f.frame is not None]
-    if planes:  # whole planar rectangles (most faces of prismatic parts): all at once
-        sums.add(*plane_nodes(planes))
+    for s in range(count):  # whole planar rectangles (most faces of prismatic parts): all at once
+        mine = [f for f in planes if solid_of[id(f)] == s]
+        if mine:
+            sums.add(*plane_nodes(mine), 2 * s)
     # trimmed planar faces: closed form from their boundary moments, all at once
     trimmed_planes = [f for f in faces if f.plane and not f.natural and f.frame is not None]
     inexact_planes = []
     if trimmed_planes:
         closed, is_exact = plane_moments(trimmed_planes, order, ref)
-        sums.totals[0] += closed[is_exact].sum(axis=0)
-        sums.totals[1] += closed[~is_exact].sum(axis=0)
+        owner = np.array([solid_of[id(f)] for f in trimmed_planes])
+        for s in np.unique(owner):
+            sums.totals[2 * s] += closed[is_exact & (owner == s)].sum(axis=0)
+            sums.totals[2 * s + 1] += closed[~is_exact & (owner == s)].sum(axis=0)
         inexact_planes = [f for f, e in zip(trimmed_planes, is_exact) if not e]
     curved = [f for f in faces if not (f.plane and f.frame is not None)]
     for f, (ders, w, is_exact) in zip(curved, faces_nodes(curved, order)):  # small Green grids shared
-        sums.add(ders, w, 0 if is_exact else 1)
+        sums.add(ders, w, 2 * solid_of[id(f)] + (0 if is_exact else 1))
         if not is_exact:
             inexact.append(f)
-    exact_total, high_total = sums.flush()
+    totals = np.atleast_2d(sums.flush()).reshape(count, 2, 14)
+    turned = totals[:, :, 1].sum(axis=1) < 0  # per solid: its faces point inwards
+    for s in np.flatnonzero(turned):
+        if inside_out is not None:
+            inside_out.append((int(s) + 1, float(totals[s, :, 1].sum())))
+        totals[s, :, 1:] *= -1.0  # volume and moments change sign with the faces; the area does not
+    exact_total, high_total = totals[:, 0].sum(axis=0), totals[:, 1].sum(axis=0)
     total = exact_total + high_total
     vol, area, centroid, inertia = _finish(total, ref, density)
     nat = sum(f.natural for f in faces)
 
     def estimate() -> float:
-        low = _Accumulator(ref)
+        low = _Accumulator(ref, groups=count)
         for f in inexact:
-            low.add(*face_nodes(f, max(2, order - 4))[:2])
+            low.add(*face_nodes(f, max(2, order - 4))[:2], solid_of[id(f)])
         if inexact_planes:
-            low.totals[0] += plane_moments(inexact_planes, max(2, order - 4), ref)[0].sum(axis=0)
-        return abs(high_total[1] - low.flush()[1]) / vol
+            rows = plane_moments(inexact_planes, max(2, order - 4), ref)[0]
+            owner = np.array([solid_of[id(f)] for f in inexact_planes])
+            for s in np.unique(owner):
+                low.totals[s] += rows[owner == s].sum(axis=0)
+        low_total = np.atleast_2d(low.flush()).copy()
+        low_total[turned, 1:] *= -1.0
+        return abs(high_total[1] - low_total.sum(axis=0)[1]) / vol
 
     return MassProperties(
         vol, area, centroid, inertia, density,

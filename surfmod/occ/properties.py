@@ -23,15 +23,37 @@ from .bindings import box_limits, TopTools_IndexedDataMapOfShapeListOfShape
 from .topo import faces_of, solids_of, wrapped
 
 
-def gprops(shape, eps: float = 1e-9) -> dict:
+def gprops(shape, eps: float = 1e-9, inside_out: list | None = None) -> dict:
     """``BRepGProp`` volume and surface properties at relative tolerance ``eps``.
 
     Returns volume, area, centroid and the inertia matrix about the centroid
     (OCCT's ``MatrixOfInertia``: diagonal ``∫(y²+z²)``, off-diagonal ``−∫xy``).
+
+    With ``inside_out`` (a list) each solid of ``shape`` is measured apart and one whose
+    volume comes out negative (its faces point into its material) is measured again
+    turned outward, its ``(number from 1, volume)`` appended: the volume pass that
+    orients the solids is the one measured (the second only for a solid inside out).
     """
     with kernel("BRepGProp.VolumeProperties_s"):
         vp = GProp_GProps()
-        verr = BRepGProp.VolumeProperties_s(shape, vp, float(eps), False, False)
+        if inside_out is None:
+            verr = BRepGProp.VolumeProperties_s(shape, vp, float(eps), False, False)
+        else:
+            parts = []
+            for number, solid in enumerate(solids_of(shape), 1):
+                part = GProp_GProps()
+                err = BRepGProp.VolumeProperties_s(solid, part, float(eps), False, False)
+                if part.Mass() < 0:
+                    inside_out.append((number, part.Mass()))
+                    part = GProp_GProps()
+                    err = BRepGProp.VolumeProperties_s(solid.Reversed(), part, float(eps), False, False)
+                parts.append((part, err))
+            if len(parts) == 1:  # one solid: its own figures, bit for bit as without ``inside_out``
+                vp, verr = parts[0]
+            else:  # BRepGProp's error is relative: the solids' absolute errors summed, over the volume
+                for part, _ in parts:
+                    vp.Add(part)
+                verr = sum(abs(err * part.Mass()) for part, err in parts) / vp.Mass() if parts else 0.0
         sp = GProp_GProps()
         serr = BRepGProp.SurfaceProperties_s(shape, sp, float(eps), False)
     return {

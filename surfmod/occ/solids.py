@@ -7,6 +7,7 @@ import warnings
 
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+from OCP.BRepCheck import BRepCheck_NoError, BRepCheck_Shell
 from OCP.BRepLib import BRepLib
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
@@ -121,11 +122,39 @@ def _edge_uses(solid) -> tuple[list, dict]:
     return faces, uses
 
 
-def oriented_solid(solid):
+def _shells_agree(solid) -> bool:
+    """True when OCCT finds every edge shared by two faces of each shell of ``solid``
+    run one way in one face and the other way in the other (``BRepCheck_Shell``'s
+    orientation check): then no face is at odds and :func:`_edge_uses` need not run.
+    OCCT's check walks the edges in C++, 5-8 times faster than that Python walk (7.7 ms
+    against 37 ms on the 1018 faces of pythonocc_11752); any other answer (a face at odds,
+    an open or non-manifold shell) leaves the judgement to the walk."""
+    with kernel("BRepCheck_Shell"):
+        return all(BRepCheck_Shell(shell).Orientation(True) == BRepCheck_NoError for shell in shells_of(solid))
+
+
+def _face_links(solid) -> tuple[list, set, list]:
+    """``(faces, links, odd uses)`` of ``solid``: its faces (distinct, explorer order),
+    ``(a, b, odd)`` for faces ``a`` and ``b`` sharing an edge (``odd`` where the edge runs
+    the same way in both), and the uses of each edge that runs so; the one pass over the
+    edges that :func:`oriented_solid` and :func:`faces_at_odds` share.  ``([], set(),
+    [])`` when OCCT finds the shells consistent (:func:`_shells_agree`): nothing to turn."""
+    if _shells_agree(solid):
+        return [], set(), []
+    faces, uses = _edge_uses(solid)
+    shared = [u for u in uses.values() if len(u) == 2 and u[0][0] != u[1][0]]  # seams are not judged
+    links = {(u[0][0], u[1][0], u[0][1] == u[1][1]) for u in shared}
+    return faces, links, [u for u in shared if u[0][1] == u[1][1]]
+
+
+def oriented_solid(solid, outward: bool = True):
     """``solid`` with its faces made to agree (:func:`consistent_turns` over the edges
-    they share, for a solid of one shell) and then turned outward as a whole by the sign
-    of its enclosed volume; returns ``(solid, faces turned (positions in explorer
-    order), enclosed volume before)``.  ``solid`` itself when nothing needed turning.
+    they share, for a solid of one shell) and then, with ``outward``, turned outward as a
+    whole by the sign of its enclosed volume; returns ``(solid, faces turned (positions
+    in explorer order), enclosed volume before)``.  ``solid`` itself when nothing needed
+    turning.  ``outward=False`` leaves the whole-solid turn to a caller that integrates
+    the volume anyway (the mass quadrature, BRepGProp's cross-check), so it is computed
+    once: the volume returned is then NaN.
 
     >>> import build123d as bd
     >>> s, turned, volume = oriented_solid(bd.Solid.make_box(1, 2, 3).wrapped.Reversed())
@@ -136,10 +165,8 @@ def oriented_solid(solid):
     shells = shells_of(solid)
     with kernel("BRep_Builder"):
         if len(shells) == 1:
-            faces, uses = _edge_uses(solid)
-            links = {(u[0][0], u[1][0], u[0][1] == u[1][1]) for u in uses.values()
-                     if len(u) == 2 and u[0][0] != u[1][0]}
-            if any(odd for _, _, odd in links):
+            faces, links, odd = _face_links(solid)
+            if odd:
                 turned = consistent_turns(sorted(links), {k: 1 for k in range(len(faces))})
             if turned:
                 builder, shell, out = BRep_Builder(), TopoDS_Shell(), TopoDS_Solid()
@@ -150,6 +177,8 @@ def oriented_solid(solid):
                 builder.MakeSolid(out)
                 builder.Add(out, shell)
                 solid = out
+        if not outward:
+            return solid, turned, float("nan")
         props = GProp_GProps()
         BRepGProp.VolumeProperties_s(solid, props)
     return (solid.Reversed() if props.Mass() < 0 else solid), turned, props.Mass()
@@ -166,13 +195,13 @@ def faces_at_odds(shape) -> list[tuple[int, int, list[int]]]:
     >>> faces_at_odds(bd.Solid.make_box(1, 2, 3).wrapped)
     []
     """
-    index = {f.__hash__(): k for k, f in reversed(list(enumerate(_explore(shape, TopAbs_FACE))))}
-    out = []
+    out, index = [], None
     with kernel("TopExp_Explorer"):
         for number, solid in enumerate(solids_of(shape), 1):
-            faces, uses = _edge_uses(solid)
-            odd = [u for u in uses.values() if len(u) == 2 and u[0][0] != u[1][0] and u[0][1] == u[1][1]]
+            faces, _, odd = _face_links(solid)
             if odd:
+                if index is None:  # the positions in the whole shape, needed only to name faces
+                    index = {f.__hash__(): k for k, f in reversed(list(enumerate(_explore(shape, TopAbs_FACE))))}
                 out.append((number, len(odd), sorted({index.get(faces[k].__hash__(), -1) for u in odd for k, _ in u})))
     return out
 
@@ -201,9 +230,12 @@ def open_faces(shape) -> list[int]:
     return _faces_outside(shape, [s for s in shells_of(shape) if BRep_Tool.IsClosed_s(s)])
 
 
-def closed_solid(shape):
+def closed_solid(shape, outward: bool = True):
     """A closed solid (or compound of them) for volume work; open shells are sewn at the
-    model's tolerance and refused if they stay open."""
+    model's tolerance and refused if they stay open.  Each closed solid's faces are made
+    to agree (:func:`oriented_solid`); ``outward=False`` leaves turning a whole solid by
+    the sign of its volume to the caller, which integrates that volume anyway and then
+    says so as this does (the solids are those of the result, in order)."""
     solids = solids_of(shape)
     if solids:
         out = []
@@ -212,7 +244,7 @@ def closed_solid(shape):
             if all(BRep_Tool.IsClosed_s(sh) for sh in shells):
                 # volume work needs faces that agree and point out: turned from the model
                 # (shared edges, then the sign of the enclosed volume), never face by face
-                oriented, turned, volume = oriented_solid(s)
+                oriented, turned, volume = oriented_solid(s, outward)
                 if turned:
                     warnings.warn(f"solid {i + 1}: face(s) {', '.join(map(str, turned[:10]))}"
                                   f"{' ...' if len(turned) > 10 else ''} of its shell point against their "
