@@ -34,7 +34,55 @@ def test_mesh_folder_to_csv(tmp_path, capsys):
     rows = list(csv.DictReader(rows_path.open()))
     assert len(rows) == 2 and all(r["watertight"] == "yes" and int(r["triangles"]) > 0 for r in rows)
     assert all((folder / r["stl"]).exists() or shutil.os.path.exists(r["stl"]) for r in rows)
-    assert "2 of 2 file(s) meshed watertight" in capsys.readouterr().out
+    assert all((r["exit"], r["closed"], r["manifold"], r["outward"], r["repairs"], r["verdict"])
+               == ("0", "yes", "yes", "yes", "0", "") for r in rows)
+    assert "2 of 2 file(s) meshed, every STL read back as promised; rows in" in capsys.readouterr().out
+
+
+def test_mesh_folder_rows_carry_each_stl_verdict_and_exit_3(tmp_path, capsys, monkeypatch):
+    """A folder run judges each STL as the single-file command does: the file whose STL
+    reads back with facets wound against each other and inside out gets exit 3, NO in
+    outward, its repairs counted and the broken promise in words in its row (the other
+    file's row stays sound), and the run exits 3."""
+    import surfmod.io.stl as stl
+    from surfmod.meshing.closure import Closure
+
+    folder = _folder(tmp_path)
+    real = stl.judge_stl
+
+    def judge(path, groups):  # the STL of b.Stp (the temporary file beside b.stl) reads back broken
+        failing = real(path, groups)
+        if Path(path).name.startswith(".b.stl"):
+            failing = failing + [("solid 1", Closure(0, 0, 4, 0, -2.5, (1, 2)))]
+        return failing
+
+    monkeypatch.setattr(stl, "judge_stl", judge)
+    rows_path = tmp_path / "mesh.csv"
+    args = ["mesh", str(folder), "--tolerance", "0.05", "--csv", str(rows_path), "--no-progress", "--jobs", "1"]
+    assert main(args) == 3
+    rows = {Path(r["file"]).name: r for r in csv.DictReader(rows_path.open())}
+    broken, sound = rows["b.Stp"], rows["A.STEP"]
+    assert (broken["exit"], broken["closed"], broken["manifold"], broken["outward"], broken["repairs"]) == \
+        ("3", "yes", "yes", "NO", "5")  # 4 edges wound against each other, and the solid turned once
+    assert broken["verdict"] == ("solid 1: 4 edge(s) joining facets of opposite orientation; enclosed volume -2.5 "
+                                 "(inside out or not closed); along face(s) 1, 2")
+    assert (sound["exit"], sound["outward"], sound["repairs"], sound["verdict"]) == ("0", "yes", "0", "")
+    out = capsys.readouterr().out
+    assert "1 of 2 file(s) meshed, every STL read back as promised; 1 broke a promise (exit 3)" in out
+    # without --csv the table says the same, and the exit status does not depend on where rows go
+    assert main(args[:4] + args[6:]) == 3
+    table = capsys.readouterr().out
+    assert "solid 1: 4 edge(s) joining facets of opposite orientation" in table
+
+
+def test_mesh_folder_exit_1_when_a_file_is_not_meshed(tmp_path, capsys):
+    folder = _folder(tmp_path)
+    (folder / "broken.step").write_text("ISO-10303-21;\nnot a model\n")
+    assert main(["mesh", str(folder), "--tolerance", "0.05", "--csv", str(tmp_path / "m.csv"), "--no-progress",
+                 "--jobs", "1"]) == 1
+    rows = {Path(r["file"]).name: r for r in csv.DictReader((tmp_path / "m.csv").open())}
+    assert rows["broken.step"]["exit"] == "1" and rows["broken.step"]["verdict"].startswith("error: ")
+    assert "2 of 3 file(s) meshed, every STL read back as promised; 1 not meshed (exit 1)" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("command", ["check", "mesh"])

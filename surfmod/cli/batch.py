@@ -28,13 +28,14 @@ import io
 import os
 import sys
 import threading
+import warnings
 from pathlib import Path
 
 from joblib import Parallel, delayed
 from tqdm import tqdm
 
 from .. import child
-from ..errors import SurfmodError
+from ..errors import RoundTripWarning, SurfmodError
 from ..atomic import target_path
 from ..io.step import import_step
 from ..io.stl import export_stl
@@ -291,48 +292,83 @@ def batch_run(args, job, options, columns, desc, failed_row, record=tuple):
         sink.close()
 
 
-MESH_COLUMNS = [("file", "<36.36"), ("triangles", ">10d"), ("watertight", "<10.10"), ("max dev", ">10.2e"),
-                ("stl", "<")]
+MESH_COLUMNS = [("file", "<36.36"), ("exit", ">4d"), ("triangles", ">10d"), ("watertight", "<10.10"),
+                ("closed", "<6.6"), ("manifold", "<8.8"), ("outward", "<7.7"), ("repairs", ">7d"),
+                ("max dev", ">10.2e"), ("stl", "<"), ("verdict", "<")]
+#: exit status of one file whose STL was written but breaks its promise (as ``surfmod mesh FILE``)
+EXIT_BROKEN = 3
 
 
 def mesh_failed(path, message) -> tuple:
-    """The one row of a file ``surfmod mesh`` could not mesh."""
-    return (str(path), 0, "-", float("nan"), f"error: {message}")
+    """The one row of a file ``surfmod mesh`` could not mesh (exit 1, nothing judged)."""
+    return (str(path), 1, 0, "-", "-", "-", "-", 0, float("nan"), "-", f"error: {message}")
+
+
+def stl_verdict(mesh) -> tuple:
+    """``(exit, closed, manifold, outward, repairs, verdict)`` of the STL ``mesh`` as
+    :func:`surfmod.export_stl` read it back and judged it: ``closed``, ``manifold`` and
+    ``outward`` ``"yes"``/``"NO"`` over every solid that promised to close, ``repairs``
+    the edges and facets admesh would mend (open, non-manifold and inconsistently wound
+    edges, degenerate facets) plus one per solid inside out, and the broken promises in
+    words (empty when kept); exit 3 on any, as the single-file command.
+
+    >>> from surfmod.meshing.closure import Closure
+    >>> class M: info = {"stl_problems": ["solid 2: 3 open edge(s)"], "stl_verdicts": [("solid 2", Closure(3, 0, 0, 0, 1.0, (4,)))]}
+    >>> stl_verdict(M())
+    (3, 'NO', 'yes', 'yes', 3, 'solid 2: 3 open edge(s)')
+    """
+    verdicts = [v for _, v in mesh.info.get("stl_verdicts", [])]
+    problems = mesh.info.get("stl_problems", [])
+
+    def said(bad) -> str:
+        return "NO" if any(bad(v) for v in verdicts) else "yes"
+
+    repairs = sum(v.open + v.non_manifold + v.inconsistent + v.degenerate + (v.volume <= 0) for v in verdicts)
+    return (EXIT_BROKEN if problems else 0, said(lambda v: v.open), said(lambda v: v.non_manifold),
+            said(lambda v: v.inconsistent or v.volume <= 0), int(repairs), "; ".join(problems))
 
 
 def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None, strict: bool = False) -> list[tuple]:
     """Mesh one STEP file to an STL beside it (or in ``out_dir``) with the per-file mesh
-    function of ``surfmod mesh``; ``[(file, triangles, watertight, max deviation, stl or
-    error)]``."""
+    function of ``surfmod mesh``; ``[(file, exit, triangles, watertight, closed, manifold,
+    outward, repairs, max deviation, stl, verdict)]``: the STL read back and judged
+    (:func:`stl_verdict`), exit 3 when it breaks a promise, 1 with the error when the file
+    cannot be meshed, as ``surfmod mesh FILE`` would exit."""
     p = Path(path)
     out = (Path(out_dir) / p.with_suffix(".stl").name) if out_dir else p.with_suffix(".stl")
     try:
-        mesh = export_stl(import_step(p), out, tolerance=tolerance, ascii=ascii, strict=strict, progress=False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RoundTripWarning)  # the row says it, in its verdict
+            mesh = export_stl(import_step(p), out, tolerance=tolerance, ascii=ascii, strict=strict, progress=False)
     except SurfmodError as exc:
         return [mesh_failed(p, " ".join(str(exc).split()))]
+    code, closed, manifold, outward, repairs, verdict = stl_verdict(mesh)
     dev = mesh.info.get("max_deviation")
-    return [(str(p), len(mesh.faces), "yes" if mesh.to_trimesh().is_watertight else "NO",
-             float("nan") if dev is None else float(dev), str(out))]
+    return [(str(p), code, len(mesh.faces), "yes" if mesh.to_trimesh().is_watertight else "NO", closed, manifold,
+             outward, repairs, float("nan") if dev is None else float(dev), str(out), verdict)]
 
 
 def run_mesh(args) -> int:
-    """``surfmod mesh PATH...`` over files and folders: one row per file."""
+    """``surfmod mesh PATH...`` over files and folders: one row per file; the exit status
+    is the worst file's (3, an STL that breaks its promise, over 1, a file not meshed)."""
     args.files = step_files(args.step)
     out_dir = None
     if args.out:
         out_dir = Path(args.out)
         if not out_dir.is_dir():
             raise SurfmodError(f"out: with several files or folders --out must be an existing folder, got {out_dir}")
-    bad = total = 0
+    codes = []
     options = {"tolerance": args.tolerance, "ascii": args.ascii, "out_dir": None if out_dir is None else str(out_dir),
                "strict": bool(getattr(args, "strict", False))}
     for row, _ in batch_run(args, mesh_file, options, MESH_COLUMNS, "mesh", mesh_failed):
-        total += 1
-        bad += str(row[4]).startswith("error") or row[2] != "yes"
+        codes.append(int(row[1]))
     resumed = f" ({args.skipped} already in {args.csv})" if args.skipped else ""
-    print(f"{total - bad} of {total} file(s) meshed watertight{resumed}"
+    broken, failed = codes.count(EXIT_BROKEN), sum(c not in (0, EXIT_BROKEN) for c in codes)
+    print(f"{codes.count(0)} of {len(codes)} file(s) meshed, every STL read back as promised{resumed}"
+          + (f"; {broken} broke a promise (exit 3)" if broken else "")
+          + (f"; {failed} not meshed (exit 1)" if failed else "")
           + (f"; rows in {args.csv}" if args.csv else ""))
-    return 1 if bad else 0
+    return EXIT_BROKEN if broken else 1 if failed else 0
 
 
 def is_batch(args) -> bool:

@@ -3,6 +3,8 @@ slicers, measured against the B-rep; faces whose model is itself off by more tha
 tolerance are reported (or refused with ``--strict``).  The STL is read back before exit
 0: exit 3 when a solid's triangles are not closed, 2-manifold and outward, or a face's
 triangles stray where its nodes and tolerance do not (``BROKEN:`` lines name them).
+Over folders, each file's row carries the same verdict and its exit status, and the
+command exits 3 when any file's STL broke a promise (:func:`surfmod.cli.batch.run_mesh`).
 
 The same concept as :mod:`surfmod.occ.mesh` (OCCT's BRepMesh) at the top: the command that meshes a B-rep.
 """
@@ -16,10 +18,7 @@ from ..errors import RoundTripWarning
 from ..io.step import import_step
 from ..io.stl import export_stl
 from ..meshing.brep import describe_faces
-from .batch import add_batch_arguments, is_batch, run_mesh
-
-#: exit code of an STL written that breaks its promise (named on the lines before)
-EXIT_BROKEN = 3
+from .batch import EXIT_BROKEN, add_batch_arguments, is_batch, run_mesh
 
 
 def register(sub) -> None:

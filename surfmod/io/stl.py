@@ -110,7 +110,9 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
     Faces in no closed shell promise nothing of the kind (``info["open_faces"]``).  A
     solid that breaks the promise, and a face whose triangles stray from it farther than
     its nodes and its model tolerance explain (a meshing failure, not the model's), are
-    listed in ``info["stl_problems"]`` and said in a
+    listed in ``info["stl_problems"]`` (the solids' verdicts, counts of open,
+    non-manifold and inconsistent edges and degenerate facets, in ``info["stl_verdicts"]``
+    as ``(name, Closure)``) and said in a
     :class:`~surfmod.errors.RoundTripWarning` naming the solids and faces; ``strict=True``
     raises instead and writes nothing.  Before that, a part with an open or non-manifold
     edge, a degenerate facet or a mis-meshed face is meshed again at the finer
@@ -168,6 +170,7 @@ def _written(tmp, mesh: Mesh, ascii: bool) -> tuple[list[str], bool]:
     with open(tmp, "wb") as fh:
         (write_ascii if ascii else write_binary)(fh, mesh.vertices[mesh.triangles()])
     failing = judge_stl(tmp, mesh.info["stl_groups"])
+    mesh.info["stl_verdicts"] = failing  # what a folder run's row says of each file: counts, not only words
     mis_meshed = [r for r in mesh.info["faces_over_tolerance"] if r.get("cause") == "mesh"]
     problems = [f"{name}: {verdict.describe()}" for name, verdict in failing] + [
         f"face {r['face']} ({r['surface']}): triangles {r['deviation']:.3g} off the face while its nodes are "
