@@ -23,7 +23,7 @@ G-code is never returned.  The default tolerance is a tenth of the scallop heigh
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from tqdm import tqdm
@@ -39,6 +39,7 @@ from .gcode import gcode_text
 from .toolpath_exact import exact_heights
 from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
+from .verify import lift_gouges
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
 # the refinement inserts a location (the rest is the margin between sample points).
@@ -330,8 +331,15 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         bar.set_postfix_str("meshing")
         meter = _Meter(max_work, bar)
         part = _part(shape, tool.cutter, tolerance, meter)
-        return raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
+        path = raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
                            bar, meter=meter)
+        bar.set_postfix_str("against the exact faces")
+    # the mesh's triangles can miss where a face leaves its own mesh by more than BRepMesh
+    # measured: the moves are held against points of the exact faces too, and lifted there
+    points, lift = lift_gouges(shape, path.points, tool.cutter, tolerance)
+    if not lift.any():
+        return path
+    return replace(path, points=checks.frozen(points), lifted=max(path.lifted, float(lift.max())))
 
 
 def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction: str, bounds, tolerance: float,
