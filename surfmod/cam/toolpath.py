@@ -19,6 +19,11 @@ staircases, and a final check on other sample points must find every move within
 (:func:`~surfmod.cam.toolpath_moves.lift_moves`: material is left there, reported as
 ``Toolpath.lifted``); a path that still cuts deeper raises ``SurfmodError``: gouging
 G-code is never returned.  The default tolerance is a tenth of the scallop height.
+
+The triangles can miss where a face leaves its mesh by more than BRepMesh measured, so
+the moves are then held against points of the exact faces (:mod:`surfmod.cam.verify`)
+and lifted where those come deeper than half the tolerance into the tool (also counted
+in ``Toolpath.lifted``); ``surfmod toolpath`` judges the written G-code once more.
 """
 
 from __future__ import annotations
