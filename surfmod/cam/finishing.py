@@ -148,6 +148,18 @@ def _leave(out: Moves, top: float, safe: float):
     out.add([[p[0], p[1], safe]], RAPID)
 
 
+def _add_raster(out: Moves, pts: np.ndarray, top, part: _Part, tool: Tool, safe: float, allowed: float, what: str):
+    """A raster's cutter locations ``pts`` added to ``out``: entered from the clearance
+    height (the entry judged on the drop-cutter heights), cut, and left above the stock."""
+    before = sum(len(q) for q in out.points)
+    _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe, allowed)
+    entry = np.concatenate(out.points)[max(before - 1, 0):]
+    if move_gouge(part.height, entry).max() > allowed:
+        raise NoSafePathError(f"toolpath: no safe path: {what} cuts the part")
+    out.add(pts[1:], FEED)
+    _leave(out, float(top(pts[-1:, :2])[0]), safe)
+
+
 def _normals(tri: np.ndarray) -> np.ndarray:
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n *= np.where(n[:, 2:3] < 0, -1.0, 1.0)
@@ -542,14 +554,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
             k = int(np.argmax(depth))
             raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
     path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, across=across)
-    pts = path.points
-    before = sum(len(q) for q in out.points)
-    _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe, allowed)
-    entry = np.concatenate(out.points)[max(before - 1, 0):]
-    if move_gouge(part.height, entry).max() > allowed:
-        raise NoSafePathError("toolpath: no safe path: the raster's entry cuts the part")
-    out.add(pts[1:], FEED)
-    _leave(out, float(top(pts[-1:, :2])[0]), safe)
+    _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
     motion = out.motion()
     threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)
     report = {"stepover": path.stepover, "scallop": scallop if scallop is not None else path.scallop,
@@ -587,14 +592,7 @@ def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, to
             if str(exc).startswith("bounds:"):
                 continue  # the tool touches no face there
             raise
-        pts = path.points
-        before = sum(len(q) for q in out.points)
-        _enter(out, pts[0], float(top(pts[:1, :2])[0]), part, tool, safe, allowed)
-        entry = np.concatenate(out.points)[max(before - 1, 0):]
-        if move_gouge(part.height, entry).max() > allowed:
-            raise NoSafePathError("toolpath: no safe path: a cross pass's entry cuts the part")
-        out.add(pts[1:], FEED)
-        _leave(out, float(top(pts[-1:, :2])[0]), safe)
+        _add_raster(out, path.points, top, part, tool, safe, allowed, "a cross pass's entry")
         passes += path.n_passes
     return out.motion(), passes
 

@@ -56,6 +56,16 @@ def _gap(px, py, i, j, x0, y0, cell):
     return math.sqrt(gx * gx + gy * gy)
 
 
+@njit(cache=True, inline="always")
+def _cells(px, py, radius, x0, y0, cell, nx, ny):
+    """The range of buckets within ``radius`` of (px, py): ``i0, i1, j0, j1`` inclusive."""
+    i0 = max(int(math.floor((px - radius - x0) / cell)), 0)
+    i1 = min(int(math.floor((px + radius - x0) / cell)), nx - 1)
+    j0 = max(int(math.floor((py - radius - y0) / cell)), 0)
+    j1 = min(int(math.floor((py + radius - y0) / cell)), ny - 1)
+    return i0, i1, j0, j1
+
+
 @njit(cache=True)
 def deepest(starts, points, x0, y0, cell, nx, ny, probes, radius, corner):
     """For each probe (tip point) the deepest bucketed point inside the tool and its index
@@ -67,10 +77,7 @@ def deepest(starts, points, x0, y0, cell, nx, ny, probes, radius, corner):
     which = np.full(n, -1, np.int64)
     for k in range(n):
         px, py, pz = probes[k, 0], probes[k, 1], probes[k, 2]
-        i0 = max(int(math.floor((px - radius - x0) / cell)), 0)
-        i1 = min(int(math.floor((px + radius - x0) / cell)), nx - 1)
-        j0 = max(int(math.floor((py - radius - y0) / cell)), 0)
-        j1 = min(int(math.floor((py + radius - y0) / cell)), ny - 1)
+        i0, i1, j0, j1 = _cells(px, py, radius, x0, y0, cell, nx, ny)
         best, arg = -1.0, -1
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
@@ -104,10 +111,7 @@ def drop_heights(starts, points, x0, y0, cell, nx, ny, xy, radius, corner):
         px, py = xy[k, 0], xy[k, 1]
         ic = int(math.floor((px - x0) / cell))
         jc = int(math.floor((py - y0) / cell))
-        i0 = max(int(math.floor((px - radius - x0) / cell)), 0)
-        i1 = min(int(math.floor((px + radius - x0) / cell)), nx - 1)
-        j0 = max(int(math.floor((py - radius - y0) / cell)), 0)
-        j1 = min(int(math.floor((py + radius - y0) / cell)), ny - 1)
+        i0, i1, j0, j1 = _cells(px, py, radius, x0, y0, cell, nx, ny)
         best = -np.inf
         for pass_ in range(2):
             for i in range(i0, i1 + 1):
