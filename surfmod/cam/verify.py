@@ -237,20 +237,32 @@ def _inside(face, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
     return inside.reshape(uu.shape)
 
 
-def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES, sag: float | None = None) -> np.ndarray:
+def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES, sag: float | None = None, *,
+                fit: bool = False) -> np.ndarray:
     """Points ``(N, 3)`` on every face of ``shape`` inside its trim and on every edge that
     bounds a face, about ``spacing`` apart (closer on faces curved so much that they leave
-    the points' chords by more than ``sag``); more than ``max_samples`` (counted on the
-    faces' parameter grids before any is evaluated) raises ``SurfmodError``."""
+    the points' chords by more than ``sag``).  More than ``max_samples`` (counted on the
+    faces' parameter grids before any is evaluated) raises ``SurfmodError``; with ``fit``
+    the points stand farther apart instead, as many as the cap allows (see
+    :func:`sampled_part`)."""
     from ..occ.discretize import edge_length, sample_curve
     from ..occ.topo import curve_of_edge, faces_of, geometric_edges, wrapped
 
     spacing = checks.positive(spacing, "spacing")
     faces = [from_face(f) for f in faces_of(shape)]
-    grids = [_face_grid(f, spacing, sag) for f in faces]
     edges = [e for _, e, owners in geometric_edges(wrapped(shape)) if owners]
-    counts = [max(2, math.ceil(edge_length(e) / spacing) + 1) for e in edges]
-    total = sum(len(a) * len(b) for a, b in grids) + sum(counts)
+    lengths = [edge_length(e) for e in edges]
+
+    def plan(spacing, sag):
+        grids = [_face_grid(f, spacing, sag) for f in faces]
+        counts = [max(2, math.ceil(length / spacing) + 1) for length in lengths]
+        return grids, counts, sum(len(a) * len(b) for a, b in grids) + sum(counts)
+
+    grids, counts, total = plan(spacing, sag)
+    if fit and total > max_samples:  # a count grows as 1/spacing² at most
+        grow = 1.1 * math.sqrt(total / max_samples)
+        spacing, sag = spacing * grow, None if sag is None else sag * grow * grow
+        grids, counts, total = plan(spacing, sag)
     checks.work(total, max_samples, "max_samples",
                 f"the verification's {total:,} points on the part, {spacing:.3g} mm apart "
                 f"(a larger scallop or tolerance, or no verification)")
@@ -265,7 +277,7 @@ def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES, sag: floa
         out.append(sample_curve(curve, t0, t1, n))
     if not out:
         raise SurfmodError("part: has no faces to verify against")
-    return np.concatenate(out)
+    return np.concatenate(out), spacing
 
 
 def spacing_for(limit: float, radius: float, corner: float) -> float:
@@ -285,15 +297,17 @@ _SAMPLED: dict = {}
 
 
 def sampled_part(shape, spacing: float, cell: float, max_samples: int = MAX_SAMPLES,
-                 sag: float | None = None) -> PartPoints:
-    """:func:`part_points` of ``shape`` bucketed by ``cell``; the last one is kept, so a
-    path's repair and its verdict sample the part once."""
+                 sag: float | None = None, fit: bool = False) -> tuple:
+    """``(PartPoints, spacing)``: :func:`part_points` of ``shape`` bucketed by ``cell``, and
+    the spacing they stand at (larger than asked with ``fit`` when the cap binds); the
+    last one is kept, so a path's repair and its verdict sample the part once."""
     from ..occ.topo import wrapped
 
-    key = (hash(wrapped(shape)), float(spacing), float(cell), sag)
+    key = (hash(wrapped(shape)), float(spacing), float(cell), sag, fit, max_samples)
     if key not in _SAMPLED:
         _SAMPLED.clear()
-        _SAMPLED[key] = PartPoints.bucket(part_points(shape, spacing, max_samples, sag), cell)
+        points, used = part_points(shape, spacing, max_samples, sag, fit=fit)
+        _SAMPLED[key] = (PartPoints.bucket(points, cell), used)
     return _SAMPLED[key]
 
 
@@ -306,7 +320,7 @@ def lift_gouges(shape, points: np.ndarray, cutter, limit: float, *, rounds: int 
     ``rounds`` times (the lift leaves material, never cuts).  Returns ``(points, lift (N,))``."""
     points = np.array(points, dtype=float)
     spacing = spacing_for(limit / 2, cutter.radius, cutter.corner)
-    part = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, limit / 4)
+    part, spacing = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, limit / 4, fit=True)
     lift = np.zeros(len(points))
     for _ in range(rounds):
         probes, move = _probes(points[:-1], points[1:], spacing, max_probes)
@@ -431,7 +445,8 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         plans.append((k, op, cutter, limit))
     spacing = min(spacing_for(limit / 2, c.radius, c.corner) for _, _, c, limit in plans)
     sag = min(limit for _, _, _, limit in plans) / 4
-    part = sampled_part(job.part, spacing, _cell(spacing, min(c.radius for _, _, c, _ in plans)), max_samples, sag)
+    part, _ = sampled_part(job.part, spacing, _cell(spacing, min(c.radius for _, _, c, _ in plans)), max_samples,
+                           sag)
     findings, probes = [], 0
     for k, op, cutter, limit in plans:
         found, n = _gouge(part, moves, (owner == k) & ~moves.rapid, cutter.radius, cutter.corner, limit, spacing,
@@ -545,7 +560,11 @@ def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MA
     limit = base + 1e-4
     cutter = path.tool.cutter
     spacing = spacing_for(base / 2, cutter.radius, cutter.corner)
-    part = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, base / 4)
+    asked = spacing
+    part, spacing = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, base / 4, fit=True)
     found, n = _gouge(part, moves, ~moves.rapid, cutter.radius, cutter.corner, limit, spacing, "gouge", max_probes,
                       shape)
-    return Verification((found,), len(part.points), n, spacing=spacing)
+    notes = () if spacing <= asked else (
+        f"note: the points stand {spacing:.3g} mm apart, coarser than the {asked:.3g} the tolerance asks "
+        f"({max_samples:,} at most): between them a face may come nearer the tool than measured",)
+    return Verification((found,), len(part.points), n, spacing=spacing, notes=notes)
