@@ -6,6 +6,7 @@ within area x measured deviation, and the result says how it was made."""
 from __future__ import annotations
 
 import math
+import os
 
 import build123d as bd
 import numpy as np
@@ -24,6 +25,44 @@ def _refuse(*args, **kwargs):
 def brep_fails(monkeypatch):
     # module level, not local: gmsh runs in a child process, which gets the function by name
     monkeypatch.setattr(femesh, "_run_gmsh", _refuse)
+
+
+def _recovery_fails_when_coarse(surfaces, msh, size, order):
+    """gmsh's boundary recovery failing as it does on pythonocc_11752.stp's body region
+    on OCCT 8.0: on the triangulation of the first tolerance only (it has at most the
+    triangle count the test sets), then the real gmsh."""
+    if sum(len(triangles) for _, triangles in surfaces) <= int(os.environ["SURFMOD_TEST_COARSE_TRIANGLES"]):
+        raise femesh._GmshFailure("Could not recover boundary mesh: error 2 (forced)")
+    return femesh._run_gmsh_triangulation(surfaces, msh, size, order)
+
+
+def test_failed_boundary_recovery_is_retried_finer(brep_fails, monkeypatch):
+    from surfmod.meshing.brep import tessellate_shape
+
+    cylinder = bd.Cylinder(1.0, 2.0)
+    first = femesh.TRIANGULATION_SHARE * math.sqrt(2**2 + 2**2 + 2**2)
+    coarse = len(tessellate_shape(cylinder.wrapped, first).triangles())
+    assert len(tessellate_shape(cylinder.wrapped, first * femesh.RECOVERY_RETRY_SHARE).triangles()) > coarse
+    monkeypatch.setenv("SURFMOD_TEST_COARSE_TRIANGLES", str(coarse))
+    # module level, not local: the child process gets the function by name
+    monkeypatch.setattr(femesh, "_run_gmsh_triangulation", _recovery_fails_when_coarse)
+    fe = sm.fe_mesh(cylinder, size=0.4)
+    surface = fe.quality["surface"]
+    assert surface["tolerance"] == pytest.approx(first * femesh.RECOVERY_RETRY_SHARE, rel=1e-12)
+    assert surface["max_deviation"] <= surface["tolerance"] * (1 + 1e-9)
+    assert 0 < 2 * math.pi - fe.volume <= surface["volume_bound"]
+    assert fe.quality["inverted"] == 0 and fe.quality["SICN"]["min"] > 0
+
+
+def test_boundary_recovery_failing_twice_names_both_tolerances(brep_fails, monkeypatch):
+    monkeypatch.setenv("SURFMOD_TEST_COARSE_TRIANGLES", str(10**9))
+    monkeypatch.setattr(femesh, "_run_gmsh_triangulation", _recovery_fails_when_coarse)
+    first = femesh.TRIANGULATION_SHARE * math.sqrt(2**2 + 2**2 + 2**2)
+    # each triangulation attempt (whole solid, then its material regions) tried twice
+    pattern = (rf"triangulation: Could not recover boundary mesh: error 2 \(forced\) at tolerance {first:.3g}, "
+               rf"Could not recover boundary mesh: error 2 \(forced\) at {first / 2:.3g}")
+    with pytest.raises(sm.SurfmodError, match=pattern):
+        sm.fe_mesh(bd.Cylinder(1.0, 2.0), size=0.4)
 
 
 def test_cylinder_from_its_triangulation(brep_fails):
