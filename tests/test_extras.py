@@ -3,6 +3,7 @@ dependencies and which come with an extra; a missing extra is one clear error.""
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import tomllib
@@ -94,3 +95,20 @@ def test_calls_without_their_extra_say_which_to_install():
     lines = out.stdout.strip().splitlines()
     assert lines[0] == 'sm.fe_mesh needs the optional package \'meshio\': pip install "surfmod[fem]"'
     assert lines[1] == "[]"  # no partial file
+
+
+def test_every_upper_bound_names_its_reason():
+    """No pin without a reason: each requirement with an upper bound sits under a comment
+    (in its block of requirement and comment lines) naming the tested range or release,
+    or the release that broke."""
+    lines = (Path(__file__).resolve().parent.parent / "pyproject.toml").read_text().splitlines()
+    requirement = re.compile(r'"[A-Za-z0-9_.\-\[\]]+[^"]*<[^"]*"')
+    bounded = [i for i, line in enumerate(lines) if not line.lstrip().startswith("#") and requirement.search(line)]
+    assert bounded, "pyproject.toml has no upper bound at all: this test reads it wrongly"
+    for i in bounded:
+        j, comments = i - 1, []
+        while j >= 0 and lines[j].strip() and (lines[j].lstrip().startswith("#") or requirement.search(lines[j])):
+            if lines[j].lstrip().startswith("#"):
+                comments.append(lines[j])
+            j -= 1
+        assert re.search(r"tested|broke", " ".join(comments)), f"pyproject.toml line {i + 1}: an upper bound with no reason"

@@ -66,6 +66,15 @@ def test_every_quirk_names_a_test_that_asserts_it():
         assert calls, f"{key}: asserts no quirk_holds(...)"
 
 
+def test_every_quirk_runs_on_both_releases():
+    """.ci/run's second leg (OCCT 7.9) runs the files of .ci/occt79-tests: every quirk's
+    test must be among them, or its 7.9 verdict in QUIRKS is never asserted."""
+    listed = (Path(__file__).resolve().parent.parent / ".ci" / "occt79-tests").read_text().split()
+    for key in QUIRKS:
+        file = key.split("::")[0]
+        assert f"tests/{file}" in listed or f"tests/{key}" in listed, f"{key}: not in .ci/occt79-tests"
+
+
 def test_high_degree_derivatives_lose_digits_at_span_end():
     """OCCT's D1 of a degree-25 Bézier patch at (1, 1) is off by ~1e-4 while Value is exact;
     our evaluator gives the textbook end derivative n (P_n - P_{n-1}) to 1e-14.
