@@ -10,10 +10,11 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   (:func:`surfmod.from_face`), evaluated on a parameter grid a ``spacing`` apart on the
   surface and kept inside its trim; every edge that bounds a face sampled as finely.
   Edges bounding no face (construction wires) are not material and are left out.
-  Between points a surface can come nearer a tool by at most ``spacing² (1/c + κ)/8``
-  (``c`` the tool's corner radius, ``κ`` the surface's curvature): ``spacing`` is chosen
-  so that this stays within half the limit judged.  Where a ball cuts deepest, the
-  depth is measured once more by OCCT's exact distance (``BRepExtrema``);
+  Between points a surface can come nearer a tool by about ``spacing² (1/c + κ)/8``
+  (``c`` the tool's corner radius, ``κ`` the surface's curvature): the spacing keeps the
+  tool's share within a quarter of the limit judged, and a face curved more is sampled
+  closer (up to ``MAX_REFINE`` times).  Where a ball cuts deepest, the depth is measured
+  once more by OCCT's exact distance to the faces (``BRepExtrema``);
 - **gouge**: every move of an operation, probed at points ``spacing`` apart along it, may
   bring no point of the part deeper into the tool than the operation's limit: its
   tolerance for finishing; for roughing the tool grown by its allowance, so that it
@@ -30,7 +31,9 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
 (points on the part, probes, nodes) and refused above its bound with a line naming the
-option that lowers it.
+option that lowers it.  :func:`lift_gouges` is the repair a tool path gets from the same
+points (:func:`surfmod.toolpath`); :func:`sampled_part` keeps the last sampling, so the
+repair and the verdict sample the part once.
 """
 
 from __future__ import annotations
