@@ -242,9 +242,9 @@ def _inside(face, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
 
 def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES, sag: float | None = None, *,
                 fit: bool = False) -> np.ndarray:
-    """Points ``(N, 3)`` on every face of ``shape`` inside its trim and on every edge that
-    bounds a face, about ``spacing`` apart (closer on faces curved so much that they leave
-    the points' chords by more than ``sag``).  More than ``max_samples`` (counted on the
+    """``(points (N, 3), spacing)``: points on every face of ``shape`` inside its trim and
+    on every edge that bounds a face, about ``spacing`` apart (closer on faces curved so
+    much that they leave the points' chords by more than ``sag``), and the spacing used.  More than ``max_samples`` (counted on the
     faces' parameter grids before any is evaluated) raises ``SurfmodError``; with ``fit``
     the points stand farther apart instead, as many as the cap allows (see
     :func:`sampled_part`)."""
@@ -306,12 +306,16 @@ def sampled_part(shape, spacing: float, cell: float, max_samples: int = MAX_SAMP
     last one is kept, so a path's repair and its verdict sample the part once."""
     from ..occ.topo import wrapped
 
-    key = (hash(wrapped(shape)), float(spacing), float(cell), sag, fit, max_samples)
-    if key not in _SAMPLED:
+    occ = wrapped(shape)
+    key = (hash(occ), float(spacing), float(cell), sag, fit, max_samples)
+    # the entry holds its shape, so no other shape can take its address (and its hash)
+    # while it is kept; equal shapes share the geometry, hence the points
+    entry = _SAMPLED.get(key)
+    if entry is None or not entry[2].IsEqual(occ):
         _SAMPLED.clear()
         points, used = part_points(shape, spacing, max_samples, sag, fit=fit)
-        _SAMPLED[key] = (PartPoints.bucket(points, cell), used)
-    return _SAMPLED[key]
+        entry = _SAMPLED[key] = (PartPoints.bucket(points, cell), used, occ)
+    return entry[0], entry[1]
 
 
 def lift_gouges(shape, points: np.ndarray, cutter, limit: float, *, rounds: int = 3,
