@@ -21,8 +21,8 @@ from ..inputs import to_shape
 from .finishing import Rest, clear_part, finish, recut
 from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
-from .verify import verify_job
 from .toolpath import _part
+from .verify import verify_job
 
 #: Rapid traverse (mm/min) and tool change time (s) of the time estimate.
 RAPID_RATE = 5000.0
