@@ -158,6 +158,11 @@ def test_work_is_bounded_up_front(job):
         V.part_points(job.part, 0.01, max_samples=1000)
     with pytest.raises(SurfmodError, match="max_probes"):
         V.verify_job(job, max_probes=1000)
+    # points and stock cells fit their caps instead, coarser, and the verdict says so
+    v = V.verify_job(job, max_samples=20_000, max_nodes=2_000)
+    assert v.samples <= 20_000 and v.nodes <= 2_000 and v.spacing > job.verification.spacing
+    assert any("coarser than" in n and "points" in n for n in v.notes)
+    assert any("stock cells" in n for n in v.notes)
 
 
 def test_cam_part_residual_is_the_judges():

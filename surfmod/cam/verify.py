@@ -452,8 +452,13 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         plans.append((k, op, cutter, limit))
     spacing = min(spacing_for(limit / 2, c.radius, c.corner) for _, _, c, limit in plans)
     sag = min(limit for _, _, _, limit in plans) / 4
-    part, _ = sampled_part(job.part, spacing, _cell(spacing, min(c.radius for _, _, c, _ in plans)), max_samples,
-                           sag)
+    asked = spacing
+    part, spacing = sampled_part(job.part, spacing, _cell(spacing, min(c.radius for _, _, c, _ in plans)),
+                                 max_samples, sag, fit=True)
+    notes = []
+    if spacing > asked:
+        notes.append(f"note: the points stand {spacing:.3g} mm apart, coarser than the {asked:.3g} the limits ask "
+                     f"({max_samples:,} at most): between them a face may come nearer a tool than measured")
     findings, probes = [], 0
     for k, op, cutter, limit in plans:
         found, n = _gouge(part, moves, (owner == k) & ~moves.rapid, cutter.radius, cutter.corner, limit, spacing,
@@ -475,8 +480,11 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     cell = max(stepover / 4, 1e-3)
     lo, hi = np.asarray(job.stock, float)
     nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
-    checks.work(nx * ny, max_nodes, "max_nodes",
-                f"the verification's stock of {nx:,} x {ny:,} nodes (a larger scallop, or no verification)")
+    if nx * ny > max_nodes:  # a stock too large for the cells the stepover asks: coarser cells, said
+        wanted, cell = cell, cell * 1.05 * math.sqrt(nx * ny / max_nodes)
+        nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
+        notes.append(f"note: stock cells {cell:.3g} mm, coarser than the {wanted:.3g} the stepover asks "
+                     f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
     top = np.full((nx, ny), float(hi[2]))
     radii = np.array([job.operations[k].tool.radius for k in owner], float)
     corners = np.array([job.operations[k].tool.corner for k in owner], float)
@@ -493,7 +501,6 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         stock = Finding("rapids", -np.inf, 0.0)
     findings.append(max(stock, rapid_part, key=lambda f: f.worst))
     uncut = ~moves.rapid & ~moves.spindle & (np.linalg.norm(moves.end - moves.start, axis=1) > 0)
-    notes = []
     if uncut.any():
         findings.append(Finding("cuts with the spindle stopped", float(uncut.sum()), 0.0, None, int(uncut.sum()),
                                 int(moves.line[np.argmax(uncut)])))
