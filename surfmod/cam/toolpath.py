@@ -338,10 +338,10 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         part = _part(shape, tool.cutter, tolerance, meter)
         path = raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
                            bar, meter=meter)
+        # the mesh's triangles can miss where a face leaves its own mesh by more than BRepMesh
+        # measured: the moves are held against points of the exact faces too, and lifted there
         bar.set_postfix_str("against the exact faces")
-    # the mesh's triangles can miss where a face leaves its own mesh by more than BRepMesh
-    # measured: the moves are held against points of the exact faces too, and lifted there
-    points, lift = lift_gouges(shape, path.points, tool.cutter, tolerance)
+        points, lift = lift_gouges(shape, path.points, tool.cutter, tolerance)
     if not lift.any():
         return path
     return replace(path, points=checks.frozen(points), lifted=max(path.lifted, float(lift.max())))

@@ -226,13 +226,8 @@ def _inside(face, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
     # the polylines above (halving a chord quarters it)
     sag = max(float(np.linalg.norm(lp[1:-1:2] - 0.5 * (lp[:-2:2] + lp[2::2]), axis=1).max(initial=0.0))
               for lp in grid_loops)
-    dense = []
-    for lp in grid_loops:  # samples along the polylines at most a grid step apart
-        seg = np.diff(lp, axis=0)
-        n = np.maximum(np.ceil(np.linalg.norm(seg, axis=1)).astype(np.int64), 1)
-        k = np.repeat(np.arange(len(seg)), n)
-        t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
-        dense.append(lp[k] + t[:, None] * seg[k])
+    # samples along the polylines at most a grid step apart
+    dense = [_probes(lp[:-1], lp[1:], 1.0, MAX_PROBES)[0] for lp in grid_loops]
     dist, _ = cKDTree(np.concatenate(dense)).query(pts / scale, distance_upper_bound=sag + 2.0)
     ask = np.isfinite(dist)
     if ask.any():
@@ -296,6 +291,14 @@ def _cell(spacing: float, radius: float) -> float:
     return max(radius / 4, 3 * spacing)
 
 
+def _coarser(spacing: float, asked: float, cap: int) -> list[str]:
+    """The note a verdict carries when its points had to stand farther apart than asked."""
+    if spacing <= asked:
+        return []
+    return [f"note: the points stand {spacing:.3g} mm apart, coarser than the {asked:.3g} the limits ask "
+            f"({cap:,} at most): between them a face may come nearer a tool than measured"]
+
+
 _SAMPLED: dict = {}
 
 
@@ -335,8 +338,6 @@ def lift_gouges(shape, points: np.ndarray, cutter, limit: float, *, rounds: int 
         # each move's deepest probe (the last of its group sorted by depth)
         order = np.lexsort((depth, move))
         last = order[np.r_[move[order][1:] != move[order][:-1], True]]
-        worst = np.full(len(points) - 1, -1.0)
-        worst[move[last]] = depth[last]
         bad_probe = last[depth[last] > 0.5 * limit]
         if not len(bad_probe):
             break
@@ -443,22 +444,16 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     plans = []
     for k, op in enumerate(job.operations):
         tool = op.tool
-        if op.name == "roughing":
-            a = float(op.report.get("allowance", 0.0))
-            cutter = tool.cutter.grown(a) if a > 0 else tool.cutter
-            limit = float(op.report["tolerance"]) + digits
-        else:
-            cutter, limit = tool.cutter, float(op.report["tolerance"]) + digits
-        plans.append((k, op, cutter, limit))
+        # roughing keeps its allowance: judged with the tool grown by it
+        a = float(op.report.get("allowance", 0.0)) if op.name == "roughing" else 0.0
+        cutter = tool.cutter.grown(a) if a > 0 else tool.cutter
+        plans.append((k, op, cutter, float(op.report["tolerance"]) + digits))
     spacing = min(spacing_for(limit / 2, c.radius, c.corner) for _, _, c, limit in plans)
     sag = min(limit for _, _, _, limit in plans) / 4
     asked = spacing
     part, spacing = sampled_part(job.part, spacing, _cell(spacing, min(c.radius for _, _, c, _ in plans)),
                                  max_samples, sag, fit=True)
-    notes = []
-    if spacing > asked:
-        notes.append(f"note: the points stand {spacing:.3g} mm apart, coarser than the {asked:.3g} the limits ask "
-                     f"({max_samples:,} at most): between them a face may come nearer a tool than measured")
+    notes = _coarser(spacing, asked, max_samples)
     findings, probes = [], 0
     for k, op, cutter, limit in plans:
         found, n = _gouge(part, moves, (owner == k) & ~moves.rapid, cutter.radius, cutter.corner, limit, spacing,
@@ -578,7 +573,5 @@ def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MA
     part, spacing = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, base / 4, fit=True)
     found, n = _gouge(part, moves, ~moves.rapid, cutter.radius, cutter.corner, limit, spacing, "gouge", max_probes,
                       shape)
-    notes = () if spacing <= asked else (
-        f"note: the points stand {spacing:.3g} mm apart, coarser than the {asked:.3g} the tolerance asks "
-        f"({max_samples:,} at most): between them a face may come nearer the tool than measured",)
-    return Verification((found,), len(part.points), n, spacing=spacing, notes=notes)
+    return Verification((found,), len(part.points), n, spacing=spacing,
+                        notes=tuple(_coarser(spacing, asked, max_samples)))
