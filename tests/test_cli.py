@@ -227,3 +227,35 @@ def test_section_on_a_planar_face_draws_its_outline(tmp_path, capsys):
                  "--no-progress"]) == 0
     assert "lies on planar face(s) [2]: their outline included" in capsys.readouterr().out
     assert dxf_length(out) == pytest.approx(8 + np.pi, rel=1e-12)
+
+
+# -- a command loads only its own module ---------------------------------------------------------
+def test_command_table_is_what_the_modules_register():
+    """``COMMANDS`` names every module of ``surfmod.cli`` that registers a subcommand, with
+    the subcommand it registers, so a command line that names one loads only that module."""
+    import argparse
+    import importlib
+    import pkgutil
+
+    import surfmod.cli as cli
+
+    registered = {}
+    for info in pkgutil.iter_modules(cli.__path__):
+        module = importlib.import_module(f"surfmod.cli.{info.name}")
+        if hasattr(module, "register"):
+            sub = argparse.ArgumentParser().add_subparsers()
+            module.register(sub)
+            registered.update({name: info.name for name in sub.choices})
+    assert cli.COMMANDS == registered
+
+
+def test_a_command_loads_no_other_command():
+    """``surfmod mass --help`` in a fresh process imports no CAM module and no other command."""
+    code = ("import sys, contextlib, io\nfrom surfmod.cli import main\n"
+            "with contextlib.suppress(SystemExit), contextlib.redirect_stdout(io.StringIO()):\n"
+            "    main(['mass', '--help'])\n"
+            "print(sorted(m for m in sys.modules if m.startswith(('surfmod.cli.', 'surfmod.cam'))))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    loaded = eval(done.stdout.strip().splitlines()[-1])
+    assert "surfmod.cli.mass" in loaded
+    assert not [m for m in loaded if m.startswith("surfmod.cam") or m in ("surfmod.cli.machine", "surfmod.cli.mesh")]

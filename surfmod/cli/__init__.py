@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import pkgutil
 import re
 import sys
 import warnings
@@ -41,22 +40,33 @@ class Parser(argparse.ArgumentParser):
         self._negative_number_matcher = NEGATIVE_NUMBER
 
 
-def build_parser() -> argparse.ArgumentParser:
+#: each subcommand and the module of this package that registers it; a command line that
+#: names one loads only that module, so a command does not pay for the imports of the
+#: others (``machine`` alone loads the CAM stack); ``tests/test_cli.py`` holds the table to
+#: what the modules register
+COMMANDS = {"analyze": "analyze", "check": "check", "conformance": "conformance", "convert": "exchange",
+            "femesh": "femesh", "gallery": "gallery", "machine": "machine", "mass": "mass", "mesh": "mesh",
+            "section": "section", "toolpath": "toolpath"}
+
+
+def build_parser(argv=None) -> argparse.ArgumentParser:
+    """The command line's parser: every subcommand, or only the one ``argv`` names."""
     parser = Parser(
         prog="surfmod",
         description="Surface-modeling toolbox on OpenCASCADE, cross-checked by NumPy.",
     )
     parser.add_argument("--version", action="version", version=f"surfmod {installed_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        module = importlib.import_module(f"{__name__}.{info.name}")
-        if hasattr(module, "register"):
-            module.register(sub)
+    named = next((a for a in (argv or []) if not a.startswith("-")), None)
+    modules = [COMMANDS[named]] if named in COMMANDS else sorted(set(COMMANDS.values()))
+    for name in modules:
+        importlib.import_module(f"{__name__}.{name}").register(sub)
     return parser
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(argv)
     args = parser.parse_args(argv)
 
     said = set()
