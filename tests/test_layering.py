@@ -90,7 +90,7 @@ LAZY = {
     "scipy": "its sparse solvers, k-d trees, csgraph: 0.25-1.1 s on top of numpy",
     "matplotlib": "2.5 s; sm.render, analysis pictures and section PNGs only",
     "mpl_toolkits": "matplotlib's 3-D axes, with matplotlib",
-    "trimesh": "2.1 s; Mesh.to_trimesh (surfmod mesh's watertight check)",
+    "trimesh": "2.1 s; Mesh.to_trimesh, for users and the tests",
     "gmsh": "optional extra 'fem' (surfmod.extras.require loads it)",
     "meshio": "optional extra 'fem' (surfmod.extras.require loads it)",
     "ezdxf": "0.6 s; DXF output only (surfmod.io.dxf loads it at its top)",

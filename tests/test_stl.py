@@ -78,3 +78,20 @@ def test_bad_tolerance_writes_nothing(tmp_path):
     with pytest.raises(sm.SurfmodError, match="tolerance"):
         sm.export_stl(sm.sphere(1.0), tmp_path / "x.stl", tolerance=1e-9)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_edge_use_agrees_with_trimesh(tmp_path):
+    """``Mesh.edge_use`` (the command's watertight line without trimesh) says what trimesh
+    says: a closed solid, an open patch, a solid with facets turned, one with a facet lost."""
+    import build123d as bd
+
+    mesh = sm.export_stl(bd.Cylinder(2, 3) - bd.Box(1, 1, 5), tmp_path / "part.stl", tolerance=0.01)
+    open_patch = sm.tessellate(sm.sphere(1.0), 0.01)
+    flipped = sm.Mesh(mesh.vertices, np.concatenate([mesh.faces[:7, ::-1], mesh.faces[7:]]))
+    holed = sm.Mesh(mesh.vertices, mesh.faces[1:])
+    answers = []
+    for m in (mesh, open_patch, flipped, holed):
+        tm = m.to_trimesh()
+        assert m.edge_use() == (tm.is_watertight, tm.is_winding_consistent)
+        answers.append(m.edge_use())
+    assert answers[0] == (True, True) and answers[2] == (True, False) and answers[3][0] is False

@@ -37,8 +37,8 @@ from tqdm import tqdm
 from .. import child
 from ..errors import RoundTripWarning, SurfmodError
 from ..atomic import target_path
-from ..io.step import import_step
 from ..io.stl import export_stl
+from ..occ.isolated import read_step_file
 
 STEP_SUFFIXES = (".step", ".stp")
 #: default budget of one file's task on a cluster: seconds, and GiB resident
@@ -339,12 +339,12 @@ def mesh_file(path, tolerance: float, ascii: bool = False, out_dir=None, strict:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RoundTripWarning)  # the row says it, in its verdict
-            mesh = export_stl(import_step(p), out, tolerance=tolerance, ascii=ascii, strict=strict, progress=False)
+            mesh = export_stl(read_step_file(p, "step"), out, tolerance=tolerance, ascii=ascii, strict=strict, progress=False)
     except SurfmodError as exc:
         return [mesh_failed(p, " ".join(str(exc).split()))]
     code, closed, manifold, outward, repairs, verdict = stl_verdict(mesh)
     dev = mesh.info.get("max_deviation")
-    return [(str(p), code, len(mesh.faces), "yes" if mesh.to_trimesh().is_watertight else "NO", closed, manifold,
+    return [(str(p), code, len(mesh.faces), "yes" if mesh.edge_use()[0] else "NO", closed, manifold,
              outward, repairs, float("nan") if dev is None else float(dev), str(out), verdict)]
 
 

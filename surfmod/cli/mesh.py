@@ -15,7 +15,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import RoundTripWarning
-from ..io.step import import_step
+from ..occ.isolated import read_step_file
 from ..io.stl import export_stl
 from ..meshing.brep import describe_faces
 from .batch import EXIT_BROKEN, add_batch_arguments, is_batch, run_mesh
@@ -39,16 +39,18 @@ def run(args) -> int:
     if is_batch(args):
         return run_mesh(args)
     args.step = args.step[0]
-    shape = import_step(args.step)
+    # the kernel's shape, not a build123d one: the STL needs nothing of build123d, whose
+    # import is most of a fresh process's start-up (issue 34's start-up row)
+    shape = read_step_file(args.step, "step")
     out = Path(args.out) if args.out else Path(args.step).with_suffix(".stl")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RoundTripWarning)  # said below, one line per problem
         mesh = export_stl(shape, out, tolerance=args.tolerance, ascii=args.ascii, strict=args.strict,
                           progress=not args.no_progress)
-    tm = mesh.to_trimesh()
+    watertight, consistent = mesh.edge_use()
     dev = mesh.info.get("max_deviation")
     print(f"{out}: {len(mesh.faces)} triangles, {len(mesh.vertices)} vertices, "
-          f"watertight {tm.is_watertight}, winding consistent {tm.is_winding_consistent}"
+          f"watertight {watertight}, winding consistent {consistent}"
           + (f", measured max deviation {dev:.3g}" if dev is not None else ""))
     skipped = mesh.info.get("faces_not_meshed", [])
     if skipped:
