@@ -156,12 +156,16 @@ def test_grbl_programs_are_read_per_tool(job):
 def test_work_is_bounded_up_front(job):
     with pytest.raises(SurfmodError, match="max_samples"):
         V.part_points(job.part, 0.01, max_samples=1000)
-    with pytest.raises(SurfmodError, match="max_probes"):
-        V.verify_job(job, max_probes=1000)
-    # points and stock cells fit their caps instead, coarser, and the verdict says so
-    v = V.verify_job(job, max_samples=20_000, max_nodes=2_000)
+    moves = sum(len(op.motion.points) for op in job.operations)
+    with pytest.raises(SurfmodError, match="max_probes"):  # not even two probes per move
+        V.verify_job(job, max_probes=moves)
+    # points, probes and stock cells fit their caps instead, coarser, and the verdict says so
+    full = job.verification.probes
+    v = V.verify_job(job, max_samples=20_000, max_nodes=2_000, max_probes=full // 2)
     assert v.samples <= 20_000 and v.nodes <= 2_000 and v.spacing > job.verification.spacing
+    assert v.probes <= full // 2
     assert any("coarser than" in n and "points" in n for n in v.notes)
+    assert any("probes" in n and "coarser than" in n for n in v.notes)
     assert any("stock cells" in n for n in v.notes)
 
 

@@ -30,8 +30,10 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   band one cell wide at the part's outline are counted, not judged.
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
-(points on the part, probes, nodes) and refused above its bound with a line naming the
-option that lowers it.  :func:`lift_gouges` is the repair a tool path gets from the same
+(points on the part, probes along the moves, stock nodes); where it would pass its cap the
+points, probes or cells stand farther apart and the verdict carries a note saying so, so a
+large job is judged more coarsely, never refused (only a program of more moves than half
+``max_probes`` is).  :func:`lift_gouges` is the repair a tool path gets from the same
 points (:func:`surfmod.toolpath`); :func:`sampled_part` keeps the last sampling, so the
 repair and the verdict sample the part once.
 """
@@ -333,7 +335,7 @@ def lift_gouges(shape, points: np.ndarray, cutter, limit: float, *, rounds: int 
     part, spacing = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, limit / 4, fit=True)
     lift = np.zeros(len(points))
     for _ in range(rounds):
-        probes, move = _probes(points[:-1], points[1:], spacing, max_probes)
+        probes, move, _ = _probes(points[:-1], points[1:], spacing, max_probes)
         depth, which = part.deepest(probes, cutter.radius, cutter.corner)
         # each move's deepest probe (the last of its group sorted by depth)
         order = np.lexsort((depth, move))
@@ -358,27 +360,34 @@ def lift_gouges(shape, points: np.ndarray, cutter, limit: float, *, rounds: int 
 
 # -- probes along moves ---------------------------------------------------------------------
 def _probes(start: np.ndarray, end: np.ndarray, spacing: float, max_probes: int):
-    """Points ``spacing`` apart along each move (both ends included) and each one's move."""
+    """Points at most ``spacing`` apart along each move (both ends included), each one's
+    move, and the spacing used: wider than asked where ``max_probes`` would be passed, so a
+    long program is judged more coarsely (and says so), never refused."""
     length = np.linalg.norm(end - start, axis=1)
     n = np.ceil(length / spacing).astype(np.int64) + 1
+    if n.sum() > max_probes and 2 * len(start) < max_probes:
+        spacing = max(spacing, float(length.sum()) / (max_probes - 2 * len(start)))
+        n = np.ceil(length / spacing).astype(np.int64) + 1
     total = int(n.sum())
-    checks.work(total, max_probes, "max_probes",
-                f"the verification's {total:,} probes along the moves (a larger scallop or tolerance, "
-                f"or no verification)")
+    checks.work(total, max_probes, "max_probes", f"the verification's {total:,} probes, two per move at the least")
     move = np.repeat(np.arange(len(start)), n)
     first = np.r_[0, np.cumsum(n)[:-1]]
     t = (np.arange(total) - np.repeat(first, n)) / np.maximum(np.repeat(n - 1, n), 1)
     pts = start[move] + t[:, None] * (end - start)[move]
-    return pts, move
+    return pts, move, spacing
 
 
 def _gouge(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, radius: float, corner: float, limit: float,
-           spacing: float, what: str, max_probes: int, exact_shape=None):
-    """The deepest any point of the part comes into the tool along the picked moves."""
+           spacing: float, what: str, max_probes: int, notes: list, exact_shape=None):
+    """The deepest any point of the part comes into the tool along the picked moves; a note
+    joins ``notes`` when the probes had to stand farther apart than ``spacing``."""
     if not pick.any():
         return Finding(what, -np.inf, limit), 0
     idx = np.flatnonzero(pick)
-    probes, move = _probes(moves.start[idx], moves.end[idx], spacing, max_probes)
+    probes, move, used = _probes(moves.start[idx], moves.end[idx], spacing, max_probes)
+    if used > spacing:
+        notes.append(f"note: {what}: probes {used:.3g} mm apart along the moves, coarser than the {spacing:.3g} "
+                     f"asked ({max_probes:,} at most): between them a tool may come nearer the part than measured")
     depth, which = part.deepest(probes, radius, corner)
     if exact_shape is not None and corner == radius and depth.max() > 0:
         # the deepest ball probes measured by OCCT's exact distance from the centre to the
@@ -454,21 +463,28 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     part, spacing = sampled_part(job.part, spacing, _cell(spacing, min(c.radius for _, _, c, _ in plans)),
                                  max_samples, sag, fit=True)
     notes = _coarser(spacing, asked, max_samples)
+    # the probes along the moves, shared out by the number of moves each check judges
+    cuts = [(owner == k) & ~moves.rapid for k, _, _, _ in plans]
+    rapids = [(owner == k) & moves.rapid for k, _, _, _ in plans]
+    judged = max(sum(int(p.sum()) for p in cuts + rapids), 1)
+
+    def share(pick):
+        return max(max_probes * int(pick.sum()) // judged, 1)
+
     findings, probes = [], 0
-    for k, op, cutter, limit in plans:
-        found, n = _gouge(part, moves, (owner == k) & ~moves.rapid, cutter.radius, cutter.corner, limit, spacing,
-                          f"gouge, {op.name} (tool {op.tool.number})", max_probes - probes, job.part)
+    for (k, op, cutter, limit), pick in zip(plans, cuts):
+        found, n = _gouge(part, moves, pick, cutter.radius, cutter.corner, limit, spacing,
+                          f"gouge, {op.name} (tool {op.tool.number})", share(pick), notes, job.part)
         findings.append(found)
         probes += n
     # rapids: no point of the part inside the tool, and (below) no stock under it
-    rapid_part, n = Finding("rapids", -np.inf, 0.0), 0
-    for k, op, _, _ in plans:
-        found, m = _gouge(part, moves, (owner == k) & moves.rapid, op.tool.radius, op.tool.corner, 0.0, spacing,
-                          "rapids", max_probes - probes - n)
-        n += m
+    rapid_part = Finding("rapids", -np.inf, 0.0)
+    for (k, op, _, _), pick in zip(plans, rapids):
+        found, n = _gouge(part, moves, pick, op.tool.radius, op.tool.corner, 0.0, spacing, "rapids", share(pick),
+                          notes)
+        probes += n
         if found.worst > rapid_part.worst:
             rapid_part = found
-    probes += n
     finishing = [p for p in plans if p[1].name == "finishing"]
     stepover = min((float(p[1].report.get("stepover") or p[1].tool.radius) for p in finishing),
                    default=min(op.tool.radius for op in job.operations))
@@ -571,7 +587,7 @@ def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MA
     spacing = spacing_for(base / 2, cutter.radius, cutter.corner)
     asked = spacing
     part, spacing = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, base / 4, fit=True)
+    notes = _coarser(spacing, asked, max_samples)
     found, n = _gouge(part, moves, ~moves.rapid, cutter.radius, cutter.corner, limit, spacing, "gouge", max_probes,
-                      shape)
-    return Verification((found,), len(part.points), n, spacing=spacing,
-                        notes=tuple(_coarser(spacing, asked, max_samples)))
+                      notes, shape)
+    return Verification((found,), len(part.points), n, spacing=spacing, notes=tuple(notes))
