@@ -30,7 +30,7 @@ import numpy as np
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
 from surfmod.meshing.brep import DENSE, measure_face_meshes
-from surfmod.occ.mesh import brepmesh
+from surfmod.meshing.facemesh import brepmesh
 
 from .tables import Table, note
 

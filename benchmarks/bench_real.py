@@ -138,7 +138,7 @@ def _options(argv):
 
 
 def main(argv=None) -> None:
-    from surfmod.occ.mesh import shape_figures
+    from surfmod.meshing.figures import shape_figures
 
     jobs, words, repeats = _options(sys.argv[1:] if argv is None else argv)
     files = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))

@@ -20,7 +20,8 @@ from toolpath_reference import compound, face_boxes
 import surfmod as sm
 from surfmod.cli import main
 from surfmod.meshing.brep import DENSE, measure_face
-from surfmod.occ.mesh import brepmesh, shape_figures
+from surfmod.meshing.figures import shape_figures
+from surfmod.meshing.facemesh import brepmesh
 from surfmod.occ.bindings import OCCT_VERSION
 from surfmod.occ.sample import distances_to_face
 from surfmod.occ.topo import faces_of, solids_of

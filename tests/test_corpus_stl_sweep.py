@@ -23,7 +23,7 @@ from stlcheck import admesh_stats, needs_admesh
 from test_corpus_mesh import MODEL_DEFECTS, _check_stl, _independent_deviation
 
 import surfmod as sm
-from surfmod.occ.mesh import shape_figures
+from surfmod.meshing.figures import shape_figures
 from surfmod.occ.properties import gprops
 from surfmod.occ.topo import solids_of
 

@@ -144,7 +144,7 @@ def test_bad_input_and_no_partial_files(tmp_path):
 
 # -- real parts (tests/data/step) -----------------------------------------------
 def _corpus_fe_mesh(path):
-    from surfmod.occ.mesh import shape_figures
+    from surfmod.meshing.figures import shape_figures
     from surfmod.uses.femesh import signed_volumes
 
     _, diag = shape_figures(sm.import_step(path), samples=2)

@@ -1,7 +1,7 @@
 """The part-wide passes of the mass integrals equal their face-by-face forms: p-curves read
-for many faces at once, evaluated together (``PcurveTable``), elementary faces read in
-one pass, and trimmed planar faces in closed form (boundary moments) -- against the
-node-by-node quadrature on the corpus and closed-form solids."""
+for many faces at once, evaluated together (``PcurveTable``), and trimmed planar faces in
+closed form (boundary moments) -- against the node-by-node quadrature on the corpus and
+closed-form solids."""
 
 from __future__ import annotations
 
@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ.elementary_faces import elementary_faces
 from surfmod.occ.properties import bounding_box, vertex_mean
 from surfmod.occ.pcurves import face_pcurves, faces_pcurves
 from surfmod.occ.topo import faces_of
@@ -96,25 +95,6 @@ def test_faces_pcurves_equal_face_by_face(corpus_dir):
             for key in ("range", "sign", "wire", "breaks", "origin", "direction", "centre", "radius", "points", "knots"):
                 if key in b:
                     assert np.array_equal(a[key], b[key]), key
-
-
-@pytest.mark.parametrize("name", QUICK + ("cadquery_red_cube_blue_cylinder.step",))
-def test_elementary_faces_read_as_from_face(corpus_dir, name):
-    _, shapes = _part(corpus_dir / name)
-    fast, slow = _read_faces(shapes), [from_face(s) for s in shapes]
-    fast_faces = sum(d is not None for d in elementary_faces(shapes))
-    assert fast_faces >= 6
-    if name.startswith("cadquery"):  # its cylinder is a Geom_RectangularTrimmedSurface: read fast too
-        assert fast_faces == len(shapes) == 9
-    for a, b in zip(fast, slow):
-        assert type(a.surface) is type(b.surface)
-        assert a.domain == b.domain and a.periods == b.periods and a.reversed == b.reversed
-        for key in ("origin", "x_dir", "y_dir", "z_dir", "radius", "semi_angle", "major", "minor"):
-            if hasattr(b.surface, key) and not hasattr(b.surface, "control_points"):
-                assert np.array_equal(getattr(a.surface, key), getattr(b.surface, key)), key
-        u = np.linspace(*b.domain[0], 5)
-        v = np.linspace(*b.domain[1], 5)
-        assert np.array_equal(a._derivatives(u, v, 1), b._derivatives(u, v, 1))
 
 
 def _planes_equal_node_by_node(path):

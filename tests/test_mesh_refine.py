@@ -12,7 +12,8 @@ from test_corpus_mesh import closed_and_oriented
 import surfmod as sm
 from surfmod.meshing.brep import measure_face
 from surfmod.meshing.refine import split_round
-from surfmod.occ.mesh import brepmesh, shape_figures
+from surfmod.meshing.figures import shape_figures
+from surfmod.meshing.facemesh import brepmesh
 
 
 def _boundary_edges(tri):
@@ -134,6 +135,7 @@ def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):
     from OCP.BRepTools import BRepTools
     from OCP.GeomLProp import GeomLProp_SLProps
 
+    from surfmod.meshing import figures
     from surfmod.occ import mesh as occ_mesh
     from surfmod.occ.geom import surface_type
     from surfmod.occ.topo import faces_of
@@ -147,7 +149,7 @@ def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):
         if name not in ("Geom_ConicalSurface", "Geom_ToroidalSurface"):
             continue
         seen.add(name)
-        area, k = occ_mesh._face_figure(face, 5, floor, None)
+        area, k = figures._face_figure(face, 5, floor)
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         props, jac, vals = GeomLProp_SLProps(surf, 2, 1e-9), [], []
         for u in np.linspace(u0, u1, 3):

@@ -20,7 +20,8 @@ from OCP.gp import gp_Pnt, gp_Vec
 import surfmod as sm
 from surfmod.nets import mp_reference
 from surfmod.occ.bindings import OCCT_VERSION
-from surfmod.occ.mesh import brepmesh, clean
+from surfmod.meshing.facemesh import brepmesh
+from surfmod.occ.mesh import clean
 from surfmod.occ.sample import curve_d2
 from surfmod.occ.topo import closest_on_face, faces_of
 

@@ -91,7 +91,7 @@ def test_plane_needs_two_triangles():
 
 def test_fewer_triangles_than_brepmesh_at_equal_tolerance():
     from surfmod.meshing.brep import DENSE, measure_face_meshes
-    from surfmod.occ.mesh import brepmesh
+    from surfmod.meshing.facemesh import brepmesh
 
     s = sm.BezierSurface(wavy_net(6, 5))
     ours = sm.tessellate(s, 0.01)
@@ -194,7 +194,7 @@ def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_reported_or_refu
     import build123d as bd
 
     from surfmod.meshing.brep import DENSE, measure_face
-    from surfmod.occ.mesh import brepmesh
+    from surfmod.meshing.facemesh import brepmesh
     from surfmod.occ.sample import distances_to_face
     from surfmod.occ.topo import faces_of
 

@@ -17,16 +17,27 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..construct.conics import Conic
+from ..construct.curves import Line
+from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface, ToroidalSurface
+from ..construct.revolution import RevolutionSurface
+from ..errors import SurfmodError
+from ..readback.readers import read_surface
+
 #: Kinds of :func:`distances`' surfaces (:func:`parameters` reads them).
 PLANE, SPHERE, CYLINDER, CONE, TORUS = range(5)
-_KINDS = {"Geom_Plane": PLANE, "Geom_SphericalSurface": SPHERE, "Geom_CylindricalSurface": CYLINDER,
-          "Geom_ConicalSurface": CONE, "Geom_ToroidalSurface": TORUS}
+_KINDS = {PlaneSurface: PLANE, SphericalSurface: SPHERE, CylindricalSurface: CYLINDER, ConicalSurface: CONE,
+          ToroidalSurface: TORUS}
+#: OCCT surface types :func:`parameters` reads (the others are none of the kinds).
+_READ = ("Geom_Plane", "Geom_SphericalSurface", "Geom_CylindricalSurface", "Geom_ConicalSurface",
+         "Geom_ToroidalSurface", "Geom_SurfaceOfRevolution")
 
 
 def parameters(surf) -> tuple | None:
     """``(kind, frame (2, 3), sizes (2,))`` of an OCCT plane, sphere, cylinder, cone or
     torus as :func:`distances` takes them (also of a surface of revolution that is one of
-    those, see :func:`revolved`), ``None`` for any other surface.
+    those, see :func:`revolved`), ``None`` for any other surface: read from the surfmod
+    surface :func:`surfmod.readback.read_surface` gives.
 
     >>> import build123d as bd
     >>> from surfmod.occ.topo import face_surface
@@ -35,16 +46,19 @@ def parameters(surf) -> tuple | None:
     (True, (0.0, 0.0))
     """
     from ..occ.geom import surface_type
-    from ..occ.mesh import elementary_parameters, swept_info
 
-    if surface_type(surf) == "Geom_SurfaceOfRevolution":  # of a circle or line in a plane through the axis
-        swept = swept_info(surf)
-        return revolved(*swept["axis"], swept["curve"])
-    params = elementary_parameters(surf)
-    if params is None:
+    if surface_type(surf) not in _READ:
         return None
-    name, origin, axis, sizes = params
-    return _KINDS[name], (origin, axis), sizes
+    try:  # the bounds give no sizes here: any box will do
+        s = read_surface(surf, (0.0, 1.0, 0.0, 1.0))
+    except SurfmodError:  # a revolved curve the reader does not know
+        return None
+    if isinstance(s, RevolutionSurface):  # of a circle or line in a plane through the axis
+        return revolved(s.axis_origin, s.axis_direction, s.profile)
+    kind = _KINDS[type(s)]
+    sizes = (0.0, 0.0) if kind == PLANE else (s.major, s.minor) if kind == TORUS else \
+        (s.radius, s.semi_angle) if kind == CONE else (s.radius, 0.0)
+    return kind, (s.origin, s.z_dir), sizes
 
 
 def distances(kinds: np.ndarray, frames: np.ndarray, sizes: np.ndarray, points: np.ndarray,
@@ -135,22 +149,23 @@ def _triangle_distances(kinds, frames, sizes, nodes, triangles, faces, bary, out
             out[t] = worst
 
 
-def revolved(origin, axis, curve: dict, rtol: float = 1e-12):
+def revolved(origin, axis, curve, rtol: float = 1e-12):
     """``(kind, frame, sizes)`` of the surface a circle or line sweeps about the axis
     ``(origin, unit axis)`` when it lies in a plane through the axis (to ``rtol`` of its
     size): a torus (a sphere when the circle's centre is on the axis), a cone, a
     cylinder or a plane, the same point sets as OCCT's surface of revolution;
-    ``None`` for any other basis curve (``curve``: ``occ.mesh.curve_info``'s dict).
+    ``None`` for any other basis curve (``curve``: the surfmod curve
+    :func:`surfmod.readback.read_curve` gives).
 
-    >>> import numpy as np
-    >>> circle = {"conic": (np.array([3.0, 0, 1]), np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), 0.5, 0.5)}
+    >>> import numpy as np, surfmod as sm
+    >>> circle = sm.Circle((3, 0, 1), (0, -1, 0), 0.5)
     >>> kind, frame, sizes = revolved(np.zeros(3), np.array([0, 0, 1.0]), circle)
     >>> kind == TORUS, frame[0].tolist(), sizes
     (True, [0.0, 0.0, 1.0], (3.0, 0.5))
     """
     origin, axis = np.asarray(origin, float), np.asarray(axis, float)
-    if "conic" in curve:
-        centre, x, y, a, b = curve["conic"]
+    if isinstance(curve, Conic):
+        centre, x, y, a, b = curve.center, curve.x_dir, curve.y_dir, curve.a, curve.b
         if a != b:
             return None  # an ellipse
         normal = np.cross(x, y)
@@ -163,8 +178,8 @@ def revolved(origin, axis, curve: dict, rtol: float = 1e-12):
         if big <= rtol * scale:
             return SPHERE, (foot, axis), (float(a), 0.0)
         return TORUS, (foot, axis), (big, float(a))
-    if "line" in curve:
-        point, direction = (np.asarray(v, float) for v in curve["line"])
+    if isinstance(curve, Line):
+        point, direction = np.asarray(curve.origin, float), np.asarray(curve.direction, float)
         offset = point - origin
         scale = 1.0 + np.linalg.norm(offset)
         if abs(offset @ np.cross(axis, direction)) > rtol * scale:

@@ -38,10 +38,11 @@ from functools import partial
 import numpy as np
 
 from ..errors import InsideOutWarning, SurfmodError
-from ..eval.differential import curvatures, degenerate_mask, raw_normals
 from .closure import faces_against_neighbours
 from .deviation import DENSE, project_distances, triangle_deviations
+from .facemesh import ANALYTIC, brepmesh
 from .facesurface import FaceSurface
+from .figures import partial_figures, shape_figures
 from .polymesh import Mesh, weld
 from .refine import refine_face
 from tqdm import tqdm
@@ -100,7 +101,7 @@ def _bounds(fm, ev: FaceSurface) -> tuple:
 
 
 def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None) -> tuple[np.ndarray, float]:
-    """Measured deviation of every triangle of a :class:`~surfmod.occ.mesh.FaceMesh`
+    """Measured deviation of every triangle of a :class:`~surfmod.meshing.facemesh.FaceMesh`
     (max over ``bary`` samples) and the max deviation of its nodes from the surface.
     ``ev``: the face's :class:`FaceSurface` when the caller already has it.
 
@@ -196,7 +197,6 @@ def measure_face_meshes(face_meshes, bary=DENSE) -> np.ndarray:
     (every sample projected: the accurate figure, for comparisons).
 
     >>> import build123d as bd
-    >>> from surfmod.occ.mesh import brepmesh
     >>> d = measure_face_meshes(brepmesh(bd.Solid.make_cylinder(1, 2), 0.01))
     >>> bool(d.max() < 0.02), len(d)
     (True, 3)
@@ -214,8 +214,6 @@ def _estimate(shape, tolerance: float, evaluators: dict | None = None,
     are sampled by their :class:`FaceSurface` (all faces' curvatures in one vectorized
     pass), which is kept there by face hash for measuring; ``uv_bounds`` receives the
     faces' UV boxes (see ``shape_figures``)."""
-    from ..occ.mesh import shape_figures
-
     splines: list = []  # (FaceSurface, sample grid u, v, UV box area, its figure to fill)
     sample = None if evaluators is None else partial(_sample_spline, evaluators, splines)
     figures, diag = shape_figures(shape, sample_face=sample, uv_bounds=uv_bounds)
@@ -269,20 +267,11 @@ def _spline_partials(splines: list) -> np.ndarray:
 
 def _fill_spline_figures(splines: list, floor: float) -> None:
     """Fill each sampled face's figure ``[area of the UV box's patch, median
-    sqrt(|k1| |k2|)]``, as ``shape_figures`` gives it with ``GeomLProp`` (no curvature
-    where the normal is undefined), for all sampled faces at once."""
-    ders = _spline_partials(splines)  # (faces, samples, 3, 3, 3)
-    area = np.linalg.norm(raw_normals(ders), axis=-1).mean(axis=1) * np.array([s[3] for s in splines])
-    c = curvatures(ders)
-    vals = np.sqrt(np.maximum(np.abs(c.k1), floor) * np.maximum(np.abs(c.k2), floor))
-    defined = ~degenerate_mask(ders, 1e-9)
-    ok = defined.any(axis=1)
-    median = np.full(len(splines), floor)
-    with warnings.catch_warnings():  # faces without any defined curvature stay at the floor
-        warnings.simplefilter("ignore", RuntimeWarning)
-        median[ok] = np.nanmedian(np.where(defined, vals, np.nan)[ok], axis=1)
-    for (*_, figure), a, k in zip(splines, area.tolist(), median.tolist()):
-        figure[:] = a, k
+    sqrt(|k1| |k2|)]``, as ``shape_figures`` gives it for the other faces, for all
+    sampled faces at once."""
+    figures = partial_figures(_spline_partials(splines), np.array([s[3] for s in splines]), floor)
+    for (*_, figure), got in zip(splines, figures):
+        figure[:] = got
 
 
 def _evaluator(evaluators: dict, fm) -> FaceSurface | None:
@@ -290,7 +279,6 @@ def _evaluator(evaluators: dict, fm) -> FaceSurface | None:
     kept in ``evaluators`` for the passes and the refinement), or ``None`` for the
     surfaces measured in closed form."""
     from ..occ.geom import surface_type
-    from ..occ.mesh import ANALYTIC
 
     key = fm.face.__hash__()
     ev = evaluators.get(key)
@@ -442,7 +430,6 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     within each solid (and within the faces outside any solid), so every closed solid
     is a closed, manifold part of the mesh.
     """
-    from ..occ.mesh import brepmesh
     from ..occ.solids import open_faces
     from ..occ.topo import wrapped
 

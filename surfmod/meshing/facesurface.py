@@ -1,12 +1,12 @@
 """A face's surface evaluated as OCCT evaluates it, vectorized, for measuring meshes of
-real parts: B-spline and Bezier surfaces through the NumPy evaluator, surfaces of
-revolution and of linear extrusion from their basis curve (B-spline, Bezier, line,
-circle, ellipse) in closed form, and OCCT's ``D1`` per point for anything else.
+real parts: the surfmod surface :func:`surfmod.readback.read_surface` reads (B-spline
+and Bezier nets, swept curves, elementary and offset surfaces, each with its own
+evaluator), and OCCT per point only for a surface type the reader does not know.
 
 An extrusion of a B-spline or Bezier curve over a known UV box *is* a B-spline surface
-(the curve's net and its copy moved along the direction, degree 1 across, linear in v
-as OCCT's ``C(u) + v D``), so it goes through the same compiled kernels as B-spline
-faces: projection, partials to order 2.
+(``TabulatedCylinder.to_nurbs``: the curve's net and its copy moved along the direction,
+degree 1 across), so it goes through the same compiled kernels as B-spline faces:
+projection, partials to order 2.
 
 Parameters are OCCT's: periodic directions wrap into their period (a face trimmed
 across the seam of a periodic B-spline lives on both sides of it), other directions
@@ -17,44 +17,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..eval import local
+from ..construct.extrusion import TabulatedCylinder
+from ..errors import SurfmodError
 from ..nets.bezier import BezierCurve, BezierSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
-
-
-class _Curve:
-    """Position and first derivative ``(N, 2, 3)`` of a basis curve in OCCT's
-    parametrization (closed forms for lines and conics, NumPy for splines)."""
-
-    def __init__(self, info: dict):
-        self.spline = None
-        self.info = info
-        self._net = None
-        if "bspline" in info:
-            d = info["bspline"]
-            self.spline = BSplineCurve(d["points"], d["degree"], d["knots"], d["weights"])
-            # the compiled surface kernels evaluate the curve as the ruled surface between
-            # two copies of it (degree 1 across): C(t) = S(0, t), C'(t) = S_v(0, t)
-            h = self.spline._homogeneous
-            self._net = local.prepare(np.array([0.0, 0.0, 1.0, 1.0]), 1, self.spline.knots, self.spline.degree,
-                                      np.stack([h, h]))
-        elif "bezier" in info:
-            self.spline = BezierCurve(info["bezier"]["points"], info["bezier"]["weights"])
-        self.supported = self.spline is not None or "line" in info or "conic" in info
-
-    def d1(self, t: np.ndarray) -> np.ndarray:
-        if self.spline is not None:
-            lo, hi = self.spline.domain
-            t = np.clip(t, lo, hi)
-            if self._net is not None:
-                return local.surface_derivatives(self._net, np.zeros(len(t)), t, 1)[:, 0]
-            return self.spline._derivatives(t, 1)
-        if "line" in self.info:
-            o, d = self.info["line"]
-            return np.stack([o + t[:, None] * d, np.broadcast_to(d, (len(t), 3))], axis=1)
-        c, x, y, a, b = self.info["conic"]
-        cos, sin = np.cos(t)[:, None], np.sin(t)[:, None]
-        return np.stack([c + a * cos * x + b * sin * y, -a * sin * x + b * cos * y], axis=1)
+from ..readback.readers import parameter_space, read_surface
 
 
 class FaceSurface:
@@ -75,34 +42,23 @@ class FaceSurface:
         spline curve is then evaluated as a B-spline surface over that box widened by
         its own size on each side (and clamped there, as the other non-periodic
         directions are clamped to their range)."""
-        from ..occ.mesh import surface_info, swept_info
+        from ..occ.geom import surface_type
 
-        info = surface_info(surf)
-        self.name = info["name"]
-        self.periodic = info["periodic"]
-        self.period = info["period"]
-        self.range = info["range"]
+        self.name = surface_type(surf)
+        self.periodic, self.period, self.range = parameter_space(surf)
         self.surf = surf
+        box = tuple(bounds) if bounds is not None else self.range[0] + self.range[1]
+        try:
+            surface = read_surface(surf, box)
+        except SurfmodError:  # a type the one reader does not know: OCCT per point
+            surface = None
+        self._surface = surface
         self._spline = None
-        self._swept = None
-        if info["bspline"] is not None:
-            d = info["bspline"]
-            net = np.asarray(d["control_points"], float)
-            if np.isfinite(net).all():
-                # OCCT's Geom_BSplineSurface has validated its knots, multiplicities and
-                # weights; only the poles of a damaged file can be non-finite
-                self._spline = BSplineSurface._trusted(net, d["degree"], d["knots"], d["weights"])
-            else:  # refused with the argument named
-                self._spline = BSplineSurface(net, d["degree"], d["knots"], d["weights"])
-        elif info["bezier"] is not None:
-            self._spline = BezierSurface(info["bezier"]["control_points"], info["bezier"]["weights"])
-        else:
-            swept = swept_info(surf)
-            curve = None if swept is None else _Curve(swept["curve"])
-            if curve is not None and curve.spline is not None and "direction" in swept and bounds is not None:
-                self._spline = _extrusion_net(curve.spline.to_bspline(), swept["direction"], bounds[2:])
-            elif curve is not None and curve.supported:
-                self._swept = swept | {"eval": curve}
+        if isinstance(surface, (BSplineSurface, BezierSurface)):
+            self._spline = surface
+        elif (isinstance(surface, TabulatedCylinder) and isinstance(surface.curve, (BSplineCurve, BezierCurve))
+              and bounds is not None):
+            self._spline = _extrusion_net(surface, bounds[2:])
         if self._spline is not None:
             self.range = tuple(tuple(float(x) for x in r) for r in self._spline.domain)
 
@@ -116,7 +72,7 @@ class FaceSurface:
     @property
     def numpy(self) -> bool:
         """Whether evaluation runs in NumPy (else OCCT per point)."""
-        return self._spline is not None or self._swept is not None
+        return self._surface is not None
 
     def _map(self, x: np.ndarray, direction: int) -> np.ndarray:
         lo, hi = self.range[direction]
@@ -125,13 +81,12 @@ class FaceSurface:
         return np.clip(x, lo, hi)
 
     def d1(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        if self._spline is not None:
-            return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 1)
-        if self._swept is not None:
-            return self._swept_d1(self._map(np.asarray(u, float), 0), self._map(np.asarray(v, float), 1))
-        from ..occ.mesh import surface_d1
+        evaluator = self._spline if self._spline is not None else self._surface
+        if evaluator is not None:
+            return evaluator._derivatives(self._map(np.asarray(u, float), 0), self._map(np.asarray(v, float), 1), 1)
+        from ..occ.sample import surface_d2
 
-        return surface_d1(self.surf, u, v)
+        return surface_d2(self.surf, np.asarray(u, float), np.asarray(v, float))[:, :2, :2]
 
     def d2(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Partials to order 2, ``(N, 3, 3, 3)``, of a surface evaluated as a spline
@@ -173,44 +128,17 @@ class FaceSurface:
         return out
 
     def d0(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        if self._spline is not None:
-            return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 0)[:, 0, 0]
+        evaluator = self._spline if self._spline is not None else self._surface
+        if evaluator is not None:
+            return evaluator._derivatives(self._map(np.asarray(u, float), 0), self._map(np.asarray(v, float), 1),
+                                          0)[:, 0, 0]
         return self.d1(u, v)[:, 0, 0]
 
-    def _swept_d1(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        out = np.zeros((len(u), 2, 2, 3))
-        sw = self._swept
-        if "direction" in sw:  # extrusion: S(u, v) = C(u) + v D
-            c = sw["eval"].d1(u)
-            d = sw["direction"]
-            out[:, 0, 0] = c[:, 0] + v[:, None] * d
-            out[:, 1, 0] = c[:, 1]
-            out[:, 0, 1] = d
-            return out
-        # revolution: C(v) turned by the angle u about the axis (Rodrigues)
-        o, a = sw["axis"]
-        c = sw["eval"].d1(v)
-        cos, sin = np.cos(u)[:, None], np.sin(u)[:, None]
 
-        def turn(w):
-            along = (w @ a)[:, None] * a
-            return (w - along) * cos + np.cross(a, w) * sin + along
-
-        w = c[:, 0] - o
-        out[:, 0, 0] = o + turn(w)
-        out[:, 1, 0] = np.cross(a, turn(w))
-        out[:, 0, 1] = turn(c[:, 1])
-        return out
-
-
-def _extrusion_net(curve: BSplineCurve, direction: np.ndarray, v_box) -> BSplineSurface:
-    """``C(u) + v D`` for ``v`` over ``v_box`` widened by its length on each side, as a
-    B-spline surface of degree 1 in v: the curve's homogeneous net at both ends of the
-    v interval (exact: the v basis functions are the two linear weights of v)."""
+def _extrusion_net(surface: TabulatedCylinder, v_box) -> BSplineSurface:
+    """The extrusion of a spline curve ``C(u) + v D`` for ``v`` over ``v_box`` widened by
+    its length on each side, as a B-spline surface of degree 1 in v (exact: the v basis
+    functions are the two linear weights of v)."""
     v0, v1 = float(v_box[0]), float(v_box[1])
     margin = max(v1 - v0, 1e-6 * (1.0 + abs(v0) + abs(v1)))
-    lo, hi = v0 - margin, v1 + margin
-    pts = curve.control_points
-    net = np.stack([pts + lo * direction, pts + hi * direction], axis=1)
-    weights = None if curve.weights is None else np.stack([curve.weights, curve.weights], axis=1)
-    return BSplineSurface._trusted(net, (curve.degree, 1), (curve.knots, np.array([lo, lo, hi, hi])), weights)
+    return TabulatedCylinder._trusted(surface.curve, surface.direction, (v0 - margin, v1 + margin)).to_nurbs()

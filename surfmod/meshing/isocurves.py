@@ -56,7 +56,7 @@ class IsoCurve(Curve):
         return d[:, :, 0, :]
 
     def geom(self):
-        from ..occ.mesh import iso_curve
+        from ..occ.geom import iso_curve
 
         return iso_curve(self.surface.geom(), self.direction, self.value)
 

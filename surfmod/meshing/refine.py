@@ -104,7 +104,7 @@ def split_round(nodes, uv, tri, bad, evaluate):
 
 def refine_face(fm, tolerance: float, node_deviation: float, measure, evaluate, rounds: int = ROUNDS,
                 measured: np.ndarray | None = None):
-    """Refine the triangles of a :class:`~surfmod.occ.mesh.FaceMesh` (with (u, v) nodes)
+    """Refine the triangles of a :class:`~surfmod.meshing.facemesh.FaceMesh` (with (u, v) nodes)
     whose measured deviation exceeds ``tolerance + node_deviation`` (the face's share of
     the model's own error), boundary edges kept.
 

@@ -31,6 +31,8 @@ from ..curve import Curve
 from ..errors import SurfmodError
 from ..readback import TrimmedFace
 from ..surface import Surface
+from .facemesh import brepmesh
+from .figures import shape_diagonal
 from .grid import mesh as grid_mesh
 from .isocurves import isocurves as iso
 from .polymesh import Mesh
@@ -127,10 +129,7 @@ def display_mesh(m: Mesh, budget: int) -> Mesh:
 
 
 def _shape_mesh(shape, fraction: float = DISPLAY_TOLERANCE) -> Mesh:
-    from ..occ.mesh import brepmesh, shape_figures
-
-    _figures, diag = shape_figures(shape, samples=2)
-    fms = brepmesh(shape, max(fraction * diag, 1e-9), 0.5)
+    fms = brepmesh(shape, max(fraction * shape_diagonal(shape), 1e-9), 0.5)
     verts, tris, offset = [], [], 0
     for fm in fms:
         verts.append(fm.nodes)
@@ -142,7 +141,7 @@ def _shape_mesh(shape, fraction: float = DISPLAY_TOLERANCE) -> Mesh:
 
 
 def _shape_edges(shape, samples: int = 48) -> list[np.ndarray]:
-    from ..occ.mesh import curve_points
+    from ..occ.discretize import sample_curve
     from ..occ.topo import curve_of_edge
 
     out = []
@@ -151,7 +150,7 @@ def _shape_edges(shape, samples: int = 48) -> list[np.ndarray]:
             curve, t0, t1 = curve_of_edge(e)
         except SurfmodError:
             continue
-        out.append(curve_points(curve, np.linspace(t0, t1, samples)))
+        out.append(sample_curve(curve, t0, t1, samples))
     return out
 
 

@@ -124,3 +124,10 @@ def downcast_surface(surf):
         return surf
     down = cls.DownCast(surf)
     return down if down is not None else surf
+
+
+def iso_curve(surf, direction: int, value: float):
+    """OCCT's exact iso-parametric curve: ``UIso(value)`` (direction 0: u fixed, a curve
+    in v) or ``VIso(value)`` (direction 1)."""
+    with kernel("Geom_Surface.UIso/VIso"):
+        return surf.UIso(float(value)) if direction == 0 else surf.VIso(float(value))

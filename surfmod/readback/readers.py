@@ -12,6 +12,8 @@ surface; :class:`surfmod.readback.trimmed.TrimmedFace` adds the face's bounds an
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..construct.conics import Conic, Hyperbola, Parabola
 from ..construct.curves import Line
 from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
@@ -56,6 +58,22 @@ def read_surface(geom, bounds):
     return read(downcast_surface(geom), tuple(float(b) for b in bounds))
 
 
+def parameter_space(geom) -> tuple:
+    """``(periodic, period, range)`` of an OCCT ``Geom_Surface`` as OCCT evaluates it:
+    per direction whether it is periodic, its period (0 if not) and the parameter range
+    ``((u0, u1), (v0, v1))`` of ``Bounds`` (infinite directions as OCCT's 2e100).
+
+    >>> import surfmod as sm
+    >>> periodic, period, _ = parameter_space(sm.sphere(1.0).geom())
+    >>> periodic, round(period[0], 12)
+    ((True, False), 6.28318530718)
+    """
+    u0, u1, v0, v1 = (float(b) for b in geom.Bounds())
+    periodic = bool(geom.IsUPeriodic()), bool(geom.IsVPeriodic())
+    period = (float(geom.UPeriod()) if periodic[0] else 0.0, float(geom.VPeriod()) if periodic[1] else 0.0)
+    return periodic, period, ((u0, u1), (v0, v1))
+
+
 def read_curve(curve, t_range):
     """A surfmod curve in OCCT's own parametrization of ``curve`` (a ``Geom_Curve``):
     lines and conics over ``t_range``, B-splines and Béziers over their whole knot range
@@ -93,7 +111,12 @@ def _bspline(surf, bounds):
     from ..occ.geom import read_bspline_surface
 
     data = read_bspline_surface(surf)
-    return BSplineSurface(data["control_points"], data["degree"], data["knots"], data["weights"])
+    net = np.asarray(data["control_points"], float)
+    if np.isfinite(net).all():
+        # OCCT's Geom_BSplineSurface has validated its knots, multiplicities and weights;
+        # only the poles of a damaged file can be non-finite (refused below, named)
+        return BSplineSurface._trusted(net, data["degree"], data["knots"], data["weights"])
+    return BSplineSurface(net, data["degree"], data["knots"], data["weights"])
 
 
 @reader("Geom_BezierSurface")

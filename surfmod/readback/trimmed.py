@@ -22,10 +22,9 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks
-from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface, ToroidalSurface
 from ..mass.moments import face_moments
 from ..surface import Surface
-from .readers import read_surface
+from .readers import parameter_space, read_surface
 
 
 class TrimmedFace(Surface):
@@ -150,11 +149,7 @@ def _periods(geom, surface):
     """Per direction the period to wrap by, where OCCT's surface is periodic and the
     surfmod surface's own domain covers one period (B-splines, swept periodic curves)."""
     out = []
-    for direction, (periodic, period) in enumerate(
-        ((geom.IsUPeriodic(), geom.UPeriod() if geom.IsUPeriodic() else None),
-         (geom.IsVPeriodic(), geom.VPeriod() if geom.IsVPeriodic() else None))
-    ):
-        lo, hi = surface.domain[direction]
+    for (lo, hi), periodic, period in zip(surface.domain, *parameter_space(geom)[:2]):
         out.append(float(period) if periodic and abs((hi - lo) - period) <= 1e-9 * max(1.0, period) else None)
     return out
 
@@ -179,35 +174,6 @@ def from_face(face) -> TrimmedFace:
     return TrimmedFace(surface, shape, geom, bounds, _periods(geom, surface), reversed_)
 
 
-_ELEMENTARY = {
-    "Geom_Plane": PlaneSurface, "Geom_CylindricalSurface": CylindricalSurface, "Geom_ConicalSurface": ConicalSurface,
-    "Geom_SphericalSurface": SphericalSurface, "Geom_ToroidalSurface": ToroidalSurface,
-}
-
-
 def from_faces(shapes: list) -> list:
-    """:func:`surfmod.from_face` of every face of a part: the same ``TrimmedFace``, the
-    elementary ones (planes, cylinders, cones, spheres, tori: most faces of real parts)
-    built from one pass over their OCCT data (:func:`surfmod.occ.elementary_faces.elementary_faces`)."""
-    from ..occ.elementary_faces import elementary_faces
-
-    out = []
-    for shape, data in zip(shapes, elementary_faces(shapes)):
-        if data is None:
-            out.append(from_face(shape))
-            continue
-        name, geom, bounds, reversed_, frame, radii, periodic = data
-        u0, u1, v0, v1 = bounds
-        surface = _ELEMENTARY[name]._trusted(frame, radii, (u0, u1), (v0, v1))
-        out.append(TrimmedFace(surface, shape, geom, bounds, _elementary_periods(periodic, bounds), reversed_))
-    return out
-
-
-def _elementary_periods(periodic, bounds) -> tuple:
-    """readback's ``_periods`` of an elementary surface over ``bounds`` (``periodic``: per
-    direction whether OCCT's surface is periodic; the period is then 2π): 2π where the
-    direction is periodic and the face spans one whole period, else None."""
-    period = 2 * np.pi
-    spans = (bounds[1] - bounds[0], bounds[3] - bounds[2])
-    return tuple(period if periodic and abs(span - period) <= 1e-9 * period else None
-                 for periodic, span in zip(periodic, spans))
+    """:func:`surfmod.from_face` of every face of a part, in order."""
+    return [from_face(shape) for shape in shapes]
