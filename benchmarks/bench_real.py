@@ -138,7 +138,7 @@ def _options(argv):
 
 
 def main(argv=None) -> None:
-    from surfmod.meshing.figures import shape_figures
+    from surfmod.meshing.figures import shape_diagonal
 
     jobs, words, repeats = _options(sys.argv[1:] if argv is None else argv)
     files = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in (".step", ".stp"))
@@ -157,7 +157,7 @@ def main(argv=None) -> None:
             # StepReaderData : Unresolved Reference"): kept out of the table, said below
             with captured_stdout() as printed:
                 part = sm.import_step(path)
-                _, diag = shape_figures(part, samples=2)
+                diag = shape_diagonal(part)
                 bb = part.bounding_box()
                 centre = tuple(float(x) for x in (np.array(tuple(bb.min)) + np.array(tuple(bb.max))) / 2)
                 ours = _surfmod_jobs(path, part, 1e-3 * diag, centre, out)

@@ -20,7 +20,7 @@ from toolpath_reference import compound, face_boxes
 import surfmod as sm
 from surfmod.cli import main
 from surfmod.meshing.brep import DENSE, measure_face
-from surfmod.meshing.figures import shape_figures
+from surfmod.meshing.figures import shape_diagonal
 from surfmod.meshing.facemesh import brepmesh
 from surfmod.occ.bindings import OCCT_VERSION
 from surfmod.occ.sample import distances_to_face
@@ -47,7 +47,7 @@ def _mesh_and_check(step, tmp_path, relative=1e-3, strict=False, code=0):
     """Run ``surfmod mesh`` at ``relative`` x the bbox diagonal, which must exit ``code``;
     return ``(shape, tolerance, STL path)``."""
     shape = sm.import_step(step)
-    _, diag = shape_figures(shape, samples=2)
+    diag = shape_diagonal(shape)
     tol = relative * diag
     out = tmp_path / "part.stl"
     args = ["mesh", str(step), "--tolerance", repr(tol), "--out", str(out), "--no-progress"]

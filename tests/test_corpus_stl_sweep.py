@@ -23,7 +23,7 @@ from stlcheck import admesh_stats, needs_admesh
 from test_corpus_mesh import MODEL_DEFECTS, _check_stl, _independent_deviation
 
 import surfmod as sm
-from surfmod.meshing.figures import shape_figures
+from surfmod.meshing.figures import shape_diagonal
 from surfmod.occ.properties import gprops
 from surfmod.occ.topo import solids_of
 
@@ -54,7 +54,7 @@ def _part(shape):
 @pytest.mark.parametrize("relative", [1e-2, 1e-4])
 def test_closed_solids_give_watertight_outward_stl_at_both_ends(corpus_file, relative, tmp_path):
     part = _part(sm.import_step(corpus_file))
-    _, diag = shape_figures(part, samples=2)  # before any mesh is stored on the part
+    diag = shape_diagonal(part)  # before any mesh is stored on the part
     tol = relative * diag
     out = tmp_path / "part.stl"
     if corpus_file.name in MODEL_DEFECTS:  # the model's broken solid is named, and only it
@@ -85,7 +85,7 @@ def test_deviation_files_are_in_the_corpus():
 @pytest.mark.parametrize("name", DEVIATION_FILES)
 def test_stl_within_tolerance_at_every_tolerance(name, tmp_path):
     shape = sm.import_step(CORPUS / name)
-    _, diag = shape_figures(shape, samples=2)
+    diag = shape_diagonal(shape)
     out = tmp_path / "part.stl"
     for relative in RELATIVE:
         tol = relative * diag

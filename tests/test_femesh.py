@@ -144,10 +144,10 @@ def test_bad_input_and_no_partial_files(tmp_path):
 
 # -- real parts (tests/data/step) -----------------------------------------------
 def _corpus_fe_mesh(path):
-    from surfmod.meshing.figures import shape_figures
+    from surfmod.meshing.figures import shape_diagonal
     from surfmod.uses.femesh import signed_volumes
 
-    _, diag = shape_figures(sm.import_step(path), samples=2)
+    diag = shape_diagonal(sm.import_step(path))
     m = sm.fe_mesh(path, size=diag / 15)
     vol = signed_volumes(m.points, m.cells)
     assert (vol > 0).all() and m.quality["inverted"] == 0

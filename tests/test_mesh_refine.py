@@ -12,7 +12,7 @@ from test_corpus_mesh import closed_and_oriented
 import surfmod as sm
 from surfmod.meshing.brep import measure_face
 from surfmod.meshing.refine import split_round
-from surfmod.meshing.figures import shape_figures
+from surfmod.meshing.figures import shape_diagonal
 from surfmod.meshing.facemesh import brepmesh
 
 
@@ -66,7 +66,7 @@ def test_overshooting_cone_is_refined_in_one_brepmesh_pass(corpus_dir, tmp_path)
     within the tolerance by OCCT's own distance."""
     step = corpus_dir / "build123d_M6-1x12-countersunk-screw.step"
     shape = sm.import_step(step)
-    tol = 1e-3 * shape_figures(shape, samples=2)[1]
+    tol = 1e-3 * shape_diagonal(shape)
     (cone,) = [fm for fm in brepmesh(shape, tol) if fm.index == 3]
     assert measure_face(cone, tol)[0].max() > 1.1 * tol  # what BRepMesh gives
     out = tmp_path / "m6.stl"
@@ -86,7 +86,7 @@ def test_refined_cone_is_within_tolerance_by_occt_distance(corpus_dir):
     from surfmod.occ.sample import distances_to_face
 
     shape = sm.import_step(corpus_dir / "build123d_M6-1x12-countersunk-screw.step")
-    tol = 1e-3 * shape_figures(shape, samples=2)[1]
+    tol = 1e-3 * shape_diagonal(shape)
     fms = brepmesh(shape, tol)
     (i,) = [k for k, fm in enumerate(fms) if fm.index == 3]
     dev, node_dev = np.zeros(len(fms)), np.zeros(len(fms))
@@ -100,7 +100,7 @@ def test_refined_cone_is_within_tolerance_by_occt_distance(corpus_dir):
 
 def test_isometric_repeats_have_the_deviation_of_their_first_instance(corpus_dir):
     shape = sm.import_step(corpus_dir / "pythonocc_as1-oc-214.stp")
-    tol = 1e-3 * shape_figures(shape, samples=2)[1]
+    tol = 1e-3 * shape_diagonal(shape)
     fms = brepmesh(shape, tol)
     repeats = [fm for fm in fms if fm.repeats >= 0]
     assert len(repeats) > 50  # 160 faces, 53 distinct
@@ -128,9 +128,11 @@ def test_spline_figures_in_one_pass_equal_geomlprop(corpus_dir):
     assert len(evaluators) == 189 + 26  # every B-spline face and extrusion, kept for measuring
 
 
-def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):
-    """Cones and tori get the estimate's figures from their radii in closed form: the
-    same numbers GeomLProp's samples give (3 columns x 5 rows, no curvature at an apex)."""
+def test_estimate_figures_equal_geomlprop(corpus_dir):
+    """Cones and tori get the estimate's figures from their radii in closed form, swept
+    surfaces from their surfmod evaluators' partials: the same numbers GeomLProp's
+    samples give (5 x 5, or 3 columns x 5 rows where only v matters; no curvature at an
+    apex)."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepTools import BRepTools
     from OCP.GeomLProp import GeomLProp_SLProps
@@ -141,18 +143,19 @@ def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):
     from surfmod.occ.topo import faces_of
 
     shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp").wrapped
-    floor = 1.0 / shape_figures(shape)[1]
+    floor = 1.0 / shape_diagonal(shape)
     seen = set()
     for face in faces_of(shape):
         surf = occ_mesh.basis_surface(BRep_Tool.Surface_s(face))
         name = surface_type(surf)
-        if name not in ("Geom_ConicalSurface", "Geom_ToroidalSurface"):
+        if name not in ("Geom_ConicalSurface", "Geom_ToroidalSurface", "Geom_SurfaceOfRevolution",
+                        "Geom_SurfaceOfLinearExtrusion"):
             continue
         seen.add(name)
         area, k = figures._face_figure(face, 5, floor)
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         props, jac, vals = GeomLProp_SLProps(surf, 2, 1e-9), [], []
-        for u in np.linspace(u0, u1, 3):
+        for u in np.linspace(u0, u1, 3 if name in ("Geom_ConicalSurface", "Geom_ToroidalSurface") else 5):
             for v in np.linspace(v0, v1, 5):
                 props.SetParameters(float(u), float(v))
                 jac.append(props.D1U().Crossed(props.D1V()).Magnitude())
@@ -160,7 +163,8 @@ def test_cone_and_torus_figures_in_closed_form_equal_geomlprop(corpus_dir):
                     vals.append(np.sqrt(max(abs(props.MaxCurvature()), floor) * max(abs(props.MinCurvature()), floor)))
         assert area == pytest.approx(np.mean(jac) * (u1 - u0) * (v1 - v0), rel=1e-12)
         assert k == pytest.approx(np.median(vals) if vals else floor, rel=1e-12)
-    assert seen == {"Geom_ConicalSurface", "Geom_ToroidalSurface"}
+    assert seen == {"Geom_ConicalSurface", "Geom_ToroidalSurface", "Geom_SurfaceOfRevolution",
+                    "Geom_SurfaceOfLinearExtrusion"}
 
 
 def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
@@ -171,7 +175,7 @@ def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
     from surfmod.meshing.deviation import DENSE, triangle_deviations
 
     shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
-    tol = 1e-3 * shape_figures(shape, samples=2)[1]
+    tol = 1e-3 * shape_diagonal(shape)
     fms = brepmesh(shape, tol)
     evaluators: dict = {}
     pairs = [(fm, ev) for fm in fms if (ev := _evaluator(evaluators, fm)) is not None and ev.projector is not None]
@@ -195,7 +199,7 @@ def test_analytic_faces_measured_at_once_equal_face_by_face(corpus_dir):
     from surfmod.meshing.brep import measure_analytic_faces
 
     shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
-    tol = 1e-3 * shape_figures(shape, samples=2)[1]
+    tol = 1e-3 * shape_diagonal(shape)
     pairs = [(fm, a) for fm in brepmesh(shape, tol) if (a := analytic.parameters(fm.surface)) is not None]
     assert len({a[0] for _, a in pairs}) == 4  # planes, cylinders, cones and tori
     together = measure_analytic_faces([fm for fm, _ in pairs], [a for _, a in pairs])
