@@ -42,9 +42,6 @@ class FaceSurface:
         spline curve is then evaluated as a B-spline surface over that box widened by
         its own size on each side (and clamped there, as the other non-periodic
         directions are clamped to their range)."""
-        from ..occ.geom import surface_type
-
-        self.name = surface_type(surf)
         self.periodic, self.period, self.range = parameter_space(surf)
         self.surf = surf
         box = tuple(bounds) if bounds is not None else self.range[0] + self.range[1]
