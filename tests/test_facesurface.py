@@ -1,14 +1,15 @@
 """FaceSurface, the evaluator mesh measurement uses on a face's surface, equals OCCT's
 own evaluation where the face lives: an extrusion of a spline curve given its UV box is
 evaluated as an exact B-spline net (positions and partials to order 2 equal OCCT's D2,
-its compiled projection finds the distance along the normal), and the closed-form swept
-path wraps periodic parameters as OCCT does."""
+its compiled projection finds the distance along the normal), swept surfaces are the
+surfmod surfaces readback reads and wrap periodic parameters as OCCT does, and a type
+the reader does not know is evaluated by OCCT per point."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from OCP.Geom import Geom_SurfaceOfLinearExtrusion, Geom_SurfaceOfRevolution
+from OCP.Geom import Geom_OffsetCurve, Geom_SurfaceOfLinearExtrusion, Geom_SurfaceOfRevolution
 from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Vec
 
 import surfmod as sm
@@ -82,3 +83,16 @@ def test_revolution_of_a_periodic_curve_wraps_its_parameter():
         got = ev.d1(u + 2 * np.pi, v + shift)
         for k, l in ((0, 0), (1, 0), (0, 1)):
             np.testing.assert_allclose(got[:, k, l], ref[:, k, l], rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_revolution_of_a_curve_the_reader_does_not_know_is_evaluated_by_occt():
+    offset = Geom_OffsetCurve(_curve("plain"), 0.25, gp_Dir(0, 0, 1))  # no surfmod reader
+    surf = Geom_SurfaceOfRevolution(offset, gp_Ax1(gp_Pnt(0, -3, 0), gp_Dir(1, 0, 0)))
+    ev = FaceSurface(surf, (0.0, 1.0, 0.2, 0.8))
+    assert not ev.numpy and not ev.spline
+    u, v = np.array([0.3, 2.0, 5.9]), np.array([0.25, 0.6, 0.75])
+    ref = _occt_d2(surf, u, v)
+    got = ev.d1(u, v)
+    for k, l in ((0, 0), (1, 0), (0, 1)):
+        np.testing.assert_array_equal(got[:, k, l], ref[:, k, l])
+    np.testing.assert_array_equal(ev.d0(u, v), ref[:, 0, 0])

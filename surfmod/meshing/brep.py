@@ -15,7 +15,8 @@ once):
   tolerance, compiled (:mod:`surfmod.eval.packed`); periodic directions wrap, as OCCT
   evaluates them;
 * any other surface (Bezier, other surfaces of revolution and extrusions, offset): the
-  same in NumPy, with :class:`FaceSurface` (closed-form swept surfaces) or OCCT's ``D1``.
+  same in NumPy, with :class:`FaceSurface` (the surface :mod:`surfmod.readback` reads, or
+  OCCT per point for a type the reader does not know).
 
 A real part is not exact: BRepMesh puts the nodes of a face's boundary on the *edges'*
 3-D curves, which the model only keeps within the edges' declared tolerance of the
