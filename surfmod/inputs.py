@@ -1,4 +1,6 @@
-"""Turn whatever the user hands to a "use" into an OCCT shape.
+"""Turn whatever the user hands to a "use" into an OCCT shape, and OCCT shapes back into
+the build123d objects users get: with :mod:`surfmod.occ`, the only module that imports
+build123d.
 
 Accepted: a surfmod ``Surface`` (its face), a list/tuple of surfaces or faces (sewn into
 a closed solid when ``solid=True``), any build123d shape, an OCP ``TopoDS_Shape``, or the
@@ -8,6 +10,8 @@ path of a STEP file.
 from __future__ import annotations
 
 import os
+
+import numpy as np
 
 from .errors import SurfmodError
 from .surface import Surface
@@ -79,3 +83,40 @@ def make_solid(surfaces):
     if not isinstance(surfaces, (list, tuple)) or not surfaces:
         raise SurfmodError("surfaces: expected a non-empty list of surfaces or faces")
     return bd.Solid(to_shape(list(surfaces), "surfaces", solid=True))
+
+
+def build123d_face(shape):
+    """The build123d ``Face`` of a ``TopoDS_Face``."""
+    import build123d as bd
+
+    return bd.Face(shape)
+
+
+def build123d_shell(shape):
+    """The build123d ``Shell`` of a ``TopoDS_Shell``."""
+    import build123d as bd
+
+    return bd.Shell(shape)
+
+
+def build123d_compound(objects):
+    """A build123d ``Compound`` of a list of build123d objects, or the build123d object
+    of one ``TopoDS_Shape`` read from a file (build123d's ``cast`` picks its class).
+
+    >>> import surfmod as sm
+    >>> len(build123d_compound([sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)).face()]).faces())
+    1
+    """
+    import build123d as bd
+
+    if isinstance(objects, list):
+        return bd.Compound(objects)
+    return bd.Compound.cast(objects) if hasattr(bd.Compound, "cast") else bd.Compound(objects)
+
+
+def edge_positions(edge, ts) -> np.ndarray:
+    """Points ``(len(ts), 3)`` of a build123d ``Edge``/``Wire`` at normalized parameters
+    ``ts`` in ``[0, 1]`` (build123d's ``PositionMode.PARAMETER``)."""
+    from build123d import PositionMode
+
+    return np.array([tuple(edge.position_at(t, PositionMode.PARAMETER)) for t in ts])

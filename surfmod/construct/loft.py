@@ -25,6 +25,7 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
+from ..inputs import build123d_face, build123d_shell
 from ..nets.bspline import BSplineSurface, cartesian, homogeneous
 from ..nets.elevate import make_compatible
 from .fitting import averaging_knots
@@ -63,9 +64,7 @@ class LoftSurface(BSplineSurface):
 
     def thru_sections(self):
         """OCCT's lofted shell (a build123d ``Shell``)."""
-        import build123d as bd
-
-        return bd.Shell(self._thru()[0])
+        return build123d_shell(self._thru()[0])
 
     def geom(self):
         if self.exact_in_occt:
@@ -79,9 +78,7 @@ class LoftSurface(BSplineSurface):
     def face(self):
         if self.exact_in_occt:
             return BSplineSurface.face(self)
-        import build123d as bd
-
-        return bd.Face(self._thru()[1][0])
+        return build123d_face(self._thru()[1][0])
 
     def occt_deviation(self, samples: int = 24) -> float:
         """Max distance from a ``samples x samples`` grid of our points to OCCT's

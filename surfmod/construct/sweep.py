@@ -39,6 +39,7 @@ from .. import checks, tolerances, transforms
 from ..errors import KernelError, SurfmodError
 from ..eval.basis import basis_matrix
 from ..eval.frames import RotationMinimizingTable, any_normal, axis_rotation, frenet_frames
+from ..inputs import build123d_face
 from ..nets.bspline import BSplineCurve
 from ..surface import Surface
 from .fitting import averaging_knots
@@ -371,10 +372,8 @@ class SweptSurface(Surface):
             c = curve.to_bspline()
             return (c.geom(), *c.domain)
 
-        import build123d as bd
-
         profiles = [occ(self.profile)] + ([occ(self.end_profile)] if self.end_profile is not None else [])
-        return bd.Face(pipe_shell(profiles, occ(self.path), mode=self.mode)[1][0])
+        return build123d_face(pipe_shell(profiles, occ(self.path), mode=self.mode)[1][0])
 
     def _frame_rail(self, offset=0.05):
         """An auxiliary spine for OCCT: the path offset along our (twisted) normal,
@@ -400,9 +399,7 @@ class SweptSurface(Surface):
 
     def face(self):
         """The pipe-shell face itself (build123d ``Face``)."""
-        import build123d as bd
-
-        return bd.Face(self._pipe()[1])
+        return build123d_face(self._pipe()[1])
 
     def transformed(self, matrix) -> "SweptSurface":
         m = transforms.affine(matrix)

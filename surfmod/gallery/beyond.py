@@ -11,6 +11,7 @@ import numpy as np
 from ..ops.blend import blend
 from ..construct.elementary import CylindricalSurface
 from ..construct.fill import fill
+from ..inputs import build123d_compound
 from ..construct.offset import thicken
 from ..meshing.analyze import analyze
 from ..nets.bspline import BSplineSurface
@@ -40,20 +41,16 @@ def g2_blend():
 
 @entry("g2_blend", "G2 blend between two NURBS patches", 'sm.blend(a, "u1", b, "u0", "G2")')
 def _g2_blend():
-    import build123d as bd
-
     a, f, b = g2_blend()
-    return bd.Compound([a.face(), f.face(), b.face()])
+    return build123d_compound([a.face(), f.face(), b.face()])
 
 
 @entry("corner_fill", "G1 fill of a three-sided corner", "sm.fill([(x, 'v1'), (y, 'v1'), (z, 'v1')])")
 def _corner_fill():
-    import build123d as bd
-
     r = 2.0
     sides = [(CylindricalSurface(r, (0, 0, 0), axis, x_dir, u_range=(0, np.pi / 2), v_range=(-6, 0)), "v1")
              for axis, x_dir in (((1, 0, 0), (0, 1, 0)), ((0, 1, 0), (0, 0, 1)), ((0, 0, 1), (1, 0, 0)))]
-    return bd.Compound([s.face() for s, _ in sides] + fill(sides).faces())
+    return build123d_compound([s.face() for s, _ in sides] + fill(sides).faces())
 
 
 @entry("thicken", "thickened NURBS patch (offset + ruled walls)", "sm.thicken(s, 0.8)")

@@ -10,6 +10,7 @@ import numpy as np
 from .. import checks
 from ..curve import Curve
 from ..errors import SurfmodError
+from ..inputs import edge_positions
 from .clip import as_face_surface, project_on_face
 from ..readback.trimmed import TrimmedFace
 from ..surface import Surface, require_surface
@@ -38,10 +39,7 @@ def _as_points(points_or_curve, samples):
         return points_or_curve.points(np.linspace(t0, t1, samples))
     if hasattr(points_or_curve, "wrapped") and hasattr(points_or_curve, "position_at"):
         # a build123d Edge / Wire: sampled uniformly in its normalized parameter
-        from build123d import PositionMode
-
-        ts = np.linspace(0.0, 1.0, samples)
-        return np.array([tuple(points_or_curve.position_at(t, PositionMode.PARAMETER)) for t in ts])
+        return edge_positions(points_or_curve, np.linspace(0.0, 1.0, samples))
     return checks.finite_array(points_or_curve, "points_or_curve", last=3)
 
 

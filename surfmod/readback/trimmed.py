@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks
+from ..inputs import build123d_face
 from ..mass.moments import face_moments
 from ..surface import Surface
 from .readers import parameter_space, read_surface
@@ -99,9 +100,7 @@ class TrimmedFace(Surface):
 
     def face(self):
         """The original face as a build123d ``Face``: its trim (holes, cut edges) kept."""
-        import build123d as bd
-
-        return bd.Face(self.face_shape)
+        return build123d_face(self.face_shape)
 
     def transformed(self, matrix) -> "TrimmedFace":
         """Surface and face both mapped (OCCT ``BRepBuilderAPI_Transform``/``GTransform``).
