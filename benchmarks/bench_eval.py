@@ -200,16 +200,17 @@ def measure(single: bool) -> dict:
 
 
 def numpy_paths(grid, u, v) -> dict:
-    """The NumPy local-support paths (:mod:`surfmod.eval.vectorized`, which small work
+    """The NumPy local-support paths (:mod:`surfmod.eval.scattered`, :mod:`surfmod.eval.tensor_grid`, which small work
     takes), timed on the large cases the compiled kernels take, for comparison."""
-    from surfmod.eval import vectorized
+    from surfmod.eval.scattered import scattered
+    from surfmod.eval.tensor_grid import tensor_grid
 
     res = {}
     for n in (20, 400):
         net = nurbs(n)._local_net()
-        res[f"grid{n}"] = _time(lambda: vectorized.grid(*net[:4], net.ctrl, True, grid, grid, 0), True, 2)
+        res[f"grid{n}"] = _time(lambda: tensor_grid(*net[:4], net.ctrl, True, grid, grid, 0), True, 2)
     net = nurbs(20)._local_net()
-    res["scattered"] = _time(lambda: vectorized.scattered(*net[:4], net.ctrl, True, u, v, 0), True, 1)
+    res["scattered"] = _time(lambda: scattered(*net[:4], net.ctrl, True, u, v, 0), True, 1)
     return res
 
 
@@ -430,7 +431,7 @@ def report(one: dict, every: dict) -> None:
         table.row(f"{n}x{n}", _f(r[f"geomdl{n}"], ".1f"), _f(r[f"poly{n}"]), _x(r[f"geomdl{n}"], r[f"poly{n}"]))
     npy = r["numpy"]
     note()
-    heading("numba kernels vs the NumPy paths of small work (eval/vectorized.py; 1 core, rational bicubic):")
+    heading("numba kernels vs the NumPy paths of small work (eval/scattered.py, tensor_grid.py; 1 core, rational bicubic):")
     table = Table(("case", 24), ("NumPy", 9), ("numba", 9), ("speed-up", 9), left_first=True)
     table.header()
     table.row("1000² grid, 20x20 net", _f(npy["grid20"]), _f(one["net"]["20"]["ours"]),

@@ -91,7 +91,7 @@ def corpus_dir():
 @pytest.fixture(scope="module")
 def compiled_kernels():
     """Every evaluation goes through the compiled kernels, however small (by default small
-    work is done in NumPy, eval/vectorized.py): for the tests of the kernels themselves."""
+    work is done in NumPy, eval/scattered.py): for the tests of the kernels themselves."""
     saved = local.COMPILED_SCATTERED, local.COMPILED_GRID
     local.COMPILED_SCATTERED = local.COMPILED_GRID = 0
     yield

@@ -1,6 +1,6 @@
 """The dense NumPy evaluator of surfmod's first round, kept as a test oracle beside
 ``reference.py``: dense basis matrices and two BLAS products per grid, an algorithm
-independent of the local-support paths (surfmod/eval/vectorized.py and the compiled
+independent of the local-support paths (surfmod/eval/scattered.py, tensor_grid.py and their compiled
 kernels) that the library uses.
 
 >>> import numpy as np

@@ -16,6 +16,7 @@ from dense_eval import surface_grid
 import surfmod as sm
 from strategies import bspline_surfaces, parameters_with_knots
 from surfmod.eval import kernels, local
+from surfmod.eval.scattered_compiled import scattered_compiled, scattered_positions_compiled
 from surfmod.eval.basis import find_spans
 from surfmod.eval.rational import surface_quotient
 from surfmod.nets.knots import smooth_mask
@@ -26,7 +27,7 @@ REL = 1e-13
 
 @pytest.fixture(autouse=True, scope="module", params=["default", "compiled"])
 def evaluation_path(request):
-    """Every test twice: with the default choice (NumPy, eval/vectorized.py, for the small
+    """Every test twice: with the default choice (NumPy, eval/scattered.py, for the small
     work of most tests) and with every call forced through the compiled kernels."""
     saved = local.COMPILED_SCATTERED, local.COMPILED_GRID
     if request.param == "compiled":
@@ -275,8 +276,8 @@ def test_patch_positions_match_basis_kernel_and_textbook(p, q, rational, compile
     got = s.points(u, v)
     assert "patches" in net.cache  # the patch path ran
     basis = np.empty_like(got)
-    kernels.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
-                                net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, basis)
+    scattered_positions_compiled(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
+                                 net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, basis)
     atol = REL * _conditioning(s) * np.abs(s.control_points).max()
     np.testing.assert_allclose(got, basis, rtol=0, atol=atol)
     pick = np.r_[0:40, 3000:3040, -4:0]
@@ -301,8 +302,8 @@ def test_patch_partials_match_basis_kernel_and_textbook(p, q, rational, order, c
     got = s.derivatives(u, v, order)
     assert "patches" in net.cache  # the patch path ran
     basis = np.empty_like(got)
-    kernels.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, order, net.rational,
-                                  kernels.binomials(order), net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, basis)
+    scattered_compiled(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, order, net.rational,
+                       kernels.binomials(order), net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, basis)
     _assert_partials(got, basis, s)
     pick = np.r_[0:40, 3000:3040, -4:0]
     (pp, qq), (ku, kv) = s.degree, s.knots

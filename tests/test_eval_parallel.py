@@ -85,7 +85,7 @@ def test_parallel_grid_equals_serial_bit_for_bit(p, q, rational, monkeypatch):
     us, vs = np.linspace(0, 1, 301), np.r_[np.linspace(0, 1, 1500), 0.25, 0.0]  # unsorted tail
     monkeypatch.setattr(local, "CHUNK", 256)  # several chunks of v-points
     serial, threaded = _both(lambda: (s.grid(us, vs), s.grid_derivatives(us[::7], vs[::5], 2)), monkeypatch)
-    assert parallel.grid.signatures  # ran threaded
+    assert parallel.tensor_grid_parallel.signatures  # ran threaded
     np.testing.assert_array_equal(threaded[0], serial[0])
     np.testing.assert_array_equal(threaded[1], serial[1])
     buf = np.empty((us.size, vs.size, 3))
@@ -108,8 +108,8 @@ def test_parallel_scattered_equals_serial_bit_for_bit(rational, monkeypatch):
 
     serial, threaded = _both(run, monkeypatch)
     assert "patches" in small._local_net().cache  # the per-span patch path ran
-    assert parallel.patch_positions.signatures and parallel.scattered_positions.signatures
-    assert parallel.patch_derivatives.signatures  # order 2 on the small net: patches too
+    assert parallel.patch_positions_parallel.signatures and parallel.scattered_positions_parallel.signatures
+    assert parallel.patch_derivatives_parallel.signatures  # order 2 on the small net: patches too
     for a, b in zip(serial, threaded):
         np.testing.assert_array_equal(b, a)
 

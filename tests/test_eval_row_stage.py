@@ -1,4 +1,4 @@
-"""The compiled grid (surfmod/eval/grid_kernels.py), its row stage (surfmod/eval/row_stage.py)
+"""The compiled grid (surfmod/eval/tensor_grid_compiled.py), its row stage (surfmod/eval/row_stage.py)
 and its paired position stage (surfmod/eval/position_stage.py): runs of v-points in
 consecutive spans go through vector loops over the net's coordinate planes and give the
 one-point-at-a-time sums bit for bit, at every degree and order; grids on nets with about
@@ -16,6 +16,7 @@ import reference as ref
 
 import surfmod as sm
 from surfmod.eval import local, row_stage, threads
+from surfmod.eval.scattered import basis_at
 from surfmod.occ.sample import surface_d2
 
 
@@ -82,7 +83,7 @@ def test_vector_row_stage_equals_the_scalar_one_bit_for_bit(q, order, rational):
     rng = np.random.default_rng(q)
     vs = np.r_[(np.arange(3, 3 + 2 * row_stage.MIN_RUN) + 0.5) / spans, np.full(9, 0.5), rng.uniform(v0, v1, 20),
                v1, (np.arange(60, 60 + row_stage.MIN_RUN) + 0.25) / spans]
-    sv, bv = local._basis(net.knots_v, q, m, vs, order)
+    sv, bv = basis_at(net.knots_v, q, m, vs, order)
     starts, kinds = row_stage.runs(sv)
     assert np.any(kinds == row_stage.NEXT_SPAN) and np.any(kinds == row_stage.SCALAR)
     rows = np.array([0, 4, 5, 6, 17, 29], dtype=np.int64)
@@ -167,7 +168,7 @@ def test_the_ring_over_several_v_chunks(rational, monkeypatch):
     spans = 2200 - 3
     vs = np.sort(np.r_[(np.arange(spans) + 0.5) / spans, 0.25, 0.25, 1.0])  # one a span, and a few more
     assert 2 * local.CHUNK < vs.size
-    _, kinds = row_stage.runs(local._basis(s.knots[1], 3, 700, vs, 0)[0])
+    _, kinds = row_stage.runs(basis_at(s.knots[1], 3, 700, vs, 0)[0])
     assert np.count_nonzero(kinds == row_stage.NEXT_SPAN) >= 2 and np.any(kinds == row_stage.SCALAR)
     grid = s.grid(us, vs)
     ders = {order: s.grid_derivatives(us[::4], vs, order) for order in (1, 3)}
@@ -191,18 +192,18 @@ def test_the_ring_over_several_v_chunks(rational, monkeypatch):
 
 def test_positions_and_partials_are_one_compiled_grid():
     """One compiled path for grids: positions and partials of every order, polynomial and
-    rational, on small and big nets, in a fresh process, compile ``grid_kernels.grid``
+    rational, on small and big nets, in a fresh process, compile ``tensor_grid_compiled``
     once (one signature)."""
     script = (
         "import numpy as np, surfmod as sm\n"
         "from surfmod.gallery.synthetic import wavy_net\n"
-        "from surfmod.eval import grid_kernels, threads\n"
+        "from surfmod.eval import tensor_grid_compiled, threads\n"
         "threads.set_threads(1)\n"
         "u = np.linspace(0, 1, 1000)\n"
         "for n, w in ((20, None), (300, np.full((300, 300), 2.0))):\n"
         "    s = sm.BSplineSurface(wavy_net(n, n), (3, 3), weights=w)\n"
         "    s.grid(u, u); s.grid_derivatives(u, u[:500], 1); s.grid_derivatives(u, u[:400], 2)\n"
-        "print(len(grid_kernels.grid.signatures))\n"
+        "print(len(tensor_grid_compiled.tensor_grid_compiled.signatures))\n"
     )
     assert fresh_python(script) == ["1"]
 
@@ -220,6 +221,6 @@ def test_the_meshers_mid_sized_grids_stay_in_numpy():
         "s = sm.BSplineSurface(wavy_net(8, 8), (3, 3))\n"
         "s.grid_derivatives(np.linspace(0, 1, 103), np.linspace(0, 1, 633), 2)\n"
         "s.grid(np.linspace(0, 1, 406), np.linspace(0, 1, 813))\n"
-        "print(int('surfmod.eval.grid_kernels' in sys.modules), int('numba' in sys.modules))\n"
+        "print(int('surfmod.eval.tensor_grid_compiled' in sys.modules), int('numba' in sys.modules))\n"
     )
     assert fresh_python(script) == ["0", "0"]

@@ -121,7 +121,7 @@ def test_the_meshers_projections_compile_one_signature(tmp_path):
         "box = np.array([[0, 1, 0, 1.0]])\n"
         "uv = np.array([[0.2, 0.2], [0.8, 0.2], [0.5, 0.8]])\n"
         "pts = s.points(uv[:, 0], uv[:, 1]) + 0.01\n"
-        "packed.triangle_deviations(pk, box, pts, uv, np.array([[0, 1, 2]]), np.array([[0, 0, 1]]),\n"
+        "packed.triangle_deviations_compiled(pk, box, pts, uv, np.array([[0, 1, 2]]), np.array([[0, 0, 1]]),\n"
         "                           np.array([[1 / 3] * 3]), np.zeros(1))\n"
         "packed.project_segments(pk, box, pts, uv, np.array([[0, 0, 3]]), np.zeros(1), np.zeros(1))\n"
         "ev.projector(pts, uv, (0, 1, 0, 1), 0.0)\n"

@@ -22,7 +22,8 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from ..errors import SurfmodError
-from ..eval import local, vectorized
+from ..eval import local
+from ..eval.scattered import scattered
 from ..interop.geomdl_io import to_geomdl
 from ..interop.rhino_io import to_rhino
 from ..interop.splipy_io import to_splipy
@@ -42,14 +43,16 @@ class Adapter(NamedTuple):
 def _surfmod_compiled(obj, u, v, order):
     """surfmod's compiled basis-function kernel (what scattered points beyond a few
     thousand use), whatever the number of points."""
+    from ..eval.kernels import binomials  # numba: compiled on first use, then from its disk cache
+    from ..eval.scattered_compiled import scattered_compiled
+
     if v is None:
         return obj.derivatives(u, order)  # curves have one path, NumPy
     net = _net(obj)
-    k = local._kernels()  # the compiled scattered kernel, whatever the number of points
     out = np.empty((u.size, order + 1, order + 1, 3))
-    k.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, local.writable(u),
-                            local.writable(v), int(order), net.rational, k.binomials(order), net.inv_u,
-                            net.inv_v, net.bucket_u, net.bucket_v, out)
+    scattered_compiled(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, local.writable(u), local.writable(v),
+                       int(order), net.rational, binomials(order), net.inv_u, net.inv_v, net.bucket_u, net.bucket_v,
+                       out)
     return _placed(net, out)
 
 
@@ -76,9 +79,9 @@ def _surfmod_patches(obj, u, v, order):
     n, m = net.ctrl.shape[:2]
     if not patches.suits(net.p, net.q, n, m, net.ctrl[..., 3] if net.rational else None, (net.knots_u, net.knots_v)):
         return _surfmod_compiled(obj, u, v, order)  # where surfmod never uses patches
-    table = patches.build(net)
+    table = patches.build_table(net)
     out = np.empty((u.size, 3) if order == 0 else (u.size, order + 1, order + 1, 3))
-    kernel = patches.patch_positions if order == 0 else patches.patch_derivatives
+    kernel = patches.patch_positions_compiled if order == 0 else patches.patch_derivatives_compiled
     kernel(*patches.arguments(net, table, local.writable(u), local.writable(v), out))
     return _placed(net, out)
 
@@ -87,7 +90,7 @@ def _surfmod_numpy(obj, u, v, order):
     if v is None:
         return obj.derivatives(u, order)
     net = _net(obj)
-    out = vectorized.scattered(*net[:4], net.ctrl, net.rational, local.writable(u), local.writable(v), order)
+    out = scattered(*net[:4], net.ctrl, net.rational, local.writable(u), local.writable(v), order)
     return _placed(net, out)
 
 

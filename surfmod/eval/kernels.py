@@ -6,8 +6,10 @@ imported lazily (``import surfmod`` never imports numba) and compiled once into 
 on-disk cache (``cache=True``).  Every sizeable array they write (outputs, the grid's
 ring of rows) is allocated by the NumPy caller, so ``tracemalloc`` sees the memory and the
 caller decides the blocking; inside there are only per-chunk scratch planes of a few
-hundred KiB at most.  The grid kernels are in :mod:`surfmod.eval.grid_kernels`, the multi-threaded variants
-in :mod:`surfmod.eval.parallel`.
+hundred KiB at most.  This module holds what the kernels share (span search, basis
+functions, quotient rule); the kernels themselves are the ``_compiled`` twins
+(:mod:`surfmod.eval.scattered_compiled`, :mod:`surfmod.eval.tensor_grid_compiled`,
+:mod:`surfmod.eval.patches`) and their ``_parallel`` variants (:mod:`surfmod.eval.parallel`).
 
 Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polynomial,
 4 rational ``(w x, w y, w z, w)``), C-contiguous float64.  Spans follow
@@ -145,92 +147,9 @@ def binomials(order: int) -> np.ndarray:
     return out
 
 
-#: points per block of the scattered-derivative kernel (its planes stay in L1/L2)
-POINT_BLOCK = 128
 #: scattered points per chunk: the unit of work of the parallel variants
 #: (:mod:`surfmod.eval.parallel`); a multiple of :data:`POINT_BLOCK`
 SCATTER_CHUNK = 4096
-
-@njit(cache=True, error_model="numpy")
-def scattered_derivatives(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u, bucket_v, out,
-                          origin=None):
-    """Mixed partials at scattered pairs into ``out (N, K, K, 3)`` (Cartesian).
-
-    ``ctrl`` is ``(n, m, 4)``: homogeneous for a rational net, the weight column unused
-    otherwise.  Points go in blocks: per point the spans, the basis derivatives and a
-    gather of the local ``(p+1) x (q+1)`` net into planes; then the contraction and the
-    quotient rule run over the block with the points on the contiguous (vector) axis.
-    ``origin`` (3 values, or None) is added to the positions as they are stored: the
-    point a far net is taken about (:func:`surfmod.eval.local.prepare`)."""
-    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
-        scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v,
-                                    bucket_u, bucket_v, out, c, origin)
-
-
-@njit(cache=True, error_model="numpy")
-def scattered_derivatives_chunk(ku, p, kv, q, ctrl, u, v, order, rational, binom, inv_u, inv_v, bucket_u,
-                                bucket_v, out, chunk, origin=None):
-    """Points ``chunk * SCATTER_CHUNK`` onwards (one chunk) of :func:`scattered_derivatives`,
-    with their own scratch planes: chunks are independent."""
-    n, m = ctrl.shape[0], ctrl.shape[1]
-    kk = order + 1
-    nb = POINT_BLOCK
-    dim = 4 if rational else 3
-    ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
-    lu, ru, tu = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
-    lv, rv, tv = np.empty(q + 1), np.empty(q + 1), np.empty(q + 1)
-    du, dv = np.empty((kk, p + 1)), np.empty((kk, q + 1))
-    bu, bv = np.empty((kk, p + 1, nb)), np.empty((kk, q + 1, nb))
-    local = np.empty((p + 1, q + 1, 4, nb))
-    row = np.empty((kk, 4, nb))
-    h = np.ones((kk, kk, 4, nb))  # lanes past a short last block keep finite values
-    t0u, scale_u, table_u = bucket_u
-    t0v, scale_v, table_v = bucket_v
-    end = min(u.size, (chunk + 1) * SCATTER_CHUNK)
-    for a0 in range(chunk * SCATTER_CHUNK, end, nb):
-        cnt = min(nb, end - a0)
-        for b in range(cnt):
-            su = find_span_bucketed(ku, p, n, u[a0 + b], t0u, scale_u, table_u)
-            sv = find_span_bucketed(kv, q, m, v[a0 + b], t0v, scale_v, table_v)
-            basis_ders_point(ku, p, su, u[a0 + b], order, inv_u, ndu_u, lu, ru, tu, du)
-            basis_ders_point(kv, q, sv, v[a0 + b], order, inv_v, ndu_v, lv, rv, tv, dv)
-            for k in range(kk):
-                for i in range(p + 1):
-                    bu[k, i, b] = du[k, i]
-                for j in range(q + 1):
-                    bv[k, j, b] = dv[k, j]
-            for i in range(p + 1):
-                for j in range(q + 1):
-                    for d in range(4):
-                        local[i, j, d, b] = ctrl[su - p + i, sv - q + j, d]
-        for i in range(p + 1):
-            for l in range(kk):
-                for d in range(dim):
-                    for b in range(cnt):
-                        row[l, d, b] = bv[l, 0, b] * local[i, 0, d, b]
-                    for j in range(1, q + 1):
-                        for b in range(cnt):
-                            row[l, d, b] += bv[l, j, b] * local[i, j, d, b]
-            for k in range(kk):
-                for l in range(kk):
-                    for d in range(dim):
-                        if i == 0:
-                            for b in range(cnt):
-                                h[k, l, d, b] = bu[k, 0, b] * row[l, d, b]
-                        else:
-                            for b in range(cnt):
-                                h[k, l, d, b] += bu[k, i, b] * row[l, d, b]
-        if rational:  # on the whole block: contiguous planes vectorize
-            quotient_planes(h, binom)
-        for b in range(cnt):
-            for k in range(kk):
-                for l in range(kk):
-                    for d in range(3):
-                        out[a0 + b, k, l, d] = h[k, l, d, b]
-            if origin is not None:
-                for d in range(3):
-                    out[a0 + b, 0, 0, d] += origin[d]
-
 
 @njit(cache=True, error_model="numpy")
 def position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u, v, lu, ru, nu_, lv, rv, nv_):
@@ -261,33 +180,6 @@ def position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, 
     if rational:
         return x / w, y / w, z / w
     return x, y, z
-
-
-@njit(cache=True, error_model="numpy")
-def scattered_positions(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, origin=None):
-    """Positions at scattered pairs into ``out (N, 3)``: the order-0 case of
-    :func:`scattered_derivatives` with the cheaper Cox-de Boor triangle (A2.2) and the
-    sums kept in registers (``origin`` added, if given)."""
-    for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
-        scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, c,
-                                  origin)
-
-
-@njit(cache=True, error_model="numpy")
-def scattered_positions_chunk(ku, p, kv, q, ctrl, u, v, rational, inv_u, inv_v, bucket_u, bucket_v, out, chunk,
-                              origin=None):
-    """One chunk of :func:`scattered_positions` (points ``chunk * SCATTER_CHUNK`` on)."""
-    nu_, nv_ = np.empty(p + 1), np.empty(q + 1)
-    lu, ru = np.empty(p + 1), np.empty(p + 1)
-    lv, rv = np.empty(q + 1), np.empty(q + 1)
-    for a in range(chunk * SCATTER_CHUNK, min(u.size, (chunk + 1) * SCATTER_CHUNK)):
-        x, y, z = position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u[a], v[a],
-                              lu, ru, nu_, lv, rv, nv_)
-        if origin is not None:
-            x, y, z = x + origin[0], y + origin[1], z + origin[2]
-        out[a, 0] = x
-        out[a, 1] = y
-        out[a, 2] = z
 
 
 @njit(cache=True, error_model="numpy")

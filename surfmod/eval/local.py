@@ -12,9 +12,12 @@ rows with the v-points on the contiguous axis.  Results are written point-major,
 into a caller's array when given.  :func:`partials_finite` bounds the partials once per
 net, so callers need not rescan large outputs for NaN or infinity.
 
-The compiled kernels live in :mod:`surfmod.eval.kernels` and
-:mod:`surfmod.eval.grid_kernels`, imported on first use (so
-``import surfmod`` does not load numba).
+Every path is a twin: ``name`` in NumPy (:mod:`surfmod.eval.scattered`,
+:mod:`surfmod.eval.tensor_grid`) for small work, ``name_compiled`` (numba, one thread:
+:mod:`surfmod.eval.scattered_compiled`, :mod:`surfmod.eval.tensor_grid_compiled`,
+:mod:`surfmod.eval.patches`) for large, ``name_parallel`` (:mod:`surfmod.eval.parallel`)
+when several threads may run.  :func:`_kernel` is the one place that picks among them; the
+compiled modules are imported on first use (so ``import surfmod`` does not load numba).
 
 >>> import numpy as np
 >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
@@ -33,8 +36,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import vectorized
-from .basis import basis_derivatives, find_spans, reciprocal_table, span_buckets
+from .scattered import basis_at, scattered
+from .tensor_grid import tensor_grid
+from .basis import reciprocal_table, span_buckets
 from .threads import running_on, threads_for
 
 #: rows in the ring of contracted net rows at least: a pass reads at most five (a cubic
@@ -52,7 +56,7 @@ GRID_MIN_BLOCK = 16
 #: blocks per thread (at least): threads that finish early take more of them
 BLOCKS_PER_THREAD = 8
 #: work (points times partials per point, ``(order + 1)^2``) from which scattered pairs
-#: go through the compiled kernels; less is done in NumPy (:mod:`surfmod.eval.vectorized`),
+#: go through the compiled kernels; less is done in NumPy (:mod:`surfmod.eval.scattered`),
 #: which takes milliseconds there, while the first compiled call of a process loads numba
 #: and its kernels (about a second; minutes into an empty cache)
 COMPILED_SCATTERED = 1 << 15
@@ -70,37 +74,33 @@ def _kernels():
     return kernels
 
 
-def _kernels_for(points: int, grid: bool = False):
-    """The kernels for ``points`` evaluations (scattered, or a grid) and their thread
-    count: the single-threaded ones, or their parallel variants
-    (:mod:`surfmod.eval.parallel`, equal bit for bit) when :mod:`surfmod.eval.threads`
-    allows several threads."""
+def _kernel(name: str, points: int):
+    """The compiled twin ``name`` for ``points`` evaluations and its thread count:
+    ``name_compiled`` on one thread, or ``name_parallel`` (:mod:`surfmod.eval.parallel`,
+    equal bit for bit) when :mod:`surfmod.eval.threads` allows several threads.  The
+    modules are imported here, on first use (numba: compiled once, then from its disk cache)."""
     count = threads_for(points)
     if count > 1:
         from . import parallel
 
-        return parallel, count
-    if grid:
-        from . import grid_kernels
+        return getattr(parallel, f"{name}_parallel"), count
+    if name == "tensor_grid":
+        from . import tensor_grid_compiled as module
+    elif name.startswith("patch_"):
+        from . import patches as module
+    else:
+        from . import scattered_compiled as module
+    return getattr(module, f"{name}_compiled"), 1
 
-        return grid_kernels, 1
-    return _kernels(), 1
 
+def _run_patches(name: str, net, table, u, v, out) -> None:
+    """The per-span patch kernel ``name`` (:mod:`surfmod.eval.patches`) at the scattered
+    pairs ``(u, v)`` into ``out``, on the threads :func:`_kernel` picks."""
+    from . import patches
 
-def _run_patches(kernel: str, net, table, u, v, out) -> None:
-    """The per-span patch kernel ``kernel`` (:mod:`surfmod.eval.patches`) at the scattered
-    pairs ``(u, v)`` into ``out``, or its parallel variant (:mod:`surfmod.eval.parallel`)
-    when :mod:`surfmod.eval.threads` allows several threads, as :func:`_kernels_for`."""
-    from . import patches  # numba: compiled on first use, then from its disk cache
-
-    count = threads_for(u.size)
-    run = patches
-    if count > 1:
-        from . import parallel
-
-        run = parallel
+    run, count = _kernel(name, u.size)
     with _on(count):
-        getattr(run, kernel)(*patches.arguments(net, table, u, v, out), net.origin)
+        run(*patches.arguments(net, table, u, v, out), net.origin)
 
 
 def _on(count: int):
@@ -296,7 +296,7 @@ def _patch_table(net: LocalNet, count: int):
 
     if not patches.suits(net.p, net.q, n, m, net.ctrl[..., 3] if net.rational else None, (net.knots_u, net.knots_v)):
         return None
-    table = net.cache["patches"] = patches.build(net)
+    table = net.cache["patches"] = patches.build_table(net)
     return table
 
 
@@ -306,26 +306,7 @@ def surface_points(net: LocalNet, u, v, out=None) -> np.ndarray:
 
     Many points on a small low-degree net go through per-span polynomial patches
     (:mod:`surfmod.eval.patches`), the others through the basis-function kernel."""
-    u, v = _as_float(u), _as_float(v)
-    net = _centred(net)
-    if u.size < COMPILED_SCATTERED:
-        h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, 0)[:, 0, 0]
-        _add_origin(net, h)
-        if out is None:
-            return h
-        out[...] = h
-        return out
-    if out is None:
-        out = np.empty((u.size, 3))
-    table = _patch_table(net, u.size)  # the kernels add the origin as they store
-    if table is not None:
-        _run_patches("patch_positions", net, table, u, v, out)
-        return out
-    run, count = _kernels_for(u.size)
-    with _on(count):
-        run.scattered_positions(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, net.rational,
-                                net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, out, net.origin)
-    return out
+    return _scattered(net, u, v, 0, True, out)
 
 
 def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray:
@@ -335,34 +316,40 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
     Partials to order 1 or 2 of many points on a small low-degree net go through the
     per-span patches (:mod:`surfmod.eval.patches`, as positions do), the others through
     the basis-function kernel."""
+    return _scattered(net, u, v, order, False, out)
+
+
+def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndarray:
+    """The one place scattered pairs pick their path: NumPy (:func:`scattered`) below
+    :data:`COMPILED_SCATTERED` partials, else the per-span patches (positions, or
+    partials to order 1 or 2, on a net that suits them), else the basis-function kernel;
+    a compiled one on the threads :func:`_kernel` picks.  ``positions``: ``(N, 3)``
+    positions instead of ``(N, K, K, 3)`` partials."""
     u, v = _as_float(u), _as_float(v)
     net = _centred(net)
     if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
-        h = vectorized.scattered(*net[:4], net.ctrl, net.rational, u, v, order)
+        h = scattered(*net[:4], net.ctrl, net.rational, u, v, order)
         _add_origin(net, h[:, 0, 0])
+        h = h[:, 0, 0] if positions else h
         if out is None:
             return h
         out[...] = h
         return out
-    k = _kernels()
     if out is None:
-        out = np.empty((u.size, order + 1, order + 1, 3))
-    table = _patch_table(net, u.size) if order in (1, 2) else None
+        out = np.empty((u.size, 3) if positions else (u.size, order + 1, order + 1, 3))
+    table = _patch_table(net, u.size) if positions or order in (1, 2) else None
     if table is not None:  # the kernels add the origin as they store
-        _run_patches("patch_derivatives", net, table, u, v, out)
+        _run_patches("patch_positions" if positions else "patch_derivatives", net, table, u, v, out)
         return out
-    run, count = _kernels_for(u.size)
+    head, tail = (net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v), (net.inv_u, net.inv_v, net.bucket_u,
+                                                                         net.bucket_v, out, net.origin)
+    run, count = _kernel("scattered_positions" if positions else "scattered", u.size)
     with _on(count):
-        run.scattered_derivatives(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v, int(order),
-                                  net.rational, k.binomials(order), net.inv_u, net.inv_v, net.bucket_u,
-                                  net.bucket_v, out, net.origin)
+        if positions:
+            run(*head, net.rational, *tail)
+        else:
+            run(*head, int(order), net.rational, _kernels().binomials(order), *tail)
     return out
-
-
-def _basis(knots, degree, n_ctrl, t, order):
-    spans = find_spans(knots, degree, n_ctrl, t)
-    ders = np.ascontiguousarray(basis_derivatives(knots, degree, spans, t, order))  # (N, K, deg+1)
-    return spans, ders
 
 
 def homogeneous4(ctrl: np.ndarray) -> np.ndarray:
@@ -440,8 +427,8 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     Everything is written point-major (C order), into ``out`` when given: ``(len(us),
     len(vs), 3)`` for positions (``order == 0``), ``(len(us), len(vs), K, K, 3)`` for
     partials.  Small grids (under :data:`COMPILED_GRID` partials) are evaluated in NumPy
-    (:mod:`surfmod.eval.vectorized`), the others by the compiled grid
-    (:mod:`surfmod.eval.grid_kernels`: each net row the u-points need is contracted with
+    (:mod:`surfmod.eval.tensor_grid`), the others by its compiled twin
+    (:mod:`surfmod.eval.tensor_grid_compiled`: each net row the u-points need is contracted with
     the v-basis once per chunk of v-points into a ring, then each u-point combines its
     rows), the u-points in ascending order (unsorted ones are sorted, and their rows
     put back in place).
@@ -452,7 +439,7 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     kk = order + 1
     shape = (us.size, vs.size, kk, kk, 3)
     if us.size * vs.size * (order + 1) ** 2 < COMPILED_GRID:
-        h = vectorized.grid(knots_u, p, knots_v, q, ctrl, rational, us, vs, order)
+        h = tensor_grid(knots_u, p, knots_v, q, ctrl, rational, us, vs, order)
         _add_origin(net, h[:, :, 0, 0])
         if out is None:
             return h
@@ -477,20 +464,20 @@ def _grid_sorted(net: LocalNet, us, vs, order: int, out) -> None:
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
     n, m = ctrl.shape[:2]
     kk, dim = order + 1, 4 if rational else 3
-    su, bu = _basis(knots_u, p, n, us, order)
-    sv, bv = _basis(knots_v, q, m, vs, order)
+    su, bu = basis_at(knots_u, p, n, us, order)
+    sv, bv = basis_at(knots_v, q, m, vs, order)
     first = (su - p).astype(np.int64)
     needed = np.unique(first[:, None] + np.arange(p + 1)).size
     plan = _row_stage_plan(net, sv, bv, needed)
     ring_rows = max(RING_ROWS, p + 1)
     chunk = min(vs.size, CHUNK, max(16, RING_DOUBLES // (ring_rows * kk * dim)))
-    run, count = _kernels_for(us.size * vs.size, grid=True)
+    run, count = _kernel("tensor_grid", us.size * vs.size)
     scratch = _scratch(count, ring_rows * kk * dim * chunk)
     origin = np.zeros(3) if net.origin is None else net.origin  # added in the kernel, while in cache
     head = (bv, plan[0], sv, q, ctrl, plan[1], dim, bu, p, rational, k.binomials(order), out, origin)
     tail = (ring_rows, chunk, first, plan[2], plan[3])
     if count == 1:
-        run.grid(*head, scratch[0], *tail)
+        run(*head, scratch[0], *tail)
         return
     with _on(count):
-        run.grid(*head, scratch, *tail, _u_blocks(us.size, count))
+        run(*head, scratch, *tail, _u_blocks(us.size, count))

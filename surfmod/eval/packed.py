@@ -15,7 +15,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .kernels import binomials, scattered_derivatives
+from .kernels import binomials
+from .scattered_compiled import scattered_compiled
 from .projection_kernel import _wrap, project_distances
 
 
@@ -119,13 +120,14 @@ def project_segments(pk: NetPack, boxes: np.ndarray, points: np.ndarray, uv: np.
     return out
 
 
-def triangle_deviations(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: np.ndarray, triangles: np.ndarray,
-                        faces: np.ndarray, bary: np.ndarray, threshold: np.ndarray) -> np.ndarray:
+def triangle_deviations_compiled(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: np.ndarray,
+                                 triangles: np.ndarray, faces: np.ndarray, bary: np.ndarray,
+                                 threshold: np.ndarray) -> np.ndarray:
     """Max distance bound per triangle over its barycentric samples ``bary (K, 3)``:
     each sample ``bary @ corners`` in space and in ``(u, v)`` (``nodes (N, 3)``, ``uv
     (N, 2)``, ``triangles (T, 3)`` indexing them), projected onto its net from its
     ``(u, v)`` while its bound exceeds its net's ``threshold`` (as
-    :func:`surfmod.meshing.deviation.triangle_deviations` with a projector).
+    :func:`surfmod.meshing.deviation.triangle_deviations`, its NumPy twin, with a projector).
     ``faces (F, 3)`` rows ``(net, first triangle, end triangle)``.  Returns ``(T,)``.
 
     >>> import numpy as np, surfmod as sm
@@ -134,8 +136,9 @@ def triangle_deviations(pk: NetPack, boxes: np.ndarray, nodes: np.ndarray, uv: n
     >>> s = sm.BSplineSurface(net, (3, 3))
     >>> pk = pack([s._local_net()], [[0, 0]], [[1, 1]], [[0, 0]], [[False, False]])
     >>> uv = np.array([[0.2, 0.2], [0.8, 0.2], [0.5, 0.8]])
-    >>> d = triangle_deviations(pk, np.array([[0, 1, 0, 1.0]]), s.points(uv[:, 0], uv[:, 1]), uv,
-    ...                         np.array([[0, 1, 2]]), np.array([[0, 0, 1]]), np.array([[1 / 3] * 3]), np.zeros(1))
+    >>> d = triangle_deviations_compiled(pk, np.array([[0, 1, 0, 1.0]]), s.points(uv[:, 0], uv[:, 1]), uv,
+    ...                                  np.array([[0, 1, 2]]), np.array([[0, 0, 1]]), np.array([[1 / 3] * 3]),
+    ...                                  np.zeros(1))
     >>> bool(0.0 < d[0] < 0.6)  # the chord sags below the bump's top
     True
     """
@@ -232,4 +235,4 @@ def _derivatives_segments(pk, u, v, segments, order, binom, out):
         for i in range(b - a):
             uu[i] = _wrap(u[a + i], pk.lo[f, 0], pk.hi[f, 0], pk.period[f, 0], pk.periodic[f, 0])
             vv[i] = _wrap(v[a + i], pk.lo[f, 1], pk.hi[f, 1], pk.period[f, 1], pk.periodic[f, 1])
-        scattered_derivatives(ku, pf, kv, qf, net, uu, vv, order, rat, binom, iu, iv, bu, bv, out[a:b])
+        scattered_compiled(ku, pf, kv, qf, net, uu, vv, order, rat, binom, iu, iv, bu, bv, out[a:b])

@@ -11,7 +11,7 @@ where ``T[k, i] = N_i^(k)(mid) half^k / k!`` are the Taylor rows of the basis fu
 (computed by the same division-free Cox-de Boor triangle as every other kernel).  A
 point then costs a span search and a Horner scheme: no basis triangle, no knot look-ups;
 its partials, Horner schemes that carry their first two derivatives, the chain rule's
-factors ``(1 / half)^k`` and the quotient rule (:func:`patch_derivatives`: about a third of
+factors ``(1 / half)^k`` and the quotient rule (:func:`patch_derivatives_compiled`: about a third of
 the basis-function kernel's time on a 20x20 bicubic NURBS).  OCCT's ``BSplSLib_Cache``
 evaluates the same kind of per-span polynomial.  ``eval/local.py`` runs these kernels, or
 their parallel variants (:mod:`surfmod.eval.parallel`), with :func:`arguments`.
@@ -27,7 +27,7 @@ level of the basis-function sums (agreement 1e-13 relative, tests/test_eval_loca
 >>> knots = np.array([0, 0, 0, 0, 1, 1, 1, 1.0])
 >>> prepared = local.prepare(knots, 3, knots, 3, net)
 >>> out = np.empty((1, 3))
->>> patch_positions(*arguments(prepared, build(prepared), np.array([0.5]), np.array([0.25]), out))
+>>> patch_positions_compiled(*arguments(prepared, build_table(prepared), np.array([0.5]), np.array([0.25]), out))
 >>> out
 array([[1.5 , 0.75, 0.  ]])
 """
@@ -132,7 +132,7 @@ def _contract(rows_u, rows_v, p, q, ctrl, coeffs):
                             c[k, l, d] += t * by_v[l, d]
 
 
-def build(net) -> PatchTable:
+def build_table(net) -> PatchTable:
     """The patch table of a :class:`surfmod.eval.local.LocalNet` (see :func:`suits`)."""
     n, m = net.ctrl.shape[:2]
     p, q = net.p, net.q
@@ -155,10 +155,10 @@ def _cubic_in_y(c, o, y):
 # Horner steps may fuse into FMAs ("contract"): one rounding instead of two, never a
 # reassociated sum, so the results stay within an ulp or so of the unfused ones.
 @njit(cache=True, error_model="numpy")
-def patch_positions(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                    bucket_u, bucket_v, u, v, out, origin=None):
+def patch_positions_compiled(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                             bucket_u, bucket_v, u, v, out, origin=None):
     """Positions at scattered pairs into ``out (N, 3)``, chunk after chunk (the serial twin
-    of :func:`surfmod.eval.parallel.patch_positions`); arguments: :func:`arguments`, and
+    of :func:`surfmod.eval.parallel.patch_positions_parallel`); arguments: :func:`arguments`, and
     the ``origin`` added to the positions (a far net's centre), if any."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         positions_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
@@ -264,10 +264,10 @@ def _patch_points(flat, p, q, base, xs, ys, rational, out, c0, c1):
 
 
 @njit(cache=True, error_model="numpy")
-def patch_derivatives(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
-                      bucket_u, bucket_v, u, v, out, origin=None):
+def patch_derivatives_compiled(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
+                               bucket_u, bucket_v, u, v, out, origin=None):
     """Partials to order 1 or 2 at scattered pairs into ``out (N, K, K, 3)``, chunk after
-    chunk (the serial twin of :func:`surfmod.eval.parallel.patch_derivatives`)."""
+    chunk (the serial twin of :func:`surfmod.eval.parallel.patch_derivatives_parallel`)."""
     for c in range((u.size + SCATTER_CHUNK - 1) // SCATTER_CHUNK):
         derivatives_chunk(ku, p, kv, q, n, m, coeffs, mid_u, scale_u, mid_v, scale_v, rational,
                           bucket_u, bucket_v, u, v, out, c, origin)
@@ -351,7 +351,7 @@ def _store_partials(h, rational, out, a, kk):
 
 
 def arguments(net, table: PatchTable, u: np.ndarray, v: np.ndarray, out: np.ndarray) -> tuple:
-    """The arguments of :func:`patch_positions` and :func:`patch_derivatives` (and of their
+    """The arguments of :func:`patch_positions_compiled` and :func:`patch_derivatives_compiled` (and of their
     parallel variants) for ``net``'s table at the scattered pairs ``(u[a], v[a])`` (flat
     float64 arrays, in the domain), writing ``out``."""
     n, m = net.ctrl.shape[:2]

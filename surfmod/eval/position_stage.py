@@ -1,4 +1,4 @@
-"""The combine stage of the grid (:mod:`surfmod.eval.grid_kernels`) for positions at
+"""The combine stage of the grid (:mod:`surfmod.eval.tensor_grid_compiled`) for positions at
 degrees up to 3 in u: each u-point combines its rows of the ring with the v-points
 on the vector axis, divides by the weight and stores its points interleaved, all in one
 loop with everything in registers (the four row terms are written out; missing ones get

@@ -1,4 +1,4 @@
-"""The row stage of the grid (:mod:`surfmod.eval.grid_kernels`): a net row the u-points
+"""The row stage of the grid (:mod:`surfmod.eval.tensor_grid_compiled`): a net row the u-points
 need, contracted with the v-basis, in vector loops where the v-points allow.
 
 Each v-point's window of q+1 poles starts at its own column, so a loop over the v-points

@@ -3,7 +3,7 @@
 Control points arrive in homogeneous form: ``(..., 3)`` for polynomial splines or
 ``(..., 4)`` = ``(w x, w y, w z, w)`` for rational ones.  The result keeps that last axis;
 :mod:`surfmod.eval.rational` turns it into Cartesian derivatives.  Surfaces are evaluated
-by :mod:`surfmod.eval.local` (NumPy for small work in :mod:`surfmod.eval.vectorized`,
+by :mod:`surfmod.eval.local` (NumPy for small work in :mod:`surfmod.eval.scattered`,
 compiled kernels for large); the dense BLAS evaluator of the first round is a test
 oracle now (``tests/dense_eval.py``).
 """

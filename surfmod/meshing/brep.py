@@ -172,7 +172,7 @@ def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> 
     """:func:`measure_face` of many B-spline faces (``evs``: their :class:`FaceSurface`,
     each with a ``projector``) in two compiled calls (:mod:`surfmod.eval.packed`): per
     face its triangles' deviations and its nodes' max deviation, the same values."""
-    from ..eval.packed import project_segments, triangle_deviations
+    from ..eval.packed import project_segments, triangle_deviations_compiled
 
     for fm in fms:
         if np.isnan(fm.uv).any():
@@ -185,7 +185,8 @@ def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> 
     half = np.full(len(fms), 0.5 * tolerance)
     # a sample within half the tolerance needs only its bound; nodes farther off than
     # that are projected to convergence (the model's own error)
-    tri = triangle_deviations(pk, boxes, nodes, uv, triangles, np.c_[faces, tri_at[:-1], tri_at[1:]], bary, half)
+    tri = triangle_deviations_compiled(pk, boxes, nodes, uv, triangles, np.c_[faces, tri_at[:-1], tri_at[1:]], bary,
+                                       half)
     node = project_segments(pk, boxes, nodes, uv, np.c_[faces, node_at[:-1], node_at[1:]], half,
                             np.zeros(len(fms)))
     node_max = np.maximum.reduceat(node, node_at[:-1]) if len(node) else np.zeros(len(fms))

@@ -76,7 +76,7 @@ def project_distances(d1, points, uv, bounds, iterations: int = 6, threshold: fl
 def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None, d0=None, accurate_max=True):
     """Measured max deviation per triangle: ``positions`` (T, 3, 3), ``uvs`` (T, 3, 2)
     (B-spline faces of real parts go through the compiled
-    :func:`surfmod.eval.packed.triangle_deviations` instead).
+    :func:`surfmod.eval.packed.triangle_deviations_compiled` instead).
 
     Samples whose parameter-space bound is already at most ``threshold`` are not
     projected (their bound suffices to pass).  With ``accurate_max``, the samples within

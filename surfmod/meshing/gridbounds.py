@@ -1,4 +1,4 @@
-"""The loops of :mod:`surfmod.meshing.gridmesh_kernels` in NumPy, for lattices too small to wait
+"""The loops of :mod:`surfmod.meshing.gridbounds_compiled` in NumPy, for lattices too small to wait
 for numba: the first mesh of a process would otherwise spend a second importing numba
 and loading the kernels (minutes compiling them into an empty cache) on work NumPy does
 in milliseconds.  Same arithmetic in the same order, so the same values bit for bit
@@ -22,7 +22,7 @@ import numpy as np
 
 
 def diagonals(S, K: int, cells: tuple[int, int]) -> np.ndarray:
-    """``(ncu, ncv)`` bools as :func:`surfmod.meshing.gridmesh_kernels.diagonals`: True for the
+    """``(ncu, ncv)`` bools as :func:`~surfmod.meshing.gridbounds_compiled.diagonals_compiled`: True for the
     00-11 diagonal when its midpoint lies closer to the surface's midpoint (along the
     normal) than the 10-01 one's; ties by 3-D length."""
     ncu, ncv = cells
@@ -65,7 +65,7 @@ def _diff(S, cell_index, K: int, axis: int):
 
 
 def estimates(S, K: int, diag, kmax: float):
-    """``(est, Q)`` as :func:`surfmod.meshing.gridmesh_kernels.estimates`: the triangles' linear
+    """``(est, Q)`` as :func:`~surfmod.meshing.gridbounds_compiled.estimates_compiled`: the triangles' linear
     interpolation ``Q`` at every lattice point and the bound ``est`` of its distance to
     the surface (the residual minus its tangential part, plus ``kmax |J delta|^2 / 2``;
     ``|S - Q|`` where that is smaller or the tangent plane is degenerate)."""
@@ -107,7 +107,7 @@ def estimates(S, K: int, diag, kmax: float):
 
 
 def cell_maxima(est, K: int, cells: tuple[int, int]):
-    """``(err, eu, ev)`` as :func:`surfmod.meshing.gridmesh_kernels.cell_maxima`: per cell the
+    """``(err, eu, ev)`` as :func:`~surfmod.meshing.gridbounds_compiled.cell_maxima_compiled`: per cell the
     largest ``est`` over its lattice points (sides shared with the neighbours), and the
     largest at the midpoints of its u-sides and v-sides; 0 at least (NaN is skipped)."""
     ncu, ncv = cells

@@ -11,7 +11,7 @@ equidistributing a chordal-error bound, then *verified* and refined where it fai
    lines.
 2. **Verification.**  Every cell is sampled on a ``6 x 6`` lattice (the 25 sample points
    per triangle of :mod:`surfmod.meshing.deviation`, for either diagonal), evaluated as
-   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridmesh_kernels`).
+   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridbounds_compiled`).
    At each sample ``q = L(u, v)`` (the triangles' linear interpolation) the residual
    ``r = S(u, v) - q`` is split into its tangential part (a Gauss-Newton step
    ``J delta``, tangents by finite differences on the cell's lattice) and its normal
@@ -37,6 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
+from ..ops.closest import crease_breaks
 from . import gridbounds
 from .deviation import project_distances
 
@@ -44,7 +45,7 @@ from .deviation import project_distances
 K = 6
 #: lattice points per verification block (bounded memory)
 BLOCK_POINTS = 1 << 18
-#: lattice points from which a block is bounded by the compiled loops (gridmesh_kernels.py);
+#: lattice points from which a block is bounded by the compiled loops (gridbounds_compiled.py);
 #: smaller ones in NumPy (gridbounds.py, the same values), which spares the first mesh
 #: of a process numba's import and load
 COMPILED_LATTICE = 1 << 16
@@ -54,28 +55,6 @@ MAX_PASSES = 40
 COARSEN_PASSES = 2
 #: coarsen only when it would leave fewer than this fraction of the cells
 COARSEN_GAIN = 0.9
-
-
-def crease_breaks(s, direction: int) -> np.ndarray:
-    """Domain ends plus the knots where the surface is only C0 in ``direction``
-    (multiplicity >= degree): lines the grid must contain.
-
-    >>> import surfmod as sm, numpy as np
-    >>> net = np.zeros((5, 2, 3)); net[..., 0] = np.arange(5)[:, None]; net[..., 1] = [0, 1]
-    >>> s = sm.BSplineSurface(net, (2, 1), ([0, 0, 0, .5, .5, 1, 1, 1], [0, 0, 1, 1]))
-    >>> crease_breaks(s, 0).tolist()
-    [0.0, 0.5, 1.0]
-    """
-    lo, hi = (float(x) for x in s.domain[direction])
-    knots = getattr(s, "knots", None)
-    degree = getattr(s, "degree", None)
-    if knots is None or degree is None:
-        return np.array([lo, hi])
-    k = np.asarray(knots[direction], dtype=float)
-    vals, counts = np.unique(k, return_counts=True)
-    eps = 1e-12 * (hi - lo)
-    inner = vals[(counts >= degree[direction]) & (vals > lo + eps) & (vals < hi - eps)]
-    return np.concatenate([[lo], inner, [hi]])
 
 
 def _sample_params(s, direction: int, breaks: np.ndarray, base: int = 48) -> np.ndarray:
@@ -225,12 +204,12 @@ class GridMesh:
             diag = self.diag[i0:i1]
             compiled = S.shape[0] * S.shape[1] >= COMPILED_LATTICE
             if compiled:
-                from . import gridmesh_kernels as gk  # numba: loaded on the first large lattice
+                from .gridbounds_compiled import diagonals_compiled, estimates_compiled  # numba: first large lattice
 
-                gk.diagonals(S, K, diag)
+                diagonals_compiled(S, K, diag)
                 est = np.empty(S.shape[:2])
                 Q = np.empty_like(S)
-                gk.estimates(S, K, diag, self.kmax, est, Q)
+                estimates_compiled(S, K, diag, self.kmax, est, Q)
             else:
                 diag[...] = gridbounds.diagonals(S, K, diag.shape)
                 est, Q = gridbounds.estimates(S, K, diag, self.kmax)
@@ -244,9 +223,9 @@ class GridMesh:
         for i0, i1, est in blocks:
             parts = self.err[i0:i1], self.eu[i0:i1], self.ev[i0:i1]
             if est.size >= COMPILED_LATTICE:
-                from . import gridmesh_kernels as gk
+                from .gridbounds_compiled import cell_maxima_compiled
 
-                gk.cell_maxima(est, K, *parts)
+                cell_maxima_compiled(est, K, *parts)
             else:
                 for part, value in zip(parts, gridbounds.cell_maxima(est, K, parts[0].shape)):
                     part[...] = value

@@ -1,6 +1,8 @@
-"""Local-support evaluation in NumPy, for work too small to wait for a compiled kernel.
+"""Scattered local-support evaluation in NumPy, for work too small to wait for a compiled
+kernel; the compiled twins are in :mod:`surfmod.eval.scattered_compiled` (and
+:mod:`surfmod.eval.tensor_grid` is this module's grid).
 
-The compiled kernels (:mod:`surfmod.eval.kernels` and the grid stages) are the fast path
+The compiled kernels (``scattered_compiled``, ``tensor_grid_compiled``) are the fast path
 for large work, but a process pays for them once: importing numba and loading the
 kernels from its disk cache costs about a second, compiling them into an empty cache
 minutes.  A new user's first grid of a few thousand points, or a mesher's few hundred
@@ -32,9 +34,11 @@ from .rational import surface_quotient
 BLOCK = 1 << 13
 
 
-def _basis(knots, degree, n_ctrl, t, order):
+def basis_at(knots, degree, n_ctrl, t, order):
+    """Spans and basis derivatives ``(N, K, degree+1)`` at the parameters ``t``, C-contiguous
+    (the compiled grid reads them too)."""
     spans = find_spans(knots, degree, n_ctrl, t)
-    return spans, basis_derivatives(knots, degree, spans, t, order)  # (N, K, degree+1)
+    return spans, np.ascontiguousarray(basis_derivatives(knots, degree, spans, t, order))
 
 
 def _cartesian(h: np.ndarray, rational: bool) -> np.ndarray:
@@ -50,8 +54,8 @@ def scattered(ku, p, kv, q, ctrl, rational: bool, u, v, order: int) -> np.ndarra
     out = np.empty((u.size, kk, kk, 3))
     for a0 in range(0, u.size, BLOCK):  # loop over cache blocks, not points
         ub, vb = u[a0 : a0 + BLOCK], v[a0 : a0 + BLOCK]
-        su, bu = _basis(ku, p, n, ub, order)
-        sv, bv = _basis(kv, q, m, vb, order)
+        su, bu = basis_at(ku, p, n, ub, order)
+        sv, bv = basis_at(kv, q, m, vb, order)
         h = np.zeros((ub.size, kk, kk, dim))
         for i in range(p + 1):
             # row[a, l] = sum_j d^l Nv_j(v_a) P[su_a - p + i, sv_a - q + j]
@@ -61,24 +65,3 @@ def scattered(ku, p, kv, q, ctrl, rational: bool, u, v, order: int) -> np.ndarra
             h += bu[:, :, i, None, None] * row[:, None]
         out[a0 : a0 + BLOCK] = _cartesian(h, rational)
     return out
-
-
-def grid(ku, p, kv, q, ctrl, rational: bool, us, vs, order: int) -> np.ndarray:
-    """Partials to ``order`` on the grid ``us x vs``: ``(len(us), len(vs), K, K, 3)``.
-
-    Two stages, as the compiled grid: the net rows the u-points read are contracted with
-    the v-basis once (``rows[r, b, l]``), then every u-point combines its ``p + 1`` rows."""
-    n, m = ctrl.shape[:2]
-    kk, dim = order + 1, 4 if rational else 3
-    su, bu = _basis(ku, p, n, us, order)
-    sv, bv = _basis(kv, q, m, vs, order)
-    needed = np.unique((su[:, None] - p + np.arange(p + 1)).ravel())
-    local = ctrl[needed][:, :, :dim]  # (R, m, dim): only the rows in use
-    rows = np.zeros((needed.size, vs.size, kk, dim))
-    for j in range(q + 1):
-        rows += bv[None, :, :, j, None] * local[:, sv - q + j, None, :]
-    first = np.searchsorted(needed, su - p)
-    h = np.zeros((us.size, vs.size, kk, kk, dim))
-    for i in range(p + 1):
-        h += bu[:, None, :, None, i, None] * rows[first + i][:, :, None, :, :]
-    return _cartesian(h, rational)

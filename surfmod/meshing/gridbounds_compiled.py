@@ -1,6 +1,8 @@
-"""Compiled (numba) loops of the structured-grid verification
-(:mod:`surfmod.meshing.gridmesh`): per lattice point the triangles' linear interpolation
-and a second-order bound of its distance to the surface, and per cell the maxima.
+"""Compiled (numba) twins of :mod:`surfmod.meshing.gridbounds`, the loops of the
+structured-grid verification (:mod:`surfmod.meshing.gridmesh`): per lattice point the
+triangles' linear interpolation and a second-order bound of its distance to the surface,
+and per cell the maxima.  ``name_compiled`` computes what ``gridbounds.name`` does, into
+the caller's arrays.
 
 Imported lazily (numba), compiled once into numba's cache.
 """
@@ -31,7 +33,7 @@ def _diff(S, A, B, a, I0, K, along_u, d):
 
 
 @njit(cache=True, error_model="numpy")
-def diagonals(S, K, diag):
+def diagonals_compiled(S, K, diag):
     """Per cell: True for the 00-11 diagonal when its midpoint lies closer to the
     surface's midpoint (along the normal) than the 10-01 one's; ties by 3-D length."""
     ncu, ncv = diag.shape
@@ -62,7 +64,7 @@ def diagonals(S, K, diag):
 
 
 @njit(cache=True, error_model="numpy")
-def estimates(S, K, diag, kmax, est, Q):
+def estimates_compiled(S, K, diag, kmax, est, Q):
     """Linear interpolation ``Q`` of the grid's triangles at every lattice point and the
     bound ``est`` of its distance to the surface: the residual ``S - Q`` minus its
     tangential part (one Gauss-Newton step ``J delta``, the tangents ``J`` by finite
@@ -124,7 +126,7 @@ def estimates(S, K, diag, kmax, est, Q):
 
 
 @njit(cache=True, error_model="numpy")
-def cell_maxima(est, K, err, eu, ev):
+def cell_maxima_compiled(est, K, err, eu, ev):
     """Per cell the largest ``est`` over its lattice points (sides shared with the
     neighbours), and the largest at the midpoints of its u-sides (``eu``) and v-sides
     (``ev``).
@@ -132,7 +134,7 @@ def cell_maxima(est, K, err, eu, ev):
     >>> import numpy as np
     >>> est = np.zeros((5, 3)); est[2, 0] = 1.0  # K = 2: 2 x 1 cells; a corner both share
     >>> err, eu, ev = np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1))
-    >>> cell_maxima(est, 2, err, eu, ev)
+    >>> cell_maxima_compiled(est, 2, err, eu, ev)
     >>> err.ravel().tolist(), ev.ravel().tolist(), eu.ravel().tolist()
     ([1.0, 1.0], [0.0, 0.0], [0.0, 0.0])
     """

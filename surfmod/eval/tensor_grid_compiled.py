@@ -1,4 +1,5 @@
-"""The compiled (numba) grid ``us x vs``: positions and partials to any order, one path.
+"""The compiled (numba) twin of :mod:`surfmod.eval.tensor_grid`: the grid ``us x vs``,
+positions and partials to any order, one path.
 
 Two stages, interleaved.  The *row stage* (:func:`surfmod.eval.row_stage.contract_row`)
 contracts a net row with the v-basis; the *combine* stage forms a u-point's values from
@@ -17,7 +18,7 @@ that stay in L1 (to order 2, each row window loaded once for the three u-orders)
 quotient rule runs there (:func:`surfmod.eval.kernels.quotient_planes`), and
 :func:`_store` writes each point's ``3 K^2`` values together.  Conventions as in
 :mod:`surfmod.eval.kernels`; the multi-threaded variant (blocks of u-points, a ring
-each) is in :mod:`surfmod.eval.parallel`.
+each) is :func:`surfmod.eval.parallel.tensor_grid_parallel`.
 
 Measured against the five specialised paths this replaces (a row table or a sliding
 ring, a scalar or a vector row stage, three combine stages; 1 core, 1000² points):
@@ -41,17 +42,17 @@ PLANE_POINTS = 64
 
 
 @njit(cache=True, error_model="numpy")
-def grid(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk, first,
-         run_starts, run_kinds):
+def tensor_grid_compiled(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows,
+                         chunk, first, run_starts, run_kinds):
     """The grid ``us x vs`` into ``out`` (point-major ``(n_u, N_v, K, K, 3)``,
-    ``K = bu.shape[1]``; positions are ``K = 1``): :func:`grid_block` on all u-points."""
-    grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk,
-               first, run_starts, run_kinds, 0, bu.shape[0])
+    ``K = bu.shape[1]``; positions are ``K = 1``): :func:`tensor_grid_block` on all u-points."""
+    tensor_grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk,
+                      first, run_starts, run_kinds, 0, bu.shape[0])
 
 
 @njit(cache=True, error_model="numpy")
-def grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk,
-               first, run_starts, run_kinds, a0, a1):
+def tensor_grid_block(bv, bplan, sv, q, ctrl, planes, dim, bu, p, rational, binom, out, origin, space, ring_rows, chunk,
+                      first, run_starts, run_kinds, a0, a1):
     """u-points ``a0:a1`` of the grid, in ascending order: ``first[a]`` is u-point ``a``'s
     lowest net row (its span minus ``p``), ``bu (n_u, K, p+1)`` its basis and derivatives;
     ``bv (n_v, K, q+1)`` and ``sv`` the v-basis and spans, ``bplan``/``planes``/``run_*``
