@@ -447,7 +447,7 @@ def _settle_curvature(face: dict, k_mine, k_occ, k_point, k_scale: float, limit:
     err_mine = err_occ = 0.0
     scale = np.array([k_scale**2, k_scale, k_scale, k_scale])  # the Gaussian is 1/L^2
     for j in worst:
-        ref = np.array(mp_reference.curvatures(base.control_points, getattr(base, "weights", None), base.degree,
+        ref = np.array(mp_reference.mp_curvatures(base.control_points, getattr(base, "weights", None), base.degree,
                                                base.knots, float(uu[j]), float(vv[j])))
         err_mine = max(err_mine, float((np.abs(k_mine[j] - ref) / scale).max()))
         err_occ = max(err_occ, float((np.abs(k_occ[j] - ref) / scale).max()))

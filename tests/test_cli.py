@@ -123,10 +123,10 @@ def test_mesh_command_writes_a_watertight_stl(tmp_path, capsys):
 
 
 def test_gallery_table_keeps_long_names_whole():
-    from surfmod.gallery.runner import Row, format_table
+    from surfmod.gallery.runner import GalleryRow, format_table
 
     long = "Catmull–Clark limit of a pentagonal prism (mixed polygons)"
-    rows = [Row("a", long, "Solid", "per-face", 7.1e-15, True), Row("b", "sphere", "Geom_SphericalSurface", "parametric", 0.0, False)]
+    rows = [GalleryRow("a", long, "Solid", "per-face", 7.1e-15, True), GalleryRow("b", "sphere", "Geom_SphericalSurface", "parametric", 0.0, False)]
     lines = format_table(rows).splitlines()
     assert long in lines[2] and lines[2].endswith("yes")
     assert lines[3].endswith("NO")
@@ -258,4 +258,4 @@ def test_a_command_loads_no_other_command():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     loaded = eval(done.stdout.strip().splitlines()[-1])
     assert "surfmod.cli.mass" in loaded
-    assert not [m for m in loaded if m.startswith("surfmod.cam") or m in ("surfmod.cli.machine", "surfmod.cli.mesh")]
+    assert not [m for m in loaded if m.startswith("surfmod.cam") or m in ("surfmod.cli.machine", "surfmod.cli.mesh_stl")]

@@ -136,7 +136,7 @@ def test_strict_refuses_and_writes_nothing(tmp_path, monkeypatch, capsys):
     would tighten them, so the solid goes to the command as the reader's result)."""
     import build123d as bd
 
-    import surfmod.cli.mesh as cli_mesh
+    import surfmod.cli.mesh_stl as cli_mesh
 
     solid = bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 2) - bd.Solid.make_cylinder(2, 10)
     monkeypatch.setattr(cli_mesh, "import_step", lambda path: solid)

@@ -1,7 +1,7 @@
 """surfmod's evaluator against the 40-digit reference (:mod:`surfmod.nets.mp_reference`)
 on a stress family built here, and against OCCT's own error on it (issue 35).
 
-Every path is held to the same bar: the NumPy twin (``eval/vectorized.py``), the compiled
+Every path is held to the same bar: the NumPy twins (``eval/scattered.py``, ``eval/tensor_grid.py``), the compiled
 scattered kernel, the per-span patches, the compiled and the NumPy grids.  Positions,
 partials to order 2, normals and curvatures stay within ``max(OCCT's error, 1e-12)``
 relative of the reference, the bar of issue 35 (each order relative to its largest
@@ -108,7 +108,7 @@ def _parameters(domain, knots, rng, count=12):
 def _reference(points, weights, degree, knots, u, v):
     out = np.full((u.size, 3, 3, 3), np.nan)
     for a in range(u.size):
-        for (k, l), x in mp_reference.partials(points, weights, degree, knots, u[a], v[a]).items():
+        for (k, l), x in mp_reference.mp_partials(points, weights, degree, knots, u[a], v[a]).items():
             out[a, k, l] = [float(c) for c in x]
     return out
 
@@ -172,7 +172,7 @@ def test_surface_within_occt_and_reference(name):
     if name == "collapsed pole row":
         return  # normals and curvatures are judged where they are defined: the cases below
     normals, k_occ = surface_props(geom, u, v)
-    k_ref = np.array([mp_reference.curvatures(s.control_points, s.weights, s.degree, s.knots, a, b)
+    k_ref = np.array([mp_reference.mp_curvatures(s.control_points, s.weights, s.degree, s.knots, a, b)
                       for a, b in zip(u, v)])
     n_ref = unit_normals(ref)
     k_occ, n_occ = _curvature_error(k_occ, k_ref), np.abs(normals - n_ref).max()
@@ -191,7 +191,7 @@ def test_principal_curvatures_keep_their_digits_near_an_umbilic():
     s = sm.interpolate(sphere + np.array([1e3, -2e3, 5e2]), degree=(3, 3))
     rng = np.random.default_rng(3)
     u, v = rng.uniform(0, 1, 10), rng.uniform(0, 1, 10)
-    k_ref = np.array([mp_reference.curvatures(s.control_points, s.weights, s.degree, s.knots, a, b)
+    k_ref = np.array([mp_reference.mp_curvatures(s.control_points, s.weights, s.degree, s.knots, a, b)
                       for a, b in zip(u, v)])
     assert np.all(k_ref[:, 2] - k_ref[:, 3] < 1e-2 * np.abs(k_ref[:, 2]))  # near-umbilic everywhere
     k = np.stack(s.curvatures(u, v), axis=1)

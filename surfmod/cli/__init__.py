@@ -45,7 +45,7 @@ class Parser(argparse.ArgumentParser):
 #: others (``machine`` alone loads the CAM stack); ``tests/test_cli.py`` holds the table to
 #: what the modules register
 COMMANDS = {"analyze": "analyze", "check": "check", "conformance": "conformance", "convert": "exchange",
-            "femesh": "femesh", "gallery": "gallery", "machine": "machine", "mass": "mass", "mesh": "mesh",
+            "femesh": "femesh", "gallery": "gallery", "machine": "machine", "mass": "mass", "mesh": "mesh_stl",
             "section": "section", "toolpath": "toolpath"}
 
 

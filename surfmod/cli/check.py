@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import SurfmodError
-from ..io.step import import_step
+from ..io.step_iges import import_step
 from ..readback import from_face
 from ..occt_crosscheck import crosscheck_many
 from . import EXIT_PARTIAL

@@ -17,9 +17,7 @@ from pathlib import Path
 
 from ..atomic import atomic_path, target_path
 from ..errors import InsideOutWarning, RoundTripWarning, SurfmodError
-from ..io.iges import SUFFIXES as IGES_SUFFIXES
-from ..io.iges import export_iges, import_iges
-from ..io.step import export_step, import_step
+from ..io.step_iges import IGES_SUFFIXES, export_iges, export_step, import_iges, import_step
 from ..io.stl import export_stl
 
 STEP_SUFFIXES = (".step", ".stp")

@@ -41,7 +41,7 @@ def compute(case: Case, dps: int = DPS) -> np.ndarray:
             o.control_points, o.weights, o.degree, o.knots, t, dps)] for t in case.u]).reshape(-1, 3, 3)
     out = np.full((case.u.size, 3, 3, 3), np.nan)
     for a, (u, v) in enumerate(zip(case.u, case.v)):
-        d = mp_reference.partials(o.control_points, o.weights, o.degree, o.knots, u, v, dps)
+        d = mp_reference.mp_partials(o.control_points, o.weights, o.degree, o.knots, u, v, dps)
         for (k, l), vec in d.items():
             out[a, k, l] = [float(x) for x in vec]
     return out

@@ -33,7 +33,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..nets.bspline import BSplineCurve, BSplineSurface, cartesian, homogeneous
+from ..nets.bspline import BSplineSurface, cartesian, homogeneous
 from ..nets.elevate import elevated, make_compatible
 from .from_edge import as_curve
 
@@ -198,17 +198,3 @@ def _at_least_cubic(pair):
         return pair
     deg = pair[0].degree + 4 - len(pair[0].control_points)
     return [elevated(c, deg) for c in pair]
-
-
-def reversed_curve(curve: BSplineCurve) -> BSplineCurve:
-    """The same B-spline run backwards over the same interval.
-
-    >>> import surfmod as sm
-    >>> c = reversed_curve(sm.BSplineCurve([(0, 0, 0), (1, 1, 0), (3, 0, 0)], 2))
-    >>> c.points(0.0).tolist()
-    [3.0, 0.0, 0.0]
-    """
-    b = curve.to_bspline()
-    k = b.knots
-    w = None if b.weights is None else b.weights[::-1]
-    return BSplineCurve._trusted(b.control_points[::-1], b.degree, (k[0] + k[-1]) - k[::-1], w)

@@ -85,7 +85,7 @@ def polygon(n: int):
     return verts, inward, float(np.cos(np.pi / n))
 
 
-def distances(n: int, xy: np.ndarray):
+def side_distances(n: int, xy: np.ndarray):
     """Jets of the distances ``d_i`` from the points ``xy`` to the n sides (affine)."""
     verts, inward, _ = polygon(n)
     count = len(xy)
@@ -126,7 +126,7 @@ def side_blend(ribbons, xy: np.ndarray, power: int = 2) -> Jet:
     nearest = gap.argmin(axis=1)
     at_vertex = gap[np.arange(len(xy)), nearest] < 1e-9
     safe = np.where(at_vertex[:, None], 0.0, xy)       # vertex rows: filled in below
-    dist = distances(n, safe)
+    dist = side_distances(n, safe)
     sq = [mul(d, d) for d in dist]
     if power == 3:
         sq = [mul(d, q) for d, q in zip(dist, sq)]
@@ -147,7 +147,7 @@ def side_blend(ribbons, xy: np.ndarray, power: int = 2) -> Jet:
         out = term if out is None else out + term
     for k in np.unique(nearest[at_vertex]):
         rows = at_vertex & (nearest == k)
-        vdist = distances(n, np.repeat(verts[k][None], rows.sum(), axis=0))
+        vdist = side_distances(n, np.repeat(verts[k][None], rows.sum(), axis=0))
         before, after = (k - 1) % n, k        # side k-1 ends at vertex k, side k starts there
         mean = (ribbon_value(ribbons[before], vdist, before, r)
                 + ribbon_value(ribbons[after], vdist, after, r)).scaled(0.5)

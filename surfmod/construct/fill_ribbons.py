@@ -36,7 +36,7 @@ import numpy as np
 
 from ..errors import SurfmodError
 from ..sides import SIDES, side_params
-from .fill_domain import compose, distances, polygon, side_parameter
+from .fill_domain import compose, polygon, side_distances, side_parameter
 
 
 def _quartic_basis():
@@ -188,7 +188,7 @@ def _domain_corner(n: int, i: int):
     ``gi gi^T, gi gj^T + gj gi^T, gj gj^T`` (``g`` = inward side normals)."""
     verts, inward, _ = polygon(n)
     j = (i + 1) % n
-    dist = distances(n, verts[j][None])
+    dist = side_distances(n, verts[j][None])
     si, sj = side_parameter(dist, i), side_parameter(dist, j)
     gi, gj = inward[i], inward[j]
     basis = np.array([[gi[0] * gi[0], 2 * gi[0] * gj[0], gj[0] * gj[0]],

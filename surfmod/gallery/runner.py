@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import SurfmodError
-from ..io.step import export_step
+from ..io.step_iges import export_step
 from ..io.stl import export_stl
 from ..meshing.render import render
 from ..surface import Surface
@@ -16,7 +16,7 @@ from tqdm import tqdm
 
 
 @dataclass
-class Row:
+class GalleryRow:
     name: str
     entity: str
     construct: str
@@ -26,7 +26,7 @@ class Row:
     note: str = ""
 
 
-def run_entry(e: Entry, outdir: Path) -> Row:
+def run_entry(e: Entry, outdir: Path) -> GalleryRow:
     try:
         obj = e.build()
         if isinstance(obj, Surface):
@@ -43,16 +43,16 @@ def run_entry(e: Entry, outdir: Path) -> Row:
         export_step(obj, outdir / f"{e.name}.step")
         export_stl(obj, outdir / f"{e.name}.stl", tolerance=0.01)
         _render(obj, outdir / f"{e.name}.png")
-        return Row(e.name, e.entity, construct, mode, dev, ok)
+        return GalleryRow(e.name, e.entity, construct, mode, dev, ok)
     except SurfmodError as exc:
-        return Row(e.name, e.entity, "-", "error", float("nan"), False, str(exc))
+        return GalleryRow(e.name, e.entity, "-", "error", float("nan"), False, str(exc))
 
 
 def _render(obj, path: Path) -> None:
     render([obj], path)
 
 
-def run_gallery(outdir, *, progress: bool = True, only=None) -> list[Row]:
+def run_gallery(outdir, *, progress: bool = True, only=None) -> list[GalleryRow]:
     """Build, check and export every entry (or the named ones); one row each."""
     items = entries()
     if only:
@@ -65,7 +65,7 @@ def run_gallery(outdir, *, progress: bool = True, only=None) -> list[Row]:
     return [run_entry(e, out) for e in tqdm(items, desc="gallery", unit="entity", disable=not progress)]
 
 
-def format_table(rows: list[Row]) -> str:
+def format_table(rows: list[GalleryRow]) -> str:
     """Plain-text table, columns as wide as their longest entry (nothing is cut)."""
     we = max([len("entity"), *(len(r.entity) for r in rows)])
     wc = max([len("OCCT construct"), *(len(r.construct) for r in rows)])

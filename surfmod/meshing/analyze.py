@@ -35,7 +35,7 @@ from ..errors import SurfmodError
 from ..sides import normal_curvature
 from ..readback import from_face
 from ..surface import Surface
-from .analyze_plot import write_png
+from .analyze_plot import write_analysis_png
 
 KINDS = ("zebra", "isophote", "gaussian", "mean", "max_abs", "comb")
 #: Triangles shared out among the faces of a shape (keeps a whole part to a few seconds).
@@ -327,6 +327,6 @@ def analyze(obj, kind: str, out=None, *, light=None, stripes: int = 8, resolutio
     combs = _combs(sources, comb_curves, max(24, resolution), comb_scale) if kind == "comb" else ()
     result = Analysis(kind, light_dir, tuple(patches), combs)
     if out is not None:
-        path = write_png(result, out, eye, title=title, stripes=stripes)
+        path = write_analysis_png(result, out, eye, title=title, stripes=stripes)
         result = Analysis(kind, light_dir, tuple(patches), combs, path)
     return result

@@ -34,7 +34,7 @@ def _shade(normals_tri, eye):
     return 0.45 + 0.55 * lam
 
 
-def write_png(result, out, eye, *, title=None, stripes: int = 8, dpi: int = 110):
+def write_analysis_png(result, out, eye, *, title=None, stripes: int = 8, dpi: int = 110):
     """Draw ``result`` into the PNG ``out`` (atomic write); returns the path."""
     import matplotlib  # heavy: imported on the first picture only
     import matplotlib.cm as cm

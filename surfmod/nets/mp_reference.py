@@ -80,7 +80,7 @@ def _basis_ders(knots, p: int, i: int, t, order: int):
     return ders
 
 
-def partials(control_points, weights, degree, knots, u: float, v: float, dps: int = 40):
+def mp_partials(control_points, weights, degree, knots, u: float, v: float, dps: int = 40):
     """``d[k][l]`` (``k + l <= 2``): the partials of the surface at ``(u, v)`` as mpf 3-vectors."""
     with mp.workdps(dps):
         net = np.asarray(control_points, dtype=float)
@@ -152,18 +152,18 @@ def curve_partials(points, weights, degree: int, knots, t: float, dps: int = 40)
         return d
 
 
-def curvatures(control_points, weights, degree, knots, u: float, v: float, dps: int = 40):
+def mp_curvatures(control_points, weights, degree, knots, u: float, v: float, dps: int = 40):
     """``(gaussian, mean, k1, k2)`` at ``(u, v)`` against the normal ``Su x Sv``, as floats.
 
     >>> import numpy as np
     >>> net = np.zeros((3, 3, 3)); net[..., 0], net[..., 1] = np.mgrid[0:3, 0:3] / 2.0
     >>> net[..., 2] = (net[..., 0] - 0.5) ** 2   # z = x^2 / 2 - x / 2 + 1/4: a parabolic cylinder
-    >>> k = curvatures(net, None, (2, 2), ([0, 0, 0, 1, 1, 1],) * 2, 0.5, 0.5)
+    >>> k = mp_curvatures(net, None, (2, 2), ([0, 0, 0, 1, 1, 1],) * 2, 0.5, 0.5)
     >>> [round(x, 12) for x in k]                 # z'' = 1 at its vertex: k1 = 1
     [0.0, 0.5, 1.0, 0.0]
     """
     with mp.workdps(dps):
-        d = partials(control_points, weights, degree, knots, u, v, dps)
+        d = mp_partials(control_points, weights, degree, knots, u, v, dps)
         su, sv = d[1, 0], d[0, 1]
         cross = [su[1] * sv[2] - su[2] * sv[1], su[2] * sv[0] - su[0] * sv[2], su[0] * sv[1] - su[1] * sv[0]]
         norm = mp.sqrt(sum(x * x for x in cross))

@@ -22,7 +22,7 @@ from ..readback import read_curve
 from ..inputs import to_shape
 
 
-def plane_frame(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray]:
+def section_axes(normal: np.ndarray, x_axis=None) -> tuple[np.ndarray, np.ndarray]:
     """Orthonormal in-plane axes ``(x, y)`` with ``x × y = normal``.
 
     Without ``x_axis`` the x axis is the projection of the global X axis (or of Y when
@@ -259,7 +259,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
     samples = checks.count(samples, "samples", minimum=2)
-    xa, ya = plane_frame(normal, x_axis)
+    xa, ya = section_axes(normal, x_axis)
     shape = to_shape(obj, "obj")
     # only a length scale for the on-face test: OCCT's quick box, not the optimal one
     # (which costs more than the section itself on B-spline parts)

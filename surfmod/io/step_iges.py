@@ -1,20 +1,22 @@
-"""STEP export/import of surfmod surfaces and build123d shapes (atomic writes).
-
-The same concept as :mod:`surfmod.occ.step`, one level up: the public doors over OCCT's
-reader and writer.
+"""STEP and IGES export/import of surfmod surfaces and build123d shapes (atomic writes):
+the public doors over OCCT's readers and writers (:mod:`surfmod.occ.step`,
+:mod:`surfmod.occ.iges`).  In IGES, B-spline and NURBS surfaces travel as entity 128
+with their degrees, knots, weights and poles unchanged.
 """
 
 from __future__ import annotations
 
+import os
 import warnings
 
 from ..curve import Curve
 from ..errors import InsideOutWarning, RoundTripWarning, SurfmodError
 from ..atomic import atomic_path, target_path
+from ..inputs import build123d_compound
 from ..surface import Surface
 
 
-def to_shape(obj):
+def _export_shape(obj):
     """The TopoDS shape of a surfmod surface/curve, build123d object or TopoDS shape."""
     if isinstance(obj, Surface):
         return obj.face().wrapped
@@ -62,7 +64,7 @@ def export_step(objects, path, *, strict: bool = False) -> None:
     from ..occ.topo import compound
 
     target = target_path(path, "path", (".step", ".stp"))
-    shapes = [to_shape(o) for o in _as_list(objects)]
+    shapes = [_export_shape(o) for o in _as_list(objects)]
     shape = shapes[0] if len(shapes) == 1 else compound(shapes)
     with atomic_path(target) as tmp:
         write_step(shape, tmp)
@@ -100,9 +102,53 @@ def import_step(path, *, timeout: float | None = None, max_coordinate: float = 1
     ...     print("p.step" in str(exc))
     True
     """
-    import build123d as bd
-
     from ..occ.isolated import read_step_file
 
-    shape = read_step_file(path, "path", timeout=timeout, max_coordinate=max_coordinate)
-    return bd.Compound.cast(shape) if hasattr(bd.Compound, "cast") else bd.Compound(shape)
+    return build123d_compound(read_step_file(path, "path", timeout=timeout, max_coordinate=max_coordinate))
+
+
+#: the file suffixes of IGES
+IGES_SUFFIXES = (".igs", ".iges")
+
+
+def export_iges(objects, path, *, brep: bool = False) -> None:
+    """Write surfaces, curves or build123d shapes to one IGES file, atomically.
+
+    ``brep=True`` writes solids as IGES B-rep (entity 186) instead of trimmed surfaces.
+
+    >>> import surfmod as sm, tempfile, os
+    >>> path = os.path.join(tempfile.mkdtemp(), "p.igs")
+    >>> sm.export_iges(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), path)
+    >>> len(sm.import_iges(path).faces())
+    1
+    """
+    from ..occ.topo import compound
+    from ..occ.iges import write_iges
+
+    target = target_path(path, "path", IGES_SUFFIXES)
+    shapes = [_export_shape(o) for o in _as_list(objects)]
+    shape = shapes[0] if len(shapes) == 1 else compound(shapes)
+    with atomic_path(target) as tmp:
+        write_iges(shape, tmp, brep=bool(brep))
+
+
+def import_iges(path):
+    """Read an IGES file as a build123d shape (``Compound``/``Solid``/...); its faces go
+    back to surfmod with :func:`surfmod.from_face`.
+
+    >>> import surfmod as sm, tempfile, os
+    >>> path = os.path.join(tempfile.mkdtemp(), "p.iges")
+    >>> sm.export_iges(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), path)
+    >>> type(sm.from_face(sm.import_iges(path).faces()[0]).surface).__name__
+    'BSplineSurface'
+    """
+    from ..occ.iges import read_iges
+
+    if not os.path.isfile(os.fspath(path)):
+        raise SurfmodError(f"path: no such file {path}")
+    with open(path, "rb") as fh:
+        head = fh.read(81)
+    # IGES: fixed 80-column records, the Start section flagged by 'S' in column 73
+    if len(head) < 73 or head[72:73] != b"S":
+        raise SurfmodError(f"path: {path} is not an IGES file (no Start section record)")
+    return build123d_compound(read_iges(path))
