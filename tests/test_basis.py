@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 
 import reference as ref
 from strategies import clamped_knots
-from surfmod.eval.basis import basis_derivatives, basis_matrix, clamped_bezier_knots, find_spans
+from surfmod.eval.basis import (basis_derivatives, basis_matrix, clamped_bezier_knots, find_spans, reciprocal_table,
+                                 span_buckets)
 
 
 @settings(max_examples=40, deadline=None)
@@ -78,10 +79,10 @@ def test_compiled_basis_derivatives_match_textbook(p, extra, data):
     knots = data.draw(clamped_knots(n, p))
     t = np.unique(np.concatenate([np.linspace(knots[p], knots[n], 7), knots[p : n + 1]]))
     order = p + 1
-    inv = kernels.reciprocal_table(knots, p, n)
+    inv = reciprocal_table(knots, p, n)
     scratch = (np.empty((p + 1, p + 1)), np.empty(p + 1), np.empty(p + 1), np.empty(p + 1))
     ders = np.empty((order + 1, p + 1))
-    bucket = kernels.span_buckets(knots, p, n)
+    bucket = span_buckets(knots, p, n)
     for x in t:
         span = kernels.find_span_bucketed(knots, p, n, x, *bucket)
         assert span == find_spans(knots, p, n, np.array([x]))[0]

@@ -17,7 +17,7 @@ import surfmod as sm
 from strategies import bspline_surfaces, parameters_with_knots
 from surfmod.eval import kernels, local
 from surfmod.eval.scattered_compiled import scattered_compiled, scattered_positions_compiled
-from surfmod.eval.basis import find_spans
+from surfmod.eval.basis import find_spans, span_buckets
 from surfmod.eval.rational import surface_quotient
 from surfmod.nets.knots import smooth_mask
 from surfmod.occ.sample import surface_d2
@@ -236,7 +236,8 @@ def test_span_search_matches_numpy():
     knots = np.array([0, 0, 0, 0.2, 0.2, 0.5, 0.7, 1, 1, 1.0])
     t = np.concatenate([np.linspace(0, 1, 41), knots])
     expected = find_spans(knots, 2, 7, t)
-    got = np.array([kernels.find_span(knots, 2, 7, x) for x in t])
+    bucket = span_buckets(knots, 2, 7)
+    got = np.array([kernels.find_span_bucketed(knots, 2, 7, x, *bucket) for x in t])
     np.testing.assert_array_equal(got, expected)
 
 

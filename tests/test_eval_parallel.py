@@ -115,7 +115,7 @@ def test_parallel_scattered_equals_serial_bit_for_bit(rational, monkeypatch):
 
 
 def test_thread_setting_caps_and_names_bad_counts(monkeypatch):
-    monkeypatch.setattr(threads, "_available", lambda: 8)
+    monkeypatch.setattr(threads, "numba_threads", lambda: 8)
     with threads.limit(3):
         assert threads.threads_for(10**6) == 3
         assert threads.threads_for(threads.PARALLEL_MIN_POINTS - 1) == 1  # small work: one thread

@@ -22,8 +22,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .basis import reciprocal_table, span_buckets  # noqa: F401  (the tables the kernels read)
-
 # The per-point helpers below are plain compiled functions, not ``inline="always"``:
 # numba's own inlining copies a helper into every caller and types it again there (a
 # first `surfmod mesh` of a B-spline part compiled 24 s of kernels with it, 19 s
@@ -37,29 +35,12 @@ U1, U2, U3 = np.uint64(1), np.uint64(2), np.uint64(3)
 
 
 @njit(cache=True, error_model="numpy")
-def find_span(knots, degree, n_ctrl, t):
-    """The largest ``i`` with ``knots[i] <= t``, clipped to the domain.  A branch-free
-    binary search (the halving step compiles to a conditional move): random parameters
-    would mispredict every branch of the textbook loop."""
-    base = 0
-    size = knots.size
-    while size > 1:
-        half = size // 2
-        base = base + half if knots[base + half] <= t else base
-        size -= half
-    span = base if knots[base] <= t else base - 1
-    if span < degree:
-        return degree
-    if span > n_ctrl - 1:
-        return n_ctrl - 1
-    return span
-
-
-@njit(cache=True, error_model="numpy")
 def find_span_bucketed(knots, degree, n_ctrl, t, t0, scale, table):
-    """:func:`find_span` in O(1): a uniform bucket grid over the domain gives a span at or
-    just before the answer (see :func:`span_buckets`), then a short, well-predicted walk.
-    The walk back guards against the rounding of the bucket index."""
+    """The largest ``i`` with ``knots[i] <= t``, clipped to the domain
+    (:func:`surfmod.eval.basis.find_spans` of one parameter), in O(1): a uniform bucket
+    grid over the domain gives a span at or just before the answer
+    (:func:`~surfmod.eval.basis.span_buckets`), then a short, well-predicted walk.  The
+    walk back guards against the rounding of the bucket index."""
     b = int((t - t0) * scale)
     if b < 0:
         b = 0

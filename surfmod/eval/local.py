@@ -39,7 +39,7 @@ import numpy as np
 from .scattered import basis_at, scattered
 from .tensor_grid import tensor_grid
 from .basis import reciprocal_table, span_buckets
-from .threads import running_on, threads_for
+from .threads import numba_threads, running_on, threads_for
 
 #: rows in the ring of contracted net rows at least: a pass reads at most five (a cubic
 #: pair of positions on rows shifted by one), a u-point of degree p reads p + 1
@@ -93,16 +93,6 @@ def _kernel(name: str, points: int):
     return getattr(module, f"{name}_compiled"), 1
 
 
-def _run_patches(name: str, net, table, u, v, out) -> None:
-    """The per-span patch kernel ``name`` (:mod:`surfmod.eval.patches`) at the scattered
-    pairs ``(u, v)`` into ``out``, on the threads :func:`_kernel` picks."""
-    from . import patches
-
-    run, count = _kernel(name, u.size)
-    with _on(count):
-        run(*patches.arguments(net, table, u, v, out), net.origin)
-
-
 def _on(count: int):
     """The ``with`` context that runs numba's parallel kernels on ``count`` threads."""
     return running_on(count) if count > 1 else nullcontext()
@@ -122,9 +112,6 @@ def writable(t) -> np.ndarray:
         return np.require(np.asarray(t, dtype=float).ravel(), float, ["C", "W"])
 
 
-_as_float = writable
-
-
 class LocalNet(NamedTuple):
     """A surface's data as the kernels take it, built once per surface by :func:`prepare`."""
 
@@ -134,9 +121,9 @@ class LocalNet(NamedTuple):
     q: int
     ctrl: np.ndarray  # (n, m, 4), see homogeneous4
     rational: bool
-    inv_u: np.ndarray  # reciprocal knot differences (kernels.reciprocal_table)
+    inv_u: np.ndarray  # reciprocal knot differences (basis.reciprocal_table)
     inv_v: np.ndarray
-    bucket_u: tuple  # span search buckets (kernels.span_buckets)
+    bucket_u: tuple  # span search buckets (basis.span_buckets)
     bucket_v: tuple
     cache: dict  # tables built on first need (the per-span patches of eval/patches.py)
     origin: np.ndarray | None = None  # the point the evaluated net is taken about (see prepare)
@@ -231,13 +218,9 @@ def partials_finite(net: LocalNet, order: int) -> bool:
     key = ("partials_finite", order)
     known = net.cache.get(key)
     if known is None:
-        known = net.cache[key] = _partials_bounded(net, order)
+        bound = partial_bounds(net, order)
+        known = net.cache[key] = bool(bound is not None and np.all(bound < 1e290))
     return known
-
-
-def _partials_bounded(net: LocalNet, order: int) -> bool:
-    bound = partial_bounds(net, order)
-    return bool(bound is not None and np.all(bound < 1e290))
 
 
 def partial_bounds(net: LocalNet, order: int):
@@ -325,7 +308,7 @@ def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndar
     partials to order 1 or 2, on a net that suits them), else the basis-function kernel;
     a compiled one on the threads :func:`_kernel` picks.  ``positions``: ``(N, 3)``
     positions instead of ``(N, K, K, 3)`` partials."""
-    u, v = _as_float(u), _as_float(v)
+    u, v = writable(u), writable(v)
     net = _centred(net)
     if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
         h = scattered(*net[:4], net.ctrl, net.rational, u, v, order)
@@ -339,7 +322,11 @@ def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndar
         out = np.empty((u.size, 3) if positions else (u.size, order + 1, order + 1, 3))
     table = _patch_table(net, u.size) if positions or order in (1, 2) else None
     if table is not None:  # the kernels add the origin as they store
-        _run_patches("patch_positions" if positions else "patch_derivatives", net, table, u, v, out)
+        from . import patches
+
+        run, count = _kernel("patch_positions" if positions else "patch_derivatives", u.size)
+        with _on(count):
+            run(*patches.arguments(net, table, u, v, out), net.origin)
         return out
     head, tail = (net.knots_u, net.p, net.knots_v, net.q, net.ctrl, u, v), (net.inv_u, net.inv_v, net.bucket_u,
                                                                          net.bucket_v, out, net.origin)
@@ -369,17 +356,11 @@ def _scratch(count: int, per_slot: int) -> np.ndarray:
     """``(slots, per_slot)`` scratch for the grid's rings, one slot per thread that may
     run (numba's thread ids when ``count > 1``), kept per calling thread and reused: a
     fresh ring per call would be paged in each time."""
-    slots = 1 if count == 1 else _numba_threads()
+    slots = 1 if count == 1 else numba_threads()
     buf = getattr(_workspace, "rows", None)
     if buf is None or buf.size < slots * per_slot:
         buf = _workspace.rows = np.empty(slots * per_slot)
     return buf[: slots * per_slot].reshape(slots, per_slot)
-
-
-def _numba_threads() -> int:
-    import numba
-
-    return int(numba.config.NUMBA_NUM_THREADS)
 
 
 def _u_blocks(n_u: int, threads: int) -> np.ndarray:
@@ -435,7 +416,7 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     """
     net = _centred(net)
     knots_u, p, knots_v, q, ctrl, rational = net[:6]
-    us, vs = _as_float(us), _as_float(vs)
+    us, vs = writable(us), writable(vs)
     kk = order + 1
     shape = (us.size, vs.size, kk, kk, 3)
     if us.size * vs.size * (order + 1) ** 2 < COMPILED_GRID:

@@ -36,7 +36,7 @@ PARALLEL_MIN_POINTS = 1 << 16
 _requested: int | None = None
 
 
-def _available() -> int:
+def numba_threads() -> int:
     """Threads numba may start: ``NUMBA_NUM_THREADS`` (read by numba at import), which
     defaults to the number of cores.  Read from the environment while numba is not
     imported yet, so that asking does not import it."""
@@ -105,7 +105,7 @@ def threads_for(points: int) -> int:
     """
     if points < PARALLEL_MIN_POINTS:
         return 1
-    available = _available()
+    available = numba_threads()
     return max(1, min(available, _requested or available))
 
 
