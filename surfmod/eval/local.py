@@ -16,8 +16,10 @@ Every path is a twin: ``name`` in NumPy (:mod:`surfmod.eval.scattered`,
 :mod:`surfmod.eval.tensor_grid`) for small work, ``name_compiled`` (numba, one thread:
 :mod:`surfmod.eval.scattered_compiled`, :mod:`surfmod.eval.tensor_grid_compiled`,
 :mod:`surfmod.eval.patches`) for large, ``name_parallel`` (:mod:`surfmod.eval.parallel`)
-when several threads may run.  :func:`_kernel` is the one place that picks among them; the
-compiled modules are imported on first use (so ``import surfmod`` does not load numba).
+when several threads may run.  The amount of work picks NumPy or compiled (scattered
+pairs in :func:`_scattered`, grids in :func:`surface_grid`), :func:`_kernel` the compiled
+twin and its threads; the compiled modules are imported on first use (so
+``import surfmod`` does not load numba).
 
 >>> import numpy as np
 >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
@@ -36,9 +38,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .basis import reciprocal_table, span_buckets
 from .scattered import basis_at, scattered
 from .tensor_grid import tensor_grid
-from .basis import reciprocal_table, span_buckets
 from .threads import numba_threads, running_on, threads_for
 
 #: rows in the ring of contracted net rows at least: a pass reads at most five (a cubic
