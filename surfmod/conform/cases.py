@@ -72,12 +72,12 @@ class Case(NamedTuple):
         return h.hexdigest()[:16]
 
 
-def sample_parameters(knots, degree: int, n_ctrl: int, count: int, bounds=None) -> np.ndarray:
+def stress_parameters(knots, degree: int, n_ctrl: int, count: int, bounds=None) -> np.ndarray:
     """``count`` sample values of one direction (see the module notes): the domain ends
     (or ``bounds``), beside the interior knots nearest the shortest spans, the middle of
     the shortest spans, then evenly between.
 
-    >>> t = sample_parameters(np.array([0, 0, 0, 1e-4, 1, 1, 1.0]), 2, 4, 5)   # the short span first
+    >>> t = stress_parameters(np.array([0, 0, 0, 1e-4, 1, 1, 1.0]), 2, 4, 5)   # the short span first
     >>> print(np.array2string(t, precision=6))
     [0.00e+00 5.00e-05 7.50e-05 9.99e-05 1.00e+00]
     """
@@ -103,13 +103,13 @@ def _surface_case(name: str, s, count: int = SAMPLES, bounds=None) -> Case:
     (p, q), (ku, kv) = s.degree, s.knots
     n, m = s.control_points.shape[:2]
     (bu, bv) = bounds if bounds is not None else (None, None)
-    uu, vv = np.meshgrid(sample_parameters(ku, p, n, count, bu), sample_parameters(kv, q, m, count, bv),
+    uu, vv = np.meshgrid(stress_parameters(ku, p, n, count, bu), stress_parameters(kv, q, m, count, bv),
                          indexing="ij")
     return Case(name, s, uu.ravel(), vv.ravel())
 
 
 def _curve_case(name: str, c, count: int = 3 * SAMPLES) -> Case:
-    return Case(name, c, sample_parameters(c.knots, c.degree, len(c.control_points), count), None)
+    return Case(name, c, stress_parameters(c.knots, c.degree, len(c.control_points), count), None)
 
 
 def _net(rng, n: int, m: int, size=(10.0, 8.0), bump: float = 1.0) -> np.ndarray:
