@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ.geomapi import project_points
+from twins.geomapi import project_points
 
 from .tables import Table, note
 

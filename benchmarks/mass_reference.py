@@ -4,7 +4,7 @@ solid of the corpus: ``python -m benchmarks.mass_reference [--reference refined|
 
 ``refined`` (default) is :mod:`surfmod.occ.refined_props` (BRepGProp on the faces split
 until it converges, seconds per solid; ``tests/test_mass_reference.py`` runs it on every
-corpus solid), ``cuts`` is :mod:`surfmod.occ.moment_reference` (the solid cut by hundreds
+corpus solid), ``cuts`` is ``tests/twins/moment_reference.py`` (the solid cut by hundreds
 of planes, seconds to minutes per solid, a script's work rather than a test's).  Columns:
 centroid differences relative to volume^(1/3), inertia differences relative to its
 largest entry, for surfmod-vs-reference (``sm``), BRepGProp-vs-reference (``occ``, eps
@@ -26,7 +26,7 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 import surfmod as sm
 from surfmod.errors import SurfmodError
 from surfmod.occ.properties import gprops
-from surfmod.occ.moment_reference import moment_reference
+from twins.moment_reference import moment_reference
 from surfmod.occ.refined_props import refined_props
 from surfmod.occ.topo import faces_of, solids_of
 from surfmod.uses.mass import mass_properties

@@ -8,7 +8,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.occ.faces import infinite_plane
-from surfmod.occ.geomapi import intersect_line, intersect_surfaces
+from twins.geomapi import intersect_line, intersect_surfaces
 from surfmod.ops.intersect import as_plane
 from surfmod.ops.marching import segment_distances
 

@@ -1,4 +1,4 @@
-"""The independent moment reference (:mod:`surfmod.occ.moment_reference`): centroid and
+"""The independent moment reference (``tests/twins/moment_reference.py``): centroid and
 inertia from volumes of cut solids only, against textbook closed forms (moments of a solid
 of revolution from its profile, Steiner's theorem for a hole, a rotation applied by
 Rodrigues' formula).
@@ -33,7 +33,7 @@ import surfmod as sm
 from surfmod.errors import SurfmodError
 from surfmod.tolerances import MASS_AGREEMENT_RTOL
 from surfmod.occ.properties import gprops
-from surfmod.occ.moment_reference import (GAUSS_W, KRONROD_W, KRONROD_X, PACE_CUTS, critical_levels, cut_volumes,
+from twins.moment_reference import (GAUSS_W, KRONROD_W, KRONROD_X, PACE_CUTS, critical_levels, cut_volumes,
                                           moment_reference, _intervals, _nodes)
 
 AXIS, ANGLE, SHIFT = np.array([1.0, 2.0, 3.0]) / math.sqrt(14), 0.7, np.array([3.0, -2.0, 5.0])

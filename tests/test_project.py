@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 import surfmod as sm
 from strategies import bspline_surfaces
-from surfmod.occ.geomapi import face_distances, project_points
+from twins.geomapi import face_distances, project_points
 
 
 def _nurbs(seed=0):

@@ -12,7 +12,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.construct.elementary_closest import closest_angle
-from surfmod.occ.geomapi import face_distances, project_points
+from twins.geomapi import face_distances, project_points
 
 FULL = {
     "plane": sm.PlaneSurface((1, 2, 3), (0.3, 0.2, 1), u_range=(-2, 3), v_range=(-1, 2)),

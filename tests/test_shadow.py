@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ.hlr import hlr_outline
+from twins.hlr import hlr_outline
 from surfmod.ops.marching import segment_distances
 
 LIGHT = np.array([0.5, 0.3, -1.0])

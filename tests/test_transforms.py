@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 import surfmod as sm
 from strategies import bspline_surfaces
 from surfmod import transforms
-from surfmod.occ.transformed import geom_gtransformed, geom_transformed, named_trsf, trsf_matrix
+from twins.transformed import geom_gtransformed, geom_transformed, named_trsf, trsf_matrix
 from surfmod.occ.geom import surface_type
 from surfmod.occ.sample import surface_d0
 

@@ -85,11 +85,11 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from OCP.gp import gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 
-from ..errors import SurfmodError
-from .arrays import xyz
-from .guard import kernel
-from .topo import compound, explore, faces_of, geometric_edges, solids_of
-from .bindings import TopTools_ListOfShape
+from surfmod.errors import SurfmodError
+from surfmod.occ.arrays import xyz
+from surfmod.occ.guard import kernel
+from surfmod.occ.topo import compound, explore, faces_of, geometric_edges, solids_of
+from surfmod.occ.bindings import TopTools_ListOfShape
 
 # Gauss–Kronrod 10/21 on [-1, 1] (QUADPACK's qk21): Kronrod nodes from the end inwards,
 # the Gauss nodes every second one (odd indices), the centre last

@@ -10,10 +10,10 @@ from OCP.Geom import Geom_Line
 from OCP.GeomAPI import GeomAPI_IntCS, GeomAPI_IntSS, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Dir, gp_Lin
 
-from . import arrays
-from .discretize import curve_length, sample_curve
-from .guard import kernel
-from .sample import distances_to_face
+from surfmod.occ import arrays
+from surfmod.occ.discretize import curve_length, sample_curve
+from surfmod.occ.guard import kernel
+from surfmod.occ.sample import distances_to_face
 
 
 def intersect_surfaces(s1, s2, tolerance: float = 1e-7, samples: int = 200):

@@ -8,10 +8,10 @@ import math
 import numpy as np
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_GTrsf, gp_Mat, gp_Pnt, gp_Trsf, gp_XYZ
 
-from ..errors import SurfmodError
-from . import arrays
-from .geom import downcast_surface
-from .guard import kernel
+from surfmod.errors import SurfmodError
+from surfmod.occ import arrays
+from surfmod.occ.geom import downcast_surface
+from surfmod.occ.guard import kernel
 
 
 def named_trsf(kind: str, *args) -> gp_Trsf:

@@ -12,8 +12,8 @@ from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from . import arrays
-from .guard import kernel
+from surfmod.occ import arrays
+from surfmod.occ.guard import kernel
 
 
 def hlr_outline(face, direction, samples_per_edge: int = 60):
