@@ -2,7 +2,7 @@
 solid of the corpus: ``python -m benchmarks.mass_reference [--reference refined|cuts]
 [--budget S] [FILE ...]`` prints one row per solid.
 
-``refined`` (default) is :mod:`surfmod.occ.refined_props` (BRepGProp on the faces split
+``refined`` (default) is :func:`surfmod.uses.mass_reference.refined_props` (BRepGProp on the faces split
 until it converges, seconds per solid; ``tests/test_mass_reference.py`` runs it on every
 corpus solid), ``cuts`` is ``tests/twins/moment_reference.py`` (the solid cut by hundreds
 of planes, seconds to minutes per solid, a script's work rather than a test's).  Columns:
@@ -27,7 +27,7 @@ import surfmod as sm
 from surfmod.errors import SurfmodError
 from surfmod.occ.properties import gprops
 from twins.moment_reference import moment_reference
-from surfmod.occ.refined_props import refined_props
+from surfmod.uses.mass_reference import refined_props
 from surfmod.occ.topo import faces_of, solids_of
 from surfmod.uses.mass import mass_properties
 

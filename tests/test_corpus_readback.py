@@ -186,7 +186,7 @@ def test_mass_command_never_prints_a_disagreement_with_exit_0(monkeypatch, capsy
     monkeypatch.setattr(mass, "mass_properties", off_by_1e6)
     monkeypatch.setattr(mass, "boundary_ambiguity", lambda solid: ambiguity)
     if not decided:  # the reference cannot tell: the model's ambiguity decides between 3 and 4
-        monkeypatch.setattr(mass, "settle", lambda *a: (None, "REFERENCE UNDECIDED: (test)"))
+        monkeypatch.setattr(mass.mass_reference, "settle", lambda *a: (None, "REFERENCE UNDECIDED: (test)"))
     assert main(["mass", str(CORPUS / "cadquery_red_cube_blue_cylinder.step"), "--no-progress"]) == code
     assert word in capsys.readouterr().out
 

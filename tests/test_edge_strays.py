@@ -1,5 +1,5 @@
 """Edges whose p-curves stray from their 3-D curves beyond the declared tolerance: measured
-independently of BRepCheck (:mod:`surfmod.occ.strays`), reported per face by ``surfmod
+independently of BRepCheck (:mod:`surfmod.readback.strays`), reported per face by ``surfmod
 check`` and named by ``surfmod mass`` (exit 3, ambiguous model)."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from surfmod.occ.bindings import TopTools_IndexedMapOfShape
 import surfmod as sm
 from surfmod.cli import main
 from surfmod.cli.check import _stray_notes
-from surfmod.occ.strays import edge_strays
+from surfmod.readback.strays import edge_strays
 
 SHIFT = 0.05
 
@@ -86,7 +86,7 @@ def test_mass_names_the_edges_and_exits_3(monkeypatch, tmp_path, capsys):
 
     monkeypatch.setattr(mass, "mass_properties", centroid_off)
     monkeypatch.setattr(mass, "boundary_ambiguity", lambda s: 0.0)  # only the strays explain it
-    monkeypatch.setattr(mass, "settle", lambda *a: (None, "REFERENCE UNDECIDED: (test)"))  # nor can it tell
+    monkeypatch.setattr(mass.mass_reference, "settle", lambda *a: (None, "REFERENCE UNDECIDED: (test)"))  # nor can it tell
     assert main(["mass", str(path), "--no-progress"]) == 3
     out = capsys.readouterr().out
     assert "AMBIGUOUS MODEL: centroid differs" in out and "1 edge(s) have p-curves straying" in out

@@ -344,7 +344,7 @@ def test_mass_command_lets_the_reference_settle_moments(monkeypatch, tmp_path, c
 def test_mass_command_asks_gauss_kronrod_when_the_split_cannot_tell(monkeypatch, tmp_path, capsys, moved_side, code,
                                                                     line):
     import surfmod.cli.mass as mass
-    import surfmod.occ.refined_props as refined
+    import surfmod.uses.mass_reference as refined
     from surfmod.cli import main
 
     path = tmp_path / "hole.step"
@@ -380,7 +380,7 @@ def test_mass_command_skips_a_reference_over_budget(monkeypatch, tmp_path, capsy
     monkeypatch.setattr(mass, "mass_properties", lambda s, d=1.0, **kw: (
         dataclasses.replace(real(s, d, **kw), centroid=np.asarray(real(s, d, **kw).centroid) + 1e-4)
         if "method" not in kw else real(s, d, **kw)))
-    monkeypatch.setattr(mass, "REFERENCE_BUDGET", 1e-6)
+    monkeypatch.setattr(mass.mass_reference, "REFERENCE_BUDGET", 1e-6)
     assert main(["mass", str(path), "--no-progress"]) == 4
     out = capsys.readouterr().out
     assert "REFERENCE SKIPPED: budget: refining the faces 2 x 2 would take about" in out and "DISAGREEMENT" in out
@@ -443,14 +443,14 @@ def test_surfmod_moments_match_the_reference_on_real_parts(corpus_dir, name, ind
     assert oc < 1e-9 and oi < 1e-9  # (so is BRepGProp on these)
 
 
-# -- the refined reference (surfmod.occ.refined_props) ----------------------------------
+# -- the refined reference (surfmod.uses.mass_reference.refined_props) ----------------------------------
 def test_refined_reference_settles_brepgprop_on_a_torus_fillet(corpus_dir):
     """nist_ftc_11, a washer with two torus beads: BRepGProp's inertia at eps 1e-13 is 5e-7
     off the closed form from its profile (its adaptive rule converges the volume only); on
     faces split 2 x 2 and 4 x 4 it converges to it, as surfmod's is."""
     import mpmath as mp
 
-    from surfmod.occ.refined_props import refined_props
+    from surfmod.uses.mass_reference import refined_props
 
     mp.mp.dps = 30
     h, rr = mp.mpf("0.425"), mp.mpf("1.5")
@@ -482,11 +482,12 @@ def test_refined_reference_settles_brepgprop_on_a_torus_fillet(corpus_dir):
 
 def test_refined_reference_keeps_the_reference_point_and_refuses_past_its_budget():
     from surfmod.occ.properties import vertex_mean
-    from surfmod.occ.refined_props import gprops_about, refined_props
+    from surfmod.uses.mass_reference import refined_props
+    from surfmod.occ.properties import gprops_about
 
     part = (bd.Box(4, 3, 2) - bd.Cylinder(0.5, 3).translate((*HOLE, 0))).wrapped
     g, o = gprops_about(part, vertex_mean(part)), gprops(part, 1e-13)  # BRepGProp's loop, face by face
-    assert g.Mass() == pytest.approx(o["volume"], rel=1e-15)
+    assert g["volume"] == pytest.approx(o["volume"], rel=1e-15)
     ref = refined_props(part)
     assert np.allclose(ref.location, vertex_mean(part), rtol=0, atol=0) and ref.converged
     with pytest.raises(SurfmodError, match="budget: refining the faces 2 x 2"):
@@ -519,7 +520,7 @@ AMBIGUOUS = {
 
 
 def _off(ref, mine):
-    from surfmod.occ.properties import relative_differences
+    from surfmod.uses.mass_reference import relative_differences
 
     d = relative_differences(mine, ref)
     return max(d["volume"], d["centroid"], d["inertia"])
@@ -539,8 +540,8 @@ def test_surfmod_matches_an_independent_reference_on_every_corpus_solid(corpus_f
     * on the solids named in :data:`AMBIGUOUS` the file leaves more than 1e-9 open: there
       surfmod is within the command's 1e-7 of plain BRepGProp (the Ventilator within its
       boundary ambiguity), and a new one fails here until it is named."""
-    from surfmod.occ.kronrod_props import kronrod_props
-    from surfmod.occ.refined_props import refined_props
+    from surfmod.uses.mass_reference import kronrod_props
+    from surfmod.uses.mass_reference import refined_props
     from surfmod.occ.topo import solids_of
     from surfmod.uses.mass import boundary_ambiguity
 
@@ -571,7 +572,7 @@ def test_brepgprop_inertia_quirk_on_a_b_spline_solid_settled_by_gauss_kronrod(co
     1e-13) plain BRepGProp's inertia is 6e-9 of its largest entry off, at eps 1e-13 as at
     1e-9 (its adaptive rule converges only the volume), where its own Gauss-Kronrod rule
     with the moments converged and surfmod agree to 1e-12."""
-    from surfmod.occ.kronrod_props import kronrod_props
+    from surfmod.uses.mass_reference import kronrod_props
 
     solid = _solid(corpus_dir, "stepcode_dm1-id-214.stp", 4)
     mine = sm.mass_properties(solid, estimate_error=False)

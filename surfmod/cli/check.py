@@ -12,6 +12,7 @@ from pathlib import Path
 from ..errors import SurfmodError
 from ..io.step_iges import import_step
 from ..readback import from_face
+from ..readback.strays import edge_strays
 from ..occt_crosscheck import crosscheck_many
 from . import EXIT_PARTIAL
 from .batch import add_batch_arguments, batch_run, step_files
@@ -95,8 +96,6 @@ def check_file(path, samples: int = 24) -> list[tuple]:
 def _stray_notes(shape) -> dict:
     """Per face index a note on its edges whose p-curves stray from the 3-D curve (or
     from each other) beyond the edge's own tolerance: there the model is ambiguous."""
-    from ..occ.strays import edge_strays
-
     try:
         strays = [e for e in edge_strays(shape, samples=9) if e.ambiguous]
     except SurfmodError:

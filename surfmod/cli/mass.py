@@ -1,9 +1,9 @@
 """``surfmod mass FILE.step``: volume, area, centroid and inertia of a STEP solid, checked
 against ``BRepGProp``.  Exit 0 when all four agree within ``MASS_AGREEMENT_RTOL`` (one line
-says so), or when they differ and an independent reference (:func:`settle`: BRepGProp on
-the faces split into ever smaller iso-parametric pieces until it converges, then, where
-that split is not exact, BRepGProp's Gauss-Kronrod rule with the moments converged; both
-about the same point, within ``REFERENCE_BUDGET`` seconds) confirms surfmod's values (one
+says so), or when they differ and an independent reference (:mod:`surfmod.uses.mass_reference`:
+BRepGProp on the faces split into ever smaller iso-parametric pieces until it converges,
+then, where that split is not exact, BRepGProp's Gauss-Kronrod rule with the moments
+converged; both about the same point, within ``REFERENCE_BUDGET`` seconds) confirms surfmod's values (one
 line says which side it confirms); 4 when it confirms BRepGProp's, or cannot tell on a
 model whose edges close; 3 when it cannot tell and the model itself is ambiguous (its edges
 leave the volume open by more than the disagreement, or p-curves stray beyond their
@@ -21,25 +21,17 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import io
-import time
 from pathlib import Path
 
-from .. import tolerances
 from ..errors import SurfmodError
 from ..inputs import to_shape
+from ..uses import mass_reference
+from ..uses.mass_reference import EXIT_AMBIGUOUS, EXIT_DISAGREE
+from ..readback.strays import edge_strays
 from ..uses.mass import boundary_ambiguity, mass_properties
 from .batch import add_batch_arguments, batch_run, step_files
 from tqdm import tqdm
-
-#: exit code when surfmod and BRepGProp differ by less than the model's own ambiguity
-EXIT_AMBIGUOUS = 3
-#: exit code when they differ by more (a real disagreement)
-EXIT_DISAGREE = 4
-#: seconds the refined reference may take to settle a disagreement (each refinement's
-#: cost is estimated from the one before it, before it starts)
-REFERENCE_BUDGET = 60.0
 
 
 def register(sub) -> None:
@@ -98,8 +90,8 @@ def run(args) -> int:
 
 
 def run_one(args) -> int:
-    """``surfmod mass PART.step``: the verdict on one file, printed; ``args.result`` is
-    surfmod's ``MassProperties``."""
+    """``surfmod mass PART.step``: the verdict on one file (:func:`surfmod.uses.mass_reference.judge`),
+    printed; ``args.result`` is surfmod's ``MassProperties``."""
     with tqdm(total=3, desc="mass", unit="step", disable=args.no_progress) as bar:
         shape = to_shape(args.path, "path")
         solid = to_shape(shape, "path", solid=True)
@@ -110,124 +102,6 @@ def run_one(args) -> int:
         o = mass_properties(solid, args.density, method="occt", eps=args.eps)
         bar.update()
     print(r)
-    from ..occ.properties import relative_differences
-    from ..occ.solids import left_out_faces
-
-    left = left_out_faces(shape)
-    if left:  # an open shell beside the solids: measured it would be a guess, so it is named instead
-        print(f"NOTE: {len(left)} face(s) outside every closed solid (open shells or loose faces) are left out, "
-              f"they enclose no volume: faces {', '.join(map(str, left[:10]))}{' ...' if len(left) > 10 else ''}")
-    from ..occ.strays import edge_strays
-
-    limit = tolerances.MASS_AGREEMENT_RTOL
-    diffs = relative_differences(r, o)
-    print(f"BRepGProp (eps={args.eps:g}) relative differences: " + ", ".join(f"{k} {v:.2e}" for k, v in diffs.items())
-          + f" (limit {limit:g}; centroid relative to volume^(1/3), inertia to its largest entry)")
-    off = {k: v for k, v in diffs.items() if not v <= limit}
-    if off:
-        # BRepGProp's adaptive eps bounds the volume's error; its first and second moments
-        # converge more slowly (a cube and a cylinder: inertia 1.1e-6 off at eps 1e-9, 3.4e-8
-        # at 1e-11, 8.2e-10 at 1e-13, towards surfmod's): judge everything at a finer eps
-        fine = max(args.eps * 1e-4, 1e-14)
-        o = mass_properties(solid, args.density, method="occt", eps=fine)
-        diffs = relative_differences(r, o)
-        print(f"BRepGProp (eps={fine:g}) relative differences: " + ", ".join(f"{k} {v:.2e}" for k, v in diffs.items()))
-        off = {k: v for k, v in diffs.items() if not v <= limit}
-    # measured on the file's shape, so edges and faces carry the file's numbers, as the
-    # faces left out do; edges of those faces bound no volume and do not count
-    outside = set(left)
-    strays = sorted((e for e in edge_strays(shape) if e.ambiguous and outside.isdisjoint(e.faces)),
-                    key=lambda e: -max(e.stray, e.gap))
-    named = ", ".join(f"edge {e.edge} of faces {'/'.join(map(str, e.faces))} ({max(e.stray, e.gap):.2e} > tol "
-                      f"{e.tolerance:.1e})" for e in strays[:5]) + (" ..." if len(strays) > 5 else "")
-    amb = None
-    if strays:  # whatever the verdict: the digits below the strays are the file's, not the part's
-        amb = boundary_ambiguity(solid)
-        print(f"NOTE: {len(strays)} edge(s) have p-curves straying beyond their own tolerance: {named}; the file's "
-              f"edges leave its volume open by up to {amb:.2e} (relative): digits beyond that are the file's, not "
-              "the part's")
-    if not off:
-        print(f"AGREE: volume, area, centroid and inertia all agree with BRepGProp within {limit:g}")
-        return 0
-    worst = max(off.values())
-    side, line = settle(solid, r, o, sorted(off), limit, args.density)
-    print(line)
-    if side == "surfmod":
-        return 0
-    differ = f"{', '.join(off)} differ{'s' if len(off) == 1 else ''} from BRepGProp by up to {worst:.2e}"
-    if side is None:
-        amb = boundary_ambiguity(solid) if amb is None else amb
-        if strays or amb >= worst:
-            print(f"AMBIGUOUS MODEL: {differ} (more than {limit:g}); the model's edges leave its volume open by up to "
-                  f"{amb:.2e} (relative) and {len(strays)} edge(s) have p-curves straying beyond their own tolerance"
-                  + (f": {named}" if strays else ""))
-            return EXIT_AMBIGUOUS
-        print(f"DISAGREEMENT: {differ}, more than the model's own ambiguity {amb:.2e}, and no edge strays beyond "
-              "its tolerance")
-        return EXIT_DISAGREE
-    print(f"DISAGREEMENT: {differ}, and the reference confirms BRepGProp's")
-    return EXIT_DISAGREE
-
-
-def settle(solid, r, o, names, limit, density: float = 1.0):
-    """``(side, line)``: which of surfmod ``r`` and BRepGProp ``o`` an independent reference
-    confirms for the differing quantities ``names``: ``"surfmod"`` when surfmod is within
-    ``limit`` of it and BRepGProp is not, by more than the reference's own error estimate;
-    ``"occt"`` the other way round; ``None`` (with the reasons) when no reference can tell
-    within ``REFERENCE_BUDGET`` seconds.  The references, in turn until one tells: BRepGProp
-    on the faces split until it converges (:func:`surfmod.occ.refined_props.refined_props`),
-    then BRepGProp's Gauss–Kronrod rule with the moments converged
-    (:func:`surfmod.occ.kronrod_props.kronrod_props_within`, for solids whose split is not
-    exact), both about the solid's vertex mean, the point surfmod takes (``density`` scales
-    the references' inertia as it scales theirs)."""
-    start = time.perf_counter()
-    lines = []
-    for reference in (_split_reference, _kronrod_reference):
-        try:
-            ref, how, errors = reference(solid, names, REFERENCE_BUDGET - (time.perf_counter() - start))
-        except SurfmodError as exc:
-            lines.append(f"REFERENCE SKIPPED: {exc}")
-            continue
-        side, line = _verdict(dataclasses.replace(ref, inertia=density * ref.inertia), r, o, names, limit, how, errors)
-        lines.append(line)
-        if side is not None:  # the lines of the references that could not tell come first
-            return side, "\n".join(lines)
-    return None, "\n".join(lines)
-
-
-def _split_reference(solid, names, seconds):
-    """``(reference, how it is named, its error per quantity)``: the faces split."""
-    from ..occ.refined_props import refined_props
-
-    ref = refined_props(solid, budget=seconds)
-    return ref, f"BRepGProp on the faces split {ref.splits} x {ref.splits}", ref.changes
-
-
-def _kronrod_reference(solid, names, seconds):
-    """The same for the Gauss-Kronrod rule: one error estimate for every quantity."""
-    from ..occ.kronrod_props import kronrod_props_within
-
-    ref = kronrod_props_within(solid, seconds)
-    return ref, "BRepGProp's Gauss-Kronrod rule", dict.fromkeys(names, ref.error)
-
-
-def _verdict(ref, r, o, names, limit, how, errors):
-    from ..occ.properties import relative_differences
-
-    diffs = {"surfmod": relative_differences(r, ref), "occt": relative_differences(o, ref)}
-    sides = set()
-    for k in names:
-        mine, theirs, est = diffs["surfmod"][k], diffs["occt"][k], errors[k]
-        if mine + est <= limit < theirs - est:
-            sides.add("surfmod")
-        elif theirs + est <= limit < mine - est:
-            sides.add("occt")
-        else:
-            sides.add(None)
-    detail = ", ".join(f"{k}: surfmod {diffs['surfmod'][k]:.2e}, BRepGProp {diffs['occt'][k]:.2e} (its error "
-                       f"{errors[k]:.1e})" for k in names)
-    if sides == {"surfmod"}:
-        return "surfmod", f"REFERENCE CONFIRMS SURFMOD: {how} agrees with surfmod, not with plain BRepGProp ({detail})"
-    if sides == {"occt"}:
-        return "occt", f"REFERENCE CONFIRMS BREPGPROP: {how} agrees with plain BRepGProp, not surfmod ({detail})"
-    return None, f"REFERENCE UNDECIDED: {how} cannot tell the two apart ({detail})"
+    return mass_reference.judge(shape, solid, r, o, eps=args.eps, density=args.density,
+                                occt=lambda eps: mass_properties(solid, args.density, method="occt", eps=eps),
+                                ambiguity=lambda: boundary_ambiguity(solid), strays=edge_strays(shape))

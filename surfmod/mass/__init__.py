@@ -14,7 +14,9 @@ as one pipeline whose stages are modules, each calling only the ones before it:
 The data goes one way: faces read back (:func:`surfmod.from_face`, one package up) →
 boundary pieces → nodes and rules → moments → totals.  :func:`surfmod.mass_properties`
 (:mod:`surfmod.uses.mass`) reads its input and calls :func:`~surfmod.mass.totals.integrate`;
-``TrimmedFace.area()`` calls :func:`~surfmod.mass.moments.face_moments`.
+``TrimmedFace.area()`` calls :func:`~surfmod.mass.moments.face_moments`.  The one
+independent reference (BRepGProp on split faces, its Gauss–Kronrod rule) and the verdict
+of ``surfmod mass`` are :mod:`surfmod.uses.mass_reference`, one level up.
 
 For a solid bounded by faces with outward normal ``n`` (``x`` from the reference point)::
 

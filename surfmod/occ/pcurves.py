@@ -1,4 +1,5 @@
-"""The p-curves of a face's edges as plain data, for vectorized evaluation on the NumPy side.
+"""The p-curves of a face's edges (``BRepAdaptor_Curve2d``) as plain data, for vectorized
+evaluation on the NumPy side, and their images beside the edges' 3-D curves.
 
 :func:`face_pcurves` reads every edge of a face once: its parameter range, its sign in
 the face (``-1`` for a reversed edge), the breaks of its ``GeomAbs_CN`` intervals and
@@ -13,7 +14,13 @@ of many faces through one binary table.
 from __future__ import annotations
 
 import numpy as np
-from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
+from OCP.BRepGProp import BRepGProp
+from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
+from OCP.GProp import GProp_GProps
+from OCP.TopAbs import TopAbs_FACE
+from OCP.TopExp import TopExp
 from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_CN, GeomAbs_Line
 from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopoDS import TopoDS, TopoDS_Iterator
@@ -22,8 +29,10 @@ from OCP.gp import gp_Pnt2d, gp_Vec2d
 from ..eval.basis import knots_inside
 from .binary import bspline_curves
 from .geom import read_bspline_curve
+from .arrays import pnt, xyz, xyz_many
 from .guard import kernel
-from .bindings import TColStd_Array1OfReal
+from .bindings import TColStd_Array1OfReal, TopTools_IndexedMapOfShape
+from .topo import geometric_edges, pcurve_points
 
 
 def _xy(p) -> np.ndarray:
@@ -214,4 +223,73 @@ def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
         for i, ti in enumerate(t):
             adaptor.D1(float(ti), p, d)
             out[i] = (p.X(), p.Y(), d.X(), d.Y())
+    return out
+
+
+def _length(edge) -> float:
+    props = GProp_GProps()
+    BRepGProp.LinearProperties_s(edge, props)
+    return props.Mass()
+
+
+def edge_images(shape, samples: int) -> list[dict]:
+    """Per geometric, non-degenerate edge of ``shape`` with a 3-D curve: ``{"edge"`` (index in
+    ``TopExp``'s edge map, from 0), ``"tolerance"``, ``"length"``, ``"curve"`` (the located
+    3-D curve and its range, for :func:`distances_to_curve`), ``"faces"`` (indices in the face
+    map, from 0; a seam's face once), ``"images"`` (per face the ``(samples, 3)`` image of the
+    p-curve at equally spaced parameters) and ``"along"`` (the 3-D curve at those
+    parameters)``}``."""
+    out = []
+    with kernel("edge images (BRepAdaptor_Curve2d)"):
+        fmap = TopTools_IndexedMapOfShape()
+        TopExp.MapShapes_s(shape, TopAbs_FACE, fmap)
+        for edge_index, edge, edge_faces in geometric_edges(shape):
+            range_ = BRepAdaptor_Curve(edge)
+            first, last = range_.FirstParameter(), range_.LastParameter()
+            curve = BRep_Tool.Curve_s(edge, first, last)  # a located copy of the 3-D curve
+            if curve is None:
+                continue
+            faces, images, along = [], [], []
+            for face in edge_faces:
+                index = -1 if face.IsNull() else fmap.FindIndex(face) - 1
+                if index < 0 or index in faces:  # no face, or a seam edge: the same face twice
+                    continue
+                faces.append(index)
+                t, pts = pcurve_points(edge, face, samples)
+                images.append(pts)
+                along.append(xyz_many((curve.Value(x) for x in t.tolist()), len(t)))
+            out.append({"edge": edge_index, "tolerance": float(BRep_Tool.Tolerance_s(edge)), "length": _length(edge),
+                        "curve": (curve, first, last), "faces": faces, "images": images, "along": along})
+    return out
+
+
+def distances_to_curve(curve, points: np.ndarray) -> np.ndarray:
+    """Distance of each point to a bounded 3-D curve ``(curve, first, last)``
+    (``GeomAPI_ProjectPointOnCurve``; with no orthogonal foot, beyond the curve's ends, the
+    nearer end's distance)."""
+    curve, first, last = curve
+    out = np.empty(len(points))
+    with kernel("GeomAPI_ProjectPointOnCurve"):
+        project = GeomAPI_ProjectPointOnCurve()
+        project.Init(curve, first, last)
+        ends = xyz(curve.Value(first)), xyz(curve.Value(last))
+        for k, p in enumerate(points):
+            project.Perform(pnt(p))
+            out[k] = project.LowerDistance() if project.NbPoints() > 0 else min(
+                np.linalg.norm(p - ends[0]), np.linalg.norm(p - ends[1]))
+    return out
+
+
+def edge_deviation_samples(shape, samples: int) -> list[tuple]:
+    """Per geometric edge of ``shape``: ``(points, images, length)``: ``samples`` points of
+    its 3-D curve equally spaced in its parameter, the image of its p-curve on each of its
+    faces (a seam's face twice) at as many points, as ``BRepCheck`` samples them, and its
+    length."""
+    out = []
+    with kernel("edge deviations"):
+        for _, edge, edge_faces in geometric_edges(shape):
+            c3 = BRepAdaptor_Curve(edge)
+            t = np.linspace(c3.FirstParameter(), c3.LastParameter(), samples)
+            p3 = xyz_many((c3.Value(x) for x in t.tolist()), samples)
+            out.append((p3, [pcurve_points(edge, face, samples)[1] for face in edge_faces], _length(edge)))
     return out

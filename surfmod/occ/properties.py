@@ -1,7 +1,8 @@
-"""Global properties of shapes: ``BRepGProp`` volume, area, centroid and inertia, how far
-two sets of them differ (and what a write and read changed of a shape), the vertex mean
-BRepGProp refers its integrals to, and the one bounding box of the kernel door
-(``BRepBndLib``)."""
+"""``BRepGProp``: volume, area, centroid and inertia of shapes (plain, about a chosen point,
+by the Gauss–Kronrod rule, on faces split by ``ShapeUpgrade``), what a write and read
+changed of a shape, the vertex mean BRepGProp refers its integrals to, and the one bounding
+box of the kernel door (``BRepBndLib``).  The references built on these calls, and their
+verdict, are :mod:`surfmod.uses.mass_reference`."""
 
 from __future__ import annotations
 
@@ -11,9 +12,11 @@ import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
 from OCP.BRepBndLib import BRepBndLib
-from OCP.BRepGProp import BRepGProp
+from OCP.BRepGProp import BRepGProp, BRepGProp_Domain, BRepGProp_Face, BRepGProp_Vinert
 from OCP.GProp import GProp_GProps
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
+from OCP.ShapeUpgrade import ShapeUpgrade_ShapeDivideArea
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
+from OCP.gp import gp_Pnt
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 
@@ -70,28 +73,6 @@ def inertia_matrix(props: GProp_GProps) -> np.ndarray:
     """``props.MatrixOfInertia()`` as a ``(3, 3)`` array (about the centre of mass)."""
     m = props.MatrixOfInertia()
     return np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)])
-
-
-def relative_differences(r, o) -> dict:
-    """Mass properties ``r`` against ``o`` (anything with ``volume``, ``area``, ``centroid``
-    and ``inertia``: surfmod's, BRepGProp's, a reference's): volume and area relative, the
-    centroid relative to the volume's cube root, the inertia to its largest entry, all of
-    ``o``.
-
-    >>> from types import SimpleNamespace as P
-    >>> a = P(volume=8.0, area=24.0, centroid=(0, 0, 0), inertia=[[1.0, 0], [0, 2.0]])
-    >>> b = P(volume=8.0, area=24.0, centroid=(0, 0, 2e-6), inertia=[[1.0, 0], [0, 2.0]])
-    >>> {k: float(v) for k, v in relative_differences(b, a).items()}
-    {'volume': 0.0, 'area': 0.0, 'centroid': 1e-06, 'inertia': 0.0}
-    """
-    length = max(abs(o.volume), 1e-300) ** (1 / 3)
-    big = max(float(np.abs(np.asarray(o.inertia)).max()), 1e-300)
-    return {
-        "volume": abs(r.volume - o.volume) / max(abs(o.volume), 1e-300),
-        "area": abs(r.area - o.area) / max(abs(o.area), 1e-300),
-        "centroid": float(np.abs(np.asarray(r.centroid) - np.asarray(o.centroid)).max()) / length,
-        "inertia": float(np.abs(np.asarray(r.inertia) - np.asarray(o.inertia)).max()) / big,
-    }
 
 
 def solid_figures(solid):
@@ -190,3 +171,59 @@ def bounding_box(shape, *, optimal: bool = True) -> np.ndarray:
         else:
             BRepBndLib.Add_s(shape, box, True)
         return np.array(box_limits(box)).reshape(2, 3)
+
+
+def split_faces(shape, k: int):
+    """``shape`` with every face split into about ``k × k`` pieces along iso-parametric lines
+    of its surface (``ShapeUpgrade_ShapeDivideArea`` by numbers: the same surfaces and
+    p-curve pieces; ``k = 1``, or nothing to split: the shape itself)."""
+    if k == 1:
+        return shape
+    with kernel("ShapeUpgrade_ShapeDivideArea"):
+        divide = ShapeUpgrade_ShapeDivideArea(shape)
+        divide.SetSplittingByNumber(True)
+        divide.SetNumbersUVSplits(k, k)
+        if not divide.Perform():
+            return shape  # nothing to split (one planar face, say): the shape as it is
+        return divide.Result()
+
+
+def gprops_about(shape, location, eps: float = 1e-13) -> dict:
+    """``volume``, ``area``, ``centroid`` and ``inertia`` (as :func:`gprops`) with the volume
+    integrals taken face by face as ``BRepGProp::VolumeProperties`` takes them (forward and
+    reversed faces, the domain of a trimmed face, ``BRepGProp_Vinert``'s adaptive rule at
+    ``eps``), but about the point ``location`` the caller chooses (the area is the same
+    about any point)."""
+    total = GProp_GProps(gp_Pnt(0, 0, 0))
+    with kernel("BRepGProp_Vinert"):
+        vinert = BRepGProp_Vinert()
+        vinert.SetLocation(gp_Pnt(*map(float, location)))
+        for face in faces_of(shape):
+            if face.Orientation() not in (TopAbs_FORWARD, TopAbs_REVERSED):
+                continue  # internal and external faces bound no volume
+            bf = BRepGProp_Face()
+            bf.Load(face)
+            domain = BRepGProp_Domain()
+            if face.NbChildren() != 0:
+                domain.Init(face)
+            vinert.Perform(bf, domain, float(eps))
+            total.Add(vinert, 1.0)
+        area = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(shape, area, float(eps), False)
+    return {"volume": total.Mass(), "area": area.Mass(), "centroid": xyz(total.CentreOfMass()),
+            "inertia": inertia_matrix(total)}
+
+
+def gauss_kronrod(shape, eps: float) -> dict:
+    """:func:`gprops_about`'s figures by ``BRepGProp::VolumePropertiesGK`` with its centroid
+    and inertia flags set (the adaptive Gauss–Kronrod rule refines each face until the
+    volume *and* the moments have converged to ``eps``) about BRepGProp's own point, the
+    area by ``SurfaceProperties`` at the same ``eps``, and ``error``: the rule's estimate of
+    its relative error (negative when it failed)."""
+    with kernel("BRepGProp.VolumePropertiesGK_s"):
+        props = GProp_GProps()
+        error = BRepGProp.VolumePropertiesGK_s(shape, props, float(eps), False, True, True, True)
+        area = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(shape, area, float(eps), False)
+    return {"volume": props.Mass(), "area": area.Mass(), "centroid": xyz(props.CentreOfMass()),
+            "inertia": inertia_matrix(props), "error": float(error)}

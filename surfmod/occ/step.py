@@ -6,6 +6,9 @@ level down: that module is the public ``import_step``/``export_step`` over this 
 
 from __future__ import annotations
 
+import io
+
+from OCP.BinTools import BinTools
 from OCP.BRep import BRep_Builder
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
@@ -186,4 +189,21 @@ def read_brep(path):
         ok = BRepTools.Read_s(shape, str(path), BRep_Builder())
     if not ok or shape.IsNull():
         raise SurfmodError(f"path: {path} is not a readable BREP file")
+    return shape
+
+
+def brep_bytes(shape) -> bytes:
+    """``shape`` as OCCT binary BREP bytes (``BinTools``): how a shape crosses to another
+    process, every number bit for bit."""
+    with kernel("BinTools.Write"):
+        out = io.BytesIO()
+        BinTools.Write_s(shape, out)
+    return out.getvalue()
+
+
+def brep_from_bytes(data: bytes):
+    """The shape of :func:`brep_bytes`."""
+    with kernel("BinTools.Read"):
+        shape = TopoDS_Shape()
+        BinTools.Read_s(shape, io.BytesIO(data))
     return shape

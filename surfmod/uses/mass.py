@@ -17,6 +17,7 @@ from ..errors import InsideOutWarning, SurfmodError
 from ..inputs import to_shape
 from ..mass.totals import MassProperties, integrate
 from ..readback import from_faces
+from ..readback.strays import edge_deviations
 from ..surface import Surface
 
 
@@ -92,7 +93,6 @@ def boundary_ambiguity(obj) -> float:
     True
     """
     from ..occ.properties import bounding_box, gprops
-    from ..occ.strays import edge_deviations
 
     solid = to_shape(obj, "obj", solid=True, outward=False)  # the bound's size, not its sign
     box = bounding_box(solid)
