@@ -113,7 +113,7 @@ def test_shells_of_a_hollow_triangulation():
 
 
 def test_material_regions_drop_the_void():
-    from surfmod.occ.regions import material_regions
+    from surfmod.occ.booleans import material_regions
     from surfmod.occ.properties import gprops
 
     hollow = (bd.Box(4, 4, 4) - bd.Box(2, 2, 2)).wrapped
@@ -142,7 +142,7 @@ def _boss_on_a_bore():
 
 
 def test_solid_touching_itself_meshes_from_its_material_regions():
-    from surfmod.occ.regions import material_regions
+    from surfmod.occ.booleans import material_regions
     from surfmod.occ.properties import gprops
 
     solid = _boss_on_a_bore()
@@ -170,7 +170,7 @@ def test_11752_meshes_from_its_material_regions(tmp_path):
     their circle edges, volumes adding up to BRepGProp's), it meshes."""
     from conftest import CORPUS
 
-    from surfmod.occ.regions import material_regions
+    from surfmod.occ.booleans import material_regions
     from surfmod.occ.properties import gprops
     from surfmod.occ.topo import shells_of, solids_of
 

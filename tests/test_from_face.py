@@ -71,7 +71,7 @@ def test_the_area_of_a_face_is_from_face_area():
 
 def test_intersect_clips_to_the_face_like_brepalgoapi_section():
     from surfmod.occ.discretize import edge_length, wire_edges
-    from surfmod.occ.section import section_edges
+    from surfmod.occ.booleans import section_edges
 
     top = _holed_top()
     origin, normal = np.array([0.1, 0.0, 0.0]), np.array([1.0, 0.3, 0.0]) / np.hypot(1.0, 0.3)

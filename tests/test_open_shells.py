@@ -21,7 +21,7 @@ import surfmod as sm
 from surfmod.cli import main
 from surfmod.occ.discretize import edge_length, wire_edges
 from surfmod.occ.properties import bounding_box
-from surfmod.occ.section import section_edges
+from surfmod.occ.booleans import section_edges
 
 QUICK = CORPUS / "cadquery_red_cube_blue_cylinder.step"
 SWEEP = ["occt_screw.step", "trimesh_featuretype.STEP", "pythonocc_face_recognition_sample_part.stp",
@@ -242,7 +242,7 @@ def test_section_goes_on_past_a_face_occt_cannot_intersect(tmp_path, monkeypatch
     """BRepAlgoAPI_Section's failure on the whole model and on one face is simulated: the
     plane x = 25 crosses faces 4 and 5; face 5 is named, the DXF holds face 4's curve
     (its length BRepAlgoAPI_Section's of that face alone), exit 3."""
-    import surfmod.occ.section as occ_section
+    import surfmod.occ.booleans as occ_section
     from OCP.TopAbs import TopAbs_FACE
 
     path, out = loose_bspline_faces(tmp_path), tmp_path / "s.dxf"

@@ -390,7 +390,7 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
     area x measured deviation, and the result says so (``quality["surface"]``, printed).
     Where that triangulation crosses itself (a solid whose shells touch along a curve
     without sharing an edge there, as a void whose rim lies on the outer shell), each
-    solid is split into its material regions (:func:`surfmod.occ.regions.material_regions`,
+    solid is split into its material regions (:func:`surfmod.occ.booleans.material_regions`,
     OCCT's ``BOPAlgo_MakerVolume``), whose boundaries share their contact edges, and those
     are triangulated and filled (``quality["surface"]["split"]``).  Where gmsh's boundary
     recovery fails on a triangulation, it is retried once at half the tolerance
@@ -494,7 +494,7 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
 
 #: What fe_mesh tries, in order: gmsh on the B-rep as read, then healed by gmsh's OCC
 #: healing (:data:`HEALING`); for volumes, gmsh filling surfmod's measured triangulation of
-#: each solid, then of each solid's material regions (:func:`surfmod.occ.regions.material_regions`:
+#: each solid, then of each solid's material regions (:func:`surfmod.occ.booleans.material_regions`:
 #: a solid whose shells touch along a curve without sharing an edge there has triangles
 #: crossing at that curve, which gmsh's boundary recovery rejects).
 ATTEMPTS = {"volume": ("as read", "healed", "triangulation", "regions"), "surface": ("as read", "healed")}
@@ -535,7 +535,7 @@ def _triangulation_attempt(shape, msh: Path, size: float, order: int, seconds: f
     """Volume-mesh every solid of ``shape`` from its watertight triangulation, measured
     against the exact faces (:func:`surfmod.meshing.brep.tessellate_shape`), for parts
     whose B-rep gmsh cannot mesh; with ``regions`` each solid is first split into its
-    material regions (:func:`surfmod.occ.regions.material_regions`), each triangulated and
+    material regions (:func:`surfmod.occ.booleans.material_regions`), each triangulated and
     filled on its own (gmsh has ``seconds`` for that); when gmsh's boundary recovery fails,
     once more from a finer triangulation (:data:`RECOVERY_RETRY_SHARE`).  Returns gmsh's
     qualities and what the boundary is:
@@ -545,7 +545,7 @@ def _triangulation_attempt(shape, msh: Path, size: float, order: int, seconds: f
     area x deviation of the part's."""
     from ..occ.properties import bounding_box, gprops
     from ..occ.topo import solids_of
-    from ..occ.regions import material_regions
+    from ..occ.booleans import material_regions
 
     box = bounding_box(shape)
     tolerance = min(TRIANGULATION_SHARE * float(np.linalg.norm(box[1] - box[0])), TRIANGULATION_SIZE_SHARE * size)

@@ -1,8 +1,5 @@
-"""Interference between mating parts: overlap volume, minimum distance, contact.
-
-The same concept as :mod:`surfmod.occ.interference` (its OCCT Boolean and distance), one
-level up.
-"""
+"""Interference between mating parts: overlap volume, minimum distance, contact (OCCT's
+Boolean and distance: :mod:`surfmod.occ.booleans`)."""
 
 from __future__ import annotations
 
@@ -74,7 +71,7 @@ def interference(a, b, tolerance: float = 1e-6) -> Interference:
     >>> round(r.distance, 9), r.status
     (1.0, 'clearance')
     """
-    from ..occ.interference import common_volume, min_distance
+    from ..occ.booleans import common_volume, min_distance
     from ..occ.properties import bounding_box, gprops
 
     tolerance = checks.positive(tolerance, "tolerance")

@@ -1,7 +1,7 @@
 """Cross-section views: planar sections of a part as curves, in 3-D and in the plane's frame.
 
-The same concept as :mod:`surfmod.cli.section` (the ``surfmod section`` command over this)
-and :mod:`surfmod.occ.section` (the OCCT section it reads, one level down).
+The same concept as :mod:`surfmod.cli.section` (the ``surfmod section`` command over this);
+the OCCT section it reads is :mod:`surfmod.occ.booleans`.
 """
 
 from __future__ import annotations
@@ -229,7 +229,7 @@ def planar_faces_in(shape, origin, normal, tol: float) -> list[int]:
     >>> planar_faces_in(bd.Box(2, 2, 2), np.array([0, 0, 1.0]), np.array([0, 0, -1.0]), 1e-9)
     [5]
     """
-    from ..occ.section import planar_faces_on
+    from ..occ.booleans import planar_faces_on
 
     return planar_faces_on(shape, origin, normal, tol)
 
@@ -254,7 +254,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, 
     ((2,), True)
     """
     from ..occ.properties import bounding_box
-    from ..occ.section import section_edges
+    from ..occ.booleans import section_edges
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
