@@ -38,7 +38,7 @@ from surfmod.cam.drop_cutter import TriangleGrid, drop
 from surfmod.cam.waterline import waterline
 from surfmod.errors import SurfmodError
 from surfmod.inputs import to_shape
-from surfmod.occ.triangulation import part_triangles
+from surfmod.cam.drop_cutter import part_triangles
 
 from .tables import Table, captured_stdout, heading, note
 

@@ -2,13 +2,18 @@
 evaluator, cross-checked against OCCT's GeomAPI_IntSS / GeomAPI_IntCS.
 """
 
+import sys
 from pathlib import Path
 
 import build123d as bd
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ.geomapi import intersect_line, intersect_surfaces
+
+# OCCT's side of the cross-check: a twin kept with the tests (tests/twins), not in the package
+sys.path.append(str(Path(__file__).resolve().parent.parent / "tests"))
+from twins.geomapi import intersect_line, intersect_surfaces  # noqa: E402
+
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 

@@ -3,13 +3,18 @@ Newton, equal to GeomAPI_ProjectPointOnSurf), and the shadow of the patch on a p
 under parallel light (projected boundary + silhouettes + outline).
 """
 
+import sys
 from pathlib import Path
 
 import build123d as bd
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ.geomapi import project_points
+
+# OCCT's side of the cross-check: a twin kept with the tests (tests/twins), not in the package
+sys.path.append(str(Path(__file__).resolve().parent.parent / "tests"))
+from twins.geomapi import project_points  # noqa: E402
+
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 

@@ -3,13 +3,17 @@ non-uniform) a NURBS patch and compare each with OCCT's gp_Trsf / gp_GTrsf appli
 geom(); then split it into exact pieces by knot insertion (= OCCT's Segment).
 """
 
+import sys
 from pathlib import Path
 
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ.transformed import geom_gtransformed, geom_transformed, named_trsf
 from surfmod.occ.sample import surface_d0
+
+# OCCT's side of the cross-check: a twin kept with the tests (tests/twins), not in the package
+sys.path.append(str(Path(__file__).resolve().parent.parent / "tests"))
+from twins.transformed import geom_gtransformed, geom_transformed, named_trsf  # noqa: E402
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 

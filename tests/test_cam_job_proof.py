@@ -50,7 +50,7 @@ from stock_sim import (RS274, Cutter, Program, Stock, _shifted, cutter_locations
 
 import surfmod as sm
 from surfmod.inputs import to_shape
-from surfmod.occ.triangulation import part_triangles
+from surfmod.cam.drop_cutter import part_triangles
 
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")

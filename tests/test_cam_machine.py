@@ -14,7 +14,7 @@ from scipy.spatial import cKDTree
 import surfmod as sm
 from surfmod.cli import main
 from surfmod.cam.roughing import FEED, MAX_RAMP_ANGLE, RAPID
-from surfmod.occ.triangulation import part_triangles
+from surfmod.cam.drop_cutter import part_triangles
 
 RS274 = shutil.which("rs274")
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")

@@ -24,7 +24,7 @@ from test_cam_job_proof import rough_rest
 
 import surfmod as sm
 from surfmod.cam.roughing import MAX_RAMP_ANGLE, RAPID
-from surfmod.occ.triangulation import part_triangles
+from surfmod.cam.drop_cutter import part_triangles
 
 R, A, STEPDOWN, STEPOVER, MARGIN, CELL = 2.0, 0.3, 4.0, 1.5, 2.0, 0.1
 HOLE = (10.0, 8.0)

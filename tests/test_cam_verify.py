@@ -236,7 +236,7 @@ def test_a_low_rib_along_the_raster_is_recut_and_both_judges_agree():
     from scipy import ndimage
     from stock_sim import Cutter, Stock, parse_gcode, part_height, reachable, simulate
 
-    from surfmod.occ.triangulation import part_triangles
+    from surfmod.cam.drop_cutter import part_triangles
 
     part = bd.Box(40, 30, 5) + bd.Pos(0, 4, 3.0) * bd.Box(40, 6, 1.0)
     job = sm.machine(part, 1.0, [sm.Rough(sm.Tool("flat", 4.0), allowance=0.3),

@@ -13,7 +13,7 @@ import pytest
 import surfmod as sm
 from surfmod.cli import main
 from surfmod.cli.section import dxf_length  # noqa: F401 - the DXF's exact length, as the command judges it
-from surfmod.occ.discretize import edge_length, wire_edges
+from surfmod.occ.sample import edge_length, wire_edges
 from surfmod.occ.properties import bounding_box, gprops
 from surfmod.occ.booleans import section_edges
 from surfmod.occ.sample import surface_d0, surface_d2

@@ -166,7 +166,7 @@ def test_cam_part_job_scallop_in_stock(tmp_path):
     scallop plus the tolerance over the whole top (issue 26 measured 0.059 for the raster
     alone); the vertical walls are cut by the contours (their steep pieces) down to the part's bottom."""
     from surfmod.inputs import to_shape
-    from surfmod.occ.triangulation import part_triangles
+    from surfmod.cam.drop_cutter import part_triangles
 
     S = 0.05
     job = sm.machine(SAMPLES / "cam_part.step", 3.0, [sm.Rough(sm.Tool("flat", 5.0), stepdown=3.0, allowance=0.3),

@@ -70,7 +70,7 @@ def test_the_area_of_a_face_is_from_face_area():
 
 
 def test_intersect_clips_to_the_face_like_brepalgoapi_section():
-    from surfmod.occ.discretize import edge_length, wire_edges
+    from surfmod.occ.sample import edge_length, wire_edges
     from surfmod.occ.booleans import section_edges
 
     top = _holed_top()

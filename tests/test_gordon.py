@@ -84,7 +84,7 @@ def test_general_network_within_tolerance_and_vs_build123d():
     assert ours <= tol
     # build123d's Gordon (ocp_gordon) on the same edges meets the same tolerance
     face = s.occt_gordon()
-    from surfmod.occ.network import curve_to_surface_distances
+    from surfmod.occ.filling import curve_to_surface_distances
     from surfmod.occ.topo import face_surface
 
     geom, bounds, _ = face_surface(face)

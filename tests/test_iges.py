@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ.fullprecision import write_step_full
+from surfmod.occ.step import write_step_full
 
 
 def _nurbs(seed, rational=True):

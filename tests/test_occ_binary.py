@@ -17,7 +17,7 @@ from OCP.TopoDS import TopoDS
 
 import surfmod as sm
 from surfmod.occ import arrays
-from surfmod.occ.binary import bspline_curves
+from surfmod.occ.geom import bspline_curves
 from surfmod.occ.geom import (downcast_surface, read_bezier_surface, read_bspline_curve, read_bspline_curves_2d,
                                read_bspline_surface)
 from surfmod.occ.topo import explore, faces_of

@@ -19,7 +19,7 @@ from test_corpus_toolpath import run_and_judge
 
 import surfmod as sm
 from surfmod.cli import main
-from surfmod.occ.discretize import edge_length, wire_edges
+from surfmod.occ.sample import edge_length, wire_edges
 from surfmod.occ.properties import bounding_box
 from surfmod.occ.booleans import section_edges
 

@@ -71,7 +71,7 @@ def test_plane_missing_part_is_empty(tmp_path):
 
 def _occt_length(shape, origin, normal) -> float:
     """BRepAlgoAPI_Section's length, edge by edge (GCPnts on OCCT's own edges)."""
-    from surfmod.occ.discretize import edge_length, wire_edges
+    from surfmod.occ.sample import edge_length, wire_edges
     from surfmod.occ.booleans import section_edges
 
     shape = getattr(shape, "wrapped", shape)

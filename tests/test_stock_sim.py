@@ -210,7 +210,7 @@ def test_cam_part_toolpath_in_stock(tmp_path):
     rounding), no rapid touching stock; the residual on the reachable surface is measured
     and reported.  What issue 26 says is missing is asserted missing: the spindle is never
     started."""
-    from surfmod.occ.triangulation import part_triangles
+    from surfmod.cam.drop_cutter import part_triangles
     from surfmod.inputs import to_shape
 
     tri, deflection = part_triangles(to_shape(SAMPLES / "cam_part.step"), 0.001)
@@ -255,7 +255,7 @@ def test_corpus_finishing_path_in_stock(tmp_path, corpus_dir, name, kind):
     no rapid through stock or part."""
     import surfmod as sm
     from surfmod.inputs import to_shape
-    from surfmod.occ.triangulation import part_triangles
+    from surfmod.cam.drop_cutter import part_triangles
 
     shape = to_shape(corpus_dir / name)
     tool = sm.Tool("ball", 3.0) if kind == "ball" else sm.Tool("bull", 3.0, 1.0)

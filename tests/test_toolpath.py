@@ -15,8 +15,7 @@ from toolpath_reference import ball_clearance, flat_cuts, gcode_positions
 
 import surfmod as sm
 from surfmod.cli import main as cli_main
-from surfmod.occ import triangulation
-from surfmod.occ.triangulation import part_triangles
+from surfmod.cam.drop_cutter import part_triangles
 from surfmod.cam import toolpath as toolpath_module
 from surfmod.cam import toolpath_moves
 from surfmod.cam.cutters import CUTTERS, Ball, Flat
@@ -245,7 +244,7 @@ def test_tiny_tolerance_and_huge_work_are_refused_before_the_work(tmp_path, monk
     def no_meshing(*args, **kwargs):
         raise AssertionError("BRepMesh ran before the refusal")
 
-    monkeypatch.setattr(triangulation, "part_triangles", no_meshing)
+    monkeypatch.setattr(toolpath_module, "part_triangles", no_meshing)
     monkeypatch.setattr(toolpath_module, "MAX_TRIANGLES", 100_000)  # the sphere at 1e-4: ~600,000 estimated
     for tol, why in ((5e-324, "below the floor"), (1e-14, "below the floor"), (1e-5, "BRepMesh's time"),
                      (1e-4, "triangles, above the limit")):

@@ -233,7 +233,7 @@ def test_fiber_intervals_are_where_the_dropped_tool_reaches_z(kind, R, r):
 
 @pytest.fixture(scope="module")
 def corpus_triangles(corpus_dir):
-    from surfmod.occ.triangulation import part_triangles
+    from surfmod.cam.drop_cutter import part_triangles
     from surfmod.inputs import to_shape
 
     tri, _ = part_triangles(to_shape(corpus_dir / CORPUS_PART), 0.05)

@@ -1,5 +1,8 @@
 """Drop-cutter against a triangle soup, compiled: one scalar loop per cutter location over its candidate triangles.
 
+The soup is the part's faces meshed by BRepMesh (:func:`part_triangles`): their triangles
+lie inside each face's trim and their nodes on the exact surface.
+
 The tool is an end mill with an endless shank of its own radius above the tip: a ball
 end (sphere of radius ``r`` centred ``r`` above the tip), a flat end (a disc at the
 tip) or a bull nose (a flat core of radius ``a = r - c`` rounded by a torus of corner
@@ -389,3 +392,39 @@ def drop(grid: TriangleGrid, cutter: Cutter, xy: np.ndarray, *, contacts: bool =
                  grid.top, grid.radius, cutter.corner, z, touch, touched)
     z[~np.isfinite(z)] = np.nan
     return (z,) + ((touch,) if contacts else ()) + ((touched,) if triangles else ()) if contacts or triangles else z
+
+
+def part_triangles(shape, deflection: float, angular: float = 0.35, *, face_index: bool = False):
+    """``(triangles (M, 3, 3), deflection)``: all faces of ``shape`` meshed by BRepMesh at
+    the linear ``deflection`` (model units) and ``angular`` deflection (radians), in global
+    coordinates, and the largest chordal deflection BRepMesh measured on any face (at least
+    the requested one; some faces of real parts cannot be meshed finer than their own
+    tolerance allows).  Any triangulation stored on the shape is replaced.  A face BRepMesh
+    leaves without triangles raises ``SurfmodError`` (the tool would not see it).  With
+    ``face_index`` a third item: the faces (``faces_of`` order) and each triangle's
+    index into them ``(M,)``.  The plain loop runs over BRepMesh's faces (the kernel's
+    output), not over triangles."""
+    from ..occ.mesh import mesh_faces
+    from ..occ.topo import wrapped
+
+    if wrapped(shape) is None:
+        raise SurfmodError(f"obj: expected an OCCT shape, got {type(shape).__name__}")
+    blocks, owners, faces = [], [], []
+    unmeshed = 0
+    measured = float(deflection)
+    for _, face, got in mesh_faces(shape, deflection, angular, with_uv=False):
+        if got is None:
+            unmeshed += 1  # a face the tool cannot see: never skip it silently
+            continue
+        blocks.append(got.nodes[got.triangles])
+        owners.append(np.full(len(got.triangles), len(faces)))
+        faces.append(face)
+        measured = max(measured, got.deflection)
+    if unmeshed:
+        raise SurfmodError(f"obj: BRepMesh could not triangulate {unmeshed} face(s); a tool path over them "
+                           f"cannot be checked")
+    if not blocks:
+        raise SurfmodError("obj: has no faces to machine")
+    if face_index:
+        return np.concatenate(blocks), measured, (faces, np.concatenate(owners))
+    return np.concatenate(blocks), measured

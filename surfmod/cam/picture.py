@@ -18,7 +18,7 @@ def _figure(job, size=(7.0, 5.5), dpi=110):
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from ..occ.triangulation import part_triangles
+    from .drop_cutter import part_triangles
 
     lo, hi = job.stock
     tri, _ = part_triangles(job.part, 0.002 * float(np.ptp(job.stock, axis=0).max()))

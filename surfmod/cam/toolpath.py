@@ -39,7 +39,7 @@ from ..inputs import to_shape
 from ..meshing.brep import _estimate
 from ..meshing.render import Drawing, polyline_runs, repr_png
 from .cutters import Cutter
-from .drop_cutter import TriangleGrid, drop
+from .drop_cutter import TriangleGrid, drop, part_triangles
 from .gcode import gcode_text
 from .toolpath_exact import exact_heights
 from .tool import Tool
@@ -200,8 +200,6 @@ def _mesh_estimate(shape, tolerance: float) -> None:
 
 
 def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None) -> _Part:
-    from ..occ.triangulation import part_triangles
-
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
     _mesh_estimate(shape, tolerance)

@@ -245,7 +245,7 @@ def part_points(shape, spacing: float, max_samples: int = MAX_SAMPLES, sag: floa
     faces' parameter grids before any is evaluated) raises ``SurfmodError``; with ``fit``
     the points stand farther apart instead, as many as the cap allows (see
     :func:`sampled_part`)."""
-    from ..occ.discretize import edge_length, sample_curve
+    from ..occ.sample import edge_length, sample_curve
     from ..occ.topo import curve_of_edge, faces_of, geometric_edges, wrapped
 
     spacing = checks.positive(spacing, "spacing")

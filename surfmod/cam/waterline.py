@@ -342,7 +342,7 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     first point not repeated), the material on the left of the direction of travel
     (counter-clockwise round islands, clockwise inside pockets).
 
-    ``part``: triangles ``(M, 3, 3)`` (e.g. from :func:`surfmod.occ.triangulation.part_triangles`);
+    ``part``: triangles ``(M, 3, 3)`` (e.g. from :func:`surfmod.cam.drop_cutter.part_triangles`);
     ``tool``: a :class:`surfmod.Tool` or a :class:`~surfmod.cam.cutters.Cutter`.
     ``sampling``: spacing of the fiber grid that finds the loops (default a quarter of the
     radius; features of the tool-offset narrower than it may be missed); ``tolerance``:

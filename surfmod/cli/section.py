@@ -124,7 +124,7 @@ def run(args) -> int:
 def _judged(path, s) -> str | None:
     """None when the DXF at ``path`` is as long as the section's OCCT edges, else what
     differs and by how much."""
-    from ..occ.discretize import edge_length, wire_edges
+    from ..occ.sample import edge_length, wire_edges
 
     ours = dxf_length(path)
     occt = sum(edge_length(e) for w in s.wires for e in wire_edges(w))

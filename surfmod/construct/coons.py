@@ -63,7 +63,7 @@ class CoonsSurface(BSplineSurface):
     def occt_fill(self):
         """OCCT's ``GeomFill_BSplineCurves(c0, d1, c1 reversed, d0 reversed, CoonsStyle)``
         as a ``Geom_BSplineSurface``; OCCT needs at least 4 poles per direction."""
-        from ..occ.network import bspline_curves_fill, reversed_curve
+        from ..occ.filling import bspline_curves_fill, reversed_curve
 
         c0, c1, d0, d1 = (c.to_bspline().geom() for c in self.boundaries)
         return bspline_curves_fill(c0, d1, reversed_curve(c1), reversed_curve(d0), "coons")

@@ -61,7 +61,7 @@ class GordonSurface(BSplineSurface):
     def network_deviation(self, samples: int = 64) -> float:
         """Largest distance from ``samples`` points on every network curve to this
         surface, measured by OCCT projection (``GeomAPI_ProjectPointOnSurf``)."""
-        from ..occ.network import curve_to_surface_distances
+        from ..occ.filling import curve_to_surface_distances
 
         (u0, u1), (v0, v1) = self.domain
         geom = self.geom()
@@ -74,7 +74,7 @@ class GordonSurface(BSplineSurface):
 
     def occt_gordon(self):
         """build123d's ``Face.make_gordon_surface`` on the same network (a ``Face``)."""
-        from ..occ.network import gordon_face
+        from ..occ.filling import gordon_face
 
         return gordon_face([c.edge() for c in self.profiles], [c.edge() for c in self.guides], self.tolerance)
 

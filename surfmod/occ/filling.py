@@ -1,22 +1,28 @@
-"""OCCT's filling constructs, used as the reference beside surfmod's blends and fills:
-``BRepOffsetAPI_MakeFilling`` (plate surface through boundary edges, optionally tangent
-to support faces), and the exact B-spline conversion of a bounded surface."""
+"""OCCT's filling constructs (``GeomFill``, ``BRepOffsetAPI_MakeFilling``), used as the
+reference beside surfmod's blends, fills and curve-network surfaces: the plate surface
+through boundary edges (optionally tangent to support faces), the exact B-spline
+conversion of a bounded surface, ``GeomFill_BSplineCurves`` (Coons style) and
+build123d's Gordon surface (``Face.make_gordon_surface``), plus distances from curves to
+a surface."""
 
 from __future__ import annotations
 
 import numpy as np
-
-from .guard import check_done, kernel
-from .topo import wrapped
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeFilling
 from OCP.Geom import Geom_RectangularTrimmedSurface
 from OCP.GeomAbs import GeomAbs_C0, GeomAbs_G1, GeomAbs_G2
 from OCP.GeomConvert import GeomConvert
+from OCP.GeomFill import GeomFill_BSplineCurves, GeomFill_FillingStyle
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
+
+from ..errors import KernelError
 from .geom import read_bspline_surface
+from .guard import check_done, kernel
+from .sample import distances_to_surface
+from .topo import wrapped
 
 
 def bspline_over(geom, bounds) -> dict:
@@ -66,3 +72,42 @@ def make_filling(constraints, *, degree: int = 3, points_on_curve: int = 15, ite
         check_done(maker, "BRepOffsetAPI_MakeFilling")
         return bd.Face(TopoDS.Face(maker.Shape()))
 
+
+def bspline_curves_fill(c1, c2, c3, c4, style: str = "coons"):
+    """``GeomFill_BSplineCurves(c1, c2, c3, c4, style)``: four ``Geom_BSplineCurve``
+    handles forming a closed loop (OCCT arranges and orients them); returns the
+    ``Geom_BSplineSurface``."""
+    styles = {
+        "coons": GeomFill_FillingStyle.GeomFill_CoonsStyle,
+        "stretch": GeomFill_FillingStyle.GeomFill_StretchStyle,
+        "curved": GeomFill_FillingStyle.GeomFill_CurvedStyle,
+    }
+    with kernel("GeomFill_BSplineCurves"):
+        fill = GeomFill_BSplineCurves(c1, c2, c3, c4, styles[style])
+        return fill.Surface()
+
+
+def reversed_curve(curve):
+    """OCCT's reversed copy of a ``Geom_BSplineCurve``."""
+    with kernel("Geom_BSplineCurve.Reversed"):
+        return curve.Reversed()
+
+
+def gordon_face(profiles, guides, tolerance: float):
+    """build123d's ``Face.make_gordon_surface`` (the ``ocp_gordon`` package) on the
+    given build123d edges; raises ``KernelError`` when it fails."""
+    import build123d as bd
+
+    try:
+        return bd.Face.make_gordon_surface(list(profiles), list(guides), tolerance=tolerance)
+    except Exception as exc:  # ocp_gordon raises plain Python errors as well as OCCT ones
+        raise KernelError(f"Face.make_gordon_surface: failed ({type(exc).__name__}: {exc})") from exc
+
+
+def curve_to_surface_distances(surf, bounds, curve, samples: int) -> np.ndarray:
+    """Distances from ``samples`` points along a ``Geom_Curve`` (uniform in its
+    parameter) to a bounded ``Geom_Surface``, by OCCT point projection."""
+    with kernel("Geom_Curve.Value"):
+        t0, t1 = curve.FirstParameter(), curve.LastParameter()
+        pts = np.array([curve.Value(float(t)).Coord() for t in np.linspace(t0, t1, samples)])
+    return distances_to_surface(surf, pts, bounds)

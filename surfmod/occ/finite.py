@@ -14,11 +14,17 @@ import math
 
 import OCP.Geom as G
 import OCP.Geom2d as G2
+from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepTools import BRepTools
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
+
+from ..errors import SurfmodError
+from .bindings import box_limits
+from .guard import kernel
 
 # where no B-spline form holds the numbers, these fractions of the range are evaluated
 _FRACTIONS = (0.0, 0.5, 1.0)
@@ -126,3 +132,32 @@ def first_non_finite(shape, limit: float) -> str | None:
         if curve is not None and not _curve_ok(curve, t0, t1, limit, G):
             return f"edge {ei}"
     return None
+
+
+def check_numbers(shape, path, max_coordinate: float) -> None:
+    """Raise ``SurfmodError`` naming ``path`` when ``shape`` holds no geometry, or NaN,
+    infinite or out-of-range numbers (beyond ``max_coordinate``): its bounding box first,
+    then every number (:func:`first_non_finite`)."""
+    with kernel("BRepBndLib"):
+        box = Bnd_Box()
+        BRepBndLib.Add_s(shape, box, False)  # from the geometry, not a triangulation
+        if box.IsVoid():
+            raise SurfmodError(f"path: {path} contains no geometry")
+        corners = box_limits(box)
+    if not all(math.isfinite(c) for c in corners):
+        raise SurfmodError(f"path: {path} has NaN or infinite coordinates")
+    size = max(abs(c) for c in corners)
+    if size > max_coordinate:
+        raise SurfmodError(
+            f"path: {path} has coordinates up to {size:.3g}, beyond the limit {max_coordinate:.3g} "
+            "(max_coordinate=)"
+        )
+    # the box is built from edges and bounds: a control point of inf inside a face is
+    # not in it, and evaluating that span later crashes OCCT
+    with kernel("geometry check"):
+        where = first_non_finite(shape, max_coordinate)
+    if where is not None:
+        raise SurfmodError(
+            f"path: {path} has NaN, infinite or out-of-range numbers in the geometry of {where} "
+            f"(limit {max_coordinate:.3g}, max_coordinate=)"
+        )

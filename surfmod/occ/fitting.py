@@ -1,17 +1,30 @@
-"""OCCT's own surface fitting (``GeomAPI_PointsToBSplineSurface``), for comparisons.
+"""OCCT's surface fitting, for comparisons: ``GeomAPI_PointsToBSplineSurface`` through or near
+a grid, ``GeomPlate`` through scattered points, and the fit's independent measure
+(``Extrema_GenLocateExtPS``).
 
 The same concept as :mod:`surfmod.construct.fitting`, of which this is the OCCT twin.
+
+``project_points`` is the independent measure of a fit: every point is projected onto
+the OCCT twin (``Geom_BSplineSurface``) by ``Extrema_GenLocateExtPS`` (distance
+criterion, so minima on the border are found), started at the caller's foot-point
+parameters; where that local search fails, the global ``GeomAPI_ProjectPointOnSurf``
+takes over.  The distance of a point to *any* surface point bounds its distance to the
+surface from above, so a maximum measured this way is a guaranteed bound.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from OCP.Approx import Approx_ParametrizationType
+from OCP.Extrema import Extrema_GenLocateExtPS
+from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface, GeomAPI_ProjectPointOnSurf
 from OCP.GeomAbs import GeomAbs_Shape
-from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface
+from OCP.GeomAdaptor import GeomAdaptor_Surface
+from OCP.GeomPlate import GeomPlate_BuildPlateSurface, GeomPlate_MakeApprox, GeomPlate_PointConstraint
+from OCP.gp import gp_Pnt
 
-from ..errors import KernelError
 from . import arrays
+from ..errors import KernelError
 from .guard import kernel
 
 
@@ -33,3 +46,52 @@ def points_to_bspline_surface(points: np.ndarray, degree=(3, 3), tolerance: floa
         if not fit.IsDone():
             raise KernelError("GeomAPI_PointsToBSplineSurface: fit failed")
         return fit.Surface()
+
+
+def project_points(surf, points: np.ndarray, u: np.ndarray, v: np.ndarray):
+    """Distances ``(N,)`` and OCCT foot parameters ``(u, v)`` of ``points`` on ``surf``."""
+    n = len(points)
+    dist = np.empty(n)
+    uo, vo = np.empty(n), np.empty(n)
+    pts = np.ascontiguousarray(points, dtype=float).tolist()
+    us, vs = np.asarray(u, dtype=float).tolist(), np.asarray(v, dtype=float).tolist()
+    with kernel("Extrema_GenLocateExtPS"):
+        adaptor = GeomAdaptor_Surface(surf)
+        local = Extrema_GenLocateExtPS(adaptor, 1e-12, 1e-12)
+        glob = None
+        p = gp_Pnt()
+        for k in range(n):  # the OCCT reference side: one kernel call per point
+            x, y, z = pts[k]
+            p.SetCoord(x, y, z)
+            local.Perform(p, us[k], vs[k], True)
+            if local.IsDone():
+                dist[k] = local.SquareDistance() ** 0.5
+                uo[k], vo[k] = local.Point().Parameter()
+                continue
+            if glob is None:
+                u0, u1, v0, v1 = surf.Bounds()
+                glob = GeomAPI_ProjectPointOnSurf()
+                glob.Init(surf, u0, u1, v0, v1)
+            glob.Perform(p)
+            if glob.NbPoints() > 0:
+                dist[k] = glob.LowerDistance()
+                uo[k], vo[k] = glob.LowerDistanceParameters()
+            else:  # no extremum: the surface point at the start bounds the distance
+                q = surf.Value(us[k], vs[k])
+                dist[k] = q.Distance(p)
+                uo[k], vo[k] = us[k], vs[k]
+    return dist, uo, vo
+
+
+def plate_through_points(points: np.ndarray, degree: int = 3, max_segments: int = 9, tolerance: float = 1e-3):
+    """OCCT's ``GeomPlate`` surface constrained by points (``GeomPlate_BuildPlateSurface``
+    with ``GeomPlate_PointConstraint``s, approximated by ``GeomPlate_MakeApprox``)."""
+    with kernel("GeomPlate_BuildPlateSurface"):
+        build = GeomPlate_BuildPlateSurface(degree, 15, 2)
+        for x, y, z in np.asarray(points, dtype=float).tolist():
+            build.Add(GeomPlate_PointConstraint(gp_Pnt(x, y, z), 0))
+        build.Perform()
+        if not build.IsDone():
+            raise KernelError("GeomPlate_BuildPlateSurface: failed")
+        approx = GeomPlate_MakeApprox(build.Surface(), float(tolerance), max_segments, 8, float(tolerance) * 10, 0)
+        return approx.Surface()

@@ -1,6 +1,6 @@
 """IGES read/write through OCCT's ``IGESControl`` (the STEP side is ``step.py``).
 
-Reals are written with 17 significant digits (:mod:`surfmod.occ.fullprecision`), so
+Reals are written with 17 significant digits (as :mod:`surfmod.occ.step` writes them), so
 B-spline poles, weights and knots come back bit for bit; OCCT's own ``Write`` prints 10.
 
 The same concept as :mod:`surfmod.io.iges`, whose OCCT side (``IGESControl``) this is.
@@ -11,8 +11,7 @@ from __future__ import annotations
 import io
 
 from ..errors import KernelError
-from .step import read_with
-from .fullprecision import FLOAT_FORMAT, write_bytes
+from .step import FLOAT_FORMAT, read_with, write_bytes
 from .guard import kernel
 from OCP.IGESControl import IGESControl_Controller, IGESControl_Reader, IGESControl_Writer
 from OCP.IGESData import IGESData_IGESWriter

@@ -20,8 +20,6 @@ from threads, from joblib/loky workers and from daemon processes alike.
 from __future__ import annotations
 
 import atexit
-import io
-import math
 import os
 import pickle
 import select
@@ -35,9 +33,8 @@ import warnings
 from pathlib import Path
 
 from .. import checks
-from .finite import first_non_finite
+from .finite import check_numbers
 from ..errors import DamagedFileError, InsideOutWarning, SurfmodError
-from .guard import kernel
 
 _HEADER = struct.Struct("!Q")
 
@@ -75,44 +72,14 @@ def _read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
     and what the model says of its solids' orientation: those inside out in the file,
     read outward (:func:`~surfmod.occ.step.outward_solids`), and those whose faces
     disagree (:func:`~surfmod.occ.solids.faces_at_odds`)."""
-    from OCP.BinTools import BinTools
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-
-    from .bindings import box_limits
     from .solids import faces_at_odds
-    from .step import read_step
+    from .step import brep_bytes, read_step
 
     turned: list = []  # the solids inside out in the file, turned outward
     shape = read_step(path, turned)
     at_odds = faces_at_odds(shape)  # solids whose faces disagree: said, left to mesh and mass
-    with kernel("BRepBndLib"):
-        box = Bnd_Box()
-        BRepBndLib.Add_s(shape, box, False)  # from the geometry, not a triangulation
-        if box.IsVoid():
-            raise SurfmodError(f"path: {path} contains no geometry")
-        corners = box_limits(box)
-    if not all(math.isfinite(c) for c in corners):
-        raise SurfmodError(f"path: {path} has NaN or infinite coordinates")
-    size = max(abs(c) for c in corners)
-    if size > max_coordinate:
-        raise SurfmodError(
-            f"path: {path} has coordinates up to {size:.3g}, beyond the limit {max_coordinate:.3g} "
-            "(max_coordinate=)"
-        )
-    # the box is built from edges and bounds: a control point of inf inside a face is
-    # not in it, and evaluating that span later crashes OCCT
-    with kernel("geometry check"):
-        where = first_non_finite(shape, max_coordinate)
-    if where is not None:
-        raise SurfmodError(
-            f"path: {path} has NaN, infinite or out-of-range numbers in the geometry of {where} "
-            f"(limit {max_coordinate:.3g}, max_coordinate=)"
-        )
-    with kernel("BinTools.Write"):
-        out = io.BytesIO()
-        BinTools.Write_s(shape, out)
-    return out.getvalue(), (turned, at_odds)
+    check_numbers(shape, path, max_coordinate)
+    return brep_bytes(shape), (turned, at_odds)
 
 
 def _worker_main() -> None:
@@ -280,17 +247,14 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     if timeout is None:
         timeout = TIMEOUT_BASE + TIMEOUT_PER_MB * p.stat().st_size / 1e6
     _WORKER.prestart()  # the worker imports OCCT while this process does the same
-    from OCP.BinTools import BinTools
-    from OCP.TopoDS import TopoDS_Shape
+    from .step import brep_from_bytes
 
     try:
         data, (turned, at_odds) = _WORKER.read(str(p), timeout, max_coordinate)
     except DamagedFileError as exc:
         msg = str(exc)
         raise DamagedFileError(msg if msg.startswith(f"{name}:") else f"{name}: {msg.removeprefix('path: ')}") from None
-    with kernel("BinTools.Read"):
-        shape = TopoDS_Shape()
-        BinTools.Read_s(shape, io.BytesIO(data))
+    shape = brep_from_bytes(data)
     for number, volume in turned:
         warnings.warn(f"{p.name}: solid {number} is inside out in the file (enclosed volume {volume:.6g}): "
                       "read outward", InsideOutWarning, stacklevel=3)

@@ -27,8 +27,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Iterator
 from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 from ..eval.basis import knots_inside
-from .binary import bspline_curves
-from .geom import read_bspline_curve
+from .geom import bspline_curves, read_bspline_curve
 from .arrays import pnt, xyz, xyz_many
 from .guard import kernel
 from .bindings import TColStd_Array1OfReal, TopTools_IndexedMapOfShape

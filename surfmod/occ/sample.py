@@ -1,18 +1,28 @@
-"""Per-point sampling of OCCT geometry: the cross-check's independent side.
+"""Sampling of OCCT curves and surfaces: per-point values (``D0``/``D1``/``D2``,
+``GeomLProp``, ``GeomAPI`` projection), the cross-check's independent side, and lengths
+and samples of curves and edges (``GCPnts``) with a wire's edges in order.
 
-These are deliberately plain loops over OCCT calls (``D0``/``D1``/``D2``, ``GeomLProp``);
-they are the reference, not an evaluation path.
+These are deliberately plain loops over OCCT calls; they are the reference, not an
+evaluation path.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from OCP.gp import gp_Pnt, gp_Vec
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepTools import BRepTools_WireExplorer
+from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_QuasiUniformDeflection
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+from OCP.GeomAdaptor import GeomAdaptor_Curve
 from OCP.GeomLProp import GeomLProp_SLProps
+from OCP.TopAbs import TopAbs_REVERSED
+from OCP.TopoDS import TopoDS
+from OCP.gp import gp_Pnt, gp_Vec
 
+from . import arrays
+from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import kernel
-from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from .topo import closest_on_face
 
 
@@ -105,3 +115,43 @@ def _d2_square(surf, u, v, positions_from_value: bool) -> np.ndarray:
     out[:, 0, 0], out[:, 1, 0], out[:, 0, 1] = rows[:, 0], rows[:, 1], rows[:, 2]
     out[:, 2, 0], out[:, 0, 2], out[:, 1, 1] = rows[:, 3], rows[:, 4], rows[:, 5]
     return out
+
+
+def wire_edges(wire):
+    """The edges of a wire in connection order."""
+    out = []
+    ex = BRepTools_WireExplorer(TopoDS.Wire(getattr(wire, "wrapped", wire)))
+    while ex.More():
+        out.append(ex.Current())
+        ex.Next()
+    return out
+
+
+def edge_points(edge, deflection: float) -> np.ndarray:
+    """Points along an edge (in its orientation) whose chords stay within ``deflection``
+    of the curve (``GCPnts_QuasiUniformDeflection``)."""
+    with kernel("GCPnts_QuasiUniformDeflection"):
+        c = BRepAdaptor_Curve(edge)
+        algo = GCPnts_QuasiUniformDeflection(c, float(deflection), c.FirstParameter(), c.LastParameter())
+        if not algo.IsDone():
+            raise SurfmodError("tolerance: OCCT could not discretize a section edge at this deflection")
+        pts = np.array([xyz(algo.Value(i)) for i in range(1, algo.NbPoints() + 1)])
+    return pts[::-1] if edge.Orientation() == TopAbs_REVERSED else pts
+
+
+def edge_length(edge) -> float:
+    """Length of an edge (``GCPnts_AbscissaPoint``, OCCT's own)."""
+    with kernel("GCPnts_AbscissaPoint.Length_s"):
+        return float(GCPnts_AbscissaPoint.Length_s(BRepAdaptor_Curve(edge), 1e-12))
+
+
+def curve_length(curve, t0: float, t1: float, tol: float = 1e-10) -> float:
+    """Arc length by ``GCPnts_AbscissaPoint.Length_s``."""
+    with kernel("GCPnts_AbscissaPoint.Length_s"):
+        return float(GCPnts_AbscissaPoint.Length_s(GeomAdaptor_Curve(curve, t0, t1), tol))
+
+
+def sample_curve(curve, t0: float, t1: float, count: int) -> np.ndarray:
+    """``count`` points equally spaced in parameter."""
+    with kernel("Geom_Curve.Value"):
+        return np.array([arrays.xyz(curve.Value(float(t))) for t in np.linspace(t0, t1, count)])

@@ -103,7 +103,7 @@ class Section:
 
     @cached_property
     def polylines(self) -> list[np.ndarray]:
-        from ..occ.discretize import wire_edges
+        from ..occ.sample import wire_edges
 
         def sampled(edge):  # from_edge follows the edge's orientation
             curve = from_edge(edge)
@@ -131,7 +131,7 @@ class Section:
         (OCCT ``GCPnts_QuasiUniformDeflection``)."""
         if tolerance is None:
             return [self.to_plane(p) for p in self.polylines]
-        from ..occ.discretize import edge_points, wire_edges
+        from ..occ.sample import edge_points, wire_edges
 
         pts = np.concatenate(self.polylines) if self.polylines else np.zeros((0, 3))
         size = float(np.linalg.norm(np.ptp(pts, axis=0))) if len(pts) else 0.0
@@ -149,7 +149,7 @@ class Section:
         ``("spline", degree, control_points (N, 2), knots, weights or None)``; B-splines
         keep their knots and weights, every other curve type is converted to its exact
         B-spline form."""
-        from ..occ.discretize import wire_edges
+        from ..occ.sample import wire_edges
 
         return [[_edge_entity(self, e) for e in wire_edges(w)] for w in self.wires]
 

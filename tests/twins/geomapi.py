@@ -11,7 +11,7 @@ from OCP.GeomAPI import GeomAPI_IntCS, GeomAPI_IntSS, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Dir, gp_Lin
 
 from surfmod.occ import arrays
-from surfmod.occ.discretize import curve_length, sample_curve
+from surfmod.occ.sample import curve_length, sample_curve
 from surfmod.occ.guard import kernel
 from surfmod.occ.sample import distances_to_face
 
