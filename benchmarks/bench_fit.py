@@ -78,7 +78,7 @@ def _scipy(name, pts, tol):
 
 
 def _plate(name, pts, tol):
-    from surfmod.occ.fitting import plate_through_points
+    from twins.plate import plate_through_points
 
     sub = pts[:: max(1, len(pts) // 400)]  # GeomPlate solves a dense system per point constraint
     t = time.perf_counter()

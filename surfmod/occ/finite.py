@@ -1,4 +1,5 @@
-"""Is every number of a shape's geometry finite?  (The STEP reader's last check.)
+"""Is every number of a shape's geometry finite?  Poles, weights and values of its ``Geom``
+surfaces and curves, and its ``BRepBndLib`` box (the STEP reader's last check).
 
 A damaged STEP file can hold ``inf`` or ``nan`` in a control point that OCCT's reader
 accepts; the bounding box, built from edges and bounds, need not see it, and a later

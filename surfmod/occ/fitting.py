@@ -1,6 +1,5 @@
 """OCCT's surface fitting, for comparisons: ``GeomAPI_PointsToBSplineSurface`` through or near
-a grid, ``GeomPlate`` through scattered points, and the fit's independent measure
-(``Extrema_GenLocateExtPS``).
+a grid, and the fit's independent measure (``Extrema_GenLocateExtPS``).
 
 The same concept as :mod:`surfmod.construct.fitting`, of which this is the OCCT twin.
 
@@ -20,7 +19,6 @@ from OCP.Extrema import Extrema_GenLocateExtPS
 from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface, GeomAPI_ProjectPointOnSurf
 from OCP.GeomAbs import GeomAbs_Shape
 from OCP.GeomAdaptor import GeomAdaptor_Surface
-from OCP.GeomPlate import GeomPlate_BuildPlateSurface, GeomPlate_MakeApprox, GeomPlate_PointConstraint
 from OCP.gp import gp_Pnt
 
 from . import arrays
@@ -81,17 +79,3 @@ def project_points(surf, points: np.ndarray, u: np.ndarray, v: np.ndarray):
                 dist[k] = q.Distance(p)
                 uo[k], vo[k] = us[k], vs[k]
     return dist, uo, vo
-
-
-def plate_through_points(points: np.ndarray, degree: int = 3, max_segments: int = 9, tolerance: float = 1e-3):
-    """OCCT's ``GeomPlate`` surface constrained by points (``GeomPlate_BuildPlateSurface``
-    with ``GeomPlate_PointConstraint``s, approximated by ``GeomPlate_MakeApprox``)."""
-    with kernel("GeomPlate_BuildPlateSurface"):
-        build = GeomPlate_BuildPlateSurface(degree, 15, 2)
-        for x, y, z in np.asarray(points, dtype=float).tolist():
-            build.Add(GeomPlate_PointConstraint(gp_Pnt(x, y, z), 0))
-        build.Perform()
-        if not build.IsDone():
-            raise KernelError("GeomPlate_BuildPlateSurface: failed")
-        approx = GeomPlate_MakeApprox(build.Surface(), float(tolerance), max_segments, 8, float(tolerance) * 10, 0)
-        return approx.Surface()

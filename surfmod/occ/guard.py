@@ -1,4 +1,4 @@
-"""Turn OCCT exceptions into :class:`~surfmod.errors.KernelError` with context."""
+"""Turn OCCT exceptions (``Standard_Failure``) into :class:`~surfmod.errors.KernelError` with context."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Read STEP files in a child process, so a damaged file cannot take the caller down.
+"""Read STEP files (``STEPControl``) in a child process, so a damaged file cannot take the
+caller down.
 
 OCCT's STEP reader dereferences whatever the file says: a deleted line, a flipped byte or
 a NaN coordinate can make it crash with SIGSEGV or loop forever, and neither can be caught

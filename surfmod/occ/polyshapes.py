@@ -1,4 +1,5 @@
-"""Polylines and triangle meshes as build123d shapes with a colour and a label.
+"""Polylines and triangle meshes as build123d shapes with a colour and a label
+(``BRepBuilderAPI_MakePolygon``, ``BRepBuilderAPI_MakeFace``).
 
 The OCP CAD Viewer (``ocp_vscode.show``) draws build123d shapes and walks the
 ``children`` of a compound as a tree, each node with its ``label`` and ``color``.  Tool

@@ -13,7 +13,6 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepTools import BRepTools_WireExplorer
 from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_QuasiUniformDeflection
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
-from OCP.GeomAdaptor import GeomAdaptor_Curve
 from OCP.GeomLProp import GeomLProp_SLProps
 from OCP.TopAbs import TopAbs_REVERSED
 from OCP.TopoDS import TopoDS
@@ -144,11 +143,6 @@ def edge_length(edge) -> float:
     with kernel("GCPnts_AbscissaPoint.Length_s"):
         return float(GCPnts_AbscissaPoint.Length_s(BRepAdaptor_Curve(edge), 1e-12))
 
-
-def curve_length(curve, t0: float, t1: float, tol: float = 1e-10) -> float:
-    """Arc length by ``GCPnts_AbscissaPoint.Length_s``."""
-    with kernel("GCPnts_AbscissaPoint.Length_s"):
-        return float(GCPnts_AbscissaPoint.Length_s(GeomAdaptor_Curve(curve, t0, t1), tol))
 
 
 def sample_curve(curve, t0: float, t1: float, count: int) -> np.ndarray:

@@ -1,4 +1,5 @@
-"""Sewing subdivision-limit patches into a shell and a solid (OCCT side of surfmod.subdiv)."""
+"""Sewing subdivision-limit patches into a shell and a solid (``BRepBuilderAPI_Sewing``), and
+how the sewn faces meet (OCCT side of surfmod.subdiv)."""
 
 from __future__ import annotations
 

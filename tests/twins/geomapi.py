@@ -6,12 +6,14 @@ not an evaluation path)."""
 from __future__ import annotations
 
 import numpy as np
+from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.Geom import Geom_Line
+from OCP.GeomAdaptor import GeomAdaptor_Curve
 from OCP.GeomAPI import GeomAPI_IntCS, GeomAPI_IntSS, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Dir, gp_Lin
 
 from surfmod.occ import arrays
-from surfmod.occ.sample import curve_length, sample_curve
+from surfmod.occ.sample import sample_curve
 from surfmod.occ.guard import kernel
 from surfmod.occ.sample import distances_to_face
 
@@ -59,3 +61,9 @@ def project_points(surf, bounds, points) -> np.ndarray:
 def face_distances(face, points) -> np.ndarray:
     """Distance from each point to a face (``BRepExtrema_DistShapeShape``), boundaries included."""
     return distances_to_face(getattr(face, "wrapped", face), np.asarray(points, dtype=float))
+
+
+def curve_length(curve, t0: float, t1: float, tol: float = 1e-10) -> float:
+    """Arc length by ``GCPnts_AbscissaPoint.Length_s``."""
+    with kernel("GCPnts_AbscissaPoint.Length_s"):
+        return float(GCPnts_AbscissaPoint.Length_s(GeomAdaptor_Curve(curve, t0, t1), tol))
