@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..atomic import atomic_path, target_path
 from ..errors import InsideOutWarning, RoundTripWarning, SurfmodError
-from ..io.step_iges import IGES_SUFFIXES, export_iges, export_step, import_iges, import_step
+from ..io.step_iges import IGES_SUFFIXES, export_iges, export_step, import_iges, import_step, shape_changes
 from ..io.stl import export_stl
 
 STEP_SUFFIXES = (".step", ".stp")
@@ -98,8 +98,6 @@ def _report(given, again) -> None:
 
 
 def run(args) -> int:
-    from ..occ.properties import shape_changes
-
     tolerance = args.tolerance
     if not tolerance > 0:
         raise SurfmodError(f"--tolerance: expected a positive length, got {tolerance}")

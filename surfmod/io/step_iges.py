@@ -1,13 +1,17 @@
 """STEP and IGES export/import of surfmod surfaces and build123d shapes (atomic writes):
 the public doors over OCCT's readers and writers (:mod:`surfmod.occ.step`,
 :mod:`surfmod.occ.iges`).  In IGES, B-spline and NURBS surfaces travel as entity 128
-with their degrees, knots, weights and poles unchanged.
+with their degrees, knots, weights and poles unchanged.  :func:`shape_changes` says
+what a write and read changed of a shape (the round-trip check of ``export_step`` and
+``surfmod convert --check``).
 """
 
 from __future__ import annotations
 
 import os
 import warnings
+
+import numpy as np
 
 from ..curve import Curve
 from ..errors import InsideOutWarning, RoundTripWarning, SurfmodError
@@ -59,7 +63,6 @@ def export_step(objects, path, *, strict: bool = False) -> None:
     >>> sm.export_step(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), os.path.join(d, "p.step"))
     """
     from ..occ.isolated import read_step_file
-    from ..occ.properties import shape_changes
     from ..occ.step import write_step
     from ..occ.topo import compound
 
@@ -152,3 +155,51 @@ def import_iges(path):
     if len(head) < 73 or head[72:73] != b"S":
         raise SurfmodError(f"path: {path} is not an IGES file (no Start section record)")
     return build123d_compound(read_iges(path))
+
+
+def shape_changes(given, again, rtol: float = 1e-12) -> list[str]:
+    """What a write and read (``again``) changed of ``given``, one line per change: the
+    number of solids, of faces and of faces in no solid (loose faces, open shells); each
+    solid's face count, the sign of its enclosed volume, its volume (relative) and its
+    centroid (relative to the volume's cube root) beyond ``rtol``.  Solids pair in the
+    order the explorer meets them (numbered from 1); an empty list when nothing changed.
+
+    >>> import build123d as bd
+    >>> box = bd.Solid.make_box(1, 2, 3).wrapped
+    >>> shape_changes(box, box)
+    []
+    >>> shape_changes(box, bd.Solid.make_box(1, 2, 3.3).wrapped)
+    ['solid 1: volume 6 -> 6.6 (relative change 0.1); centroid moved 0.15 (0.0825 of the volume^(1/3))']
+    >>> shape_changes(box, box.Reversed())
+    ['solid 1: enclosed volume 6 -> -6 (turned inside out)']
+    """
+    from ..occ.properties import solid_figures
+    from ..occ.topo import faces_of, solids_of
+
+    changes = []
+    a, b = solids_of(given), solids_of(again)
+    fa, fb = len(faces_of(given)), len(faces_of(again))
+    loose_a = fa - sum(len(faces_of(x)) for x in a)
+    loose_b = fb - sum(len(faces_of(x)) for x in b)
+    if len(a) != len(b):
+        changes.append(f"solids: {len(a)} -> {len(b)}")
+    if fa != fb:
+        changes.append(f"faces: {fa} -> {fb}")
+    if loose_a != loose_b:
+        changes.append(f"faces in no solid: {loose_a} -> {loose_b}")
+    for i, (x, y) in enumerate(zip(a, b), 1):
+        nx, ny = len(faces_of(x)), len(faces_of(y))
+        if nx != ny:
+            changes.append(f"solid {i}: faces {nx} -> {ny}")
+            continue
+        (va, ca), (vb, cb) = solid_figures(x), solid_figures(y)
+        if (va < 0) != (vb < 0):
+            changes.append(f"solid {i}: enclosed volume {va:.6g} -> {vb:.6g} (turned "
+                           f"{'inside out' if vb < 0 else 'outward'})")
+            continue
+        size = max(abs(va), 1e-300)
+        dv, dc = abs(vb - va) / size, float(np.abs(cb - ca).max())
+        if dv > rtol or dc > rtol * size ** (1 / 3):
+            changes.append(f"solid {i}: volume {va:.6g} -> {vb:.6g} (relative change {dv:.3g}); "
+                           f"centroid moved {dc:.3g} ({dc / size ** (1 / 3):.3g} of the volume^(1/3))")
+    return changes

@@ -1,6 +1,5 @@
 """``BRepGProp``: volume, area, centroid and inertia of shapes (plain, about a chosen point,
-by the Gauss–Kronrod rule, on faces split by ``ShapeUpgrade``), what a write and read
-changed of a shape, the vertex mean BRepGProp refers its integrals to, and the one bounding
+by the Gauss–Kronrod rule, on faces split by ``ShapeUpgrade``), the vertex mean BRepGProp refers its integrals to, and the one bounding
 box of the kernel door (``BRepBndLib``).  The references built on these calls, and their
 verdict, are :mod:`surfmod.uses.mass_reference`."""
 
@@ -78,55 +77,11 @@ def inertia_matrix(props: GProp_GProps) -> np.ndarray:
 def solid_figures(solid):
     """Volume and centroid of one solid by BRepGProp's fixed Gauss rule (the same digits
     for the same geometry, so a change is the geometry's)."""
-    vp = GProp_GProps()
-    BRepGProp.VolumeProperties_s(solid, vp)
+    with kernel("BRepGProp.VolumeProperties_s"):
+        vp = GProp_GProps()
+        BRepGProp.VolumeProperties_s(solid, vp)
     return vp.Mass(), xyz(vp.CentreOfMass())
 
-
-def shape_changes(given, again, rtol: float = 1e-12) -> list[str]:
-    """What a write and read (``again``) changed of ``given``, one line per change: the
-    number of solids, of faces and of faces in no solid (loose faces, open shells); each
-    solid's face count, the sign of its enclosed volume, its volume (relative) and its
-    centroid (relative to the volume's cube root) beyond ``rtol``.  Solids pair in the
-    order the explorer meets them (numbered from 1); an empty list when nothing changed.
-
-    >>> import build123d as bd
-    >>> box = bd.Solid.make_box(1, 2, 3).wrapped
-    >>> shape_changes(box, box)
-    []
-    >>> shape_changes(box, bd.Solid.make_box(1, 2, 3.3).wrapped)
-    ['solid 1: volume 6 -> 6.6 (relative change 0.1); centroid moved 0.15 (0.0825 of the volume^(1/3))']
-    >>> shape_changes(box, box.Reversed())
-    ['solid 1: enclosed volume 6 -> -6 (turned inside out)']
-    """
-    changes = []
-    with kernel("BRepGProp.VolumeProperties_s"):
-        a, b = solids_of(given), solids_of(again)
-        fa, fb = len(faces_of(given)), len(faces_of(again))
-        loose_a = fa - sum(len(faces_of(x)) for x in a)
-        loose_b = fb - sum(len(faces_of(x)) for x in b)
-        if len(a) != len(b):
-            changes.append(f"solids: {len(a)} -> {len(b)}")
-        if fa != fb:
-            changes.append(f"faces: {fa} -> {fb}")
-        if loose_a != loose_b:
-            changes.append(f"faces in no solid: {loose_a} -> {loose_b}")
-        for i, (x, y) in enumerate(zip(a, b), 1):
-            nx, ny = len(faces_of(x)), len(faces_of(y))
-            if nx != ny:
-                changes.append(f"solid {i}: faces {nx} -> {ny}")
-                continue
-            (va, ca), (vb, cb) = solid_figures(x), solid_figures(y)
-            if (va < 0) != (vb < 0):
-                changes.append(f"solid {i}: enclosed volume {va:.6g} -> {vb:.6g} (turned "
-                               f"{'inside out' if vb < 0 else 'outward'})")
-                continue
-            size = max(abs(va), 1e-300)
-            dv, dc = abs(vb - va) / size, float(np.abs(cb - ca).max())
-            if dv > rtol or dc > rtol * size ** (1 / 3):
-                changes.append(f"solid {i}: volume {va:.6g} -> {vb:.6g} (relative change {dv:.3g}); "
-                               f"centroid moved {dc:.3g} ({dc / size ** (1 / 3):.3g} of the volume^(1/3))")
-    return changes
 
 
 def vertex_mean(shape) -> np.ndarray:
