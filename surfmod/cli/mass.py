@@ -3,8 +3,8 @@ against ``BRepGProp``.  Exit 0 when all four agree within ``MASS_AGREEMENT_RTOL`
 says so), or when they differ and an independent reference (:mod:`surfmod.uses.mass_reference`:
 BRepGProp on the faces split into ever smaller iso-parametric pieces until it converges,
 then, where that split is not exact, BRepGProp's Gauss-Kronrod rule with the moments
-converged; both about the same point, within ``REFERENCE_BUDGET`` seconds) confirms surfmod's values (one
-line says which side it confirms); 4 when it confirms BRepGProp's, or cannot tell on a
+converged; both about the same point, within ``REFERENCE_BUDGET`` seconds) confirms
+surfmod's values (one line says which side it confirms); 4 when it confirms BRepGProp's, or cannot tell on a
 model whose edges close; 3 when it cannot tell and the model itself is ambiguous (its edges
 leave the volume open by more than the disagreement, or p-curves stray beyond their
 edges' tolerance: they are named).  Edges that stray are named in a note whatever the
@@ -26,10 +26,10 @@ from pathlib import Path
 
 from ..errors import SurfmodError
 from ..inputs import to_shape
-from ..uses import mass_reference
-from ..uses.mass_reference import EXIT_AMBIGUOUS, EXIT_DISAGREE
 from ..readback.strays import edge_strays
+from ..uses import mass_reference
 from ..uses.mass import boundary_ambiguity, mass_properties
+from ..uses.mass_reference import EXIT_AMBIGUOUS, EXIT_DISAGREE
 from .batch import add_batch_arguments, batch_run, step_files
 from tqdm import tqdm
 
