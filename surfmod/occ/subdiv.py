@@ -66,16 +66,14 @@ def solid(faces, tolerance: float):
     return bd.Solid(s), info
 
 
-def edge_continuity(shape, samples: int = 17):
-    """OCCT's own view of how the faces of a sewn shape meet.
-
-    For every edge shared by two faces, at ``samples`` points of the edge: the distance
-    between the two faces' surface points (through each face's p-curve) and the angle
-    between their outward normals (face orientation applied).  Returns ``(max_gap,
-    max_angle_deg, edges)``; a per-edge loop (a check, not an evaluation path).
-    """
+def shared_edge_samples(shape, samples: int = 17) -> list[tuple]:
+    """OCCT's own view of how the faces of a sewn shape meet: for every non-degenerate
+    edge shared by two faces, ``(points, normals)``, each a pair of ``(samples, 3)``
+    arrays: the two faces' surface points at ``samples`` points of the edge (through each
+    face's p-curve) and their outward normals (face orientation applied, not unit).  A
+    per-edge loop (a check, not an evaluation path)."""
     s = wrapped(shape)
-    gap, angle, count = 0.0, 0.0, 0
+    out = []
     with kernel("edge continuity (BRepAdaptor_Curve2d)"):
         amap = TopTools_IndexedDataMapOfShapeListOfShape()
         TopExp.MapShapesAndAncestors_s(s, TopAbs_EDGE, TopAbs_FACE, amap)
@@ -86,7 +84,6 @@ def edge_continuity(shape, samples: int = 17):
             edge = TopoDS.Edge(amap.FindKey(i))
             if BRep_Tool.Degenerated_s(edge):
                 continue
-            count += 1
             pts, nrm = [], []
             for f in faces:
                 face = TopoDS.Face(f)
@@ -104,11 +101,5 @@ def edge_continuity(shape, samples: int = 17):
                     n_f.append((sign * n.X(), sign * n.Y(), sign * n.Z()))
                 pts.append(np.array(p_f))
                 nrm.append(np.array(n_f))
-            gap = max(gap, float(np.linalg.norm(pts[0] - pts[1], axis=1).max()))
-            n0, n1 = nrm
-            cross = np.linalg.norm(np.cross(n0, n1), axis=1)
-            dot = np.einsum("ij,ij->i", n0, n1)
-            ok = np.linalg.norm(n0, axis=1) * np.linalg.norm(n1, axis=1) > 0
-            if ok.any():
-                angle = max(angle, float(np.degrees(np.arctan2(cross[ok], dot[ok])).max()))
-    return gap, angle, count
+            out.append((pts, nrm))
+    return out

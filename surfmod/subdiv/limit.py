@@ -163,11 +163,19 @@ class LimitSurface:
 
         Crease edges are included in the angle here, so compare on crease-free cages.
         """
-        from ..occ.subdiv import edge_continuity
+        from ..occ.subdiv import shared_edge_samples
 
         samples = checks.count(samples, "samples", minimum=2)
-        gap, angle, edges = edge_continuity(self.shape(), samples)
-        return {"max_gap": gap, "max_normal_angle_deg": angle, "shared_edges": edges}
+        edges = shared_edge_samples(self.shape(), samples)
+        gap, angle = 0.0, 0.0
+        for (p0, p1), (n0, n1) in edges:
+            gap = max(gap, float(np.linalg.norm(p0 - p1, axis=1).max()))
+            cross = np.linalg.norm(np.cross(n0, n1), axis=1)
+            dot = np.einsum("ij,ij->i", n0, n1)
+            ok = np.linalg.norm(n0, axis=1) * np.linalg.norm(n1, axis=1) > 0
+            if ok.any():
+                angle = max(angle, float(np.degrees(np.arctan2(cross[ok], dot[ok])).max()))
+        return {"max_gap": gap, "max_normal_angle_deg": angle, "shared_edges": len(edges)}
 
     def shape(self):
         """:meth:`solid` for a closed cage, :meth:`shell` for an open one (built once)."""
