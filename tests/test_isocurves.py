@@ -8,7 +8,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.occ.discretize import sample_curve
+from surfmod.occ.sample import sample_curve
 from surfmod.occ.geom import iso_curve
 
 

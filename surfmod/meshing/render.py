@@ -141,7 +141,7 @@ def _shape_mesh(shape, fraction: float = DISPLAY_TOLERANCE) -> Mesh:
 
 
 def _shape_edges(shape, samples: int = 48) -> list[np.ndarray]:
-    from ..occ.discretize import sample_curve
+    from ..occ.sample import sample_curve
     from ..occ.topo import curve_of_edge
 
     out = []

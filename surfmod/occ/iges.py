@@ -3,7 +3,7 @@
 Reals are written with 17 significant digits (as :mod:`surfmod.occ.step` writes them), so
 B-spline poles, weights and knots come back bit for bit; OCCT's own ``Write`` prints 10.
 
-The same concept as :mod:`surfmod.io.iges`, whose OCCT side (``IGESControl``) this is.
+The same concept as :mod:`surfmod.io.step_iges`, whose OCCT side (``IGESControl``) this is.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 native BREP format (``BRepTools`` files for gmsh, ``BinTools`` bytes between processes).
 
 In process; files from users go through :mod:`surfmod.occ.isolated`, which runs
-:func:`read_step` in a child process.  The same concept as :mod:`surfmod.io.step`, one
+:func:`read_step` in a child process.  The same concept as :mod:`surfmod.io.step_iges`, one
 level down: that module is the public ``import_step``/``export_step`` over this one.
 
 OCCT's writers print reals with 12 (STEP) or 10 (IGES) significant digits by default,
