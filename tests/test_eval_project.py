@@ -1,4 +1,4 @@
-"""The compiled projection internals (ops/seeding.py, ops/newton.py) against plain
+"""The compiled projection internals (eval/projection_kernel.py) against plain
 NumPy: exact nearest triangles by brute force, and the NumPy Newton iteration."""
 
 from __future__ import annotations
@@ -68,12 +68,10 @@ def test_seeds_are_the_exact_nearest_triangles():
 
 def test_seed_distances_match_brute_force():
     """The kernel's top-8 foot distances equal the brute-force 8 smallest."""
-    from surfmod.ops.seeding import triangle_tables
-
     s = _surface(False)
     us, vs, g = pj.seed_grid(s)
     pts = _points(25, seed=4)
-    e, gram, cross, diam = triangle_tables(g)
+    e, gram, cross, diam = pj.triangle_tables(g)
     for p in pts:
         feet = _brute_force_feet(p, g)
         # feet from the kernel's chosen (u, v) are not recoverable in 3-D exactly, so

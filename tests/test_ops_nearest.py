@@ -1,5 +1,6 @@
-"""The NumPy seeding of closest-point projection (ops/nearest.py) against the compiled
-branch and bound (ops/seeding.py), and projections that do not depend on which ran."""
+"""The NumPy twins of closest-point projection (surfmod.ops.closest) against their compiled
+twins (surfmod.eval.projection_kernel, ``<name>_compiled``): the seeds, the Newton
+iteration, and projections that do not depend on which ran."""
 
 from __future__ import annotations
 
@@ -9,8 +10,9 @@ from conftest import fresh_python
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.ops import closest, nearest
-from surfmod.ops.seeding import seed_kernel
+from surfmod.eval.kernels import binomials
+from surfmod.eval.projection_kernel import grid_seeds_compiled, newton_in_boxes_compiled
+from surfmod.ops import closest
 
 
 @pytest.mark.parametrize("surface", [
@@ -23,12 +25,12 @@ def test_numpy_seeds_equal_the_compiled_kernel(surface, seeds):
     rng = np.random.default_rng(4)
     points = rng.uniform(-3, 11, (300, 3))
     us, vs, g = closest.seed_grid(surface)
-    e, gram, cross, diam = nearest.triangle_tables(g)
+    e, gram, cross, diam = closest.triangle_tables(g)
     n_basins = max(2, seeds // 2)
     expected = np.empty((len(points), seeds + n_basins, 2))
-    seed_kernel(points, np.ascontiguousarray(g), np.ascontiguousarray(us), np.ascontiguousarray(vs), e, gram, cross,
-                diam, nearest.row_diameters(diam), seeds, n_basins, expected)
-    got = nearest.seed_starts(points, us, vs, g, e, gram, cross, seeds, n_basins)
+    grid_seeds_compiled(points, np.ascontiguousarray(g), np.ascontiguousarray(us), np.ascontiguousarray(vs), e, gram,
+                        cross, diam, closest.row_diameters(diam), seeds, n_basins, expected)
+    got = closest.grid_seeds(points, us, vs, g, e, gram, cross, seeds, n_basins)
     if isinstance(surface, sm.BSplineSurface):  # no seam
         np.testing.assert_array_equal(got, expected)
     # a periodic grid repeats its seam: equally near feet there may come in another order,
@@ -62,3 +64,33 @@ def test_a_small_projection_takes_the_numpy_paths():
         "print(len(r.distance), 'numba' in sys.modules)\n"
     )
     assert fresh_python(script) == ["500", "False"]
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_numpy_newton_equals_the_compiled_kernel(rational):
+    """``newton_in_boxes`` and ``newton_in_boxes_compiled`` from the same starts in the
+    same boxes (pieces of a crease at u = 0.5) reach the same points."""
+    weights = np.linspace(0.5, 2, 64).reshape(8, 8) if rational else None
+    s = sm.BSplineSurface(wavy_net(8, 8), (3, 3), weights=weights)
+    rng = np.random.default_rng(5)
+    n = 400
+    points = np.c_[rng.uniform(-2, 12, n), rng.uniform(-2, 10, n), rng.uniform(-2, 3, n)]
+    (u0, u1), (v0, v1) = s.domain
+    mid = 0.5 * (u0 + u1)
+    low = rng.random(n) < 0.5
+    box = (np.where(low, u0, mid), np.where(low, mid, u1), np.full(n, v0), np.full(n, v1))
+    u = np.where(low, rng.uniform(u0, mid, n), rng.uniform(mid, u1, n))
+    v = rng.uniform(v0, v1, n)
+    expected = closest.newton_in_boxes(s, points, u, v, box, 60)
+    net = s._local_net()
+    got = u.copy(), v.copy()
+    newton_in_boxes_compiled(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v,
+                             net.bucket_u, net.bucket_v, binomials(2), binomials(0), points, *got, *box,
+                             float(u1 - u0), float(v1 - v0), 60)
+    assert all(np.all((x >= lo) & (x <= hi)) for x, lo, hi in ((got[0], box[0], box[1]), (got[1], box[2], box[3])))
+    dist = [np.linalg.norm(s.points(*x) - points, axis=1) for x in (expected, got)]
+    # the same iteration; the derivatives round differently (quotient rule grouping), so a
+    # start creeping along a flat minimum may stop a line-search step apart
+    np.testing.assert_allclose(dist[1], dist[0], rtol=2e-8, atol=1e-12)
+    same = np.maximum(np.abs(got[0] - expected[0]), np.abs(got[1] - expected[1])) <= 1e-9
+    assert same.mean() > 0.95

@@ -1,6 +1,6 @@
-"""The compiled Gauss-Newton distance bounds (surfmod.eval.projection_kernel, used by
+"""The compiled Gauss-Newton distance bounds (project_distances_compiled, used by
 mesh measurement on B-spline faces) equal the NumPy iteration of
-surfmod.meshing.deviation.project_distances to round-off: polynomial and rational
+surfmod.ops.closest.project_distances to round-off: polynomial and rational
 nets, a periodic direction (parameters past the seam wrap), guesses outside the box
 (clipped), thresholds that stop the iteration early; and every value is a distance to
 a point of the surface (an upper bound of the true distance)."""
@@ -13,9 +13,9 @@ from conftest import fresh_python
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
-from surfmod.meshing.deviation import project_distances
 from surfmod.meshing.facesurface import FaceSurface
 from surfmod.occ.topo import face_surface
+from surfmod.ops.closest import project_distances
 
 
 def _surfaces():
@@ -86,9 +86,9 @@ def test_packed_segments_equal_one_call_per_net():
             from surfmod.eval import projection_kernel as pkern
             net = ev._spline._local_net()
             ref = np.empty(150)
-            pkern.project_distances(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u,
-                                    net.inv_v, net.bucket_u, net.bucket_v, *ev.parameter_map, np.array(box), p, g,
-                                    last, ref, first)
+            pkern.project_distances_compiled(net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational,
+                                             net.inv_u, net.inv_v, net.bucket_u, net.bucket_v, *ev.parameter_map,
+                                             np.array(box), p, g, last, ref, first)
             if first == last:
                 np.testing.assert_array_equal(ref, ev.projector(p, g, box, last))
             pts.append(p), guesses.append(g), expected.append(ref)
@@ -125,6 +125,6 @@ def test_the_meshers_projections_compile_one_signature(tmp_path):
         "                           np.array([[1 / 3] * 3]), np.zeros(1))\n"
         "packed.project_segments(pk, box, pts, uv, np.array([[0, 0, 3]]), np.zeros(1), np.zeros(1))\n"
         "ev.projector(pts, uv, (0, 1, 0, 1), 0.0)\n"
-        "print(len(projection_kernel.project_distances.signatures))\n"
+        "print(len(projection_kernel.project_distances_compiled.signatures))\n"
     )
     assert fresh_python(script, env={"NUMBA_CACHE_DIR": str(tmp_path)}) == ["1"]

@@ -16,8 +16,8 @@ import numpy as np
 from numba import njit
 
 from .kernels import binomials
+from .projection_kernel import _wrap, project_distances_compiled
 from .scattered_compiled import scattered_compiled
-from .projection_kernel import _wrap, project_distances
 
 
 class NetPack(NamedTuple):
@@ -67,7 +67,7 @@ def _flat(arrays: list, dtype) -> tuple[np.ndarray, np.ndarray]:
 def pack(nets: list, lo, hi, period, periodic) -> NetPack:
     """One :class:`NetPack` of :class:`~surfmod.eval.local.LocalNet` s, with each
     surface's parameter map (``(F, 2)`` arrays-likes, see
-    :func:`surfmod.eval.projection_kernel.project_distances`).
+    :func:`surfmod.eval.projection_kernel.project_distances_compiled`).
 
     >>> import numpy as np, surfmod as sm
     >>> from surfmod.gallery.synthetic import wavy_net
@@ -101,7 +101,7 @@ def project_segments(pk: NetPack, boxes: np.ndarray, points: np.ndarray, uv: np.
                      start: np.ndarray, threshold: np.ndarray) -> np.ndarray:
     """Distance bounds of ``points (N, 3)`` from their nets, segment by segment:
     ``segments (S, 3)`` rows ``(net, first point, end point)``, each with its ``start``
-    and ``threshold`` (``(S,)``; see :func:`surfmod.eval.projection_kernel.project_distances`)
+    and ``threshold`` (``(S,)``; see :func:`surfmod.eval.projection_kernel.project_distances_compiled`)
     and its net's Gauss-Newton ``boxes[net]`` ``(u0, u1, v0, v1)``.  Returns ``(N,)``.
 
     >>> import numpy as np, surfmod as sm
@@ -202,7 +202,7 @@ def _triangle_deviations(pk, boxes, nodes, uv, triangles, faces, bary, threshold
                 for c in range(2):
                     guess[at, c] = w0 * uv[i, c] + w1 * uv[j, c] + w2 * uv[k, c]
                 at += 1
-        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, pk.lo[f], pk.hi[f], pk.period[f],
+        project_distances_compiled(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, pk.lo[f], pk.hi[f], pk.period[f],
                           pk.periodic[f], boxes[f], pts, guess, threshold[f], dist, threshold[f])
         at = 0
         for t in range(a, b):
@@ -220,7 +220,7 @@ def _project_segments(pk, boxes, points, uv, segments, start, threshold, out):
         if a == b:
             continue
         ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(pk, f)
-        project_distances(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, pk.lo[f], pk.hi[f], pk.period[f],
+        project_distances_compiled(ku, pf, kv, qf, net, rat, iu, iv, bu, bv, pk.lo[f], pk.hi[f], pk.period[f],
                           pk.periodic[f], boxes[f], points[a:b], uv[a:b], threshold[s], out[a:b], start[s])
 
 

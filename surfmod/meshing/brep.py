@@ -39,8 +39,9 @@ from functools import partial
 import numpy as np
 
 from ..errors import InsideOutWarning, SurfmodError
+from ..ops.closest import project_distances
 from .closure import faces_against_neighbours
-from .deviation import DENSE, project_distances, triangle_deviations
+from .deviation import DENSE, triangle_deviations
 from .facemesh import ANALYTIC, brepmesh
 from .facesurface import FaceSurface
 from .figures import partial_figures, shape_figures

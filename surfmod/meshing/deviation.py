@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..ops.closest import project_distances
+
 
 def _barycentric(n: int) -> np.ndarray:
     """Barycentric sample points of a triangle on an ``n``-division grid, corners excluded."""
@@ -18,59 +20,6 @@ def _barycentric(n: int) -> np.ndarray:
 
 COARSE = _barycentric(4)  # 12 points: edge points and interior
 DENSE = _barycentric(6)  # 25 points
-
-
-def project_distances(d1, points, uv, bounds, iterations: int = 6, threshold: float = 0.0, d0=None) -> np.ndarray:
-    """Distance from ``points`` (N, 3) to a surface, by Gauss-Newton from the parameter
-    guesses ``uv`` (N, 2), clipped to ``bounds = (u0, u1, v0, v1)``.
-
-    ``d1(u, v)`` returns ``(N, >=2, >=2, 3)`` derivatives (``d0`` optionally positions
-    only).  Every iterate is a point of the surface, so the smallest distance seen is an
-    upper bound of the true distance (for the guarantee, over-estimating is the safe
-    side).  Points whose bound is ``<= threshold`` (at first or after an iteration) are
-    not iterated further: below the threshold the bound is all that is asked.
-
-    >>> import numpy as np, surfmod as sm
-    >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
-    >>> d = project_distances(lambda u, v: s._derivatives(u, v, 1),
-    ...     np.array([[0.2, 0.7, 0.5]]), np.array([[0.0, 0.0]]), (0, 1, 0, 1))
-    >>> float(d[0])
-    0.5
-    """
-    u0, u1, v0, v1 = bounds
-    u = np.clip(uv[:, 0], u0, u1)
-    v = np.clip(uv[:, 1], v0, v1)
-    first = d0(u, v) if d0 is not None else d1(u, v)[:, 0, 0]
-    best = np.linalg.norm(points - first, axis=1)
-    act = np.nonzero(best > threshold)[0]
-    step_u, step_v = 0.25 * (u1 - u0), 0.25 * (v1 - v0)
-    ua, va = u[act], v[act]
-    for _ in range(iterations):
-        if act.size == 0:
-            break
-        ders = d1(ua, va)
-        r = points[act] - ders[:, 0, 0]
-        best[act] = np.minimum(best[act], np.linalg.norm(r, axis=1))
-        su, sv = ders[:, 1, 0], ders[:, 0, 1]
-        # the Gram matrix of (Su, Sv, r) per point in one product: a, b, c and the gradient
-        gram = np.matmul(np.stack([su, sv, r], axis=1), np.stack([su, sv], axis=2))
-        a, b, c, g1, g2 = gram[:, 0, 0], gram[:, 0, 1], gram[:, 1, 1], gram[:, 2, 0], gram[:, 2, 1]
-        det = a * c - b * b
-        det = det + 1e-14 * (a + c) ** 2 + np.finfo(float).tiny
-        du = np.clip((c * g1 - b * g2) / det, -step_u, step_u)
-        dv = np.clip((a * g2 - b * g1) / det, -step_v, step_v)
-        un = np.clip(ua + du, u0, u1)
-        vn = np.clip(va + dv, v0, v1)
-        # Gauss-Newton is quadratic near the foot point: once the 3-D step is below 1e-3 of
-        # the distance, the distance is known to ~1e-6 relative and the point is done
-        step3 = np.linalg.norm((un - ua)[:, None] * su + (vn - va)[:, None] * sv, axis=1)
-        moving = (step3 > 1e-3 * best[act]) & (best[act] > threshold)
-        # converged points already have their distance in ``best``
-        act, ua, va = act[moving], un[moving], vn[moving]
-    if act.size:
-        last = d0(ua, va) if d0 is not None else d1(ua, va)[:, 0, 0]
-        best[act] = np.minimum(best[act], np.linalg.norm(points[act] - last, axis=1))
-    return best
 
 
 def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None, d0=None, accurate_max=True):
@@ -108,5 +57,3 @@ def triangle_deviations(d1, positions, uvs, bounds, bary=COARSE, threshold=None,
         d[cand] = np.minimum(d[cand], project_distances(d1, q[cand], g[cand], bounds, d0=d0))
         done[cand] = True
     return d.reshape(len(positions), len(bary)).max(axis=1)
-
-

@@ -93,7 +93,7 @@ class FaceSurface:
     @property
     def projector(self):
         """``project(points, uv, bounds, threshold) -> distances``, the compiled
-        equivalent of :func:`surfmod.meshing.deviation.project_distances` on this
+        equivalent of :func:`surfmod.ops.closest.project_distances` on this
         surface (:mod:`surfmod.eval.projection_kernel`), or ``None`` when the surface is
         not a B-spline net."""
         if not isinstance(self._spline, BSplineSurface):
@@ -117,7 +117,7 @@ class FaceSurface:
 
         net = self._spline._local_net()
         out = np.empty(len(points))
-        projection_kernel.project_distances(
+        projection_kernel.project_distances_compiled(
             net.knots_u, net.p, net.knots_v, net.q, net.ctrl, net.rational, net.inv_u, net.inv_v, net.bucket_u,
             net.bucket_v, *self.parameter_map, np.array(bounds, float),
             np.ascontiguousarray(points, float), np.ascontiguousarray(uv, float), float(threshold), out,

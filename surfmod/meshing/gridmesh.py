@@ -37,9 +37,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
-from ..ops.closest import crease_breaks
+from ..ops.closest import crease_breaks, project_distances
 from . import gridbounds
-from .deviation import project_distances
 
 #: lattice divisions per cell side for verification (6: DENSE's 25 samples per triangle)
 K = 6
