@@ -1,4 +1,5 @@
-"""Closed-form distances (surfmod.meshing.analytic_distance) equal OCCT's projection distance:
+"""Closed-form distances (surfmod.construct.elementary_closest, the surfaces read by
+surfmod.meshing.analytic_distance) equal OCCT's projection distance:
 planes, spheres, cylinders, cones and tori, and surfaces of revolution of a circle or a
 line lying in a plane through the axis (a torus, a sphere, a cone, a cylinder, a plane);
 a line skew to the axis (a hyperboloid) and an ellipse get no closed form."""
@@ -19,6 +20,7 @@ from OCP.Geom import (
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Elips, gp_Pnt
 
+from surfmod.construct import elementary_closest as closed
 from surfmod.meshing import analytic_distance as analytic
 
 AXIS = gp_Ax1(gp_Pnt(0.5, -1.0, 0.2), gp_Dir(0.2, 0.3, 0.9))
@@ -56,11 +58,11 @@ def _revolutions():
     across, _ = _in_axis_plane(4.0, -1.0)
     skew = start + 0.7 * normal
     return {
-        "torus": (GC_MakeCircle(_frame(centre, normal), 0.8).Value(), analytic.TORUS),
-        "sphere": (GC_MakeCircle(_frame(on_axis, normal), 1.5).Value(), analytic.SPHERE),
-        "cone": (GC_MakeLine(gp_Pnt(*start), gp_Pnt(*tip)).Value(), analytic.CONE),
-        "cylinder": (GC_MakeLine(gp_Pnt(*start), gp_Pnt(*(start + 2.0 * a))).Value(), analytic.CYLINDER),
-        "plane": (GC_MakeLine(gp_Pnt(*start), gp_Pnt(*across)).Value(), analytic.PLANE),
+        "torus": (GC_MakeCircle(_frame(centre, normal), 0.8).Value(), closed.TORUS),
+        "sphere": (GC_MakeCircle(_frame(on_axis, normal), 1.5).Value(), closed.SPHERE),
+        "cone": (GC_MakeLine(gp_Pnt(*start), gp_Pnt(*tip)).Value(), closed.CONE),
+        "cylinder": (GC_MakeLine(gp_Pnt(*start), gp_Pnt(*(start + 2.0 * a))).Value(), closed.CYLINDER),
+        "plane": (GC_MakeLine(gp_Pnt(*start), gp_Pnt(*across)).Value(), closed.PLANE),
         "hyperboloid": (GC_MakeLine(gp_Pnt(*skew), gp_Pnt(*tip)).Value(), None),
         "ellipse": (GC_MakeEllipse(gp_Elips(_frame(centre, normal), 1.0, 0.5)).Value(), None),
     }
@@ -82,8 +84,8 @@ def test_revolved_circles_and_lines_are_their_analytic_surfaces(name):
         return
     assert params[0] == kind
     pts = _points()
-    ours = analytic.distances(np.array([params[0]]), np.array([params[1]], float), np.array([params[2]], float),
-                              pts, np.zeros(len(pts), int))
+    ours = closed.distances(np.array([params[0]]), np.array([params[1]], float), np.array([params[2]], float),
+                            pts, np.zeros(len(pts), int))
     np.testing.assert_allclose(ours, _occt_distances(surf, pts), rtol=0, atol=1e-9)
 
 
@@ -97,14 +99,14 @@ def test_elementary_surfaces_and_batched_triangles_equal_occt():
     frames = np.array([p[1] for p in params], float)
     sizes = np.array([p[2] for p in params], float)
     for f, surf in enumerate(surfaces):
-        ours = analytic.distances(kinds, frames, sizes, pts, np.full(len(pts), f))
+        ours = closed.distances(kinds, frames, sizes, pts, np.full(len(pts), f))
         np.testing.assert_allclose(ours, _occt_distances(surf, pts), rtol=0, atol=1e-9)
     # triangles: the max over their samples, each sample's distance as above
     tri = np.arange(len(pts)).reshape(-1, 3)
     bary = np.array([[0.2, 0.3, 0.5], [0.6, 0.2, 0.2], [1 / 3, 1 / 3, 1 / 3]])
     faces = np.array([[f, 8 * f, 8 * f + 8] for f in range(5)])
-    got = analytic.triangle_distances(kinds, frames, sizes, pts, tri, faces, bary)
+    got = closed.triangle_distances(kinds, frames, sizes, pts, tri, faces, bary)
     for f in range(5):
         samples = np.einsum("kj,tjd->tkd", bary, pts[tri[8 * f:8 * f + 8]]).reshape(-1, 3)
-        expect = analytic.distances(kinds, frames, sizes, samples, np.full(len(samples), f))
+        expect = closed.distances(kinds, frames, sizes, samples, np.full(len(samples), f))
         np.testing.assert_allclose(got[8 * f:8 * f + 8], expect.reshape(8, 3).max(axis=1), rtol=1e-13, atol=1e-13)

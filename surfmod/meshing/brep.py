@@ -7,7 +7,7 @@ once):
 
 * planes, cylinders, cones, spheres and tori, and surfaces of revolution that are one of
   those (a circle or line in a plane through the axis): the exact distance in closed
-  form (:mod:`surfmod.meshing.analytic_distance`);
+  form (:mod:`surfmod.construct.elementary_closest`);
 * B-spline faces, and extrusions of spline curves (exact B-spline nets over their
   box): the *UV-parametric error* ``|q - S(uv)|`` of each sample ``q`` of a triangle and
   its UV-interpolated parameter (an upper bound of the distance, ``S(uv)`` being a point
@@ -38,8 +38,10 @@ from functools import partial
 
 import numpy as np
 
+from ..construct import elementary_closest
 from ..errors import InsideOutWarning, SurfmodError
 from ..ops.closest import project_distances
+from . import analytic_distance
 from .closure import faces_against_neighbours
 from .deviation import DENSE, triangle_deviations
 from .facemesh import ANALYTIC, brepmesh
@@ -109,8 +111,6 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
 
     Values at most ``tolerance / 2`` may be upper bounds; larger ones are projections.
     """
-    from . import analytic_distance
-
     params = analytic_distance.parameters(fm.surface)
     if params is not None:  # closed forms
         return measure_analytic_faces([fm], [params], bary)[0]
@@ -149,21 +149,20 @@ def _packed(evs: list):
 
 def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np.ndarray, float]]:
     """:func:`measure_face` of many plane, sphere, cylinder, cone and torus faces
-    (``params``: their :func:`surfmod.meshing.analytic_distance.parameters`) in two compiled
-    calls: per face its triangles' deviations and its nodes' max deviation."""
-    from . import analytic_distance
-
+    (``params``: their :func:`surfmod.meshing.analytic_distance.parameters`) in two
+    closed-form calls: per face its triangles' deviations and its nodes' max deviation."""
     kinds = np.array([k for k, _, _ in params])
     frames = np.array([f for _, f, _ in params], float).reshape(-1, 2, 3)
     sizes = np.array([z for _, _, z in params], float).reshape(-1, 2)
     nodes, triangles, node_at, tri_at = _concatenated(fms)
-    node = analytic_distance.distances(kinds, frames, sizes, nodes, np.repeat(np.arange(len(fms)), np.diff(node_at)))
+    owner = np.repeat(np.arange(len(fms)), np.diff(node_at))
+    node = elementary_closest.distances(kinds, frames, sizes, nodes, owner)
     # planes are measured at their nodes (exact: the distance is linear on a triangle),
     # the others at their triangles' samples
-    curved = np.nonzero(kinds != analytic_distance.PLANE)[0]
-    tri = analytic_distance.triangle_distances(kinds, frames, sizes, nodes, triangles,
-                                      np.c_[curved, tri_at[curved], tri_at[curved + 1]], bary)
-    on_plane = np.repeat(kinds == analytic_distance.PLANE, np.diff(tri_at))
+    curved = np.nonzero(kinds != elementary_closest.PLANE)[0]
+    tri = elementary_closest.triangle_distances(kinds, frames, sizes, nodes, triangles,
+                                                np.c_[curved, tri_at[curved], tri_at[curved + 1]], bary)
+    on_plane = np.repeat(kinds == elementary_closest.PLANE, np.diff(tri_at))
     tri[on_plane] = node[triangles[on_plane]].max(axis=1, initial=0.0)
     return [(tri[tri_at[f]:tri_at[f + 1]], float(node[node_at[f]:node_at[f + 1]].max(initial=0.0)))
             for f in range(len(fms))]
@@ -295,8 +294,6 @@ def _measure_faces(fms: list, evaluators: dict, tolerance: float, desc: str, pro
     for the analytic faces and one compiled call for the B-spline nets (all faces of each
     kind at once), the other faces one by one; an isometric repeat of a face takes its
     first instance's figures."""
-    from . import analytic_distance
-
     first = [i for i, fm in enumerate(fms) if fm.repeats < 0]
     params = {i: a for i in first if (a := analytic_distance.parameters(fms[i].surface)) is not None}
     evs = {i: _evaluator(evaluators, fms[i]) for i in first if i not in params}
