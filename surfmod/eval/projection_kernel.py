@@ -46,35 +46,6 @@ def _wrap(x, lo, hi, period, periodic):
 
 
 @njit(cache=True, error_model="numpy")
-def _first_partials(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, u, v, ndu_u, ndu_v, lu, ru, tu,
-                    lv, rv, tv, du, dv, h, out):
-    """``out[0]`` S, ``out[1]`` Su, ``out[2]`` Sv (Cartesian: the quotient rule applied)."""
-    n, m = ctrl.shape[0], ctrl.shape[1]
-    su = find_span_bucketed(ku, p, n, u, bucket_u[0], bucket_u[1], bucket_u[2])
-    sv = find_span_bucketed(kv, q, m, v, bucket_v[0], bucket_v[1], bucket_v[2])
-    basis_ders_point(ku, p, su, u, 1, inv_u, ndu_u, lu, ru, tu, du)
-    basis_ders_point(kv, q, sv, v, 1, inv_v, ndu_v, lv, rv, tv, dv)
-    h[:, :] = 0.0
-    for i in range(p + 1):
-        ci = su - p + i
-        for j in range(q + 1):
-            cj = sv - q + j
-            b00, b10, b01 = du[0, i] * dv[0, j], du[1, i] * dv[0, j], du[0, i] * dv[1, j]
-            for d in range(4):
-                c = ctrl[ci, cj, d]
-                h[0, d] += b00 * c
-                h[1, d] += b10 * c
-                h[2, d] += b01 * c
-    w = h[0, 3] if rational else 1.0
-    for d in range(3):
-        out[0, d] = h[0, d] / w
-    for k in range(1, 3):
-        wk = h[k, 3] if rational else 0.0
-        for d in range(3):
-            out[k, d] = (h[k, d] - wk * out[0, d]) / w
-
-
-@njit(cache=True, error_model="numpy")
 def project_distances_compiled(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v, lo, hi, period,
                                periodic, box, points, uv, threshold, out, start):
     """Distance bounds from ``points (N, 3)`` to the surface into ``out (N,)``, from the
@@ -85,11 +56,12 @@ def project_distances_compiled(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucke
     until their bound is within ``threshold``.  ``start`` is always given (``threshold``
     when no other), so that every caller compiles the one signature."""
     first_stop = start
-    ndu_u, ndu_v = np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1))
-    lu, ru, tu = np.empty(p + 1), np.empty(p + 1), np.empty(p + 1)
-    lv, rv, tv = np.empty(q + 1), np.empty(q + 1), np.empty(q + 1)
-    du, dv = np.empty((2, p + 1)), np.empty((2, q + 1))
-    h, s = np.empty((3, 4)), np.empty((3, 3))
+    sc = (np.empty((p + 1, p + 1)), np.empty((q + 1, q + 1)), np.empty(p + 1), np.empty(p + 1), np.empty(p + 1),
+          np.empty(q + 1), np.empty(q + 1), np.empty(q + 1), np.empty((2, p + 1)), np.empty((2, q + 1)),
+          np.empty((2, 2, 4)), np.empty((2, 4)))
+    lu, ru, tu, lv, rv, tv = sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
+    binom = np.array([[1.0, 0.0], [1.0, 1.0]])  # C(k, i) to order 1
+    s = np.empty((2, 2, 3))  # S, Su, Sv at [0, 0], [1, 0], [0, 1]
     u0, u1, v0, v1 = box[0], box[1], box[2], box[3]
     step_u, step_v = 0.25 * (u1 - u0), 0.25 * (v1 - v0)
     for a in range(points.shape[0]):
@@ -102,24 +74,23 @@ def project_distances_compiled(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucke
         active = best > first_stop
         if active:
             for _ in range(ITERATIONS):
-                _first_partials(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
-                                _wrap(ua, lo[0], hi[0], period[0], periodic[0]),
-                                _wrap(va, lo[1], hi[1], period[1], periodic[1]), ndu_u, ndu_v, lu, ru, tu, lv, rv,
-                                tv, du, dv, h, s)
-                rx, ry, rz = px - s[0, 0], py - s[0, 1], pz - s[0, 2]
+                _eval(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
+                      _wrap(ua, lo[0], hi[0], period[0], periodic[0]), _wrap(va, lo[1], hi[1], period[1], periodic[1]),
+                      1, binom, sc, s)
+                rx, ry, rz = px - s[0, 0, 0], py - s[0, 0, 1], pz - s[0, 0, 2]
                 best = min(best, np.sqrt(rx * rx + ry * ry + rz * rz))
-                aa = s[1, 0] * s[1, 0] + s[1, 1] * s[1, 1] + s[1, 2] * s[1, 2]
-                bb = s[1, 0] * s[2, 0] + s[1, 1] * s[2, 1] + s[1, 2] * s[2, 2]
-                cc = s[2, 0] * s[2, 0] + s[2, 1] * s[2, 1] + s[2, 2] * s[2, 2]
-                g1 = s[1, 0] * rx + s[1, 1] * ry + s[1, 2] * rz
-                g2 = s[2, 0] * rx + s[2, 1] * ry + s[2, 2] * rz
+                aa = s[1, 0, 0] * s[1, 0, 0] + s[1, 0, 1] * s[1, 0, 1] + s[1, 0, 2] * s[1, 0, 2]
+                bb = s[1, 0, 0] * s[0, 1, 0] + s[1, 0, 1] * s[0, 1, 1] + s[1, 0, 2] * s[0, 1, 2]
+                cc = s[0, 1, 0] * s[0, 1, 0] + s[0, 1, 1] * s[0, 1, 1] + s[0, 1, 2] * s[0, 1, 2]
+                g1 = s[1, 0, 0] * rx + s[1, 0, 1] * ry + s[1, 0, 2] * rz
+                g2 = s[0, 1, 0] * rx + s[0, 1, 1] * ry + s[0, 1, 2] * rz
                 det = aa * cc - bb * bb + 1e-14 * (aa + cc) ** 2 + 2.2250738585072014e-308
                 dn = min(max((cc * g1 - bb * g2) / det, -step_u), step_u)
                 dm = min(max((aa * g2 - bb * g1) / det, -step_v), step_v)
                 un, vn = min(max(ua + dn, u0), u1), min(max(va + dm, v0), v1)
-                ex = (un - ua) * s[1, 0] + (vn - va) * s[2, 0]
-                ey = (un - ua) * s[1, 1] + (vn - va) * s[2, 1]
-                ez = (un - ua) * s[1, 2] + (vn - va) * s[2, 2]
+                ex = (un - ua) * s[1, 0, 0] + (vn - va) * s[0, 1, 0]
+                ey = (un - ua) * s[1, 0, 1] + (vn - va) * s[0, 1, 1]
+                ez = (un - ua) * s[1, 0, 2] + (vn - va) * s[0, 1, 2]
                 moving = np.sqrt(ex * ex + ey * ey + ez * ez) > 1e-3 * best and best > threshold
                 ua, va = un, vn
                 if not moving:  # converged, or within the threshold: the bound is in ``best``
