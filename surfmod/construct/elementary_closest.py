@@ -42,9 +42,9 @@ TWO_PI = 2.0 * math.pi
 #: Kinds of :func:`distances`' surfaces (:func:`surfmod.meshing.analytic_distance.parameters`
 #: reads them from OCCT).
 KINDS = PLANE, SPHERE, CYLINDER, CONE, TORUS = range(5)
-#: samples per block of :func:`triangle_distances`: a block's dozen temporaries take a few
-#: MiB whatever the part (5M triangles of 25 samples would take 10 GiB at once); smaller
-#: blocks were slower (2^11: 1.3x on 300k samples), larger ones no faster
+#: samples per block of :func:`triangle_distances`: a block's temporaries take a few MiB
+#: whatever the part (5M triangles of 25 samples would take GiBs at once); smaller blocks
+#: were slower on a part's 300k samples, larger ones no faster
 BLOCK_SAMPLES = 1 << 16
 
 
