@@ -139,7 +139,7 @@ def test_strict_refuses_and_writes_nothing(tmp_path, monkeypatch, capsys):
     import surfmod.cli.mesh_stl as cli_mesh
 
     solid = bd.fillet(bd.Solid.make_box(10, 10, 10).edges(), 2) - bd.Solid.make_cylinder(2, 10)
-    monkeypatch.setattr(cli_mesh, "import_step", lambda path: solid)
+    monkeypatch.setattr(cli_mesh, "read_step_file", lambda path, name: solid.wrapped)
     out = tmp_path / "t.stl"
     assert main(["mesh", "part.step", "--tolerance", "0.01", "--out", str(out), "--no-progress"]) == 0
     text = capsys.readouterr().out
