@@ -96,7 +96,7 @@ def main(argv=()) -> None:
     grid = np.stack([gx, gy, wave(gx, gy)], -1)
     pts = grid.reshape(-1, 3)
     _ours("wave, 60x60 grid", pts, tol)
-    from surfmod.occ.fitting import points_to_bspline_surface
+    from surfmod.occ.points_to_bspline import points_to_bspline_surface
 
     t = time.perf_counter()
     geom = points_to_bspline_surface(grid, (3, 3), tol, interpolate=False)

@@ -335,22 +335,6 @@ def test_a_needless_lazy_import_is_found(tmp_path):
         "surfmod.user:4 surfmod.light", "surfmod.user:5 json"]
 
 
-def test_module_names_are_unique_or_the_same_concept():
-    """Two modules of one name in different packages only where they are the same concept
-    at two levels, and then both docstrings say so (the words "same concept")."""
-    by_name: dict[str, list[str]] = {}
-    for name, path in MODULES.items():
-        if path.name != "__init__.py" and name.count(".") >= 2:
-            by_name.setdefault(name.rsplit(".", 1)[1], []).append(name)
-    bad = []
-    for names in by_name.values():
-        for name in names if len(names) > 1 else ():
-            doc = ast.get_docstring(ast.parse(MODULES[name].read_text())) or ""
-            if "same concept" not in " ".join(doc.split()):
-                bad.append(f"{name} (also {', '.join(n for n in names if n != name)})")
-    assert not bad, "modules of one name in several packages whose docstring does not say why:\n" + "\n".join(bad)
-
-
 @pytest.mark.parametrize("key", [k for names in RANKS for k in names])
 def test_rank_table_names_a_module(key):
     assert any(n.split(".")[1:2] == [key] for n in MODULES), f"{key}: no such module or package"
@@ -553,3 +537,122 @@ def test_a_kind_switch_is_found(tmp_path):
                                    'def g(code):\n    return {"flat": 0}.get(code) if code == BALL else 3\n'
                                    'class C:\n    def h(self, c):\n        return isinstance(c, (Bull, int))\n')
     assert kind_switches(tmp_path) == ["a:f", "a:g", "a:h"]
+
+
+# --- the house: one concept in one place (issue 34) ----------------------------------------------
+#: the kernel door stays thin: modules (its __init__ aside), lines (with it), the largest module;
+#: the lines are a ratchet at today's 3,846 (issue 34 asks for 3,200: the reader process's
+#: own child-process code and the Geom builders of analytic.py are what is left to move)
+OCC_MODULES, OCC_LINES, OCC_LARGEST = 24, 3850, 300
+#: module names that two packages share: each a command over the function it names or a
+#: function over its OCCT twin, and the higher imports the lower
+MAX_SAME_NAMED = 6
+#: public top-level names defined in more than one module; the command protocol of
+#: ``surfmod.cli`` (``register``, ``run``) is one name by design and not counted
+MAX_REPEATED_NAMES = 15
+#: where build123d may be imported: the door and the one module that turns user input into shapes
+BUILD123D_SITES = ("surfmod.occ", "surfmod.inputs")
+
+
+def _lines(path: Path) -> int:
+    return len(path.read_text().splitlines())
+
+
+def door_figures(modules) -> tuple[int, int, int]:
+    """``(modules, lines, largest)`` of ``surfmod.occ``: the package's own ``__init__`` is
+    not a module of the count, its lines are."""
+    occ = {n: p for n, p in modules.items() if n == "surfmod.occ" or n.startswith("surfmod.occ.")}
+    sizes = [_lines(p) for n, p in occ.items() if n != "surfmod.occ"]
+    return len(sizes), sum(_lines(p) for p in occ.values()), max(sizes)
+
+
+def test_occ_is_a_thin_door():
+    count, lines, largest = door_figures(MODULES)
+    assert count <= OCC_MODULES and lines <= OCC_LINES and largest <= OCC_LARGEST, (count, lines, largest)
+
+
+def entry_points(root: Path) -> set[str]:
+    """Modules reached by name rather than by an import statement: the lazy public names of
+    ``surfmod/__init__.py``, the commands of ``surfmod.cli.COMMANDS`` and the gallery's
+    modules (found by ``pkgutil``)."""
+    tree = ast.parse((root / "surfmod" / "__init__.py").read_text())
+    exports = next(n.value for n in tree.body if isinstance(n, ast.Assign) and n.targets[0].id == "_EXPORTS")
+    found = {"surfmod" + ast.literal_eval(v) for v in exports.values}
+    cli = ast.parse((root / "surfmod" / "cli" / "__init__.py").read_text())
+    commands = next(n.value for n in cli.body if isinstance(n, ast.AnnAssign | ast.Assign)
+                    and getattr(n.targets[0] if isinstance(n, ast.Assign) else n.target, "id", "") == "COMMANDS")
+    found |= {f"surfmod.cli.{ast.literal_eval(v)}" for v in commands.values}
+    found |= {f"surfmod.gallery.{p.stem}" for p in (root / "surfmod" / "gallery").glob("*.py")}
+    return found
+
+
+def uncalled_modules(modules, edges, entries: set[str]) -> list[str]:
+    """Modules no other module of the package imports and that are no entry point (a
+    package's ``__init__`` is reached through its package)."""
+    called = set()
+    for source, found in edges.items():
+        for target, _line, _in_function in found:
+            while target and target not in modules:
+                target = target.rpartition(".")[0]
+            if target and target != source:
+                called.add(target)
+    return sorted(n for n, p in modules.items()
+                  if n not in called and n not in entries and p.name != "__init__.py")
+
+
+def test_every_module_has_a_caller_in_the_package():
+    """Code that only tests use lives in ``tests/`` (``tests/twins/``), not in the package."""
+    assert not uncalled_modules(MODULES, EDGES, entry_points(ROOT.parent))
+
+
+def test_an_uncalled_module_is_found():
+    modules = {"surfmod.a": Path("a.py"), "surfmod.b": Path("b.py"), "surfmod.c": Path("c.py")}
+    edges = {"surfmod.a": [("surfmod.b.f", 1, False)], "surfmod.b": [], "surfmod.c": []}
+    assert uncalled_modules(modules, edges, {"surfmod.a"}) == ["surfmod.c"]
+
+
+def test_build123d_enters_only_at_the_door():
+    bad = [f"{name}:{line}" for name, found in EDGES.items() for target, line, _ in found
+           if target.split(".")[0] == "build123d" and not name.startswith(BUILD123D_SITES)]
+    assert not bad, "build123d imported past the door: " + ", ".join(bad)
+
+
+def same_named_pairs(modules, edges) -> tuple[list[tuple[str, ...]], list[str]]:
+    """Groups of modules that share a name, and those of them whose higher-ranked module
+    does not import its lower namesake (a pair in name only)."""
+    by_name: dict[str, list[str]] = {}
+    for name, path in modules.items():
+        if path.name != "__init__.py" and name.count(".") >= 2:
+            by_name.setdefault(name.rsplit(".", 1)[1], []).append(name)
+    groups = [tuple(sorted(v, key=lambda n: _level(n)[1])) for v in by_name.values() if len(v) > 1]
+    loose = []
+    for group in groups:
+        for low, high in zip(group, group[1:]):
+            targets = {t for t, _, _ in edges[high]}
+            if not any(t == low or t.startswith(low + ".") for t in targets):
+                loose.append(f"{high} does not import {low}")
+    return groups, loose
+
+
+def test_same_named_modules_are_real_pairs():
+    """A module name two packages share is one concept at two levels: a command over the
+    function it names, or a function over its OCCT twin; the higher imports the lower."""
+    groups, loose = same_named_pairs(MODULES, EDGES)
+    assert len(groups) <= MAX_SAME_NAMED, groups
+    assert not loose, loose
+
+
+def repeated_names(modules) -> dict[str, list[str]]:
+    """Public top-level functions and classes defined in more than one module."""
+    where: dict[str, list[str]] = {}
+    for name, path in modules.items():
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, (ast.FunctionDef, ast.ClassDef)) and not node.name.startswith("_"):
+                if not (name.startswith("surfmod.cli.") and node.name in ("register", "run")):
+                    where.setdefault(node.name, []).append(name)
+    return {k: v for k, v in where.items() if len(v) > 1}
+
+
+def test_few_public_names_are_defined_twice():
+    repeated = repeated_names(MODULES)
+    assert len(repeated) <= MAX_REPEATED_NAMES, "\n".join(f"{k}: {v}" for k, v in sorted(repeated.items()))

@@ -17,7 +17,7 @@ Both return a :class:`FittedSurface` (a B-spline surface that *is* its OCCT twin
 :meth:`FittedSurface.occt_fit` builds OCCT's own fit (``GeomAPI_PointsToBSplineSurface``)
 of the same data for comparison.
 
-The same concept as :mod:`surfmod.occ.fitting`, its OCCT twin (``GeomAPI_PointsToBSplineSurface``) behind the kernel door.
+Its OCCT twin (``GeomAPI_PointsToBSplineSurface``) is :mod:`surfmod.occ.points_to_bspline`, behind the kernel door.
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ class FittedSurface(BSplineSurface):
         ``(geom, max_distance)`` where ``max_distance`` is the largest distance from a
         data point to OCCT's surface (point projection).
         """
-        from ..occ.fitting import points_to_bspline_surface
+        from ..occ.points_to_bspline import points_to_bspline_surface
         from ..occ.sample import distances_to_surface
 
         tol = tolerance if tolerance is not None else (self.tolerance or 1e-6)

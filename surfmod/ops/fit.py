@@ -22,7 +22,7 @@
    ``tolerance`` is halved; repeat until every distance is within ``tolerance`` or the
    next refinement would pass ``max_poles`` (then ``converged`` is False).
 5. **Measured with OCCT**: the final distances come from projecting *every* point onto
-   the OCCT twin (:func:`surfmod.occ.fitting.project_points`); if OCCT measures a
+   the OCCT twin (:func:`surfmod.occ.points_to_bspline.project_points`); if OCCT measures a
    point beyond the tolerance, refinement resumes from those distances.
 """
 
@@ -360,7 +360,7 @@ def fit(points, tolerance: float, degree=(3, 3), *, smoothing: float = 1e-6, bas
             u, v = fu, fv
         occt = False
         if dist.max() <= tol:
-            from ..occ.fitting import project_points
+            from ..occ.points_to_bspline import project_points
 
             dist, _, _ = project_points(surface.geom(), q, fu, fv)
             occt = True
@@ -374,7 +374,7 @@ def fit(points, tolerance: float, degree=(3, 3), *, smoothing: float = 1e-6, bas
             break
         knots = [k if nk is None else nk for k, nk in zip(knots, new)]
     if not occt:
-        from ..occ.fitting import project_points
+        from ..occ.points_to_bspline import project_points
 
         dist, _, _ = project_points(surface.geom(), q, fu, fv)
     return _result(surface, dist, (fu, fv), bool(dist.max() <= tol), tol, iterations, smoothing)

@@ -1,7 +1,7 @@
 """OCCT's surface fitting, for comparisons: ``GeomAPI_PointsToBSplineSurface`` through or near
 a grid, and the fit's independent measure (``Extrema_GenLocateExtPS``).
 
-The same concept as :mod:`surfmod.construct.fitting`, of which this is the OCCT twin.
+The OCCT twin of :mod:`surfmod.construct.fitting` and the judge of :mod:`surfmod.ops.fit`.
 
 ``project_points`` is the independent measure of a fit: every point is projected onto
 the OCCT twin (``Geom_BSplineSurface``) by ``Extrema_GenLocateExtPS`` (distance
