@@ -458,6 +458,13 @@ def test_import_surfmod_loads_no_kernel():
     assert fresh_python(code) == ["False", "False"], "import surfmod must not load OCP/build123d"
 
 
+def test_the_step_reader_door_loads_no_kernel_before_its_process_starts():
+    """``surfmod.occ.isolated`` (``OCC_LAZY``) starts the reader process before it imports
+    OCCT, so the two imports overlap; an OCP import at its top would undo that."""
+    code = "import sys, surfmod.occ.isolated; print('OCP' in sys.modules)"
+    assert fresh_python(code) == ["False"]
+
+
 def test_no_subpackage_shadows_a_public_name():
     # importing every module binds submodules as package attributes: none may hide a
     # public function or class of the same name (sm.mesh once did)

@@ -34,7 +34,6 @@ import warnings
 from pathlib import Path
 
 from .. import checks
-from .finite import check_numbers
 from ..errors import DamagedFileError, InsideOutWarning, SurfmodError
 
 _HEADER = struct.Struct("!Q")
@@ -73,6 +72,7 @@ def _read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
     and what the model says of its solids' orientation: those inside out in the file,
     read outward (:func:`~surfmod.occ.step.outward_solids`), and those whose faces
     disagree (:func:`~surfmod.occ.solids.faces_at_odds`)."""
+    from .finite import check_numbers
     from .solids import faces_at_odds
     from .step import brep_bytes, read_step
 
