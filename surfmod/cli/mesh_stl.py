@@ -6,8 +6,8 @@ triangles stray where its nodes and tolerance do not (``BROKEN:`` lines name the
 Over folders, each file's row carries the same verdict and its exit status, and the
 command exits 3 when any file's STL broke a promise (:func:`surfmod.cli.batch.run_mesh`).
 
-The mesh is surfmod's own (:func:`surfmod.meshing.brep.tessellate_shape`), not OCCT's
-BRepMesh.
+The mesh is BRepMesh's, every triangle measured against its exact face and refined where
+the meshing, not the model, is the cause (:func:`surfmod.meshing.brep.tessellate_shape`).
 """
 
 from __future__ import annotations
