@@ -554,9 +554,11 @@ OCC_MODULES, OCC_LINES, OCC_LARGEST = 24, 3850, 300
 #: module names that two packages share: each a command over the function it names or a
 #: function over its OCCT twin, and the higher imports the lower
 MAX_SAME_NAMED = 6
-#: public top-level names defined in more than one module; the command protocol of
-#: ``surfmod.cli`` (``register``, ``run``) is one name by design and not counted
-MAX_REPEATED_NAMES = 15
+#: public top-level names defined in more than one module (issue 34 allows 15; the rest are
+#: a door's builder beside the closed form of the same surface, e.g. ``occ.analytic.plane``
+#: and ``construct.elementary_closest.plane``); the command protocol of ``surfmod.cli``
+#: (``register``, ``run``) is one name by design and not counted
+MAX_REPEATED_NAMES = 12
 #: where build123d may be imported: the door and the one module that turns user input into shapes
 BUILD123D_SITES = ("surfmod.occ", "surfmod.inputs")
 

@@ -45,7 +45,7 @@ MAX_RADIUS = 1e4
 
 
 @dataclass(frozen=True)
-class Arc:
+class ArcRun:
     """Points ``start..end`` (inclusive indices) of a path lie on the circle round ``centre``
     (XY) of ``radius``, swept counter-clockwise (``G3``) when ``ccw``, else ``G2``."""
 
@@ -69,7 +69,7 @@ def _circle(a, b, c):
 
 
 def _fits(pts: np.ndarray, tolerance: float, sagitta: float):
-    """The :class:`Arc` fields (centre, radius, ccw) when ``pts`` are one arc, else None."""
+    """The :class:`ArcRun` fields (centre, radius, ccw) when ``pts`` are one arc, else None."""
     n = len(pts)
     got = _circle(pts[0, :2], pts[n // 2, :2], pts[-1, :2])
     if got is None:
@@ -95,7 +95,7 @@ def _fits(pts: np.ndarray, tolerance: float, sagitta: float):
     return (float(centre[0]), float(centre[1])), r, bool(step[0] > 0)
 
 
-def find_arcs(points, kind=None, *, tolerance: float = TOLERANCE, sagitta: float = MAX_SAGITTA) -> list[Arc]:
+def find_arcs(points, kind=None, *, tolerance: float = TOLERANCE, sagitta: float = MAX_SAGITTA) -> list[ArcRun]:
     """The arcs of the path ``points (N, 3)``, in order and disjoint but for shared end
     points; ``kind (N,)`` (how each point is reached) must be one value along an arc
     (its first point excepted).  Greedy: each arc as long as it fits, then the next.
@@ -155,6 +155,6 @@ def find_arcs(points, kind=None, *, tolerance: float = TOLERANCE, sagitta: float
             else:
                 hi = mid
         centre, r, ccw = _fits(pts[i:lo + 1], tolerance, sagitta)
-        arcs.append(Arc(i, lo, centre, r, ccw))
+        arcs.append(ArcRun(i, lo, centre, r, ccw))
         i = lo
     return arcs

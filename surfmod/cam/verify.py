@@ -499,7 +499,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     top = np.full((nx, ny), float(hi[2]))
     radii = np.array([job.operations[k].tool.radius for k in owner], float)
     corners = np.array([job.operations[k].tool.corner for k in owner], float)
-    into, node = K.sweep(top, float(lo[0]), float(lo[1]), cell, moves.start, moves.end, moves.rapid, radii, corners,
+    into, node = K.sweep_stock(top, float(lo[0]), float(lo[1]), cell, moves.start, moves.end, moves.rapid, radii, corners,
                          cell / 2)
     through = np.where(moves.rapid, into, -np.inf)
     stock_hit = 1e-6  # a rapid grazing the top it just cut is no collision

@@ -160,7 +160,7 @@ def closing(tips, cell, radius, corner):
 
 
 @njit(cache=True)
-def sweep(top, x0, y0, cell, starts, ends, rapid, radii, corners, step):
+def sweep_stock(top, x0, y0, cell, starts, ends, rapid, radii, corners, step):
     """Run the moves over the stock's height field ``top`` (nx, ny) in order: a feed
     lowers every node to the tool's lower surface, a rapid cuts nothing and is measured.
     Each move is stamped at points at most ``step`` apart in (x, y).  Returns, per move,
