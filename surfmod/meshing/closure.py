@@ -87,6 +87,21 @@ class Closure:
         return "; ".join(said)
 
 
+def edge_uses(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The edges of triangles ``tri`` (``(T, 3)`` vertex indices), taken as the directed
+    edges 0-1, 1-2, 2-0 of every triangle in turn: ``(inverse, counts, forward)``, the
+    undirected edge of each directed one (``(3 T,)``) and per undirected edge how many
+    triangles use it and how many of them run it from its lower vertex to its higher.
+
+    >>> edge_uses(np.array([[0, 1, 2], [0, 2, 3]]))[1:]
+    (array([1, 2, 1, 1, 1]), array([1., 1., 0., 1., 1.]))
+    """
+    directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    _, inverse, counts = np.unique(np.sort(directed, axis=1), axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    return inverse, counts, np.bincount(inverse, weights=directed[:, 0] < directed[:, 1], minlength=len(counts))
+
+
 def closure(corners: np.ndarray, faces: np.ndarray | None = None) -> Closure:
     """Judge facets ``(T, 3, 3)`` as one closed solid; ``faces`` (``T`` ints) names the
     B-rep face of each facet.
@@ -106,15 +121,9 @@ def closure(corners: np.ndarray, faces: np.ndarray | None = None) -> Closure:
     _, index = np.unique(flat, axis=0, return_inverse=True)
     tri = index.reshape(-1, 3)
     degenerate = (tri[:, 0] == tri[:, 1]) | (tri[:, 1] == tri[:, 2]) | (tri[:, 0] == tri[:, 2])
-    good = tri[~degenerate]
-    directed = np.concatenate([good[:, [0, 1]], good[:, [1, 2]], good[:, [2, 0]]])
     owner = np.tile(np.nonzero(~degenerate)[0], 3)
-    undirected = np.sort(directed, axis=1)
-    keys, inverse, counts = np.unique(undirected, axis=0, return_inverse=True, return_counts=True)
-    inverse = inverse.ravel()
+    inverse, counts, ways = edge_uses(tri[~degenerate])
     # per undirected edge met twice: the two uses must run opposite ways
-    forward = (directed[:, 0] < directed[:, 1]).astype(np.int64)
-    ways = np.bincount(inverse, weights=forward, minlength=len(keys))
     bad_edge = (counts == 1) | (counts > 2) | ((counts == 2) & (ways != 1))
     c = corners.astype(np.float64)
     volume = float(np.einsum("ij,ij->i", c[:, 0], np.cross(c[:, 1], c[:, 2])).sum() / 6.0)

@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import checks, pictures
 from ..errors import SurfmodError
+from .closure import edge_uses
 
 
 @dataclass(frozen=True)
@@ -77,10 +78,7 @@ class Mesh:
         tri = self.triangles()
         if not len(tri):
             return False, False
-        directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-        _, inverse, counts = np.unique(np.sort(directed, axis=1), axis=0, return_inverse=True, return_counts=True)
-        inverse = inverse.ravel()
-        forward = np.bincount(inverse, weights=directed[:, 0] < directed[:, 1], minlength=len(counts))
+        _, counts, forward = edge_uses(tri)
         shared = counts == 2
         return bool(shared.all()), bool((forward[shared] == 1).all())
 
