@@ -226,7 +226,6 @@ def test_cli_machine(part_file, tmp_path, capsys):
     (["--scallop", "1"], "scallop"),
     (["--post", "fanuc"], "post"),
     (["--stock", "-1", "-1", "-1", "1", "1", "1"], "stock"),
-    (["--rough", "flat:1"], "flute_length"),
 ])
 def test_cli_bad_input(part_file, tmp_path, capsys, args, word):
     out = tmp_path / "bad.ngc"

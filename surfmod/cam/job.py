@@ -19,6 +19,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
 from .finishing import Rest, clear_part, finish, recut
+from .holder import StockModel, clear_body
 from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import _part
@@ -84,7 +85,9 @@ class Operation:
         m, s = divmod(self.time_estimate, 60)
         text = f"{self.name}: {self.tool}, cutting length {self.length:.0f} mm, time {int(m)} min {s:04.1f} s"
         left = left_summary(self.report.get("left")) if self.name == "roughing" else ""
-        return f"{text}; {left}" if left else text
+        held = self.report.get("holder")
+        text = f"{text}; {left}" if left else text
+        return f"{text}; {held}" if held else text
 
 
 @dataclass(frozen=True)
@@ -173,11 +176,12 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     return motion, report, part
 
 
-def _recut(job: Job, finishing: dict) -> Job:
+def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     """One round of repair: where the verification found the last finishing's scallop
     broken, cross passes over those regions (:func:`surfmod.cam.finishing.recut`) are
-    added to it, and the job is judged again.  Passes that would reach deeper than the
-    tool's flutes are not added; the verdict then stands."""
+    added to it, and the job is judged again.  Moves of the passes whose shank or holder
+    would collide are left out (:func:`surfmod.cam.holder.clear_body`); the verdict then
+    stands where they were."""
     found = next((f for f in job.verification.findings if f.what.startswith("residual") and not f.ok), None)
     if found is None or not found.boxes or not finishing:
         return job
@@ -185,8 +189,11 @@ def _recut(job: Job, finishing: dict) -> Job:
     op, (spec, part, rest) = job.operations[k], finishing[k]
     extra, passes = recut(part, op.tool, found.boxes, stepover=float(op.report["stepover"]), direction=spec.direction,
                           tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest)
-    cutting = extra.points[extra.kind != RAPID, 2]
-    if passes == 0 or float(job.stock[1, 2]) - float(cutting.min()) > op.tool.flute_length + 1e-9:
+    if passes == 0:
+        return job
+    extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
+                          job.safe_height)
+    if not np.any(extra.kind != RAPID):
         return job
     motion = Motion(np.concatenate([op.motion.points, extra.points]), np.concatenate([op.motion.kind, extra.kind]))
     seg = np.linalg.norm(np.diff(extra.points, axis=0), axis=1)
@@ -198,7 +205,17 @@ def _recut(job: Job, finishing: dict) -> Job:
     return replace(job, verification=verify_job(job))
 
 
-def machine(part, stock, operations, *, progress: bool = False, verify: bool = True) -> Job:
+def _held(motion, tool, stock_model, part, tolerance, safe, strict, name):
+    """The operation's moves cleared of shank and holder collisions; with ``strict`` a
+    collision refuses the job."""
+    motion, held = clear_body(motion, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe)
+    if held is not None and strict:
+        raise SurfmodError(f"strict: the {name} with {tool}: {held} (a longer tool: flute_length, shank_length; "
+                           f"a narrower holder; or strict=False to leave it)")
+    return motion, held
+
+
+def machine(part, stock, operations, *, progress: bool = False, verify: bool = True, strict: bool = False) -> Job:
     """Machine ``part`` (a build123d shape, STEP path or surfmod surfaces) from ``stock``
     (a margin in mm, or a box ``[[x0, y0, z0], [x1, y1, z1]]`` holding the part) by
     ``operations`` in order (:class:`Rough`, :class:`Finish`); tools without a number get
@@ -206,8 +223,14 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     stock down to the part plus its allowance (:mod:`surfmod.cam.roughing`); finishing is
     the gouge-checked drop-cutter path (:func:`surfmod.toolpath`) plus waterline contours on
     the steep regions, with the rest it cannot reach reported
-    (:mod:`surfmod.cam.finishing`).  Raises
-    ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut.
+    (:mod:`surfmod.cam.finishing`).
+
+    Above the flutes a tool does not cut: every move whose shank or holder
+    (:attr:`Tool.body <surfmod.cam.tool.Tool.body>`) would touch the part or the stock is
+    left out, the tool going round it by the clearance height, and what is left uncut is
+    reported in the operation's ``report["holder"]`` (:class:`~surfmod.cam.holder.Held`:
+    area, deepest point; see :mod:`surfmod.cam.holder`).  With ``strict`` such a collision
+    raises ``SurfmodError`` instead.
 
     With ``verify`` (the default) the job's LinuxCNC program is read back and judged
     against the exact part and the stock (:func:`surfmod.cam.verify.verify_job`: gouge,
@@ -221,17 +244,21 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     ops = list(operations) if isinstance(operations, (list, tuple)) else [operations]
     if not ops or not all(isinstance(o, (Rough, Finish)) for o in ops):
         raise SurfmodError("operations: expected a list of sm.Rough / sm.Finish")
+    wrong = next((o.tool for o in ops if not isinstance(o.tool, Tool)), None)
+    if wrong is not None:
+        raise SurfmodError(f"tool: expected a surfmod Tool, got {type(wrong).__name__}")
     box = bounding_box(shape.wrapped if hasattr(shape, "wrapped") else shape)
     if not np.all(np.isfinite(box)) or np.any(box[1] - box[0] <= 0):
         raise SurfmodError("part: has no solid extent to machine")
     stock = stock_box(box, stock)
     safe = float(stock[1, 2] + CLEARANCE)
+    strict = bool(strict)
+    # the stock model the shanks and holders are held against, shared by the operations
+    stock_model = StockModel(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
     numbers = {}
     with tqdm(total=2 * len(ops), desc="machine", unit="stage", disable=not progress) as bar:
         for k, op in enumerate(ops):
-            if not isinstance(op.tool, Tool):
-                raise SurfmodError(f"tool: expected a surfmod Tool, got {type(op.tool).__name__}")
             tool = op.tool.with_defaults(k + 1)
             if numbers.setdefault(tool.number, tool) != tool:
                 raise SurfmodError(f"tool: number {tool.number} is given to two different tools")
@@ -249,11 +276,9 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover, CLEARANCE,
                                        deflection=p.deflection)
-                cut_depth = float(stock[1, 2] - report["low"]) if report["levels"] else 0.0
-                if cut_depth > tool.flute_length + 1e-9:
-                    raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the roughing cuts "
-                                       f"{cut_depth:.4g} mm deep")
-                report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance)
+                motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing")
+                report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
+                              holder=held)
                 rest = Rest(tool.radius + allowance, allowance + stepdown + p.lift)
                 name = "roughing"
             else:
@@ -264,15 +289,13 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 lowest = float(box[1, 2] - tool.flute_length) + 1e-9
                 motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest)
                 finishing[k] = (op, finish_part, rest)
-                # after roughing the finishing tool works below the part's top
-                low = float(motion.points[motion.kind != RAPID, 2].min())
-                if box[1, 2] - low > tool.flute_length + 1e-9:
-                    raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the finishing "
-                                       f"goes {box[1, 2] - low:.4g} mm below the part's top")
+                motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe, strict,
+                                     "finishing")
+                report["holder"] = held
                 name = "finishing"
             bar.update()
             done.append(Operation(name, tool, motion, motion_time(motion, tool) + TOOL_CHANGE_TIME, report))
     job = Job(shape, stock, tuple(done), safe)
     if verify:
-        job = _recut(replace(job, verification=verify_job(job)), finishing)
+        job = _recut(replace(job, verification=verify_job(job)), finishing, stock_model)
     return job

@@ -1,9 +1,10 @@
 """End mills (flat, ball, bull nose) and the tool table of a job.
 
 A tool is its cutting end (profile ``f(d)``: the height of the end above the tip at
-distance ``d`` from the axis) on a shank as wide as the end; ``flute_length`` is how deep
-it can cut.  The table (number, speeds and feeds of each tool) comes from a TOML or JSON
-file or from defaults.
+distance ``d`` from the axis) with flutes ``flute_length`` long, above them a shank that
+does not cut and the holder it sits in (:attr:`Tool.body`: what must clear the part and the
+stock, :mod:`surfmod.cam.holder`).  The table (number, speeds and feeds, flutes, shank and
+holder of each tool) comes from a TOML or JSON file or from defaults.
 """
 
 from __future__ import annotations
@@ -24,6 +25,15 @@ from .cutters import CUTTERS, cutter
 DEFAULT_SURFACE_SPEED = 200.0  # m/min
 DEFAULT_CHIP_LOAD = 0.04  # mm per tooth, two flutes
 MAX_SPINDLE = 24000.0
+#: Default shank and holder, in tool radii: the shank sticks out this far above the flutes,
+#: the holder is a cylinder this wide (of the wider of the end and the shank) and this long.
+DEFAULT_SHANK_LENGTH = 2.0
+DEFAULT_HOLDER_RADIUS = 2.5
+DEFAULT_HOLDER_LENGTH = 8.0
+#: Slices of a cone holder widening upwards: each is held as a cylinder of its top radius
+#: standing at its bottom (the cone inside it, at most ``(top - bottom radius) / CONE_SLICES``
+#: wider than the cone).
+CONE_SLICES = 8
 SHAPE = frozenset({"corner", "core", "profile", "stepover_for_scallop", "scallop_for_stepover"})  # its cutter's
 
 
@@ -38,6 +48,13 @@ class Tool:
     ``corner`` (the corner radius: the radius for a ball, 0 for a flat end), ``core`` (the
     flat bottom's radius), ``profile(d)``, ``stepover_for_scallop(h)`` and
     ``scallop_for_stepover(s)``.
+
+    Above the flutes the tool does not cut: a shank of ``shank_radius`` (default the
+    radius) sticks out ``shank_length`` (default two radii) into a holder of
+    ``holder_radius`` (default 2.5 times the wider of the radius and the shank's) and
+    ``holder_length`` (default eight radii); a ``holder_top_radius`` other than the holder
+    radius makes the holder a cone (the collet nut's taper).  The spindle above the holder
+    is not modelled.  :attr:`body` is that stack as discs.
 
     >>> import surfmod as sm
     >>> t = sm.Tool("ball", 3.0)
@@ -56,6 +73,11 @@ class Tool:
     spindle: float | None = None
     feed: float | None = None
     plunge_feed: float | None = None
+    shank_radius: float | None = None
+    shank_length: float | None = None
+    holder_radius: float | None = None
+    holder_length: float | None = None
+    holder_top_radius: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "cutter", cutter(self.kind, self.radius, self.corner_radius))
@@ -68,6 +90,44 @@ class Tool:
         for name in ("spindle", "feed", "plunge_feed"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, checks.positive(getattr(self, name), name))
+        r = self.radius
+        shank = r if self.shank_radius is None else checks.positive(self.shank_radius, "shank_radius")
+        stick = DEFAULT_SHANK_LENGTH * r if self.shank_length is None else checks.real(self.shank_length,
+                                                                                       "shank_length")
+        if stick < 0:
+            raise SurfmodError(f"shank_length: must be >= 0, got {self.shank_length!r}")
+        holder = (DEFAULT_HOLDER_RADIUS * max(r, shank) if self.holder_radius is None
+                  else checks.positive(self.holder_radius, "holder_radius"))
+        if holder < shank:
+            raise SurfmodError(f"holder_radius: {holder:g} is narrower than the shank radius {shank:g}")
+        length = (DEFAULT_HOLDER_LENGTH * r if self.holder_length is None
+                  else checks.positive(self.holder_length, "holder_length"))
+        top = holder if self.holder_top_radius is None else checks.positive(self.holder_top_radius,
+                                                                            "holder_top_radius")
+        for name, value in (("shank_radius", shank), ("shank_length", stick), ("holder_radius", holder),
+                            ("holder_length", length), ("holder_top_radius", top)):
+            object.__setattr__(self, name, float(value))
+
+    @property
+    def body(self) -> np.ndarray:
+        """The parts above the flutes that must not touch anything, as discs ``(K, 2)``:
+        radius and the height of its bottom above the tip, lowest first: the shank (even
+        one no wider than the end meets the stock above the flutes in front of it), then
+        the holder; a cone holder widening upwards is held by :data:`CONE_SLICES` cylinders
+        each as wide as its slice's top.
+
+        >>> Tool("flat", 2.0, shank_radius=3.0, shank_length=5.0, flute_length=10.0).body.tolist()
+        [[3.0, 10.0], [7.5, 15.0]]
+        """
+        bottom = self.flute_length + self.shank_length
+        discs = [(self.shank_radius, self.flute_length)]
+        rb, rt = self.holder_radius, self.holder_top_radius
+        if rt > rb:
+            discs += [(rb + (rt - rb) * (k + 1) / CONE_SLICES, bottom + self.holder_length * k / CONE_SLICES)
+                      for k in range(CONE_SLICES)]
+        else:
+            discs.append((rb, bottom))
+        return np.array(discs, float)
 
     @property
     def diameter(self) -> float:
@@ -92,8 +152,9 @@ class Tool:
 def parse_tool(text: str, name: str = "tool") -> Tool:
     """``"flat:R"``, ``"ball:R"`` or ``"bull:R:r"`` (radius, corner radius in mm) as a Tool.
 
-    >>> parse_tool("bull:3:0.5")
-    Tool(kind='bull', radius=3.0, corner_radius=0.5, flute_length=18.0, number=None, spindle=None, feed=None, plunge_feed=None)
+    >>> t = parse_tool("bull:3:0.5")
+    >>> t.kind, t.radius, t.corner_radius, t.flute_length, t.holder_radius
+    ('bull', 3.0, 0.5, 18.0, 7.5)
     """
     parts = str(text).split(":")
     try:
@@ -111,7 +172,8 @@ def parse_tool(text: str, name: str = "tool") -> Tool:
 def load_tool_table(path) -> dict[int, Tool]:
     """Tools by number from a TOML (``[[tool]]`` tables) or JSON (``{"tool": [...]}``) file;
     each entry has ``number``, ``kind``, ``radius`` and optionally ``corner_radius``,
-    ``flute_length``, ``spindle``, ``feed``, ``plunge_feed``.
+    ``flute_length``, ``shank_radius``, ``shank_length``, ``holder_radius``,
+    ``holder_length``, ``holder_top_radius``, ``spindle``, ``feed``, ``plunge_feed``.
 
     >>> import tempfile, os
     >>> p = os.path.join(tempfile.mkdtemp(), "tools.toml")
@@ -129,7 +191,8 @@ def load_tool_table(path) -> dict[int, Tool]:
     entries = data.get("tool") if isinstance(data, dict) else None
     if not isinstance(entries, list):
         raise SurfmodError(f"tools: {p.name} has no list of [[tool]] entries")
-    known = {"number", "kind", "radius", "corner_radius", "flute_length", "spindle", "feed", "plunge_feed"}
+    known = {"number", "kind", "radius", "corner_radius", "flute_length", "shank_radius", "shank_length",
+             "holder_radius", "holder_length", "holder_top_radius", "spindle", "feed", "plunge_feed"}
     table = {}
     for k, entry in enumerate(entries):
         if not isinstance(entry, dict) or "number" not in entry or not set(entry) <= known:

@@ -23,11 +23,20 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   stepover wide, from which each feed removes what the tool's lower surface sweeps, in
   the program's order.  A rapid whose tool goes below the stock's top there runs through
   material;
+- **holder and shank**: above its flutes a tool does not cut (:attr:`Tool.body
+  <surfmod.cam.tool.Tool.body>`): along every move, its discs wider than the end dropped
+  onto the part's points (grown by half the probes' spacing) and, in the stock sweep
+  below, every disc measured against the stock the moves before left
+  (:func:`~surfmod.cam.verify_kernels.sweep_body`), each disc narrower by the operation's
+  limit (a rub beside a wall), may stand no lower than the part or the stock beyond the 4
+  decimals written and the stamped sweep's sag;
 - **residual**: after the last finishing, the stock left above the lowest the finishing
   tool can reach (the part's closing by the tool, from its drop onto the part's points),
   measured normal to that surface, is at most the scallop plus the tolerance wherever the
   tool reaches.  A height field cannot see a wall: nodes steeper than ``WALL_SLOPE`` and a
-  band one cell wide at the part's outline are counted, not judged.
+  band one cell wide at the part's outline are counted, not judged; so are the nodes the
+  shank or holder keeps the tool from (the whole tool's reach, from its discs' drops,
+  above the end's).
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
 (points on the part, probes along the moves, stock nodes); where it would pass its cap the
@@ -57,6 +66,9 @@ from .program import ProgramMoves, concatenate, read_program
 #: points on the part, probes along the moves and stock nodes one verification may take
 MAX_SAMPLES = 30_000_000
 MAX_PROBES = 60_000_000
+#: probes of the holder and shank check along the moves (a radius of the narrowest disc
+#: wider than the end over 16 apart: few beside the gouge probes), at most
+MAX_BODY_PROBES = 20_000_000
 MAX_NODES = 30_000_000
 #: nodes of the stock steeper than this (degrees) are walls the height field cannot judge
 WALL_SLOPE = 80.0
@@ -115,6 +127,8 @@ class Verification:
     walls: int = 0
     spacing: float = 0.0
     notes: tuple = field(default=())
+    #: probes of the holder and shank check (their own cap, ``MAX_BODY_PROBES``)
+    body_probes: int = 0
 
     @property
     def ok(self) -> bool:
@@ -123,6 +137,7 @@ class Verification:
     def lines(self) -> list[str]:
         head = (f"verified against the exact part: {self.samples:,} points {self.spacing:.3g} mm apart, "
                 f"{self.probes:,} probes along the moves"
+                + (f" ({self.body_probes:,} more for holder and shank)" if self.body_probes else "")
                 + (f", stock of {self.nodes:,} nodes ({self.walls:,} on walls not judged)" if self.nodes else ""))
         return [head] + [str(f) for f in self.findings] + list(self.notes)
 
@@ -406,6 +421,33 @@ def _gouge(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, radius: floa
     return Finding(what, float(depth[k]), limit, where, len(bad), int(moves.line[idx[move[k]]])), len(probes)
 
 
+def _body_part(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, tool, slack: float, limit: float,
+               max_probes: int, what: str):
+    """How far the part's points stand above the bottom of the tool's discs wider than its
+    end (:attr:`~surfmod.cam.tool.Tool.body`, each less ``slack``, grown by half the probes'
+    spacing, at the lowest height within it) along the picked moves, against ``limit``."""
+    discs = [(r, h) for r, h in tool.body if r - slack > tool.radius]
+    if not discs or not pick.any():
+        return Finding(what, -np.inf, limit), 0
+    idx = np.flatnonzero(pick)
+    a, b = moves.start[idx], moves.end[idx]
+    probes, move, used = _probes(a, b, min(r for r, _ in discs) / 16, max_probes)
+    seg = b - a
+    low = np.maximum(probes[:, 2] - np.abs(seg[move, 2]) / np.maximum(np.linalg.norm(seg[move], axis=1), 1e-300)
+                     * used / 2, np.minimum(a[move, 2], b[move, 2]))
+    ceiling = float(part.points[:, 2].max())
+    depth = np.full(len(probes), -np.inf)
+    for r, h in discs:
+        near = low + h < ceiling
+        if near.any():
+            depth[near] = np.maximum(depth[near], part.drop(probes[near, :2], r - slack + used / 2, 0.0) - (low[near] + h))
+    k = int(np.argmax(depth))
+    if not depth[k] > -np.inf:
+        return Finding(what, -np.inf, limit), len(probes)
+    return Finding(what, float(depth[k]), limit, tuple(float(v) for v in probes[k]),
+                   len(np.unique(move[depth > limit])), int(moves.line[idx[move[k]]])), len(probes)
+
+
 # -- the job --------------------------------------------------------------------------------
 def _program_moves(job, texts: list[str], post: str) -> tuple[ProgramMoves, np.ndarray]:
     """The programs' moves in the order the machine runs them, and each move's operation."""
@@ -443,7 +485,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     ...                                          sm.Finish(sm.Tool("ball", 2.0), scallop=0.05)], verify=False)
     >>> v = verify_job(job)
     >>> v.ok, [f.what.split(" (")[0] for f in v.findings]
-    (True, ['gouge, roughing', 'gouge, finishing', 'rapids', 'residual after finishing'])
+    (True, ['gouge, roughing', 'gouge, finishing', 'rapids', 'holder and shank, roughing', 'holder and shank, finishing', 'residual after finishing'])
     """
     from .post import programs
 
@@ -499,8 +541,33 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     top = np.full((nx, ny), float(hi[2]))
     radii = np.array([job.operations[k].tool.radius for k in owner], float)
     corners = np.array([job.operations[k].tool.corner for k in owner], float)
-    into, node = K.sweep_stock(top, float(lo[0]), float(lo[1]), cell, moves.start, moves.end, moves.rapid, radii, corners,
-                         cell / 2)
+    # the shank and holder of each move's tool measured against the stock as it stands then
+    bodies = [op.tool.body for op in job.operations]
+    discs = np.zeros((len(bodies), max(len(b) for b in bodies), 2))
+    for k, b in enumerate(bodies):
+        discs[k, :len(b)] = b
+    slack = np.array([limit for _, _, _, limit in plans])
+    # a disc may rub sideways within the operation's limit, never stand below the part or
+    # the stock: beyond the 4 decimals and the stamped sweep's sag over a quarter cell
+    low_limit = digits + (cell / 4) ** 2 / (2 * cell)
+    into, node, sink, sink_node, _ = K.sweep_body(top, float(lo[0]), float(lo[1]), cell, moves.start, moves.end,
+                                                  moves.rapid, radii, corners, cell / 2, discs,
+                                                  np.ascontiguousarray(owner, dtype=np.int64), slack,
+                                                  np.zeros(len(plans)), np.zeros(len(owner), np.bool_), False)
+    held, body_probes = [], 0
+    for k, op, _, limit in plans:
+        found, n = _body_part(part, moves, owner == k, op.tool, limit, low_limit,
+                              max(MAX_BODY_PROBES * int((owner == k).sum()) // max(len(owner), 1), 1),
+                              f"holder and shank, {op.name} (tool {op.tool.number})")
+        body_probes += n
+        mine = np.flatnonzero(owner == k)
+        if mine.size and sink[mine].max() > max(found.worst, 0.0):
+            w = mine[int(np.argmax(sink[mine]))]
+            i, j = divmod(int(sink_node[w]), ny)
+            found = Finding(found.what, float(sink[w]), low_limit,
+                            (float(lo[0] + i * cell), float(lo[1] + j * cell), float(top[i, j])),
+                            int((sink[mine] > low_limit).sum()), int(moves.line[w]))
+        held.append(found)
     through = np.where(moves.rapid, into, -np.inf)
     stock_hit = 1e-6  # a rapid grazing the top it just cut is no collision
     k = int(np.argmax(through)) if len(through) else 0
@@ -511,6 +578,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     else:
         stock = Finding("rapids", -np.inf, 0.0)
     findings.append(max(stock, rapid_part, key=lambda f: f.worst))
+    findings += held
     uncut = ~moves.rapid & ~moves.spindle & (np.linalg.norm(moves.end - moves.start, axis=1) > 0)
     if uncut.any():
         findings.append(Finding("cuts with the spindle stopped", float(uncut.sum()), 0.0, None, int(uncut.sum()),
@@ -518,9 +586,13 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     walls = 0
     if finishing:
         k, op, cutter, limit = finishing[-1]
-        found, walls = _residual(part, top, lo, cell, op, cutter, limit)
+        found, walls, held = _residual(part, top, lo, cell, op, cutter, limit)
         findings.append(found)
-    return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes))
+        if held:
+            notes.append(f"note: residual: {held:,} nodes the shank or holder keeps the finishing tool from, "
+                         f"not judged (the holder finding and the operation's report say what is left)")
+    return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes),
+                        body_probes)
 
 
 def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):
@@ -530,6 +602,15 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
     xy = np.column_stack([gx.ravel(), gy.ravel()])
     tips = part.drop(xy, cutter.radius, cutter.corner).reshape(nx, ny)
     reach = K.closing(tips, cell, cutter.radius, cutter.corner)
+    # where the shank or holder stops the tool above the part, the tool does not reach it:
+    # the lowest the whole tool reaches, from its discs' drops onto the part's points
+    body = [(r - limit, h) for r, h in op.tool.body if r - limit > cutter.radius]
+    held = np.zeros((nx, ny), bool)
+    if body:
+        stand = tips.copy()
+        for r, h in body:
+            stand = np.maximum(stand, part.drop(xy, r, 0.0).reshape(nx, ny) - h)
+        held = np.isfinite(reach) & (K.closing(stand, cell, cutter.radius, cutter.corner) > reach + limit)
     # the part under each node (the highest of its points within the node's cell), and the
     # outline: a node whose neighbours are not all over the part is not judged
     under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
@@ -539,7 +620,7 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
     inner[:-1] &= on[1:]
     inner[:, 1:] &= on[:, :-1]
     inner[:, :-1] &= on[:, 1:]
-    inner &= np.isfinite(reach)
+    inner &= np.isfinite(reach) & ~held
     # on the grid the closing can fall below the part at the rim of a wall (the tool just
     # across it): the tool never reaches below the part under the node
     reach = np.maximum(reach, under)
@@ -554,7 +635,7 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
     bound = scallop + limit + sag
     what = f"residual after {op.name} (tool {op.tool.number}, normal to the reachable surface)"
     if not judged.any():
-        return Finding(what, -np.inf, bound), int(steep.sum())
+        return Finding(what, -np.inf, bound), int(steep.sum()), int(held.sum())
     vals = np.where(judged, left, -np.inf)
     i, j = np.unravel_index(int(np.argmax(vals)), vals.shape)
     worst = float(vals[i, j])
@@ -563,7 +644,7 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
     boxes = tuple((float(gx[a.start, 0]), float(gy[0, b.start]), float(gx[a.stop - 1, 0]), float(gy[0, b.stop - 1]))
                   for a, b in ndimage.find_objects(labels))
     return Finding(what, worst, bound, (float(gx[i, j]), float(gy[i, j]), float(top[i, j])), int(over.sum()),
-                   boxes=boxes), int(steep.sum())
+                   boxes=boxes), int(steep.sum()), int(held.sum())
 
 
 def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MAX_SAMPLES,

@@ -11,6 +11,9 @@ point of a surface of revolution lies in the point's own meridian plane).
 
 Points are bucketed on an (x, y) grid, each cell's list from its highest point down, so a
 probe stops reading a cell at the first point below its tip: nothing lower can be inside.
+
+Above its flutes a tool does not cut: :func:`sweep_body` measures its shank and holder
+against the stock the moves before left (:mod:`surfmod.cam.holder`).
 """
 
 from __future__ import annotations
@@ -166,21 +169,113 @@ def sweep_stock(top, x0, y0, cell, starts, ends, rapid, radii, corners, step):
     Each move is stamped at points at most ``step`` apart in (x, y).  Returns, per move,
     how far the tool's lower surface went below the stock's top (the deepest, -inf where
     it covered no stock) and that node's flat index."""
+    m = starts.shape[0]
+    none = np.zeros((1, 1, 2))
+    out = sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, none, np.zeros(m, np.int64),
+                     np.zeros(1), np.zeros(1), np.zeros(m, np.bool_), False)
+    return out[0], out[1]
+
+
+@njit(cache=True)
+def _log(log_i, log_v, n, index, value):
+    """Append (index, value) to the undo log, doubling it when full."""
+    if n == log_i.shape[0]:
+        grown_i = np.empty(2 * n, np.int64)
+        grown_v = np.empty(2 * n)
+        grown_i[:n] = log_i
+        grown_v[:n] = log_v
+        log_i, log_v = grown_i, grown_v
+    log_i[n] = index
+    log_v[n] = value
+    return log_i, log_v
+
+
+@njit(cache=True)
+def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, body, tool_of, slack, limit, skip,
+               remove):
+    """:func:`sweep_stock` with the tool's body above its flutes (the discs ``body[tool_of[k]]``:
+    radius, height of the bottom above the tip; radius 0 pads) measured against the stock
+    before each stamp: how far the stock stands above a disc's bottom within the disc's
+    radius less the tool's ``slack[tool_of[k]]`` (a rub within it is no collision), over the capsule from
+    the stamp before to this one (the disc at every point between), at the lower of the
+    two heights.  The end's own column is left out where the tool already stands (a
+    move's first stamp) or descends vertically (its flutes cut the column on the way down).
+
+    With ``remove``, a move marked ``skip`` or whose body goes deeper than ``limit[tool]``
+    into the stock cuts nothing (its stamps undone) and is reported removed, so later moves
+    meet the stock it left; so is a rapid whose end goes deeper than ``slack[tool]`` into it.  Returns per move: ``into`` and its node (as :func:`sweep_stock`), the
+    body's deepest ``sink`` into the stock (-inf where it met none) and its node, and
+    ``removed``."""
     nx, ny = top.shape
     m = starts.shape[0]
     into = np.full(m, -np.inf)
     node = np.full(m, -1, np.int64)
+    sink = np.full(m, -np.inf)
+    sink_node = np.full(m, -1, np.int64)
+    removed = np.zeros(m, np.bool_)
+    ceiling = -np.inf
+    for i in range(nx):
+        for j in range(ny):
+            ceiling = max(ceiling, top[i, j])
+    lowest = np.full(body.shape[0], np.inf)
+    for t in range(body.shape[0]):
+        for q in range(body.shape[1]):
+            if body[t, q, 0] > slack[t]:
+                lowest[t] = min(lowest[t], body[t, q, 1])
+    log_i = np.empty(1024, np.int64)
+    log_v = np.empty(1024)
     for k in range(m):
+        if remove and skip[k]:
+            removed[k] = True
+            continue
         ax, ay, az = starts[k, 0], starts[k, 1], starts[k, 2]
         bx, by, bz = ends[k, 0], ends[k, 1], ends[k, 2]
         radius, corner = radii[k], corners[k]
+        tk = tool_of[k]
         length = math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
         pieces = max(1, int(math.ceil(length / step)))
         if length == 0.0:
             pieces = 0  # a vertical move: its lowest end is stamped alone
+        # the body can meet stock only below the highest node, and never on the way up
+        measure = min(az, bz) + lowest[tk] < ceiling and not (pieces == 0 and bz >= az)
+        logged = 0
+        px, py, pz = ax, ay, az
         for s in range(pieces + 1):
             t = s / pieces if pieces else (1.0 if bz < az else 0.0)
             cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
+            if measure:
+                own = s == 0 or pieces == 0
+                zl = min(cz, pz)
+                ux, uy = cx - px, cy - py
+                uu = ux * ux + uy * uy
+                for q in range(body.shape[1]):
+                    reach = body[tk, q, 0] - slack[tk]
+                    if reach <= 0.0:
+                        continue
+                    bottom = zl + body[tk, q, 1]
+                    i0 = max(int(math.ceil((min(cx, px) - reach - x0) / cell)), 0)
+                    i1 = min(int(math.floor((max(cx, px) + reach - x0) / cell)), nx - 1)
+                    j0 = max(int(math.ceil((min(cy, py) - reach - y0) / cell)), 0)
+                    j1 = min(int(math.floor((max(cy, py) + reach - y0) / cell)), ny - 1)
+                    for i in range(i0, i1 + 1):
+                        gx = x0 + i * cell
+                        for j in range(j0, j1 + 1):
+                            gap = top[i, j] - bottom
+                            if gap <= sink[k]:
+                                continue
+                            gy = y0 + j * cell
+                            w = 0.0 if uu == 0.0 else min(max(((gx - px) * ux + (gy - py) * uy) / uu, 0.0), 1.0)
+                            if math.sqrt((gx - px - w * ux) ** 2 + (gy - py - w * uy) ** 2) >= reach:
+                                continue
+                            if own and math.sqrt((gx - cx) ** 2 + (gy - cy) ** 2) < radius:
+                                continue
+                            sink[k], sink_node[k] = gap, i * ny + j
+                if remove and sink[k] > limit[tk]:
+                    for e in range(logged - 1, -1, -1):  # undo this move's stamps
+                        top[log_i[e] // ny, log_i[e] % ny] = log_v[e]
+                    removed[k] = True
+                    break
+            px, py, pz = cx, cy, cz
             i0 = max(int(math.ceil((cx - radius - x0) / cell)), 0)
             i1 = min(int(math.floor((cx + radius - x0) / cell)), nx - 1)
             j0 = max(int(math.ceil((cy - radius - y0) / cell)), 0)
@@ -198,5 +293,10 @@ def sweep_stock(top, x0, y0, cell, starts, ends, rapid, radii, corners, step):
                         if gap > into[k]:
                             into[k], node[k] = gap, i * ny + j
                     elif gap > 0.0:
+                        if remove and measure:
+                            log_i, log_v = _log(log_i, log_v, logged, i * ny + j, top[i, j])
+                            logged += 1
                         top[i, j] = z
-    return into, node
+        if remove and rapid[k] and into[k] > slack[tk]:
+            removed[k] = True  # a rapid into the stock left here: the relink comes down at the feed
+    return into, node, sink, sink_node, removed

@@ -36,6 +36,9 @@ def register(sub) -> None:
     p.add_argument("--no-verify", action="store_true",
                    help="skip reading the program back and judging it against the exact part and the stock "
                         "(faster; the program's header says it was not verified)")
+    p.add_argument("--strict", action="store_true",
+                   help="refuse (exit 1, nothing written) where a tool's shank or holder would collide, instead "
+                        "of leaving that region uncut and reporting it")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(run=run)
 
@@ -55,7 +58,9 @@ def run(args) -> int:
     the scallop is broken, re-cut: :func:`~surfmod.cam.job.machine`; GRBL's programs judged
     as written), write them with the verdict in their header and print the summary.  Exit 0 when every promise holds, 3 when the program
     is written but a promise is broken (the lines before say which and where); on bad
-    input one line and exit 1, nothing written."""
+    input one line and exit 1, nothing written.  Where a shank or holder would collide the
+    region is left and reported (exit 0 when every promise holds); ``--strict`` refuses
+    instead: one line, exit 1, nothing written (the input asks what the tools cannot do)."""
     if args.post not in POSTS:
         raise SurfmodError(f"post: expected one of {', '.join(POSTS)}, got {args.post!r}")
     target_path(args.out, "out", SUFFIXES)
@@ -79,7 +84,7 @@ def run(args) -> int:
     stock = args.stock_margin if args.stock is None else [args.stock[:3], args.stock[3:]]
     job = machine(shape, stock, [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
                                  Finish(finish_tool, scallop=args.scallop)], progress=not args.no_progress,
-                  verify=not args.no_verify)
+                  verify=not args.no_verify, strict=args.strict)
     texts = programs(job, args.post)  # any refusal before a file is written
     program_paths(args.out, job, args.post)
     if args.no_verify:

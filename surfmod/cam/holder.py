@@ -1,0 +1,183 @@
+"""Shank and holder collisions: what does not cut must clear the part and the stock.
+
+Above its flutes a tool does not cut (:attr:`surfmod.cam.tool.Tool.body`: the shank from
+the flutes' end, the holder from the shank's).  Every move of an operation, cutting or
+linking, is checked twice:
+
+- **against the part**: the discs wider than the cutting end (a wider shank, the holder)
+  dropped as flat cylinders onto the part's mesh (:func:`surfmod.cam.drop_cutter.drop`)
+  at probes along the move, each disc grown by half the probes' spacing (so it holds the
+  disc at every point between) and its bottom at the lowest height within half a spacing;
+  the mesh's deflection is added to the heights found (the exact faces lie at most that
+  far above the mesh).  A narrower shank stands in the column the end's drop-cutter
+  already keeps clear of the part;
+- **against the stock**: the operation's moves swept in order through a height-field
+  stock model shared by the job's operations (:func:`surfmod.cam.verify_kernels.sweep_body`):
+  before each stamp of the cutting end, the stock may stand no higher than a disc's bottom
+  within the disc (the shank, even as narrow as the end, meets stock above the flutes in
+  front of the tool).
+
+A disc may rub sideways within the operation's tolerance (its radius is taken that much
+smaller: the end's own side comes that near a wall), but never stand lower than the part
+or the stock under it.
+A move that fails either check is removed: the tool retracts to the clearance height,
+crosses, and comes straight down at the plunge feed onto the start of the next move kept
+(a flat or bull end must cut at its centre there: the stock the removed moves leave is
+not what the operation's own ramps and helices were laid out for).  What the removed moves
+would have cut is left, and reported (:class:`Held`): the (x, y) area where more than the
+tolerance is left, the deepest point they would have reached and the thickness left.
+
+The work is counted before it starts: probes along the moves (at most
+:data:`MAX_HOLDER_PROBES`, else they stand farther apart and the discs grow with them, a
+more cautious check) and stock nodes (at most :data:`MAX_STOCK_NODES`, else coarser cells).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .cutters import Flat
+from .drop_cutter import TriangleGrid, drop
+from .roughing import PLUNGE, RAPID, Motion, Moves
+from .verify import _probes
+from .verify_kernels import sweep_body, sweep_stock
+
+#: probes along the moves for the part check, and stock nodes of the job's model, at most
+MAX_HOLDER_PROBES = 20_000_000
+MAX_STOCK_NODES = 4_000_000
+#: probes along a move per disc radius
+PROBES_PER_RADIUS = 16
+
+
+@dataclass(frozen=True)
+class Held:
+    """What an operation's shank and holder kept it from: ``moves`` removed, the (x, y)
+    ``area`` (mm²) where they leave more than the tolerance, the ``deepest`` point (x, y, z)
+    they would have reached and the ``thickness`` left there at most."""
+
+    moves: int
+    area: float
+    deepest: tuple
+    thickness: float
+
+    def __str__(self) -> str:
+        x, y, z = self.deepest
+        return (f"holder/shank would collide: {self.moves} moves left out, {self.area:.3g} mm² left uncut "
+                f"(at most {self.thickness:.3g} mm thick), deepest ({x:.4g}, {y:.4g}, {z:.4g})")
+
+
+class StockModel:
+    """The stock as a height field over its box (cells a quarter of the smallest tool
+    radius, at most :data:`MAX_STOCK_NODES` nodes), lowered by each operation's kept moves."""
+
+    def __init__(self, stock: np.ndarray, smallest_radius: float):
+        lo, hi = np.asarray(stock, float)
+        cell = smallest_radius / 4
+        span = hi[:2] - lo[:2]
+        if np.prod(np.floor(span / cell) + 1) > MAX_STOCK_NODES:
+            cell = 1.05 * math.sqrt(float(np.prod(span)) / MAX_STOCK_NODES)
+        nx, ny = (np.floor(span / cell).astype(int) + 1)
+        self.top = np.full((int(nx), int(ny)), float(hi[2]))
+        self.origin = (float(lo[0]), float(lo[1]))
+        self.cell = float(cell)
+
+    def sweep(self, moves, rapid, tool, body, slack: float, skip, remove: bool):
+        start, end = np.ascontiguousarray(moves[:-1]), np.ascontiguousarray(moves[1:])
+        m = len(start)
+        discs = np.zeros((1, max(len(body), 1), 2))
+        discs[0, :len(body)] = body
+        return sweep_body(self.top, *self.origin, self.cell, start, end, rapid, np.full(m, tool.radius),
+                          np.full(m, tool.corner), self.cell / 2, discs, np.zeros(m, np.int64), np.array([float(slack)]),
+                          np.zeros(1), skip, remove)
+
+
+def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float) -> np.ndarray:
+    """Per move (``points[k] -> points[k + 1]``): how far the part stands above the bottom
+    of the tool's discs wider than its end (see the module), -inf where it stays below."""
+    sink = np.full(max(len(points) - 1, 0), -np.inf)
+    discs = [(r, h) for r, h in tool.body if r - slack > tool.radius]
+    if not discs or not len(sink):
+        return sink
+    top = float(triangles[:, :, 2].max()) + deflection
+    spacing = min(r for r, _ in discs) / PROBES_PER_RADIUS
+    probes, move, spacing = _probes(points[:-1], points[1:], spacing, MAX_HOLDER_PROBES)
+    seg = points[1:] - points[:-1]
+    slope = np.abs(seg[:, 2]) / np.maximum(np.linalg.norm(seg, axis=1), 1e-300)
+    # the lowest the move goes within half a spacing
+    low = np.maximum(probes[:, 2] - slope[move] * spacing / 2, np.minimum(points[:-1, 2], points[1:, 2])[move])
+    for r, h in discs:
+        near = low + h < top  # above the part's top the disc meets nothing
+        if not near.any():
+            continue
+        reach = r - slack + spacing / 2
+        z = drop(TriangleGrid(triangles, reach), Flat(reach), probes[near, :2])
+        depth = np.nan_to_num(z, nan=-np.inf) + deflection - (low[near] + h)
+        np.maximum.at(sink, move[near], depth)
+    return sink
+
+
+def relink(motion: Motion, removed: np.ndarray, safe: float) -> Motion:
+    """``motion`` without the moves ``removed`` (per move into ``points[k + 1]``): after a
+    gap the tool goes up to ``safe``, across, and down onto the start of the next cutting
+    move kept; the program's own links in the gap are dropped."""
+    pts, kind = motion.points, motion.kind
+    out = Moves()
+    out.add(pts[:1], kind[0])
+    gap = False
+    for k in range(1, len(pts)):
+        if removed[k - 1]:
+            gap = True
+            continue
+        if gap and kind[k] == RAPID:
+            continue
+        if gap:
+            start, cur = pts[k - 1], out.last
+            if np.any(start != cur):
+                if cur[2] < safe:
+                    out.add([[cur[0], cur[1], safe]], RAPID)
+                out.add([[start[0], start[1], safe]], RAPID)
+                # at the feed: the moves left out leave stock the program's own entries
+                # did not expect
+                out.add([start], PLUNGE)
+            gap = False
+        out.add(pts[k:k + 1], kind[k])
+    last = out.last
+    if gap and last[2] < safe:
+        out.add([[last[0], last[1], safe]], RAPID)
+    return out.motion()
+
+
+def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
+               safe: float):
+    """``(motion, held)``: ``motion`` swept through ``stock`` with the moves whose shank or
+    holder would touch the part or the stock removed and relinked (:func:`relink`), and
+    what that leaves (:class:`Held`, None when nothing is removed)."""
+    pts = np.asarray(motion.points, float)
+    if len(pts) < 2:
+        return motion, None
+    rapid = motion.kind[1:] == RAPID
+    skip = part_sink(triangles, deflection, tool, pts, slack) > 0.0
+    before = stock.top.copy()
+    *_, removed = stock.sweep(pts, rapid, tool, tool.body, slack, skip, True)
+    if not removed.any():
+        return motion, None
+    kept = relink(motion, removed, safe)
+    # what the removed cuts would have taken beyond the stock the kept moves leave
+    cuts = removed & ~rapid
+    if not cuts.any():
+        return kept, Held(int(removed.sum()), 0.0, tuple(pts[1:][removed][0]), 0.0)
+    would = stock.top.copy()
+    a, b = pts[:-1][cuts], pts[1:][cuts]
+    n = len(a)
+    sweep_stock(would, *stock.origin, stock.cell, np.ascontiguousarray(a), np.ascontiguousarray(b),
+                np.zeros(n, np.bool_), np.full(n, tool.radius), np.full(n, tool.corner), stock.cell / 2)
+    left = np.minimum(stock.top, before) - would
+    over = left > slack
+    if not over.any():
+        return kept, Held(int(removed.sum()), 0.0, tuple(float(v) for v in b[np.argmin(b[:, 2])]), 0.0)
+    i, j = np.unravel_index(int(np.argmin(np.where(over, would, np.inf))), would.shape)
+    deepest = (stock.origin[0] + i * stock.cell, stock.origin[1] + j * stock.cell, float(would[i, j]))
+    return kept, Held(int(removed.sum()), float(over.sum()) * stock.cell ** 2, deepest, float(left[over].max()))

@@ -1,0 +1,165 @@
+"""Shank and holder collisions: a deep box pocket a short tool cannot reach to the floor.
+
+The part is a 24 x 24 x 10 block (top z = 5) with a 12 x 12 pocket down to z = -3, cut from
+stock that is the block itself.  A holder of radius 7 is wider than the pocket (half
+width 6): wherever its bottom is below the block's top it stands on the block.  The judge
+is exact geometry on that box, applied to the program as written (read back by the
+tests' own G-code reader, :mod:`stock_sim`), not the package's checks.
+"""
+
+import json
+
+import build123d as bd
+import numpy as np
+import pytest
+from stock_sim import parse_gcode
+
+import surfmod as sm
+from surfmod.cli import main
+from surfmod.cam.tool import load_tool_table
+
+TOP, FLOOR, HALF, BLOCK = 5.0, -3.0, 6.0, 12.0
+HOLDER = 7.0
+
+
+def pocket():
+    return bd.Box(24, 24, 10) - bd.Pos(0, 0, 1) * bd.Box(12, 12, 8)
+
+
+def tools(flute, shank_length):
+    common = dict(flute_length=flute, shank_length=shank_length, holder_radius=HOLDER, holder_length=20.0)
+    return sm.Tool("flat", 2.0, **common), sm.Tool("ball", 1.5, **common)
+
+
+def job_for(flute, shank_length, **kw):
+    rough, finish = tools(flute, shank_length)
+    return sm.machine(pocket(), 0.0, [sm.Rough(rough, stepdown=2.0, allowance=0.3),
+                                     sm.Finish(finish, scallop=0.05)], **kw)
+
+
+@pytest.fixture(scope="module")
+def short_job():
+    return job_for(4.0, 0.0)
+
+
+@pytest.fixture(scope="module")
+def long_job():
+    return job_for(10.0, 1.0)
+
+
+def holder_hits(a, b, radius, bottom_above_tip):
+    """Exact: does a flat-bottomed cylinder of ``radius`` at ``bottom_above_tip`` over the
+    tip, moved from ``a`` to ``b``, meet the block's top face (the square of half width
+    BLOCK less the open pocket of half width HALF) from below its top?  Checked at points
+    0.01 mm apart along the move (each position exactly)."""
+    n = int(np.ceil(np.linalg.norm(b - a) / 0.01)) + 1
+    p = a + np.linspace(0, 1, n)[:, None] * (b - a)
+    low = p[:, 2] + bottom_above_tip < TOP - 1e-6
+    inside_pocket = (np.abs(p[:, 0]) + radius <= HALF) & (np.abs(p[:, 1]) + radius <= HALF)
+    gap = np.hypot(np.maximum(np.abs(p[:, 0]) - BLOCK, 0), np.maximum(np.abs(p[:, 1]) - BLOCK, 0))
+    return bool(np.any(low & ~inside_pocket & (gap < radius)))
+
+
+def written(job, tmp_path):
+    path = tmp_path / "job.ngc"
+    sm.export_gcode(job, path)
+    return parse_gcode(path.read_text())
+
+
+def test_short_tool_leaves_the_floor_and_never_collides(short_job, tmp_path):
+    prog = written(short_job, tmp_path)
+    for op in short_job.operations:
+        t = op.tool
+        moves = [m for m in prog.moves if m.tool == t.number]
+        assert moves
+        bottom = t.flute_length + t.shank_length
+        # at every written move the holder clears the block: exact, on the box
+        assert not any(holder_hits(m.a, m.b, HOLDER, bottom) for m in moves)
+        # nothing of it goes below the block's top less the holder's height over the tip
+        assert min(min(m.a[2], m.b[2]) for m in moves if not m.rapid) >= TOP - bottom - 1e-3
+        held = op.report["holder"]
+        assert held is not None and held.moves > 0
+        # the floor under the pocket is left: most of its 144 mm², the deepest point on it
+        assert 100.0 < held.area <= 12.0 * 12.0
+        assert abs(held.deepest[0]) < HALF and abs(held.deepest[1]) < HALF
+        assert abs(held.deepest[2] - (FLOOR + (0.3 if op.name == "roughing" else 0.0))) < 0.01
+        assert "left uncut" in str(op)
+    v = short_job.verification
+    assert v.ok, str(v)
+    assert [f.what for f in v.findings if f.what.startswith("holder")] == [
+        "holder and shank, roughing (tool 1)", "holder and shank, finishing (tool 2)"]
+    assert any("keeps the finishing tool from" in n for n in v.notes)
+
+
+def test_long_tool_cuts_the_same_pocket(long_job, tmp_path):
+    prog = written(long_job, tmp_path)
+    assert all(op.report["holder"] is None for op in long_job.operations)
+    assert long_job.verification.ok, str(long_job.verification)
+    finish = long_job.operations[1].tool
+    lowest = min(min(m.a[2], m.b[2]) for m in prog.moves if m.tool == finish.number and not m.rapid
+                 and max(abs(m.a[0]), abs(m.a[1])) < HALF)
+    assert abs(lowest - FLOOR) < 0.01  # the ball's tip on the pocket's floor
+    bottom = finish.flute_length + finish.shank_length
+    assert not any(holder_hits(m.a, m.b, HOLDER, bottom) for m in prog.moves if m.tool == finish.number)
+
+
+def test_strict_refuses(tmp_path, capsys):
+    with pytest.raises(sm.SurfmodError, match="strict"):
+        job_for(4.0, 0.0, strict=True, verify=False)
+    step = tmp_path / "pocket.step"
+    bd.export_step(pocket(), str(step))
+    table = tmp_path / "tools.json"
+    table.write_text(json.dumps({"tool": [
+        {"number": 1, "kind": "flat", "radius": 2.0, "flute_length": 4.0, "shank_length": 0.0,
+         "holder_radius": HOLDER, "holder_length": 20.0},
+        {"number": 2, "kind": "ball", "radius": 1.5, "flute_length": 4.0, "shank_length": 0.0,
+         "holder_radius": HOLDER, "holder_length": 20.0}]}))
+    out = tmp_path / "job.ngc"
+    argv = ["machine", str(step), "--out", str(out), "--stock-margin", "0", "--rough", "flat:2", "--finish",
+            "ball:1.5", "--scallop", "0.05", "--stepdown", "2", "--allowance", "0.3", "--tools", str(table),
+            "--no-progress", "--no-verify", "--strict"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "strict" in err[0] and "holder" in err[0]
+    assert not out.exists()
+
+
+def test_tool_body_fields(tmp_path):
+    t = sm.Tool("flat", 2.0)
+    # the defaults: shank as the end, sticking out two radii, a holder 2.5 radii wide, 8 long
+    assert (t.shank_radius, t.shank_length, t.holder_radius, t.holder_length, t.holder_top_radius) == (
+        2.0, 4.0, 5.0, 16.0, 5.0)
+    assert t.body.tolist() == [[2.0, 12.0], [5.0, 16.0]]
+    cone = sm.Tool("ball", 1.0, flute_length=5.0, shank_length=1.0, holder_radius=3.0, holder_length=8.0,
+                   holder_top_radius=7.0)
+    b = cone.body
+    assert len(b) == 1 + 8 and b[1].tolist() == [3.5, 6.0] and b[-1].tolist() == [7.0, 13.0]
+    # every slice's cylinder holds the cone: its radius at least the cone's over the slice
+    h = np.linspace(6.0, 14.0, 801)
+    cone_r = 3.0 + (h - 6.0) / 8.0 * 4.0
+    held = np.array([b[1:][b[1:, 1] <= x + 1e-12, 0].max() for x in h])
+    assert np.all(held >= cone_r - 1e-12)
+    toml = tmp_path / "t.toml"
+    toml.write_text('[[tool]]\nnumber = 1\nkind = "flat"\nradius = 3\nflute_length = 25\nshank_radius = 3.5\n'
+                    'shank_length = 10\nholder_radius = 12\nholder_length = 40\nholder_top_radius = 16\n')
+    got = load_tool_table(toml)[1]
+    assert (got.shank_radius, got.shank_length, got.holder_radius, got.holder_length, got.holder_top_radius) == (
+        3.5, 10.0, 12.0, 40.0, 16.0)
+
+
+@pytest.mark.parametrize("fields, word", [
+    (dict(shank_radius=0), "shank_radius"),
+    (dict(shank_length=-1), "shank_length"),
+    (dict(holder_radius=1.0, shank_radius=2.0), "holder_radius"),
+    (dict(holder_radius=-3), "holder_radius"),
+    (dict(holder_length=0), "holder_length"),
+    (dict(holder_top_radius=float("nan")), "holder_top_radius"),
+    (dict(holder_length="long"), "holder_length"),
+])
+def test_tool_body_bad_input(tmp_path, fields, word):
+    with pytest.raises(sm.SurfmodError, match=word):
+        sm.Tool("flat", 2.0, **fields)
+    table = tmp_path / "t.json"
+    table.write_text(json.dumps({"tool": [dict(number=1, kind="flat", radius=2.0, **fields)]}, allow_nan=True))
+    with pytest.raises(sm.SurfmodError, match=word):
+        load_tool_table(table)
