@@ -85,6 +85,15 @@ def make_solid(surfaces):
     return bd.Solid(to_shape(list(surfaces), "surfaces", solid=True))
 
 
+def upright_cylinder(base, radius: float, height: float):
+    """A build123d solid cylinder standing on ``base`` (the centre of its bottom) along +Z
+    (a tool's holder, :mod:`surfmod.cam.holder`)."""
+    import build123d as bd
+
+    bottom = (bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)
+    return bd.Pos(*map(float, base)) * bd.Cylinder(float(radius), float(height), align=bottom)
+
+
 def build123d_face(shape):
     """The build123d ``Face`` of a ``TopoDS_Face``."""
     import build123d as bd

@@ -16,6 +16,8 @@ from stock_sim import parse_gcode
 
 import surfmod as sm
 from surfmod.cli import main
+from surfmod.cam.drop_cutter import part_triangles
+from surfmod.cam.holder import part_sink
 from surfmod.cam.tool import load_tool_table
 
 TOP, FLOOR, HALF, BLOCK = 5.0, -3.0, 6.0, 12.0
@@ -129,11 +131,11 @@ def test_tool_body_fields(tmp_path):
     # the defaults: shank as the end, sticking out two radii, a holder 2.5 radii wide, 8 long
     assert (t.shank_radius, t.shank_length, t.holder_radius, t.holder_length, t.holder_top_radius) == (
         2.0, 4.0, 5.0, 16.0, 5.0)
-    assert t.body.tolist() == [[2.0, 12.0], [5.0, 16.0]]
+    assert t.body.tolist() == [[2.0, 12.0, 4.0], [5.0, 16.0, 16.0]]
     cone = sm.Tool("ball", 1.0, flute_length=5.0, shank_length=1.0, holder_radius=3.0, holder_length=8.0,
                    holder_top_radius=7.0)
     b = cone.body
-    assert len(b) == 1 + 8 and b[1].tolist() == [3.5, 6.0] and b[-1].tolist() == [7.0, 13.0]
+    assert len(b) == 1 + 8 and b[1].tolist() == [3.5, 6.0, 1.0] and b[-1].tolist() == [7.0, 13.0, 1.0]
     # every slice's cylinder holds the cone: its radius at least the cone's over the slice
     h = np.linspace(6.0, 14.0, 801)
     cone_r = 3.0 + (h - 6.0) / 8.0 * 4.0
@@ -163,3 +165,17 @@ def test_tool_body_bad_input(tmp_path, fields, word):
     table.write_text(json.dumps({"tool": [dict(number=1, kind="flat", radius=2.0, **fields)]}, allow_nan=True))
     with pytest.raises(sm.SurfmodError, match=word):
         load_tool_table(table)
+
+
+def test_close_calls_settled_exactly():
+    """Over a sphere of radius 10 the mesh lies below the surface by up to its deflection:
+    a holder hovering half a deflection above the top is flagged by the mesh's margin and
+    cleared by OCCT's exact distance; one a deflection into the sphere stays flagged."""
+    part = bd.Sphere(10)
+    triangles, deflection = part_triangles(part, 0.05)
+    tool = sm.Tool("ball", 1.0, flute_length=3.0, shank_length=0.0, holder_radius=4.0, holder_length=10.0)
+    hover = np.array([[0.0, 0.0, 7.0 + deflection / 2], [0.5, 0.0, 7.2 + deflection / 2]])
+    assert 0 < part_sink(triangles, deflection, tool, hover, 0.01)[0] <= deflection
+    assert part_sink(triangles, deflection, tool, hover, 0.01, part)[0] == -np.inf
+    into = hover - [0.0, 0.0, 1.5 * deflection]  # the holder's bottom a deflection below z = 10
+    assert part_sink(triangles, deflection, tool, into, 0.01, part)[0] > 0

@@ -9,7 +9,8 @@ linking, is checked twice:
   at probes along the move, each disc grown by half the probes' spacing (so it holds the
   disc at every point between) and its bottom at the lowest height within half a spacing;
   the mesh's deflection is added to the heights found (the exact faces lie at most that
-  far above the mesh).  A narrower shank stands in the column the end's drop-cutter
+  far above the mesh), and where only that margin flags a move, OCCT's exact distance
+  from the disc as a solid cylinder to the part settles it (a bounded number of them).  A narrower shank stands in the column the end's drop-cutter
   already keeps clear of the part;
 - **against the stock**: the operation's moves swept in order through a height-field
   stock model shared by the job's operations (:func:`surfmod.cam.verify_kernels.sweep_body`):
@@ -39,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..inputs import upright_cylinder
 from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
 from .roughing import PLUNGE, RAPID, Motion, Moves
@@ -50,6 +52,9 @@ MAX_HOLDER_PROBES = 20_000_000
 MAX_STOCK_NODES = 4_000_000
 #: probes along a move per disc radius
 PROBES_PER_RADIUS = 16
+#: cylinders OCCT's exact distance settles per operation, and the gap it must find
+EXACT_CONFIRMS = 200
+EXACT_GAP = 1e-7
 
 
 @dataclass(frozen=True)
@@ -88,35 +93,72 @@ class StockModel:
         start, end = np.ascontiguousarray(moves[:-1]), np.ascontiguousarray(moves[1:])
         m = len(start)
         discs = np.zeros((1, max(len(body), 1), 2))
-        discs[0, :len(body)] = body
+        discs[0, :len(body)] = body[:, :2]
         return sweep_body(self.top, *self.origin, self.cell, start, end, rapid, np.full(m, tool.radius),
                           np.full(m, tool.corner), self.cell / 2, discs, np.zeros(m, np.int64), np.array([float(slack)]),
                           np.zeros(1), skip, remove)
 
 
-def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float) -> np.ndarray:
+def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float, shape=None):
     """Per move (``points[k] -> points[k + 1]``): how far the part stands above the bottom
-    of the tool's discs wider than its end (see the module), -inf where it stays below."""
+    of the tool's discs wider than its end (see the module), -inf where it stays below.
+    With ``shape``, moves flagged by the deflection alone (the mesh itself clear of the
+    discs) are settled by OCCT's exact distance from each such disc as a solid cylinder
+    to the part, up to :data:`EXACT_CONFIRMS` cylinders (beyond, they stay flagged)."""
     sink = np.full(max(len(points) - 1, 0), -np.inf)
-    discs = [(r, h) for r, h in tool.body if r - slack > tool.radius]
+    discs = [(r, h, length) for r, h, length in tool.body if r - slack > tool.radius]
     if not discs or not len(sink):
         return sink
     top = float(triangles[:, :, 2].max()) + deflection
-    spacing = min(r for r, _ in discs) / PROBES_PER_RADIUS
+    spacing = min(r for r, _, _ in discs) / PROBES_PER_RADIUS
     probes, move, spacing = _probes(points[:-1], points[1:], spacing, MAX_HOLDER_PROBES)
     seg = points[1:] - points[:-1]
     slope = np.abs(seg[:, 2]) / np.maximum(np.linalg.norm(seg, axis=1), 1e-300)
     # the lowest the move goes within half a spacing
     low = np.maximum(probes[:, 2] - slope[move] * spacing / 2, np.minimum(points[:-1, 2], points[1:, 2])[move])
-    for r, h in discs:
-        near = low + h < top  # above the part's top the disc meets nothing
-        if not near.any():
+    found = []  # (probe, disc, depth on the mesh with the deflection)
+    for q, (r, h, _) in enumerate(discs):
+        near = np.flatnonzero(low + h < top)  # above the part's top the disc meets nothing
+        if not near.size:
             continue
         reach = r - slack + spacing / 2
         z = drop(TriangleGrid(triangles, reach), Flat(reach), probes[near, :2])
         depth = np.nan_to_num(z, nan=-np.inf) + deflection - (low[near] + h)
+        hit = depth > 0.0
+        found.append((near[hit], np.full(int(hit.sum()), q), depth[hit]))
         np.maximum.at(sink, move[near], depth)
+    if shape is None or not found:
+        return sink
+    which, disc, depth = (np.concatenate(v) for v in zip(*found))
+    # a move flagged only by the deflection is confirmed exactly when all its flagged
+    # probes are few enough
+    close = sink[move[which]] <= deflection
+    if not close.any() or close.sum() > EXACT_CONFIRMS:
+        return sink
+    which, disc = which[close], disc[close]
+    radius = np.array([discs[q][0] - slack + spacing / 2 for q in disc])
+    base = np.column_stack([probes[which, :2], low[which] + np.array([discs[q][1] for q in disc])])
+    clear = _cylinder_clearance(shape, base, radius, [max(discs[q][2], 1e-6) for q in disc]) > EXACT_GAP
+    cleared = np.ones(len(sink), bool)
+    np.logical_and.at(cleared, move[which], clear)
+    settled = np.unique(move[which])
+    sink[settled[cleared[settled]]] = -np.inf
     return sink
+
+
+def _cylinder_clearance(shape, bases, radii, heights) -> np.ndarray:
+    """The distance of each upright solid cylinder (``bases`` (N, 3) the centres of their
+    bottoms, ``radii``, ``heights``) from ``shape`` (OCCT's ``BRepExtrema``): 0 where they
+    touch or overlap, or where one lies inside the other."""
+    from ..occ.booleans import min_distance
+    from ..occ.topo import wrapped
+
+    target = wrapped(shape)
+    out = np.empty(len(bases))
+    for k, (p, r, h) in enumerate(zip(bases, radii, heights)):
+        d, _, _, inner = min_distance(wrapped(upright_cylinder(p, r, h)), target)
+        out[k] = 0.0 if inner else d
+    return out
 
 
 def relink(motion: Motion, removed: np.ndarray, safe: float) -> Motion:
@@ -151,15 +193,16 @@ def relink(motion: Motion, removed: np.ndarray, safe: float) -> Motion:
 
 
 def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
-               safe: float):
+               safe: float, shape=None):
     """``(motion, held)``: ``motion`` swept through ``stock`` with the moves whose shank or
-    holder would touch the part or the stock removed and relinked (:func:`relink`), and
-    what that leaves (:class:`Held`, None when nothing is removed)."""
+    holder would touch the part (``triangles``, and ``shape`` for the close calls) or the
+    stock removed and relinked (:func:`relink`), and what that leaves (:class:`Held`, None
+    when nothing is removed)."""
     pts = np.asarray(motion.points, float)
     if len(pts) < 2:
         return motion, None
     rapid = motion.kind[1:] == RAPID
-    skip = part_sink(triangles, deflection, tool, pts, slack) > 0.0
+    skip = part_sink(triangles, deflection, tool, pts, slack, shape) > 0.0
     before = stock.top.copy()
     *_, removed = stock.sweep(pts, rapid, tool, tool.body, slack, skip, True)
     if not removed.any():

@@ -192,7 +192,7 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     if passes == 0:
         return job
     extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
-                          job.safe_height)
+                          job.safe_height, job.part)
     if not np.any(extra.kind != RAPID):
         return job
     motion = Motion(np.concatenate([op.motion.points, extra.points]), np.concatenate([op.motion.kind, extra.kind]))
@@ -205,10 +205,11 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     return replace(job, verification=verify_job(job))
 
 
-def _held(motion, tool, stock_model, part, tolerance, safe, strict, name):
+def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape):
     """The operation's moves cleared of shank and holder collisions; with ``strict`` a
     collision refuses the job."""
-    motion, held = clear_body(motion, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe)
+    motion, held = clear_body(motion, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe,
+                              shape)
     if held is not None and strict:
         raise SurfmodError(f"strict: the {name} with {tool}: {held} (a longer tool: flute_length, shank_length; "
                            f"a narrower holder; or strict=False to leave it)")
@@ -276,7 +277,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover, CLEARANCE,
                                        deflection=p.deflection)
-                motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing")
+                motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape)
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
                 rest = Rest(tool.radius + allowance, allowance + stepdown + p.lift)
@@ -290,7 +291,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest)
                 finishing[k] = (op, finish_part, rest)
                 motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe, strict,
-                                     "finishing")
+                                     "finishing", shape)
                 report["holder"] = held
                 name = "finishing"
             bar.update()

@@ -110,23 +110,23 @@ class Tool:
 
     @property
     def body(self) -> np.ndarray:
-        """The parts above the flutes that must not touch anything, as discs ``(K, 2)``:
-        radius and the height of its bottom above the tip, lowest first: the shank (even
+        """The parts above the flutes that must not touch anything, as discs ``(K, 3)``:
+        radius, the height of its bottom above the tip and its length, lowest first: the shank (even
         one no wider than the end meets the stock above the flutes in front of it), then
         the holder; a cone holder widening upwards is held by :data:`CONE_SLICES` cylinders
         each as wide as its slice's top.
 
         >>> Tool("flat", 2.0, shank_radius=3.0, shank_length=5.0, flute_length=10.0).body.tolist()
-        [[3.0, 10.0], [7.5, 15.0]]
+        [[3.0, 10.0, 5.0], [7.5, 15.0, 16.0]]
         """
         bottom = self.flute_length + self.shank_length
-        discs = [(self.shank_radius, self.flute_length)]
-        rb, rt = self.holder_radius, self.holder_top_radius
+        discs = [(self.shank_radius, self.flute_length, self.shank_length)]
+        rb, rt, length = self.holder_radius, self.holder_top_radius, self.holder_length
         if rt > rb:
-            discs += [(rb + (rt - rb) * (k + 1) / CONE_SLICES, bottom + self.holder_length * k / CONE_SLICES)
+            discs += [(rb + (rt - rb) * (k + 1) / CONE_SLICES, bottom + length * k / CONE_SLICES, length / CONE_SLICES)
                       for k in range(CONE_SLICES)]
         else:
-            discs.append((rb, bottom))
+            discs.append((rb, bottom, length))
         return np.array(discs, float)
 
     @property

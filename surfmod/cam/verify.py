@@ -426,7 +426,7 @@ def _body_part(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, tool, sl
     """How far the part's points stand above the bottom of the tool's discs wider than its
     end (:attr:`~surfmod.cam.tool.Tool.body`, each less ``slack``, grown by half the probes'
     spacing, at the lowest height within it) along the picked moves, against ``limit``."""
-    discs = [(r, h) for r, h in tool.body if r - slack > tool.radius]
+    discs = [(r, h) for r, h, _ in tool.body if r - slack > tool.radius]
     if not discs or not pick.any():
         return Finding(what, -np.inf, limit), 0
     idx = np.flatnonzero(pick)
@@ -545,7 +545,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     bodies = [op.tool.body for op in job.operations]
     discs = np.zeros((len(bodies), max(len(b) for b in bodies), 2))
     for k, b in enumerate(bodies):
-        discs[k, :len(b)] = b
+        discs[k, :len(b)] = b[:, :2]
     slack = np.array([limit for _, _, _, limit in plans])
     # a disc may rub sideways within the operation's limit, never stand below the part or
     # the stock: beyond the 4 decimals and the stamped sweep's sag over a quarter cell
@@ -604,7 +604,7 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
     reach = K.closing(tips, cell, cutter.radius, cutter.corner)
     # where the shank or holder stops the tool above the part, the tool does not reach it:
     # the lowest the whole tool reaches, from its discs' drops onto the part's points
-    body = [(r - limit, h) for r, h in op.tool.body if r - limit > cutter.radius]
+    body = [(r - limit, h) for r, h, _ in op.tool.body if r - limit > cutter.radius]
     held = np.zeros((nx, ny), bool)
     if body:
         stand = tips.copy()
