@@ -112,6 +112,7 @@ _EXPORTS = {
     "toolpath": ".cam.toolpath",
     "Toolpath": ".cam.toolpath",
     "Tool": ".cam.tool",
+    "Machine": ".cam.machine_table",
     "machine": ".cam.job",
     "Job": ".cam.job",
     "Rough": ".cam.job",

@@ -18,15 +18,14 @@ from tqdm import tqdm
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
+from .cycle_time import cycle_time, feed_time
 from .finishing import Rest, clear_part, finish, recut
-from .roughing import FEED, RAPID, Motion, left_summary, rough
+from .machine_table import MACHINE, Machine
+from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import _part
 from .verify import verify_job
 
-#: Rapid traverse (mm/min) and tool change time (s) of the time estimate.
-RAPID_RATE = 5000.0
-TOOL_CHANGE_TIME = 8.0
 #: Clearance of links and retracts above the stock (mm).
 CLEARANCE = 5.0
 
@@ -62,13 +61,22 @@ class Finish:
 class Operation:
     """One operation of a :class:`Job`: its ``name``, ``tool`` (numbered, with speeds and
     feeds), ``motion`` (cutter locations and how the tool moves to each), machining
-    ``time_estimate`` (s) and a ``report`` (levels, scallop, rest left...)."""
+    ``time_estimate`` (s: the tool change plus the moves as ``machine`` runs them,
+    :mod:`surfmod.cam.cycle_time`) and a ``report`` (levels, scallop, rest left...);
+    ``feed_time`` is the plain feed-rate sum instead."""
 
     name: str
     tool: Tool
     motion: Motion = field(repr=False)
     time_estimate: float
     report: dict = field(default_factory=dict, repr=False)
+    machine: Machine = field(default=MACHINE, repr=False)
+
+    @property
+    def feed_time(self) -> float:
+        """Seconds as the plain feed-rate sum (every move at its feed from end to end, no
+        acceleration or corner), plus the tool change: what ``time_estimate`` refines."""
+        return feed_time(self.motion, self.tool, self.machine) + self.machine.tool_change
 
     @property
     def moves(self) -> np.ndarray:
@@ -97,10 +105,17 @@ class Job:
     safe_height: float
     #: what :func:`surfmod.cam.verify.verify_job` found in its LinuxCNC program (None: not verified)
     verification: object = field(default=None, repr=False)
+    #: the machine whose limits the time estimates follow
+    machine: Machine = field(default=MACHINE, repr=False)
 
     @property
     def time_estimate(self) -> float:
         return float(sum(op.time_estimate for op in self.operations))
+
+    @property
+    def feed_time(self) -> float:
+        """The plain feed-rate sum of every operation (see :attr:`Operation.feed_time`)."""
+        return float(sum(op.feed_time for op in self.operations))
 
     def __str__(self) -> str:
         lo, hi = self.stock
@@ -118,14 +133,9 @@ class Job:
         return job_png(self)
 
 
-def motion_time(motion: Motion, tool: Tool) -> float:
-    """Seconds: rapids at ``RAPID_RATE``, cuts at the tool's feed, ramps at its plunge feed."""
-    if len(motion.points) < 2:
-        return 0.0
-    seg = np.linalg.norm(np.diff(motion.points, axis=0), axis=1)
-    kind = motion.kind[1:]
-    rate = np.where(kind == RAPID, RAPID_RATE, np.where(kind == FEED, tool.feed, tool.plunge_feed))
-    return float((seg / rate).sum() * 60.0)
+def operation_time(motion: Motion, tool: Tool, machine: Machine) -> float:
+    """An operation's ``time_estimate``: the tool change plus the moves as ``machine`` runs them."""
+    return machine.tool_change + cycle_time(motion, tool, machine)
 
 
 def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
@@ -193,12 +203,13 @@ def _recut(job: Job, finishing: dict) -> Job:
     report = dict(op.report, recut={"regions": len(found.boxes), "passes": passes, "before": found.worst,
                                     "length": float(seg[extra.kind[1:] != RAPID].sum())})
     ops = list(job.operations)
-    ops[k] = replace(op, motion=motion, time_estimate=motion_time(motion, op.tool) + TOOL_CHANGE_TIME, report=report)
+    ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine), report=report)
     job = replace(job, operations=tuple(ops))
     return replace(job, verification=verify_job(job))
 
 
-def machine(part, stock, operations, *, progress: bool = False, verify: bool = True) -> Job:
+def machine(part, stock, operations, *, progress: bool = False, verify: bool = True,
+            machine: Machine = MACHINE) -> Job:
     """Machine ``part`` (a build123d shape, STEP path or surfmod surfaces) from ``stock``
     (a margin in mm, or a box ``[[x0, y0, z0], [x1, y1, z1]]`` holding the part) by
     ``operations`` in order (:class:`Rough`, :class:`Finish`); tools without a number get
@@ -214,11 +225,17 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     rapids through stock or part, the scallop left); where the scallop is broken, cross
     passes over those regions are added to the finishing (its ``report["recut"]``) and the
     job is judged again.  ``job.verification`` holds what was found last,
-    ``job.verification.ok`` whether every promise holds."""
+    ``job.verification.ok`` whether every promise holds.
+
+    ``machine`` (a :class:`~surfmod.cam.machine_table.Machine`: axis velocities and
+    accelerations, rapid rate, corner blending, tool change) is what the operations'
+    ``time_estimate`` follow (:mod:`surfmod.cam.cycle_time`); by default a small hobby mill."""
     from ..occ.properties import bounding_box
 
     shape = to_shape(part, "part")
     ops = list(operations) if isinstance(operations, (list, tuple)) else [operations]
+    if not isinstance(machine, Machine):
+        raise SurfmodError(f"machine: expected a surfmod Machine, got {type(machine).__name__}")
     if not ops or not all(isinstance(o, (Rough, Finish)) for o in ops):
         raise SurfmodError("operations: expected a list of sm.Rough / sm.Finish")
     box = bounding_box(shape.wrapped if hasattr(shape, "wrapped") else shape)
@@ -271,8 +288,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                                        f"goes {box[1, 2] - low:.4g} mm below the part's top")
                 name = "finishing"
             bar.update()
-            done.append(Operation(name, tool, motion, motion_time(motion, tool) + TOOL_CHANGE_TIME, report))
-    job = Job(shape, stock, tuple(done), safe)
+            done.append(Operation(name, tool, motion, operation_time(motion, tool, machine), report, machine))
+    job = Job(shape, stock, tuple(done), safe, machine=machine)
     if verify:
         job = _recut(replace(job, verification=verify_job(job)), finishing)
     return job

@@ -8,6 +8,7 @@ from dataclasses import replace
 from ..atomic import target_path
 from ..cam.finishing import summary_lines
 from ..cam.job import Finish, Rough, machine
+from ..cam.machine_table import MACHINE, load_machine_table
 from ..cam.post import POSTS, SUFFIXES, export_job, program_paths, programs
 from ..cam.tool import load_tool_table, parse_tool
 from ..cam.verify import verify_job
@@ -33,6 +34,8 @@ def register(sub) -> None:
     p.add_argument("--post", default="linuxcnc", help=f"post-processor: {', '.join(POSTS)}")
     p.add_argument("--tools", help="tool table (TOML or JSON) giving tool 1 and 2 their flutes, speeds, feeds")
     p.add_argument("--png", help="picture of the moves over the shaded part")
+    p.add_argument("--machine", help="machine table (TOML [machine] or JSON): axis velocities and accelerations, "
+                                     "rapid rate, blend tolerance, tool change time of the time estimate")
     p.add_argument("--no-verify", action="store_true",
                    help="skip reading the program back and judging it against the exact part and the stock "
                         "(faster; the program's header says it was not verified)")
@@ -62,6 +65,7 @@ def run(args) -> int:
     if args.png:
         target_path(args.png, "png", (".png",))
     table = load_tool_table(args.tools) if args.tools else {}
+    mill = load_machine_table(args.machine) if args.machine else MACHINE
     rough_tool = _tool(args.rough, 1, table, "rough")
     finish_tool = _tool(args.finish, 2, table, "finish")
     if args.stepdown is not None and not args.stepdown > 0:
@@ -79,7 +83,7 @@ def run(args) -> int:
     stock = args.stock_margin if args.stock is None else [args.stock[:3], args.stock[3:]]
     job = machine(shape, stock, [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
                                  Finish(finish_tool, scallop=args.scallop)], progress=not args.no_progress,
-                  verify=not args.no_verify)
+                  verify=not args.no_verify, machine=mill)
     texts = programs(job, args.post)  # any refusal before a file is written
     program_paths(args.out, job, args.post)
     if args.no_verify:
@@ -96,7 +100,8 @@ def run(args) -> int:
         write_png(job, args.png)
     print(job)
     for op in job.operations:
-        print(f"  {op.name}: length {op.length:.1f} mm, time estimate {op.time_estimate:.1f} s, tool {op.tool}")
+        print(f"  {op.name}: length {op.length:.1f} mm, time estimate {op.time_estimate:.1f} s "
+              f"(feed-rate sum {op.feed_time:.1f} s), tool {op.tool}")
         if op.name == "finishing":
             for line in summary_lines(op.report):
                 print(f"    {line}")
