@@ -15,15 +15,13 @@ fields of :class:`Machine`; what it leaves out keeps the default.  The cycle tim
 
 from __future__ import annotations
 
-import json
-import tomllib
 from dataclasses import dataclass, fields
-from pathlib import Path
 
 import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from .tool import read_table
 
 
 def _axes(value, name: str) -> tuple:
@@ -86,13 +84,7 @@ def load_machine_table(path) -> Machine:
     """A :class:`Machine` from a TOML (``[machine]`` table) or JSON (``{"machine": {...}}``)
     file; the fields it does not give keep their defaults, a field it does not know is
     refused."""
-    p = Path(path)
-    if not p.is_file():
-        raise SurfmodError(f"machine: no such file {str(path)!r}")
-    try:
-        data = tomllib.loads(p.read_text()) if p.suffix.lower() == ".toml" else json.loads(p.read_text())
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise SurfmodError(f"machine: {p.name} is not a machine table: {exc}") from None
+    p, data = read_table(path, "machine", "machine table")
     entry = data.get("machine") if isinstance(data, dict) else None
     if not isinstance(entry, dict):
         raise SurfmodError(f"machine: {p.name} has no [machine] table")
