@@ -113,6 +113,45 @@ def test_diagonal_is_limited_by_the_axis_that_saturates():
     assert total([[0, 0, 0], [length, 0, 0]], 10000.0, machine) == pytest.approx(length / 100 + 100 / 500, rel=1e-12)
 
 
+def test_random_path_keeps_every_limit():
+    # a random polyline (repeated points, reversals, every axis) checked move by move with
+    # the limits recomputed here: rest at both ends, no vertex faster than its moves allow,
+    # no speed change beyond what the move's acceleration gives over its length, the
+    # profile's time from its own entry, peak and exit speeds, and maximal speeds (a
+    # vertex below both neighbours' reach must be held by its own corner)
+    rng = np.random.default_rng(7)
+    pts = np.cumsum(rng.normal(size=(400, 3)) * rng.choice([0.05, 1.0, 20.0], size=(400, 1)), axis=0)
+    pts[50] = pts[49]
+    machine = sm.Machine(max_velocity=(6000, 4000, 2000), max_acceleration=(800, 400, 150), blend_tolerance=0.02)
+    feeds = rng.choice([300.0, 1500.0, 9000.0], size=len(pts) - 1)
+    p = plan(pts, feeds, machine)
+    seg = np.diff(pts, axis=0)
+    length = np.linalg.norm(seg, axis=1)
+    keep = length > 0
+    u = seg[keep] / length[keep, None]
+    vmax, amax = np.array(machine.max_velocity) / 60, np.array(machine.max_acceleration)
+    cruise = np.array([min([f / 60] + [vmax[i] / abs(d[i]) for i in range(3) if d[i]])
+                       for f, d in zip(feeds[keep], u)])
+    acc = np.array([min(amax[i] / abs(d[i]) for i in range(3) if d[i]) for d in u])
+    assert len(p.length) == keep.sum() == len(pts) - 2
+    np.testing.assert_allclose(p.cruise, cruise, rtol=1e-12)
+    v, w = p.speed, p.speed**2
+    assert v[0] == 0 and v[-1] == 0
+    assert np.all(v[1:] <= cruise * (1 + 1e-12)) and np.all(v[:-1] <= cruise * (1 + 1e-12))
+    assert np.all(np.abs(np.diff(w)) <= 2 * acc * p.length * (1 + 1e-9) + 1e-9)
+    assert np.all(p.peak <= cruise * (1 + 1e-12)) and np.all(p.time >= p.length / cruise * (1 - 1e-12))
+    up, down = (p.peak**2 - w[:-1]) / (2 * acc), (p.peak**2 - w[1:]) / (2 * acc)
+    assert np.all(up + down <= p.length * (1 + 1e-9) + 1e-12)
+    expected = (p.peak - v[:-1]) / acc + (p.peak - v[1:]) / acc + (p.length - up - down) / p.peak
+    np.testing.assert_allclose(p.time, expected, rtol=1e-9)
+    # maximal: an interior vertex strictly below what both moves allow is a corner limit,
+    # so it is never above the reach of its neighbours and at least one corner holds it
+    reach = np.minimum(np.sqrt(w[:-2] + 2 * acc[:-1] * p.length[:-1]), np.sqrt(w[2:] + 2 * acc[1:] * p.length[1:]))
+    held = v[1:-1] < np.minimum(reach, np.minimum(cruise[:-1], cruise[1:])) * (1 - 1e-9)
+    turn = np.linalg.norm(u[1:] - u[:-1], axis=1)
+    assert held.any() and np.all(turn[held] > 1e-6)
+
+
 def test_job_estimate_against_the_feed_rate_sum():
     part = bd.Box(20, 20, 5) + bd.Pos(0, 0, 4) * bd.Cylinder(5, 3)
     slow = sm.Machine(max_acceleration=100, tool_change=3)
