@@ -218,6 +218,7 @@ def test_cli_machine_table(tmp_path, capsys):
     slow = [float(x) for x in re.findall(r"time estimate ([\d.]+) s \(feed-rate sum ([\d.]+) s\)",
                                                        text)[0]]
     assert slow[0] > slow[1] > 20
+    assert "machine: axes 5000/5000/3000 mm/min, 50/50/50 mm/s², rapid 5000 mm/min, blending 0 mm" in text
     table.write_text("[machine]\nmax_acceleration = [500, 500, 0]\n")
     out.unlink()
     assert main(argv + ["--machine", str(table)]) == 1

@@ -10,13 +10,16 @@ from end to end.  A machine (:class:`~surfmod.cam.machine_table.Machine`) cannot
   circular arc tangent to both moves that leaves the corner by at most ``P``, driven at
   the speed whose centripetal acceleration the axes allow, ``v² = a_n R``.  For a turn
   of ``φ`` the deviation of the arc of radius ``R`` is ``R (1/cos(φ/2) - 1)``, so
-  ``R = P cos(φ/2) / (1 - cos(φ/2))``: the junction deviation of grbl
-  (``planner.c``, ``v² = a δ sin(θ/2) / (1 - sin(θ/2))`` with θ = π - φ the angle between
-  the moves) and the blend arc of LinuxCNC's trajectory planner (``blendmath.c``).  The
-  arc must fit on the moves: its tangent length ``R tan(φ/2)`` at most half the shorter
-  one (LinuxCNC consumes at most half a segment per blend), which on a circle of many
-  chords gives ``R → r`` and the centripetal limit ``v = sqrt(a r)``.  ``P = 0`` stops at
-  every corner; a straight-through point (turn below ``STRAIGHT``) keeps the speed;
+  ``R = P cos(φ/2) / (1 - cos(φ/2))``: grbl's junction deviation (``planner.c``,
+  ``v² = a δ sin(θ/2) / (1 - sin(θ/2))``, θ = π - φ the angle between the moves, ``a``
+  the axis limits projected on the junction vector ``u2 - u1`` as here) and the blend arc
+  of LinuxCNC's trajectory planner (``src/emc/tp/blendmath.c``; LinuxCNC keeps a share
+  of the acceleration for the tangent, ``BLEND_ACC_RATIO_NORMAL``, so it is a little
+  slower there).  The arc must fit on the moves: its tangent length ``R tan(φ/2)`` at
+  most half the shorter one (LinuxCNC's blend takes at most half of a segment's nominal
+  length), which on a circle of many chords gives ``R → r cos(π/n)`` and the centripetal
+  limit ``v = sqrt(a r)``.  ``P = 0`` stops at every corner; a straight-through point
+  (turn below ``STRAIGHT``) keeps the speed;
 - each move accelerates from its entry speed and brakes to its exit speed: where it is
   too short to reach its feed the profile is a triangle.
 

@@ -37,7 +37,7 @@ def _axes(value, name: str) -> tuple:
 @dataclass(frozen=True)
 class Machine:
     """A milling machine's limits, by default a small hobby/prosumer mill (stepper-driven
-    ball screws, in the range of a Tormach PCNC 440 or a well-tuned desktop router):
+    ball screws, a desktop mill or a well-tuned router):
 
     - ``max_velocity`` (mm/min, per axis X, Y, Z; one number for all): 5000, 5000, 3000;
     - ``max_acceleration`` (mm/s², per axis): 500, 500, 250;

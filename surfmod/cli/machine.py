@@ -99,6 +99,8 @@ def run(args) -> int:
 
         write_png(job, args.png)
     print(job)
+    if args.machine:  # the limits the time estimates below follow
+        print(f"  {job.machine}")
     for op in job.operations:
         print(f"  {op.name}: length {op.length:.1f} mm, time estimate {op.time_estimate:.1f} s "
               f"(feed-rate sum {op.feed_time:.1f} s), tool {op.tool}")
