@@ -117,6 +117,7 @@ _EXPORTS = {
     "Job": ".cam.job",
     "Rough": ".cam.job",
     "Finish": ".cam.job",
+    "Rest": ".cam.job",
     "Operation": ".cam.job",
     "export_gcode": ".cam.gcode",
     "make_solid": ".inputs",

@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -19,9 +20,12 @@ from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
 from .cycle_time import cycle_time, feed_time
-from .finishing import Rest, clear_part, finish, recut
+from .drop_cutter import TriangleGrid
+from .finishing import Leftover, clear_part, finish, recut
 from .machine_table import MACHINE, Machine
-from .roughing import RAPID, Motion, left_summary, rough
+from .rest import MAX_LOCATIONS, StockModel, left_over, rest_moves, rest_part_top
+from .rest import summary_line as rest_summary
+from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import _part
 from .verify import verify_job
@@ -55,6 +59,23 @@ class Finish:
     stepover: float | None = None
     direction: str = "x"
     steep_angle: float | None = 45.0
+
+
+@dataclass(frozen=True)
+class Rest:
+    """Rest machining with a smaller ``tool``: it cuts only where the operations ``after``
+    (None: all before it in the job; else their positions in the list, from 0, or the
+    operations themselves) left more than ``scallop`` (default: the last finishing's)
+    plus the tolerance above the part, measured in the job's stock model swept along
+    their moves; its passes are its own drop-cutter rasters clipped to those regions
+    (:mod:`surfmod.cam.rest`).  A tool no smaller than the finishing's is allowed (it
+    still cuts what the stock model shows left where it reaches, e.g. after roughing
+    alone) with a warning.  ``max_points`` bounds the passes' raster locations."""
+
+    tool: Tool
+    after: object = None
+    scallop: float | None = None
+    max_points: int = MAX_LOCATIONS
 
 
 @dataclass(frozen=True)
@@ -92,6 +113,8 @@ class Operation:
         m, s = divmod(self.time_estimate, 60)
         text = f"{self.name}: {self.tool}, cutting length {self.length:.0f} mm, time {int(m)} min {s:04.1f} s"
         left = left_summary(self.report.get("left")) if self.name == "roughing" else ""
+        if self.name == "rest":
+            left = rest_summary(self.report)
         return f"{text}; {left}" if left else text
 
 
@@ -157,7 +180,7 @@ def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
     return box
 
 
-def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Rest | None, lowest: float):
+def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float):
     if op.stepover is not None and op.scallop is not None:
         raise SurfmodError("stepover: give either stepover or scallop, not both")
     if op.scallop is None and op.stepover is None:
@@ -192,6 +215,8 @@ def _recut(job: Job, finishing: dict) -> Job:
     if found is None or not found.boxes or not finishing:
         return job
     k = max(finishing)
+    if any(o.name == "rest" for o in job.operations[k + 1:]):
+        return job  # the residual judged is the rest tool's, which cross passes of the finishing do not serve
     op, (spec, part, rest) = job.operations[k], finishing[k]
     extra, passes = recut(part, op.tool, found.boxes, stepover=float(op.report["stepover"]), direction=spec.direction,
                           tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest)
@@ -206,6 +231,71 @@ def _recut(job: Job, finishing: dict) -> Job:
     ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine), report=report)
     job = replace(job, operations=tuple(ops))
     return replace(job, verification=verify_job(job))
+
+
+def _after(op: Rest, k: int, specs: list) -> list[int]:
+    """The positions of the operations a rest operation at position ``k`` follows."""
+    if k == 0:
+        raise SurfmodError("after: a rest operation needs an operation before it")
+    if op.after is None:
+        return list(range(k))
+    items = list(op.after) if isinstance(op.after, (list, tuple)) else [op.after]
+    out = []
+    for a in items:
+        if isinstance(a, (Rough, Finish, Rest)):
+            idx = next((i for i in range(k) if specs[i] is a), None)
+        elif isinstance(a, (int, np.integer)) and not isinstance(a, bool) and 0 <= a < k:
+            idx = int(a)
+        else:
+            idx = None
+        if idx is None:
+            raise SurfmodError(f"after: expected operations before the rest operation (positions 0..{k - 1} "
+                               f"or the operations themselves), got {a!r}")
+        out.append(idx)
+    if not out:
+        raise SurfmodError("after: give at least one operation before the rest operation")
+    return sorted(set(out))
+
+
+def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: np.ndarray, safe: float):
+    """The rest operation's motion and report (:mod:`surfmod.cam.rest`)."""
+    after = _after(op, k, specs)
+    cutting = [done[i] for i in after if done[i].name != "roughing"]
+    if op.scallop is not None:
+        scallop = checks.positive(op.scallop, "scallop")
+    elif cutting:
+        scallop = float(cutting[-1].report["scallop"])
+    else:
+        raise SurfmodError("scallop: give the rest operation's scallop (no finishing before it)")
+    stepover = tool.stepover_for_scallop(scallop)  # a scallop >= the radius raises here
+    smallest = min((o.tool.radius for o in cutting), default=None)
+    if smallest is not None and tool.radius >= smallest:
+        warnings.warn(f"rest: {tool} is no smaller than the tools before it (r={smallest:g}): it cuts only what "
+                      f"the stock model shows left where it reaches", UserWarning, stacklevel=3)
+    tolerance = scallop / 10
+    part = clear_part(_part(shape, tool.cutter, tolerance), tool)
+    cell = max(min([stepover] + [float(o.report["stepover"]) for o in cutting]) / 4, 1e-3)
+    model = StockModel(stock, cell)
+    for i in after:
+        model.sweep(done[i].motion, done[i].tool)
+    part_top = rest_part_top(part, model)
+    threshold = scallop + tolerance + model.sag
+    near = TriangleGrid(part.grid.triangles, threshold)
+    mask, before = left_over(model, part_top, near)
+    motion, info = rest_moves(part, tool, model, mask, stepover=stepover, tolerance=tolerance, safe=safe,
+                              max_points=op.max_points)
+    cuts = motion.points[motion.kind != RAPID, 2]
+    top = float(part.box[1, 2])
+    if len(cuts) and top - float(cuts.min()) > tool.flute_length + 1e-9:
+        raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the rest machining goes "
+                           f"{top - float(cuts.min()):.4g} mm below the part's top")
+    model.sweep(motion, tool)
+    _, left = left_over(model, part_top, near)
+    report = dict(info, after=after, scallop=scallop, stepover=stepover, tolerance=tolerance, threshold=threshold,
+                  cell=model.cell, before=before, left=left, deflection=part.deflection)
+    if model.note:
+        report["note"] = model.note
+    return motion, report
 
 
 def machine(part, stock, operations, *, progress: bool = False, verify: bool = True,
@@ -236,8 +326,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     ops = list(operations) if isinstance(operations, (list, tuple)) else [operations]
     if not isinstance(machine, Machine):
         raise SurfmodError(f"machine: expected a surfmod Machine, got {type(machine).__name__}")
-    if not ops or not all(isinstance(o, (Rough, Finish)) for o in ops):
-        raise SurfmodError("operations: expected a list of sm.Rough / sm.Finish")
+    if not ops or not all(isinstance(o, (Rough, Finish, Rest)) for o in ops):
+        raise SurfmodError("operations: expected a list of sm.Rough / sm.Finish / sm.Rest")
     box = bounding_box(shape.wrapped if hasattr(shape, "wrapped") else shape)
     if not np.all(np.isfinite(box)) or np.any(box[1] - box[0] <= 0):
         raise SurfmodError("part: has no solid extent to machine")
@@ -271,8 +361,12 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the roughing cuts "
                                        f"{cut_depth:.4g} mm deep")
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance)
-                rest = Rest(tool.radius + allowance, allowance + stepdown + p.lift)
+                rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift)
                 name = "roughing"
+            elif isinstance(op, Rest):
+                bar.update()
+                motion, report = _rest(shape, op, tool, k, ops, done, stock, safe)
+                name = "rest"
             else:
                 if op.scallop is not None:
                     tool.stepover_for_scallop(op.scallop)  # scallop >= radius etc. raise here

@@ -485,17 +485,13 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         probes += n
         if found.worst > rapid_part.worst:
             rapid_part = found
-    finishing = [p for p in plans if p[1].name == "finishing"]
+    # the residual is judged after the last finishing or rest operation, with its tool
+    finishing = [p for p in plans if p[1].name in ("finishing", "rest")]
     stepover = min((float(p[1].report.get("stepover") or p[1].tool.radius) for p in finishing),
                    default=min(op.tool.radius for op in job.operations))
-    cell = max(stepover / 4, 1e-3)
     lo, hi = np.asarray(job.stock, float)
-    nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
-    if nx * ny > max_nodes:  # a stock too large for the cells the stepover asks: coarser cells, said
-        wanted, cell = cell, cell * 1.05 * math.sqrt(nx * ny / max_nodes)
-        nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
-        notes.append(f"note: stock cells {cell:.3g} mm, coarser than the {wanted:.3g} the stepover asks "
-                     f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
+    cell, nx, ny, note = stock_cells(job.stock, max(stepover / 4, 1e-3), max_nodes)
+    notes += [note] if note else []
     top = np.full((nx, ny), float(hi[2]))
     radii = np.array([job.operations[k].tool.radius for k in owner], float)
     corners = np.array([job.operations[k].tool.corner for k in owner], float)
@@ -521,6 +517,24 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         found, walls = _residual(part, top, lo, cell, op, cutter, limit)
         findings.append(found)
     return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes))
+
+
+def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
+    """The height-field stock's grid over the box ``stock``: ``(cell, nx, ny, note)``,
+    nodes ``lo + cell * (i, j)``; where ``cell`` would give more than ``max_nodes`` nodes
+    the cells are coarser and ``note`` says so (else None).
+
+    >>> stock_cells([[0, 0, 0], [10, 5, 2]], 0.5)[1:]
+    (21, 11, None)
+    """
+    lo, hi = np.asarray(stock, float)
+    nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
+    if nx * ny <= max_nodes:
+        return cell, nx, ny, None
+    wanted, cell = cell, cell * 1.05 * math.sqrt(nx * ny / max_nodes)
+    nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
+    return cell, nx, ny, (f"note: stock cells {cell:.3g} mm, coarser than the {wanted:.3g} the stepover asks "
+                          f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
 
 
 def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):
