@@ -205,10 +205,13 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
 def summary_line(report: dict) -> str:
     """The rest operation's report as a line for the ``surfmod machine`` summary.
 
-    >>> summary_line({"after": [0, 1], "threshold": 0.055, "runs": 3, "regions": 1, "passes": 40,
-    ...               "before": {"area": 12.5, "max": 1.2, "regions": 4},
-    ...               "left": {"area": 0.25, "max": 0.07, "regions": 1}})
-    'rest after operations 1, 2: left more than 0.055 mm on 12.5 mm^2 (4 region(s), up to 1.2 mm) before, 0.25 mm^2 (1 region(s), up to 0.07 mm) after; 3 cuts in 1 region(s), 40 passes'
+    >>> line = summary_line({"after": [0, 1], "threshold": 0.055, "runs": 3, "regions": 1, "passes": 40,
+    ...                      "before": {"area": 12.5, "max": 1.2, "regions": 4},
+    ...                      "left": {"area": 0.25, "max": 0.07, "regions": 1}})
+    >>> print(line.replace(" before, ", " before,\\n").replace("; ", ";\\n"))
+    rest after operations 1, 2: left more than 0.055 mm on 12.5 mm^2 (4 region(s), up to 1.2 mm) before,
+    0.25 mm^2 (1 region(s), up to 0.07 mm) after;
+    3 cuts in 1 region(s), 40 passes
     """
     b, a = report["before"], report["left"]
     ops = ", ".join(str(k + 1) for k in report["after"])
