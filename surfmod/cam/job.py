@@ -20,10 +20,9 @@ from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
 from .cycle_time import cycle_time, feed_time
-from .drop_cutter import TriangleGrid
 from .finishing import Leftover, clear_part, finish, recut
 from .machine_table import MACHINE, Machine
-from .rest import MAX_LOCATIONS, StockModel, left_over, rest_moves, rest_part_top
+from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_moves, rest_part_top
 from .rest import summary_line as rest_summary
 from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
@@ -70,7 +69,8 @@ class Rest:
     their moves; its passes are its own drop-cutter rasters clipped to those regions
     (:mod:`surfmod.cam.rest`).  A tool no smaller than the finishing's is allowed (it
     still cuts what the stock model shows left where it reaches, e.g. after roughing
-    alone) with a warning.  ``max_points`` bounds the passes' raster locations."""
+    alone) with a warning.  ``max_points`` bounds the passes' raster locations (and a
+    hundred times it the thickness test's node-triangle pairs)."""
 
     tool: Tool
     after: object = None
@@ -280,8 +280,8 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
         model.sweep(done[i].motion, done[i].tool)
     part_top = rest_part_top(part, model)
     threshold = scallop + tolerance + model.sag
-    near = TriangleGrid(part.grid.triangles, threshold)
-    mask, before = left_over(model, part_top, near)
+    pairs = op.max_points * PAIRS_PER_POINT
+    mask, before = left_over(model, part_top, part, threshold, pairs)
     motion, info = rest_moves(part, tool, model, mask, stepover=stepover, tolerance=tolerance, safe=safe,
                               max_points=op.max_points)
     cuts = motion.points[motion.kind != RAPID, 2]
@@ -290,7 +290,7 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
         raise SurfmodError(f"flute_length: {tool} reaches {tool.flute_length:g} mm, the rest machining goes "
                            f"{top - float(cuts.min()):.4g} mm below the part's top")
     model.sweep(motion, tool)
-    _, left = left_over(model, part_top, near)
+    _, left = left_over(model, part_top, part, threshold, pairs)
     report = dict(info, after=after, scallop=scallop, stepover=stepover, tolerance=tolerance, threshold=threshold,
                   cell=model.cell, before=before, left=left, deflection=part.deflection)
     if model.note:

@@ -7,10 +7,10 @@ lower surface along the moves already made (the verifier's compiled sweep,
 :func:`surfmod.cam.verify_kernels.sweep_stock`), is held against the part's top (a vertical
 ray onto the rest tool's triangles, :func:`~surfmod.cam.finishing.height_field`).  The
 stock over a node is *left* where it is thicker than the scallop plus the tolerance plus
-the sweep's sampling: the ball of that radius centred on the stock's top there touches
-no triangle of the part (its drop-cutter height lies below; its shank sees a wall beside
-the node, so the material on a wall's flank, a sliver thin across however tall, is not
-counted, as a vertical measure would).  Those nodes are the rest regions; their area
+the sweep's sampling: the stock's top there lies farther than that from every triangle
+of the part, in 3D (so the material on a wall's flank, a sliver thin across however
+tall, is not counted, as a vertical measure would count it; a fillet a ball left in a
+corner is).  Those nodes are the rest regions; their area
 before and after the rest operation is its report.
 
 **The moves** are the rest tool's own gouge-checked drop-cutter rasters
@@ -37,8 +37,6 @@ from scipy import ndimage
 from .. import checks
 from ..errors import SurfmodError
 from . import verify_kernels as K
-from .cutters import Ball
-from .drop_cutter import TriangleGrid, drop
 from .finishing import RECUT_SHARE, REST_CLEARANCE, _add_raster, height_field
 from .roughing import RAPID, Motion, Moves
 from .tool import Tool
@@ -47,8 +45,12 @@ from .verify import MAX_NODES, stock_cells
 
 #: raster runs this many tool radii apart along the raster are joined by its own moves
 BRIDGE_RADII = 4.0
-#: raster locations the rest passes may take, estimated from the regions before any drop
+#: raster locations the rest passes may take, estimated from the regions before any drop;
+#: the thickness test may take PAIRS_PER_POINT (node, triangle) pairs per location of it
 MAX_LOCATIONS = 2_000_000
+PAIRS_PER_POINT = 100
+#: (node, triangle) pairs of the thickness test measured at once
+PAIR_BLOCK = 2_000_000
 
 
 class StockModel:
@@ -90,20 +92,64 @@ class StockModel:
         return out
 
 
-def left_over(stock: StockModel, part_top: np.ndarray, near: TriangleGrid):
-    """Where the stock model holds more than ``near.radius`` of material above the part,
-    measured as thickness: a node is left when the ball of that radius centred on the
-    stock's top there touches no triangle (the drop-cutter of that ball, whose shank
-    also counts a wall beside the node; nodes off the part are not counted).  Returns
-    ``(mask, stats)``, stats ``area`` (mm²), ``max`` (the highest left node's height above
-    the part, vertical, mm) and ``regions``."""
-    t = near.radius
+def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Distance from each point ``p`` (N, 3) to its triangle ``tri`` (N, 3, 3): to the
+    plane where the point's foot lies inside, else to the nearest of the three edges
+    (a degenerate triangle is its edges).
+
+    >>> tri = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0]]] * 3, float)
+    >>> point_triangle_distance(np.array([[0.5, 0.5, 3.0], [3.0, 0.0, 0.0], [-1.0, -1.0, 1.0]]), tri).round(6).tolist()
+    [3.0, 1.0, 1.732051]
+    """
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    v0, v1, w = b - a, c - a, p - a
+    d00, d01, d11 = (v0 * v0).sum(1), (v0 * v1).sum(1), (v1 * v1).sum(1)
+    d20, d21 = (w * v0).sum(1), (w * v1).sum(1)
+    den = d00 * d11 - d01 * d01
+    ok = den > 1e-300 * np.maximum(d00 * d11, 1e-300)
+    den = np.where(ok, den, 1.0)
+    s, t = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+    inside = ok & (s >= 0) & (t >= 0) & (s + t <= 1)
+    n = np.cross(v0, v1)
+    plane = np.abs((w * n).sum(1)) / np.where(ok, np.linalg.norm(n, axis=1), 1.0)
+    edge = np.full(len(p), np.inf)
+    for s0, e in ((a, v0), (a, v1), (b, c - b)):
+        q = p - s0
+        ee = (e * e).sum(1)
+        u = np.clip((q * e).sum(1) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+        edge = np.minimum(edge, np.linalg.norm(q - u[:, None] * e, axis=1))
+    return np.where(inside, plane, edge)
+
+
+def left_over(stock: StockModel, part_top: np.ndarray, part: _Part, threshold: float, max_pairs: int):
+    """Where the stock model holds material thicker than ``threshold`` on the part: a
+    node over the part is left when the stock's top there lies farther than it from
+    every triangle (measured in 3D, so the flank of a wall the stock hugs is thin however
+    tall, and the fillet a ball left in a corner is thick).  The triangles tried at a
+    node are those of ``part``'s drop grid (all within the tool's radius in (x, y));
+    their (node, triangle) pairs, counted before any distance, may be at most
+    ``max_pairs``.  Returns ``(mask, stats)``, stats ``area`` (mm²), ``max`` (the highest
+    left node's height above the part, vertical, mm) and ``regions``."""
     height = np.where(np.isfinite(part_top), stock.top - part_top, -np.inf)
-    mask = height > t  # a thickness above t needs a height above it first
+    mask = height > threshold  # a thickness above the threshold needs a height above it first
     if mask.any():
         X, Y = np.meshgrid(stock.x, stock.y, indexing="ij")
-        h = drop(near, Ball(t), np.column_stack([X[mask], Y[mask]]))
-        mask[mask] = ~(np.nan_to_num(h, nan=-np.inf) > stock.top[mask] - t)
+        q = np.column_stack([X[mask], Y[mask], stock.top[mask]])
+        grid = part.grid
+        start, stop = grid.segments(q[:, :2])
+        n = np.maximum(stop - start, 0)
+        checks.work(int(n.sum()), max_pairs, "max_points",
+                    f"the rest's thickness test of {len(q):,} stock nodes against the triangles near each "
+                    f"(a hundred pairs per raster location of max_points)")
+        near = np.full(len(q), np.inf)
+        done = np.r_[0, np.cumsum(n)]
+        lo = 0
+        while lo < len(q):  # blocks of about PAIR_BLOCK pairs, at least one node each
+            hi = max(int(np.searchsorted(done, done[lo] + PAIR_BLOCK, "right")) - 1, lo + 1)
+            qi, ti = grid.pairs(q[lo:hi, :2], start[lo:hi], stop[lo:hi])
+            np.minimum.at(near, lo + qi, point_triangle_distance(q[lo + qi], grid.triangles[ti]))
+            lo = hi
+        mask[mask] = near > threshold
     regions = int(ndimage.label(mask, structure=np.ones((3, 3)))[1]) if mask.any() else 0
     stats = {"area": float(mask.sum()) * stock.cell ** 2, "max": float(height[mask].max()) if mask.any() else 0.0,
              "regions": regions}
