@@ -72,8 +72,9 @@ class StockModel:
 
     @property
     def sag(self) -> float:
-        """How far the stamped sweep can stand above the true one for a tool of corner
-        radius at least a cell (stamps half a cell apart: the profile's sag over a quarter)."""
+        """How far the stamped sweep can stand above the true one (stamps half a cell
+        apart: the profile's sag over a quarter cell, for a corner radius of a cell or
+        more, as the verifier bounds it)."""
         return (self.cell / 4) ** 2 / (2 * self.cell)
 
     def sweep(self, motion: Motion, tool: Tool) -> None:
@@ -85,11 +86,6 @@ class StockModel:
         K.sweep_stock(self.top, float(self.lo[0]), float(self.lo[1]), self.cell, np.ascontiguousarray(p[:-1]),
                       np.ascontiguousarray(p[1:]), np.asarray(motion.kind[1:] == RAPID), np.full(n, tool.radius),
                       np.full(n, tool.corner), self.cell / 2)
-
-    def copy(self) -> "StockModel":
-        out = object.__new__(StockModel)
-        out.lo, out.cell, out.note, out.top = self.lo, self.cell, self.note, self.top.copy()
-        return out
 
 
 def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
@@ -264,7 +260,9 @@ def summary_line(report: dict) -> str:
     return (f"rest after operations {ops}: left more than {report['threshold']:.3g} mm on {b['area']:.4g} mm^2 "
             f"({b['regions']} region(s), up to {b['max']:.3g} mm) before, {a['area']:.4g} mm^2 "
             f"({a['regions']} region(s), up to {a['max']:.3g} mm) after; {report['runs']} cuts in "
-            f"{report['regions']} region(s), {report['passes']} passes")
+            f"{report['regions']} region(s), {report['passes']} passes"
+            + (f", moves lifted by up to {report['lifted']:.3g} mm where refining could not follow the part "
+               f"(material left)" if report.get("lifted", 0.0) > 0 else ""))
 
 
 def rest_part_top(part: _Part, stock: StockModel) -> np.ndarray:
