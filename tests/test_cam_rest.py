@@ -16,6 +16,7 @@ from toolpath_reference import ball_clearance
 
 import surfmod as sm
 from surfmod.cam.drop_cutter import part_triangles
+from surfmod.cam.job import _after
 from surfmod.cam.rest import _runs
 from surfmod.cam.roughing import RAPID
 from surfmod.cli import main
@@ -160,6 +161,17 @@ def test_rest_bad_input():
         sm.machine(block, 1.0, [sm.Rough(ROUGH, allowance=0.3), sm.Rest(REST)], verify=False)
     with pytest.raises(sm.SurfmodError, match="^scallop"):
         sm.machine(block, 0.0, [sm.Finish(FINISH, scallop=SCALLOP), sm.Rest(REST, scallop=-1.0)], verify=False)
+
+
+def test_after_names_earlier_operations():
+    rough, finish = sm.Rough(ROUGH), sm.Finish(FINISH, scallop=SCALLOP)
+    ops = [rough, finish]
+    assert _after(sm.Rest(REST), 2, ops) == [0, 1]
+    assert _after(sm.Rest(REST, after=finish), 2, ops) == [1]
+    assert _after(sm.Rest(REST, after=[1, 0, 1]), 2, ops) == [0, 1]
+    for bad in ([], -1, 2, sm.Finish(FINISH, scallop=SCALLOP), "finishing"):
+        with pytest.raises(sm.SurfmodError, match="^after"):
+            _after(sm.Rest(REST, after=bad), 2, ops)
 
 
 def test_a_rest_tool_no_smaller_warns_and_cuts_nothing_on_open_ground():

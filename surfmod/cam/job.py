@@ -302,12 +302,13 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
             machine: Machine = MACHINE) -> Job:
     """Machine ``part`` (a build123d shape, STEP path or surfmod surfaces) from ``stock``
     (a margin in mm, or a box ``[[x0, y0, z0], [x1, y1, z1]]`` holding the part) by
-    ``operations`` in order (:class:`Rough`, :class:`Finish`); tools without a number get
+    ``operations`` in order (:class:`Rough`, :class:`Finish`, :class:`Rest`); tools without a number get
     1, 2, ... in that order, and speeds and feeds from their diameter.  Roughing clears the
     stock down to the part plus its allowance (:mod:`surfmod.cam.roughing`); finishing is
     the gouge-checked drop-cutter path (:func:`surfmod.toolpath`) plus waterline contours on
     the steep regions, with the rest it cannot reach reported
-    (:mod:`surfmod.cam.finishing`).  Raises
+    (:mod:`surfmod.cam.finishing`); rest machining cuts with a smaller tool where the
+    job's stock model shows more than the scallop left (:mod:`surfmod.cam.rest`).  Raises
     ``SurfmodError`` when a tool's flutes are shorter than the depth it must cut.
 
     With ``verify`` (the default) the job's LinuxCNC program is read back and judged
