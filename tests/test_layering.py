@@ -91,6 +91,7 @@ LAZY = {
     "matplotlib": "2.5 s; sm.render, analysis pictures and section PNGs only",
     "mpl_toolkits": "matplotlib's 3-D axes, with matplotlib",
     "trimesh": "2.1 s; Mesh.to_trimesh, for users and the tests",
+    "plotly": "the job view's HTML only (surfmod/cam/job_view.py)",
     "gmsh": "optional extra 'fem' (surfmod.extras.require loads it)",
     "meshio": "optional extra 'fem' (surfmod.extras.require loads it)",
     "ezdxf": "0.6 s; DXF output only (surfmod.io.dxf loads it at its top)",

@@ -155,6 +155,11 @@ class Job:
 
         return job_png(self)
 
+    def _repr_html_(self) -> str:
+        from .job_view import job_html
+
+        return job_html(self, full_html=False)
+
 
 def operation_time(motion: Motion, tool: Tool, machine: Machine) -> float:
     """An operation's ``time_estimate``: the tool change plus the moves as ``machine`` runs them."""

@@ -53,6 +53,7 @@ from ..inputs import to_shape
 from ..readback.trimmed import from_face
 from . import verify_kernels as K
 from .program import ProgramMoves, concatenate, read_program
+from .stock_field import KEPT_NODES, StockField
 
 #: points on the part, probes along the moves and stock nodes one verification may take
 MAX_SAMPLES = 30_000_000
@@ -115,6 +116,9 @@ class Verification:
     walls: int = 0
     spacing: float = 0.0
     notes: tuple = field(default=())
+    #: the stock after the program (:class:`~surfmod.cam.stock_field.StockField`, at most
+    #: ``KEPT_NODES`` nodes; None for a tool path alone)
+    stock: StockField | None = field(default=None, repr=False, compare=False)
 
     @property
     def ok(self) -> bool:
@@ -511,12 +515,17 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     if uncut.any():
         findings.append(Finding("cuts with the spindle stopped", float(uncut.sum()), 0.0, None, int(uncut.sum()),
                                 int(moves.line[np.argmax(uncut)])))
+    # the part under each node: the highest of its points within the node's cell
+    gx, gy = np.meshgrid(lo[0] + cell * np.arange(nx), lo[1] + cell * np.arange(ny), indexing="ij")
+    xy = np.column_stack([gx.ravel(), gy.ravel()])
+    under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
     walls = 0
     if finishing:
         k, op, cutter, limit = finishing[-1]
-        found, walls = _residual(part, top, lo, cell, op, cutter, limit)
+        found, walls = _residual(part, top, under, lo, cell, op, cutter, limit)
         findings.append(found)
-    return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes))
+    kept = StockField.over_part(top, under, lo[:2], cell, WALL_SLOPE).coarsened(KEPT_NODES)
+    return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes), kept)
 
 
 def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
@@ -537,16 +546,16 @@ def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
                           f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
 
 
-def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):
-    """The stock left above the finishing tool's reach, normal to it, where it reaches."""
+def _residual(part: PartPoints, top: np.ndarray, under: np.ndarray, lo: np.ndarray, cell: float, op, cutter,
+              limit: float):
+    """The stock left above the finishing tool's reach, normal to it, where it reaches
+    (``under``: the part's height under each node)."""
     nx, ny = top.shape
     gx, gy = np.meshgrid(lo[0] + cell * np.arange(nx), lo[1] + cell * np.arange(ny), indexing="ij")
     xy = np.column_stack([gx.ravel(), gy.ravel()])
     tips = part.drop(xy, cutter.radius, cutter.corner).reshape(nx, ny)
     reach = K.closing(tips, cell, cutter.radius, cutter.corner)
-    # the part under each node (the highest of its points within the node's cell), and the
-    # outline: a node whose neighbours are not all over the part is not judged
-    under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
+    # the outline: a node whose neighbours are not all over the part is not judged
     on = np.isfinite(under)
     inner = on.copy()
     inner[1:] &= on[:-1]

@@ -40,6 +40,8 @@ def register(sub) -> None:
     p.add_argument("--png", help="picture of the moves over the shaded part")
     p.add_argument("--machine", help="machine table (TOML [machine] or JSON): axis velocities and accelerations, "
                                      "rapid rate, blend tolerance, tool change time of the time estimate")
+    p.add_argument("--html", help="the job in the browser: part, moves per operation, stock left (one file, "
+                                  "no network needed)")
     p.add_argument("--no-verify", action="store_true",
                    help="skip reading the program back and judging it against the exact part and the stock "
                         "(faster; the program's header says it was not verified)")
@@ -68,6 +70,8 @@ def run(args) -> int:
     target_path(args.out, "out", SUFFIXES)
     if args.png:
         target_path(args.png, "png", (".png",))
+    if args.html:
+        target_path(args.html, "html", (".html", ".htm"))
     table = load_tool_table(args.tools) if args.tools else {}
     mill = load_machine_table(args.machine) if args.machine else MACHINE
     rough_tool = _tool(args.rough, 1, table, "rough")
@@ -106,6 +110,10 @@ def run(args) -> int:
         from ..cam.picture import write_png
 
         write_png(job, args.png)
+    if args.html:
+        from ..cam.job_view import write_html
+
+        write_html(job, args.html)
     print(job)
     if args.machine:  # the limits the time estimates below follow
         print(f"  {job.machine}")
@@ -115,7 +123,7 @@ def run(args) -> int:
         if op.name == "finishing":
             for line in summary_lines(op.report):
                 print(f"    {line}")
-    for p in written + ([args.png] if args.png else []):
+    for p in written + [path for path in (args.png, args.html) if path]:
         print(f"wrote {p}")
     if job.verification is not None and not job.verification.ok:
         broken = [f.what for f in job.verification.findings if not f.ok]
