@@ -7,7 +7,8 @@ It holds, each a trace the legend switches on and off:
 - **the part**, shaded: BRepMesh's triangles at ``VIEW_DEFLECTION`` of the stock's size,
   simplified to at most ``VIEW_TRIANGLES`` (:func:`surfmod.meshing.render.display_mesh`);
 - **each operation's moves**, cuts in the operation's colour, rapids apart (grey,
-  dashed): at most ``VIEW_POINTS`` tool locations over the whole job, shared by the
+  dashed); the last operation's cuts are shown, the others' and the rapids are listed
+  in the legend, one click away (drawn at once they hide the part): at most ``VIEW_POINTS`` tool locations over the whole job, shared by the
   operations as their moves are; where an operation has more, every ``s``-th location is
   kept, a chord drawn where the moves it stands for all cut or are all rapids, left out
   where they mix;
@@ -49,7 +50,7 @@ VIEW_TRIANGLES = 20_000
 VIEW_POINTS = 50_000
 VIEW_NODES = 40_000
 #: BRepMesh's deflection for the part, as a share of the stock's largest side
-VIEW_DEFLECTION = 0.002
+VIEW_DEFLECTION = 0.0005
 #: the least material the stock surface shows (mm), where no finishing sets a limit
 LEAST_LEFT = 1e-3
 
@@ -75,7 +76,7 @@ def _part_trace(job) -> dict:
             "x": _typed(mesh.vertices[:, 0]), "y": _typed(mesh.vertices[:, 1]), "z": _typed(mesh.vertices[:, 2]),
             "i": _typed(faces[:, 0], "i4"), "j": _typed(faces[:, 1], "i4"), "k": _typed(faces[:, 2], "i4"),
             "color": PART_COLOR, "flatshading": True, "hoverinfo": "skip",
-            "lighting": {"ambient": 0.55, "diffuse": 0.6, "specular": 0.05, "roughness": 0.9},
+            "lighting": {"ambient": 0.7, "diffuse": 0.5, "specular": 0.05, "roughness": 0.9},
             "lightposition": {"x": 1e5, "y": -2e5, "z": 3e5}}
 
 
@@ -98,8 +99,9 @@ def _polylines(runs: list) -> np.ndarray:
     return np.concatenate([piece for run in runs for piece in (run, gap)][:-1])
 
 
-def _line_trace(points: np.ndarray, name: str, line: dict, group: str) -> dict:
+def _line_trace(points: np.ndarray, name: str, line: dict, group: str, shown: bool) -> dict:
     return {"type": "scatter3d", "mode": "lines", "name": name, "legendgroup": group, "line": line,
+            "visible": True if shown else "legendonly",
             "x": _typed(points[:, 0]), "y": _typed(points[:, 1]), "z": _typed(points[:, 2]), "hoverinfo": "name"}
 
 
@@ -117,10 +119,10 @@ def _move_traces(job) -> list[dict]:
         if runs.get(1):
             colour = OPERATION_COLORS[k % len(OPERATION_COLORS)]
             traces.append(_line_trace(_polylines(runs[1]), f"{k + 1} {op.name} ({op.tool})",
-                                      {"color": colour, "width": 2.5}, group))
+                                      {"color": colour, "width": 2}, group, k == len(counts) - 1))
         if runs.get(0):
             traces.append(_line_trace(_polylines(runs[0]), f"{k + 1} {op.name}: rapids",
-                                      {"color": RAPID_COLOR, "width": 1.5, "dash": "dash"}, group))
+                                      {"color": RAPID_COLOR, "width": 1.5, "dash": "dash"}, group, False))
     return traces
 
 
@@ -162,7 +164,7 @@ def title(job) -> str:
     lo, hi = np.asarray(job.stock, float)
     m, s = divmod(job.time_estimate, 60)
     ops = ", ".join(f"{k + 1} {op.name} {op.tool}" for k, op in enumerate(job.operations))
-    return (f"job: stock {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} x {hi[2] - lo[2]:g} mm, {ops}; "
+    return (f"job: stock {hi[0] - lo[0]:.4g} x {hi[1] - lo[1]:.4g} x {hi[2] - lo[2]:.4g} mm, {ops}; "
             f"time estimate {int(m)} min {s:04.1f} s; {_verdict(job)}")
 
 

@@ -22,7 +22,8 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
 - **stock**: a height field over the stock box, a cell a quarter of the finishing
   stepover wide, from which each feed removes what the tool's lower surface sweeps, in
   the program's order.  A rapid whose tool goes below the stock's top there runs through
-  material;
+  material.  The stock left is kept with the verdict (``Verification.stock``, a
+  :class:`~surfmod.cam.stock_field.StockField`), which the job view draws;
 - **residual**: after the last finishing, the stock left above the lowest the finishing
   tool can reach (the part's closing by the tool, from its drop onto the part's points),
   measured normal to that surface, is at most the scallop plus the tolerance wherever the
