@@ -105,7 +105,7 @@ def test_page_is_self_contained_with_a_trace_per_operation(job):
     assert shown.sum() > 20 and np.array_equal(np.isfinite(z), shown)
     assert np.allclose(z[shown], field.top[shown], atol=1e-5)
     assert np.allclose(colour[shown], field.left[shown], atol=1e-5)
-    assert len(page) < 4.8e6 + 3.4e6
+    assert len(page) < 4.82e6 + 0.6e6  # plotly.js and this small job's data
 
 
 def test_moves_kept_within_the_bound_are_the_jobs(job, monkeypatch):
@@ -129,6 +129,20 @@ def test_moves_kept_within_the_bound_are_the_jobs(job, monkeypatch):
             share = cutting[a + 1:b + 1]
             assert lab == (1 if share.all() else 0 if not share.any() else -1)
         assert (label == -1).any() and (label == 1).any()
+
+
+def test_part_and_stock_kept_within_their_bounds(job, monkeypatch):
+    """The part within its triangles (BRepMesh coarser where its estimate passes the
+    mesh's bound) and the stock within its nodes, the most left kept."""
+    monkeypatch.setattr(job_view, "VIEW_TRIANGLES", 60)
+    monkeypatch.setattr(job_view, "MESH_TRIANGLES", 100)
+    monkeypatch.setattr(job_view, "VIEW_NODES", 100)
+    data = job_view.job_figure(job)["data"]
+    part, stock = data[0], data[-1]
+    assert 12 <= len(_array(part["i"])) <= 60 and part["name"].startswith(f"part ({len(_array(part['i']))} ")
+    z = _array(stock["z"])
+    assert z.size <= 100 and len(_array(stock["x"])) * len(_array(stock["y"])) == z.size
+    assert np.nanmax(_array(stock["surfacecolor"])) == pytest.approx(np.nanmax(job.verification.stock.left), 1e-6)
 
 
 def test_a_job_not_verified_says_so(job):

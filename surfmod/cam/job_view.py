@@ -4,8 +4,9 @@ and a notebook shows (``Job._repr_html_``).
 
 It holds, each a trace the legend switches on and off:
 
-- **the part**, shaded: BRepMesh's triangles at ``VIEW_DEFLECTION`` of the stock's size,
-  simplified to at most ``VIEW_TRIANGLES`` (:func:`surfmod.meshing.render.display_mesh`);
+- **the part**, shaded: BRepMesh's triangles at ``VIEW_DEFLECTION`` of the stock's size
+  (coarser where the curvature estimate passes ``MESH_TRIANGLES``), simplified to at
+  most ``VIEW_TRIANGLES`` (:func:`surfmod.meshing.render.display_mesh`);
 - **each operation's moves**, cuts in the operation's colour, rapids apart (grey,
   dashed); the last operation's cuts are shown, the others' and the rapids are listed
   in the legend, one click away (drawn at once they hide the part): at most ``VIEW_POINTS`` tool locations over the whole job, shared by the
@@ -21,8 +22,9 @@ It holds, each a trace the legend switches on and off:
   verification's verdict.
 
 The numbers go into the page as typed arrays (4-byte floats and integers, base64), so the
-data is at most about 64 bytes a triangle, 64 a tool location and 11 a stock node:
-3.4 MB at the bounds, beside plotly.js's 4.8 MB (a job of a few operations: 1-2 MB).
+data is at most 64 bytes a triangle (three corners of its own, three indices), 48 a tool
+location (drawn in two traces at most, and a gap) and 11 a stock node: 4.1 MB at the
+bounds, beside plotly.js's 4.8 MB (the tests' small job: 0.5 MB).
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ import math
 import numpy as np
 
 from ..atomic import atomic_path, target_path
+from ..meshing.brep import _estimate
 from ..meshing.polymesh import Mesh
 from ..meshing.render import display_mesh, polyline_runs
 from .roughing import RAPID
@@ -49,6 +52,8 @@ STOCK_SCALE = "YlOrRd"
 VIEW_TRIANGLES = 20_000
 VIEW_POINTS = 50_000
 VIEW_NODES = 40_000
+#: triangles BRepMesh may make for the part (by the curvature estimate, before it runs)
+MESH_TRIANGLES = 200_000
 #: BRepMesh's deflection for the part, as a share of the stock's largest side
 VIEW_DEFLECTION = 0.0005
 #: the least material the stock surface shows (mm), where no finishing sets a limit
@@ -67,7 +72,11 @@ def _typed(a, dtype: str = "f4") -> dict:
 def _part_trace(job) -> dict:
     from .drop_cutter import part_triangles
 
-    tri, _ = part_triangles(job.part, VIEW_DEFLECTION * float(np.ptp(job.stock, axis=0).max()))
+    deflection = VIEW_DEFLECTION * float(np.ptp(job.stock, axis=0).max())
+    estimate, _ = _estimate(job.part, deflection)
+    if estimate > MESH_TRIANGLES:  # a triangle's sag grows with its area: the count falls as 1 / deflection
+        deflection *= 1.1 * estimate / MESH_TRIANGLES
+    tri, _ = part_triangles(job.part, deflection)
     # BRepMesh repeats a node for each face it bounds: merge them, then simplify to the bound
     nodes, index = np.unique(tri.reshape(-1, 3), axis=0, return_inverse=True)
     mesh = display_mesh(Mesh(nodes, index.reshape(-1, 3)), VIEW_TRIANGLES)
