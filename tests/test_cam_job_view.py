@@ -83,6 +83,18 @@ def test_the_stock_kept_is_the_independent_simulation(job):
     assert np.nanmax(field.left) > 0.3
 
 
+def test_the_verifier_keeps_a_bounded_stock_losing_no_material_left(job, monkeypatch):
+    from surfmod.cam import verify
+
+    full = job.verification.stock
+    monkeypatch.setattr(verify, "KEPT_NODES", 500)
+    kept = verify.verify_job(job).stock
+    assert kept.top.size <= 500 < full.top.size and not kept.top.flags.writeable
+    assert np.nanmax(kept.left) == np.nanmax(full.left) and kept.top.max() == full.top.max()
+    f = round(kept.cell / full.cell)
+    assert f >= 2 and kept.origin[0] == pytest.approx(full.origin[0] + 0.5 * (f - 1) * full.cell)
+
+
 def test_page_is_self_contained_with_a_trace_per_operation(job):
     page = job_view.job_html(job)
     assert page.startswith("<html>") or page.lstrip().lower().startswith("<!doctype html>")

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import checks
+
 #: nodes a kept field holds at most (two float arrays: 16 MB)
 KEPT_NODES = 1_000_000
 
@@ -39,10 +41,16 @@ class StockField:
     origin: tuple
     cell: float
 
+    def __post_init__(self):
+        object.__setattr__(self, "top", checks.frozen(self.top))
+        object.__setattr__(self, "left", checks.frozen(self.left))
+
     @classmethod
-    def over_part(cls, top: np.ndarray, under: np.ndarray, origin, cell: float, wall_slope: float) -> "StockField":
+    def over_part(cls, top: np.ndarray, under: np.ndarray, origin, cell: float, wall_slope: float,
+                  max_nodes: int = KEPT_NODES) -> "StockField":
         """The field of ``top`` over a part whose height under each node is ``under``
-        (-inf where there is none); nodes steeper than ``wall_slope`` degrees are walls."""
+        (-inf where there is none), at most ``max_nodes`` nodes (see :meth:`coarsened`);
+        nodes steeper than ``wall_slope`` degrees are walls."""
         part = np.where(np.isfinite(under), under, np.nan)
         if min(part.shape) >= 2:
             gx, gy = np.gradient(part, cell)
@@ -51,7 +59,8 @@ class StockField:
             cos = np.where(np.isfinite(part), 1.0, np.nan)
         wall = ~(cos > math.cos(math.radians(wall_slope)))
         left = np.where(wall, np.nan, np.maximum(top - part, 0.0) * cos)
-        return cls(np.asarray(top, float), left, (float(origin[0]), float(origin[1])), float(cell))
+        return cls(*_pooled(np.asarray(top, float), left, (float(origin[0]), float(origin[1])), float(cell),
+                            max_nodes))
 
     @property
     def x(self) -> np.ndarray:
@@ -65,14 +74,21 @@ class StockField:
         """At most ``max_nodes`` nodes: the maxima over blocks of ``f x f`` nodes (``f`` the
         least that fits), each standing at its block's centre."""
         nx, ny = self.top.shape
-        f = max(1, math.ceil(math.sqrt(nx * ny / max(int(max_nodes), 1))))
-        while math.ceil(nx / f) * math.ceil(ny / f) > max_nodes:
-            f += 1  # the ceilings of the block counts can pass the square root's guess
-        if f == 1:
-            return self
-        top, left = _block_max(self.top, f), _block_max(self.left, f)
-        shift = 0.5 * (f - 1) * self.cell
-        return StockField(top, left, (self.origin[0] + shift, self.origin[1] + shift), self.cell * f)
+        return self if nx * ny <= max_nodes else StockField(*_pooled(self.top, self.left, self.origin, self.cell,
+                                                                     max_nodes))
+
+
+def _pooled(top: np.ndarray, left: np.ndarray, origin: tuple, cell: float, max_nodes: int) -> tuple:
+    """``(top, left, origin, cell)`` at most ``max_nodes`` nodes: the maxima over blocks
+    of ``f x f`` nodes (``f`` the least that fits), each standing at its block's centre."""
+    nx, ny = top.shape
+    f = max(1, math.ceil(math.sqrt(nx * ny / max(int(max_nodes), 1))))
+    while math.ceil(nx / f) * math.ceil(ny / f) > max_nodes:
+        f += 1  # the ceilings of the block counts can pass the square root's guess
+    if f == 1:
+        return top, left, origin, cell
+    shift = 0.5 * (f - 1) * cell
+    return _block_max(top, f), _block_max(left, f), (origin[0] + shift, origin[1] + shift), cell * f
 
 
 def _block_max(a: np.ndarray, f: int) -> np.ndarray:

@@ -525,7 +525,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         k, op, cutter, limit = finishing[-1]
         found, walls = _residual(part, top, under, lo, cell, op, cutter, limit)
         findings.append(found)
-    kept = StockField.over_part(top, under, lo[:2], cell, WALL_SLOPE).coarsened(KEPT_NODES)
+    kept = StockField.over_part(top, under, lo[:2], cell, WALL_SLOPE, KEPT_NODES)
     return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes), kept)
 
 
