@@ -516,17 +516,16 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     if uncut.any():
         findings.append(Finding("cuts with the spindle stopped", float(uncut.sum()), 0.0, None, int(uncut.sum()),
                                 int(moves.line[np.argmax(uncut)])))
-    # the part under each node: the highest of its points within the node's cell
-    gx, gy = np.meshgrid(lo[0] + cell * np.arange(nx), lo[1] + cell * np.arange(ny), indexing="ij")
-    xy = np.column_stack([gx.ravel(), gy.ravel()])
-    under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
     walls = 0
     if finishing:
         k, op, cutter, limit = finishing[-1]
-        found, walls = _residual(part, top, under, lo, cell, op, cutter, limit)
+        found, walls = _residual(part, top, lo, cell, op, cutter, limit)
         findings.append(found)
-    kept = StockField.over_part(top, under, lo[:2], cell, WALL_SLOPE, KEPT_NODES)
-    return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes), kept)
+    # the part under each node as the residual reads it: its highest point within the cell
+    kept = StockField.over_part(top, lambda xy: part.drop(xy, 0.75 * cell, 0.0), lo[:2], cell, WALL_SLOPE,
+                                KEPT_NODES)
+    return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes),
+                        stock=kept)
 
 
 def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
@@ -547,16 +546,16 @@ def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
                           f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
 
 
-def _residual(part: PartPoints, top: np.ndarray, under: np.ndarray, lo: np.ndarray, cell: float, op, cutter,
-              limit: float):
-    """The stock left above the finishing tool's reach, normal to it, where it reaches
-    (``under``: the part's height under each node)."""
+def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):
+    """The stock left above the finishing tool's reach, normal to it, where it reaches."""
     nx, ny = top.shape
     gx, gy = np.meshgrid(lo[0] + cell * np.arange(nx), lo[1] + cell * np.arange(ny), indexing="ij")
     xy = np.column_stack([gx.ravel(), gy.ravel()])
     tips = part.drop(xy, cutter.radius, cutter.corner).reshape(nx, ny)
     reach = K.closing(tips, cell, cutter.radius, cutter.corner)
-    # the outline: a node whose neighbours are not all over the part is not judged
+    # the part under each node (the highest of its points within the node's cell), and the
+    # outline: a node whose neighbours are not all over the part is not judged
+    under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
     on = np.isfinite(under)
     inner = on.copy()
     inner[1:] &= on[:-1]
