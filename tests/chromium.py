@@ -1,7 +1,8 @@
 """A page rendered by headless Chromium (Debian ``chromium``): its screenshot and what its
 console said.  The tests of the job view and ``docs/job_view_picture.py`` share it.
 
-Chromium runs with a fresh profile, no network services, software WebGL (SwiftShader:
+Chromium runs with a fresh profile, no network (no host name resolves, so a page that
+needs one draws nothing), no network services, software WebGL (SwiftShader:
 plotly's 3-D scenes are WebGL) and a virtual time budget that lets the page's scripts
 run and draw before the screenshot is taken; a wall-clock ``timeout`` only stops a hung
 browser.
@@ -40,7 +41,7 @@ def screenshot(page: Path, png: Path, size=(900, 700), budget_ms: int = 8000, ti
     with tempfile.TemporaryDirectory(prefix="surfmod-chromium-") as profile:
         run = subprocess.run(
             [exe, "--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--disable-quic",
-             "--no-first-run", "--disable-background-networking", "--disable-component-update", "--disable-sync",
+             "--no-first-run", "--disable-background-networking", "--host-resolver-rules=MAP * ~NOTFOUND", "--disable-component-update", "--disable-sync",
              f"--user-data-dir={profile}", f"--screenshot={png}", f"--window-size={size[0]},{size[1]}",
              f"--virtual-time-budget={budget_ms}", "--enable-logging=stderr", "--v=0",
              Path(page).resolve().as_uri()],
