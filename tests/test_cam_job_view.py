@@ -209,3 +209,14 @@ def test_page_renders_in_headless_chromium(job, tmp_path):
     (tmp_path / "off.html").write_text(pio.to_html(figure, include_plotlyjs=True, validate=False))
     assert chromium.screenshot(tmp_path / "off.html", tmp_path / "off.png") == []
     assert part_pixels(tmp_path / "off.png") < 0.001 * 900 * 700
+
+
+@pytest.mark.skipif(chromium.find() is None, reason="chromium not installed (Debian: apt-get install chromium)")
+def test_chromium_reports_a_failing_script_and_a_page_needing_the_network(tmp_path):
+    """The console scan above can fail: a script error is reported, and so is a page that
+    loads plotly.js from the network (no host name resolves there)."""
+    page = tmp_path / "cdn.html"
+    page.write_text('<html><head><script src="https://cdn.plot.ly/plotly-2.35.2.min.js"></script></head>'
+                    '<body><div id="d"></div><script>Plotly.newPlot("d", [{y: [1, 2]}]);</script></body></html>')
+    errors = chromium.screenshot(page, tmp_path / "cdn.png", (300, 200), budget_ms=2000)
+    assert len(errors) == 1 and "Plotly is not defined" in errors[0]
