@@ -19,16 +19,25 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 
 class ChildFailure(Exception):
-    """The child did not finish by its deadline, or died; ``str`` says which."""
+    """The child did not finish by its deadline, held too much memory, or died; ``str``
+    says which, and ``cause`` is ``"deadline"``, ``"memory"`` or ``"died"`` (then
+    ``returncode`` is the child's exit code, negative for a signal)."""
+
+    def __init__(self, message: str, cause: str = "died", returncode: int | None = None):
+        super().__init__(message)
+        self.cause, self.returncode = cause, returncode
 
 
 #: seconds between two looks at the child's memory when it has a memory budget
 MEMORY_POLL = 0.25
 #: seconds between two looks of a child (or a worker) at its parent
 PARENT_POLL = 0.5
+#: seconds a :class:`Server`'s warm-up call may take (its child's start and imports)
+WARMUP_SECONDS = 120.0
 _watching: list = []
 
 
@@ -73,7 +82,7 @@ def call(fn, args: tuple, seconds: float, what: str, memory: float | None = None
     # the import path first, on its own: the child needs it before it can unpickle ``fn``
     request = pickle.dumps(list(sys.path)) + pickle.dumps((fn, args))
     proc = subprocess.Popen([sys.executable, "-m", "surfmod.child"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            stderr=subprocess.DEVNULL)
+                            stderr=subprocess.DEVNULL, env=_child_env())
     deadline = time.monotonic() + seconds
     while True:
         left = deadline - time.monotonic()
@@ -83,21 +92,27 @@ def call(fn, args: tuple, seconds: float, what: str, memory: float | None = None
             break
         except subprocess.TimeoutExpired:
             request = None
-            if time.monotonic() >= deadline:
-                failure = f"{what} did not finish within {seconds:g} s"
-            elif memory and resident_bytes(proc.pid) > memory:
-                failure = f"{what} held more than {memory / 2**30:.3g} GiB"
-            else:
+            failure = _over_budget(proc.pid, deadline, seconds, what, memory)
+            if failure is None:
                 continue
             proc.kill()
             proc.communicate()
-            raise ChildFailure(failure) from None
+            raise failure from None
     if proc.returncode != 0 or not out:
-        raise ChildFailure(f"{what} died (exit code {proc.returncode})")
+        raise ChildFailure(f"{what} died (exit code {proc.returncode})", "died", proc.returncode)
     kind, value = pickle.loads(out)
     if kind == "raised":
         raise value
     return value
+
+
+def _over_budget(pid: int, deadline: float, seconds: float, what: str, memory: float | None):
+    """The :class:`ChildFailure` of a child past its deadline or its memory, else None."""
+    if time.monotonic() >= deadline:
+        return ChildFailure(f"{what} did not finish within {seconds:g} s", "deadline")
+    if memory and resident_bytes(pid) > memory:
+        return ChildFailure(f"{what} held more than {memory / 2**30:.3g} GiB", "memory")
+    return None
 
 
 class Server:
@@ -106,7 +121,12 @@ class Server:
     over its budget kills the child, and the next call starts a fresh one.  A child left
     holding more than half the memory budget after a call is retired too, so what one
     file's shapes leave behind never reaches the next file's budget.  Not shared between
-    threads (give each thread its own).
+    threads (give each thread its own, or a lock).
+
+    ``warmup`` (``(fn, args)``, optional) is the first call of every fresh child, sent
+    as it starts: it runs while the caller goes on (:meth:`start` early, e.g. to import
+    a library in the child while the caller imports its own), and its time is charged to
+    :data:`WARMUP_SECONDS`, not to the next call's deadline.
 
     >>> server = Server()
     >>> server.call(divmod, (7, 2), 60.0, "divmod"), server.call(divmod, (9, 4), 60.0, "divmod")
@@ -114,13 +134,21 @@ class Server:
     >>> server.close()
     """
 
-    def __init__(self):
+    def __init__(self, warmup: tuple | None = None):
         self.proc = None
+        self.warmup = warmup
+        self._warming = False
 
-    def _start(self) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-m", "surfmod.child", "--serve"], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
-        self.proc.stdin.write(_framed(pickle.dumps(list(sys.path))))
+    def start(self) -> None:
+        """Start the child (and its warm-up) now if none runs; calls wait for it."""
+        if self.proc is None or self.proc.poll() is not None:
+            self.proc = subprocess.Popen([sys.executable, "-m", "surfmod.child", "--serve"], stdin=subprocess.PIPE,
+                                         stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=_child_env())
+            self.proc.stdin.write(_framed(pickle.dumps(list(sys.path))))
+            self._warming = self.warmup is not None
+            if self._warming:
+                self.proc.stdin.write(_framed(pickle.dumps(self.warmup)))
+            self.proc.stdin.flush()
 
     def close(self) -> None:
         """End the child (it is killed: it may be inside a call that never returns)."""
@@ -131,38 +159,50 @@ class Server:
 
     def call(self, fn, args: tuple, seconds: float, what: str, memory: float | None = None):
         """:func:`call`'s contract, in the one child."""
-        if self.proc is None or self.proc.poll() is not None:
-            self._start()
+        self.start()
+        if self._warming:
+            self._warming = False
+            self._answer(WARMUP_SECONDS, f"{what}: the child's start", None)
         try:
             self.proc.stdin.write(_framed(pickle.dumps((fn, args))))
             self.proc.stdin.flush()
         except BrokenPipeError:
             self.close()
             raise ChildFailure(f"{what}: the child died before the call") from None
+        return self._answer(seconds, what, memory)
+
+    def _answer(self, seconds: float, what: str, memory: float | None):
+        """The value of the call the child is working on (see :func:`call`)."""
         fd, deadline = self.proc.stdout.fileno(), time.monotonic() + seconds
         while not select.select([fd], [], [], max(min(deadline - time.monotonic(), MEMORY_POLL), 0.0))[0]:
-            if time.monotonic() >= deadline:
-                failure = f"{what} did not finish within {seconds:g} s"
-            elif memory and resident_bytes(self.proc.pid) > memory:
-                failure = f"{what} held more than {memory / 2**30:.3g} GiB"
-            else:
-                continue
-            self.close()
-            raise ChildFailure(failure)
+            failure = _over_budget(self.proc.pid, deadline, seconds, what, memory)
+            if failure is not None:
+                self.close()
+                raise failure
         blob = _read_framed(fd)
         if blob is None:
             code = self.proc.wait()
             self.proc = None
-            raise ChildFailure(f"{what} died (exit code {code})")
+            raise ChildFailure(f"{what} died (exit code {code})", "died", code)
         held = resident_bytes(self.proc.pid) if memory else 0.0
         if held > memory / 2 if memory else False:
             self.close()
         if held > memory if memory else False:  # between two looks, or at the end: over all the same
-            raise ChildFailure(f"{what} held more than {memory / 2**30:.3g} GiB")
+            raise ChildFailure(f"{what} held more than {memory / 2**30:.3g} GiB", "memory")
         kind, value = pickle.loads(blob)
         if kind == "raised":
             raise value
         return value
+
+
+def _child_env() -> dict:
+    """The environment of a child: the caller's, with the folder holding this surfmod
+    first on ``PYTHONPATH``, so ``-m surfmod.child`` finds the package the caller runs
+    (a checkout on ``sys.path`` only, not installed, included)."""
+    env = dict(os.environ)
+    root = str(Path(__file__).resolve().parents[1])
+    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    return env
 
 
 def _framed(blob: bytes) -> bytes:

@@ -12,6 +12,7 @@ import pytest
 
 import surfmod as sm
 from surfmod.cli import main
+from surfmod.nets import mp_reference
 from surfmod.cli.section import dxf_length  # noqa: F401 - the DXF's exact length, as the command judges it
 from surfmod.occ.sample import edge_length, wire_edges
 from surfmod.occ.properties import bounding_box, gprops
@@ -41,10 +42,27 @@ def _faces_match_occt(path):
         size = max(float(np.ptp(ref_p, axis=0).max()), 1e-3)
         dev_p = float(np.abs(mine[:, 0, 0] - ref_p).max()) / size
         d_scale = max(float(np.abs(ref_d[:, [1, 0], [0, 1]]).max()), 1e-300)
-        dev_d = float(np.abs(mine[:, [1, 0], [0, 1]] - ref_d[:, [1, 0], [0, 1]]).max()) / d_scale
-        assert dev_p <= 1e-9 and dev_d <= 1e-9, (path.name, i, s.occt_construct, dev_p, dev_d)
+        gaps = np.abs(mine[:, [1, 0], [0, 1]] - ref_d[:, [1, 0], [0, 1]]).max(axis=(1, 2)) / d_scale
+        if gaps.max() > 1e-9:  # the two disagree: the 40-digit reference says which is right
+            _surfmod_right(s.surface, uu, vv, mine, ref_d, d_scale, np.argsort(gaps)[-3:], (path.name, i))
+        assert dev_p <= 1e-9, (path.name, i, s.occt_construct, dev_p)
         worst = max(worst, dev_p)
     return worst
+
+
+def _surfmod_right(surface, uu, vv, mine, occ, scale, worst, where):
+    """At the samples ``worst``, surfmod's first partials are within 1e-12 (relative to
+    ``scale``) of the 40-digit reference and OCCT's are farther: a rational face with
+    crowded knots, on which OCCT's quotient rule cancels (ansys_race_car_nose.stp face 51:
+    OCCT 1.8e-9 off, surfmod 5e-16)."""
+    assert isinstance(surface, sm.BSplineSurface), (where, "OCCT and surfmod disagree on a non-B-spline face")
+    for a in worst:
+        d = mp_reference.mp_partials(surface.control_points, surface.weights, surface.degree, surface.knots,
+                                     uu[a], vv[a])
+        ref = np.array([[float(x) for x in d[1, 0]], [float(x) for x in d[0, 1]]])
+        mine_err = np.abs(mine[a, [1, 0], [0, 1]] - ref).max() / scale
+        occ_err = np.abs(occ[a, [1, 0], [0, 1]] - ref).max() / scale
+        assert mine_err <= 1e-12 and mine_err < occ_err, (where, a, mine_err, occ_err)
 
 
 def test_quick_file_faces_evaluate_where_they_live():

@@ -120,6 +120,12 @@ PROMISES = {
         (r"^cam_job\.ngc: \d+ lines, (\d+) tool changes", lambda n: int(n) == 2),
         (r"^GRBL programs \['cam_job_pocket_T1\.nc', 'cam_job_pocket_T2\.nc'\], (\d+) arc words", lambda n: int(n) > 0),
     ],
+    "cam_rest_machining.py": [
+        (rf"^area left thicker than {NUM} mm: {NUM} mm\^2 after finishing, {NUM} mm\^2 after the rest tool",
+         lambda _t, before, after: float(before) > 30 and float(after) <= 0.02 * float(before)),
+        (r"^verified: (\w+)", lambda ok: ok == "True"),
+        (r"^cam_rest_job\.ngc: \d+ lines, (\d+) tool changes", lambda n: int(n) == 3),
+    ],
     "cam_job_viewer.py": [(r"^moves shown (\d+) of (\d+)$", lambda shown, made: int(shown) == int(made) > 0)],
     "conformance_own_evaluator.py": [
         (r"own de Boor conforms: (\w+) ; off by 1e-9 conforms: (\w+)", lambda own, off: own == "True" and off == "False"),

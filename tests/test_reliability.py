@@ -140,9 +140,9 @@ def test_5_the_worker_is_reused_and_the_shape_is_exact():
     from surfmod.occ.step import read_step
 
     first = sm.import_step(SCREW)
-    pid = isolated._WORKER._proc.pid
+    pid = isolated._READER.server.proc.pid
     second = sm.import_step(CORPUS / "cadquery_red_cube_blue_cylinder.step")
-    assert isolated._WORKER._proc.pid == pid
+    assert isolated._READER.server.proc.pid == pid
     assert len(second.solids()) == 2
     # BinTools carries the geometry bit for bit: same vertices as an in-process read
     import build123d as bd

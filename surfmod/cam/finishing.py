@@ -33,7 +33,7 @@ after that is lifted (reported as ``lifted``).
 
 **Links** between contours run along the part when the straight move stays clear of it
 and is short (at most a tool radius across, no more than 1.5 levels down); otherwise the
-tool goes up at the feed to above the stock the roughing can have left (:class:`Rest`),
+tool goes up at the feed to above the stock the roughing can have left (:class:`Leftover`),
 then rapidly to the clearance height, across, down to that height, and enters as the raster
 does (a ball plunges, a flat or bull end helixes).
 
@@ -80,7 +80,7 @@ SPLIT_SLACK = 3
 
 
 @dataclass(frozen=True)
-class Rest:
+class Leftover:
     """What a roughing pass left: over any (x, y) column, stock at most ``above`` higher
     than the part's highest point within ``reach`` of the column (the roughing tool's
     radius plus its allowance: its grown tool stood at every column it could, levels
@@ -103,7 +103,7 @@ def clear_part(part: _Part, tool: Tool) -> _Part:
 class _StockTop:
     """The height above which no stock is left over the finishing tool's footprint."""
 
-    def __init__(self, part: _Part, tool: Tool, rest: Rest | None, stock: np.ndarray, safe: float):
+    def __init__(self, part: _Part, tool: Tool, rest: Leftover | None, stock: np.ndarray, safe: float):
         self.part, self.rest, self.stock, self.safe = part, rest, stock, safe
         self.grid = None if rest is None else TriangleGrid(part.grid.triangles, tool.radius + rest.reach)
 
@@ -500,7 +500,7 @@ def rest_left(part: _Part, tool: Tool, floor: float, threshold: float, spacing: 
 # ----------------------------------------------------------------------------------------------
 
 def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | None, direction: str,
-           steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Rest | None,
+           steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Leftover | None,
            lowest: float | None = None):
     """The finishing :class:`~surfmod.cam.roughing.Motion` (waterline pieces on the steep
     regions, then the raster) and its report; contours no lower than ``lowest`` (where
@@ -571,7 +571,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
 
 
 def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, tolerance: float,
-          stock: np.ndarray, safe: float, rest: Rest | None):
+          stock: np.ndarray, safe: float, rest: Leftover | None):
     """Cross passes over the regions a finishing left too much on: a drop-cutter raster
     across ``direction`` over each box ``(x0, y0, x1, y1)`` grown by the tool radius, each
     entered and left as the finishing's raster is.  Returns the :class:`Motion` (from and

@@ -13,7 +13,8 @@ linking, is checked twice:
   from the disc as a solid cylinder to the part settles it (a bounded number of them).  A narrower shank stands in the column the end's drop-cutter
   already keeps clear of the part;
 - **against the stock**: the operation's moves swept in order through a height-field
-  stock model shared by the job's operations (:func:`surfmod.cam.verify_kernels.sweep_body`):
+  stock model shared by the job's operations (:class:`surfmod.cam.rest.StockModel`, swept
+  by :func:`surfmod.cam.verify_kernels.sweep_body`):
   before each stamp of the cutting end, the stock may stand no higher than a disc's bottom
   within the disc (the shank, even as narrow as the end, meets stock above the flutes in
   front of the tool).
@@ -35,7 +36,6 @@ more cautious check) and stock nodes (at most :data:`MAX_STOCK_NODES`, else coar
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +43,7 @@ import numpy as np
 from ..inputs import upright_cylinder
 from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
+from .rest import StockModel
 from .roughing import PLUNGE, RAPID, Motion, Moves
 from .verify import _probes
 from .verify_kernels import sweep_body, sweep_stock
@@ -74,29 +75,22 @@ class Held:
                 f"(at most {self.thickness:.3g} mm thick), deepest ({x:.4g}, {y:.4g}, {z:.4g})")
 
 
-class StockModel:
-    """The stock as a height field over its box (cells a quarter of the smallest tool
-    radius, at most :data:`MAX_STOCK_NODES` nodes), lowered by each operation's kept moves."""
+def body_stock(stock: np.ndarray, smallest_radius: float) -> StockModel:
+    """The job's stock model the bodies are held against: cells a quarter of the smallest
+    tool radius, at most :data:`MAX_STOCK_NODES` nodes (coarser cells beyond)."""
+    return StockModel(stock, smallest_radius / 4, MAX_STOCK_NODES)
 
-    def __init__(self, stock: np.ndarray, smallest_radius: float):
-        lo, hi = np.asarray(stock, float)
-        cell = smallest_radius / 4
-        span = hi[:2] - lo[:2]
-        if np.prod(np.floor(span / cell) + 1) > MAX_STOCK_NODES:
-            cell = 1.05 * math.sqrt(float(np.prod(span)) / MAX_STOCK_NODES)
-        nx, ny = (np.floor(span / cell).astype(int) + 1)
-        self.top = np.full((int(nx), int(ny)), float(hi[2]))
-        self.origin = (float(lo[0]), float(lo[1]))
-        self.cell = float(cell)
 
-    def sweep(self, moves, rapid, tool, body, slack: float, skip, remove: bool):
-        start, end = np.ascontiguousarray(moves[:-1]), np.ascontiguousarray(moves[1:])
-        m = len(start)
-        discs = np.zeros((1, max(len(body), 1), 2))
-        discs[0, :len(body)] = body[:, :2]
-        return sweep_body(self.top, *self.origin, self.cell, start, end, rapid, np.full(m, tool.radius),
-                          np.full(m, tool.corner), self.cell / 2, discs, np.zeros(m, np.int64), np.array([float(slack)]),
-                          np.zeros(1), skip, remove)
+def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, slack: float, skip: np.ndarray):
+    """``stock`` swept along ``pts`` with the moves whose body meets it (or ``skip``) undone:
+    :func:`~surfmod.cam.verify_kernels.sweep_body`'s ``removed``."""
+    m = len(pts) - 1
+    discs = tool.body[None, :, :2].copy()
+    *_, removed = sweep_body(stock.top, float(stock.lo[0]), float(stock.lo[1]), stock.cell,
+                             np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:]), rapid,
+                             np.full(m, tool.radius), np.full(m, tool.corner), stock.cell / 2, discs,
+                             np.zeros(m, np.int64), np.array([float(slack)]), np.zeros(1), skip, True)
+    return removed
 
 
 def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float, shape=None):
@@ -204,7 +198,7 @@ def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, d
     rapid = motion.kind[1:] == RAPID
     skip = part_sink(triangles, deflection, tool, pts, slack, shape) > 0.0
     before = stock.top.copy()
-    *_, removed = stock.sweep(pts, rapid, tool, tool.body, slack, skip, True)
+    removed = _sweep_body(stock, pts, rapid, tool, slack, skip)
     if not removed.any():
         return motion, None
     kept = relink(motion, removed, safe)
@@ -215,12 +209,13 @@ def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, d
     would = stock.top.copy()
     a, b = pts[:-1][cuts], pts[1:][cuts]
     n = len(a)
-    sweep_stock(would, *stock.origin, stock.cell, np.ascontiguousarray(a), np.ascontiguousarray(b),
-                np.zeros(n, np.bool_), np.full(n, tool.radius), np.full(n, tool.corner), stock.cell / 2)
+    sweep_stock(would, float(stock.lo[0]), float(stock.lo[1]), stock.cell, np.ascontiguousarray(a),
+                np.ascontiguousarray(b), np.zeros(n, np.bool_), np.full(n, tool.radius), np.full(n, tool.corner),
+                stock.cell / 2)
     left = np.minimum(stock.top, before) - would
     over = left > slack
     if not over.any():
         return kept, Held(int(removed.sum()), 0.0, tuple(float(v) for v in b[np.argmin(b[:, 2])]), 0.0)
     i, j = np.unravel_index(int(np.argmin(np.where(over, would, np.inf))), would.shape)
-    deepest = (stock.origin[0] + i * stock.cell, stock.origin[1] + j * stock.cell, float(would[i, j]))
+    deepest = (float(stock.x[i]), float(stock.y[j]), float(would[i, j]))
     return kept, Held(int(removed.sum()), float(over.sum()) * stock.cell ** 2, deepest, float(left[over].max()))

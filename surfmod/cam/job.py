@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -18,16 +19,17 @@ from tqdm import tqdm
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
-from .finishing import Rest, clear_part, finish, recut
-from .holder import StockModel, clear_body
+from .cycle_time import cycle_time, feed_time
+from .finishing import Leftover, clear_part, finish, recut
+from .holder import body_stock, clear_body
+from .machine_table import MACHINE, Machine
+from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_moves, rest_part_top
+from .rest import summary_line as rest_summary
 from .roughing import FEED, RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import _part
 from .verify import verify_job
 
-#: Rapid traverse (mm/min) and tool change time (s) of the time estimate.
-RAPID_RATE = 5000.0
-TOOL_CHANGE_TIME = 8.0
 #: Clearance of links and retracts above the stock (mm).
 CLEARANCE = 5.0
 
@@ -60,16 +62,43 @@ class Finish:
 
 
 @dataclass(frozen=True)
+class Rest:
+    """Rest machining with a smaller ``tool``: it cuts only where the operations ``after``
+    (None: all before it in the job; else their positions in the list, from 0, or the
+    operations themselves) left more than ``scallop`` (default: the last finishing's)
+    plus the tolerance above the part, measured in the job's stock model swept along
+    their moves; its passes are its own drop-cutter rasters clipped to those regions
+    (:mod:`surfmod.cam.rest`).  A tool no smaller than the finishing's is allowed (it
+    still cuts what the stock model shows left where it reaches, e.g. after roughing
+    alone) with a warning.  ``max_points`` bounds the passes' raster locations (and a
+    hundred times it the thickness test's node-triangle pairs)."""
+
+    tool: Tool
+    after: object = None
+    scallop: float | None = None
+    max_points: int = MAX_LOCATIONS
+
+
+@dataclass(frozen=True)
 class Operation:
     """One operation of a :class:`Job`: its ``name``, ``tool`` (numbered, with speeds and
     feeds), ``motion`` (cutter locations and how the tool moves to each), machining
-    ``time_estimate`` (s) and a ``report`` (levels, scallop, rest left...)."""
+    ``time_estimate`` (s: the tool change plus the moves as ``machine`` runs them,
+    :mod:`surfmod.cam.cycle_time`) and a ``report`` (levels, scallop, rest left...);
+    ``feed_time`` is the plain feed-rate sum instead."""
 
     name: str
     tool: Tool
     motion: Motion = field(repr=False)
     time_estimate: float
     report: dict = field(default_factory=dict, repr=False)
+    machine: Machine = field(default=MACHINE, repr=False)
+
+    @property
+    def feed_time(self) -> float:
+        """Seconds as the plain feed-rate sum (every move at its feed from end to end, no
+        acceleration or corner), plus the tool change: what ``time_estimate`` refines."""
+        return feed_time(self.motion, self.tool, self.machine) + self.machine.tool_change
 
     @property
     def moves(self) -> np.ndarray:
@@ -85,6 +114,8 @@ class Operation:
         m, s = divmod(self.time_estimate, 60)
         text = f"{self.name}: {self.tool}, cutting length {self.length:.0f} mm, time {int(m)} min {s:04.1f} s"
         left = left_summary(self.report.get("left")) if self.name == "roughing" else ""
+        if self.name == "rest":
+            left = rest_summary(self.report)
         held = self.report.get("holder")
         text = f"{text}; {left}" if left else text
         return f"{text}; {held}" if held else text
@@ -100,10 +131,17 @@ class Job:
     safe_height: float
     #: what :func:`surfmod.cam.verify.verify_job` found in its LinuxCNC program (None: not verified)
     verification: object = field(default=None, repr=False)
+    #: the machine whose limits the time estimates follow
+    machine: Machine = field(default=MACHINE, repr=False)
 
     @property
     def time_estimate(self) -> float:
         return float(sum(op.time_estimate for op in self.operations))
+
+    @property
+    def feed_time(self) -> float:
+        """The plain feed-rate sum of every operation (see :attr:`Operation.feed_time`)."""
+        return float(sum(op.feed_time for op in self.operations))
 
     def __str__(self) -> str:
         lo, hi = self.stock
@@ -120,15 +158,15 @@ class Job:
 
         return job_png(self)
 
+    def _repr_html_(self) -> str:
+        from .job_view import job_html
 
-def motion_time(motion: Motion, tool: Tool) -> float:
-    """Seconds: rapids at ``RAPID_RATE``, cuts at the tool's feed, ramps at its plunge feed."""
-    if len(motion.points) < 2:
-        return 0.0
-    seg = np.linalg.norm(np.diff(motion.points, axis=0), axis=1)
-    kind = motion.kind[1:]
-    rate = np.where(kind == RAPID, RAPID_RATE, np.where(kind == FEED, tool.feed, tool.plunge_feed))
-    return float((seg / rate).sum() * 60.0)
+        return job_html(self, full_html=False)
+
+
+def operation_time(motion: Motion, tool: Tool, machine: Machine) -> float:
+    """An operation's ``time_estimate``: the tool change plus the moves as ``machine`` runs them."""
+    return machine.tool_change + cycle_time(motion, tool, machine)
 
 
 def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
@@ -150,7 +188,7 @@ def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
     return box
 
 
-def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Rest | None, lowest: float):
+def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float):
     if op.stepover is not None and op.scallop is not None:
         raise SurfmodError("stepover: give either stepover or scallop, not both")
     if op.scallop is None and op.stepover is None:
@@ -186,6 +224,8 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     if found is None or not found.boxes or not finishing:
         return job
     k = max(finishing)
+    if any(o.name == "rest" for o in job.operations[k + 1:]):
+        return job  # the residual judged is the rest tool's, which cross passes of the finishing do not serve
     op, (spec, part, rest) = job.operations[k], finishing[k]
     extra, passes = recut(part, op.tool, found.boxes, stepover=float(op.report["stepover"]), direction=spec.direction,
                           tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest)
@@ -200,7 +240,7 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     report = dict(op.report, recut={"regions": len(found.boxes), "passes": passes, "before": found.worst,
                                     "length": float(seg[extra.kind[1:] != RAPID].sum())})
     ops = list(job.operations)
-    ops[k] = replace(op, motion=motion, time_estimate=motion_time(motion, op.tool) + TOOL_CHANGE_TIME, report=report)
+    ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine), report=report)
     job = replace(job, operations=tuple(ops))
     return replace(job, verification=verify_job(job))
 
@@ -216,15 +256,79 @@ def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape)
     return motion, held
 
 
-def machine(part, stock, operations, *, progress: bool = False, verify: bool = True, strict: bool = False) -> Job:
+def _after(op: Rest, k: int, specs: list) -> list[int]:
+    """The positions of the operations a rest operation at position ``k`` follows."""
+    if k == 0:
+        raise SurfmodError("after: a rest operation needs an operation before it")
+    if op.after is None:
+        return list(range(k))
+    items = list(op.after) if isinstance(op.after, (list, tuple)) else [op.after]
+    out = []
+    for a in items:
+        if isinstance(a, (Rough, Finish, Rest)):
+            idx = next((i for i in range(k) if specs[i] is a), None)
+        elif isinstance(a, (int, np.integer)) and not isinstance(a, bool) and 0 <= a < k:
+            idx = int(a)
+        else:
+            idx = None
+        if idx is None:
+            raise SurfmodError(f"after: expected operations before the rest operation (positions 0..{k - 1} "
+                               f"or the operations themselves), got {a!r}")
+        out.append(idx)
+    if not out:
+        raise SurfmodError("after: give at least one operation before the rest operation")
+    return sorted(set(out))
+
+
+def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: np.ndarray, safe: float, held):
+    """The rest operation's motion and report (:mod:`surfmod.cam.rest`); ``held`` clears
+    its moves of shank and holder collisions (:func:`_held`)."""
+    after = _after(op, k, specs)
+    cutting = [done[i] for i in after if done[i].name != "roughing"]
+    if op.scallop is not None:
+        scallop = checks.positive(op.scallop, "scallop")
+    elif cutting:
+        scallop = float(cutting[-1].report["scallop"])
+    else:
+        raise SurfmodError("scallop: give the rest operation's scallop (no finishing before it)")
+    stepover = tool.stepover_for_scallop(scallop)  # a scallop >= the radius raises here
+    smallest = min((o.tool.radius for o in cutting), default=None)
+    if smallest is not None and tool.radius >= smallest:
+        warnings.warn(f"rest: {tool} is no smaller than the tools before it (r={smallest:g}): it cuts only what "
+                      f"the stock model shows left where it reaches", UserWarning, stacklevel=3)
+    tolerance = scallop / 10
+    part = clear_part(_part(shape, tool.cutter, tolerance), tool)
+    cell = max(min([stepover] + [float(o.report["stepover"]) for o in cutting]) / 4, 1e-3)
+    model = StockModel(stock, cell)
+    for i in after:
+        model.sweep(done[i].motion, done[i].tool)
+    part_top = rest_part_top(part, model)
+    threshold = scallop + tolerance + model.sag
+    pairs = op.max_points * PAIRS_PER_POINT
+    mask, before = left_over(model, part_top, part, threshold, pairs)
+    motion, info = rest_moves(part, tool, model, mask, stepover=stepover, tolerance=tolerance, safe=safe,
+                              max_points=op.max_points)
+    motion, kept_out = held(motion, part, tolerance)
+    model.sweep(motion, tool)
+    _, left = left_over(model, part_top, part, threshold, pairs)
+    report = dict(info, after=after, scallop=scallop, stepover=stepover, tolerance=tolerance, threshold=threshold,
+                  cell=model.cell, before=before, left=left, deflection=part.deflection, holder=kept_out)
+    if model.note:
+        report["note"] = model.note
+    return motion, report
+
+
+def machine(part, stock, operations, *, progress: bool = False, verify: bool = True,
+            machine: Machine = MACHINE, strict: bool = False) -> Job:
     """Machine ``part`` (a build123d shape, STEP path or surfmod surfaces) from ``stock``
     (a margin in mm, or a box ``[[x0, y0, z0], [x1, y1, z1]]`` holding the part) by
-    ``operations`` in order (:class:`Rough`, :class:`Finish`); tools without a number get
+    ``operations`` in order (:class:`Rough`, :class:`Finish`, :class:`Rest`); tools without a number get
     1, 2, ... in that order, and speeds and feeds from their diameter.  Roughing clears the
     stock down to the part plus its allowance (:mod:`surfmod.cam.roughing`); finishing is
     the gouge-checked drop-cutter path (:func:`surfmod.toolpath`) plus waterline contours on
     the steep regions, with the rest it cannot reach reported
-    (:mod:`surfmod.cam.finishing`).
+    (:mod:`surfmod.cam.finishing`); rest machining cuts with a smaller tool where the
+    job's stock model shows more than the scallop left (:mod:`surfmod.cam.rest`).
 
     Above the flutes a tool does not cut: every move whose shank or holder
     (:attr:`Tool.body <surfmod.cam.tool.Tool.body>`) would touch the part or the stock is
@@ -238,13 +342,19 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     rapids through stock or part, the scallop left); where the scallop is broken, cross
     passes over those regions are added to the finishing (its ``report["recut"]``) and the
     job is judged again.  ``job.verification`` holds what was found last,
-    ``job.verification.ok`` whether every promise holds."""
+    ``job.verification.ok`` whether every promise holds.
+
+    ``machine`` (a :class:`~surfmod.cam.machine_table.Machine`: axis velocities and
+    accelerations, rapid rate, corner blending, tool change) is what the operations'
+    ``time_estimate`` follow (:mod:`surfmod.cam.cycle_time`); by default a small hobby mill."""
     from ..occ.properties import bounding_box
 
     shape = to_shape(part, "part")
     ops = list(operations) if isinstance(operations, (list, tuple)) else [operations]
-    if not ops or not all(isinstance(o, (Rough, Finish)) for o in ops):
-        raise SurfmodError("operations: expected a list of sm.Rough / sm.Finish")
+    if not isinstance(machine, Machine):
+        raise SurfmodError(f"machine: expected a surfmod Machine, got {type(machine).__name__}")
+    if not ops or not all(isinstance(o, (Rough, Finish, Rest)) for o in ops):
+        raise SurfmodError("operations: expected a list of sm.Rough / sm.Finish / sm.Rest")
     wrong = next((o.tool for o in ops if not isinstance(o.tool, Tool)), None)
     if wrong is not None:
         raise SurfmodError(f"tool: expected a surfmod Tool, got {type(wrong).__name__}")
@@ -255,7 +365,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     safe = float(stock[1, 2] + CLEARANCE)
     strict = bool(strict)
     # the stock model the shanks and holders are held against, shared by the operations
-    stock_model = StockModel(stock, min(o.tool.radius for o in ops))
+    stock_model = body_stock(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
     numbers = {}
     with tqdm(total=2 * len(ops), desc="machine", unit="stage", disable=not progress) as bar:
@@ -280,8 +390,14 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape)
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
-                rest = Rest(tool.radius + allowance, allowance + stepdown + p.lift)
+                rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift)
                 name = "roughing"
+            elif isinstance(op, Rest):
+                bar.update()
+                motion, report = _rest(shape, op, tool, k, ops, done, stock, safe,
+                                       lambda m, part, tol: _held(m, tool, stock_model, part, tol, safe, strict,
+                                                                  "rest machining", shape))
+                name = "rest"
             else:
                 if op.scallop is not None:
                     tool.stepover_for_scallop(op.scallop)  # scallop >= radius etc. raise here
@@ -295,8 +411,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 report["holder"] = held
                 name = "finishing"
             bar.update()
-            done.append(Operation(name, tool, motion, motion_time(motion, tool) + TOOL_CHANGE_TIME, report))
-    job = Job(shape, stock, tuple(done), safe)
+            done.append(Operation(name, tool, motion, operation_time(motion, tool, machine), report, machine))
+    job = Job(shape, stock, tuple(done), safe, machine=machine)
     if verify:
         job = _recut(replace(job, verification=verify_job(job)), finishing, stock_model)
     return job

@@ -169,6 +169,19 @@ def parse_tool(text: str, name: str = "tool") -> Tool:
     return Tool(parts[0], *numbers)
 
 
+def read_table(path, name: str, what: str) -> tuple[Path, object]:
+    """The file ``path`` and what it holds, read as TOML (suffix ``.toml``) or else JSON: the
+    tool table's and the machine table's reader; a missing or unreadable file is refused
+    naming the argument ``name``."""
+    p = Path(path)
+    if not p.is_file():
+        raise SurfmodError(f"{name}: no such file {str(path)!r}")
+    try:
+        return p, tomllib.loads(p.read_text()) if p.suffix.lower() == ".toml" else json.loads(p.read_text())
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise SurfmodError(f"{name}: {p.name} is not a {what}: {exc}") from None
+
+
 def load_tool_table(path) -> dict[int, Tool]:
     """Tools by number from a TOML (``[[tool]]`` tables) or JSON (``{"tool": [...]}``) file;
     each entry has ``number``, ``kind``, ``radius`` and optionally ``corner_radius``,
@@ -181,13 +194,7 @@ def load_tool_table(path) -> dict[int, Tool]:
     >>> load_tool_table(p)[3].spindle
     18000.0
     """
-    p = Path(path)
-    if not p.is_file():
-        raise SurfmodError(f"tools: no such file {str(path)!r}")
-    try:
-        data = tomllib.loads(p.read_text()) if p.suffix.lower() == ".toml" else json.loads(p.read_text())
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise SurfmodError(f"tools: {p.name} is not a tool table: {exc}") from None
+    p, data = read_table(path, "tools", "tool table")
     entries = data.get("tool") if isinstance(data, dict) else None
     if not isinstance(entries, list):
         raise SurfmodError(f"tools: {p.name} has no list of [[tool]] entries")

@@ -22,7 +22,8 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
 - **stock**: a height field over the stock box, a cell a quarter of the finishing
   stepover wide, from which each feed removes what the tool's lower surface sweeps, in
   the program's order.  A rapid whose tool goes below the stock's top there runs through
-  material;
+  material.  The stock left is kept with the verdict (``Verification.stock``, a
+  :class:`~surfmod.cam.stock_field.StockField`), which the job view draws;
 - **holder and shank**: above its flutes a tool does not cut (:attr:`Tool.body
   <surfmod.cam.tool.Tool.body>`): along every move, its discs wider than the end dropped
   onto the part's points (grown by half the probes' spacing) and, in the stock sweep
@@ -62,6 +63,7 @@ from ..inputs import to_shape
 from ..readback.trimmed import from_face
 from . import verify_kernels as K
 from .program import ProgramMoves, concatenate, read_program
+from .stock_field import KEPT_NODES, StockField
 
 #: points on the part, probes along the moves and stock nodes one verification may take
 MAX_SAMPLES = 30_000_000
@@ -129,6 +131,9 @@ class Verification:
     notes: tuple = field(default=())
     #: probes of the holder and shank check (their own cap, ``MAX_BODY_PROBES``)
     body_probes: int = 0
+    #: the stock after the program (:class:`~surfmod.cam.stock_field.StockField`, at most
+    #: ``KEPT_NODES`` nodes; None for a tool path alone)
+    stock: StockField | None = field(default=None, repr=False, compare=False)
 
     @property
     def ok(self) -> bool:
@@ -527,17 +532,13 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         probes += n
         if found.worst > rapid_part.worst:
             rapid_part = found
-    finishing = [p for p in plans if p[1].name == "finishing"]
+    # the residual is judged after the last finishing or rest operation, with its tool
+    finishing = [p for p in plans if p[1].name in ("finishing", "rest")]
     stepover = min((float(p[1].report.get("stepover") or p[1].tool.radius) for p in finishing),
                    default=min(op.tool.radius for op in job.operations))
-    cell = max(stepover / 4, 1e-3)
     lo, hi = np.asarray(job.stock, float)
-    nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
-    if nx * ny > max_nodes:  # a stock too large for the cells the stepover asks: coarser cells, said
-        wanted, cell = cell, cell * 1.05 * math.sqrt(nx * ny / max_nodes)
-        nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
-        notes.append(f"note: stock cells {cell:.3g} mm, coarser than the {wanted:.3g} the stepover asks "
-                     f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
+    cell, nx, ny, note = stock_cells(job.stock, max(stepover / 4, 1e-3), max_nodes)
+    notes += [note] if note else []
     top = np.full((nx, ny), float(hi[2]))
     radii = np.array([job.operations[k].tool.radius for k in owner], float)
     corners = np.array([job.operations[k].tool.corner for k in owner], float)
@@ -589,10 +590,31 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         found, walls, held = _residual(part, top, lo, cell, op, cutter, limit)
         findings.append(found)
         if held:
-            notes.append(f"note: residual: {held:,} nodes the shank or holder keeps the finishing tool from, "
+            notes.append(f"note: residual: {held:,} nodes the shank or holder keeps the {op.name} tool from, "
                          f"not judged (the holder finding and the operation's report say what is left)")
+    # the part under each node as the residual reads it: its highest point within the cell
+    kept = StockField.over_part(top, lambda xy: part.drop(xy, 0.75 * cell, 0.0), lo[:2], cell, WALL_SLOPE,
+                                KEPT_NODES)
     return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes),
-                        body_probes)
+                        stock=kept, body_probes=body_probes)
+
+
+def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
+    """The height-field stock's grid over the box ``stock``: ``(cell, nx, ny, note)``,
+    nodes ``lo + cell * (i, j)``; where ``cell`` would give more than ``max_nodes`` nodes
+    the cells are coarser and ``note`` says so (else None).
+
+    >>> stock_cells([[0, 0, 0], [10, 5, 2]], 0.5)[1:]
+    (21, 11, None)
+    """
+    lo, hi = np.asarray(stock, float)
+    nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
+    if nx * ny <= max_nodes:
+        return cell, nx, ny, None
+    wanted, cell = cell, cell * 1.05 * math.sqrt(nx * ny / max_nodes)
+    nx, ny = (int(math.floor((hi[i] - lo[i]) / cell)) + 1 for i in range(2))
+    return cell, nx, ny, (f"note: stock cells {cell:.3g} mm, coarser than the {wanted:.3g} the stepover asks "
+                          f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
 
 
 def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):

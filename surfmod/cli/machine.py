@@ -1,4 +1,5 @@
-"""``surfmod machine PART.step --out JOB.ngc --stock-margin M --rough flat:R --finish ball:R --scallop S``."""
+"""``surfmod machine PART.step --out JOB.ngc --stock-margin M --rough flat:R --finish ball:R --scallop S
+[--rest ball:r]``."""
 
 from __future__ import annotations
 
@@ -7,7 +8,8 @@ from dataclasses import replace
 
 from ..atomic import target_path
 from ..cam.finishing import summary_lines
-from ..cam.job import Finish, Rough, machine
+from ..cam.job import Finish, Rest, Rough, machine
+from ..cam.machine_table import MACHINE, load_machine_table
 from ..cam.post import POSTS, SUFFIXES, export_job, program_paths, programs
 from ..cam.tool import load_tool_table, parse_tool
 from ..cam.verify import verify_job
@@ -28,11 +30,18 @@ def register(sub) -> None:
     p.add_argument("--rough", required=True, help="roughing tool flat:R, ball:R or bull:R:r (tool 1)")
     p.add_argument("--finish", required=True, help="finishing tool flat:R, ball:R or bull:R:r (tool 2)")
     p.add_argument("--scallop", type=float, required=True, help="finishing scallop height (mm)")
+    p.add_argument("--rest", help="rest machining tool flat:R, ball:R or bull:R:r (tool 3): cuts only where the "
+                                  "finishing left more than the scallop (a tool no smaller than the finishing's: "
+                                  "a warning)")
     p.add_argument("--stepdown", type=float, help="roughing level spacing (default the rough tool radius)")
     p.add_argument("--allowance", type=float, default=0.5, help="material roughing leaves on the part (mm)")
     p.add_argument("--post", default="linuxcnc", help=f"post-processor: {', '.join(POSTS)}")
-    p.add_argument("--tools", help="tool table (TOML or JSON) giving tool 1 and 2 their flutes, speeds, feeds")
+    p.add_argument("--tools", help="tool table (TOML or JSON) giving tools 1, 2 (and 3) their flutes, speeds, feeds")
     p.add_argument("--png", help="picture of the moves over the shaded part")
+    p.add_argument("--machine", help="machine table (TOML [machine] or JSON): axis velocities and accelerations, "
+                                     "rapid rate, blend tolerance, tool change time of the time estimate")
+    p.add_argument("--html", help="the job in the browser: part, moves per operation, stock left (one file, "
+                                  "no network needed)")
     p.add_argument("--no-verify", action="store_true",
                    help="skip reading the program back and judging it against the exact part and the stock "
                         "(faster; the program's header says it was not verified)")
@@ -66,9 +75,13 @@ def run(args) -> int:
     target_path(args.out, "out", SUFFIXES)
     if args.png:
         target_path(args.png, "png", (".png",))
+    if args.html:
+        target_path(args.html, "html", (".html", ".htm"))
     table = load_tool_table(args.tools) if args.tools else {}
+    mill = load_machine_table(args.machine) if args.machine else MACHINE
     rough_tool = _tool(args.rough, 1, table, "rough")
     finish_tool = _tool(args.finish, 2, table, "finish")
+    rest_tool = _tool(args.rest, 3, table, "rest") if args.rest else None
     if args.stepdown is not None and not args.stepdown > 0:
         raise SurfmodError(f"stepdown: must be > 0, got {args.stepdown:g}")
     if not args.scallop > 0:
@@ -76,15 +89,18 @@ def run(args) -> int:
     if args.scallop >= finish_tool.radius:
         raise SurfmodError(f"scallop: {args.scallop:g} must be smaller than the finishing tool radius "
                            f"{finish_tool.radius:g}")
+    if rest_tool is not None and args.scallop >= rest_tool.radius:
+        raise SurfmodError(f"scallop: {args.scallop:g} must be smaller than the rest tool radius {rest_tool.radius:g}")
     if not args.allowance >= 0:
         raise SurfmodError(f"allowance: must be >= 0, got {args.allowance:g}")
     if args.stock_margin is not None and not args.stock_margin >= 0:
         raise SurfmodError(f"stock_margin: must be >= 0, got {args.stock_margin:g}")
     shape = to_shape(args.path, "path", solid=True)
     stock = args.stock_margin if args.stock is None else [args.stock[:3], args.stock[3:]]
-    job = machine(shape, stock, [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
-                                 Finish(finish_tool, scallop=args.scallop)], progress=not args.no_progress,
-                  verify=not args.no_verify, strict=args.strict)
+    ops = [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
+           Finish(finish_tool, scallop=args.scallop)] + ([Rest(rest_tool)] if rest_tool is not None else [])
+    job = machine(shape, stock, ops, progress=not args.no_progress, verify=not args.no_verify,
+                  machine=mill, strict=args.strict)
     texts = programs(job, args.post)  # any refusal before a file is written
     program_paths(args.out, job, args.post)
     if args.no_verify:
@@ -99,13 +115,20 @@ def run(args) -> int:
         from ..cam.picture import write_png
 
         write_png(job, args.png)
+    if args.html:
+        from ..cam.job_view import write_html
+
+        write_html(job, args.html)
     print(job)
+    if args.machine:  # the limits the time estimates below follow
+        print(f"  {job.machine}")
     for op in job.operations:
-        print(f"  {op.name}: length {op.length:.1f} mm, time estimate {op.time_estimate:.1f} s, tool {op.tool}")
+        print(f"  {op.name}: length {op.length:.1f} mm, time estimate {op.time_estimate:.1f} s "
+              f"(feed-rate sum {op.feed_time:.1f} s), tool {op.tool}")
         if op.name == "finishing":
             for line in summary_lines(op.report):
                 print(f"    {line}")
-    for p in written + ([args.png] if args.png else []):
+    for p in written + [path for path in (args.png, args.html) if path]:
         print(f"wrote {p}")
     if job.verification is not None and not job.verification.ok:
         broken = [f.what for f in job.verification.findings if not f.ok]

@@ -38,7 +38,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import derivative_nets
 from .basis import reciprocal_table, span_buckets
+from .rational import surface_quotient
 from .scattered import basis_at, scattered
 from .tensor_grid import tensor_grid
 from .threads import numba_threads, running_on, threads_for
@@ -156,6 +158,8 @@ def prepare(knots_u, p: int, knots_v, q: int, hctrl: np.ndarray, points=None, we
                    reciprocal_table(ku, p, n), reciprocal_table(kv, q, m),
                    span_buckets(ku, p, n), span_buckets(kv, q, m), {})
     centre = None if points is None else far_centre(points)
+    if points is not None and weights is not None:  # the derivative nets difference them
+        net.cache["cartesian"] = (np.asarray(points, float), np.asarray(weights, float))
     if centre is not None:
         net.cache["centred"] = net._replace(ctrl=homogeneous4(moved_homogeneous(points, weights, centre)), cache={},
                                             origin=centre)
@@ -309,8 +313,11 @@ def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndar
     :data:`COMPILED_SCATTERED` partials, else the per-span patches (positions, or
     partials to order 1 or 2, on a net that suits them), else the basis-function kernel;
     a compiled one on the threads :func:`_kernel` picks.  ``positions``: ``(N, 3)``
-    positions instead of ``(N, K, K, 3)`` partials."""
+    positions instead of ``(N, K, K, 3)`` partials.  Partials of a net with crowded
+    knots come from its derivative nets (:func:`_from_derivative_nets`)."""
     u, v = writable(u), writable(v)
+    if not positions and order > 0 and _crowded(net):
+        return _store(_from_derivative_nets(net, order, lambda d: surface_points(d, u, v)), out)
     net = _centred(net)
     if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
         h = scattered(*net[:4], net.ctrl, net.rational, u, v, order)
@@ -338,6 +345,80 @@ def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndar
             run(*head, net.rational, *tail)
         else:
             run(*head, int(order), net.rational, _kernels().binomials(order), *tail)
+    return out
+
+
+def _store(h: np.ndarray, out):
+    """``h``, or ``h`` written into ``out`` when given."""
+    if out is None:
+        return h
+    out[...] = h
+    return out
+
+
+def _crowded(net: LocalNet) -> bool:
+    """Whether the net's knots are crowded (:func:`surfmod.eval.derivative_nets.crowded`),
+    known once per net."""
+    known = net.cache.get("crowded")
+    if known is None:
+        known = net.cache["crowded"] = derivative_nets.crowded(net.knots_u, net.p, net.knots_v, net.q)
+    return known
+
+
+def _from_derivative_nets(net: LocalNet, order: int, positions) -> np.ndarray:
+    """Partials ``(..., K, K, 3)`` of ``net`` from its derivative nets
+    (:mod:`surfmod.eval.derivative_nets`), each evaluated as positions by
+    ``positions(LocalNet) -> (..., 3)``; the nets are built once per net and order.
+
+    A polynomial net's derivative nets are the differences of its own poles (a
+    difference of neighbouring poles is exact, and the centring of :func:`prepare`
+    would round them first); its positions are the net's own.  A rational net's are the
+    differences of the homogeneous net about its centre, the weights apart, and the
+    quotient rule puts them together."""
+    key = ("derivative_nets", order)
+    nets = net.cache.get(key)
+    if nets is None:
+        nets = net.cache[key] = _derivative_local_nets(net, order)
+    kk = order + 1
+    if not net.rational:
+        first = positions(net)
+        h = np.zeros(first.shape[:-1] + (kk, kk, 3))
+        h[..., 0, 0, :] = first
+        for (k, l), (xyz, _) in nets.items():
+            h[..., k, l, :] = positions(xyz)
+        return h
+    h = None
+    for (k, l), (xyz, w) in nets.items():
+        a = positions(xyz)
+        if h is None:
+            h = np.zeros(a.shape[:-1] + (kk, kk, 4))
+        h[..., k, l, :3] = a
+        h[..., k, l, 3] = positions(w)[..., 0]
+    out = surface_quotient(h)
+    _add_origin(_centred(net), out[..., 0, 0, :])
+    return out
+
+
+def _derivative_local_nets(net: LocalNet, order: int) -> dict:
+    """``{(k, l): (xyz, w)}``: each derivative net as polynomial :class:`LocalNet` s, the
+    homogeneous coordinates and (rational nets) the weights in a net of their own
+    (``w`` None for a polynomial net, whose own positions are ``(0, 0)``)."""
+    base = _centred(net) if net.rational else net
+    cartesian = net.cache.get("cartesian")
+    if cartesian is not None:
+        cartesian = cartesian + (np.zeros(3) if base.origin is None else base.origin,)
+    nets = derivative_nets.derivative_nets(base.knots_u, base.p, base.knots_v, base.q,
+                                           base.ctrl if net.rational else base.ctrl[..., :3], order, cartesian)
+    if net.rational:
+        nets[0, 0] = (base.knots_u, base.p, base.knots_v, base.q, base.ctrl)
+    out = {}
+    for kl, (ku, p, kv, q, poles) in nets.items():
+        weights = None
+        if net.rational:
+            weights = np.zeros(poles.shape[:2] + (3,))
+            weights[..., 0] = poles[..., 3]
+            weights = prepare(ku, p, kv, q, weights)
+        out[kl] = (prepare(ku, p, kv, q, np.ascontiguousarray(poles[..., :3])), weights)
     return out
 
 
@@ -416,11 +497,14 @@ def surface_grid(net: LocalNet, us, vs, order: int, out=None) -> np.ndarray:
     rows), the u-points in ascending order (unsorted ones are sorted, and their rows
     put back in place).
     """
-    net = _centred(net)
-    knots_u, p, knots_v, q, ctrl, rational = net[:6]
     us, vs = writable(us), writable(vs)
     kk = order + 1
     shape = (us.size, vs.size, kk, kk, 3)
+    if order > 0 and _crowded(net):
+        h = _from_derivative_nets(net, order, lambda d: surface_grid(d, us, vs, 0)[:, :, 0, 0])
+        return _store(h, None if out is None else out.reshape(shape))
+    net = _centred(net)
+    knots_u, p, knots_v, q, ctrl, rational = net[:6]
     if us.size * vs.size * (order + 1) ** 2 < COMPILED_GRID:
         h = tensor_grid(knots_u, p, knots_v, q, ctrl, rational, us, vs, order)
         _add_origin(net, h[:, :, 0, 0])

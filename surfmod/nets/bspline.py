@@ -14,7 +14,7 @@ import numpy as np
 from .. import checks, transforms
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..eval import local
+from ..eval import derivative_nets, local
 from ..eval.basis import basis_matrix
 from ..eval.rational import curve_quotient
 from ..eval.tensor import curve_derivatives
@@ -96,7 +96,16 @@ class BSplineCurve(Curve):
 
     def _derivatives(self, t, order):
         centre, net = self._centred or (None, self._homogeneous)
-        h = curve_derivatives(self.knots, self.degree, net, t, order)
+        if order > 0 and derivative_nets.crowded(self.knots, self.degree, [0.0, 1.0], 0):
+            # crowded knots: each derivative from its derivative net (eval/derivative_nets.py)
+            cartesian = None if self.weights is None else (self.control_points, self.weights,
+                                                           np.zeros(3) if centre is None else centre)
+            h = derivative_nets.curve_from_nets(self.knots, self.degree, net if self.rational else
+                                                  self._homogeneous, t, order, cartesian)
+            if centre is not None and not self.rational:
+                h[:, 0] = curve_derivatives(self.knots, self.degree, net, t, 0)[:, 0]
+        else:
+            h = curve_derivatives(self.knots, self.degree, net, t, order)
         out = curve_quotient(h) if self.rational else h
         if centre is not None:
             out[:, 0] += centre

@@ -3,70 +3,43 @@ caller down.
 
 OCCT's STEP reader dereferences whatever the file says: a deleted line, a flipped byte or
 a NaN coordinate can make it crash with SIGSEGV or loop forever, and neither can be caught
-inside the process.  So the reading happens in one long-lived worker process (started on
-first use, reused afterwards, so the normal case pays the interpreter start once):
+inside the process.  So the reading happens in one long-lived :class:`surfmod.child.Server`
+(started on first use, reused afterwards, so the normal case pays the interpreter start
+once; its start, OCCT's import included, overlaps the caller's own and is not charged to a
+file's time limit):
 
-* the parent sends the path; the worker reads the file, checks that every coordinate of
-  the shape is finite and of sane size, and sends the shape back as OCCT binary BRep bytes
-  (``BinTools``), or the reason it refused;
-* if the worker dies (a crash in OCCT) or does not answer within the time limit (it is
-  then killed), the parent raises :class:`~surfmod.errors.DamagedFileError` naming the
-  file, and starts a fresh worker on the next call.
+* the child reads the file, checks that every coordinate of the shape is finite and of
+  sane size, and returns the shape as OCCT binary BRep bytes (``BinTools``), or raises
+  the reason it refused;
+* if the child dies (a crash in OCCT) or does not answer within the time limit (it is
+  then killed), :func:`read_step_file` raises :class:`~surfmod.errors.DamagedFileError`
+  naming the file, and the next read starts a fresh child.
 
-The worker is a plain ``python -m surfmod.occ.isolated`` subprocess talking over its
-stdin and a private copy of its stdout (OCCT's own messages go to /dev/null), so it works
-from threads, from joblib/loky workers and from daemon processes alike.
+The child is the plain ``python -m surfmod.child`` process of :mod:`surfmod.child`, so it
+works from threads, from joblib/loky workers and from daemon processes alike, and it dies
+with its parent.
 """
 
 from __future__ import annotations
 
 import atexit
 import os
-import pickle
-import select
 import signal
-import struct
-import subprocess
-import sys
 import threading
-import time
 import warnings
-from pathlib import Path
 
 from .. import checks
+from ..child import ChildFailure, Server
 from ..errors import DamagedFileError, InsideOutWarning, SurfmodError
 
-_HEADER = struct.Struct("!Q")
+
+def _load_occt() -> int:
+    """The reader child's warm-up: OCCT's STEP reader imported before the first file."""
+    from . import step  # noqa: F401
+
+    return os.getpid()
 
 
-def _send(fh, obj) -> None:
-    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
-    fh.write(_HEADER.pack(len(data)) + data)
-    fh.flush()
-
-
-def _recv_exact(fd: int, size: int, deadline: float | None) -> bytes:
-    """``size`` bytes from ``fd``; ``EOFError`` when the writer died, ``TimeoutError`` past ``deadline``."""
-    chunks, left = [], size
-    while left:
-        if deadline is not None:
-            wait = deadline - time.monotonic()
-            if wait <= 0 or not select.select([fd], [], [], wait)[0]:
-                raise TimeoutError
-        chunk = os.read(fd, min(left, 1 << 20))
-        if not chunk:
-            raise EOFError
-        chunks.append(chunk)
-        left -= len(chunk)
-    return b"".join(chunks)
-
-
-def _recv(fd: int, deadline: float | None):
-    (size,) = _HEADER.unpack(_recv_exact(fd, _HEADER.size, deadline))
-    return pickle.loads(_recv_exact(fd, size, deadline))
-
-
-# -- the worker side ------------------------------------------------------------------------
 def _read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
     """Read ``path`` with OCCT, check its coordinates, return the shape as BinTools bytes
     and what the model says of its solids' orientation: those inside out in the file,
@@ -83,131 +56,53 @@ def _read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
     return brep_bytes(shape), (turned, at_odds)
 
 
-def _worker_main() -> None:
-    """Serve read requests from stdin until it closes."""
-    reply = os.fdopen(os.dup(1), "wb")
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)  # OCCT prints banners to stdout: keep them off the protocol
-    requests = sys.stdin.buffer.fileno()
-    from . import step  # noqa: F401  (load OCCT before the first request)
-
-    _send(reply, ("ready", os.getpid()))
-    while True:
-        try:
-            path, max_coordinate = _recv(requests, None)
-        except EOFError:
-            return
-        try:
-            _send(reply, ("ok", *_read_and_check(path, max_coordinate)))
-        except SurfmodError as exc:
-            msg = str(exc)  # every refusal names the file (a kernel failure names its operation)
-            _send(reply, ("error", type(exc).__name__, msg if path in msg else f"path: {path}: {msg}"))
-        except Exception as exc:  # noqa: BLE001 - a reader fault must reach the parent as text, not kill the loop
-            _send(reply, ("error", "KernelError", f"path: reading {path} failed ({type(exc).__name__}: {exc})"))
-
-
-# -- the parent side ------------------------------------------------------------------------
-class _Worker:
-    """One reusable reader process; ``read`` is serialized by a lock."""
+class _Reader:
+    """The reader child of this process, one read at a time (a lock: threads share it);
+    a forked process starts its own rather than share its parent's."""
 
     def __init__(self) -> None:
-        self._proc: subprocess.Popen | None = None
-        self._ready = False
-        self._owner = -1
-        self._lock = threading.Lock()
+        self.server = Server(warmup=(_load_occt, ()))
+        self.owner = os.getpid()
+        self.lock = threading.Lock()
 
-    def _spawn(self) -> None:
-        """Start a worker without waiting for it (it imports OCCT meanwhile)."""
-        root = str(Path(__file__).resolve().parents[2])  # the folder holding the surfmod package
-        env = dict(os.environ)
-        env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-        self._proc = subprocess.Popen(
-            [sys.executable, "-m", "surfmod.occ.isolated"],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL,
-            env=env,
-            close_fds=True,
-        )
-        self._ready = False
+    def _own(self) -> None:
+        if self.owner != os.getpid():  # forked: the parent's child is not this process's to use or kill
+            self.server.proc, self.owner = None, os.getpid()
 
-    def prestart(self) -> None:
-        """Spawn the worker now if none runs, so its start overlaps the caller's own
-        imports; ``read`` waits for it."""
-        with self._lock:
-            if self._owner != os.getpid():  # a forked child must not share the parent's worker
-                self._proc, self._owner = None, os.getpid()
-            if self._proc is None or self._proc.poll() is not None:
-                self._spawn()
-
-    def _wait_ready(self) -> None:
-        proc = self._proc
-        try:
-            kind = _recv(proc.stdout.fileno(), time.monotonic() + 120.0)[0]
-        except (EOFError, TimeoutError):
-            kind = None
-        if kind != "ready":
-            self._proc = None
-            self._kill(proc)
-            raise DamagedFileError("STEP reader: the reader process did not start")
-        self._ready = True
-
-    @staticmethod
-    def _kill(proc: subprocess.Popen) -> None:
-        if proc.poll() is None:
-            proc.kill()
-        proc.wait()
-        for fh in (proc.stdin, proc.stdout):
-            try:
-                fh.close()
-            except OSError:
-                pass
-
-    def close(self) -> None:
-        proc, self._proc = self._proc, None
-        if proc is not None and self._owner == os.getpid():
-            try:
-                proc.stdin.close()  # the worker exits on EOF
-                proc.wait(timeout=2)
-            except (OSError, subprocess.TimeoutExpired):
-                pass
-            self._kill(proc)
+    def start(self) -> None:
+        with self.lock:
+            self._own()
+            self.server.start()
 
     def read(self, path: str, timeout: float, max_coordinate: float) -> tuple[bytes, list]:
-        with self._lock:
-            if self._owner != os.getpid():  # a forked child must not share the parent's worker
-                self._proc, self._owner = None, os.getpid()
-            if self._proc is None or self._proc.poll() is not None:
-                self._spawn()
-            if not self._ready:  # the start is not charged to the file's time limit
-                self._wait_ready()
-            deadline = time.monotonic() + timeout
-            proc = self._proc
+        with self.lock:
+            self._own()
             try:
-                _send(proc.stdin, (path, max_coordinate))
-                answer = _recv(proc.stdout.fileno(), deadline)
-            except TimeoutError:
-                self._proc = None
-                self._kill(proc)
-                raise DamagedFileError(
-                    f"path: reading {path} did not finish within {timeout:g} s; the reader was stopped "
-                    "(a damaged file can make OCCT loop; raise timeout= for a huge file)"
-                ) from None
-            except (EOFError, BrokenPipeError, OSError):
-                self._proc = None
-                self._kill(proc)
-                code = proc.returncode
+                return self.server.call(_read_and_check, (path, max_coordinate), timeout, f"reading {path}")
+            except ChildFailure as exc:
+                if exc.cause == "deadline":
+                    raise DamagedFileError(
+                        f"path: reading {path} did not finish within {timeout:g} s; the reader was stopped "
+                        "(a damaged file can make OCCT loop; raise timeout= for a huge file)") from None
+                if "the child's start" in str(exc):
+                    raise DamagedFileError("STEP reader: the reader process did not start") from None
+                code = exc.returncode
                 how = f"signal {signal.Signals(-code).name}" if code and code < 0 else f"exit code {code}"
-                raise DamagedFileError(
-                    f"path: OCCT crashed reading {path} ({how}); the file is damaged"
-                ) from None
-        if answer[0] == "ok":
-            return answer[1], answer[2]
-        raise DamagedFileError(answer[2])  # answer = ("error", exception type, message)
+                raise DamagedFileError(f"path: OCCT crashed reading {path} ({how}); the file is damaged") from None
+            except SurfmodError as exc:
+                msg = str(exc)  # every refusal names the file (a kernel failure names its operation)
+                raise DamagedFileError(msg if path in msg else f"path: {path}: {msg}") from None
+            except Exception as exc:  # noqa: BLE001 - any reader fault is the file's, named
+                raise DamagedFileError(f"path: reading {path} failed ({type(exc).__name__}: {exc})") from None
+
+    def close(self) -> None:
+        with self.lock:
+            if self.owner == os.getpid():
+                self.server.close()
 
 
-_WORKER = _Worker()
-atexit.register(_WORKER.close)
+_READER = _Reader()
+atexit.register(_READER.close)
 
 
 #: default time limit of one read: a base plus an allowance per megabyte of file
@@ -247,11 +142,11 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
         raise SurfmodError(f"{name}: {p} is not a STEP file (not a readable STEP header: ISO-10303-21 missing)")
     if timeout is None:
         timeout = TIMEOUT_BASE + TIMEOUT_PER_MB * p.stat().st_size / 1e6
-    _WORKER.prestart()  # the worker imports OCCT while this process does the same
+    _READER.start()  # the child imports OCCT while this process does the same
     from .step import brep_from_bytes
 
     try:
-        data, (turned, at_odds) = _WORKER.read(str(p), timeout, max_coordinate)
+        data, (turned, at_odds) = _READER.read(str(p), timeout, max_coordinate)
     except DamagedFileError as exc:
         msg = str(exc)
         raise DamagedFileError(msg if msg.startswith(f"{name}:") else f"{name}: {msg.removeprefix('path: ')}") from None
@@ -271,8 +166,4 @@ def stop_worker() -> None:
 
     >>> stop_worker()
     """
-    _WORKER.close()
-
-
-if __name__ == "__main__":
-    _worker_main()
+    _READER.close()

@@ -1,0 +1,103 @@
+"""The stock after a program as the verifier swept it (:func:`surfmod.cam.verify.verify_job`):
+a height field over the stock box and, node by node, how much material stands on the part.
+
+The verifier keeps it with its verdict (``job.verification.stock``), so that what is
+pictured (:mod:`surfmod.cam.job_view`) is what was judged, not a second simulation.  It
+holds at most ``KEPT_NODES`` nodes: a finer field is kept as the maxima over square blocks
+of nodes (the highest stock, the most left), so nothing left is lost from sight.
+
+>>> top = np.array([[1.0, 1.0, 1.0], [1.0, 1.5, 1.0], [1.0, 1.0, 1.0]])
+>>> def level_part(xy):  # at height 0, but for the node (2, 0)
+...     return np.where((xy[:, 0] == 2) & (xy[:, 1] == 0), -np.inf, 0.0)
+>>> field = StockField.over_part(top, level_part, (0.0, 0.0), 1.0, 80.0)
+>>> field.left.tolist()  # NaN off the part and beside its outline (no slope there)
+[[1.0, 1.0, 1.0], [nan, 1.5, 1.0], [nan, nan, 1.0]]
+>>> small = field.coarsened(4)
+>>> small.top.tolist(), small.left.tolist(), small.origin, small.cell
+([[1.5, 1.0], [1.0, 1.0]], [[1.5, 1.0], [nan, 1.0]], (0.5, 0.5), 2.0)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import checks
+
+#: nodes a kept field holds at most (two float arrays: 16 MB)
+KEPT_NODES = 1_000_000
+
+
+@dataclass(frozen=True)
+class StockField:
+    """``top`` (nx, ny): the stock's height at the nodes ``origin + cell * (i, j)``;
+    ``left``: the material above the part there, measured along the part's normal (the
+    height over the part times the cosine of its slope), NaN off the part and on walls
+    the height field cannot see."""
+
+    top: np.ndarray
+    left: np.ndarray
+    origin: tuple
+    cell: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "top", checks.frozen(self.top))
+        object.__setattr__(self, "left", checks.frozen(self.left))
+
+    @classmethod
+    def over_part(cls, top: np.ndarray, height, origin, cell: float, wall_slope: float,
+                  max_nodes: int = KEPT_NODES) -> "StockField":
+        """The field of ``top`` over a part whose height under points ``xy`` (N, 2) is
+        ``height(xy)`` (-inf where there is none), at most ``max_nodes`` nodes (see
+        :meth:`coarsened`); nodes steeper than ``wall_slope`` degrees are walls."""
+        nx, ny = np.shape(top)
+        gx, gy = np.meshgrid(origin[0] + cell * np.arange(nx), origin[1] + cell * np.arange(ny), indexing="ij")
+        under = np.asarray(height(np.column_stack([gx.ravel(), gy.ravel()])), float).reshape(nx, ny)
+        part = np.where(np.isfinite(under), under, np.nan)
+        if min(part.shape) >= 2:
+            gx, gy = np.gradient(part, cell)
+            cos = 1.0 / np.sqrt(1.0 + gx * gx + gy * gy)  # NaN beside the part's outline too
+        else:
+            cos = np.where(np.isfinite(part), 1.0, np.nan)
+        wall = ~(cos > math.cos(math.radians(wall_slope)))
+        left = np.where(wall, np.nan, np.maximum(top - part, 0.0) * cos)
+        return cls(*_pooled(np.asarray(top, float), left, (float(origin[0]), float(origin[1])), float(cell),
+                            max_nodes))
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.origin[0] + self.cell * np.arange(self.top.shape[0])
+
+    @property
+    def y(self) -> np.ndarray:
+        return self.origin[1] + self.cell * np.arange(self.top.shape[1])
+
+    def coarsened(self, max_nodes: int) -> "StockField":
+        """At most ``max_nodes`` nodes: the maxima over blocks of ``f x f`` nodes (``f`` the
+        least that fits), each standing at its block's centre."""
+        nx, ny = self.top.shape
+        return self if nx * ny <= max_nodes else StockField(*_pooled(self.top, self.left, self.origin, self.cell,
+                                                                     max_nodes))
+
+
+def _pooled(top: np.ndarray, left: np.ndarray, origin: tuple, cell: float, max_nodes: int) -> tuple:
+    """``(top, left, origin, cell)`` at most ``max_nodes`` nodes: the maxima over blocks
+    of ``f x f`` nodes (``f`` the least that fits), each standing at its block's centre."""
+    nx, ny = top.shape
+    f = max(1, math.ceil(math.sqrt(nx * ny / max(int(max_nodes), 1))))
+    while math.ceil(nx / f) * math.ceil(ny / f) > max_nodes:
+        f += 1  # the ceilings of the block counts can pass the square root's guess
+    if f == 1:
+        return top, left, origin, cell
+    shift = 0.5 * (f - 1) * cell
+    return _block_max(top, f), _block_max(left, f), (origin[0] + shift, origin[1] + shift), cell * f
+
+
+def _block_max(a: np.ndarray, f: int) -> np.ndarray:
+    """Maxima over ``f x f`` blocks (the last ones cut short), NaN where a block is all NaN."""
+    nx, ny = a.shape
+    filled = np.pad(np.where(np.isnan(a), -np.inf, a), ((0, -nx % f), (0, -ny % f)), constant_values=-np.inf)
+    out = filled.reshape(filled.shape[0] // f, f, filled.shape[1] // f, f).max(axis=(1, 3))
+    return np.where(np.isneginf(out), np.nan, out)
