@@ -126,6 +126,15 @@ PROMISES = {
         (r"^verified: (\w+)", lambda ok: ok == "True"),
         (r"^cam_rest_job\.ngc: \d+ lines, (\d+) tool changes", lambda n: int(n) == 3),
     ],
+    "cam_holder.py": [
+        # the 12 x 12 floor (144 mm^2) left by the short tool, down to the floor at z = -3
+        (rf"^short tool, \w+: floor left {NUM} mm\^2, deepest z {NUM}",
+         lambda area, z: 100 < float(area) <= 144 and -3.0 <= float(z) < -2.6),
+        (r"^short tool verified: (\w+)", lambda ok: ok == "True"),
+        (rf"^long tool: nothing held back: (\w+), lowest cut in the pocket z {NUM}",
+         lambda held, z: held == "True" and abs(float(z) + 3.0) < 0.01),
+        (r"^long tool verified: (\w+)", lambda ok: ok == "True"),
+    ],
     "cam_job_viewer.py": [(r"^moves shown (\d+) of (\d+)$", lambda shown, made: int(shown) == int(made) > 0)],
     "conformance_own_evaluator.py": [
         (r"own de Boor conforms: (\w+) ; off by 1e-9 conforms: (\w+)", lambda own, off: own == "True" and off == "False"),
