@@ -179,3 +179,17 @@ def test_close_calls_settled_exactly():
     assert part_sink(triangles, deflection, tool, hover, 0.01, part)[0] == -np.inf
     into = hover - [0.0, 0.0, 1.5 * deflection]  # the holder's bottom a deflection below z = 10
     assert part_sink(triangles, deflection, tool, into, 0.01, part)[0] > 0
+
+
+def test_rest_machining_is_held_too(tmp_path):
+    """The rest ball in the same short holder finds the floor left and would go there: its
+    moves are held back as well, reported, and none of them written collides."""
+    rough, finish = tools(4.0, 0.0)
+    small = sm.Tool("ball", 0.75, flute_length=4.0, shank_length=0.0, holder_radius=HOLDER, holder_length=20.0)
+    job = sm.machine(pocket(), 0.0, [sm.Rough(rough, stepdown=2.0, allowance=0.3), sm.Finish(finish, scallop=0.05),
+                                     sm.Rest(small)], verify=False)
+    rest = job.operations[2]
+    assert rest.name == "rest" and rest.report["holder"] is not None and rest.report["holder"].moves > 0
+    prog = written(job, tmp_path)
+    moves = [m for m in prog.moves if m.tool == 3]
+    assert moves and not any(holder_hits(m.a, m.b, HOLDER, 4.0) for m in moves)
