@@ -10,19 +10,18 @@ linking, is checked twice:
   disc at every point between) and its bottom at the lowest height within half a spacing;
   the mesh's deflection is added to the heights found (the exact faces lie at most that
   far above the mesh), and where only that margin flags a move, OCCT's exact distance
-  from the disc as a solid cylinder to the part settles it (a bounded number of them).  A narrower shank stands in the column the end's drop-cutter
-  already keeps clear of the part;
+  from the disc as a solid cylinder to the part settles it (a bounded number of them).
+  A narrower shank stands in the column the end's drop-cutter already keeps clear of
+  the part;
 - **against the stock**: the operation's moves swept in order through a height-field
-  stock model shared by the job's operations (:class:`surfmod.cam.rest.StockModel`, swept
-  by :func:`surfmod.cam.verify_kernels.sweep_body`):
-  before each stamp of the cutting end, the stock may stand no higher than a disc's bottom
-  within the disc (the shank, even as narrow as the end, meets stock above the flutes in
-  front of the tool).
+  stock model shared by the job's operations (:class:`surfmod.cam.rest.StockModel`,
+  swept by :func:`surfmod.cam.verify_kernels.sweep_body`): before each stamp of the
+  cutting end, the stock may stand no higher than a disc's bottom within the disc (the
+  shank, even as narrow as the end, meets stock above the flutes in front of the tool).
 
 A disc may rub sideways within the operation's tolerance (its radius is taken that much
 smaller: the end's own side comes that near a wall), but never stand lower than the part
-or the stock under it.
-A move that fails either check is removed: the tool retracts to the clearance height,
+or the stock under it.  A move that fails either check is removed: the tool retracts to the clearance height,
 crosses, and comes straight down at the plunge feed onto the start of the next move kept
 (a flat or bull end must cut at its centre there: the stock the removed moves leave is
 not what the operation's own ramps and helices were laid out for).  What the removed moves
@@ -190,32 +189,32 @@ def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, d
                safe: float, shape=None):
     """``(motion, held)``: ``motion`` swept through ``stock`` with the moves whose shank or
     holder would touch the part (``triangles``, and ``shape`` for the close calls) or the
-    stock removed and relinked (:func:`relink`), and what that leaves (:class:`Held`, None
-    when nothing is removed)."""
+    stock removed and relinked (:func:`relink`), and what that leaves (:class:`Held`; None
+    where nothing more than the tolerance is left, the links replaced included)."""
     pts = np.asarray(motion.points, float)
     if len(pts) < 2:
         return motion, None
     rapid = motion.kind[1:] == RAPID
     skip = part_sink(triangles, deflection, tool, pts, slack, shape) > 0.0
-    before = stock.top.copy()
     removed = _sweep_body(stock, pts, rapid, tool, slack, skip)
     if not removed.any():
         return motion, None
     kept = relink(motion, removed, safe)
-    # what the removed cuts would have taken beyond the stock the kept moves leave
+    # what the removed cuts would have taken beyond the stock the kept moves leave (links
+    # replaced by the relinking leave nothing)
     cuts = removed & ~rapid
     if not cuts.any():
-        return kept, Held(int(removed.sum()), 0.0, tuple(pts[1:][removed][0]), 0.0)
+        return kept, None
     would = stock.top.copy()
     a, b = pts[:-1][cuts], pts[1:][cuts]
     n = len(a)
     sweep_stock(would, float(stock.lo[0]), float(stock.lo[1]), stock.cell, np.ascontiguousarray(a),
                 np.ascontiguousarray(b), np.zeros(n, np.bool_), np.full(n, tool.radius), np.full(n, tool.corner),
                 stock.cell / 2)
-    left = np.minimum(stock.top, before) - would
+    left = stock.top - would
     over = left > slack
-    if not over.any():
-        return kept, Held(int(removed.sum()), 0.0, tuple(float(v) for v in b[np.argmin(b[:, 2])]), 0.0)
+    if not over.any():  # the moves left out would have taken no more than the tolerance
+        return kept, None
     i, j = np.unravel_index(int(np.argmin(np.where(over, would, np.inf))), would.shape)
     deepest = (float(stock.x[i]), float(stock.y[j]), float(would[i, j]))
     return kept, Held(int(removed.sum()), float(over.sum()) * stock.cell ** 2, deepest, float(left[over].max()))
