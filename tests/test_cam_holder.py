@@ -8,6 +8,7 @@ tests' own G-code reader, :mod:`stock_sim`), not the package's checks.
 """
 
 import json
+from dataclasses import replace
 
 import build123d as bd
 import numpy as np
@@ -19,6 +20,7 @@ from surfmod.cli import main
 from surfmod.cam.drop_cutter import part_triangles
 from surfmod.cam.holder import part_sink
 from surfmod.cam.tool import load_tool_table
+from surfmod.cam.verify import verify_job
 
 TOP, FLOOR, HALF, BLOCK = 5.0, -3.0, 6.0, 12.0
 HOLDER = 7.0
@@ -49,17 +51,22 @@ def long_job():
     return job_for(10.0, 1.0)
 
 
-def holder_hits(a, b, radius, bottom_above_tip):
-    """Exact: does a flat-bottomed cylinder of ``radius`` at ``bottom_above_tip`` over the
-    tip, moved from ``a`` to ``b``, meet the block's top face (the square of half width
-    BLOCK less the open pocket of half width HALF) from below its top?  Checked at points
-    0.01 mm apart along the move (each position exactly)."""
+def holder_depth(a, b, radius, bottom_above_tip):
+    """Exact: how far below the block's top face (the square of half width BLOCK less the
+    open pocket of half width HALF) a flat-bottomed cylinder of ``radius`` at
+    ``bottom_above_tip`` over the tip stands where it overlaps the face, moved from ``a``
+    to ``b`` (-inf where it never overlaps); each position exactly, 0.01 mm apart."""
     n = int(np.ceil(np.linalg.norm(b - a) / 0.01)) + 1
     p = a + np.linspace(0, 1, n)[:, None] * (b - a)
-    low = p[:, 2] + bottom_above_tip < TOP - 1e-6
     inside_pocket = (np.abs(p[:, 0]) + radius <= HALF) & (np.abs(p[:, 1]) + radius <= HALF)
     gap = np.hypot(np.maximum(np.abs(p[:, 0]) - BLOCK, 0), np.maximum(np.abs(p[:, 1]) - BLOCK, 0))
-    return bool(np.any(low & ~inside_pocket & (gap < radius)))
+    over = ~inside_pocket & (gap < radius)
+    return float(np.max(TOP - (p[over, 2] + bottom_above_tip), initial=-np.inf))
+
+
+def holder_hits(a, b, radius, bottom_above_tip):
+    """Does the cylinder stand below the block's top face anywhere along the move?"""
+    return holder_depth(a, b, radius, bottom_above_tip) > 1e-6
 
 
 def written(job, tmp_path):
@@ -193,3 +200,21 @@ def test_rest_machining_is_held_too(tmp_path):
     prog = written(job, tmp_path)
     moves = [m for m in prog.moves if m.tool == 3]
     assert moves and not any(holder_hits(m.a, m.b, HOLDER, 4.0) for m in moves)
+
+
+def test_verifier_finds_a_holder_too_low(short_job, tmp_path):
+    """The short job's program judged as if the holder sat 2 mm lower on the tools (flutes
+    of 2 mm): the moves whose holder cleared the block's top by a hair now stand 2 mm into
+    it, and the verifier says so for each operation."""
+    lower = [replace(op, tool=replace(op.tool, flute_length=2.0)) for op in short_job.operations]
+    v = verify_job(replace(short_job, operations=tuple(lower)))
+    held = [f for f in v.findings if f.what.startswith("holder")]
+    assert len(held) == 2 and not any(f.ok for f in held)
+    prog = written(short_job, tmp_path)
+    for f, op in zip(held, short_job.operations):
+        # the exact depth on the box, of the moves as written, with the lower holder
+        exact = max(holder_depth(m.a, m.b, HOLDER, 2.0) for m in prog.moves if m.tool == op.tool.number)
+        assert 1.0 < exact <= 2.0 + 1e-3  # the tips kept stand at z >= 1 where the holder overlaps
+        # the verifier's probes grow the disc by half their spacing: as deep or a little deeper
+        assert exact - 1e-3 <= f.worst <= exact + 0.05, (str(f), exact)
+        assert f.where is not None and f.line > 0
