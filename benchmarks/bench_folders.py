@@ -21,6 +21,7 @@ its task when the peak does not grow with the number of files.
 ``python -m benchmarks folders``                   N = 50 (then 100): a few minutes on 2 cores
 ``python -m benchmarks folders --files 10000``     the ten-thousand-file run (then 20,000)
 ``python -m benchmarks folders --files 500 --no-double``   one size only
+``python -m benchmarks folders --files 10000 --no-double --modes dask``   the cluster alone
 """
 
 from __future__ import annotations
@@ -145,21 +146,26 @@ def _options(argv):
     parser = argparse.ArgumentParser(prog="python -m benchmarks folders", add_help=False)
     parser.add_argument("--files", type=int, default=FILES, help=f"files in the folder (default {FILES})")
     parser.add_argument("--no-double", action="store_true", help="skip the run of twice as many files")
+    parser.add_argument("--modes", default="jobs,dask", help="runs to make: jobs, dask or both (default jobs,dask)")
     opts, _ = parser.parse_known_args(argv)
     if opts.files < 1:
         raise SystemExit(f"--files: expected a positive count, got {opts.files}")
-    return opts.files, not opts.no_double
+    modes = [m.strip() for m in opts.modes.split(",") if m.strip()]
+    if not modes or any(m not in ("jobs", "dask") for m in modes):
+        raise SystemExit(f"--modes: expected jobs, dask or jobs,dask, got {opts.modes!r}")
+    return opts.files, not opts.no_double, modes
 
 
 def main(argv=None) -> None:
-    count, double = _options(sys.argv[1:] if argv is None else argv)
+    count, double, modes = _options(sys.argv[1:] if argv is None else argv)
     if not corpus_files():
         print(f"no corpus file at {CORPUS}")
         return
     sizes = [count, 2 * count] if double else [count]
-    note(f"surfmod check DIR: {WORKERS} local processes (--jobs {WORKERS}) against a local Dask cluster of "
-         f"{WORKERS} workers, one thread each (--scheduler); the folder links the {len(corpus_files())} corpus "
-         "files in turn; rows to a CSV; each run in a fresh process (NUMBA_NUM_THREADS and OMP_NUM_THREADS 1 "
+    runs = {"jobs": f"{WORKERS} local processes (--jobs {WORKERS})",
+            "dask": f"a local Dask cluster of {WORKERS} workers, one thread each (--scheduler)"}
+    note(f"surfmod check DIR: {' against '.join(runs[m] for m in modes)}; the folder links the "
+         f"{len(corpus_files())} corpus files in turn; rows to a CSV; each run in a fresh process (NUMBA_NUM_THREADS and OMP_NUM_THREADS 1 "
          "unless set); peak and end memory per worker tree (worker, task child, STEP reader)")
     table = Table(("run", 22, "<"), ("files", 6), ("faces", 7), ("not passed", 10), ("seconds", 8),
                   ("files/min", 9), ("start s", 7), ("peak worker MiB", 15), ("end MiB", 8), ("exit", 4))
@@ -170,6 +176,8 @@ def main(argv=None) -> None:
             folder = Path(tmp) / f"folder{n}"
             build_folder(folder, n)
             for mode, name in (("jobs", f"--jobs {WORKERS}"), ("dask", f"--scheduler ({WORKERS} workers)")):
+                if mode not in modes:
+                    continue
                 r = results[mode, n] = _run(mode, folder, Path(tmp) / f"{mode}{n}.csv")
                 peak = max(w["peak"] for w in r["workers"]) / MIB
                 end = max(w["now"] for w in r["workers"]) / MIB
@@ -177,13 +185,13 @@ def main(argv=None) -> None:
                 table.row(name, str(r["files"]), str(r["faces"]), str(r["failed"]), f"{r['seconds']:.1f}",
                           f"{60 * n / r['seconds']:.0f}", f"{r['start']:.1f}", f"{peak:.0f}", f"{end:.0f}",
                           str(r["code"]))
-    for n in sizes:
+    for n in sizes if len(modes) == 2 else ():
         r_jobs, r_dask = results["jobs", n], results["dask", n]
         note(f"{n} files: the cluster checks {r_dask['seconds'] / r_jobs['seconds']:.2f}x as long as --jobs "
              f"{WORKERS} ({60 * n / r_dask['seconds']:.0f} against {60 * n / r_jobs['seconds']:.0f} files/min).")
     if double:
         growth = ", ".join(f"{name} {results[mode, 2 * count]['peak'] / results[mode, count]['peak']:.2f}x"
-                           for mode, name in (("jobs", "--jobs"), ("dask", "cluster")))
+                           for mode, name in (("jobs", "--jobs"), ("dask", "cluster")) if mode in modes)
         note(f"Peak worker memory at {2 * count} files over the peak at {count}: {growth} (1.00x: a file's shapes "
              "are freed after its task; memory that grew with the files would show here).")
 

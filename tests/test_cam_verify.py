@@ -12,14 +12,18 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import build123d as bd
 import numpy as np
 import pytest
+from stock_sim import Cutter, Stock, parse_gcode, simulate
 
 import surfmod as sm
 from surfmod.cam import verify as V
+from surfmod.cam.job import _relink
+from surfmod.cam.roughing import PLUNGE, RAPID, Motion
 from surfmod.cam.program import read_program
 from surfmod.cam.post import programs
 from surfmod.cli import main
@@ -258,3 +262,31 @@ def test_a_low_rib_along_the_raster_is_recut_and_both_judges_agree():
     simulated = float(((stock.top - reach) * cos)[judged].max())
     assert simulated <= residual.limit + 0.005, simulated
     assert abs(simulated - residual.worst) < 0.01, (simulated, residual.worst)
+
+
+def test_a_rapid_through_the_stock_is_relinked_over_it(job):
+    """A rapid across the uncut block (the roughing's motion doctored as the issue's
+    keyboard case came out) is found, then re-linked by sm.machine's repair: up to the safe
+    height, across, down at the plunge feed; judged again, every promise holds, and the
+    tests' own stock simulation of the new program sees no rapid remove material."""
+    rough = job.operations[0]
+    pts, kind = rough.motion.points, rough.motion.kind
+    first = int(np.argmax(kind != RAPID))  # the rapids before the first cut stay above the stock
+    low = np.array([[-11.0, -11.0, 7.0], [11.0, 11.0, 7.0]])
+    doctored = Motion(np.insert(pts, first, low, axis=0), np.insert(kind, first, [RAPID, RAPID]))
+    bad = replace(job, operations=(replace(rough, motion=doctored),) + job.operations[1:])
+    bad = replace(bad, verification=V.verify_job(bad))
+    rapids = _finding(bad.verification, "rapids")
+    assert not rapids.ok and len(rapids.segments) >= 1 and rapids.worst == pytest.approx(0.5, abs=1e-9)
+    fixed = _relink(bad)
+    assert fixed.verification.ok, fixed.verification.lines()
+    op = fixed.operations[0]
+    assert op.report["relinked"] == len(rapids.segments) and "re-linked over it" in str(op)
+    # the doctored rapid's end is now reached from straight above, at the plunge feed
+    at = int(np.flatnonzero(np.all(op.motion.points == low[1], axis=1))[0])
+    assert op.motion.kind[at] == PLUNGE and op.motion.kind[at - 1] == RAPID
+    assert np.allclose(op.motion.points[at - 1], [11.0, 11.0, fixed.safe_height])
+    program = parse_gcode(programs(fixed)[0])
+    cutters = {o.tool.number: Cutter(o.tool.kind, o.tool.radius) for o in fixed.operations}
+    report = simulate(program, cutters, Stock(fixed.stock, 0.25))
+    assert report.rapid_cut <= 1e-6, report

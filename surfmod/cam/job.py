@@ -25,7 +25,7 @@ from .holder import body_stock, clear_body
 from .machine_table import MACHINE, Machine
 from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_moves, rest_part_top
 from .rest import summary_line as rest_summary
-from .roughing import FEED, RAPID, Motion, left_summary, rough
+from .roughing import FEED, PLUNGE, RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import _part
 from .verify import verify_job
@@ -116,6 +116,8 @@ class Operation:
         left = left_summary(self.report.get("left")) if self.name == "roughing" else ""
         if self.name == "rest":
             left = rest_summary(self.report)
+        if self.report.get("relinked"):  # rapids the verification found in stock, taken over it
+            left = "; ".join(filter(None, [left, f"{self.report['relinked']} rapid(s) through stock re-linked over it"]))
         held = self.report.get("holder")
         text = f"{text}; {left}" if left else text
         return f"{text}; {held}" if held else text
@@ -254,6 +256,42 @@ def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape)
         raise SurfmodError(f"strict: the {name} with {tool}: {held} (a longer tool: flute_length, shank_length; "
                            f"a narrower holder; or strict=False to leave it)")
     return motion, held
+
+
+#: how far (mm) a move the verifier read from the program may lie from the motion it was
+#: written from: the posts write 4 decimals
+PROGRAM_ROUNDING = 1e-3
+
+
+def _relink(job: Job) -> Job:
+    """One round of repair: every rapid the verification found running through stock is
+    re-linked over it (up to the job's safe height, across, and down to where it was
+    going at the tool's plunge feed), and the job is judged again.  A rapid the program
+    holds but no operation's motion does (none today) is left, and its verdict stands."""
+    found = next((f for f in job.verification.findings if f.what == "rapids" and f.segments), None)
+    if found is None:
+        return job
+    ops, relinked = list(job.operations), 0
+    for k in sorted({seg[0] for seg in found.segments}):
+        pts, kind = ops[k].motion.points, ops[k].motion.kind
+        ends = [np.asarray(seg[1:], float) for seg in found.segments if seg[0] == k]
+        into = [i for i in range(1, len(pts)) if kind[i] == RAPID
+                and any(np.abs(pts[i - 1] - a).max() <= PROGRAM_ROUNDING and np.abs(pts[i] - b).max() <= PROGRAM_ROUNDING
+                        for a, b in ends)]
+        if not into:
+            continue
+        for i in reversed(into):  # each rapid into point i becomes up, across, down
+            above = np.array([[pts[i - 1, 0], pts[i - 1, 1], job.safe_height], [pts[i, 0], pts[i, 1], job.safe_height]])
+            pts, kind = np.insert(pts, i, above, axis=0), np.insert(kind, i, [RAPID, RAPID])
+            kind[i + 2] = PLUNGE
+        motion, op = Motion(pts, kind), ops[k]
+        ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine),
+                         report=dict(op.report, relinked=len(into)))
+        relinked += len(into)
+    if not relinked:
+        return job
+    job = replace(job, operations=tuple(ops))
+    return replace(job, verification=verify_job(job))
 
 
 def _after(op: Rest, k: int, specs: list) -> list[int]:
@@ -414,5 +452,5 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
             done.append(Operation(name, tool, motion, operation_time(motion, tool, machine), report, machine))
     job = Job(shape, stock, tuple(done), safe, machine=machine)
     if verify:
-        job = _recut(replace(job, verification=verify_job(job)), finishing, stock_model)
+        job = _relink(_recut(replace(job, verification=verify_job(job)), finishing, stock_model))
     return job

@@ -51,7 +51,7 @@ repair and the verdict sample the part once.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import ndimage
@@ -103,6 +103,9 @@ class Finding:
     line: int = 0
     #: the (x, y) boxes ``(x0, y0, x1, y1)`` of the connected regions beyond the limit
     boxes: tuple = ()
+    #: the moves beyond the limit as ``(operation, start, end)`` (rapids through stock:
+    #: what :func:`surfmod.cam.job.machine` re-links)
+    segments: tuple = ()
 
     @property
     def ok(self) -> bool:
@@ -575,10 +578,13 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     if len(through) and through[k] > stock_hit:
         i, j = divmod(int(node[k]), ny)
         where = (float(lo[0] + i * cell), float(lo[1] + j * cell), float(top[i, j]))
-        stock = Finding("rapids", float(through[k]), 0.0, where, int((through > stock_hit).sum()), int(moves.line[k]))
+        hits = np.flatnonzero(through > stock_hit)
+        segments = tuple((int(owner[h]), tuple(map(float, moves.start[h])), tuple(map(float, moves.end[h])))
+                         for h in hits)
+        stock = Finding("rapids", float(through[k]), 0.0, where, hits.size, int(moves.line[k]), segments=segments)
     else:
         stock = Finding("rapids", -np.inf, 0.0)
-    findings.append(max(stock, rapid_part, key=lambda f: f.worst))
+    findings.append(replace(max(stock, rapid_part, key=lambda f: f.worst), segments=stock.segments))
     findings += held
     uncut = ~moves.rapid & ~moves.spindle & (np.linalg.norm(moves.end - moves.start, axis=1) > 0)
     if uncut.any():
