@@ -1,5 +1,5 @@
 """``surfmod machine PART.step --out JOB.ngc --stock-margin M --rough flat:R --finish ball:R --scallop S
-[--rest ball:r]``."""
+[--rest ball:r] [--strict]``."""
 
 from __future__ import annotations
 
