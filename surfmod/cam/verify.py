@@ -37,7 +37,7 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   tool reaches.  A height field cannot see a wall: nodes steeper than ``WALL_SLOPE`` and a
   band one cell wide at the part's outline are counted, not judged; so are the nodes the
   shank or holder keeps the tool from (the whole tool's reach, from its discs' drops,
-  above the end's).
+  above the end's), and a tool radius round them.
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
 (points on the part, probes along the moves, stock nodes); where it would pass its cap the
@@ -450,8 +450,8 @@ def _body_part(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, tool, sl
         if near.any():
             depth[near] = np.maximum(depth[near], part.drop(probes[near, :2], r - slack + used / 2, 0.0) - (low[near] + h))
     k = int(np.argmax(depth))
-    if not depth[k] > -np.inf:
-        return Finding(what, -np.inf, limit), len(probes)
+    if not depth[k] > 0:
+        return Finding(what, float(depth[k]), limit), len(probes)
     return Finding(what, float(depth[k]), limit, tuple(float(v) for v in probes[k]),
                    len(np.unique(move[depth > limit])), int(moves.line[idx[move[k]]])), len(probes)
 
@@ -638,7 +638,12 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
         stand = tips.copy()
         for r, h in body:
             stand = np.maximum(stand, part.drop(xy, r, 0.0).reshape(nx, ny) - h)
-        held = np.isfinite(reach) & (K.closing(stand, cell, cutter.radius, cutter.corner) > reach + limit)
+        held = K.closing(stand, cell, cutter.radius, cutter.corner) > reach + limit
+        # the job leaves out whole moves, judged with some caution: a tool's footprint
+        # round what the holder keeps it from is not judged either
+        n = int(cutter.radius / cell)
+        ii, jj = np.mgrid[-n:n + 1, -n:n + 1]
+        held = ndimage.binary_dilation(held, structure=ii ** 2 + jj ** 2 <= n * n) & np.isfinite(reach)
     # the part under each node (the highest of its points within the node's cell), and the
     # outline: a node whose neighbours are not all over the part is not judged
     under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
