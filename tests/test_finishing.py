@@ -14,8 +14,10 @@ import pytest
 from stock_sim import RS274, Cutter, Stock, normal_residual, parse_canon, part_height, reachable, run_rs274, simulate
 
 import surfmod as sm
+from surfmod.cam import waterline as waterline_module
 from surfmod.cam.finishing import summary_lines
 from surfmod.cam.roughing import FEED, PLUNGE, RAPID
+from surfmod.errors import SurfmodError
 
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")
@@ -245,3 +247,33 @@ def test_featuretype_waterline_follows_notches_instead_of_lifting(corpus_dir):
     assert wl["split"] > 0  # the notches are there: pieces had gouging chords
     assert rep["lifted"] <= rep["tolerance"] and wl["lifted"] <= rep["tolerance"], rep["lifted"]
     assert rep["gouge"] + rep["deflection"] <= rep["tolerance"]
+
+
+def test_a_big_part_spreads_the_waterline_fibers_to_fit_the_cap(monkeypatch):
+    """Issue 36: a metre-size part was refused with "choose a coarser sampling", an option
+    `surfmod machine` does not have.  Where fibers half a radius apart over all levels
+    would pass the waterline's cap, the finishing spreads them (up to a radius) and says
+    so; where even a radius does not fit, it refuses naming the scallop, which the
+    command has.  The cap is lowered here so that a small part meets it."""
+    part = bd.Box(20, 20, 5) + bd.Pos(0, 0, 4) * bd.Cylinder(5, 3)
+    tool = sm.Tool("ball", 1.0)
+    seen, count = [], waterline_module.fiber_pairs
+
+    def spy(tri, radius, sampling, levels):  # the triangles and radius the finishing counts with
+        seen.append((tri, radius, levels))
+        return count(tri, radius, sampling, levels)
+
+    monkeypatch.setattr(waterline_module, "fiber_pairs", spy)
+    free = sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False).operations[0].report["waterline"]
+    assert "sampling" not in free
+    tri, radius, tri_levels = seen[0]
+    # a cap between what fibers half a radius and a radius apart need
+    cap = math.sqrt(count(tri, radius, tool.radius / 2, tri_levels) * count(tri, radius, tool.radius, tri_levels))
+    monkeypatch.setattr(waterline_module, "MAX_PAIRS", cap)
+    job = sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False)
+    w = job.operations[0].report["waterline"]
+    assert tool.radius / 2 < w["sampling"] <= tool.radius and w["levels"] == tri_levels
+    assert any("spread from half the tool radius" in line for line in summary_lines(job.operations[0].report))
+    monkeypatch.setattr(waterline_module, "MAX_PAIRS", 10)
+    with pytest.raises(SurfmodError, match=r"^scallop: the waterline's \d+ levels .* choose a larger scallop"):
+        sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False)

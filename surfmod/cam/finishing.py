@@ -60,7 +60,7 @@ from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
 from .tool import Tool
 from .toolpath import REFINE_SHARE, _Part, raster_path
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
-from .waterline import ContourPoints, waterline
+from .waterline import ContourPoints, fiber_pairs, sampling_within, waterline
 
 #: Steep regions: slopes within this many degrees below the threshold count too (the
 #: classification samples the drop-cutter surface, the raster's slope bound its triangles).
@@ -292,7 +292,18 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     if not len(levels):
         return [], info
     grown = tool.cutter.grown(g)
-    sampling = tool.radius / 2
+    # fibers half a radius apart, spread up to a radius (a contour round any feature is
+    # a tool wide, so fibers a radius apart still meet it) where a big part's fibers over
+    # all its levels would pass the waterline's cap; beyond that the scallop (which spaces
+    # the levels) or the tool must change, and the refusal names the command's --scallop
+    sampling = sampling_within(tri, grown.radius, tool.radius / 2, len(levels), tool.radius)
+    if sampling is None:
+        raise SurfmodError(f"scallop: the waterline's {len(levels)} levels {spacing:.3g} mm apart on this part's "
+                           f"{len(tri):,} triangles pass its cap even with fibers a tool radius apart "
+                           f"(about {fiber_pairs(tri, grown.radius, tool.radius, len(levels)):.3g} fiber-triangle "
+                           f"pairs); choose a larger scallop or a larger finishing tool")
+    if sampling > tool.radius / 2:
+        info["sampling"] = sampling
     loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord)
     contour = None  # built at the first gouging chord (most parts have none)
     allowed = tolerance - part.deflection + part.lift
@@ -644,7 +655,9 @@ def summary_lines(report: dict) -> list[str]:
                      f"{w['contours']} contours, length {w['length']:.0f} mm"
                      + (f", {w['split']} chords split at the contour where they would cut the part"
                         if w.get("split") else "")
-                     + (" (the flutes reach no lower)" if w.get("flute_limited") else ""))
+                     + (" (the flutes reach no lower)" if w.get("flute_limited") else "")
+                     + (f"; fibers {w['sampling']:.3g} mm apart, spread from half the tool radius to fit the "
+                        "waterline's cap" if w.get("sampling") else ""))
     elif w is not None:
         lines.append(f"waterline: no slopes >= {report['steep_angle']:g} deg")
     if not report.get("scallop_held", True):

@@ -36,6 +36,38 @@ PAIRS_PER_BLOCK = 400_000
 MAX_REFINE = 30
 
 
+def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels: int) -> float:
+    """The (fiber, triangle) pairs :func:`waterline` meets over ``levels`` levels with
+    fibers ``sampling`` apart: each triangle meets the grid lines within ``radius`` of
+    its box, in both directions, and the refinement's fibers add about as many again.
+
+    >>> fiber_pairs(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float), 0.5, 0.5, 3)  # 2 x (5 + 5) x 3
+    60.0
+    """
+    span = np.maximum(tri[:, :, :2].max(axis=1) - tri[:, :, :2].min(axis=1), 0) + 2 * radius
+    return 2.0 * float((span / sampling + 1).sum()) * levels
+
+
+def sampling_within(tri: np.ndarray, radius: float, sampling: float, levels: int, most: float) -> float | None:
+    """``sampling``, or the finest spacing up to ``most`` at which :func:`waterline`'s
+    fibers fit :data:`MAX_PAIRS` over ``levels`` levels (the pairs fall as the spacing
+    grows); None when even ``most`` does not fit.
+
+    >>> tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
+    >>> sampling_within(tri, 0.5, 0.5, 3, 2.0)
+    0.5
+    """
+    if fiber_pairs(tri, radius, sampling, levels) <= MAX_PAIRS:
+        return sampling
+    if fiber_pairs(tri, radius, most, levels) > MAX_PAIRS:
+        return None
+    lo, hi = sampling, most
+    for _ in range(40):  # bisection on a monotone count: 40 halvings reach 1e-12 of the bracket
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if fiber_pairs(tri, radius, mid, levels) <= MAX_PAIRS else (mid, hi)
+    return hi
+
+
 # ----------------------------------------------------------------------------------------------
 # fibers against the mesh
 
@@ -380,12 +412,9 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     x = np.arange(lo[0] - R - 2 * h, hi[0] + R + 2 * h + h, h)
     y = np.arange(lo[1] - R - 2 * h, hi[1] + R + 2 * h + h, h)
     fib = _Fibers(tri, cutter, 1.5 * h)
-    # bound the work: each triangle meets the grid lines within R of its box (both
-    # directions); refinement fibers add about as many again
-    span = np.maximum(tri[:, :, :2].max(axis=1) - tri[:, :, :2].min(axis=1), 0) + 2 * R
-    per_level = 2.0 * float((span / h + 1).sum())
-    if per_level * len(levels) > MAX_PAIRS:
-        raise SurfmodError(f"sampling: {sampling} gives ~{per_level * len(levels):.3g} fiber-triangle pairs "
+    pairs = fiber_pairs(tri, R, h, len(levels))
+    if pairs > MAX_PAIRS:
+        raise SurfmodError(f"sampling: {sampling} gives ~{pairs:.3g} fiber-triangle pairs "
                            f"over {len(levels)} levels (limit {MAX_PAIRS:.0e}); choose a coarser sampling")
     out = [None] * len(levels)
     shanks = (_Shank(), _Shank())
