@@ -21,11 +21,11 @@ from ..errors import SurfmodError
 from ..inputs import to_shape
 from .cycle_time import cycle_time, feed_time
 from .finishing import Leftover, clear_part, finish, recut
-from .holder import body_stock, clear_body
+from .holder import body_stock, clear_body, relink
 from .machine_table import MACHINE, Machine
 from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_moves, rest_part_top
 from .rest import summary_line as rest_summary
-from .roughing import FEED, PLUNGE, RAPID, Motion, left_summary, rough
+from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import _part
 from .verify import verify_job
@@ -265,29 +265,27 @@ PROGRAM_ROUNDING = 1e-3
 
 def _relink(job: Job) -> Job:
     """One round of repair: every rapid the verification found running through stock is
-    re-linked over it (up to the job's safe height, across, and down to where it was
-    going at the tool's plunge feed), and the job is judged again.  A rapid the program
-    holds but no operation's motion does (none today) is left, and its verdict stands."""
+    left out and the tool re-linked over it (:func:`surfmod.cam.holder.relink`: up to the
+    job's safe height, across, and down at the plunge feed), and the job is judged again.
+    A rapid the program holds but no operation's motion does (none today) is left, and
+    its verdict stands."""
     found = next((f for f in job.verification.findings if f.what == "rapids" and f.segments), None)
     if found is None:
         return job
     ops, relinked = list(job.operations), 0
     for k in sorted({seg[0] for seg in found.segments}):
-        pts, kind = ops[k].motion.points, ops[k].motion.kind
-        ends = [np.asarray(seg[1:], float) for seg in found.segments if seg[0] == k]
-        into = [i for i in range(1, len(pts)) if kind[i] == RAPID
-                and any(np.abs(pts[i - 1] - a).max() <= PROGRAM_ROUNDING and np.abs(pts[i] - b).max() <= PROGRAM_ROUNDING
-                        for a, b in ends)]
-        if not into:
+        op = ops[k]
+        pts, kind = op.motion.points, op.motion.kind
+        removed = np.zeros(len(pts) - 1, bool)  # per move into points[i + 1]
+        for _, a, b in (seg for seg in found.segments if seg[0] == k):
+            removed |= ((kind[1:] == RAPID) & (np.abs(pts[:-1] - a).max(axis=1) <= PROGRAM_ROUNDING)
+                        & (np.abs(pts[1:] - b).max(axis=1) <= PROGRAM_ROUNDING))
+        if not removed.any():
             continue
-        for i in reversed(into):  # each rapid into point i becomes up, across, down
-            above = np.array([[pts[i - 1, 0], pts[i - 1, 1], job.safe_height], [pts[i, 0], pts[i, 1], job.safe_height]])
-            pts, kind = np.insert(pts, i, above, axis=0), np.insert(kind, i, [RAPID, RAPID])
-            kind[i + 2] = PLUNGE
-        motion, op = Motion(pts, kind), ops[k]
+        motion = relink(op.motion, removed, job.safe_height)
         ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine),
-                         report=dict(op.report, relinked=len(into)))
-        relinked += len(into)
+                         report=dict(op.report, relinked=int(removed.sum())))
+        relinked += int(removed.sum())
     if not relinked:
         return job
     job = replace(job, operations=tuple(ops))
