@@ -39,6 +39,7 @@ from ..errors import SurfmodError
 from . import verify_kernels as K
 from .finishing import RECUT_SHARE, REST_CLEARANCE, _add_raster, height_field
 from .roughing import RAPID, Motion, Moves
+from .stock_field import NodeGrid
 from .tool import Tool
 from .toolpath import _Part, raster_path
 from .verify import MAX_NODES, stock_cells
@@ -53,22 +54,16 @@ PAIRS_PER_POINT = 100
 PAIR_BLOCK = 2_000_000
 
 
-class StockModel:
+class StockModel(NodeGrid):
     """The job's stock as a height field: ``top[i, j]`` over the node
-    ``lo + cell * (i, j)`` of the stock box; :meth:`sweep` lowers it along a motion."""
+    ``lo + cell * (i, j)`` of the stock box (``origin``: its x and y); :meth:`sweep`
+    lowers it along a motion."""
 
     def __init__(self, stock: np.ndarray, cell: float, max_nodes: int = MAX_NODES):
         self.lo = np.asarray(stock, float)[0]
+        self.origin = (float(self.lo[0]), float(self.lo[1]))
         self.cell, nx, ny, self.note = stock_cells(stock, cell, max_nodes)
         self.top = np.full((nx, ny), float(np.asarray(stock, float)[1, 2]))
-
-    @property
-    def x(self) -> np.ndarray:
-        return self.lo[0] + self.cell * np.arange(self.top.shape[0])
-
-    @property
-    def y(self) -> np.ndarray:
-        return self.lo[1] + self.cell * np.arange(self.top.shape[1])
 
     @property
     def sag(self) -> float:

@@ -30,8 +30,37 @@ from .. import checks
 KEPT_NODES = 1_000_000
 
 
+def grid_axes(origin, cell: float, shape) -> tuple[np.ndarray, np.ndarray]:
+    """The x and the y of the nodes ``origin + cell * (i, j)`` of an ``(nx, ny)`` grid: the
+    stock's height fields (the verifier's, the job's model, the kept field) all stand on one.
+
+    >>> [a.tolist() for a in grid_axes((1.0, 2.0), 0.5, (3, 2))]
+    [[1.0, 1.5, 2.0], [2.0, 2.5]]
+    """
+    return origin[0] + cell * np.arange(shape[0]), origin[1] + cell * np.arange(shape[1])
+
+
+def grid_points(origin, cell: float, shape) -> np.ndarray:
+    """The grid's nodes as ``(nx * ny, 2)`` points, node ``(i, j)`` at row ``i * ny + j``."""
+    gx, gy = np.meshgrid(*grid_axes(origin, cell, shape), indexing="ij")
+    return np.column_stack([gx.ravel(), gy.ravel()])
+
+
+class NodeGrid:
+    """``x`` and ``y`` of a height field ``top`` on the nodes ``origin + cell * (i, j)``
+    (:func:`grid_axes`), for the classes that hold one."""
+
+    @property
+    def x(self) -> np.ndarray:
+        return grid_axes(self.origin, self.cell, self.top.shape)[0]
+
+    @property
+    def y(self) -> np.ndarray:
+        return grid_axes(self.origin, self.cell, self.top.shape)[1]
+
+
 @dataclass(frozen=True)
-class StockField:
+class StockField(NodeGrid):
     """``top`` (nx, ny): the stock's height at the nodes ``origin + cell * (i, j)``;
     ``left``: the material above the part there, measured along the part's normal (the
     height over the part times the cosine of its slope), NaN off the part and on walls
@@ -53,8 +82,7 @@ class StockField:
         ``height(xy)`` (-inf where there is none), at most ``max_nodes`` nodes (see
         :meth:`coarsened`); nodes steeper than ``wall_slope`` degrees are walls."""
         nx, ny = np.shape(top)
-        gx, gy = np.meshgrid(origin[0] + cell * np.arange(nx), origin[1] + cell * np.arange(ny), indexing="ij")
-        under = np.asarray(height(np.column_stack([gx.ravel(), gy.ravel()])), float).reshape(nx, ny)
+        under = np.asarray(height(grid_points(origin, cell, (nx, ny))), float).reshape(nx, ny)
         part = np.where(np.isfinite(under), under, np.nan)
         if min(part.shape) >= 2:
             gx, gy = np.gradient(part, cell)
@@ -65,14 +93,6 @@ class StockField:
         left = np.where(wall, np.nan, np.maximum(top - part, 0.0) * cos)
         return cls(*_pooled(np.asarray(top, float), left, (float(origin[0]), float(origin[1])), float(cell),
                             max_nodes))
-
-    @property
-    def x(self) -> np.ndarray:
-        return self.origin[0] + self.cell * np.arange(self.top.shape[0])
-
-    @property
-    def y(self) -> np.ndarray:
-        return self.origin[1] + self.cell * np.arange(self.top.shape[1])
 
     def coarsened(self, max_nodes: int) -> "StockField":
         """At most ``max_nodes`` nodes: the maxima over blocks of ``f x f`` nodes (``f`` the

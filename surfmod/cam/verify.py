@@ -63,7 +63,7 @@ from ..inputs import to_shape
 from ..readback.trimmed import from_face
 from . import verify_kernels as K
 from .program import ProgramMoves, concatenate, read_program
-from .stock_field import KEPT_NODES, StockField
+from .stock_field import KEPT_NODES, StockField, grid_axes
 
 #: points on the part, probes along the moves and stock nodes one verification may take
 MAX_SAMPLES = 30_000_000
@@ -626,7 +626,7 @@ def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
 def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):
     """The stock left above the finishing tool's reach, normal to it, where it reaches."""
     nx, ny = top.shape
-    gx, gy = np.meshgrid(lo[0] + cell * np.arange(nx), lo[1] + cell * np.arange(ny), indexing="ij")
+    gx, gy = np.meshgrid(*grid_axes(lo, cell, (nx, ny)), indexing="ij")
     xy = np.column_stack([gx.ravel(), gy.ravel()])
     tips = part.drop(xy, cutter.radius, cutter.corner).reshape(nx, ny)
     reach = K.closing(tips, cell, cutter.radius, cutter.corner)
