@@ -113,15 +113,18 @@ def derivative_nets(knots_u, p: int, knots_v, q: int, ctrl: np.ndarray, order: i
     return nets
 
 
-def curve_from_nets(knots, degree: int, ctrl: np.ndarray, t, order: int, cartesian=None) -> np.ndarray:
+def curve_from_nets(knots, degree: int, ctrl: np.ndarray, t, order: int, cartesian=None,
+                    positions: np.ndarray | None = None) -> np.ndarray:
     """Derivatives ``0..order`` ``(len(t), order + 1, d)`` of the curve ``ctrl``
     (``(n, d)``; rational: homogeneous, with ``cartesian`` as in :func:`derivative_nets`)
-    on ``degree`` and ``knots``, each from its derivative net."""
+    on ``degree`` and ``knots``, each from its derivative net; the positions (order 0)
+    are those of the net ``positions`` when given (the curve about its centre, whose
+    differences would carry the centring's rounding), else of ``ctrl``."""
     t = np.asarray(t, dtype=float).ravel()
     column = None if cartesian is None else (cartesian[0][:, None], cartesian[1][:, None], cartesian[2])
     nets = derivative_nets(knots, degree, [0.0, 1.0], 0, ctrl[:, None], order, column)
     out = np.zeros((t.size, order + 1, ctrl.shape[-1]))
-    out[:, 0] = tensor.curve_derivatives(knots, degree, ctrl, t, 0)[:, 0]
+    out[:, 0] = tensor.curve_derivatives(knots, degree, ctrl if positions is None else positions, t, 0)[:, 0]
     for (k, _), (k_u, deg, _, _, poles) in nets.items():
         out[:, k] = tensor.curve_derivatives(k_u, deg, poles[:, 0], t, 0)[:, 0]
     return out

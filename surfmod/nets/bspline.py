@@ -101,9 +101,7 @@ class BSplineCurve(Curve):
             cartesian = None if self.weights is None else (self.control_points, self.weights,
                                                            np.zeros(3) if centre is None else centre)
             h = derivative_nets.curve_from_nets(self.knots, self.degree, net if self.rational else
-                                                  self._homogeneous, t, order, cartesian)
-            if centre is not None and not self.rational:
-                h[:, 0] = curve_derivatives(self.knots, self.degree, net, t, 0)[:, 0]
+                                                  self._homogeneous, t, order, cartesian, positions=net)
         else:
             h = curve_derivatives(self.knots, self.degree, net, t, order)
         out = curve_quotient(h) if self.rational else h
