@@ -24,8 +24,9 @@ from pathlib import Path
 
 class ChildFailure(Exception):
     """The child did not finish by its deadline, held too much memory, or died; ``str``
-    says which, and ``cause`` is ``"deadline"``, ``"memory"`` or ``"died"`` (then
-    ``returncode`` is the child's exit code, negative for a signal)."""
+    says which, and ``cause`` is ``"deadline"``, ``"memory"``, ``"died"`` (then
+    ``returncode`` is the child's exit code, negative for a signal) or ``"start"`` (a
+    :class:`Server`'s warm-up failed, however)."""
 
     def __init__(self, message: str, cause: str = "died", returncode: int | None = None):
         super().__init__(message)
@@ -162,7 +163,10 @@ class Server:
         self.start()
         if self._warming:
             self._warming = False
-            self._answer(WARMUP_SECONDS, f"{what}: the child's start", None)
+            try:
+                self._answer(WARMUP_SECONDS, f"{what}: the child's start", None)
+            except ChildFailure as exc:
+                raise ChildFailure(str(exc), "start", exc.returncode) from None
         try:
             self.proc.stdin.write(_framed(pickle.dumps((fn, args))))
             self.proc.stdin.flush()

@@ -37,3 +37,17 @@ def test_a_stuck_child_is_killed_at_its_deadline():
 def test_a_crash_is_a_failure_not_a_dead_caller():
     with pytest.raises(child.ChildFailure, match=r"^crasher died \(exit code -11\)$"):
         child.call(_crashes, (), 60.0, "crasher")
+
+
+def test_a_server_whose_warm_up_dies_says_its_start_failed():
+    """The warm-up's failure is the child's start, not the call's (the STEP reader names
+    it "the reader process did not start"); the next call starts a fresh child."""
+    server = child.Server(warmup=(_crashes, ()))
+    try:
+        with pytest.raises(child.ChildFailure, match=r"^pow: the child's start died \(exit code -11\)$") as caught:
+            server.call(pow, (2, 10), 60.0, "pow")
+        assert caught.value.cause == "start" and caught.value.returncode == -11
+        server.warmup = None
+        assert server.call(pow, (2, 10), 60.0, "pow") == 1024
+    finally:
+        server.close()

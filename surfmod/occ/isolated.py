@@ -80,12 +80,12 @@ class _Reader:
             try:
                 return self.server.call(_read_and_check, (path, max_coordinate), timeout, f"reading {path}")
             except ChildFailure as exc:
+                if exc.cause == "start":
+                    raise DamagedFileError("STEP reader: the reader process did not start") from None
                 if exc.cause == "deadline":
                     raise DamagedFileError(
                         f"path: reading {path} did not finish within {timeout:g} s; the reader was stopped "
                         "(a damaged file can make OCCT loop; raise timeout= for a huge file)") from None
-                if "the child's start" in str(exc):
-                    raise DamagedFileError("STEP reader: the reader process did not start") from None
                 code = exc.returncode
                 how = f"signal {signal.Signals(-code).name}" if code and code < 0 else f"exit code {code}"
                 raise DamagedFileError(f"path: OCCT crashed reading {path} ({how}); the file is damaged") from None
