@@ -252,7 +252,13 @@ def test_equals_opencamlib_waterline(tmp_path, corpus_triangles, kind, R, r):
     (ours,) = waterline(tri, tool(kind, R, r), [z], sampling=sampling)
     theirs, _ = ocl_waterline(tmp_path, tri, kind, R, r, z, sampling)
     real = [lp for lp in theirs if len(lp) >= 3]
-    assert len(ours) == len(real)
+    # each of OCL's loops lies along one of ours and each of ours has one of OCL's along it
+    # (OCL sometimes returns one loop in pieces: on trimesh_featuretype's outer loop, two
+    # pieces 6 and 33 mm apart along a straight stretch, so the counts alone differ)
+    owner = [{int(np.argmin([polyline_distance(p[None], [lp])[0] for lp in ours])) for p in piece}
+             for piece in real]
+    assert all(len(o) == 1 for o in owner), owner
+    assert set().union(*owner) == set(range(len(ours))) and len(ours) <= len(real)
     for lp in ours:
         assert len(lp) >= 3 and np.all(lp[:, 2] == z)
     pts_ocl = np.vstack(theirs)

@@ -1,7 +1,8 @@
 """Drop-cutter against a triangle soup, compiled: one scalar loop per cutter location over its candidate triangles.
 
-The soup is the part's faces meshed by BRepMesh (:func:`part_triangles`): their triangles
-lie inside each face's trim and their nodes on the exact surface.
+The soup is the part's faces meshed by BRepMesh and measured against them
+(:func:`part_triangles`): their triangles lie inside each face's trim, within a measured
+deviation of the exact surface.
 
 The tool is an end mill with an endless shank of its own radius above the tip: a ball
 end (sphere of radius ``r`` centred ``r`` above the tip), a flat end (a disc at the
@@ -43,6 +44,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import SurfmodError
+from ..meshing.brep import tessellate_shape
 from .cutters import Ball, Cutter, Flat
 
 # Barycentric slack for "contact inside the triangle": neighbouring triangles share the
@@ -395,36 +397,31 @@ def drop(grid: TriangleGrid, cutter: Cutter, xy: np.ndarray, *, contacts: bool =
 
 
 def part_triangles(shape, deflection: float, angular: float = 0.35, *, face_index: bool = False):
-    """``(triangles (M, 3, 3), deflection)``: all faces of ``shape`` meshed by BRepMesh at
-    the linear ``deflection`` (model units) and ``angular`` deflection (radians), in global
-    coordinates, and the largest chordal deflection BRepMesh measured on any face (at least
-    the requested one; some faces of real parts cannot be meshed finer than their own
-    tolerance allows).  Any triangulation stored on the shape is replaced.  A face BRepMesh
-    leaves without triangles raises ``SurfmodError`` (the tool would not see it).  With
-    ``face_index`` a third item: the faces (``faces_of`` order) and each triangle's
-    index into them ``(M,)``.  The plain loop runs over BRepMesh's faces (the kernel's
-    output), not over triangles."""
-    from ..occ.mesh import mesh_faces
-    from ..occ.topo import wrapped
+    """``(triangles (M, 3, 3), deflection)``: all faces of ``shape`` meshed at the linear
+    ``deflection`` (model units) and ``angular`` deflection (radians), in global
+    coordinates, and the largest deviation of any triangle from its exact face (at least
+    the requested deflection).  The mesh is :func:`surfmod.meshing.brep.tessellate_shape`'s:
+    BRepMesh's triangles measured against the exact faces and refined where they stray
+    (BRepMesh leaves twisted ruled B-spline faces, e.g. face 78 of trimesh_featuretype,
+    25 times its deflection away and says so), so the deviation is measured, not
+    BRepMesh's own estimate; only what the model itself is off by (its edges' declared
+    tolerance) stays above the request.  A face left without triangles raises
+    ``SurfmodError`` (the tool would not see it).  With ``face_index`` a third item: the
+    faces (``faces_of`` order) and each triangle's index into them ``(M,)``."""
+    from ..occ.topo import faces_of, wrapped
 
     if wrapped(shape) is None:
         raise SurfmodError(f"obj: expected an OCCT shape, got {type(shape).__name__}")
-    blocks, owners, faces = [], [], []
-    unmeshed = 0
-    measured = float(deflection)
-    for _, face, got in mesh_faces(shape, deflection, angular, with_uv=False):
-        if got is None:
-            unmeshed += 1  # a face the tool cannot see: never skip it silently
-            continue
-        blocks.append(got.nodes[got.triangles])
-        owners.append(np.full(len(got.triangles), len(faces)))
-        faces.append(face)
-        measured = max(measured, got.deflection)
-    if unmeshed:
-        raise SurfmodError(f"obj: BRepMesh could not triangulate {unmeshed} face(s); a tool path over them "
-                           f"cannot be checked")
-    if not blocks:
+    if not faces_of(shape):
         raise SurfmodError("obj: has no faces to machine")
+    mesh = tessellate_shape(shape, float(deflection), angular=angular)
+    unmeshed = mesh.info["faces_not_meshed"]
+    if unmeshed:
+        raise SurfmodError(f"obj: BRepMesh could not triangulate {len(unmeshed)} face(s); a tool path over them "
+                           f"cannot be checked")
+    triangles = mesh.vertices[mesh.faces]
+    measured = max(float(deflection), float(mesh.info["max_deviation"]))
     if face_index:
-        return np.concatenate(blocks), measured, (faces, np.concatenate(owners))
-    return np.concatenate(blocks), measured
+        owner = np.concatenate([labels for _, _, labels in mesh.info["stl_groups"]])
+        return triangles, measured, (faces_of(shape), owner)
+    return triangles, measured
