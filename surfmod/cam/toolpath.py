@@ -5,11 +5,12 @@ one level down.
 
 The part is every face of the input (walls, undersides and trimmed faces included), meshed
 by OCCT's BRepMesh inside each face's trim at a chordal deflection of 40 % of the
-gouge ``tolerance``.  The end mill (ball, flat or bull nose, with a shank of its own radius up to
-infinity) is dropped onto that mesh in closed form (:mod:`surfmod.cam.drop_cutter`), so a
-cutter location touches but never enters the triangles; where BRepMesh reports a larger
-deflection than asked for (faces of real parts that cannot be meshed finer than their own
-tolerance) every height is lifted by the difference.
+gouge ``tolerance``, measured against the exact faces and refined where it strays
+(:func:`~surfmod.cam.drop_cutter.part_triangles`).  The end mill (ball, flat or bull nose,
+with a shank of its own radius up to infinity) is dropped onto that mesh in closed form
+(:mod:`surfmod.cam.drop_cutter`), so a cutter location touches but never enters the
+triangles; where the measured deviation is larger than asked for (faces of real parts
+whose edges lie off them by their own tolerance) every height is lifted by the difference.
 
 Every straight G1 move between cutter locations is then checked along its length, not only
 at its ends (:mod:`surfmod.cam.toolpath_moves`): locations are inserted where a move would
@@ -20,7 +21,7 @@ staircases, and a final check on other sample points must find every move within
 ``Toolpath.lifted``); a path that still cuts deeper raises ``SurfmodError``: gouging
 G-code is never returned.  The default tolerance is a tenth of the scallop height.
 
-The triangles can miss where a face leaves its mesh by more than BRepMesh measured, so
+The triangles can miss where a face leaves its mesh between the measured samples, so
 the moves are then held against points of the exact faces (:mod:`surfmod.cam.verify`)
 and lifted where those come deeper than half the tolerance into the tool (also counted
 in ``Toolpath.lifted``); ``surfmod toolpath`` judges the written G-code once more.
@@ -336,8 +337,8 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
         part = _part(shape, tool.cutter, tolerance, meter)
         path = raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
                            bar, meter=meter)
-        # the mesh's triangles can miss where a face leaves its own mesh by more than BRepMesh
-        # measured: the moves are held against points of the exact faces too, and lifted there
+        # the mesh's triangles can miss where a face leaves them between the measured
+        # samples: the moves are held against points of the exact faces too, and lifted there
         bar.set_postfix_str("against the exact faces")
         points, lift = lift_gouges(shape, path.points, tool.cutter, tolerance)
     if not lift.any():
