@@ -18,7 +18,9 @@ from stock_sim import parse_gcode
 import surfmod as sm
 from surfmod.cli import main
 from surfmod.cam.drop_cutter import part_triangles
-from surfmod.cam.holder import part_sink
+from surfmod.cam.holder import clear_body, part_sink
+from surfmod.cam.rest import StockModel
+from surfmod.cam.roughing import FEED, RAPID, Motion
 from surfmod.cam.tool import load_tool_table
 from surfmod.cam.verify import verify_job
 
@@ -218,3 +220,20 @@ def test_verifier_finds_a_holder_too_low(short_job, tmp_path):
         # the verifier's probes grow the disc by half their spacing: as deep or a little deeper
         assert exact - 1e-3 <= f.worst <= exact + 0.05, (str(f), exact)
         assert f.where is not None and f.line > 0
+
+
+def test_a_rim_between_the_model_nodes_is_met():
+    """The job's stock model samples the stock a cell apart: a holder whose rim passes
+    between two nodes into a wall must still be met.  A flat r = 8 slot cut along y at
+    x = 11.5 leaves a wall at x = 19.5; a holder of radius 6 over a tool at x = 13.6 reaches
+    x = 19.59, 14.5 mm below the wall's top, while the model's nodes (cells of 1 mm) stand
+    at x = 19 (cut) and 20 (beyond the rim)."""
+    stock = StockModel(np.array([[0.0, 0.0, -10.0], [40.0, 40.0, 20.0]]), 1.0)
+    slot = Motion(np.array([[11.5, -10.0, 0.0], [11.5, 50.0, 0.0]]), np.array([RAPID, FEED], np.int8))
+    stock.sweep(slot, sm.Tool("flat", 8.0, flute_length=40.0))
+    tool = sm.Tool("flat", 2.0, flute_length=5.0, shank_length=0.0, holder_radius=6.0, holder_length=20.0)
+    far = np.array([[[0.0, 0.0, -100.0], [1.0, 0.0, -100.0], [0.0, 1.0, -100.0]]])  # no part near
+    moves = Motion(np.array([[13.6, -10.0, 30.0], [13.6, -10.0, 0.5], [13.6, 50.0, 0.5], [13.6, 50.0, 30.0]]),
+                   np.array([RAPID, RAPID, FEED, RAPID], np.int8))
+    kept, _ = clear_body(moves, tool, stock, far, 0.0, 0.01, 30.0)
+    assert len(kept.points) < len(moves.points) and not np.any(kept.kind == FEED)

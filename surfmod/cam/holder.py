@@ -82,9 +82,15 @@ def body_stock(stock: np.ndarray, smallest_radius: float) -> StockModel:
 
 def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, slack: float, skip: np.ndarray):
     """``stock`` swept along ``pts`` with the moves whose body meets it (or ``skip``) undone:
-    :func:`~surfmod.cam.verify_kernels.sweep_body`'s ``removed``."""
+    :func:`~surfmod.cam.verify_kernels.sweep_body`'s ``removed``.  The model samples the
+    stock a cell apart, coarser than the verifier's: a disc wider than the end is grown by
+    a cell, so that an edge of stock between the nodes its rim passes is met too (on
+    zoo's flange-xy, 0.875 mm cells let a holder pass 4.7 mm into a level's step that the
+    verifier's 0.245 mm cells found)."""
     m = len(pts) - 1
     discs = tool.body[None, :, :2].copy()
+    wider = discs[..., 0] > tool.radius + slack
+    discs[..., 0][wider] += stock.cell
     *_, removed = sweep_body(stock.top, float(stock.lo[0]), float(stock.lo[1]), stock.cell,
                              np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:]), rapid,
                              np.full(m, tool.radius), np.full(m, tool.corner), stock.cell / 2, discs,
@@ -182,7 +188,28 @@ def relink(motion: Motion, removed: np.ndarray, safe: float) -> Motion:
     last = out.last
     if gap and last[2] < safe:
         out.add([[last[0], last[1], safe]], RAPID)
-    return out.motion()
+    return _without_dips(out.motion())
+
+
+def _without_dips(motion: Motion) -> Motion:
+    """``motion`` without the rapid dips a removal leaves: a rapid straight down whose
+    next move is a rapid straight back up (the program's own entry to moves left out).
+
+    >>> m = _without_dips(Motion(np.array([[0, 0, 9], [0, 0, 1], [0, 0, 9], [5, 0, 9.0]]), np.full(4, RAPID, np.int8)))
+    >>> m.points.tolist()
+    [[0.0, 0.0, 9.0], [5.0, 0.0, 9.0]]
+    """
+    p, kind = motion.points, motion.kind
+    if len(p) < 3:
+        return motion
+    a, b, c = p[:-2], p[1:-1], p[2:]
+    dip = ((kind[1:-1] == RAPID) & (kind[2:] == RAPID) & np.all(a[:, :2] == b[:, :2], axis=1)
+           & np.all(b[:, :2] == c[:, :2], axis=1) & (b[:, 2] < a[:, 2]) & (c[:, 2] > b[:, 2]))
+    if not dip.any():
+        return motion
+    keep = np.r_[True, ~dip, True]
+    keep[2:] &= ~(dip & np.all(c == a, axis=1))  # back where it was: the climb goes too
+    return Motion(p[keep], kind[keep])
 
 
 def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
