@@ -27,7 +27,7 @@ from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_mo
 from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
-from .toolpath import _part
+from .toolpath import MAX_WORK, _Meter, _part
 from .verify import verify_job
 
 #: Clearance of links and retracts above the stock (mm).
@@ -190,7 +190,8 @@ def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
     return box
 
 
-def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float):
+def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float,
+            progress: bool = False):
     if op.stepover is not None and op.scallop is not None:
         raise SurfmodError("stepover: give either stepover or scallop, not both")
     if op.scallop is None and op.stepover is None:
@@ -210,9 +211,18 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     else:
         cusp = tool.scallop_for_stepover(stepover)
         tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
-    part = clear_part(_part(shape, tool.cutter, tolerance), tool)
-    motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
-                            steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
+    # every drop of the finishing is charged to one cap, estimated before the raster
+    # starts; a small tool on a fine scallop is refused there, naming the scallop, and
+    # the bar counts the triangle tests (the finishing is most of a small tool's job)
+    with tqdm(total=1, desc="finishing", unit=" tests", unit_scale=True, leave=False, disable=not progress) as bar:
+        meter = _Meter(MAX_WORK, bar if progress else None, "scallop",
+                       f"choose a larger scallop than {op.scallop:g} or a larger finishing tool"
+                       if op.scallop is not None else "choose a larger stepover or a larger finishing tool")
+        part = clear_part(_part(shape, tool.cutter, tolerance, meter), tool)
+        motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
+                                steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest,
+                                lowest=lowest)
+    part.meter.bar = None  # the repairs (re-cut passes) run after the bar is closed
     return motion, report, part
 
 
@@ -404,8 +414,9 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     stock_model = body_stock(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
     numbers = {}
-    with tqdm(total=2 * len(ops), desc="machine", unit="stage", disable=not progress) as bar:
+    with tqdm(total=2 * len(ops) + bool(verify), desc="machine", unit="stage", disable=not progress) as bar:
         for k, op in enumerate(ops):
+            bar.set_postfix_str(type(op).__name__.lower())
             tool = op.tool.with_defaults(k + 1)
             if numbers.setdefault(tool.number, tool) != tool:
                 raise SurfmodError(f"tool: number {tool.number} is given to two different tools")
@@ -440,7 +451,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 # the contours go no deeper than the flutes reach below the part's top
                 lowest = float(box[1, 2] - tool.flute_length) + 1e-9
-                motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest)
+                motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest, progress)
                 finishing[k] = (op, finish_part, rest)
                 motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe, strict,
                                      "finishing", shape)
@@ -448,7 +459,9 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 name = "finishing"
             bar.update()
             done.append(Operation(name, tool, motion, operation_time(motion, tool, machine), report, machine))
-    job = Job(shape, stock, tuple(done), safe, machine=machine)
-    if verify:
-        job = _relink(_recut(replace(job, verification=verify_job(job)), finishing, stock_model))
+        job = Job(shape, stock, tuple(done), safe, machine=machine)
+        if verify:
+            bar.set_postfix_str("verifying the program")
+            job = _relink(_recut(replace(job, verification=verify_job(job)), finishing, stock_model))
+            bar.update()
     return job

@@ -30,10 +30,29 @@ def _up(values: np.ndarray, digits: int) -> np.ndarray:
     return np.ceil(np.round(values * scale, 6)) / scale
 
 
+#: the move lines of the last few operations written: a job's program is made for its
+#: verification, again for the file and once more with the verdict in its header; the
+#: moves (most of the time: the arcs) are the same each time
+_WRITTEN: dict = {}
+WRITTEN_KEPT = 8
+
+
 def _moves(op, digits: int, arcs: bool = True) -> list[str]:
     """G0/G1 (and G2/G3) lines of an operation's motion, feeds modal (written when they
     change).  Circular runs (:func:`surfmod.cam.arcs.find_arcs`, found on the heights as
     written) become one arc word each, its centre ``I J`` from the written start."""
+    key = (id(op), digits, arcs)
+    entry = _WRITTEN.get(key)
+    if entry is not None and entry[0] is op:  # the entry holds its operation: no other can take its id
+        return list(entry[1])
+    if len(_WRITTEN) >= WRITTEN_KEPT:
+        _WRITTEN.clear()
+    lines = _move_lines(op, digits, arcs)
+    _WRITTEN[key] = (op, lines)
+    return list(lines)
+
+
+def _move_lines(op, digits: int, arcs: bool) -> list[str]:
     pts = np.array(op.motion.points, float)
     kind = op.motion.kind
     # arcs are found on the path itself: an arc between ends rounded up lies above it

@@ -144,15 +144,26 @@ class Toolpath:
 
 class _Meter:
     """The drop-cutter work of one path against its cap, charged before each drop (so a
-    refusal comes before the work), shown on the progress bar."""
+    refusal comes before the work), shown on the progress bar.  ``flag`` and ``hint``
+    name what the caller can change (``surfmod machine`` has no ``max_work``: its
+    finishing names ``--scallop``); by default the refusal names ``max_work``."""
 
-    def __init__(self, cap: float = np.inf, bar=None):
+    def __init__(self, cap: float = np.inf, bar=None, flag: str | None = None, hint: str = ""):
         self.used, self.cap, self.bar = 0, cap, bar
+        self.flag, self.hint = flag, hint
+
+    def refuse(self, estimate: float, what: str) -> None:
+        """Raise when ``estimate`` triangle tests pass the cap."""
+        if estimate <= self.cap:
+            return
+        if self.flag is None:
+            checks.work(estimate, int(self.cap), "max_work", what)
+        raise SurfmodError(f"{self.flag}: {what} needs about {estimate:,.0f} triangle tests, above the cap "
+                               f"{int(self.cap):,}; {self.hint}")
 
     def charge(self, work: int, what: str) -> None:
         if self.used + work > self.cap:
-            checks.work(self.used + work, int(self.cap), "max_work",
-                        f"the drop-cutter ({what}, after {self.used:,} triangle tests)")
+            self.refuse(self.used + work, f"the drop-cutter ({what}, after {self.used:,} triangle tests)")
         self.used += work
         if self.bar is not None:
             if self.used > self.bar.total:  # more refinement than estimated: the bar grows, never stalls at 100 %
@@ -357,11 +368,11 @@ def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction
     xy, index, across = raster(lo, hi, stepover, step, direction, across)
     if meter is not None:
         first = part.grid.entries(xy)
-        checks.work(NOMINAL_DROPS * first, int(meter.cap), "max_work",
-                    f"the drop-cutter over {len(xy):,} locations of {first / max(len(xy), 1):,.0f} triangle tests "
-                    f"each, {NOMINAL_DROPS} drops a location at the least (a larger tolerance, scallop or step)")
+        meter.refuse(NOMINAL_DROPS * first,
+                     f"the drop-cutter over {len(xy):,} locations of {first / max(len(xy), 1):,.0f} triangle tests "
+                     f"each, {NOMINAL_DROPS} drops a location at the least (a larger tolerance, scallop or step)")
         if bar is not None:
-            bar.total = NOMINAL_DROPS * first
+            bar.total = meter.used + NOMINAL_DROPS * first
     stage("dropping")
     z = part.height(xy)
     if np.isnan(z).all():
