@@ -165,3 +165,30 @@ def test_cam_part_job_in_stock(tmp_path):
 def test_corpus_job_in_stock(tmp_path, corpus_dir, name):
     got = prove(corpus_dir / name, tmp_path)
     print(name, {k: v for k, v in got.items() if k != "job"})
+
+
+#: a part that needs a 1 mm tool (issue 36): a 60 mm Fusion 360 spur gear of ten teeth,
+#: 5 mm thick, its tooth roots rounded 1.59 mm and a 2 mm deep recess with 2 mm corners;
+#: a flat r = 1 roughs and a ball r = 0.8 finishes (the issue's tools), the scallop 2.5 %
+#: of the ball's radius, the judge's stock cells 0.1 mm (about a quarter of the stepover)
+SMALL_TOOL_JOB = {"name": "f360grbl_gear.step", "R1": 1.0, "R2": 0.8, "SCALLOP": 0.02, "CELL": 0.1}
+
+
+@needs_rs274
+@pytest.mark.corpus
+@pytest.mark.xfail(strict=True, reason=(
+    "issue 36, open: a roughing ramp entry rapids down to the level above + 0.5 at (1.667, -15.710), 0.996 mm "
+    "from a sliver the levels above left standing at 5.5 in the recess's corner (their rings passed 1.000 "
+    "from it); the job's and the verifier's height-field stocks (cells 0.089) do not hold the sliver, the "
+    "judge's 0.1 mm cells do: rapid through stock 2.0 mm (line 229446 of rs274's output)"))
+def test_corpus_job_with_a_small_tool(tmp_path, corpus_dir, monkeypatch):
+    settings = dict(SMALL_TOOL_JOB)
+    name = settings.pop("name")
+    for key, value in settings.items():  # prove() reads the tools and the cell from here
+        monkeypatch.setitem(globals(), key, value)
+    got = prove(corpus_dir / name, tmp_path)
+    fin = got["job"].operations[1].report
+    # the ball reaches the tooth roots (their fillets are larger than it) and the floor
+    # of the recess: most of the gear's top is judged shallow ground
+    assert got["nodes"] > 50_000 and fin["stepover"] < 0.4, {k: v for k, v in got.items() if k != "job"}
+    print(name, {k: v for k, v in got.items() if k != "job"})

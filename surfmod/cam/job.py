@@ -222,6 +222,7 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
         motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
                                 steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest,
                                 lowest=lowest)
+        bar.total = max(bar.n, 1)  # the contours' drops came after the raster's estimate: the bar ends full
     part.meter.bar = None  # the repairs (re-cut passes) run after the bar is closed
     return motion, report, part
 
