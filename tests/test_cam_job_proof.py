@@ -177,10 +177,13 @@ SMALL_TOOL_JOB = {"name": "f360grbl_gear.step", "R1": 1.0, "R2": 0.8, "SCALLOP":
 @needs_rs274
 @pytest.mark.corpus
 @pytest.mark.xfail(strict=True, reason=(
-    "issue 36, open: a roughing ramp entry rapids down to the level above + 0.5 at (1.667, -15.710), 0.996 mm "
-    "from a sliver the levels above left standing at 5.5 in the recess's corner (their rings passed 1.000 "
-    "from it); the job's and the verifier's height-field stocks (cells 0.089) do not hold the sliver, the "
-    "judge's 0.1 mm cells do: rapid through stock 2.0 mm (line 229446 of rs274's output)"))
+    "issue 36, open, two findings at walls: (1) a roughing ramp entry rapids down to the level above + 0.5 at "
+    "(1.667, -15.710), 0.996 mm from a sliver the levels above left 5.5 high in a recess corner (their rings "
+    "passed 1.000 from it); the job's and the verifier's height-field stocks (0.089 mm cells) do not hold it, "
+    "this judge's 0.1 mm cells do: rapid through stock 2.0 mm; (2) this judge's part height, from a mesh at "
+    "0.01, puts the top (z 5) on a node 4 um inside the 10 mm bore at (-4.6, 1.949), where the chords of the "
+    "bore's edge cross it, so the ball dropping into the bore reads as a 4.27 mm gouge (the verifier, on the "
+    "exact faces: 0.0003)"))
 def test_corpus_job_with_a_small_tool(tmp_path, corpus_dir, monkeypatch):
     settings = dict(SMALL_TOOL_JOB)
     name = settings.pop("name")
