@@ -184,6 +184,111 @@ def test_cam_part_residual_is_the_judges():
     assert 0.02 < residual.worst <= residual.limit < 0.035, residual
 
 
+# -- walls ----------------------------------------------------------------------------------------
+DRAFT, CONE_H, BALL = 10.0, 6.0, 1.5  # a cone boss 6 high whose wall leans 10 degrees in
+
+
+@pytest.fixture(scope="module")
+def cone_job():
+    top = 5.0 - CONE_H * math.tan(math.radians(DRAFT))
+    part = bd.Box(20, 20, 5) + bd.Pos(0, 0, 2.5 + CONE_H / 2) * bd.Cone(5, top, CONE_H)
+    return sm.machine(part, 2.0, [sm.Rough(sm.Tool("flat", 3.0), stepdown=2.0, allowance=0.3),
+                                  sm.Finish(sm.Tool("ball", BALL), scallop=0.05)])
+
+
+def _cone_contours(lines: list[str], start: int) -> dict:
+    """The waterline contours round the cone after line ``start``: by tip height, the lines
+    setting it and the contour's distance from the cone's axis (the moves after such a
+    line run in x and y alone)."""
+    found, z, zline, run = {}, None, None, []
+
+    def close():
+        r = np.hypot(*np.array(run).T) if len(run) > 5 else np.zeros(1)
+        if 3.5 < r.min() and r.max() < 7.5:
+            lines_, radii = found.setdefault(z, ([], []))
+            lines_.append(zline)
+            radii.append(float(r.mean()))
+
+    for i in range(start, len(lines)):
+        g = re.fullmatch(r"G1(?: X(-?[\d.]+))?(?: Y(-?[\d.]+))?(?: Z(-?[\d.]+))?(?: F\d+)?", lines[i])
+        if g and g[3] is None and z is not None and (g[1] or g[2]):
+            last = run[-1] if run else (math.nan, math.nan)
+            run.append((float(g[1]) if g[1] else last[0], float(g[2]) if g[2] else last[1]))
+            continue
+        close()
+        run = []
+        z, zline = (float(g[3]), i) if g and g[3] else (None, None)
+    return found
+
+
+def _left_on_cone(levels: dict, z: np.ndarray) -> np.ndarray:
+    """The textbook: material on the cone's wall at heights ``z``, measured along its
+    normal, that a ball end on its cylinder leaves from the contours at ``levels`` (tip
+    height: distance of the axis from the cone's), each in the meridian plane of its
+    contact: the ball below its equator, the cylinder's side above it."""
+    lean = math.radians(DRAFT)
+    n = np.array([math.cos(lean), math.sin(lean)])  # the wall's outward normal (r, z)
+    p = np.column_stack([5.0 - (z - 2.5) * math.tan(lean), z])
+    left = np.full(len(z), np.inf)
+    for tip, axis in levels.items():
+        centre = np.array([axis, tip + BALL])
+        d = p - centre
+        b, c = d @ n, np.einsum("ij,ij->i", d, d) - BALL ** 2
+        ball = np.where(b * b >= c, -b - np.sqrt(np.maximum(b * b - c, 0.0)), np.inf)
+        ball = np.where(p[:, 1] + ball * n[1] <= centre[1], ball, np.inf)
+        side = (axis - BALL - p[:, 0]) / n[0]
+        side = np.where(p[:, 1] + side * n[1] >= centre[1], side, np.inf)
+        left = np.minimum(left, np.maximum(np.minimum(ball, side), 0.0))
+    return left
+
+
+def test_a_clean_job_leaves_its_scallop_on_a_leaning_wall(cone_job):
+    v = cone_job.verification
+    assert v.ok, str(v)
+    wall = _finding(v, "residual on walls")
+    # the waterline's cusps are there, within the scallop: 0.044 for its levels 0.72 apart
+    spacing = cone_job.operations[1].report["waterline"]["spacing"]
+    assert 0.5 * (BALL - math.sqrt(BALL ** 2 - (spacing / 2) ** 2)) < wall.worst <= wall.limit, wall
+    assert v.dexels > 1000 and v.wall_points > 1000 and "dexels along x and y" in v.lines()[0]
+
+
+def test_a_wall_cusp_left_by_every_other_waterline_level_is_measured(cone_job):
+    """Every other contour round the cone lifted 2 mm off it (0.35 mm along its normal: it
+    cuts nothing of the wall) and the raster left out (it climbs the cone's flanks too):
+    the cusps between the contours kept are twice as high as the finishing made them, and
+    the verifier measures the highest as the textbook has it, to the dexels' resolution."""
+    lines = programs(cone_job)[0].splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith("(operation: finishing"))
+    contours = _cone_contours(lines, start)
+    tips = sorted(contours, reverse=True)
+    assert len(tips) >= 6
+    for tip in tips[1::2]:
+        for i in contours[tip][0]:
+            lines[i] = re.sub(r"Z-?[\d.]+", f"Z{tip + 2.0:.4f}", lines[i])
+    # the raster: from the entry to its first point up to the last lift to the safe height
+    x0, y0 = cone_job.operations[1].report["toolpath"].points[0][:2]
+    end = max(i for i, ln in enumerate(lines) if ln.startswith("G0 Z"))
+    entry = max(i for i in range(start, end) if lines[i].startswith(f"G0 X{x0:.4f} Y{y0:.4f}"))
+    v = V.verify_job(cone_job, texts=["\n".join(lines[:entry] + lines[end:])])
+    wall = _finding(v, "residual on walls")
+    assert not v.ok and not wall.ok and wall.count > 10, wall
+    assert _finding(v, "gouge, finishing").ok
+    # the textbook over the wall above the lowest contact (below it: the fillet at the floor)
+    kept = {tip: float(np.mean(contours[tip][1])) for tip in tips[::2]}
+    z = np.linspace(min(kept) + BALL * (1 - math.sin(math.radians(DRAFT))), 2.5 + CONE_H, 6001)
+    left = _left_on_cone(kept, z)
+    peak = int(np.argmax(left))
+    cusp = float(left[peak])
+    # the ball alone would leave 0.184 between contacts 1.44 apart on the wall; the cylinder
+    # above its equator, standing off the leaning wall, cuts the cusp's top down to 0.127
+    assert 0.1 < cusp < 0.18, cusp
+    # the dexels stand a cell apart in z: the nearest is at most half a cell from the peak
+    cell = cone_job.operations[1].report["stepover"] / 4
+    near = np.abs(z - z[peak]) <= cell / 2
+    assert cusp - (cusp - left[near].min()) - wall.limit / 2 <= wall.worst <= cusp + wall.limit / 2, (wall, cusp)
+    assert abs(math.hypot(wall.where[0], wall.where[1]) - (5.0 - (wall.where[2] - 2.5) * math.tan(math.radians(DRAFT)))) < 0.25
+
+
 # -- toolpaths -----------------------------------------------------------------------------------
 def test_toolpath_judged_against_exact_faces_not_loose_wires(tmp_path, capsys):
     # the spline cage holds six loose B-spline edges (no face): construction curves, not

@@ -62,8 +62,9 @@ from ..errors import SurfmodError
 from ..inputs import to_shape
 from ..readback.trimmed import from_face
 from . import verify_kernels as K
+from . import wall_dexels as W
 from .program import ProgramMoves, concatenate, read_program
-from .stock_field import KEPT_NODES, StockField, grid_axes
+from .stock_field import KEPT_NODES, StockField, grid_axes, grid_points
 
 #: points on the part, probes along the moves and stock nodes one verification may take
 MAX_SAMPLES = 30_000_000
@@ -72,6 +73,12 @@ MAX_PROBES = 60_000_000
 #: wider than the end over 16 apart: few beside the gouge probes), at most
 MAX_BODY_PROBES = 20_000_000
 MAX_NODES = 30_000_000
+#: interval cuts the dexels along x and y may take (:func:`~surfmod.cam.wall_dexels.sweep_work`)
+MAX_DEXEL_WORK = 400_000_000
+#: dexels along x and y together, at most (each holds ``wall_dexels.SEGMENTS`` intervals)
+MAX_DEXELS = 3_000_000
+#: stock points on walls the dexels judge, at most (beyond it every n-th is judged)
+MAX_WALL_POINTS = 2_000_000
 #: nodes of the stock steeper than this (degrees) are walls the height field cannot judge
 WALL_SLOPE = 80.0
 #: the least upward share of a contact normal a lift counts on (beside a vertical wall a
@@ -134,6 +141,9 @@ class Verification:
     notes: tuple = field(default=())
     #: probes of the holder and shank check (their own cap, ``MAX_BODY_PROBES``)
     body_probes: int = 0
+    #: the dexels along x and y that judged the walls, and the points of their stock judged
+    dexels: int = 0
+    wall_points: int = 0
     #: the stock after the program (:class:`~surfmod.cam.stock_field.StockField`, at most
     #: ``KEPT_NODES`` nodes; None for a tool path alone)
     stock: StockField | None = field(default=None, repr=False, compare=False)
@@ -146,7 +156,9 @@ class Verification:
         head = (f"verified against the exact part: {self.samples:,} points {self.spacing:.3g} mm apart, "
                 f"{self.probes:,} probes along the moves"
                 + (f" ({self.body_probes:,} more for holder and shank)" if self.body_probes else "")
-                + (f", stock of {self.nodes:,} nodes ({self.walls:,} on walls not judged)" if self.nodes else ""))
+                + (f", stock of {self.nodes:,} nodes ({self.walls:,} on walls" if self.nodes else "")
+                + (f", judged by {self.dexels:,} dexels along x and y at {self.wall_points:,} points)"
+                   if self.nodes and self.dexels else ")" if self.nodes else ""))
         return [head] + [str(f) for f in self.findings] + list(self.notes)
 
     def __str__(self) -> str:
@@ -483,7 +495,8 @@ def _program_moves(job, texts: list[str], post: str) -> tuple[ProgramMoves, np.n
 
 
 def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, max_samples: int = MAX_SAMPLES,
-               max_probes: int = MAX_PROBES, max_nodes: int = MAX_NODES) -> Verification:
+               max_probes: int = MAX_PROBES, max_nodes: int = MAX_NODES,
+               max_dexel_work: int = MAX_DEXEL_WORK) -> Verification:
     """Judge the program(s) of ``job`` (as :func:`surfmod.cam.post.programs` writes them
     for ``post``, or the given ``texts``) against the exact part and the stock: gouge per
     operation, rapids through stock or part, the scallop left (see the module).
@@ -590,19 +603,24 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     if uncut.any():
         findings.append(Finding("cuts with the spindle stopped", float(uncut.sum()), 0.0, None, int(uncut.sum()),
                                 int(moves.line[np.argmax(uncut)])))
-    walls = 0
+    walls = dexels = judged_walls = 0
     if finishing:
         k, op, cutter, limit = finishing[-1]
-        found, walls, held = _residual(part, top, lo, cell, op, cutter, limit)
+        # the part under each node: the highest of its points within the node's cell
+        under = part.drop(grid_points(lo[:2], cell, (nx, ny)), 0.75 * cell, 0.0).reshape(nx, ny)
+        found, walls, held = _residual(part, top, under, lo, cell, op, cutter, limit)
         findings.append(found)
         if held:
             notes.append(f"note: residual: {held:,} nodes the shank or holder keeps the {op.name} tool from, "
                          f"not judged (the holder finding and the operation's report say what is left)")
+        found, dexels, judged_walls = _wall_residual(part, moves, radii, corners, np.asarray(job.stock, float), under,
+                                                     cell, op, cutter, limit, max_dexel_work, notes, job.part)
+        findings.append(found)
     # the part under each node as the residual reads it: its highest point within the cell
     kept = StockField.over_part(top, lambda xy: part.drop(xy, 0.75 * cell, 0.0), lo[:2], cell, WALL_SLOPE,
                                 KEPT_NODES)
     return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes),
-                        stock=kept, body_probes=body_probes)
+                        stock=kept, body_probes=body_probes, dexels=dexels, wall_points=judged_walls)
 
 
 def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
@@ -623,7 +641,8 @@ def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
                           f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
 
 
-def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op, cutter, limit: float):
+def _residual(part: PartPoints, top: np.ndarray, under: np.ndarray, lo: np.ndarray, cell: float, op, cutter,
+              limit: float):
     """The stock left above the finishing tool's reach, normal to it, where it reaches."""
     nx, ny = top.shape
     gx, gy = np.meshgrid(*grid_axes(lo, cell, (nx, ny)), indexing="ij")
@@ -644,9 +663,7 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
         n = int(cutter.radius / cell)
         ii, jj = np.mgrid[-n:n + 1, -n:n + 1]
         held = ndimage.binary_dilation(held, structure=ii ** 2 + jj ** 2 <= n * n) & np.isfinite(reach)
-    # the part under each node (the highest of its points within the node's cell), and the
-    # outline: a node whose neighbours are not all over the part is not judged
-    under = part.drop(xy, 0.75 * cell, 0.0).reshape(nx, ny)
+    # the outline: a node whose neighbours are not all over the part is not judged
     on = np.isfinite(under)
     inner = on.copy()
     inner[1:] &= on[:-1]
@@ -678,6 +695,97 @@ def _residual(part: PartPoints, top: np.ndarray, lo: np.ndarray, cell: float, op
                   for a, b in ndimage.find_objects(labels))
     return Finding(what, worst, bound, (float(gx[i, j]), float(gy[i, j]), float(top[i, j])), int(over.sum()),
                    boxes=boxes), int(steep.sum()), int(held.sum())
+
+
+def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, corners: np.ndarray, stock: np.ndarray,
+                   under: np.ndarray, cell: float, op, cutter, limit: float, max_work: int, notes: list, shape):
+    """The material the program leaves on the part's steep faces where the finishing tool
+    reaches, from the dexels along x and y (:mod:`~surfmod.cam.wall_dexels`): ``(finding,
+    dexels, points judged)``; ``under`` is the part's top on the height field's nodes
+    (``cell`` apart), ``notes`` gets what was coarser than asked."""
+    from ..occ.topo import closest_on_face, compound, faces_of
+
+    lo, hi = stock
+    what = f"residual on walls after {op.name} (tool {op.tool.number}, normal to the wall)"
+    # the dexels kept: round the places the height field sees steep (a wall, the outline)
+    sx, sy, zlo, zhi = W.steep_band(under, lo[:2], cell, float(lo[2]), W.DEXEL_SLOPE - 10.0)
+    axes = []
+    for swap in (False, True):
+        order = [1, 0, 2] if swap else [0, 1, 2]
+        a0, a1, l0, l1, at = (lo[1], hi[1], lo[0], hi[0], sx) if swap else (lo[0], hi[0], lo[1], hi[1], sy)
+        axes.append((swap, np.ascontiguousarray(moves.start[:, order]), np.ascontiguousarray(moves.end[:, order]),
+                     a0, a1, l0, l1, at))
+
+    def plan(c):
+        levels = int(math.floor((hi[2] - lo[2]) / c))
+        out, cuts, kept = [], 0.0, 0
+        for swap, a, b, a0, a1, l0, l1, at in axes:
+            keep = W.band(np.ascontiguousarray((at - l0) / c + 0.5), zlo, zhi, float(lo[2]), c,
+                          int(math.floor((l1 - l0) / c)) + 1, levels)
+            any_ = keep.any(axis=1)
+            kbot = np.where(any_, np.argmax(keep, axis=1), levels)
+            ktop = np.where(any_, levels - 1 - np.argmax(keep[:, ::-1], axis=1), -1)
+            cuts += W.sweep_work(a, b, moves.rapid, radii, corners, l0, c, c / 2, kbot, ktop)
+            kept += int(keep.sum())
+            out.append((swap, a, b, a0, a1, l0, keep, kbot, ktop))
+        return out, max(cuts / max_work, kept / MAX_DEXELS)
+
+    wanted = cell
+    plans, over = plan(cell)
+    while over > 1.0:  # both counts fall at least as the square of the cell: a few rounds
+        cell *= 1.05 * math.sqrt(over)
+        plans, over = plan(cell)
+    if cell > wanted:
+        notes.append(f"note: walls: dexels {cell:.3g} mm apart, coarser than the {wanted:.3g} of the stock's cells "
+                     f"({max_work:,} cuts, {MAX_DEXELS:,} dexels at most): cusps between their levels are seen "
+                     f"lower than they are")
+    points, dexels, full = [], 0, 0
+    for swap, a, b, a0, a1, l0, keep, kbot, ktop in plans:
+        seg = np.empty(keep.shape + (W.SEGMENTS, 2))
+        seg[:, :, 0, 0], seg[:, :, 0, 1] = a0, a1
+        cnt = keep.astype(np.int64)
+        full += W.sweep_dexels(seg, cnt, kbot, ktop, l0, lo[2], cell, a, b, moves.rapid, radii, corners, cell / 2)
+        points.append(W.wall_points(seg, cnt, a0, a1, l0, lo[2], cell, swap))
+        dexels += int(keep.sum())
+    if full:
+        notes.append(f"note: walls: {full:,} cuts met a dexel holding {W.SEGMENTS} intervals already and left it "
+                     f"whole (more material judged, never less)")
+    q = np.concatenate(points)
+    # the stock points the part's bounding box (grown by the tool) can reach at all
+    box_lo, box_hi = part.points.min(axis=0) - cutter.radius, part.points.max(axis=0) + cutter.radius
+    q = q[np.all((q >= box_lo) & (q <= box_hi), axis=1)]
+    if len(q) > MAX_WALL_POINTS:
+        every = math.ceil(len(q) / MAX_WALL_POINTS)
+        notes.append(f"note: walls: every {every}th of {len(q):,} stock points judged ({MAX_WALL_POINTS:,} at most)")
+        q = q[::every]
+    scallop = float(op.report.get("scallop") or 0.0)
+    # the stamps' sag between stamps half a cell apart, as in the height field
+    bound = scallop + limit + (cell / 4) ** 2 / (2 * max(cutter.corner, cell))
+    if not len(q):
+        return Finding(what, -np.inf, bound), dexels, 0
+    depth, normal, foot = W.feet(cKDTree(part.points), part.points, q)
+    steep = W.steep_normals(normal)
+    q, depth, normal, foot = q[steep], depth[steep], normal[steep], foot[steep]
+    # reached: the tool tangent there, and no disc of its shank or holder below the part
+    tips = W.tangent_tips(foot, normal, cutter.radius, cutter.corner)
+    # no point of the part deeper than the limit, the tip not below the stock's bottom (the
+    # table: a wall's last ``c`` above it is the corner's fillet) nor below the part's top
+    # less the flutes (above them the shank meets the stock in front: the job's own rule)
+    floor = max(float(lo[2]), float(part.points[:, 2].max()) - op.tool.flute_length)
+    reach = (part.deepest(tips, cutter.radius, cutter.corner)[0] <= limit) & (tips[:, 2] >= floor - limit)
+    for r, h, _ in op.tool.body:
+        if r - limit > cutter.radius and reach.any():
+            reach[reach] = part.drop(tips[reach, :2], r - limit, 0.0) - h <= tips[reach, 2] + limit
+    q, depth = q[reach], depth[reach]
+    if not len(q):
+        return Finding(what, -np.inf, bound), dexels, 0
+    # the deepest measured again against the exact faces
+    top_k = np.argsort(depth)[-EXACT_PROBES:]
+    exact, _ = closest_on_face(compound(faces_of(shape)), q[top_k])
+    depth[top_k] = exact
+    k = int(np.argmax(depth))
+    return (Finding(what, float(depth[k]), bound, tuple(float(v) for v in q[k]), int((depth > bound).sum())),
+            dexels, len(q))
 
 
 def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MAX_SAMPLES,
