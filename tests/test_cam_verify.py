@@ -88,7 +88,8 @@ def test_a_made_job_passes(job):
     assert v is not None and v.ok, str(v)
     assert [f.what.split(" (")[0] for f in v.findings] == ["gouge, roughing", "gouge, finishing", "rapids",
                                                            "holder and shank, roughing",
-                                                           "holder and shank, finishing", "residual after finishing"]
+                                                           "holder and shank, finishing", "residual after finishing",
+                                                           "residual on walls after finishing"]
     residual = _finding(v, "residual")
     assert 0.5 * 0.05 < residual.worst <= residual.limit  # cusps are there, within the scallop
     assert v.samples > 50_000 and v.probes > 50_000 and v.nodes > 10_000

@@ -35,12 +35,25 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   tool can reach (the part's closing by the tool, from its drop onto the part's points),
   measured normal to that surface, is at most the scallop plus the tolerance wherever the
   tool reaches.  A height field cannot see a wall: nodes steeper than ``WALL_SLOPE`` and a
-  band one cell wide at the part's outline are counted, not judged; so are the nodes the
-  shank or holder keeps the tool from (the whole tool's reach, from its discs' drops,
-  above the end's), and a tool radius round them.
+  band one cell wide at the part's outline are left to the walls' judge below; the nodes
+  the shank or holder keeps the tool from (the whole tool's reach, from its discs' drops,
+  above the end's), and a tool radius round them, are counted, not judged;
+- **walls**: the stock is also dexels along x and along y, a cell apart, kept in a band
+  round every place the height field sees rise steeper than ``DEXEL_SLOPE`` less 10° (a
+  wall, the part's outline), each holding its material as intervals, swept by each tool's
+  exact envelope (its end, and a cylinder of its radius going up) along every feed move in
+  program order (:mod:`~surfmod.cam.wall_dexels`).  Every end of an interval is a point of
+  the stock's surface; where the part at its foot is steeper than ``DEXEL_SLOPE`` its
+  distance to the part is the material left there, measured along the part's normal (a
+  plane through the nearest points of the exact part; the deepest once more by OCCT's exact
+  distance), judged against the same limit where the finishing tool reaches: tangent to
+  the part at the foot it takes in no point of the part beyond the limit, stands no lower
+  than the table nor the part's top less its flutes, the normal does not face down (an
+  overhang) and no disc of its shank or holder stands below the part.  A cusp between the
+  dexels' levels is seen lower, by at most its slope over half a cell.
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
-(points on the part, probes along the moves, stock nodes); where it would pass its cap the
+(points on the part, probes along the moves, stock nodes, the dexels' cuts); where it would pass its cap the
 points, probes or cells stand farther apart and the verdict carries a note saying so, so a
 large job is judged more coarsely, never refused (only a program of more moves than half
 ``max_probes`` is).  :func:`lift_gouges` is the repair a tool path gets from the same
@@ -79,6 +92,8 @@ MAX_DEXEL_WORK = 400_000_000
 MAX_DEXELS = 3_000_000
 #: stock points on walls the dexels judge, at most (beyond it every n-th is judged)
 MAX_WALL_POINTS = 2_000_000
+#: stock points on walls asked at a time whether the finishing tool reaches them
+REACH_CHUNK = 4096
 #: nodes of the stock steeper than this (degrees) are walls the height field cannot judge
 WALL_SLOPE = 80.0
 #: the least upward share of a contact normal a lift counts on (beside a vertical wall a
@@ -129,8 +144,9 @@ class Finding:
 @dataclass(frozen=True)
 class Verification:
     """What :func:`verify_job` / :func:`verify_toolpath` found: the ``findings`` (gouge per
-    operation, rapids, residual), and the work: points on the part, probes along the moves,
-    stock nodes, and the wall nodes the height field counted but could not judge."""
+    operation, rapids, residual, residual on walls), and the work: points on the part, probes
+    along the moves, stock nodes, the wall nodes the height field leaves to the dexels, the
+    dexels kept and the points of their stock judged."""
 
     findings: tuple
     samples: int
@@ -191,6 +207,16 @@ class PartPoints:
     def deepest(self, probes: np.ndarray, radius: float, corner: float):
         return K.deepest(self.starts, self.points, *self.origin, self.cell, *self.shape,
                          np.ascontiguousarray(probes, dtype=float), radius, corner)
+
+    def around(self, q: np.ndarray, rings: int) -> np.ndarray:
+        """The points of the buckets within ``rings`` buckets of those holding the points
+        ``q`` (their (x, y); outside the grid: its nearest bucket)."""
+        nx, ny = self.shape
+        ij = np.floor((q[:, :2] - np.array(self.origin)) / self.cell).astype(np.int64)
+        mask = np.zeros((nx, ny), bool)
+        mask[np.clip(ij[:, 0], 0, nx - 1), np.clip(ij[:, 1], 0, ny - 1)] = True
+        mask = ndimage.binary_dilation(mask, structure=np.ones((3, 3), bool), iterations=rings)
+        return self.points[np.repeat(mask.ravel(), np.diff(self.starts))]
 
     def drop(self, xy: np.ndarray, radius: float, corner: float) -> np.ndarray:
         return K.drop_heights(self.starts, self.points, *self.origin, self.cell, *self.shape,
@@ -506,7 +532,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     ...                                          sm.Finish(sm.Tool("ball", 2.0), scallop=0.05)], verify=False)
     >>> v = verify_job(job)
     >>> v.ok, [f.what.split(" (")[0] for f in v.findings]
-    (True, ['gouge, roughing', 'gouge, finishing', 'rapids', 'holder and shank, roughing', 'holder and shank, finishing', 'residual after finishing'])
+    (True, ['gouge, roughing', 'gouge, finishing', 'rapids', 'holder and shank, roughing', 'holder and shank, finishing', 'residual after finishing', 'residual on walls after finishing'])
     """
     from .post import programs
 
@@ -763,28 +789,48 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
     bound = scallop + limit + (cell / 4) ** 2 / (2 * max(cutter.corner, cell))
     if not len(q):
         return Finding(what, -np.inf, bound), dexels, 0
-    depth, normal, foot = W.feet(cKDTree(part.points), part.points, q)
+    # the part's points near them (their nearest lie within two buckets of a stock point
+    # nearer the part than a bucket; a farther one is measured exactly below if deepest)
+    near = part.around(q, 2)
+    depth, normal, foot = W.feet(cKDTree(near), near, q)
     steep = W.steep_normals(normal)
     q, depth, normal, foot = q[steep], depth[steep], normal[steep], foot[steep]
-    # reached: the tool tangent there, and no disc of its shank or holder below the part
     tips = W.tangent_tips(foot, normal, cutter.radius, cutter.corner)
-    # no point of the part deeper than the limit, the tip not below the stock's bottom (the
-    # table: a wall's last ``c`` above it is the corner's fillet) nor below the part's top
-    # less the flutes (above them the shank meets the stock in front: the job's own rule)
+    # the tip not below the stock's bottom (the table: a wall's last ``c`` above it is the
+    # corner's fillet) nor below the part's top less the flutes (above them the shank meets
+    # the stock in front: the job's own rule)
     floor = max(float(lo[2]), float(part.points[:, 2].max()) - op.tool.flute_length)
-    reach = (part.deepest(tips, cutter.radius, cutter.corner)[0] <= limit) & (tips[:, 2] >= floor - limit)
-    for r, h, _ in op.tool.body:
-        if r - limit > cutter.radius and reach.any():
-            reach[reach] = part.drop(tips[reach, :2], r - limit, 0.0) - h <= tips[reach, 2] + limit
-    q, depth = q[reach], depth[reach]
-    if not len(q):
-        return Finding(what, -np.inf, bound), dexels, 0
+
+    def reached(pick):
+        """The tool tangent at these feet takes in no point of the part beyond the limit,
+        and no disc of its shank or holder stands below the part."""
+        t = tips[pick]
+        ok = (t[:, 2] >= floor - limit) & (part.deepest(t, cutter.radius, cutter.corner)[0] <= limit)
+        for r, h, _ in op.tool.body:
+            if r - limit > cutter.radius and ok.any():
+                ok[ok] = part.drop(t[ok, :2], r - limit, 0.0) - h <= t[ok, 2] + limit
+        return ok
+
+    # every point beyond the bound is asked (they are counted), then the next deepest a
+    # chunk at a time until one is reached: none asked later lies deeper
+    order = np.argsort(-depth)
+    asked = int((depth > bound).sum())
+    reach = np.zeros(len(q), bool)
+    reach[order[:asked]] = reached(order[:asked])
+    for start in range(asked, len(order), REACH_CHUNK):
+        if reach.any():
+            break
+        chunk = order[start:start + REACH_CHUNK]
+        reach[chunk] = reached(chunk)
+    if not reach.any():
+        return Finding(what, -np.inf, bound), dexels, len(q)
+    judged, depth_r = q[reach], depth[reach]
     # the deepest measured again against the exact faces
-    top_k = np.argsort(depth)[-EXACT_PROBES:]
-    exact, _ = closest_on_face(compound(faces_of(shape)), q[top_k])
-    depth[top_k] = exact
-    k = int(np.argmax(depth))
-    return (Finding(what, float(depth[k]), bound, tuple(float(v) for v in q[k]), int((depth > bound).sum())),
+    top_k = np.argsort(depth_r)[-EXACT_PROBES:]
+    exact, _ = closest_on_face(compound(faces_of(shape)), judged[top_k])
+    depth_r[top_k] = exact
+    k = int(np.argmax(depth_r))
+    return (Finding(what, float(depth_r[k]), bound, tuple(float(v) for v in judged[k]), int((depth_r > bound).sum())),
             dexels, len(q))
 
 

@@ -7,7 +7,9 @@ a step between two nodes and a cusp on it, thinner than a cell, is not there at 
 dexel along x at ``(y_j, z_k)`` is a line through the stock holding the material on it as
 intervals ``[x0, x1]`` (at most ``SEGMENTS`` of them); the dexels along y likewise, one
 kernel serving both with the coordinates swapped.  The lines stand a ``cell`` apart,
-their levels at ``z0 + (k + 1/2) cell``.
+their levels at ``z0 + (k + 1/2) cell``.  Only walls need them: they are kept in a band
+round the places the height field sees steep (:func:`steep_band`, :func:`band`), the
+others stand empty and cost a test each.
 
 The tool is an end of radius ``R`` and corner ``c`` (:class:`~surfmod.cam.cutters.Cutter`)
 on a cylinder of its radius going up: at a height ``h`` above the tip its section is a disc
@@ -19,8 +21,8 @@ move from ``A`` to ``B`` removes from each dexel the chord of those discs:
 - at the levels below it (the corner's band, and a descending move's column), the move is
   stamped at points at most ``step`` apart, each stamp's disc at that level cut.
 
-Every move is estimated before any is swept (:func:`sweep_work`): the lines a capsule
-crosses and the stamps' lines, counted in the dexels' plane.
+Every move is estimated before any is swept (:func:`sweep_work`): the kept dexels of the
+lines its capsule crosses and its stamps' lines, counted in the dexels' plane.
 
 **Judged** (:func:`wall_residual`): every end of a material interval is a point of the
 stock's surface.  Its distance to the part is the material left there, measured along the
