@@ -186,6 +186,47 @@ def test_cam_part_residual_is_the_judges():
 
 
 # -- walls ----------------------------------------------------------------------------------------
+def _one_move(start, end, radius, corner, swap, cell=0.1):
+    """Dexels over the box [-5, 5]² x [0, 4] after one feed move: the intervals of each."""
+    from surfmod.cam import wall_dexels as W
+
+    order = [1, 0, 2] if swap else [0, 1, 2]
+    a, b = (np.array([p], float)[:, order] for p in (start, end))
+    lines, levels = int(10 / cell) + 1, int(4 / cell)
+    seg = np.zeros((lines, levels, W.SEGMENTS, 2))
+    seg[:, :, 0] = -5.0, 5.0
+    cnt = np.ones((lines, levels), np.int64)
+    full = W.sweep_dexels(seg, cnt, np.zeros(lines, np.int64), np.full(lines, levels - 1), -5.0, 0.0, cell, a, b,
+                          np.zeros(1, bool), np.array([radius]), np.array([corner]), cell / 2)
+    assert full == 0
+    return seg, cnt
+
+
+def test_dexels_lose_the_tools_exact_section():
+    # a ball along x at y = 0.3, tip at z 1: the dexel along y through x = 0 (a stamp's own
+    # place) loses the ball's section at each level, then the cylinder's
+    seg, cnt = _one_move((-3, 0.3, 1), (3, 0.3, 1), 1.5, 1.5, swap=True)
+    for k in range(40):
+        h = (k + 0.5) * 0.1 - 1.0
+        r = 0.0 if h <= 0 else 1.5 if h >= 1.5 else math.sqrt(1.5 ** 2 - (1.5 - h) ** 2)
+        got = np.sort(seg[50, k, :cnt[50, k]], axis=0)
+        want = [[-5.0, 5.0]] if r == 0 else [[-5.0, 0.3 - r], [0.3 + r, 5.0]]
+        assert np.allclose(got, want, atol=1e-12), (k, got, want)
+    # a flat end on a diagonal: above its tip the capsule round the move, exactly (against
+    # discs 1e-4 apart along it)
+    seg, cnt = _one_move((0, 0, 1), (3, 4, 1), 2.0, 0.0, swap=False)
+    t = np.linspace(0, 1, 50_001)
+    for j in range(0, 101, 7):
+        y = -5 + 0.1 * j
+        d = y - 4 * t
+        inside = np.abs(d) < 2.0
+        half = np.sqrt(np.maximum(4.0 - d * d, 0.0))
+        lo, hi = (3 * t - half)[inside].min(initial=np.inf), (3 * t + half)[inside].max(initial=-np.inf)
+        got = np.sort(seg[j, 15, :cnt[j, 15]], axis=0)
+        want = [[-5.0, 5.0]] if lo > hi else [[-5.0, lo], [hi, 5.0]]
+        assert np.allclose(got, want, atol=1e-6), (j, got, want)
+
+
 DRAFT, CONE_H, BALL = 10.0, 6.0, 1.5  # a cone boss 6 high whose wall leans 10 degrees in
 
 
@@ -318,6 +359,10 @@ def test_cli_machine_exit_3_and_header_on_a_broken_promise(tmp_path, capsys, mon
     out = tmp_path / "a.ngc"
     assert main(args + ["--out", str(out)]) == 0
     assert "(verified: gouge, roughing" in out.read_text()
+    # the walls' finding in the summary and the header, with its maximum and where
+    assert re.search(r"residual on walls after finishing \(tool 2, normal to the wall\): max [\d.e-]+ mm at \(",
+                     capsys.readouterr().out)
+    assert "residual on walls after finishing [tool 2" in out.read_text()
     out = tmp_path / "b.ngc"
     assert main(args + ["--out", str(out), "--no-verify"]) == 0
     assert "(not verified: --no-verify" in out.read_text()
