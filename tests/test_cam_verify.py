@@ -167,12 +167,14 @@ def test_work_is_bounded_up_front(job):
         V.verify_job(job, max_probes=moves)
     # points, probes and stock cells fit their caps instead, coarser, and the verdict says so
     full = job.verification.probes
-    v = V.verify_job(job, max_samples=20_000, max_nodes=2_000, max_probes=full // 2)
+    v = V.verify_job(job, max_samples=20_000, max_nodes=2_000, max_probes=full // 2, max_dexel_work=200_000)
     assert v.samples <= 20_000 and v.nodes <= 2_000 and v.spacing > job.verification.spacing
     assert v.probes <= full // 2
     assert any("coarser than" in n and "points" in n for n in v.notes)
     assert any("probes" in n and "coarser than" in n for n in v.notes)
     assert any("stock cells" in n for n in v.notes)
+    assert any(n.startswith("note: walls: dexels") and "coarser than" in n for n in v.notes)
+    assert 0 < v.dexels < job.verification.dexels
 
 
 def test_cam_part_residual_is_the_judges():
