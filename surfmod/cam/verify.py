@@ -136,7 +136,12 @@ class Finding:
     def __str__(self) -> str:
         at = "" if self.where is None else " at ({:.4g}, {:.4g}, {:.4g})".format(*self.where)
         line = f" (line {self.line})" if self.line else ""
-        worst = "nothing inside the tool" if not self.worst > 0 else f"max {self.worst:.3g} mm"
+        if self.worst > 0:
+            worst = f"max {self.worst:.3g} mm"
+        elif self.what.startswith("residual"):  # material left, not points inside a tool
+            worst = "nothing left" if np.isfinite(self.worst) else "no place the tool reaches"
+        else:
+            worst = "nothing inside the tool"
         verdict = "ok" if self.ok else f"BROKEN: {self.count} beyond it"
         return f"{self.what}: {worst}{at}{line}, limit {self.limit:.3g} mm, {verdict}"
 
