@@ -88,10 +88,10 @@ MAX_BODY_PROBES = 20_000_000
 MAX_NODES = 30_000_000
 #: interval cuts the dexels along x and y may take (:func:`~surfmod.cam.wall_dexels.sweep_work`)
 MAX_DEXEL_WORK = 400_000_000
-#: dexels along x and y together, at most (each holds ``wall_dexels.SEGMENTS`` intervals)
-MAX_DEXELS = 3_000_000
+#: dexels along x and y together, at most (each holds ``wall_dexels.SEGMENTS`` intervals: 256 MB)
+MAX_DEXELS = 2_000_000
 #: stock points on walls the dexels judge, at most (beyond it every n-th is judged)
-MAX_WALL_POINTS = 2_000_000
+MAX_WALL_POINTS = 1_000_000
 #: stock points on walls asked at a time whether the finishing tool reaches them
 REACH_CHUNK = 4096
 #: nodes of the stock steeper than this (degrees) are walls the height field cannot judge
