@@ -458,20 +458,22 @@ def simulate(program: Program, cutters: dict[int, Cutter], stock: Stock, part_to
 # ----------------------------------------------------------------------------------------------
 # the part as a height field, and the surface a tool can reach
 
-def part_height(triangles: np.ndarray, x: np.ndarray, y: np.ndarray, *, block: int = 2_000_000) -> np.ndarray:
-    """Top of the triangles over each grid node ``(len(x), len(y))`` (-inf where none):
-    a vertical ray from above, exact on the triangles."""
+def ray_hits(triangles: np.ndarray, axis: int, u: np.ndarray, v: np.ndarray, *, slack: float = 1e-12,
+             block: int = 2_000_000):
+    """Where lines parallel to coordinate ``axis`` (0 x, 1 y, 2 z) cross the triangles: the
+    lines pass through the grid ``(u_i, v_j)`` of the two other coordinates (in their
+    order: y, z for x lines; x, z for y lines; x, y for z lines).  Yields blocks of
+    ``(i, j, position along axis, triangle index)``, exact on the triangles (barycentric
+    test with ``slack``)."""
     tri = np.asarray(triangles, dtype=float)
-    top = np.full((len(x), len(y)), -np.inf)
-    h = (x[1] - x[0]) if len(x) > 1 else 1.0
-    lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
-    i0 = np.searchsorted(x, lo[:, 0] - 1e-12, "left")
-    i1 = np.searchsorted(x, hi[:, 0] + 1e-12, "right")
-    j0 = np.searchsorted(y, lo[:, 1] - 1e-12, "left")
-    j1 = np.searchsorted(y, hi[:, 1] + 1e-12, "right")
+    cu, cv = [k for k in range(3) if k != axis]
+    lo, hi = tri[:, :, [cu, cv]].min(axis=1), tri[:, :, [cu, cv]].max(axis=1)
+    i0 = np.searchsorted(u, lo[:, 0] - 1e-12, "left")
+    i1 = np.searchsorted(u, hi[:, 0] + 1e-12, "right")
+    j0 = np.searchsorted(v, lo[:, 1] - 1e-12, "left")
+    j1 = np.searchsorted(v, hi[:, 1] + 1e-12, "right")
     ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
     counts = ni * nj
-    del h
     edges = np.r_[0, np.cumsum(counts)]
     starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
     for s0, s1 in zip(starts[:-1], starts[1:]):
@@ -483,19 +485,26 @@ def part_height(triangles: np.ndarray, x: np.ndarray, y: np.ndarray, *, block: i
         local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
         ii = i0[t] + local // np.maximum(nj[t], 1)
         jj = j0[t] + local % np.maximum(nj[t], 1)
-        px, py = x[ii], y[jj]
+        pu, pv = u[ii], v[jj]
         A, B, C = tri[t, 0], tri[t, 1], tri[t, 2]
         v0, v1 = B - A, C - A
-        den = v0[:, 0] * v1[:, 1] - v1[:, 0] * v0[:, 1]
+        den = v0[:, cu] * v1[:, cv] - v1[:, cu] * v0[:, cv]
         good = np.abs(den) > 1e-300
         den = np.where(good, den, 1.0)
-        wx, wy = px - A[:, 0], py - A[:, 1]
-        l1 = (wx * v1[:, 1] - v1[:, 0] * wy) / den
-        l2 = (v0[:, 0] * wy - wx * v0[:, 1]) / den
-        slack = 1e-12
+        wx, wy = pu - A[:, cu], pv - A[:, cv]
+        l1 = (wx * v1[:, cv] - v1[:, cu] * wy) / den
+        l2 = (v0[:, cu] * wy - wx * v0[:, cv]) / den
         inside = good & (l1 >= -slack) & (l2 >= -slack) & (l1 + l2 <= 1 + slack)
-        z = A[:, 2] + l1 * v0[:, 2] + l2 * v1[:, 2]
-        np.maximum.at(top, (ii[inside], jj[inside]), z[inside])
+        z = A[:, axis] + l1 * v0[:, axis] + l2 * v1[:, axis]
+        yield ii[inside], jj[inside], z[inside], t[inside]
+
+
+def part_height(triangles: np.ndarray, x: np.ndarray, y: np.ndarray, *, block: int = 2_000_000) -> np.ndarray:
+    """Top of the triangles over each grid node ``(len(x), len(y))`` (-inf where none):
+    a vertical ray from above, exact on the triangles."""
+    top = np.full((len(x), len(y)), -np.inf)
+    for ii, jj, z, _ in ray_hits(triangles, 2, x, y, block=block):
+        np.maximum.at(top, (ii, jj), z)
     return top
 
 
@@ -545,3 +554,430 @@ def normal_residual(top: np.ndarray, surface: np.ndarray, h: float) -> np.ndarra
     gx, gy = np.gradient(np.where(np.isfinite(surface), surface, np.nan), h)
     res = (top - surface) / np.sqrt(1 + gx * gx + gy * gy)
     return np.where(np.isfinite(res), res, np.nan)
+
+
+# ----------------------------------------------------------------------------------------------
+# dexels along x and y: the stock on vertical walls
+#
+# A tool coming from above carries its shank upwards, so the set one move removes is closed
+# upwards and convex (a convex tool swept along a segment): a line along x (or y) at height
+# z meets it in one interval, which only grows with z.  A line therefore records only the
+# moves whose tool ends between its height and a corner radius below (where the tool's
+# section still changes with height), plus the first line above them (the shank, whose
+# section no longer changes); the stock left on a line is then the stock minus the union of
+# what the lines at or below it recorded.  The intervals are exact: closed forms for flat
+# and ball, a bracketed search of convex functions for bull.
+
+CUT_PAIRS_LIMIT = 60_000_000  # (line, move) pairs one sweep may evaluate
+_SLOPE = 1e6  # slope of the tool's section radius continued below its tip (see _numeric_cut)
+
+
+def _ends_interval(es, eq, r2, q0):
+    """Line (s, q0) against discs of squared radius ``r2`` at (es, eq): (lo, hi), empty lo > hi."""
+    d2 = r2 - (q0 - eq) ** 2
+    half = np.sqrt(np.maximum(d2, 0.0))
+    return np.where(d2 >= 0, es - half, np.inf), np.where(d2 >= 0, es + half, -np.inf)
+
+
+def _affine_interval(coef, const, lo_bound, hi_bound):
+    """The s with ``lo_bound <= coef * s + const <= hi_bound`` (all s or none where coef is 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b = (lo_bound - const) / coef, (hi_bound - const) / coef
+    flat = coef == 0
+    holds = (const >= lo_bound) & (const <= hi_bound)
+    lo = np.where(flat, np.where(holds, -np.inf, np.inf), np.minimum(a, b))
+    hi = np.where(flat, np.where(holds, np.inf, -np.inf), np.maximum(a, b))
+    return lo, hi
+
+
+def _stadium_cut(a, b, R, q0):
+    """Line ``q = q0`` in the plane against the disc of radius R swept from a to b ((n, 2)
+    arrays of (s, q)): the hull of the two end discs and the band between them."""
+    lo1, hi1 = _ends_interval(a[:, 0], a[:, 1], R * R, q0)
+    lo2, hi2 = _ends_interval(b[:, 0], b[:, 1], R * R, q0)
+    vs, vq = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+    L2 = vs * vs + vq * vq
+    L = np.sqrt(L2)
+    dq = q0 - a[:, 1]
+    # along the segment: 0 <= (s - a_s) vs + dq vq <= L2; across it: |(s - a_s) vq - dq vs| <= R L
+    tlo, thi = _affine_interval(vs, dq * vq, 0.0, L2)
+    plo, phi = _affine_interval(vq, -dq * vs, -R * L, R * L)
+    blo, bhi = np.maximum(tlo, plo) + a[:, 0], np.minimum(thi, phi) + a[:, 0]
+    band = (L2 > 0) & (blo <= bhi)
+    lo = np.minimum(np.minimum(lo1, lo2), np.where(band, blo, np.inf))
+    hi = np.maximum(np.maximum(hi1, hi2), np.where(band, bhi, -np.inf))
+    return lo, hi
+
+
+def _below(a, b, zc, z0):
+    """Parameter interval [t0, t1] of a -> b where the height ``zc`` (+ t (b - a)_z) is at
+    most z0; t0 > t1 where never."""
+    dz = b[:, 2] - a[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tc = (z0 - zc) / dz
+    never = np.where(dz == 0, zc > z0, False)
+    t0 = np.where(dz < 0, np.clip(tc, 0, 1), 0.0)
+    t1 = np.where(dz > 0, np.clip(tc, 0, 1), 1.0)
+    t0 = np.where(never | ((dz > 0) & (tc < 0)) | ((dz < 0) & (tc > 1)), 1.0, t0)
+    t1 = np.where(never | ((dz > 0) & (tc < 0)) | ((dz < 0) & (tc > 1)), 0.0, t1)
+    return t0, t1
+
+
+def _shank_cut(a, b, R, lift, q0, z0):
+    """The part of the swept tool whose section is the full disc R (heights from tip +
+    ``lift`` up) against the line: the stadium swept over the t where that part reaches z0."""
+    t0, t1 = _below(a, b, a[:, 2] + lift, z0)
+    v = b - a
+    lo, hi = _stadium_cut((a + t0[:, None] * v)[:, :2], (a + t1[:, None] * v)[:, :2], R, q0)
+    empty = t0 > t1
+    return np.where(empty, np.inf, lo), np.where(empty, -np.inf, hi)
+
+
+def _capsule_cut(a, b, R, q0, z0):
+    """Line (s, q0, z0) against the capsule of radius R round the segment a -> b (centres)."""
+    lo1, hi1 = _ends_interval(a[:, 0], a[:, 1], R * R - (z0 - a[:, 2]) ** 2, q0)
+    lo2, hi2 = _ends_interval(b[:, 0], b[:, 1], R * R - (z0 - b[:, 2]) ** 2, q0)
+    e = b - a
+    E2 = (e * e).sum(axis=1)
+    w0 = np.column_stack([np.zeros(len(a)), q0 - a[:, 1], z0 - a[:, 2]])
+    w0e = (w0 * e).sum(axis=1)
+    safe = np.where(E2 > 0, E2, 1.0)
+    # distance² to the axis, a quadratic in X = s - a_s: c2 X² + c1 X + c0 <= 0
+    c2 = 1 - e[:, 0] ** 2 / safe
+    c1 = -2 * e[:, 0] * w0e / safe
+    c0 = (w0 * w0).sum(axis=1) - w0e ** 2 / safe - R * R
+    par = c2 < 1e-12
+    disc = c1 * c1 - 4 * c2 * c0
+    root = np.sqrt(np.maximum(disc, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        qlo = np.where(par, np.where(c0 <= 0, -np.inf, np.inf), (-c1 - root) / (2 * c2))
+        qhi = np.where(par, np.where(c0 <= 0, np.inf, -np.inf), (-c1 + root) / (2 * c2))
+    qlo = np.where(~par & (disc < 0), np.inf, qlo)
+    qhi = np.where(~par & (disc < 0), -np.inf, qhi)
+    tlo, thi = _affine_interval(e[:, 0], w0e, 0.0, E2)
+    clo, chi = np.maximum(qlo, tlo) + a[:, 0], np.minimum(qhi, thi) + a[:, 0]
+    cyl = (E2 > 0) & (clo <= chi)
+    lo = np.minimum(np.minimum(lo1, lo2), np.where(cyl, clo, np.inf))
+    hi = np.maximum(np.maximum(hi1, hi2), np.where(cyl, chi, -np.inf))
+    return lo, hi
+
+
+def _golden(f, lo, hi, steps=GOLDEN_STEPS):
+    """Minimum of convex ``f`` on [lo, hi] per element (golden section)."""
+    g = (math.sqrt(5) - 1) / 2
+    x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+    f1, f2 = f(x1), f(x2)
+    for _ in range(steps):
+        left = f1 <= f2
+        hi, lo = np.where(left, x2, hi), np.where(left, lo, x1)
+        keep_x, keep_f = np.where(left, x1, x2), np.where(left, f1, f2)
+        fresh = np.where(left, hi - g * (hi - lo), lo + g * (hi - lo))
+        fresh_f = f(fresh)
+        x1, x2 = np.where(left, fresh, keep_x), np.where(left, keep_x, fresh)
+        f1, f2 = np.where(left, fresh_f, keep_f), np.where(left, keep_f, fresh_f)
+    xs = np.stack([lo, hi, x1, x2])
+    fs = np.stack([f(lo), f(hi), f1, f2])
+    k = np.argmin(fs, axis=0)
+    return xs[k, np.arange(xs.shape[1])], fs[k, np.arange(fs.shape[1])]
+
+
+def _numeric_cut(cutter: Cutter, a, b, q0, z0):
+    """Any tool by bracketed searches.  At parameter t the line meets the tool's section at
+    z0 (a disc of radius rho(z0 - tip_z)) where h(t) = rho - |q0 - q(t)| >= 0; rho is concave
+    in height, so h is concave and {h >= 0} an interval, found by maximising h and bisecting
+    each side.  On it, s(t) -+ sqrt(rho² - dq²) are convex / concave (the set of (t, s) in the
+    swept tool is convex): their extremes are the interval's ends.  Below the tip rho is
+    continued with slope ``_SLOPE`` (a concave continuation; it shifts t by ~1e-6 mm / |dz|)."""
+    R, r = cutter.radius, cutter.corner
+    core = R - r
+    v = b - a
+
+    def rho(u):
+        uu = np.clip(u, 0.0, r)
+        true = np.where(u >= r, R, core + np.sqrt(np.maximum(r * r - (r - uu) ** 2, 0.0))) if r > 0 else \
+            np.full(np.shape(u), R)
+        return np.minimum(np.where(u >= 0, true, core), core + _SLOPE * u)
+
+    def h(t):
+        return rho(z0 - a[:, 2] - t * v[:, 2]) - np.abs(q0 - a[:, 1] - t * v[:, 1])
+
+    zero, one = np.zeros(len(a)), np.ones(len(a))
+    tm, hm = _golden(lambda t: -h(t), zero, one)
+    hit = -hm >= 0
+
+    def bisect(inside, outside):
+        for _ in range(GOLDEN_STEPS):
+            mid = (inside + outside) / 2
+            ok = h(mid) >= 0
+            inside, outside = np.where(ok, mid, inside), np.where(ok, outside, mid)
+        return inside
+
+    t0 = np.where(h(zero) >= 0, zero, bisect(tm, zero))
+    t1 = np.where(h(one) >= 0, one, bisect(tm, one))
+
+    def half(t):
+        u = z0 - a[:, 2] - t * v[:, 2]
+        dq = q0 - a[:, 1] - t * v[:, 1]
+        return np.sqrt(np.maximum(rho(np.maximum(u, 0.0)) ** 2 - dq * dq, 0.0))
+
+    _, lo = _golden(lambda t: a[:, 0] + t * v[:, 0] - half(t), t0, t1)
+    _, neg = _golden(lambda t: -(a[:, 0] + t * v[:, 0] + half(t)), t0, t1)
+    return np.where(hit, lo, np.inf), np.where(hit, -neg, -np.inf)
+
+
+def line_cut(cutter: Cutter, a, b, q0, z0, *, numeric: bool = False):
+    """The interval of the line ``(s, q0, z0)`` (s free) the tool removes moving from tip a
+    to tip b ((n, 3) arrays in (s, q, z) coordinates; q0, z0 (n,)); lo > hi where none."""
+    a, b = np.atleast_2d(np.asarray(a, float)), np.atleast_2d(np.asarray(b, float))
+    q0, z0 = np.broadcast_to(q0, len(a)).astype(float), np.broadcast_to(z0, len(a)).astype(float)
+    if numeric or cutter.kind == "bull":
+        return _numeric_cut(cutter, a, b, q0, z0)
+    R = cutter.radius
+    if cutter.kind == "flat":
+        return _shank_cut(a, b, R, 0.0, q0, z0)
+    up = np.array([0.0, 0.0, R])
+    lo1, hi1 = _capsule_cut(a + up, b + up, R, q0, z0)
+    lo2, hi2 = _shank_cut(a, b, R, R, q0, z0)
+    return np.minimum(lo1, lo2), np.maximum(hi1, hi2)
+
+
+def _merge(line, lo, hi, span):
+    """Union of intervals per line: sorted disjoint (line, lo, hi) (values inside [0, span))."""
+    if not len(line):
+        return line, lo, hi
+    key = line * span
+    order = np.lexsort((lo, line))
+    line, lo, hi = line[order], lo[order], hi[order]
+    reach = np.maximum.accumulate(key[order] + hi)  # lines far apart: no leak across lines
+    start = np.r_[True, key[order][1:] + lo[1:] > reach[:-1]]
+    group = np.cumsum(start) - 1
+    end = np.zeros(group[-1] + 1)
+    np.maximum.at(end, group, hi)
+    return line[start], lo[start], end
+
+
+class SideDexels:
+    """Dexels along ``axis`` (0: lines along x on the grid (y_j, z_k); 1: along y on (x_i,
+    z_k)) through the stock box: the stock on each line is the box's extent minus the
+    removed intervals.  :meth:`cut` sweeps moves; :meth:`removed` gives the union per line."""
+
+    def __init__(self, box, axis: int, q: np.ndarray, z: np.ndarray):
+        self.box = np.asarray(box, dtype=float)
+        self.axis = int(axis)
+        self.q = np.unique(np.asarray(q, dtype=float))
+        zt = self.box[1, 2]
+        z = np.unique(np.asarray(z, dtype=float))  # ascending: what a line removes, the lines above do
+        self.z = z[z < zt]  # no stock above the box
+        self.s0, self.s1 = self.box[0, self.axis], self.box[1, self.axis]
+        self.span = (self.s1 - self.s0) + 4.0
+        self._rec: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self._union = None
+
+    def _frame(self, p):
+        return np.column_stack([p[:, self.axis], p[:, 1 - self.axis], p[:, 2]])
+
+    def pairs(self, cutter: Cutter, a, b):
+        """Per move (rows of a, b in x, y, z) its line window: (j0, j1, k0, k1) (k1 inclusive)."""
+        R, r = cutter.radius, cutter.corner
+        fa, fb = self._frame(a), self._frame(b)
+        j0 = np.searchsorted(self.q, np.minimum(fa[:, 1], fb[:, 1]) - R, "left")
+        j1 = np.searchsorted(self.q, np.maximum(fa[:, 1], fb[:, 1]) + R, "right")
+        k0 = np.searchsorted(self.z, np.minimum(fa[:, 2], fb[:, 2]), "left")
+        k1 = np.minimum(np.searchsorted(self.z, np.maximum(fa[:, 2], fb[:, 2]) + r, "left"), len(self.z) - 1)
+        return fa, fb, j0, j1, k0, k1
+
+    def cut(self, cutter: Cutter, a, b, *, limit: int = CUT_PAIRS_LIMIT, block: int = 1_000_000):
+        """Record what the moves a[m] -> b[m] remove (lines between each move's lowest tip and
+        a corner radius above its highest; the line above takes the shank's section)."""
+        fa, fb, j0, j1, k0, k1 = self.pairs(cutter, np.asarray(a, float), np.asarray(b, float))
+        nj, nk = np.maximum(j1 - j0, 0), np.where(k0 < len(self.z), np.maximum(k1 - k0 + 1, 0), 0)
+        counts = nj * nk
+        total = int(counts.sum())
+        if total > limit:
+            raise ValueError(f"side dexels: {total:.3g} line-move pairs (limit {limit:.3g}); choose a coarser grid")
+        nz = len(self.z)
+        edges = np.r_[0, np.cumsum(counts)]
+        starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
+        for s0, s1 in zip(starts[:-1], starts[1:]):
+            if s1 <= s0:
+                continue
+            ids = np.arange(s0, min(s1, len(counts)))
+            c = counts[ids]
+            m = np.repeat(ids, c)
+            local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
+            jj = j0[m] + local // np.maximum(nk[m], 1)
+            kk = k0[m] + local % np.maximum(nk[m], 1)
+            lo, hi = line_cut(cutter, fa[m], fb[m], self.q[jj], self.z[kk])
+            lo, hi = np.maximum(lo, self.s0 - 1.0), np.minimum(hi, self.s1 + 1.0)
+            keep = lo < hi
+            self._union = None
+            self._rec.append(_merge((jj * nz + kk)[keep], lo[keep] - self.s0 + 2.0, hi[keep] - self.s0 + 2.0,
+                                    self.span))
+
+    def removed(self):
+        """Union of the removed intervals per line ``j * len(z) + k``, sorted: (line, lo, hi),
+        each line's union taken with the lines below it (the removed set is closed upwards)."""
+        nz = len(self.z)
+        if self._union is not None:
+            return self._union
+        if not self._rec:
+            return np.zeros(0, int), np.zeros(0), np.zeros(0)
+        line = np.concatenate([r[0] for r in self._rec])
+        lo = np.concatenate([r[1] for r in self._rec])
+        hi = np.concatenate([r[2] for r in self._rec])
+        line, lo, hi = _merge(line, lo, hi, self.span)
+        self._rec = [(line, lo, hi)]
+        k = line % nz
+        out = [[], [], []]
+        below = (np.zeros(0, int), np.zeros(0), np.zeros(0))
+        for level in range(nz):
+            at = k == level
+            cur = _merge(np.r_[line[at], below[0] + 1], np.r_[lo[at], below[1]], np.r_[hi[at], below[2]],
+                         self.span)
+            for o, v in zip(out, cur):
+                o.append(v)
+            below = cur
+        line, lo, hi = (np.concatenate(o) for o in out)
+        order = np.argsort(line * self.span + lo, kind="stable")
+        self._union = line[order], lo[order] + self.s0 - 2.0, hi[order] + self.s0 - 2.0
+        return self._union
+
+    def thickness(self, line, pos, outward):
+        """Stock left on each line from ``pos`` in direction ``outward`` (+-1) to the nearest
+        removed point (to the box's side where none); negative: the removed interval covers
+        pos, by how far it reaches back."""
+        rl, rlo, rhi = self.removed()
+        line, pos, outward = np.asarray(line), np.asarray(pos, float), np.asarray(outward)
+        base = line * self.span - self.s0 + 2.0
+        klo, khi = rl * self.span + rlo - self.s0 + 2.0, rl * self.span + rhi - self.s0 + 2.0
+        up = np.searchsorted(khi, base + pos, "right")  # first interval ending beyond pos
+        upc = np.minimum(up, len(rl) - 1)
+        has_up = (up < len(rl)) & (rl[upc] == line) if len(rl) else np.zeros(len(line), bool)
+        t_up = np.where(has_up, rlo[upc] - pos if len(rl) else 0.0, self.s1 - pos)
+        dn = np.searchsorted(klo, base + pos, "left") - 1  # last interval starting before pos
+        dnc = np.clip(dn, 0, max(len(rl) - 1, 0))
+        has_dn = (dn >= 0) & (rl[dnc] == line) if len(rl) else np.zeros(len(line), bool)
+        t_dn = np.where(has_dn, pos - rhi[dnc] if len(rl) else 0.0, pos - self.s0)
+        return np.where(outward > 0, t_up, t_dn)
+
+
+def side_grids(box, h: float, *, phase: float = 0.5137):
+    """Dexels along x and along y through the stock ``box`` a distance ``h`` apart, their
+    lines set off the grid by ``phase`` cells (so that no line lies in a face of the part
+    drawn on round coordinates)."""
+    box = np.asarray(box, dtype=float)
+
+    def ticks(lo, hi):
+        n = int(math.floor((hi - lo) / h - phase)) + 1
+        if n > 1_000_000:
+            raise ValueError("side dexels: too many lines; choose a coarser h")
+        return lo + h * (phase + np.arange(max(n, 0)))
+
+    z = ticks(box[0, 2], box[1, 2])
+    return SideDexels(box, 0, ticks(box[0, 1], box[1, 1]), z), SideDexels(box, 1, ticks(box[0, 0], box[1, 0]), z)
+
+
+@dataclass
+class WallPoints:
+    """Where the dexel lines of one :class:`SideDexels` cross steep faces of the part: line
+    id, position along the line, outward sense along it (+-1), the face's unit outward
+    normal (n, 3), the point (n, 3), and the room outside it along the line to the part's
+    next crossing or the stock's side."""
+
+    line: np.ndarray
+    pos: np.ndarray
+    outward: np.ndarray
+    normal: np.ndarray
+    point: np.ndarray
+    room: np.ndarray
+
+    def __len__(self):
+        return len(self.line)
+
+    def take(self, mask):
+        return WallPoints(*(getattr(self, f)[mask] for f in ("line", "pos", "outward", "normal", "point", "room")))
+
+
+def wall_points(triangles: np.ndarray, dex: SideDexels, *, steep: float = 60.0) -> WallPoints:
+    """The crossings of the dexel lines with the part's faces steeper than ``steep`` degrees
+    whose normal lies within 45 degrees of the line (each steep point is measured by the
+    family of lines nearer its normal).  Inside and outside alternate along a line (the
+    part's closed surface), which orients each crossing whatever the triangles' winding;
+    lines left with an odd count (through a vertex) are dropped."""
+    tri = np.asarray(triangles, dtype=float)
+    nz = len(dex.z)
+    parts = [list(p) for p in zip(*ray_hits(tri, dex.axis, dex.q, dex.z))]
+    if not parts:
+        return WallPoints(*(np.zeros((0,) + s) for s in ((), (), (), (3,), (3,), ())))
+    jj, kk, pos, t = (np.concatenate(p) for p in parts)
+    line = jj * nz + kk
+    order = np.lexsort((pos, line))
+    line, pos, t = line[order], pos[order], t[order]
+    n = np.cross(tri[t, 1] - tri[t, 0], tri[t, 2] - tri[t, 0])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    # a line through an edge meets both triangles there: one crossing (same sense), unless
+    # it grazes the surface (opposite senses: in and out at once, both kept)
+    twin = np.r_[False, (line[1:] == line[:-1]) & (np.abs(pos[1:] - pos[:-1]) <= 1e-9)
+                 & (np.sign(n[1:, dex.axis]) == np.sign(n[:-1, dex.axis]))]
+    line, pos, t, n = line[~twin], pos[~twin], t[~twin], n[~twin]
+    count = np.bincount(line, minlength=len(dex.q) * nz)
+    even = count[line] % 2 == 0
+    line, pos, t, n = line[even], pos[even], t[even], n[even]
+    first = np.r_[True, line[1:] != line[:-1]]
+    rank = np.arange(len(line)) - np.maximum.accumulate(np.where(first, np.arange(len(line)), 0))
+    outward = np.where(rank % 2 == 0, -1, 1)
+    n *= np.where(n[:, dex.axis] * outward >= 0, 1.0, -1.0)[:, None]
+    same_next = np.r_[line[1:] == line[:-1], False]
+    same_prev = np.r_[False, line[1:] == line[:-1]]
+    nxt = np.where(same_next, np.r_[pos[1:], 0.0] - pos, dex.s1 - pos)
+    prv = np.where(same_prev, pos - np.r_[0.0, pos[:-1]], pos - dex.s0)
+    room = np.where(outward > 0, nxt, prv)
+    point = np.zeros((len(line), 3))
+    point[:, dex.axis] = pos
+    point[:, 1 - dex.axis] = dex.q[line // nz]
+    point[:, 2] = dex.z[line % nz]
+    keep = (np.abs(n[:, 2]) <= math.cos(math.radians(steep))) & (np.abs(n[:, dex.axis]) >= np.abs(n[:, 1 - dex.axis]))
+    return WallPoints(line, pos, outward, n, point, room).take(keep)
+
+
+def wall_left(dex: SideDexels, walls: WallPoints) -> np.ndarray:
+    """Stock left outside each wall point measured along its normal: the thickness along
+    the line to the nearest removed point times the normal's share along the line (the
+    distance of that point from the face's plane), at most the room outside it; negative
+    where a removed interval covers the point (a cut into the wall, by as much)."""
+    along = dex.thickness(walls.line, walls.pos, walls.outward)
+    return np.minimum(along, walls.room) * np.abs(walls.normal[:, dex.axis])
+
+
+def wall_reach(walls: WallPoints, top: np.ndarray, x: np.ndarray, y: np.ndarray, cutter: Cutter, *,
+               offset: float = 0.0, eps: float = 1e-9, block: int = 4_000_000) -> np.ndarray:
+    """Which wall points the tool can touch from above: the tool grown by ``offset`` placed
+    against the point along its normal (a ball's centre at P + (R + offset) n, a flat end's
+    rim, a bull's torus) must clear the part's height field ``top`` on the grid (x, y)
+    within its radius less a cell (the point's own face lies at the full radius), by eps.
+    Points under overhangs and in corners tighter than the tool fail."""
+    R, r = cutter.radius, cutter.corner
+    core = R - r
+    h = float(x[1] - x[0])
+    n = walls.normal
+    nh = n[:, :2] / np.maximum(np.linalg.norm(n[:, :2], axis=1, keepdims=True), 1e-300)
+    tip = walls.point + (r + offset) * n
+    tip[:, :2] += core * nh
+    tip[:, 2] -= r
+    reach_r = R + offset - h
+    m = int(math.ceil(reach_r / h)) + 1
+    di, dj = (g.ravel() for g in np.mgrid[-m:m + 1, -m:m + 1])
+    out = np.zeros(len(walls), bool)
+    per = max(1, block // len(di))
+    for c0 in range(0, len(walls), per):
+        tp = tip[c0:c0 + per]
+        ic = np.rint((tp[:, 0] - x[0]) / h).astype(int)[:, None] + di
+        jc = np.rint((tp[:, 1] - y[0]) / h).astype(int)[:, None] + dj
+        inside = (ic >= 0) & (ic < len(x)) & (jc >= 0) & (jc < len(y))
+        icc, jcc = np.clip(ic, 0, len(x) - 1), np.clip(jc, 0, len(y) - 1)
+        d = np.hypot(x[icc] - tp[:, :1], y[jcc] - tp[:, 1:2])
+        grown = r - np.sqrt(np.maximum((r + offset) ** 2 - np.maximum(d - core, 0.0) ** 2, 0.0))
+        near = inside & (d <= reach_r)
+        clear = np.where(near, top[icc, jcc] - grown, -np.inf).max(axis=1)
+        out[c0:c0 + per] = clear <= tp[:, 2] + eps
+    return out

@@ -46,7 +46,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 from stock_sim import (RS274, Cutter, Program, Stock, _shifted, cutter_locations, normal_residual, parse_canon,
-                       part_height, reachable, run_rs274, simulate)
+                       part_height, reachable, run_rs274, side_grids, simulate, wall_left, wall_points, wall_reach)
 
 import surfmod as sm
 from surfmod.inputs import to_shape
@@ -55,6 +55,7 @@ from surfmod.cam.drop_cutter import part_triangles
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")
 R1, R2, SCALLOP, ALLOWANCE, MARGIN, CELL = 5.0, 3.0, 0.15, 0.5, 2.0, 0.25
+SIDE_CELL = 0.4  # spacing of the dexels along x and y (in y or x, and in z)
 ROUNDING = 1e-4
 #: corpus parts (20-150 mm, pockets and holes)
 CORPUS_JOBS = ["stepcode_FOOT_BACK_000.stp", "stepcode_TAIL_MIDDLE_PART.stp", "nist_ftc_11_asme1_rb.stp",
@@ -94,6 +95,24 @@ def rough_rest(stock: Stock, top: np.ndarray, rough: sm.Operation, cell: float) 
             "left_area": float((above & declared).sum()) * cell * cell, "above": above}
 
 
+def sweep_sides(sides, prog: Program, tool: int, cutter: Cutter):
+    moves = [m for m in prog.moves if m.tool == tool]
+    a, b = np.array([m.a for m in moves]), np.array([m.b for m in moves])
+    for dex in sides:
+        dex.cut(cutter, a, b)
+
+
+def walls_left(sides, walls) -> np.ndarray:
+    return np.concatenate([wall_left(dex, w) for dex, w in zip(sides, walls)])
+
+
+def wall_check(walls, floor, stock: Stock, cutter: Cutter, left: np.ndarray, bound: np.ndarray, offset: float):
+    """Wall points left thicker than ``bound`` that the tool (grown by ``offset``) can touch,
+    and the points it can touch (the judged footprint on walls)."""
+    reach = np.concatenate([wall_reach(w, floor, stock.x, stock.y, cutter, offset=offset) for w in walls])
+    return reach & (left > bound), reach
+
+
 def prove(path: Path, tmp_path: Path) -> dict:
     shape = to_shape(path)
     rough, finish = sm.Tool("flat", R1, flute_length=80), sm.Tool("ball", R2, flute_length=80)
@@ -106,6 +125,10 @@ def prove(path: Path, tmp_path: Path) -> dict:
     stock = Stock(job.stock, CELL)
     top = part_height(tri, stock.x, stock.y)
     bottom = float(job.stock[0, 2])
+    floor = np.where(np.isfinite(top), top, bottom)  # the tool cannot go below the stock
+    sides = side_grids(job.stock, SIDE_CELL)
+    walls = [wall_points(tri, dex) for dex in sides]
+    wall_nz = np.abs(np.concatenate([w.normal[:, 2] for w in walls]))
 
     # roughing
     rep = simulate(Program([m for m in prog.moves if m.tool == 1]), {1: Cutter("flat", R1)}, stock, top)
@@ -115,6 +138,25 @@ def prove(path: Path, tmp_path: Path) -> dict:
     share = rest["share"]
     assert share == 0, f"roughing leaves {share:.3%} of the stock above allowance + cusp, unreported"
     assert rest["left_area"] <= rest["declared_area"] + 1e-9, rest
+    # roughing on the walls: never nearer than the allowance; at most the allowance, the
+    # stair of a stepdown on the slope and the rings' margin (roughing._boundary: a
+    # ring stands cell²/16R + its mesh's tolerance inside the boundary, pushed up to twice
+    # that) wherever the tool grown by the allowance can touch the wall
+    rough_rep = job.operations[0].report
+    sweep_sides(sides, prog, 1, Cutter("flat", R1))
+    left = walls_left(sides, walls)
+    assert left.min() >= ALLOWANCE - deflection - ROUNDING, f"roughing cuts {ALLOWANCE - left.min():.4f} into a wall"
+    ring = 2 * (rough_rep["cell"] ** 2 / (16 * R1) + rough_rep["tolerance"])
+    rough_bound = ALLOWANCE + rough_rep["stepdown"] * wall_nz + ring + deflection + ROUNDING
+    over, rough_reach = wall_check(walls, floor, stock, Cutter("flat", R1), left, rough_bound, ALLOWANCE)
+    declared = np.zeros(len(left), bool)
+    pts = np.concatenate([w.point for w in walls])
+    for g in rough_rep["left"]:
+        for x, y in g["ring"]:
+            declared |= np.hypot(pts[:, 0] - x, pts[:, 1] - y) <= R1 + CELL
+    over &= ~declared
+    assert not over.any(), f"roughing leaves {left[over].max():.4f} on {over.sum()} wall points, e.g. {pts[over][0]}"
+    rough_wall = float(left.max())
 
     # finishing on the roughed stock
     fin = job.operations[1]
@@ -148,13 +190,24 @@ def prove(path: Path, tmp_path: Path) -> dict:
     normal = normal_residual(stock.top, reach, CELL)[steep]
     steep_worst = float(np.nanmax(normal, initial=0.0))
     assert steep_worst <= SCALLOP + tol + lift, f"normal residual {steep_worst:.4f} on steep ground > S + tol + lift"
+    # walls (steeper than 60 degrees) through the dexels along x and y: where the ball can
+    # touch the wall, at most S + tolerance + lift is left normal to it, and no cut into it
+    sweep_sides(sides, prog, 2, Cutter("ball", R2))
+    left = walls_left(sides, walls)
+    assert left.min() >= -(tol + deflection + ROUNDING), f"finishing cuts {-left.min():.4f} into a wall"
+    over, reach = wall_check(walls, floor, stock, Cutter("ball", R2), left, SCALLOP + tol + lift, 0.0)
+    assert not over.any(), f"finishing leaves {left[over].max():.4f} > S + tol + lift on {over.sum()} wall points, " \
+                           f"e.g. {pts[over][0]}"
     return {"job": job, "rest_share": share, "residual": float(residual.max()), "nodes": int(shallow.sum()),
-            "steep_nodes": int(steep.sum()), "steep_residual": steep_worst}
+            "steep_nodes": int(steep.sum()), "steep_residual": steep_worst, "wall_points": len(left),
+            "wall_nodes": int(reach.sum()), "wall_residual": float(left[reach].max(initial=0.0)), "rough_wall": rough_wall,
+            "rough_wall_nodes": int(rough_reach.sum())}
 
 
 @needs_rs274
 def test_cam_part_job_in_stock(tmp_path):
     got = prove(SAMPLES / "cam_part.step", tmp_path)
+    print({k: v for k, v in got.items() if k != "job"})
     # the top of the mould is shallow: most of it is judged
     assert got["nodes"] > 40_000 and got["residual"] > SCALLOP / 2
 
