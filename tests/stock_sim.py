@@ -23,6 +23,12 @@ readers' ``arc_chord``: the chords lie inside the arc by at most that).
 Work and memory are bounded: nodes are visited per move inside the move's box grown by
 the tool radius, moves are batched up to ``PAIRS_PER_BATCH`` (node, move) pairs, and long
 moves are split into pieces of at most ``PIECE`` tool radii.
+
+A height field places a wall only to a cell.  :class:`SideDexels` adds lines along x and
+along y (a tri-dexel stock with the height field): the interval each move's tool cuts from
+a line is exact, and :func:`wall_points`, :func:`wall_left` and :func:`wall_reach`
+measure the stock left normal to the part's steep faces where the tool can touch them.
+Their work is counted before it starts (``CUT_PAIRS_LIMIT`` line-move pairs).
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from scipy import ndimage
 
 RS274 = shutil.which("rs274") or ("/usr/bin/rs274" if Path("/usr/bin/rs274").exists() else None)
 PAIRS_PER_BATCH = 2_000_000
@@ -485,18 +492,24 @@ def ray_hits(triangles: np.ndarray, axis: int, u: np.ndarray, v: np.ndarray, *, 
         local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
         ii = i0[t] + local // np.maximum(nj[t], 1)
         jj = j0[t] + local % np.maximum(nj[t], 1)
-        pu, pv = u[ii], v[jj]
-        A, B, C = tri[t, 0], tri[t, 1], tri[t, 2]
-        v0, v1 = B - A, C - A
-        den = v0[:, cu] * v1[:, cv] - v1[:, cu] * v0[:, cv]
-        good = np.abs(den) > 1e-300
-        den = np.where(good, den, 1.0)
-        wx, wy = pu - A[:, cu], pv - A[:, cv]
-        l1 = (wx * v1[:, cv] - v1[:, cu] * wy) / den
-        l2 = (v0[:, cu] * wy - wx * v0[:, cv]) / den
-        inside = good & (l1 >= -slack) & (l2 >= -slack) & (l1 + l2 <= 1 + slack)
-        z = A[:, axis] + l1 * v0[:, axis] + l2 * v1[:, axis]
+        inside, z = _crossing(tri[t], u[ii], v[jj], axis, slack)
         yield ii[inside], jj[inside], z[inside], t[inside]
+
+
+def _crossing(tri, pu, pv, axis, slack):
+    """Whether the line along ``axis`` through (pu, pv) (the other two coordinates in
+    order) crosses each triangle (barycentric test with ``slack``), and where along it."""
+    cu, cv = [k for k in range(3) if k != axis]
+    A, B, C = tri[:, 0], tri[:, 1], tri[:, 2]
+    v0, v1 = B - A, C - A
+    den = v0[:, cu] * v1[:, cv] - v1[:, cu] * v0[:, cv]
+    good = np.abs(den) > 1e-300
+    den = np.where(good, den, 1.0)
+    wx, wy = pu - A[:, cu], pv - A[:, cv]
+    l1 = (wx * v1[:, cv] - v1[:, cu] * wy) / den
+    l2 = (v0[:, cu] * wy - wx * v0[:, cv]) / den
+    inside = good & (l1 >= -slack) & (l2 >= -slack) & (l1 + l2 <= 1 + slack)
+    return inside, A[:, axis] + l1 * v0[:, axis] + l2 * v1[:, axis]
 
 
 def part_height(triangles: np.ndarray, x: np.ndarray, y: np.ndarray, *, block: int = 2_000_000) -> np.ndarray:
@@ -794,7 +807,8 @@ class SideDexels:
         counts = nj * nk
         total = int(counts.sum())
         if total > limit:
-            raise ValueError(f"side dexels: {total:.3g} line-move pairs (limit {limit:.3g}); choose a coarser grid")
+            raise ValueError(f"side dexels: {total:.3g} line-move pairs (limit {limit:.3g}); pass a coarser h to "
+                             f"side_grids or a larger limit")
         nz = len(self.z)
         edges = np.r_[0, np.cumsum(counts)]
         starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
@@ -870,7 +884,7 @@ def side_grids(box, h: float, *, phase: float = 0.5137):
     def ticks(lo, hi):
         n = int(math.floor((hi - lo) / h - phase)) + 1
         if n > 1_000_000:
-            raise ValueError("side dexels: too many lines; choose a coarser h")
+            raise ValueError(f"side dexels: {n} lines along one axis (limit 1e6); choose a coarser h")
         return lo + h * (phase + np.arange(max(n, 0)))
 
     z = ticks(box[0, 2], box[1, 2])
@@ -898,12 +912,36 @@ class WallPoints:
         return WallPoints(*(getattr(self, f)[mask] for f in ("line", "pos", "outward", "normal", "point", "room")))
 
 
-def wall_points(triangles: np.ndarray, dex: SideDexels, *, steep: float = 60.0) -> WallPoints:
+def vertex_normals(triangles: np.ndarray, owner: np.ndarray) -> np.ndarray:
+    """Unit normals (M, 3, 3) at each triangle's corners, averaged (weighted by the corner's
+    angle) over the triangles of the same face (``owner``) meeting at that corner: a
+    smooth face's normal, nearer its own than a facet's (a facet of a hole of radius 3
+    meshed to 0.01 tilts by up to 0.08 rad)."""
+    tri = np.asarray(triangles, dtype=float)
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    corners = tri.reshape(-1, 3)
+    key = np.column_stack([np.repeat(np.asarray(owner), 3), np.round(corners / 1e-9)])
+    _, vid = np.unique(key, axis=0, return_inverse=True)
+    vid = vid.ravel()
+    e1 = np.roll(tri, -1, axis=1) - tri
+    e2 = np.roll(tri, 1, axis=1) - tri
+    cos = (e1 * e2).sum(axis=2) / np.maximum(np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2), 1e-300)
+    weight = np.arccos(np.clip(cos, -1, 1)).ravel()
+    acc = np.zeros((vid.max() + 1, 3))
+    np.add.at(acc, vid, weight[:, None] * np.repeat(n, 3, axis=0))
+    acc /= np.maximum(np.linalg.norm(acc, axis=1, keepdims=True), 1e-300)
+    return acc[vid].reshape(-1, 3, 3)
+
+
+def wall_points(triangles: np.ndarray, dex: SideDexels, *, steep: float = 60.0,
+                normals: np.ndarray | None = None) -> WallPoints:
     """The crossings of the dexel lines with the part's faces steeper than ``steep`` degrees
     whose normal lies within 45 degrees of the line (each steep point is measured by the
     family of lines nearer its normal).  Inside and outside alternate along a line (the
     part's closed surface), which orients each crossing whatever the triangles' winding;
-    lines left with an odd count (through a vertex) are dropped."""
+    lines left with an odd count (through a vertex) are dropped.  ``normals`` (from
+    :func:`vertex_normals`) are interpolated at each crossing instead of the facet's."""
     tri = np.asarray(triangles, dtype=float)
     nz = len(dex.z)
     parts = [list(p) for p in zip(*ray_hits(tri, dex.axis, dex.q, dex.z))]
@@ -926,16 +964,27 @@ def wall_points(triangles: np.ndarray, dex: SideDexels, *, steep: float = 60.0) 
     first = np.r_[True, line[1:] != line[:-1]]
     rank = np.arange(len(line)) - np.maximum.accumulate(np.where(first, np.arange(len(line)), 0))
     outward = np.where(rank % 2 == 0, -1, 1)
+    point = np.zeros((len(line), 3))
+    point[:, dex.axis] = pos
+    point[:, 1 - dex.axis] = dex.q[line // nz]
+    point[:, 2] = dex.z[line % nz]
+    if normals is not None:  # barycentric weights of the crossing on its triangle
+        A, v0, v1 = tri[t, 0], tri[t, 1] - tri[t, 0], tri[t, 2] - tri[t, 0]
+        w = point - A
+        d00, d01, d11 = (v0 * v0).sum(1), (v0 * v1).sum(1), (v1 * v1).sum(1)
+        d20, d21 = (w * v0).sum(1), (w * v1).sum(1)
+        den = np.maximum(d00 * d11 - d01 * d01, 1e-300)
+        b1, b2 = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+        vn = normals[t]
+        smooth = (1 - b1 - b2)[:, None] * vn[:, 0] + b1[:, None] * vn[:, 1] + b2[:, None] * vn[:, 2]
+        smooth /= np.maximum(np.linalg.norm(smooth, axis=1, keepdims=True), 1e-300)
+        n = np.where((smooth * n).sum(1, keepdims=True) >= 0, smooth, -smooth)
     n *= np.where(n[:, dex.axis] * outward >= 0, 1.0, -1.0)[:, None]
     same_next = np.r_[line[1:] == line[:-1], False]
     same_prev = np.r_[False, line[1:] == line[:-1]]
     nxt = np.where(same_next, np.r_[pos[1:], 0.0] - pos, dex.s1 - pos)
     prv = np.where(same_prev, pos - np.r_[0.0, pos[:-1]], pos - dex.s0)
     room = np.where(outward > 0, nxt, prv)
-    point = np.zeros((len(line), 3))
-    point[:, dex.axis] = pos
-    point[:, 1 - dex.axis] = dex.q[line // nz]
-    point[:, 2] = dex.z[line % nz]
     keep = (np.abs(n[:, 2]) <= math.cos(math.radians(steep))) & (np.abs(n[:, dex.axis]) >= np.abs(n[:, 1 - dex.axis]))
     return WallPoints(line, pos, outward, n, point, room).take(keep)
 
@@ -950,21 +999,37 @@ def wall_left(dex: SideDexels, walls: WallPoints) -> np.ndarray:
 
 
 def wall_reach(walls: WallPoints, top: np.ndarray, x: np.ndarray, y: np.ndarray, cutter: Cutter, *,
-               offset: float = 0.0, eps: float = 1e-9, block: int = 4_000_000) -> np.ndarray:
+               offset: float = 0.0, below: float = 0.0, slack: float = 1e-3, eps: float = 1e-9,
+               triangles: np.ndarray | None = None, ring: int = 64, quick: tuple | None = None,
+               block: int = 4_000_000) -> np.ndarray:
     """Which wall points the tool can touch from above: the tool grown by ``offset`` placed
     against the point along its normal (a ball's centre at P + (R + offset) n, a flat end's
     rim, a bull's torus) must clear the part's height field ``top`` on the grid (x, y)
     within its radius less a cell (the point's own face lies at the full radius), by eps.
-    Points under overhangs and in corners tighter than the tool fail."""
+    Points under overhangs and in corners tighter than the tool fail, and so does every
+    face turned downwards (more than ``1e-3`` of its normal): a tool whose body goes up
+    has no surface turned upwards to touch it with.  With ``below`` the tool must also
+    clear the part touching the face ``below`` lower (slid down the face's steepest
+    descent): a stepdown's stair above a floor is not the wall's to hold."""
+    if below > 0:
+        n = walls.normal
+        down = n[:, 2:3] * n - np.array([0.0, 0.0, 1.0])  # steepest descent along the face
+        down *= below / np.maximum(-down[:, 2:3], 1e-12)
+        lower = WallPoints(walls.line, walls.pos, walls.outward, n, walls.point + down, walls.room)
+        kw = dict(offset=offset, slack=slack, eps=eps, triangles=triangles, ring=ring, quick=quick, block=block)
+        return wall_reach(walls, top, x, y, cutter, **kw) & wall_reach(lower, top, x, y, cutter, **kw)
     R, r = cutter.radius, cutter.corner
     core = R - r
     h = float(x[1] - x[0])
-    n = walls.normal
-    nh = n[:, :2] / np.maximum(np.linalg.norm(n[:, :2], axis=1, keepdims=True), 1e-300)
-    tip = walls.point + (r + offset) * n
-    tip[:, :2] += core * nh
-    tip[:, 2] -= r
-    reach_r = R + offset - h
+    tip = _placed(walls, cutter, offset)
+    reach_r = R + offset - slack
+    if quick is not None:  # the reach map at the node nearest each tip (beyond it: nothing)
+        grid, pad = quick
+        i = np.rint((tip[:, 0] - x[0]) / h).astype(int) + pad
+        j = np.rint((tip[:, 1] - y[0]) / h).astype(int) + pad
+        ok = (i >= 0) & (i < grid.shape[0]) & (j >= 0) & (j < grid.shape[1])
+        clear = np.where(ok, grid[np.clip(i, 0, grid.shape[0] - 1), np.clip(j, 0, grid.shape[1] - 1)], -np.inf)
+        return (clear <= tip[:, 2] + eps) & (walls.normal[:, 2] >= -1e-3)
     m = int(math.ceil(reach_r / h)) + 1
     di, dj = (g.ravel() for g in np.mgrid[-m:m + 1, -m:m + 1])
     out = np.zeros(len(walls), bool)
@@ -980,4 +1045,82 @@ def wall_reach(walls: WallPoints, top: np.ndarray, x: np.ndarray, y: np.ndarray,
         near = inside & (d <= reach_r)
         clear = np.where(near, top[icc, jcc] - grown, -np.inf).max(axis=1)
         out[c0:c0 + per] = clear <= tp[:, 2] + eps
+    if triangles is not None and out.any():
+        idx = np.flatnonzero(out)
+        ang = 2 * np.pi * np.arange(ring) / ring
+        px = (tip[idx, :1] + reach_r * np.cos(ang)).ravel()
+        py = (tip[idx, 1:2] + reach_r * np.sin(ang)).ravel()
+        grown = r - math.sqrt(max((r + offset) ** 2 - max(reach_r - core, 0.0) ** 2, 0.0))
+        rim = heights_at(triangles, px, py).reshape(len(idx), ring).max(axis=1) - grown
+        out[idx] = rim <= tip[idx, 2] + eps
+    return out & (walls.normal[:, 2] >= -1e-3)
+
+
+def reach_map(top: np.ndarray, h: float, cutter: Cutter, *, offset: float = 0.0, slack: float = 1e-3):
+    """(map, pad): per node of the grid padded by ``pad`` nodes on each side, the lowest tip height at which the tool grown by ``offset`` clears the
+    height field ``top`` within its radius less ``slack``, for any axis within half a cell
+    diagonal of the node: the grown profile is read that much further out and the disc
+    shrunk by it, so the map errs towards reachable (:func:`wall_reach` then confirms)."""
+    R, r = cutter.radius, cutter.corner
+    core = R - r
+    shift = h * math.sqrt(0.5)
+    radius = R + offset - slack - shift
+    m = int(math.floor(max(radius, 0.0) / h))
+    di, dj = np.mgrid[-m:m + 1, -m:m + 1]
+    d = h * np.hypot(di, dj)
+    foot = d <= radius
+    grown = r - np.sqrt(np.maximum((r + offset) ** 2 - np.maximum(d + shift - core, 0.0) ** 2, 0.0))
+    # padded by the footprint (a tool beyond the grid still sees the nodes it covers)
+    filled = np.pad(np.where(np.isfinite(top), top, -1e300), m + 1, constant_values=-1e300)
+    return ndimage.grey_dilation(filled, footprint=foot, structure=np.where(foot, -grown, 0.0), mode="constant",
+                                 cval=-1e300), m + 1
+
+
+def _placed(walls: WallPoints, cutter: Cutter, offset: float) -> np.ndarray:
+    """Tip of the tool grown by ``offset`` touching each wall point along its normal."""
+    r, core = cutter.corner, cutter.radius - cutter.corner
+    n = walls.normal
+    nh = n[:, :2] / np.maximum(np.linalg.norm(n[:, :2], axis=1, keepdims=True), 1e-300)
+    tip = walls.point + (r + offset) * n
+    tip[:, :2] += core * nh
+    tip[:, 2] -= r
+    return tip
+
+
+def heights_at(triangles: np.ndarray, px: np.ndarray, py: np.ndarray, *, cell: float = 1.0,
+               block: int = 4_000_000) -> np.ndarray:
+    """Top of the triangles over scattered points (-inf where none): the triangles are
+    binned by their (x, y) boxes into cells, each point tested against its cell's."""
+    tri = np.asarray(triangles, dtype=float)
+    lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
+    origin = lo.min(axis=0)
+    c0 = np.floor((lo - origin) / cell).astype(np.int64)
+    c1 = np.floor((hi - origin) / cell).astype(np.int64)
+    ncol = int(c1[:, 1].max()) + 1
+    ni, nj = c1[:, 0] - c0[:, 0] + 1, c1[:, 1] - c0[:, 1] + 1
+    count = ni * nj
+    if count.sum() > 50_000_000:
+        raise ValueError("heights_at: triangles span too many cells; choose a larger cell")
+    t = np.repeat(np.arange(len(tri)), count)
+    local = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    key = (c0[t, 0] + local // nj[t]) * ncol + c0[t, 1] + local % nj[t]
+    order = np.argsort(key, kind="stable")
+    key, t = key[order], t[order]
+    out = np.full(len(px), -np.inf)
+    pi, pj = np.floor((px - origin[0]) / cell).astype(np.int64), np.floor((py - origin[1]) / cell).astype(np.int64)
+    ok = (pi >= 0) & (pj >= 0) & (pj < ncol)
+    pk = np.where(ok, pi * ncol + pj, -1)
+    first, last = np.searchsorted(key, pk, "left"), np.searchsorted(key, pk, "right")
+    n_c = np.where(ok, last - first, 0)
+    edges = np.r_[0, np.cumsum(n_c)]
+    starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
+    for s0, s1 in zip(starts[:-1], starts[1:]):
+        if s1 <= s0:
+            continue
+        ids = np.arange(s0, min(s1, len(n_c)))
+        c = n_c[ids]
+        p = np.repeat(ids, c)
+        k = t[first[p] + np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)]
+        inside, z = _crossing(tri[k], px[p], py[p], 2, 1e-12)
+        np.maximum.at(out, p[inside], z[inside])
     return out

@@ -27,10 +27,28 @@ job's stock, one tool after the other:
 - on steep ground (30-85 degrees, two cells clear of the outline, holes, near-vertical
   walls and the rest the ball cannot reach, where the opening stands more than ``S``
   above the part), the material left measured normal to the reachable surface is at
-  most ``S + tolerance + lift``: there the waterline contours hold the scallop.  (A
-  height field cannot see cusps on vertical walls; cam_part has only those, the corpus
-  parts FOOT_BACK, TAIL_MIDDLE_PART and nist_ftc_11 have 900-5200 such nodes, worst
-  0.09-0.12 mm against 0.17-0.18 allowed.)
+  most ``S + tolerance + lift``: there the waterline contours hold the scallop;
+- on walls (faces steeper than 60 degrees, vertical ones included) the dexels along x
+  and y (``SIDE_CELL`` apart in the other horizontal and in z) measure the stock left
+  normal to the face at every crossing of a dexel with it, wherever the tool placed
+  against the face clears the part (not under an overhang, not in a corner tighter than
+  the tool, not below the stock's floor): after roughing at least the allowance and,
+  where the tool grown by the allowance and the rings' margin also clears the part a
+  stepdown lower on the face (above a floor the stair is the floor's), at most ``allowance + stepdown cos θ``
+  (the stair on a slope θ) plus the rings' margin
+  (``roughing._boundary``: ``cell² / 16R`` + the roughing mesh's tolerance, pushed up to
+  twice that), outside the reported ``left`` regions; after finishing no cut into a wall
+  beyond the tolerance and at most ``S + tolerance + lift`` left.  Wall points are the
+  dexels' crossings with the part's triangles, oriented by the crossings' parity along a
+  line, with the face's normal interpolated from its corners (``vertex_normals``); the
+  tool's placement is sieved on a reach map of the height field and, where a point holds
+  more than the bound, confirmed on the grid's nodes and on the exact triangles along the
+  tool's rim (a hole a hair narrower than the tool).  Faces turned downwards are never
+  reached.  Finishing leaves at most 0.026 on cam_part's walls (29816 points judged,
+  bound 0.19), 0.066 on FOOT_BACK (3136), 0.080 on TAIL_MIDDLE_PART (13603), 0.028 on
+  nist_ftc_11 (672); on trimesh_featuretype it leaves the Ø6.74 through holes full below
+  z 16.7 (6.75 mm on 14742 wall points the Ø6 ball reaches: ``WALL_FINDINGS``, xfail).
+  Roughing leaves 0.603-0.613 on cam_part's walls (allowance 0.5).
 
 Coarse settings (flat r = 5, ball r = 3, scallop 0.15, stock cells 0.25 mm) keep each
 part to seconds.  No part may have stock left after roughing (before issue 26's fix
@@ -46,12 +64,19 @@ import numpy as np
 import pytest
 from scipy import ndimage
 from stock_sim import (RS274, Cutter, Program, Stock, _shifted, cutter_locations, normal_residual, parse_canon,
-                       part_height, reachable, run_rs274, side_grids, simulate, wall_left, wall_points, wall_reach)
+                       part_height, reach_map, reachable, run_rs274, side_grids, simulate, vertex_normals, wall_left,
+                       wall_points, wall_reach)
 
 import surfmod as sm
 from surfmod.inputs import to_shape
 from surfmod.cam.drop_cutter import part_triangles
 
+#: parts where the dexels along x and y find the product's finishing leaving too much on walls
+WALL_FINDINGS = {
+    "trimesh_featuretype.STEP": "finishing leaves up to 6.75 mm (the whole bore) on the walls of the Ø6.74 through "
+                                "holes the Ø6 ball fits into: 14742 wall points from z 3.0 to 18.6, the ball stops "
+                                "at z 16.7 (bound S + tol + lift = 0.31)",
+}
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")
 R1, R2, SCALLOP, ALLOWANCE, MARGIN, CELL = 5.0, 3.0, 0.15, 0.5, 2.0, 0.25
@@ -106,11 +131,24 @@ def walls_left(sides, walls) -> np.ndarray:
     return np.concatenate([wall_left(dex, w) for dex, w in zip(sides, walls)])
 
 
-def wall_check(walls, floor, stock: Stock, cutter: Cutter, left: np.ndarray, bound: np.ndarray, offset: float):
-    """Wall points left thicker than ``bound`` that the tool (grown by ``offset``) can touch,
-    and the points it can touch (the judged footprint on walls)."""
-    reach = np.concatenate([wall_reach(w, floor, stock.x, stock.y, cutter, offset=offset) for w in walls])
-    return reach & (left > bound), reach
+def wall_check(walls, floor, stock: Stock, cutter: Cutter, left: np.ndarray, bound: np.ndarray, offset: float,
+               slack: float, tri: np.ndarray, below: float = 0.0):
+    """Wall points left thicker than ``bound`` that the tool (grown by ``offset``) can touch
+    (and ``below`` lower on the face), and the points the quick reach map lets it touch
+    less those over the bound that the tool placed at each over the grid's nodes and the
+    exact triangles cannot touch (the judged footprint; the quick map is a little generous
+    with points within the bound)."""
+    kw = dict(offset=offset, below=below, slack=slack)
+    quick = reach_map(floor, CELL, cutter, offset=offset, slack=slack)
+    reach = np.concatenate([wall_reach(w, floor, stock.x, stock.y, cutter, quick=quick, **kw) for w in walls])
+    over = reach & (left > bound)
+    if over.any():
+        k = np.cumsum([0] + [len(w) for w in walls])
+        for w, a, b in zip(walls, k[:-1], k[1:]):
+            cand = np.flatnonzero(over[a:b])
+            over[a + cand] = wall_reach(w.take(cand), floor, stock.x, stock.y, cutter, triangles=tri, **kw)
+    judged = reach & ((left <= bound) | over)  # less the candidates the exact placement refused
+    return over, judged
 
 
 def prove(path: Path, tmp_path: Path) -> dict:
@@ -121,13 +159,14 @@ def prove(path: Path, tmp_path: Path) -> dict:
     sm.export_gcode(job, ngc, post="linuxcnc")
     prog = parse_canon(run_rs274(ngc, tmp_path / "job.txt"), arc_chord=1e-4)
     assert prog.tool_changes == [1, 2] and prog.ended
-    tri, deflection = part_triangles(shape, 0.01)
+    tri, deflection, (_, owner) = part_triangles(shape, 0.01, face_index=True)
     stock = Stock(job.stock, CELL)
     top = part_height(tri, stock.x, stock.y)
     bottom = float(job.stock[0, 2])
     floor = np.where(np.isfinite(top), top, bottom)  # the tool cannot go below the stock
     sides = side_grids(job.stock, SIDE_CELL)
-    walls = [wall_points(tri, dex) for dex in sides]
+    normals = vertex_normals(tri, owner)
+    walls = [wall_points(tri, dex, normals=normals) for dex in sides]
     wall_nz = np.abs(np.concatenate([w.normal[:, 2] for w in walls]))
 
     # roughing
@@ -138,17 +177,17 @@ def prove(path: Path, tmp_path: Path) -> dict:
     share = rest["share"]
     assert share == 0, f"roughing leaves {share:.3%} of the stock above allowance + cusp, unreported"
     assert rest["left_area"] <= rest["declared_area"] + 1e-9, rest
-    # roughing on the walls: never nearer than the allowance; at most the allowance, the
-    # stair of a stepdown on the slope and the rings' margin (roughing._boundary: a
-    # ring stands cell²/16R + its mesh's tolerance inside the boundary, pushed up to twice
-    # that) wherever the tool grown by the allowance can touch the wall
+    # roughing on the walls (see the module's docstring): never nearer than the allowance,
+    # at most allowance + stepdown cos θ + the rings' margin where the tool grown by both
+    # touches the wall and a stepdown lower on it
     rough_rep = job.operations[0].report
     sweep_sides(sides, prog, 1, Cutter("flat", R1))
     left = walls_left(sides, walls)
     assert left.min() >= ALLOWANCE - deflection - ROUNDING, f"roughing cuts {ALLOWANCE - left.min():.4f} into a wall"
     ring = 2 * (rough_rep["cell"] ** 2 / (16 * R1) + rough_rep["tolerance"])
     rough_bound = ALLOWANCE + rough_rep["stepdown"] * wall_nz + ring + deflection + ROUNDING
-    over, rough_reach = wall_check(walls, floor, stock, Cutter("flat", R1), left, rough_bound, ALLOWANCE)
+    over, rough_reach = wall_check(walls, floor, stock, Cutter("flat", R1), left, rough_bound, ALLOWANCE + ring,
+                                   deflection, tri, rough_rep["stepdown"])
     declared = np.zeros(len(left), bool)
     pts = np.concatenate([w.point for w in walls])
     for g in rough_rep["left"]:
@@ -156,7 +195,7 @@ def prove(path: Path, tmp_path: Path) -> dict:
             declared |= np.hypot(pts[:, 0] - x, pts[:, 1] - y) <= R1 + CELL
     over &= ~declared
     assert not over.any(), f"roughing leaves {left[over].max():.4f} on {over.sum()} wall points, e.g. {pts[over][0]}"
-    rough_wall = float(left.max())
+    rough_wall = float(left[rough_reach].max(initial=0.0))
 
     # finishing on the roughed stock
     fin = job.operations[1]
@@ -195,7 +234,7 @@ def prove(path: Path, tmp_path: Path) -> dict:
     sweep_sides(sides, prog, 2, Cutter("ball", R2))
     left = walls_left(sides, walls)
     assert left.min() >= -(tol + deflection + ROUNDING), f"finishing cuts {-left.min():.4f} into a wall"
-    over, reach = wall_check(walls, floor, stock, Cutter("ball", R2), left, SCALLOP + tol + lift, 0.0)
+    over, reach = wall_check(walls, floor, stock, Cutter("ball", R2), left, SCALLOP + tol + lift, 0.0, deflection, tri)
     assert not over.any(), f"finishing leaves {left[over].max():.4f} > S + tol + lift on {over.sum()} wall points, " \
                            f"e.g. {pts[over][0]}"
     return {"job": job, "rest_share": share, "residual": float(residual.max()), "nodes": int(shallow.sum()),
@@ -208,13 +247,15 @@ def prove(path: Path, tmp_path: Path) -> dict:
 def test_cam_part_job_in_stock(tmp_path):
     got = prove(SAMPLES / "cam_part.step", tmp_path)
     print({k: v for k, v in got.items() if k != "job"})
-    # the top of the mould is shallow: most of it is judged
+    # the top of the mould is shallow: most of it is judged; so are its walls
+    assert got["wall_nodes"] > 25_000 and got["rough_wall_nodes"] > 20_000
     assert got["nodes"] > 40_000 and got["residual"] > SCALLOP / 2
 
 
 @needs_rs274
 @pytest.mark.corpus
-@pytest.mark.parametrize("name", sorted(CORPUS_JOBS))
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=WALL_FINDINGS[n]))
+                                  if n in WALL_FINDINGS else n for n in sorted(CORPUS_JOBS)])
 def test_corpus_job_in_stock(tmp_path, corpus_dir, name):
     got = prove(corpus_dir / name, tmp_path)
     print(name, {k: v for k, v in got.items() if k != "job"})

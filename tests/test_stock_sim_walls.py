@@ -7,7 +7,8 @@ cusp's ridge; on a vertical wall the ball's cylindrical body clears everything a
 lowest centre (no cusp there: a cusp ``R - sqrt(R² - dz²)`` only below it); a program
 with every other level left out, and one simulated with a smaller tool than it was made
 for, caught by the wall measure; a post under a plate, whose walls no tool from above
-reaches."""
+reaches; a hole a hair narrower than the ball, which the height field's nodes miss and
+the exact triangles catch."""
 
 from __future__ import annotations
 
@@ -15,8 +16,11 @@ import math
 
 import numpy as np
 import pytest
-from stock_sim import (Cutter, SideDexels, line_cut, parse_gcode, part_height, side_grids, wall_left, wall_points,
-                       wall_reach)
+from build123d import Box, Cylinder
+from stock_sim import (Cutter, SideDexels, heights_at, line_cut, parse_gcode, part_height, reach_map, side_grids,
+                       vertex_normals, wall_left, wall_points, wall_reach)
+
+from surfmod.cam.drop_cutter import part_triangles
 
 R = 3.0
 
@@ -208,3 +212,66 @@ def test_walls_under_a_plate_are_out_of_reach():
         assert post.sum() > 50 and not reach[post].any()
         rim = walls.point[:, 2] > 8
         assert reach[rim].all()
+
+
+@pytest.mark.parametrize("cutter", [Cutter("flat", R), Cutter("bull", R, 1.0)])
+def test_flat_and_bull_beside_a_vertical_wall(cutter):
+    """One pass with the axis ``R + 0.2`` off a vertical wall, tip at z = 5: 0.2 is left
+    where the full radius reaches, ``R + 0.2 - (core + sqrt(r² - (r - u)²))`` at a height
+    u above the tip in a bull's corner, and the line below the tip is not cut."""
+    tri = box(0, L, 0, W, 0, H)
+    stock_box = np.array([[-2.0, -5.0, 0.0], [L + 10, W + 5, H]])
+    zs = np.linspace(4.05, 9.05, 51)
+    dex = SideDexels(stock_box, 0, np.array([W / 2]), zs)
+    a, b = np.array([[L + R + 0.2, -10.0, 5.0]]), np.array([[L + R + 0.2, W + 10, 5.0]])
+    dex.cut(cutter, a, b)
+    walls = wall_points(tri, dex)
+    walls = walls.take(walls.normal[:, 0] > 0.99)
+    left = wall_left(dex, walls)
+    u = walls.point[:, 2] - 5.0
+    r, core = cutter.corner, cutter.radius - cutter.corner
+    section = np.where(u >= r, R, core + np.sqrt(np.maximum(r * r - (r - np.clip(u, 0, r)) ** 2, 0.0)))
+    want = np.where(u >= 0, R + 0.2 - section, stock_box[1, 0] - L)
+    assert len(left) == len(zs)
+    np.testing.assert_allclose(left, want, atol=1e-9)
+
+
+def test_work_is_refused_above_its_bound():
+    dx, _ = side_grids(np.array([[0.0, 0.0, 0.0], [100.0, 100.0, 50.0]]), 0.05)
+    a, b = np.array([[0.0, 0.0, 0.0]]), np.array([[100.0, 100.0, 0.0]])
+    with pytest.raises(ValueError, match="coarser h"):
+        dx.cut(Cutter("ball", 3.0), a, b, limit=1000)
+
+
+def test_heights_at_scattered_points_equal_the_grid():
+    tri = np.concatenate([box(10, 20, 10, 20, 0, 8), box(4, 26, 4, 26, 8, 11), slope_part()])
+    x, y = np.linspace(-1, 31, 97), np.linspace(-2, 29, 63)
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    np.testing.assert_array_equal(heights_at(tri, X.ravel(), Y.ravel()), part_height(tri, x, y).ravel())
+
+
+@pytest.mark.parametrize("hole, fits", [(R - 0.04, False), (R + 0.1, True)])
+def test_a_hole_a_hair_narrower_than_the_ball(hole, fits):
+    """Walls of a through hole (stock floor 5 below the hole's top face is at -5): the quick
+    map and the nodes alone let a ball of radius R into a hole of radius R - 0.04 (the
+    lune it would cut lies between nodes); the exact triangles on the tool's circle do not.
+    A hole of R + 0.1 takes it down to its floor's reach (centre no lower than -2)."""
+    tri, deflection, (_, owner) = part_triangles((Box(20, 20, 10) - Cylinder(hole, 10)).wrapped, 0.002,
+                                                 face_index=True)
+    stock_box = np.array([[-10.0, -10.0, -5.0], [10.0, 10.0, 5.0]])
+    walls = wall_points(tri, side_grids(stock_box, 0.25)[0], normals=vertex_normals(tri, owner))
+    radial = -walls.point[:, :2] / np.hypot(walls.point[:, 0], walls.point[:, 1])[:, None]
+    inner = (np.hypot(walls.point[:, 0], walls.point[:, 1]) < hole + 0.01) & (walls.point[:, 2] > -1.9)
+    # the face's normal, not the facet's: radial within the mesh's own tilt
+    assert np.abs(walls.normal[inner, :2] - radial[inner]).max() < 2e-3
+    walls = walls.take(inner)
+    x = np.arange(-10, 10.0001, 0.25)
+    top = part_height(tri, x, x)
+    floor = np.where(np.isfinite(top), top, -5.0)
+    ball = Cutter("ball", R)
+    slack = deflection + 1e-6
+    quick = wall_reach(walls, floor, x, x, ball, slack=slack, quick=reach_map(floor, 0.25, ball, slack=slack))
+    exact = wall_reach(walls, floor, x, x, ball, slack=slack, triangles=tri)
+    assert len(walls) > 100
+    assert quick.all()  # a first sieve: never refuses what the tool reaches
+    assert exact.all() == fits and exact.any() == fits
