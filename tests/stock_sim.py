@@ -1057,8 +1057,9 @@ def wall_reach(walls: WallPoints, top: np.ndarray, x: np.ndarray, y: np.ndarray,
 
 
 def reach_map(top: np.ndarray, h: float, cutter: Cutter, *, offset: float = 0.0, slack: float = 1e-3):
-    """(map, pad): per node of the grid padded by ``pad`` nodes on each side, the lowest tip height at which the tool grown by ``offset`` clears the
-    height field ``top`` within its radius less ``slack``, for any axis within half a cell
+    """(map, pad): per node of the grid padded by ``pad`` nodes on each side, the lowest
+    tip height at which the tool grown by ``offset`` clears the height field ``top``
+    within its radius less ``slack``, for any axis within half a cell
     diagonal of the node: the grown profile is read that much further out and the disc
     shrunk by it, so the map errs towards reachable (:func:`wall_reach` then confirms)."""
     R, r = cutter.radius, cutter.corner
