@@ -84,15 +84,3 @@ def knots_and_mults(flat_knots: np.ndarray):
     """A full knot vector -> OCCT's (distinct knots, multiplicities) pair."""
     values, counts = np.unique(np.asarray(flat_knots, dtype=float), return_counts=True)
     return reals_1d(values), ints_1d(counts)
-
-
-def to_numpy_1d(arr) -> np.ndarray:
-    value = arr.Value
-    return np.fromiter((value(i) for i in range(arr.Lower(), arr.Upper() + 1)), float, arr.Upper() - arr.Lower() + 1)
-
-
-def pnts_to_numpy_1d(arr) -> np.ndarray:
-    # one flat fromiter over Coord() tuples: a third of the time of a list of arrays
-    value, n = arr.Value, arr.Upper() - arr.Lower() + 1
-    return np.fromiter(chain.from_iterable(value(i).Coord() for i in range(arr.Lower(), arr.Upper() + 1)),
-                       float, 3 * n).reshape(n, 3)

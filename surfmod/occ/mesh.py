@@ -17,16 +17,19 @@ import numpy as np
 
 from ..errors import SurfmodError
 from .guard import kernel
-from OCP.BRep import BRep_Tool
+from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.BRepTools import BRepTools
 from OCP.BinTools import BinTools_ShapeSet
+from OCP.Geom2d import Geom2d_TrimmedCurve
+from OCP.Precision import Precision
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
-from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_SOLID
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS
 from .geom import surface_type
-from .topo import faces_of, wrapped
+from .topo import explore, faces_of, wrapped
 
 
 def clean(shape) -> None:
@@ -205,6 +208,18 @@ def read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTria
     return _face_triangles(face, _local_triangulation(face), with_uv, with_nodes, next(_GROUPS))
 
 
+def bound_cone_seams(faces) -> None:
+    """Trim cone seams' unbounded p-curves to the edge's range, in place (same values): BRepMesh's seam refinement
+    tells the two apart at ``FirstParameter()``, -1e100 for a line, and swaps them on a seam 1e-16 off vertical."""
+    for face in (TopoDS.Face(f.Oriented(TopAbs_FORWARD)) for f in faces):
+        edges = explore(face, TopAbs_EDGE) if surface_type(face_basis(face)) == "Geom_ConicalSurface" else []
+        for edge in (TopoDS.Edge(e.Oriented(TopAbs_FORWARD)) for e in edges):
+            sides = [BRep_Tool.CurveOnSurface_s(e, face, 0.0, 0.0) for e in (edge, TopoDS.Edge(edge.Reversed()))]
+            if BRep_Tool.IsClosed_s(edge, face) and any(Precision.IsInfinite_s(c.FirstParameter()) for c in sides):
+                pair = (Geom2d_TrimmedCurve(c, *BRep_Tool.Range_s(edge, face)) for c in sides)
+                BRep_Builder().UpdateEdge(edge, *pair, face, BRep_Tool.Tolerance_s(edge))
+
+
 def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool = False, parallel: bool = False,
                with_uv=True, with_nodes: bool = True) -> list[tuple]:
     """The one BRepMesh call of surfmod: clear any stored triangulation, run
@@ -226,8 +241,9 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
         raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
     clean(shp)
     with kernel("BRepMesh_IncrementalMesh"):
-        BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
         faces = list(faces_of(shp))
+        bound_cone_seams(faces)
+        BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
         table = _triangulation_table(faces)
         if table is None:  # read face by face, sharing nothing
             table = [_local_triangulation(face) for face in faces]
@@ -246,8 +262,7 @@ def face_uv_triangles(face, deflection: float, angular: float = 0.1):
     ((_, _, got),) = mesh_faces(face, deflection, angular, parallel=True, with_nodes=False)
     if got is None or np.isnan(got.uv).any():
         raise SurfmodError("obj: OCCT could not triangulate a trimmed face's parameter region")
-    uv, idx = got.uv, got.triangles
-    return uv, idx
+    return got.uv, got.triangles
 
 
 def face_instances(shape) -> list[tuple]:
