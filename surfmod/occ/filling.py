@@ -15,14 +15,13 @@ from OCP.GeomAbs import GeomAbs_C0, GeomAbs_G1, GeomAbs_G2
 from OCP.GeomConvert import GeomConvert
 from OCP.GeomFill import GeomFill_BSplineCurves, GeomFill_FillingStyle
 from OCP.TopAbs import TopAbs_EDGE
-from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 from ..errors import KernelError
 from .geom import read_bspline_surface
 from .guard import check_done, kernel
 from .sample import distances_to_surface
-from .topo import wrapped
+from .topo import explore, wrapped
 
 
 def bspline_over(geom, bounds) -> dict:
@@ -37,16 +36,13 @@ def bspline_over(geom, bounds) -> dict:
 def nearest_edge(face, point):
     """The edge of ``face`` whose midpoint is closest to ``point`` (a TopoDS_Edge)."""
     best, best_d = None, np.inf
-    explorer = TopExp_Explorer(wrapped(face), TopAbs_EDGE)
     with kernel("BRepAdaptor_Curve"):
-        while explorer.More():
-            e = TopoDS.Edge(explorer.Current())
+        for e in (TopoDS.Edge(x) for x in explore(wrapped(face), TopAbs_EDGE)):
             c = BRepAdaptor_Curve(e)
             p = c.Value(0.5 * (c.FirstParameter() + c.LastParameter()))
             d = float(np.linalg.norm(np.array([p.X(), p.Y(), p.Z()]) - point))
             if d < best_d:
                 best, best_d = e, d
-            explorer.Next()
     return best
 
 

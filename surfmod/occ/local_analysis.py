@@ -15,12 +15,12 @@ from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_G2
 from OCP.LocalAnalysis import LocalAnalysis_SurfaceContinuity
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN
-from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 from .guard import kernel
-from .topo import faces_of, shape_list, wrapped
+from .topo import explore, faces_of, shape_list, wrapped
 from .bindings import TopTools_IndexedDataMapOfShapeListOfShape
 
 
@@ -121,12 +121,7 @@ def face_edges_uv(face, samples: int) -> list:
     f = TopoDS.Face(wrapped(face))
     out = []
     with kernel("face edges (BRepAdaptor_Curve2d)"):
-        explorer = TopExp_Explorer(f, TopAbs_EDGE)
-        while explorer.More():
-            edge = TopoDS.Edge(explorer.Current())
-            explorer.Next()
-            if BRep_Tool.Degenerated_s(edge):
-                continue
-            uv, tangent = _pcurve_samples(edge, f, samples)
-            out.append((uv, tangent))
+        for edge in (TopoDS.Edge(e) for e in explore(f, TopAbs_EDGE)):
+            if not BRep_Tool.Degenerated_s(edge):
+                out.append(_pcurve_samples(edge, f, samples))  # (uv, tangent)
     return out
