@@ -132,3 +132,25 @@ def test_admesh_finds_nothing_to_fix_on_the_tilted_cone(tmp_path):
     sm.export_stl(_frustum(TILT), path, tolerance=TOL)
     stats = admesh_stats(path)
     assert stats["Number of parts"] == 1 and all(stats[k] == 0 for k in ADMESH_REPAIRS), stats
+
+
+def _seam_pcurves(solid):
+    """The cone face's seam p-curves (forward, reversed) and their range."""
+    cone = next(f for f in _subs(solid, TopAbs_FACE, TopoDS.Face) if BRepAdaptor_Surface(f).GetType() == GeomAbs_Cone)
+    face = TopoDS.Face(cone.Oriented(TopAbs_FORWARD))
+    seam = next(TopoDS.Edge(e.Oriented(TopAbs_FORWARD)) for e in _subs(face, TopAbs_EDGE, TopoDS.Edge)
+                if BRep_Tool.IsClosed_s(e, face))
+    sides = [BRep_Tool.CurveOnSurface_s(e, face, 0.0, 0.0) for e in (seam, TopoDS.Edge(seam.Reversed()))]
+    return sides, BRep_Tool.Range_s(seam, face)
+
+
+def test_the_seams_are_bounded_in_place_with_the_same_values():
+    solid = _frustum(TILT)
+    before, (t0, t1) = _seam_pcurves(solid)
+    ts = np.linspace(t0, t1, 7)
+    sm.tessellate(solid, TOL)  # meshing bounds them, in the solid itself
+    after, span = _seam_pcurves(solid)
+    assert span == (t0, t1) and all(c.FirstParameter() == t0 and c.LastParameter() == t1 for c in after)
+    for old, new in zip(before, after):  # the same curve, bit for bit, over the edge
+        assert [old.Value(t).Coord() for t in ts] == [new.Value(t).Coord() for t in ts]
+    assert BRepCheck_Analyzer(solid).IsValid()
