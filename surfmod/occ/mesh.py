@@ -21,8 +21,7 @@ from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.BRepTools import BRepTools
 from OCP.BinTools import BinTools_ShapeSet
-from OCP.Geom2d import Geom2d_TrimmedCurve
-from OCP.Precision import Precision
+from OCP.Geom2d import Geom2d_Line, Geom2d_TrimmedCurve
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_SOLID
 from OCP.TopLoc import TopLoc_Location
@@ -205,13 +204,14 @@ def read_triangulation(face, with_uv: bool, with_nodes: bool = True) -> FaceTria
 
 
 def bound_cone_seams(faces) -> None:
-    """Trim cone seams' unbounded p-curves to the edge's range, in place (same values): BRepMesh's seam refinement
-    tells the two apart at ``FirstParameter()``, -1e100 for a line, and swaps them on a seam 1e-16 off vertical."""
+    """Trim cone seams' line p-curves leaning off the v direction to the edge's range, in place (same values):
+    BRepMesh's seam refinement tells the two apart at ``FirstParameter()``, -1e100 for a line, and swaps them."""
     for face in (TopoDS.Face(f.Oriented(TopAbs_FORWARD)) for f in faces):
         edges = explore(face, TopAbs_EDGE) if surface_type(face_basis(face)) == "Geom_ConicalSurface" else []
         for edge in (TopoDS.Edge(e.Oriented(TopAbs_FORWARD)) for e in edges):
             sides = [BRep_Tool.CurveOnSurface_s(e, face, 0.0, 0.0) for e in (edge, TopoDS.Edge(edge.Reversed()))]
-            if BRep_Tool.IsClosed_s(edge, face) and any(Precision.IsInfinite_s(c.FirstParameter()) for c in sides):
+            leaning = any(isinstance(c, Geom2d_Line) and c.Lin2d().Direction().X() != 0.0 for c in sides)
+            if leaning and BRep_Tool.IsClosed_s(edge, face):
                 pair = (Geom2d_TrimmedCurve(c, *BRep_Tool.Range_s(edge, face)) for c in sides)
                 BRep_Builder().UpdateEdge(edge, *pair, face, BRep_Tool.Tolerance_s(edge))
 
