@@ -14,6 +14,8 @@ lower than the verified path).
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
 from ..atomic import atomic_path, target_path
@@ -107,6 +109,11 @@ def _operation(op, job, post: str, digits: int, coolant: bool, arcs: bool) -> li
     return out
 
 
+#: The longest line LinuxCNC's interpreter reads (rs274ngc's LINELEN): a longer one is
+#: refused with "Command too long" and the program does not run.
+LINE_LENGTH = 255
+
+
 def _comment(text: str) -> str:
     """A comment: RS274NGC comments do not nest, so parentheses inside become brackets."""
     return "(" + text.replace("(", "[").replace(")", "]") + ")"
@@ -114,7 +121,9 @@ def _comment(text: str) -> str:
 
 def _header(job, title: str, note: str | None) -> list[str]:
     lo, hi = job.stock
-    return ["%", _comment(title)] + ([_comment(note)] if note else []) + [
+    # the note's findings one comment line each, wrapped: LinuxCNC refuses a longer line
+    notes = [_comment(line) for part in (note or "").split("; ") for line in textwrap.wrap(part, LINE_LENGTH - 2)]
+    return ["%", _comment(title)] + notes + [
             f"(stock X{lo[0]:g}..{hi[0]:g} Y{lo[1]:g}..{hi[1]:g} Z{lo[2]:g}..{hi[2]:g} mm, part coordinates)",
             "G21 G90 G17 G94 (mm, absolute, XY plane, feed per minute)", "G40 G49 G80 (no compensation, no offset)"]
 
@@ -123,7 +132,7 @@ def programs(job, post: str = "linuxcnc", *, digits: int = 4, coolant: bool = Fa
              note: str | None = None) -> list[str]:
     """The program texts of ``job``: one for ``"linuxcnc"``, one per tool for ``"grbl"``;
     circular runs of the moves as ``G2``/``G3`` unless ``arcs=False`` (all ``G1``);
-    ``note``: a comment line under the title (what the verification found)."""
+    ``note``: comment lines under the title (what the verification found, a line per finding)."""
     if post not in POSTS:
         raise SurfmodError(f"post: expected one of {', '.join(POSTS)}, got {post!r}")
     if int(digits) != digits or not 1 <= digits <= 6:
