@@ -22,6 +22,7 @@ from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.BRepTools import BRepTools
 from OCP.BinTools import BinTools_ShapeSet
 from OCP.Geom2d import Geom2d_Line, Geom2d_TrimmedCurve
+from OCP.IMeshData import IMeshData_Failure
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_SOLID
 from OCP.TopLoc import TopLoc_Location
@@ -239,9 +240,11 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
     with kernel("BRepMesh_IncrementalMesh"):
         faces = list(faces_of(shp))
         bound_cone_seams(faces)
-        BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
+        done = BRepMesh_IncrementalMesh(shp, float(deflection), bool(relative), float(angular), bool(parallel))
         bare = [f for f in faces if BRep_Tool.Triangulation_s(f, TopLoc_Location()) is None]
-        if bare:  # narrower than the deflection (see BARE_FINER): meshed alone first, their edges then shared
+        # narrower than the deflection (see BARE_FINER): meshed alone first, their edges then shared; not
+        # where BRepMesh found a wire crossing itself or open (PL1045A: alone it meshes a face 136 off)
+        if bare and done.GetStatusFlags() == int(IMeshData_Failure):
             clean(shp)
             for face, finer in ((f, k) for f in bare for k in BARE_FINER):
                 if BRep_Tool.Triangulation_s(face, TopLoc_Location()) is None:
