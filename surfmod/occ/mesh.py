@@ -221,7 +221,8 @@ def mesh_faces(shape, deflection: float, angular: float = 0.5, *, relative: bool
                with_uv=True, with_nodes: bool = True) -> list[tuple]:
     """The one BRepMesh call of surfmod: clear any stored triangulation, run
     ``BRepMesh_IncrementalMesh(shape, deflection, relative, angular, parallel)`` and read
-    every face's triangulation back.
+    every face's triangulation back (after :func:`bound_cone_seams`; faces it left bare
+    meshed alone first, finer, see :data:`BARE_FINER`).
 
     Returns ``[(index, face, FaceTriangles or None)]`` per face in exploration order
     (``None``: BRepMesh left the face without triangles).  ``with_uv`` is a bool or a
