@@ -259,20 +259,21 @@ def test_a_big_part_spreads_the_waterline_fibers_to_fit_the_cap(monkeypatch):
     tool = sm.Tool("ball", 1.0)
     seen, count = [], waterline_module.fiber_pairs
 
-    def spy(tri, radius, sampling, levels):  # the triangles and radius the finishing counts with
-        seen.append((tri, radius, levels))
-        return count(tri, radius, sampling, levels)
+    def spy(tri, radius, sampling, levels, corner):  # the triangles, radius and levels the finishing counts with
+        seen.append((tri, radius, levels, corner))
+        return count(tri, radius, sampling, levels, corner)
 
     monkeypatch.setattr(waterline_module, "fiber_pairs", spy)
     free = sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False).operations[0].report["waterline"]
     assert "sampling" not in free
-    tri, radius, tri_levels = seen[0]
+    tri, radius, tri_levels, corner = seen[0]
     # a cap between what fibers half a radius and a radius apart need
-    cap = math.sqrt(count(tri, radius, tool.radius / 2, tri_levels) * count(tri, radius, tool.radius, tri_levels))
+    cap = math.sqrt(count(tri, radius, tool.radius / 2, tri_levels, corner)
+                    * count(tri, radius, tool.radius, tri_levels, corner))
     monkeypatch.setattr(waterline_module, "MAX_PAIRS", cap)
     job = sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False)
     w = job.operations[0].report["waterline"]
-    assert tool.radius / 2 < w["sampling"] <= tool.radius and w["levels"] == tri_levels
+    assert tool.radius / 2 < w["sampling"] <= tool.radius and w["levels"] == len(tri_levels)
     assert any("spread from half the tool radius" in line for line in summary_lines(job.operations[0].report))
     monkeypatch.setattr(waterline_module, "MAX_PAIRS", 10)
     with pytest.raises(SurfmodError, match=r"^scallop: the waterline's \d+ levels .* choose a larger scallop"):

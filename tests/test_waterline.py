@@ -19,7 +19,7 @@ from ocl_reference import waterline as ocl_waterline
 from surfmod.cam.cutters import cutter
 from surfmod.cam.drop_cutter import TriangleGrid, drop, triangle_rows
 from surfmod.cam.fiber_contact import pair_intervals
-from surfmod.cam.waterline import waterline
+from surfmod.cam.waterline import _waterline, fiber_pairs, waterline
 from surfmod.errors import SurfmodError
 
 CORPUS_PART = "trimesh_featuretype.STEP"
@@ -182,6 +182,36 @@ def test_bad_input_and_bounds():
         waterline(square(), tool("ball", 1.0), [0.0], sampling=-1)
     with pytest.raises(SurfmodError, match="sampling"):  # the work estimate refuses before starting
         waterline(square(1000.0), tool("ball", 1.0), np.zeros(50), sampling=1e-3)
+
+
+@pytest.mark.parametrize("kind, R, r", [("ball", 1.5, 1.5), ("flat", 1.5, 0.0), ("bull", 1.5, 0.6)])
+def test_the_pair_estimate_counts_the_pairs_met(kind, R, r):
+    """Issue 36: the fibers meet the triangles through an index by height and grid line,
+    and ``fiber_pairs`` counts what that meets before the work starts.  A pyramid with
+    a shelf over 40 levels: the estimate is an upper bound within 1.5x of the grid pairs
+    met.  Levels wholly below the part cost the first's pairs once, not once per level
+    (the old count, triangles x lines x levels, was 40x for them)."""
+    a, top = 10.0, 8.0
+    base = np.array([[-a, -a, 0], [a, -a, 0], [a, a, 0], [-a, a, 0]], float)
+    tri = [[base[k], base[(k + 1) % 4], [0.0, 0.0, top]] for k in range(4)]
+    shelf = square(6.0, z=6.0)
+    shelf[..., 0] += a + 0.5
+    tri = np.concatenate([np.array(tri), shelf])
+    # refine the pyramid's faces so the index has triangles to skip: 4 x 64 + the shelf
+    for _ in range(3):
+        m = [(t[0] + t[1]) / 2 for t in tri], [(t[1] + t[2]) / 2 for t in tri], [(t[2] + t[0]) / 2 for t in tri]
+        tri = np.concatenate([np.stack([tri[:, 0], m[0], m[2]], 1), np.stack([m[0], tri[:, 1], m[1]], 1),
+                              np.stack([m[2], m[1], tri[:, 2]], 1), np.stack([m[0], m[1], m[2]], 1)])
+    cut = tool(kind, R, r)
+    levels = np.linspace(0.1, 7.9, 40)
+    _, fib = _waterline(tri, cut, levels, 0.4, None)
+    estimate = fiber_pairs(tri, R, 0.4, levels, cut.corner)
+    assert fib.pairs <= estimate <= 1.5 * fib.pairs, (fib.pairs, estimate)
+    below = np.linspace(-5.0, -1.0 - r, 40)
+    _, one = _waterline(tri, cut, below[:1], 0.4, None)
+    _, many = _waterline(tri, cut, below, 0.4, None)
+    assert many.pairs == one.pairs > 0
+    assert fiber_pairs(tri, R, 0.4, below, cut.corner) == fiber_pairs(tri, R, 0.4, below[:1], cut.corner)
 
 
 def intervals(tri, ox, oy, dx, dy, z, shape):

@@ -296,11 +296,11 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     # a tool wide, so fibers a radius apart still meet it) where a big part's fibers over
     # all its levels would pass the waterline's cap; beyond that the scallop (which spaces
     # the levels) or the tool must change, and the refusal names the command's --scallop
-    sampling = sampling_within(tri, grown.radius, tool.radius / 2, len(levels), tool.radius)
+    sampling = sampling_within(tri, grown.radius, tool.radius / 2, levels - g, tool.radius, grown.corner)
     if sampling is None:
         raise SurfmodError(f"scallop: the waterline's {len(levels)} levels {spacing:.3g} mm apart on this part's "
                            f"{len(tri):,} triangles pass its cap even with fibers a tool radius apart "
-                           f"(about {fiber_pairs(tri, grown.radius, tool.radius, len(levels)):.3g} fiber-triangle "
+                           f"(about {fiber_pairs(tri, grown.radius, tool.radius, levels - g, grown.corner):.3g} fiber-triangle "
                            f"pairs); choose a larger scallop or a larger finishing tool")
     if sampling > tool.radius / 2:
         info["sampling"] = sampling

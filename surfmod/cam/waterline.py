@@ -17,8 +17,14 @@ that exact point inserted, until none does.  A chord can still cross a notch of 
 contour whose middle it misses; :class:`ContourPoints` splits given chords at exact
 contour points (finishing does it where the drop-cutter check finds a chord cutting).
 
-Work is bounded before it starts: the number of (fiber, triangle) pairs from the grid
-and the triangles' boxes is estimated and refused above ``MAX_PAIRS``; refinement stops
+The triangles are indexed by height and by grid line: at a level only those the tool's
+end can touch there (reaching into [z, z + corner radius)) are met, each with the grid
+lines within the radius of its box; those wholly above are met once and carried down
+as shank intervals, those wholly below not at all (:func:`fiber_pairs`).  The
+refinement's fibers meet the triangles of a bucket grid near them (:class:`~surfmod.cam.drop_cutter.TriangleGrid`).
+
+Work is bounded before it starts: the number of (fiber, triangle) pairs on the grid
+lines is counted from that index and refused above ``MAX_PAIRS``; refinement stops
 after ``MAX_REFINE`` rounds (each halves the chord error's scale).
 """
 
@@ -36,35 +42,55 @@ PAIRS_PER_BLOCK = 400_000
 MAX_REFINE = 30
 
 
-def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels: int) -> float:
-    """The (fiber, triangle) pairs :func:`waterline` meets over ``levels`` levels with
-    fibers ``sampling`` apart: each triangle meets the grid lines within ``radius`` of
-    its box, in both directions, and the refinement's fibers add about as many again.
+def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner: float = 0.0) -> float:
+    """The (fiber, triangle) pairs :func:`waterline` meets at the tip heights ``levels``
+    with fibers ``sampling`` apart, for a tool of ``radius`` and corner radius ``corner``.
 
-    >>> fiber_pairs(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float), 0.5, 0.5, 3)  # 2 x (5 + 5) x 3
-    60.0
-    """
-    span = np.maximum(tri[:, :, :2].max(axis=1) - tri[:, :, :2].min(axis=1), 0) + 2 * radius
-    return 2.0 * float((span / sampling + 1).sum()) * levels
-
-
-def sampling_within(tri: np.ndarray, radius: float, sampling: float, levels: int, most: float) -> float | None:
-    """``sampling``, or the finest spacing up to ``most`` at which :func:`waterline`'s
-    fibers fit :data:`MAX_PAIRS` over ``levels`` levels (the pairs fall as the spacing
-    grows); None when even ``most`` does not fit.
+    The triangles are indexed by height and by grid line: at a level z only those
+    reaching into [z, z + corner) are met (the band: the tool's rounded end can touch
+    them there), each with the grid lines within ``radius`` of its box in both directions;
+    a triangle wholly above z + corner is met once, at the first level below it, and its
+    shank intervals carried down; one wholly below z is not met at all.  (The refinement's
+    fibers, a few per contour point, each meet the triangles within reach of it: work that
+    follows the contours found, bounded by :data:`MAX_REFINE` rounds.)
 
     >>> tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
-    >>> sampling_within(tri, 0.5, 0.5, 3, 2.0)
+    >>> fiber_pairs(tri, 0.5, 0.5, [0.0, -1.0, -2.0], 0.5)  # (5 + 5) lines: in the band at 0, joined at -1
+    20.0
+    >>> fiber_pairs(tri, 0.5, 0.5, [1.0, 2.0], 0.5)  # every level above the triangle: none
+    0.0
+    """
+    z = np.sort(np.atleast_1d(np.asarray(levels, dtype=float)))
+    span = np.maximum(tri[:, :, :2].max(axis=1) - tri[:, :, :2].min(axis=1), 0) + 2 * radius
+    lines = (span / sampling + 1).sum(axis=1)
+    top, bottom = tri[:, :, 2].max(axis=1), tri[:, :, 2].min(axis=1)
+    # levels in (bottom - corner, top]: the band; any level at or below bottom - corner: joined once
+    band = np.searchsorted(z, top, "right") - np.searchsorted(z, bottom - corner, "right")
+    joined = np.searchsorted(z, bottom - corner, "right") > 0
+    return float((lines * (band + joined)).sum())
+
+
+def sampling_within(tri: np.ndarray, radius: float, sampling: float, levels, most: float,
+                    corner: float = 0.0) -> float | None:
+    """``sampling``, or the finest spacing up to ``most`` at which :func:`waterline`'s
+    fibers fit :data:`MAX_PAIRS` at the tip heights ``levels`` (the pairs fall as the
+    spacing grows); None when even ``most`` does not fit.
+
+    >>> tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
+    >>> sampling_within(tri, 0.5, 0.5, [0.0, -1.0], 2.0)
     0.5
     """
-    if fiber_pairs(tri, radius, sampling, levels) <= MAX_PAIRS:
+    def count(h):
+        return fiber_pairs(tri, radius, h, levels, corner)
+
+    if count(sampling) <= MAX_PAIRS:
         return sampling
-    if fiber_pairs(tri, radius, most, levels) > MAX_PAIRS:
+    if count(most) > MAX_PAIRS:
         return None
     lo, hi = sampling, most
     for _ in range(40):  # bisection on a monotone count: 40 halvings reach 1e-12 of the bracket
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if fiber_pairs(tri, radius, mid, levels) <= MAX_PAIRS else (mid, hi)
+        lo, hi = (lo, mid) if count(mid) <= MAX_PAIRS else (mid, hi)
     return hi
 
 
@@ -94,6 +120,8 @@ class _Fibers:
         self.grid = TriangleGrid(triangles, self.R + reach)
         self.lo = triangles[:, :, :2].min(axis=1)
         self.hi = triangles[:, :, :2].max(axis=1)
+        self.pairs = 0  # (fiber, triangle) pairs met so far on the grid lines: what fiber_pairs estimates
+        self.refined = 0  # and by the refinement's fibers
 
     def lines(self, at, axis: int, z, shank: "_Shank"):
         """Merged components ``(start, end)`` along each grid line: the lines
@@ -125,6 +153,7 @@ class _Fibers:
         o[:, axis] = at[li]
         d = np.zeros((len(ti), 2))
         d[:, 1 - axis] = 1.0
+        self.pairs += len(ti)
         t0, t1 = pair_intervals(self.grid.rows, ti, o[:, 0], o[:, 1], d[:, 0], d[:, 1], z, self.cutter)
         hit = t0 <= t1
         return li[hit], t0[hit], t1[hit]
@@ -143,6 +172,7 @@ class _Fibers:
             ext = np.abs(d[qg]) * reach[qg, None] + self.R
             keep = (self.top[ti] >= z) & np.all((o[qg] + ext >= self.lo[ti]) & (o[qg] - ext <= self.hi[ti]), axis=1)
             qg, ti = qg[keep], ti[keep]
+            self.refined += len(ti)
             lo, hi = pair_intervals(self.grid.rows, ti, o[qg, 0], o[qg, 1], d[qg, 0], d[qg, 1], z, self.cutter)
             hit = lo <= hi
             out_q.append(qg[hit]), out_lo.append(lo[hit]), out_hi.append(hi[hit])
@@ -388,6 +418,12 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     >>> bool(np.allclose(loop[:, :2].min(axis=0), -1.0, atol=1e-9)), float(loop[0, 2])
     (True, 0.0)
     """
+    return _waterline(part, tool, z_levels, sampling, tolerance)[0]
+
+
+def _waterline(part, tool, z_levels, sampling, tolerance):
+    """:func:`waterline`'s contours and its :class:`_Fibers` (whose ``pairs`` counts the
+    fiber-triangle pairs met, against the estimate :func:`fiber_pairs` checked first)."""
     cutter = getattr(tool, "cutter", tool)
     R = cutter.radius
     tri = np.asarray(part, dtype=float)
@@ -412,7 +448,7 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     x = np.arange(lo[0] - R - 2 * h, hi[0] + R + 2 * h + h, h)
     y = np.arange(lo[1] - R - 2 * h, hi[1] + R + 2 * h + h, h)
     fib = _Fibers(tri, cutter, 1.5 * h)
-    pairs = fiber_pairs(tri, R, h, len(levels))
+    pairs = fiber_pairs(tri, R, h, levels, cutter.corner)
     if pairs > MAX_PAIRS:
         raise SurfmodError(f"sampling: {sampling} gives ~{pairs:.3g} fiber-triangle pairs "
                            f"over {len(levels)} levels (limit {MAX_PAIRS:.0e}); choose a coarser sampling")
@@ -424,4 +460,4 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
         if loops:
             loops = _refine(fib, z, loops, tol, 1.5 * h)
         out[k] = [np.column_stack([p, np.full(len(p), z)]) for p in loops]
-    return out
+    return out, fib
