@@ -34,6 +34,21 @@ from .verify import verify_job
 CLEARANCE = 5.0
 
 
+def roughing_tolerance(allowance: float, stepdown: float) -> float:
+    """The tolerance the roughing's mesh is made for (its deflection is
+    :data:`~surfmod.cam.toolpath.MESH_SHARE` of it): a quarter of the ``allowance``, since
+    the roughing only has to leave the allowance give or take that (the finishing cuts
+    the rest to its own, finer mesh), at most a tenth of the ``stepdown`` (the stairs the
+    levels leave are coarser still); 0.01 mm with no allowance, never below 0.005 mm.
+
+    >>> roughing_tolerance(0.5, 5.0), roughing_tolerance(0.5, 1.0), roughing_tolerance(0.0, 5.0)
+    (0.125, 0.1, 0.01)
+    """
+    if allowance <= 0:
+        return 0.01
+    return max(min(allowance / 4, stepdown / 10), 0.005)
+
+
 @dataclass(frozen=True)
 class Rough:
     """Z-level roughing with ``tool``: levels ``stepdown`` apart (default the tool radius),
@@ -430,7 +445,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 if not np.isfinite(allowance) or allowance < 0:
                     raise SurfmodError(f"allowance: must be >= 0, got {op.allowance!r}")
                 grown = tool.cutter.roughing_offset(allowance) if allowance > 0 else tool.cutter
-                tolerance = max(min(allowance / 4, 0.05), 0.005) if allowance > 0 else 0.01
+                tolerance = roughing_tolerance(allowance, stepdown)
                 p = _part(shape, grown, tolerance)
                 bar.update()
                 motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover, CLEARANCE,
