@@ -251,3 +251,33 @@ def test_no_solid(tmp_path, capsys):
     assert main(["machine", str(path), "--out", str(tmp_path / "x.ngc"), "--stock-margin", "2", "--rough",
                  "flat:2", "--finish", "ball:1", "--scallop", "0.05", "--no-progress"]) == 1
     assert not (tmp_path / "x.ngc").exists()
+
+
+@pytest.mark.parametrize("target, value, flag", [
+    ("surfmod.cam.job.MAX_WORK", 1000, "--scallop"),             # the finishing's drop-cutter work
+    ("surfmod.cam.toolpath.MAX_TRIANGLES", 10, "--allowance"),   # the roughing's mesh, the first stage
+    ("surfmod.cam.verify.MAX_PROBES", 10, "--no-verify"),        # the verification's probes
+])
+def test_cli_a_stage_cap_names_a_flag_the_command_has(part_file, tmp_path, capsys, monkeypatch, target, value,
+                                                      flag):
+    """Issue 36: every stage estimates its work before it starts and refuses above its cap
+    in one line naming an option the command has (not the inner functions' max_work,
+    tolerance, max_probes).  The caps are lowered here so that a small part meets them."""
+    import surfmod.cam.verify as verify_module
+
+    monkeypatch.setattr(target, value)
+    # verify_job's default cap was bound when it was defined
+    monkeypatch.setattr(verify_module.verify_job, "__kwdefaults__",
+                        dict(verify_module.verify_job.__kwdefaults__, max_probes=verify_module.MAX_PROBES))
+    with pytest.raises(SystemExit):
+        main(["machine", "--help"])
+    assert flag in capsys.readouterr().out
+    out = tmp_path / "capped.ngc"
+    argv = ["machine", str(part_file), "--out", str(out), "--stock-margin", "2", "--rough", "flat:2",
+            "--finish", "ball:1", "--scallop", "0.08", "--no-progress"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    keyword = flag.removeprefix("--no-").removeprefix("--")
+    assert len(err) == 1 and f"error: {keyword}: the " in err[0], err
+    assert flag != "--no-verify" or "--no-verify" in err[0]
+    assert not out.exists()

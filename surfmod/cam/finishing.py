@@ -536,10 +536,6 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     else:
         across, step_xy, phi = None, stepover, 0.0
     top = _StockTop(part, tool, rest, stock, safe)
-    # the raster first: its work is estimated (and refused above the part's meter) before
-    # any drop of the finishing, the contours' included
-    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, part.meter.bar,
-                       across=across, meter=part.meter)
     out = Moves()
     wl_info = None
     if steep_angle is not None:
@@ -568,6 +564,9 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         if depth.max() > allowed:
             k = int(np.argmax(depth))
             raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
+    # a part metered by the job (a finite cap) has the raster's drop-cutter work estimated up front
+    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, across=across,
+                       meter=part.meter if math.isfinite(part.meter.cap) else None)
     _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
     motion = out.motion()
     threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)

@@ -10,7 +10,9 @@
 
 from __future__ import annotations
 
+import re
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -34,19 +36,21 @@ from .verify import verify_job
 CLEARANCE = 5.0
 
 
-def roughing_tolerance(allowance: float, stepdown: float) -> float:
+def roughing_tolerance(allowance: float, stepdown: float, size: float) -> float:
     """The tolerance the roughing's mesh is made for (its deflection is
-    :data:`~surfmod.cam.toolpath.MESH_SHARE` of it): a quarter of the ``allowance``, since
-    the roughing only has to leave the allowance give or take that (the finishing cuts
-    the rest to its own, finer mesh), at most a tenth of the ``stepdown`` (the stairs the
-    levels leave are coarser still); 0.01 mm with no allowance, never below 0.005 mm.
+    :data:`~surfmod.cam.toolpath.MESH_SHARE` of it), graded to what roughing needs, not to
+    the finishing's scallop: a quarter of the ``allowance`` (the roughing only has to leave
+    the allowance give or take that; the finishing cuts the rest on its own, finer mesh),
+    at most a tenth of the ``stepdown`` and 0.05 mm, or 1e-4 of the part's ``size`` on a
+    part over 500 mm (a metre-size plate meshes at the allowance, not at a small part's
+    0.05); 0.01 mm with no allowance, never below 0.005 mm.
 
-    >>> roughing_tolerance(0.5, 5.0), roughing_tolerance(0.5, 1.0), roughing_tolerance(0.0, 5.0)
-    (0.125, 0.1, 0.01)
+    >>> roughing_tolerance(0.5, 5.0, 80.0), roughing_tolerance(0.5, 30.0, 1000.0), roughing_tolerance(0.0, 5.0, 80.0)
+    (0.05, 0.1, 0.01)
     """
     if allowance <= 0:
         return 0.01
-    return max(min(allowance / 4, stepdown / 10), 0.005)
+    return max(min(allowance / 4, stepdown / 10, max(0.05, 1e-4 * size)), 0.005)
 
 
 @dataclass(frozen=True)
@@ -205,8 +209,32 @@ def stock_box(part_box: np.ndarray, stock) -> np.ndarray:
     return box
 
 
+#: keywords of the refusals inside a stage that neither ``sm.machine`` nor ``surfmod machine``
+#: takes: a stage re-raises them naming its own option (:func:`_stage`)
+INNER_KEYWORDS = ("max_work", "max_points", "max_samples", "max_probes", "tolerance", "sampling")
+
+
+@contextmanager
+def _stage(bar, what: str, option: str, advice: str):
+    """One stage of :func:`machine`, shown on ``bar`` while it runs and counted on it when
+    done.  Every stage estimates its work before it starts and refuses above its cap; a
+    refusal that names an inner keyword (:data:`INNER_KEYWORDS`, e.g. ``max_work`` of the
+    drop-cutter) is re-raised in one line naming ``option``, which the job's operations and
+    the command's flags have, with ``advice`` on how to change it."""
+    bar.set_postfix_str(what)
+    try:
+        yield
+    except SurfmodError as exc:
+        keyword, _, text = str(exc).partition(": ")
+        if keyword not in INNER_KEYWORDS:
+            raise
+        text = re.sub(r"; pass \w+= a larger value to allow it$", "", text)
+        raise SurfmodError(f"{option}: the {what} ({keyword}): {text}; {advice}") from None
+    bar.update()
+
+
 def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float,
-            progress: bool = False):
+            meter: _Meter | None = None):
     if op.stepover is not None and op.scallop is not None:
         raise SurfmodError("stepover: give either stepover or scallop, not both")
     if op.scallop is None and op.stepover is None:
@@ -226,19 +254,9 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     else:
         cusp = tool.scallop_for_stepover(stepover)
         tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
-    # every drop of the finishing is charged to one cap, estimated before the raster
-    # starts; a small tool on a fine scallop is refused there, naming the scallop, and
-    # the bar counts the triangle tests (the finishing is most of a small tool's job)
-    with tqdm(total=1, desc="finishing", unit=" tests", unit_scale=True, leave=False, disable=not progress) as bar:
-        meter = _Meter(MAX_WORK, bar if progress else None, "scallop",
-                       f"choose a larger scallop than {op.scallop:g} or a larger finishing tool"
-                       if op.scallop is not None else "choose a larger stepover or a larger finishing tool")
-        part = clear_part(_part(shape, tool.cutter, tolerance, meter), tool)
-        motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
-                                steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest,
-                                lowest=lowest)
-        bar.total = max(bar.n, 1)  # the contours' drops came after the raster's estimate: the bar ends full
-    part.meter.bar = None  # the repairs (re-cut passes) run after the bar is closed
+    part = clear_part(_part(shape, tool.cutter, tolerance, meter), tool)
+    motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
+                            steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
     return motion, report, part
 
 
@@ -430,9 +448,10 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     stock_model = body_stock(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
     numbers = {}
+    # the bar counts stages (two per operation, the verification), and the finishing's
+    # drop-cutter work (triangle tests) on a second line while it runs
     with tqdm(total=2 * len(ops) + bool(verify), desc="machine", unit="stage", disable=not progress) as bar:
         for k, op in enumerate(ops):
-            bar.set_postfix_str(type(op).__name__.lower())
             tool = op.tool.with_defaults(k + 1)
             if numbers.setdefault(tool.number, tool) != tool:
                 raise SurfmodError(f"tool: number {tool.number} is given to two different tools")
@@ -445,21 +464,23 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 if not np.isfinite(allowance) or allowance < 0:
                     raise SurfmodError(f"allowance: must be >= 0, got {op.allowance!r}")
                 grown = tool.cutter.roughing_offset(allowance) if allowance > 0 else tool.cutter
-                tolerance = roughing_tolerance(allowance, stepdown)
-                p = _part(shape, grown, tolerance)
-                bar.update()
-                motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover, CLEARANCE,
-                                       deflection=p.deflection)
-                motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape)
+                tolerance = roughing_tolerance(allowance, stepdown, float(np.max(box[1] - box[0])))
+                with _stage(bar, "roughing's mesh", "allowance", "a larger allowance meshes coarser"):
+                    p = _part(shape, grown, tolerance)
+                with _stage(bar, "roughing", "stepdown", "a larger stepdown or roughing tool"):
+                    motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover,
+                                           CLEARANCE, deflection=p.deflection)
+                    motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape)
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
                 rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift)
                 name = "roughing"
             elif isinstance(op, Rest):
                 bar.update()
-                motion, report = _rest(shape, op, tool, k, ops, done, stock, safe,
-                                       lambda m, part, tol: _held(m, tool, stock_model, part, tol, safe, strict,
-                                                                  "rest machining", shape))
+                with _stage(bar, "rest machining", "scallop", "a larger scallop or rest tool"):
+                    motion, report = _rest(shape, op, tool, k, ops, done, stock, safe,
+                                           lambda m, part, tol: _held(m, tool, stock_model, part, tol, safe, strict,
+                                                                      "rest machining", shape))
                 name = "rest"
             else:
                 if op.scallop is not None:
@@ -467,17 +488,19 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 # the contours go no deeper than the flutes reach below the part's top
                 lowest = float(box[1, 2] - tool.flute_length) + 1e-9
-                motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest, progress)
+                with (tqdm(total=1, desc="  drop-cutter", unit=" tests", unit_scale=True, leave=False, position=1,
+                           disable=not progress) as tests,
+                      _stage(bar, "finishing", "scallop", "a larger scallop or finishing tool")):
+                    motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest,
+                                                          _Meter(MAX_WORK, tests))
+                    motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe,
+                                         strict, "finishing", shape)
                 finishing[k] = (op, finish_part, rest)
-                motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe, strict,
-                                     "finishing", shape)
                 report["holder"] = held
                 name = "finishing"
-            bar.update()
             done.append(Operation(name, tool, motion, operation_time(motion, tool, machine), report, machine))
         job = Job(shape, stock, tuple(done), safe, machine=machine)
         if verify:
-            bar.set_postfix_str("verifying the program")
-            job = _relink(_recut(replace(job, verification=verify_job(job)), finishing, stock_model))
-            bar.update()
+            with _stage(bar, "verification", "verify", "verify=False, surfmod machine --no-verify, skips it"):
+                job = _relink(_recut(replace(job, verification=verify_job(job)), finishing, stock_model))
     return job
