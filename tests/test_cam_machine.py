@@ -281,3 +281,17 @@ def test_cli_a_stage_cap_names_a_flag_the_command_has(part_file, tmp_path, capsy
     assert len(err) == 1 and f"error: {keyword}: the " in err[0], err
     assert flag != "--no-verify" or "--no-verify" in err[0]
     assert not out.exists()
+
+
+def test_the_progress_bar_moves_through_the_stages(part_file, capsys):
+    """Issue 36: the bar names each stage as it starts, counts the waterline's levels and
+    the finishing's drop-cutter work, and ends at its total."""
+    sm.machine(str(part_file), 2.0, [sm.Rough(sm.Tool("flat", 2.0), stepdown=1.5, allowance=0.3),
+                                     sm.Finish(sm.Tool("ball", 1.0), scallop=0.08)], progress=True)
+    err = capsys.readouterr().err
+    for stage in ("roughing's mesh", "roughing", "finishing", "verification"):
+        assert f"stage/s, {stage}]" in err or f"stage, {stage}]" in err or f", {stage}]" in err, stage
+    levels = re.findall(r"waterline level (\d+)/(\d+)", err)
+    assert levels and levels[-1][0] == levels[-1][1] and int(levels[-1][1]) > 1
+    assert re.search(r"drop-cutter: +\d+%.*[1-9][\d.]*[kM]? tests", err)
+    assert "5/5" in err

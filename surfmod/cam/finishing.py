@@ -304,7 +304,9 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
                            f"pairs); choose a larger scallop or a larger finishing tool")
     if sampling > tool.radius / 2:
         info["sampling"] = sampling
-    loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord)
+    loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord, bar=part.meter.bar)
+    if part.meter.bar is not None:
+        part.meter.bar.set_description_str("  drop-cutter")
     contour = None  # built at the first gouging chord (most parts have none)
     allowed = tolerance - part.deflection + part.lift
     w = 0.25 * spacing

@@ -398,7 +398,7 @@ class ContourPoints:
         return np.insert(pts, which + 1, mid + off[:, None] * normal, axis=0)
 
 
-def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance: float | None = None):
+def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance: float | None = None, bar=None):
     """Waterline contours of ``tool`` round ``part`` at each tip height in ``z_levels``:
     a list (one entry per level) of closed loops ``(N, 3)`` in part coordinates (the
     first point not repeated), the material on the left of the direction of travel
@@ -409,7 +409,7 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     ``sampling``: spacing of the fiber grid that finds the loops (default a quarter of the
     radius; features of the tool-offset narrower than it may be missed); ``tolerance``:
     how far a chord's middle may lie from the exact contour (default 1e-6 of the part's
-    size).
+    size); ``bar``: a tqdm bar whose description counts the levels done.
 
     >>> import numpy as np
     >>> from surfmod.cam.cutters import Flat
@@ -418,10 +418,10 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     >>> bool(np.allclose(loop[:, :2].min(axis=0), -1.0, atol=1e-9)), float(loop[0, 2])
     (True, 0.0)
     """
-    return _waterline(part, tool, z_levels, sampling, tolerance)[0]
+    return _waterline(part, tool, z_levels, sampling, tolerance, bar)[0]
 
 
-def _waterline(part, tool, z_levels, sampling, tolerance):
+def _waterline(part, tool, z_levels, sampling, tolerance, bar=None):
     """:func:`waterline`'s contours and its :class:`_Fibers` (whose ``pairs`` counts the
     fiber-triangle pairs met, against the estimate :func:`fiber_pairs` checked first)."""
     cutter = getattr(tool, "cutter", tool)
@@ -454,7 +454,9 @@ def _waterline(part, tool, z_levels, sampling, tolerance):
                            f"over {len(levels)} levels (limit {MAX_PAIRS:.0e}); choose a coarser sampling")
     out = [None] * len(levels)
     shanks = (_Shank(), _Shank())
-    for k in np.argsort(-levels, kind="stable"):  # top first: the shank intervals carry down
+    for i, k in enumerate(np.argsort(-levels, kind="stable")):  # top first: the shank intervals carry down
+        if bar is not None:
+            bar.set_description_str(f"  waterline level {i + 1}/{len(levels)}")
         z = levels[k]
         loops = _grid_contours(fib, z, x, y, shanks)
         if loops:
