@@ -102,12 +102,31 @@ class TriangleGrid:
         ok = np.all((ij >= 0) & (ij < self.shape), axis=1)
         return np.where(ok, ij[:, 0] * self.shape[1] + ij[:, 1], -1)
 
-    def segments(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(start, stop)`` of each location's cell list (empty outside the grid)."""
+    def segments(self, xy: np.ndarray, above: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(start, stop)`` of each location's cell list (empty outside the grid); with
+        ``above``, only its head of triangles whose top reaches ``above`` (give or take
+        2e-6 of the height range: callers test the tops themselves).
+
+        >>> tri = np.array([[[0, 0, 1], [4, 0, 1], [0, 4, 1]], [[0, 0, 3], [4, 0, 3], [0, 4, 3]]], float)
+        >>> grid = TriangleGrid(tri, 0.5)
+        >>> [(b - a).tolist() for a, b in (grid.segments(np.array([[1.0, 1.0]]), z) for z in (0.0, 2.0, 4.0))]
+        [[2], [1], [0]]
+        """
         cell_id = self._cell_ids(xy)
         start = np.searchsorted(self._cells, cell_id, "left")
         stop = np.where(cell_id >= 0, np.searchsorted(self._cells, cell_id, "right"), start)
-        return start, stop
+        if above is None:
+            return start, stop
+        # each list runs from its highest top down: one search on (cell, fall from the top)
+        # finds where the tops pass below ``above``
+        if not hasattr(self, "_fall"):
+            lo, hi = float(self.top.min()), float(self.top.max())
+            self._scale = 0.5 / max(hi - lo, 1e-300)
+            self._fall = self._cells + (hi - self.top[self._tris]) * self._scale
+        fall = (float(self.top.max()) - above) * self._scale + 1e-6
+        fall = -0.25 if fall < 0 else min(fall, 0.75)  # above every top: none; below every one: the whole list
+        head = np.searchsorted(self._fall, cell_id + fall, "right")
+        return start, np.clip(head, start, stop)
 
     def pairs(self, xy: np.ndarray, start: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(location index, triangle index)`` pairs of the list entries ``start:stop`` of

@@ -161,7 +161,7 @@ class _Fibers:
     def query(self, o, d, z, reach):
         """Per fiber (the segment ``o ± reach d``: origin (F, 2), unit direction (F, 2),
         ``reach`` (F,) at most the grid's): pair arrays (fiber index, t0, t1)."""
-        start, stop = self.grid.segments(o)
+        start, stop = self.grid.segments(o, above=z)  # triangles wholly below z cannot meet the tool
         out_q, out_lo, out_hi = [], [], []
         block = np.cumsum(np.maximum(stop - start, 0)) // PAIRS_PER_BLOCK
         cuts = np.r_[0, np.nonzero(np.diff(block))[0] + 1, len(o)]
