@@ -293,5 +293,5 @@ def test_the_progress_bar_moves_through_the_stages(part_file, capsys):
         assert f"stage/s, {stage}]" in err or f"stage, {stage}]" in err or f", {stage}]" in err, stage
     levels = re.findall(r"waterline level (\d+)/(\d+)", err)
     assert levels and levels[-1][0] == levels[-1][1] and int(levels[-1][1]) > 1
-    assert re.search(r"drop-cutter: +\d+%.*[1-9][\d.]*[kM]? tests", err)
+    assert re.search(r"finishing: +\d+%.*[1-9][\d.]*[kM]? tests", err)
     assert "5/5" in err

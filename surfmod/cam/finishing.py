@@ -298,15 +298,18 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     # the levels) or the tool must change, and the refusal names the command's --scallop
     sampling = sampling_within(tri, grown.radius, tool.radius / 2, levels - g, tool.radius, grown.corner)
     if sampling is None:
+        most = fiber_pairs(tri, grown.radius, tool.radius, levels - g, grown.corner)
         raise SurfmodError(f"scallop: the waterline's {len(levels)} levels {spacing:.3g} mm apart on this part's "
                            f"{len(tri):,} triangles pass its cap even with fibers a tool radius apart "
-                           f"(about {fiber_pairs(tri, grown.radius, tool.radius, levels - g, grown.corner):.3g} fiber-triangle "
-                           f"pairs); choose a larger scallop or a larger finishing tool")
+                           f"(about {most:.3g} fiber-triangle pairs); choose a larger scallop or a larger finishing "
+                           f"tool")
     if sampling > tool.radius / 2:
         info["sampling"] = sampling
-    loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord, bar=part.meter.bar)
-    if part.meter.bar is not None:
-        part.meter.bar.set_description_str("  drop-cutter")
+    bar = part.meter.bar  # the finishing's bar names the waterline's level while it runs
+    desc = bar.desc if bar is not None else ""
+    loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord, bar=bar)
+    if bar is not None:
+        bar.set_description_str(desc)
     contour = None  # built at the first gouging chord (most parts have none)
     allowed = tolerance - part.deflection + part.lift
     w = 0.25 * spacing
@@ -538,6 +541,10 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     else:
         across, step_xy, phi = None, stepover, 0.0
     top = _StockTop(part, tool, rest, stock, safe)
+    # the raster first: its work is estimated (and refused above the part's meter) before
+    # any drop of the finishing, the contours' included
+    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, part.meter.bar,
+                       across=across, meter=part.meter)
     out = Moves()
     wl_info = None
     if steep_angle is not None:
@@ -566,9 +573,6 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         if depth.max() > allowed:
             k = int(np.argmax(depth))
             raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
-    # a part metered by the job (a finite cap) has the raster's drop-cutter work estimated up front
-    path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, across=across,
-                       meter=part.meter if math.isfinite(part.meter.cap) else None)
     _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
     motion = out.motion()
     threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)

@@ -234,7 +234,7 @@ def _stage(bar, what: str, option: str, advice: str):
 
 
 def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float,
-            meter: _Meter | None = None):
+            progress: bool = False):
     if op.stepover is not None and op.scallop is not None:
         raise SurfmodError("stepover: give either stepover or scallop, not both")
     if op.scallop is None and op.stepover is None:
@@ -254,9 +254,19 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     else:
         cusp = tool.scallop_for_stepover(stepover)
         tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
-    part = clear_part(_part(shape, tool.cutter, tolerance, meter), tool)
-    motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
-                            steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest, lowest=lowest)
+    # every drop of the finishing is charged to one cap, estimated before the raster
+    # starts; a small tool on a fine scallop is refused there, naming the scallop, and
+    # the bar counts the triangle tests (the finishing is most of a small tool's job)
+    with tqdm(total=1, desc="finishing", unit=" tests", unit_scale=True, leave=False, disable=not progress) as bar:
+        meter = _Meter(MAX_WORK, bar if progress else None, "scallop",
+                       f"choose a larger scallop than {op.scallop:g} or a larger finishing tool"
+                       if op.scallop is not None else "choose a larger stepover or a larger finishing tool")
+        part = clear_part(_part(shape, tool.cutter, tolerance, meter), tool)
+        motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
+                                steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest,
+                                lowest=lowest)
+        bar.total = max(bar.n, 1)  # the contours' drops came after the raster's estimate: the bar ends full
+    part.meter.bar = None  # the repairs (re-cut passes) run after the bar is closed
     return motion, report, part
 
 
@@ -448,8 +458,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     stock_model = body_stock(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
     numbers = {}
-    # the bar counts stages (two per operation, the verification), and the finishing's
-    # drop-cutter work (triangle tests) on a second line while it runs
+    # the bar counts stages (two per operation, the verification); the finishing's own
+    # bar its drop-cutter work (triangle tests) and the waterline's levels while it runs
     with tqdm(total=2 * len(ops) + bool(verify), desc="machine", unit="stage", disable=not progress) as bar:
         for k, op in enumerate(ops):
             tool = op.tool.with_defaults(k + 1)
@@ -488,11 +498,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 # the contours go no deeper than the flutes reach below the part's top
                 lowest = float(box[1, 2] - tool.flute_length) + 1e-9
-                with (tqdm(total=1, desc="  drop-cutter", unit=" tests", unit_scale=True, leave=False, position=1,
-                           disable=not progress) as tests,
-                      _stage(bar, "finishing", "scallop", "a larger scallop or finishing tool")):
-                    motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest,
-                                                          _Meter(MAX_WORK, tests))
+                with _stage(bar, "finishing", "scallop", "a larger scallop or finishing tool"):
+                    motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest, progress)
                     motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe,
                                          strict, "finishing", shape)
                 finishing[k] = (op, finish_part, rest)
