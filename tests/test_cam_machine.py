@@ -295,3 +295,19 @@ def test_the_progress_bar_moves_through_the_stages(part_file, capsys):
     assert levels and levels[-1][0] == levels[-1][1] and int(levels[-1][1]) > 1
     assert re.search(r"finishing: +\d+%.*[1-9][\d.]*[kM]? tests", err)
     assert "5/5" in err
+
+
+def test_a_finishing_mesh_refused_before_any_operation_runs(monkeypatch):
+    """A scallop whose mesh tolerance (a tenth of it) lies below 1e-6 of a 1.2 m part is
+    refused before the roughing starts, in one line naming the scallop."""
+    import surfmod.cam.job as job_module
+
+    def no_roughing(*args, **kwargs):
+        raise AssertionError("the roughing ran before the finishing's refusal")
+
+    monkeypatch.setattr(job_module, "rough", no_roughing)
+    rail = bd.Box(40, 40, 1200)
+    with pytest.raises(sm.SurfmodError) as err:
+        sm.machine(rail, 2.0, [sm.Rough(sm.Tool("flat", 2.0)), sm.Finish(sm.Tool("ball", 1.0), scallop=0.01)])
+    text = str(err.value)
+    assert text.startswith("scallop: the finishing's mesh (tolerance): 0.001 is below") and "\n" not in text, text

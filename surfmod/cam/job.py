@@ -29,7 +29,7 @@ from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_mo
 from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
-from .toolpath import MAX_WORK, _Meter, _part
+from .toolpath import MAX_WORK, _Meter, _mesh_estimate, _part
 from .verify import verify_job
 
 #: Clearance of links and retracts above the stock (mm).
@@ -222,6 +222,15 @@ def _stage(bar, what: str, option: str, advice: str):
     drop-cutter) is re-raised in one line naming ``option``, which the job's operations and
     the command's flags have, with ``advice`` on how to change it."""
     bar.set_postfix_str(what)
+    with _options(what, option, advice):
+        yield
+    bar.update()
+
+
+@contextmanager
+def _options(what: str, option: str, advice: str):
+    """A refusal naming an inner keyword (:data:`INNER_KEYWORDS`) re-raised in one line
+    naming ``option`` (see :func:`_stage`)."""
     try:
         yield
     except SurfmodError as exc:
@@ -230,11 +239,22 @@ def _stage(bar, what: str, option: str, advice: str):
             raise
         text = re.sub(r"; pass \w+= a larger value to allow it$", "", text)
         raise SurfmodError(f"{option}: the {what} ({keyword}): {text}; {advice}") from None
-    bar.update()
 
 
-def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float,
-            progress: bool = False):
+def _rough_settings(op: Rough, tool: Tool, box: np.ndarray) -> tuple:
+    """``(stepdown, stepover, allowance, mesh tolerance)`` of a roughing, checked."""
+    stepdown = tool.radius if op.stepdown is None else checks.positive(op.stepdown, "stepdown")
+    stepover = 0.8 * tool.radius if op.stepover is None else checks.positive(op.stepover, "stepover")
+    if stepover >= tool.radius:
+        raise SurfmodError(f"stepover: roughing needs a stepover below the tool radius {tool.radius:g}")
+    allowance = float(op.allowance)
+    if not np.isfinite(allowance) or allowance < 0:
+        raise SurfmodError(f"allowance: must be >= 0, got {op.allowance!r}")
+    return stepdown, stepover, allowance, roughing_tolerance(allowance, stepdown, float(np.max(box[1] - box[0])))
+
+
+def _finish_settings(op: Finish, tool: Tool) -> tuple:
+    """``(stepover or None, steep angle or None, tolerance)`` of a finishing, checked."""
     if op.stepover is not None and op.scallop is not None:
         raise SurfmodError("stepover: give either stepover or scallop, not both")
     if op.scallop is None and op.stepover is None:
@@ -254,6 +274,12 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     else:
         cusp = tool.scallop_for_stepover(stepover)
         tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
+    return stepover, steep, tolerance
+
+
+def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float,
+            progress: bool = False):
+    stepover, steep, tolerance = _finish_settings(op, tool)
     # every drop of the finishing is charged to one cap, estimated before the raster
     # starts; a small tool on a fine scallop is refused there, naming the scallop, and
     # the bar counts the triangle tests (the finishing is most of a small tool's job)
@@ -454,6 +480,16 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     stock = stock_box(box, stock)
     safe = float(stock[1, 2] + CLEARANCE)
     strict = bool(strict)
+    # a mesh that would be refused is refused before any operation runs (an 80-20 rail
+    # 1.2 m long had its finishing refused after 9 minutes of roughing)
+    for k, op in enumerate(ops):
+        tool = op.tool.with_defaults(k + 1)
+        if isinstance(op, Rough):
+            with _options("roughing's mesh", "allowance", "a larger allowance meshes coarser"):
+                _mesh_estimate(shape, _rough_settings(op, tool, box)[3])
+        elif isinstance(op, Finish):
+            with _options("finishing's mesh", "scallop", "choose a larger scallop or finishing tool"):
+                _mesh_estimate(shape, _finish_settings(op, tool)[2])
     # the stock model the shanks and holders are held against, shared by the operations
     stock_model = body_stock(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
@@ -466,15 +502,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
             if numbers.setdefault(tool.number, tool) != tool:
                 raise SurfmodError(f"tool: number {tool.number} is given to two different tools")
             if isinstance(op, Rough):
-                stepdown = tool.radius if op.stepdown is None else checks.positive(op.stepdown, "stepdown")
-                stepover = 0.8 * tool.radius if op.stepover is None else checks.positive(op.stepover, "stepover")
-                if stepover >= tool.radius:
-                    raise SurfmodError(f"stepover: roughing needs a stepover below the tool radius {tool.radius:g}")
-                allowance = float(op.allowance)
-                if not np.isfinite(allowance) or allowance < 0:
-                    raise SurfmodError(f"allowance: must be >= 0, got {op.allowance!r}")
+                stepdown, stepover, allowance, tolerance = _rough_settings(op, tool, box)
                 grown = tool.cutter.roughing_offset(allowance) if allowance > 0 else tool.cutter
-                tolerance = roughing_tolerance(allowance, stepdown, float(np.max(box[1] - box[0])))
                 with _stage(bar, "roughing's mesh", "allowance", "a larger allowance meshes coarser"):
                     p = _part(shape, grown, tolerance)
                 with _stage(bar, "roughing", "stepdown", "a larger stepdown or roughing tool"):
