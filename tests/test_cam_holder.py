@@ -237,3 +237,19 @@ def test_a_rim_between_the_model_nodes_is_met():
                    np.array([RAPID, RAPID, FEED, RAPID], np.int8))
     kept, _ = clear_body(moves, tool, stock, far, 0.0, 0.01, 30.0)
     assert len(kept.points) < len(moves.points) and not np.any(kept.kind == FEED)
+
+
+def test_the_plunge_onto_a_move_after_a_gap_is_held_too():
+    """After moves left out, the tool comes straight down onto the next move kept: where
+    that move is not measured itself (of no length, or straight up), the plunge still is.
+    On zoo's bracket the relink plunged 159 mm onto such moves, the holder 68 mm in the
+    stock.  Here a block 20 high is uncut; every move of a tool whose holder stands 5 mm
+    above its tip, at z = 0, buries the holder."""
+    stock = StockModel(np.array([[0.0, 0.0, -10.0], [40.0, 40.0, 20.0]]), 1.0)
+    tool = sm.Tool("flat", 2.0, flute_length=5.0, shank_length=0.0, holder_radius=6.0, holder_length=20.0)
+    far = np.array([[[0.0, 0.0, -100.0], [1.0, 0.0, -100.0], [0.0, 1.0, -100.0]]])
+    pts = [[20, 20, 30], [20, 20, 0], [25, 20, 0], [25, 20, 30], [30, 30, 30], [30, 30, 0], [30, 30, 0],
+           [30, 30, 30]]
+    kinds = [RAPID, FEED, FEED, RAPID, RAPID, RAPID, FEED, RAPID]
+    kept, _ = clear_body(Motion(np.array(pts, float), np.array(kinds, np.int8)), tool, stock, far, 0.0, 0.01, 30.0)
+    assert kept.points[:, 2].min() > 15.0, kept.points.tolist()

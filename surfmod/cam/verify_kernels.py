@@ -203,9 +203,16 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
 
     With ``remove``, a move marked ``skip`` or whose body goes deeper than ``limit[tool]``
     into the stock cuts nothing (its stamps undone) and is reported removed, so later moves
-    meet the stock it left; so is a rapid whose end goes deeper than ``slack[tool]`` into it.  Returns per move: ``into`` and its node (as :func:`sweep_stock`), the
-    body's deepest ``sink`` into the stock (-inf where it met none) and its node, and
-    ``removed``."""
+    meet the stock it left; so is a rapid whose end goes deeper than ``slack[tool]`` into it.
+    The first feed move after a removed one is reached by a plunge straight down onto its
+    start (:func:`surfmod.cam.holder.relink`), through the stock the removed moves left: the
+    body is measured along that plunge too (the end's own column aside: the flutes cut it on
+    the way down), and the move is removed where the plunge would bury it.  A move's own
+    measure does not cover it where the move is not measured at all (a move straight up or
+    of no length: on zoo's bracket the relink plunged 159 mm onto such moves, the holder
+    68 mm into the stock).  Returns per move: ``into`` and its node (as
+    :func:`sweep_stock`), the body's deepest ``sink`` into the stock (-inf where it met
+    none) and its node, and ``removed``."""
     nx, ny = top.shape
     m = starts.shape[0]
     into = np.full(m, -np.inf)
@@ -224,14 +231,21 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                 lowest[t] = min(lowest[t], body[t, q, 1])
     log_i = np.empty(1024, np.int64)
     log_v = np.empty(1024)
+    gap = False  # a move before was removed: the next feed move is reached by a plunge
     for k in range(m):
         if remove and skip[k]:
-            removed[k] = True
+            removed[k] = gap = True
             continue
         ax, ay, az = starts[k, 0], starts[k, 1], starts[k, 2]
         bx, by, bz = ends[k, 0], ends[k, 1], ends[k, 2]
         radius, corner = radii[k], corners[k]
         tk = tool_of[k]
+        if remove and gap and not rapid[k]:
+            buried = _plunge_sink(top, x0, y0, cell, ax, ay, az, radius, body[tk], slack[tk])
+            if buried > limit[tk]:
+                sink[k] = buried
+                removed[k] = True
+                continue
         length = math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
         pieces = max(1, int(math.ceil(length / step)))
         if length == 0.0:
@@ -299,4 +313,35 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                         top[i, j] = z
         if remove and rapid[k] and into[k] > slack[tk]:
             removed[k] = True  # a rapid into the stock left here: the relink comes down at the feed
+        if removed[k]:
+            gap = True
+        elif not rapid[k]:
+            gap = False
     return into, node, sink, sink_node, removed
+
+
+@njit(cache=True)
+def _plunge_sink(top, x0, y0, cell, x, y, z, radius, discs, slack):
+    """How far the stock stands above the bottom of the discs (radius, height above the tip)
+    wider than the end, less ``slack``, of a tool plunged straight down to the tip height
+    ``z`` at ``(x, y)`` (-inf where it meets none); the end's own column is cut on the way."""
+    nx, ny = top.shape
+    worst = -np.inf
+    for q in range(discs.shape[0]):
+        reach = discs[q, 0] - slack
+        if reach <= radius:
+            continue
+        bottom = z + discs[q, 1]
+        i0 = max(int(math.ceil((x - reach - x0) / cell)), 0)
+        i1 = min(int(math.floor((x + reach - x0) / cell)), nx - 1)
+        j0 = max(int(math.ceil((y - reach - y0) / cell)), 0)
+        j1 = min(int(math.floor((y + reach - y0) / cell)), ny - 1)
+        for i in range(i0, i1 + 1):
+            dx = x0 + i * cell - x
+            for j in range(j0, j1 + 1):
+                dy = y0 + j * cell - y
+                d = math.sqrt(dx * dx + dy * dy)
+                if d < radius or d >= reach:
+                    continue
+                worst = max(worst, top[i, j] - bottom)
+    return worst
