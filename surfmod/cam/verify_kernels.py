@@ -69,6 +69,17 @@ def _cells(px, py, radius, x0, y0, cell, nx, ny):
     return i0, i1, j0, j1
 
 
+@njit(cache=True, inline="always")
+def _nodes(px, py, radius, x0, y0, cell, nx, ny):
+    """The range of stock nodes (``x0 + i * cell``, ``y0 + j * cell``) within ``radius`` of
+    (px, py) in x and in y: ``i0, i1, j0, j1`` inclusive."""
+    i0 = max(int(math.ceil((px - radius - x0) / cell)), 0)
+    i1 = min(int(math.floor((px + radius - x0) / cell)), nx - 1)
+    j0 = max(int(math.ceil((py - radius - y0) / cell)), 0)
+    j1 = min(int(math.floor((py + radius - y0) / cell)), ny - 1)
+    return i0, i1, j0, j1
+
+
 @njit(cache=True)
 def deepest(starts, points, x0, y0, cell, nx, ny, probes, radius, corner):
     """For each probe (tip point) the deepest bucketed point inside the tool and its index
@@ -290,10 +301,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                     removed[k] = True
                     break
             px, py, pz = cx, cy, cz
-            i0 = max(int(math.ceil((cx - radius - x0) / cell)), 0)
-            i1 = min(int(math.floor((cx + radius - x0) / cell)), nx - 1)
-            j0 = max(int(math.ceil((cy - radius - y0) / cell)), 0)
-            j1 = min(int(math.floor((cy + radius - y0) / cell)), ny - 1)
+            i0, i1, j0, j1 = _nodes(cx, cy, radius, x0, y0, cell, nx, ny)
             for i in range(i0, i1 + 1):
                 dx = x0 + i * cell - cx
                 for j in range(j0, j1 + 1):
@@ -332,16 +340,9 @@ def _plunge_sink(top, x0, y0, cell, x, y, z, radius, discs, slack):
         if reach <= radius:
             continue
         bottom = z + discs[q, 1]
-        i0 = max(int(math.ceil((x - reach - x0) / cell)), 0)
-        i1 = min(int(math.floor((x + reach - x0) / cell)), nx - 1)
-        j0 = max(int(math.ceil((y - reach - y0) / cell)), 0)
-        j1 = min(int(math.floor((y + reach - y0) / cell)), ny - 1)
+        i0, i1, j0, j1 = _nodes(x, y, reach, x0, y0, cell, nx, ny)
         for i in range(i0, i1 + 1):
-            dx = x0 + i * cell - x
             for j in range(j0, j1 + 1):
-                dy = y0 + j * cell - y
-                d = math.sqrt(dx * dx + dy * dy)
-                if d < radius or d >= reach:
-                    continue
-                worst = max(worst, top[i, j] - bottom)
+                if radius <= math.hypot(x0 + i * cell - x, y0 + j * cell - y) < reach:
+                    worst = max(worst, top[i, j] - bottom)
     return worst
