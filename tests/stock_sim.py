@@ -480,7 +480,17 @@ def ray_hits(triangles: np.ndarray, axis: int, u: np.ndarray, v: np.ndarray, *, 
     j0 = np.searchsorted(v, lo[:, 1] - 1e-12, "left")
     j1 = np.searchsorted(v, hi[:, 1] + 1e-12, "right")
     ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
-    counts = ni * nj
+    for t, local in _blocks(ni * nj, block):
+        ii = i0[t] + local // np.maximum(nj[t], 1)
+        jj = j0[t] + local % np.maximum(nj[t], 1)
+        inside, z = _crossing(tri[t], u[ii], v[jj], axis, slack)
+        yield ii[inside], jj[inside], z[inside], t[inside]
+
+
+def _blocks(counts: np.ndarray, block: int):
+    """Each item ``i`` owning ``counts[i]`` pairs, in blocks of about ``block`` pairs (a
+    block holds whole items): per block, each pair's item and its place among the item's
+    pairs (``0 .. counts[i] - 1``)."""
     edges = np.r_[0, np.cumsum(counts)]
     starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
     for s0, s1 in zip(starts[:-1], starts[1:]):
@@ -488,12 +498,7 @@ def ray_hits(triangles: np.ndarray, axis: int, u: np.ndarray, v: np.ndarray, *, 
             continue
         ids = np.arange(s0, min(s1, len(counts)))
         c = counts[ids]
-        t = np.repeat(ids, c)
-        local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
-        ii = i0[t] + local // np.maximum(nj[t], 1)
-        jj = j0[t] + local % np.maximum(nj[t], 1)
-        inside, z = _crossing(tri[t], u[ii], v[jj], axis, slack)
-        yield ii[inside], jj[inside], z[inside], t[inside]
+        yield np.repeat(ids, c), np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
 
 
 def _crossing(tri, pu, pv, axis, slack):
@@ -810,15 +815,7 @@ class SideDexels:
             raise ValueError(f"side dexels: {total:.3g} line-move pairs (limit {limit:.3g}); pass a coarser h to "
                              f"side_grids or a larger limit")
         nz = len(self.z)
-        edges = np.r_[0, np.cumsum(counts)]
-        starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
-        for s0, s1 in zip(starts[:-1], starts[1:]):
-            if s1 <= s0:
-                continue
-            ids = np.arange(s0, min(s1, len(counts)))
-            c = counts[ids]
-            m = np.repeat(ids, c)
-            local = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
+        for m, local in _blocks(counts, block):
             jj = j0[m] + local // np.maximum(nk[m], 1)
             kk = k0[m] + local % np.maximum(nk[m], 1)
             lo, hi = line_cut(cutter, fa[m], fb[m], self.q[jj], self.z[kk])
@@ -1112,16 +1109,8 @@ def heights_at(triangles: np.ndarray, px: np.ndarray, py: np.ndarray, *, cell: f
     ok = (pi >= 0) & (pj >= 0) & (pj < ncol)
     pk = np.where(ok, pi * ncol + pj, -1)
     first, last = np.searchsorted(key, pk, "left"), np.searchsorted(key, pk, "right")
-    n_c = np.where(ok, last - first, 0)
-    edges = np.r_[0, np.cumsum(n_c)]
-    starts = np.searchsorted(edges, np.arange(0, edges[-1] + block, block))
-    for s0, s1 in zip(starts[:-1], starts[1:]):
-        if s1 <= s0:
-            continue
-        ids = np.arange(s0, min(s1, len(n_c)))
-        c = n_c[ids]
-        p = np.repeat(ids, c)
-        k = t[first[p] + np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)]
+    for p, local in _blocks(np.where(ok, last - first, 0), block):
+        k = t[first[p] + local]
         inside, z = _crossing(tri[k], px[p], py[p], 2, 1e-12)
         np.maximum.at(out, p[inside], z[inside])
     return out

@@ -145,18 +145,24 @@ def test_loops_are_closed_oriented_and_nested():
     assert areas[1] == pytest.approx(400 + 80 + math.pi, rel=1e-5)
 
 
+def pyramid_and_shelf() -> np.ndarray:
+    """A square pyramid 20 wide and 8 high and, beside it, a shelf at z = 6 whose band
+    joins the pyramid's offset at the low levels."""
+    a, top = 10.0, 8.0
+    base = np.array([[-a, -a, 0], [a, -a, 0], [a, a, 0], [-a, a, 0]], float)
+    tri = [[base[k], base[(k + 1) % 4], [0.0, 0.0, top]] for k in range(4)]
+    shelf = square(6.0, z=6.0)
+    shelf[..., 0] += a + 0.5
+    return np.concatenate([np.array(tri), shelf])
+
+
 @pytest.mark.parametrize("kind, R, r", [("ball", 1.5, 0.0), ("bull", 1.5, 0.5), ("flat", 1.5, 0.0)])
 def test_levels_together_equal_levels_alone(kind, R, r):
     """Several levels in one call (unsorted) give each level's loops of a call of its own:
     the triangles wholly above a level's corner height, met once and carried down the
     levels, forbid what they forbid when met at that level.  A pyramid and, beside it, a
     shelf at z = 6 whose band joins the pyramid's offset at the low levels."""
-    a, top = 10.0, 8.0
-    base = np.array([[-a, -a, 0], [a, -a, 0], [a, a, 0], [-a, a, 0]], float)
-    tri = [[base[k], base[(k + 1) % 4], [0.0, 0.0, top]] for k in range(4)]
-    shelf = square(6.0, z=6.0)
-    shelf[..., 0] += a + 0.5
-    tri = np.concatenate([np.array(tri), shelf])
+    tri = pyramid_and_shelf()
     levels = [1.0, 5.5, 3.0, 0.2, 6.2]
     together = waterline(tri, tool(kind, R, r), levels, sampling=0.4)
     for z, loops in zip(levels, together):
@@ -191,12 +197,7 @@ def test_the_pair_estimate_counts_the_pairs_met(kind, R, r):
     a shelf over 40 levels: the estimate is an upper bound within 1.5x of the grid pairs
     met.  Levels wholly below the part cost the first's pairs once, not once per level
     (the old count, triangles x lines x levels, was 40x for them)."""
-    a, top = 10.0, 8.0
-    base = np.array([[-a, -a, 0], [a, -a, 0], [a, a, 0], [-a, a, 0]], float)
-    tri = [[base[k], base[(k + 1) % 4], [0.0, 0.0, top]] for k in range(4)]
-    shelf = square(6.0, z=6.0)
-    shelf[..., 0] += a + 0.5
-    tri = np.concatenate([np.array(tri), shelf])
+    tri = pyramid_and_shelf()
     # refine the pyramid's faces so the index has triangles to skip: 4 x 64 + the shelf
     for _ in range(3):
         m = [(t[0] + t[1]) / 2 for t in tri], [(t[1] + t[2]) / 2 for t in tri], [(t[2] + t[0]) / 2 for t in tri]

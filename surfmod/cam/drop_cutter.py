@@ -431,7 +431,8 @@ def part_triangles(shape, deflection: float, angular: float = 0.35, *, face_inde
 
     if wrapped(shape) is None:
         raise SurfmodError(f"obj: expected an OCCT shape, got {type(shape).__name__}")
-    if not faces_of(shape):
+    faces = faces_of(shape)
+    if not faces:
         raise SurfmodError("obj: has no faces to machine")
     mesh = tessellate_shape(shape, float(deflection), angular=angular)
     unmeshed = mesh.info["faces_not_meshed"]
@@ -442,5 +443,5 @@ def part_triangles(shape, deflection: float, angular: float = 0.35, *, face_inde
     measured = max(float(deflection), float(mesh.info["max_deviation"]))
     if face_index:
         owner = np.concatenate([labels for _, _, labels in mesh.info["stl_groups"]])
-        return triangles, measured, (faces_of(shape), owner)
+        return triangles, measured, (faces, owner)
     return triangles, measured
