@@ -272,13 +272,22 @@ def _follow(part: _Part, contour: ContourPoints, z: float, piece: np.ndarray, de
     return piece, depth
 
 
-def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float):
+def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float,
+                      box: np.ndarray | None = None, keep=None, highest: float = math.inf):
     """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
-    the top of its steep triangles (slope ≥ ``steep_angle``) down to ``bottom``, ``spacing``
-    the distance of neighbouring levels along the walls.  Returns ``(pieces, info)``:
-    pieces per level (top first), each ``(N, 3)``, closed ones with their first point
-    repeated, and a report dict."""
+    the top of its steep triangles (slope ≥ ``steep_angle``, no higher than ``highest``)
+    down to ``bottom``, ``spacing`` the distance of neighbouring levels along the walls.
+    With an (x, y) ``box`` ``[[x0, y0], [x1, y1]]`` only the triangles within two tool
+    radii of it are contoured (so the contours are exact for the tool standing over the
+    box), and ``keep(xy, z)`` (True where a contour point at tip height ``z`` is wanted)
+    narrows the steep pieces further.  Returns ``(pieces, info)``: pieces per level (top
+    first), each ``(N, 3)``, closed ones with their first point repeated, and a report dict."""
     tri = part.grid.triangles
+    if box is not None:
+        reach = 2 * (tool.radius + part.deflection)
+        near = (np.all(tri[:, :, :2].min(axis=1) <= np.asarray(box)[1] + reach, axis=1)
+                & np.all(tri[:, :, :2].max(axis=1) >= np.asarray(box)[0] - reach, axis=1))
+        tri = tri[near]
     n = _normals(tri)
     slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
     steep = slope >= steep_angle - STEEP_MARGIN
@@ -287,7 +296,8 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
         return [], info
     chord = _chord(part, tool, tolerance)
     g = chord + part.deflection  # the tool keeps the mesh's whole deflection from it (walls amplify any gouge)
-    levels = _levels(tri, slope, steep, spacing, float(tri[steep, :, 2].max()), bottom, tool.corner + tool.radius)
+    levels = _levels(tri, slope, steep, spacing, min(float(tri[steep, :, 2].max()), highest), bottom,
+                     tool.corner + tool.radius)
     levels = _with_floors(levels, tri, slope, bottom, g + 0.5 * tolerance)
     if not len(levels):
         return [], info
@@ -325,10 +335,12 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
             h_in = np.nan_to_num(part.height(xy - w * outward), nan=bottom_z)
             h_out = np.nan_to_num(part.height(xy + w * outward), nan=bottom_z)
             cl_slope = np.degrees(np.arctan2(np.maximum(h_in - h_out, 0.0), 2 * w))
-            keep = cl_slope >= steep_angle - STEEP_MARGIN
-            if not keep.any():
+            wanted = cl_slope >= steep_angle - STEEP_MARGIN
+            if keep is not None:
+                wanted &= keep(xy, z)
+            if not wanted.any():
                 continue
-            for piece in _pieces(np.column_stack([xy, np.full(len(xy), z)]), keep):
+            for piece in _pieces(np.column_stack([xy, np.full(len(xy), z)]), wanted):
                 if len(piece) < 2:
                     continue
                 depth = move_gouge(part.height, piece)
@@ -349,6 +361,40 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
                 contours=count, length=length, lifted=lifted, split=split, top=float(levels[0]), bottom=float(levels[-1]),
                 margin=g)
     return out, info
+
+
+def contour_spacing(part: _Part, tool: Tool, scallop: float, tolerance: float, stepover: float | None):
+    """The distance of neighbouring contours along a wall for cusps within ``scallop``
+    (``stepover`` for a tool without a corner), and whether that holds the scallop
+    (:func:`_budget`): the contours keep a chord + the deflection from the mesh, give or
+    take a chord, and the mesh lies within the deflection of the faces."""
+    budget, held = _budget(scallop, 2 * part.deflection + 2 * _chord(part, tool, tolerance))
+    return (tool.cutter.cusp_spacing(budget) if tool.corner > 0 else stepover), held
+
+
+def contour_moves(out: Moves, part: _Part, tool: Tool, top, safe: float, steep_angle: float, spacing: float,
+                  tolerance: float, bottom: float, **where) -> dict:
+    """The steep pieces of the waterline contours (:func:`_waterline_pieces`, ``where``
+    its ``box``, ``keep`` and ``highest``) appended to ``out`` level by level, linked
+    (:func:`_order_pieces`) and left above the stock ``top(xy)`` gives; returns their report."""
+    levels, info = _waterline_pieces(part, tool, steep_angle, spacing, tolerance, bottom, **where)
+    if any(levels):
+        info["links"] = _order_pieces(out, levels, part, tool, top, safe, tolerance, 1.5 * spacing)
+        _leave(out, float(top(out.last[None, :2])[0]), safe)
+    return info
+
+
+def judge_links(part: _Part, out: Moves, allowed: float, what: str) -> np.ndarray:
+    """Every move in ``out`` (the contours' links, entries and retracts among them) judged
+    once more on the drop-cutter heights (the contours and rasters were judged as they
+    were made): the depth of each move, or ``NoSafePathError`` naming the first deepest."""
+    if not out.points:
+        return np.full(1, -np.inf)
+    depth = move_gouge(part.height, out.motion().points)
+    if depth.max() > allowed:
+        k = int(np.argmax(depth))
+        raise NoSafePathError(f"toolpath: no safe path: {what} move {k + 1} cuts {depth.max():.3g} deep")
+    return depth
 
 
 def _link_clear(part: _Part, a, b, allowed: float, step: float) -> np.ndarray | None:
@@ -549,30 +595,16 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     wl_info = None
     if steep_angle is not None:
         if scallop is not None:
-            # the contours keep a chord + the deflection from the mesh, give or take a chord,
-            # and the mesh lies within the deflection of the faces
-            wl_budget, wl_held = _budget(scallop, 2 * part.deflection + 2 * _chord(part, tool, tolerance))
+            spacing, wl_held = contour_spacing(part, tool, scallop, tolerance, stepover)
             held = held and wl_held
-            spacing = tool.cutter.cusp_spacing(wl_budget) if tool.corner > 0 else stepover
         else:
             spacing = stepover
         # no deeper than the flutes reach below the part's top (the raster's own depth is checked by the job)
         bottom = float(stock[0, 2]) if lowest is None else max(float(stock[0, 2]), lowest)
-        levels, wl_info = _waterline_pieces(part, tool, steep_angle, spacing, tolerance, bottom)
+        wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, bottom)
         wl_info["flute_limited"] = bottom > float(stock[0, 2])
-        if any(levels):
-            wl_info["links"] = _order_pieces(out, levels, part, tool, top, safe, tolerance, 1.5 * spacing)
-            _leave(out, float(top(out.last[None, :2])[0]), safe)
-    # the contours' links, entries and retracts judged once more on the drop-cutter heights
-    # (the contours themselves and the raster were judged as they were made)
     allowed = tolerance - part.deflection + part.lift
-    depth = np.full(1, -np.inf)
-    if out.points:
-        wl_motion = out.motion()
-        depth = move_gouge(part.height, wl_motion.points)
-        if depth.max() > allowed:
-            k = int(np.argmax(depth))
-            raise NoSafePathError(f"toolpath: no safe path: finishing move {k + 1} cuts {depth.max():.3g} deep")
+    depth = judge_links(part, out, allowed, "finishing")
     _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
     motion = out.motion()
     threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)

@@ -422,8 +422,10 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
     threshold = scallop + tolerance + model.sag
     pairs = op.max_points * PAIRS_PER_POINT
     mask, before = left_over(model, part_top, part, threshold, pairs)
-    motion, info = rest_moves(part, tool, model, mask, stepover=stepover, tolerance=tolerance, safe=safe,
-                              max_points=op.max_points)
+    # the contours go no deeper than the flutes reach below the part's top, as the finishing's
+    bottom = max(float(stock[0, 2]), float(part.box[1, 2]) - tool.flute_length)
+    motion, info = rest_moves(part, tool, model, mask, scallop=scallop, stepover=stepover, tolerance=tolerance,
+                              safe=safe, bottom=bottom, max_points=op.max_points)
     motion, kept_out = held(motion, part, tolerance)
     model.sweep(motion, tool)
     _, left = left_over(model, part_top, part, threshold, pairs)

@@ -37,7 +37,8 @@ from scipy import ndimage
 from .. import checks
 from ..errors import SurfmodError
 from . import verify_kernels as K
-from .finishing import RECUT_SHARE, REST_CLEARANCE, _add_raster, height_field
+from .finishing import RECUT_SHARE, REST_CLEARANCE, _add_raster, contour_moves, contour_spacing, height_field, \
+    judge_links
 from .roughing import RAPID, Motion, Moves
 from .stock_field import NodeGrid
 from .tool import Tool
@@ -52,6 +53,9 @@ MAX_LOCATIONS = 2_000_000
 PAIRS_PER_POINT = 100
 #: (node, triangle) pairs of the thickness test measured at once
 PAIR_BLOCK = 2_000_000
+#: the rest region's slopes (degrees) from which contours finish it: the rasters' passes,
+#: ``cos 45°`` of the stepover apart, hold the scallop on slopes across them up to this
+STEEP_ANGLE = 45.0
 
 
 class StockModel(NodeGrid):
@@ -194,18 +198,41 @@ def _grid_boxes(reach: np.ndarray, stock: StockModel):
                     for a, b in ndimage.find_objects(labels)]
 
 
-def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, stepover: float, tolerance: float,
-               safe: float, max_points: int = MAX_LOCATIONS):
+class _LeftNear:
+    """Whether a contour point at ``xy``, tip height ``z``, of the rest region ``label``
+    can meet what the stock model shows left: a left node within the tool's radius and a
+    cell of ``xy`` (the region's reach) whose stock stands above ``z``.  ``high`` is the
+    highest left stock within that reach of each node (-inf beyond every region)."""
+
+    def __init__(self, stock: StockModel, mask: np.ndarray, disc: np.ndarray, labels: np.ndarray):
+        self.high = ndimage.maximum_filter(np.where(mask, stock.top, -np.inf), footprint=disc, mode="constant",
+                                           cval=-np.inf)
+        self.stock, self.labels, self.label = stock, labels, 0
+
+    def __call__(self, xy: np.ndarray, z: float) -> np.ndarray:
+        nx, ny = self.high.shape
+        i = np.rint((xy[:, 0] - self.stock.lo[0]) / self.stock.cell).astype(int)
+        j = np.rint((xy[:, 1] - self.stock.lo[1]) / self.stock.cell).astype(int)
+        on = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
+        out = np.zeros(len(xy), bool)
+        out[on] = (self.labels[i[on], j[on]] == self.label) & (self.high[i[on], j[on]] > z)
+        return out
+
+
+def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, scallop: float, stepover: float,
+               tolerance: float, safe: float, bottom: float, max_points: int = MAX_LOCATIONS):
     """The rest tool's moves over the nodes of ``mask`` (see the module): a
     :class:`~surfmod.cam.roughing.Motion` from and back to the clearance height, and a
-    report (``regions``, ``passes``, ``runs``, ``lifted``)."""
+    report (``regions``, ``passes``, ``runs``, ``lifted``, ``levels``, ``contours``).
+    Contours go no lower than ``bottom``."""
     out = Moves()
-    info = {"regions": 0, "passes": 0, "runs": 0, "lifted": 0.0}
+    info = {"regions": 0, "passes": 0, "runs": 0, "lifted": 0.0, "levels": 0, "contours": 0}
     if not mask.any():
         return out.motion(), info
     n = int(math.ceil((tool.radius + stock.cell) / stock.cell))
     di, dj = np.mgrid[-n:n + 1, -n:n + 1]
-    reach = ndimage.binary_dilation(mask, structure=np.hypot(di, dj) * stock.cell <= tool.radius + stock.cell)
+    disc = np.hypot(di, dj) * stock.cell <= tool.radius + stock.cell
+    reach = ndimage.binary_dilation(mask, structure=disc)
     labels, boxes = _grid_boxes(reach, stock)
     step = tool.radius / 4
     spacing = stepover * RECUT_SHARE
@@ -215,6 +242,19 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
     top = _AboveStock(stock, tool.radius, safe)
     allowed = tolerance - part.deflection + part.lift
     nx, ny = reach.shape
+    # the steep part first, by contours as the finishing's (its scallop, levels spaced by
+    # the walls' slope): a raster climbing a wall leaves cusps as tall as its steps there
+    levels_apart, _ = contour_spacing(part, tool, scallop, tolerance, stepover)
+    left = _LeftNear(stock, mask, disc, labels)
+    for label, bounds in enumerate(boxes, start=1):
+        left.label = label
+        highest = float(left.high[labels == label].max())
+        wl = contour_moves(out, part, tool, top, safe, STEEP_ANGLE, levels_apart, tolerance, bottom, box=bounds,
+                           keep=left, highest=highest)
+        info["levels"] += wl["levels"]
+        info["contours"] += wl["contours"]
+        info["lifted"] = max(info["lifted"], wl["lifted"])
+    judge_links(part, out, allowed, "rest")
     for label, bounds in enumerate(boxes, start=1):
         for direction in ("x", "y"):
             try:
@@ -243,18 +283,20 @@ def summary_line(report: dict) -> str:
     """The rest operation's report as a line for the ``surfmod machine`` summary.
 
     >>> line = summary_line({"after": [0, 1], "threshold": 0.055, "runs": 3, "regions": 1, "passes": 40,
-    ...                      "before": {"area": 12.5, "max": 1.2, "regions": 4},
+    ...                      "contours": 12, "levels": 7, "before": {"area": 12.5, "max": 1.2, "regions": 4},
     ...                      "left": {"area": 0.25, "max": 0.07, "regions": 1}})
     >>> print(line.replace(" before, ", " before,\\n").replace("; ", ";\\n"))
     rest after operations 1, 2: left more than 0.055 mm on 12.5 mm^2 (4 region(s), up to 1.2 mm) before,
     0.25 mm^2 (1 region(s), up to 0.07 mm) after;
-    3 cuts in 1 region(s), 40 passes
+    12 contours on 7 levels, 3 cuts in 1 region(s), 40 passes
     """
     b, a = report["before"], report["left"]
     ops = ", ".join(str(k + 1) for k in report["after"])
     return (f"rest after operations {ops}: left more than {report['threshold']:.3g} mm on {b['area']:.4g} mm^2 "
             f"({b['regions']} region(s), up to {b['max']:.3g} mm) before, {a['area']:.4g} mm^2 "
-            f"({a['regions']} region(s), up to {a['max']:.3g} mm) after; {report['runs']} cuts in "
+            f"({a['regions']} region(s), up to {a['max']:.3g} mm) after; "
+            + (f"{report['contours']} contours on {report['levels']} levels, " if report.get("contours") else "")
+            + f"{report['runs']} cuts in "
             f"{report['regions']} region(s), {report['passes']} passes"
             + (f", moves lifted by up to {report['lifted']:.3g} mm where refining could not follow the part "
                f"(material left)" if report.get("lifted", 0.0) > 0 else ""))
