@@ -11,7 +11,7 @@ import build123d as bd
 import numpy as np
 import pytest
 from stock_sim import RS274, Cutter, Program, Stock, normal_residual, parse_canon, parse_gcode, part_height, \
-    run_rs274, simulate
+    run_rs274, side_grids, simulate, vertex_normals, wall_left, wall_points
 from toolpath_reference import ball_clearance
 
 import surfmod as sm
@@ -75,14 +75,13 @@ def test_rest_report_and_verdict(job):
     assert "rest after operations 1, 2" in text and "mm^2" in text
     assert any(f.what.startswith("gouge, rest (tool 3)") and f.ok for f in job.verification.findings)
     assert any(f.what.startswith("residual after rest (tool 3") and f.ok for f in job.verification.findings)
-    # the walls' judge (dexels along x and y) sees what the height field could not: the rest
-    # tool's passes leave cusps above the scallop where they climb the pocket's concave
-    # corners (r = 1 for a ball of 0.75: the cusp grows by about s²/(8(ρ - c))); reported,
-    # not hidden, and every other promise holds
+    # the walls' judge (dexels along x and y) sees what the height field could not: rasters
+    # alone climbing the pocket's concave vertical corners (r = 1) left 0.070 mm there
+    # (limit 0.056); the rest's contours on its steep part leave 0.013
+    assert rep["contours"] > 0 and rep["levels"] > 0 and "contours on" in text
     walls = next(f for f in job.verification.findings if f.what.startswith("residual on walls after rest (tool 3"))
-    assert all(f.ok for f in job.verification.findings if f is not walls), str(job.verification)
-    assert not walls.ok and walls.worst < 2 * walls.limit, walls
-    assert min(abs(walls.where[0]), abs(walls.where[1])) > HALF - 2 * FILLET, walls  # in a corner
+    assert walls.ok and walls.worst <= walls.limit, walls
+    assert job.verification.ok, str(job.verification)
 
 
 def _left_area(top, surface, judged, h, bound):
@@ -119,6 +118,45 @@ def test_rest_in_the_tests_own_stock_simulation(job, program):
     tolerance = SCALLOP / 10
     assert max(first.gouge, second.gouge) <= tolerance + ROUNDING + 1e-6
     assert second.rapid_cut <= 1e-6 and second.cut_without_spindle == 0
+
+
+def test_rest_holds_the_scallop_on_the_corner_walls(program):
+    """The tests' own dexels along x and y (``stock_sim.SideDexels``) over two of the
+    pocket's vertical corners (r = 1, the rest ball's 0.75 reaches every point of them),
+    swept by every tool's feed moves: above the floor fillet at most the scallop, the
+    tolerance and the lines' spacing is left normal to the wall, and nothing is cut into
+    it.  The rest operation's rasters alone (before its contours) left 0.073 mm on these
+    two corners; with the contours 0.013 is left."""
+    prog, _ = program
+    tri, _, (_, owner) = part_triangles(to_shape(pocket()), 0.002, face_index=True)
+    normals = vertex_normals(tri, owner)
+    cutters = {1: Cutter("flat", ROUGH.radius), 2: Cutter("ball", FINISH.radius), 3: Cutter("ball", REST.radius)}
+    feeds = {t: [m for m in prog.moves if m.tool == t and not m.rapid] for t in cutters}
+    h = 0.05  # the lines' spacing: a cusp's crest between contour levels ~0.5 mm apart is met within h²/(8 r)
+    left = []
+    for corner in ((-1, 1), (1, -1)):  # the corners the rasters left most on
+        ends = np.sort(np.outer([HALF - 2 * FILLET, HALF + 0.5], corner), axis=0)
+        box = np.c_[ends, [FLOOR + FILLET, 4.0]]
+        sides = side_grids(box, h)
+        for t, cutter in cutters.items():
+            a, b = np.array([m.a for m in feeds[t]]), np.array([m.b for m in feeds[t]])
+            near = (np.all(np.minimum(a, b)[:, :2] <= box[1, :2] + cutter.radius, axis=1)
+                    & np.all(np.maximum(a, b)[:, :2] >= box[0, :2] - cutter.radius, axis=1))
+            for dex in sides:
+                dex.cut(cutter, a[near], b[near])
+        for dex in sides:
+            w = wall_points(tri, dex, steep=60.0, normals=normals)
+            p = w.point
+            # on the corner's arc (beyond the straight walls' ends), above the floor fillet, below the rim
+            on = (np.all((p[:, :2] >= box[0, :2]) & (p[:, :2] <= box[1, :2]), axis=1)
+                  & (np.abs(p[:, :2]).min(axis=1) > HALF - FILLET) & (p[:, 2] > FLOOR + FILLET + 0.02)
+                  & (p[:, 2] < 4.0 - 0.02))
+            left.append(wall_left(dex, w)[on])
+    left = np.concatenate(left)
+    assert len(left) > 1000
+    tolerance = SCALLOP / 10
+    assert left.min() >= -(tolerance + ROUNDING), f"a cut {-left.min():.4f} into a corner wall"
+    assert left.max() <= SCALLOP + tolerance + 0.01, f"{left.max():.4f} left on a corner wall"  # measured 0.0128
 
 
 def test_rest_moves_never_gouge_exact(job, program):

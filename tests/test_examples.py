@@ -185,12 +185,7 @@ def test_promise_checker_can_fail():
 
 
 #: scripts whose printed verdict states a promise surfmod does not keep yet, with why
-KNOWN_BROKEN = {
-    "cam_rest_machining.py": "the walls' judge finds 0.070 mm (limit 0.056) on the pocket's vertical corners "
-                             "(radius 1) just above the floor fillet, the same with a rest ball of 0.5: the rest "
-                             "tool cuts rasters only, whose passes leave cusps on a concave vertical wall; it has no "
-                             "contours for walls",
-}
+KNOWN_BROKEN: dict[str, str] = {}
 
 
 @pytest.mark.parametrize("script", [pytest.param(s, marks=pytest.mark.xfail(strict=True, reason=KNOWN_BROKEN[s]))

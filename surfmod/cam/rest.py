@@ -13,7 +13,13 @@ tall, is not counted, as a vertical measure would count it; a fillet a ball left
 corner is).  Those nodes are the rest regions; their area
 before and after the rest operation is its report.
 
-**The moves** are the rest tool's own gouge-checked drop-cutter rasters
+**The moves** first finish each region's steep part (slopes from ``STEEP_ANGLE``) by
+the finishing's waterline contours (:func:`~surfmod.cam.finishing.contour_moves`, levels
+:func:`~surfmod.cam.finishing.contour_spacing` apart: the scallop and the walls' slope
+set them), made of the triangles within two tool radii of the region and kept where a
+left node within the tool's reach holds stock above the level (:class:`_LeftNear`): a
+raster climbing a wall leaves cusps as tall as its steps there.  Then the rest tool's
+own gouge-checked drop-cutter rasters
 (:func:`~surfmod.cam.toolpath.raster_path`), one along x and one along y over each
 region's box (passes a ``cos 45°`` share of the scallop's stepover apart, as the repair's
 cross passes: fillets along walls in either direction are crossed), clipped to where the
