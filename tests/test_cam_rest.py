@@ -15,6 +15,7 @@ from stock_sim import RS274, Cutter, Program, Stock, normal_residual, parse_cano
 from toolpath_reference import ball_clearance
 
 import surfmod as sm
+import surfmod.cam.rest as cam_rest
 from surfmod.cam.drop_cutter import part_triangles
 from surfmod.cam.job import _after
 from surfmod.cam.rest import _runs
@@ -192,6 +193,18 @@ def test_runs_joined_along_the_raster():
     assert _runs(inside, pts, 2.5) == [(0, 7), (9, 11)]
     assert _runs(inside, pts, 0.5) == [(0, 4), (4, 7), (9, 11)]
     assert _runs(np.zeros(5, bool), pts[:5], 1.0) == []
+
+
+def test_rest_contours_refused_before_any_above_their_cap(monkeypatch):
+    """The contours' fiber-triangle pairs over every rest region are estimated before the
+    first contour is made, and refused above the waterline's cap naming the scallop."""
+    def made(*args, **kw):
+        raise AssertionError("a contour was made before the estimate refused")
+
+    monkeypatch.setattr(cam_rest, "MAX_PAIRS", 1000)
+    monkeypatch.setattr(cam_rest, "contour_moves", made)
+    with pytest.raises(sm.SurfmodError, match=r"^scallop: the rest's contours over 1 region\(s\).*limit 1e\+03"):
+        sm.machine(pocket(), 1.0, [sm.Finish(FINISH, scallop=SCALLOP), sm.Rest(REST)], verify=False)
 
 
 def test_rest_bad_input():

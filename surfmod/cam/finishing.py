@@ -272,6 +272,17 @@ def _follow(part: _Part, contour: ContourPoints, z: float, piece: np.ndarray, de
     return piece, depth
 
 
+def near_box(part: _Part, tool: Tool, box) -> np.ndarray:
+    """The triangles of ``part`` within two radii of ``tool`` (grown by the mesh's
+    deflection) of the (x, y) ``box`` ``[[x0, y0], [x1, y1]]``: every triangle the tool
+    standing over the box can touch."""
+    tri, box = part.grid.triangles, np.asarray(box, float)
+    reach = 2 * (tool.radius + part.deflection)
+    near = (np.all(tri[:, :, :2].min(axis=1) <= box[1] + reach, axis=1)
+            & np.all(tri[:, :, :2].max(axis=1) >= box[0] - reach, axis=1))
+    return tri[near]
+
+
 def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float,
                       box: np.ndarray | None = None, keep=None, highest: float = math.inf):
     """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
@@ -282,12 +293,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     box), and ``keep(xy, z)`` (True where a contour point at tip height ``z`` is wanted)
     narrows the steep pieces further.  Returns ``(pieces, info)``: pieces per level (top
     first), each ``(N, 3)``, closed ones with their first point repeated, and a report dict."""
-    tri = part.grid.triangles
-    if box is not None:
-        reach = 2 * (tool.radius + part.deflection)
-        near = (np.all(tri[:, :, :2].min(axis=1) <= np.asarray(box)[1] + reach, axis=1)
-                & np.all(tri[:, :, :2].max(axis=1) >= np.asarray(box)[0] - reach, axis=1))
-        tri = tri[near]
+    tri = part.grid.triangles if box is None else near_box(part, tool, box)
     n = _normals(tri)
     slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
     steep = slope >= steep_angle - STEEP_MARGIN

@@ -43,13 +43,14 @@ from scipy import ndimage
 from .. import checks
 from ..errors import SurfmodError
 from . import verify_kernels as K
-from .finishing import RECUT_SHARE, REST_CLEARANCE, _add_raster, contour_moves, contour_spacing, height_field, \
-    judge_links
+from .finishing import RECUT_SHARE, REST_CLEARANCE, STEEP_MARGIN, _add_raster, contour_moves, contour_spacing, \
+    height_field, judge_links, near_box
 from .roughing import RAPID, Motion, Moves
 from .stock_field import NodeGrid
 from .tool import Tool
 from .toolpath import _Part, raster_path
 from .verify import MAX_NODES, stock_cells
+from .waterline import MAX_PAIRS, fiber_pairs
 
 #: raster runs this many tool radii apart along the raster are joined by its own moves
 BRIDGE_RADII = 4.0
@@ -252,11 +253,21 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
     # the walls' slope): a raster climbing a wall leaves cusps as tall as its steps there
     levels_apart, _ = contour_spacing(part, tool, scallop, tolerance, stepover)
     left = _LeftNear(stock, mask, disc, labels)
+    highest = ndimage.maximum(left.high, labels, np.arange(1, len(boxes) + 1))
+    # the contours' work over every region, estimated before any: the waterline's fibers
+    # half a radius apart, levels as close as its steepest walls put them (each region's
+    # call is capped again on its own)
+    closest = levels_apart * math.sin(math.radians(STEEP_ANGLE - STEEP_MARGIN))
+    pairs = sum(fiber_pairs(near_box(part, tool, b), tool.radius, tool.radius / 2,
+                            np.arange(h, bottom - closest, -closest), tool.corner) for b, h in zip(boxes, highest))
+    if pairs > MAX_PAIRS:
+        raise SurfmodError(f"scallop: the rest's contours over {len(boxes)} region(s), levels {closest:.3g} mm apart, "
+                           f"need about {pairs:.3g} fiber-triangle pairs (limit {MAX_PAIRS:.0e}); choose a larger "
+                           f"scallop or rest tool")
     for label, bounds in enumerate(boxes, start=1):
         left.label = label
-        highest = float(left.high[labels == label].max())
         wl = contour_moves(out, part, tool, top, safe, STEEP_ANGLE, levels_apart, tolerance, bottom, box=bounds,
-                           keep=left, highest=highest)
+                           keep=left, highest=float(highest[label - 1]))
         info["levels"] += wl["levels"]
         info["contours"] += wl["contours"]
         info["lifted"] = max(info["lifted"], wl["lifted"])
