@@ -18,7 +18,7 @@ from __future__ import annotations
 import re
 
 import numpy as np
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
 from OCP.Extrema import Extrema_ExtFlag_MIN
@@ -84,25 +84,61 @@ def _planar_runs(points: np.ndarray):
 
 def ball_clearance(part, points: np.ndarray, radius: float, top: float) -> float:
     """Smallest distance from the part to the ribbons swept by the ball centre and its
-    axis up to height ``top``; the deepest cut of the path is ``radius`` minus it."""
-    best = np.inf
+    axis up to height ``top``, capped at ``radius``; the deepest cut of the path is
+    ``radius`` minus it.  Each ribbon is measured against the faces whose bounding boxes
+    come within ``radius`` of its own: a face farther away cuts nothing, and the distance
+    to the others is the distance to the whole part wherever it is below ``radius``."""
+    faces, boxes = face_boxes(getattr(part, "wrapped", part))
+    best = radius
     for run in _planar_runs(points):
         keep = np.r_[True, np.any(np.abs(np.diff(run, axis=0)) > 0, axis=1)]
         run = run[keep]
-        if len(run) < 2 or np.linalg.norm(run[-1, :2] - run[0, :2]) < 1e-12:
+        if len(run) < 2:
             continue
-        centre = run + [0.0, 0.0, radius]
-        polygon = BRepBuilderAPI_MakePolygon()
-        for x, y, z in centre:
-            polygon.Add(gp_Pnt(float(x), float(y), float(z)))
-        polygon.Add(gp_Pnt(float(centre[-1, 0]), float(centre[-1, 1]), top))
-        polygon.Add(gp_Pnt(float(centre[0, 0]), float(centre[0, 1]), top))
-        polygon.Close()
-        face = BRepBuilderAPI_MakeFace(polygon.Wire(), True).Face()
-        dist = BRepExtrema_DistShapeShape(face, part, Extrema_ExtFlag_MIN)
-        assert dist.IsDone()
-        best = min(best, dist.Value())
+        best = min(best, *(_ribbon_clearance(faces, boxes, run[k:k + RIBBON + 1], radius, top)
+                           for k in range(0, len(run) - 1, RIBBON)))
     return best
+
+
+#: points per ribbon piece: the pieces of a ribbon share their ends, so together they are
+#: the ribbon, and a short piece meets few faces' boxes (OCCT measures it against those)
+RIBBON = 32
+
+
+def _ribbon_clearance(faces, boxes, run, radius, top):
+    """The distance from the faces near it to the ribbon of one piece of a run (capped at
+    ``radius``).  A piece may start or end on a vertical move (a step up a wall): there the
+    ribbon's side would run back over that move, so the polygon starts after the first
+    stack of positions at one (x, y) and ends before the last one, and each stack is its
+    own vertical edge from its lowest centre up to ``top``."""
+    centre = run + [0.0, 0.0, radius]
+    lo = centre.min(axis=0) - radius
+    hi = np.r_[centre.max(axis=0)[:2], max(top, centre[:, 2].max())] + radius
+    near = np.nonzero(np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1))[0]
+    if not len(near):
+        return radius
+    moved = np.linalg.norm(np.diff(centre[:, :2], axis=0), axis=1) > 1e-12
+    if not moved.any():
+        ribbon = [_riser(centre, top)]
+    else:
+        first, last = int(np.argmax(moved)), len(moved) - int(np.argmax(moved[::-1]))
+        polygon = BRepBuilderAPI_MakePolygon()
+        for x, y, z in centre[first:last + 1]:
+            polygon.Add(gp_Pnt(float(x), float(y), float(z)))
+        polygon.Add(gp_Pnt(float(centre[last, 0]), float(centre[last, 1]), top))
+        polygon.Add(gp_Pnt(float(centre[first, 0]), float(centre[first, 1]), top))
+        polygon.Close()
+        ribbon = [BRepBuilderAPI_MakeFace(polygon.Wire(), True).Face()]
+        ribbon += [_riser(stack, top) for stack in (centre[:first + 1], centre[last:]) if len(stack) > 1]
+    dist = BRepExtrema_DistShapeShape(compound(ribbon), compound(faces[k] for k in near), Extrema_ExtFlag_MIN)
+    assert dist.IsDone()
+    return min(dist.Value(), radius)
+
+
+def _riser(stack, top):
+    """The vertical edge swept by the axis above a stack of centres at one (x, y)."""
+    x, y, z = stack[np.argmin(stack[:, 2])]
+    return BRepBuilderAPI_MakeEdge(gp_Pnt(float(x), float(y), float(z)), gp_Pnt(float(x), float(y), top)).Edge()
 
 
 def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float) -> list[int]:
