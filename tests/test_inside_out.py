@@ -59,6 +59,10 @@ def test_a_corpus_solid_inside_out_in_its_file_is_named_and_its_rewrite_is_not()
     ["check", "--samples", "8"],
     ["mesh", "--tolerance", "0.5", "--out", "{tmp}/rev.stl"],
     ["toolpath", "--radius", "2", "--scallop", "0.5", "--out", "{tmp}/rev.nc"],
+    # the whole job, verified against the part read outward (issue 36): exit 0 means its
+    # gouge, rapid and residual checks held, which they cannot on material turned inside out
+    ["machine", "--rough", "flat:5", "--finish", "ball:5", "--scallop", "0.5", "--stock-margin", "1",
+     "--out", "{tmp}/rev.ngc"],
 ], ids=lambda a: a[0])
 def test_every_command_that_reads_solids_says_so_in_one_line(inside_out_step, tmp_path, capsys, args):
     command, *rest = args
