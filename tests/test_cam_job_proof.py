@@ -32,7 +32,8 @@ job's stock, one tool after the other:
   and y (``SIDE_CELL`` apart in the other horizontal and in z) measure the stock left
   normal to the face at every crossing of a dexel with it, wherever the tool placed
   against the face clears the part (not under an overhang, not in a corner tighter than
-  the tool, not below the stock's floor): after roughing at least the allowance and,
+  the tool, not below the stock's floor): after roughing at least the allowance (or all
+  the room the line has outside the face, where the part comes back nearer) and,
   where the tool grown by the allowance and the rings' margin also clears the part a
   stepdown lower on the face (above a floor the stair is the floor's), at most ``allowance + stepdown cos θ``
   (the stair on a slope θ) plus the rings' margin
@@ -46,10 +47,13 @@ job's stock, one tool after the other:
   tool's rim (a hole a hair narrower than the tool).  Faces turned downwards are never
   reached.  Finishing leaves at most 0.008 on cam_part's walls (29816 points judged,
   bound 0.19), 0.051 on FOOT_BACK (3136), 0.080 on TAIL_MIDDLE_PART (13603), 0.025 on
-  nist_ftc_11 (672); on trimesh_featuretype it leaves the Ø6.74 through holes full below
+  nist_ftc_11 (672), 0.224 on stepcode_HEAD_BACK (58192; its file has the solid inside
+  out, the job reads it outward); on trimesh_featuretype it leaves the Ø6.74 through holes full below
   z 16.7 (6.75 mm on 14208 wall points the Ø6 ball reaches: ``WALL_FINDINGS``, xfail).
   Roughing leaves at most 0.553 on cam_part's walls (allowance 0.5), 1.5-1.9 on the
-  sloped walls of FOOT_BACK and TAIL_MIDDLE_PART.
+  sloped walls of FOOT_BACK and TAIL_MIDDLE_PART, 2.66 on HEAD_BACK's sphere.  HEAD_BACK's
+  two halves meet at x 250 in a ring step 0.01 mm high: a dexel grazing the sphere past it
+  has 0.25 mm of room outside the ring, less than the allowance, and is held to that room.
 
 Coarse settings (flat r = 5, ball r = 3, scallop 0.15, stock cells 0.25 mm) keep each
 part to seconds.  No part may have stock left after roughing (before issue 26's fix
@@ -88,7 +92,7 @@ SIDE_CELL = 0.4  # spacing of the dexels along x and y (in y or x, and in z)
 ROUNDING = 1e-4
 #: corpus parts (20-150 mm, pockets and holes)
 CORPUS_JOBS = ["stepcode_FOOT_BACK_000.stp", "stepcode_TAIL_MIDDLE_PART.stp", "nist_ftc_11_asme1_rb.stp",
-               "trimesh_featuretype.STEP"]
+               "trimesh_featuretype.STEP", "stepcode_HEAD_BACK.stp"]
 
 
 def _disc_min(a: np.ndarray, radius: float, h: float) -> np.ndarray:
@@ -187,7 +191,12 @@ def prove(path: Path, tmp_path: Path) -> dict:
     rough_rep = job.operations[0].report
     sweep_sides(sides, prog, 1, Cutter("flat", R1))
     left = walls_left(sides, walls)
-    assert left.min() >= ALLOWANCE - deflection - ROUNDING, f"roughing cuts {ALLOWANCE - left.min():.4f} into a wall"
+    # where the part comes back along the line nearer than the allowance (a slit, or a line
+    # grazing the part past a step: stepcode_HEAD_BACK's 0.01 mm ring at x 250), the stock
+    # there can hold no more than that room
+    room = np.concatenate([w.room * np.abs(w.normal[:, dex.axis]) for dex, w in zip(sides, walls)])
+    short = left - np.minimum(ALLOWANCE, room)
+    assert short.min() >= -(deflection + ROUNDING), f"roughing cuts {-short.min():.4f} into a wall"
     ring = 2 * (rough_rep["cell"] ** 2 / (16 * R1) + rough_rep["tolerance"])
     rough_bound = ALLOWANCE + rough_rep["stepdown"] * wall_nz + ring + deflection + ROUNDING
     over, rough_reach = wall_check(walls, floor, stock, Cutter("flat", R1), left, rough_bound, ALLOWANCE + ring,
