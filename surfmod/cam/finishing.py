@@ -568,11 +568,11 @@ def rest_left(part: _Part, tool: Tool, floor: float, threshold: float, spacing: 
 # ----------------------------------------------------------------------------------------------
 
 def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | None, direction: str,
-           steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Leftover | None,
-           lowest: float | None = None):
+           steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Leftover | None):
     """The finishing :class:`~surfmod.cam.roughing.Motion` (waterline pieces on the steep
-    regions, then the raster) and its report; contours no lower than ``lowest`` (where
-    the flutes end, default the stock's bottom)."""
+    regions, then the raster) and its report; the contours go down to the stock's bottom
+    (how deep the tool may go is its shank's and holder's to say: the job holds every
+    move against them, :mod:`surfmod.cam.holder`)."""
     margin = part.lift + part.deflection  # what exactness costs the scallop (see the module doc)
     held = True
     if scallop is not None:
@@ -605,10 +605,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
             held = held and wl_held
         else:
             spacing = stepover
-        # no deeper than the flutes reach below the part's top (the raster's own depth is checked by the job)
-        bottom = float(stock[0, 2]) if lowest is None else max(float(stock[0, 2]), lowest)
-        wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, bottom)
-        wl_info["flute_limited"] = bottom > float(stock[0, 2])
+        wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, float(stock[0, 2]))
     allowed = tolerance - part.deflection + part.lift
     depth = judge_links(part, out, allowed, "finishing")
     _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
@@ -701,7 +698,6 @@ def summary_lines(report: dict) -> list[str]:
                      f"{w['contours']} contours, length {w['length']:.0f} mm"
                      + (f", {w['split']} chords split at the contour where they would cut the part"
                         if w.get("split") else "")
-                     + (" (the flutes reach no lower)" if w.get("flute_limited") else "")
                      + (f"; fibers {w['sampling']:.3g} mm apart, spread from half the tool radius to fit the "
                         "waterline's cap" if w.get("sampling") else ""))
     elif w is not None:

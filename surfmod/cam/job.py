@@ -277,7 +277,7 @@ def _finish_settings(op: Finish, tool: Tool) -> tuple:
     return stepover, steep, tolerance
 
 
-def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None, lowest: float,
+def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None,
             progress: bool = False):
     stepover, steep, tolerance = _finish_settings(op, tool)
     # every drop of the finishing is charged to one cap, estimated before the raster
@@ -289,8 +289,7 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
                        if op.scallop is not None else "choose a larger stepover or a larger finishing tool")
         part = clear_part(_part(shape, tool.cutter, tolerance, meter), tool)
         motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
-                                steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest,
-                                lowest=lowest)
+                                steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest)
         bar.total = max(bar.n, 1)  # the contours' drops came after the raster's estimate: the bar ends full
     part.meter.bar = None  # the repairs (re-cut passes) run after the bar is closed
     return motion, report, part
@@ -422,10 +421,10 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
     threshold = scallop + tolerance + model.sag
     pairs = op.max_points * PAIRS_PER_POINT
     mask, before = left_over(model, part_top, part, threshold, pairs)
-    # the contours go no deeper than the flutes reach below the part's top, as the finishing's
-    bottom = max(float(stock[0, 2]), float(part.box[1, 2]) - tool.flute_length)
+    # the contours go down to the stock's bottom, as the finishing's: the holder check
+    # (``held``) decides how deep the tool goes, not its flutes
     motion, info = rest_moves(part, tool, model, mask, scallop=scallop, stepover=stepover, tolerance=tolerance,
-                              safe=safe, bottom=bottom, max_points=op.max_points)
+                              safe=safe, bottom=float(stock[0, 2]), max_points=op.max_points)
     motion, kept_out = held(motion, part, tolerance)
     model.sweep(motion, tool)
     _, left = left_over(model, part_top, part, threshold, pairs)
@@ -527,10 +526,11 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 if op.scallop is not None:
                     tool.stepover_for_scallop(op.scallop)  # scallop >= radius etc. raise here
                 bar.update()
-                # the contours go no deeper than the flutes reach below the part's top
-                lowest = float(box[1, 2] - tool.flute_length) + 1e-9
+                # the contours go down to the stock's bottom: how deep the tool goes is its
+                # body's to say (a shank no wider than the end follows the flutes down a
+                # hole; the holder stops where it would meet the part or the stock)
                 with _stage(bar, "finishing", "scallop", "a larger scallop or finishing tool"):
-                    motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, lowest, progress)
+                    motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, progress)
                     motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe,
                                          strict, "finishing", shape)
                 finishing[k] = (op, finish_part, rest)

@@ -48,8 +48,9 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   plane through the nearest points of the exact part; the deepest once more by OCCT's exact
   distance), judged against the same limit where the finishing tool reaches: tangent to
   the part at the foot it takes in no point of the part beyond the limit, stands no lower
-  than the table nor the part's top less its flutes, the normal does not face down (an
-  overhang) and no disc of its shank or holder stands below the part.  A cusp between the
+  than the table, the normal does not face down (an overhang) and no disc of its shank or
+  holder wider than its end stands below the part (the flutes set no depth of their own:
+  a shank no wider than the end follows them down a hole).  A cusp between the
   dexels' levels is seen lower, by at most its slope over half a cell.
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
@@ -802,9 +803,9 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
     q, depth, normal, foot = q[steep], depth[steep], normal[steep], foot[steep]
     tips = W.tangent_tips(foot, normal, cutter.radius, cutter.corner)
     # the tip not below the stock's bottom (the table: a wall's last ``c`` above it is the
-    # corner's fillet) nor below the part's top less the flutes (above them the shank meets
-    # the stock in front: the job's own rule)
-    floor = max(float(lo[2]), float(part.points[:, 2].max()) - op.tool.flute_length)
+    # corner's fillet); the flutes set no floor of their own: a shank no wider than the end
+    # follows them down, and what is wider is held against the part below (the job's rule)
+    floor = float(lo[2])
 
     def reached(pick):
         """The tool tangent at these feet takes in no point of the part beyond the limit,

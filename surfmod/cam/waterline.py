@@ -11,7 +11,10 @@ closed form from the triangle's features, as OpenCAMLib's push-cutter does.
 The contours come from a grid of fibers of spacing
 ``sampling``: node states (inside or outside) and the exact crossing on every grid edge
 whose nodes differ, joined cell by cell (marching squares, the material kept on the
-left) into closed loops; then every chord whose midpoint lies farther than
+left) into closed loops.  A loop is found only where a node of the grid lies inside it:
+a hole a little wider than the tool leaves it a pit narrower than the spacing, which
+uniform fibers miss at every level, so one more fiber in x and one in y pass through the
+middle of every pit (:func:`pit_lines`); then every chord whose midpoint lies farther than
 ``tolerance`` from the true contour (measured along a fiber normal to the chord) gets
 that exact point inserted, until none does.  A chord can still cross a notch of the
 contour whose middle it misses; :class:`ContourPoints` splits given chords at exact
@@ -40,6 +43,9 @@ from .fiber_contact import pair_intervals
 MAX_PAIRS = 200_000_000  # (fiber, triangle) pairs over all levels: beyond this, coarsen sampling
 PAIRS_PER_BLOCK = 400_000
 MAX_REFINE = 30
+#: a pit: the tool's positions against steep triangles (slope over 30°) gathered within
+#: three fiber cells whose wall normals, weighted by area, cancel to under this share
+PIT_BALANCE = 0.5
 
 
 def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner: float = 0.0) -> float:
@@ -61,8 +67,11 @@ def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner:
     0.0
     """
     z = np.sort(np.atleast_1d(np.asarray(levels, dtype=float)))
-    span = np.maximum(tri[:, :, :2].max(axis=1) - tri[:, :, :2].min(axis=1), 0) + 2 * radius
+    lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
+    span = np.maximum(hi - lo, 0) + 2 * radius
     lines = (span / sampling + 1).sum(axis=1)
+    for axis, at in enumerate(pit_lines(tri, radius, sampling)):  # the pits' own fibers
+        lines += np.searchsorted(at, hi[:, axis] + radius, "right") - np.searchsorted(at, lo[:, axis] - radius)
     top, bottom = tri[:, :, 2].max(axis=1), tri[:, :, 2].min(axis=1)
     # levels in (bottom - corner, top]: the band; any level at or below bottom - corner: joined once
     band = np.searchsorted(z, top, "right") - np.searchsorted(z, bottom - corner, "right")
@@ -92,6 +101,47 @@ def sampling_within(tri: np.ndarray, radius: float, sampling: float, levels, mos
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if count(mid) <= MAX_PAIRS else (mid, hi)
     return hi
+
+
+def pit_lines(tri: np.ndarray, radius: float, sampling: float) -> tuple[np.ndarray, np.ndarray]:
+    """The x and the y of one more fiber each through every pit of the tool's positions:
+    where the tool standing against the steep triangles (its axis ``radius`` out along
+    their horizontal normal) gathers within three cells of ``sampling`` from walls facing
+    every way (their area-weighted normals cancel to under :data:`PIT_BALANCE`), as in a
+    hole a little wider than the tool.  The fibers cross at the weighted middle of those
+    positions, so a node of the grid lies in the pit.
+
+    >>> a = np.linspace(2 * np.pi, 0, 33)[:-1]  # a hole of radius 1.1, 1 deep: 64 triangles facing in
+    >>> rim = np.column_stack([1.1 * np.cos(a) + 5, 1.1 * np.sin(a) - 2])
+    >>> nxt = np.roll(rim, -1, axis=0)
+    >>> wall = [[[*p, 0], [*q, 0], [*q, 1]] for p, q in zip(rim, nxt)] + [[[*p, 0], [*q, 1], [*p, 1]] for p, q in zip(rim, nxt)]
+    >>> [np.round(v, 6).tolist() for v in pit_lines(np.array(wall, float), 1.0, 0.5)]
+    [[5.0], [-2.0]]
+    """
+    tri = np.asarray(tri, float)
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    flat = np.hypot(n[:, 0], n[:, 1])  # twice the area times the normal's horizontal share
+    steep = flat > 0.5 * np.linalg.norm(n, axis=1)
+    if not steep.any():
+        return np.zeros(0), np.zeros(0)
+    w, nh = flat[steep], n[steep, :2] / flat[steep, None]
+    at = tri[steep, :, :2].mean(axis=1) + radius * nh
+    cell = np.floor((at - at.min(axis=0)) / sampling).astype(np.int64)
+    keys, inv = np.unique(cell, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    sums = np.zeros((len(keys), 5))  # weight, weighted normal (2), weighted position (2)
+    np.add.at(sums, inv, np.column_stack([w, w[:, None] * nh, w[:, None] * at]))
+    # each occupied cell with its eight neighbours: a pit straddling cells is whole in one
+    index = {tuple(k): i for i, k in enumerate(keys.tolist())}
+    window = sums.copy()
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            if di or dj:
+                other = np.array([index.get((a + di, b + dj), -1) for a, b in keys.tolist()])
+                window[other >= 0] += sums[other[other >= 0]]
+    pit = np.hypot(window[:, 1], window[:, 2]) < PIT_BALANCE * window[:, 0]
+    middle = window[pit, 3:] / window[pit, :1]
+    return tuple(np.unique(np.round(middle[:, k] / sampling, 3)) * sampling for k in range(2))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -447,6 +497,8 @@ def _waterline(part, tool, z_levels, sampling, tolerance, bar=None):
     # the grid: the part's box grown by the radius and two cells, all outside
     x = np.arange(lo[0] - R - 2 * h, hi[0] + R + 2 * h + h, h)
     y = np.arange(lo[1] - R - 2 * h, hi[1] + R + 2 * h + h, h)
+    px, py = pit_lines(tri, R, h)
+    x, y = np.union1d(x, px), np.union1d(y, py)
     fib = _Fibers(tri, cutter, 1.5 * h)
     pairs = fiber_pairs(tri, R, h, levels, cutter.corner)
     if pairs > MAX_PAIRS:
