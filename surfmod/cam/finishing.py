@@ -193,16 +193,18 @@ def _levels(tri, slope, steep, spacing, top, bottom, reach):
     return np.array(out, float)
 
 
-def _with_floors(levels: np.ndarray, tri: np.ndarray, slope: np.ndarray, bottom: float, above: float) -> np.ndarray:
-    """``levels`` plus a level ``above`` each flat floor (triangles within ``FLOOR_SLOPE``
-    of level) between the lowest and the highest level: the contour along a wall's foot.
+def _with_floors(levels: np.ndarray, tri: np.ndarray, slope: np.ndarray, bottom: float, above) -> np.ndarray:
+    """``levels`` plus a level at each offset in ``above`` from each flat floor (triangles
+    within ``FLOOR_SLOPE`` of level) between the lowest and the highest level: the contour
+    along a wall's foot, and the lowest the holder lets the tool go beside that floor.
     Levels spaced along the wall rarely fall on a floor, and the raster's passes across
     the fillet the tool leaves there are too far apart on its slope (a ring of 0.1-0.3 mm
     round a boss or a pocket wall, for a scallop of 0.03-0.08)."""
     if not len(levels):
         return levels
     flat = slope < FLOOR_SLOPE
-    floors = np.unique(np.round(tri[flat, :, 2].mean(axis=1), 9)) + above
+    heights = np.unique(np.round(tri[flat, :, 2].mean(axis=1), 9))
+    floors = np.concatenate([heights + a for a in np.atleast_1d(above)])
     floors = floors[(floors >= max(bottom, levels.min())) & (floors <= levels.max())]
     merged = np.unique(np.concatenate([levels, floors]))[::-1]
     keep = np.r_[True, -np.diff(merged) > 1e-6]
@@ -284,14 +286,15 @@ def near_box(part: _Part, tool: Tool, box) -> np.ndarray:
 
 
 def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float,
-                      box: np.ndarray | None = None, keep=None, highest: float = math.inf):
+                      box: np.ndarray | None = None, keep=None, highest: float = math.inf, left: float = 0.0):
     """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
     the top of its steep triangles (slope ≥ ``steep_angle``, no higher than ``highest``)
     down to ``bottom``, ``spacing`` the distance of neighbouring levels along the walls.
     With an (x, y) ``box`` ``[[x0, y0], [x1, y1]]`` only the triangles within two tool
     radii of it are contoured (so the contours are exact for the tool standing over the
     box), and ``keep(xy, z)`` (True where a contour point at tip height ``z`` is wanted)
-    narrows the steep pieces further.  Returns ``(pieces, info)``: pieces per level (top
+    narrows the steep pieces further; ``left``: the stock a floor may still hold when the
+    contours run (a roughing's).  Returns ``(pieces, info)``: pieces per level (top
     first), each ``(N, 3)``, closed ones with their first point repeated, and a report dict."""
     tri = part.grid.triangles if box is None else near_box(part, tool, box)
     n = _normals(tri)
@@ -304,7 +307,13 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     g = chord + part.deflection  # the tool keeps the mesh's whole deflection from it (walls amplify any gouge)
     levels = _levels(tri, slope, steep, spacing, min(float(tri[steep, :, 2].max()), highest), bottom,
                      tool.corner + tool.radius)
-    levels = _with_floors(levels, tri, slope, bottom, g + 0.5 * tolerance)
+    foot = g + 0.5 * tolerance
+    # below a floor's height less the holder's (its lowest disc wider than the end) the
+    # holder would stand on that floor and the job leaves those contours out: a contour
+    # just above, on a clear floor and on one holding ``left``, cuts the wall down to there
+    wider = [h for r, h, _ in tool.body if r > tool.radius]
+    holder = [foot + m - wider[0] for m in sorted({0.0, left})] if wider else []
+    levels = _with_floors(levels, tri, slope, bottom, [foot] + holder)
     if not len(levels):
         return [], info
     grown = tool.cutter.grown(g)
@@ -605,7 +614,8 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
             held = held and wl_held
         else:
             spacing = stepover
-        wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, float(stock[0, 2]))
+        wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, float(stock[0, 2]),
+                                left=0.0 if rest is None else rest.above)
     allowed = tolerance - part.deflection + part.lift
     depth = judge_links(part, out, allowed, "finishing")
     _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
