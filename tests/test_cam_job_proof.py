@@ -77,8 +77,6 @@ import surfmod as sm
 from surfmod.inputs import to_shape
 from surfmod.cam.drop_cutter import part_triangles
 
-#: parts where the dexels along x and y find the product's finishing leaving too much on walls
-WALL_FINDINGS: dict[str, str] = {}
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")
 R1, R2, SCALLOP, ALLOWANCE, MARGIN, CELL = 5.0, 3.0, 0.15, 0.5, 2.0, 0.25
@@ -275,8 +273,7 @@ def test_cam_part_job_in_stock(tmp_path):
 
 @needs_rs274
 @pytest.mark.corpus
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=WALL_FINDINGS[n]))
-                                  if n in WALL_FINDINGS else n for n in sorted(CORPUS_JOBS)])
+@pytest.mark.parametrize("name", sorted(CORPUS_JOBS))
 def test_corpus_job_in_stock(tmp_path, corpus_dir, name):
     got = prove(corpus_dir / name, tmp_path)
     print(name, {k: v for k, v in got.items() if k not in ("job", "finish")})

@@ -451,8 +451,9 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     (:attr:`Tool.body <surfmod.cam.tool.Tool.body>`) would touch the part or the stock is
     left out, the tool going round it by the clearance height, and what is left uncut is
     reported in the operation's ``report["holder"]`` (:class:`~surfmod.cam.holder.Held`:
-    area, deepest point; see :mod:`surfmod.cam.holder`).  With ``strict`` such a collision
-    raises ``SurfmodError`` instead.
+    area, deepest point; see :mod:`surfmod.cam.holder`).  That is the only bound on how
+    deep a tool goes: not its flutes (a shank no wider than the end follows them down a
+    hole).  With ``strict`` such a collision raises ``SurfmodError`` instead.
 
     With ``verify`` (the default) the job's LinuxCNC program is read back and judged
     against the exact part and the stock (:func:`surfmod.cam.verify.verify_job`: gouge,

@@ -42,8 +42,9 @@ class Tool:
     """An end mill: ``kind`` ``"flat"``, ``"ball"`` or ``"bull"``, ``radius`` > 0, and for a
     bull nose its ``corner_radius`` (``0 < corner_radius < radius``: a flat core of radius
     ``radius - corner_radius`` rounded by a torus).  ``flute_length`` (default three
-    diameters) bounds the depth it may cut; ``number`` (the T word), ``spindle`` (rpm),
-    ``feed`` and ``plunge_feed`` (mm/min) default from the diameter.  Its shape is
+    diameters) is its cutting length (how deep it goes is its shank's and holder's to
+    say); ``number`` (the T word), ``spindle`` (rpm), ``feed`` and ``plunge_feed``
+    (mm/min) default from the diameter.  Its shape is
     ``cutter``, a :class:`~surfmod.cam.cutters.Cutter`, which also answers for the tool
     ``corner`` (the corner radius: the radius for a ball, 0 for a flat end), ``core`` (the
     flat bottom's radius), ``profile(d)``, ``stepover_for_scallop(h)`` and
