@@ -84,10 +84,12 @@ class Leftover:
     """What a roughing pass left: over any (x, y) column, stock at most ``above`` higher
     than the part's highest point within ``reach`` of the column (the roughing tool's
     radius plus its allowance: its grown tool stood at every column it could, levels
-    ``stepdown`` apart)."""
+    ``stepdown`` apart); on a flat floor it cut at a level of its own, ``on_floors``
+    (its allowance and its mesh's lift)."""
 
     reach: float
     above: float
+    on_floors: float
 
 
 def clear_part(part: _Part, tool: Tool) -> _Part:
@@ -615,7 +617,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         else:
             spacing = stepover
         wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, float(stock[0, 2]),
-                                left=0.0 if rest is None else rest.above)
+                                left=0.0 if rest is None else rest.on_floors + tolerance)
     allowed = tolerance - part.deflection + part.lift
     depth = judge_links(part, out, allowed, "finishing")
     _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")

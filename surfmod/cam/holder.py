@@ -44,12 +44,12 @@ from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
 from .rest import StockModel
 from .roughing import PLUNGE, RAPID, Motion, Moves
-from .verify import _probes
+from .verify import BODY_NODES, _probes, body_cell
 from .verify_kernels import sweep_body, sweep_stock
 
 #: probes along the moves for the part check, and stock nodes of the job's model, at most
 MAX_HOLDER_PROBES = 20_000_000
-MAX_STOCK_NODES = 4_000_000
+MAX_STOCK_NODES = BODY_NODES
 #: probes along a move per disc radius
 PROBES_PER_RADIUS = 16
 #: cylinders OCCT's exact distance settles per operation, and the gap it must find
@@ -77,7 +77,7 @@ class Held:
 def body_stock(stock: np.ndarray, smallest_radius: float) -> StockModel:
     """The job's stock model the bodies are held against: cells a quarter of the smallest
     tool radius, at most :data:`MAX_STOCK_NODES` nodes (coarser cells beyond)."""
-    return StockModel(stock, smallest_radius / 4, MAX_STOCK_NODES)
+    return StockModel(stock, body_cell(stock, smallest_radius), MAX_STOCK_NODES)
 
 
 def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, slack: float, skip: np.ndarray):

@@ -514,7 +514,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape)
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
-                rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift)
+                rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift, allowance + p.lift)
                 name = "roughing"
             elif isinstance(op, Rest):
                 bar.update()

@@ -49,8 +49,9 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   distance), judged against the same limit where the finishing tool reaches: tangent to
   the part at the foot it takes in no point of the part beyond the limit, stands no lower
   than the table, the normal does not face down (an overhang) and no disc of its shank or
-  holder wider than its end stands below the part (the flutes set no depth of their own:
-  a shank no wider than the end follows them down a hole).  A cusp between the
+  holder wider than its end (grown by the job's body cell, :func:`body_cell`) stands below
+  the part (the flutes set no depth of their own: a shank no wider than the end follows
+  them down a hole).  A cusp between the
   dexels' levels is seen lower, by at most its slope over half a cell.
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
@@ -95,6 +96,9 @@ MAX_DEXELS = 2_000_000
 MAX_WALL_POINTS = 1_000_000
 #: stock points on walls asked at a time whether the finishing tool reaches them
 REACH_CHUNK = 4096
+#: stock nodes of the model the job holds shanks and holders against, at most
+#: (:func:`body_cell`, :func:`surfmod.cam.holder.body_stock`)
+BODY_NODES = 4_000_000
 #: nodes of the stock steeper than this (degrees) are walls the height field cannot judge
 WALL_SLOPE = 80.0
 #: the least upward share of a contact normal a lift counts on (beside a vertical wall a
@@ -645,14 +649,23 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         if held:
             notes.append(f"note: residual: {held:,} nodes the shank or holder keeps the {op.name} tool from, "
                          f"not judged (the holder finding and the operation's report say what is left)")
+        grow = body_cell(job.stock, min(o.tool.radius for o in job.operations))
         found, dexels, judged_walls = _wall_residual(part, moves, radii, corners, np.asarray(job.stock, float), under,
-                                                     cell, op, cutter, limit, max_dexel_work, notes, job.part)
+                                                     cell, op, cutter, limit, max_dexel_work, notes, job.part, grow)
         findings.append(found)
     # the part under each node as the residual reads it: its highest point within the cell
     kept = StockField.over_part(top, lambda xy: part.drop(xy, 0.75 * cell, 0.0), lo[:2], cell, WALL_SLOPE,
                                 KEPT_NODES)
     return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes),
                         stock=kept, body_probes=body_probes, dexels=dexels, wall_points=judged_walls)
+
+
+def body_cell(stock, smallest_radius: float) -> float:
+    """The cell of the stock model a job holds its shanks and holders against: a quarter
+    of its smallest tool radius, coarser beyond :data:`BODY_NODES` nodes.  The job grows
+    each disc wider than the end by it (:func:`surfmod.cam.holder.body_stock`), and the
+    walls' judge asks where the tool reaches with the same discs."""
+    return stock_cells(stock, smallest_radius / 4, BODY_NODES)[0]
 
 
 def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
@@ -730,11 +743,13 @@ def _residual(part: PartPoints, top: np.ndarray, under: np.ndarray, lo: np.ndarr
 
 
 def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, corners: np.ndarray, stock: np.ndarray,
-                   under: np.ndarray, cell: float, op, cutter, limit: float, max_work: int, notes: list, shape):
+                   under: np.ndarray, cell: float, op, cutter, limit: float, max_work: int, notes: list, shape,
+                   grow: float = 0.0):
     """The material the program leaves on the part's steep faces where the finishing tool
     reaches, from the dexels along x and y (:mod:`~surfmod.cam.wall_dexels`): ``(finding,
     dexels, points judged)``; ``under`` is the part's top on the height field's nodes
-    (``cell`` apart), ``notes`` gets what was coarser than asked."""
+    (``cell`` apart), ``notes`` gets what was coarser than asked; the discs wider than the
+    end are taken ``grow`` wider where the tool's reach is asked (the job's body cell)."""
     from ..occ.topo import closest_on_face, compound, faces_of
 
     lo, hi = stock
@@ -809,12 +824,14 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
 
     def reached(pick):
         """The tool tangent at these feet takes in no point of the part beyond the limit,
-        and no disc of its shank or holder stands below the part."""
+        and no disc of its shank or holder wider than the end stands below the part, each
+        such disc as wide as the job holds it (grown by its stock model's cell: where the
+        job keeps a holder out, the wall is not asked of it)."""
         t = tips[pick]
         ok = (t[:, 2] >= floor - limit) & (part.deepest(t, cutter.radius, cutter.corner)[0] <= limit)
         for r, h, _ in op.tool.body:
             if r - limit > cutter.radius and ok.any():
-                ok[ok] = part.drop(t[ok, :2], r - limit, 0.0) - h <= t[ok, 2] + limit
+                ok[ok] = part.drop(t[ok, :2], r - limit + grow, 0.0) - h <= t[ok, 2] + limit
         return ok
 
     # every point beyond the bound is asked (they are counted), then the next deepest a
