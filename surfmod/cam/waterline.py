@@ -34,6 +34,7 @@ after ``MAX_REFINE`` rounds (each halves the chord error's scale).
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..errors import SurfmodError
 from .cutters import Cutter
@@ -46,6 +47,8 @@ MAX_REFINE = 30
 #: a pit: the tool's positions against steep triangles (slope over 30°) gathered within
 #: three fiber cells whose wall normals, weighted by area, cancel to under this share
 PIT_BALANCE = 0.5
+#: times a pit's middle is moved to the middle of the positions near it
+PIT_SHIFTS = 3
 
 
 def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner: float = 0.0) -> float:
@@ -106,9 +109,10 @@ def sampling_within(tri: np.ndarray, radius: float, sampling: float, levels, mos
 def pit_lines(tri: np.ndarray, radius: float, sampling: float) -> tuple[np.ndarray, np.ndarray]:
     """The x and the y of one more fiber each through every pit of the tool's positions:
     where the tool standing against the steep triangles (its axis ``radius`` out along
-    their horizontal normal) gathers within three cells of ``sampling`` from walls facing
-    every way (their area-weighted normals cancel to under :data:`PIT_BALANCE`), as in a
-    hole a little wider than the tool.  The fibers cross at the weighted middle of those
+    their horizontal normal) gathers within three cells of ``sampling``, less than a
+    ``sampling`` from its middle (root mean square), from walls facing every way (their
+    area-weighted normals cancel to under :data:`PIT_BALANCE`), as in a hole a little wider
+    than the tool.  The fibers cross at the weighted middle of those
     positions, so a node of the grid lies in the pit.
 
     >>> a = np.linspace(2 * np.pi, 0, 33)[:-1]  # a hole of radius 1.1, 1 deep: 64 triangles facing in
@@ -126,22 +130,38 @@ def pit_lines(tri: np.ndarray, radius: float, sampling: float) -> tuple[np.ndarr
         return np.zeros(0), np.zeros(0)
     w, nh = flat[steep], n[steep, :2] / flat[steep, None]
     at = tri[steep, :, :2].mean(axis=1) + radius * nh
-    cell = np.floor((at - at.min(axis=0)) / sampling).astype(np.int64)
-    keys, inv = np.unique(cell, axis=0, return_inverse=True)
-    inv = inv.ravel()
-    sums = np.zeros((len(keys), 5))  # weight, weighted normal (2), weighted position (2)
-    np.add.at(sums, inv, np.column_stack([w, w[:, None] * nh, w[:, None] * at]))
+    cell = np.floor((at - at.min(axis=0)) / sampling).astype(np.int64) + 1
+    width = int(cell[:, 1].max()) + 2  # a row of cells, its neighbours' included
+    keys, inv = np.unique(cell[:, 0] * width + cell[:, 1], return_inverse=True)
+    sums = np.zeros((len(keys), 6))  # weight, weighted normal (2), position (2) and its square
+    np.add.at(sums, inv.ravel(), np.column_stack([w, w[:, None] * nh, w[:, None] * at, w * (at * at).sum(axis=1)]))
     # each occupied cell with its eight neighbours: a pit straddling cells is whole in one
-    index = {tuple(k): i for i, k in enumerate(keys.tolist())}
     window = sums.copy()
-    for di in (-1, 0, 1):
-        for dj in (-1, 0, 1):
-            if di or dj:
-                other = np.array([index.get((a + di, b + dj), -1) for a, b in keys.tolist()])
-                window[other >= 0] += sums[other[other >= 0]]
-    pit = np.hypot(window[:, 1], window[:, 2]) < PIT_BALANCE * window[:, 0]
-    middle = window[pit, 3:] / window[pit, :1]
-    return tuple(np.unique(np.round(middle[:, k] / sampling, 3)) * sampling for k in range(2))
+    for step in (-width - 1, -width, -width + 1, -1, 1, width - 1, width, width + 1):
+        k = np.minimum(np.searchsorted(keys, keys + step), len(keys) - 1)
+        found = keys[k] == keys + step
+        window[found] += sums[k[found]]
+    middle = window[:, 3:5] / window[:, :1]
+    spread = window[:, 5] / window[:, 0] - (middle * middle).sum(axis=1)  # the positions' variance
+    # balanced, and narrow: a pit as wide as the spacing holds a node of the grid already
+    pit = np.flatnonzero((np.hypot(window[:, 1], window[:, 2]) < PIT_BALANCE * window[:, 0])
+                         & (spread < sampling ** 2))
+    # the windows round one pit overlap: the heaviest (holding all of it) speaks for those
+    # within a spacing of its middle; each pass keeps one and drops at least itself
+    kept, order = [], pit[np.argsort(-window[pit, 0], kind="stable")]
+    while len(order):
+        kept.append(middle[order[0]])
+        order = order[np.hypot(*(middle[order] - middle[order[0]]).T) >= sampling]
+    kept = np.reshape(kept, (-1, 2))
+    # the window's middle leans towards other walls in it: moved to the weighted middle of
+    # the positions within half a spacing of it, a few times (a pit narrower than the
+    # spacing is then all that is left round it)
+    tree = cKDTree(at)
+    for _ in range(PIT_SHIFTS):
+        for k, near in enumerate(tree.query_ball_point(kept, 0.5 * sampling)):
+            if near:
+                kept[k] = np.average(at[near], axis=0, weights=w[near])
+    return np.unique(kept[:, 0]), np.unique(kept[:, 1])
 
 
 # ----------------------------------------------------------------------------------------------
