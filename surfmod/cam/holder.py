@@ -94,7 +94,7 @@ def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, sla
     *_, removed = sweep_body(stock.top, float(stock.lo[0]), float(stock.lo[1]), stock.cell,
                              np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:]), rapid,
                              np.full(m, tool.radius), np.full(m, tool.corner), stock.cell / 2, discs,
-                             np.zeros(m, np.int64), np.array([float(slack)]), np.zeros(1), skip, True)
+                             np.zeros(m, np.int64), np.array([float(slack)]), np.zeros(1), skip, True, 0.0)
     return removed
 
 

@@ -13,9 +13,16 @@ ring, so the tool, wider than that, sweeps it all; each ring engages about ``ste
 of material radially beside the one before, up to a grid cell more).  Rings are clipped
 to the stock grown by ``radius + stepover / 2`` and cut from the far side inwards towards the part; open
 stock is entered from the air, sideways; a closed ring from the end of the ring before
-at the level when that is near, else by a ramp along itself from the level above, or
+at the level when that is near, else by a ramp along itself, or
 (a ring too short to ramp along) by a helix round its centre as wide as the region
-allows — never a straight plunge.  A region too small even for a helix of
+allows — never a straight plunge.  The ramp comes down rapidly only to half a unit above
+the lowest level that cleared the tool's disc round its start with ``ENTRY_CELLS`` grid
+cells to spare (the rings cleared, exactly, the region where the tool stood grown by its
+radius; the boundary ring stands up to two cells inside that region and the grid's
+distance errs by about a cell): it starts at the ring's point where that level is
+lowest, the level above wherever the ring lies well inside what it cleared.  Beside a
+wall the levels above left their stair of allowance: an entry there starts higher and
+ramps down through it, never rapids into it.  A region too small even for a helix of
 ``MIN_HELIX`` tool radii is left, with every level below it, and reported (``left``:
 level, centre, at most how much (x, y) area of stock): the job's summary names it.
 Links go up to the clearance height above the stock, except a short link (at most
@@ -60,6 +67,11 @@ MIN_HELIX = 0.05
 HELIX_POINTS = 24
 #: Splitting rounds for moves that cut between their ends (each halves the moves cut).
 SPLIT_ROUNDS = 12
+#: How deep (grid cells) inside the region where the tool stood at a level a point must
+#: lie for that level to have cleared the tool's disc round it with a cell to spare (the
+#: boundary ring up to two cells inside, the grid's distance up to a cell off, a cell of
+#: margin: the stock models judging the program sample no finer than that).
+ENTRY_CELLS = 4.0
 
 
 @dataclass(frozen=True)
@@ -186,6 +198,9 @@ def rough(part_grid: TriangleGrid, lift: float, grown: Cutter, tool: Tool, allow
     # nodes of regions left uncut: the levels below them are left too (their entries
     # would start in material the level above did not remove)
     blocked = np.zeros(H.shape, bool)
+    # per node, the lowest level whose rings cleared the tool's disc round it (with
+    # ENTRY_CELLS to spare): an entry may come down rapidly to just above it
+    cleared = np.full(H.shape, top)
     for z in levels:
         zc = z + FREE_EPS
         free = H <= zc
@@ -209,7 +224,8 @@ def rough(part_grid: TriangleGrid, lift: float, grown: Cutter, tool: Tool, allow
             gen = contourpy.contour_generator(xs, ys, dist.T, line_type=contourpy.LineType.Separate)
             rings = [(line, False) for d in rings_at for line in gen.lines(float(d))]
             rings += [(line, False) for line in _boundary(xs, ys, H, zc, dist, height, cell, R, deflection)]
-        level = _Level(z, previous, safe, height, step, stepover, stock, lo_box, hi_box, xs, ys, dist, cell, R)
+        level = _Level(z, previous, safe, height, step, stepover, stock, lo_box, hi_box, xs, ys, dist, cell, R,
+                       cleared)
         labels = None
         for line, whole_box in rings:
             closed = len(line) > 2 and np.allclose(line[0], line[-1])
@@ -232,6 +248,9 @@ def rough(part_grid: TriangleGrid, lift: float, grown: Cutter, tool: Tool, allow
                     same[0].update(z=min(same[0]["z"], gone["z"]), area=max(same[0]["area"], gone["area"]))
                 else:
                     left.append(gone)
+        # a level with no part in it ringed the whole grown box (no stock beyond it)
+        inside = np.ones(H.shape, bool) if free.all() else dist >= ENTRY_CELLS * cell
+        cleared[inside & ~blocked] = z
         previous = z
         if progress is not None:
             progress.update(0)
@@ -359,12 +378,23 @@ class _Level:
     dist: np.ndarray
     cell: float
     R: float
+    cleared: np.ndarray
 
     def nodes(self, pts):
         """Grid nodes nearest the points (index arrays)."""
         i = np.clip(np.round((pts[:, 0] - self.xs[0]) / self.cell).astype(int), 0, len(self.xs) - 1)
         j = np.clip(np.round((pts[:, 1] - self.ys[0]) / self.cell).astype(int), 0, len(self.ys) - 1)
         return i, j
+
+    def entry(self, pts):
+        """The height an entry may come down to rapidly at each point (half a unit above
+        it): the highest of the lowest levels that cleared the four nodes round it."""
+        fx = np.clip((pts[:, 0] - self.xs[0]) / self.cell, 0, len(self.xs) - 1)
+        fy = np.clip((pts[:, 1] - self.ys[0]) / self.cell, 0, len(self.ys) - 1)
+        i0, j0 = np.floor(fx).astype(int), np.floor(fy).astype(int)
+        i1, j1 = np.minimum(i0 + 1, len(self.xs) - 1), np.minimum(j0 + 1, len(self.ys) - 1)
+        c = self.cleared
+        return np.maximum(np.maximum(c[i0, j0], c[i1, j0]), np.maximum(c[i0, j1], c[i1, j1]))
 
     def left(self, pts):
         """The report of a region left uncut round the ring ``pts``: its (deepest) level
@@ -398,9 +428,16 @@ def _cut_piece(out: Moves, piece, closed: bool, lv: _Level):
                 ring = np.vstack([path[k:-1], path[:k + 1]])
                 out.add(ring, FEED)
                 return None
-        # ramp along the ring from just above the level before, going round as needed
+        # ramp along the ring from just above the lowest level that cleared round its
+        # start (the ring starts where that level is lowest), going round as needed
+        over = lv.entry(pts[:-1])
+        k = 0 if over[0] <= over.min() else int(np.argmin(over))
+        if k:
+            pts = np.vstack([pts[k:-1], pts[:k + 1]])
+            path = np.vstack([path[k:-1], path[:k + 1]])
         L = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
-        drop_z = lv.previous + 0.5 - z
+        start_z = float(over[k]) + 0.5
+        drop_z = start_z - z
         turns = min(int(np.ceil(drop_z / np.tan(np.radians(RAMP_ANGLE)) / max(L, 1e-9))), MAX_RAMP_TURNS)
         if L * turns >= drop_z / np.tan(np.radians(MAX_RAMP_ANGLE)):
             ramp = np.vstack([pts[:-1]] * turns + [pts[:1]])
@@ -409,6 +446,8 @@ def _cut_piece(out: Moves, piece, closed: bool, lv: _Level):
             # wide as the region allows, else the region is left (reported)
             c = pts[:-1].mean(axis=0)
             rho = min(float(_sample(lv.dist, lv.xs, lv.ys, lv.cell, c[None])[0]) - 1.5 * lv.cell, lv.R / 2)
+            start_z = float(lv.entry((c + [max(rho, 0.0), 0.0])[None])[0]) + 0.5
+            drop_z = start_z - z
             helix_turns = int(np.ceil(drop_z / np.tan(np.radians(RAMP_ANGLE)) / (2 * np.pi * max(rho, 1e-9))))
             helix_turns = min(helix_turns, MAX_RAMP_TURNS)
             if rho < MIN_HELIX * lv.R or 2 * np.pi * rho * helix_turns < drop_z / np.tan(np.radians(MAX_RAMP_ANGLE)):
@@ -418,9 +457,9 @@ def _cut_piece(out: Moves, piece, closed: bool, lv: _Level):
             ramp = c + rho * np.column_stack([np.cos(ang), np.sin(ang)])
             # then across to the ring, inside the circle the helix cleared, and round it
         s = np.r_[0, np.cumsum(np.linalg.norm(np.diff(ramp, axis=0), axis=1))]
-        rz = np.maximum(lv.previous + 0.5 - drop_z * s / s[-1], height(ramp))
+        rz = np.maximum(start_z - drop_z * s / s[-1], height(ramp))
         _link(out, np.array([ramp[0, 0], ramp[0, 1], lv.safe]), lv.safe)
-        out.add([[ramp[0, 0], ramp[0, 1], max(lv.previous + 0.5, rz[0])]], RAPID)
+        out.add([[ramp[0, 0], ramp[0, 1], max(start_z, rz[0])]], RAPID)
         out.add(np.column_stack([ramp, rz])[1:], PLUNGE)
         out.add(path if not np.allclose(ramp[-1], pts[0]) else path[1:], FEED)
         return None

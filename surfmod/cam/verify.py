@@ -22,7 +22,9 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
 - **stock**: a height field over the stock box, a cell a quarter of the finishing
   stepover wide, from which each feed removes what the tool's lower surface sweeps, in
   the program's order.  A rapid whose tool goes below the stock's top there runs through
-  material.  The stock left is kept with the verdict (``Verification.stock``, a
+  material; the tool is grown sideways by a cell for it (not going straight up, out of
+  the column it cut), since a node stands for the stock up to a cell round it: a sliver
+  the moves left between two nodes is met.  The stock left is kept with the verdict (``Verification.stock``, a
   :class:`~surfmod.cam.stock_field.StockField`), which the job view draws;
 - **holder and shank**: above its flutes a tool does not cut (:attr:`Tool.body
   <surfmod.cam.tool.Tool.body>`): along every move, its discs wider than the end dropped
@@ -606,7 +608,7 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     into, node, sink, sink_node, _ = K.sweep_body(top, float(lo[0]), float(lo[1]), cell, moves.start, moves.end,
                                                   moves.rapid, radii, corners, cell / 2, discs,
                                                   np.ascontiguousarray(owner, dtype=np.int64), slack,
-                                                  np.zeros(len(plans)), np.zeros(len(owner), np.bool_), False)
+                                                  np.zeros(len(plans)), np.zeros(len(owner), np.bool_), False, cell)
     held, body_probes = [], 0
     for k, op, _, limit in plans:
         found, n = _body_part(part, moves, owner == k, op.tool, limit, low_limit,

@@ -183,7 +183,7 @@ def sweep_stock(top, x0, y0, cell, starts, ends, rapid, radii, corners, step):
     m = starts.shape[0]
     none = np.zeros((1, 1, 2))
     out = sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, none, np.zeros(m, np.int64),
-                     np.zeros(1), np.zeros(1), np.zeros(m, np.bool_), False)
+                     np.zeros(1), np.zeros(1), np.zeros(m, np.bool_), False, 0.0)
     return out[0], out[1]
 
 
@@ -203,7 +203,7 @@ def _log(log_i, log_v, n, index, value):
 
 @njit(cache=True)
 def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, body, tool_of, slack, limit, skip,
-               remove):
+               remove, grow):
     """:func:`sweep_stock` with the tool's body above its flutes (the discs ``body[tool_of[k]]``:
     radius, height of the bottom above the tip; radius 0 pads) measured against the stock
     before each stamp: how far the stock stands above a disc's bottom within the disc's
@@ -221,7 +221,10 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
     the way down), and the move is removed where the plunge would bury it.  A move's own
     measure does not cover it where the move is not measured at all (a move straight up or
     of no length: on zoo's bracket the relink plunged 159 mm onto such moves, the holder
-    68 mm into the stock).  Returns per move: ``into`` and its node (as
+    68 mm into the stock).  A rapid is measured with the tool grown sideways by ``grow``
+    (its profile moved out by it: a node stands for the stock up to a cell round it, and a
+    sliver narrower than a cell between the nodes the moves left is stock all the same),
+    except straight up, where the tool leaves the column it has just cut.  Returns per move: ``into`` and its node (as
     :func:`sweep_stock`), the body's deepest ``sink`` into the stock (-inf where it met
     none) and its node, and ``removed``."""
     nx, ny = top.shape
@@ -261,6 +264,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
         pieces = max(1, int(math.ceil(length / step)))
         if length == 0.0:
             pieces = 0  # a vertical move: its lowest end is stamped alone
+        wide = grow if rapid[k] and not (pieces == 0 and bz >= az) else 0.0
         # the body can meet stock only below the highest node, and never on the way up
         measure = min(az, bz) + lowest[tk] < ceiling and not (pieces == 0 and bz >= az)
         logged = 0
@@ -301,15 +305,15 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                     removed[k] = True
                     break
             px, py, pz = cx, cy, cz
-            i0, i1, j0, j1 = _nodes(cx, cy, radius, x0, y0, cell, nx, ny)
+            i0, i1, j0, j1 = _nodes(cx, cy, radius + wide, x0, y0, cell, nx, ny)
             for i in range(i0, i1 + 1):
                 dx = x0 + i * cell - cx
                 for j in range(j0, j1 + 1):
                     dy = y0 + j * cell - cy
                     d = math.sqrt(dx * dx + dy * dy)
-                    if d >= radius:
+                    if d >= radius + wide:
                         continue
-                    z = cz + profile(d, radius, corner)
+                    z = cz + profile(max(d - wide, 0.0), radius, corner)
                     gap = top[i, j] - z
                     if rapid[k]:
                         if gap > into[k]:
