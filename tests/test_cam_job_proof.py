@@ -162,7 +162,7 @@ def prove(path: Path, tmp_path: Path) -> dict:
     assert prog.tool_changes == [1, 2] and prog.ended
     tri, deflection, (_, owner) = part_triangles(shape, 0.01, face_index=True)
     stock = Stock(job.stock, CELL)
-    top = part_height(tri, stock.x, stock.y)
+    top = part_height(tri, stock.x, stock.y, deflection=deflection)  # no face lifted over a hole's chord
     bottom = float(job.stock[0, 2])
     floor = np.where(np.isfinite(top), top, bottom)  # the tool cannot go below the stock
     sides = side_grids(job.stock, SIDE_CELL)

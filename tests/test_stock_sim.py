@@ -157,6 +157,23 @@ def test_hemisphere_cusp_between_circular_passes(tmp_path):
 # --- bad programs are caught -------------------------------------------------------------------
 
 @needs_rs274
+def test_part_height_does_not_lift_a_hole_onto_a_chord():
+    """A face's triangle ends on a chord of a round hole's edge (radius 5, 20° each side):
+    a node between the chord and the arc lies in the hole.  Read plainly it takes the
+    face's height; with the mesh's deflection (the chord's sagitta) it takes the hole's,
+    and the face's nodes farther from the edge keep theirs."""
+    r, th, h = 5.0, math.radians(20), 0.2
+    sag = r * (1 - math.cos(th))
+    tri = np.array([[[r * math.cos(th), r * math.sin(th), 2.0], [r * math.cos(th), -r * math.sin(th), 2.0],
+                     [r + 3, 0.0, 2.0]]])
+    x0 = r - 0.6 * sag  # inside the hole, on the triangle
+    x, y = x0 + h * np.arange(-1, 3), h * np.arange(-1, 2)
+    plain = part_height(tri, x, y)
+    assert plain[1, 1] == 2.0 and np.isinf(plain[0, 1])  # the chord lifts the node; the hole is open
+    top = part_height(tri, x, y, deflection=sag)
+    assert np.all(np.isinf(top[:2])) and np.all(top[2:] == 2.0)
+
+
 def test_rapid_through_stock_is_caught(tmp_path):
     """A G0 link below the stock's top (the mistake a finishing pass without retract
     makes) is found and named by its line; the same program retracting first is clean."""
