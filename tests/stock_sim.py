@@ -1022,6 +1022,51 @@ def wall_left(dex: SideDexels, walls: WallPoints) -> np.ndarray:
     return np.minimum(along, walls.room) * np.abs(walls.normal[:, dex.axis])
 
 
+#: most points :func:`surface_distance` measures (each against every triangle's box)
+SURFACE_POINTS_LIMIT = 20_000
+
+
+def _closest_on_triangles(p, a, b, c):
+    """The point of each triangle (a, b, c: (k, 3)) nearest ``p`` (3,) (Ericson's regions)."""
+    ab, ac, ap, bp, cp = b - a, c - a, p - a, p - b, p - c
+    d1, d2 = (ab * ap).sum(1), (ac * ap).sum(1)
+    d3, d4 = (ab * bp).sum(1), (ac * bp).sum(1)
+    d5, d6 = (ab * cp).sum(1), (ac * cp).sum(1)
+    va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        total = va + vb + vc
+        face = a + ab * (vb / total)[:, None] + ac * (vc / total)[:, None]
+        on_ab = a + ab * (d1 / (d1 - d3))[:, None]
+        on_ac = a + ac * (d2 / (d2 - d6))[:, None]
+        on_bc = b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))[:, None]
+    cases = [(d1 <= 0) & (d2 <= 0), (d3 >= 0) & (d4 <= d3), (vc <= 0) & (d1 >= 0) & (d3 <= 0),
+             (d6 >= 0) & (d5 <= d6), (vb <= 0) & (d2 >= 0) & (d6 <= 0),
+             (va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0)]
+    out = face
+    for case, q in reversed(list(zip(cases, [a, b, on_ab, c, on_ac, on_bc]))):
+        out = np.where(case[:, None], q, out)
+    return out
+
+
+def surface_distance(triangles: np.ndarray, points: np.ndarray, reach: float) -> np.ndarray:
+    """Distance from each point (n, 3) to the nearest of the triangles, ``inf`` where none
+    lies within ``reach`` (only triangles whose box comes that near are measured)."""
+    points = np.atleast_2d(np.asarray(points, float))
+    if len(points) > SURFACE_POINTS_LIMIT:
+        raise ValueError(f"surface_distance: {len(points)} points, more than {SURFACE_POINTS_LIMIT}")
+    tri = np.asarray(triangles, float)
+    lo, hi = tri.min(axis=1) - reach, tri.max(axis=1) + reach
+    out = np.full(len(points), np.inf)
+    for k, p in enumerate(points):
+        near = np.flatnonzero(np.all((lo <= p) & (p <= hi), axis=1))
+        if near.size:
+            t = tri[near]
+            q = _closest_on_triangles(p, t[:, 0], t[:, 1], t[:, 2])
+            d = float(np.linalg.norm(q - p, axis=1).min())
+            out[k] = d if d <= reach else np.inf
+    return out
+
+
 def wall_reach(walls: WallPoints, top: np.ndarray, x: np.ndarray, y: np.ndarray, cutter: Cutter, *,
                offset: float = 0.0, below: float = 0.0, slack: float = 1e-3, eps: float = 1e-9,
                triangles: np.ndarray | None = None, ring: int = 64, quick: tuple | None = None,

@@ -8,7 +8,7 @@ lowest centre (no cusp there: a cusp ``R - sqrt(R² - dz²)`` only below it); a 
 with every other level left out, and one simulated with a smaller tool than it was made
 for, caught by the wall measure; a post under a plate, whose walls no tool from above
 reaches; a hole a hair narrower than the ball, which the height field's nodes miss and
-the exact triangles catch."""
+the exact triangles catch; the distance from points to triangles against dense samples."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from build123d import Box, Cylinder
 from stock_sim import (Cutter, SideDexels, heights_at, line_cut, parse_gcode, part_height, reach_map, side_grids,
-                       vertex_normals, wall_left, wall_points, wall_reach)
+                       surface_distance, vertex_normals, wall_left, wall_points, wall_reach)
 
 from surfmod.cam.drop_cutter import part_triangles
 
@@ -241,6 +241,20 @@ def test_work_is_refused_above_its_bound():
     a, b = np.array([[0.0, 0.0, 0.0]]), np.array([[100.0, 100.0, 0.0]])
     with pytest.raises(ValueError, match="coarser h"):
         dx.cut(Cutter("ball", 3.0), a, b, limit=1000)
+
+
+def test_surface_distance_equals_dense_samples():
+    rng = np.random.default_rng(1)
+    tri, pts = rng.normal(size=(20, 3, 3)), 2 * rng.normal(size=(20, 3))
+    u, v = np.meshgrid(np.linspace(0, 1, 121), np.linspace(0, 1, 121))
+    u, v = u[u + v <= 1], v[u + v <= 1]
+    dense = (tri[:, None, 0] + u[:, None] * (tri[:, None, 1] - tri[:, None, 0])
+             + v[:, None] * (tri[:, None, 2] - tri[:, None, 0])).reshape(-1, 3)
+    sampled = np.array([np.linalg.norm(dense - p, axis=1).min() for p in pts])
+    got = surface_distance(tri, pts, 100.0)
+    # the samples lie on the triangles: never nearer than the exact, at most a sample's gap farther
+    assert np.all(got <= sampled + 1e-12) and np.all(sampled - got < 0.03)
+    assert np.all(np.isinf(surface_distance(tri, pts + 50.0, 1.0)))
 
 
 def test_heights_at_scattered_points_equal_the_grid():
