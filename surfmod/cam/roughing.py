@@ -69,8 +69,9 @@ HELIX_POINTS = 24
 SPLIT_ROUNDS = 12
 #: How deep (grid cells) inside the region where the tool stood at a level a point must
 #: lie for that level to have cleared the tool's disc round it with a cell to spare (the
-#: boundary ring up to two cells inside, the grid's distance up to a cell off, a cell of
-#: margin: the stock models judging the program sample no finer than that).
+#: boundary ring up to two cells inside, the grid's distance up to a cell off, and a cell
+#: of margin: the verifier measures rapids with the tool grown by its own stock cell, a
+#: quarter of the finishing stepover, commonly finer than this grid's third of the roughing's).
 ENTRY_CELLS = 4.0
 
 
