@@ -253,3 +253,30 @@ def test_the_plunge_onto_a_move_after_a_gap_is_held_too():
     kinds = [RAPID, FEED, FEED, RAPID, RAPID, RAPID, FEED, RAPID]
     kept, _ = clear_body(Motion(np.array(pts, float), np.array(kinds, np.int8)), tool, stock, far, 0.0, 0.01, 30.0)
     assert kept.points[:, 2].min() > 15.0, kept.points.tolist()
+
+
+def test_a_holder_over_cusps_the_model_cannot_see_is_held():
+    """The job's stock model is coarser than the finishing's passes: nodes a cell apart
+    on the passes see the bottom, not the cusps between them.  A ball r = 2 rasters along y
+    0.5 apart at z = 18 (the nodes, 1 apart, lie on passes); the cusps stand
+    ``r - sqrt(r² - 0.25²)`` = 0.0157 high (the textbook cusp).  A plunge beside them
+    brings the holder's bottom 0.006 into the cusps: the model alone sees 0.01 of clear air,
+    the holder must clear it by the cusp (on zoo's flange-xy the finishing's holder passed
+    0.008 over the finished top, into its 0.033 cusps)."""
+    r, step, z = 2.0, 0.5, 18.0
+    cusp = r - np.sqrt(r * r - (step / 2) ** 2)
+    stock = StockModel(np.array([[0.0, 0.0, 0.0], [40.0, 40.0, 20.0]]), 1.0)
+    ball = sm.Tool("ball", r, flute_length=10.0)
+    xs = np.arange(0.0, 40.0 + step / 2, step)
+    pts = np.array([[x, y, z] for k, x in enumerate(xs) for y in ((-5.0, 45.0) if k % 2 == 0 else (45.0, -5.0))])
+    stock.sweep(Motion(pts, np.full(len(pts), FEED, np.int8)), ball)
+    assert abs(float(stock.top[5:35, 5:35].max()) - z) < 1e-9  # the model is blind to the cusps
+    tool = sm.Tool("ball", r, flute_length=5.0, shank_length=0.0, holder_radius=6.0, holder_length=20.0)
+    far = np.array([[[0.0, 0.0, -100.0], [1.0, 0.0, -100.0], [0.0, 1.0, -100.0]]])
+    tip = z + cusp - 0.006 - 5.0  # the holder's bottom 0.006 below the cusps' tops
+    plunge = Motion(np.array([[20.25, 20.0, 30.0], [20.25, 20.0, tip], [20.25, 20.0, 30.0]]),
+                    np.array([RAPID, FEED, FEED], np.int8))
+    kept, _ = clear_body(plunge, tool, stock, far, 0.0, 0.001, 30.0)
+    assert kept.points[:, 2].min() == tip  # blind: kept
+    kept, _ = clear_body(plunge, tool, stock, far, 0.0, 0.001, 30.0, cusp=cusp)
+    assert kept.points[:, 2].min() > tip + 1.0, kept.points.tolist()

@@ -443,3 +443,21 @@ def test_a_rapid_through_the_stock_is_relinked_over_it(job):
     cutters = {o.tool.number: Cutter(o.tool.kind, o.tool.radius) for o in fixed.operations}
     report = simulate(program, cutters, Stock(fixed.stock, 0.25))
     assert report.rapid_cut <= 1e-6, report
+
+
+def test_stock_left_in_a_bore_under_the_top_is_not_a_wall_left():
+    """A 3-axis tool cannot enter a bore along y under the block's top: its stock plug
+    stays, its end flush with the side faces.  The part's points near the plug's centre
+    (the bore's top and bottom, 4 mm away) fit a plane along the side face, steep and
+    reachable; the exact nearest point, on the bore, faces down or is under the top.  The
+    walls' judge settles its deepest from the exact foot: the side faces are judged, the
+    plug is not (on main the plug was a wall 3.01 mm thick; on zoo's flange-xy 7.56)."""
+    part = bd.Box(16, 10, 16) - bd.Rot(90, 0, 0) * bd.Cylinder(4, 12)
+    job = sm.machine(part, 2.0, [sm.Rough(sm.Tool("flat", 2.0)), sm.Finish(sm.Tool("ball", 1.5), scallop=0.05)])
+    wall = _finding(job.verification, "residual on walls")
+    assert job.verification.wall_points > 10_000 and wall.ok, str(job.verification)
+    # the finishing moved 0.2 mm along y: the face at y = 5 beside the bore keeps 0.2
+    head, tail = programs(job, "linuxcnc")[0].split("(operation: finishing")
+    moved = re.sub(r"Y(-?[\d.]+)", lambda m: f"Y{float(m.group(1)) + 0.2:.4f}", tail)
+    doctored = _finding(V.verify_job(job, texts=[head + "(operation: finishing" + moved]), "residual on walls")
+    assert 0.15 < doctored.worst < 0.25 and abs(doctored.where[1] - 5.2) < 0.1, doctored

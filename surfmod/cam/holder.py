@@ -17,7 +17,9 @@ linking, is checked twice:
   stock model shared by the job's operations (:class:`surfmod.cam.rest.StockModel`,
   swept by :func:`surfmod.cam.verify_kernels.sweep_body`): before each stamp of the
   cutting end, the stock may stand no higher than a disc's bottom within the disc (the
-  shank, even as narrow as the end, meets stock above the flutes in front of the tool).
+  shank, even as narrow as the end, meets stock above the flutes in front of the tool),
+  less the highest cusp the finishing passes so far leave (the model's cells, a quarter
+  of the smallest tool, are wider than those passes: it does not see their cusps).
 
 A disc may rub sideways within the operation's tolerance (its radius is taken that much
 smaller: the end's own side comes that near a wall), but never stand lower than the part
@@ -80,13 +82,16 @@ def body_stock(stock: np.ndarray, smallest_radius: float) -> StockModel:
     return StockModel(stock, body_cell(stock, smallest_radius), MAX_STOCK_NODES)
 
 
-def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, slack: float, skip: np.ndarray):
+def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, slack: float, skip: np.ndarray,
+                cusp: float):
     """``stock`` swept along ``pts`` with the moves whose body meets it (or ``skip``) undone:
     :func:`~surfmod.cam.verify_kernels.sweep_body`'s ``removed``.  The model samples the
     stock a cell apart, coarser than the verifier's: a disc wider than the end is grown by
     a cell, so that an edge of stock between the nodes its rim passes is met too (on
     zoo's flange-xy, 0.875 mm cells let a holder pass 4.7 mm into a level's step that the
-    verifier's 0.245 mm cells found)."""
+    verifier's 0.245 mm cells found).  Nor does it see the cusps finer passes left
+    between its nodes: a disc must clear the model by ``cusp`` (on flange-xy the
+    finishing's holder passed 0.008 mm over the finished top, into its 0.033 mm cusps)."""
     m = len(pts) - 1
     discs = tool.body[None, :, :2].copy()
     wider = discs[..., 0] > tool.radius + slack
@@ -94,7 +99,7 @@ def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, sla
     *_, removed = sweep_body(stock.top, float(stock.lo[0]), float(stock.lo[1]), stock.cell,
                              np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:]), rapid,
                              np.full(m, tool.radius), np.full(m, tool.corner), stock.cell / 2, discs,
-                             np.zeros(m, np.int64), np.array([float(slack)]), np.zeros(1), skip, True, 0.0)
+                             np.zeros(m, np.int64), np.array([float(slack)]), np.array([-float(cusp)]), skip, True, 0.0)
     return removed
 
 
@@ -213,17 +218,19 @@ def _without_dips(motion: Motion) -> Motion:
 
 
 def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
-               safe: float, shape=None):
+               safe: float, shape=None, cusp: float = 0.0):
     """``(motion, held)``: ``motion`` swept through ``stock`` with the moves whose shank or
-    holder would touch the part (``triangles``, and ``shape`` for the close calls) or the
-    stock removed and relinked (:func:`relink`), and what that leaves (:class:`Held`; None
-    where nothing more than the tolerance is left, the links replaced included)."""
+    holder would touch the part (``triangles``, and ``shape`` for the close calls) or come
+    within ``cusp`` of the stock (the highest cusp the passes so far leave between the
+    model's nodes) removed and relinked (:func:`relink`), and what that leaves
+    (:class:`Held`; None where nothing more than the tolerance is left, the links replaced
+    included)."""
     pts = np.asarray(motion.points, float)
     if len(pts) < 2:
         return motion, None
     rapid = motion.kind[1:] == RAPID
     skip = part_sink(triangles, deflection, tool, pts, slack, shape) > 0.0
-    removed = _sweep_body(stock, pts, rapid, tool, slack, skip)
+    removed = _sweep_body(stock, pts, rapid, tool, slack, skip, cusp)
     if not removed.any():
         return motion, None
     kept = relink(motion, removed, safe)

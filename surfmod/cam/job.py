@@ -313,7 +313,7 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     if passes == 0:
         return job
     extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
-                          job.safe_height, job.part)
+                          job.safe_height, job.part, _cusp(job.operations))
     if not np.any(extra.kind != RAPID):
         return job
     motion = Motion(np.concatenate([op.motion.points, extra.points]), np.concatenate([op.motion.kind, extra.kind]))
@@ -326,11 +326,18 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     return replace(job, verification=verify_job(job))
 
 
-def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape):
-    """The operation's moves cleared of shank and holder collisions; with ``strict`` a
-    collision refuses the job."""
+def _cusp(done) -> float:
+    """The highest cusp the finishing and rest operations ``done`` leave: the scallop
+    with its tolerance (the job's stock model is too coarse to see them)."""
+    return max((float(o.report["scallop"]) + float(o.report["tolerance"]) for o in done if o.name != "roughing"),
+               default=0.0)
+
+
+def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape, cusp):
+    """The operation's moves cleared of shank and holder collisions, a disc clearing the
+    stock model by ``cusp``; with ``strict`` a collision refuses the job."""
     motion, held = clear_body(motion, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe,
-                              shape)
+                              shape, cusp)
     if held is not None and strict:
         raise SurfmodError(f"strict: the {name} with {tool}: {held} (a longer tool: flute_length, shank_length; "
                            f"a narrower holder; or strict=False to leave it)")
@@ -397,7 +404,8 @@ def _after(op: Rest, k: int, specs: list) -> list[int]:
 
 def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: np.ndarray, safe: float, held):
     """The rest operation's motion and report (:mod:`surfmod.cam.rest`); ``held`` clears
-    its moves of shank and holder collisions (:func:`_held`)."""
+    its moves of shank and holder collisions (:func:`_held`, given the moves, the part, the
+    tolerance and the scallop)."""
     after = _after(op, k, specs)
     cutting = [done[i] for i in after if done[i].name != "roughing"]
     if op.scallop is not None:
@@ -425,7 +433,7 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
     # (``held``) decides how deep the tool goes, not its flutes
     motion, info = rest_moves(part, tool, model, mask, scallop=scallop, stepover=stepover, tolerance=tolerance,
                               safe=safe, bottom=float(stock[0, 2]), max_points=op.max_points)
-    motion, kept_out = held(motion, part, tolerance)
+    motion, kept_out = held(motion, part, tolerance, scallop)
     model.sweep(motion, tool)
     _, left = left_over(model, part_top, part, threshold, pairs)
     report = dict(info, after=after, scallop=scallop, stepover=stepover, tolerance=tolerance, threshold=threshold,
@@ -511,7 +519,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 with _stage(bar, "roughing", "stepdown", "a larger stepdown or roughing tool"):
                     motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover,
                                            CLEARANCE, deflection=p.deflection)
-                    motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape)
+                    motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape,
+                                         _cusp(done))
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
                 rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift, allowance + p.lift)
@@ -520,8 +529,9 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 with _stage(bar, "rest machining", "scallop", "a larger scallop or rest tool"):
                     motion, report = _rest(shape, op, tool, k, ops, done, stock, safe,
-                                           lambda m, part, tol: _held(m, tool, stock_model, part, tol, safe, strict,
-                                                                      "rest machining", shape))
+                                           lambda m, part, tol, scallop: _held(
+                                               m, tool, stock_model, part, tol, safe, strict, "rest machining", shape,
+                                               max(_cusp(done), scallop + tol)))
                 name = "rest"
             else:
                 if op.scallop is not None:
@@ -532,8 +542,10 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 # hole; the holder stops where it would meet the part or the stock)
                 with _stage(bar, "finishing", "scallop", "a larger scallop or finishing tool"):
                     motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, progress)
-                    motion, held = _held(motion, tool, stock_model, finish_part, float(report["tolerance"]), safe,
-                                         strict, "finishing", shape)
+                    tolerance = float(report["tolerance"])
+                    # its own cusps too: a holder coming down beside the part passes over them
+                    motion, held = _held(motion, tool, stock_model, finish_part, tolerance, safe, strict, "finishing",
+                                         shape, max(_cusp(done), float(report["scallop"]) + tolerance))
                 finishing[k] = (op, finish_part, rest)
                 report["holder"] = held
                 name = "finishing"

@@ -108,6 +108,8 @@ WALL_SLOPE = 80.0
 MIN_RISE_SHARE = 0.05
 #: how many of the deepest ball probes OCCT's exact distance measures again
 EXACT_PROBES = 16
+#: rounds of them on walls, where the exact foot may leave a point unjudged (an overhang)
+EXACT_ROUNDS = 8
 #: grid points per face direction, at most, and how much closer than the tool asks a
 #: curved face's points may stand
 MAX_FACE_GRID = 4000
@@ -829,7 +831,9 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
         and no disc of its shank or holder wider than the end stands below the part, each
         such disc as wide as the job holds it (grown by its stock model's cell: where the
         job keeps a holder out, the wall is not asked of it)."""
-        t = tips[pick]
+        return reached_at(tips[pick])
+
+    def reached_at(t):
         ok = (t[:, 2] >= floor - limit) & (part.deepest(t, cutter.radius, cutter.corner)[0] <= limit)
         for r, h, _ in op.tool.body:
             if r - limit > cutter.radius and ok.any():
@@ -850,11 +854,33 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
     if not reach.any():
         return Finding(what, -np.inf, bound), dexels, len(q)
     judged, depth_r = q[reach], depth[reach]
-    # the deepest measured again against the exact faces
-    top_k = np.argsort(depth_r)[-EXACT_PROBES:]
-    exact, _ = closest_on_face(compound(faces_of(shape)), judged[top_k])
-    depth_r[top_k] = exact
+    # the deepest measured again against the exact faces, and judged again from the exact
+    # foot: the part's points near a stock point may give it a foot on another face than
+    # its nearest (on zoo's flange-xy a plug of stock in a bore under the rim got the back
+    # face's normal, steep and reachable; its nearest point is the bore's top, 7.56 mm
+    # above it, an overhang).  The vector from the nearest point to a point outside is the
+    # part's normal there.
+    faces = compound(faces_of(shape))
+    exact = np.zeros(len(judged), bool)
+    for _ in range(EXACT_ROUNDS):
+        open_ = np.flatnonzero(~exact & np.isfinite(depth_r))
+        k = int(np.argmax(depth_r))
+        if not open_.size or exact[k] or depth_r[k] <= bound:  # what is left deepest is settled or within
+            break
+        top_k = open_[np.argsort(depth_r[open_])[-EXACT_PROBES:]]
+        dist, foot = closest_on_face(faces, judged[top_k])
+        normal = (judged[top_k] - foot) / np.maximum(dist, 1e-300)[:, None]
+        # on the part (within the sampling) a point has no normal of its own: kept
+        stays = (dist <= limit) | (W.steep_normals(normal) & reached_at(W.tangent_tips(foot, normal, cutter.radius,
+                                                                                      cutter.corner)))
+        depth_r[top_k] = np.where(stays, dist, -np.inf)
+        exact[top_k] = True
     k = int(np.argmax(depth_r))
+    if not np.isfinite(depth_r[k]):
+        return Finding(what, -np.inf, bound), dexels, len(q)
+    if not exact[k] and depth_r[k] > bound:
+        notes.append(f"note: walls: {EXACT_ROUNDS * EXACT_PROBES} deepest points measured exactly and left by the "
+                     f"exact foot, the deepest judged from the part's points")
     return (Finding(what, float(depth_r[k]), bound, tuple(float(v) for v in judged[k]), int((depth_r > bound).sum())),
             dexels, len(q))
 

@@ -213,7 +213,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
     move's first stamp) or descends vertically (its flutes cut the column on the way down).
 
     With ``remove``, a move marked ``skip`` or whose body goes deeper than ``limit[tool]``
-    into the stock cuts nothing (its stamps undone) and is reported removed, so later moves
+    into the stock (a negative limit: comes nearer it than that) cuts nothing (its stamps undone) and is reported removed, so later moves
     meet the stock it left; so is a rapid whose end goes deeper than ``slack[tool]`` into it.
     The first feed move after a removed one is reached by a plunge straight down onto its
     start (:func:`surfmod.cam.holder.relink`), through the stock the removed moves left: the
@@ -265,8 +265,9 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
         if length == 0.0:
             pieces = 0  # a vertical move: its lowest end is stamped alone
         wide = grow if rapid[k] and not (pieces == 0 and bz >= az) else 0.0
-        # the body can meet stock only below the highest node, and never on the way up
-        measure = min(az, bz) + lowest[tk] < ceiling and not (pieces == 0 and bz >= az)
+        # the body can meet stock only below the highest node (less a negative limit: a
+        # clearance asked), and never on the way up
+        measure = min(az, bz) + lowest[tk] < ceiling - min(limit[tk], 0.0) and not (pieces == 0 and bz >= az)
         logged = 0
         px, py, pz = ax, ay, az
         for s in range(pieces + 1):
@@ -289,8 +290,8 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                     for i in range(i0, i1 + 1):
                         gx = x0 + i * cell
                         for j in range(j0, j1 + 1):
-                            gap = top[i, j] - bottom
-                            if gap <= sink[k]:
+                            over = top[i, j] - bottom
+                            if over <= sink[k]:
                                 continue
                             gy = y0 + j * cell
                             w = 0.0 if uu == 0.0 else min(max(((gx - px) * ux + (gy - py) * uy) / uu, 0.0), 1.0)
@@ -298,7 +299,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                                 continue
                             if own and math.sqrt((gx - cx) ** 2 + (gy - cy) ** 2) < radius:
                                 continue
-                            sink[k], sink_node[k] = gap, i * ny + j
+                            sink[k], sink_node[k] = over, i * ny + j
                 if remove and sink[k] > limit[tk]:
                     for e in range(logged - 1, -1, -1):  # undo this move's stamps
                         top[log_i[e] // ny, log_i[e] % ny] = log_v[e]
@@ -314,11 +315,11 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                     if d >= radius + wide:
                         continue
                     z = cz + profile(max(d - wide, 0.0), radius, corner)
-                    gap = top[i, j] - z
+                    over = top[i, j] - z
                     if rapid[k]:
-                        if gap > into[k]:
-                            into[k], node[k] = gap, i * ny + j
-                    elif gap > 0.0:
+                        if over > into[k]:
+                            into[k], node[k] = over, i * ny + j
+                    elif over > 0.0:
                         if remove and measure:
                             log_i, log_v = _log(log_i, log_v, logged, i * ny + j, top[i, j])
                             logged += 1
