@@ -15,8 +15,9 @@ from stock_sim import RS274, Cutter, Stock, normal_residual, parse_canon, part_h
 
 import surfmod as sm
 from surfmod.cam import waterline as waterline_module
-from surfmod.cam.finishing import summary_lines
+from surfmod.cam.finishing import clear_part, recut, summary_lines
 from surfmod.cam.roughing import FEED, PLUNGE, RAPID
+from surfmod.cam.toolpath import _part
 from surfmod.errors import SurfmodError
 
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
@@ -278,3 +279,23 @@ def test_a_big_part_spreads_the_waterline_fibers_to_fit_the_cap(monkeypatch):
     monkeypatch.setattr(waterline_module, "MAX_PAIRS", 10)
     with pytest.raises(SurfmodError, match=r"^scallop: the waterline's \d+ levels .* choose a larger scallop"):
         sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False)
+
+
+def test_cross_passes_stand_closer_the_further_the_residual_was_over():
+    """A repair over a region left ``over`` times its bound runs its cross passes closer by
+    the square root (a cusp on concave ground grows as the square of the spacing), at most
+    four times closer: over a plate with a hole a ball dips into, 1, 4 and 100 times over
+    give passes a 0.71, 0.35 and 0.18 stepover apart."""
+    part = bd.Box(40, 40, 5) - bd.Cylinder(1.5, 6)
+    tool = sm.Tool("ball", 5.2).with_defaults(2)
+    mesh = clear_part(_part(part, tool.cutter, 0.005), tool)
+    stock = np.array([[-22.0, -22.0, -2.5], [22.0, 22.0, 4.5]])
+    xs = []
+    for over in (1.0, 4.0, 100.0):
+        motion, passes = recut(mesh, tool, [(-2.0, -2.0, 2.0, 2.0)], stepover=1.0, direction="x", tolerance=0.005,
+                               stock=stock, safe=10.0, rest=None, over=over)
+        feed = motion.points[1:][motion.kind[1:] == FEED]
+        xs.append(np.unique(np.round(feed[:, 0], 6)))
+    gaps = [float(np.median(np.diff(x))) for x in xs]
+    asked = np.array([1.0, 0.5, 0.25]) * math.sqrt(0.5)  # the passes spread evenly over the box: no wider
+    assert np.all((asked * 0.95 < gaps) & (gaps <= asked + 1e-9)), gaps

@@ -309,7 +309,8 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
         return job  # the residual judged is the rest tool's, which cross passes of the finishing do not serve
     op, (spec, part, rest) = job.operations[k], finishing[k]
     extra, passes = recut(part, op.tool, found.boxes, stepover=float(op.report["stepover"]), direction=spec.direction,
-                          tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest)
+                          tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest,
+                          over=found.worst / found.limit)
     if passes == 0:
         return job
     extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
