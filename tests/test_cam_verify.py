@@ -309,11 +309,13 @@ def test_a_wall_cusp_left_by_every_other_waterline_level_is_measured(cone_job):
     for tip in tips[1::2]:
         for i in contours[tip][0]:
             lines[i] = re.sub(r"Z-?[\d.]+", f"Z{tip + 2.0:.4f}", lines[i])
-    # the raster: from the entry to its first point up to the last lift to the safe height
+    # the raster (the finishing's first moves): from the entry to its first point up to its
+    # lift to the safe height, before the first contour
     x0, y0 = cone_job.operations[1].report["toolpath"].points[0][:2]
-    end = max(i for i, ln in enumerate(lines) if ln.startswith("G0 Z"))
-    entry = max(i for i in range(start, end) if lines[i].startswith(f"G0 X{x0:.4f} Y{y0:.4f}"))
-    v = V.verify_job(cone_job, texts=["\n".join(lines[:entry] + lines[end:])])
+    first = min(i for rows, _ in contours.values() for i in rows)
+    entry = min(i for i in range(start, first) if lines[i].startswith(f"G0 X{x0:.4f} Y{y0:.4f}"))
+    end = min(i for i in range(entry, first) if lines[i] == f"G0 Z{cone_job.safe_height:.4f}")
+    v = V.verify_job(cone_job, texts=["\n".join(lines[:entry] + lines[end + 1:])])
     wall = _finding(v, "residual on walls")
     assert not v.ok and not wall.ok and wall.count > 10, wall
     assert _finding(v, "gouge, finishing").ok

@@ -288,7 +288,8 @@ def near_box(part: _Part, tool: Tool, box) -> np.ndarray:
 
 
 def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float,
-                      box: np.ndarray | None = None, keep=None, highest: float = math.inf, left: float = 0.0):
+                      box: np.ndarray | None = None, keep=None, highest: float = math.inf, left: float = 0.0,
+                      clear: float = 0.0):
     """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
     the top of its steep triangles (slope ≥ ``steep_angle``, no higher than ``highest``)
     down to ``bottom``, ``spacing`` the distance of neighbouring levels along the walls.
@@ -296,7 +297,8 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     radii of it are contoured (so the contours are exact for the tool standing over the
     box), and ``keep(xy, z)`` (True where a contour point at tip height ``z`` is wanted)
     narrows the steep pieces further; ``left``: the stock a floor may still hold when the
-    contours run (a roughing's).  Returns ``(pieces, info)``: pieces per level (top
+    contours run (a roughing's); ``clear``: how far the job holds a holder disc above the
+    stock (the cusps its model cannot see, :func:`surfmod.cam.job.machine`).  Returns ``(pieces, info)``: pieces per level (top
     first), each ``(N, 3)``, closed ones with their first point repeated, and a report dict."""
     tri = part.grid.triangles if box is None else near_box(part, tool, box)
     n = _normals(tri)
@@ -312,9 +314,10 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     foot = g + 0.5 * tolerance
     # below a floor's height less the holder's (its lowest disc wider than the end) the
     # holder would stand on that floor and the job leaves those contours out: a contour
-    # just above, on a clear floor and on one holding ``left``, cuts the wall down to there
+    # just above (by ``clear`` too), on a clear floor and on one holding ``left``, cuts the
+    # wall down to there
     wider = [h for r, h, _ in tool.body if r > tool.radius]
-    holder = [foot + m - wider[0] for m in sorted({0.0, left})] if wider else []
+    holder = [foot + m + clear - wider[0] for m in sorted({0.0, left})] if wider else []
     levels = _with_floors(levels, tri, slope, bottom, [foot] + holder)
     if not len(levels):
         return [], info
@@ -609,18 +612,24 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     path = raster_path(part, tool, step_xy, tool.radius / 4, direction, bounds, tolerance, part.meter.bar,
                        across=across, meter=part.meter)
     out = Moves()
-    wl_info = None
+    allowed = tolerance - part.deflection + part.lift
+    # the raster before the contours: the floors are clear when a contour's holder comes
+    # down beside them, so the walls are cut down to the holder's limit over a clear floor
+    _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
+    wl_info, depth = None, np.full(1, -np.inf)
     if steep_angle is not None:
         if scallop is not None:
             spacing, wl_held = contour_spacing(part, tool, scallop, tolerance, stepover)
             held = held and wl_held
         else:
             spacing = stepover
+        first = len(out.points)
         wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, float(stock[0, 2]),
-                                left=0.0 if rest is None else rest.on_floors + tolerance)
-    allowed = tolerance - part.deflection + part.lift
-    depth = judge_links(part, out, allowed, "finishing")
-    _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
+                                left=0.0 if rest is None else rest.on_floors + tolerance,
+                                clear=(scallop if scallop is not None else path.scallop) + tolerance)
+        contours = Moves()  # their links judged once more; the raster was as it was made
+        contours.points, contours.kinds = out.points[first:], out.kinds[first:]
+        depth = judge_links(part, contours, allowed, "finishing")
     motion = out.motion()
     threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)
     report = {"stepover": path.stepover, "scallop": scallop if scallop is not None else path.scallop,

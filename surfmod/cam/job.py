@@ -30,7 +30,7 @@ from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import MAX_WORK, _Meter, _mesh_estimate, _part
-from .verify import verify_job
+from .verify import cusp_clearance, verify_job
 
 #: Clearance of links and retracts above the stock (mm).
 CLEARANCE = 5.0
@@ -314,7 +314,7 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     if passes == 0:
         return job
     extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
-                          job.safe_height, job.part, _cusp(job.operations))
+                          job.safe_height, job.part, cusp_clearance(job.operations))
     if not np.any(extra.kind != RAPID):
         return job
     motion = Motion(np.concatenate([op.motion.points, extra.points]), np.concatenate([op.motion.kind, extra.kind]))
@@ -325,13 +325,6 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine), report=report)
     job = replace(job, operations=tuple(ops))
     return replace(job, verification=verify_job(job))
-
-
-def _cusp(done) -> float:
-    """The highest cusp the finishing and rest operations ``done`` leave: the scallop
-    with its tolerance (the job's stock model is too coarse to see them)."""
-    return max((float(o.report["scallop"]) + float(o.report["tolerance"]) for o in done if o.name != "roughing"),
-               default=0.0)
 
 
 def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape, cusp):
@@ -521,7 +514,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover,
                                            CLEARANCE, deflection=p.deflection)
                     motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape,
-                                         _cusp(done))
+                                         cusp_clearance(done))
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
                 rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift, allowance + p.lift)
@@ -532,7 +525,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     motion, report = _rest(shape, op, tool, k, ops, done, stock, safe,
                                            lambda m, part, tol, scallop: _held(
                                                m, tool, stock_model, part, tol, safe, strict, "rest machining", shape,
-                                               max(_cusp(done), scallop + tol)))
+                                               max(cusp_clearance(done), scallop + tol)))
                 name = "rest"
             else:
                 if op.scallop is not None:
@@ -546,7 +539,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     tolerance = float(report["tolerance"])
                     # its own cusps too: a holder coming down beside the part passes over them
                     motion, held = _held(motion, tool, stock_model, finish_part, tolerance, safe, strict, "finishing",
-                                         shape, max(_cusp(done), float(report["scallop"]) + tolerance))
+                                         shape, max(cusp_clearance(done), float(report["scallop"]) + tolerance))
                 finishing[k] = (op, finish_part, rest)
                 report["holder"] = held
                 name = "finishing"

@@ -267,7 +267,7 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
     for label, bounds in enumerate(boxes, start=1):
         left.label = label
         wl = contour_moves(out, part, tool, top, safe, STEEP_ANGLE, levels_apart, tolerance, bottom, box=bounds,
-                           keep=left, highest=float(highest[label - 1]))
+                           keep=left, highest=float(highest[label - 1]), clear=scallop + tolerance)
         info["levels"] += wl["levels"]
         info["contours"] += wl["contours"]
         info["lifted"] = max(info["lifted"], wl["lifted"])

@@ -655,7 +655,8 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
                          f"not judged (the holder finding and the operation's report say what is left)")
         grow = body_cell(job.stock, min(o.tool.radius for o in job.operations))
         found, dexels, judged_walls = _wall_residual(part, moves, radii, corners, np.asarray(job.stock, float), under,
-                                                     cell, op, cutter, limit, max_dexel_work, notes, job.part, grow)
+                                                     cell, op, cutter, limit, max_dexel_work, notes, job.part, grow,
+                                                     cusp_clearance(job.operations[:k + 1]))
         findings.append(found)
     # the part under each node as the residual reads it: its highest point within the cell
     kept = StockField.over_part(top, lambda xy: part.drop(xy, 0.75 * cell, 0.0), lo[:2], cell, WALL_SLOPE,
@@ -746,14 +747,23 @@ def _residual(part: PartPoints, top: np.ndarray, under: np.ndarray, lo: np.ndarr
                    boxes=boxes), int(steep.sum()), int(held.sum())
 
 
+def cusp_clearance(operations) -> float:
+    """The highest cusp the finishing and rest ``operations`` leave: their scallop with its
+    tolerance.  The job holds every holder disc that far above its stock model (too coarse
+    to see the cusps), so the walls' reach asks no more of a tool."""
+    return max((float(o.report["scallop"]) + float(o.report["tolerance"]) for o in operations
+                if o.name != "roughing"), default=0.0)
+
+
 def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, corners: np.ndarray, stock: np.ndarray,
                    under: np.ndarray, cell: float, op, cutter, limit: float, max_work: int, notes: list, shape,
-                   grow: float = 0.0):
+                   grow: float = 0.0, clear: float = 0.0):
     """The material the program leaves on the part's steep faces where the finishing tool
     reaches, from the dexels along x and y (:mod:`~surfmod.cam.wall_dexels`): ``(finding,
     dexels, points judged)``; ``under`` is the part's top on the height field's nodes
     (``cell`` apart), ``notes`` gets what was coarser than asked; the discs wider than the
-    end are taken ``grow`` wider where the tool's reach is asked (the job's body cell)."""
+    end are taken ``grow`` wider and ``clear`` higher where the tool's reach is asked (as
+    the job holds them: its body cell, :func:`cusp_clearance`)."""
     from ..occ.topo import closest_on_face, compound, faces_of
 
     lo, hi = stock
@@ -837,7 +847,7 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
         ok = (t[:, 2] >= floor - limit) & (part.deepest(t, cutter.radius, cutter.corner)[0] <= limit)
         for r, h, _ in op.tool.body:
             if r - limit > cutter.radius and ok.any():
-                ok[ok] = part.drop(t[ok, :2], r - limit + grow, 0.0) - h <= t[ok, 2] + limit
+                ok[ok] = part.drop(t[ok, :2], r - limit + grow, 0.0) - h + clear <= t[ok, 2] + limit
         return ok
 
     # every point beyond the bound is asked (they are counted), then the next deepest a
