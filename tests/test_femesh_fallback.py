@@ -6,7 +6,6 @@ within area x measured deviation, and the result says how it was made."""
 from __future__ import annotations
 
 import math
-import os
 
 import build123d as bd
 import numpy as np
@@ -17,35 +16,38 @@ from surfmod.cli import main
 from surfmod.uses import femesh
 
 
-def _refuse(*args, **kwargs):
-    raise femesh._GmshFailure("Invalid boundary mesh (overlapping facets) on surface 1 (forced)")
+def _forced_failures(monkeypatch, coarse_triangles: int = -1):
+    """gmsh's runs of fe_mesh fail as the test forces: every run on the B-rep (as read,
+    healed), and every run filling a triangulation of at most ``coarse_triangles``
+    triangles with boundary recovery's failure, as on pythonocc_11752.stp's body region on
+    OCCT 8.0; the other runs are the real gmsh in its child process.  A forced failure is
+    raised here, not in a child: each child start imports surfmod and this module, seconds
+    each, and what a failing child does is test_child.py's."""
+    in_child = femesh._gmsh_in_child
+
+    def forced(fn, args, seconds):
+        if fn is femesh._run_gmsh:
+            raise femesh._GmshFailure("Invalid boundary mesh (overlapping facets) on surface 1 (forced)")
+        if fn is femesh._run_gmsh_triangulation and sum(len(t) for _, t in args[0]) <= coarse_triangles:
+            raise femesh._GmshFailure("Could not recover boundary mesh: error 2 (forced)")
+        return in_child(fn, args, seconds)
+
+    monkeypatch.setattr(femesh, "_gmsh_in_child", forced)
 
 
 @pytest.fixture
 def brep_fails(monkeypatch):
-    # module level, not local: gmsh runs in a child process, which gets the function by name
-    monkeypatch.setattr(femesh, "_run_gmsh", _refuse)
+    _forced_failures(monkeypatch)
 
 
-def _recovery_fails_when_coarse(surfaces, msh, size, order):
-    """gmsh's boundary recovery failing as it does on pythonocc_11752.stp's body region
-    on OCCT 8.0: on the triangulation of the first tolerance only (it has at most the
-    triangle count the test sets), then the real gmsh."""
-    if sum(len(triangles) for _, triangles in surfaces) <= int(os.environ["SURFMOD_TEST_COARSE_TRIANGLES"]):
-        raise femesh._GmshFailure("Could not recover boundary mesh: error 2 (forced)")
-    return femesh._run_gmsh_triangulation(surfaces, msh, size, order)
-
-
-def test_failed_boundary_recovery_is_retried_finer(brep_fails, monkeypatch):
+def test_failed_boundary_recovery_is_retried_finer(monkeypatch):
     from surfmod.meshing.brep import tessellate_shape
 
     cylinder = bd.Cylinder(1.0, 2.0)
     first = femesh.TRIANGULATION_SHARE * math.sqrt(2**2 + 2**2 + 2**2)
     coarse = len(tessellate_shape(cylinder.wrapped, first).triangles())
     assert len(tessellate_shape(cylinder.wrapped, first * femesh.RECOVERY_RETRY_SHARE).triangles()) > coarse
-    monkeypatch.setenv("SURFMOD_TEST_COARSE_TRIANGLES", str(coarse))
-    # module level, not local: the child process gets the function by name
-    monkeypatch.setattr(femesh, "_run_gmsh_triangulation", _recovery_fails_when_coarse)
+    _forced_failures(monkeypatch, coarse)
     fe = sm.fe_mesh(cylinder, size=0.4)
     surface = fe.quality["surface"]
     assert surface["tolerance"] == pytest.approx(first * femesh.RECOVERY_RETRY_SHARE, rel=1e-12)
@@ -54,9 +56,8 @@ def test_failed_boundary_recovery_is_retried_finer(brep_fails, monkeypatch):
     assert fe.quality["inverted"] == 0 and fe.quality["SICN"]["min"] > 0
 
 
-def test_boundary_recovery_failing_twice_names_both_tolerances(brep_fails, monkeypatch):
-    monkeypatch.setenv("SURFMOD_TEST_COARSE_TRIANGLES", str(10**9))
-    monkeypatch.setattr(femesh, "_run_gmsh_triangulation", _recovery_fails_when_coarse)
+def test_boundary_recovery_failing_twice_names_both_tolerances(monkeypatch):
+    _forced_failures(monkeypatch, 10**9)
     first = femesh.TRIANGULATION_SHARE * math.sqrt(2**2 + 2**2 + 2**2)
     # each triangulation attempt (whole solid, then its material regions) tried twice
     pattern = (rf"triangulation: Could not recover boundary mesh: error 2 \(forced\) at tolerance {first:.3g}, "
