@@ -16,6 +16,13 @@ from surfmod.meshing.figures import shape_diagonal
 from surfmod.meshing.facemesh import brepmesh
 
 
+@pytest.fixture(scope="module")
+def ventilator(corpus_dir):
+    """pythonocc_Ventilator.stp (2.2 MB), read once for the tests of this module that
+    measure it: none changes it (brepmesh clears the triangulations it finds)."""
+    return sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+
+
 def _boundary_edges(tri):
     e = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
     edges, counts = np.unique(e, axis=0, return_counts=True)
@@ -113,12 +120,12 @@ def test_isometric_repeats_have_the_deviation_of_their_first_instance(corpus_dir
         assert nd == pytest.approx(nd0, rel=1e-9, abs=1e-12 * tol)
 
 
-def test_spline_figures_in_one_pass_equal_geomlprop(corpus_dir):
+def test_spline_figures_in_one_pass_equal_geomlprop(ventilator):
     """The triangle estimate samples B-spline faces with surfmod's evaluator (all faces'
     curvatures at once) and gets what GeomLProp, face by face, gives."""
     from surfmod.meshing.brep import _estimate
 
-    part = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+    part = ventilator
     evaluators: dict = {}
     for tolerance in (0.05, 0.5):
         by_occt, diag = _estimate(part, tolerance)
@@ -128,7 +135,7 @@ def test_spline_figures_in_one_pass_equal_geomlprop(corpus_dir):
     assert len(evaluators) == 189 + 26  # every B-spline face and extrusion, kept for measuring
 
 
-def test_estimate_figures_equal_geomlprop(corpus_dir):
+def test_estimate_figures_equal_geomlprop(ventilator):
     """Cones and tori get the estimate's figures from their radii in closed form, swept
     surfaces from their surfmod evaluators' partials: the same numbers GeomLProp's
     samples give (5 x 5, or 3 columns x 5 rows where only v matters; no curvature at an
@@ -142,7 +149,7 @@ def test_estimate_figures_equal_geomlprop(corpus_dir):
     from surfmod.occ.geom import surface_type
     from surfmod.occ.topo import faces_of
 
-    shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp").wrapped
+    shape = ventilator.wrapped
     floor = 1.0 / shape_diagonal(shape)
     seen = set()
     for face in faces_of(shape):
@@ -167,14 +174,14 @@ def test_estimate_figures_equal_geomlprop(corpus_dir):
                     "Geom_SurfaceOfLinearExtrusion"}
 
 
-def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
+def test_spline_faces_measured_in_one_call_equal_face_by_face(ventilator):
     """measure_spline_faces (every B-spline face of a part in one compiled call) gives
     each face the triangle and node deviations measure_face gives it alone (to the
     round-off of the samples' coordinates)."""
     from surfmod.meshing.brep import _bounds, _evaluator, measure_spline_faces
     from surfmod.meshing.deviation import DENSE, triangle_deviations
 
-    shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+    shape = ventilator
     tol = 1e-3 * shape_diagonal(shape)
     fms = brepmesh(shape, tol)
     evaluators: dict = {}
@@ -192,13 +199,13 @@ def test_spline_faces_measured_in_one_call_equal_face_by_face(corpus_dir):
             np.testing.assert_allclose(tri, by_numpy, rtol=1e-9, atol=1e-12 * tol)
 
 
-def test_analytic_faces_measured_at_once_equal_face_by_face(corpus_dir):
+def test_analytic_faces_measured_at_once_equal_face_by_face(ventilator):
     """measure_analytic_faces (every plane, cylinder, cone and torus face of a part in
     one compiled pass) gives each face what measure_face gives it alone."""
     from surfmod.meshing import analytic_distance as analytic
     from surfmod.meshing.brep import measure_analytic_faces
 
-    shape = sm.import_step(corpus_dir / "pythonocc_Ventilator.stp")
+    shape = ventilator
     tol = 1e-3 * shape_diagonal(shape)
     pairs = [(fm, a) for fm in brepmesh(shape, tol) if (a := analytic.parameters(fm.surface)) is not None]
     assert len({a[0] for _, a in pairs}) == 4  # planes, cylinders, cones and tori
