@@ -584,9 +584,10 @@ def rest_left(part: _Part, tool: Tool, floor: float, threshold: float, spacing: 
 def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | None, direction: str,
            steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Leftover | None):
     """The finishing :class:`~surfmod.cam.roughing.Motion` (the raster, then waterline
-    pieces on the steep regions, cut once the floors beside them are clear) and its report; the contours go down to the stock's bottom
-    (how deep the tool may go is its shank's and holder's to say: the job holds every
-    move against them, :mod:`surfmod.cam.holder`)."""
+    pieces on the steep regions, cut once the floors beside them are clear) and its
+    report; the contours go down to the stock's bottom (how deep the tool may go is its
+    shank's and holder's to say: the job holds every move against them,
+    :mod:`surfmod.cam.holder`)."""
     margin = part.lift + part.deflection  # what exactness costs the scallop (see the module doc)
     held = True
     if scallop is not None:

@@ -213,8 +213,8 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
     move's first stamp) or descends vertically (its flutes cut the column on the way down).
 
     With ``remove``, a move marked ``skip`` or whose body goes deeper than ``limit[tool]``
-    into the stock (a negative limit: comes nearer it than that) cuts nothing (its stamps undone) and is reported removed, so later moves
-    meet the stock it left; so is a rapid whose end goes deeper than ``slack[tool]`` into it.
+    into the stock (a negative limit: comes nearer it than that) cuts nothing (its stamps
+    undone) and is reported removed, so later moves meet the stock it left; so is a rapid whose end goes deeper than ``slack[tool]`` into it.
     The first feed move after a removed one is reached by a plunge straight down onto its
     start (:func:`surfmod.cam.holder.relink`), through the stock the removed moves left: the
     body is measured along that plunge too (the end's own column aside: the flutes cut it on
@@ -224,9 +224,9 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
     68 mm into the stock).  A rapid is measured with the tool grown sideways by ``grow``
     (its profile moved out by it: a node stands for the stock up to a cell round it, and a
     sliver narrower than a cell between the nodes the moves left is stock all the same),
-    except straight up, where the tool leaves the column it has just cut.  Returns per move: ``into`` and its node (as
-    :func:`sweep_stock`), the body's deepest ``sink`` into the stock (-inf where it met
-    none) and its node, and ``removed``."""
+    except straight up, where the tool leaves the column it has just cut.  Returns per
+    move: ``into`` and its node (as :func:`sweep_stock`), the body's deepest ``sink`` into
+    the stock (-inf where it met none) and its node, and ``removed``."""
     nx, ny = top.shape
     m = starts.shape[0]
     into = np.full(m, -np.inf)
