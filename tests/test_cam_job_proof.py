@@ -91,8 +91,8 @@ ROUNDING = 1e-4
 KNOWN_SHORT = {
     "stepcode_HEAD_BACK.stp": (
         "roughing leaves 1.9e-5 of the stock's nodes (0.002 %) above allowance + cusp, unreported: the proof "
-        "passes with the roughing entries (ENTRY_CELLS), the depth rule (pit fibers, no flute floor) and the "
-        "holder's cusp clearance each alone, and fails with all three merged: not yet bisected"),
+        "passes with the roughing entries (ENTRY_CELLS) alone and with the depth rule (pit fibers, no flute "
+        "floor) alone, and fails with both (before the holder's cusp clearance came in too)"),
 }
 
 CORPUS_JOBS = ["stepcode_FOOT_BACK_000.stp", "stepcode_TAIL_MIDDLE_PART.stp", "nist_ftc_11_asme1_rb.stp",
