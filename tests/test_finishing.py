@@ -264,9 +264,9 @@ def test_a_big_part_spreads_the_waterline_fibers_to_fit_the_cap(monkeypatch):
     tool = sm.Tool("ball", 1.0)
     seen, count = [], waterline_module.fiber_pairs
 
-    def spy(tri, radius, sampling, levels, corner):  # the triangles, radius and levels the finishing counts with
+    def spy(tri, radius, sampling, levels, corner, pits=None):  # what the finishing counts with
         seen.append((tri, radius, levels, corner))
-        return count(tri, radius, sampling, levels, corner)
+        return count(tri, radius, sampling, levels, corner, pits)
 
     monkeypatch.setattr(waterline_module, "fiber_pairs", spy)
     free = sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False).operations[0].report["waterline"]

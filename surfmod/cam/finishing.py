@@ -298,8 +298,9 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     box), and ``keep(xy, z)`` (True where a contour point at tip height ``z`` is wanted)
     narrows the steep pieces further; ``left``: the stock a floor may still hold when the
     contours run (a roughing's); ``clear``: how far the job holds a holder disc above the
-    stock (the cusps its model cannot see, :func:`surfmod.cam.job.machine`).  Returns ``(pieces, info)``: pieces per level (top
-    first), each ``(N, 3)``, closed ones with their first point repeated, and a report dict."""
+    stock (the cusps its model cannot see, :func:`surfmod.cam.job.machine`).  Returns
+    ``(pieces, info)``: pieces per level (top first), each ``(N, 3)``, closed ones with
+    their first point repeated, and a report dict."""
     tri = part.grid.triangles if box is None else near_box(part, tool, box)
     n = _normals(tri)
     slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
@@ -404,13 +405,14 @@ def contour_moves(out: Moves, part: _Part, tool: Tool, top, safe: float, steep_a
     return info
 
 
-def judge_links(part: _Part, out: Moves, allowed: float, what: str) -> np.ndarray:
-    """Every move in ``out`` (the contours' links, entries and retracts among them) judged
-    once more on the drop-cutter heights (the contours and rasters were judged as they
-    were made): the depth of each move, or ``NoSafePathError`` naming the first deepest."""
-    if not out.points:
+def judge_links(part: _Part, out: Moves, allowed: float, what: str, first: int = 0) -> np.ndarray:
+    """Every move in ``out`` from its run ``first`` on (the contours' links, entries and
+    retracts among them) judged once more on the drop-cutter heights (the contours and
+    rasters were judged as they were made): the depth of each move, or
+    ``NoSafePathError`` naming the first deepest."""
+    if len(out.points) <= first:
         return np.full(1, -np.inf)
-    depth = move_gouge(part.height, out.motion().points)
+    depth = move_gouge(part.height, np.concatenate(out.points[first:]))
     if depth.max() > allowed:
         k = int(np.argmax(depth))
         raise NoSafePathError(f"toolpath: no safe path: {what} move {k + 1} cuts {depth.max():.3g} deep")
@@ -628,9 +630,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         wl_info = contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, float(stock[0, 2]),
                                 left=0.0 if rest is None else rest.on_floors + tolerance,
                                 clear=(scallop if scallop is not None else path.scallop) + tolerance)
-        contours = Moves()  # their links judged once more; the raster was as it was made
-        contours.points, contours.kinds = out.points[first:], out.kinds[first:]
-        depth = judge_links(part, contours, allowed, "finishing")
+        depth = judge_links(part, out, allowed, "finishing", first)  # the raster was judged as it was made
     motion = out.motion()
     threshold = scallop if scallop is not None else max(tool.scallop_for_stepover(step_xy), tolerance)
     report = {"stepover": path.stepover, "scallop": scallop if scallop is not None else path.scallop,

@@ -836,14 +836,12 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
     # follows them down, and what is wider is held against the part below (the job's rule)
     floor = float(lo[2])
 
-    def reached(pick):
-        """The tool tangent at these feet takes in no point of the part beyond the limit,
-        and no disc of its shank or holder wider than the end stands below the part, each
-        such disc as wide as the job holds it (grown by its stock model's cell: where the
-        job keeps a holder out, the wall is not asked of it)."""
-        return reached_at(tips[pick])
-
-    def reached_at(t):
+    def reached(t):
+        """The tool at tips ``t`` (tangent at feet) takes in no point of the part beyond the
+        limit, and no disc of its shank or holder wider than the end stands below the part,
+        each such disc as wide and as high as the job holds it (grown by its stock model's
+        cell, raised by the cusps: where the job keeps a holder out, the wall is not asked
+        of it)."""
         ok = (t[:, 2] >= floor - limit) & (part.deepest(t, cutter.radius, cutter.corner)[0] <= limit)
         for r, h, _ in op.tool.body:
             if r - limit > cutter.radius and ok.any():
@@ -855,12 +853,12 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
     order = np.argsort(-depth)
     asked = int((depth > bound).sum())
     reach = np.zeros(len(q), bool)
-    reach[order[:asked]] = reached(order[:asked])
+    reach[order[:asked]] = reached(tips[order[:asked]])
     for start in range(asked, len(order), REACH_CHUNK):
         if reach.any():
             break
         chunk = order[start:start + REACH_CHUNK]
-        reach[chunk] = reached(chunk)
+        reach[chunk] = reached(tips[chunk])
     if not reach.any():
         return Finding(what, -np.inf, bound), dexels, len(q)
     judged, depth_r = q[reach], depth[reach]
@@ -881,8 +879,8 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
         dist, foot = closest_on_face(faces, judged[top_k])
         normal = (judged[top_k] - foot) / np.maximum(dist, 1e-300)[:, None]
         # on the part (within the sampling) a point has no normal of its own: kept
-        stays = (dist <= limit) | (W.steep_normals(normal) & reached_at(W.tangent_tips(foot, normal, cutter.radius,
-                                                                                      cutter.corner)))
+        stays = (dist <= limit) | (W.steep_normals(normal) & reached(W.tangent_tips(foot, normal, cutter.radius,
+                                                                                   cutter.corner)))
         depth_r[top_k] = np.where(stays, dist, -np.inf)
         exact[top_k] = True
     k = int(np.argmax(depth_r))

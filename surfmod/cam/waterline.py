@@ -51,7 +51,8 @@ PIT_BALANCE = 0.5
 PIT_SHIFTS = 3
 
 
-def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner: float = 0.0) -> float:
+def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner: float = 0.0,
+                pits: tuple | None = None) -> float:
     """The (fiber, triangle) pairs :func:`waterline` meets at the tip heights ``levels``
     with fibers ``sampling`` apart, for a tool of ``radius`` and corner radius ``corner``.
 
@@ -61,7 +62,9 @@ def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner:
     a triangle wholly above z + corner is met once, at the first level below it, and its
     shank intervals carried down; one wholly below z is not met at all.  (The refinement's
     fibers, a few per contour point, each meet the triangles within reach of it: work that
-    follows the contours found, bounded by :data:`MAX_REFINE` rounds.)
+    follows the contours found, bounded by :data:`MAX_REFINE` rounds.)  The fibers
+    through pits (:func:`pit_lines`) count too; ``pits`` gives them where the caller has
+    them already.
 
     >>> tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
     >>> fiber_pairs(tri, 0.5, 0.5, [0.0, -1.0, -2.0], 0.5)  # (5 + 5) lines: in the band at 0, joined at -1
@@ -73,7 +76,7 @@ def fiber_pairs(tri: np.ndarray, radius: float, sampling: float, levels, corner:
     lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
     span = np.maximum(hi - lo, 0) + 2 * radius
     lines = (span / sampling + 1).sum(axis=1)
-    for axis, at in enumerate(pit_lines(tri, radius, sampling)):  # the pits' own fibers
+    for axis, at in enumerate(pit_lines(tri, radius, sampling) if pits is None else pits):
         lines += np.searchsorted(at, hi[:, axis] + radius, "right") - np.searchsorted(at, lo[:, axis] - radius)
     top, bottom = tri[:, :, 2].max(axis=1), tri[:, :, 2].min(axis=1)
     # levels in (bottom - corner, top]: the band; any level at or below bottom - corner: joined once
@@ -520,7 +523,7 @@ def _waterline(part, tool, z_levels, sampling, tolerance, bar=None):
     px, py = pit_lines(tri, R, h)
     x, y = np.union1d(x, px), np.union1d(y, py)
     fib = _Fibers(tri, cutter, 1.5 * h)
-    pairs = fiber_pairs(tri, R, h, levels, cutter.corner)
+    pairs = fiber_pairs(tri, R, h, levels, cutter.corner, (px, py))
     if pairs > MAX_PAIRS:
         raise SurfmodError(f"sampling: {sampling} gives ~{pairs:.3g} fiber-triangle pairs "
                            f"over {len(levels)} levels (limit {MAX_PAIRS:.0e}); choose a coarser sampling")
