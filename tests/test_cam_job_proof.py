@@ -86,7 +86,6 @@ needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package li
 R1, R2, SCALLOP, ALLOWANCE, MARGIN, CELL = 5.0, 3.0, 0.15, 0.5, 2.0, 0.25
 SIDE_CELL = 0.4  # spacing of the dexels along x and y (in y or x, and in z)
 ROUNDING = 1e-4
-#: corpus parts (20-150 mm, pockets and holes)
 #: corpus jobs whose proof fails, and why (issue 36, open)
 KNOWN_SHORT = {
     "stepcode_HEAD_BACK.stp": (
@@ -95,6 +94,7 @@ KNOWN_SHORT = {
         "floor) alone, and fails with both (before the holder's cusp clearance came in too)"),
 }
 
+#: corpus parts (20-150 mm, pockets and holes)
 CORPUS_JOBS = ["stepcode_FOOT_BACK_000.stp", "stepcode_TAIL_MIDDLE_PART.stp", "nist_ftc_11_asme1_rb.stp",
                "trimesh_featuretype.STEP", "stepcode_HEAD_BACK.stp"]
 

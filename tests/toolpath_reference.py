@@ -114,7 +114,7 @@ def _ribbon_clearance(faces, boxes, run, radius, top):
     centre = run + [0.0, 0.0, radius]
     lo = centre.min(axis=0) - radius
     hi = np.r_[centre.max(axis=0)[:2], max(top, centre[:, 2].max())] + radius
-    near = np.nonzero(np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1))[0]
+    near = _near(boxes, lo, hi)
     if not len(near):
         return radius
     moved = np.linalg.norm(np.diff(centre[:, :2], axis=0), axis=1) > 1e-12
@@ -154,7 +154,7 @@ def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float)
                     np.ceil(abs(b[2] - a[2]) / (depth / 4)) if np.linalg.norm(b[:2] - a[:2]) > 0 else 0, 1))
         lo = np.r_[np.minimum(a, b)[:2] - rho, min(a[2], b[2]) + depth]
         hi = np.r_[np.maximum(a, b)[:2] + rho, top]
-        near = np.nonzero(np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1))[0]
+        near = _near(boxes, lo, hi)
         if not len(near):
             continue
         target = compound(faces[k] for k in near)
@@ -168,6 +168,11 @@ def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float)
                 bad.append(i)
                 break
     return bad
+
+
+def _near(boxes: np.ndarray, lo, hi) -> np.ndarray:
+    """Indices of the faces whose boxes ``(F, 2, 3)`` meet the box ``lo``-``hi``."""
+    return np.flatnonzero(np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1))
 
 
 def compound(shapes):
