@@ -3,7 +3,8 @@
 One validator per kind of argument, reused everywhere: arrays of numbers
 (:func:`finite_array`), single numbers (:func:`real`, :func:`positive`, :func:`angle`),
 integers (:func:`count`, :func:`derivative_order`), points and directions, parameter
-arrays that must broadcast (:func:`parameter_pair`), file paths (:func:`file_path`),
+arrays that must broadcast (:func:`parameter_pair`), file paths (:func:`file_path`) and
+STEP files (:func:`step_file`),
 surfaces and curves (:func:`surface`, :func:`curve`), and the cost of a piece of work
 against its cap (:func:`work`).  Each raises :class:`~surfmod.errors.SurfmodError` whose
 message starts with the argument's name; arrays come back as float64.  Inside the package
@@ -28,12 +29,14 @@ The limits, documented once (README "Errors and limits"):
 from __future__ import annotations
 
 import math
+import mmap
 import os
+import re
 from pathlib import Path
 
 import numpy as np
 
-from .errors import SurfmodError
+from .errors import DamagedFileError, SurfmodError
 
 LARGEST = 1e70
 MAX_DERIVATIVE_ORDER = 20
@@ -278,6 +281,59 @@ def file_path(value, name: str = "path") -> Path:
         size = len(os.fsencode(part))
         if size > MAX_PATH_COMPONENT:
             raise SurfmodError(f"{name}: file name of {size} bytes is longer than the limit {MAX_PATH_COMPONENT}")
+    return p
+
+
+#: a list element that reads as no number within :data:`LARGEST`: NaN and infinity as C
+#: libraries print them, and reals of an exponent of 70 or more (the pass below keeps those
+#: that still fit).  OCCT 8.0's reader loops on a control point of ``inf`` or ``1.E308``
+#: (over 240 s where the file reads in 3 s), so such numbers never reach it.
+_NOT_A_NUMBER = (rb"[(,]\s*[-+]?(?:nan|inf(?:inity)?|\d+\.#\w+|\d*\.?\d*e\+?0*(?:[7-9]\d|[1-9]\d\d+))"
+                 rb"\s*(?=[,)])")
+_SUSPECT = re.compile(_NOT_A_NUMBER, re.IGNORECASE)
+#: the same with strings and comments matched first, so a name such as 'a,inf,b' is skipped
+_TOKENS = re.compile(rb"'(?:[^']|'')*'|/\*.*?\*/|" + _NOT_A_NUMBER, re.IGNORECASE | re.DOTALL)
+
+
+def _out_of_range(token: bytes) -> bool:
+    """Whether a token :data:`_NOT_A_NUMBER` matched is NaN, infinite or beyond :data:`LARGEST`."""
+    try:
+        return not abs(float(token)) <= LARGEST
+    except ValueError:  # '1.#QNAN' and the like
+        return True
+
+
+def step_file(value, name: str = "path") -> Path:
+    """An existing STEP file whose text OCCT can be given: a STEP header, and no number
+    that is NaN, infinite or beyond :data:`LARGEST` (:class:`~surfmod.errors.DamagedFileError`
+    naming the file).
+
+    >>> import tempfile
+    >>> bad = Path(tempfile.mkdtemp()) / "p.step"
+    >>> _ = bad.write_bytes(b"ISO-10303-21;\\nDATA;\\n#1=CARTESIAN_POINT('',(0.,nan,1.));\\nENDSEC;")
+    >>> step_file(bad)
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.DamagedFileError: path: ... has a number that is NaN, infinite or beyond 1e+70 ('nan' at byte 46)
+    """
+    p = file_path(value, name)
+    if not p.is_file():
+        raise SurfmodError(f"{name}: no such file {p}")
+    try:
+        with open(p, "rb") as fh:
+            if b"ISO-10303-21" not in fh.read(256):
+                raise SurfmodError(f"{name}: {p} is not a STEP file (not a readable STEP header: ISO-10303-21 missing)")
+            with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as text:
+                # one pass in C over the whole file; the string-aware pass only where it hit
+                if _SUSPECT.search(text):
+                    for m in _TOKENS.finditer(text):
+                        token = m.group()[1:].strip()
+                        if m.group().startswith((b"(", b",")) and _out_of_range(token):
+                            token = token.decode("ascii")
+                            raise DamagedFileError(f"{name}: {p} has a number that is NaN, infinite or beyond "
+                                                   f"{LARGEST:g} ({token!r} at byte {m.start() + 1})")
+    except OSError as exc:
+        raise SurfmodError(f"{name}: cannot read {p} ({exc.strerror})") from None
     return p
 
 

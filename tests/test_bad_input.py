@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
 import surfmod as sm
+from surfmod.checks import step_file
 
 NET = np.random.default_rng(0).uniform(-1, 1, (5, 4, 3))
 
@@ -104,3 +107,24 @@ def test_inputs_are_copied_and_frozen():
     assert s.control_points[0, 0, 0] != 99.0
     with pytest.raises(ValueError):
         s.control_points[0, 0, 0] = 1.0
+
+
+STEP_TEXT = ("ISO-10303-21;\nHEADER;\nFILE_NAME('a,inf,b /* x */','',(''),(''),'','','');\nENDSEC;\nDATA;\n"
+             "#1=CARTESIAN_POINT('it''s,nan,here',(0.,{x},1.E69));\n/* (1.,inf,2.) */\nENDSEC;\nEND-ISO-10303-21;\n")
+
+
+@pytest.mark.parametrize("x", ["nan", "-INF", "Infinity", "1.#QNAN", "1.E70000", "-1.E308", "9.9E307", " 2.E71 "])
+def test_step_text_with_numbers_out_of_range_is_refused_before_occt(tmp_path, x):
+    # OCCT 8.0's reader loops on such a control point; the text is refused before it reads
+    path = tmp_path / "p.step"
+    path.write_text(STEP_TEXT.format(x=x))
+    with pytest.raises(sm.DamagedFileError, match=rf"^path: .*p\.step has a number that is NaN, infinite or beyond "
+                                                  rf"1e\+70 \('{re.escape(x.strip())}' at byte \d+\)$"):
+        step_file(path)
+
+
+@pytest.mark.parametrize("x", ["1.E70", "-1.E69", "0.", "1.E-400", "7.E07"])
+def test_step_text_in_range_passes_even_with_inf_in_strings_and_comments(tmp_path, x):
+    path = tmp_path / "p.step"
+    path.write_text(STEP_TEXT.format(x=x))
+    assert step_file(path) == path

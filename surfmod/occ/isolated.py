@@ -118,8 +118,9 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     ``timeout`` defaults to ``TIMEOUT_BASE + TIMEOUT_PER_MB`` per megabyte of file.
     Raises :class:`~surfmod.errors.SurfmodError` naming ``name`` for a path that is not a
     readable file, and :class:`~surfmod.errors.DamagedFileError` (a ``KernelError``) naming
-    the file when OCCT refuses it, crashes on it, runs past ``timeout`` seconds, or yields
-    NaN or coordinates beyond ``max_coordinate``.
+    the file when its text holds NaN or infinity (:func:`surfmod.checks.step_file`), or OCCT
+    refuses it, crashes on it, runs past ``timeout`` seconds, or yields NaN or coordinates
+    beyond ``max_coordinate``.
 
     >>> import os, tempfile, surfmod as sm
     >>> path = os.path.join(tempfile.mkdtemp(), "p.step")
@@ -127,19 +128,10 @@ def read_step_file(path, name: str = "path", *, timeout: float | None = None, ma
     >>> read_step_file(path).ShapeType().name
     'TopAbs_SHELL'
     """
-    p = checks.file_path(path, name)
     if timeout is not None:
         timeout = checks.positive(timeout, "timeout")
     max_coordinate = checks.positive(max_coordinate, "max_coordinate")
-    if not p.is_file():
-        raise SurfmodError(f"{name}: no such file {p}")
-    try:
-        with open(p, "rb") as fh:
-            head = fh.read(256)
-    except OSError as exc:
-        raise SurfmodError(f"{name}: cannot read {p} ({exc.strerror})") from None
-    if b"ISO-10303-21" not in head:
-        raise SurfmodError(f"{name}: {p} is not a STEP file (not a readable STEP header: ISO-10303-21 missing)")
+    p = checks.step_file(path, name)
     if timeout is None:
         timeout = TIMEOUT_BASE + TIMEOUT_PER_MB * p.stat().st_size / 1e6
     _READER.start()  # the child imports OCCT while this process does the same
