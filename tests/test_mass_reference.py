@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from types import SimpleNamespace
 
 import build123d as bd
 import numpy as np
@@ -519,6 +520,12 @@ AMBIGUOUS = {
 }
 
 
+#: solids whose refinement changes them (the split re-fits p-curves: axom's B-spline sphere
+#: moves by 7.6e2 of the tolerance), so they go to the Gauss-Kronrod rule without it (its
+#: refinements cost 65 s)
+UNREFINABLE = {("axom_boxed_sphere.step", 0)}
+
+
 def _off(ref, mine):
     from surfmod.uses.mass_reference import relative_differences
 
@@ -535,8 +542,9 @@ def test_surfmod_matches_an_independent_reference_on_every_corpus_solid(corpus_f
       quantity by less than 1e-10);
     * where it has not (its split changes the solid: ShapeUpgrade fits p-curves again on
       stepcode_dm1's B-spline solids, stepcode_TAIL_TURBINE, build123d's screw thread,
-      axom's B-spline sphere, nist_ctc_05), BRepGProp's Gauss-Kronrod rule with the
-      moments converged, its own error estimate below 1e-9;
+      axom's B-spline sphere, nist_ctc_05; those in :data:`UNREFINABLE` without trying),
+      BRepGProp's Gauss-Kronrod rule with the moments converged, its own error estimate
+      below 1e-9;
     * on the solids named in :data:`AMBIGUOUS` the file leaves more than 1e-9 open: there
       surfmod is within the command's 1e-7 of plain BRepGProp (the Ventilator within its
       boundary ambiguity), and a new one fails here until it is named."""
@@ -548,23 +556,25 @@ def test_surfmod_matches_an_independent_reference_on_every_corpus_solid(corpus_f
     for i, solid in enumerate(solids_of(sm.import_step(corpus_file).wrapped)):
         key = (corpus_file.name, i)
         mine = sm.mass_properties(solid, estimate_error=False)
-        # bounded by its splits (a count: SPLITS), not by the clock of a loaded machine
-        ref = refined_props(solid, budget=math.inf)
-        estimate = max(ref.changes[k] for k in ("volume", "centroid", "inertia"))
-        # a named solid goes to the last branch even where the refined reference settles
-        # (asitus_SHIELD_INTEGRATED: settled 1.65e-9 from surfmod, the file open by 1.3e-4)
-        if estimate < 1e-10 and key not in AMBIGUOUS:
-            assert _off(ref, mine) < 1e-9, (key, _off(ref, mine))
+        if key in AMBIGUOUS:
+            # no reference settles what the file leaves open: plain BRepGProp, no refinement
+            # (linkrods' refined reference alone took 94 s)
+            o = gprops(solid, 1e-13)
+            plain = SimpleNamespace(volume=o["volume"], area=o["area"], centroid=o["centroid"], inertia=o["inertia"])
+            limit = max(MASS_AGREEMENT_RTOL, boundary_ambiguity(solid)) if key == ("pythonocc_Ventilator.stp", 0) else (
+                MASS_AGREEMENT_RTOL)
+            assert _off(plain, mine) < limit, (key, _off(plain, mine))
             continue
-        if key not in AMBIGUOUS:
-            gk = kronrod_props(solid, 1e-10)
-            assert gk.error < 1e-9 and _off(gk, mine) < 1e-9, (key, _off(gk, mine), gk.error, estimate)
-            continue
-        o = gprops(solid, 1e-13)
-        plain = dataclasses.replace(ref, volume=o["volume"], area=o["area"], centroid=o["centroid"], inertia=o["inertia"])
-        limit = max(MASS_AGREEMENT_RTOL, boundary_ambiguity(solid)) if key == ("pythonocc_Ventilator.stp", 0) else (
-            MASS_AGREEMENT_RTOL)
-        assert _off(plain, mine) < limit, (key, _off(plain, mine))
+        estimate = math.inf
+        if key not in UNREFINABLE:
+            # bounded by its splits (a count: SPLITS), not by the clock of a loaded machine
+            ref = refined_props(solid, budget=math.inf)
+            estimate = max(ref.changes[k] for k in ("volume", "centroid", "inertia"))
+            if estimate < 1e-10:
+                assert _off(ref, mine) < 1e-9, (key, _off(ref, mine))
+                continue
+        gk = kronrod_props(solid, 1e-10)
+        assert gk.error < 1e-9 and _off(gk, mine) < 1e-9, (key, _off(gk, mine), gk.error, estimate)
 
 
 def test_brepgprop_inertia_quirk_on_a_b_spline_solid_settled_by_gauss_kronrod(corpus_dir):
