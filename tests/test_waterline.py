@@ -145,6 +145,35 @@ def test_loops_are_closed_oriented_and_nested():
     assert areas[1] == pytest.approx(400 + 80 + math.pi, rel=1e-5)
 
 
+def box_walls(x0, y0, x1, y1, top):
+    """The four walls (from z = 0) and the lid of an axis-aligned box: 10 triangles."""
+    c = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    tri = []
+    for p, q in zip(c, np.roll(c, -1, axis=0)):
+        tri += [[[*p, 0], [*q, 0], [*q, top]], [[*p, 0], [*q, top], [*p, top]]]
+    return tri + [[[x0, y0, top], [x1, y0, top], [x1, y1, top]], [[x0, y0, top], [x1, y1, top], [x0, y1, top]]]
+
+
+@pytest.mark.parametrize("R, h", [(0.7, 0.35), (1.1, 0.55), (1.3, 0.35)])
+def test_rows_along_a_wall_give_the_exact_contour(R, h):
+    """Issue 36: a fiber can run along a straight wall's offset (a pit's fiber did on
+    trimesh_featuretype), and a rounding then puts a node outside for the row and inside
+    for the column through it; the column's crossing was taken at the middle of its
+    edge, half a spacing into the material, deeper than the refinement looks (the
+    finishing lifted a piece 2.36 mm there).  A comb of ten teeth whose ends' offsets lie on
+    the grid's rows (which start at the part's low y less R and two spacings): every loop
+    point lies at R from the boxes (before: up to h / 2 off)."""
+    rows = np.arange(-R - 2 * h, 20, h)
+    rects = [(0.0, 0.0, 31.0, 2.0)] + [(3.0 * i + 1, 0.0, 3.0 * i + 2.5, rows[np.searchsorted(rows, 3 + 0.7 * i)] - R)
+                                       for i in range(10)]
+    tri = np.array([t for r in rects for t in box_walls(*r, 5.0)], float)
+    loops, = waterline(tri, tool("flat", R), [1.0], sampling=h)
+    assert len(loops) >= 1
+    for lp in loops:
+        d = np.min([box_distance(lp[:, :2], r[:2], r[2:]) for r in rects], axis=0)
+        assert np.abs(d - R).max() < 1e-9
+
+
 def pyramid_and_shelf() -> np.ndarray:
     """A square pyramid 20 wide and 8 high and, beside it, a shelf at z = 6 whose band
     joins the pyramid's offset at the low levels."""

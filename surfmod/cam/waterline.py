@@ -11,7 +11,9 @@ closed form from the triangle's features, as OpenCAMLib's push-cutter does.
 The contours come from a grid of fibers of spacing
 ``sampling``: node states (inside or outside) and the exact crossing on every grid edge
 whose nodes differ, joined cell by cell (marching squares, the material kept on the
-left) into closed loops.  A loop is found only where a node of the grid lies inside it:
+left) into closed loops; where a fiber runs along the contour (a straight wall's offset)
+and the line across sees no boundary within an edge, the crossing is the node it
+disagrees on (:func:`_line_crossings`).  A loop is found only where a node of the grid lies inside it:
 a hole a little wider than the tool leaves it a pit narrower than the spacing, which
 uniform fibers miss at every level, so one more fiber in x and one in y pass through the
 middle of every pit (:func:`pit_lines`); then every chord whose midpoint lies farther than
@@ -293,7 +295,11 @@ def _union_nearest(n, qi, lo, hi):
 def _line_crossings(t, state, c_lo, c_hi):
     """Along one grid line with nodes at ``t`` and their ``state``: the crossing on each
     edge (i, i+1) whose states differ (NaN elsewhere) from the line's components: the end
-    of the one holding the inside node, else the nearest boundary within the edge."""
+    of the one holding the inside node, else the nearest boundary within the edge.  With
+    no boundary within the edge the line sees one state all along it, and the node whose
+    state it contradicts is the crossing: the states come from the rows, and a row (or
+    this line) tangent to the contour there, e.g. a fiber along a straight wall's offset,
+    sees the node a rounding off the other side."""
     out = np.full(len(t) - 1, np.nan)
     differ = np.flatnonzero(state[:-1] != state[1:])
     if not len(differ):
@@ -308,9 +314,12 @@ def _line_crossings(t, state, c_lo, c_hi):
         start = np.where(k_start < len(c_lo), c_lo[np.minimum(k_start, len(c_lo) - 1)], np.inf)
         got = np.where(leaving, end, start)
         ok = (got >= a) & (got <= b)
+        # the line's own state at a: inside a component starting at or before it
+        k_a = np.searchsorted(c_lo, a, "right") - 1
+        inside_a = (k_a >= 0) & (c_hi[np.maximum(k_a, 0)] >= a)
     else:
-        got, ok = a, np.zeros(len(a), bool)
-    out[differ] = np.where(ok, got, 0.5 * (a + b))  # a tangency seen by one line only: refined later
+        got, ok, inside_a = a, np.zeros(len(a), bool), np.zeros(len(a), bool)
+    out[differ] = np.where(ok, got, np.where(inside_a != leaving, a, b))
     return out
 
 
