@@ -19,7 +19,7 @@ from ocl_reference import waterline as ocl_waterline
 from surfmod.cam.cutters import cutter
 from surfmod.cam.drop_cutter import TriangleGrid, drop, triangle_rows
 from surfmod.cam.fiber_contact import pair_intervals
-from surfmod.cam.waterline import _waterline, fiber_pairs, waterline
+from surfmod.cam.waterline import _waterline, fiber_pairs, pit_lines, waterline
 from surfmod.errors import SurfmodError
 
 CORPUS_PART = "trimesh_featuretype.STEP"
@@ -298,6 +298,27 @@ def corpus_triangles(corpus_dir):
 
     tri, _ = part_triangles(to_shape(corpus_dir / CORPUS_PART), 0.05)
     return tri
+
+
+def test_pit_fibers_cross_the_holes_and_run_along_no_wall(corpus_triangles):
+    """Issue 36: trimesh_featuretype's eight Ø6.74 holes leave a ball of radius 3 pits
+    narrower than the spacing 1.5; a fiber in x and one in y cross each.  Windows
+    balanced by the walls of a pocket a few cells wide were once moved onto one wall's
+    tool positions (16 fibers more, each along a wall's offset, where a rounding decides
+    on which side of the contour a node lies) and mirrored pits gave fibers a rounding
+    apart: every fiber now lies at least 1e-6 from the offset of every wall facing
+    across it, and from the next fiber."""
+    tri, R = corpus_triangles, 3.0
+    lines = pit_lines(tri, R, 1.5)
+    for axis, holes in ((0, [-57.0738, -28.4988, 0.0762, 28.6512]), (1, [-25.4, 25.4])):
+        assert np.abs(lines[axis][:, None] - holes).min(axis=0).max() < 1e-6
+        assert np.diff(lines[axis]).min() > 1e-6
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n = n / np.linalg.norm(n, axis=1)[:, None]
+    for axis in (0, 1):
+        wall = np.abs(n[:, axis]) > 1 - 1e-9  # a vertical wall facing along the axis
+        offset = tri[wall, :, axis].mean(axis=1) + R * np.sign(n[wall, axis])
+        assert np.abs(lines[axis][:, None] - offset).min() > 1e-6
 
 
 @needs_opencamlib

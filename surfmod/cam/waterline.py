@@ -118,7 +118,9 @@ def pit_lines(tri: np.ndarray, radius: float, sampling: float) -> tuple[np.ndarr
     ``sampling`` from its middle (root mean square), from walls facing every way (their
     area-weighted normals cancel to under :data:`PIT_BALANCE`), as in a hole a little wider
     than the tool.  The fibers cross at the weighted middle of those
-    positions, so a node of the grid lies in the pit.
+    positions, so a node of the grid lies in the pit; a middle whose positions within a
+    spacing no longer balance (moved onto one wall) is no pit, and fibers closer than a
+    millionth of the spacing are one.
 
     >>> a = np.linspace(2 * np.pi, 0, 33)[:-1]  # a hole of radius 1.1, 1 deep: 64 triangles facing in
     >>> rim = np.column_stack([1.1 * np.cos(a) + 5, 1.1 * np.sin(a) - 2])
@@ -166,7 +168,21 @@ def pit_lines(tri: np.ndarray, radius: float, sampling: float) -> tuple[np.ndarr
         for k, near in enumerate(tree.query_ball_point(kept, 0.5 * sampling)):
             if near:
                 kept[k] = np.average(at[near], axis=0, weights=w[near])
-    return np.unique(kept[:, 0]), np.unique(kept[:, 1])
+    # a window balanced by walls a few cells apart can be moved onto one wall's positions:
+    # a fiber there runs along that wall's offset and finds nothing a grid line does not;
+    # a pit is still balanced among the positions within a spacing of its middle
+    near = tree.query_ball_point(kept, sampling)
+    pit = [bool(k) and np.hypot(*(w[k, None] * nh[k]).sum(axis=0)) < PIT_BALANCE * w[k].sum() for k in near]
+    kept = kept[np.asarray(pit, bool)]
+    # pits mirrored across the part give one fiber, not two a rounding apart
+    return tuple(_distinct(kept[:, axis], 1e-6 * sampling) for axis in (0, 1))
+
+
+def _distinct(values, gap):
+    """``values`` sorted, each no closer than ``gap`` to the one before it (the first of a
+    run kept)."""
+    v = np.unique(values)
+    return v[np.r_[True, np.diff(v) > gap]] if len(v) else v
 
 
 # ----------------------------------------------------------------------------------------------
