@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import surfmod as sm
-from surfmod.occ import isolated
+from surfmod import inputs
 from surfmod.occ.step import read_step
 
 from .tables import Table, note
@@ -26,7 +26,7 @@ def main() -> None:
     if not files:
         print(f"no corpus at {CORPUS}")
         return
-    isolated.stop_worker()
+    inputs.stop_worker()
     t = time.perf_counter()
     sm.import_step(files[0])
     start = time.perf_counter() - t

@@ -17,7 +17,7 @@ from test_occt_quirks import quirk_holds
 
 import surfmod as sm
 from surfmod import atomic, checks
-from surfmod.occ import isolated
+from surfmod import inputs
 
 ROOT = Path(__file__).resolve().parent.parent
 SCREW = CORPUS / "occt_screw.step"
@@ -140,9 +140,9 @@ def test_5_the_worker_is_reused_and_the_shape_is_exact():
     from surfmod.occ.step import read_step
 
     first = sm.import_step(SCREW)
-    pid = isolated._READER.server.proc.pid
+    pid = inputs._READER.server.proc.pid
     second = sm.import_step(CORPUS / "cadquery_red_cube_blue_cylinder.step")
-    assert isolated._READER.server.proc.pid == pid
+    assert inputs._READER.server.proc.pid == pid
     assert len(second.solids()) == 2
     # BinTools carries the geometry bit for bit: same vertices as an in-process read
     import build123d as bd

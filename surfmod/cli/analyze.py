@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
-from ..inputs import load_step
+from ..inputs import read_step_file
 from ..meshing.analyze import analyze
 from ..readback import from_face
 from . import EXIT_PARTIAL
@@ -57,7 +57,7 @@ def run(args) -> int:
             light = [float(x) for x in args.light.split(",")]
         except ValueError:
             raise SurfmodError(f"light: expected x,y,z, got {args.light!r}") from None
-    shape = load_step(args.path, "path")
+    shape = read_step_file(args.path, "path")
     options = dict(light=light, stripes=args.stripes, resolution=args.resolution)
     try:
         result, failed = analyze(shape, args.kind, args.out, **options), {}

@@ -38,7 +38,7 @@ from .. import child
 from ..errors import RoundTripWarning, SurfmodError
 from ..atomic import target_path
 from ..io.stl import export_stl
-from ..occ.isolated import read_step_file
+from ..inputs import read_step_file
 
 STEP_SUFFIXES = (".step", ".stp")
 #: default budget of one file's task on a cluster: seconds, and GiB resident

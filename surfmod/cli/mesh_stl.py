@@ -16,7 +16,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import RoundTripWarning
-from ..occ.isolated import read_step_file
+from ..inputs import read_step_file
 from ..io.stl import export_stl
 from ..meshing.brep import describe_faces
 from .batch import EXIT_BROKEN, add_batch_arguments, is_batch, run_mesh

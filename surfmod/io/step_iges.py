@@ -16,7 +16,7 @@ import numpy as np
 from ..curve import Curve
 from ..errors import InsideOutWarning, RoundTripWarning, SurfmodError
 from ..atomic import atomic_path, target_path
-from ..inputs import build123d_compound
+from ..inputs import build123d_compound, read_step_file
 from ..surface import Surface
 
 
@@ -62,7 +62,6 @@ def export_step(objects, path, *, strict: bool = False) -> None:
     >>> d = tempfile.mkdtemp()
     >>> sm.export_step(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), os.path.join(d, "p.step"))
     """
-    from ..occ.isolated import read_step_file
     from ..occ.step import write_step
     from ..occ.topo import compound
 
@@ -105,8 +104,6 @@ def import_step(path, *, timeout: float | None = None, max_coordinate: float = 1
     ...     print("p.step" in str(exc))
     True
     """
-    from ..occ.isolated import read_step_file
-
     return build123d_compound(read_step_file(path, "path", timeout=timeout, max_coordinate=max_coordinate))
 
 

@@ -1,7 +1,7 @@
 """STEP read/write of TopoDS shapes (``STEPControl``), with full-precision reals, and OCCT's
 native BREP format (``BRepTools`` files for gmsh, ``BinTools`` bytes between processes).
 
-In process; files from users go through :mod:`surfmod.occ.isolated`, which runs
+In process; files from users go through :func:`surfmod.inputs.read_step_file`, which runs
 :func:`read_step` in a child process.  The same concept as :mod:`surfmod.io.step_iges`, one
 level down: that module is the public ``import_step``/``export_step`` over this one.
 
