@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from OCP.Geom import Geom_Plane
+from OCP.gp import gp_Dir, gp_Pnt
 
 import surfmod as sm
-from surfmod.occ.faces import infinite_plane
 from twins.geomapi import intersect_line, intersect_surfaces
 from surfmod.ops.intersect import as_plane
 from surfmod.ops.marching import segment_distances
@@ -45,7 +46,7 @@ def test_surface_plane_matches_intss():
     s = _nurbs()
     origin, normal = np.array([2, 1.5, 0.1]), np.array([0.3, 0.2, 1.0])
     curves = sm.intersect(s, (origin, normal))
-    theirs = intersect_surfaces(s.geom(), infinite_plane(origin, normal))
+    theirs = intersect_surfaces(s.geom(), Geom_Plane(gp_Pnt(*origin), gp_Dir(*normal)))
     assert len(curves) == len(theirs) == 2
     n = normal / np.linalg.norm(normal)
     for c in curves:

@@ -18,7 +18,7 @@ from OCP.TopoDS import TopoDS
 import surfmod as sm
 from surfmod.occ import arrays
 from surfmod.occ.geom import bspline_curves
-from surfmod.occ.geom import (downcast_surface, read_bezier_surface, read_bspline_curve, read_bspline_curves_2d,
+from surfmod.occ.geom import (_padded, downcast_surface, read_bezier_surface, read_bspline_curve,
                                read_bspline_surface)
 from surfmod.occ.topo import explore, faces_of
 
@@ -35,6 +35,11 @@ def _pole_by_pole(curve) -> dict:
     k = curve.NbKnots()
     knots = np.repeat([curve.Knot(i) for i in range(1, k + 1)], [curve.Multiplicity(i) for i in range(1, k + 1)])
     return {"points": pts, "weights": w, "knots": knots, "degree": curve.Degree()}
+
+
+def read_bspline_curves_2d(curves: list) -> list[dict]:
+    """The B-spline p-curves of many faces through one binary table, as read_bspline_curve reads one."""
+    return [_padded(d) for d in bspline_curves(curves, 2)]
 
 
 def _same(a: dict, b: dict) -> bool:

@@ -5,10 +5,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from OCP.BRepCheck import BRepCheck_Analyzer
 
 import surfmod as sm
-from surfmod.occ.faces import face_area, face_is_valid
+from surfmod.occ.faces import face_area
 from surfmod.ops.trim import trimmed_area
+
+
+def face_is_valid(face) -> bool:
+    return BRepCheck_Analyzer(getattr(face, "wrapped", face)).IsValid()
 
 
 def _nurbs():

@@ -15,11 +15,11 @@ from ..errors import SurfmodError
 from .arrays import pnt, xyz
 from .guard import kernel
 from OCP.Geom import (Geom_Circle, Geom_ConicalSurface, Geom_CylindricalSurface, Geom_Ellipse, Geom_Hyperbola,
-    Geom_Line, Geom_OffsetSurface, Geom_Parabola, Geom_Plane, Geom_RectangularTrimmedSurface, Geom_SphericalSurface,
+    Geom_Line, Geom_OffsetSurface, Geom_Parabola, Geom_Plane, Geom_SphericalSurface,
     Geom_SurfaceOfLinearExtrusion, Geom_SurfaceOfRevolution, Geom_ToroidalSurface, Geom_TrimmedCurve)
 from OCP.GeomFill import GeomFill
 from OCP.gp import gp_Circ, gp_Elips, gp_Hypr, gp_Lin, gp_Parab
-from .geom import bezier_curve, read_bspline_curve
+from .geom import read_bspline_curve
 
 
 def _dir(v) -> gp_Dir:
@@ -83,10 +83,6 @@ def trimmed(curve, t0, t1):
         return Geom_TrimmedCurve(curve, float(t0), float(t1))
 
 
-def curve_type(curve) -> str:
-    return curve.DynamicType().Name()
-
-
 def read_curve(curve) -> dict:
     """Plain data of an OCCT curve in its own parametrization.
 
@@ -94,9 +90,7 @@ def read_curve(curve) -> dict:
     ``bspline``, ``bezier``;
     trimmed curves are unwrapped (the caller keeps the parameter range).
     """
-
-
-    name = curve_type(curve)
+    name = curve.DynamicType().Name()
     with kernel(f"reading {name}"):
         if name == "Geom_TrimmedCurve":
             return read_curve(curve.BasisCurve())
@@ -104,23 +98,20 @@ def read_curve(curve) -> dict:
             lin = curve.Lin()
             return {"kind": "line", "origin": xyz(lin.Location()), "direction": xyz(lin.Direction())}
         if name == "Geom_Circle":
-            c = curve
-            return {"kind": "circle", "frame": read_ax3(c.Position()), "radius": c.Radius()}
+            return {"kind": "circle", "frame": read_ax3(curve.Position()), "radius": curve.Radius()}
         if name == "Geom_Ellipse":
-            e = curve
-            return {"kind": "ellipse", "frame": read_ax3(e.Position()), "major": e.MajorRadius(), "minor": e.MinorRadius()}
+            return {"kind": "ellipse", "frame": read_ax3(curve.Position()), "major": curve.MajorRadius(),
+                    "minor": curve.MinorRadius()}
         if name == "Geom_Parabola":
             return {"kind": "parabola", "frame": read_ax3(curve.Position()), "focal": curve.Focal()}
         if name == "Geom_Hyperbola":
             return {"kind": "hyperbola", "frame": read_ax3(curve.Position()), "major": curve.MajorRadius(), "minor": curve.MinorRadius()}
         if name == "Geom_BSplineCurve":
-            data = read_bspline_curve(curve)
-            return {"kind": "bspline", **data}
+            return {"kind": "bspline", **read_bspline_curve(curve)}
         if name == "Geom_BezierCurve":
-            b = curve
-            pts = np.array([xyz(b.Pole(i)) for i in range(1, b.NbPoles() + 1)])
-            w = np.array([b.Weight(i) for i in range(1, b.NbPoles() + 1)]) if b.IsRational() else None
-            return {"kind": "bezier", "points": pts, "weights": w}
+            poles = range(1, curve.NbPoles() + 1)
+            w = np.array([curve.Weight(i) for i in poles]) if curve.IsRational() else None
+            return {"kind": "bezier", "points": np.array([xyz(curve.Pole(i)) for i in poles]), "weights": w}
     raise SurfmodError(f"curve: unsupported OCCT curve type {name}")
 
 
@@ -224,12 +215,3 @@ def transformed(geom, matrix):
     with kernel("Geom_Geometry.Transformed"):
         return geom.Transformed(trsf(matrix))
 
-
-def rectangular_trimmed(basis, u0, u1, v0, v1):
-    """``Geom_RectangularTrimmedSurface`` of ``basis`` over ``[u0, u1] x [v0, v1]``."""
-    with kernel("Geom_RectangularTrimmedSurface"):
-        return Geom_RectangularTrimmedSurface(basis, float(u0), float(u1), float(v0), float(v1))
-
-
-def bezier_curve_geom(points, weights=None):
-    return bezier_curve(np.asarray(points, float), None if weights is None else np.asarray(weights, float))

@@ -1,16 +1,15 @@
-"""Faces from surfaces (``BRepBuilderAPI_MakeFace``): segments, bounded and infinite planes,
-faces trimmed by loops of p-curves, and their areas and validity (``BRepCheck``)."""
+"""Faces from surfaces (``BRepBuilderAPI_MakeFace``): segments, bounded surfaces,
+faces trimmed by loops of p-curves, and their areas."""
 
 from __future__ import annotations
 
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
-from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
-from OCP.Geom import Geom_Plane, Geom_RectangularTrimmedSurface
+from OCP.Geom import Geom_RectangularTrimmedSurface
 from OCP.Geom2d import Geom2d_BSplineCurve
-from OCP.gp import gp_Dir, gp_Pnt2d
+from OCP.gp import gp_Pnt2d
 from OCP.GProp import GProp_GProps
 from OCP.ShapeFix import ShapeFix_Face
 
@@ -92,20 +91,8 @@ def face_area(face, eps: float = 1e-10) -> float:
         return float(props.Mass())
 
 
-def face_is_valid(face) -> bool:
-    """``BRepCheck_Analyzer`` verdict."""
-    with kernel("BRepCheck_Analyzer"):
-        return bool(BRepCheck_Analyzer(getattr(face, "wrapped", face)).IsValid())
-
-
 def bounded(surf, bounds):
     """``Geom_RectangularTrimmedSurface`` over ``bounds = (u0, u1, v0, v1)``."""
     u0, u1, v0, v1 = map(float, bounds)
     with kernel("Geom_RectangularTrimmedSurface"):
         return Geom_RectangularTrimmedSurface(surf, u0, u1, v0, v1)
-
-
-def infinite_plane(origin, normal):
-    """``Geom_Plane`` through ``origin`` with ``normal``."""
-    with kernel("Geom_Plane"):
-        return Geom_Plane(arrays.pnt(origin), gp_Dir(*map(float, normal)))

@@ -25,28 +25,23 @@ from OCP.TopoDS import TopoDS
 
 from ..errors import SurfmodError
 from .bindings import box_limits
+from .geom import downcast_surface
 from .guard import kernel
 
 # where no B-spline form holds the numbers, these fractions of the range are evaluated
 _FRACTIONS = (0.0, 0.5, 1.0)
 
 
-def _downcast(geom, module):
-    cls = getattr(module, geom.DynamicType().Name(), None)
-    down = cls.DownCast(geom) if cls is not None and hasattr(cls, "DownCast") else None
-    return geom if down is None else down
-
-
 def _basis(geom, module, attribute: str):
     """Through trimming and offset wrappers (``attribute``: ``BasisSurface`` or
     ``BasisCurve``) to the geometry that holds the numbers."""
     for _ in range(8):  # nesting is shallow in any file; bounded anyway
-        geom = _downcast(geom, module)
+        geom = downcast_surface(geom, module)
         inner = getattr(geom, attribute, None)
         if inner is None:
             return geom
         geom = inner()
-    return _downcast(geom, module)
+    return downcast_surface(geom, module)
 
 
 def _finite_xyz(p, limit: float) -> bool:

@@ -125,24 +125,17 @@ def _padded(data: dict) -> dict:
     return {"points": points, "weights": data["weights"], "knots": data["knots"], "degree": data["degree"]}
 
 
-def read_bspline_curves_2d(curves: list) -> list[dict]:
-    """:func:`read_bspline_curve` of many non-periodic ``Geom2d_BSplineCurve`` (the
-    B-spline p-curves of a face) through one binary table."""
-    return [_padded(d) for d in bspline_curves(curves, 2)]
-
-
 def surface_type(surf) -> str:
     """OCCT dynamic type name of a Geom_Surface handle, e.g. ``Geom_BSplineSurface``."""
     return surf.DynamicType().Name()
 
 
-def downcast_surface(surf):
-    """The most derived Python wrapper of a ``Geom_Surface`` handle."""
-    cls = getattr(G, surface_type(surf), None)
-    if cls is None or not hasattr(cls, "DownCast"):
-        return surf
-    down = cls.DownCast(surf)
-    return down if down is not None else surf
+def downcast_surface(surf, module=G):
+    """The most derived Python wrapper of a ``Geom_Surface`` handle (of a curve's too,
+    a 2-D one with ``module`` ``OCP.Geom2d``)."""
+    cls = getattr(module, surface_type(surf), None)
+    down = cls.DownCast(surf) if cls is not None and hasattr(cls, "DownCast") else None
+    return surf if down is None else down
 
 
 def iso_curve(surf, direction: int, value: float):
