@@ -20,13 +20,13 @@ from OCP.BRep import BRep_Tool
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepTools import BRepTools
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 from ..errors import SurfmodError
 from .bindings import box_limits
 from .geom import downcast_surface
 from .guard import kernel
+from .topo import explore
 
 # where no B-spline form holds the numbers, these fractions of the range are evaluated
 _FRACTIONS = (0.0, 0.5, 1.0)
@@ -97,35 +97,17 @@ def _curve_ok(curve, t0: float, t1: float, limit: float, module) -> bool:
 def first_non_finite(shape, limit: float) -> str | None:
     """``None`` when every number is finite and within ``limit``, else what is not
     (``"face 3"``, ``"edge 12"``, ``"p-curve of edge 4 on face 2"``)."""
-    faces = TopExp_Explorer(shape, TopAbs_FACE)
-    fi = 0
-    while faces.More():
-        fi += 1
-        face = TopoDS.Face(faces.Current())
-        faces.Next()
+    for fi, face in enumerate(map(TopoDS.Face, explore(shape, TopAbs_FACE)), 1):
         surf = BRep_Tool.Surface_s(face)
         if surf is not None and not _surface_ok(surf, BRepTools.UVBounds_s(face), limit):
             return f"face {fi}"
-        edges = TopExp_Explorer(face, TopAbs_EDGE)
-        ei = 0
-        while edges.More():
-            ei += 1
-            edge = TopoDS.Edge(edges.Current())
-            edges.Next()
+        for ei, edge in enumerate(map(TopoDS.Edge, explore(face, TopAbs_EDGE)), 1):
             pcurve, t0, t1 = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0), *BRep_Tool.Range_s(edge)
             if pcurve is not None and not _curve_ok(pcurve, t0, t1, math.inf, G2):
                 return f"p-curve of edge {ei} on face {fi}"
-    edges = TopExp_Explorer(shape, TopAbs_EDGE)
-    ei = 0
-    while edges.More():
-        ei += 1
-        edge = TopoDS.Edge(edges.Current())
-        edges.Next()
-        if BRep_Tool.Degenerated_s(edge):
-            continue
-        curve = BRep_Tool.Curve_s(edge, 0.0, 0.0)
-        t0, t1 = BRep_Tool.Range_s(edge)
-        if curve is not None and not _curve_ok(curve, t0, t1, limit, G):
+    for ei, edge in enumerate(map(TopoDS.Edge, explore(shape, TopAbs_EDGE)), 1):
+        curve = None if BRep_Tool.Degenerated_s(edge) else BRep_Tool.Curve_s(edge, 0.0, 0.0)
+        if curve is not None and not _curve_ok(curve, *BRep_Tool.Range_s(edge), limit, G):
             return f"edge {ei}"
     return None
 
