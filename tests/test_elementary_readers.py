@@ -7,10 +7,10 @@ import importlib.util
 
 import numpy as np
 import pytest
+from OCP.Geom import Geom_RectangularTrimmedSurface
 
 import surfmod as sm
 from surfmod.occ import analytic as occ
-from surfmod.occ.faces import bounded
 from surfmod.occ.geom import bezier_curve, surface_type
 from surfmod.occ.sample import surface_d0
 from surfmod.occ.topo import face_from_surface, face_surface
@@ -141,7 +141,7 @@ def test_revolution_and_extrusion_keep_occt_parametrization_of_every_basis_curve
 
 def test_rectangular_trimmed_surface_is_unwrapped():
     cyl = occ.cylinder((np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, 1.0])), 2.0)
-    trimmed = bounded(cyl, (0.5, 2.5, -1.0, 3.0))
+    trimmed = Geom_RectangularTrimmedSurface(cyl, 0.5, 2.5, -1.0, 3.0)
     face = face_from_surface(trimmed, 0.7, 2.0, 0.0, 2.0)
     s = sm.from_face(face)
     assert isinstance(s.surface, sm.CylindricalSurface)

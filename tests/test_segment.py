@@ -9,9 +9,15 @@ from hypothesis import strategies as st
 
 import surfmod as sm
 from strategies import bspline_surfaces
-from surfmod.occ.faces import segmented
-from surfmod.occ.geom import read_bezier_surface, read_bspline_surface
+from surfmod.occ.geom import downcast_surface, read_bezier_surface, read_bspline_surface
 from surfmod.occ.sample import surface_d0
+
+
+def segmented(surf, u0: float, u1: float, v0: float, v1: float):
+    """A copy of a B-spline or Bézier ``surf`` cut down by OCCT's ``Segment``: the twin."""
+    out = downcast_surface(surf.Copy())
+    out.Segment(float(u0), float(u1), float(v0), float(v1))
+    return out
 
 
 def _size(s):

@@ -16,7 +16,7 @@ so for a ``with`` block.
 >>> threads.threads_for(10**7)
 1
 >>> with threads.limit(None):
-...     threads.get_threads() is None
+...     threads.threads_for(10**7) >= 1
 True
 >>> threads.set_threads(previous)
 1
@@ -55,8 +55,6 @@ def set_threads(count: int | None) -> int | None:
 
     >>> from surfmod.eval import threads
     >>> old = threads.set_threads(2)
-    >>> threads.get_threads()
-    2
     >>> threads.set_threads(old)
     2
     """
@@ -65,16 +63,6 @@ def set_threads(count: int | None) -> int | None:
         raise SurfmodError(f"count: expected a positive integer or None, got {count!r}")
     previous, _requested = _requested, count
     return previous
-
-
-def get_threads() -> int | None:
-    """The cap set by :func:`set_threads` (``None``: no cap).
-
-    >>> from surfmod.eval import threads
-    >>> threads.get_threads() is None or threads.get_threads() >= 1
-    True
-    """
-    return _requested
 
 
 @contextmanager

@@ -115,26 +115,6 @@ def _chebyshev_rows(y: np.ndarray, count: int) -> np.ndarray:
     return T
 
 
-def lagrange_values(y: np.ndarray, x: np.ndarray, bw: np.ndarray) -> np.ndarray:
-    """``(N, K)``: the Lagrange basis of the points ``x`` (barycentric weights ``bw``) at
-    ``y``, so that ``Σ_k L_k(y) f(x_k)`` is the interpolant of ``f`` (exact for
-    polynomials of degree ``< K``).
-
-    >>> x, bw, _ = chebyshev(4)
-    >>> L = lagrange_values(np.array([0.3, x[1]]), x, bw)
-    >>> float(round(L[0] @ (x**3), 14)), L[1].round(15).tolist() == [0, 1, 0, 0]
-    (0.027, True)
-    """
-    d = y[:, None] - x[None, :]
-    hit = d == 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = bw / d
-        L = t / t.sum(axis=1, keepdims=True)
-    rows = hit.any(axis=1)
-    L[rows] = hit[rows]  # a value at an interpolation point is that point's value
-    return L
-
-
 def interpolation_points(degree, order: int) -> tuple[int, bool]:
     """Interpolation points per span along a direction for Green's grid
     (:func:`grid_nodes`): ``5p + 1`` where the surface is a polynomial of degree ``p``

@@ -1,5 +1,5 @@
-"""Faces from surfaces (``BRepBuilderAPI_MakeFace``): segments, bounded surfaces,
-faces trimmed by loops of p-curves, and their areas."""
+"""Faces from surfaces (``BRepBuilderAPI_MakeFace``) trimmed by loops of p-curves, and
+their areas."""
 
 from __future__ import annotations
 
@@ -7,24 +7,14 @@ import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
-from OCP.Geom import Geom_RectangularTrimmedSurface
 from OCP.Geom2d import Geom2d_BSplineCurve
 from OCP.gp import gp_Pnt2d
 from OCP.GProp import GProp_GProps
 from OCP.ShapeFix import ShapeFix_Face
 
 from . import arrays
-from .geom import downcast_surface
 from .guard import check_done, kernel
 from .bindings import MakeSegment2d, TColgp_Array1OfPnt2d
-
-
-def segmented(surf, u0: float, u1: float, v0: float, v1: float):
-    """A copy of a B-spline or Bézier ``surf`` cut down by OCCT's ``Segment``."""
-    with kernel("Geom_BSplineSurface.Segment"):
-        out = downcast_surface(surf.Copy())
-        out.Segment(float(u0), float(u1), float(v0), float(v1))
-    return out
 
 
 def _pcurves(loop):
@@ -91,8 +81,3 @@ def face_area(face, eps: float = 1e-10) -> float:
         return float(props.Mass())
 
 
-def bounded(surf, bounds):
-    """``Geom_RectangularTrimmedSurface`` over ``bounds = (u0, u1, v0, v1)``."""
-    u0, u1, v0, v1 = map(float, bounds)
-    with kernel("Geom_RectangularTrimmedSurface"):
-        return Geom_RectangularTrimmedSurface(surf, u0, u1, v0, v1)
