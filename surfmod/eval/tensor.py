@@ -20,15 +20,10 @@ from .basis import basis_derivatives, find_spans
 BLOCK = 1 << 14
 
 
-def _planar(ctrl: np.ndarray) -> np.ndarray:
-    """Control points as coordinate planes ``(dim, n_points)`` for fast ``take``."""
-    return np.ascontiguousarray(ctrl.reshape(-1, ctrl.shape[-1]).T)
-
-
 def curve_derivatives(knots, degree, ctrl, t, order):
     """Derivatives 0..order of a spline curve: ``(len(t), order + 1, dim)``."""
     t = np.asarray(t, dtype=float).ravel()
-    planes = _planar(ctrl)
+    planes = np.ascontiguousarray(ctrl.reshape(-1, ctrl.shape[-1]).T)  # (dim, n_points): fast ``take``
     out = np.empty((order + 1, planes.shape[0], t.size))  # (K, dim, N), planar
     for b0 in range(0, t.size, BLOCK):
         tb = t[b0 : b0 + BLOCK]

@@ -78,11 +78,6 @@ def _job(job: Job):
     return group([part, _stock(job.stock), *ops], label="job")
 
 
-def _toolpath(tp: Toolpath):
-    # a finishing path is one continuous feed move, links and staircases included
-    return _moves(tp.points, np.ones(len(tp.points), np.int8), OPERATION_COLORS[0], f"toolpath {tp.tool}")
-
-
 def _analysis(result: Analysis):
     values = result.values
     finite = values[np.isfinite(values)]
@@ -142,7 +137,8 @@ def to_build123d(obj, *, color=None, label: str | None = None):
     elif isinstance(obj, Analysis):
         out = _analysis(obj)
     elif isinstance(obj, Toolpath):
-        out = _toolpath(obj)
+        # a finishing path is one continuous feed move, links and staircases included
+        out = _moves(obj.points, np.ones(len(obj.points), np.int8), OPERATION_COLORS[0], f"toolpath {obj.tool}")
     elif isinstance(obj, Job):
         out = _job(obj)
     else:

@@ -181,10 +181,6 @@ def min_triangle_angles(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
     return worst
 
 
-def _gmsh():
-    return require("gmsh", "fem", "sm.fe_mesh")  # the optional extra 'fem', loaded on the first FE mesh only
-
-
 #: gmsh's OCC healing, tried when a part does not mesh as read (real STEP parts: tiny or
 #: degenerate edges, faces that touch without sharing edges make "overlapping facets")
 HEALING = {
@@ -202,7 +198,7 @@ def _gmsh_model(name: str):
     one global state, and each run has a child process of its own, :func:`_gmsh_in_child`).
     gmsh's own exceptions become ``_GmshFailure`` (retried healed, then reported); the
     model is removed afterwards."""
-    gmsh = _gmsh()
+    gmsh = require("gmsh", "fem", "sm.fe_mesh")  # the optional extra 'fem', loaded on the first FE mesh only
     own = not gmsh.isInitialized()
     if own:
         gmsh.initialize(interruptible=False)
