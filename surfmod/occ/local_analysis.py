@@ -14,14 +14,12 @@ from OCP.BRepClass import BRepClass_FaceClassifier
 from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_G2
 from OCP.LocalAnalysis import LocalAnalysis_SurfaceContinuity
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN
-from OCP.TopExp import TopExp
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN
 from OCP.TopoDS import TopoDS
 from OCP.gp import gp_Pnt2d, gp_Vec2d
 
 from .guard import kernel
-from .topo import explore, faces_of, shape_list, wrapped
-from .bindings import TopTools_IndexedDataMapOfShapeListOfShape
+from .topo import explore, faces_of, geometric_edges, wrapped
 
 
 def _pcurve_samples(edge, face, samples: int):
@@ -86,19 +84,15 @@ def shared_edges(shape, samples: int) -> list[dict]:
     all_faces = faces_of(s)
     records = []
     with kernel("shared edges (BRepAdaptor_Curve2d)"):
-        amap = TopTools_IndexedDataMapOfShapeListOfShape()
-        TopExp.MapShapesAndAncestors_s(s, TopAbs_EDGE, TopAbs_FACE, amap)
-        for i in range(1, amap.Extent() + 1):
+        for index, edge, faces in geometric_edges(s):
             ancestors = []
-            for f in shape_list(amap.FindFromIndex(i)):
+            for f in faces:
                 if not any(f.IsSame(g) for g in ancestors):
                     ancestors.append(f)
-            edge = TopoDS.Edge(amap.FindKey(i))
-            if len(ancestors) != 2 or BRep_Tool.Degenerated_s(edge):
+            if len(ancestors) != 2:
                 continue  # free edges, seams (one face twice), non-manifold edges
-            rec = {"edge": i - 1, "faces": [], "face_shapes": [], "uv": [], "tangent": [], "inward": []}
-            for f in ancestors:
-                face = TopoDS.Face(f)
+            rec = {"edge": index, "faces": [], "face_shapes": [], "uv": [], "tangent": [], "inward": []}
+            for face in ancestors:
                 rec["faces"].append(next((k for k, g in enumerate(all_faces) if g.IsSame(face)), -1))
                 rec["face_shapes"].append(face)
                 uv, tangent = _pcurve_samples(edge, face, samples)

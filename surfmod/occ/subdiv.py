@@ -6,18 +6,15 @@ from __future__ import annotations
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepCheck import BRepCheck_Analyzer
-from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.BRepLib import BRepLib
 from OCP.gp import gp_Pnt, gp_Vec
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
-from OCP.TopExp import TopExp
+from OCP.TopAbs import TopAbs_REVERSED
 from OCP.TopoDS import TopoDS
 
 from ..errors import KernelError
-from .bindings import TopTools_IndexedDataMapOfShapeListOfShape
 from .guard import check_done, kernel
-from .topo import shape_list, shells_of, wrapped
+from .topo import geometric_edges, shells_of, wrapped
 
 
 def sew(faces, tolerance: float):
@@ -75,18 +72,11 @@ def shared_edge_samples(shape, samples: int = 17) -> list[tuple]:
     s = wrapped(shape)
     out = []
     with kernel("edge continuity (BRepAdaptor_Curve2d)"):
-        amap = TopTools_IndexedDataMapOfShapeListOfShape()
-        TopExp.MapShapesAndAncestors_s(s, TopAbs_EDGE, TopAbs_FACE, amap)
-        for i in range(1, amap.Extent() + 1):
-            faces = shape_list(amap.FindFromIndex(i))
+        for _, edge, faces in geometric_edges(s):
             if len(faces) != 2:
                 continue
-            edge = TopoDS.Edge(amap.FindKey(i))
-            if BRep_Tool.Degenerated_s(edge):
-                continue
             pts, nrm = [], []
-            for f in faces:
-                face = TopoDS.Face(f)
+            for face in faces:
                 pcurve = BRepAdaptor_Curve2d(edge, face)
                 t0, t1 = pcurve.FirstParameter(), pcurve.LastParameter()
                 surf = BRepAdaptor_Surface(face, False)
