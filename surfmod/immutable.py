@@ -64,7 +64,3 @@ class Immutable:
             twin = build()
             object.__setattr__(self, "_occt_twin", twin)
         return twin
-
-    def _adopt_twin(self, twin) -> None:
-        """Seed the cache with an OCCT object the value was read from (``from_face``)."""
-        object.__setattr__(self, "_occt_twin", twin)
