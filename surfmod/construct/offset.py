@@ -186,6 +186,14 @@ def bicubic_approximation(exact: Surface, bu, bv, tol: float, mults=({}, {}), ma
                        f"(max error {err.max():.3g}); loosen it or raise max_rounds")
 
 
+def _nonzero(value, name: str) -> float:
+    """One finite, non-zero number (an offset's distance, a slab's thickness)."""
+    x = checks.real(value, name)
+    if x == 0.0:
+        raise SurfmodError(f"{name}: must be non-zero, got {value!r}")
+    return x
+
+
 def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: int = 10) -> OffsetApproximation:
     """A bicubic B-spline within ``tolerance`` of the offset ``S + distance * N`` (``N``
     the unit normal ``Su x Sv``), in the parameters of ``s``.  Raises ``SurfmodError``
@@ -198,12 +206,7 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
     """
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
-    try:
-        d = float(distance)
-    except (TypeError, ValueError):
-        raise SurfmodError(f"distance: expected a number, got {distance!r}") from None
-    if not np.isfinite(d) or d == 0.0:
-        raise SurfmodError(f"distance: must be finite and non-zero, got {distance!r}")
+    d = _nonzero(distance, "distance")
     size = model_size(s) + abs(d)
     tol = checks.tolerance(tolerance, "tolerance", size)
     if tol < FIT_FLOOR * size:
@@ -233,12 +236,7 @@ def thicken(s: Surface, thickness: float, tolerance: float = 1e-5, *, symmetric:
     """
     if not isinstance(s, Surface):
         raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
-    try:
-        t = float(thickness)
-    except (TypeError, ValueError):
-        raise SurfmodError(f"thickness: expected a number, got {thickness!r}") from None
-    if not np.isfinite(t) or t == 0.0:
-        raise SurfmodError(f"thickness: must be finite and non-zero, got {thickness!r}")
+    t = _nonzero(thickness, "thickness")
     try:
         far = offset(s, t / 2 if symmetric else t, tolerance)
         inner = offset(s, -t / 2, tolerance) if symmetric else None
