@@ -13,8 +13,6 @@
 ``GEOMETRIC_TOL``
     Default pass threshold of the geometric cross-check for constructs OCCT only
     approximates (sweeps, lofts, fits), in model units.
-``LINEAR``
-    Default modelling tolerance handed to OCCT builders (sewing, pipe shells).
 ``CROSSCHECK_POSITION_RTOL``
     Pass limit of the parametric cross-check on positions, relative to the size of the
     geometry: both evaluators round at ``EXACT_RTOL``; a tenfold margin covers the
@@ -42,7 +40,6 @@ EXACT_RTOL = 1e-12
 DERIVATIVE_RTOL = 1e-10
 DEGENERATE_NORMAL = 1e-10
 GEOMETRIC_TOL = 1e-4
-LINEAR = 1e-7
 CROSSCHECK_POSITION_RTOL = 10 * EXACT_RTOL
 CROSSCHECK_NORMAL_RTOL = 1e-8
 CROSSCHECK_CURVATURE_RTOL = 1e-7
