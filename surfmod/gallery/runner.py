@@ -42,14 +42,10 @@ def run_entry(e: Entry, outdir: Path) -> GalleryRow:
             ok = all(r.passed for r in results)
         export_step(obj, outdir / f"{e.name}.step")
         export_stl(obj, outdir / f"{e.name}.stl", tolerance=0.01)
-        _render(obj, outdir / f"{e.name}.png")
+        render([obj], outdir / f"{e.name}.png")
         return GalleryRow(e.name, e.entity, construct, mode, dev, ok)
     except SurfmodError as exc:
         return GalleryRow(e.name, e.entity, "-", "error", float("nan"), False, str(exc))
-
-
-def _render(obj, path: Path) -> None:
-    render([obj], path)
 
 
 def run_gallery(outdir, *, progress: bool = True, only=None) -> list[GalleryRow]:

@@ -221,18 +221,6 @@ def _edge_entity(sec: Section, edge) -> tuple:
     return ("spline", c.degree, sec.to_plane(c.control_points), np.asarray(c.knots), None if c.weights is None else np.asarray(c.weights))
 
 
-def planar_faces_in(shape, origin, normal, tol: float) -> list[int]:
-    """Indices of the planar faces of ``shape`` lying in the plane ``(origin, normal)``
-    (offset within ``tol``).
-
-    >>> import build123d as bd, numpy as np
-    >>> planar_faces_in(bd.Box(2, 2, 2), np.array([0, 0, 1.0]), np.array([0, 0, -1.0]), 1e-9)
-    [5]
-    """
-    from ..occ.booleans import planar_faces_on
-
-    return planar_faces_on(shape, origin, normal, tol)
-
 
 def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, partial: bool = False) -> Section:
     """Planar section of a part (or of surfaces): curves where the plane cuts it.
@@ -254,7 +242,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, 
     ((2,), True)
     """
     from ..occ.properties import bounding_box
-    from ..occ.booleans import section_edges
+    from ..occ.booleans import planar_faces_on, section_edges
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
@@ -265,7 +253,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, 
     # (which costs more than the section itself on B-spline parts)
     box = bounding_box(shape, optimal=False)
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
-    on = tuple(planar_faces_in(shape, origin, normal, tol))
+    on = tuple(planar_faces_on(shape, origin, normal, tol))
     skipped: dict = {}
     wires = section_edges(shape, origin, normal, skipped if partial else None)
     return Section(checks.frozen(origin), checks.frozen(normal), checks.frozen(xa), checks.frozen(ya),
