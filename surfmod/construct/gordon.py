@@ -183,12 +183,7 @@ def _compatible_sum(terms):
         for d in (0, 1):
             net, ks[d] = _elevate_along(net, ks[d], deg[d], out_deg[d], d)
         elevated.append((sign, net, ks))
-    common = []
-    for d in (0, 1):
-        # merged_knots works on curves: stand-ins carrying each term's knot vector
-        stand_ins = [BSplineCurve._trusted(np.zeros((len(ks[d]) - out_deg[d] - 1, 3)), out_deg[d], ks[d])
-                     for _, _, ks in elevated]
-        common.append(merged_knots(stand_ins, tol=0.0))
+    common = [merged_knots([ks[d] for _, _, ks in elevated], tol=0.0) for d in (0, 1)]
     total = None
     knots_out = None
     for sign, net, ks in elevated:

@@ -90,13 +90,13 @@ def with_knots(curve: BSplineCurve, values, mults, tol: float = KNOT_TOL) -> BSp
     return BSplineCurve._trusted(pts, curve.degree, k, w)
 
 
-def merged_knots(curves, tol: float = KNOT_TOL):
-    """Distinct knot values and maximal multiplicities over all curves (first curve's
-    values win when two are within ``tol``)."""
+def merged_knots(knot_vectors, tol: float = KNOT_TOL):
+    """Distinct knot values and maximal multiplicities over all knot vectors, sorted (the
+    first vector's values win when two are within ``tol``)."""
     values: list[float] = []
     mults: list[int] = []
-    for c in curves:
-        vals, counts = np.unique(c.knots, return_counts=True)
+    for knots in knot_vectors:
+        vals, counts = np.unique(knots, return_counts=True)
         for v, m in zip(vals, counts):
             hit = [i for i, x in enumerate(values) if abs(x - v) <= tol]
             if hit:
@@ -125,7 +125,7 @@ def make_compatible(curves, tol: float = KNOT_TOL):
     spans = [c.domain[1] - c.domain[0] for c in curves]
     widest = curves[int(np.argmax(spans))].domain
     curves = [reparametrized(elevated(c, degree), *widest) for c in curves]
-    values, mults = merged_knots(curves, tol)
+    values, mults = merged_knots([c.knots for c in curves], tol)
     first = with_knots(curves[0], values, mults, tol)
     vals1, mults1 = np.unique(first.knots, return_counts=True)
     return [first] + [with_knots(c, vals1, mults1, tol) for c in curves[1:]]

@@ -27,7 +27,7 @@ from ..eval.basis import basis_matrix
 from ..nets import knots as kn
 from ..nets.bspline import BSplineSurface, cartesian
 from ..nets.convert import as_bspline_surface
-from ..nets.elevate import KNOT_TOL, elevate_degree
+from ..nets.elevate import KNOT_TOL, elevate_degree, merged_knots
 from ..sides import SIDES
 from .continuity import _as_surface
 from ..surface import Surface
@@ -81,15 +81,7 @@ def _compatible(curves):
             k, flat = elevate_degree(knots, p, flat, degree - p)
             c = np.moveaxis(flat.reshape(flat.shape[0], ctrl.shape[0], ctrl.shape[2]), 0, 1)
         up.append((k, c))
-    values, mults = [], []
-    for k, _ in up:
-        for value, mult in zip(*np.unique(k, return_counts=True)):
-            hit = [i for i, x in enumerate(values) if abs(x - value) <= KNOT_TOL]
-            if hit:
-                mults[hit[0]] = max(mults[hit[0]], int(mult))
-            else:
-                values.append(float(value))
-                mults.append(int(mult))
+    values, mults = merged_knots([k for k, _ in up])
     out = []
     for k, c in up:
         h = np.moveaxis(c, 1, 0)
