@@ -195,6 +195,15 @@ def parse_canon(text: str, arc_chord: float = ARC_CHORD) -> Program:
     return prog
 
 
+def read_back(ngc: Path, arc_chord: float = ARC_CHORD) -> Program:
+    """The program at ``ngc`` as LinuxCNC's interpreter runs it (:func:`parse_canon` of
+    ``rs274``'s output, beside it as ``.txt``), or read from its text by
+    :func:`parse_gcode` where rs274 is not installed."""
+    if RS274 is not None:
+        return parse_canon(run_rs274(ngc, Path(ngc).with_suffix(".txt")), arc_chord=arc_chord)
+    return parse_gcode(Path(ngc).read_text(), arc_chord=arc_chord)
+
+
 _WORD = re.compile(r"([A-Z])\s*([-+]?\d*\.?\d+)")
 
 
@@ -551,6 +560,51 @@ def part_height(triangles: np.ndarray, x: np.ndarray, y: np.ndarray, *, block: i
     near = heights_at(triangles, px, py).reshape(len(ii), EDGE_DIRECTIONS).min(axis=1)
     top[ii, jj] = np.minimum(top[ii, jj], near)
     return top
+
+
+def _cross2(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+
+
+def disc_top(triangles: np.ndarray, centres: np.ndarray, radius: float) -> np.ndarray:
+    """The highest point of the triangles over the disc of ``radius`` round each ``(x, y)``
+    of ``centres`` (-inf where none lies over it): a flat end's drop height, exact on the
+    triangles, where a height field sampled a cell apart misses a step between its nodes.
+    A plane's highest point over a triangle cut by a disc lies at a corner inside the disc,
+    where an edge crosses the circle, on the circle up the plane's slope, or (a level
+    triangle) anywhere, the centre among them."""
+    tri = np.asarray(triangles, float)
+    lo, hi = tri[..., :2].min(axis=1), tri[..., :2].max(axis=1)
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    r2 = radius * radius
+    out = np.full(len(centres), -np.inf)
+    for k, c in enumerate(np.asarray(centres, float)):
+        near = np.flatnonzero(np.all(lo <= c + radius, axis=1) & np.all(hi >= c - radius, axis=1))
+        if not near.size:
+            continue
+        t, n = tri[near], normal[near]
+        d = t[..., :2] - c
+        z = np.where((d * d).sum(-1) <= r2, t[..., 2], -np.inf).max(axis=1)
+        p, e = d, np.roll(d, -1, axis=1) - d
+        zp, ze = t[..., 2], np.roll(t[..., 2], -1, axis=1) - t[..., 2]
+        a, b, cc = (e * e).sum(-1), 2 * (p * e).sum(-1), (p * p).sum(-1) - r2
+        root = np.sqrt(np.maximum(b * b - 4 * a * cc, 0.0))
+        for sign in (-1.0, 1.0):
+            s = (-b + sign * root) / np.maximum(2 * a, 1e-300)
+            ok = (b * b - 4 * a * cc >= 0) & (a > 0) & (s >= 0) & (s <= 1)
+            z = np.maximum(z, np.where(ok, zp + s * ze, -np.inf).max(axis=1))
+        # on the circle up the slope, or the centre of a level triangle: kept if inside
+        level = np.abs(n[:, 2]) > 1e-12 * np.abs(n).max(axis=1)
+        g = -n[:, :2] / np.where(level, n[:, 2], 1.0)[:, None]
+        gl = np.hypot(g[:, 0], g[:, 1])
+        q = np.where((gl > 0)[:, None], radius * g / np.maximum(gl, 1e-300)[:, None], 0.0)
+        v0, v1, v2 = d[:, 0], d[:, 1], d[:, 2]
+        cross = [_cross2(v1 - v0, q - v0), _cross2(v2 - v1, q - v1), _cross2(v0 - v2, q - v2)]
+        inside = level & ((np.min(cross, axis=0) >= 0) | (np.max(cross, axis=0) <= 0))
+        zq = t[:, 0, 2] + ((q - v0) * g).sum(-1)
+        z = np.maximum(z, np.where(inside, zq, -np.inf))
+        out[k] = z.max()
+    return out
 
 
 def _disc_offsets(cutter: Cutter, h: float):

@@ -23,7 +23,7 @@ from dataclasses import replace
 
 import build123d as bd
 import numpy as np
-from stock_sim import RS274, Cutter, Program, Stock, _pieces, parse_canon, parse_gcode, run_rs274
+from stock_sim import Cutter, Program, Stock, _pieces, read_back
 
 import surfmod as sm
 from surfmod.cam.roughing import FEED, RAPID, Motion
@@ -68,10 +68,7 @@ def test_entries_come_down_clear_of_the_stock_left(tmp_path):
     assert down.sum() >= 3
     ngc = tmp_path / "rough.ngc"
     sm.export_gcode(job, ngc, post="linuxcnc")
-    if RS274 is not None:
-        prog = parse_canon(run_rs274(ngc, tmp_path / "rough.txt"), arc_chord=1e-4)
-    else:
-        prog = parse_gcode(ngc.read_text(), arc_chord=1e-4)
+    prog = read_back(ngc, arc_chord=1e-4)
     worst = judge_rapids(prog, Cutter("flat", R), Stock(job.stock, JUDGE_CELL), WIDER)
     assert worst <= 0, f"a rapid comes down within {WIDER} of stock, {worst:.3f} below its top"
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import build123d as bd
 import numpy as np
 import pytest
-from stock_sim import RS274, Cutter, Program, Stock, parse_canon, parse_gcode, part_height, run_rs274, simulate
+from stock_sim import Cutter, Program, Stock, part_height, read_back, simulate
 from test_cam_job_proof import rough_rest
 
 import surfmod as sm
@@ -39,22 +39,25 @@ def block():
     return part - slot - pocket - hole + island
 
 
+def rough_and_sweep(shape, rough: sm.Rough, margin: float, cell: float, folder):
+    """``sm.machine`` of ``rough`` alone, its LinuxCNC program read back and swept through
+    the tests' stock (``cell``): ``(job, stock, part top, simulation report, mesh
+    deflection, part triangles)``."""
+    job = sm.machine(shape, margin, [rough])
+    ngc = folder / "rough.ngc"
+    sm.export_gcode(job, ngc, post="linuxcnc")
+    prog = read_back(ngc, arc_chord=1e-4)
+    tri, deflection = part_triangles(shape, 0.01)
+    stock = Stock(job.stock, cell)
+    top = part_height(tri, stock.x, stock.y)
+    rep = simulate(Program([m for m in prog.moves if m.tool == 1]), {1: Cutter("flat", rough.tool.radius)}, stock, top)
+    return job, stock, top, rep, deflection, tri
+
+
 @pytest.fixture(scope="module")
 def roughed(tmp_path_factory):
-    shape = block()
-    job = sm.machine(shape, MARGIN, [sm.Rough(sm.Tool("flat", R, flute_length=30), stepdown=STEPDOWN, allowance=A,
-                                              stepover=STEPOVER)])
-    ngc = tmp_path_factory.mktemp("regions") / "rough.ngc"
-    sm.export_gcode(job, ngc, post="linuxcnc")
-    if RS274 is not None:
-        prog = parse_canon(run_rs274(ngc, ngc.with_suffix(".txt")), arc_chord=1e-4)
-    else:
-        prog = parse_gcode(ngc.read_text(), arc_chord=1e-4)
-    tri, deflection = part_triangles(shape, 0.01)
-    stock = Stock(job.stock, CELL)
-    top = part_height(tri, stock.x, stock.y)
-    rep = simulate(Program([m for m in prog.moves if m.tool == 1]), {1: Cutter("flat", R)}, stock, top)
-    return job, stock, top, rep, deflection
+    rough = sm.Rough(sm.Tool("flat", R, flute_length=30), stepdown=STEPDOWN, allowance=A, stepover=STEPOVER)
+    return rough_and_sweep(block(), rough, MARGIN, CELL, tmp_path_factory.mktemp("regions"))
 
 
 def test_the_hole_is_reported_left(roughed):
@@ -71,7 +74,7 @@ def test_the_hole_is_reported_left(roughed):
 
 
 def test_no_gouge_no_rapid_through_stock(roughed):
-    _, _, _, rep, deflection = roughed
+    _, _, _, rep, deflection, _ = roughed
     assert rep.gouge <= -A + deflection + 1e-4, str(rep)
     assert rep.rapid_cut <= 1e-9 and rep.rapid_part < 0 and rep.cut_without_spindle == 0, str(rep)
 
@@ -91,8 +94,8 @@ def test_entries_ramp_never_plunge(roughed):
 
 
 def test_every_other_region_is_cleared(roughed):
-    job, stock, top, _, _ = roughed
-    rest = rough_rest(stock, top, job.operations[0], CELL)
+    job, stock, top, _, _, tri = roughed
+    rest = rough_rest(stock, top, job.operations[0], CELL, tri)
     assert rest["share"] == 0, rest["share"]
     # the hole is the one place left: material over its floor, inside the reported area
     assert 0 < rest["left_area"] <= rest["declared_area"]
