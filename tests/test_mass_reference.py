@@ -517,6 +517,11 @@ AMBIGUOUS = {
     # Creo 2021: boundary_ambiguity 1.28e-4; 1.54e-9 from the Gauss-Kronrod rule (its error
     # 8e-12), 1.63e-9 from plain BRepGProp, 1.65e-9 from the refined reference
     ("asitus_SHIELD_INTEGRATED.stp", 0): 1.7e-9,
+    # OCCT's test part for its bug 27693 (ST-Developer 15): 60 of its 254 edges stray 1e-4
+    # to 9.2e-3 from their p-curves' images, boundary_ambiguity 9.3e-5; 2.85e-7 from the
+    # Gauss-Kronrod rule (its error 2.3e-11), 1.05e-7 from the refined reference (not
+    # settled: its last split moved the volume 7e-9), 9.0e-12 from plain BRepGProp
+    ("occt_cornetta.stp", 0): 2.9e-7,
 }
 
 
