@@ -56,6 +56,10 @@ job's stock, one tool after the other:
   out, the job reads it outward), 0.171 on trimesh_featuretype (77256), its eight Ø6.74
   through holes included (they were left full below z 16.7 until the waterline put fibers
   through the Ø6 ball's pits and the contours went below the flutes).
+  On occt_cornetta, issue 36's 280 mm mould, at the issue's tools (flat r = 12, ball
+  r = 9, S 0.09): 0.083 on its walls (39457 points), 0.082 on shallow and 0.092 on steep
+  ground; a ball placed against the side of its plate would stand below the stock's bottom
+  (the table): such wall points are not the tool's to reach.
   Roughing leaves at most 0.553 on cam_part's walls (allowance 0.5), 1.5-1.9 on the
   sloped walls of FOOT_BACK and TAIL_MIDDLE_PART, 2.66 on HEAD_BACK's sphere.  HEAD_BACK's
   two halves meet at x 250 in a ring step 0.01 mm high: a dexel grazing the sphere past it
@@ -75,7 +79,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy import ndimage
-from stock_sim import (RS274, Cutter, Program, Stock, _shifted, cutter_locations, disc_top, normal_residual,
+from stock_sim import (RS274, Cutter, Program, Stock, _placed, _shifted, cutter_locations, disc_top, normal_residual,
                        parse_canon, part_height, reach_map, reachable, run_rs274, side_grids, simulate,
                        surface_distance, vertex_normals, wall_left, wall_points, wall_reach)
 
@@ -233,6 +237,10 @@ def wall_check(walls, floor, stock: Stock, cutter: Cutter, left: np.ndarray, bou
     kw = dict(offset=offset, below=below, slack=slack)
     quick = reach_map(floor, CELL, cutter, offset=offset, slack=slack)
     reach = np.concatenate([wall_reach(w, floor, stock.x, stock.y, cutter, quick=quick, **kw) for w in walls])
+    # the tip stands on the stock's bottom at lowest (the table), also where the tool is
+    # placed beyond the stock's grid, where wall_reach sees no floor (a ball r 9 against
+    # the side of occt_cornetta's plate, 2 mm inside the stock's edge, 9 mm below it)
+    reach &= np.concatenate([_placed(w, cutter, offset)[:, 2] for w in walls]) >= stock.bottom - 1e-9
     over = reach & (left > bound)
     if over.any():
         k = np.cumsum([0] + [len(w) for w in walls])
@@ -384,16 +392,43 @@ def test_corpus_job_in_stock(tmp_path, corpus_dir, name):
 SMALL_TOOL_JOB = {"name": "f360grbl_gear.step", "R1": 1.0, "R2": 0.8, "SCALLOP": 0.02, "CELL": 0.1}
 
 
+def prove_with(settings: dict, corpus_dir: Path, tmp_path: Path, monkeypatch) -> dict:
+    """:func:`prove` on the corpus part ``settings["name"]`` with the module's tools, scallop
+    and cells set to the rest of ``settings``."""
+    settings = dict(settings)
+    name = settings.pop("name")
+    for key, value in settings.items():  # prove() reads the tools and the cells from here
+        monkeypatch.setitem(globals(), key, value)
+    got = prove(corpus_dir / name, tmp_path)
+    print(name, {k: v for k, v in got.items() if k not in ("job", "finish")})
+    return got
+
+
 @needs_rs274
 @pytest.mark.corpus
 def test_corpus_job_with_a_small_tool(tmp_path, corpus_dir, monkeypatch):
-    settings = dict(SMALL_TOOL_JOB)
-    name = settings.pop("name")
-    for key, value in settings.items():  # prove() reads the tools and the cell from here
-        monkeypatch.setitem(globals(), key, value)
-    got = prove(corpus_dir / name, tmp_path)
+    got = prove_with(SMALL_TOOL_JOB, corpus_dir, tmp_path, monkeypatch)
     fin = got["job"].operations[1].report
     # the ball reaches the tooth roots (their fillets are larger than it) and the floor
     # of the recess: most of the gear's top is judged shallow ground
     assert got["nodes"] > 50_000 and fin["stepover"] < 0.4, {k: v for k, v in got.items() if k != "job"}
-    print(name, {k: v for k, v in got.items() if k not in ("job", "finish")})
+
+
+#: issue 36's freeform mould: OCCT's test part for its bug 27693, 280 x 160 x 62 mm, a
+#: raised block of 74 B-spline faces with rounded walls on a plate, a recessed slot with
+#: two holes; a flat r = 12 roughs and a ball r = 9 finishes (4.3 and 3.2 % of its length,
+#: the issue's tools), the scallop 1 % of the ball's radius, the judge's stock cells 0.5 mm
+#: (a fifth of the 2.5 mm stepover) and its wall dexels 0.8 mm apart (at 0.4 the dexels
+#: would meet the moves 7.6e7 times, above the judge's 6e7)
+MOULD_JOB = {"name": "occt_cornetta.stp", "R1": 12.0, "R2": 9.0, "SCALLOP": 0.09, "CELL": 0.5, "SIDE_CELL": 0.8}
+
+
+@needs_rs274
+@pytest.mark.corpus
+def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
+    got = prove_with(MOULD_JOB, corpus_dir, tmp_path, monkeypatch)
+    # the plate and the block's top are judged shallow ground (26,247 nodes; the rest is
+    # within two ball radii of a wall), the block's rounded walls steep ground (5,323) and
+    # the walls through the dexels (39,457 points)
+    assert got["nodes"] > 20_000 and got["steep_nodes"] > 4_000 and got["wall_nodes"] > 30_000, \
+        {k: v for k, v in got.items() if k != "job"}
