@@ -79,9 +79,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy import ndimage
-from stock_sim import (RS274, Cutter, Program, Stock, _placed, _shifted, cutter_locations, disc_top, normal_residual,
-                       parse_canon, part_height, reach_map, reachable, run_rs274, side_grids, simulate,
-                       surface_distance, vertex_normals, wall_left, wall_points, wall_reach)
+from stock_sim import (RS274, Cutter, Program, Stock, _placed, _shifted, cutter_locations, disc_top,
+                       normal_residual, parse_canon, part_height, reach_map, reachable, run_rs274, side_grids,
+                       simulate, surface_distance, vertex_normals, wall_left, wall_points, wall_reach)
 
 import surfmod as sm
 from surfmod.inputs import to_shape
