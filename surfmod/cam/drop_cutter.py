@@ -97,6 +97,12 @@ class TriangleGrid:
         self._cells = cell_id[order]
         self._tris = tri_id[order]
 
+    @property
+    def listed(self) -> np.ndarray:
+        """The triangle of each cell-list entry (the lists one after the other, as
+        :meth:`segments` indexes them)."""
+        return self._tris
+
     def _cell_ids(self, xy: np.ndarray) -> np.ndarray:
         ij = np.floor((xy - self.origin) / self.cell).astype(np.int64)
         ok = np.all((ij >= 0) & (ij < self.shape), axis=1)

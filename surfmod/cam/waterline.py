@@ -36,6 +36,7 @@ after ``MAX_REFINE`` rounds (each halves the chord error's scale).
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from scipy.spatial import cKDTree
 
 from ..errors import SurfmodError
@@ -256,18 +257,50 @@ class _Fibers:
         out_q, out_lo, out_hi = [], [], []
         block = np.cumsum(np.maximum(stop - start, 0)) // PAIRS_PER_BLOCK
         cuts = np.r_[0, np.nonzero(np.diff(block))[0] + 1, len(o)]
+        # the triangle's box grown by R must meet the fiber's box, and reach above z
+        ext = np.abs(d) * reach[:, None] + self.R
         for s0, s1 in zip(cuts[:-1], cuts[1:]):
-            qi, ti = self.grid.pairs(o[s0:s1], start[s0:s1], stop[s0:s1])
-            qg = qi + s0
-            # the triangle's box grown by R must meet the fiber's box, and reach above z
-            ext = np.abs(d[qg]) * reach[qg, None] + self.R
-            keep = (self.top[ti] >= z) & np.all((o[qg] + ext >= self.lo[ti]) & (o[qg] - ext <= self.hi[ti]), axis=1)
-            qg, ti = qg[keep], ti[keep]
+            qg, ti = _segment_pairs(self.grid.listed, self.grid.lo, self.grid.hi, self.lo, self.hi, self.top,
+                                    float(z), o[s0:s1], ext[s0:s1], start[s0:s1], stop[s0:s1])
+            qg += s0
             self.refined += len(ti)
             lo, hi = pair_intervals(self.grid.rows, ti, o[qg, 0], o[qg, 1], d[qg, 0], d[qg, 1], z, self.cutter)
             hit = lo <= hi
             out_q.append(qg[hit]), out_lo.append(lo[hit]), out_hi.append(hi[hit])
         return np.concatenate(out_q), np.concatenate(out_lo), np.concatenate(out_hi)
+
+
+@njit(cache=True)
+def _segment_pairs(tris, grid_lo, grid_hi, lo, hi, top, z, o, ext, start, stop):
+    """``(fiber, triangle)`` of the cell-list entries ``start:stop`` of each fiber whose
+    box (``o ± ext``) meets the triangle's (x, y) box ``lo``..``hi``, whose middle ``o``
+    lies in the box the grid listed the triangle for, and whose top reaches ``z``.  Walked
+    twice (count, then fill) so that only the pairs kept are ever stored: on a metre part
+    under a 26 mm ball the lists hold thousands of triangles per fiber, of which a few
+    dozen are kept (the refinement of nist_ctc_02's contours spent half the job building
+    and filtering the full lists in numpy)."""
+    n = 0
+    for q in range(len(o)):
+        for e in range(start[q], stop[q]):
+            n += _near(tris[e], grid_lo, grid_hi, lo, hi, top, z, o[q], ext[q])
+    qi = np.empty(n, np.int64)
+    ti = np.empty(n, np.int64)
+    n = 0
+    for q in range(len(o)):
+        for e in range(start[q], stop[q]):
+            t = tris[e]
+            if _near(t, grid_lo, grid_hi, lo, hi, top, z, o[q], ext[q]):
+                qi[n] = q
+                ti[n] = t
+                n += 1
+    return qi, ti
+
+
+@njit(cache=True, inline="always")
+def _near(t, grid_lo, grid_hi, lo, hi, top, z, p, ext):
+    return (top[t] >= z and p[0] >= grid_lo[t, 0] and p[0] <= grid_hi[t, 0] and p[1] >= grid_lo[t, 1]
+            and p[1] <= grid_hi[t, 1] and p[0] + ext[0] >= lo[t, 0] and p[0] - ext[0] <= hi[t, 0]
+            and p[1] + ext[1] >= lo[t, 1] and p[1] - ext[1] <= hi[t, 1])
 
 
 def _components(qi, lo, hi):
