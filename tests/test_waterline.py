@@ -19,7 +19,7 @@ from ocl_reference import waterline as ocl_waterline
 from surfmod.cam.cutters import cutter
 from surfmod.cam.drop_cutter import TriangleGrid, drop, triangle_rows
 from surfmod.cam.fiber_contact import pair_intervals
-from surfmod.cam.waterline import _waterline, fiber_pairs, pit_lines, waterline
+from surfmod.cam.waterline import _Fibers, _waterline, fiber_pairs, pit_lines, waterline
 from surfmod.errors import SurfmodError
 
 CORPUS_PART = "trimesh_featuretype.STEP"
@@ -287,6 +287,36 @@ def test_fiber_intervals_are_where_the_dropped_tool_reaches_z(kind, R, r):
     inside = (ts[None, :] >= t0[:, None]) & (ts[None, :] <= t1[:, None])
     assert not np.any(inside & (h < z - 1e-9))
     assert not np.any(~inside & (h > z + 1e-9))
+
+
+@pytest.mark.parametrize("kind, R, r", [("ball", 1.5, 0.0), ("bull", 1.5, 0.6)])
+def test_fiber_query_meets_what_every_triangle_meets(kind, R, r):
+    """The refinement's fibers (short segments ``o ± reach d``) take their triangles from
+    the grid's lists in one compiled walk: the intervals found are exactly those of every
+    triangle in the soup met by brute force (pair_intervals on all of them, clipped to the
+    fiber), a fiber at a time.  Random triangles at random heights, fibers of random
+    length and direction over them, two levels."""
+    rng = np.random.default_rng(5)
+    n = 3000
+    centre = rng.random((n, 3)) * [60, 60, 8]
+    tri = centre[:, None, :] + rng.random((n, 3, 3)) * 3 - 1.5
+    fib = _Fibers(tri, cutter(kind, R, r), 4.0)
+    f = 400
+    o = rng.random((f, 2)) * 60
+    ang = rng.random(f) * 2 * np.pi
+    d = np.column_stack([np.cos(ang), np.sin(ang)])
+    reach = rng.uniform(0.05, 4.0, f)
+    for z in (2.0, 6.0):
+        qi, lo, hi = fib.query(o, d, z, reach)
+        got = {(int(q), round(float(a), 9), round(float(b), 9)) for q, a, b in zip(qi, lo, hi)
+               if a <= reach[q] and b >= -reach[q]}
+        want = set()
+        for q in range(f):
+            t0, t1 = intervals(tri, np.full(n, o[q, 0]), np.full(n, o[q, 1]), np.full(n, d[q, 0]),
+                               np.full(n, d[q, 1]), z, cutter(kind, R, r))
+            on = (t0 <= t1) & (t0 <= reach[q]) & (t1 >= -reach[q])
+            want |= {(q, round(float(a), 9), round(float(b), 9)) for a, b in zip(t0[on], t1[on])}
+        assert len(want) > 200 and got == want
 
 
 # --- OpenCAMLib ---------------------------------------------------------------------------------
