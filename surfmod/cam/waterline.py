@@ -212,6 +212,7 @@ class _Fibers:
         self.grid = TriangleGrid(triangles, self.R + reach)
         self.lo = triangles[:, :, :2].min(axis=1)
         self.hi = triangles[:, :, :2].max(axis=1)
+        self.boxes = np.ascontiguousarray(np.column_stack([self.lo, self.hi, self.top]))
         self.pairs = 0  # (fiber, triangle) pairs met so far on the grid lines: what fiber_pairs estimates
         self.refined = 0  # and by the refinement's fibers
 
@@ -260,8 +261,8 @@ class _Fibers:
         # the triangle's box grown by R must meet the fiber's box, and reach above z
         ext = np.abs(d) * reach[:, None] + self.R
         for s0, s1 in zip(cuts[:-1], cuts[1:]):
-            qg, ti = _segment_pairs(self.grid.listed, self.grid.lo, self.grid.hi, self.lo, self.hi, self.top,
-                                    float(z), o[s0:s1], ext[s0:s1], start[s0:s1], stop[s0:s1])
+            qg, ti = _segment_pairs(self.grid.listed, self.boxes, float(z), o[s0:s1], ext[s0:s1], start[s0:s1],
+                                    stop[s0:s1])
             qg += s0
             self.refined += len(ti)
             lo, hi = pair_intervals(self.grid.rows, ti, o[qg, 0], o[qg, 1], d[qg, 0], d[qg, 1], z, self.cutter)
@@ -271,36 +272,32 @@ class _Fibers:
 
 
 @njit(cache=True)
-def _segment_pairs(tris, grid_lo, grid_hi, lo, hi, top, z, o, ext, start, stop):
+def _segment_pairs(tris, boxes, z, o, ext, start, stop):
     """``(fiber, triangle)`` of the cell-list entries ``start:stop`` of each fiber whose
-    box (``o ± ext``) meets the triangle's (x, y) box ``lo``..``hi``, whose middle ``o``
-    lies in the box the grid listed the triangle for, and whose top reaches ``z``.  Walked
-    twice (count, then fill) so that only the pairs kept are ever stored: on a metre part
-    under a 26 mm ball the lists hold thousands of triangles per fiber, of which a few
-    dozen are kept (the refinement of nist_ctc_02's contours spent half the job building
-    and filtering the full lists in numpy)."""
+    box (``o ± ext``) meets the triangle's (x, y) box and whose top reaches ``z``
+    (``boxes``: a row per triangle, x0 y0 x1 y1 top, so that an entry reads one cache
+    line).  Only the pairs kept are returned: on a metre part under a 26 mm ball the
+    lists hold thousands of triangles per fiber, of which a few dozen are kept (the
+    refinement of nist_ctc_02's contours spent half the job building and filtering the
+    full lists in numpy).  The box grown by ``ext`` lies inside the one the grid listed
+    the triangle for (``ext`` is at most R + the grid's reach), so that is not tested."""
     n = 0
     for q in range(len(o)):
-        for e in range(start[q], stop[q]):
-            n += _near(tris[e], grid_lo, grid_hi, lo, hi, top, z, o[q], ext[q])
+        n += max(stop[q] - start[q], 0)
     qi = np.empty(n, np.int64)
     ti = np.empty(n, np.int64)
     n = 0
     for q in range(len(o)):
+        x0, x1 = o[q, 0] - ext[q, 0], o[q, 0] + ext[q, 0]
+        y0, y1 = o[q, 1] - ext[q, 1], o[q, 1] + ext[q, 1]
         for e in range(start[q], stop[q]):
             t = tris[e]
-            if _near(t, grid_lo, grid_hi, lo, hi, top, z, o[q], ext[q]):
+            b = boxes[t]
+            if b[4] >= z and x1 >= b[0] and x0 <= b[2] and y1 >= b[1] and y0 <= b[3]:
                 qi[n] = q
                 ti[n] = t
                 n += 1
-    return qi, ti
-
-
-@njit(cache=True, inline="always")
-def _near(t, grid_lo, grid_hi, lo, hi, top, z, p, ext):
-    return (top[t] >= z and p[0] >= grid_lo[t, 0] and p[0] <= grid_hi[t, 0] and p[1] >= grid_lo[t, 1]
-            and p[1] <= grid_hi[t, 1] and p[0] + ext[0] >= lo[t, 0] and p[0] - ext[0] <= hi[t, 0]
-            and p[1] + ext[1] >= lo[t, 1] and p[1] - ext[1] <= hi[t, 1])
+    return qi[:n], ti[:n]
 
 
 def _components(qi, lo, hi):
