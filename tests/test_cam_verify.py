@@ -419,6 +419,41 @@ def test_a_low_rib_along_the_raster_is_recut_and_both_judges_agree():
     assert abs(simulated - residual.worst) < 0.01, (simulated, residual.worst)
 
 
+def test_beside_a_step_at_a_walls_foot_the_repair_adds_passes_along_the_raster():
+    """A rib 2 mm high along x butting into a 65 degree wall the raster runs up, all tilted
+    8 degrees (no floor for a contour level): beside the rib, at the wall's foot, the
+    ground the ball leaves is its own side, made by one position at a corner of its
+    drop-cutter surface (HEAD_BACK's seam step, 0.215 against 0.166).  Cross passes alone
+    miss that position along the wall's slope and left 0.065 (limit 0.056); passes along
+    the raster between the finishing's hold it, and the tests' simulation agrees."""
+    from scipy import ndimage
+    from stock_sim import part_height, reachable
+
+    from surfmod.cam.drop_cutter import part_triangles
+
+    run = math.tan(math.radians(25.0)) * 10  # the wall's run over its 10 mm rise
+    wall = bd.extrude(bd.make_face(bd.Plane.XZ * bd.Polyline((0, 0), (run, 10), (20, 10), (20, 0), close=True)),
+                      amount=15, both=True)
+    low = (bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)
+    part = bd.Rot(0, 8, 0) * (bd.Box(40, 30, 5, align=low) + wall + bd.Pos(0, 4, 0) * bd.Box(40, 6, 7, align=low))
+    job = sm.machine(part, 1.0, [sm.Finish(sm.Tool("ball", 3.0), scallop=0.05)])
+    fin = job.operations[0]
+    residual = _finding(job.verification, "residual after")
+    assert fin.report["recut"]["before"] > 2 * residual.limit
+    assert job.verification.ok, str(job.verification)
+
+    stock = Stock(job.stock, 0.1)
+    tri, _ = part_triangles(job.part, 0.002)
+    top = part_height(tri, stock.x, stock.y)
+    simulate(parse_gcode(programs(job)[0]), {1: Cutter("ball", 3.0)}, stock, top)
+    reach = np.maximum(reachable(np.where(np.isfinite(top), top, job.stock[0, 2]), Cutter("ball", 3.0), 0.1), top)
+    gx, gy = np.gradient(reach, 0.1)
+    cos = 1 / np.sqrt(1 + gx * gx + gy * gy)
+    judged = ndimage.binary_erosion(np.isfinite(top), iterations=2) & (cos > math.cos(math.radians(60)))
+    simulated = float(((stock.top - reach) * cos)[judged].max())
+    assert simulated <= residual.limit + 0.005, simulated
+
+
 def test_a_rapid_through_the_stock_is_relinked_over_it(job):
     """A rapid across the uncut block (the roughing's motion doctored as the issue's
     keyboard case came out) is found, then re-linked by sm.machine's repair: up to the safe

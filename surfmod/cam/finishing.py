@@ -647,7 +647,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
 
 
 def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, tolerance: float,
-          stock: np.ndarray, safe: float, rest: Leftover | None, over: float = 1.0):
+          stock: np.ndarray, safe: float, rest: Leftover | None, over: float = 1.0, raster=None):
     """Cross passes over the regions a finishing left too much on: a drop-cutter raster
     across ``direction`` over each box ``(x0, y0, x1, y1)`` grown by the tool radius, each
     entered and left as the finishing's raster is.  Returns the :class:`Motion` (from and
@@ -660,24 +660,46 @@ def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, to
     ``s²/(8(ρ - c))`` (see the module), unbounded where the ground is the tool's own
     closing: over a hole a ball dips into (Analysis Situs' nist_ctc_02, ball r 26 over
     holes of r 7.5) passes at the finishing's spacing left 1.91 mm against 0.29, cross
-    passes at 0.71 of it still 0.32."""
+    passes at 0.71 of it still 0.32.
+
+    With the finishing's ``raster`` (its :class:`~surfmod.cam.toolpath.Toolpath`), passes
+    along ``direction`` between its passes over each box are added too, each gap split in
+    ``max(2, ceil(2 sqrt(over)))``.  Where a
+    raster pass turns from shallow ground up a wall it runs up, the ground the tool leaves
+    beside the turn is its ball's side (HEAD_BACK beside its seam's step: the surface the
+    tool reaches there slopes 43 degrees, formed by one ball position at a corner of the
+    drop-cutter surface).  There the rest grows with the passes' distance from that
+    position: linearly for cross passes (they miss it along the wall's slope), only
+    quadratically for passes along the raster (they miss it sideways)."""
     other = "y" if direction == "x" else "x"
     top = _StockTop(part, tool, rest, stock, safe)
     allowed = tolerance - part.deflection + part.lift
+    axis = 1 if direction == "x" else 0
+    between = None
+    if raster is not None and raster.n_passes > 1:
+        # each gap split in n: the rest there falls with the square of the passes' distance
+        n = max(2, math.ceil(2.0 * math.sqrt(over)))
+        done = _path_across(raster)
+        between = (done[:-1, None] + np.diff(done)[:, None] * np.arange(1, n) / n).ravel()
     out, passes = Moves(), 0
     for x0, y0, x1, y1 in _merged(np.asarray(boxes, float).reshape(-1, 4), tool.radius):
         bounds = np.array([[x0, y0], [x1, y1]])
-        try:
-            # passes closer by cos 45°: the cusps hold on slopes across them up to the
-            # waterline's threshold (the finishing's raster adapts its spacing; these do not)
-            path = raster_path(part, tool, stepover * RECUT_SHARE / min(max(math.sqrt(over), 1.0), 4.0),
-                               tool.radius / 4, other, bounds, tolerance)
-        except SurfmodError as exc:
-            if str(exc).startswith("bounds:"):
-                continue  # the tool touches no face there
-            raise
-        _add_raster(out, path.points, top, part, tool, safe, allowed, "a cross pass's entry")
-        passes += path.n_passes
+        # passes closer by cos 45°: the cusps hold on slopes across them up to the
+        # waterline's threshold (the finishing's raster adapts its spacing; these do not)
+        runs = [(other, stepover * RECUT_SHARE / min(max(math.sqrt(over), 1.0), 4.0), None)]
+        if between is not None:
+            inside = between[(between >= bounds[0, axis]) & (between <= bounds[1, axis])]
+            if len(inside):
+                runs.append((direction, stepover, inside))
+        for way, step, across in runs:
+            try:
+                path = raster_path(part, tool, step, tool.radius / 4, way, bounds, tolerance, across=across)
+            except SurfmodError as exc:
+                if str(exc).startswith("bounds:"):
+                    continue  # the tool touches no face there
+                raise
+            _add_raster(out, path.points, top, part, tool, safe, allowed, "a cross pass's entry")
+            passes += path.n_passes
     return out.motion(), passes
 
 

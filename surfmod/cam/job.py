@@ -310,7 +310,7 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     op, (spec, part, rest) = job.operations[k], finishing[k]
     extra, passes = recut(part, op.tool, found.boxes, stepover=float(op.report["stepover"]), direction=spec.direction,
                           tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest,
-                          over=found.worst / found.limit)
+                          over=found.worst / found.limit, raster=op.report.get("toolpath"))
     if passes == 0:
         return job
     extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
