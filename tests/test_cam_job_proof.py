@@ -96,9 +96,10 @@ ROUNDING = 1e-4
 KNOWN_SHORT = {
     "stepcode_HEAD_BACK.stp": (
         "finishing leaves 0.276 normal to steep ground (bound S + tol + lift 0.244) at (228.25, 52.75, 18.06), "
-        "slope 72 deg, where the job's own verifier finds its walls within 0.127 (its residual is broken elsewhere: "
-        "0.215 at (193.7, -2.0), beside the seam's 3 mm step along x); its roughing passes since rough_rest judges "
-        "the nodes its grid leaves on the exact triangles (the seams at y 0 and x 250)"),
+        "slope 72 deg, where the job's own verifier finds its walls within 0.124 and exits 0 (residual 0.141, "
+        "limit 0.166, since the repair passes along the raster beside the seam's step); its wall dexels are 1.03 mm "
+        "apart there, capped, against 0.333 asked; its roughing passes since rough_rest judges the nodes its grid "
+        "leaves on the exact triangles (the seams at y 0 and x 250)"),
 }
 
 #: corpus parts (20-150 mm, pockets and holes)
