@@ -47,6 +47,35 @@ def merged(meshes: list[Mesh]) -> Mesh:
     return Mesh(np.concatenate(verts), np.concatenate(faces), info)
 
 
+def as_written(mesh: Mesh) -> Mesh:
+    """``mesh`` as an STL holds it: the triangles whose corners float32 makes equal (the
+    file stores float32, and a reader finds them degenerate) are left out, with their
+    groups' counts and face labels.  OCCT's test part for its bug 27693 meshes two nodes
+    of one face 4e-14 apart: written as they were, the STL held 4 degenerate facets that
+    admesh removes.  The mesh in double keeps them (a weld at float32 would move nodes by
+    up to half a float32 step and change what gmsh fills).
+
+    >>> m = Mesh(np.array([[0., 0, 0], [1, 0, 0], [1 + 4e-14, 0, 0], [0, 1, 0]]), np.array([[0, 1, 3], [1, 2, 3]]),
+    ...          {"stl_groups": [("solid 1", 2, np.array([7, 8]))]})
+    >>> w = as_written(m)
+    >>> w.triangles().tolist(), w.info["stl_groups"][0][1], w.info["stl_groups"][0][2].tolist()
+    ([[0, 1, 3]], 1, [7])
+    """
+    tri = mesh.triangles()
+    c = mesh.vertices.astype(np.float32)[tri]
+    gone = (np.all(c[:, 0] == c[:, 1], axis=1) | np.all(c[:, 1] == c[:, 2], axis=1)
+            | np.all(c[:, 0] == c[:, 2], axis=1))
+    if not gone.any():
+        return mesh
+    info, groups, start = dict(mesh.info), [], 0
+    for name, count, faces in info.get("stl_groups", [(None, len(tri), None)]):
+        keep = ~gone[start:start + count]
+        groups.append((name, int(keep.sum()), None if faces is None else np.asarray(faces)[keep]))
+        start += count
+    info["stl_groups"] = groups
+    return Mesh(mesh.vertices, tri[~gone], info)
+
+
 def facet_normals(tri: np.ndarray) -> np.ndarray:
     """Unit normals (float32) of triangles ``(T, 3, 3)`` as an STL reader recomputes and
     checks them: from the vertices rounded to float32 (what the file holds), edge vectors
@@ -130,7 +159,7 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
     items = list(objects) if isinstance(objects, (list, tuple)) else [objects]
     if not items:
         raise SurfmodError("objects: nothing to export")
-    mesh = merged([_mesh_of(o, tolerance, strict, progress) for o in items])
+    mesh = as_written(merged([_mesh_of(o, tolerance, strict, progress) for o in items]))
     meshed = any(not isinstance(o, Mesh) for o in items)
     with atomic_path(target) as tmp:
         problems, finer_may_close = _written(tmp, mesh, ascii)
@@ -139,7 +168,7 @@ def export_stl(objects, path, tolerance: float = 0.01, *, ascii: bool = False, s
         # a solid is open or a face was mis-meshed; orientation is not the mesh's to fix
         for fraction in REMESH if problems and finer_may_close and meshed else ():
             try:
-                finer = merged([_mesh_of(o, tolerance * fraction, strict, progress) for o in items])
+                finer = as_written(merged([_mesh_of(o, tolerance * fraction, strict, progress) for o in items]))
             except SurfmodError:  # past max_triangles: the first mesh stays, reported
                 break
             left, finer_may_close = _written(tmp, finer, ascii)

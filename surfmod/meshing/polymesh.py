@@ -93,33 +93,22 @@ def weld(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.nd
     """Merge vertices with identical coordinates and drop the triangles that collapse.
 
     BRepMesh repeats the nodes of a shared edge in every face's triangulation, bit for
-    bit, so exact equality is the right test (no distance threshold to choose): equality
-    of the float32 coordinates an STL holds, since a reader joins what the file makes
-    equal.  OCCT's test part for its bug 27693 meshes two nodes 4e-14 apart in one face:
-    welded only where bit-equal they left two facets whose corners the STL makes equal
-    (degenerate, what admesh removes).  A merged vertex keeps the coordinates of one of
-    its nodes.
+    bit, so exact equality is the right test (no distance threshold to choose).
 
     >>> v, t = weld(np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0]]),
     ...             np.array([[0, 1, 2], [3, 4, 2]]))
     >>> len(v), t.tolist()
     (4, [[0, 2, 1], [2, 3, 1]])
-    >>> v, t = weld(np.array([[0., 0, 0], [1, 0, 0], [1 + 4e-14, 0, 0], [0, 1, 0]]),
-    ...             np.array([[0, 1, 3], [1, 2, 3]]))
-    >>> len(v), t.tolist()
-    (3, [[0, 2, 1]])
     """
     # np.unique(axis=0)'s result (rows in lexicographic order) at half its cost: one
-    # lexsort, then a new vertex wherever a sorted row differs from the one before;
-    # sorted by the float32 rows first, so rows equal there are neighbours
-    key = vertices.astype(np.float32)
-    order = np.lexsort(np.vstack([vertices.T[::-1], key.T[::-1]]))
-    rows = key[order]
+    # lexsort, then a new vertex wherever a sorted row differs from the one before
+    order = np.lexsort(vertices.T[::-1])
+    rows = vertices[order]
     new = np.ones(len(rows), bool)
     new[1:] = np.any(rows[1:] != rows[:-1], axis=1)
     inverse = np.empty(len(rows), np.int64)
     inverse[order] = np.cumsum(new) - 1
-    unique = vertices[order][new]
+    unique = rows[new]
     tri = inverse[triangles]
     keep = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
     return unique, tri[keep]
