@@ -664,9 +664,8 @@ def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, to
 
     With the finishing's ``raster`` (its :class:`~surfmod.cam.toolpath.Toolpath`), passes
     along ``direction`` between its passes over each box are added too, each gap split in
-    ``max(2, ceil(2 sqrt(over)))``.  Where a
-    raster pass turns from shallow ground up a wall it runs up, the ground the tool leaves
-    beside the turn is its ball's side (HEAD_BACK beside its seam's step: the surface the
+    ``max(2, ceil(2 sqrt(over)))``.  Where a raster pass turns from shallow ground up a
+    wall it runs up, the ground the tool leaves beside the turn is its ball's side (HEAD_BACK beside its seam's step: the surface the
     tool reaches there slopes 43 degrees, formed by one ball position at a corner of the
     drop-cutter surface).  There the rest grows with the passes' distance from that
     position: linearly for cross passes (they miss it along the wall's slope), only
