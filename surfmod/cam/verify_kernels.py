@@ -214,7 +214,8 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
 
     With ``remove``, a move marked ``skip`` or whose body goes deeper than ``limit[tool]``
     into the stock (a negative limit: comes nearer it than that) cuts nothing (its stamps
-    undone) and is reported removed, so later moves meet the stock it left; so is a rapid whose end goes deeper than ``slack[tool]`` into it.
+    undone) and is reported removed, so later moves meet the stock it left; so is a rapid
+    whose end goes deeper than ``slack[tool]`` into it.
     The first feed move after a removed one is reached by a plunge straight down onto its
     start (:func:`surfmod.cam.holder.relink`), through the stock the removed moves left: the
     body is measured along that plunge too (the end's own column aside: the flutes cut it on

@@ -14,9 +14,9 @@ whose nodes differ, joined cell by cell (marching squares, the material kept on 
 left) into closed loops; where a fiber runs along the contour (a straight wall's offset)
 and the line across sees no boundary within an edge, the crossing is the node it
 disagrees on (:func:`_line_crossings`).  A loop is found only where a node of the grid
-lies inside it: a hole a little wider than the tool leaves it a pit narrower than the spacing, which
-uniform fibers miss at every level, so one more fiber in x and one in y pass through the
-middle of every pit (:func:`pit_lines`); then every chord whose midpoint lies farther than
+lies inside it: a hole a little wider than the tool leaves it a pit narrower than the
+spacing, which uniform fibers miss at every level, so one more fiber in x and one in y pass
+through the middle of every pit (:func:`pit_lines`); then every chord whose midpoint lies farther than
 ``tolerance`` from the true contour (measured along a fiber normal to the chord) gets
 that exact point inserted, until none does.  A chord can still cross a notch of the
 contour whose middle it misses; :class:`ContourPoints` splits given chords at exact
