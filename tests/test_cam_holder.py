@@ -9,6 +9,7 @@ tests' own G-code reader, :mod:`stock_sim`), not the package's checks.
 
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import build123d as bd
 import numpy as np
@@ -220,6 +221,32 @@ def test_verifier_finds_a_holder_too_low(short_job, tmp_path):
         # the verifier's probes grow the disc by half their spacing: as deep or a little deeper
         assert exact - 1e-3 <= f.worst <= exact + 0.05, (str(f), exact)
         assert f.where is not None and f.line > 0
+
+
+def test_a_wall_is_cut_down_to_where_the_holder_lets_the_tool_go():
+    """cam_part as ``python -m benchmarks cam`` machines it: ball r 3 with its holder
+    (r 7.5) 24 mm above the tip.  Beside the part's x = 80 wall the holder passes over the
+    mould's top (the part 23.7 high within its radius, the job's stock model 23.87 after
+    the raster): the job leaves out the wall's two lowest contours (tips 0 and 0.015) for
+    y 22.5-34.5, and the next level stands at 1.64, so 0.30 mm was left on the wall at
+    z 3.36, which the tool reaches with its tip at 0.36 (the holder 0.29 above the part).
+    The contour again at the lowest height the holder allows there (tip 0.04) cuts it:
+    every promise holds."""
+    part = Path(__file__).resolve().parent.parent / "step_samples" / "cam_part.step"
+    job = sm.machine(str(part), 2.0, [sm.Rough(sm.Tool("flat", 5.0), stepdown=5.0, allowance=0.5),
+                                      sm.Finish(sm.Tool("ball", 3.0), scallop=0.15)])
+    walls = next(f for f in job.verification.findings if f.what.startswith("residual on walls"))
+    assert walls.worst < 0.02 and job.verification.ok, "\n".join(job.verification.lines())
+    fin = job.operations[1]
+    assert fin.report["waterline"]["at_reach"] == 1
+    # the contour at the holder's reach: the wall's (x = 80 + r + margin) beside the held
+    # moves, above the tips left out by no more than the model's cusps ask
+    p = fin.motion.points
+    at = p[(np.abs(p[:, 0] - 83.0079) < 1e-3) & (np.abs(p[:, 1] - 32.0) < 2.5)]
+    low = at[:, 2].min()
+    assert 0.0154 < low < 0.06, np.unique(at[:, 2])
+    # what the holder still keeps the tool from: the stock's last 0.04 on the table beside the wall
+    assert fin.report["holder"].thickness < 0.05
 
 
 def test_a_rim_between_the_model_nodes_is_met():

@@ -52,6 +52,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import ndimage
+from scipy.spatial import cKDTree
 
 from ..errors import SurfmodError
 from .cutters import Flat
@@ -702,6 +703,32 @@ def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, to
     return out.motion(), passes
 
 
+def reach_contours(part: _Part, tool: Tool, groups, *, spacing: float, steep_angle: float, tolerance: float,
+                   stock: np.ndarray, safe: float, rest: Leftover | None):
+    """One waterline level per group ``(z, moves)`` of :func:`surfmod.cam.holder.reach_levels`
+    (where the job's holder check left contours out, the lowest height the shank and holder
+    let the tool cut there), its steep pieces kept within the tool's radius, and the rise,
+    of the moves left out; linked, entered and left as the finishing's contours.  Returns
+    the :class:`Motion` (from and back to the clearance height)."""
+    top = _StockTop(part, tool, rest, stock, safe)
+    out = Moves()
+    for z, moves in groups:
+        ends = moves[:, :, :2]
+        n = np.maximum(np.ceil(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1) / (tool.radius / 4)), 1).astype(int)
+        t = np.concatenate([np.linspace(0.0, 1.0, k + 1) for k in n])
+        xy = np.repeat(ends[:, 0], n + 1, axis=0) + t[:, None] * np.repeat(ends[:, 1] - ends[:, 0], n + 1, axis=0)
+        reach = tool.radius + z - float(moves[:, 0, 2].min())
+        tree = cKDTree(xy)
+
+        def keep(p, _z, tree=tree, reach=reach):
+            return tree.query(p, distance_upper_bound=reach)[0] <= reach
+
+        contour_moves(out, part, tool, top, safe, steep_angle, spacing, tolerance, z, highest=z, keep=keep,
+                      box=[xy.min(axis=0) - reach, xy.max(axis=0) + reach])
+    judge_links(part, out, tolerance - part.deflection + part.lift, "finishing")
+    return out.motion()
+
+
 def _merged(boxes: np.ndarray, grow: float) -> list:
     """The boxes grown by ``grow``, overlapping ones merged into their common box until
     none overlap (each merge removes a box, so at most ``len(boxes)`` rounds)."""
@@ -749,6 +776,8 @@ def summary_lines(report: dict) -> list[str]:
                      f"{w['contours']} contours, length {w['length']:.0f} mm"
                      + (f", {w['split']} chords split at the contour where they would cut the part"
                         if w.get("split") else "")
+                     + (f", {w['at_reach']} more level(s) where the holder kept contours out, at the lowest "
+                        "it lets the tool cut" if w.get("at_reach") else "")
                      + (f"; fibers {w['sampling']:.3g} mm apart, spread from half the tool radius to fit the "
                         "waterline's cap" if w.get("sampling") else ""))
     elif w is not None:

@@ -29,6 +29,9 @@ crosses, and comes straight down at the plunge feed onto the start of the next m
 not what the operation's own ramps and helices were laid out for).  What the removed moves
 would have cut is left, and reported (:class:`Held`): the (x, y) area where more than the
 tolerance is left, the deepest point they would have reached and the thickness left.
+Where the moves left out are a waterline contour's (at one height), :func:`reach_levels`
+says how high the tool must stand there for its body to clear, and the job contours
+those places again at that height (:func:`surfmod.cam.finishing.reach_contours`).
 
 The work is counted before it starts: probes along the moves (at most
 :data:`MAX_HOLDER_PROBES`, else they stand farther apart and the discs grow with them, a
@@ -37,7 +40,7 @@ more cautious check) and stock nodes (at most :data:`MAX_STOCK_NODES`, else coar
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -57,6 +60,10 @@ PROBES_PER_RADIUS = 16
 #: cylinders OCCT's exact distance settles per operation, and the gap it must find
 EXACT_CONFIRMS = 200
 EXACT_GAP = 1e-7
+#: contours again where the check left one out (:func:`reach_levels`): at most this many
+#: levels, each this far (mm) above the lowest height the body clears
+MAX_REACH_LEVELS = 16
+REACH_MARGIN = 1e-4
 
 
 @dataclass(frozen=True)
@@ -69,6 +76,8 @@ class Held:
     area: float
     deepest: tuple
     thickness: float
+    #: the cutting moves left out, ``(K, 2, 3)`` (start and end of each)
+    cuts: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def __str__(self) -> str:
         x, y, z = self.deepest
@@ -82,25 +91,28 @@ def body_stock(stock: np.ndarray, smallest_radius: float) -> StockModel:
     return StockModel(stock, body_cell(stock, smallest_radius), MAX_STOCK_NODES)
 
 
-def _sweep_body(stock: StockModel, pts: np.ndarray, rapid: np.ndarray, tool, slack: float, skip: np.ndarray,
-                cusp: float):
-    """``stock`` swept along ``pts`` with the moves whose body meets it (or ``skip``) undone:
-    :func:`~surfmod.cam.verify_kernels.sweep_body`'s ``removed``.  The model samples the
-    stock a cell apart, coarser than the verifier's: a disc wider than the end is grown by
-    a cell, so that an edge of stock between the nodes its rim passes is met too (on
-    zoo's flange-xy, 0.875 mm cells let a holder pass 4.7 mm into a level's step that the
-    verifier's 0.245 mm cells found).  Nor does it see the cusps finer passes left
-    between its nodes: a disc must clear the model by ``cusp`` (on flange-xy the
-    finishing's holder passed 0.008 mm over the finished top, into its 0.033 mm cusps)."""
-    m = len(pts) - 1
+def _sweep_body(stock: StockModel, a: np.ndarray, b: np.ndarray, rapid: np.ndarray, tool, slack: float,
+                skip: np.ndarray, cusp: float, remove: bool = True):
+    """``stock`` swept along the moves ``a -> b`` with the moves whose body meets it (or
+    ``skip``) undone: :func:`~surfmod.cam.verify_kernels.sweep_body`'s ``(sink, removed)``
+    (without ``remove``, the model is left as it is and ``sink`` measures every move).
+    The model samples the stock a cell apart, coarser than the verifier's: a disc wider
+    than the end is grown by a cell, so that an edge of stock between the nodes its rim
+    passes is met too (on zoo's flange-xy, 0.875 mm cells let a holder pass 4.7 mm into a
+    level's step that the verifier's 0.245 mm cells found).  Nor does it see the cusps
+    finer passes left between its nodes: a disc must clear the model by ``cusp`` (on
+    flange-xy the finishing's holder passed 0.008 mm over the finished top, into its
+    0.033 mm cusps)."""
+    m = len(a)
     discs = tool.body[None, :, :2].copy()
     wider = discs[..., 0] > tool.radius + slack
     discs[..., 0][wider] += stock.cell
-    *_, removed = sweep_body(stock.top, float(stock.lo[0]), float(stock.lo[1]), stock.cell,
-                             np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:]), rapid,
-                             np.full(m, tool.radius), np.full(m, tool.corner), stock.cell / 2, discs,
-                             np.zeros(m, np.int64), np.array([float(slack)]), np.array([-float(cusp)]), skip, True, 0.0)
-    return removed
+    *_, sink, _, removed = sweep_body(stock.top if remove else stock.top.copy(), float(stock.lo[0]),
+                                      float(stock.lo[1]), stock.cell, np.ascontiguousarray(a),
+                                      np.ascontiguousarray(b), rapid, np.full(m, tool.radius),
+                                      np.full(m, tool.corner), stock.cell / 2, discs, np.zeros(m, np.int64),
+                                      np.array([float(slack)]), np.array([-float(cusp)]), skip, remove, 0.0)
+    return sink, removed
 
 
 def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float, shape=None):
@@ -223,24 +235,27 @@ def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, d
     holder would touch the part (``triangles``, and ``shape`` for the close calls) or come
     within ``cusp`` of the stock (the highest cusp the passes so far leave between the
     model's nodes) removed and relinked (:func:`relink`), and what that leaves
-    (:class:`Held`; None where nothing more than the tolerance is left, the links replaced
-    included)."""
+    (:func:`left_out`)."""
     pts = np.asarray(motion.points, float)
     if len(pts) < 2:
         return motion, None
     rapid = motion.kind[1:] == RAPID
     skip = part_sink(triangles, deflection, tool, pts, slack, shape) > 0.0
-    removed = _sweep_body(stock, pts, rapid, tool, slack, skip, cusp)
+    _, removed = _sweep_body(stock, pts[:-1], pts[1:], rapid, tool, slack, skip, cusp)
     if not removed.any():
         return motion, None
-    kept = relink(motion, removed, safe)
-    # what the removed cuts would have taken beyond the stock the kept moves leave (links
-    # replaced by the relinking leave nothing)
-    cuts = removed & ~rapid
-    if not cuts.any():
-        return kept, None
+    cuts = removed & ~rapid  # links replaced by the relinking leave nothing
+    return relink(motion, removed, safe), left_out(stock, tool, pts[:-1][cuts], pts[1:][cuts], int(removed.sum()),
+                                                   slack)
+
+
+def left_out(stock: StockModel, tool, a: np.ndarray, b: np.ndarray, moves: int, slack: float) -> Held | None:
+    """What the cutting moves ``a -> b`` left out (of ``moves`` removed in all) would have
+    taken beyond the stock as the model holds it now (None where no more than ``slack``);
+    the sweep is a minimum, so this may be asked again after more moves are swept."""
+    if not len(a):
+        return None
     would = stock.top.copy()
-    a, b = pts[:-1][cuts], pts[1:][cuts]
     n = len(a)
     sweep_stock(would, float(stock.lo[0]), float(stock.lo[1]), stock.cell, np.ascontiguousarray(a),
                 np.ascontiguousarray(b), np.zeros(n, np.bool_), np.full(n, tool.radius), np.full(n, tool.corner),
@@ -248,7 +263,43 @@ def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, d
     left = stock.top - would
     over = left > slack
     if not over.any():  # the moves left out would have taken no more than the tolerance
-        return kept, None
+        return None
     i, j = np.unravel_index(int(np.argmin(np.where(over, would, np.inf))), would.shape)
     deepest = (float(stock.x[i]), float(stock.y[j]), float(would[i, j]))
-    return kept, Held(int(removed.sum()), float(over.sum()) * stock.cell ** 2, deepest, float(left[over].max()))
+    return Held(moves, float(over.sum()) * stock.cell ** 2, deepest, float(left[over].max()),
+                np.stack([a, b], axis=1))
+
+
+def reach_levels(held: Held, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
+                 cusp: float, window: float) -> list:
+    """Where the check left out moves at constant height (a waterline contour's), the
+    lowest heights the tool can cut there: each move raised by how far the stock model
+    (by ``cusp`` too) or the part stands above its discs' bottoms, the moves grouped by
+    that height, a group at most ``window`` deep (else the window doubles until at most
+    :data:`MAX_REACH_LEVELS` groups are left) and cut at its highest.  Returns ``(z,
+    moves)`` pairs, lowest first, ``moves`` the group's ``(K, 2, 3)`` moves as left out."""
+    if held is None or held.cuts is None:
+        return []
+    cuts = held.cuts[np.abs(held.cuts[:, 0, 2] - held.cuts[:, 1, 2]) <= 1e-9]
+    if not len(cuts):
+        return []
+    a, b = cuts[:, 0], cuts[:, 1]
+    sink, _ = _sweep_body(stock, a, b, np.zeros(len(a), np.bool_), tool, slack, np.zeros(len(a), np.bool_), cusp,
+                          remove=False)
+    # the part below the discs: each move alone (the polyline a0 b0 a1 b1 ...: its even moves)
+    part = part_sink(triangles, deflection, tool, cuts.reshape(-1, 3), slack)[::2]
+    up = np.maximum(sink + cusp, part)
+    z = a[:, 2] + up + REACH_MARGIN
+    ok = np.isfinite(up) & (up > 0.0)
+    z, cuts = z[ok], cuts[ok]
+    order = np.argsort(z)
+    z, cuts = z[order], cuts[order]
+    while True:
+        groups, start = [], 0
+        while start < len(z):
+            end = int(np.searchsorted(z, z[start] + window, "right"))
+            groups.append((float(z[end - 1]), cuts[start:end]))
+            start = end
+        if len(groups) <= MAX_REACH_LEVELS:
+            return groups
+        window *= 2.0

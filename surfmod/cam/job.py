@@ -22,8 +22,8 @@ from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
 from .cycle_time import cycle_time, feed_time
-from .finishing import Leftover, clear_part, finish, recut
-from .holder import body_stock, clear_body, relink
+from .finishing import Leftover, clear_part, finish, reach_contours, recut
+from .holder import body_stock, clear_body, left_out, reach_levels, relink
 from .machine_table import MACHINE, Machine
 from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_moves, rest_part_top
 from .rest import summary_line as rest_summary
@@ -338,6 +338,32 @@ def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape,
     return motion, held
 
 
+def _at_reach(motion, held, tool, stock_model, part, report, stock, safe, rest, shape, cusp):
+    """Where the holder check left waterline contours out, those contours again at the
+    lowest height the shank and holder let the tool cut there (on cam_part a holder over
+    the mould's top left out the foot of the outer wall's contours, the next level 1.6 mm
+    up: 0.30 mm left on a wall the tool reaches), themselves held and appended; returns
+    the motion and what is left out in all."""
+    w = report.get("waterline")
+    if held is None or not w or not w["levels"]:
+        return motion, held
+    tolerance = float(report["tolerance"])
+    groups = reach_levels(held, tool, stock_model, part.grid.triangles, part.deflection, tolerance, cusp,
+                          w["spacing"] / 2)
+    if not groups:
+        return motion, held
+    extra = reach_contours(part, tool, groups, spacing=w["spacing"], steep_angle=report["steep_angle"],
+                           tolerance=tolerance, stock=stock, safe=safe, rest=rest)
+    if not np.any(extra.kind != RAPID):
+        return motion, held
+    extra, again = clear_body(extra, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe, shape,
+                              cusp)
+    cuts = held.cuts if again is None else np.concatenate([held.cuts, again.cuts])
+    held = left_out(stock_model, tool, cuts[:, 0], cuts[:, 1], held.moves + (again.moves if again else 0), tolerance)
+    w["at_reach"] = len(groups)
+    return Motion(np.concatenate([motion.points, extra.points]), np.concatenate([motion.kind, extra.kind])), held
+
+
 #: how far (mm) a move the verifier read from the program may lie from the motion it was
 #: written from: the posts write 4 decimals
 PROGRAM_ROUNDING = 1e-3
@@ -538,8 +564,11 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, progress)
                     tolerance = float(report["tolerance"])
                     # its own cusps too: a holder coming down beside the part passes over them
+                    cusp = max(cusp_clearance(done), float(report["scallop"]) + tolerance)
                     motion, held = _held(motion, tool, stock_model, finish_part, tolerance, safe, strict, "finishing",
-                                         shape, max(cusp_clearance(done), float(report["scallop"]) + tolerance))
+                                         shape, cusp)
+                    motion, held = _at_reach(motion, held, tool, stock_model, finish_part, report, stock, safe, rest,
+                                             shape, cusp)
                 finishing[k] = (op, finish_part, rest)
                 report["holder"] = held
                 name = "finishing"
