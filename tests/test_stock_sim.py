@@ -174,6 +174,31 @@ def test_part_height_does_not_lift_a_hole_onto_a_chord():
     assert np.all(np.isinf(top[:2])) and np.all(top[2:] == 2.0)
 
 
+def test_part_height_keeps_a_steep_face_under_overlapping_sheets():
+    """stepcode_HEAD_BACK's 72° slope at (228.25, 52.75): a face (its face 3), a copy of
+    it turned the other way 1 µm above (face 11) and a sheet 1 mm below along the normal
+    (face 2, hidden), on a grid 0.25 apart with the mesh's deflection 0.077.  Every node
+    reads the top sheet: round it the face goes on as a plane, no step to take.  (The old
+    judge took the lowest point within twice the deflection at every node of a slope
+    steeper than 45°: 0.476 lower here, the face eroded 0.147 along its normal, which the
+    proof read as finishing's residual.)  The sheet's foot, 0.05 inside its edge over a
+    floor 5 lower, still reads the floor: a step on a steep face is a step."""
+    g, d = math.tan(math.radians(72)), 0.0774
+
+    def sheet(x0, x1, z0, slope, flip=False):
+        c = [(x0, 0.0), (x1, 0.0), (x1, 4.0), (x0, 4.0)]
+        p = np.array([(x, y, z0 + slope * x) for x, y in c])
+        tris = np.array([p[[0, 1, 2]], p[[0, 2, 3]]])
+        return tris[:, ::-1] if flip else tris
+
+    tri = np.concatenate([sheet(0, 4, 0.0, g), sheet(0, 4, 1e-3, g, flip=True), sheet(0, 4, -math.hypot(1, g), g),
+                          sheet(-4, 0, -5.0, 0.0)])
+    x, y = -0.2 + 0.25 * np.arange(16), 0.5 + 0.25 * np.arange(12)
+    top = part_height(tri, x, y, deflection=d)
+    np.testing.assert_allclose(top[2:], np.broadcast_to(1e-3 + g * x[2:, None], top[2:].shape), rtol=0, atol=1e-12)
+    assert np.all(top[:2] == -5.0)
+
+
 def test_rapid_through_stock_is_caught(tmp_path):
     """A G0 link below the stock's top (the mistake a finishing pass without retract
     makes) is found and named by its line; the same program retracting first is clean."""
