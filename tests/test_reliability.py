@@ -335,6 +335,12 @@ def test_11_nan_and_huge_coordinates_are_refused_before_any_use(tmp_path):
     data = (CORPUS / "stepcode_HEAD_FRONT.stp").read_bytes()
     old = b"#56=CARTESIAN_POINT('Control Point',(9.84251968504,"
     assert data.count(old) == 1
+    # a finite pole inside a face the text scan passes: the box of the geometry holds
+    # every pole (1e20 inches: 2.77e21 mm at its corner), so the reader refuses it by that
+    pole = tmp_path / "head-huge-pole.stp"
+    pole.write_bytes(data.replace(old, b"#56=CARTESIAN_POINT('Control Point',(1.E20,"))
+    with pytest.raises(sm.DamagedFileError, match=r"^path: .*head-huge-pole\.stp has coordinates up to 2\.77e\+21, "):
+        sm.import_step(pole)
     pole = tmp_path / "head-inf-pole.stp"
     pole.write_bytes(data.replace(old, b"#56=CARTESIAN_POINT('Control Point',(inf,"))
     # OCCT 8.0's reader loops on this pole (over 240 s where the file reads in 3 s): the

@@ -26,12 +26,12 @@ def read_and_check(path: str, max_coordinate: float) -> tuple[bytes, list]:
     and what the model says of its solids' orientation: those inside out in the file,
     read outward (:func:`~surfmod.occ.step.outward_solids`), and those whose faces
     disagree (:func:`~surfmod.occ.solids.faces_at_odds`)."""
-    from .finite import check_numbers
+    from .properties import check_coordinates
     from .solids import faces_at_odds
     from .step import brep_bytes, read_step
 
     turned: list = []  # the solids inside out in the file, turned outward
     shape = read_step(path, turned)
     at_odds = faces_at_odds(shape)  # solids whose faces disagree: said, left to mesh and mass
-    check_numbers(shape, path, max_coordinate)
+    check_coordinates(shape, path, max_coordinate)
     return brep_bytes(shape), (turned, at_odds)

@@ -19,6 +19,7 @@ from OCP.gp import gp_Pnt
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 
+from ..errors import SurfmodError
 from .arrays import xyz
 from .guard import kernel
 from .bindings import box_limits, TopTools_IndexedDataMapOfShapeListOfShape
@@ -126,6 +127,27 @@ def bounding_box(shape, *, optimal: bool = True) -> np.ndarray:
         else:
             BRepBndLib.Add_s(shape, box, True)
         return np.array(box_limits(box)).reshape(2, 3)
+
+
+def check_coordinates(shape, path, max_coordinate: float) -> None:
+    """Raise ``SurfmodError`` naming ``path`` when ``shape`` holds no geometry, or NaN,
+    infinite or out-of-range coordinates (beyond ``max_coordinate``) in its box from the
+    geometry (the STEP reader's last check).  The box holds every pole of a B-spline or
+    Bézier face, not only its edges (``BndLib_AddSurface``), and the reader's text scan
+    (:func:`surfmod.checks.step_file`) has refused NaN, infinity and numbers beyond
+    1e70 before OCCT read the file: no number inside a face escapes both."""
+    with kernel("BRepBndLib"):
+        box = Bnd_Box()
+        BRepBndLib.Add_s(shape, box, False)  # from the geometry, not a triangulation
+        if box.IsVoid():
+            raise SurfmodError(f"path: {path} contains no geometry")
+        corners = box_limits(box)
+    if not all(np.isfinite(corners)):
+        raise SurfmodError(f"path: {path} has NaN or infinite coordinates")
+    size = max(abs(c) for c in corners)
+    if size > max_coordinate:
+        raise SurfmodError(f"path: {path} has coordinates up to {size:.3g}, beyond the limit {max_coordinate:.3g} "
+                           "(max_coordinate=)")
 
 
 def split_faces(shape, k: int):
