@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ.analytic import default_x_dir as occ_x_dir
-from surfmod.occ.analytic import transformed as occ_transformed
+from twins.transformed import default_x_dir as occ_x_dir
+from twins.transformed import transformed as occ_transformed
 from surfmod.occ.sample import curve_d2
 from surfmod.transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
 

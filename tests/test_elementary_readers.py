@@ -14,6 +14,7 @@ from surfmod.occ import analytic as occ
 from surfmod.occ.geom import bezier_curve, surface_type
 from surfmod.occ.sample import surface_d0
 from surfmod.occ.topo import face_from_surface, face_surface
+from twins.transformed import transformed as occ_transformed
 
 EXPECTED_CLASS = {
     "Geom_Plane": sm.PlaneSurface,
@@ -120,13 +121,13 @@ def _basis_curves():
     spline = sm.BSplineCurve([(1, 0, 0), (2, 0, 1), (1.5, 0, 2), (2.5, 0, 3)], 3, weights=[1, 2, 1, 1])
     return {
         "line": (occ.infinite_line((1, 0, -1), (0.3, 0, 1)), (-1.0, 2.0)),
-        "circle": (occ.circle((3, 0, 0), (0, 1, 0), (1, 0, 0), 1.0), (-1.0, 4.0)),
-        "ellipse": (occ.ellipse((3, 0, 0), (0, 1, 0), (0, 0, 1), 1.0, 0.5), (0.5, 6.0)),
-        "parabola": (occ.parabola((3, 0, 0), (0, 1, 0), (0, 0, 1), 0.5), (-1.0, 1.5)),
-        "hyperbola": (occ.hyperbola((1, 0, 0), (0, 1, 0), (1, 0, 0), 1.0, 0.5), (-1.0, 1.2)),
+        "circle": (occ.conic("circle", (3, 0, 0), (0, 1, 0), (1, 0, 0), 1.0), (-1.0, 4.0)),
+        "ellipse": (occ.conic("ellipse", (3, 0, 0), (0, 1, 0), (0, 0, 1), 1.0, 0.5), (0.5, 6.0)),
+        "parabola": (occ.conic("parabola", (3, 0, 0), (0, 1, 0), (0, 0, 1), 0.5), (-1.0, 1.5)),
+        "hyperbola": (occ.conic("hyperbola", (1, 0, 0), (0, 1, 0), (1, 0, 0), 1.0, 0.5), (-1.0, 1.2)),
         "bspline": (spline.geom(), (0.2, 0.9)),
         "bezier": (bezier_curve(np.array([(1.0, 0, 0), (2, 0, 1), (1, 0, 3)]), np.array([1.0, 3, 1])), (0.0, 1.0)),
-        "trimmed": (occ.trimmed(occ.circle((3, 0, 0), (0, 1, 0), (1, 0, 0), 1.0), -1.0, 2.0), (-1.0, 2.0)),
+        "trimmed": (occ.trimmed(occ.conic("circle", (3, 0, 0), (0, 1, 0), (1, 0, 0), 1.0), -1.0, 2.0), (-1.0, 2.0)),
     }
 
 
@@ -140,7 +141,7 @@ def test_revolution_and_extrusion_keep_occt_parametrization_of_every_basis_curve
 
 
 def test_rectangular_trimmed_surface_is_unwrapped():
-    cyl = occ.cylinder((np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, 1.0])), 2.0)
+    cyl = occ.elementary("cylinder", (np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, 1.0])), 2.0)
     trimmed = Geom_RectangularTrimmedSurface(cyl, 0.5, 2.5, -1.0, 3.0)
     face = face_from_surface(trimmed, 0.7, 2.0, 0.0, 2.0)
     s = sm.from_face(face)
@@ -200,7 +201,7 @@ def test_offset_similarity_transform_matches_gp_trsf():
     m = mirror_matrix((1, 0, 0), (1, 2, 3))
     t = s.transformed(m)
     uu, vv = (a.ravel() for a in np.meshgrid(np.linspace(0, 6, 5), np.linspace(0, 6, 5)))
-    np.testing.assert_allclose(t.points(uu, vv), surface_d0(occ.transformed(s.geom(), m), uu, vv), atol=1e-13)
+    np.testing.assert_allclose(t.points(uu, vv), surface_d0(occ_transformed(s.geom(), m), uu, vv), atol=1e-13)
 
 
 @pytest.mark.parametrize(

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ.analytic import transformed as occ_transformed
+from twins.transformed import transformed as occ_transformed
 from surfmod.occ.sample import surface_d0, surface_d2
 from surfmod.transforms import mirror_matrix, rotation_matrix, scale_matrix
 

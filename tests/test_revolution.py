@@ -10,7 +10,7 @@ import pytest
 
 import surfmod as sm
 from reference import surface_area as area
-from surfmod.occ.analytic import transformed as occ_transformed
+from twins.transformed import transformed as occ_transformed
 from surfmod.occ.sample import surface_d0
 from surfmod.transforms import mirror_matrix, rotation_matrix, scale_matrix
 

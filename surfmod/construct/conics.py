@@ -77,12 +77,12 @@ class Conic(Curve):
         return out
 
     def _basis_geom(self):
-        from ..occ.analytic import circle, ellipse
+        from ..occ.analytic import conic
 
         if self.a == self.b:
-            return circle(self.center, self.normal, self.x_dir, self.a)
+            return conic("circle", self.center, self.normal, self.x_dir, self.a)
         if self.a >= self.b:
-            return ellipse(self.center, self.normal, self.x_dir, self.a, self.b)
+            return conic("ellipse", self.center, self.normal, self.x_dir, self.a, self.b)
         raise SurfmodError("ellipse: OCCT needs the major radius along X (a >= b)")
 
     def geom(self):
@@ -285,9 +285,9 @@ class Parabola(_FramedCurve):
         return fx, fy
 
     def _basis_geom(self):
-        from ..occ.analytic import parabola
+        from ..occ.analytic import conic
 
-        return parabola(self.center, self.normal, self.x_dir, self.focal)
+        return conic("parabola", self.center, self.normal, self.x_dir, self.focal)
 
     def to_bspline(self) -> BSplineCurve:
         """The exact quadratic Bézier (same parametrization: the parabola is polynomial)."""
@@ -326,9 +326,9 @@ class Hyperbola(_FramedCurve):
         return fx, fy
 
     def _basis_geom(self):
-        from ..occ.analytic import hyperbola
+        from ..occ.analytic import conic
 
-        return hyperbola(self.center, self.normal, self.x_dir, self.a, self.b)
+        return conic("hyperbola", self.center, self.normal, self.x_dir, self.a, self.b)
 
     def to_bspline(self) -> BSplineCurve:
         """Exact rational quadratic (one segment, middle weight ``cosh((t1 - t0) / 2)``)."""

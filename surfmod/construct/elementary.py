@@ -163,9 +163,9 @@ class PlaneSurface(ElementarySurface):
         return closest.plane(local, box)
 
     def _build_geom(self):
-        from ..occ.analytic import plane
+        from ..occ.analytic import elementary
 
-        return plane(self.frame)
+        return elementary("plane", self.frame)
 
     def implicit(self, xyz) -> np.ndarray:
         """Signed distance ``(x - O) . Z``."""
@@ -216,9 +216,9 @@ class CylindricalSurface(ElementarySurface):
         return closest.cylinder(local, box)
 
     def _build_geom(self):
-        from ..occ.analytic import cylinder
+        from ..occ.analytic import elementary
 
-        return cylinder(self.frame, self.radius)
+        return elementary("cylinder", self.frame, self.radius)
 
     def implicit(self, xyz) -> np.ndarray:
         """``x^2 + y^2 - R^2`` in the frame."""
@@ -285,9 +285,9 @@ class ConicalSurface(ElementarySurface):
         return closest.cone(local, box, self.radius, self.semi_angle)
 
     def _build_geom(self):
-        from ..occ.analytic import cone
+        from ..occ.analytic import elementary
 
-        return cone(self.frame, self.semi_angle, self.radius)
+        return elementary("cone", self.frame, self.semi_angle, self.radius)
 
     def implicit(self, xyz) -> np.ndarray:
         """``x^2 + y^2 - (R + z tan a)^2`` in the frame."""
@@ -350,9 +350,9 @@ class SphericalSurface(ElementarySurface):
         return closest.sphere(local, box)
 
     def _build_geom(self):
-        from ..occ.analytic import sphere
+        from ..occ.analytic import elementary
 
-        return sphere(self.frame, self.radius)
+        return elementary("sphere", self.frame, self.radius)
 
     def implicit(self, xyz) -> np.ndarray:
         """``|x - C|^2 - R^2``."""
@@ -412,9 +412,9 @@ class ToroidalSurface(ElementarySurface):
         return closest.torus(local, box, self.major)
 
     def _build_geom(self):
-        from ..occ.analytic import torus
+        from ..occ.analytic import elementary
 
-        return torus(self.frame, self.major, self.minor)
+        return elementary("torus", self.frame, self.major, self.minor)
 
     def implicit(self, xyz) -> np.ndarray:
         """``(|p|^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + y^2)`` in the frame."""

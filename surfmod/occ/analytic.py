@@ -41,36 +41,27 @@ def ax2(origin, normal, x_dir) -> gp_Ax2:
         return gp_Ax2(pnt(origin), _dir(normal), _dir(x_dir))
 
 
-def default_x_dir(normal) -> np.ndarray:
-    """The X direction ``gp_Ax2(P, N)`` picks for a main direction ``N``."""
-    with kernel("gp_Ax2"):
-        return xyz(gp_Ax2(pnt((0.0, 0.0, 0.0)), _dir(normal)).XDirection())
-
-
 def read_ax3(pos) -> tuple:
     """``(origin, x, y, z)`` of a ``gp_Ax3`` / ``gp_Ax2``."""
     return xyz(pos.Location()), xyz(pos.XDirection()), xyz(pos.YDirection()), xyz(pos.Direction())
 
 
 # -- curves ---------------------------------------------------------------------------------
-def circle(origin, normal, x_dir, radius):
-    with kernel("Geom_Circle"):
-        return Geom_Circle(gp_Circ(ax2(origin, normal, x_dir), float(radius)))
+#: conic -> (Geom class, gp class, the numbers after its frame: read-back key -> getter)
+_CONICS = {
+    "circle": (Geom_Circle, gp_Circ, {"radius": "Radius"}),
+    "ellipse": (Geom_Ellipse, gp_Elips, {"major": "MajorRadius", "minor": "MinorRadius"}),
+    "parabola": (Geom_Parabola, gp_Parab, {"focal": "Focal"}),
+    "hyperbola": (Geom_Hyperbola, gp_Hypr, {"major": "MajorRadius", "minor": "MinorRadius"}),
+}
 
 
-def ellipse(origin, normal, x_dir, major, minor):
-    with kernel("Geom_Ellipse"):
-        return Geom_Ellipse(gp_Elips(ax2(origin, normal, x_dir), float(major), float(minor)))
-
-
-def parabola(origin, normal, x_dir, focal):
-    with kernel("Geom_Parabola"):
-        return Geom_Parabola(gp_Parab(ax2(origin, normal, x_dir), float(focal)))
-
-
-def hyperbola(origin, normal, x_dir, major, minor):
-    with kernel("Geom_Hyperbola"):
-        return Geom_Hyperbola(gp_Hypr(ax2(origin, normal, x_dir), float(major), float(minor)))
+def conic(kind: str, origin, normal, x_dir, *numbers):
+    """The ``Geom_*`` conic ``kind`` (a key of ``_CONICS``) in the frame
+    ``gp_Ax2(origin, normal, x_dir)`` with its numbers in the table's order."""
+    geom, gp, _ = _CONICS[kind]
+    with kernel(geom.__name__):
+        return geom(gp(ax2(origin, normal, x_dir), *map(float, numbers)))
 
 
 def infinite_line(origin, direction):
@@ -81,6 +72,13 @@ def infinite_line(origin, direction):
 def trimmed(curve, t0, t1):
     with kernel("Geom_TrimmedCurve"):
         return Geom_TrimmedCurve(curve, float(t0), float(t1))
+
+
+_CONIC_NAMES = {geom.__name__: (kind, fields) for kind, (geom, _, fields) in _CONICS.items()}
+
+
+def _numbers(geom, fields: dict) -> dict:
+    return {key: getattr(geom, getter)() for key, getter in fields.items()}
 
 
 def read_curve(curve) -> dict:
@@ -97,15 +95,9 @@ def read_curve(curve) -> dict:
         if name == "Geom_Line":
             lin = curve.Lin()
             return {"kind": "line", "origin": xyz(lin.Location()), "direction": xyz(lin.Direction())}
-        if name == "Geom_Circle":
-            return {"kind": "circle", "frame": read_ax3(curve.Position()), "radius": curve.Radius()}
-        if name == "Geom_Ellipse":
-            return {"kind": "ellipse", "frame": read_ax3(curve.Position()), "major": curve.MajorRadius(),
-                    "minor": curve.MinorRadius()}
-        if name == "Geom_Parabola":
-            return {"kind": "parabola", "frame": read_ax3(curve.Position()), "focal": curve.Focal()}
-        if name == "Geom_Hyperbola":
-            return {"kind": "hyperbola", "frame": read_ax3(curve.Position()), "major": curve.MajorRadius(), "minor": curve.MinorRadius()}
+        if (found := _CONIC_NAMES.get(name)) is not None:
+            kind, fields = found
+            return {"kind": kind, "frame": read_ax3(curve.Position()), **_numbers(curve, fields)}
         if name == "Geom_BSplineCurve":
             return {"kind": "bspline", **read_bspline_curve(curve)}
         if name == "Geom_BezierCurve":
@@ -116,45 +108,30 @@ def read_curve(curve) -> dict:
 
 
 # -- elementary surfaces ----------------------------------------------------------------------
-def plane(frame):
-    with kernel("Geom_Plane"):
-        return Geom_Plane(ax3(frame))
+#: surface -> (Geom class, the numbers after its frame in the constructor's order: read-back key -> getter)
+_ELEMENTARY = {
+    "plane": (Geom_Plane, {}),
+    "cylinder": (Geom_CylindricalSurface, {"radius": "Radius"}),
+    "cone": (Geom_ConicalSurface, {"semi_angle": "SemiAngle", "radius": "RefRadius"}),
+    "sphere": (Geom_SphericalSurface, {"radius": "Radius"}),
+    "torus": (Geom_ToroidalSurface, {"major": "MajorRadius", "minor": "MinorRadius"}),
+}
+_ELEMENTARY_FIELDS = {geom.__name__: fields for geom, fields in _ELEMENTARY.values()}
 
 
-def cylinder(frame, radius):
-    with kernel("Geom_CylindricalSurface"):
-        return Geom_CylindricalSurface(ax3(frame), float(radius))
-
-
-def cone(frame, semi_angle, ref_radius):
-    with kernel("Geom_ConicalSurface"):
-        return Geom_ConicalSurface(ax3(frame), float(semi_angle), float(ref_radius))
-
-
-def sphere(frame, radius):
-    with kernel("Geom_SphericalSurface"):
-        return Geom_SphericalSurface(ax3(frame), float(radius))
-
-
-def torus(frame, major, minor):
-    with kernel("Geom_ToroidalSurface"):
-        return Geom_ToroidalSurface(ax3(frame), float(major), float(minor))
+def elementary(kind: str, frame, *numbers):
+    """The ``Geom_*`` elementary surface ``kind`` (a key of ``_ELEMENTARY``) on
+    ``ax3(frame)`` with its numbers in the table's order."""
+    geom, _ = _ELEMENTARY[kind]
+    with kernel(geom.__name__):
+        return geom(ax3(frame), *map(float, numbers))
 
 
 def read_elementary(surf) -> dict:
     """Frame and radii of a downcast Geom_Plane / Cylindrical / Conical / Spherical / Toroidal surface."""
     name = surf.DynamicType().Name()
     with kernel(f"reading {name}"):
-        out = {"kind": name, "frame": read_ax3(surf.Position())}
-        if name == "Geom_CylindricalSurface":
-            out["radius"] = surf.Radius()
-        elif name == "Geom_ConicalSurface":
-            out["radius"], out["semi_angle"] = surf.RefRadius(), surf.SemiAngle()
-        elif name == "Geom_SphericalSurface":
-            out["radius"] = surf.Radius()
-        elif name == "Geom_ToroidalSurface":
-            out["major"], out["minor"] = surf.MajorRadius(), surf.MinorRadius()
-    return out
+        return {"kind": name, "frame": read_ax3(surf.Position()), **_numbers(surf, _ELEMENTARY_FIELDS.get(name, {}))}
 
 
 # -- swept analytic surfaces --------------------------------------------------------------------
@@ -200,7 +177,6 @@ def ruled(curve1, curve2):
         return GeomFill.Surface_s(curve1, curve2)
 
 
-# -- transforms ------------------------------------------------------------------------------
 def trsf(matrix) -> gp_Trsf:
     """``gp_Trsf`` of a 4x4 similarity matrix (rotation/mirror times uniform scale)."""
     m = np.asarray(matrix, dtype=float)
@@ -208,10 +184,3 @@ def trsf(matrix) -> gp_Trsf:
     with kernel("gp_Trsf.SetValues"):
         t.SetValues(*(float(x) for x in m[:3, :4].ravel()))
     return t
-
-
-def transformed(geom, matrix):
-    """``geom.Transformed(gp_Trsf(matrix))`` for a similarity matrix."""
-    with kernel("Geom_Geometry.Transformed"):
-        return geom.Transformed(trsf(matrix))
-

@@ -10,6 +10,7 @@ from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_GTrsf, gp_Mat, gp_Pnt, gp_Trsf, gp
 
 from surfmod.errors import SurfmodError
 from surfmod.occ import arrays
+from surfmod.occ.analytic import trsf
 from surfmod.occ.geom import downcast_surface
 from surfmod.occ.guard import kernel
 
@@ -75,3 +76,17 @@ def geom_gtransformed(surf, matrix):
                 g.Transforms(xyz)
                 out.SetPole(i, j, gp_Pnt(xyz))
     return out
+
+
+def transformed(geom, matrix):
+    """``geom.Transformed(gp_Trsf(matrix))`` for a similarity matrix (the door's
+    :func:`~surfmod.occ.analytic.trsf`)."""
+    with kernel("Geom_Geometry.Transformed"):
+        return geom.Transformed(trsf(matrix))
+
+
+def default_x_dir(normal) -> np.ndarray:
+    """The X direction ``gp_Ax2(P, N)`` picks for a main direction ``N``: the reference
+    of :func:`surfmod.construct.axes.default_x_dir`."""
+    with kernel("gp_Ax2"):
+        return arrays.xyz(gp_Ax2(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(*map(float, normal))).XDirection())
