@@ -339,6 +339,7 @@ def _spline_breaks_are_their_knots(path):
 
     shapes = _faces(path)
     splines = [r for recs in faces_pcurves(shapes) for r in recs if r["kind"] == "bspline"]
+    taylor_pieces(splines)  # the breaks of those read in bulk, from their knots
     for rec in splines:
         pc = rec["adaptor"]
         b, (f, l) = pc.BSpline(), rec["range"]

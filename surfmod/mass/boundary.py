@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..eval.basis import basis_derivatives
-from .breaks import ANGULAR_PIECE
+from .breaks import ANGULAR_PIECE, spline_breaks
 from .rules import gauss
 
 #: curved p-curves are cut into at least this many pieces before Gauss
@@ -91,10 +91,11 @@ def _taylor_pieces(rec: dict):
 
 
 def taylor_pieces(records: list) -> None:
-    """Set ``rec["taylor"]`` (see :func:`_taylor_pieces`) on every B-spline p-curve record
-    that lacks it, with one basis evaluation per degree for all of them: their knot
-    vectors and control points are laid end to end, and each span's basis reads only its
-    own curve's knots (``knots[span - p + 1 .. span + p]``), so one call serves all.
+    """Set ``rec["taylor"]`` (see :func:`_taylor_pieces`), and ``rec["breaks"]``
+    (:func:`~surfmod.mass.breaks.spline_breaks`), on every B-spline p-curve record that lacks them, with one
+    basis evaluation per degree for all of them: their knot vectors and control points
+    are laid end to end, and each span's basis reads only its own curve's knots
+    (``knots[span - p + 1 .. span + p]``), so one call serves all.
 
     >>> import build123d as bd
     >>> from surfmod.occ.pcurves import face_pcurves
@@ -104,6 +105,7 @@ def taylor_pieces(records: list) -> None:
     >>> coef.shape[1:] == (recs[0]["degree"] + 1, 2)
     True
     """
+    spline_breaks([rec for rec in records if rec["kind"] == "bspline" and "breaks" not in rec])
     groups: dict = {}
     for rec in records:
         if rec["kind"] == "bspline" and "taylor" not in rec:

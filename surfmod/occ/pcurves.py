@@ -55,7 +55,8 @@ def _bspline_data(pc):
 def face_pcurves(face) -> list[dict]:
     """Per edge of ``face`` (outer wire and holes, as ``TopExp_Explorer`` visits them):
     ``{"kind", "wire", "range", "sign", "breaks", ...}`` (``wire``: index of the edge's
-    wire) where ``kind`` is ``"line"`` (``origin``,
+    wire; a B-spline not periodic gets its ``breaks`` from its knots in
+    :func:`surfmod.mass.boundary.taylor_pieces`) where ``kind`` is ``"line"`` (``origin``,
     ``direction``: ``P(t) = origin + t direction``), ``"circle"`` (``centre``, ``x``, ``y``,
     ``radius``: ``P(t) = centre + radius (cos t x + sin t y)``), ``"bspline"`` (``points``
     ``(n, 2)``, ``weights``, ``knots``, ``degree``) or ``"other"``; every record carries its ``adaptor``
@@ -85,8 +86,6 @@ def faces_pcurves(faces: list) -> list[list[dict]]:
         for (rec, _), data in zip(splines, bspline_curves([b for _, b in splines], 2)):
             rec.update(kind="bspline", points=data["points"], weights=data["weights"], knots=data["knots"],
                        degree=data["degree"])
-        if splines:
-            _spline_breaks([rec for rec, _ in splines])
     if lines:  # every straight p-curve's data in one array (rows are views: no array per line)
         data = np.array([d for _, d in lines])  # (L, 6): origin, direction, range
         for k, (rec, _) in enumerate(lines):
@@ -141,7 +140,7 @@ def _face_records(face, splines: list, lines: list) -> list[dict]:
             else:
                 if kind == _BSPLINE and not (b := pc.BSpline()).IsPeriodic():
                     splines.append((rec, b))  # read by the caller, all in one binary table
-                    out.append(rec)  # its breaks from its knots, once they are read
+                    out.append(rec)  # its breaks from its knots: mass.boundary.taylor_pieces
                     continue
                 rec["breaks"] = (_periodic_knot_breaks(b, f, l) if kind == _BSPLINE
                                  else _intervals(pc, pc.NbIntervals(GeomAbs_CN)))
@@ -162,46 +161,10 @@ def _intervals(pc, n: int) -> np.ndarray:
 
 def _periodic_knot_breaks(b, f: float, l: float) -> np.ndarray:
     """The breaks of a periodic B-spline p-curve ``b`` over ``[f, l]``: its knots, repeated
-    every period, strictly inside, between the ends (see :func:`_spline_breaks` for why
-    not OCCT's intervals)."""
+    every period, strictly inside, between the ends (see
+    :func:`surfmod.mass.breaks.spline_breaks` for why not OCCT's intervals)."""
     knots = [b.Knot(i) for i in range(1, b.NbKnots() + 1)]
     return np.concatenate([[f], knots_inside(knots, f, l, b.LastParameter() - b.FirstParameter()), [l]])
-
-
-def _spline_breaks(records: list) -> None:
-    """Set ``"breaks"`` on (non-periodic) B-spline p-curve records from their knots, for
-    all records at once: every distinct knot strictly inside the edge's range is a break (a
-    spline is no more than ``C^(p-1)`` there), between the range's ends.  Not the adaptor's
-    ``GeomAbs_CN`` intervals: OCCT 7.9 reports one interval for some curves with simple
-    interior knots (a degree-5 p-curve of koch_Follower_Gripper_Static_Part, knots 0.1,
-    0.2, 0.3 inside its range), and Gauss across those knots put that face's area 8e-7 off;
-    a break OCCT would merge into a nearby end only adds a short piece."""
-    knots = [rec["knots"] for rec in records]
-    sizes = np.array([len(k) for k in knots])
-    count = len(records)
-    owner = np.repeat(np.arange(count), sizes)
-    flat = np.concatenate(knots)
-    ranges = np.array([rec["range"] for rec in records])
-    # each interior knot value once (where it first appears), strictly inside its record's
-    # range (the end knots bound no interval: a range reaching past them continues the end
-    # spans)
-    first = np.ones(len(flat), bool)
-    first[1:] = (flat[1:] != flat[:-1]) | (owner[1:] != owner[:-1])
-    ends = np.cumsum(sizes)
-    lo, hi = flat[ends - sizes], flat[ends - 1]
-    keep = first & (flat > np.maximum(ranges[:, 0], lo)[owner]) & (flat < np.minimum(ranges[:, 1], hi)[owner])
-    kept, kept_owner = flat[keep], owner[keep]
-    inside = np.bincount(kept_owner, minlength=count)
-    # per record [first, knots inside..., last], laid end to end (kept knots are grouped
-    # by record already), handed out as views
-    width = inside + 2
-    start = np.cumsum(width) - width
-    out = np.empty(int(width.sum()))
-    out[start] = ranges[:, 0]
-    out[start + width - 1] = ranges[:, 1]
-    out[np.arange(len(kept)) - (np.cumsum(inside) - inside)[kept_owner] + start[kept_owner] + 1] = kept
-    for rec, lo_, n_in in zip(records, start.tolist(), inside.tolist()):
-        rec["breaks"] = out[lo_ : lo_ + n_in + 2]
 
 
 def adaptor_d1(adaptor, t: np.ndarray) -> np.ndarray:
