@@ -4,7 +4,9 @@ build123d.
 
 Accepted: a surfmod ``Surface`` (its face), a list/tuple of surfaces or faces (sewn into
 a closed solid when ``solid=True``), any build123d shape, an OCP ``TopoDS_Shape``, or the
-path of a STEP file.
+path of a STEP file.  Volume work gets a closed solid whose faces agree and point out
+(:func:`closed_solid`: the faces to turn are chosen here, from the edges they share that
+the door reports).
 
 A STEP file is read in one long-lived :class:`surfmod.child.Server` (started on first
 use, reused afterwards, so the normal case pays the interpreter start once; its start,
@@ -54,8 +56,8 @@ def to_shape(obj, name: str = "obj", *, solid: bool = False, outward: bool = Tru
     """The OCCT shape for ``obj``; with ``solid=True`` a closed, outward-oriented solid
     (open shells raise ``SurfmodError``); ``outward=False`` leaves turning each solid by
     the sign of its volume to a caller that integrates it anyway
-    (:func:`surfmod.occ.solids.closed_solid`)."""
-    from .occ.solids import closed_solid, sew_solid
+    (:func:`closed_solid`)."""
+    from .occ.solids import sew_solid
 
     if isinstance(obj, (str, os.PathLike)):
         shape = read_step_file(obj, name)
@@ -77,6 +79,109 @@ def to_shape(obj, name: str = "obj", *, solid: bool = False, outward: bool = Tru
             msg = str(exc)
             raise SurfmodError(msg if msg.startswith(name) else f"{name}: {msg}") from None
     return shape
+
+
+def closed_solid(shape, outward: bool = True):
+    """A closed solid (or compound of them) for volume work; open shells are sewn at the
+    model's tolerance and refused if they stay open.  Each closed solid's faces are made
+    to agree (:func:`oriented_solid`); ``outward=False`` leaves turning a whole solid by
+    the sign of its volume to the caller, which integrates that volume anyway and then
+    says so as this does (the solids are those of the result, in order)."""
+    from .occ.solids import is_closed, loose_faces_solid, solid_of_shell
+    from .occ.topo import compound, shells_of, solids_of
+
+    solids = solids_of(shape)
+    if solids:
+        out = []
+        for i, s in enumerate(solids):
+            shells = shells_of(s)
+            if all(is_closed(sh) for sh in shells):
+                # volume work needs faces that agree and point out: turned from the model
+                # (shared edges, then the sign of the enclosed volume), never face by face
+                oriented, turned, volume = oriented_solid(s, outward)
+                if turned:
+                    warnings.warn(f"solid {i + 1}: face(s) {', '.join(map(str, turned[:10]))}"
+                                  f"{' ...' if len(turned) > 10 else ''} of its shell point against their "
+                                  "neighbours: turned to agree with them", InsideOutWarning, stacklevel=3)
+                if volume < 0:
+                    warnings.warn(f"solid {i + 1} is inside out (enclosed volume {volume:.6g}): turned outward",
+                                  InsideOutWarning, stacklevel=3)
+                out.append(oriented)
+            elif len(shells) == 1:
+                out.append(solid_of_shell(shells[0], f"solid {i}"))
+            else:
+                raise SurfmodError(f"obj: solid {i} has an open shell among {len(shells)} (free edges): "
+                                   "volume needs a closed boundary")
+        return out[0] if len(out) == 1 else compound(out)
+    shells = shells_of(shape)
+    if shells:
+        out = [solid_of_shell(sh, f"shell {i}") for i, sh in enumerate(shells)]
+        return out[0] if len(out) == 1 else compound(out)
+    return loose_faces_solid(shape)
+
+
+def oriented_solid(solid, outward: bool = True):
+    """``solid`` with its faces made to agree (:func:`consistent_turns` over the edges
+    they share, for a solid of one shell) and then, with ``outward``, turned outward as a
+    whole by the sign of its enclosed volume; returns ``(solid, faces turned (positions
+    in explorer order), enclosed volume before)``.  ``solid`` itself when nothing needed
+    turning.  ``outward=False`` leaves the whole-solid turn to a caller that integrates
+    the volume anyway (the mass quadrature, BRepGProp's cross-check), so it is computed
+    once: the volume returned is then NaN.
+
+    >>> import build123d as bd
+    >>> s, turned, volume = oriented_solid(bd.Solid.make_box(1, 2, 3).wrapped.Reversed())
+    >>> turned, round(volume, 12)
+    ([], -6.0)
+    """
+    from .occ.solids import enclosed_volume, face_links, solid_of_faces
+    from .occ.topo import shells_of
+
+    turned: list = []
+    if len(shells_of(solid)) == 1:
+        faces, links, odd = face_links(solid)
+        if odd:
+            turned = consistent_turns(sorted(links), {k: 1 for k in range(len(faces))})
+        if turned:
+            solid = solid_of_faces(face.Reversed() if k in turned else face for k, face in enumerate(faces))
+    if not outward:
+        return solid, turned, float("nan")
+    volume = enclosed_volume(solid)
+    return (solid.Reversed() if volume < 0 else solid), turned, volume
+
+
+def consistent_turns(links, sizes: dict) -> list:
+    """The faces to turn so that no two neighbours disagree: ``links`` are ``(a, b,
+    odd)`` for faces ``a`` and ``b`` sharing an edge (``odd`` true where the edge runs the
+    same way in both: they disagree), ``sizes`` each face's weight (triangles, or 1).  Of
+    the two consistent colourings of each connected set of faces the lighter one turns;
+    ``[]`` when no colouring is consistent (a non-orientable or self-contradicting set).
+
+    >>> consistent_turns([(0, 1, 0), (1, 2, 1), (0, 2, 1)], {0: 5, 1: 5, 2: 1})
+    [2]
+    """
+    neighbours: dict = {}
+    for a, b, odd in links:
+        neighbours.setdefault(a, []).append((b, int(odd)))
+        neighbours.setdefault(b, []).append((a, int(odd)))
+    colour: dict = {}
+    for start in sorted(sizes, key=lambda f: -sizes[f]):  # each connected set from its largest face
+        if start in colour:
+            continue
+        colour[start], todo, part = 0, [start], [start]
+        while todo:
+            f = todo.pop()
+            for g, odd in neighbours.get(f, ()):
+                if g not in colour:
+                    colour[g] = colour[f] ^ odd
+                    todo.append(g)
+                    part.append(g)
+                elif colour[g] != colour[f] ^ odd:
+                    return []
+        if sum(sizes[f] for f in part if colour[f]) > sum(sizes[f] for f in part) / 2:
+            for f in part:
+                colour[f] ^= 1
+    return sorted(int(f) for f, c in colour.items() if c)
 
 
 def make_solid(surfaces):

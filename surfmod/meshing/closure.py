@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import KernelError, SurfmodError
+from ..inputs import consistent_turns
 
 #: binary STL: 80-byte header, uint32 count, then 50-byte records (io/stl.py writes them)
 STL_RECORD = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
@@ -168,8 +169,6 @@ def faces_against_neighbours(tri: np.ndarray, labels: np.ndarray) -> list[int]:
     if not same_way.any() or (same_way & (fa == fb)).any():
         return []  # all agree; or a face at odds with itself, which no turning of whole faces mends
     links = np.unique(np.stack([fa, fb, same_way.astype(int)], axis=1)[fa != fb], axis=0)
-    from ..occ.solids import consistent_turns
-
     return consistent_turns(links.tolist(), dict(zip(*np.unique(labels, return_counts=True))))
 
 

@@ -1,9 +1,9 @@
 """Closed solids from faces and shells (``BRepBuilderAPI_Sewing``, ``BRepBuilderAPI_MakeSolid``):
-what volume work (mass properties, FE meshes, interference) is given to measure."""
+what volume work (mass properties, FE meshes, interference) is given to measure, and the
+edges their faces share.  Which faces to turn, and when, is decided above the door
+(:func:`surfmod.inputs.closed_solid`)."""
 
 from __future__ import annotations
-
-import warnings
 
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
@@ -15,9 +15,9 @@ from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
 
-from ..errors import InsideOutWarning, SurfmodError
+from ..errors import SurfmodError
 from .guard import check_done, kernel
-from .topo import compound, shells_of, solids_of
+from .topo import shells_of, solids_of
 from .topo import explore as _explore
 
 SEW_TOLERANCE = 1e-6
@@ -54,7 +54,7 @@ def sew_solid(face_shapes, tolerance: float = SEW_TOLERANCE):
     return solid
 
 
-def _solid_of_shell(shell, what: str):
+def solid_of_shell(shell, what: str):
     """A solid bounded by one shell; an open shell is sewn at the model's own tolerance
     first (loose faces that OCCT sewing joins), and refused only if it stays open."""
     if not BRep_Tool.IsClosed_s(shell):
@@ -73,40 +73,6 @@ def _solid_of_shell(shell, what: str):
 def _faces_outside(shape, owners) -> list[int]:
     inside = {f.__hash__() for owner in owners for f in _explore(owner, TopAbs_FACE)}
     return [k for k, f in enumerate(_explore(shape, TopAbs_FACE)) if f.__hash__() not in inside]
-
-
-def consistent_turns(links, sizes: dict) -> list:
-    """The faces to turn so that no two neighbours disagree: ``links`` are ``(a, b,
-    odd)`` for faces ``a`` and ``b`` sharing an edge (``odd`` true where the edge runs the
-    same way in both: they disagree), ``sizes`` each face's weight (triangles, or 1).  Of
-    the two consistent colourings of each connected set of faces the lighter one turns;
-    ``[]`` when no colouring is consistent (a non-orientable or self-contradicting set).
-
-    >>> consistent_turns([(0, 1, 0), (1, 2, 1), (0, 2, 1)], {0: 5, 1: 5, 2: 1})
-    [2]
-    """
-    neighbours: dict = {}
-    for a, b, odd in links:
-        neighbours.setdefault(a, []).append((b, int(odd)))
-        neighbours.setdefault(b, []).append((a, int(odd)))
-    colour: dict = {}
-    for start in sorted(sizes, key=lambda f: -sizes[f]):  # each connected set from its largest face
-        if start in colour:
-            continue
-        colour[start], todo, part = 0, [start], [start]
-        while todo:
-            f = todo.pop()
-            for g, odd in neighbours.get(f, ()):
-                if g not in colour:
-                    colour[g] = colour[f] ^ odd
-                    todo.append(g)
-                    part.append(g)
-                elif colour[g] != colour[f] ^ odd:
-                    return []
-        if sum(sizes[f] for f in part if colour[f]) > sum(sizes[f] for f in part) / 2:
-            for f in part:
-                colour[f] ^= 1
-    return sorted(int(f) for f, c in colour.items() if c)
 
 
 def _edge_uses(solid) -> tuple[list, dict]:
@@ -133,55 +99,48 @@ def _shells_agree(solid) -> bool:
         return all(BRepCheck_Shell(shell).Orientation(True) == BRepCheck_NoError for shell in shells_of(solid))
 
 
-def _face_links(solid) -> tuple[list, set, list]:
+def face_links(solid) -> tuple[list, set, list]:
     """``(faces, links, odd uses)`` of ``solid``: its faces (distinct, explorer order),
     ``(a, b, odd)`` for faces ``a`` and ``b`` sharing an edge (``odd`` where the edge runs
     the same way in both), and the uses of each edge that runs so; the one pass over the
-    edges that :func:`oriented_solid` and :func:`faces_at_odds` share.  ``([], set(),
-    [])`` when OCCT finds the shells consistent (:func:`_shells_agree`): nothing to turn."""
+    edges that :func:`surfmod.inputs.oriented_solid` and :func:`faces_at_odds` share.
+    ``([], set(), [])`` when OCCT finds the shells consistent (:func:`_shells_agree`):
+    nothing to turn."""
     if _shells_agree(solid):
         return [], set(), []
-    faces, uses = _edge_uses(solid)
+    with kernel("TopExp_Explorer"):
+        faces, uses = _edge_uses(solid)
     shared = [u for u in uses.values() if len(u) == 2 and u[0][0] != u[1][0]]  # seams are not judged
     links = {(u[0][0], u[1][0], u[0][1] == u[1][1]) for u in shared}
     return faces, links, [u for u in shared if u[0][1] == u[1][1]]
 
 
-def oriented_solid(solid, outward: bool = True):
-    """``solid`` with its faces made to agree (:func:`consistent_turns` over the edges
-    they share, for a solid of one shell) and then, with ``outward``, turned outward as a
-    whole by the sign of its enclosed volume; returns ``(solid, faces turned (positions
-    in explorer order), enclosed volume before)``.  ``solid`` itself when nothing needed
-    turning.  ``outward=False`` leaves the whole-solid turn to a caller that integrates
-    the volume anyway (the mass quadrature, BRepGProp's cross-check), so it is computed
-    once: the volume returned is then NaN.
-
-    >>> import build123d as bd
-    >>> s, turned, volume = oriented_solid(bd.Solid.make_box(1, 2, 3).wrapped.Reversed())
-    >>> turned, round(volume, 12)
-    ([], -6.0)
-    """
-    turned: list = []
-    shells = shells_of(solid)
+def solid_of_faces(faces):
+    """A solid of one closed shell of ``faces`` as given (``TopoDS_Face`` s, each
+    oriented as it is to face)."""
     with kernel("BRep_Builder"):
-        if len(shells) == 1:
-            faces, links, odd = _face_links(solid)
-            if odd:
-                turned = consistent_turns(sorted(links), {k: 1 for k in range(len(faces))})
-            if turned:
-                builder, shell, out = BRep_Builder(), TopoDS_Shell(), TopoDS_Solid()
-                builder.MakeShell(shell)
-                for k, face in enumerate(faces):
-                    builder.Add(shell, face.Reversed() if k in turned else face)
-                shell.Closed(True)
-                builder.MakeSolid(out)
-                builder.Add(out, shell)
-                solid = out
-        if not outward:
-            return solid, turned, float("nan")
+        builder, shell, out = BRep_Builder(), TopoDS_Shell(), TopoDS_Solid()
+        builder.MakeShell(shell)
+        for face in faces:
+            builder.Add(shell, face)
+        shell.Closed(True)
+        builder.MakeSolid(out)
+        builder.Add(out, shell)
+    return out
+
+
+def enclosed_volume(solid) -> float:
+    """The volume ``solid``'s faces enclose as they are oriented (negative when they
+    point inwards): ``BRepGProp``'s volume."""
+    with kernel("BRepGProp.VolumeProperties_s"):
         props = GProp_GProps()
         BRepGProp.VolumeProperties_s(solid, props)
-    return (solid.Reversed() if props.Mass() < 0 else solid), turned, props.Mass()
+    return props.Mass()
+
+
+def is_closed(shape) -> bool:
+    """Whether a shell (or solid) has no free edge (``BRep_Tool.IsClosed``)."""
+    return BRep_Tool.IsClosed_s(shape)
 
 
 def faces_at_odds(shape) -> list[tuple[int, int, list[int]]]:
@@ -198,7 +157,7 @@ def faces_at_odds(shape) -> list[tuple[int, int, list[int]]]:
     out, index = [], None
     with kernel("TopExp_Explorer"):
         for number, solid in enumerate(solids_of(shape), 1):
-            faces, _, odd = _face_links(solid)
+            faces, _, odd = face_links(solid)
             if odd:
                 if index is None:  # the positions in the whole shape, needed only to name faces
                     index = {f.__hash__(): k for k, f in reversed(list(enumerate(_explore(shape, TopAbs_FACE))))}
@@ -207,9 +166,10 @@ def faces_at_odds(shape) -> list[tuple[int, int, list[int]]]:
 
 
 def left_out_faces(shape) -> list[int]:
-    """Indices (``faces_of`` order) of the faces :func:`closed_solid` leaves out: those
-    outside every solid when the shape has solids (open shells and loose faces beside
-    them: they enclose no volume), outside every shell when it has shells but no solid.
+    """Indices (``faces_of`` order) of the faces :func:`surfmod.inputs.closed_solid`
+    leaves out: those outside every solid when the shape has solids (open shells and
+    loose faces beside them: they enclose no volume), outside every shell when it has
+    shells but no solid.
 
     >>> import build123d as bd
     >>> left_out_faces(bd.Compound([bd.Box(1, 1, 1), bd.Face.make_rect(1, 1)]).wrapped)
@@ -230,50 +190,18 @@ def open_faces(shape) -> list[int]:
     return _faces_outside(shape, [s for s in shells_of(shape) if BRep_Tool.IsClosed_s(s)])
 
 
-def closed_solid(shape, outward: bool = True):
-    """A closed solid (or compound of them) for volume work; open shells are sewn at the
-    model's tolerance and refused if they stay open.  Each closed solid's faces are made
-    to agree (:func:`oriented_solid`); ``outward=False`` leaves turning a whole solid by
-    the sign of its volume to the caller, which integrates that volume anyway and then
-    says so as this does (the solids are those of the result, in order)."""
-    solids = solids_of(shape)
-    if solids:
-        out = []
-        for i, s in enumerate(solids):
-            shells = shells_of(s)
-            if all(BRep_Tool.IsClosed_s(sh) for sh in shells):
-                # volume work needs faces that agree and point out: turned from the model
-                # (shared edges, then the sign of the enclosed volume), never face by face
-                oriented, turned, volume = oriented_solid(s, outward)
-                if turned:
-                    warnings.warn(f"solid {i + 1}: face(s) {', '.join(map(str, turned[:10]))}"
-                                  f"{' ...' if len(turned) > 10 else ''} of its shell point against their "
-                                  "neighbours: turned to agree with them", InsideOutWarning, stacklevel=3)
-                if volume < 0:
-                    warnings.warn(f"solid {i + 1} is inside out (enclosed volume {volume:.6g}): turned outward",
-                                  InsideOutWarning, stacklevel=3)
-                out.append(oriented)
-            elif len(shells) == 1:
-                out.append(_solid_of_shell(shells[0], f"solid {i}"))
-            else:
-                raise SurfmodError(f"obj: solid {i} has an open shell among {len(shells)} (free edges): "
-                                   "volume needs a closed boundary")
-        return out[0] if len(out) == 1 else compound(out)
-    shells = shells_of(shape)
-    if shells:
-        out = [_solid_of_shell(sh, f"shell {i}") for i, sh in enumerate(shells)]
-        return out[0] if len(out) == 1 else compound(out)
+def loose_faces_solid(shape):
+    """A solid of the faces of ``shape`` (which has no shell): one closed shell when they
+    share their edges already (e.g. one periodic face, a full sphere or torus closed by
+    its own seam and poles), else sewn at the model's tolerance."""
     faces = _explore(shape, TopAbs_FACE)
     if not faces:
         raise SurfmodError("obj: has no faces, so no solid to measure")
-    # faces that already share their edges (e.g. one periodic face: a full sphere or
-    # torus closed by its own seam and poles) form a closed shell without sewing
-
     builder = BRep_Builder()
     shell = TopoDS_Shell()
     builder.MakeShell(shell)
     for f in faces:
         builder.Add(shell, f)
     if BRep_Tool.IsClosed_s(shell):
-        return _solid_of_shell(shell, "the shell of its faces")
+        return solid_of_shell(shell, "the shell of its faces")
     return sew_solid(faces, max(SEW_TOLERANCE, model_tolerance(shape)))
