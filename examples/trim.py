@@ -9,7 +9,7 @@ import build123d as bd
 import numpy as np
 
 import surfmod as sm
-from surfmod.occ.faces import face_area
+from surfmod.occ.properties import gprops
 
 OUT = Path(__file__).resolve().parent.parent / "step_samples"
 
@@ -30,7 +30,7 @@ hole = sm.BSplineCurve(
 )
 
 face = sm.trim(patch, [outer, hole])
-occ_area = face_area(face, 1e-10)
+occ_area = gprops(face.wrapped, 1e-10)["area"]  # BRepGProp at relative accuracy 1e-10
 np_area = sm.trimmed_area(patch, [outer, hole])
 print(f"trimmed area: OCCT {occ_area:.10f}, NumPy {np_area:.10f}, rel. diff {abs(occ_area - np_area) / np_area:.1e}")
 

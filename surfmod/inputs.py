@@ -134,7 +134,8 @@ def oriented_solid(solid, outward: bool = True):
     >>> turned, round(volume, 12)
     ([], -6.0)
     """
-    from .occ.solids import enclosed_volume, face_links, solid_of_faces
+    from .occ.properties import solid_figures
+    from .occ.solids import face_links, solid_of_faces
     from .occ.topo import shells_of
 
     turned: list = []
@@ -146,7 +147,7 @@ def oriented_solid(solid, outward: bool = True):
             solid = solid_of_faces(face.Reversed() if k in turned else face for k, face in enumerate(faces))
     if not outward:
         return solid, turned, float("nan")
-    volume = enclosed_volume(solid)
+    volume = solid_figures(solid)[0]  # negative when the faces point inwards
     return (solid.Reversed() if volume < 0 else solid), turned, volume
 
 

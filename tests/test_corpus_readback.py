@@ -17,7 +17,7 @@ from surfmod.nets import mp_reference
 from surfmod.cli.section import dxf_length  # noqa: F401 - the DXF's exact length, as the command judges it
 from surfmod.occ.sample import edge_length, wire_edges
 from surfmod.occ.properties import bounding_box, gprops
-from surfmod.occ.booleans import section_edges
+from surfmod.occ.booleans import cut_edges, wires_of
 from surfmod.occ.sample import surface_d0, surface_d2
 from surfmod.occ.topo import face_from_surface, face_surface, faces_of, solids_of
 from surfmod.readback import from_face
@@ -235,7 +235,7 @@ def _sections_match(path, tmp_path):
         centre = bounding_box(solid).mean(axis=0)
         normal = np.array([0.0, 0.0, 1.0])
         sec = sm.section(solid, centre, normal)  # on a planar face: its outline
-        ref = sum(edge_length(e) for w in section_edges(solid, centre, normal) for e in wire_edges(w))
+        ref = sum(edge_length(e) for w in wires_of(cut_edges(solid, centre, normal)) for e in wire_edges(w))
         out = tmp_path / f"s{i}.dxf"
         sm.export_dxf(sec, out)
         assert abs(dxf_length(out) - ref) <= 1e-6 * ref, (path.name, i)

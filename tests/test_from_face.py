@@ -71,13 +71,13 @@ def test_the_area_of_a_face_is_from_face_area():
 
 def test_intersect_clips_to_the_face_like_brepalgoapi_section():
     from surfmod.occ.sample import edge_length, wire_edges
-    from surfmod.occ.booleans import section_edges
+    from surfmod.occ.booleans import cut_edges, wires_of
 
     top = _holed_top()
     origin, normal = np.array([0.1, 0.0, 0.0]), np.array([1.0, 0.3, 0.0]) / np.hypot(1.0, 0.3)
     curves = sm.intersect(top, (origin, normal))  # a build123d Face is accepted
     assert len(curves) == 2  # the hole splits the chord
-    ref = sum(edge_length(e) for w in section_edges(top.wrapped, origin, normal) for e in wire_edges(w))
+    ref = sum(edge_length(e) for w in wires_of(cut_edges(top.wrapped, origin, normal)) for e in wire_edges(w))
     assert abs(sum(c.length for c in curves) - ref) <= 1e-6 * ref
     # the untrimmed plane would give one chord across the whole 4 x 3 rectangle
     whole = sm.intersect(sm.from_face(top).surface, (origin, normal))

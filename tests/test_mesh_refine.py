@@ -153,7 +153,7 @@ def test_estimate_figures_equal_geomlprop(ventilator):
     floor = 1.0 / shape_diagonal(shape)
     seen = set()
     for face in faces_of(shape):
-        surf = occ_mesh.basis_surface(BRep_Tool.Surface_s(face))
+        surf = occ_mesh.face_basis(face)
         name = surface_type(surf)
         if name not in ("Geom_ConicalSurface", "Geom_ToroidalSurface", "Geom_SurfaceOfRevolution",
                         "Geom_SurfaceOfLinearExtrusion"):

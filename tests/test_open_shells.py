@@ -21,7 +21,7 @@ import surfmod as sm
 from surfmod.cli import main
 from surfmod.occ.sample import edge_length, wire_edges
 from surfmod.occ.properties import bounding_box
-from surfmod.occ.booleans import section_edges
+from surfmod.occ.booleans import cut_edges, wires_of
 
 QUICK = CORPUS / "cadquery_red_cube_blue_cylinder.step"
 SWEEP = ["occt_screw.step", "trimesh_featuretype.STEP", "pythonocc_face_recognition_sample_part.stp",
@@ -90,7 +90,7 @@ def check_section(path, tmp_path, capsys):
     out = tmp_path / "part.dxf"
     tilted = np.array([0.1, 0.2, 1.0]) / math.sqrt(1.05)
     for normal in (np.array([0.0, 0.0, 1.0]), tilted, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])):
-        ref = sum(edge_length(e) for w in section_edges(shell, centre, normal) for e in wire_edges(w))
+        ref = sum(edge_length(e) for w in wires_of(cut_edges(shell, centre, normal)) for e in wire_edges(w))
         if ref == 0:
             continue
         capsys.readouterr()
@@ -248,17 +248,17 @@ def test_section_goes_on_past_a_face_occt_cannot_intersect(tmp_path, monkeypatch
     path, out = loose_bspline_faces(tmp_path), tmp_path / "s.dxf"
     faces = sm.import_step(path).faces()
     origin, normal = np.array([25.0, 0, 0]), np.array([1.0, 0, 0])
-    per_face = [sum(edge_length(e) for w in section_edges(f.wrapped, origin, normal) for e in wire_edges(w))
+    per_face = [sum(edge_length(e) for w in wires_of(cut_edges(f.wrapped, origin, normal)) for e in wire_edges(w))
                 for f in faces]
     assert [x > 0 for x in per_face] == [False] * 4 + [True] * 2
-    real = occ_section._cut
+    real = occ_section.cut_edges
 
-    def failing(shape, pln):
+    def failing(shape, origin, normal):
         if shape.ShapeType() != TopAbs_FACE or _is_last_patch(shape):
             raise sm.SurfmodError("obj: OCCT could not section this shape")
-        return real(shape, pln)
+        return real(shape, origin, normal)
 
-    monkeypatch.setattr(occ_section, "_cut", failing)
+    monkeypatch.setattr(occ_section, "cut_edges", failing)
     with pytest.raises(sm.SurfmodError, match="could not section"):
         sm.section(path, origin, normal)
     assert main(["section", str(path), "--origin", "25", "0", "0", "--normal", "1", "0", "0", "--out", str(out),

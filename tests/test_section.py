@@ -72,10 +72,10 @@ def test_plane_missing_part_is_empty(tmp_path):
 def _occt_length(shape, origin, normal) -> float:
     """BRepAlgoAPI_Section's length, edge by edge (GCPnts on OCCT's own edges)."""
     from surfmod.occ.sample import edge_length, wire_edges
-    from surfmod.occ.booleans import section_edges
+    from surfmod.occ.booleans import cut_edges, wires_of
 
     shape = getattr(shape, "wrapped", shape)
-    return sum(edge_length(e) for w in section_edges(shape, np.array(origin, float), np.array(normal, float))
+    return sum(edge_length(e) for w in wires_of(cut_edges(shape, np.array(origin, float), np.array(normal, float)))
                for e in wire_edges(w))
 
 

@@ -6,10 +6,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
 
 import surfmod as sm
-from surfmod.occ.faces import face_area
 from surfmod.ops.trim import trimmed_area
+
+
+def face_area(face, eps: float = 1e-10) -> float:
+    """OCCT's area of a face (``BRepGProp.SurfaceProperties_s`` at relative accuracy ``eps``)."""
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(getattr(face, "wrapped", face), props, eps, False)
+    return float(props.Mass())
 
 
 def face_is_valid(face) -> bool:

@@ -3,7 +3,8 @@ common volume of two parts (with their ``BRepExtrema`` distance), and the materi
 of a solid whose boundary touches itself.
 
 Sections: ``BRepAlgoAPI_Section`` edges chained into wires, and the planar faces lying in a
-plane (:mod:`surfmod.uses.section` turns these wires into section curves and areas).
+plane (:mod:`surfmod.uses.section` turns these wires into section curves and areas, and
+sections face by face what OCCT cannot section whole).
 Interference: the ``BRepAlgoAPI_Common`` volume of two parts and their
 ``BRepExtrema_DistShapeShape`` distance (:mod:`surfmod.uses.interference` reports them).
 
@@ -39,11 +40,11 @@ from .properties import gprops
 from .topo import explore, faces_of, solids_of, wrapped
 
 
-def _cut(shape, pln) -> list:
-    """The edges of ``BRepAlgoAPI_Section`` of ``shape`` by the plane ``pln``;
-    ``SurfmodError`` when OCCT fails."""
+def cut_edges(shape, origin, normal) -> list:
+    """The edges of ``BRepAlgoAPI_Section`` of ``shape`` by the plane ``(origin,
+    normal)``; ``SurfmodError`` when OCCT fails."""
     with kernel("BRepAlgoAPI_Section"):
-        op = BRepAlgoAPI_Section(shape, pln, False)
+        op = BRepAlgoAPI_Section(shape, gp_Pln(gp_Pnt(*map(float, origin)), gp_Dir(*map(float, normal))), False)
         op.Approximation(False)
         op.ComputePCurveOn1(False)
         op.Build()
@@ -52,33 +53,10 @@ def _cut(shape, pln) -> list:
         return explore(op.Shape(), TopAbs_EDGE)
 
 
-def section_edges(shape, origin, normal, skipped: dict | None = None):
-    """Section of ``shape`` by a plane: a list of build123d ``Wire``s (edges chained
-    end to end with ``ShapeAnalysis_FreeBounds``).
-
-    When OCCT cannot section the whole shape and ``skipped`` is a dict, the shape is
-    sectioned face by face (one Boolean a face): the faces OCCT cannot intersect go into
-    ``skipped`` as ``{index: reason}`` and the others' curves are returned; without
-    ``skipped``, or when no face can be sectioned, the failure is raised."""
+def wires_of(edges) -> list:
+    """``edges`` chained end to end into build123d ``Wire`` s (``ShapeAnalysis_FreeBounds``)."""
     import build123d as bd
 
-    pln = gp_Pln(gp_Pnt(*map(float, origin)), gp_Dir(*map(float, normal)))
-    try:
-        edges = _cut(shape, pln)
-    except SurfmodError:
-        if skipped is None:
-            raise
-        faces, edges, lost = faces_of(shape), [], {}
-        for i, face in enumerate(faces):
-            try:
-                edges.extend(_cut(face, pln))
-            except SurfmodError as exc:
-                lost[i] = " ".join(str(exc).split())
-        if len(lost) == len(faces):
-            raise
-        skipped.update(lost)
-    if not edges:
-        return []
     with kernel("ShapeAnalysis_FreeBounds (section wires)"):
         seq = TopTools_HSequenceOfShape()
         for e in edges:

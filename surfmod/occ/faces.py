@@ -1,15 +1,12 @@
-"""Faces from surfaces (``BRepBuilderAPI_MakeFace``) trimmed by loops of p-curves, and
-their areas."""
+"""Faces from surfaces (``BRepBuilderAPI_MakeFace``) trimmed by loops of p-curves."""
 
 from __future__ import annotations
 
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
-from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
 from OCP.Geom2d import Geom2d_BSplineCurve
 from OCP.gp import gp_Pnt2d
-from OCP.GProp import GProp_GProps
 from OCP.ShapeFix import ShapeFix_Face
 
 from . import arrays
@@ -71,13 +68,3 @@ def trimmed_face(surf, loops, tolerance: float = 1e-7):
         fixer.FixOrientation()
         face = fixer.Face()
     return bd.Face(face)
-
-
-def face_area(face, eps: float = 1e-10) -> float:
-    """Area of a face/shape by ``BRepGProp.SurfaceProperties_s`` at relative accuracy ``eps``."""
-    props = GProp_GProps()
-    with kernel("BRepGProp.SurfaceProperties_s"):
-        BRepGProp.SurfaceProperties_s(getattr(face, "wrapped", face), props, eps, False)
-        return float(props.Mass())
-
-

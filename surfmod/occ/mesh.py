@@ -37,17 +37,14 @@ def clean(shape) -> None:
         BRepTools.Clean_s(wrapped(shape))
 
 
-def basis_surface(surf):
-    """The surface under ``Geom_RectangularTrimmedSurface`` wrappers (same parametrization)."""
-    while surface_type(surf) == "Geom_RectangularTrimmedSurface":
-        surf = surf.BasisSurface()
-    return surf
-
-
 def face_basis(face):
-    """The face's surface (located) without its rectangular-trim wrappers."""
+    """The face's surface (located) without its ``Geom_RectangularTrimmedSurface``
+    wrappers (same parametrization)."""
     with kernel("BRep_Tool.Surface"):
-        return basis_surface(BRep_Tool.Surface_s(face))
+        surf = BRep_Tool.Surface_s(face)
+        while surface_type(surf) == "Geom_RectangularTrimmedSurface":
+            surf = surf.BasisSurface()
+        return surf
 
 
 def uv_box(face) -> tuple:

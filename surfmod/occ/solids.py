@@ -11,8 +11,6 @@ from OCP.BRepCheck import BRepCheck_NoError, BRepCheck_Shell
 from OCP.BRepLib import BRepLib
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-from OCP.BRepGProp import BRepGProp
-from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
 
 from ..errors import SurfmodError
@@ -127,15 +125,6 @@ def solid_of_faces(faces):
         builder.MakeSolid(out)
         builder.Add(out, shell)
     return out
-
-
-def enclosed_volume(solid) -> float:
-    """The volume ``solid``'s faces enclose as they are oriented (negative when they
-    point inwards): ``BRepGProp``'s volume."""
-    with kernel("BRepGProp.VolumeProperties_s"):
-        props = GProp_GProps()
-        BRepGProp.VolumeProperties_s(solid, props)
-    return props.Mass()
 
 
 def is_closed(shape) -> bool:

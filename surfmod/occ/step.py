@@ -16,10 +16,8 @@ from __future__ import annotations
 import io
 
 from OCP.BRep import BRep_Builder
-from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
 from OCP.BinTools import BinTools
-from OCP.GProp import GProp_GProps
 from OCP.IFSelect import IFSelect_RetDone
 from OCP.Interface import Interface_Static
 from OCP.Message import Message, Message_Gravity
@@ -30,6 +28,7 @@ from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoD
 
 from ..errors import KernelError, SurfmodError
 from .guard import kernel
+from .properties import solid_figures
 
 
 def _quiet_messages() -> None:
@@ -132,16 +131,6 @@ def read_with(reader, kind: str, path: str):
     return shape
 
 
-def _shell_sign(solid) -> float:
-    """-1 when OCCT's reader uses the solid's shell REVERSED, else 1."""
-    it = TopoDS_Iterator(solid, False, False)
-    while it.More():
-        if it.Value().ShapeType() == TopAbs_SHELL and it.Value().Orientation() == TopAbs_REVERSED:
-            return -1.0
-        it.Next()
-    return 1.0
-
-
 def outward_solids(shape, inside_out: list | None = None):
     """``shape`` with every solid whose enclosed volume is negative (its faces point
     inwards) reversed, so each solid's faces point out of its material.
@@ -163,11 +152,12 @@ def outward_solids(shape, inside_out: list | None = None):
 
     def outward(solid):
         met[0] += 1
-        props = GProp_GProps()
-        BRepGProp.VolumeProperties_s(solid, props)
-        if inside_out is not None and _shell_sign(solid) * props.Mass() < 0.0:
-            inside_out.append((met[0], _shell_sign(solid) * props.Mass()))
-        return solid.Reversed() if props.Mass() < 0.0 else solid
+        volume = solid_figures(solid)[0]
+        # a REVERSED shell, which :func:`_solid_shells_forward` would turn, counted FORWARD
+        in_file = volume * (-1.0 if _solid_shells_forward(solid) is not solid else 1.0)
+        if inside_out is not None and in_file < 0.0:
+            inside_out.append((met[0], in_file))
+        return solid.Reversed() if volume < 0.0 else solid
 
     with kernel("BRepGProp.VolumeProperties_s"):
         return map_solids(shape, outward)

@@ -242,7 +242,7 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, 
     ((2,), True)
     """
     from ..occ.properties import bounding_box
-    from ..occ.booleans import planar_faces_on, section_edges
+    from ..occ.booleans import planar_faces_on, wires_of
 
     origin = checks.point(plane_origin, "plane_origin")
     normal = checks.direction(plane_normal, "plane_normal")
@@ -255,6 +255,33 @@ def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, 
     tol = 1e-9 * max(1.0, float(np.linalg.norm(box[1] - box[0])))
     on = tuple(planar_faces_on(shape, origin, normal, tol))
     skipped: dict = {}
-    wires = section_edges(shape, origin, normal, skipped if partial else None)
+    wires = wires_of(_section_edges(shape, origin, normal, skipped if partial else None))
     return Section(checks.frozen(origin), checks.frozen(normal), checks.frozen(xa), checks.frozen(ya),
                    wires, [bool(w.is_closed) for w in wires], samples, on, skipped)
+
+
+def _section_edges(shape, origin, normal, skipped: dict | None) -> list:
+    """The edges of ``shape``'s section by the plane.  When OCCT cannot section the whole
+    shape and ``skipped`` is a dict, the shape is sectioned face by face (one Boolean a
+    face): the faces OCCT cannot intersect go into ``skipped`` as ``{index: reason}`` and
+    the others' edges are returned; without ``skipped``, or when no face can be
+    sectioned, the failure is raised."""
+    from ..occ import booleans
+    from ..occ.topo import faces_of
+
+    try:
+        return booleans.cut_edges(shape, origin, normal)
+    except SurfmodError as whole:
+        if skipped is None:
+            raise
+        failure = whole
+    faces, edges, lost = faces_of(shape), [], {}
+    for i, face in enumerate(faces):
+        try:
+            edges.extend(booleans.cut_edges(face, origin, normal))
+        except SurfmodError as exc:
+            lost[i] = " ".join(str(exc).split())
+    if len(lost) == len(faces):
+        raise failure
+    skipped.update(lost)
+    return edges
