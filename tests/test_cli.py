@@ -122,6 +122,20 @@ def test_mesh_command_writes_a_watertight_stl(tmp_path, capsys):
     assert stl.is_watertight and abs(stl.volume - part.volume) < 0.01 * part.volume
 
 
+def test_mesh_of_a_small_part_loads_neither_numba_nor_joblib(tmp_path):
+    """A fresh ``surfmod mesh`` of a 96-face part (one B-spline face: 25 estimate samples,
+    67k measure samples) runs its estimate and measure in NumPy: loading numba and the
+    kernels was half of the command's time (issue 34's start-up row), and joblib serves
+    folder runs only."""
+    part = Path(__file__).resolve().parent / "data" / "step" / "trimesh_featuretype.STEP"
+    script = ("import sys\nfrom surfmod.cli import main\n"
+              "assert main(['mesh', sys.argv[1], '--out', sys.argv[2], '--no-progress']) == 0\n"
+              "print([m for m in ('numba', 'joblib') if m in sys.modules])\n")
+    done = subprocess.run([sys.executable, "-c", script, str(part), str(tmp_path / "part.stl")], capture_output=True,
+                          text=True, check=True)
+    assert "watertight True" in done.stdout and done.stdout.splitlines()[-1] == "[]", done.stdout
+
+
 def test_gallery_table_keeps_long_names_whole():
     from surfmod.gallery.runner import GalleryRow, format_table
 

@@ -102,6 +102,7 @@ LAZY = {
     "rhino3dm": "optional extra 'interop'",
     "opencamlib": "optional, the CAM cross-check and benchmarks",
     "importlib": "importlib.metadata, 0.19 s; sm.__version__ and surfmod --version only",
+    "joblib": "0.15 s; the CLI's local folder runs only (surfmod.cli.batch), not a single file's command",
     "ocl": "opencamlib's module name",
 }
 

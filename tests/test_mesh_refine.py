@@ -176,9 +176,10 @@ def test_estimate_figures_equal_geomlprop(ventilator):
 
 def test_spline_faces_measured_in_one_call_equal_face_by_face(ventilator):
     """measure_spline_faces (every B-spline face of a part in one compiled call) gives
-    each face the triangle and node deviations measure_face gives it alone (to the
-    round-off of the samples' coordinates)."""
-    from surfmod.meshing.brep import _bounds, _evaluator, measure_spline_faces
+    each face the triangle and node deviations measure_face gives it alone, in NumPy
+    (each face's samples are below COMPILED_MEASURE), to the round-off of the samples'
+    coordinates: the compiled measure and its NumPy twin agree."""
+    from surfmod.meshing.brep import COMPILED_MEASURE, _bounds, _evaluator, _samples, measure_spline_faces
     from surfmod.meshing.deviation import DENSE, triangle_deviations
 
     shape = ventilator
@@ -187,6 +188,7 @@ def test_spline_faces_measured_in_one_call_equal_face_by_face(ventilator):
     evaluators: dict = {}
     pairs = [(fm, ev) for fm in fms if (ev := _evaluator(evaluators, fm)) is not None and ev.projector is not None]
     assert len(pairs) > 150  # B-spline faces and extrusions of B-spline curves
+    assert max(_samples([fm], DENSE) for fm, _ in pairs) < COMPILED_MEASURE  # alone, each in NumPy
     together = measure_spline_faces([fm for fm, _ in pairs], [ev for _, ev in pairs], tol)
     for k, ((fm, ev), (tri, node)) in enumerate(zip(pairs, together)):
         alone_tri, alone_node = measure_face(fm, tol, ev=ev)

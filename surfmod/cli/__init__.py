@@ -49,13 +49,26 @@ COMMANDS = {"analyze": "analyze", "check": "check", "conformance": "conformance"
             "section": "section", "toolpath": "toolpath"}
 
 
+class _Version(argparse.Action):
+    """``--version``: the installed version, looked up only when asked for (reading the
+    metadata costs 0.1-0.2 s, which no other command line should pay)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
+                 help="show program's version number and exit"):
+        super().__init__(option_strings, dest, nargs=0, default=default, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"surfmod {installed_version()}")
+        parser.exit()
+
+
 def build_parser(argv=None) -> argparse.ArgumentParser:
     """The command line's parser: every subcommand, or only the one ``argv`` names."""
     parser = Parser(
         prog="surfmod",
         description="Surface-modeling toolbox on OpenCASCADE, cross-checked by NumPy.",
     )
-    parser.add_argument("--version", action="version", version=f"surfmod {installed_version()}")
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     named = next((a for a in (argv or []) if not a.startswith("-")), None)
     modules = [COMMANDS[named]] if named in COMMANDS else sorted(set(COMMANDS.values()))

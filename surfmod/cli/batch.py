@@ -31,7 +31,6 @@ import threading
 import warnings
 from pathlib import Path
 
-from joblib import Parallel, delayed
 from tqdm import tqdm
 
 from .. import child
@@ -88,6 +87,8 @@ def _watched(job, client_pid, path, options):
 
 
 def _local(job, files, options, jobs):
+    from joblib import Parallel, delayed  # 0.15 s: a folder run's, not a single file's
+
     n_jobs = jobs if len(files) > 1 else 1
     # rows as each file completes, not in file order: a slow file holds back nobody's rows
     return Parallel(n_jobs=n_jobs, return_as="generator_unordered")(

@@ -17,9 +17,10 @@ Every path is a twin: ``name`` in NumPy (:mod:`surfmod.eval.scattered`,
 :mod:`surfmod.eval.scattered_compiled`, :mod:`surfmod.eval.tensor_grid_compiled`,
 :mod:`surfmod.eval.patches`) for large, ``name_parallel`` (:mod:`surfmod.eval.parallel`)
 when several threads may run.  The amount of work picks NumPy or compiled (scattered
-pairs in :func:`_scattered`, grids in :func:`surface_grid`), :func:`_kernel` the compiled
-twin and its threads; the compiled modules are imported on first use (so
-``import surfmod`` does not load numba).
+pairs in :func:`_scattered`, grids in :func:`surface_grid`; a caller that counted a whole
+task up front and found it small keeps its scattered pairs in NumPy with
+:func:`numpy_only`), :func:`_kernel` the compiled twin and its threads; the compiled
+modules are imported on first use (so ``import surfmod`` does not load numba).
 
 >>> import numpy as np
 >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]
@@ -32,7 +33,7 @@ from __future__ import annotations
 
 import threading
 import warnings
-from contextlib import nullcontext
+from contextlib import contextmanager, nullcontext
 from math import comb
 from typing import NamedTuple
 
@@ -70,6 +71,24 @@ COMPILED_SCATTERED = 1 << 15
 #: fraction of compiling them (12-25 s each); the meshers' and the gallery's grids (up
 #: to 640k partials) stay below it, so a first `surfmod gallery` compiles no grid stage
 COMPILED_GRID = 3 << 18
+
+
+_TASK = threading.local()
+
+
+@contextmanager
+def numpy_only():
+    """Scattered pairs evaluated inside the block run in NumPy whatever their number: for
+    a task its caller has counted up front and found small as a whole (the measure of a
+    small part's mesh, :data:`surfmod.meshing.brep.COMPILED_MEASURE`), where one piece
+    past :data:`COMPILED_SCATTERED` would make a fresh process load numba and a kernel
+    (about a second) for what NumPy does in a fraction of that."""
+    before = getattr(_TASK, "numpy", False)
+    _TASK.numpy = True
+    try:
+        yield
+    finally:
+        _TASK.numpy = before
 
 
 def _kernels():
@@ -310,8 +329,9 @@ def surface_derivatives(net: LocalNet, u, v, order: int, out=None) -> np.ndarray
 
 def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndarray:
     """The one place scattered pairs pick their path: NumPy (:func:`scattered`) below
-    :data:`COMPILED_SCATTERED` partials, else the per-span patches (positions, or
-    partials to order 1 or 2, on a net that suits them), else the basis-function kernel;
+    :data:`COMPILED_SCATTERED` partials or inside :func:`numpy_only`, else the per-span
+    patches (positions, or partials to order 1 or 2, on a net that suits them), else the
+    basis-function kernel;
     a compiled one on the threads :func:`_kernel` picks.  ``positions``: ``(N, 3)``
     positions instead of ``(N, K, K, 3)`` partials.  Partials of a net with crowded
     knots come from its derivative nets (:func:`_from_derivative_nets`)."""
@@ -319,7 +339,7 @@ def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndar
     if not positions and order > 0 and _crowded(net):
         return _store(_from_derivative_nets(net, order, lambda d: surface_points(d, u, v)), out)
     net = _centred(net)
-    if u.size * (order + 1) ** 2 < COMPILED_SCATTERED:
+    if u.size * (order + 1) ** 2 < COMPILED_SCATTERED or getattr(_TASK, "numpy", False):
         h = scattered(*net[:4], net.ctrl, net.rational, u, v, order)
         _add_origin(net, h[:, 0, 0])
         h = h[:, 0, 0] if positions else h

@@ -12,8 +12,8 @@ once):
   box): the *UV-parametric error* ``|q - S(uv)|`` of each sample ``q`` of a triangle and
   its UV-interpolated parameter (an upper bound of the distance, ``S(uv)`` being a point
   of the face), then Gauss-Newton projection of the samples whose bound exceeds half the
-  tolerance, compiled (:mod:`surfmod.eval.packed`); periodic directions wrap, as OCCT
-  evaluates them;
+  tolerance, compiled (:mod:`surfmod.eval.packed`), or in NumPy while they are few
+  (:data:`COMPILED_MEASURE`); periodic directions wrap, as OCCT evaluates them;
 * any other surface (Bezier, other surfaces of revolution and extrusions, offset): the
   same in NumPy, with :class:`FaceSurface` (the surface :mod:`surfmod.readback` reads, or
   OCCT per point for a type the reader does not know).
@@ -40,6 +40,7 @@ import numpy as np
 
 from ..construct import elementary_closest
 from ..errors import InsideOutWarning, SurfmodError
+from ..eval.local import COMPILED_SCATTERED, numpy_only
 from ..ops.closest import project_distances
 from . import analytic_distance
 from .closure import faces_against_neighbours
@@ -84,6 +85,13 @@ def allowed_deviation(node_dev, tolerance: float):
     return np.maximum(tolerance, np.asarray(node_dev, float) + MIN_SHARE * tolerance)
 
 
+#: B-spline faces are measured in NumPy while the samples of all of them (every triangle's
+#: and every node, :func:`_samples`), counted before measuring, are fewer than this, and
+#: in compiled calls (:mod:`surfmod.eval.packed`) from here on: NumPy measures about a
+#: million samples a second (70 ms for the 67k of trimesh_featuretype's B-spline face),
+#: where a fresh process pays about a second to load numba and the kernels, so that
+#: ``surfmod mesh`` of a small part loads no numba.
+COMPILED_MEASURE = 1 << 18
 #: Surface types a :class:`FaceSurface` may evaluate as a spline net (see ``FaceSurface.spline``).
 SPLINE_EVALUATED = ("Geom_BSplineSurface", "Geom_BezierSurface", "Geom_SurfaceOfLinearExtrusion")
 
@@ -115,8 +123,21 @@ def measure_face(fm, tolerance: float, bary=DENSE, ev: FaceSurface | None = None
     if params is not None:  # closed forms
         return measure_analytic_faces([fm], [params], bary)[0]
     ev = FaceSurface(fm.surface, fm.bounds) if ev is None else ev
-    if ev.projector is not None:  # a B-spline net: compiled Gauss-Newton
+    if ev.projector is None:
+        return _measure_numpy(fm, tolerance, bary, ev)
+    if _samples([fm], bary) >= COMPILED_MEASURE:  # a large B-spline face: compiled Gauss-Newton
         return measure_spline_faces([fm], [ev], tolerance, bary)[0]
+    with numpy_only():  # a small one: every evaluation in NumPy, no numba to load
+        return _measure_numpy(fm, tolerance, bary, ev)
+
+
+def _samples(fms: list, bary) -> int:
+    """The points measuring ``fms`` evaluates: ``bary`` samples per triangle, and the nodes."""
+    return sum(len(fm.triangles) * len(bary) + len(fm.nodes) for fm in fms)
+
+
+def _measure_numpy(fm, tolerance: float, bary, ev: FaceSurface) -> tuple[np.ndarray, float]:
+    """:func:`measure_face` of a face with its :class:`FaceSurface` ``ev``, in NumPy."""
     box = _bounds(fm, ev)
     if np.isnan(fm.uv).any():
         raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
@@ -248,21 +269,26 @@ def _sample_spline(evaluators: dict, splines: list, face, surf, bounds, samples:
 
 def _spline_partials(splines: list) -> np.ndarray:
     """Partials to order 2 of every sampled face on its grid, ``(faces, samples, 3, 3, 3)``:
-    the B-spline ones in one compiled call (:mod:`surfmod.eval.packed`)."""
-    from ..eval.packed import derivatives_segments
-
+    the B-spline ones in one compiled call (:mod:`surfmod.eval.packed`) when they are
+    :data:`~surfmod.eval.local.COMPILED_SCATTERED` partials or more, else face by face in
+    NumPy."""
     size = len(splines[0][1])
     out = np.empty((len(splines), size, 3, 3, 3))
     nets = [i for i, (ev, *_) in enumerate(splines) if ev.projector is not None]  # B-spline nets
+    if len(nets) * size * 9 < COMPILED_SCATTERED:  # few samples: NumPy face by face, no numba to load
+        nets = []
     if nets:
+        from ..eval.packed import derivatives_segments  # numba: loaded only for this much work
+
         pk = _packed([splines[i][0] for i in nets])
         at = size * np.arange(len(nets) + 1)
         ders = derivatives_segments(pk, np.concatenate([splines[i][1] for i in nets]),
                                     np.concatenate([splines[i][2] for i in nets]),
                                     np.c_[np.arange(len(nets)), at[:-1], at[1:]], 2)
         out[nets] = ders.reshape(len(nets), size, 3, 3, 3)
+    done = set(nets)
     for i, (ev, uu, vv, *_) in enumerate(splines):
-        if ev.projector is None:  # Bezier
+        if i not in done:  # Bezier, or few samples
             out[i] = ev.d2(uu, vv)
     return out
 
@@ -299,7 +325,7 @@ def _measure_faces(fms: list, evaluators: dict, tolerance: float, desc: str, pro
     evs = {i: _evaluator(evaluators, fms[i]) for i in first if i not in params}
     splines = [i for i, ev in evs.items() if ev is not None and ev.projector is not None and len(fms[i].nodes)]
     measured = {}
-    if splines:
+    if splines and _samples([fms[i] for i in splines], DENSE) >= COMPILED_MEASURE:  # else face by face, NumPy
         measured.update(zip(splines, measure_spline_faces([fms[i] for i in splines], [evs[i] for i in splines],
                                                           tolerance)))
     if params:
