@@ -105,9 +105,10 @@ def _tampered(job, pattern, replacement, count=1):
     return text, new
 
 
-def test_a_move_lowered_into_the_part_is_a_gouge_measured_exactly(job):
-    # a finishing move ending on the box top (z 2.5) clear of the boss and the box's edges
-    # (so the plane alone is in reach): the ball sunk about 0.5 into it there, then back up
+def _lowered(job):
+    """The job's program with a finishing move ending on the box top (z 2.5) clear of the
+    boss and the box's edges (so the plane alone is in reach) sunk about 0.5 into it there,
+    then back up: ``(lines, line index, x, y, depth sunk)``."""
     text = programs(job)[0]
     moves = read_program(text)
     lines = text.splitlines()
@@ -121,7 +122,11 @@ def test_a_move_lowered_into_the_part_is_a_gouge_measured_exactly(job):
     assert lines[k].startswith("G1 ")
     lines[k] = re.sub(r" Z-?[\d.]+", "", lines[k]) + f" Z{z[m] - 0.5:.4f}"
     lines.insert(k + 1, f"G1 Z{z[m]:.4f}")
-    x, y, sunk = x[m], y[m], 0.5 - (z[m] - TOP)
+    return lines, k, x[m], y[m], 0.5 - (z[m] - TOP)
+
+
+def test_a_move_lowered_into_the_part_is_a_gouge_measured_exactly(job):
+    lines, k, x, y, sunk = _lowered(job)
     v = V.verify_job(job, texts=["\n".join(lines)])
     gouge = _finding(v, "gouge, finishing")
     assert not v.ok and not gouge.ok and gouge.line in (k + 1, k + 2)
@@ -129,6 +134,22 @@ def test_a_move_lowered_into_the_part_is_a_gouge_measured_exactly(job):
     assert abs(gouge.worst - sunk) < 1e-9, gouge
     assert abs(gouge.where[2] - TOP) < 1e-9 and math.hypot(gouge.where[0] - x, gouge.where[1] - y) < 1.5
     assert _finding(v, "gouge, roughing").ok
+
+
+def test_a_verdict_after_a_repair_measures_the_changed_stretch_again(job, monkeypatch):
+    # given the verdict before (as the job's repair gives it), the moves it measured
+    # against the part are taken from it: the lowered move and the one after it are
+    # measured again, and the verdict is the one judged from scratch
+    lines, k, *_ = _lowered(job)
+    fresh = V.verify_job(job, texts=["\n".join(lines)])
+    probed = []
+    probes = V._probes
+    monkeypatch.setattr(V, "_probes", lambda *a: probed.append(len(a[0])) or probes(*a))
+    again = V.verify_job(job, texts=["\n".join(lines)], before=job.verification)
+    assert [str(f) for f in again.findings] == [str(f) for f in fresh.findings]
+    assert not _finding(again, "gouge, finishing").ok and again.probes == fresh.probes
+    # the checks along the moves probed the two changed moves alone (one stretch a check)
+    assert probed and max(probed) <= 2 and fresh.probes > 50_000
 
 
 def test_a_rapid_through_the_stock_is_found(job):

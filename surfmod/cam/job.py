@@ -324,7 +324,7 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     ops = list(job.operations)
     ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine), report=report)
     job = replace(job, operations=tuple(ops))
-    return replace(job, verification=verify_job(job))
+    return replace(job, verification=verify_job(job, before=job.verification))
 
 
 def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape, cusp):
@@ -395,7 +395,7 @@ def _relink(job: Job) -> Job:
     if not relinked:
         return job
     job = replace(job, operations=tuple(ops))
-    return replace(job, verification=verify_job(job))
+    return replace(job, verification=verify_job(job, before=job.verification))
 
 
 def _after(op: Rest, k: int, specs: list) -> list[int]:

@@ -7,8 +7,8 @@ holds at most ``KEPT_NODES`` nodes: a finer field is kept as the maxima over squ
 of nodes (the highest stock, the most left), so nothing left is lost from sight.
 
 >>> top = np.array([[1.0, 1.0, 1.0], [1.0, 1.5, 1.0], [1.0, 1.0, 1.0]])
->>> def level_part(xy):  # at height 0, but for the node (2, 0)
-...     return np.where((xy[:, 0] == 2) & (xy[:, 1] == 0), -np.inf, 0.0)
+>>> level_part = np.zeros((3, 3))  # at height 0, but for the node (2, 0)
+>>> level_part[2, 0] = -np.inf
 >>> field = StockField.over_part(top, level_part, (0.0, 0.0), 1.0, 80.0)
 >>> field.left.tolist()  # NaN off the part and beside its outline (no slope there)
 [[1.0, 1.0, 1.0], [nan, 1.5, 1.0], [nan, nan, 1.0]]
@@ -76,13 +76,12 @@ class StockField(NodeGrid):
         object.__setattr__(self, "left", checks.frozen(self.left))
 
     @classmethod
-    def over_part(cls, top: np.ndarray, height, origin, cell: float, wall_slope: float,
+    def over_part(cls, top: np.ndarray, under: np.ndarray, origin, cell: float, wall_slope: float,
                   max_nodes: int = KEPT_NODES) -> "StockField":
-        """The field of ``top`` over a part whose height under points ``xy`` (N, 2) is
-        ``height(xy)`` (-inf where there is none), at most ``max_nodes`` nodes (see
+        """The field of ``top`` over a part whose height at its nodes is ``under`` (the
+        shape of ``top``, -inf where there is none), at most ``max_nodes`` nodes (see
         :meth:`coarsened`); nodes steeper than ``wall_slope`` degrees are walls."""
-        nx, ny = np.shape(top)
-        under = np.asarray(height(grid_points(origin, cell, (nx, ny))), float).reshape(nx, ny)
+        under = np.asarray(under, float).reshape(np.shape(top))
         part = np.where(np.isfinite(under), under, np.nan)
         if min(part.shape) >= 2:
             gx, gy = np.gradient(part, cell)

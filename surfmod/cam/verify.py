@@ -60,7 +60,8 @@ Each finding keeps its maximum and where it is.  The work is estimated before it
 (points on the part, probes along the moves, stock nodes, the dexels' cuts); where it would pass its cap the
 points, probes or cells stand farther apart and the verdict carries a note saying so, so a
 large job is judged more coarsely, never refused (only a program of more moves than half
-``max_probes`` is).  :func:`lift_gouges` is the repair a tool path gets from the same
+``max_probes`` is).  A verdict after a repair measures against the part only the stretch of
+the program the repair changed (:func:`verify_job`'s ``before``).  :func:`lift_gouges` is the repair a tool path gets from the same
 points (:func:`surfmod.toolpath`); :func:`sampled_part` keeps the last sampling, so the
 repair and the verdict sample the part once.
 """
@@ -177,6 +178,9 @@ class Verification:
     #: the stock after the program (:class:`~surfmod.cam.stock_field.StockField`, at most
     #: ``KEPT_NODES`` nodes; None for a tool path alone)
     stock: StockField | None = field(default=None, repr=False, compare=False)
+    #: what was measured against the part alone, for a verdict after a repair
+    #: (:func:`verify_job`'s ``before``)
+    measured: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def ok(self) -> bool:
@@ -452,60 +456,129 @@ def _probes(start: np.ndarray, end: np.ndarray, spacing: float, max_probes: int)
     return pts, move, spacing
 
 
-def _gouge(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, radius: float, corner: float, limit: float,
-           spacing: float, what: str, max_probes: int, notes: list, exact_shape=None):
-    """The deepest any point of the part comes into the tool along the picked moves; a note
-    joins ``notes`` when the probes had to stand farther apart than ``spacing``."""
-    if not pick.any():
-        return Finding(what, -np.inf, limit), 0
-    idx = np.flatnonzero(pick)
-    probes, move, used = _probes(moves.start[idx], moves.end[idx], spacing, max_probes)
-    if used > spacing:
-        notes.append(f"note: {what}: probes {used:.3g} mm apart along the moves, coarser than the {spacing:.3g} "
-                     f"asked ({max_probes:,} at most): between them a tool may come nearer the part than measured")
-    depth, which = part.deepest(probes, radius, corner)
-    if exact_shape is not None and corner == radius and depth.max() > 0:
-        # the deepest ball probes measured by OCCT's exact distance from the centre to the
-        # faces (a loose vertex or wire of the file is construction geometry, not material)
-        from ..occ.topo import closest_on_face, compound, faces_of
+@dataclass(frozen=True)
+class _Measured:
+    """One check's measure of each move against the part alone (no stock: the same
+    wherever the move stands in the program): the moves, the probes' spacing, and per move
+    the deepest ``depth``, ``where`` it is and how many ``probes`` it took."""
 
-        top = np.argsort(depth)[-EXACT_PROBES:]
-        top = top[depth[top] > 0]
-        dist, _ = closest_on_face(compound(faces_of(exact_shape)), probes[top] + [0.0, 0.0, radius])
-        depth[top] = np.maximum(depth[top], radius - dist)
-    k = int(np.argmax(depth))
-    if depth[k] <= 0:
-        return Finding(what, float(depth[k]), limit), len(probes)
-    bad = np.unique(move[depth > limit])
-    where = tuple(float(v) for v in part.points[which[k]]) if which[k] >= 0 else tuple(probes[k])
-    return Finding(what, float(depth[k]), limit, where, len(bad), int(moves.line[idx[move[k]]])), len(probes)
+    start: np.ndarray
+    end: np.ndarray
+    used: float
+    depth: np.ndarray
+    where: np.ndarray
+    probes: np.ndarray
+
+
+def _spacing(start: np.ndarray, end: np.ndarray, spacing: float, max_probes: int) -> float:
+    """The probes' spacing :func:`_probes` takes along the moves."""
+    length = np.linalg.norm(end - start, axis=1)
+    if (np.ceil(length / spacing) + 1).sum() > max_probes and 2 * len(start) < max_probes:
+        return max(spacing, float(length.sum()) / (max_probes - 2 * len(start)))
+    return spacing
+
+
+def _per_move(start: np.ndarray, end: np.ndarray, spacing: float, max_probes: int, measure, before):
+    """:class:`_Measured` of the moves ``start``-``end``: ``measure(probes, move, used)``
+    gives each probe's depth and where; the moves at the head and the tail that
+    ``before`` (a :class:`_Measured` at the same spacing, or None) measured already are
+    taken from it, so a verdict after a repair that changed one stretch of the program
+    measures that stretch alone."""
+    used = _spacing(start, end, spacing, max_probes)
+    m = len(start)
+    head = tail = 0
+    if before is not None and before.used == used:
+        n = min(m, len(before.start))
+        same = np.all((start[:n] == before.start[:n]) & (end[:n] == before.end[:n]), axis=1)
+        head = int(np.argmin(same)) if not same.all() else n
+        k = n - head
+        same = np.all((start[m - k:] == before.start[len(before.start) - k:])
+                      & (end[m - k:] == before.end[len(before.end) - k:]), axis=1)[::-1]
+        tail = int(np.argmin(same)) if not same.all() else k
+    depth, where, probes = np.empty(m), np.empty((m, 3)), np.empty(m, np.int64)
+    if head or tail:
+        old = len(before.start)
+        for mine, theirs in ((slice(0, head), slice(0, head)), (slice(m - tail, m), slice(old - tail, old))):
+            depth[mine], where[mine], probes[mine] = before.depth[theirs], before.where[theirs], before.probes[theirs]
+    fresh = slice(head, m - tail)
+    if m - tail > head:
+        pts, move, _ = _probes(start[fresh], end[fresh], used, max_probes)
+        d, w = measure(pts, move + head, used)
+        order = np.lexsort((d, move))  # each move's deepest probe: the last of its group
+        last = order[np.r_[move[order][1:] != move[order][:-1], True]]
+        depth[fresh], where[fresh] = d[last], w[last]
+        probes[fresh] = np.bincount(move, minlength=m - tail - head)
+    return _Measured(start, end, used, depth, where, probes)
+
+
+def _gouge(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, radius: float, corner: float, limit: float,
+           spacing: float, what: str, max_probes: int, notes: list, exact_shape=None, before=None):
+    """The deepest any point of the part comes into the tool along the picked moves, and
+    its :class:`_Measured` (``before``: the same check's before a repair, see
+    :func:`_per_move`); a note joins ``notes`` when the probes had to stand farther apart
+    than ``spacing``."""
+    if not pick.any():
+        return Finding(what, -np.inf, limit), 0, None
+    idx = np.flatnonzero(pick)
+
+    def measure(probes, move, used):
+        depth, which = part.deepest(probes, radius, corner)
+        if exact_shape is not None and corner == radius and depth.max() > 0:
+            # the deepest ball probes measured by OCCT's exact distance from the centre to
+            # the faces (a loose vertex or wire of the file is construction geometry, not
+            # material); those of the moves a verdict before measured are its deepest too
+            from ..occ.topo import closest_on_face, compound, faces_of
+
+            top = np.argsort(depth)[-EXACT_PROBES:]
+            top = top[depth[top] > 0]
+            dist, _ = closest_on_face(compound(faces_of(exact_shape)), probes[top] + [0.0, 0.0, radius])
+            depth[top] = np.maximum(depth[top], radius - dist)
+        return depth, np.where((which >= 0)[:, None], part.points[np.maximum(which, 0)], probes)
+
+    got = _per_move(moves.start[idx], moves.end[idx], spacing, max_probes, measure, before)
+    if got.used > spacing:
+        notes.append(f"note: {what}: probes {got.used:.3g} mm apart along the moves, coarser than the {spacing:.3g} "
+                     f"asked ({max_probes:,} at most): between them a tool may come nearer the part than measured")
+    n = int(got.probes.sum())
+    k = int(np.argmax(got.depth))
+    if got.depth[k] <= 0:
+        return Finding(what, float(got.depth[k]), limit), n, got
+    return Finding(what, float(got.depth[k]), limit, tuple(float(v) for v in got.where[k]),
+                   int((got.depth > limit).sum()), int(moves.line[idx[k]])), n, got
 
 
 def _body_part(part: PartPoints, moves: ProgramMoves, pick: np.ndarray, tool, slack: float, limit: float,
-               max_probes: int, what: str):
+               max_probes: int, what: str, before=None):
     """How far the part's points stand above the bottom of the tool's discs wider than its
     end (:attr:`~surfmod.cam.tool.Tool.body`, each less ``slack``, grown by half the probes'
-    spacing, at the lowest height within it) along the picked moves, against ``limit``."""
+    spacing, at the lowest height within it) along the picked moves, against ``limit``, and
+    its :class:`_Measured` (``before``: see :func:`_per_move`)."""
     discs = [(r, h) for r, h, _ in tool.body if r - slack > tool.radius]
     if not discs or not pick.any():
-        return Finding(what, -np.inf, limit), 0
+        return Finding(what, -np.inf, limit), 0, None
     idx = np.flatnonzero(pick)
     a, b = moves.start[idx], moves.end[idx]
-    probes, move, used = _probes(a, b, min(r for r, _ in discs) / 16, max_probes)
-    seg = b - a
-    low = np.maximum(probes[:, 2] - np.abs(seg[move, 2]) / np.maximum(np.linalg.norm(seg[move], axis=1), 1e-300)
-                     * used / 2, np.minimum(a[move, 2], b[move, 2]))
     ceiling = float(part.points[:, 2].max())
-    depth = np.full(len(probes), -np.inf)
-    for r, h in discs:
-        near = low + h < ceiling
-        if near.any():
-            depth[near] = np.maximum(depth[near], part.drop(probes[near, :2], r - slack + used / 2, 0.0) - (low[near] + h))
-    k = int(np.argmax(depth))
-    if not depth[k] > 0:
-        return Finding(what, float(depth[k]), limit), len(probes)
-    return Finding(what, float(depth[k]), limit, tuple(float(v) for v in probes[k]),
-                   len(np.unique(move[depth > limit])), int(moves.line[idx[move[k]]])), len(probes)
+
+    def measure(probes, move, used):
+        seg = b[move] - a[move]
+        low = np.maximum(probes[:, 2] - np.abs(seg[:, 2]) / np.maximum(np.linalg.norm(seg, axis=1), 1e-300)
+                         * used / 2, np.minimum(a[move, 2], b[move, 2]))
+        depth = np.full(len(probes), -np.inf)
+        for r, h in discs:
+            near = low + h < ceiling
+            if near.any():
+                depth[near] = np.maximum(depth[near],
+                                         part.drop(probes[near, :2], r - slack + used / 2, 0.0) - (low[near] + h))
+        return depth, probes
+
+    got = _per_move(a, b, min(r for r, _ in discs) / 16, max_probes, measure, before)
+    n = int(got.probes.sum())
+    k = int(np.argmax(got.depth))
+    if not got.depth[k] > 0:
+        return Finding(what, float(got.depth[k]), limit), n, got
+    return Finding(what, float(got.depth[k]), limit, tuple(float(v) for v in got.where[k]),
+                   int((got.depth > limit).sum()), int(moves.line[idx[k]])), n, got
 
 
 # -- the job --------------------------------------------------------------------------------
@@ -536,10 +609,17 @@ def _program_moves(job, texts: list[str], post: str) -> tuple[ProgramMoves, np.n
 
 def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, max_samples: int = MAX_SAMPLES,
                max_probes: int = MAX_PROBES, max_nodes: int = MAX_NODES,
-               max_dexel_work: int = MAX_DEXEL_WORK) -> Verification:
+               max_dexel_work: int = MAX_DEXEL_WORK, before: Verification | None = None) -> Verification:
     """Judge the program(s) of ``job`` (as :func:`surfmod.cam.post.programs` writes them
     for ``post``, or the given ``texts``) against the exact part and the stock: gouge per
     operation, rapids through stock or part, the scallop left (see the module).
+
+    ``before``: the verdict of this job before a repair changed a stretch of its program
+    (:func:`surfmod.cam.job.machine`'s re-cut and re-link).  What is measured against the
+    part alone, move by move (gouge, rapids into the part, holder and shank over the
+    part), is taken from it for the moves before and after that stretch, as are the
+    part's heights under the stock's nodes and what the finishing tool reaches there; the
+    stock is swept again from the start (what a move meets depends on every move before it).
 
     >>> import surfmod as sm, build123d as bd
     >>> job = sm.machine(bd.Box(20, 20, 5), 1.0, [sm.Rough(sm.Tool("flat", 3.0), allowance=0.3),
@@ -566,6 +646,9 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     part, spacing = sampled_part(job.part, spacing, _cell(spacing, min(c.radius for _, _, c, _ in plans)),
                                  max_samples, sag, fit=True)
     notes = _coarser(spacing, asked, max_samples)
+    # what a verdict before measured on this same sampling of the part
+    old = before.measured if before is not None and before.measured.get("part") is part else {}
+    measured = {"part": part}
     # the probes along the moves, shared out by the number of moves each check judges
     cuts = [(owner == k) & ~moves.rapid for k, _, _, _ in plans]
     rapids = [(owner == k) & moves.rapid for k, _, _, _ in plans]
@@ -576,15 +659,18 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
 
     findings, probes = [], 0
     for (k, op, cutter, limit), pick in zip(plans, cuts):
-        found, n = _gouge(part, moves, pick, cutter.radius, cutter.corner, limit, spacing,
-                          f"gouge, {op.name} (tool {op.tool.number})", share(pick), notes, job.part)
+        key = ("gouge", k, cutter.radius, cutter.corner, limit)
+        found, n, measured[key] = _gouge(part, moves, pick, cutter.radius, cutter.corner, limit, spacing,
+                                         f"gouge, {op.name} (tool {op.tool.number})", share(pick), notes, job.part,
+                                         old.get(key))
         findings.append(found)
         probes += n
     # rapids: no point of the part inside the tool, and (below) no stock under it
     rapid_part = Finding("rapids", -np.inf, 0.0)
     for (k, op, _, _), pick in zip(plans, rapids):
-        found, n = _gouge(part, moves, pick, op.tool.radius, op.tool.corner, 0.0, spacing, "rapids", share(pick),
-                          notes)
+        key = ("rapids", k, op.tool.radius, op.tool.corner)
+        found, n, measured[key] = _gouge(part, moves, pick, op.tool.radius, op.tool.corner, 0.0, spacing, "rapids",
+                                         share(pick), notes, before=old.get(key))
         probes += n
         if found.worst > rapid_part.worst:
             rapid_part = found
@@ -613,9 +699,10 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
                                                   np.zeros(len(plans)), np.zeros(len(owner), np.bool_), False, cell)
     held, body_probes = [], 0
     for k, op, _, limit in plans:
-        found, n = _body_part(part, moves, owner == k, op.tool, limit, low_limit,
-                              max(MAX_BODY_PROBES * int((owner == k).sum()) // max(len(owner), 1), 1),
-                              f"holder and shank, {op.name} (tool {op.tool.number})")
+        key = ("body", k, op.tool.radius, op.tool.body.tobytes(), limit)
+        found, n, measured[key] = _body_part(part, moves, owner == k, op.tool, limit, low_limit,
+                                             max(MAX_BODY_PROBES * int((owner == k).sum()) // max(len(owner), 1), 1),
+                                             f"holder and shank, {op.name} (tool {op.tool.number})", old.get(key))
         body_probes += n
         mine = np.flatnonzero(owner == k)
         if mine.size and sink[mine].max() > max(found.worst, 0.0):
@@ -644,11 +731,17 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         findings.append(Finding("cuts with the spindle stopped", float(uncut.sum()), 0.0, None, int(uncut.sum()),
                                 int(moves.line[np.argmax(uncut)])))
     walls = dexels = judged_walls = 0
+    # the part under each node: the highest of its points within the node's cell
+    key = ("under", tuple(lo), cell, nx, ny)
+    under = measured[key] = old.get(key, None)
+    if under is None:
+        under = measured[key] = part.drop(grid_points(lo[:2], cell, (nx, ny)), 0.75 * cell, 0.0).reshape(nx, ny)
     if finishing:
         k, op, cutter, limit = finishing[-1]
-        # the part under each node: the highest of its points within the node's cell
-        under = part.drop(grid_points(lo[:2], cell, (nx, ny)), 0.75 * cell, 0.0).reshape(nx, ny)
-        found, walls, held = _residual(part, top, under, lo, cell, op, cutter, limit)
+        key = ("reach", k, tuple(lo), cell, nx, ny, cutter.radius, cutter.corner, op.tool.body.tobytes(), limit)
+        measured[key] = old.get(key) or _reach(part, lo, cell, (nx, ny), op, cutter, limit)
+        reach, held = measured[key]
+        found, walls, held = _residual(top, under, reach, held, lo, cell, op, cutter, limit)
         findings.append(found)
         if held:
             notes.append(f"note: residual: {held:,} nodes the shank or holder keeps the {op.name} tool from, "
@@ -658,11 +751,10 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
                                                      cell, op, cutter, limit, max_dexel_work, notes, job.part, grow,
                                                      cusp_clearance(job.operations[:k + 1]))
         findings.append(found)
-    # the part under each node as the residual reads it: its highest point within the cell
-    kept = StockField.over_part(top, lambda xy: part.drop(xy, 0.75 * cell, 0.0), lo[:2], cell, WALL_SLOPE,
-                                KEPT_NODES)
+    kept = StockField.over_part(top, under, lo[:2], cell, WALL_SLOPE, KEPT_NODES)
     return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes),
-                        stock=kept, body_probes=body_probes, dexels=dexels, wall_points=judged_walls)
+                        stock=kept, body_probes=body_probes, dexels=dexels, wall_points=judged_walls,
+                        measured=measured)
 
 
 def body_cell(stock, smallest_radius: float) -> float:
@@ -691,12 +783,12 @@ def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
                           f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
 
 
-def _residual(part: PartPoints, top: np.ndarray, under: np.ndarray, lo: np.ndarray, cell: float, op, cutter,
-              limit: float):
-    """The stock left above the finishing tool's reach, normal to it, where it reaches."""
-    nx, ny = top.shape
-    gx, gy = np.meshgrid(*grid_axes(lo, cell, (nx, ny)), indexing="ij")
-    xy = np.column_stack([gx.ravel(), gy.ravel()])
+def _reach(part: PartPoints, lo: np.ndarray, cell: float, shape: tuple, op, cutter, limit: float):
+    """``(reach, held)`` on the stock's nodes: the lowest the finishing tool's lower
+    surface reaches over each (the part's closing by the tool), and the nodes the shank or
+    holder keeps it from (see :func:`_residual`)."""
+    nx, ny = shape
+    xy = grid_points(lo[:2], cell, shape)
     tips = part.drop(xy, cutter.radius, cutter.corner).reshape(nx, ny)
     reach = K.closing(tips, cell, cutter.radius, cutter.corner)
     # where the shank or holder stops the tool above the part, the tool does not reach it:
@@ -713,6 +805,14 @@ def _residual(part: PartPoints, top: np.ndarray, under: np.ndarray, lo: np.ndarr
         n = int(cutter.radius / cell)
         ii, jj = np.mgrid[-n:n + 1, -n:n + 1]
         held = ndimage.binary_dilation(held, structure=ii ** 2 + jj ** 2 <= n * n) & np.isfinite(reach)
+    return reach, held
+
+
+def _residual(top: np.ndarray, under: np.ndarray, reach: np.ndarray, held: np.ndarray, lo: np.ndarray, cell: float,
+              op, cutter, limit: float):
+    """The stock left above the finishing tool's reach (:func:`_reach`), normal to it,
+    where it reaches."""
+    gx, gy = np.meshgrid(*grid_axes(lo, cell, top.shape), indexing="ij")
     # the outline: a node whose neighbours are not all over the part is not judged
     on = np.isfinite(under)
     inner = on.copy()
@@ -915,6 +1015,6 @@ def verify_toolpath(path, obj, *, text: str | None = None, max_samples: int = MA
     asked = spacing
     part, spacing = sampled_part(shape, spacing, _cell(spacing, cutter.radius), max_samples, base / 4, fit=True)
     notes = _coarser(spacing, asked, max_samples)
-    found, n = _gouge(part, moves, ~moves.rapid, cutter.radius, cutter.corner, limit, spacing, "gouge", max_probes,
-                      notes, shape)
+    found, n, _ = _gouge(part, moves, ~moves.rapid, cutter.radius, cutter.corner, limit, spacing, "gouge",
+                         max_probes, notes, shape)
     return Verification((found,), len(part.points), n, spacing=spacing, notes=tuple(notes))

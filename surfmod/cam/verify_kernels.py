@@ -201,6 +201,22 @@ def _log(log_i, log_v, n, index, value):
     return log_i, log_v
 
 
+#: nodes a side of the blocks whose highest stock :func:`sweep_body` keeps
+BLOCK = 8
+
+
+@njit(cache=True)
+def _block_max(top, out):
+    """The highest node of each ``BLOCK`` x ``BLOCK`` block of ``top`` into ``out``."""
+    nx, ny = top.shape
+    out[:] = -np.inf
+    for i in range(nx):
+        for j in range(ny):
+            b = out[i // BLOCK, j // BLOCK]
+            if top[i, j] > b:
+                out[i // BLOCK, j // BLOCK] = top[i, j]
+
+
 @njit(cache=True)
 def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, body, tool_of, slack, limit, skip,
                remove, grow):
@@ -235,10 +251,15 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
     sink = np.full(m, -np.inf)
     sink_node = np.full(m, -1, np.int64)
     removed = np.zeros(m, np.bool_)
-    ceiling = -np.inf
-    for i in range(nx):
-        for j in range(ny):
-            ceiling = max(ceiling, top[i, j])
+    # the highest stock over blocks of BLOCK x BLOCK nodes: a disc skips every block
+    # whose highest node stays below its bottom.  Stock only falls between two moves (a
+    # removed move's stamps are undone within it), so maxima taken at the start of a move
+    # are never below the stock while it lasts; they are taken again once the stamps have
+    # visited as many nodes as the grid holds (at most as much work as the stamps)
+    bmax = np.empty(((nx + BLOCK - 1) // BLOCK, (ny + BLOCK - 1) // BLOCK))
+    _block_max(top, bmax)
+    ceiling = bmax.max()
+    visits = 0
     lowest = np.full(body.shape[0], np.inf)
     for t in range(body.shape[0]):
         for q in range(body.shape[1]):
@@ -248,6 +269,10 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
     log_v = np.empty(1024)
     gap = False  # a move before was removed: the next feed move is reached by a plunge
     for k in range(m):
+        if visits > nx * ny:
+            _block_max(top, bmax)
+            ceiling = bmax.max()
+            visits = 0
         if remove and skip[k]:
             removed[k] = gap = True
             continue
@@ -288,19 +313,24 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                     i1 = min(int(math.floor((max(cx, px) + reach - x0) / cell)), nx - 1)
                     j0 = max(int(math.ceil((min(cy, py) - reach - y0) / cell)), 0)
                     j1 = min(int(math.floor((max(cy, py) + reach - y0) / cell)), ny - 1)
-                    for i in range(i0, i1 + 1):
-                        gx = x0 + i * cell
-                        for j in range(j0, j1 + 1):
-                            over = top[i, j] - bottom
-                            if over <= sink[k]:
-                                continue
-                            gy = y0 + j * cell
-                            w = 0.0 if uu == 0.0 else min(max(((gx - px) * ux + (gy - py) * uy) / uu, 0.0), 1.0)
-                            if math.sqrt((gx - px - w * ux) ** 2 + (gy - py - w * uy) ** 2) >= reach:
-                                continue
-                            if own and math.sqrt((gx - cx) ** 2 + (gy - cy) ** 2) < radius:
-                                continue
-                            sink[k], sink_node[k] = over, i * ny + j
+                    for bi in range(i0 // BLOCK, i1 // BLOCK + 1):
+                        for bj in range(j0 // BLOCK, j1 // BLOCK + 1):
+                            if bmax[bi, bj] - bottom <= sink[k]:
+                                continue  # no node of the block stands higher
+                            for i in range(max(i0, bi * BLOCK), min(i1, bi * BLOCK + BLOCK - 1) + 1):
+                                gx = x0 + i * cell
+                                for j in range(max(j0, bj * BLOCK), min(j1, bj * BLOCK + BLOCK - 1) + 1):
+                                    over = top[i, j] - bottom
+                                    if over <= sink[k]:
+                                        continue
+                                    gy = y0 + j * cell
+                                    w = 0.0 if uu == 0.0 else min(max(((gx - px) * ux + (gy - py) * uy) / uu, 0.0),
+                                                                  1.0)
+                                    if math.sqrt((gx - px - w * ux) ** 2 + (gy - py - w * uy) ** 2) >= reach:
+                                        continue
+                                    if own and math.sqrt((gx - cx) ** 2 + (gy - cy) ** 2) < radius:
+                                        continue
+                                    sink[k], sink_node[k] = over, i * ny + j
                 if remove and sink[k] > limit[tk]:
                     for e in range(logged - 1, -1, -1):  # undo this move's stamps
                         top[log_i[e] // ny, log_i[e] % ny] = log_v[e]
@@ -308,6 +338,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                     break
             px, py, pz = cx, cy, cz
             i0, i1, j0, j1 = _nodes(cx, cy, radius + wide, x0, y0, cell, nx, ny)
+            visits += max(i1 - i0 + 1, 0) * max(j1 - j0 + 1, 0)
             for i in range(i0, i1 + 1):
                 dx = x0 + i * cell - cx
                 for j in range(j0, j1 + 1):
