@@ -142,10 +142,12 @@ def test_a_verdict_after_a_repair_measures_the_changed_stretch_again(job, monkey
     # measured again, and the verdict is the one judged from scratch
     lines, k, *_ = _lowered(job)
     fresh = V.verify_job(job, texts=["\n".join(lines)])
+    before = V.verify_job(job)
+    assert not job.verification.measured  # the job keeps none of it
     probed = []
     probes = V._probes
     monkeypatch.setattr(V, "_probes", lambda *a: probed.append(len(a[0])) or probes(*a))
-    again = V.verify_job(job, texts=["\n".join(lines)], before=job.verification)
+    again = V.verify_job(job, texts=["\n".join(lines)], before=before)
     assert [str(f) for f in again.findings] == [str(f) for f in fresh.findings]
     assert not _finding(again, "gouge, finishing").ok and again.probes == fresh.probes
     # the checks along the moves probed the two changed moves alone (one stretch a check)

@@ -577,4 +577,6 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
         if verify:
             with _stage(bar, "verification", "verify", "verify=False, surfmod machine --no-verify, skips it"):
                 job = _relink(_recut(replace(job, verification=verify_job(job)), finishing, stock_model))
+            # what the repairs reused is not kept with the job
+            job = replace(job, verification=replace(job.verification, measured={}))
     return job

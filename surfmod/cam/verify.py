@@ -69,6 +69,7 @@ repair and the verdict sample the part once.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -647,8 +648,10 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
                                  max_samples, sag, fit=True)
     notes = _coarser(spacing, asked, max_samples)
     # what a verdict before measured on this same sampling of the part
-    old = before.measured if before is not None and before.measured.get("part") is part else {}
-    measured = {"part": part}
+    # (held weakly: a verdict does not keep the part's points alive)
+    same = before is not None and "part" in before.measured and before.measured["part"]() is part
+    old = before.measured if same else {}
+    measured = {"part": weakref.ref(part)}
     # the probes along the moves, shared out by the number of moves each check judges
     cuts = [(owner == k) & ~moves.rapid for k, _, _, _ in plans]
     rapids = [(owner == k) & moves.rapid for k, _, _, _ in plans]
