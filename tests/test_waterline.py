@@ -319,6 +319,34 @@ def test_fiber_query_meets_what_every_triangle_meets(kind, R, r):
         assert len(want) > 200 and got == want
 
 
+@pytest.mark.parametrize("kind, R, r", [("ball", 3.0, 3.0), ("bull", 3.0, 1.0), ("flat", 3.0, 0.0)])
+def test_short_fibers_on_a_wall_meet_the_triangles_the_tool_can_reach(kind, R, r):
+    """Issue 36: a refinement fiber meets only the triangles the tool at its level can
+    touch: those whose box comes within the tool's radius at their top (the ball's end is
+    narrow low on a wall), not every triangle within R.  Fibers 0.1 mm long across the
+    contour of a 60-degree slope meshed in 0.25 mm squares meet at most 2.5x the pairs
+    that have an interval on them (the boxes grown by R: 9.1x for the ball, 6.3x for the
+    bull, 5x for the flat end), and the intervals are those of every triangle."""
+    u = np.linspace(0, 20, 81)
+    X, Y = np.meshgrid(u, u, indexing="ij")
+    P = np.stack([X, Y, math.tan(math.radians(60)) * X], -1)
+    a, b, c, d = P[:-1, :-1], P[1:, :-1], P[1:, 1:], P[:-1, 1:]
+    tri = np.concatenate([np.stack([a, b, c], 2).reshape(-1, 3, 3), np.stack([a, c, d], 2).reshape(-1, 3, 3)])
+    cut, z = tool(kind, R, r), 15.0
+    (loop,), = waterline(tri, cut, [z], sampling=1.0)
+    o = loop[(loop[:, 1] > 5) & (loop[:, 1] < 15), :2]
+    across = np.tile([[1.0, 0.0]], (len(o), 1))
+    fib = _Fibers(tri, cut, 1.5)
+    qi, lo, hi = fib.query(o, across, z, np.full(len(o), 0.05))
+    on = (lo <= 0.05) & (hi >= -0.05)
+    assert len(o) > 10 and on.sum() >= len(o) and fib.refined <= 2.5 * on.sum(), (fib.refined, on.sum())
+    for q in range(len(o)):
+        t0, t1 = intervals(tri, np.full(len(tri), o[q, 0]), np.full(len(tri), o[q, 1]), np.ones(len(tri)),
+                           np.zeros(len(tri)), z, cut)
+        want = (t0 <= t1) & (t0 <= 0.05) & (t1 >= -0.05)
+        assert np.array_equal(np.sort(lo[on & (qi == q)]), np.sort(t0[want])), q
+
+
 # --- OpenCAMLib ---------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
