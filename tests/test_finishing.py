@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import build123d as bd
 import numpy as np
@@ -15,8 +16,8 @@ from stock_sim import RS274, Cutter, Stock, normal_residual, parse_canon, part_h
 
 import surfmod as sm
 from surfmod.cam import waterline as waterline_module
-from surfmod.cam.finishing import clear_part, recut, summary_lines
-from surfmod.cam.roughing import FEED, PLUNGE, RAPID
+from surfmod.cam.finishing import clear_part, judge_links, recut, summary_lines
+from surfmod.cam.roughing import FEED, PLUNGE, RAPID, Moves
 from surfmod.cam.toolpath import _part
 from surfmod.errors import SurfmodError
 
@@ -301,3 +302,32 @@ def test_cross_passes_stand_closer_the_further_the_residual_was_over():
     gaps = [float(np.median(np.diff(x))) for x in xs]
     asked = np.array([1.0, 0.5, 0.25]) * math.sqrt(0.5)  # the passes spread evenly over the box: no wider
     assert np.all((asked * 0.95 < gaps) & (gaps <= asked + 1e-9)), gaps
+
+
+def test_links_are_judged_and_the_contours_judged_as_made_are_not_again():
+    """Issue 36: the contours' pieces are gouge-checked as they are made; the finishing's
+    last verdict judges the links, entries and retracts between them, not the pieces'
+    moves again (that took 5 of the 280 mm mould's 140 s).  A bump 1 high at x 5: a
+    judged piece of 100 moves over flat ground costs no drop but the move into it; a link
+    across the bump is found and named by its place in the sequence; the depth reported
+    is the deepest of both."""
+    seen = []
+
+    def height(xy):
+        seen.append(len(xy))
+        return np.where(np.abs(xy[:, 0] - 5.0) < 0.3, 1.0, 0.0)
+
+    part = SimpleNamespace(height=height)
+    out = Moves()
+    out.add([[0.0, 0.0, 2.0], [0.0, 0.0, 0.0]], PLUNGE)
+    out.add(np.column_stack([np.linspace(0.01, 1.0, 100), np.zeros(100), np.zeros(100)]), FEED, -0.25)
+    out.add([[1.0, 0.0, 2.0]], RAPID)
+    depth = judge_links(part, out, 0.01, "finishing")
+    assert sum(seen) == 3 * (3 + 2) and depth.max() == 0.0  # 3 moves: down, into the piece, up
+    out.add([[1.0, 0.0, 0.0], [9.0, 0.0, 0.0]], FEED)  # down, then across the bump
+    with pytest.raises(SurfmodError, match="finishing move 104 cuts 1 deep"):
+        judge_links(part, out, 0.01, "finishing")
+    again = Moves()
+    again.add([[0.0, 0.0, 1.0]], FEED)
+    again.add([[1.0, 0.0, 1.0], [2.0, 0.0, 1.0]], FEED, 0.005)
+    assert judge_links(part, again, 0.01, "finishing").max() == 0.005

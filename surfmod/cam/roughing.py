@@ -91,11 +91,16 @@ class Moves:
 
     def __init__(self):
         self.points, self.kinds = [], []
+        #: run index -> the deepest its own moves cut, for runs judged as they were made
+        #: (the finishing's contours): :func:`~surfmod.cam.finishing.judge_links` skips them
+        self.judged = {}
 
-    def add(self, pts, kind):
+    def add(self, pts, kind, deepest: float | None = None):
         pts = np.atleast_2d(np.asarray(pts, float))
         self.points.append(pts)
         self.kinds.append(np.full(len(pts), kind, np.int8))
+        if deepest is not None:
+            self.judged[len(self.points) - 1] = deepest
 
     @property
     def last(self):

@@ -92,24 +92,32 @@ def _worst_per_move(excess: np.ndarray, owner: np.ndarray, n_moves: int):
     return worst, arg
 
 
-def move_gouge(height, points: np.ndarray) -> np.ndarray:
+def move_gouge(height, points: np.ndarray, moves: np.ndarray | None = None) -> np.ndarray:
     """Per move ``(N-1,)``: the largest depth (drop-cutter height minus the straight
     move's height) at ``CHECK_SAMPLES`` centred interior samples ``t = (j + ½)/n`` and at
     the end points; ≤ 0 means the move clears.  ``height(xy)`` is the drop-cutter height.
+    With ``moves`` (indices ``i``: the move from ``points[i]`` to ``points[i + 1]``) only
+    those, one depth each.
 
     >>> import numpy as np
     >>> bump = lambda xy: np.where(np.abs(xy[:, 0] - 1) < 0.3, 1.0, 0.0)
     >>> move_gouge(bump, np.array([[0.0, 0, 0], [2, 0, 0]])).tolist()
     [1.0]
+    >>> move_gouge(bump, np.array([[0.0, 0, 0], [2, 0, 0], [4, 0, 0]]), np.array([1])).tolist()
+    [0.0]
     """
-    moves = np.arange(len(points) - 1)
+    every = moves is None
+    moves = np.arange(len(points) - 1) if every else np.asarray(moves, np.int64)
     if not len(moves):
         return np.zeros(0)
     excess, owner, _, _ = _excess(height, points, moves, np.full(len(moves), CHECK_SAMPLES), centred=True)
     worst, _ = _worst_per_move(excess, owner, len(moves))
-    ends = height(points[:, :2])
-    end_excess = np.where(np.isnan(ends), -np.inf, ends - points[:, 2])
-    return np.maximum(worst, np.maximum(end_excess[:-1], end_excess[1:]))
+    at = points if every else points[np.r_[moves, moves + 1]]
+    ends = height(at[:, :2])
+    end_excess = np.where(np.isnan(ends), -np.inf, ends - at[:, 2])
+    if every:
+        return np.maximum(worst, np.maximum(end_excess[:-1], end_excess[1:]))
+    return np.maximum(worst, np.maximum(end_excess[:len(moves)], end_excess[len(moves):]))
 
 
 def lift_moves(height, points: np.ndarray, depth: np.ndarray, target: float, rounds: int = 4):
