@@ -556,7 +556,8 @@ def part_height(triangles: np.ndarray, x: np.ndarray, y: np.ndarray, *, block: i
     for ii, jj, z, t in ray_hits(tri, 2, x, y, block=block):
         order = np.lexsort((z, jj, ii))  # per node, its highest hit last
         ii, jj, z, t = ii[order], jj[order], z[order], t[order]
-        last = np.r_[(ii[1:] != ii[:-1]) | (jj[1:] != jj[:-1]), True]
+        last = np.ones(len(ii), dtype=bool)  # a block of triangles may hit no node at all
+        last[:-1] = (ii[1:] != ii[:-1]) | (jj[1:] != jj[:-1])
         ii, jj, z, t = ii[last], jj[last], z[last], t[last]
         higher = z > top[ii, jj]
         top[ii[higher], jj[higher]] = z[higher]

@@ -174,6 +174,14 @@ def test_part_height_does_not_lift_a_hole_onto_a_chord():
     assert np.all(np.isinf(top[:2])) and np.all(top[2:] == 2.0)
 
 
+def test_part_height_over_a_triangle_whose_box_alone_covers_the_node():
+    """A node inside a triangle's box but outside the triangle: its block of ray hits is
+    empty, and the node stays uncovered (cam_part's finishing proof met one)."""
+    tri = np.array([[[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 1.0]]])
+    assert part_height(tri, np.array([0.25, 0.5]), np.array([0.75])).tolist() == [[-np.inf], [-np.inf]]
+    assert part_height(tri, np.array([0.75]), np.array([0.25])).tolist() == [[1.0]]
+
+
 def test_part_height_keeps_a_steep_face_under_overlapping_sheets():
     """stepcode_HEAD_BACK's 72° slope at (228.25, 52.75): a face (its face 3), a copy of
     it turned the other way 1 µm above (face 11) and a sheet 1 mm below along the normal
