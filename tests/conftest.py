@@ -112,7 +112,6 @@ SLOW_FIRST = (
     "test_mass_green.py::test_green_grid_equals_node_by_node_on_the_corpus",
     "test_femesh.py::test_no_inverted_tet_on_any_corpus_solid",
     "test_femesh_fallback.py::test_11752",
-    "test_mass_reference.py::test_surfmod_matches_an_independent_reference_on_every_corpus_solid",
 )
 
 
