@@ -23,7 +23,7 @@ from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
 from ..nets.bspline import BSplineSurface
 from ..sides import SIDES, side_params
-from ..surface import Surface, model_size
+from ..surface import Surface, model_size, require_surface
 from ..inputs import make_solid
 from ..nets.convert import as_bspline_surface
 from .offset_surface import OffsetSurface
@@ -204,8 +204,7 @@ def offset(s: Surface, distance: float, tolerance: float = 1e-4, *, max_rounds: 
     >>> o.max_deviation < 1e-6, round(float(np.linalg.norm(o.points(0.7, 1.0)[:2])), 6)
     (True, 2.5)
     """
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
+    s = require_surface(s, "s")
     d = _nonzero(distance, "distance")
     size = model_size(s) + abs(d)
     tol = checks.tolerance(tolerance, "tolerance", size)
@@ -234,8 +233,7 @@ def thicken(s: Surface, thickness: float, tolerance: float = 1e-5, *, symmetric:
     >>> round(slab.volume, 9)
     3.0
     """
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"s: expected a surfmod surface, got {type(s).__name__}")
+    s = require_surface(s, "s")
     t = _nonzero(thickness, "thickness")
     try:
         far = offset(s, t / 2 if symmetric else t, tolerance)

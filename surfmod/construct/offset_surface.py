@@ -14,7 +14,7 @@ import numpy as np
 from .. import tolerances, transforms
 from ..errors import SurfmodError
 from ..eval.differential import degenerate_mask
-from ..surface import Surface
+from ..surface import Surface, require_surface
 from .elementary import PlaneSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
 
 
@@ -127,8 +127,7 @@ class OffsetSurface(Surface):
     occt_construct = "Geom_OffsetSurface"
 
     def __init__(self, base: Surface, distance: float):
-        if not isinstance(base, Surface):
-            raise SurfmodError(f"base: expected a surfmod surface, got {type(base).__name__}")
+        base = require_surface(base, "base")
         d = float(distance)
         if not np.isfinite(d):
             raise SurfmodError(f"distance: must be finite, got {distance!r}")

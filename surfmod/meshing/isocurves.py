@@ -18,7 +18,7 @@ from ..construct.from_edge import from_edge
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..readback import from_face
-from ..surface import Surface
+from ..surface import Surface, require_surface
 
 
 class IsoCurve(Curve):
@@ -34,8 +34,7 @@ class IsoCurve(Curve):
     occt_construct = "Geom_Surface.UIso/VIso"
 
     def __init__(self, surface: Surface, direction: int, value: float):
-        if not isinstance(surface, Surface):
-            raise SurfmodError(f"surface: expected a surfmod surface, got {type(surface).__name__}")
+        surface = require_surface(surface, "surface")
         if direction not in (0, 1):
             raise SurfmodError(f"direction: must be 0 (u fixed) or 1 (v fixed), got {direction!r}")
         name = "u" if direction == 0 else "v"

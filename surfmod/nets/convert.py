@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
-from ..surface import Surface
+from ..surface import Surface, require_surface
 from .bspline import BSplineSurface
 
 
@@ -24,8 +24,7 @@ def as_bspline_surface(s: Surface, name: str) -> BSplineSurface:
     if isinstance(s, BSplineSurface):
         out = s.to_bspline()
         return out.segment(*out.domain) if not _clamped(out) else out
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"{name}: expected a surfmod surface, got {type(s).__name__}")
+    s = require_surface(s, name)
     if not s.exact_in_occt:
         raise SurfmodError(f"{name}: {type(s).__name__} has no exact B-spline form (fit it first)")
     from ..occ.filling import bspline_over

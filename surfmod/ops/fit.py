@@ -38,7 +38,7 @@ from ..eval.basis import basis_derivatives, find_spans
 from ..nets.bspline import BSplineSurface
 from .closest import newton_closest
 from .project import project
-from ..surface import Surface
+from ..surface import require_surface
 
 #: points per chunk when assembling the normal equations (memory bound)
 CHUNK = 200_000
@@ -125,8 +125,7 @@ def mean_normal_frame(points: np.ndarray, sample: int = 20_000, neighbours: int 
 
 def base_parameters(points: np.ndarray, base):
     """Parameters in ``[0, 1]^2`` by projection onto ``base`` (a surfmod surface)."""
-    if not isinstance(base, Surface):
-        raise SurfmodError(f"base: expected a surfmod Surface, got {type(base).__name__}")
+    base = require_surface(base, "base")
     pr = project(points, base)
     return _unit(pr.u, "base"), _unit(pr.v, "base")
 

@@ -21,7 +21,7 @@ from ..construct.plane import ThreePointPlane
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
 from .clip import as_face_surface, clip_curves
-from ..surface import Surface
+from ..surface import Surface, require_surface
 from . import marching
 from .closest import closest_points, nearest_samples, seed_parameters
 from tqdm import tqdm
@@ -335,8 +335,7 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
     swap = _is_plane_spec(a) and isinstance(b, Surface)
     if swap:
         a, b = b, a
-    if not isinstance(a, Surface):
-        raise SurfmodError(f"{'b' if swap else 'a'}: expected a surfmod Surface, got {type(a).__name__}")
+    a = require_surface(a, "b" if swap else "a")
     plane = None if isinstance(b, Surface) else as_plane(b, "a" if swap else "b")
     problem = SurfaceSurface(a, b, tol) if plane is None else SurfacePlane(a, *plane, tol)
     # below the floor Newton's stop test is never met and coincidence never detected
@@ -373,8 +372,7 @@ def intersect_line(s: Surface, origin, direction, *, tolerance: float = 1e-9) ->
     >>> sm.intersect_line(s, (0.5, 1.0, 3.0), (0, 0, -2))
     array([[0.25, 0.5 , 3.  ]])
     """
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
+    s = require_surface(s, "s")
     o = checks.point(origin, "origin")
     d = checks.direction(direction, "direction")
     tol = checks.tolerance(tolerance, "tolerance", _size(s))

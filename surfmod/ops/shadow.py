@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..surface import Surface
+from ..surface import Surface, require_surface
 from . import marching
 from .intersect import _Base, _implicit_seeds, _size, as_plane, plane_frame
 from .closest import nearest_samples, seed_parameters
@@ -191,8 +191,7 @@ def shadow(obj: Surface, light_direction, plane, *, max_angle: float = 2.5) -> S
     >>> round(sh.area, 12), len(sh.outline)
     (2.0, 1)
     """
-    if not isinstance(obj, Surface):
-        raise SurfmodError(f"obj: expected a surfmod Surface, got {type(obj).__name__}")
+    obj = require_surface(obj, "obj")
     light = checks.direction(light_direction, "light_direction")
     origin, normal = as_plane(plane, "plane")
     if abs(light @ normal) < 1e-9:

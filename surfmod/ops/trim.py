@@ -19,7 +19,7 @@ from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
 from .clip import as_face_surface
 from ..readback.trimmed import TrimmedFace
-from ..surface import Surface, model_size
+from ..surface import Surface, model_size, require_surface
 
 #: OCCT's ``Precision::Confusion()``: the smallest distance its topology tells apart
 OCCT_CONFUSION = 1e-7
@@ -148,8 +148,7 @@ def trim(s: Surface, boundary_curve_uv, *, tolerance: float = 1e-7):
     >>> round(sm.trim(s, square).area, 9)
     1.0
     """
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
+    s = require_surface(s, "s")
     tol = checks.tolerance(tolerance, "tolerance", model_size(s))
     # the 3-D edges are approximated from the p-curves to this tolerance (BRepLib
     # BuildCurves3d): below OCCT's confusion tolerance it only multiplies segments (1e-11
@@ -252,8 +251,7 @@ def trimmed_area(s: Surface, boundary_curve_uv=None, order: int = 24) -> float:
         # deprecated (one release): a face's area has one name, sm.from_face(face).area()
         warnings.warn("trimmed_area(face) is deprecated: use sm.from_face(face).area()", DeprecationWarning, stacklevel=2)
         return face.area()
-    if not isinstance(s, Surface):
-        raise SurfmodError(f"s: expected a surfmod Surface, got {type(s).__name__}")
+    s = require_surface(s, "s")
     order = checks.count(order, "order", minimum=2)
     loops = boundary_loops(s, boundary_curve_uv)
     ub, vb = _surface_breaks(s, 0), _surface_breaks(s, 1)
