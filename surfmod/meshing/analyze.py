@@ -36,6 +36,8 @@ from ..sides import normal_curvature
 from ..readback import from_face
 from ..surface import Surface
 from .analyze_plot import write_analysis_png
+from .grid import grid_faces
+from .refine import edge_table
 
 KINDS = ("zebra", "isophote", "gaussian", "mean", "max_abs", "comb")
 #: Triangles shared out among the faces of a shape (keeps a whole part to a few seconds).
@@ -113,27 +115,17 @@ class Analysis:
 
 
 # -- sampling --------------------------------------------------------------------------------------
-def grid_triangles(nu: int, nv: int) -> np.ndarray:
-    """Two triangles per cell of an ``nu x nv`` node grid (row-major node numbering)."""
-    i, j = np.meshgrid(np.arange(nu - 1), np.arange(nv - 1), indexing="ij")
-    a = (i * nv + j).ravel()
-    b, c, d = a + nv, a + 1, a + nv + 1
-    return np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)])
-
-
 def _surface_samples(s: Surface, resolution: int):
     (u0, u1), (v0, v1) = s.domain
     us, vs = np.linspace(u0, u1, resolution), np.linspace(v0, v1, resolution)
     uu, vv = np.meshgrid(us, vs, indexing="ij")
-    return np.stack([uu.ravel(), vv.ravel()], 1), grid_triangles(resolution, resolution), 1.0
+    return np.stack([uu.ravel(), vv.ravel()], 1), grid_faces(resolution, resolution), 1.0
 
 
 def refine(uv: np.ndarray, tri: np.ndarray):
     """One uniform 4-split of a triangulation (shared edge midpoints, so it stays conforming)."""
-    edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-    key = np.sort(edges, axis=1)
-    unique, inverse = np.unique(key, axis=0, return_inverse=True)
-    mid = len(uv) + inverse.reshape(3, -1).T                      # (T, 3) midpoints of e01, e12, e20
+    sides, unique, _ = edge_table(tri)
+    mid = len(uv) + sides                                         # (T, 3) midpoints of e01, e12, e20
     uv = np.concatenate([uv, 0.5 * (uv[unique[:, 0]] + uv[unique[:, 1]])])
     a, b, c = tri.T
     m01, m12, m20 = mid.T

@@ -24,7 +24,7 @@ ROUNDS = 6
 _EDGE_CORNERS = np.array([[0, 1], [1, 2], [2, 0]])
 
 
-def _edge_table(tri: np.ndarray):
+def edge_table(tri: np.ndarray):
     """``(edge id per triangle side (T, 3), vertex pairs of each edge (E, 2), sides per edge (E,))``."""
     sides = np.sort(tri[:, _EDGE_CORNERS], axis=2).reshape(-1, 2).astype(np.int64)
     # one integer key per vertex pair: a 1-D unique, several times faster than axis=0
@@ -53,7 +53,7 @@ def split_round(nodes, uv, tri, bad, evaluate):
     >>> len(n), len(t), kept.tolist(), n[-1].tolist()
     (5, 4, [], [0.5, 0.5, 0.0])
     """
-    side_edge, pairs, counts = _edge_table(tri)
+    side_edge, pairs, counts = edge_table(tri)
     interior = counts[side_edge] == 2
     ends = nodes[tri[:, _EDGE_CORNERS]]
     length = np.where(interior, np.linalg.norm(ends[:, :, 0] - ends[:, :, 1], axis=2), -1.0)
