@@ -26,7 +26,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..curve import Curve
 from ..errors import SurfmodError
 from ..gallery import entries
 from ..interop.common import nurbs_of
@@ -34,7 +33,6 @@ from ..io.step_iges import import_step
 from ..nets.bezier import BezierCurve, BezierSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..readback import from_faces
-from ..surface import Surface
 
 #: the real-parts corpus of the repository
 CORPUS = Path(__file__).resolve().parents[2] / "tests" / "data" / "step"

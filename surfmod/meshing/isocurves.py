@@ -17,7 +17,7 @@ from .. import checks
 from ..construct.from_edge import from_edge
 from ..curve import Curve
 from ..errors import SurfmodError
-from ..readback import from_face
+from ..readback import surface_of
 from ..surface import Surface, require_surface
 
 
@@ -133,11 +133,7 @@ def isocurves(s, nu: int, nv: int) -> IsoCurves:
     >>> iso.u_curves[2].points(0.5)
     array([1.5, 1.5, 0. ])
     """
-    if not isinstance(s, Surface):
-        if getattr(s, "wrapped", None) is None and not hasattr(s, "ShapeType"):
-            raise SurfmodError(f"s: expected a surfmod surface or a build123d Face, got {type(s).__name__}")
-
-        s = from_face(s)
+    s = surface_of(s, "s")
     counts = []
     for value, name in ((nu, "nu"), (nv, "nv")):
         n = checks.count(value, name, minimum=0)

@@ -27,9 +27,9 @@ from ..eval.basis import basis_matrix
 from ..nets import knots as kn
 from ..nets.bspline import BSplineSurface, cartesian
 from ..nets.convert import as_bspline_surface
+from ..readback import surface_of
 from ..nets.elevate import KNOT_TOL, elevate_degree, merged_knots
 from ..sides import SIDES
-from .continuity import _as_surface
 from ..surface import Surface
 
 ORDERS = {"G0": 0, "G1": 1, "G2": 2}
@@ -116,14 +116,6 @@ def _normals_disagree(a: BSplineSurface, side: str, out: BSplineSurface) -> bool
     return float(np.sum(n_a * n_out)) < 0.0
 
 
-def _surface(obj, name):
-    """A surfmod surface, or the surface of a build123d / OCP face (``sm.from_face``)."""
-    if isinstance(obj, Surface):
-        return obj
-
-    return _as_surface(obj, name)
-
-
 def _check_side(side, name):
     if side not in SIDES:
         raise SurfmodError(f"{name}: side must be one of u0, u1, v0, v1, got {side!r}")
@@ -176,7 +168,7 @@ def blend(a: Surface, side_a: str, b: Surface, side_b: str, continuity: str = "G
     order = ORDERS[continuity]
     auto = tension is None
     ta, tb = _tensions(1.0 if auto else tension)
-    a, b = _surface(a, "a"), _surface(b, "b")
+    a, b = surface_of(a, "a"), surface_of(b, "b")
     sa, sb = as_bspline_surface(a, "a"), as_bspline_surface(b, "b")
     rows_a, ka, pa = side_curves(sa, side_a, order)
     rows_b, kb, pb = side_curves(sb, side_b, order)

@@ -27,7 +27,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..readback import from_face
+from ..readback import from_face, surface_of
 from ..surface import Surface
 from ..sides import SIDES, measure, side_params, side_vectors
 from .project import closest_points
@@ -332,8 +332,8 @@ def continuity(a, b=None, samples: int = 50, *, edge=None, occt: bool = False) -
             return replace(parts[0], label="face a | face b")
         if parts:
             return _combined("face a | face b", parts)
-    a = _as_surface(a, "a")
-    b = _as_surface(b, "b")
+    a = surface_of(a, "a")
+    b = surface_of(b, "b")
     if edge is None:
         return _matched(a, b, samples, occt)
     else:
@@ -369,12 +369,3 @@ def _matched(a: Surface, b: Surface, samples: int, occt: bool) -> Continuity:
                       sign * r.curvature_a, r.params_b, r.params_a, r.occt)
 
 
-def _as_surface(obj, name: str) -> Surface:
-    if isinstance(obj, Surface):
-        return obj
-    if _is_shape(obj):
-        try:
-            return from_face(obj)
-        except SurfmodError as exc:
-            raise SurfmodError(f"{name}: {exc}") from None
-    raise SurfmodError(f"{name}: expected a surfmod surface or a face, got {type(obj).__name__}")

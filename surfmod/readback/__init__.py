@@ -7,6 +7,6 @@ paths read faces only through here.
 """
 
 from .readers import read_curve, read_surface
-from .trimmed import TrimmedFace, from_face, from_faces
+from .trimmed import TrimmedFace, from_face, from_faces, surface_of
 
-__all__ = ["TrimmedFace", "from_face", "from_faces", "read_curve", "read_surface"]
+__all__ = ["TrimmedFace", "from_face", "from_faces", "read_curve", "read_surface", "surface_of"]

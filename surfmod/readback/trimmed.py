@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import checks
+from ..errors import SurfmodError
 from ..inputs import build123d_face
 from ..mass.moments import face_moments
 from ..surface import Surface
@@ -171,6 +172,25 @@ def from_face(face) -> TrimmedFace:
     geom = downcast_surface(geom)
     surface = read_surface(geom, bounds)
     return TrimmedFace(surface, shape, geom, bounds, _periods(geom, surface), reversed_)
+
+
+def surface_of(value, name: str) -> Surface:
+    """``value`` if it is a surfmod surface, else the :func:`from_face` of a build123d or
+    OCP face; anything else raises one ``SurfmodError`` naming ``name``.
+
+    >>> surface_of("plane", "a")
+    Traceback (most recent call last):
+    ...
+    surfmod.errors.SurfmodError: a: expected a surfmod surface or a face, got str
+    """
+    if isinstance(value, Surface):
+        return value
+    if getattr(value, "wrapped", None) is None and not hasattr(value, "ShapeType"):
+        raise SurfmodError(f"{name}: expected a surfmod surface or a face, got {type(value).__name__}")
+    try:
+        return from_face(value)
+    except SurfmodError as exc:
+        raise SurfmodError(f"{name}: {exc}") from None
 
 
 def from_faces(shapes: list) -> list:
