@@ -21,7 +21,7 @@ from .errors import SurfmodError
 from .curve import Curve
 from .eval.differential import curvatures, degenerate_mask, unit_normals
 from .nets import mp_reference
-from .nets.knots import smooth_mask
+from .nets.knots import smooth_mask, span_samples
 from .readback import from_face
 from .readback.trimmed import TrimmedFace
 from .surface import Surface
@@ -199,9 +199,7 @@ def sufficient_parameters(s, direction: int, samples: int) -> np.ndarray:
     ends = np.unique(np.concatenate([[lo], inner, [hi]]))
     if (ends.size - 1) * (per_span - 1) + 1 >= dense.size:
         return dense
-    t = np.linspace(0.0, 1.0, per_span)[:-1]
-    few = (ends[:-1, None] + np.diff(ends)[:, None] * t).ravel()
-    return np.concatenate([few, [hi]])
+    return span_samples(ends, per_span - 1)
 
 
 def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense") -> list:

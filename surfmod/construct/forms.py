@@ -18,6 +18,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
+from ..nets.knots import span_samples
 from .fitting import FittedSurface, interpolate
 
 _MAX_SAMPLES = 513
@@ -222,11 +223,6 @@ def _call_f(f, x, y):
     return z
 
 
-def _error_grid(x, per_span=3):
-    f = np.linspace(0.0, 1.0, per_span + 1)[:-1]
-    return np.concatenate([(x[:-1, None] + np.diff(x)[:, None] * f).ravel(), x[-1:]])
-
-
 def explicit(f, x_range, y_range, tolerance: float | None = None) -> ExplicitSurface:
     """The explicit surface ``z = f(x, y)`` over ``x_range x y_range`` as a bicubic B-spline.
 
@@ -255,7 +251,7 @@ def explicit(f, x_range, y_range, tolerance: float | None = None) -> ExplicitSur
         z = _call_f(f, xs[:, None], ys[None, :])
         pts = np.stack(np.broadcast_arrays(xs[:, None], ys[None, :], z), axis=-1)
         fit = interpolate(pts, (3, 3), parameters=(xs, ys))
-        xe, ye = _error_grid(xs), _error_grid(ys)
+        xe, ye = span_samples(xs, 3), span_samples(ys, 3)
         err = np.abs(fit.grid(xe, ye)[..., 2] - _call_f(f, xe[:, None], ye[None, :]))
         max_err = float(err.max())
         if max_err <= tol:

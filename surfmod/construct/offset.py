@@ -26,6 +26,7 @@ from ..sides import SIDES, side_params
 from ..surface import Surface, model_size, require_surface
 from ..inputs import make_solid
 from ..nets.convert import as_bspline_surface
+from ..nets.knots import span_samples
 from .offset_surface import OffsetSurface
 from .ruled import ruled
 
@@ -54,12 +55,6 @@ def _breaks(s: Surface, direction: int) -> np.ndarray:
     return np.array([lo, hi])
 
 
-def _samples(breaks: np.ndarray, per_span: int) -> np.ndarray:
-    t = np.linspace(0.0, 1.0, per_span + 1)[:-1]
-    pts = (breaks[:-1, None] + t[None, :] * np.diff(breaks)[:, None]).ravel()
-    return np.concatenate([pts, breaks[-1:]])
-
-
 def _region(u, v, mask) -> str:
     return (f"u in [{u[mask].min():.6g}, {u[mask].max():.6g}], "
             f"v in [{v[mask].min():.6g}, {v[mask].max():.6g}]")
@@ -68,8 +63,8 @@ def _region(u, v, mask) -> str:
 def precheck(s: Surface, distance: float, per_span: int = 8, minimum: int = 33) -> None:
     """Raise ``SurfmodError`` where the offset by ``distance`` folds (``d k >= 1``) or
     where the base has a crease (normal jump across a C0 knot line)."""
-    us = _samples(_breaks(s, 0), per_span)
-    vs = _samples(_breaks(s, 1), per_span)
+    us = span_samples(_breaks(s, 0), per_span)
+    vs = span_samples(_breaks(s, 1), per_span)
     if us.size < minimum:
         us = np.linspace(*s.domain[0], minimum)
     if vs.size < minimum:
@@ -130,7 +125,7 @@ def _knots(breaks, mults, p=3):
 
 
 def _fit(exact: Surface, bu, bv, mults, per_span: int = 6):
-    us, vs = _samples(bu, per_span), _samples(bv, per_span)
+    us, vs = span_samples(bu, per_span), span_samples(bv, per_span)
     grid = exact.grid(us, vs)
     ku, kv = _knots(bu, mults[0]), _knots(bv, mults[1])
     net = _lsq(us, ku, 3, grid)                                   # (nu, len(vs), 3)

@@ -30,6 +30,7 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
+from ..nets.knots import span_samples
 from .fitting import FittedSurface, averaging_knots, interpolate
 from .forms import ImplicitSurface
 
@@ -206,19 +207,10 @@ def superellipsoid_implicit(rx, ry, rz, s1, s2, x, y, z) -> np.ndarray:
     return a ** (s2 / s1) + np.abs(np.asarray(z, dtype=float) / rz) ** (2.0 / s1) - 1.0
 
 
-def _check_grid(us, vs, per_span):
-    def refine(t):
-        f = np.linspace(0.0, 1.0, per_span + 1)[:-1]
-        return np.concatenate([(t[:-1, None] + np.diff(t)[:, None] * f).ravel(), t[-1:]])
-
-    return refine(us), refine(vs)
-
-
 def _deviation(s, per_span):
-    us, vs = _check_grid(np.unique(s.knots[0]), np.unique(s.knots[1]), per_span)
-    # also between data parameters (the knots of an interpolant sit between them)
-    uu = np.unique(np.concatenate([us, _check_grid(s.parameters[0], s.parameters[0][:2], per_span)[0]]))
-    vv = np.unique(np.concatenate([vs, _check_grid(s.parameters[1], s.parameters[1][:2], per_span)[0]]))
+    # at the knots and also between data parameters (the knots of an interpolant sit between them)
+    uu, vv = (np.unique(np.concatenate([span_samples(np.unique(s.knots[k]), per_span),
+                                        span_samples(s.parameters[k], per_span)])) for k in (0, 1))
     fitted = s.grid(uu, vv)
     exact = s.analytic_points(uu[:, None], vv[None, :])
     return float(np.linalg.norm(fitted - exact, axis=-1).max())

@@ -37,6 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
+from ..nets.knots import span_samples
 from ..ops.closest import crease_breaks, project_distances
 from . import gridbounds
 
@@ -65,9 +66,7 @@ def _sample_params(s, direction: int, breaks: np.ndarray, base: int = 48) -> np.
     spans = spans[(spans >= lo) & (spans <= hi)]
     n = max(1, len(spans) - 1)
     per = max(4 if n <= 256 else (2 if n <= 1024 else 1), int(np.ceil(base / n)))
-    t = np.linspace(0.0, 1.0, per + 1)[:-1]
-    pts = (spans[:-1, None] + t[None, :] * np.diff(spans)[:, None]).ravel()
-    return np.unique(np.concatenate([pts, [hi]]))
+    return np.unique(np.append(span_samples(spans, per), hi))
 
 
 def _fundamental(d: np.ndarray):

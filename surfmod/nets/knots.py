@@ -9,6 +9,17 @@ from __future__ import annotations
 import numpy as np
 
 
+def span_samples(breaks: np.ndarray, per_span: int) -> np.ndarray:
+    """``per_span`` equally spaced parameters in each span between consecutive ``breaks``
+    (the span's start included), then the last break.
+
+    >>> span_samples(np.array([0.0, 1.0, 3.0]), 2).tolist()
+    [0.0, 0.5, 1.0, 2.0, 3.0]
+    """
+    t = np.linspace(0.0, 1.0, per_span + 1)[:-1]
+    return np.concatenate([(breaks[:-1, None] + np.diff(breaks)[:, None] * t).ravel(), breaks[-1:]])
+
+
 def multiplicity(knots: np.ndarray, t: float) -> int:
     """How many times ``t`` occurs in ``knots`` (exact comparison)."""
     return int(np.count_nonzero(knots == t))
