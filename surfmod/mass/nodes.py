@@ -10,7 +10,7 @@ integrands ``g`` of the divergence theorem (``x·n``, ``x_i (x·n)``, ``x_i x_j 
   direction ``v``): Gauss on the exact p-curves of the boundary (outer integral),
   and the inner integral from the face box's edge to each boundary node, either by
   Gauss node by node or, where that evaluates fewer points, on one fixed grid per cell
-  (inner span × outer span, :func:`surfmod.mass.rules.grid_nodes`): the integrands' tensor interpolant at
+  (inner span × outer span, :func:`surfmod.mass.rules.grids_nodes`): the integrands' tensor interpolant at
   Chebyshev points, whose inner antiderivative is exact, so every boundary node only adds
   weights to the grid points and the surface is evaluated on the grids alone (exact
   where the surface is a polynomial in both directions; ``2 order`` points per span
@@ -46,7 +46,7 @@ from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from .breaks import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks, is_face, knot_breaks
 from .boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
-from .rules import (GridJob, exact_order, gauss, green_layout, grid_nodes, grids_nodes, inner_nodes,  # noqa: F401
+from .rules import (GridJob, exact_order, gauss, green_layout, grids_nodes, inner_nodes,  # noqa: F401
                         interpolation_points)
 
 #: relative tolerance (to the box size) for "this p-curve lies on the face box's border"

@@ -2,7 +2,7 @@
 
 Gauss–Legendre rules (cached), the orders exact for polynomial directions, and the
 inner integrals of Green's theorem: node by node (:func:`inner_nodes`) or on one fixed
-interpolation grid per cell (:func:`grid_nodes`).  On a cell (inner span × outer span)
+interpolation grid per cell (:func:`grids_nodes`).  On a cell (inner span × outer span)
 the integrands are replaced by their tensor interpolant at Chebyshev points of the
 first kind (inside the span: a degree-1 spline's derivatives jump at its ends), exact
 where the surface is a polynomial of degree ``p`` there (``5p + 1`` points: the
@@ -117,7 +117,7 @@ def _chebyshev_rows(y: np.ndarray, count: int) -> np.ndarray:
 
 def interpolation_points(degree, order: int) -> tuple[int, bool]:
     """Interpolation points per span along a direction for Green's grid
-    (:func:`grid_nodes`): ``5p + 1`` where the surface is a polynomial of degree ``p``
+    (:func:`grids_nodes`): ``5p + 1`` where the surface is a polynomial of degree ``p``
     (the integrands' degree: exact), else ``2 order`` (the polynomial degree Gauss of
     ``order`` integrates exactly).
 
@@ -171,21 +171,6 @@ def _sum_rows(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
-def grid_nodes(mf, k: int, counts, P: np.ndarray, wb: np.ndarray, full, partial, q):
-    """Green's inner integrals of all boundary nodes on one fixed grid per cell (inner span
-    × outer span): on each cell the integrands are replaced by their tensor interpolant at
-    ``counts`` Chebyshev points (exact where the surface is a polynomial there, see
-    :func:`interpolation_points`), whose inner antiderivative is integrated exactly.  Then
-
-        Σ_n wb_n ∫_{lo}^{u_n} g(s, t_n) ds = Σ_cells Σ_jl Ω_jl g(s_j, t_l),
-
-    ``Ω`` summing, over the boundary nodes, ``wb · L_l(t_n) · ∫ ℓ_j`` (over the whole
-    spans below the node and the partial one): the surface is evaluated on the grids only,
-    whatever the number of boundary nodes.  Returns the used cells' points and weights
-    (:class:`GreenGrid`); :func:`grids_nodes` does many faces at once."""
-    return grids_nodes([GridJob(mf.breaks[k], mf.breaks[1 - k], P[:, k], P[:, 1 - k], wb, full, partial, q)], counts)[0]
-
-
 class GridJob:
     """One face's share of :func:`grids_nodes`: its inner and outer breaks, and per
     boundary node on its grids the inner and outer coordinates, the weight and
@@ -208,10 +193,21 @@ def _padded_breaks(jobs: list, attr: str) -> np.ndarray:
 
 
 def grids_nodes(jobs: list, counts) -> list:
-    """:func:`grid_nodes` of many faces (:class:`GridJob` each) with the same ``counts``,
-    in one pass: their cells are laid out on one array padded to the most spans of any
-    face (padding spans have zero length and get no weight), so every face's sums are the
-    ones it gets alone, term for term, without the fixed cost of a pass per face."""
+    """Green's inner integrals of all boundary nodes on one fixed grid per cell (inner span
+    × outer span), for many faces (:class:`GridJob` each) with the same ``counts``: on each
+    cell the integrands are replaced by their tensor interpolant at ``counts`` Chebyshev
+    points (exact where the surface is a polynomial there, see
+    :func:`interpolation_points`), whose inner antiderivative is integrated exactly.  Then
+
+        Σ_n wb_n ∫_{lo}^{u_n} g(s, t_n) ds = Σ_cells Σ_jl Ω_jl g(s_j, t_l),
+
+    ``Ω`` summing, over the boundary nodes, ``wb · L_l(t_n) · ∫ ℓ_j`` (over the whole
+    spans below the node and the partial one): the surface is evaluated on the grids only,
+    whatever the number of boundary nodes.  Returns per face the used cells' points and
+    weights (:class:`GreenGrid`).  The faces' cells are laid out on one array padded to
+    the most spans of any face (padding spans have zero length and get no weight), so
+    every face's sums are the ones it gets alone, term for term, without the fixed cost of
+    a pass per face."""
     ks, kt = counts
     xs = chebyshev(ks)[0]
     xt = chebyshev(kt)[0]
@@ -278,7 +274,7 @@ def _used(index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 class GreenGrid:
-    """The grid points of :func:`grid_nodes`: per used cell ``c`` (inner span ``si[c]``,
+    """The grid points of :func:`grids_nodes`: per used cell ``c`` (inner span ``si[c]``,
     outer span ``qi[c]``) the tensor ``s[c] × t[c]`` (``(C, ks)``, ``(C, kt)``: inner and
     outer coordinates), flattened cell by cell, inner index before outer, with
     ``weights``; :meth:`coordinates` lays the points out flat, :meth:`derivatives`
