@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..eval.basis import basis_matrix
+from ..eval.basis import basis_matrix, knots_inside
 from ..nets.bspline import BSplineSurface
 from ..sides import SIDES, side_params
 from ..surface import Surface, model_size, require_surface
@@ -48,11 +48,8 @@ class OffsetApproximation(BSplineSurface):
 def _breaks(s: Surface, direction: int) -> np.ndarray:
     """Distinct knots of a B-spline base inside its domain (ends included), else the ends."""
     lo, hi = s.domain[direction]
-    if isinstance(s, BSplineSurface):
-        k = s.knots[direction]
-        inner = k[(k > lo) & (k < hi)]
-        return np.unique(np.concatenate([[lo], inner, [hi]]))
-    return np.array([lo, hi])
+    inner = knots_inside(s.knots[direction], lo, hi) if isinstance(s, BSplineSurface) else []
+    return np.concatenate([[lo], inner, [hi]])
 
 
 def _region(u, v, mask) -> str:

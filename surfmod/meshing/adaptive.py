@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
+from ..eval.basis import knots_inside
 from .deviation import COARSE, DENSE, triangle_deviations
 from .domain import _sides, _surface_size
 
@@ -50,12 +51,8 @@ class _Lattice:
 def _breaks(s, direction: int) -> np.ndarray:
     lo, hi = s.domain[direction]
     knots = getattr(s, "knots", None)
-    if knots is not None:
-        k = np.unique(np.asarray(knots[direction], dtype=float))
-        k = k[(k > lo) & (k < hi)]
-        inner = k[(k - lo > 1e-12 * (hi - lo)) & (hi - k > 1e-12 * (hi - lo))]
-        return np.concatenate([[lo], inner, [hi]])
-    return np.linspace(lo, hi, 3)
+    k = knots_inside(knots[direction], lo, hi) if knots is not None else np.empty(0)
+    return np.concatenate([[lo], k[(k - lo > 1e-12 * (hi - lo)) & (hi - k > 1e-12 * (hi - lo))], [hi]])
 
 
 def _start_counts(s, tolerance: float, scale: float = 1.0, samples: int = 33) -> tuple[int, int]:

@@ -17,6 +17,7 @@ from .. import checks
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve
+from ..nets.knots import span_samples
 from .clip import as_face_surface
 from ..readback.trimmed import TrimmedFace
 from ..surface import Surface, model_size, require_surface
@@ -62,9 +63,7 @@ class Loop:
 
 
 def _curve_breaks(curve, per_span):
-    k = np.unique(curve.knots[curve.degree : len(curve.control_points) + 1])
-    fine = [np.linspace(a, b, per_span, endpoint=False) for a, b in zip(k[:-1], k[1:])]
-    return np.concatenate(fine + [k[-1:]])
+    return span_samples(np.unique(curve.knots[curve.degree : len(curve.control_points) + 1]), per_span)
 
 
 def _loop(value, name, domain) -> Loop:
