@@ -46,9 +46,3 @@ def from_homogeneous(h: np.ndarray, rational: bool):
     if np.any(w <= 0):
         raise SurfmodError("weights: all weights must be > 0")
     return h[..., :3] / w[..., None], w
-
-
-def homogeneous_of(points: np.ndarray, weights) -> np.ndarray:
-    """``(..., 4)`` homogeneous points ``(w x, w y, w z, w)`` (weights 1 if None)."""
-    w = np.ones(points.shape[:-1]) if weights is None else np.asarray(weights)
-    return np.concatenate([points * w[..., None], w[..., None]], axis=-1)

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
-from ..nets.bspline import BSplineCurve, BSplineSurface
+from ..nets.bspline import BSplineCurve, BSplineSurface, homogeneous
 from ..extras import require
-from .common import from_homogeneous, homogeneous_of, nurbs_of
+from .common import from_homogeneous, nurbs_of
 
 
 def to_geomdl(obj):
@@ -35,7 +35,7 @@ def to_geomdl(obj):
         c = (NURBS if b.rational else BSpline).Curve(normalize_kv=False)
         c.degree = b.degree
         if b.rational:
-            c.ctrlptsw = homogeneous_of(b.control_points, b.weights).tolist()
+            c.ctrlptsw = homogeneous(b.control_points, b.weights).tolist()
         else:
             c.ctrlpts = b.control_points.tolist()
         c.knotvector = b.knots.tolist()
@@ -43,7 +43,7 @@ def to_geomdl(obj):
     n, m = b.control_points.shape[:2]
     s = (NURBS if b.rational else BSpline).Surface(normalize_kv=False)
     s.degree_u, s.degree_v = b.degree
-    flat = (homogeneous_of(b.control_points, b.weights) if b.rational else b.control_points).reshape(n * m, -1)
+    flat = homogeneous(b.control_points, b.weights).reshape(n * m, -1)
     s.set_ctrlpts(flat.tolist(), n, m)
     s.knotvector_u = b.knots[0].tolist()
     s.knotvector_v = b.knots[1].tolist()

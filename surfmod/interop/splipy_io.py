@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SurfmodError
-from ..nets.bspline import BSplineCurve, BSplineSurface
+from ..nets.bspline import BSplineCurve, BSplineSurface, homogeneous
 from ..extras import require
-from .common import from_homogeneous, homogeneous_of, nurbs_of
+from .common import from_homogeneous, nurbs_of
 
 
 def to_splipy(obj):
@@ -26,7 +26,7 @@ def to_splipy(obj):
     """
     splipy = require("splipy", "interop", "to_splipy")
     kind, b = nurbs_of(obj)
-    ctrl = homogeneous_of(b.control_points, b.weights) if b.rational else b.control_points
+    ctrl = homogeneous(b.control_points, b.weights)
     if kind == "curve":
         basis = splipy.BSplineBasis(b.degree + 1, b.knots)
         return splipy.Curve(basis, np.array(ctrl), rational=b.rational, raw=True)
