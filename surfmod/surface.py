@@ -58,9 +58,9 @@ def finite_result(out: np.ndarray, u: np.ndarray, v: np.ndarray, what: str) -> n
     )
 
 
-def model_size(*surfaces) -> float:
-    """The bounding-box diagonal of 9 x 9 samples of each surface (the scale that
-    tolerances are judged against).
+def model_size(*surfaces, samples: int = 9) -> float:
+    """The bounding-box diagonal of ``samples`` x ``samples`` points of each surface (the
+    scale that tolerances are judged against; the tessellators sample 17 x 17).
 
     >>> import surfmod as sm
     >>> round(model_size(sm.plane((0, 0, 0), (3, 0, 0), (0, 4, 0))), 12)
@@ -69,7 +69,8 @@ def model_size(*surfaces) -> float:
     pts = []
     for s in surfaces:
         (u0, u1), (v0, v1) = s.domain
-        pts.append(s._grid_derivatives(np.linspace(u0, u1, 9), np.linspace(v0, v1, 9), 0)[:, :, 0, 0].reshape(-1, 3))
+        us, vs = np.linspace(u0, u1, samples), np.linspace(v0, v1, samples)
+        pts.append(s._grid_derivatives(us, vs, 0)[:, :, 0, 0].reshape(-1, 3))
     pts = np.concatenate(pts)
     with np.errstate(invalid="ignore", over="ignore"):
         size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))

@@ -25,8 +25,9 @@ import numpy as np
 
 from ..errors import SurfmodError
 from ..eval.basis import knots_inside
+from ..surface import model_size
 from .deviation import COARSE, DENSE, triangle_deviations
-from .domain import _sides, _surface_size
+from .domain import _sides
 
 #: Lattice steps per start cell, as a power of two (depth limit of the refinement).
 LEVELS = 22
@@ -95,7 +96,7 @@ class _Refiner:
         self.s, self.tol, self.max_triangles = s, tolerance, max_triangles
         (u0, u1), (v0, v1) = s.domain
         self.bounds = (u0, u1, v0, v1)
-        self.size = _surface_size(s)
+        self.size = model_size(s, samples=17)
         ub, vb = _breaks(s, 0), _breaks(s, 1)
         if getattr(s, "knots", None) is None:
             nu, nv = _start_counts(s, tolerance, start_scale)

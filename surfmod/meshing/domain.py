@@ -1,22 +1,10 @@
-"""Facts about a surface's parameter domain that every tessellator needs: the size of
-the surface, which sides collapse to a point (poles) and which directions close on
-themselves (seams), so that their vertices are shared and the mesh is watertight."""
+"""Facts about a surface's parameter domain that every tessellator needs: which sides
+collapse to a point (poles) and which directions close on themselves (seams), so that
+their vertices are shared and the mesh is watertight."""
 
 from __future__ import annotations
 
 import numpy as np
-
-
-def _surface_size(s) -> float:
-    """Bounding-box diagonal of a 17 x 17 sample grid.
-
-    >>> import surfmod as sm
-    >>> round(_surface_size(sm.plane((0, 0, 0), (3, 0, 0), (0, 4, 0))), 12)
-    5.0
-    """
-    (u0, u1), (v0, v1) = s.domain
-    pts = s.grid(np.linspace(u0, u1, 17), np.linspace(v0, v1, 17)).reshape(-1, 3)
-    return float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
 
 
 def _sides(s, size: float):

@@ -30,13 +30,13 @@ from ..atomic import atomic_path, target_path
 from ..curve import Curve
 from ..errors import SurfmodError
 from ..readback import TrimmedFace
-from ..surface import Surface
+from ..surface import Surface, model_size
 from .facemesh import brepmesh
 from .figures import shape_diagonal
 from .grid import mesh as grid_mesh
 from .isocurves import isocurves as iso
 from .polymesh import Mesh
-from .tessellate import _surface_size, tessellate_surface
+from .tessellate import tessellate_surface
 
 #: Display tessellation: chordal tolerance as a fraction of the object's size.
 DISPLAY_TOLERANCE = 0.004
@@ -84,7 +84,7 @@ class Drawing:
 
 
 def _surface_mesh(s, fraction: float = DISPLAY_TOLERANCE, budget: int = DISPLAY_TRIANGLES) -> Mesh:
-    size = _surface_size(s)
+    size = model_size(s, samples=17)
     try:
         m = tessellate_surface(s, max(fraction * size, 1e-12), budget)
         if len(m.faces) <= budget:

@@ -19,11 +19,11 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..surface import Surface
+from ..surface import Surface, model_size
 from .brep import MAX_TRIANGLES, tessellate_shape
 from .adaptive import _ear_clip, _Refiner  # noqa: F401  (_ear_clip: tested here)
 from .deviation import DENSE
-from .domain import _sides, _surface_size
+from .domain import _sides
 from .gridmesh import grid_tessellate
 from .polymesh import Mesh
 from tqdm import tqdm
@@ -60,7 +60,7 @@ def estimate_triangles(s, tolerance: float, size: float) -> float:
 def _check_tolerance(s, tolerance: float, max_triangles: int) -> tuple[float, float]:
     """The surface size and the curvature estimate of the triangle count; refuses tolerances below float64 resolution or needing more than
     ``max_triangles`` by the curvature estimate (before anything large is allocated)."""
-    size = _surface_size(s)
+    size = model_size(s, samples=17)
     if tolerance < MIN_RELATIVE_TOLERANCE * size:
         raise SurfmodError(
             f"tolerance: {tolerance:g} is below {MIN_RELATIVE_TOLERANCE:g} x the surface size {size:.3g}; "
