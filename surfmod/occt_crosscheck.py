@@ -24,7 +24,7 @@ from .nets import mp_reference
 from .nets.knots import smooth_mask, span_samples
 from .readback import from_face
 from .readback.trimmed import TrimmedFace
-from .surface import Surface
+from .surface import Surface, model_size
 
 
 class _CrossCheckFields(NamedTuple):
@@ -138,11 +138,9 @@ def crosscheck(obj, samples: int = 64, tolerance: float | None = None, *, sampli
     if not isinstance(obj, Surface):
         obj = from_face(obj)
     if tolerance is not None:  # a pass threshold below round-off of the surface's size could never pass
-        (u0, u1), (v0, v1) = obj.domain
-        grid = obj.grid(np.linspace(u0, u1, 5), np.linspace(v0, v1, 5)).reshape(-1, 3)
-        tolerance = checks.tolerance(tolerance, "tolerance", float(np.linalg.norm(np.ptp(grid, axis=0))))
+        tolerance = checks.tolerance(tolerance, "tolerance", model_size(obj))
     if obj.exact_in_occt:
-        return _check_parametric(obj, samples, sampling == "sufficient")
+        return _judge_parametric([_parametric_samples(obj, samples, sampling == "sufficient")])[0]
     return _check_geometric(obj, samples, tolerance)
 
 
@@ -245,10 +243,6 @@ def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense") -> list
 #: faces compared in one vectorized pass: enough to pay NumPy's fixed costs once per
 #: many faces, few enough to bound the memory of a part with thousands of faces
 BATCH_FACES = 256
-
-
-def _check_parametric(s: Surface, samples: int, sufficient: bool = False) -> CrossCheck:
-    return _judge_parametric([_parametric_samples(s, samples, sufficient)])[0]
 
 
 _DERIVATIVES = ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
