@@ -71,40 +71,20 @@ def resident_bytes(pid: int) -> float:
         return float("nan")
 
 
-def call(fn, args: tuple, seconds: float, what: str, memory: float | None = None):
-    """``fn(*args)`` in a child process; ``fn`` and ``args`` must pickle (a module-level
-    function, paths and arrays).  Raises :class:`ChildFailure` naming ``what`` when the
-    child is still running after ``seconds``, holds more than ``memory`` bytes resident
-    (looked at every ``MEMORY_POLL`` s, on Linux), or dies.
+def call(fn, args: tuple, seconds: float, what: str):
+    """``fn(*args)`` in a fresh child process (a :class:`Server` for one call); ``fn`` and
+    ``args`` must pickle (a module-level function, paths and arrays).  Raises
+    :class:`ChildFailure` naming ``what`` when the child is still running after
+    ``seconds`` or dies.
 
     >>> call(divmod, (7, 2), 60.0, "divmod")
     (3, 1)
     """
-    # the import path first, on its own: the child needs it before it can unpickle ``fn``
-    request = pickle.dumps(list(sys.path)) + pickle.dumps((fn, args))
-    proc = subprocess.Popen([sys.executable, "-m", "surfmod.child"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            stderr=subprocess.DEVNULL, env=_child_env())
-    deadline = time.monotonic() + seconds
-    while True:
-        left = deadline - time.monotonic()
-        try:
-            # the request is sent once; a retry after a timeout goes on where it stopped
-            out, _ = proc.communicate(request, timeout=max(min(left, MEMORY_POLL) if memory else left, 0.0))
-            break
-        except subprocess.TimeoutExpired:
-            request = None
-            failure = _over_budget(proc.pid, deadline, seconds, what, memory)
-            if failure is None:
-                continue
-            proc.kill()
-            proc.communicate()
-            raise failure from None
-    if proc.returncode != 0 or not out:
-        raise ChildFailure(f"{what} died (exit code {proc.returncode})", "died", proc.returncode)
-    kind, value = pickle.loads(out)
-    if kind == "raised":
-        raise value
-    return value
+    server = Server()
+    try:
+        return server.call(fn, args, seconds, what)
+    finally:
+        server.close()
 
 
 def _over_budget(pid: int, deadline: float, seconds: float, what: str, memory: float | None):
@@ -143,7 +123,7 @@ class Server:
     def start(self) -> None:
         """Start the child (and its warm-up) now if none runs; calls wait for it."""
         if self.proc is None or self.proc.poll() is not None:
-            self.proc = subprocess.Popen([sys.executable, "-m", "surfmod.child", "--serve"], stdin=subprocess.PIPE,
+            self.proc = subprocess.Popen([sys.executable, "-m", "surfmod.child"], stdin=subprocess.PIPE,
                                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=_child_env())
             self.proc.stdin.write(_framed(pickle.dumps(list(sys.path))))
             self._warming = self.warmup is not None
@@ -159,7 +139,10 @@ class Server:
             self.proc = None
 
     def call(self, fn, args: tuple, seconds: float, what: str, memory: float | None = None):
-        """:func:`call`'s contract, in the one child."""
+        """``fn(*args)`` in the child; ``fn`` and ``args`` must pickle.  Raises
+        :class:`ChildFailure` naming ``what`` when the child is still running after
+        ``seconds``, holds more than ``memory`` bytes resident (looked at every
+        ``MEMORY_POLL`` s, on Linux), or dies."""
         self.start()
         if self._warming:
             self._warming = False
@@ -176,7 +159,7 @@ class Server:
         return self._answer(seconds, what, memory)
 
     def _answer(self, seconds: float, what: str, memory: float | None):
-        """The value of the call the child is working on (see :func:`call`)."""
+        """The value of the call the child is working on (see :meth:`call`)."""
         fd, deadline = self.proc.stdout.fileno(), time.monotonic() + seconds
         while not select.select([fd], [], [], max(min(deadline - time.monotonic(), MEMORY_POLL), 0.0))[0]:
             failure = _over_budget(self.proc.pid, deadline, seconds, what, memory)
@@ -247,15 +230,10 @@ def _main() -> None:
     reply = os.fdopen(os.dup(1), "wb")
     os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
     stream = sys.stdin.buffer
-    if sys.argv[1:] == ["--serve"]:  # Server: framed calls until the parent closes the pipe
-        sys.path[:] = pickle.loads(_read_framed(stream))
-        while (request := _read_framed(stream)) is not None:
-            reply.write(_framed(_answer(*pickle.loads(request))))
-            reply.flush()
-        return
-    sys.path[:] = pickle.load(stream)
-    reply.write(_answer(*pickle.load(stream)))
-    reply.flush()
+    sys.path[:] = pickle.loads(_read_framed(stream))
+    while (request := _read_framed(stream)) is not None:  # framed calls until the parent closes the pipe
+        reply.write(_framed(_answer(*pickle.loads(request))))
+        reply.flush()
 
 
 if __name__ == "__main__":
