@@ -128,20 +128,10 @@ def crosscheck(obj, samples: int = 64, tolerance: float | None = None, *, sampli
     >>> sm.crosscheck(sm.CylindricalSurface(2.0, v_range=(0, 5)), samples=24, sampling="sufficient").samples
     25
     """
-    samples = checks.count(samples, "samples", minimum=2)
-    if tolerance is not None:
-        tolerance = checks.positive(tolerance, "tolerance")
-    if sampling not in SAMPLINGS:
-        raise SurfmodError(f"sampling: expected one of {', '.join(SAMPLINGS)}, got {sampling!r}")
-    if isinstance(obj, Curve):
-        return _check_curve(obj, samples)
-    if not isinstance(obj, Surface):
-        obj = from_face(obj)
-    if tolerance is not None:  # a pass threshold below round-off of the surface's size could never pass
-        tolerance = checks.tolerance(tolerance, "tolerance", model_size(obj))
-    if obj.exact_in_occt:
-        return _judge_parametric([_parametric_samples(obj, samples, sampling == "sufficient")])[0]
-    return _check_geometric(obj, samples, tolerance)
+    result = crosscheck_many([obj], samples, sampling=sampling, tolerance=tolerance)[0]
+    if isinstance(result, SurfmodError):
+        raise result
+    return result
 
 
 #: parameter values per direction on an elementary surface: 5 values over the face's
@@ -200,7 +190,7 @@ def sufficient_parameters(s, direction: int, samples: int) -> np.ndarray:
     return span_samples(ends, per_span - 1)
 
 
-def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense") -> list:
+def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense", tolerance: float | None = None) -> list:
     """:func:`crosscheck` of many surfaces or faces at once: per object a
     :class:`CrossCheck` (the same figures as ``crosscheck`` gives it alone) or the
     :class:`~surfmod.errors.SurfmodError` that reading or sampling it raised.  OCCT is
@@ -213,6 +203,8 @@ def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense") -> list
     [True, True]
     """
     samples = checks.count(samples, "samples", minimum=2)
+    if tolerance is not None:
+        tolerance = checks.positive(tolerance, "tolerance")
     if sampling not in SAMPLINGS:
         raise SurfmodError(f"sampling: expected one of {', '.join(SAMPLINGS)}, got {sampling!r}")
     out: list = [None] * len(objs)
@@ -224,8 +216,10 @@ def crosscheck_many(objs, samples: int = 64, *, sampling: str = "dense") -> list
                 continue
             if not isinstance(obj, Surface):
                 obj = from_face(obj)
+            # a pass threshold below round-off of the surface's size could never pass
+            limit = None if tolerance is None else checks.tolerance(tolerance, "tolerance", model_size(obj))
             if not obj.exact_in_occt:
-                out[i] = _check_geometric(obj, samples, None)
+                out[i] = _check_geometric(obj, samples, limit)
                 continue
             batch.append(_parametric_samples(obj, samples, sampling == "sufficient"))
             where.append(i)
