@@ -351,20 +351,17 @@ def face_nodes(mf: MassFace, order: int):
     orientation, so ``Su × Sv`` is the outward ``n dA``) and weights for the face's
     integrals; ``exact`` says no piece depended on ``order`` (every rule was exact by
     degree), so a lower ``order`` gives the same result."""
+    if not mf.natural:  # Green's theorem (see the module notes)
+        return faces_nodes([mf], order)[0]
     mu, eu = _direction_order(mf, 0, order)
     mv, ev = _direction_order(mf, 1, order)
-    if mf.natural:
-        un, uw = _spans(mf.breaks[0], mu)
-        vn, vw = _spans(mf.breaks[1], mv)
-        if mf.grid_evaluate is not None:  # u-major, as the repeat/tile below
-            ders = mf.grid_evaluate(un, vn, 1).reshape(-1, 2, 2, 3)
-        else:
-            ders = mf.evaluate(np.repeat(un, vn.size), np.tile(vn, un.size), 1)
-        w = np.outer(uw, vw).ravel()
-        exact = eu and ev
+    un, uw = _spans(mf.breaks[0], mu)
+    vn, vw = _spans(mf.breaks[1], mv)
+    if mf.grid_evaluate is not None:  # u-major, as the repeat/tile below
+        ders = mf.grid_evaluate(un, vn, 1).reshape(-1, 2, 2, 3)
     else:
-        ders, w, exact = _green(mf, order, (mu, mv), (eu, ev))
-    return _signed(mf, ders), w, exact
+        ders = mf.evaluate(np.repeat(un, vn.size), np.tile(vn, un.size), 1)
+    return _signed(mf, ders), np.outer(uw, vw).ravel(), eu and ev
 
 
 def _signed(mf: MassFace, ders: np.ndarray) -> np.ndarray:
@@ -496,15 +493,8 @@ def prepare_boundaries(faces: list, order: int) -> None:
             mf.boundary[order] = got
 
 
-def _green(mf: MassFace, order: int, orders, exacts):
-    """Green's theorem nodes (see the module notes)."""
-    plan = _green_plan(mf, order, orders, exacts)
-    grid = grids_nodes([plan.job], plan.counts)[0] if plan.job is not None else None
-    return _green_nodes(mf, plan, grid)
-
-
 class _GreenPlan:
-    """What :func:`_green` decides for a face before its grids are built: the inner
+    """What :func:`faces_nodes` decides for a trimmed face before its grids are built: the inner
     direction ``k``, the boundary nodes ``P`` with their weights and layout, which of them
     go onto grids (``job``, a :class:`~surfmod.mass.rules.GridJob`, or None) and the
     rest, node by node."""
