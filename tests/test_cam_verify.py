@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 from stock_sim import Cutter, Stock, parse_gcode, part_height, reachable, simulate
+from twins.program_lines import read_program_lines
 
 import surfmod as sm
 from surfmod.cam import verify as V
@@ -82,6 +83,55 @@ def test_words_outside_the_dialect_name_their_line(text, word):
     with pytest.raises(SurfmodError, match=r"program: line \d+") as err:
         read_program(text)
     assert word in str(err.value)
+
+
+def _read(reader, text, tool=0):
+    """What a reader makes of ``text``: its moves, or the message it refuses it with."""
+    try:
+        return reader(text, tool=tool)
+    except SurfmodError as err:
+        return str(err)
+
+
+def _same_reading(a, b):
+    if isinstance(a, str) or isinstance(b, str):
+        return a == b
+    return all(np.array_equal(getattr(a, f), getattr(b, f)) and getattr(a, f).dtype == getattr(b, f).dtype
+               for f in ("start", "end", "rapid", "tool", "spindle", "line"))
+
+
+#: lines a random program is drawn from: the posts' own, what an operator may type
+#: (lower case, spaces, comments, %), and what is outside the dialect
+_LINES = ["G0 Z{z}", "G0 X{x} Y{y}", "G1 X{x} Y{y} Z{z} F300", "G1 X{x}", "g1 y {y} z{z}", "X{x} Y{y}",
+          "G2 X{x} Y{y} I{i} J{j}", "G3 X{x} Y{y} Z{z} I{i} J{j} F200", "G3 X{x} Y{y} I{i}", "G2 X{x} Y{y}",
+          "T{t} M6", "M6 T{t}", "T{t}", "G43 H{t}", "S1000 M3", "M5", "M3 M5 M3", "M8", "M9", "%", "", "  \t ",
+          "(operation: roughing)", "G1 X{x} (a comment) Y{y} ; and a tail", "N10 G1 Z{z}", "G21 G90 G17 G94",
+          "G0 X{x} G1 Y{y}", "G0 X{x} X{y}", "G20", "G91 G1 X{x}", "Q5", "M98", "X1..2", "G1 X{x} \tY{y}",
+          "\tG1 Z{z}\t", "% %", "G01 X{x}", "G1.0 Y{y}", "M30", "G1 X+{x} Y.5", "G1 X{x}Y{y}Z{z}"]
+
+
+def test_the_whole_text_reader_reads_as_a_controller_line_by_line(job):
+    """The reader takes the words of the whole text at once and carries the modes as
+    arrays; a reader of one line at a time (its former self) gives the same moves bit for
+    bit, and for a program outside the dialect the same message on the same line, on the
+    job's program and on 400 random ones that mix the posts' lines with typed and broken ones."""
+    text = programs(job)[0]
+    assert len(read_program(text)) > 10_000 and _same_reading(read_program(text), read_program_lines(text))
+    rng = np.random.default_rng(36)
+    refused = 0
+    for _ in range(400):
+        lines = []
+        for _ in range(int(rng.integers(1, 40))):
+            # the broken lines a few times in a program at most
+            k = int(rng.integers(len(_LINES) if rng.random() < 0.05 else _LINES.index("G20")))
+            x, y, z, i, j = (f"{v:.4f}" for v in rng.uniform(-20, 20, 5))
+            lines.append(_LINES[k].format(x=x, y=y, z=z, i=i, j=j, t=int(rng.integers(1, 4))))
+        text = "\n".join(lines)
+        tool = int(rng.integers(3))
+        a, b = _read(read_program, text, tool), _read(read_program_lines, text, tool)
+        assert _same_reading(a, b), (text, a, b)
+        refused += isinstance(a, str)
+    assert 40 < refused < 360  # both kinds of program were drawn
 
 
 # -- verdicts ------------------------------------------------------------------------------------

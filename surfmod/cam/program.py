@@ -24,8 +24,15 @@ from ..errors import SurfmodError
 
 #: the most chords one arc word becomes (the chord grows beyond it)
 MAX_CHORDS = 4096
-_WORD = re.compile(r"([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
-_COMMENT = re.compile(r"\([^)]*\)|;.*$")
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)"
+#: a word, or the end of a line (the whole text is read at once)
+_TOKEN = re.compile(rf"([A-Z_])({_NUMBER})|\n")
+#: a line that is not words only
+_BAD_LINE = re.compile(rf"^(?!(?:[A-Z]{_NUMBER})*$).+", re.M)
+_COMMENT = re.compile(r"\([^)\n]*\)|;[^\n]*")
+#: white space at either end of a line (str.strip's), and a line that is only ``%``
+_EDGES = re.compile(r"^[^\S\n]+|[^\S\n]+$", re.M)
+_PERCENT = re.compile(r"^%$", re.M)
 #: words the posts write that do not move the tool (modes already in force, coolant, end)
 _QUIET_G = {17.0, 21.0, 40.0, 43.0, 49.0, 80.0, 90.0, 94.0}
 _QUIET_M = {8.0, 9.0, 30.0, 2.0}
@@ -65,82 +72,93 @@ def _arc(start, end, centre, ccw: bool, chord: float) -> np.ndarray:
     return pts
 
 
+def _last(mask: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Index of the last word of ``mask`` at or before each word index of ``at`` (-1: none)."""
+    return np.concatenate([[-1], np.maximum.accumulate(np.where(mask, np.arange(len(mask)), -1))])[at + 1]
+
+
 def read_program(text: str, *, tool: int = 0, chord: float = 1e-4) -> ProgramMoves:
     """The moves of one program ``text`` (see the module); ``tool``: the tool in the
     spindle before any ``M6`` (a GRBL program per tool), ``chord``: the arcs' sagitta.
+
+    The words of the whole text are read at once and the modes carried from line to line
+    as arrays (a program of 100,000 lines in a fraction of a second); the first line that
+    breaks the dialect is the one named, as a controller reading line by line would stop.
 
     >>> moves = read_program("T1 M6\\nG0 Z5\\nS1000 M3\\nG0 X0 Y0\\nG1 Z0 F100\\nG1 X10\\nM5\\nM30")
     >>> moves.end.tolist()[-1], moves.rapid.tolist(), moves.tool.tolist()
     ([10.0, 0.0, 0.0], [True, False, False], [1, 1, 1])
     """
-    pos = np.full(3, np.nan)
-    motion, current, selected, spindle = None, int(tool), int(tool), False
-    starts, ends, rapid, tools, turning, lines = [], [], [], [], [], []
-    for number, raw in enumerate(str(text).splitlines(), start=1):
-        body = _COMMENT.sub("", raw).strip().upper()
-        if not body or body == "%":
-            continue
-        words = _WORD.findall(body.replace(" ", ""))
-        if "".join(f"{a}{b}" for a, b in words) != body.replace(" ", ""):
-            raise SurfmodError(f"program: line {number}: cannot read {raw.strip()!r}")
-        target, centre, change = {}, {}, False
-        for letter, value in words:
-            v = float(value)
-            if letter == "G":
-                if v in (0.0, 1.0, 2.0, 3.0):
-                    motion = int(v)
-                elif v not in _QUIET_G:
-                    raise SurfmodError(f"program: line {number}: G{value} is outside the posts' dialect")
-            elif letter == "M":
-                if v == 3.0:
-                    spindle = True
-                elif v == 5.0:
-                    spindle = False
-                elif v == 6.0:
-                    change = True
-                elif v not in _QUIET_M:
-                    raise SurfmodError(f"program: line {number}: M{value} is outside the posts' dialect")
-            elif letter in "XYZ":
-                target["XYZ".index(letter)] = v
-            elif letter in "IJ":
-                centre["IJ".index(letter)] = v
-            elif letter == "T":
-                selected = int(v)
-            elif letter not in "FSHN":
-                raise SurfmodError(f"program: line {number}: {letter}{value} is outside the posts' dialect")
-        if change:
-            current = selected
-        if not target:
-            continue
-        if motion is None:
-            raise SurfmodError(f"program: line {number}: coordinates before any G0/G1/G2/G3")
-        end = pos.copy()
-        for axis, v in target.items():
-            end[axis] = v
-        start = np.where(np.isnan(pos), end, pos)  # an axis not yet written: the tool stands there
-        if np.isnan(end).any():
-            pos = end
-            continue
-        if motion in (2, 3):
-            if len(centre) != 2:
-                raise SurfmodError(f"program: line {number}: an arc needs both I and J")
-            pts = _arc(start, end, (start[0] + centre[0], start[1] + centre[1]), motion == 3, chord)
-        else:
-            pts = end[None, :]
-        prev = start
-        for p in pts:
-            starts.append(prev)
-            ends.append(p)
-            prev = p
-        n = len(pts)
-        rapid += [motion == 0] * n
-        tools += [current] * n
-        turning += [spindle] * n
-        lines += [number] * n
-        pos = end
-    return ProgramMoves(np.array(starts, float).reshape(-1, 3), np.array(ends, float).reshape(-1, 3),
-                        np.array(rapid, bool), np.array(tools, np.int64), np.array(turning, bool),
-                        np.array(lines, np.int64))
+    raw = str(text).splitlines()
+    # comments out, each line stripped, upper case, spaces out: what each line says
+    body = _COMMENT.sub("", "\n".join(raw))
+    body = _PERCENT.sub("", _EDGES.sub("", body)).upper().replace(" ", "")
+    errors = []  # (line, rank within the line, message): the first is raised
+    bad = _BAD_LINE.search(body)
+    if bad:
+        number = body.count("\n", 0, bad.start()) + 1
+        errors.append((number, 0, f"program: line {number}: cannot read {raw[number - 1].strip()!r}"))
+    # the words, each with its line (from 0); a last word that says nothing stands for "none"
+    letters, values = zip(*_TOKEN.findall(body + "\n_0"))
+    letter = np.array(letters, dtype="U1")
+    newline = letter == ""
+    line = np.cumsum(newline)[~newline]
+    letter, values = letter[~newline], [v for v in values if v]
+    value = np.fromiter(map(float, values), float, len(values))
+    g, m = letter == "G", letter == "M"
+    moving = g & np.isin(value, (0.0, 1.0, 2.0, 3.0))
+    outside = ((g & ~moving & ~np.isin(value, list(_QUIET_G))) | (m & ~np.isin(value, [3.0, 5.0, 6.0, *_QUIET_M]))
+               | ~np.isin(letter, list("GMXYZIJTFSHN_")))
+    if outside.any():
+        w = int(np.argmax(outside))
+        number = int(line[w]) + 1
+        errors.append((number, 1, f"program: line {number}: {letter[w]}{values[w]} is outside the posts' dialect"))
+    # the modes in force at the end of each line: set by its last word of them or by an earlier line
+    n_lines = len(raw)
+    end_word = np.searchsorted(line, np.arange(n_lines), side="right") - 1
+    motion = np.where((w := _last(moving, end_word)) >= 0, value[w], -1).astype(np.int64)
+    spindle = value[_last(m & np.isin(value, (3.0, 5.0)), end_word)] == 3.0
+    selected = np.where((w := _last(letter == "T", end_word)) >= 0, value[w], tool).astype(np.int64)
+    changed = line[_last(m & (value == 6.0), end_word)]
+    current = np.where(changed < n_lines, selected[np.minimum(changed, n_lines - 1)], int(tool))
+    # each line's coordinates (the last word of an axis wins)
+    axes = np.full((n_lines + 1, 5), np.nan)
+    for k, a in enumerate("XYZIJ"):
+        w = np.flatnonzero(letter == a)
+        last = np.ones(len(w), bool)
+        last[:-1] = line[w][1:] != line[w][:-1]
+        axes[line[w[last]], k] = value[w[last]]
+    moved = np.flatnonzero(~np.isnan(axes[:n_lines, :3]).all(axis=1))
+    if np.any(early := motion[moved] < 0):
+        number = int(moved[np.argmax(early)]) + 1
+        errors.append((number, 2, f"program: line {number}: coordinates before any G0/G1/G2/G3"))
+    # the position after each such line: every axis as last written
+    target = axes[moved, :3]
+    held = np.maximum.accumulate(np.where(np.isnan(target), -1, np.arange(len(moved))[:, None]), axis=0)
+    end = np.where(held >= 0, target[held, np.arange(3)], np.nan)
+    pos = np.roll(end, 1, axis=0)
+    pos[:1] = np.nan
+    start = np.where(np.isnan(pos), end, pos)  # an axis not yet written: the tool stands there
+    run = ~np.isnan(end).any(axis=1)
+    moved, start, end = moved[run], start[run], end[run]
+    arc = np.isin(motion[moved], (2, 3))
+    if np.any(open_arc := arc & np.isnan(axes[moved, 3:]).any(axis=1)):
+        number = int(moved[np.argmax(open_arc)]) + 1
+        errors.append((number, 3, f"program: line {number}: an arc needs both I and J"))
+    if errors:
+        raise SurfmodError(min(errors)[2])
+    chords = {k: _arc(start[k], end[k], (start[k, 0] + axes[moved[k], 3], start[k, 1] + axes[moved[k], 4]),
+                      motion[moved[k]] == 3, chord) for k in np.flatnonzero(arc)}
+    count = np.ones(len(moved), np.int64)
+    count[list(chords)] = [len(c) for c in chords.values()]
+    first = np.cumsum(count) - count
+    ends = np.repeat(end, count, axis=0)
+    for k, c in chords.items():
+        ends[first[k]:first[k] + len(c)] = c
+    starts = np.roll(ends, 1, axis=0)
+    starts[first] = start  # each line's first piece starts where the tool stood
+    where = np.repeat(moved, count)
+    return ProgramMoves(starts, ends, motion[where] == 0, current[where], spindle[where], where + 1)
 
 
 def concatenate(parts: list[ProgramMoves]) -> ProgramMoves:
