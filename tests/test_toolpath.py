@@ -95,6 +95,23 @@ def test_triangle_features_closed_forms():
     assert flat == pytest.approx([4.0, 0.1, 0.0], abs=1e-14)
 
 
+def test_grid_cell_lists_run_from_the_highest_top_down():
+    """The grid's cell lists, placed by a compiled counting sort, are the ones a sort of
+    every (cell, triangle) entry by cell, then falling top, then triangle makes: on
+    random triangles with many equal tops (the first triangle of equal tops first)."""
+    rng = np.random.default_rng(5)
+    tri = rng.uniform(0, 40, (3000, 3, 3))
+    tri[:, :, 2] = np.round(tri[:, :, 2] / 8)  # tops of five values: most lists hold ties
+    for radius in (0.7, 3.0, 11.0):
+        grid = TriangleGrid(tri, radius)
+        i0 = np.floor((grid.lo - grid.origin) / grid.cell).astype(np.int64)
+        i1 = np.floor((grid.hi - grid.origin) / grid.cell).astype(np.int64)
+        entries = [(ix * grid.shape[1] + iy, -grid.top[t], t) for t in range(len(tri))
+                   for ix in range(i0[t, 0], i1[t, 0] + 1) for iy in range(i0[t, 1], i1[t, 1] + 1)]
+        cells, _, tris = np.array(sorted(entries)).T
+        assert np.array_equal(grid._cells, cells) and np.array_equal(grid.listed, tris)
+
+
 @pytest.mark.parametrize("kind", ["ball", "flat"])
 def test_no_gouge_on_spline_surface(kind):
     tp = sm.toolpath(bumpy(), sm.Tool(kind, 2.0), stepover=2.5, step=1.0)

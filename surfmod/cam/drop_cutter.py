@@ -84,18 +84,10 @@ class TriangleGrid:
         self.shape = (np.floor(span / self.cell).astype(np.int64) + 1)
         i0 = np.floor((lo - self.origin) / self.cell).astype(np.int64)
         i1 = np.floor((hi - self.origin) / self.cell).astype(np.int64)
-        nx, ny = i1[:, 0] - i0[:, 0] + 1, i1[:, 1] - i0[:, 1] + 1
-        counts = nx * ny
-        tri_id = np.repeat(np.arange(len(counts)), counts)
-        local = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-        ix = i0[tri_id, 0] + local % nx[tri_id]
-        iy = i0[tri_id, 1] + local // nx[tri_id]
-        cell_id = ix * self.shape[1] + iy
-        # each cell's list from its highest triangle down: a drop stops at the first
-        # triangle whose top is below the height already found (no later one can beat it)
-        order = np.lexsort((-self.top[tri_id], cell_id))
-        self._cells = cell_id[order]
-        self._tris = tri_id[order]
+        # each cell's list from its highest triangle down (of equal tops the first): a drop
+        # stops at the first triangle whose top is below the height already found
+        self._cells, self._tris = _cell_lists(i0, i1, np.argsort(-self.top, kind="stable"), int(self.shape[1]),
+                                              int(self.shape.prod()))
 
     @property
     def listed(self) -> np.ndarray:
@@ -151,6 +143,28 @@ class TriangleGrid:
         (each entry costs a box test, most of them nothing more), known before it is done."""
         start, stop = self.segments(np.asarray(xy, dtype=float).reshape(-1, 2))
         return int(np.maximum(stop - start, 0).sum())
+
+
+@njit(cache=True)
+def _cell_lists(i0, i1, order, ny, n_cells):
+    """The cells' lists one after the other: the cell and the triangle of each entry, the
+    triangles whose cells span ``i0``..``i1`` listed in each in the sequence ``order``
+    (a counting sort by cell: one pass to count, one to place)."""
+    start = np.zeros(n_cells + 1, np.int64)
+    for t in order:
+        for ix in range(i0[t, 0], i1[t, 0] + 1):
+            for iy in range(i0[t, 1], i1[t, 1] + 1):
+                start[ix * ny + iy + 1] += 1
+    for k in range(n_cells):
+        start[k + 1] += start[k]
+    cells, tris = np.empty(start[n_cells], np.int64), np.empty(start[n_cells], np.int64)
+    for t in order:
+        for ix in range(i0[t, 0], i1[t, 0] + 1):
+            for iy in range(i0[t, 1], i1[t, 1] + 1):
+                c = ix * ny + iy
+                cells[start[c]], tris[start[c]] = c, t
+                start[c] += 1
+    return cells, tris
 
 
 def triangle_rows(tri: np.ndarray) -> np.ndarray:
