@@ -194,14 +194,22 @@ def test_a_verdict_after_a_repair_measures_the_changed_stretch_again(job, monkey
     fresh = V.verify_job(job, texts=["\n".join(lines)])
     before = V.verify_job(job)
     assert not job.verification.measured  # the job keeps none of it
-    probed = []
-    probes = V._probes
+    probed, swept = [], []
+    probes, sweep = V._probes, V.K.sweep_body
     monkeypatch.setattr(V, "_probes", lambda *a: probed.append(len(a[0])) or probes(*a))
+    monkeypatch.setattr(V.K, "sweep_body", lambda *a: swept.append(len(a[4])) or sweep(*a))
     again = V.verify_job(job, texts=["\n".join(lines)], before=before)
     assert [str(f) for f in again.findings] == [str(f) for f in fresh.findings]
     assert not _finding(again, "gouge, finishing").ok and again.probes == fresh.probes
     # the checks along the moves probed the two changed moves alone (one stretch a check)
     assert probed and max(probed) <= 2 and fresh.probes > 50_000
+    # the stock was swept again from the last stock kept before the lowered move, not from the start
+    moves = read_program("\n".join(lines))
+    assert 0 < sum(swept) <= (moves.line > k).sum() + len(moves) / V.SWEEP_MARKS + 1
+    # and the whole program swept at once finds what the stretches found
+    monkeypatch.setattr(V, "SWEEP_MARKS", 1)
+    whole = V.verify_job(job, texts=["\n".join(lines)])
+    assert [str(f) for f in whole.findings] == [str(f) for f in fresh.findings]
 
 
 def test_a_rapid_through_the_stock_is_found(job):

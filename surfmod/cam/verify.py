@@ -103,6 +103,10 @@ REACH_CHUNK = 4096
 #: stock nodes of the model the job holds shanks and holders against, at most
 #: (:func:`body_cell`, :func:`surfmod.cam.holder.body_stock`)
 BODY_NODES = 4_000_000
+#: the stock kept at most this many times along a sweep of the program, in at most this
+#: many bytes (:func:`_sweep`)
+SWEEP_MARKS = 8
+SWEEP_BYTES = 64_000_000
 #: nodes of the stock steeper than this (degrees) are walls the height field cannot judge
 WALL_SLOPE = 80.0
 #: the least upward share of a contact normal a lift counts on (beside a vertical wall a
@@ -608,6 +612,45 @@ def _program_moves(job, texts: list[str], post: str) -> tuple[ProgramMoves, np.n
     return concatenate(parts), np.concatenate(owners)
 
 
+def _sweep(top, lo, cell, moves: ProgramMoves, owner, radii, corners, discs, slack, kept):
+    """:func:`~surfmod.cam.verify_kernels.sweep_body` over the moves (its per-move
+    ``into``, node, ``sink``, node) in stretches, the stock ``top`` kept as it stands at
+    the start of each; ``kept``: what the sweep of the verdict before kept.  The moves
+    before the first one that differs from that verdict's meet the same stock, so their
+    stretches are taken from it and the sweep goes on from the last kept stock before
+    that move (a re-cut appends its passes: the whole program is not swept again).
+    Cutting a sweep into stretches changes no finding: the stock carries over, and the
+    kernel's block maxima only skip nodes that could not count."""
+    columns = (moves.start, moves.end, moves.rapid, owner, radii, corners)
+    m = len(owner)
+    marks = min(SWEEP_MARKS, SWEEP_BYTES // top.nbytes)  # none: a stock too large to keep is swept whole
+    stride = kept["stride"] if kept else max(-(-m // max(marks, 1)), 1)
+    out = [np.full(m, -np.inf), np.full(m, -1, np.int64), np.full(m, -np.inf), np.full(m, -1, np.int64)]
+    begin, tops = 0, {}
+    if kept and kept["tops"]:
+        n = min(m, len(kept["columns"][0]))
+        differ = np.zeros(n, bool)
+        for a, b in zip(columns, kept["columns"]):
+            d = a[:n] != b[:n]
+            differ |= d if d.ndim == 1 else d.any(axis=1)
+        first = int(np.argmax(differ)) if differ.any() else n
+        begin = max(k for k in kept["tops"] if k <= first)
+        top[:] = kept["tops"][begin]
+        tops = {k: v for k, v in kept["tops"].items() if k <= begin}
+        for mine, theirs in zip(out, kept["out"]):
+            mine[:begin] = theirs[:begin]
+    for a in range(begin, max(m, 1), stride):
+        b = min(a + stride, m)
+        if marks:
+            tops[a] = top.copy()
+        got = K.sweep_body(top, float(lo[0]), float(lo[1]), cell, moves.start[a:b], moves.end[a:b], moves.rapid[a:b],
+                           radii[a:b], corners[a:b], cell / 2, discs, np.ascontiguousarray(owner[a:b], dtype=np.int64),
+                           slack, np.zeros(len(slack)), np.zeros(b - a, np.bool_), False, cell)
+        for mine, part in zip(out, got):
+            mine[a:b] = part
+    return out, {"stride": stride, "columns": columns, "tops": tops, "out": out}
+
+
 def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, max_samples: int = MAX_SAMPLES,
                max_probes: int = MAX_PROBES, max_nodes: int = MAX_NODES,
                max_dexel_work: int = MAX_DEXEL_WORK, before: Verification | None = None) -> Verification:
@@ -685,8 +728,8 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     cell, nx, ny, note = stock_cells(job.stock, max(stepover / 4, 1e-3), max_nodes)
     notes += [note] if note else []
     top = np.full((nx, ny), float(hi[2]))
-    radii = np.array([job.operations[k].tool.radius for k in owner], float)
-    corners = np.array([job.operations[k].tool.corner for k in owner], float)
+    radii = np.array([op.tool.radius for op in job.operations], float)[owner]
+    corners = np.array([op.tool.corner for op in job.operations], float)[owner]
     # the shank and holder of each move's tool measured against the stock as it stands then
     bodies = [op.tool.body for op in job.operations]
     discs = np.zeros((len(bodies), max(len(b) for b in bodies), 2))
@@ -696,10 +739,9 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     # a disc may rub sideways within the operation's limit, never stand below the part or
     # the stock: beyond the 4 decimals and the stamped sweep's sag over a quarter cell
     low_limit = digits + (cell / 4) ** 2 / (2 * cell)
-    into, node, sink, sink_node, _ = K.sweep_body(top, float(lo[0]), float(lo[1]), cell, moves.start, moves.end,
-                                                  moves.rapid, radii, corners, cell / 2, discs,
-                                                  np.ascontiguousarray(owner, dtype=np.int64), slack,
-                                                  np.zeros(len(plans)), np.zeros(len(owner), np.bool_), False, cell)
+    key = ("sweep", tuple(lo), cell, nx, ny, discs.tobytes(), slack.tobytes())
+    (into, node, sink, sink_node), measured[key] = _sweep(top, lo, cell, moves, owner, radii, corners, discs, slack,
+                                                          old.get(key))
     held, body_probes = [], 0
     for k, op, _, limit in plans:
         key = ("body", k, op.tool.radius, op.tool.body.tobytes(), limit)
