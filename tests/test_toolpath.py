@@ -134,6 +134,36 @@ def test_walls_every_move_checked_exactly():
     assert worst_cut(block, np.column_stack([xy, z]), r, top) > 40 * tp.tolerance  # deep into a wall
 
 
+def test_the_drop_heights_known_under_the_points_spare_the_final_drops(monkeypatch):
+    """The raster carries each point's drop height beside it, so the final check of every
+    move does not drop at its ends again: on the stepped block (walls, staircases,
+    refinement) the path is the one made with every end dropped again, bit for bit, with
+    fewer locations dropped."""
+    block, tool = stepped_block(), sm.Tool("ball", 1.5)
+    gouge, checked = toolpath_module.move_gouge, []
+
+    def known(height, points, *a):  # the column holds the drop height under every point
+        z = height(points[:, :2])
+        checked.append(np.array_equal(points[:, 3], np.where(np.isnan(z), -np.inf, z)))
+        return gouge(height, points, *a)
+
+    monkeypatch.setattr(toolpath_module, "move_gouge", known)
+    sm.toolpath(block, tool, scallop=0.05)
+    assert checked and all(checked)
+    monkeypatch.setattr(toolpath_module, "move_gouge", gouge)
+    dropped, drop_at = [], toolpath_module.drop
+    monkeypatch.setattr(toolpath_module, "drop", lambda grid, cutter, xy, **kw: dropped.append(len(xy))
+                        or drop_at(grid, cutter, xy, **kw))
+    fast = sm.toolpath(block, tool, scallop=0.05)
+    fast_drops = sum(dropped)
+    dropped.clear()
+    monkeypatch.setattr(toolpath_module, "move_gouge", lambda height, points, *a: gouge(height, points[:, :3], *a))
+    again = sm.toolpath(block, tool, scallop=0.05)
+    assert np.array_equal(fast.points, again.points) and np.array_equal(fast.contacts, again.contacts)
+    assert (fast.gouge, fast.lifted) == (again.gouge, again.lifted)
+    assert fast_drops + len(fast.points) <= sum(dropped)
+
+
 def test_flat_end_walls_exact(tmp_path):
     """Flat end + shank along every move of a wall part, by shrunken OCCT cylinders."""
     block = bd.Box(20, 16, 4) + bd.Pos(2, 1, 4) * bd.Box(6, 5, 4)

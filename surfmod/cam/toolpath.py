@@ -378,7 +378,9 @@ def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction
     if np.isnan(z).all():
         raise SurfmodError("bounds: the tool touches no face inside these bounds")
     floor = float(np.nanmin(z))  # where the tool touches nothing it stays at the lowest level
-    points = np.column_stack([xy, np.where(np.isnan(z), floor, z)])
+    # the drop height under each point rides along as a fourth column: the final check
+    # takes it instead of dropping at every point again
+    points = np.column_stack([xy, np.where(np.isnan(z), floor, z), np.where(np.isnan(z), -np.inf, z)])
     stage("refining")
     allowed = tolerance - part.deflection + part.lift
     if allowed <= 0:
@@ -402,6 +404,7 @@ def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction
         # face, say): lift those moves, which leaves material but never cuts
         points, lift, depth = lift_moves(part.height, points, depth, REFINE_SHARE * allowed)
         lifted = float(lift.max())
+    points = points[:, :3]
     gouge = float(depth.max()) if len(depth) else 0.0
     if gouge > allowed:
         worst = int(np.argmax(depth))

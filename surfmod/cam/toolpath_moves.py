@@ -97,7 +97,9 @@ def move_gouge(height, points: np.ndarray, moves: np.ndarray | None = None) -> n
     move's height) at ``CHECK_SAMPLES`` centred interior samples ``t = (j + ½)/n`` and at
     the end points; ≤ 0 means the move clears.  ``height(xy)`` is the drop-cutter height.
     With ``moves`` (indices ``i``: the move from ``points[i]`` to ``points[i + 1]``) only
-    those, one depth each.
+    those, one depth each.  A fourth column of ``points``, where given, is the drop height
+    under each point already known (-inf: the tool touches nothing), taken instead of
+    dropping there again.
 
     >>> import numpy as np
     >>> bump = lambda xy: np.where(np.abs(xy[:, 0] - 1) < 0.3, 1.0, 0.0)
@@ -113,7 +115,7 @@ def move_gouge(height, points: np.ndarray, moves: np.ndarray | None = None) -> n
     excess, owner, _, _ = _excess(height, points, moves, np.full(len(moves), CHECK_SAMPLES), centred=True)
     worst, _ = _worst_per_move(excess, owner, len(moves))
     at = points if every else points[np.r_[moves, moves + 1]]
-    ends = height(at[:, :2])
+    ends = at[:, 3] if at.shape[1] > 3 else height(at[:, :2])
     end_excess = np.where(np.isnan(ends), -np.inf, ends - at[:, 2])
     if every:
         return np.maximum(worst, np.maximum(end_excess[:-1], end_excess[1:]))
@@ -159,8 +161,9 @@ def staircase_steep(points: np.ndarray, index: np.ndarray, slope: float = STEEP_
     rise = b[:, 2] - a[:, 2]
     steep = (np.abs(rise) > slope * run) & (run > 0)
     at = np.nonzero(steep)[0] + 1
-    corner = np.where((rise[steep] > 0)[:, None], np.column_stack([a[steep, :2], b[steep, 2]]),
-                      np.column_stack([b[steep, :2], a[steep, 2]]))
+    # (a known drop height in a fourth column goes with its (x, y))
+    corner = np.where((rise[steep] > 0)[:, None], np.column_stack([a[steep, :2], b[steep, 2], a[steep, 3:]]),
+                      np.column_stack([b[steep, :2], a[steep, 2], b[steep, 3:]]))
     return np.insert(points, at, corner, axis=0), np.insert(index, at, -1)
 
 
@@ -197,7 +200,7 @@ def refine_moves(height, points: np.ndarray, index: np.ndarray, target: float, m
         a, b = points[moves], points[moves + 1]
         split = span > min_length
         # split: the worst sample becomes a cutter location at its drop height
-        new_pts = [np.column_stack([xy[arg[split]], drop[arg[split]]])]
+        new_pts = [np.column_stack([xy[arg[split]], drop[arg[split]], drop[arg[split]]])[:, :points.shape[1]]]
         at = [moves[split] + 1]
         # staircase: up at a, level above the highest sampled drop, down at b
         sample_top = np.full(len(counts), -np.inf)
@@ -205,7 +208,7 @@ def refine_moves(height, points: np.ndarray, index: np.ndarray, target: float, m
         sample_top = sample_top[bad]
         top = np.maximum(np.maximum(a[~split, 2], b[~split, 2]), sample_top[~split] + target / 2)
         for end in (a[~split], b[~split]):
-            new_pts.append(np.column_stack([end[:, :2], top]))
+            new_pts.append(np.column_stack([end[:, :2], top, end[:, 3:]]))
             at.append(moves[~split] + 1)
         new_pts = np.concatenate(new_pts)
         at = np.concatenate(at)
