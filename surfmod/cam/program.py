@@ -30,9 +30,8 @@ _TOKEN = re.compile(rf"([A-Z_])({_NUMBER})|\n")
 #: a line that is not words only
 _BAD_LINE = re.compile(rf"^(?!(?:[A-Z]{_NUMBER})*$).+", re.M)
 _COMMENT = re.compile(r"\([^)\n]*\)|;[^\n]*")
-#: white space at either end of a line (str.strip's), and a line that is only ``%``
-_EDGES = re.compile(r"^[^\S\n]+|[^\S\n]+$", re.M)
-_PERCENT = re.compile(r"^%$", re.M)
+#: a line that is only ``%`` (white space aside), and white space at either end of a line
+_EDGES = re.compile(r"^[^\S\n]*%[^\S\n]*$|^[^\S\n]+|[^\S\n]+$", re.M)
 #: words the posts write that do not move the tool (modes already in force, coolant, end)
 _QUIET_G = {17.0, 21.0, 40.0, 43.0, 49.0, 80.0, 90.0, 94.0}
 _QUIET_M = {8.0, 9.0, 30.0, 2.0}
@@ -91,8 +90,7 @@ def read_program(text: str, *, tool: int = 0, chord: float = 1e-4) -> ProgramMov
     """
     raw = str(text).splitlines()
     # comments out, each line stripped, upper case, spaces out: what each line says
-    body = _COMMENT.sub("", "\n".join(raw))
-    body = _PERCENT.sub("", _EDGES.sub("", body)).upper().replace(" ", "")
+    body = _EDGES.sub("", _COMMENT.sub("", "\n".join(raw))).upper().replace(" ", "")
     errors = []  # (line, rank within the line, message): the first is raised
     bad = _BAD_LINE.search(body)
     if bad:
