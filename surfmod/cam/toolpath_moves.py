@@ -74,7 +74,7 @@ def _excess(height, points: np.ndarray, moves: np.ndarray, counts: np.ndarray, c
     j = np.arange(len(owner)) - np.repeat(np.cumsum(counts) - counts, counts)
     n = counts[owner]
     t = (j + 0.5) / n if centred else (j + 1.0) / (n + 1.0)
-    a, b = points[moves[owner]], points[moves[owner] + 1]
+    a, b = points[moves[owner], :3], points[moves[owner] + 1, :3]
     p = a + t[:, None] * (b - a)
     drop = height(p[:, :2])
     return np.where(np.isnan(drop), -np.inf, drop - p[:, 2]), owner, p[:, :2], drop
@@ -157,7 +157,7 @@ def staircase_steep(points: np.ndarray, index: np.ndarray, slope: float = STEEP_
     corner) by a vertical and a level move: rising moves go up first, falling moves
     across first, so the tool never leans into the wall."""
     a, b = points[:-1], points[1:]
-    run = np.linalg.norm((b - a)[:, :2], axis=1)
+    run = np.linalg.norm(b[:, :2] - a[:, :2], axis=1)
     rise = b[:, 2] - a[:, 2]
     steep = (np.abs(rise) > slope * run) & (run > 0)
     at = np.nonzero(steep)[0] + 1
@@ -188,7 +188,7 @@ def refine_moves(height, points: np.ndarray, index: np.ndarray, target: float, m
         off = np.where(np.isfinite(excess), np.abs(excess), -np.inf)
         worst, arg = _worst_per_move(off, owner, len(moves))
         cut, _ = _worst_per_move(excess, owner, len(moves))
-        span = np.linalg.norm((points[moves + 1] - points[moves])[:, :2], axis=1)
+        span = np.linalg.norm(points[moves + 1, :2] - points[moves, :2], axis=1)
         # short moves are split no further unless they cut (steep ones become staircases
         # in staircase_steep, which also covers jumps of the drop height at wall edges)
         bad = ((worst > target) & (span > min_length)) | (cut > target)

@@ -663,7 +663,8 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
     part alone, move by move (gouge, rapids into the part, holder and shank over the
     part), is taken from it for the moves before and after that stretch, as are the
     part's heights under the stock's nodes and what the finishing tool reaches there; the
-    stock is swept again from the start (what a move meets depends on every move before it).
+    stock is swept again from the last state kept before the first changed move (what a move
+    meets depends on every move before it).
 
     >>> import surfmod as sm, build123d as bd
     >>> job = sm.machine(bd.Box(20, 20, 5), 1.0, [sm.Rough(sm.Tool("flat", 3.0), allowance=0.3),
