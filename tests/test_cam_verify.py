@@ -19,11 +19,13 @@ import build123d as bd
 import numpy as np
 import pytest
 from scipy import ndimage
+from scipy.spatial import cKDTree
 from stock_sim import Cutter, Stock, parse_gcode, part_height, reachable, simulate
 from twins.program_lines import read_program_lines
 
 import surfmod as sm
 from surfmod.cam import verify as V
+from surfmod.cam import wall_dexels as W
 from surfmod.cam.drop_cutter import part_triangles
 from surfmod.cam.job import _relink
 from surfmod.cam.roughing import PLUNGE, RAPID, Motion
@@ -310,6 +312,28 @@ def test_dexels_lose_the_tools_exact_section():
         got = np.sort(seg[j, 15, :cnt[j, 15]], axis=0)
         want = [[-5.0, 5.0]] if lo > hi else [[-5.0, lo], [hi, 5.0]]
         assert np.allclose(got, want, atol=1e-6), (j, got, want)
+
+
+def test_a_stock_point_on_a_bores_axis_is_measured_from_its_wall():
+    # points 0.3 apart on a bore of radius 20; stock points within 0.5 of its axis are as
+    # far from a whole ring of them: the 8 nearest of the exact query lie round the ring,
+    # and the plane through them passes near the axis (depth 0.1 where it is 19.5).  Taken
+    # from the patch round the nearest of the points one per 1.5 mm voxel, the depth is
+    # the bore's radius to within the sag of the patch's points; a point nearer the wall
+    # than ``far`` keeps the exact query
+    r, s = 20.0, 0.3
+    t, z = np.meshgrid(np.arange(0, 2 * np.pi, s / r), np.arange(-30, 30, s))
+    ring = np.column_stack([r * np.cos(t).ravel(), r * np.sin(t).ravel(), z.ravel()])
+    rng = np.random.default_rng(3)
+    q = np.column_stack([rng.uniform(-19.5, 19.5, 400), rng.normal(0, 0.5, 400), rng.uniform(-10, 10, 400)])
+    tree = cKDTree(ring)
+    depth, normal, foot = W.feet(tree, ring, q, 1.5, 6.0)
+    true = r - np.hypot(q[:, 0], q[:, 1])
+    assert np.all(depth >= true - 0.01) and np.all(depth <= true + 0.02)
+    assert np.allclose(np.hypot(foot[:, 0], foot[:, 1]), r, atol=0.02) and np.abs(normal[:, 2]).max() < 0.02
+    exact = W.feet(tree, ring, q)[0]
+    wall = true < 6.0 - 1.5 * math.sqrt(3)
+    assert np.array_equal(depth[wall], exact[wall]) and np.abs(exact - true).max() > 10
 
 
 DRAFT, CONE_H, BALL = 10.0, 6.0, 1.5  # a cone boss 6 high whose wall leans 10 degrees in

@@ -971,9 +971,12 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
     if not len(q):
         return Finding(what, -np.inf, bound), dexels, 0
     # the part's points near them (their nearest lie within two buckets of a stock point
-    # nearer the part than a bucket; a farther one is measured exactly below if deepest)
+    # nearer the part than a bucket; a farther one is measured exactly below if deepest);
+    # a point farther than a bucket and the bound takes its plane from the part's points
+    # one per voxel (a quarter bucket) first: never one the bound holds
     near = part.around(q, 2)
-    depth, normal, foot = W.feet(cKDTree(near), near, q)
+    voxel = part.cell / 4
+    depth, normal, foot = W.feet(cKDTree(near), near, q, voxel, max(part.cell, bound + math.sqrt(3) * voxel))
     steep = W.steep_normals(normal)
     q, depth, normal, foot = q[steep], depth[steep], normal[steep], foot[steep]
     tips = W.tangent_tips(foot, normal, cutter.radius, cutter.corner)

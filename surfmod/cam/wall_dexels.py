@@ -227,11 +227,29 @@ def wall_points(seg, cnt, a0: float, a1: float, l0: float, z0: float, cell: floa
     return np.column_stack([across, along, level] if swap else [along, across, level])
 
 
-def feet(tree: cKDTree, part_points: np.ndarray, q: np.ndarray):
+def feet(tree: cKDTree, part_points: np.ndarray, q: np.ndarray, voxel: float = 0.0, far: float = np.inf):
     """For stock points ``q``: their distance to the part along its normal, the normal
     (pointing to ``q``) and the foot on the part, from the plane through the
-    ``PLANE_POINTS`` nearest part points (never more than the nearest one's distance)."""
-    dist, idx = tree.query(q, k=PLANE_POINTS)
+    ``PLANE_POINTS`` nearest part points (never more than the nearest one's distance).
+
+    A point farther than ``far`` from the part takes instead the ``PLANE_POINTS`` round the
+    nearest of the part's points kept one per ``voxel`` cube: a point on a bore's axis is
+    as far from a whole ring of points, all of which the tree visits (0.37 ms a query on
+    NIST CTC-02 against 1.4 us beside a wall).  Its nearest then lies at most a voxel's
+    diagonal farther than the exact one: the depth is judged more strictly, never less."""
+    idx = np.empty((len(q), PLANE_POINTS), np.int64)
+    dist = np.empty((len(q), PLANE_POINTS))
+    away = np.zeros(len(q), bool)
+    if voxel > 0 and np.isfinite(far) and len(q):
+        _, first = np.unique(np.floor(part_points / voxel).astype(np.int64), axis=0, return_index=True)
+        d, k = cKDTree(part_points[first]).query(q)
+        away = d > far
+        # the patch round the nearest kept point: the tree's query at a point of it is local
+        _, patch = tree.query(part_points[first[k[away]]], k=PLANE_POINTS)
+        gap = np.linalg.norm(part_points[patch] - q[away, None, :], axis=2)
+        order = np.argsort(gap, axis=1)
+        idx[away], dist[away] = np.take_along_axis(patch, order, axis=1), np.take_along_axis(gap, order, axis=1)
+    dist[~away], idx[~away] = tree.query(q[~away], k=PLANE_POINTS)
     near = part_points[idx]  # (M, k, 3)
     centre = near.mean(axis=1)
     d = near - centre[:, None, :]
