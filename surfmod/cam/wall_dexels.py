@@ -27,9 +27,10 @@ lines its capsule crosses and its stamps' lines, counted in the dexels' plane.
 **Judged** (:func:`wall_residual`): every end of a material interval is a point of the
 stock's surface.  Its distance to the part is the material left there, measured along the
 normal of the part at its foot: from the plane through the nearest points of the exact
-part (``PLANE_POINTS`` of them), never more than the nearest point's own distance; the
-worst are measured again by OCCT's exact distance.  A point is judged where the part under
-it is steep (slope at least ``DEXEL_SLOPE``; the height field judges the rest) and the
+part (``PLANE_POINTS`` of them; for a point far from the part, those round the nearest of
+the points kept one per voxel, :func:`feet`), never more than the nearest point's own
+distance; the worst are measured again by OCCT's exact distance.  A point is judged where
+the part under it is steep (slope at least ``DEXEL_SLOPE``; the height field judges the rest) and the
 finishing tool reaches: the tool tangent to the part at the foot, its corner's centre on
 the normal, takes in no point of the part deeper than the operation's limit, the normal
 does not face down (under an overhang nothing from above touches), and no disc of the
