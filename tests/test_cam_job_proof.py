@@ -94,6 +94,9 @@ needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package li
 R1, R2, SCALLOP, ALLOWANCE, MARGIN, CELL = 5.0, 3.0, 0.15, 0.5, 2.0, 0.25
 SIDE_CELL = 0.4  # spacing of the dexels along x and y (in y or x, and in z)
 ROUNDING = 1e-4
+FLUTE, SHANK = 80.0, None  # both tools' flutes and the shank above them (None: the tool's default)
+NECK = 0.0  # how much narrower than the end the shank is
+DEFLECTION = 0.01  # the judge's mesh of the part
 #: corpus parts (20-150 mm, pockets and holes)
 CORPUS_JOBS = ["stepcode_FOOT_BACK_000.stp", "stepcode_TAIL_MIDDLE_PART.stp", "nist_ftc_11_asme1_rb.stp",
                "trimesh_featuretype.STEP", "stepcode_HEAD_BACK.stp"]
@@ -246,13 +249,14 @@ def wall_check(walls, floor, stock: Stock, cutter: Cutter, left: np.ndarray, bou
 
 def prove(path: Path, tmp_path: Path) -> dict:
     shape = to_shape(path)
-    rough, finish = sm.Tool("flat", R1, flute_length=80), sm.Tool("ball", R2, flute_length=80)
+    rough, finish = (sm.Tool(kind, r, flute_length=FLUTE, shank_length=SHANK, shank_radius=r - NECK)
+                     for kind, r in (("flat", R1), ("ball", R2)))
     job = sm.machine(shape, MARGIN, [sm.Rough(rough, allowance=ALLOWANCE), sm.Finish(finish, scallop=SCALLOP)])
     ngc = tmp_path / "job.ngc"
     sm.export_gcode(job, ngc, post="linuxcnc")
     prog = parse_canon(run_rs274(ngc, tmp_path / "job.txt"), arc_chord=1e-4)
     assert prog.tool_changes == [1, 2] and prog.ended
-    tri, deflection, (_, owner) = part_triangles(shape, 0.01, face_index=True)
+    tri, deflection, (_, owner) = part_triangles(shape, DEFLECTION, face_index=True)
     stock = Stock(job.stock, CELL)
     top = part_height(tri, stock.x, stock.y, deflection=deflection)  # no face lifted over a hole's chord
     bottom = float(job.stock[0, 2])
@@ -423,4 +427,28 @@ def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
     # within two ball radii of a wall), the block's rounded walls steep ground (5,323) and
     # the walls through the dexels (39,457 points)
     assert got["nodes"] > 20_000 and got["steep_nodes"] > 4_000 and got["wall_nodes"] > 30_000, \
+        {k: v for k, v in got.items() if k != "job"}
+
+
+#: issue 36's pocketed plate larger than 500 mm: NIST CTC-02, 680 x 860 x 400 mm, pockets
+#: 330 mm deep from its top (floors at z -290), bosses, ribs and bores; a flat r = 30
+#: roughs and a ball r = 25 finishes (60 and 50 mm tools) on 420 mm of reach (flutes
+#: 100 mm, above them a neck 1 mm narrower: a shank as wide would rub the roughing's
+#: allowance on the walls taller than the flutes), the scallop 2 % of the ball's radius;
+#: the judge's stock cells 2 mm (a fifth of the 10 mm stepover), its wall dexels 4 mm
+#: apart (at 2 mm the finishing's 638,674 moves as rs274 reads them back would meet them
+#: 1.75e8 times, above the judge's 6e7) and its mesh 0.05 mm (the file's own edges are
+#: 0.097 off its faces)
+PLATE_JOB = {"name": "nist_ctc_02_asme1_rc.stp", "R1": 30.0, "R2": 25.0, "SCALLOP": 0.5, "CELL": 2.0,
+             "SIDE_CELL": 4.0, "FLUTE": 100.0, "SHANK": 320.0, "NECK": 1.0, "DEFLECTION": 0.05}
+
+
+@needs_rs274
+@pytest.mark.corpus
+def test_corpus_job_on_a_pocketed_plate(tmp_path, corpus_dir, monkeypatch):
+    got = prove_with(PLATE_JOB, corpus_dir, tmp_path, monkeypatch)
+    # the floors and the top are judged shallow ground (22,182 nodes: residual 0.307), the
+    # rounded edges steep ground (737: 0.346), the pockets' walls through the dexels
+    # (36,363 of 97,397 points: 0.516 after finishing, 29,084 after roughing)
+    assert got["nodes"] > 20_000 and got["steep_nodes"] > 500 and got["wall_nodes"] > 30_000, \
         {k: v for k, v in got.items() if k != "job"}
