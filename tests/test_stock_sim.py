@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from stock_sim import (RS274, Cutter, Stock, envelope, normal_residual, parse_canon, parse_gcode, part_height,
-                       reachable, run_rs274, simulate)
+from stock_sim import (RS274, Cutter, Move, Program, Stock, envelope, normal_residual, parse_canon, parse_gcode,
+                       part_height, reachable, run_rs274, simulate)
 
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")
@@ -39,6 +39,28 @@ def raster_program(passes_y, x0, x1, z, tool=1):
 
 
 # --- the swept envelopes against brute force ----------------------------------------------------
+
+@pytest.mark.parametrize("cutter", [Cutter("ball", 1.3), Cutter("flat", 0.9)])
+def test_compiled_simulation_equals_the_numpy_one(cutter, rng):
+    """The compiled sweep of flat and ball ends gives the stock, the lowest tool heights
+    and the report of the NumPy envelopes bit for bit: random feeds and rapids (level,
+    sloped, plunging, diagonal, some beyond the stock's edge, some longer than a piece)
+    over a stock with a part under it, the spindle stopped on a few."""
+    ends = rng.uniform([-3, -3, -1], [13, 9, 4], (400, 3))
+    ends[1::7, 2] = ends[::7, 2][:len(ends[1::7])]  # level moves
+    ends[3::11, :2] = ends[2::11, :2][:len(ends[3::11])]  # plunges
+    moves = [Move(a, b, bool(k % 5 == 0), 1, bool(k % 13), k) for k, (a, b) in enumerate(zip(ends[:-1], ends[1:]))]
+    moves.append(Move(ends[0], ends[0], False, 1, True, 999))  # no motion
+    reports, stocks = [], []
+    for compiled in (True, False):
+        stock = Stock([[0, 0, 0], [10, 6, 3]], 0.1)
+        part = np.where(stock.top > 0, 0.5 + 0.1 * np.sin(stock.nodes()[0]), -np.inf)
+        reports.append(simulate(Program(moves), {1: cutter}, stock, part, compiled=compiled))
+        stocks.append(stock.top)
+    assert np.array_equal(stocks[0], stocks[1])
+    assert vars(reports[0]) == vars(reports[1])
+    assert reports[0].rapid_cut_lines and reports[0].cut_without_spindle and reports[0].gouge > 0
+
 
 @pytest.mark.parametrize("cutter", [Cutter("ball", 2.0), Cutter("flat", 1.5), Cutter("bull", 2.0, 0.6)])
 @pytest.mark.parametrize("b", [(3.0, 1.0, 0.0), (3.0, 1.0, 1.7), (0.5, -2.0, -2.5), (0.0, 0.0, 1.0)])
