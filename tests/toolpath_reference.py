@@ -18,7 +18,8 @@ from __future__ import annotations
 import re
 
 import numpy as np
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon,
+                                BRepBuilderAPI_MakeVertex)
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
 from OCP.Extrema import Extrema_ExtFlag_MIN
@@ -160,12 +161,21 @@ def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float)
             p = a + t * (b - a)
             axis = gp_Ax2(gp_Pnt(float(p[0]), float(p[1]), float(p[2] + depth)), gp_Dir(0, 0, 1))
             cutter = BRepPrimAPI_MakeCylinder(axis, rho, top - p[2] - depth).Shape()
-            dist = BRepExtrema_DistShapeShape(cutter, target, Extrema_ExtFlag_MIN)
+            # a vertex CLEAR below the bottom's centre: OCCT then skips every pair of
+            # sub-shapes whose boxes stand farther apart than that (a third less work on
+            # occt_screw), and a distance of 1e-9 or less is found as before
+            mark = BRepBuilderAPI_MakeVertex(gp_Pnt(float(p[0]), float(p[1]), float(p[2] + depth - CLEAR))).Vertex()
+            dist = BRepExtrema_DistShapeShape(cutter, compound([target, mark]), Extrema_ExtFlag_MIN)
             assert dist.IsDone()
             if dist.Value() <= 1e-9:
                 bad.append(i)
                 break
     return bad
+
+
+#: how far below a flat end's placement :func:`flat_cuts` puts its vertex (above the 1e-9
+#: that counts as meeting the part)
+CLEAR = 1e-6
 
 
 def _near_strips(boxes: np.ndarray, centre: np.ndarray, top: float, radius: float) -> np.ndarray:
