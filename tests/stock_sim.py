@@ -161,10 +161,12 @@ def parse_canon(text: str, arc_chord: float = ARC_CHORD) -> Program:
             continue
         name, args = m.groups()
         if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"):
-            p = np.array(_numbers(args)[:3])
-            if pos is not None and np.any(p != pos):
-                prog.moves.append(Move(pos, p, name == "STRAIGHT_TRAVERSE", tool, spindle, i + 1))
-            pos = p
+            xyz = _numbers(args)[:3]
+            if pos is None or xyz != pos.tolist():  # lists: a NumPy comparison per line cost seconds
+                p = np.array(xyz)
+                if pos is not None:
+                    prog.moves.append(Move(pos, p, name == "STRAIGHT_TRAVERSE", tool, spindle, i + 1))
+                pos = p
         elif name == "ARC_FEED":
             v = _numbers(args)
             if pos is None:
