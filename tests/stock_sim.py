@@ -300,15 +300,11 @@ def envelope(cutter: Cutter, qx: np.ndarray, qy: np.ndarray, a: np.ndarray, b: n
 
 def _envelope(cutter, qx, qy, a, b):
     R = cutter.radius
+    if cutter.kind in KERNEL_KINDS:
+        return _node_envelopes(KERNEL_KINDS[cutter.kind], qx, qy, *map(float, a[:3]), *map(float, b[:3]), float(R))
     t0, t1, ok = _cover(qx, qy, a, b, R)
     out = np.full(qx.shape, np.inf)
     dz = b[2] - a[2]
-    if cutter.kind == "flat":
-        t = np.where(dz > 0, t0, t1)
-        out[ok] = a[2] + t[ok] * dz
-        return out
-    if cutter.kind == "ball":
-        return np.where(ok, _ball_envelope(qx, qy, a, b, R), np.inf)
     # bull: on a level move the closest axis point is lowest; else minimise the convex
     # z(t) + f(d(t)) over the covered interval
     vx, vy = b[0] - a[0], b[1] - a[1]
@@ -338,29 +334,6 @@ def _envelope(cutter, qx, qy, a, b):
         f1, f2 = np.where(left, fresh_f, keep_f), np.where(left, keep_f, fresh_f)
     out[idx] = np.minimum.reduce([height(lo), height(hi), f1, f2])
     return out
-
-
-def _ball_envelope(qx, qy, a, b, R):
-    """Lowest point over each node of the capsule swept by the ball's centre (a, b tips)."""
-    wx, wy = qx - a[0], qy - a[1]
-    ex, ey, ez = b[0] - a[0], b[1] - a[1], b[2] - a[2]
-    m = wx * wx + wy * wy
-    out = np.full(qx.shape, np.inf)
-    for p, mm in ((a, m), (b, (qx - b[0]) ** 2 + (qy - b[1]) ** 2)):
-        out = np.minimum(out, np.where(mm <= R * R, p[2] + R - np.sqrt(np.maximum(R * R - mm, 0.0)), np.inf))
-    A = ex * ex + ey * ey
-    if A <= 1e-24:
-        return out
-    L2 = A + ez * ez
-    k = wx * ex + wy * ey
-    disc = k * k * ez * ez - A * (m * L2 - k * k - R * R * L2)
-    ok = disc >= 0
-    s = (k * ez - np.sqrt(np.where(ok, disc, 0.0))) / A  # lower root: centre height offset
-    u = (k + s * ez) / L2
-    ok &= (u >= 0) & (u <= 1)
-    # the centre sits at a_z + R + s over the node: the capsule's lowest point is R below
-    # the cylinder's lower crossing, i.e. the crossing itself (s measured from a's centre)
-    return np.minimum(out, np.where(ok, a[2] + R + s, np.inf))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -565,9 +538,21 @@ def _sweep_moves(a, b, rapid, kind, R, piece, eps, x, y, top, floor, lowest):  #
     return removed, rapid_cut, rapid_part, over
 
 
+@njit(cache=True)
+def _node_envelopes(kind, qx, qy, ax, ay, az, bx, by, bz, R):  # pragma: no cover - compiled
+    """:func:`_node_envelope` over every node ``(qx[k], qy[k])``."""
+    out = np.empty(qx.shape)
+    for k in range(qx.size):
+        out[k] = _node_envelope(kind, qx[k], qy[k], ax, ay, az, bx, by, bz, R)
+    return out
+
+
 @njit(cache=True, inline="always")
 def _node_envelope(kind, qx, qy, ax, ay, az, bx, by, bz, R):  # pragma: no cover - compiled
-    """:func:`_envelope` of a flat or ball end over one node."""
+    """The lowest height over one node of a flat (``kind`` 0) or ball (1) end of radius
+    ``R`` swept straight from tip ``a`` to tip ``b``: the flat end's disc where the axis
+    first (rising) or last (falling) comes within ``R`` of the node; the ball's lowest
+    point of the capsule its centre sweeps (its ends' spheres and the cylinder between)."""
     wx, wy = qx - ax, qy - ay
     vx, vy = bx - ax, by - ay
     vv = vx * vx + vy * vy
@@ -587,7 +572,8 @@ def _node_envelope(kind, qx, qy, ax, ay, az, bx, by, bz, R):  # pragma: no cover
     dz = bz - az
     if kind == 0:
         return az + (t0 if dz > 0 else t1) * dz
-    # the ball: _ball_envelope
+    # the ball: the spheres at the ends, then the lower crossing of the cylinder (the
+    # centre at a_z + R + s over the node)
     out = np.inf
     m = wx * wx + wy * wy
     if m <= R * R:

@@ -41,9 +41,11 @@ def raster_program(passes_y, x0, x1, z, tool=1):
 # --- the swept envelopes against brute force ----------------------------------------------------
 
 @pytest.mark.parametrize("cutter", [Cutter("ball", 1.3), Cutter("flat", 0.9)])
-def test_compiled_simulation_equals_the_numpy_one(cutter, rng):
+def test_compiled_simulation_equals_the_move_by_move_one(cutter, rng):
     """The compiled sweep of flat and ball ends gives the stock, the lowest tool heights
-    and the report of the NumPy envelopes bit for bit: random feeds and rapids (level,
+    and the report of the move-by-move loop through :func:`envelope` bit for bit (its
+    pieces, windows and bookkeeping; the envelopes are judged against dense positions
+    above): random feeds and rapids (level,
     sloped, plunging, diagonal, some beyond the stock's edge, some longer than a piece)
     over a stock with a part under it, the spindle stopped on a few."""
     ends = rng.uniform([-3, -3, -1], [13, 9, 4], (400, 3))
