@@ -98,14 +98,15 @@ def compiled_kernels():
     local.COMPILED_SCATTERED, local.COMPILED_GRID = saved
 
 
-#: Tests of a minute or more on the 2-core CI machine (the corpus judges), collected first
-#: and the longest first: pytest-xdist's workers start on them and the short tests fill in
-#: behind, instead of one long test arriving last and leaving the other worker idle for its
-#: whole run.  The order works only with the tests handed out one by one (``--maxschedchunk=1``
-#: in pyproject's addopts): xdist's ``load`` scheduling otherwise sends each worker a first
-#: chunk of consecutive tests (an eighth of the run: 133 of the corpus run's 1068), and the
-#: first worker's chunk held every slow test while the other ran out of work (the corpus
-#: run's last 3.5 minutes on one worker).  A test matching no entry keeps its place after.
+#: Tests of a minute or more on the 2-core CI machine (the corpus judges), the longest
+#: first: each of pytest-xdist's workers starts on its share of them and the short tests fill
+#: in behind, instead of one long test arriving last and leaving the other worker idle for
+#: its whole run.  xdist's ``load`` scheduling sends each worker a first chunk of
+#: consecutive tests (an eighth of the run on two workers: 133 of the corpus run's 1068),
+#: then the rest one short batch at a time; with the slow tests simply collected first,
+#: the first worker's chunk held them all and the other ran out of work (the corpus run's
+#: last 3.5 minutes on one worker).  So :func:`pytest_collection_modifyitems` deals them
+#: into the workers' first chunks, the longest first, in turn.
 SLOW_FIRST = (
     "test_corpus_toolpath.py::test_corpus_toolpath_never_gouges[pythonocc_Ventilator.stp]",
     "test_corpus_toolpath.py::test_ventilator",
@@ -132,4 +133,26 @@ def _slowness(item) -> int:
 
 
 def pytest_collection_modifyitems(config, items):
+    """The :data:`SLOW_FIRST` tests dealt into the first chunks xdist's ``load`` scheduler
+    sends its workers (worker w gets the w-th chunk of ``chunk`` consecutive tests: the
+    scheduler's own arithmetic), in snake order (0, 1, 1, 0, 0, 1 …), the rest of each
+    chunk and of the run in collection order (under another ``--dist`` mode, merely an
+    order); without xdist, slow first."""
     items.sort(key=_slowness)  # stable
+    workers = getattr(config, "workerinput", {}).get("workercount", 1)  # set on xdist's workers
+    if workers < 2:
+        return
+    chunk = max(min(len(items) // workers // 4, config.getoption("maxschedchunk", None) or len(items)), 2)
+    slow = [item for item in items if _slowness(item) < len(SLOW_FIRST)]
+    rest = items[len(slow):]
+    dealt = [[] for _ in range(workers)]
+    for k, item in enumerate(slow):
+        turn = k % (2 * workers)
+        dealt[turn if turn < workers else 2 * workers - 1 - turn].append(item)
+    order, overflow = [], []
+    for share in dealt:
+        fill = max(chunk - len(share), 0)
+        order += share[:chunk] + rest[:fill]
+        overflow += share[chunk:]
+        rest = rest[fill:]
+    items[:] = order + overflow + rest
