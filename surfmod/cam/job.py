@@ -278,7 +278,7 @@ def _finish_settings(op: Finish, tool: Tool) -> tuple:
 
 
 def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest: Leftover | None,
-            progress: bool = False):
+            progress: bool = False, estimate: float | None = None):
     stepover, steep, tolerance = _finish_settings(op, tool)
     # every drop of the finishing is charged to one cap, estimated before the raster
     # starts; a small tool on a fine scallop is refused there, naming the scallop, and
@@ -287,7 +287,7 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
         meter = _Meter(MAX_WORK, bar if progress else None, "scallop",
                        f"choose a larger scallop than {op.scallop:g} or a larger finishing tool"
                        if op.scallop is not None else "choose a larger stepover or a larger finishing tool")
-        part = clear_part(_part(shape, tool.cutter, tolerance, meter), tool)
+        part = clear_part(_part(shape, tool.cutter, tolerance, meter, estimate), tool)
         motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
                                 steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest)
         bar.total = max(bar.n, 1)  # the contours' drops came after the raster's estimate: the bar ends full
@@ -512,14 +512,16 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
     strict = bool(strict)
     # a mesh that would be refused is refused before any operation runs (an 80-20 rail
     # 1.2 m long had its finishing refused after 9 minutes of roughing)
+    # (each estimate is passed on to the operation's meshing, which then skips the check)
+    estimates = {}
     for k, op in enumerate(ops):
         tool = op.tool.with_defaults(k + 1)
         if isinstance(op, Rough):
             with _options("roughing's mesh", "allowance", "a larger allowance meshes coarser"):
-                _mesh_estimate(shape, _rough_settings(op, tool, box)[3])
+                estimates[k] = _mesh_estimate(shape, _rough_settings(op, tool, box)[3])
         elif isinstance(op, Finish):
             with _options("finishing's mesh", "scallop", "choose a larger scallop or finishing tool"):
-                _mesh_estimate(shape, _finish_settings(op, tool)[2])
+                estimates[k] = _mesh_estimate(shape, _finish_settings(op, tool)[2])
     # the stock model the shanks and holders are held against, shared by the operations
     stock_model = body_stock(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
@@ -535,7 +537,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 stepdown, stepover, allowance, tolerance = _rough_settings(op, tool, box)
                 grown = tool.cutter.roughing_offset(allowance) if allowance > 0 else tool.cutter
                 with _stage(bar, "roughing's mesh", "allowance", "a larger allowance meshes coarser"):
-                    p = _part(shape, grown, tolerance)
+                    p = _part(shape, grown, tolerance, estimate=estimates[k])
                 with _stage(bar, "roughing", "stepdown", "a larger stepdown or roughing tool"):
                     motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover,
                                            CLEARANCE, deflection=p.deflection)
@@ -561,7 +563,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 # body's to say (a shank no wider than the end follows the flutes down a
                 # hole; the holder stops where it would meet the part or the stock)
                 with _stage(bar, "finishing", "scallop", "a larger scallop or finishing tool"):
-                    motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, progress)
+                    motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, progress, estimates[k])
                     tolerance = float(report["tolerance"])
                     # its own cusps too: a holder coming down beside the part passes over them
                     cusp = max(cusp_clearance(done), float(report["scallop"]) + tolerance)

@@ -191,10 +191,10 @@ class _Part:
         return drop(self.grid, self.cutter, xy) + self.lift
 
 
-def _mesh_estimate(shape, tolerance: float) -> None:
-    """Refuse, before BRepMesh runs, a tolerance whose curvature estimate of the mesh
-    exceeds :data:`MAX_TRIANGLES` or whose tolerance lies below :data:`TOLERANCE_FLOOR`
-    of the part's size."""
+def _mesh_estimate(shape, tolerance: float) -> float:
+    """The curvature estimate of the part's mesh at ``tolerance`` (triangles); refuses,
+    before BRepMesh runs, a tolerance whose estimate exceeds :data:`MAX_TRIANGLES` or
+    which lies below :data:`TOLERANCE_FLOOR` of the part's size."""
     from ..occ.properties import bounding_box
 
     box = bounding_box(shape, optimal=False)
@@ -209,12 +209,17 @@ def _mesh_estimate(shape, tolerance: float) -> None:
         raise SurfmodError(
             f"tolerance: {tolerance:.3g} meshes the part at deflection {deflection:.3g}, about "
             f"{estimate:,.0f} triangles, above the limit {MAX_TRIANGLES:,} (a larger tolerance or scallop)")
+    return float(estimate)
 
 
-def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None) -> _Part:
+def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None, estimate: float | None = None) -> _Part:
+    """The part meshed for ``tolerance``; ``estimate`` is :func:`_mesh_estimate`'s value
+    when the caller has already checked this tolerance (the survey costs 0.4 s on a
+    280 mm mould), else the check runs here."""
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
-    _mesh_estimate(shape, tolerance)
+    if estimate is None:
+        _mesh_estimate(shape, tolerance)
     try:
         triangles, measured, (faces, owner) = part_triangles(shape, requested, face_index=True)
     except SurfmodError as exc:
