@@ -112,6 +112,47 @@ def test_grid_cell_lists_run_from_the_highest_top_down():
         assert np.array_equal(grid._cells, cells) and np.array_equal(grid.listed, tris)
 
 
+def exhaustive_drop(grid, cutter, xy):
+    """Every triangle of each location's list solved (no bound prunes any), the first
+    of the highest heights winning: what the pruned, warm-started walk must equal."""
+    from surfmod.cam.drop_cutter import _drop_triangle
+
+    start, stop = grid.segments(xy)
+    z, won, contact = np.full(len(xy), -np.inf), np.full(len(xy), -1), np.empty(3)
+    for i, (qx, qy) in enumerate(xy):
+        for ti in grid.listed[start[i]:stop[i]]:
+            if np.all((grid.lo[ti] <= (qx, qy)) & ((qx, qy) <= grid.hi[ti])):
+                h = _drop_triangle(cutter.code, qx, qy, grid.rows, ti, grid.lo[ti], grid.hi[ti], grid.top[ti],
+                                   grid.radius, cutter.corner, -np.inf, contact)
+                if h > z[i]:
+                    z[i], won[i] = h, ti
+    z[~np.isfinite(z)] = np.nan
+    return z, won
+
+
+@pytest.mark.parametrize("kind", ["ball", "flat", "bull"])
+def test_the_warm_started_drop_equals_the_exhaustive_search_bit_for_bit(kind):
+    """Each location's walk starts from the previous location's triangle and prunes with
+    bounds widened against rounding: heights and triangles equal, bit for bit, those of
+    solving every triangle, on a real mesh (a contact passes its triangle's top by
+    rounding there) and on random triangles with tied tops, in raster and random order."""
+    tri_real, _ = part_triangles(to_shape(bumpy()), 0.01)
+    rng = np.random.default_rng(7)
+    tri_tied = rng.uniform(0, 20, (400, 3, 3))
+    tri_tied[:, :, 2] = np.round(tri_tied[:, :, 2] / 5)  # flat triangles at four heights: ties everywhere
+    for tri, r in ((tri_real, 1.5), (tri_tied, 2.0)):
+        cutter = CUTTERS[kind](r, r / 3) if kind == "bull" else CUTTERS[kind](r)
+        grid = TriangleGrid(tri, r)
+        (x0, y0), (x1, y1) = tri[:, :, :2].min(axis=(0, 1)), tri[:, :, :2].max(axis=(0, 1))
+        gx, gy = np.meshgrid(np.linspace(x0 - r, x1 + r, 23), np.linspace(y0 - r, y1 + r, 19), indexing="ij")
+        raster = np.c_[gx.ravel(), gy.ravel()]
+        for xy in (raster, rng.permutation(raster)):
+            z, won = drop(grid, cutter, xy, triangles=True)
+            z_all, won_all = exhaustive_drop(grid, cutter, xy)
+            assert np.array_equal(z, z_all, equal_nan=True), np.nanmax(np.abs(z - z_all))
+            assert np.array_equal(won, won_all)
+
+
 @pytest.mark.parametrize("kind", ["ball", "flat"])
 def test_no_gouge_on_spline_surface(kind):
     tp = sm.toolpath(bumpy(), sm.Tool(kind, 2.0), stepover=2.5, step=1.0)
