@@ -388,15 +388,18 @@ def test_corpus_job_in_stock(tmp_path, corpus_dir, name):
 SMALL_TOOL_JOB = {"name": "f360grbl_gear.step", "R1": 1.0, "R2": 0.8, "SCALLOP": 0.02, "CELL": 0.1}
 
 
-def prove_with(settings: dict, corpus_dir: Path, tmp_path: Path, monkeypatch) -> dict:
+def prove_with(settings: dict, corpus_dir: Path, tmp_path: Path, monkeypatch, least: dict | None = None) -> dict:
     """:func:`prove` on the corpus part ``settings["name"]`` with the module's tools, scallop
-    and cells set to the rest of ``settings``."""
+    and cells set to the rest of ``settings``; with ``least``, each named count of the
+    proof (nodes judged shallow or steep, wall points) at least that."""
     settings = dict(settings)
     name = settings.pop("name")
     for key, value in settings.items():  # prove() reads the tools and the cells from here
         monkeypatch.setitem(globals(), key, value)
     got = prove(corpus_dir / name, tmp_path)
-    print(name, {k: v for k, v in got.items() if k not in ("job", "finish")})
+    shown = {k: v for k, v in got.items() if k not in ("job", "finish")}
+    print(name, shown)
+    assert all(got[key] > count for key, count in (least or {}).items()), shown
     return got
 
 
@@ -422,12 +425,11 @@ MOULD_JOB = {"name": "occt_cornetta.stp", "R1": 12.0, "R2": 9.0, "SCALLOP": 0.09
 @needs_rs274
 @pytest.mark.corpus
 def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
-    got = prove_with(MOULD_JOB, corpus_dir, tmp_path, monkeypatch)
     # the plate and the block's top are judged shallow ground (26,247 nodes; the rest is
     # within two ball radii of a wall), the block's rounded walls steep ground (5,323) and
     # the walls through the dexels (39,457 points)
-    assert got["nodes"] > 20_000 and got["steep_nodes"] > 4_000 and got["wall_nodes"] > 30_000, \
-        {k: v for k, v in got.items() if k != "job"}
+    prove_with(MOULD_JOB, corpus_dir, tmp_path, monkeypatch,
+               least={"nodes": 20_000, "steep_nodes": 4_000, "wall_nodes": 30_000})
 
 
 #: issue 36's pocketed plate larger than 500 mm: NIST CTC-02, 680 x 860 x 400 mm, pockets
@@ -448,9 +450,8 @@ PLATE_JOB = {"name": "nist_ctc_02_asme1_rc.stp", "R1": 30.0, "R2": 25.0, "SCALLO
 @needs_rs274
 @pytest.mark.heavy
 def test_corpus_job_on_a_pocketed_plate(tmp_path, corpus_dir, monkeypatch):
-    got = prove_with(PLATE_JOB, corpus_dir, tmp_path, monkeypatch)
     # the floors and the top are judged shallow ground (22,182 nodes: residual 0.307), the
     # rounded edges steep ground (737: 0.346), the pockets' walls through the dexels
     # (36,363 of 97,397 points: 0.516 after finishing, 29,084 after roughing)
-    assert got["nodes"] > 20_000 and got["steep_nodes"] > 500 and got["wall_nodes"] > 30_000, \
-        {k: v for k, v in got.items() if k != "job"}
+    prove_with(PLATE_JOB, corpus_dir, tmp_path, monkeypatch,
+               least={"nodes": 20_000, "steep_nodes": 500, "wall_nodes": 30_000})
