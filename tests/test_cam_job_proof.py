@@ -413,6 +413,26 @@ def test_corpus_job_with_a_small_tool(tmp_path, corpus_dir, monkeypatch):
     assert got["nodes"] > 50_000 and fin["stepover"] < 0.4, {k: v for k, v in got.items() if k != "job"}
 
 
+#: walls under overhangs: a 30 x 30 mm T-slot profile 40 mm long lying on its side (from
+#: three-cad-viewer's examples, never tuned to), slots whose lips overhang their undercuts
+#: on the top and both sides; a flat r = 1.5 roughs and a ball r = 1 finishes (5 and 3 % of
+#: its width) on 40 mm flutes, the scallop 2 % of the ball's radius, the judge's stock
+#: cells 0.1 mm (a quarter of the 0.4 mm stepover) and its wall dexels 0.2 mm apart.  The
+#: slots' hidden walls are material the dexels keep and no tool from above can reach.
+OVERHANG_JOB = {"name": "tcv_profile4040.step", "R1": 1.5, "R2": 1.0, "SCALLOP": 0.02, "CELL": 0.1,
+                "SIDE_CELL": 0.2, "FLUTE": 40.0}
+
+
+@needs_rs274
+@pytest.mark.corpus
+def test_corpus_job_under_overhangs(tmp_path, corpus_dir, monkeypatch):
+    # the profile's top and slot floors are judged shallow ground (60,333 nodes: residual
+    # 0.0192), the rounded edges steep ground (5,502) and the walls through the
+    # dexels (54,324 of 142,540 points reached: 0.0087); the undercuts stay unreached
+    prove_with(OVERHANG_JOB, corpus_dir, tmp_path, monkeypatch,
+               least={"nodes": 40_000, "steep_nodes": 3_000, "wall_nodes": 40_000})
+
+
 #: issue 36's freeform mould: OCCT's test part for its bug 27693, 280 x 160 x 62 mm, a
 #: raised block of 74 B-spline faces with rounded walls on a plate, a recessed slot with
 #: two holes; a flat r = 12 roughs and a ball r = 9 finishes (4.3 and 3.2 % of its length,
