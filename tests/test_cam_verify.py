@@ -20,12 +20,14 @@ import numpy as np
 import pytest
 from scipy import ndimage
 from scipy.spatial import cKDTree
-from stock_sim import Cutter, Stock, parse_gcode, part_height, reachable, simulate
+from stock_sim import Cutter, Stock, parse_gcode, part_height, reachable, side_grids, simulate, vertex_normals, \
+    wall_left, wall_points
 from twins.program_lines import read_program_lines
 
 import surfmod as sm
 from surfmod.cam import verify as V
 from surfmod.cam import wall_dexels as W
+from surfmod.cam.cutters import Bull
 from surfmod.cam.drop_cutter import part_triangles
 from surfmod.cam.job import _relink
 from surfmod.cam.roughing import PLUNGE, RAPID, Motion
@@ -440,6 +442,88 @@ def test_a_wall_cusp_left_by_every_other_waterline_level_is_measured(cone_job):
     near = np.abs(z - z[peak]) <= cell / 2
     assert cusp - (cusp - left[near].min()) - wall.limit / 2 <= wall.worst <= cusp + wall.limit / 2, (wall, cusp)
     assert abs(math.hypot(wall.where[0], wall.where[1]) - (5.0 - (wall.where[2] - 2.5) * math.tan(math.radians(DRAFT)))) < 0.25
+
+
+
+LEAN = 14.0  # a boss whose wall stands 76 degrees
+
+
+def test_a_bull_nose_at_a_stepover_is_held_to_its_contours_cusp():
+    """A bull nose (corner 1) finishing at a stepover of 2.5 has no scallop on flat ground
+    (its core spans the stepover), but its contours 2.5 apart along a 76 degree wall leave
+    cusps its corner cannot close: 0.394 (``Cutter.wall_cusp``), and 0.41 measured by the
+    tests' own dexels (the contours keep the mesh's deflection and a chord off it).  The
+    walls' verdict is held to the cusp of such contours on a 70 degree wall (0.525), no
+    longer to the raster's zero cusp on flat ground (it was 0.34 against 0.042: broken)."""
+    part = (bd.Box(30, 30, 3, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MAX))
+            + bd.Cone(7.5, 7.5 - 10 * math.tan(math.radians(LEAN)), 10.0,
+                      align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)))
+    job = sm.machine(part, 2.0, [sm.Rough(sm.Tool("flat", 3.0), allowance=0.5),
+                                 sm.Finish(sm.Tool("bull", 3.0, 1.0), stepover=2.5)])
+    v, report = job.verification, job.operations[1].report
+    assert v.ok, str(v)
+    assert report["scallop"] == 0.0 and report["waterline"]["spacing"] == 2.5
+    # the contours' levels, 2.42 apart in z: 2.5 along the wall
+    along = report["waterline"]["z_spacing"][1] / math.sin(math.radians(90 - LEAN))
+    cusp = Bull(3.0, 1.0).wall_cusp(along, 90 - LEAN)
+    assert 0.39 < cusp < 0.40 and along == pytest.approx(2.5, abs=0.01)
+    wall = _finding(v, "residual on walls")
+    assert wall.limit == pytest.approx(Bull(3.0, 1.0).wall_cusp(2.5, W.DEXEL_SLOPE) + float(report["tolerance"]),
+                                       abs=0.02)
+    # the verifier's dexels a cell (0.6 mm) apart in z see the cusps' crests lower
+    assert 0.75 * cusp < wall.worst <= wall.limit, (wall, cusp)
+    # the tests' own dexels 0.05 apart over one side of the wall, cut by every feed move
+    text = programs(job)[0]
+    moves = [m for m in parse_gcode(text).moves if not m.rapid]
+    tri, _, (_, owner) = part_triangles(part, 0.002, face_index=True)
+    box = np.array([[-1.0, -8.0, 1.5], [1.0, -5.0, 9.5]])
+    sides = side_grids(box, 0.05)
+    for number, cutter in ((1, Cutter("flat", 3.0)), (2, Cutter("bull", 3.0, 1.0))):
+        a, b = (np.array([getattr(m, e) for m in moves if m.tool == number]) for e in "ab")
+        near = (np.all(np.minimum(a, b)[:, :2] <= box[1, :2] + cutter.radius, axis=1)
+                & np.all(np.maximum(a, b)[:, :2] >= box[0, :2] - cutter.radius, axis=1))
+        a, b = a[near], b[near]
+        for dex in sides:
+            dex.cut(cutter, a, b)
+    left = np.concatenate([wall_left(dex, wall_points(tri, dex, steep=60.0, normals=vertex_normals(tri, owner)))
+                           for dex in sides])
+    margin = report["waterline"]["margin"]
+    assert cusp < np.nanmax(left) <= cusp + margin + 0.01 < wall.limit, (np.nanmax(left), cusp)
+
+
+@pytest.mark.parametrize("cutter", [Bull(3.0, 1.0), Bull(2.0, 0.5), sm.Tool("ball", 1.0).cutter,
+                                    sm.Tool("flat", 3.0).cutter])
+def test_a_wall_cusp_is_the_tools_section_measured_point_by_point(cutter):
+    """``Cutter.wall_cusp`` against the tool's section drawn as a polygon (its corner's arc
+    in 400 chords, the flanks up to 20 mm) and measured off the wall at 4,001 points
+    between the two positions and as many round the highest: the lower of the two near
+    sides, at its highest."""
+    c, core = cutter.corner, cutter.core
+    arc = np.linspace(-np.pi / 2, 0, 400)
+    right = np.column_stack([core + c * np.cos(arc), c + c * np.sin(arc)])
+    section = np.concatenate([right, [[cutter.radius, 20.0], [-cutter.radius, 20.0]], right[::-1] * [-1, 1]])
+    assert cutter.wall_cusp(2.5, 90.0) == 0.0  # on a vertical wall the flank sweeps all between
+    for slope in (45.0, 70.0, 76.0, 85.0, 89.5):
+        for spacing in (0.5, 1.5, 2.5):
+            beta = math.radians(90.0 - slope)
+            d = section @ [-math.cos(beta), math.sin(beta)]
+            t = section @ [math.sin(beta), math.cos(beta)]
+            k = int(np.argmin(d))
+            d, t = d - d[k], t - t[k]
+            e0, e1 = np.c_[t, d], np.roll(np.c_[t, d], -1, axis=0)
+
+            def near(x):
+                lo, hi = np.minimum(e0[:, 0], e1[:, 0]), np.maximum(e0[:, 0], e1[:, 0])
+                on = (x[:, None] >= lo) & (x[:, None] <= hi) & (hi > lo)
+                w = (x[:, None] - e0[:, 0]) / np.where(hi > lo, e1[:, 0] - e0[:, 0], 1.0)
+                return np.where(on, e0[:, 1] + w * (e1[:, 1] - e0[:, 1]), np.inf).min(axis=1)
+
+            x = np.linspace(0.0, spacing, 4001)
+            top = x[np.argmax(np.minimum(near(x), near(x - spacing)))]
+            x = np.linspace(top - spacing / 4000, top + spacing / 4000, 4001)  # again round the crest
+            want = float(np.max(np.minimum(near(x), near(x - spacing))))
+            # the chords lie inside the arc by at most 8e-6 mm
+            assert cutter.wall_cusp(spacing, slope) == pytest.approx(want, abs=2e-5), (slope, spacing)
 
 
 # -- toolpaths -----------------------------------------------------------------------------------

@@ -119,6 +119,7 @@ PROMISES = {
     "cam_machining.py": [
         (r"^cam_job\.ngc: \d+ lines, (\d+) tool changes", lambda n: int(n) == 2),
         (r"^GRBL programs \['cam_job_pocket_T1\.nc', 'cam_job_pocket_T2\.nc'\], (\d+) arc words", lambda n: int(n) > 0),
+        (r"^pocket job verified: (\w+)", lambda ok: ok == "True"),
     ],
     "cam_rest_machining.py": [
         (rf"^area left thicker than {NUM} mm: {NUM} mm\^2 after finishing, {NUM} mm\^2 after the rest tool",

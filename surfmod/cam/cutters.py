@@ -65,6 +65,43 @@ class Cutter:
             return 0.0
         return float(c - np.sqrt(max(c * c - half * half, 0.0)))
 
+    def wall_cusp(self, spacing: float, slope: float) -> float:
+        """Cusp height, normal to a plane wall of ``slope`` degrees, between two positions
+        of the tool (axis up) touching it ``spacing`` apart along it: waterline contours on
+        a wall.  The tool's section through its axis is the half-strip of the core
+        (``|r| ≤ R − c``, ``z ≥ c``: flat bottom, flanks going up) grown by the corner's
+        disc; in the wall's frame (``t`` along it, ``d`` off it) its near side is the least
+        of the discs round the strip's two corners and the strip's two edges moved ``c``
+        towards the wall, each where it holds; the cusp stands where the near sides of the
+        two positions cross (found by halving: the near side is convex).  A ball's is the
+        circle's cusp below the equator and 0 on a vertical wall, where the flank sweeps
+        everything between the contours.
+
+        >>> round(Bull(3.0, 1.0).wall_cusp(2.5, 70.0), 4), Bull(3.0, 1.0).wall_cusp(2.5, 90.0)
+        (0.5254, 0.0)
+        """
+        c, core = self.corner, self.core
+        beta = math.radians(90.0 - min(max(float(slope), 0.0), 90.0))  # the wall's normal below horizontal
+        sb, cb = math.sin(beta), math.cos(beta)
+
+        def near(t):
+            """The tool's distance from the wall at ``t`` along it from the contact (inf off it)."""
+            best = math.inf
+            for t0, d0 in ((0.0, 0.0), (-2.0 * core * sb, 2.0 * core * cb)):  # the strip's corners
+                if abs(t - t0) <= c:
+                    best = min(best, d0 + c - math.sqrt(c * c - (t - t0) ** 2))
+            if cb > 0.0 and t >= c * sb:  # the flank, going up
+                best = min(best, c * (1.0 - cb) + (t - c * sb) * sb / cb)
+            if sb > 0.0 and -c * cb - 2.0 * core * sb <= t <= -c * cb:  # the flat bottom, going down
+                best = min(best, c * (1.0 - sb) + (-t - c * cb) * cb / sb)
+            return best
+
+        lo, hi = 0.0, float(spacing)  # the lower position's near side rises from 0, the upper's falls to 0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if near(mid) < near(mid - spacing) else (lo, mid)
+        return float(min(near(lo), near(lo - spacing)))
+
     def grown(self, g: float) -> Cutter:
         """The cutter grown by ``g`` in every direction (tip ``g`` lower), keeping this one ``g`` off."""
         return Bull(self.radius + g, self.corner + g)

@@ -48,7 +48,10 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   the stock's surface; where the part at its foot is steeper than ``DEXEL_SLOPE`` its
   distance to the part is the material left there, measured along the part's normal (a
   plane through the nearest points of the exact part; the deepest once more by OCCT's exact
-  distance), judged against the same limit where the finishing tool reaches: tangent to
+  distance), judged against the same limit (or the cusp the finishing's contours leave on
+  a wall of ``DEXEL_SLOPE`` where more: a stepover asked of a bull nose,
+  :meth:`~surfmod.cam.cutters.Cutter.wall_cusp`)
+  where the finishing tool reaches: tangent to
   the part at the foot it takes in no point of the part beyond the limit, stands no lower
   than the table, the normal does not face down (an overhang) and no disc of its shank or
   holder wider than its end (grown by the job's body cell, :func:`body_cell`) stands below
@@ -901,6 +904,14 @@ def cusp_clearance(operations) -> float:
                 if o.name != "roughing"), default=0.0)
 
 
+def _contours_cusp(op, cutter) -> float:
+    """The cusp ``op``'s waterline contours leave on the least steep wall the dexels judge
+    (``wall_dexels.DEXEL_SLOPE``): its levels stand at most the report's ``spacing`` apart
+    along every wall (:meth:`~surfmod.cam.cutters.Cutter.wall_cusp`); 0 without contours."""
+    spacing = (op.report.get("waterline") or {}).get("spacing")
+    return cutter.wall_cusp(float(spacing), W.DEXEL_SLOPE) if spacing else 0.0
+
+
 def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, corners: np.ndarray, stock: np.ndarray,
                    under: np.ndarray, cell: float, op, cutter, limit: float, max_work: int, notes: list, shape,
                    grow: float = 0.0, clear: float = 0.0):
@@ -965,7 +976,9 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
         every = math.ceil(len(q) / MAX_WALL_POINTS)
         notes.append(f"note: walls: every {every}th of {len(q):,} stock points judged ({MAX_WALL_POINTS:,} at most)")
         q = q[::every]
-    scallop = float(op.report.get("scallop") or 0.0)
+    # the cusps the contours leave on the least steep wall judged: ``spacing`` apart along
+    # it, more than the scallop where a stepover was asked (a bull's corner 1 mm, 2.5 apart)
+    scallop = max(float(op.report.get("scallop") or 0.0), _contours_cusp(op, cutter))
     # the stamps' sag between stamps half a cell apart, as in the height field
     bound = scallop + limit + (cell / 4) ** 2 / (2 * max(cutter.corner, cell))
     if not len(q):
