@@ -211,7 +211,10 @@ class Verification:
 @dataclass(frozen=True)
 class PartPoints:
     """Points of the exact part bucketed on an (x, y) grid of ``cell``: ``points`` sorted
-    by cell, highest first in each; ``starts`` the cells' offsets (``nx * ny + 1``)."""
+    by cell, highest first in each, then by x and y, so that their order is a function of
+    the points alone (whatever order they come in, the walls' nearest points
+    (:func:`~surfmod.cam.wall_dexels.feet`) break their ties alike); ``starts`` the
+    cells' offsets (``nx * ny + 1``)."""
 
     points: np.ndarray
     starts: np.ndarray
@@ -225,7 +228,7 @@ class PartPoints:
         nx, ny = (np.floor((points[:, :2].max(axis=0) - lo) / cell).astype(np.int64) + 2)
         ij = np.floor((points[:, :2] - lo) / cell).astype(np.int64)
         cid = ij[:, 0] * ny + ij[:, 1]
-        order = np.lexsort((-points[:, 2], cid))
+        order = np.lexsort((points[:, 1], points[:, 0], -points[:, 2], cid))
         starts = np.searchsorted(cid[order], np.arange(nx * ny + 1))
         return cls(np.ascontiguousarray(points[order]), starts.astype(np.int64), (float(lo[0]), float(lo[1])),
                    float(cell), (int(nx), int(ny)))

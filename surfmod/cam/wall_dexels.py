@@ -237,12 +237,24 @@ def feet(tree: cKDTree, part_points: np.ndarray, q: np.ndarray, voxel: float = 0
     nearest of the part's points kept one per ``voxel`` cube: a point on a bore's axis is
     as far from a whole ring of points, all of which the tree visits (0.37 ms a query on
     NIST CTC-02 against 1.4 us beside a wall).  Its nearest then lies at most a voxel's
-    diagonal farther than the exact one: the depth is judged more strictly, never less."""
+    diagonal farther than the exact one: the depth is judged more strictly, never less.
+
+    Among equal distances (points on a grid) the tree and the coarse copy take the
+    points in the order given: the verifier gives them in
+    :class:`~surfmod.cam.verify.PartPoints`' order, a function of the points alone."""
     idx = np.empty((len(q), PLANE_POINTS), np.int64)
     dist = np.empty((len(q), PLANE_POINTS))
     away = np.zeros(len(q), bool)
     if voxel > 0 and np.isfinite(far) and len(q):
-        _, first = np.unique(np.floor(part_points / voxel).astype(np.int64), axis=0, return_index=True)
+        # the first point in each voxel, the voxels numbered in the order of (i, j, k): one
+        # integer each sorts 7x faster than rows (1.41 -> 0.19 s CPU on the 280 mm mould)
+        cube = np.floor(part_points / voxel).astype(np.int64)
+        cube -= cube.min(axis=0)
+        span = cube.max(axis=0) + 1
+        if float(np.prod(span.astype(float))) < 2.0 ** 62:
+            _, first = np.unique((cube[:, 0] * span[1] + cube[:, 1]) * span[2] + cube[:, 2], return_index=True)
+        else:
+            _, first = np.unique(cube, axis=0, return_index=True)
         d, k = cKDTree(part_points[first]).query(q)
         away = d > far
         # the patch round the nearest kept point: the tree's query at a point of it is local
