@@ -86,8 +86,10 @@ class TriangleGrid:
         i1 = np.floor((hi - self.origin) / self.cell).astype(np.int64)
         # each cell's list from its highest triangle down (of equal tops the first): a drop
         # stops at the first triangle whose top is below the height already found
-        self._cells, self._tris = _cell_lists(i0, i1, np.argsort(-self.top, kind="stable"), int(self.shape[1]),
-                                              int(self.shape.prod()))
+        order = np.argsort(-self.top, kind="stable")
+        self._cells, self._tris = _cell_lists(i0, i1, order, int(self.shape[1]), int(self.shape.prod()))
+        self._order = order
+        self._drops: dict = {}  # (cutter code, corner) -> the drops' cell lists (:meth:`_drop_lists`)
 
     @property
     def listed(self) -> np.ndarray:
@@ -138,6 +140,26 @@ class TriangleGrid:
         keep = np.all((p >= self.lo[ti]) & (p <= self.hi[ti]), axis=1)
         return qi[keep], ti[keep]
 
+    def _drop_lists(self, code: int, corner: float):
+        """The cell lists a drop of the cutter ``code`` (corner ``corner``) walks: each
+        cell's triangles that some location of the cell can touch, ordered by the highest
+        tip height any location of the cell can get from them (the triangle's top lowered
+        by the cutter's profile at the distance between the cell and the triangle's box,
+        :func:`_cell_bounds`), highest first; and each triangle's place in the top-down
+        order of :attr:`listed` (a drop's tie-break).  ``(offsets per cell, triangles,
+        bounds, rank)``, built on the first drop and kept."""
+        lists = self._drops.get((code, corner))
+        if lists is None:
+            rank = np.empty(len(self.top), np.int64)
+            rank[self._order] = np.arange(len(self.top))
+            box = np.ascontiguousarray(np.column_stack([self.lo + self.radius, self.hi - self.radius]))
+            slack = 1e-9 * (float(np.abs(self.origin).sum()) + self.cell * float(self.shape.max()) + self.radius)
+            offsets, tris, bounds = _cell_bounds(self._cells, self._tris, box, self.top, self.origin, self.cell,
+                                                 int(self.shape[1]), int(self.shape.prod()), slack, code,
+                                                 self.radius, float(corner))
+            lists = self._drops[(code, corner)] = (offsets, tris, bounds, rank)
+        return lists
+
     def entries(self, xy: np.ndarray) -> int:
         """How many cell-list entries the locations ``xy`` (N, 2) walk: the work of a drop
         (each entry costs a box test, most of them nothing more), known before it is done."""
@@ -165,6 +187,61 @@ def _cell_lists(i0, i1, order, ny, n_cells):
                 cells[start[c]], tris[start[c]] = c, t
                 start[c] += 1
     return cells, tris
+
+
+@njit(cache=True, error_model="numpy")
+def _cell_bounds(cells, tris, box, top, origin, cell, ny, n_cells, slack, code, r, c):
+    """The drop lists of :meth:`TriangleGrid._drop_lists` from the top-down lists
+    (``cells``, ``tris``; ``box``: each triangle's own (x, y) box, x0 y0 x1 y1).  A
+    triangle's bound in a cell is its top lifted (ball) or lowered (bull) by the profile at
+    the least distance ``d`` between the cell's square and its box, the bound
+    :func:`_drop_triangle` takes at a location from the location's own distance, which is
+    never less; stored as float32 rounded up.  A triangle whose box lies farther than
+    ``r`` from the whole cell (the grid lists it for its box grown by ``r``, corners
+    included) touches no location of it and is left out; both tests have a hair of
+    slack (``slack`` on the cell's sides, 1e-9 relative on the distance), so rounding in
+    the cell of a location never drops a touch."""
+    offsets = np.zeros(n_cells + 1, np.int64)
+    keep = np.zeros(len(tris), np.bool_)
+    bound = np.empty(len(tris))
+    r2 = r * r
+    for k in range(len(tris)):
+        ci, t = cells[k], tris[k]
+        x0 = origin[0] + (ci // ny) * cell - slack
+        y0 = origin[1] + (ci % ny) * cell - slack
+        gx = max(max(box[t, 0] - (x0 + cell + 2 * slack), x0 - box[t, 2]), 0.0)
+        gy = max(max(box[t, 1] - (y0 + cell + 2 * slack), y0 - box[t, 3]), 0.0)
+        d2 = gx * gx + gy * gy
+        if d2 > r2 * (1.0 + 1e-9):
+            continue
+        keep[k] = True
+        offsets[ci + 1] += 1
+        if code == BALL:
+            bound[k] = top[t] + np.sqrt(max(r2 - d2, 0.0)) - r
+        elif code == FLAT:
+            bound[k] = top[t]
+        else:
+            bound[k] = top[t] - min(_bull_profile(np.sqrt(d2), r - c, c), c)
+    for ci in range(n_cells):
+        offsets[ci + 1] += offsets[ci]
+    out_tris = np.empty(offsets[n_cells], np.int32)
+    out_bound = np.empty(offsets[n_cells], np.float32)
+    fill = offsets[:-1].copy()
+    for k in range(len(tris)):
+        if keep[k]:
+            ci = cells[k]
+            j = fill[ci]
+            out_tris[j] = tris[k]
+            b = np.float32(bound[k])
+            out_bound[j] = b if b >= bound[k] else np.nextafter(b, np.float32(np.inf))
+            fill[ci] = j + 1
+    for ci in range(n_cells):  # each cell's list from its highest bound down
+        a, b = offsets[ci], offsets[ci + 1]
+        if b - a > 1:
+            order = np.argsort(-out_bound[a:b])
+            out_tris[a:b] = out_tris[a:b][order]
+            out_bound[a:b] = out_bound[a:b][order]
+    return offsets, out_tris, out_bound
 
 
 def triangle_rows(tri: np.ndarray) -> np.ndarray:
@@ -393,42 +470,44 @@ PRUNE_SLACK = 1e-9
 
 
 @njit(cache=True, error_model="numpy")
-def _drop_kernel(code, xy, start, stop, tris, rows, lo, hi, top, r, c, z, touch, touched):
-    """Per location: the highest tip height over its cell list, its contact and triangle.
+def _drop_kernel(code, xy, cell_id, offsets, tris, bounds, rank, rows, lo, hi, top, r, c, z, touch, touched):
+    """Per location: the highest tip height over its cell's drop list, its contact and
+    triangle (of equal heights the one first in the top-down order, ``rank``).
 
-    The list runs from the highest triangle top down, and no triangle lifts the tip above
-    its top (:func:`_drop_triangle`'s tighter bound skips the rest before any contact is
-    solved), so the walk stops at the first top below the height found: on a fine mesh
-    most of a list is never read.  The previous location's triangle is tried first (its
-    height on a raster's next location prunes most of the walk at once); the bounds are
-    widened by :data:`PRUNE_SLACK`, so the result is the maximum over every triangle, and
-    of equal heights the first in the list wins, whichever was tried first."""
+    The list runs from the highest bound down (:meth:`TriangleGrid._drop_lists`: no
+    triangle lifts the tip above its bound anywhere in the cell, and
+    :func:`_drop_triangle`'s tighter bound at the location skips most of the rest before
+    any contact is solved), so the walk stops at the first bound below the height found:
+    on a fine mesh most of a list is never read.  The previous location's triangle is tried
+    first (its height on a raster's next location prunes most of the walk at once); the
+    bounds are widened by :data:`PRUNE_SLACK`, so the result is the maximum over every
+    triangle, whichever was tried first."""
     contact = np.empty(3)
     warm = -1
     for i in range(len(xy)):
         qx, qy = xy[i, 0], xy[i, 1]
         best, winner, bound = -np.inf, -1, -np.inf
+        tried = -1
         if warm >= 0 and lo[warm, 0] <= qx <= hi[warm, 0] and lo[warm, 1] <= qy <= hi[warm, 1]:
+            tried = warm
             h = _drop_triangle(code, qx, qy, rows, warm, lo[warm], hi[warm], top[warm], r, c, -np.inf, contact)
             if h > best:
                 best, winner = h, warm
                 bound = h - PRUNE_SLACK * (abs(h) + abs(qx) + abs(qy) + r)
                 touch[i, 0], touch[i, 1], touch[i, 2] = contact[0], contact[1], contact[2]
-        early = winner >= 0  # the winner is not yet placed in the list: equal heights before it win
-        for k in range(start[i], stop[i]):
-            ti = tris[k]
-            if top[ti] < bound:
-                break
-            if not (lo[ti, 0] <= qx <= hi[ti, 0] and lo[ti, 1] <= qy <= hi[ti, 1]):
-                continue
-            if early and ti == winner:
-                early = False
-                continue
-            h = _drop_triangle(code, qx, qy, rows, ti, lo[ti], hi[ti], top[ti], r, c, bound, contact)
-            if h > best or (early and h == best):
-                best, winner, early = h, ti, False
-                bound = h - PRUNE_SLACK * (abs(h) + abs(qx) + abs(qy) + r)
-                touch[i, 0], touch[i, 1], touch[i, 2] = contact[0], contact[1], contact[2]
+        cell = cell_id[i]
+        if cell >= 0:
+            for k in range(offsets[cell], offsets[cell + 1]):
+                if bounds[k] < bound:
+                    break
+                ti = tris[k]
+                if ti == tried or not (lo[ti, 0] <= qx <= hi[ti, 0] and lo[ti, 1] <= qy <= hi[ti, 1]):
+                    continue
+                h = _drop_triangle(code, qx, qy, rows, ti, lo[ti], hi[ti], top[ti], r, c, bound, contact)
+                if h > best or (h == best and winner >= 0 and rank[ti] < rank[winner]):
+                    best, winner = h, ti
+                    bound = h - PRUNE_SLACK * (abs(h) + abs(qx) + abs(qy) + r)
+                    touch[i, 0], touch[i, 1], touch[i, 2] = contact[0], contact[1], contact[2]
         z[i] = best
         touched[i] = winner
         warm = winner if winner >= 0 else warm
@@ -449,11 +528,11 @@ def drop(grid: TriangleGrid, cutter: Cutter, xy: np.ndarray, *, contacts: bool =
     if cutter.radius != grid.radius:
         raise SurfmodError(f"cutter: radius {cutter.radius:g} differs from the grid's {grid.radius:g}")
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    start, stop = grid.segments(xy)
+    offsets, tris, bounds, rank = grid._drop_lists(cutter.code, cutter.corner)
     z, touch = np.empty(len(xy)), np.full((len(xy), 3), np.nan)
     touched = np.empty(len(xy), dtype=np.int64)
-    _drop_kernel(cutter.code, np.ascontiguousarray(xy), start, stop, grid._tris, grid.rows, grid.lo, grid.hi,
-                 grid.top, grid.radius, cutter.corner, z, touch, touched)
+    _drop_kernel(cutter.code, np.ascontiguousarray(xy), grid._cell_ids(xy), offsets, tris, bounds, rank, grid.rows,
+                 grid.lo, grid.hi, grid.top, grid.radius, float(cutter.corner), z, touch, touched)
     z[~np.isfinite(z)] = np.nan
     return (z,) + ((touch,) if contacts else ()) + ((touched,) if triangles else ()) if contacts or triangles else z
 
