@@ -16,7 +16,8 @@ from stock_sim import RS274, Cutter, Stock, normal_residual, parse_canon, part_h
 
 import surfmod as sm
 from surfmod.cam import waterline as waterline_module
-from surfmod.cam.finishing import clear_part, judge_links, recut, summary_lines
+from surfmod.cam.drop_cutter import TriangleGrid, drop
+from surfmod.cam.finishing import judge_links, recut, summary_lines
 from surfmod.cam.roughing import FEED, PLUNGE, RAPID, Moves
 from surfmod.cam.toolpath import _part
 from surfmod.errors import SurfmodError
@@ -284,6 +285,22 @@ def test_a_big_part_spreads_the_waterline_fibers_to_fit_the_cap(monkeypatch):
         sm.machine(part, 1.0, [sm.Finish(tool, scallop=0.05)], verify=False)
 
 
+def test_a_clear_part_drops_the_tool_grown_by_the_deflection():
+    """``_part(..., clear=True)`` (the finishing's mesh) drops the cutter grown by the
+    mesh's deflection and lifts every height by it, on a grid built once for the grown
+    radius: its heights are those of a grid built for the grown tool from the plain
+    part's triangles, bit for bit."""
+    part = bd.Box(20, 20, 5) + bd.Pos(0, 0, 2.5) * bd.Sphere(6)
+    cutter = sm.Tool("ball", 2.0).cutter
+    plain, clear = _part(part, cutter, 0.01), _part(part, cutter, 0.01, clear=True)
+    d = clear.deflection
+    assert d == plain.deflection and clear.lift == d and clear.cutter == cutter.grown(d)
+    assert clear.grid.radius == cutter.radius + d
+    xy = np.random.default_rng(3).uniform(-12, 12, (500, 2))
+    grown = drop(TriangleGrid(plain.grid.triangles, cutter.radius + d), cutter.grown(d), xy) + d
+    assert np.array_equal(clear.height(xy), grown, equal_nan=True)
+
+
 def test_cross_passes_stand_closer_the_further_the_residual_was_over():
     """A repair over a region left ``over`` times its bound runs its cross passes closer by
     the square root (a cusp on concave ground grows as the square of the spacing), at most
@@ -291,7 +308,7 @@ def test_cross_passes_stand_closer_the_further_the_residual_was_over():
     give passes a 0.71, 0.35 and 0.18 stepover apart."""
     part = bd.Box(40, 40, 5) - bd.Cylinder(1.5, 6)
     tool = sm.Tool("ball", 5.2).with_defaults(2)
-    mesh = clear_part(_part(part, tool.cutter, 0.005), tool)
+    mesh = _part(part, tool.cutter, 0.005, clear=True)
     stock = np.array([[-22.0, -22.0, -2.5], [22.0, 22.0, 4.5]])
     xs = []
     for over in (1.0, 4.0, 100.0):

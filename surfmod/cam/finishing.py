@@ -18,7 +18,7 @@ for less what exactness costs: the tool keeps the mesh's deflection ``δ`` from 
 which lies within ``δ`` of the faces (``2 δ``), the contours also their chord tolerance.
 
 **Exact and gouge-free.**  All heights are drop-cutter heights of the tool grown by ``δ``
-(:func:`clear_part`): the tool never touches the faces the mesh stands for, in any
+(``_part(..., clear=True)``, :func:`surfmod.cam.toolpath._part`): the tool never touches the faces the mesh stands for, in any
 direction (a vertical lift would not do: on a wall of slope θ the mesh's ``δ`` is
 ``δ / cos θ`` deep measured vertically).  The waterline
 (:func:`surfmod.cam.waterline.waterline`) is computed for the tool grown by ``g`` = ``δ``
@@ -48,7 +48,7 @@ and box are reported, not cut.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
@@ -91,16 +91,6 @@ class Leftover:
     reach: float
     above: float
     on_floors: float
-
-
-def clear_part(part: _Part, tool: Tool) -> _Part:
-    """``part`` for ``tool`` grown by the mesh's deflection ``δ``
-    (:meth:`~surfmod.cam.cutters.Cutter.grown`): its heights keep the tool ``δ`` from
-    every triangle in every direction, so it never touches the faces the mesh stands for.
-    (A vertical lift by ``δ`` would not do on a wall of slope θ: there the mesh's ``δ`` is
-    ``δ / cos θ`` deep measured vertically.)"""
-    d = part.deflection
-    return replace(part, grid=TriangleGrid(part.grid.triangles, tool.radius + d), cutter=tool.cutter.grown(d), lift=d)
 
 
 class _StockTop:

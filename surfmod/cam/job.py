@@ -22,7 +22,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
 from .cycle_time import cycle_time, feed_time
-from .finishing import Leftover, clear_part, finish, reach_contours, recut
+from .finishing import Leftover, finish, reach_contours, recut
 from .holder import body_stock, clear_body, left_out, reach_levels, relink
 from .machine_table import MACHINE, Machine
 from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_moves, rest_part_top
@@ -287,7 +287,7 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
         meter = _Meter(MAX_WORK, bar if progress else None, "scallop",
                        f"choose a larger scallop than {op.scallop:g} or a larger finishing tool"
                        if op.scallop is not None else "choose a larger stepover or a larger finishing tool")
-        part = clear_part(_part(shape, tool.cutter, tolerance, meter, estimate), tool)
+        part = _part(shape, tool.cutter, tolerance, meter, estimate, clear=True)
         motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
                                 steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest)
         bar.total = max(bar.n, 1)  # the contours' drops came after the raster's estimate: the bar ends full
@@ -440,7 +440,7 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
         warnings.warn(f"rest: {tool} is no smaller than the tools before it (r={smallest:g}): it cuts only what "
                       f"the stock model shows left where it reaches", UserWarning, stacklevel=3)
     tolerance = scallop / 10
-    part = clear_part(_part(shape, tool.cutter, tolerance), tool)
+    part = _part(shape, tool.cutter, tolerance, clear=True)
     cell = max(min([stepover] + [float(o.report["stepover"]) for o in cutting]) / 4, 1e-3)
     model = StockModel(stock, cell)
     for i in after:

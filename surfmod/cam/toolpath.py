@@ -212,10 +212,16 @@ def _mesh_estimate(shape, tolerance: float) -> float:
     return float(estimate)
 
 
-def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None, estimate: float | None = None) -> _Part:
+def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None, estimate: float | None = None, *,
+          clear: bool = False) -> _Part:
     """The part meshed for ``tolerance``; ``estimate`` is :func:`_mesh_estimate`'s value
     when the caller has already checked this tolerance (the survey costs 0.4 s on a
-    280 mm mould), else the check runs here."""
+    280 mm mould), else the check runs here.  With ``clear`` the cutter is grown by the
+    mesh's deflection ``δ`` (:meth:`~surfmod.cam.cutters.Cutter.grown`) and every height
+    lifted by ``δ``: the heights keep the tool ``δ`` from every triangle in every
+    direction, so it never touches the faces the mesh stands for (a vertical lift by
+    ``δ`` would not do on a wall of slope θ: there the mesh's ``δ`` is ``δ / cos θ`` deep
+    measured vertically); the grid is built once, for the grown radius."""
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
     if estimate is None:
@@ -226,8 +232,12 @@ def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None, es
         raise NoSafePathError(f"toolpath: no safe path: {exc}") from None
     points = triangles.reshape(-1, 3)
     box = np.array([points.min(axis=0), points.max(axis=0)])
-    return _Part(TriangleGrid(triangles, cutter.radius), cutter, max(measured, requested),
-                 max(measured - requested, 0.0), box, faces, owner, meter or _Meter())
+    deflection = max(measured, requested)
+    lift = max(measured - requested, 0.0)
+    if clear:
+        cutter, lift = cutter.grown(deflection), deflection
+    return _Part(TriangleGrid(triangles, cutter.radius), cutter, deflection, lift, box, faces, owner,
+                 meter or _Meter())
 
 
 def _check_tool(tool) -> Tool:
