@@ -119,6 +119,46 @@ def test_synthetic_program_arcs_are_the_circles():
     assert len(plain.splitlines()) - len(text.splitlines()) == 180 + 192 - 5
 
 
+def _pass(c, r, a0, a1, n, z, safe):
+    """A feed arc entered and left as the finishing does: rapid over its start, down, cut,
+    up at the feed, rapid to the clearance height."""
+    ring = circle(c, r, a0, a1, n, z)
+    x, y = ring[0, :2]
+    pts = [[x, y, safe], [x, y, z + 1.0], ring, [[*ring[-1, :2], z + 1.0]], [[*ring[-1, :2], safe]]]
+    kinds = [[RAPID], [RAPID], np.full(len(ring), FEED), [FEED], [RAPID]]
+    return np.vstack(pts), np.concatenate(kinds).astype(np.int8)
+
+
+def test_an_extended_operation_keeps_its_written_head(monkeypatch):
+    """A finishing with a repair's passes appended writes its first motion's lines from
+    the written ones and only the passes afresh: the program equals the one written from
+    scratch, on passes whose arcs end at the join, and falls back to writing it all where
+    the join is an arc's middle (a circle cut in two)."""
+    import surfmod.cam.post as post_module
+
+    tool = sm.Tool("ball", 3.0).with_defaults(2)
+    stock = np.array([[-30.0, -30.0, -5.0], [30.0, 30.0, 0.0]])
+    rng = np.random.default_rng(11)
+    head = [_pass(rng.uniform(-9, 9, 2), rng.uniform(3, 12), a, a + rng.uniform(1, 3), 40, -rng.uniform(0, 4), 20.0)
+            for a in rng.uniform(0, 6, 5)]
+    tail = [_pass(rng.uniform(-9, 9, 2), rng.uniform(3, 12), a, a - rng.uniform(1, 3), 40, -rng.uniform(0, 4), 20.0)
+            for a in rng.uniform(0, 6, 4)]
+    ring = circle((0, 0), 8.0, 0.0, 3.0, 60, -1.0)
+    cases = [(np.vstack([p for p, _ in head]), np.concatenate([k for _, k in head]),
+              np.vstack([p for p, _ in tail]), np.concatenate([k for _, k in tail]), True),
+             (ring[:31], np.full(31, FEED, np.int8), ring[31:], np.full(30, FEED, np.int8), False)]
+    for p0, k0, p1, k1, joins in cases:
+        first = Operation("finishing", tool, Motion(p0, k0), 60.0)
+        whole = Operation("finishing", tool, Motion(np.vstack([p0, p1]), np.concatenate([k0, k1])), 60.0)
+        monkeypatch.setattr(post_module, "_WRITTEN", {})
+        programs(Job(None, stock, (first,), 20.0))
+        assert post_module._joins(first, whole) is joins
+        kept = programs(Job(None, stock, (whole,), 20.0))[0]
+        monkeypatch.setattr(post_module, "_WRITTEN", {})
+        assert kept == programs(Job(None, stock, (whole,), 20.0))[0]
+        assert re.search(r"^G[23] ", kept, flags=re.M)
+
+
 @needs_rs274
 @pytest.mark.parametrize("post", ["linuxcnc", "grbl"])
 def test_rs274_traces_the_polyline(tmp_path, post):

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..atomic import atomic_path, target_path
 from ..errors import SurfmodError
-from .arcs import find_arcs
+from .arcs import TOLERANCE as ARC_TOLERANCE, find_arcs
 from .roughing import FEED, RAPID
 
 POSTS = ("linuxcnc", "grbl")
@@ -42,21 +42,48 @@ WRITTEN_KEPT = 8
 def _moves(op, digits: int, arcs: bool = True) -> list[str]:
     """G0/G1 (and G2/G3) lines of an operation's motion, feeds modal (written when they
     change).  Circular runs (:func:`surfmod.cam.arcs.find_arcs`, found on the heights as
-    written) become one arc word each, its centre ``I J`` from the written start."""
+    written) become one arc word each, its centre ``I J`` from the written start.
+
+    An operation whose motion extends one written before (a finishing with a repair's
+    cross passes appended) keeps that one's lines and writes only the rest, when the
+    written motion ends with a move and the rest's second move is one that are no
+    longer across than the arcs' ``tolerance`` (a retract, a descent): no arc holds such
+    a move, and every arc has four or more, so no arc of the whole crosses the join and
+    the greedy search finds the same arcs on each side (:func:`_joins`)."""
     key = (id(op), digits, arcs)
     entry = _WRITTEN.get(key)
     if entry is not None and entry[0] is op:  # the entry holds its operation: no other can take its id
         return list(entry[1])
+    head = next((e for k, e in _WRITTEN.items() if k[1:] == key[1:] and _joins(e[0], op)), None)
     if len(_WRITTEN) >= WRITTEN_KEPT:
         _WRITTEN.clear()
-    lines = _move_lines(op, digits, arcs)
-    _WRITTEN[key] = (op, lines)
+    pts, kind = np.array(op.motion.points, float), op.motion.kind
+    if head is None:
+        lines, state = _move_lines(pts, kind, op.tool, digits, arcs, ((None, None, None), None))
+    else:
+        m = len(head[0].motion.points)
+        lines, state = _move_lines(pts[m:], kind[m:], op.tool, digits, arcs, head[2])
+        lines = head[1] + lines
+    _WRITTEN[key] = (op, lines, state)
     return list(lines)
 
 
-def _move_lines(op, digits: int, arcs: bool) -> list[str]:
-    pts = np.array(op.motion.points, float)
-    kind = op.motion.kind
+def _joins(head, op) -> bool:
+    """Does ``op``'s motion extend ``head``'s (same tool) at a join no arc can cross: the
+    last move of ``head`` and the second move after it no longer across than the arcs'
+    tolerance?"""
+    a, b = head.motion, op.motion
+    m = len(a.points)
+    if head.tool != op.tool or len(b.points) < m + 2 or m < 2:
+        return False
+    across = np.hypot(*(b.points[[m - 1, m + 1], :2] - b.points[[m - 2, m], :2]).T)
+    return bool(np.all(across <= ARC_TOLERANCE) and np.array_equal(b.points[:m], a.points)
+                and np.array_equal(b.kind[:m], a.kind))
+
+
+def _move_lines(pts: np.ndarray, kind: np.ndarray, tool, digits: int, arcs: bool, state: tuple):
+    """The lines of the moves to ``pts`` and the writer's state after them (the last
+    position written and the feed in force), from ``state``."""
     # arcs are found on the path itself: an arc between ends rounded up lies above it
     found = find_arcs(pts, kind) if arcs else []
     pts[:, 2] = _up(pts[:, 2], digits)
@@ -64,11 +91,12 @@ def _move_lines(op, digits: int, arcs: bool) -> list[str]:
     # rounded first and + 0.0: no "-0.0000" words
     cols = [np.char.mod(fmt, np.round(pts[:, k], digits) + 0.0) for k in range(3)]
     arc_at = {a.start: a for a in found if kind[a.start + 1] != RAPID}
-    lines, last, feed_now = [], (None, None, None), None
+    lines = []
+    last, feed_now = state
 
     def feed_word(k):
         nonlocal feed_now
-        f = op.tool.feed if kind[k] == FEED else op.tool.plunge_feed
+        f = tool.feed if kind[k] == FEED else tool.plunge_feed
         if f == feed_now:
             return ""
         feed_now = f
@@ -91,7 +119,7 @@ def _move_lines(op, digits: int, arcs: bool) -> list[str]:
         ij = [fmt % (round(arc.centre[k] - float(last[k]), digits) + 0.0) for k in range(2)]
         lines.append(f"{'G3' if arc.ccw else 'G2'} {words} I{ij[0]} J{ij[1]}{feed_word(j)}")
         last, i = end, j  # a next arc may start where this one ends
-    return lines
+    return lines, (last, feed_now)
 
 
 def _operation(op, job, post: str, digits: int, coolant: bool, arcs: bool) -> list[str]:
