@@ -19,7 +19,7 @@ from ocl_reference import waterline as ocl_waterline
 from surfmod.cam.cutters import cutter
 from surfmod.cam.drop_cutter import TriangleGrid, drop, triangle_rows
 from surfmod.cam.fiber_contact import pair_intervals
-from surfmod.cam.waterline import _Fibers, _waterline, fiber_pairs, pit_lines, waterline
+from surfmod.cam.waterline import ContourPoints, _Fibers, _waterline, fiber_pairs, pit_lines, waterline
 from surfmod.errors import SurfmodError
 
 CORPUS_PART = "trimesh_featuretype.STEP"
@@ -428,3 +428,18 @@ def test_drop_cutter_equals_opencamlib(tmp_path, corpus_triangles, kind, R, r):
     miss = np.isnan(ours)
     assert miss.mean() < 0.2 and np.all(theirs[miss] == floor)
     assert np.abs(theirs[~miss] - ours[~miss]).max() < 1e-8 * float((hi - lo).max())
+
+
+def test_contour_points_on_the_waterline_fibers_split_as_their_own():
+    """Finishing splits its gouging chords on the fibers its waterline built (one grid of
+    the part, not two): the points are those of contour points built afresh, bit for bit,
+    chords across the loops of a pyramid with a shelf, ball and bull."""
+    tri = pyramid_and_shelf()
+    for cut in (tool("ball", 1.5), tool("bull", 1.5, 0.5)):
+        (loops,), fibers = _waterline(tri, cut, [2.0], 0.4, None)
+        shared, own = ContourPoints(tri, cut, 0.6, fibers), ContourPoints(tri, cut, 0.6)
+        assert shared.fib is fibers and own.fib is not fibers
+        for loop in loops:
+            pts = loop[::5, :2]
+            which = np.arange(len(pts) - 1)
+            assert np.array_equal(shared.split(2.0, pts, which), own.split(2.0, pts, which))

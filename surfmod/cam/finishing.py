@@ -61,7 +61,7 @@ from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
 from .tool import Tool
 from .toolpath import REFINE_SHARE, _Part, raster_path
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
-from .waterline import ContourPoints, fiber_pairs, sampling_within, waterline
+from .waterline import ContourPoints, _waterline, fiber_pairs, sampling_within
 
 #: Steep regions: slopes within this many degrees below the threshold count too (the
 #: classification samples the drop-cutter surface, the raster's slope bound its triangles).
@@ -330,7 +330,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
         info["sampling"] = sampling
     bar = part.meter.bar  # the finishing's bar names the waterline's level while it runs
     desc = bar.desc if bar is not None else ""
-    loops = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord, bar=bar)
+    loops, fibers = _waterline(tri, grown, levels - g, sampling, chord, bar)
     if bar is not None:
         bar.set_description_str(desc)
     contour = None  # built at the first gouging chord (most parts have none)
@@ -359,7 +359,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
                 depth = move_gouge(part.height, piece)
                 if depth.max() > allowed:  # a chord crosses a notch its middle missed: follow the contour
                     if contour is None:
-                        contour = ContourPoints(tri, grown, 1.5 * sampling)
+                        contour = ContourPoints(tri, grown, 1.5 * sampling, fibers)  # the waterline's own
                     piece, depth = _follow(part, contour, z - g, piece, depth, allowed, chord)
                     split += 1
                 piece, lift, deepest = _judge(part, piece, allowed, depth)

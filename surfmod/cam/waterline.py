@@ -521,14 +521,16 @@ class ContourPoints:
     [[-1.0, 5.0], [-0.707107, -0.707107], [5.0, -1.0]]
     """
 
-    def __init__(self, part, tool, reach: float):
+    def __init__(self, part, tool, reach: float, fibers: "_Fibers | None" = None):
+        """``fibers``: those :func:`_waterline` returned for the same triangles and tool at
+        a sampling of ``reach / 1.5`` (its fibers reach that far), reused, not built again."""
         cutter = getattr(tool, "cutter", tool)
         tri = np.asarray(part, dtype=float)
         if tri.ndim != 3 or tri.shape[1:] != (3, 3) or not len(tri):
             raise SurfmodError(f"part: expected triangles (M, 3, 3), got shape {tri.shape}")
         if not reach > 0:
             raise SurfmodError(f"reach: must be > 0, got {reach}")
-        self.fib, self.reach = _Fibers(tri, cutter, float(reach)), float(reach)
+        self.fib, self.reach = fibers or _Fibers(tri, cutter, float(reach)), float(reach)
 
     def split(self, z: float, pts: np.ndarray, which: np.ndarray) -> np.ndarray:
         """The polyline ``pts`` (N, 2) with each chord ``i`` in ``which`` (from ``pts[i]`` to
