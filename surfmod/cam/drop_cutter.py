@@ -88,6 +88,7 @@ class TriangleGrid:
         # stops at the first triangle whose top is below the height already found
         order = np.argsort(-self.top, kind="stable")
         self._cells, self._tris = _cell_lists(i0, i1, order, int(self.shape[1]), int(self.shape.prod()))
+        self._offsets = np.searchsorted(self._cells, np.arange(int(self.shape.prod()) + 1))  # each cell's first
         self._order = order
         self._drops: dict = {}  # (cutter code, corner) -> the drops' cell lists (:meth:`_drop_lists`)
 
@@ -113,8 +114,9 @@ class TriangleGrid:
         [[2], [1], [0]]
         """
         cell_id = self._cell_ids(xy)
-        start = np.searchsorted(self._cells, cell_id, "left")
-        stop = np.where(cell_id >= 0, np.searchsorted(self._cells, cell_id, "right"), start)
+        inside = np.maximum(cell_id, 0)
+        start = self._offsets[inside]
+        stop = np.where(cell_id >= 0, self._offsets[inside + 1], start)
         if above is None:
             return start, stop
         # each list runs from its highest top down: one search on (cell, fall from the top)
@@ -147,11 +149,15 @@ class TriangleGrid:
         by the cutter's profile at the distance between the cell and the triangle's box,
         :func:`_cell_bounds`), highest first; and each triangle's place in the top-down
         order of :attr:`listed` (a drop's tie-break).  ``(offsets per cell, triangles,
-        bounds, rank)``, built on the first drop and kept."""
+        bounds, rank)``, built on the first drop and kept.  A flat end's bound is the top
+        itself: it walks the top-down lists as they are."""
         lists = self._drops.get((code, corner))
         if lists is None:
             rank = np.empty(len(self.top), np.int64)
             rank[self._order] = np.arange(len(self.top))
+            if code == FLAT:
+                lists = self._drops[(code, corner)] = (self._offsets, self._tris, self.top[self._tris], rank)
+                return lists
             box = np.ascontiguousarray(np.column_stack([self.lo + self.radius, self.hi - self.radius]))
             slack = 1e-9 * (float(np.abs(self.origin).sum()) + self.cell * float(self.shape.max()) + self.radius)
             offsets, tris, bounds = _cell_bounds(self._cells, self._tris, box, self.top, self.origin, self.cell,
@@ -218,8 +224,6 @@ def _cell_bounds(cells, tris, box, top, origin, cell, ny, n_cells, slack, code, 
         offsets[ci + 1] += 1
         if code == BALL:
             bound[k] = top[t] + np.sqrt(max(r2 - d2, 0.0)) - r
-        elif code == FLAT:
-            bound[k] = top[t]
         else:
             bound[k] = top[t] - min(_bull_profile(np.sqrt(d2), r - c, c), c)
     for ci in range(n_cells):
