@@ -35,7 +35,11 @@ large tool a location's list holds thousands of triangles of which a few dozen c
 a bound per triangle (its highest vertex, lifted by the ball over its box) against the
 best height found so far skips the rest before any contact is solved, which is why the
 loop is compiled rather than vectorized over pairs (the pairs' arrays alone cost a
-millisecond per location there).
+millisecond per location there).  A drop walks its cell's list from the highest bound
+any location of the cell can get from a triangle down (the top lowered by the cutter's
+profile at the cell's distance from the triangle's box), so it stops at the first
+bound below the height found: under a large ball most triangles whose tops stand above
+the contact lie too far to lift it there, and are never read.
 """
 
 from __future__ import annotations
