@@ -94,7 +94,7 @@ class TriangleGrid:
         self._cells, self._tris = _cell_lists(i0, i1, order, int(self.shape[1]), int(self.shape.prod()))
         self._offsets = np.searchsorted(self._cells, np.arange(int(self.shape.prod()) + 1))  # each cell's first
         self._order = order
-        self._drops: dict = {}  # (cutter code, corner) -> the drops' cell lists (:meth:`_drop_lists`)
+        self._drops: dict = {}  # corner radius -> the drops' cell lists (:meth:`_drop_lists`)
 
     @property
     def listed(self) -> np.ndarray:
@@ -146,28 +146,29 @@ class TriangleGrid:
         keep = np.all((p >= self.lo[ti]) & (p <= self.hi[ti]), axis=1)
         return qi[keep], ti[keep]
 
-    def _drop_lists(self, code: int, corner: float):
-        """The cell lists a drop of the cutter ``code`` (corner ``corner``) walks: each
+    def _drop_lists(self, corner: float):
+        """The cell lists a drop of a cutter of corner radius ``corner`` walks: each
         cell's triangles that some location of the cell can touch, ordered by the highest
         tip height any location of the cell can get from them (the triangle's top lowered
         by the cutter's profile at the distance between the cell and the triangle's box,
         :func:`_cell_bounds`), highest first; and each triangle's place in the top-down
         order of :attr:`listed` (a drop's tie-break).  ``(offsets per cell, triangles,
-        bounds, rank)``, built on the first drop and kept.  A flat end's bound is the top
-        itself: it walks the top-down lists as they are."""
-        lists = self._drops.get((code, corner))
+        bounds, rank)``, built on the first drop and kept.  Without a corner (a flat end)
+        the profile is level and the bound the top itself: the top-down lists serve as
+        they are."""
+        lists = self._drops.get(corner)
         if lists is None:
             rank = np.empty(len(self.top), np.int64)
             rank[self._order] = np.arange(len(self.top))
-            if code == FLAT:
-                lists = self._drops[(code, corner)] = (self._offsets, self._tris, self.top[self._tris], rank)
+            if corner == 0.0:
+                lists = self._drops[corner] = (self._offsets, self._tris, self.top[self._tris], rank)
                 return lists
             box = np.ascontiguousarray(np.column_stack([self.lo + self.radius, self.hi - self.radius]))
             slack = 1e-9 * (float(np.abs(self.origin).sum()) + self.cell * float(self.shape.max()) + self.radius)
             offsets, tris, bounds = _cell_bounds(self._cells, self._tris, box, self.top, self.origin, self.cell,
-                                                 int(self.shape[1]), int(self.shape.prod()), slack, code,
-                                                 self.radius, float(corner))
-            lists = self._drops[(code, corner)] = (offsets, tris, bounds, rank)
+                                                 int(self.shape[1]), int(self.shape.prod()), slack, self.radius,
+                                                 corner)
+            lists = self._drops[corner] = (offsets, tris, bounds, rank)
         return lists
 
     def entries(self, xy: np.ndarray) -> int:
@@ -200,11 +201,12 @@ def _cell_lists(i0, i1, order, ny, n_cells):
 
 
 @njit(cache=True, error_model="numpy")
-def _cell_bounds(cells, tris, box, top, origin, cell, ny, n_cells, slack, code, r, c):
+def _cell_bounds(cells, tris, box, top, origin, cell, ny, n_cells, slack, r, c):
     """The drop lists of :meth:`TriangleGrid._drop_lists` from the top-down lists
     (``cells``, ``tris``; ``box``: each triangle's own (x, y) box, x0 y0 x1 y1).  A
-    triangle's bound in a cell is its top lifted (ball) or lowered (bull) by the profile at
-    the least distance ``d`` between the cell's square and its box, the bound
+    triangle's bound in a cell is its top less the cutter's profile (a ball's is the bull's
+    of a corner as large as the radius) at the least distance ``d`` between the cell's
+    square and its box, the bound
     :func:`_drop_triangle` takes at a location from the location's own distance, which is
     never less; stored as float32 rounded up.  A triangle whose box lies farther than
     ``r`` from the whole cell (the grid lists it for its box grown by ``r``, corners
@@ -226,10 +228,8 @@ def _cell_bounds(cells, tris, box, top, origin, cell, ny, n_cells, slack, code, 
             continue
         keep[k] = True
         offsets[ci + 1] += 1
-        if code == BALL:
-            bound[k] = top[t] + np.sqrt(max(r2 - d2, 0.0)) - r
-        else:
-            bound[k] = top[t] - min(_bull_profile(np.sqrt(d2), r - c, c), c)
+        # the bull's profile (a ball's is its corner of the full radius), as _drop_triangle's
+        bound[k] = top[t] - min(_bull_profile(np.sqrt(d2), r - c, c), c)
     for ci in range(n_cells):
         offsets[ci + 1] += offsets[ci]
     out_tris = np.empty(offsets[n_cells], np.int32)
@@ -536,7 +536,7 @@ def drop(grid: TriangleGrid, cutter: Cutter, xy: np.ndarray, *, contacts: bool =
     if cutter.radius != grid.radius:
         raise SurfmodError(f"cutter: radius {cutter.radius:g} differs from the grid's {grid.radius:g}")
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    offsets, tris, bounds, rank = grid._drop_lists(cutter.code, cutter.corner)
+    offsets, tris, bounds, rank = grid._drop_lists(float(cutter.corner))
     z, touch = np.empty(len(xy)), np.full((len(xy), 3), np.nan)
     touched = np.empty(len(xy), dtype=np.int64)
     _drop_kernel(cutter.code, np.ascontiguousarray(xy), grid._cell_ids(xy), offsets, tris, bounds, rank, grid.rows,
