@@ -132,6 +132,7 @@ def _slowness(item) -> int:
     return next((k for k, key in enumerate(SLOW_FIRST) if key in item.nodeid), len(SLOW_FIRST))
 
 
+@pytest.hookimpl(trylast=True)  # after ``-m``'s deselection: the chunks are of the tests that run
 def pytest_collection_modifyitems(config, items):
     """The :data:`SLOW_FIRST` tests dealt into the first chunks xdist's ``load`` scheduler
     sends its workers (worker w gets the w-th chunk of ``chunk`` consecutive tests: the
