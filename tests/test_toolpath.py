@@ -11,6 +11,11 @@ import textwrap
 import build123d as bd
 import numpy as np
 import pytest
+import toolpath_reference
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+from OCP.Extrema import Extrema_ExtFlag_MIN
+from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 from toolpath_reference import ball_clearance, flat_cuts, gcode_positions
 
 import surfmod as sm
@@ -155,6 +160,39 @@ def test_the_warm_started_drop_equals_the_exhaustive_search_bit_for_bit(kind):
             assert np.array_equal(z, z_all, equal_nan=True), np.nanmax(np.abs(z - z_all))
             assert np.array_equal(won, won_all)
             assert np.array_equal(touch, touch_all, equal_nan=True)
+
+
+def test_the_judges_culling_finds_what_the_whole_part_finds(monkeypatch):
+    """The exact judges measure against the faces whose (u, v) cells' boxes come near and
+    skip flat-end placements nearer to a measured one than its distance: on paths that cut
+    the walls and the curved pocket, the same ball depth and the same flat-end moves as
+    with every face of the part at every placement."""
+    block = stepped_block()
+    part = to_shape(block)
+    xy, _, _ = toolpath_moves.raster((-16, -10), (-4, 0), 2.5, 1.25, "x")
+    r, tol = 1.5, 0.05
+    ball = np.column_stack([xy, drop_cutter(block, sm.Tool("ball", r), xy, tolerance=tol)[0]])
+    flat = np.column_stack([xy, drop_cutter(block, sm.Tool("flat", r), xy, tolerance=tol)[0]])
+    flat = np.vstack([flat, [[-14, -8, 9], [-9, -5, 0.3]]])  # and a long plunge into the pocket's floor
+    culled = worst_cut(block, ball, r, 30.0), flat_cuts(part, flat, r, tol, 30.0)
+    assert culled[0] > 2 * tol and len(culled[1]) > 4 and culled[1][-1] == len(flat) - 2
+
+    every = toolpath_reference.face_boxes(part)[0]
+    monkeypatch.setattr(toolpath_reference, "_near_strips", lambda boxes, *_: np.arange(len(boxes)))
+    assert worst_cut(block, ball, r, 30.0) == culled[0]
+    whole, rho, cut = toolpath_reference.compound(every), r - tol, []
+    for i in range(len(flat) - 1):
+        a, b = flat[i], flat[i + 1]
+        n = int(max(np.ceil(np.linalg.norm(b[:2] - a[:2]) / (r / 20)),
+                    np.ceil(abs(b[2] - a[2]) / (tol / 4)) if np.linalg.norm(b[:2] - a[:2]) > 0 else 0, 1))
+        for t in np.linspace(0.0, 1.0, n + 1):
+            p = a + t * (b - a)
+            axis = gp_Ax2(gp_Pnt(float(p[0]), float(p[1]), float(p[2] + tol)), gp_Dir(0, 0, 1))
+            cutter = BRepPrimAPI_MakeCylinder(axis, rho, 30.0 - p[2] - tol).Shape()
+            if BRepExtrema_DistShapeShape(cutter, whole, Extrema_ExtFlag_MIN).Value() <= 1e-9:
+                cut.append(i)
+                break
+    assert cut == culled[1]
 
 
 @pytest.mark.parametrize("kind", ["ball", "flat"])

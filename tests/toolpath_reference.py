@@ -18,8 +18,7 @@ from __future__ import annotations
 import re
 
 import numpy as np
-from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon,
-                                BRepBuilderAPI_MakeVertex)
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
 from OCP.Extrema import Extrema_ExtFlag_MIN
@@ -86,10 +85,11 @@ def _planar_runs(points: np.ndarray):
 def ball_clearance(part, points: np.ndarray, radius: float, top: float) -> float:
     """Smallest distance from the part to the ribbons swept by the ball centre and its
     axis up to height ``top``, capped at ``radius``; the deepest cut of the path is
-    ``radius`` minus it.  Each ribbon is measured against the faces whose bounding boxes
-    come within ``radius`` of its own: a face farther away cuts nothing, and the distance
-    to the others is the distance to the whole part wherever it is below ``radius``."""
-    faces, boxes = face_boxes(getattr(part, "wrapped", part))
+    ``radius`` minus it.  Each ribbon is measured against the faces with a box of
+    :func:`face_cells` within ``radius`` of its own: a face farther away cuts nothing, and
+    the distance to the others is the distance to the whole part wherever it is below
+    ``radius``."""
+    faces, boxes = face_cells(getattr(part, "wrapped", part))
     best = radius
     for run in _planar_runs(points):
         keep = np.r_[True, np.any(np.abs(np.diff(run, axis=0)) > 0, axis=1)]
@@ -140,14 +140,19 @@ def _riser(stack, top):
     return BRepBuilderAPI_MakeEdge(gp_Pnt(float(x), float(y), float(z)), gp_Pnt(float(x), float(y), top)).Edge()
 
 
-def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float) -> list[int]:
-    """Indices of moves where the flat end, shrunk by ``depth``, meets the part.  Each
-    cylinder is measured against the faces whose bounding boxes meet its own (the same
-    distance as against the whole part, found faster)."""
-    faces, boxes = face_boxes(getattr(part, "wrapped", part))
+def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float, moves=None) -> list[int]:
+    """Indices of moves (of ``moves``, by default every one) where the flat end, shrunk by
+    ``depth``, meets the part.  Each cylinder is measured against the faces with a box of
+    :func:`face_cells` meeting it (the same distance as against the whole part, found
+    faster); a placement no such box meets is clear without asking OCCT, and so is one
+    nearer than ``D`` to the last placement measured, ``D`` from the part (from those
+    faces by OCCT, from the others by their cells' boxes): the cylinder there lies within
+    that one moved by less than ``D`` and, placed lower, a slab at its top that no box
+    meets, so no point of it comes within 0 of the part."""
+    faces, boxes = face_cells(getattr(part, "wrapped", part))
     rho = radius - depth
-    bad = []
-    for i in range(len(points) - 1):
+    bad, last, clear = [], None, 0.0
+    for i in range(len(points) - 1) if moves is None else moves:
         a, b = points[i], points[i + 1]
         n = int(max(np.ceil(np.linalg.norm(b[:2] - a[:2]) / (radius / 20)),
                     np.ceil(abs(b[2] - a[2]) / (depth / 4)) if np.linalg.norm(b[:2] - a[:2]) > 0 else 0, 1))
@@ -156,26 +161,28 @@ def flat_cuts(part, points: np.ndarray, radius: float, depth: float, top: float)
         near = _near(boxes, lo, hi)
         if not len(near):
             continue
-        target = compound(faces[k] for k in near)
+        boxes_near = boxes[near]
         for t in np.linspace(0.0, 1.0, n + 1):
             p = a + t * (b - a)
+            if last is not None and np.linalg.norm(p - last) < clear - 1e-9 and (
+                    p[2] >= last[2] or not len(_near_cylinder(boxes, p[:2], rho, top + p[2] - last[2], top))):
+                continue
+            here = near[_near_cylinder(boxes_near, p[:2], rho, p[2] + depth, top)]
+            if not len(here):
+                continue
             axis = gp_Ax2(gp_Pnt(float(p[0]), float(p[1]), float(p[2] + depth)), gp_Dir(0, 0, 1))
             cutter = BRepPrimAPI_MakeCylinder(axis, rho, top - p[2] - depth).Shape()
-            # a vertex CLEAR below the bottom's centre: OCCT then skips every pair of
-            # sub-shapes whose boxes stand farther apart than that (a third less work on
-            # occt_screw), and a distance of 1e-9 or less is found as before
-            mark = BRepBuilderAPI_MakeVertex(gp_Pnt(float(p[0]), float(p[1]), float(p[2] + depth - CLEAR))).Vertex()
-            dist = BRepExtrema_DistShapeShape(cutter, compound([target, mark]), Extrema_ExtFlag_MIN)
+            dist = BRepExtrema_DistShapeShape(cutter, compound(faces[k] for k in here), Extrema_ExtFlag_MIN)
             assert dist.IsDone()
             if dist.Value() <= 1e-9:
                 bad.append(i)
                 break
+            # the faces left out are at least their cells' boxes' distance away
+            others = np.ones(len(faces), bool)
+            others[here] = False
+            last = p
+            clear = min(dist.Value(), _cylinder_gap(boxes[others], p[:2], rho, p[2] + depth, top).min(initial=np.inf))
     return bad
-
-
-#: how far below a flat end's placement :func:`flat_cuts` puts its vertex (above the 1e-9
-#: that counts as meeting the part)
-CLEAR = 1e-6
 
 
 def _near_strips(boxes: np.ndarray, centre: np.ndarray, top: float, radius: float) -> np.ndarray:
@@ -187,13 +194,37 @@ def _near_strips(boxes: np.ndarray, centre: np.ndarray, top: float, radius: floa
     lo = np.minimum(centre[:-1], centre[1:])
     hi = np.maximum(centre[:-1], centre[1:])
     hi[:, 2] = np.maximum(hi[:, 2], top)
-    gap = np.maximum(0.0, np.maximum(lo[None] - boxes[:, None, 1], boxes[:, None, 0] - hi[None]))
-    return np.flatnonzero(np.sqrt((gap * gap).sum(-1)).min(1) < radius)
+    # the faces whose whole box is near first, then their cells
+    whole = np.stack([boxes[:, :, 0].min(1), boxes[:, :, 1].max(1)], axis=1)
+    near = np.flatnonzero(_gap(whole[:, None], lo, hi).min(1) < radius)
+    return near[_gap(boxes[near, :, None], lo, hi).min((1, 2)) < radius]
+
+
+def _cylinder_gap(boxes: np.ndarray, centre, rho: float, bottom: float, top: float) -> np.ndarray:
+    """Distances ``(F, K)`` from the boxes ``(F, K, 2, 3)`` to the upright cylinder of
+    radius ``rho`` around ``centre`` (x, y) from ``bottom`` to ``top``: the (x, y)
+    rectangle's distance beyond ``rho`` from the axis, and the z ranges' gap."""
+    gap = np.maximum(0.0, np.maximum(boxes[:, :, 0, :2] - centre, centre - boxes[:, :, 1, :2]))
+    side = np.maximum(np.hypot(gap[..., 0], gap[..., 1]) - rho, 0.0)
+    up = np.maximum(0.0, np.maximum(boxes[:, :, 0, 2] - top, bottom - boxes[:, :, 1, 2]))
+    return np.hypot(side, up)
+
+
+def _near_cylinder(boxes: np.ndarray, centre, rho: float, bottom: float, top: float) -> np.ndarray:
+    """Indices of the faces with a box of ``(F, K, 2, 3)`` meeting that cylinder."""
+    return np.flatnonzero((_cylinder_gap(boxes, centre, rho, bottom, top) <= 0).any(axis=1))
+
+
+def _gap(boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Least distances between boxes ``(..., 2, 3)`` and the boxes ``lo``-``hi`` ``(S, 3)``
+    (broadcast as ``boxes[..., 0, :]`` against ``lo``)."""
+    gap = np.maximum(0.0, np.maximum(lo - boxes[..., 1, :], boxes[..., 0, :] - hi))
+    return np.sqrt((gap * gap).sum(-1))
 
 
 def _near(boxes: np.ndarray, lo, hi) -> np.ndarray:
-    """Indices of the faces whose boxes ``(F, 2, 3)`` meet the box ``lo``-``hi``."""
-    return np.flatnonzero(np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1))
+    """Indices of the faces with a box of ``(F, K, 2, 3)`` meeting the box ``lo``-``hi``."""
+    return np.flatnonzero(np.any(np.all((boxes[:, :, 0] <= hi) & (boxes[:, :, 1] >= lo), axis=2), axis=1))
 
 
 def compound(shapes):
@@ -226,3 +257,41 @@ def face_boxes(part):
         explorer.Next()
     return faces, np.array(boxes)
 
+
+#: each face's (u, v) rectangle is cut into SPLIT x SPLIT cells for :func:`face_cells`
+SPLIT = 4
+
+
+def face_cells(part, split: int = SPLIT):
+    """The faces of ``part`` and OCCT's bounding boxes ``(F, split², 2, 3)`` of the cells
+    of each face's (u, v) rectangle: the box ``BRepBndLib`` gives a face is
+    ``BndLib_AddSurface`` over that whole rectangle (a plane's from its edges), so the cells,
+    grown by the largest tolerance of the face's edges and vertices, hold the face as surely
+    and far more tightly (a cylinder's box holds the whole ring
+    around a ribbon passing inside it).  A plane keeps its one box."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BndLib import BndLib_AddSurface
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.BRepTools import BRepTools
+    from OCP.GeomAbs import GeomAbs_Plane
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_VERTEX
+    from OCP.TopoDS import TopoDS
+
+    faces, whole = face_boxes(part)
+    cells = np.repeat(whole[:, None], split * split, axis=1)
+    for k, face in enumerate(faces):
+        face = TopoDS.Face(face)
+        surface = BRepAdaptor_Surface(face)
+        if surface.GetType() == GeomAbs_Plane:
+            continue
+        u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+        us, vs = np.linspace(u0, u1, split + 1), np.linspace(v0, v1, split + 1)
+        # an edge's curve lies within its tolerance of the surface, a vertex within its own
+        tol = max(BRep_Tool.MaxTolerance_s(face, kind) for kind in (TopAbs_FACE, TopAbs_EDGE, TopAbs_VERTEX))
+        for i in range(split):
+            for j in range(split):
+                box = Bnd_Box()
+                BndLib_AddSurface.Add_s(surface, us[i], us[i + 1], vs[j], vs[j + 1], tol, box)
+                cells[k, i * split + j] = np.reshape(box_limits(box), (2, 3))
+    return faces, cells
