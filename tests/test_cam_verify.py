@@ -198,6 +198,10 @@ def test_a_verdict_after_a_repair_measures_the_changed_stretch_again(job, monkey
     fresh = V.verify_job(job, texts=["\n".join(lines)])
     before = V.verify_job(job)
     assert not job.verification.measured  # the job keeps none of it
+    # the verdict before holds how the part was sampled, not its points: sampled again
+    # (the kept sampling dropped, a verdict samples anew), the part's measures are still its
+    V._SAMPLED.clear()
+    V.verify_job(job)
     probed, swept = [], []
     probes, sweep = V._probes, V.K.sweep_body
     monkeypatch.setattr(V, "_probes", lambda *a: probed.append(len(a[0])) or probes(*a))
