@@ -708,13 +708,14 @@ def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, to
 
 
 def reach_contours(part: _Part, tool: Tool, groups, *, spacing: float, steep_angle: float, tolerance: float,
-                   stock: np.ndarray, safe: float, rest: Leftover | None):
+                   safe: float, stock: np.ndarray | None = None, rest: Leftover | None = None, top=None):
     """One waterline level per group ``(z, moves)`` of :func:`surfmod.cam.holder.reach_levels`
     (where the job's holder check left contours out, the lowest height the shank and holder
     let the tool cut there), its steep pieces kept within the tool's radius, and the rise,
-    of the moves left out; linked, entered and left as the finishing's contours.  Returns
-    the :class:`Motion` (from and back to the clearance height)."""
-    top = _StockTop(part, tool, rest, stock, safe)
+    of the moves left out; linked, entered and left as the finishing's contours (the stock
+    over them from ``stock`` and ``rest``, or ``top``: a rest operation's, from its stock
+    model).  Returns the :class:`Motion` (from and back to the clearance height)."""
+    top = _StockTop(part, tool, rest, stock, safe) if top is None else top
     out = Moves()
     for z, moves in groups:
         ends = moves[:, :, :2]

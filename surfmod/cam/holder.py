@@ -4,22 +4,28 @@ Above its flutes a tool does not cut (:attr:`surfmod.cam.tool.Tool.body`: the sh
 the flutes' end, the holder from the shank's).  Every move of an operation, cutting or
 linking, is checked twice:
 
-- **against the part**: the discs wider than the cutting end (a wider shank, the holder)
-  dropped as flat cylinders onto the part's mesh (:func:`surfmod.cam.drop_cutter.drop`)
-  at probes along the move, each disc grown by half the probes' spacing (so it holds the
-  disc at every point between) and its bottom at the lowest height within half a spacing;
-  the mesh's deflection is added to the heights found (the exact faces lie at most that
-  far above the mesh), and where only that margin flags a move, OCCT's exact distance
-  from the disc as a solid cylinder to the part settles it (a bounded number of them).
-  A narrower shank stands in the column the end's drop-cutter already keeps clear of
-  the part;
+- **against the part**, by the reach rule the verifier judges with too
+  (:func:`surfmod.cam.verify.body_stand`): the discs wider than the cutting end (a wider
+  shank, the holder) dropped as flat cylinders onto the part's mesh
+  (:func:`surfmod.cam.drop_cutter.drop`) at probes along the move, each disc grown by half
+  the probes' spacing (so it holds the disc at every point between) and its bottom at the
+  lowest height within half a spacing, must stand the highest cusp the finishing passes
+  so far leave above the part (the model's cells, a quarter of the smallest tool, are
+  wider than those passes: it does not see their cusps; counted here alone); the mesh's
+  deflection is added to the heights found (the exact faces lie at most that far above
+  the mesh), and where only that margin flags a move, OCCT's exact distance from the disc
+  as a solid cylinder to the part settles it (a bounded number of them).  A narrower
+  shank stands in the column the end's drop-cutter already keeps clear of the part;
 - **against the stock**: the operation's moves swept in order through a height-field
   stock model shared by the job's operations (:class:`surfmod.cam.rest.StockModel`,
   swept by :func:`surfmod.cam.verify_kernels.sweep_body`): before each stamp of the
-  cutting end, the stock may stand no higher than a disc's bottom within the disc (the
-  shank, even as narrow as the end, meets stock above the flutes in front of the tool),
-  less the highest cusp the finishing passes so far leave (the model's cells, a quarter
-  of the smallest tool, are wider than those passes: it does not see their cusps).
+  cutting end, the stock more than the cusps above the part may stand no higher than a
+  disc's bottom within the disc (the shank, even as narrow as the end, meets stock above
+  the flutes in front of the tool).  Beside a wall taller than the flutes, within the
+  allowance a roughing left on it, a shank as wide as the end meets that skin, thinner
+  than a cell: there the narrow discs are held a cell wider against the stock no
+  thicker than the skin (on a boss 30 mm tall the raster beside it, before the contours
+  cut the skin, rubbed it 24.5 mm deep).
 
 A disc may rub sideways within the operation's tolerance (its radius is taken that much
 smaller: the end's own side comes that near a wall), but never stand lower than the part
@@ -47,9 +53,10 @@ import numpy as np
 from ..inputs import upright_cylinder
 from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
+from .finishing import height_field
 from .rest import StockModel
 from .roughing import PLUNGE, RAPID, Motion, Moves
-from .verify import BODY_NODES, _probes, body_cell
+from .verify import BODY_NODES, _probes, body_cell, body_stand
 from .verify_kernels import sweep_body, sweep_stock
 
 #: probes along the moves for the part check, and stock nodes of the job's model, at most
@@ -91,33 +98,78 @@ def body_stock(stock: np.ndarray, smallest_radius: float) -> StockModel:
     return StockModel(stock, body_cell(stock, smallest_radius), MAX_STOCK_NODES)
 
 
+def _floor(stock: StockModel, triangles: np.ndarray) -> np.ndarray:
+    """The part's top (``triangles``) under the stock model's nodes, kept with the model for
+    the mesh it was taken from."""
+    kept = getattr(stock, "floor", None)
+    if kept is None or kept[0] is not triangles:
+        stock.floor = kept = (triangles, height_field(triangles, stock.x, stock.y))
+    return kept[1]
+
+
+def _flush(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float,
+           skin: float) -> np.ndarray:
+    """Per move (``points[k] -> points[k + 1]``): whether a disc of the tool no wider than
+    its end comes within ``skin`` (the allowance the roughing left on the walls) and
+    ``slack`` of a wall of the part that rises above its bottom (a finishing tool beside a
+    wall; not the roughing itself, which keeps its allowance off)."""
+    narrow = [h for r, h, _ in tool.body if r - slack <= tool.radius]
+    flush = np.zeros(max(len(points) - 1, 0), bool)
+    if not narrow or not len(flush) or skin <= 0.0:
+        return flush
+    probes, move, _ = _probes(points[:-1], points[1:], tool.radius / PROBES_PER_RADIUS, MAX_HOLDER_PROBES)
+    low = np.minimum(points[:-1, 2], points[1:, 2])[move]
+    near = np.flatnonzero(low + min(narrow) < float(triangles[:, :, 2].max()) + deflection)
+    if near.size:
+        reach = tool.radius + skin + 2 * slack
+        z = np.nan_to_num(drop(TriangleGrid(triangles, reach), Flat(reach), probes[near, :2]), nan=-np.inf)
+        np.logical_or.at(flush, move[near], z + deflection > low[near] + min(narrow))
+    return flush
+
+
 def _sweep_body(stock: StockModel, a: np.ndarray, b: np.ndarray, rapid: np.ndarray, tool, slack: float,
-                skip: np.ndarray, cusp: float, remove: bool = True):
+                skip: np.ndarray, floor: np.ndarray, rise: float, flush=None, thin: float = 0.0,
+                remove: bool = True):
     """``stock`` swept along the moves ``a -> b`` with the moves whose body meets it (or
     ``skip``) undone: :func:`~surfmod.cam.verify_kernels.sweep_body`'s ``(sink, removed)``
     (without ``remove``, the model is left as it is and ``sink`` measures every move).
     The model samples the stock a cell apart, coarser than the verifier's: a disc wider
     than the end is grown by a cell, so that an edge of stock between the nodes its rim
     passes is met too (on zoo's flange-xy, 0.875 mm cells let a holder pass 4.7 mm into a
-    level's step that the verifier's 0.245 mm cells found).  Nor does it see the cusps
-    finer passes left between its nodes: a disc must clear the model by ``cusp`` (on
-    flange-xy the finishing's holder passed 0.008 mm over the finished top, into its
-    0.033 mm cusps)."""
+    level's step that the verifier's 0.245 mm cells found).  A move ``flush`` against a
+    wall holds its discs no wider than the end a cell wider too, against the nodes whose
+    stock stands no more than ``thin`` (the roughing's skin, often thinner than a cell,
+    which stands between the nodes) above the part.  Only the stock more than ``rise``
+    (the cusps) above the part's top at a node (``floor``) counts: a grown disc comes over
+    the wall's own column, and the cusps between the model's nodes are the part's rule
+    (:func:`part_sink`)."""
     m = len(a)
-    discs = tool.body[None, :, :2].copy()
-    wider = discs[..., 0] > tool.radius + slack
-    discs[..., 0][wider] += stock.cell
+    discs = np.column_stack([tool.body[:, :2], np.full(len(tool.body), np.inf)])
+    wider = discs[:, 0] > tool.radius + slack
+    discs[wider, 0] += stock.cell
+    # beside a wall: the discs no wider than the end once more, a cell wider, against the
+    # skin alone (the stock no thicker than it: not what no tool reaches in a corner)
+    skin = discs[~wider].copy()
+    skin[:, 0] += stock.cell
+    skin[:, 2] = thin + rise
+    body = np.zeros((2, 2 * len(discs), 3))
+    body[0, :len(discs)] = discs
+    body[1, :len(discs)] = discs
+    body[1, len(discs):len(discs) + len(skin)] = skin
+    of = np.zeros(m, np.int64) if flush is None else flush.astype(np.int64)
     *_, sink, _, removed = sweep_body(stock.top if remove else stock.top.copy(), float(stock.lo[0]),
                                       float(stock.lo[1]), stock.cell, np.ascontiguousarray(a),
                                       np.ascontiguousarray(b), rapid, np.full(m, tool.radius),
-                                      np.full(m, tool.corner), stock.cell / 2, discs, np.zeros(m, np.int64),
-                                      np.array([float(slack)]), np.array([-float(cusp)]), skip, remove, 0.0)
+                                      np.full(m, tool.corner), stock.cell / 2, body, of,
+                                      np.full(2, float(slack)), np.zeros(2), skip, remove, 0.0, floor, float(rise))
     return sink, removed
 
 
-def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float, shape=None):
-    """Per move (``points[k] -> points[k + 1]``): how far the part stands above the bottom
-    of the tool's discs wider than its end (see the module), -inf where it stays below.
+def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float, shape=None,
+              clear: float = 0.0):
+    """Per move (``points[k] -> points[k + 1]``): how far the tool's discs wider than its
+    end stand below the part plus ``clear`` (the cusps) by the reach rule
+    (:func:`~surfmod.cam.verify.body_stand`, see the module), -inf where they stay above.
     With ``shape``, moves flagged by the deflection alone (the mesh itself clear of the
     discs) are settled by OCCT's exact distance from each such disc as a solid cylinder
     to the part, up to :data:`EXACT_CONFIRMS` cylinders (beyond, they stay flagged)."""
@@ -132,20 +184,16 @@ def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray
     slope = np.abs(seg[:, 2]) / np.maximum(np.linalg.norm(seg, axis=1), 1e-300)
     # the lowest the move goes within half a spacing
     low = np.maximum(probes[:, 2] - slope[move] * spacing / 2, np.minimum(points[:-1, 2], points[1:, 2])[move])
-    found = []  # (probe, disc, depth on the mesh with the deflection)
-    for q, (r, h, _) in enumerate(discs):
-        near = np.flatnonzero(low + h < top)  # above the part's top the disc meets nothing
-        if not near.size:
-            continue
-        reach = r - slack + spacing / 2
-        z = drop(TriangleGrid(triangles, reach), Flat(reach), probes[near, :2])
-        depth = np.nan_to_num(z, nan=-np.inf) + deflection - (low[near] + h)
-        hit = depth > 0.0
-        found.append((near[hit], np.full(int(hit.sum()), q), depth[hit]))
-        np.maximum.at(sink, move[near], depth)
-    if shape is None or not found:
+
+    def mesh(xy, r):
+        return np.nan_to_num(drop(TriangleGrid(triangles, r), Flat(r), xy), nan=-np.inf) + deflection
+
+    depth = body_stand(mesh, probes[:, :2], tool, slack, spacing / 2, clear, low, top) - low
+    np.maximum.at(sink, move, depth.max(axis=0))
+    hit = depth > 0.0
+    if shape is None or not hit.any():
         return sink
-    which, disc, depth = (np.concatenate(v) for v in zip(*found))
+    disc, which = np.nonzero(hit)
     # a move flagged only by the deflection is confirmed exactly when all its flagged
     # probes are few enough
     close = sink[move[which]] <= deflection
@@ -153,10 +201,10 @@ def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray
         return sink
     which, disc = which[close], disc[close]
     radius = np.array([discs[q][0] - slack + spacing / 2 for q in disc])
-    base = np.column_stack([probes[which, :2], low[which] + np.array([discs[q][1] for q in disc])])
-    clear = _cylinder_clearance(shape, base, radius, [max(discs[q][2], 1e-6) for q in disc]) > EXACT_GAP
+    base = np.column_stack([probes[which, :2], low[which] + np.array([discs[q][1] for q in disc]) - clear])
+    gap = _cylinder_clearance(shape, base, radius, [max(discs[q][2], 1e-6) for q in disc]) > EXACT_GAP
     cleared = np.ones(len(sink), bool)
-    np.logical_and.at(cleared, move[which], clear)
+    np.logical_and.at(cleared, move[which], gap)
     settled = np.unique(move[which])
     sink[settled[cleared[settled]]] = -np.inf
     return sink
@@ -230,18 +278,20 @@ def _without_dips(motion: Motion) -> Motion:
 
 
 def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
-               safe: float, shape=None, cusp: float = 0.0):
+               safe: float, shape=None, cusp: float = 0.0, skin: float = 0.0):
     """``(motion, held)``: ``motion`` swept through ``stock`` with the moves whose shank or
-    holder would touch the part (``triangles``, and ``shape`` for the close calls) or come
-    within ``cusp`` of the stock (the highest cusp the passes so far leave between the
-    model's nodes) removed and relinked (:func:`relink`), and what that leaves
-    (:func:`left_out`)."""
+    holder would come within ``cusp`` of the part (``triangles``, and ``shape`` for the
+    close calls; the highest cusp the passes so far leave) or meet the stock left on it
+    (``skin`` the roughing's allowance on the walls) removed and relinked
+    (:func:`relink`), and what that leaves (:func:`left_out`)."""
     pts = np.asarray(motion.points, float)
     if len(pts) < 2:
         return motion, None
     rapid = motion.kind[1:] == RAPID
-    skip = part_sink(triangles, deflection, tool, pts, slack, shape) > 0.0
-    _, removed = _sweep_body(stock, pts[:-1], pts[1:], rapid, tool, slack, skip, cusp)
+    skip = part_sink(triangles, deflection, tool, pts, slack, shape, cusp) > 0.0
+    flush = _flush(triangles, deflection, tool, pts, slack, skin)
+    _, removed = _sweep_body(stock, pts[:-1], pts[1:], rapid, tool, slack, skip, _floor(stock, triangles),
+                             cusp + slack, flush, skin)
     if not removed.any():
         return motion, None
     cuts = removed & ~rapid  # links replaced by the relinking leave nothing
@@ -271,7 +321,7 @@ def left_out(stock: StockModel, tool, a: np.ndarray, b: np.ndarray, moves: int, 
 
 
 def reach_levels(held: Held, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
-                 cusp: float, window: float) -> list:
+                 cusp: float, window: float, skin: float = 0.0) -> list:
     """Where the check left out moves at constant height (a waterline contour's), the
     lowest heights the tool can cut there: each move raised by how far the stock model
     (by ``cusp`` too) or the part stands above its discs' bottoms, the moves grouped by
@@ -284,11 +334,12 @@ def reach_levels(held: Held, tool, stock: StockModel, triangles: np.ndarray, def
     if not len(cuts):
         return []
     a, b = cuts[:, 0], cuts[:, 1]
-    sink, _ = _sweep_body(stock, a, b, np.zeros(len(a), np.bool_), tool, slack, np.zeros(len(a), np.bool_), cusp,
-                          remove=False)
-    # the part below the discs: each move alone (the polyline a0 b0 a1 b1 ...: its even moves)
-    part = part_sink(triangles, deflection, tool, cuts.reshape(-1, 3), slack)[::2]
-    up = np.maximum(sink + cusp, part)
+    # each move alone (the polyline a0 b0 a1 b1 ...: its even moves)
+    flush = _flush(triangles, deflection, tool, cuts.reshape(-1, 3), slack, skin)[::2]
+    sink, _ = _sweep_body(stock, a, b, np.zeros(len(a), np.bool_), tool, slack, np.zeros(len(a), np.bool_),
+                          _floor(stock, triangles), cusp + slack, flush, skin, remove=False)
+    part = part_sink(triangles, deflection, tool, cuts.reshape(-1, 3), slack, clear=cusp)[::2]
+    up = np.maximum(sink, part)
     z = a[:, 2] + up + REACH_MARGIN
     ok = np.isfinite(up) & (up > 0.0)
     z, cuts = z[ok], cuts[ok]

@@ -25,7 +25,8 @@ from .cycle_time import cycle_time, feed_time
 from .finishing import Leftover, finish, reach_contours, recut
 from .holder import body_stock, clear_body, left_out, reach_levels, relink
 from .machine_table import MACHINE, Machine
-from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, StockModel, left_over, rest_moves, rest_part_top
+from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, STEEP_ANGLE, StockModel, _AboveStock, left_over, rest_moves, \
+    rest_part_top
 from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
@@ -314,7 +315,7 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     if passes == 0:
         return job
     extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
-                          job.safe_height, job.part, cusp_clearance(job.operations))
+                          job.safe_height, job.part, cusp_clearance(job.operations), wall_skin(job.operations))
     if not np.any(extra.kind != RAPID):
         return job
     motion = Motion(np.concatenate([op.motion.points, extra.points]), np.concatenate([op.motion.kind, extra.kind]))
@@ -327,41 +328,50 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     return replace(job, verification=verify_job(job, before=job.verification))
 
 
-def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape, cusp):
-    """The operation's moves cleared of shank and holder collisions, a disc clearing the
-    stock model by ``cusp``; with ``strict`` a collision refuses the job."""
+def wall_skin(operations) -> float:
+    """The allowance the roughing ``operations`` leave on the walls, the thickest, since the
+    last finishing or rest operation (whose contours cut it)."""
+    last = max((k for k, o in enumerate(operations) if o.name != "roughing"), default=-1)
+    return max((float(o.report["allowance"]) for o in operations[last + 1:] if o.name == "roughing"), default=0.0)
+
+
+def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape, cusp, skin, contours=None):
+    """``(motion, held, levels)``: the operation's moves cleared of shank and holder
+    collisions, a disc clearing the part by ``cusp`` (``skin``: :func:`wall_skin`), and
+    where that left waterline contours out, those again at the holder's reach
+    (:func:`_at_reach`, given the operation's ``contours``: their ``spacing``,
+    ``steep_angle`` and where the stock stands for :func:`~surfmod.cam.finishing.reach_contours`;
+    None: it has none) in ``levels`` levels; with ``strict`` a collision refuses the job."""
     motion, held = clear_body(motion, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe,
-                              shape, cusp)
+                              shape, cusp, skin)
     if held is not None and strict:
         raise SurfmodError(f"strict: the {name} with {tool}: {held} (a longer tool: flute_length, shank_length; "
                            f"a narrower holder; or strict=False to leave it)")
-    return motion, held
+    if held is None or contours is None:
+        return motion, held, 0
+    return _at_reach(motion, held, tool, stock_model, part, tolerance, safe, shape, cusp, skin, contours)
 
 
-def _at_reach(motion, held, tool, stock_model, part, report, stock, safe, rest, shape, cusp):
+def _at_reach(motion, held, tool, stock_model, part, tolerance, safe, shape, cusp, skin, contours):
     """Where the holder check left waterline contours out, those contours again at the
     lowest height the shank and holder let the tool cut there (on cam_part a holder over
     the mould's top left out the foot of the outer wall's contours, the next level 1.6 mm
     up: 0.30 mm left on a wall the tool reaches), themselves held and appended; returns
-    the motion and what is left out in all."""
-    w = report.get("waterline")
-    if held is None or not w or not w["levels"]:
-        return motion, held
-    tolerance = float(report["tolerance"])
+    the motion, what is left out in all and the levels added (see :func:`_held`)."""
+    spacing = contours["spacing"]
     groups = reach_levels(held, tool, stock_model, part.grid.triangles, part.deflection, tolerance, cusp,
-                          w["spacing"] / 2)
+                          spacing / 2, skin)
     if not groups:
-        return motion, held
-    extra = reach_contours(part, tool, groups, spacing=w["spacing"], steep_angle=report["steep_angle"],
-                           tolerance=tolerance, stock=stock, safe=safe, rest=rest)
+        return motion, held, 0
+    extra = reach_contours(part, tool, groups, tolerance=tolerance, safe=safe, **contours)
     if not np.any(extra.kind != RAPID):
-        return motion, held
+        return motion, held, 0
     extra, again = clear_body(extra, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe, shape,
-                              cusp)
+                              cusp, skin)
     cuts = held.cuts if again is None else np.concatenate([held.cuts, again.cuts])
     held = left_out(stock_model, tool, cuts[:, 0], cuts[:, 1], held.moves + (again.moves if again else 0), tolerance)
-    w["at_reach"] = len(groups)
-    return Motion(np.concatenate([motion.points, extra.points]), np.concatenate([motion.kind, extra.kind])), held
+    return (Motion(np.concatenate([motion.points, extra.points]), np.concatenate([motion.kind, extra.kind])), held,
+            len(groups))
 
 
 #: how far (mm) a move the verifier read from the program may lie from the motion it was
@@ -425,7 +435,7 @@ def _after(op: Rest, k: int, specs: list) -> list[int]:
 def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: np.ndarray, safe: float, held):
     """The rest operation's motion and report (:mod:`surfmod.cam.rest`); ``held`` clears
     its moves of shank and holder collisions (:func:`_held`, given the moves, the part, the
-    tolerance and the scallop)."""
+    tolerance, the scallop and its contours)."""
     after = _after(op, k, specs)
     cutting = [done[i] for i in after if done[i].name != "roughing"]
     if op.scallop is not None:
@@ -453,7 +463,12 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
     # (``held``) decides how deep the tool goes, not its flutes
     motion, info = rest_moves(part, tool, model, mask, scallop=scallop, stepover=stepover, tolerance=tolerance,
                               safe=safe, bottom=float(stock[0, 2]), max_points=op.max_points)
-    motion, kept_out = held(motion, part, tolerance, scallop)
+    # its contours again at the holder's reach where it left them out, as the finishing's
+    contours = (dict(spacing=info["spacing"], steep_angle=STEEP_ANGLE, top=_AboveStock(model, tool.radius, safe))
+                if info["levels"] else None)
+    motion, kept_out, levels = held(motion, part, tolerance, scallop, contours)
+    if levels:
+        info["at_reach"] = levels
     model.sweep(motion, tool)
     _, left = left_over(model, part_top, part, threshold, pairs)
     report = dict(info, after=after, scallop=scallop, stepover=stepover, tolerance=tolerance, threshold=threshold,
@@ -541,8 +556,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 with _stage(bar, "roughing", "stepdown", "a larger stepdown or roughing tool"):
                     motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover,
                                            CLEARANCE, deflection=p.deflection)
-                    motion, held = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape,
-                                         cusp_clearance(done))
+                    motion, held, _ = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape,
+                                            cusp_clearance(done), wall_skin(done))
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
                 rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift, allowance + p.lift)
@@ -551,9 +566,9 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 bar.update()
                 with _stage(bar, "rest machining", "scallop", "a larger scallop or rest tool"):
                     motion, report = _rest(shape, op, tool, k, ops, done, stock, safe,
-                                           lambda m, part, tol, scallop: _held(
+                                           lambda m, part, tol, scallop, contours: _held(
                                                m, tool, stock_model, part, tol, safe, strict, "rest machining", shape,
-                                               max(cusp_clearance(done), scallop + tol)))
+                                               max(cusp_clearance(done), scallop + tol), wall_skin(done), contours))
                 name = "rest"
             else:
                 if op.scallop is not None:
@@ -567,10 +582,13 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     tolerance = float(report["tolerance"])
                     # its own cusps too: a holder coming down beside the part passes over them
                     cusp = max(cusp_clearance(done), float(report["scallop"]) + tolerance)
-                    motion, held = _held(motion, tool, stock_model, finish_part, tolerance, safe, strict, "finishing",
-                                         shape, cusp)
-                    motion, held = _at_reach(motion, held, tool, stock_model, finish_part, report, stock, safe, rest,
-                                             shape, cusp)
+                    w = report.get("waterline")
+                    contours = (dict(spacing=w["spacing"], steep_angle=report["steep_angle"], stock=stock, rest=rest)
+                                if w and w["levels"] else None)
+                    motion, held, levels = _held(motion, tool, stock_model, finish_part, tolerance, safe, strict,
+                                                 "finishing", shape, cusp, wall_skin(done), contours)
+                    if levels:
+                        w["at_reach"] = levels
                 finishing[k] = (op, finish_part, rest)
                 report["holder"] = held
                 name = "finishing"

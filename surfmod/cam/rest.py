@@ -269,6 +269,7 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
         wl = contour_moves(out, part, tool, top, safe, STEEP_ANGLE, levels_apart, tolerance, bottom, box=bounds,
                            keep=left, highest=float(highest[label - 1]), clear=scallop + tolerance)
         info["levels"] += wl["levels"]
+        info["spacing"] = levels_apart
         info["contours"] += wl["contours"]
         info["lifted"] = max(info["lifted"], wl["lifted"])
     judge_links(part, out, allowed, "rest")

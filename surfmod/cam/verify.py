@@ -38,8 +38,9 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   measured normal to that surface, is at most the scallop plus the tolerance wherever the
   tool reaches.  A height field cannot see a wall: nodes steeper than ``WALL_SLOPE`` and a
   band one cell wide at the part's outline are left to the walls' judge below; the nodes
-  the shank or holder keeps the tool from (the whole tool's reach, from its discs' drops,
-  above the end's), and a tool radius round them, are counted, not judged;
+  the shank or holder keeps the tool from (the whole tool's reach by the job's reach rule,
+  :func:`body_stand`, above the end's), and a tool radius round them, are counted, not
+  judged;
 - **walls**: the stock is also dexels along x and along y, a cell apart, kept in a band
   round every place the height field sees rise steeper than ``DEXEL_SLOPE`` less 10° (a
   wall, the part's outline), each holding its material as intervals, swept by each tool's
@@ -55,8 +56,8 @@ triangles, :mod:`surfmod.cam.drop_cutter`):
   the part at the foot it takes in no point of the part beyond the limit, stands no lower
   than the table, the normal does not face down (an overhang) and no disc of its shank or
   holder wider than its end (grown by the job's body cell, :func:`body_cell`) stands below
-  the part (the flutes set no depth of their own: a shank no wider than the end follows
-  them down a hole).  A cusp between the
+  the part and its cusps (:func:`body_stand`; the flutes set no depth of their own: a
+  shank no wider than the end follows them down a hole).  A cusp between the
   dexels' levels is seen lower, by at most its slope over half a cell.
 
 Each finding keeps its maximum and where it is.  The work is estimated before it starts
@@ -650,7 +651,7 @@ def _sweep(top, lo, cell, moves: ProgramMoves, owner, radii, corners, discs, sla
             tops[a] = top.copy()
         got = K.sweep_body(top, float(lo[0]), float(lo[1]), cell, moves.start[a:b], moves.end[a:b], moves.rapid[a:b],
                            radii[a:b], corners[a:b], cell / 2, discs, np.ascontiguousarray(owner[a:b], dtype=np.int64),
-                           slack, np.zeros(len(slack)), np.zeros(b - a, np.bool_), False, cell)
+                           slack, np.zeros(len(slack)), np.zeros(b - a, np.bool_), False, cell, np.zeros((1, 1)), 0.0)
         for mine, part in zip(out, got):
             mine[a:b] = part
     return out, {"stride": stride, "columns": columns, "tops": tops, "out": out}
@@ -791,18 +792,21 @@ def verify_job(job, post: str = "linuxcnc", texts: list[str] | None = None, *, m
         under = measured[key] = part.drop(grid_points(lo[:2], cell, (nx, ny)), 0.75 * cell, 0.0).reshape(nx, ny)
     if finishing:
         k, op, cutter, limit = finishing[-1]
-        key = ("reach", k, tuple(lo), cell, nx, ny, cutter.radius, cutter.corner, op.tool.body.tobytes(), limit)
-        measured[key] = old.get(key) or _reach(part, lo, cell, (nx, ny), op, cutter, limit)
+        # the discs as wide and as high as the job holds them (its stock model's cell, the cusps)
+        grow = body_cell(job.stock, min(o.tool.radius for o in job.operations))
+        clear = cusp_clearance(job.operations[:k + 1])
+        key = ("reach", k, tuple(lo), cell, nx, ny, cutter.radius, cutter.corner, op.tool.body.tobytes(), limit, grow,
+               clear)
+        measured[key] = old.get(key) or _reach(part, lo, cell, (nx, ny), op, cutter, limit, grow, clear)
         reach, held = measured[key]
         found, walls, held = _residual(top, under, reach, held, lo, cell, op, cutter, limit)
         findings.append(found)
         if held:
             notes.append(f"note: residual: {held:,} nodes the shank or holder keeps the {op.name} tool from, "
                          f"not judged (the holder finding and the operation's report say what is left)")
-        grow = body_cell(job.stock, min(o.tool.radius for o in job.operations))
         found, dexels, judged_walls = _wall_residual(part, moves, radii, corners, np.asarray(job.stock, float), under,
                                                      cell, op, cutter, limit, max_dexel_work, notes, job.part, grow,
-                                                     cusp_clearance(job.operations[:k + 1]))
+                                                     clear)
         findings.append(found)
     kept = StockField.over_part(top, under, lo[:2], cell, WALL_SLOPE, KEPT_NODES)
     return Verification(tuple(findings), len(part.points), probes, nx * ny, walls, spacing, tuple(notes),
@@ -836,22 +840,22 @@ def stock_cells(stock, cell: float, max_nodes: int = MAX_NODES):
                           f"({max_nodes:,} nodes at most): cusps narrower than a cell are seen lower than they are")
 
 
-def _reach(part: PartPoints, lo: np.ndarray, cell: float, shape: tuple, op, cutter, limit: float):
+def _reach(part: PartPoints, lo: np.ndarray, cell: float, shape: tuple, op, cutter, limit: float, grow: float,
+           clear: float):
     """``(reach, held)`` on the stock's nodes: the lowest the finishing tool's lower
     surface reaches over each (the part's closing by the tool), and the nodes the shank or
-    holder keeps it from (see :func:`_residual`)."""
+    holder keeps it from (:func:`body_stand`, its discs ``grow`` wider and ``clear`` above
+    the part; see :func:`_residual`)."""
     nx, ny = shape
     xy = grid_points(lo[:2], cell, shape)
     tips = part.drop(xy, cutter.radius, cutter.corner).reshape(nx, ny)
     reach = K.closing(tips, cell, cutter.radius, cutter.corner)
     # where the shank or holder stops the tool above the part, the tool does not reach it:
-    # the lowest the whole tool reaches, from its discs' drops onto the part's points
-    body = [(r - limit, h) for r, h, _ in op.tool.body if r - limit > cutter.radius]
+    # the lowest the whole tool reaches, by the reach rule the job follows
+    body = body_stand(lambda q, r: part.drop(q, r, 0.0), xy, op.tool, limit, grow, clear)
     held = np.zeros((nx, ny), bool)
-    if body:
-        stand = tips.copy()
-        for r, h in body:
-            stand = np.maximum(stand, part.drop(xy, r, 0.0).reshape(nx, ny) - h)
+    if len(body):
+        stand = np.maximum(tips, body.max(axis=0).reshape(nx, ny))
         held = K.closing(stand, cell, cutter.radius, cutter.corner) > reach + limit
         # the job leaves out whole moves, judged with some caution: a tool's footprint
         # round what the holder keeps it from is not judged either
@@ -898,6 +902,29 @@ def _residual(top: np.ndarray, under: np.ndarray, reach: np.ndarray, held: np.nd
                   for a, b in ndimage.find_objects(labels))
     return Finding(what, worst, bound, (float(gx[i, j]), float(gy[i, j]), float(top[i, j])), int(over.sum()),
                    boxes=boxes), int(steep.sum()), int(held.sum())
+
+
+def body_stand(drop, xy: np.ndarray, tool, slack: float, grow: float = 0.0, clear: float = 0.0, low=None,
+               ceiling: float = np.inf) -> np.ndarray:
+    """The reach rule, one for the job and its judge: the lowest the tip may stand over each
+    (x, y) of ``xy`` for every disc of the tool's shank and holder wider than its end by
+    more than ``slack`` (:attr:`~surfmod.cam.tool.Tool.body`; taken ``slack`` narrower, a
+    rub within it, and ``grow`` wider) to stand ``clear`` above the part within it: the
+    cusps the finishing leaves on the part, counted here and nowhere else
+    (:func:`cusp_clearance`).  ``drop(xy, radius)`` is the part's highest point within
+    ``radius`` of each (-inf where none).  Returns one row per such disc (none: no rows);
+    with the tip's heights ``low``, a disc is dropped only where it stands below
+    ``ceiling`` (the part's top), else -inf."""
+    rows = []
+    for r, h, _ in tool.body:
+        if r - slack <= tool.radius:
+            continue  # a narrower shank stands in the column the end keeps clear of the part
+        row = np.full(len(xy), -np.inf)
+        near = np.arange(len(xy)) if low is None else np.flatnonzero(low + h - clear < ceiling)
+        if near.size:
+            row[near] = drop(xy[near], r - slack + grow) - h + clear
+        rows.append(row)
+    return np.array(rows).reshape(len(rows), len(xy))
 
 
 def cusp_clearance(operations) -> float:
@@ -1009,9 +1036,9 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
         cell, raised by the cusps: where the job keeps a holder out, the wall is not asked
         of it)."""
         ok = (t[:, 2] >= floor - limit) & (part.deepest(t, cutter.radius, cutter.corner)[0] <= limit)
-        for r, h, _ in op.tool.body:
-            if r - limit > cutter.radius and ok.any():
-                ok[ok] = part.drop(t[ok, :2], r - limit + grow, 0.0) - h + clear <= t[ok, 2] + limit
+        if ok.any():
+            body = body_stand(lambda q, r: part.drop(q, r, 0.0), t[ok, :2], op.tool, limit, grow, clear)
+            ok[ok] = np.all(body <= t[ok, 2] + limit, axis=0)
         return ok
 
     # every point beyond the bound is asked (they are counted), then the next deepest a

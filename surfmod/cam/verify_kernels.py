@@ -183,7 +183,7 @@ def sweep_stock(top, x0, y0, cell, starts, ends, rapid, radii, corners, step):
     m = starts.shape[0]
     none = np.zeros((1, 1, 2))
     out = sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, none, np.zeros(m, np.int64),
-                     np.zeros(1), np.zeros(1), np.zeros(m, np.bool_), False, 0.0)
+                     np.zeros(1), np.zeros(1), np.zeros(m, np.bool_), False, 0.0, np.zeros((1, 1)), 0.0)
     return out[0], out[1]
 
 
@@ -219,7 +219,7 @@ def _block_max(top, out):
 
 @njit(cache=True)
 def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, body, tool_of, slack, limit, skip,
-               remove, grow):
+               remove, grow, floor, rise):
     """:func:`sweep_stock` with the tool's body above its flutes (the discs ``body[tool_of[k]]``:
     radius, height of the bottom above the tip; radius 0 pads) measured against the stock
     before each stamp: how far the stock stands above a disc's bottom within the disc's
@@ -227,6 +227,11 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
     the stamp before to this one (the disc at every point between), at the lower of the
     two heights.  The end's own column is left out where the tool already stands (a
     move's first stamp) or descends vertically (its flutes cut the column on the way down).
+    With a ``floor`` as large as ``top`` (the part's top at each node; else ``(1, 1)``)
+    only the stock more than ``rise`` above it counts: a disc beside a wall meets the
+    stock left on it, not the part's own column under the nodes; a disc with a third
+    value (``body[t, q, 2]``) counts only the nodes whose stock stands no more than that
+    above the floor (a skin).
 
     With ``remove``, a move marked ``skip`` or whose body goes deeper than ``limit[tool]``
     into the stock (a negative limit: comes nearer it than that) cuts nothing (its stamps
@@ -267,6 +272,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                 lowest[t] = min(lowest[t], body[t, q, 1])
     log_i = np.empty(1024, np.int64)
     log_v = np.empty(1024)
+    floored = floor.shape[0] == nx and floor.shape[1] == ny
     gap = False  # a move before was removed: the next feed move is reached by a plunge
     for k in range(m):
         if visits > nx * ny:
@@ -281,7 +287,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
         radius, corner = radii[k], corners[k]
         tk = tool_of[k]
         if remove and gap and not rapid[k]:
-            buried = _plunge_sink(top, x0, y0, cell, ax, ay, az, radius, body[tk], slack[tk])
+            buried = _plunge_sink(top, x0, y0, cell, ax, ay, az, radius, body[tk], slack[tk], floor, rise)
             if buried > limit[tk]:
                 sink[k] = buried
                 removed[k] = True
@@ -309,6 +315,7 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                     if reach <= 0.0:
                         continue
                     bottom = zl + body[tk, q, 1]
+                    thin = body[tk, q, 2] if body.shape[2] > 2 else np.inf
                     i0 = max(int(math.ceil((min(cx, px) - reach - x0) / cell)), 0)
                     i1 = min(int(math.floor((max(cx, px) + reach - x0) / cell)), nx - 1)
                     j0 = max(int(math.ceil((min(cy, py) - reach - y0) / cell)), 0)
@@ -320,8 +327,8 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
                             for i in range(max(i0, bi * BLOCK), min(i1, bi * BLOCK + BLOCK - 1) + 1):
                                 gx = x0 + i * cell
                                 for j in range(max(j0, bj * BLOCK), min(j1, bj * BLOCK + BLOCK - 1) + 1):
-                                    over = top[i, j] - bottom
-                                    if over <= sink[k]:
+                                    over = top[i, j] - (max(bottom, floor[i, j] + rise) if floored else bottom)
+                                    if over <= sink[k] or (floored and top[i, j] - floor[i, j] > thin):
                                         continue
                                     gy = y0 + j * cell
                                     w = 0.0 if uu == 0.0 else min(max(((gx - px) * ux + (gy - py) * uy) / uu, 0.0),
@@ -366,20 +373,25 @@ def sweep_body(top, x0, y0, cell, starts, ends, rapid, radii, corners, step, bod
 
 
 @njit(cache=True)
-def _plunge_sink(top, x0, y0, cell, x, y, z, radius, discs, slack):
+def _plunge_sink(top, x0, y0, cell, x, y, z, radius, discs, slack, floor, rise):
     """How far the stock stands above the bottom of the discs (radius, height above the tip)
     wider than the end, less ``slack``, of a tool plunged straight down to the tip height
-    ``z`` at ``(x, y)`` (-inf where it meets none); the end's own column is cut on the way."""
+    ``z`` at ``(x, y)`` (-inf where it meets none); the end's own column is cut on the way.
+    ``floor`` and ``rise`` as in :func:`sweep_body`."""
     nx, ny = top.shape
+    floored = floor.shape[0] == nx and floor.shape[1] == ny
     worst = -np.inf
     for q in range(discs.shape[0]):
         reach = discs[q, 0] - slack
         if reach <= radius:
             continue
         bottom = z + discs[q, 1]
+        thin = discs[q, 2] if discs.shape[1] > 2 else np.inf
         i0, i1, j0, j1 = _nodes(x, y, reach, x0, y0, cell, nx, ny)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
+                if floored and top[i, j] - floor[i, j] > thin:
+                    continue
                 if radius <= math.hypot(x0 + i * cell - x, y0 + j * cell - y) < reach:
-                    worst = max(worst, top[i, j] - bottom)
+                    worst = max(worst, top[i, j] - (max(bottom, floor[i, j] + rise) if floored else bottom))
     return worst
