@@ -455,8 +455,8 @@ def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
 #: issue 36's pocketed plate larger than 500 mm: NIST CTC-02, 680 x 860 x 400 mm, pockets
 #: 330 mm deep from its top (floors at z -290), bosses, ribs and bores; a flat r = 30
 #: roughs and a ball r = 25 finishes (60 and 50 mm tools) on 420 mm of reach (flutes
-#: 100 mm, above them a neck 1 mm narrower: a shank as wide would rub the roughing's
-#: allowance on the walls taller than the flutes), the scallop 2 % of the ball's radius;
+#: 100 mm, above them a shank as wide as the end: beside the walls taller than the
+#: flutes the job keeps it off the roughing's allowance), the scallop 2 % of the ball's radius;
 #: the judge's stock cells 2 mm (a fifth of the 10 mm stepover), its wall dexels 4 mm
 #: apart (at 2 mm the finishing's 638,674 moves as rs274 reads them back would meet them
 #: 1.75e8 times, above the judge's 6e7) and its mesh 0.05 mm (the file's own edges are
@@ -464,7 +464,7 @@ def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
 #: job itself (waterline 165 s, the verification's gouge measure 130 s, drop-cutter 108 s,
 #: meshing 89 s): marked ``heavy``, run with ``python -m pytest -q -m heavy``, outside CI
 PLATE_JOB = {"name": "nist_ctc_02_asme1_rc.stp", "R1": 30.0, "R2": 25.0, "SCALLOP": 0.5, "CELL": 2.0,
-             "SIDE_CELL": 4.0, "FLUTE": 100.0, "SHANK": 320.0, "NECK": 1.0, "DEFLECTION": 0.05}
+             "SIDE_CELL": 4.0, "FLUTE": 100.0, "SHANK": 320.0, "DEFLECTION": 0.05}
 
 
 @needs_rs274

@@ -71,8 +71,8 @@ class Finish:
     """Finishing with ``tool``: the drop-cutter zig-zag along ``direction`` over the whole
     part plus waterline (constant-Z) contours on the regions steeper than ``steep_angle``
     degrees (None: no contours), spaced so that the cusps measured along the surface stay
-    within ``scallop`` on every slope (or passes ``stepover`` apart, levels
-    ``stepover · sin(steep_angle)`` apart on the walls); see :mod:`surfmod.cam.finishing`."""
+    within ``scallop`` on every slope (or passes and contours ``stepover`` apart, the
+    contours measured along the walls); see :mod:`surfmod.cam.finishing`."""
 
     tool: Tool
     scallop: float | None = None
