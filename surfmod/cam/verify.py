@@ -929,8 +929,8 @@ def body_stand(drop, xy: np.ndarray, tool, slack: float, grow: float = 0.0, clea
 
 def cusp_clearance(operations) -> float:
     """The highest cusp the finishing and rest ``operations`` leave: their scallop with its
-    tolerance.  The job holds every holder disc that far above its stock model (too coarse
-    to see the cusps), so the walls' reach asks no more of a tool."""
+    tolerance.  :func:`body_stand` holds every disc of a shank or holder that far above the
+    part, in the job and in the verifier's reach alike."""
     return max((float(o.report["scallop"]) + float(o.report["tolerance"]) for o in operations
                 if o.name != "roughing"), default=0.0)
 
