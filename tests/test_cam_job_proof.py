@@ -460,9 +460,9 @@ def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
 #: the judge's stock cells 2 mm (a fifth of the 10 mm stepover), its wall dexels 4 mm
 #: apart (at 2 mm the finishing's 638,674 moves as rs274 reads them back would meet them
 #: 1.75e8 times, above the judge's 6e7) and its mesh 0.05 mm (the file's own edges are
-#: 0.097 off its faces).  The proof takes about 12 CPU minutes, nine tenths of them the
-#: job itself (waterline 165 s, the verification's gouge measure 130 s, drop-cutter 108 s,
-#: meshing 89 s): marked ``heavy``, run with ``python -m pytest -q -m heavy``, outside CI
+#: 0.097 off its faces).  The proof takes about 8 CPU minutes, most of them the job itself
+#: (its waterline, drop-cutter and meshing, the verification's gouge measure): marked
+#: ``heavy``, run with ``python -m pytest -q -m heavy``, outside CI
 PLATE_JOB = {"name": "nist_ctc_02_asme1_rc.stp", "R1": 30.0, "R2": 25.0, "SCALLOP": 0.5, "CELL": 2.0,
              "SIDE_CELL": 4.0, "FLUTE": 100.0, "SHANK": 320.0, "DEFLECTION": 0.05}
 
