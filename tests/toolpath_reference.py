@@ -18,11 +18,21 @@ from __future__ import annotations
 import re
 
 import numpy as np
+from OCP.Bnd import Bnd_Box
+from OCP.BndLib import BndLib_AddSurface
+from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+from OCP.BRepTools import BRepTools
 from OCP.Extrema import Extrema_ExtFlag_MIN
+from OCP.GeomAbs import GeomAbs_Plane
 from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_VERTEX
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Compound
 
 from surfmod.occ.bindings import box_limits
 
@@ -30,11 +40,6 @@ from surfmod.occ.bindings import box_limits
 def material(shape):
     """The faces of ``shape`` as one compound: free edges and vertices of a STEP file
     (construction wires) are not material a tool can cut."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopAbs import TopAbs_FACE
-    from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS_Compound
-
     shape = getattr(shape, "wrapped", shape)
     compound, builder = TopoDS_Compound(), BRep_Builder()
     builder.MakeCompound(compound)
@@ -228,8 +233,6 @@ def _near(boxes: np.ndarray, lo, hi) -> np.ndarray:
 
 
 def compound(shapes):
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
 
     compound, builder = TopoDS_Compound(), BRep_Builder()
     builder.MakeCompound(compound)
@@ -240,11 +243,6 @@ def compound(shapes):
 
 def face_boxes(part):
     """The faces of ``part`` and their OCCT bounding boxes ``(F, 2, 3)``."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-    from OCP.TopAbs import TopAbs_FACE
-    from OCP.TopExp import TopExp_Explorer
-
     faces, boxes = [], []
     explorer = TopExp_Explorer(part, TopAbs_FACE)
     while explorer.More():
@@ -269,15 +267,6 @@ def face_cells(part, split: int = SPLIT):
     grown by the largest tolerance of the face's edges and vertices, hold the face as surely
     and far more tightly (a cylinder's box holds the whole ring
     around a ribbon passing inside it).  A plane keeps its one box."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BndLib import BndLib_AddSurface
-    from OCP.BRep import BRep_Tool
-    from OCP.BRepAdaptor import BRepAdaptor_Surface
-    from OCP.BRepTools import BRepTools
-    from OCP.GeomAbs import GeomAbs_Plane
-    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_VERTEX
-    from OCP.TopoDS import TopoDS
-
     faces, whole = face_boxes(part)
     cells = np.repeat(whole[:, None], split * split, axis=1)
     for k, face in enumerate(faces):
