@@ -47,53 +47,17 @@ def _spans(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
 
 def pcurve_d1(rec: dict, t: np.ndarray) -> np.ndarray:
     """``(N, 4)``: ``u, v, du/dt, dv/dt`` of a p-curve record at parameters ``t``."""
-    from ..occ.pcurves import adaptor_d1
-
-    kind = rec["kind"]
-    t = np.asarray(t, dtype=float)
-    out = np.empty((t.size, 4))
-    if kind == "line":
-        out[:, :2] = rec["origin"] + t[:, None] * rec["direction"]
-        out[:, 2:] = rec["direction"]
-    elif kind == "circle":
-        c, s = np.cos(t)[:, None], np.sin(t)[:, None]
-        r, x, y = rec["radius"], rec["x"], rec["y"]
-        out[:, :2] = rec["centre"] + r * (c * x + s * y)
-        out[:, 2:] = r * (c * y - s * x)
-    elif kind == "bspline":
-        if "taylor" not in rec:
-            rec["taylor"] = _taylor_pieces(rec)
-        starts, centres, coef = rec["taylor"]
-        j = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(starts) - 1)
-        dt = (t - centres[j])[:, None]
-        c = coef[j]  # (N, p+1, dim)
-        val, der = c[:, -1], np.zeros_like(c[:, -1])
-        for k in range(c.shape[1] - 2, -1, -1):  # Horner for the value and its derivative
-            der = der * dt + val
-            val = val * dt + c[:, k]
-        if rec["weights"] is None:
-            out[:, :2], out[:, 2:] = val, der
-        else:
-            out[:, :2] = val[:, :2] / val[:, 2:]
-            out[:, 2:] = (der[:, :2] - out[:, :2] * der[:, 2:]) / val[:, 2:]
-    else:
-        out[:] = adaptor_d1(rec["adaptor"], t)
-    return out
-
-
-def _taylor_pieces(rec: dict):
-    """A B-spline p-curve as one polynomial per knot span: ``(starts (S,), centres (S,),
-    coefficients (S, p+1, dim))`` with ``C(t) = Σ_k c_k (t - centre)^k`` in homogeneous coordinates
-    ``(w u, w v, w)`` (``(u, v)`` when polynomial).  Beyond the ends the first and last
-    spans continue, as OCCT evaluates."""
-    taylor_pieces([rec])
-    return rec["taylor"]
+    t = np.asarray(t, dtype=float).ravel()
+    return PcurveTable([rec]).d1(np.zeros(t.size, int), t)
 
 
 def taylor_pieces(records: list) -> None:
-    """Set ``rec["taylor"]`` (see :func:`_taylor_pieces`), and ``rec["breaks"]``
-    (:func:`~surfmod.mass.breaks.spline_breaks`), on every B-spline p-curve record that lacks them, with one
-    basis evaluation per degree for all of them: their knot vectors and control points
+    """Set ``rec["taylor"]`` and ``rec["breaks"]`` (:func:`~surfmod.mass.breaks.spline_breaks`) on
+    every B-spline p-curve record that lacks them.  ``rec["taylor"]`` is the p-curve as one
+    polynomial per knot span: ``(starts (S,), centres (S,), coefficients (S, p+1, dim))``
+    with ``C(t) = Σ_k c_k (t - centre)^k`` in homogeneous coordinates ``(w u, w v, w)``
+    (``(u, v)`` when polynomial); beyond the ends the first and last spans continue, as
+    OCCT evaluates.  One basis evaluation per degree serves all of them: their knot vectors and control points
     are laid end to end, and each span's basis reads only its own curve's knots
     (``knots[span - p + 1 .. span + p]``), so one call serves all.
 
@@ -163,8 +127,7 @@ def _span_derivatives(knots, p: int, span, mid, poles) -> np.ndarray:
 
 def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
     """Parameters where a p-curve crosses the lines ``u = c`` and ``v = c``: exact on
-    straight p-curves, else sign changes on one sampling refined by Newton steps (all
-    crossings at once)."""
+    straight and circular p-curves, else :func:`_table_crossings` on its pieces ``cuts``."""
     if not len(lines_u) and not len(lines_v):
         return np.zeros(0)
     f, l = cuts[0], cuts[-1]
@@ -186,22 +149,9 @@ def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.nda
         turns = np.arange(np.floor((f - base.max()) / (2 * np.pi)), np.ceil((l - base.min()) / (2 * np.pi)) + 1)
         t = (base[:, None] + 2 * np.pi * turns[None, :]).ravel()
         return t[(t > f) & (t < l)]
-    a, b = cuts[:-1, None], cuts[1:, None]
-    t = np.unique((a + (b - a) * np.linspace(0.0, 1.0, per_piece + 1)).ravel())
-    s = pcurve_d1(rec, t)[:, coord] - lines[None, :]  # (T, L)
-    i, j = np.nonzero(s[:-1] * s[1:] < 0)
-    if not len(i):
-        return np.zeros(0)
-    lo, hi, c, cj = t[i], t[i + 1], lines[j], coord[j]
-    x = lo + (hi - lo) * s[i, j] / (s[i, j] - s[i + 1, j])
-    rows = np.arange(len(x))
-    for _ in range(6):
-        q = pcurve_d1(rec, x)
-        d = q[rows, 2 + cj]
-        step = np.divide(q[rows, cj] - c, d, out=np.zeros_like(x), where=d != 0.0)
-        x = np.clip(x - step, lo, hi)
-        if np.all(np.abs(step) <= 1e-15 * max(1.0, abs(l - f))):
-            break
+    pieces = len(cuts) - 1
+    x, _ = _table_crossings(PcurveTable([rec]), np.zeros(pieces, int), cuts[:-1], cuts[1:], np.full(pieces, abs(l - f)),
+                            np.tile(lines, (pieces, 1)), np.tile(coord, (pieces, 1)), per_piece)
     return x
 
 
@@ -245,7 +195,7 @@ class PcurveTable:
                 self.centre[i], self.ax[i], self.ay[i], self.radius[i] = rec["centre"], rec["x"], rec["y"], rec["radius"]
             elif kind == 2:
                 if "taylor" not in rec:
-                    rec["taylor"] = _taylor_pieces(rec)
+                    taylor_pieces([rec])
                 splines.append((i, rec))
                 self.polynomial[i] = rec["weights"] is None
         if splines:
@@ -579,11 +529,3 @@ def _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges):
     tol = 1e-13 * np.maximum(1.0, ranges[rec_m, 1] - ranges[rec_m, 0])
     close = (rec_m[1:] == rec_m[:-1]) & (np.diff(val_m) <= tol[1:]) & gained[rec_m[1:]]
     return merged[np.concatenate([[True], ~close])]
-
-
-def _boundary(pcurves, outer_order, lines_u, lines_v, table: PcurveTable | None = None, angular=(False, False)):
-    """:func:`boundaries` of one face: ``(P (N, 2), dP (N, 2), weights (N,), exact)``;
-    ``outer_order(rec)`` is the Gauss order for a p-curve (``(order, exact)``)."""
-    rules = [outer_order(rec) for rec in pcurves]
-    face = (pcurves, [m for m, _ in rules], [ok for _, ok in rules], lines_u, lines_v, tuple(angular))
-    return boundaries([face], table)[0]

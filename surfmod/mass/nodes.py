@@ -45,7 +45,7 @@ from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from .breaks import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks, is_face, knot_breaks
-from .boundary import PIECES, PcurveTable, _boundary, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
+from .boundary import PIECES, PcurveTable, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
 from .rules import (GridJob, exact_order, gauss, green_layout, grids_nodes, inner_nodes,  # noqa: F401
                         interpolation_points)
 
