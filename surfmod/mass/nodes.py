@@ -176,14 +176,19 @@ class MassFace:
         return self.pcurves is None
 
 
+def _border_tolerance(bounds: np.ndarray) -> np.ndarray:
+    """``(R, 4)``: how far from each border line of the boxes ``bounds`` (``(R, 4)``) a point still lies on it."""
+    u0, u1, v0, v1 = bounds.T
+    tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
+    return tol[:, [0, 0, 1, 1]]
+
+
 def _lines_on_box_border(lines: list, bounds: np.ndarray) -> np.ndarray:
     """:func:`_records_on_box_border` of straight p-curves only (``bounds`` ``(R, 4)``, per
     record): both ends of each on one border line, a few array operations for all of them
     without a :class:`PcurveTable`."""
     bounds = np.asarray(bounds, dtype=float)
-    u0, u1, v0, v1 = bounds.T
-    tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
-    tol = tol[:, [0, 0, 1, 1]]
+    tol = _border_tolerance(bounds)
     data = np.array([rec["line"] if "line" in rec else np.concatenate([rec["origin"], rec["direction"], rec["range"]])
                      for rec in lines])  # (origin, direction, range) rows, as faces_pcurves reads them
     o, d, r = data[:, :2], data[:, 2:4], data[:, 4:]
@@ -192,20 +197,12 @@ def _lines_on_box_border(lines: list, bounds: np.ndarray) -> np.ndarray:
     return np.any(first & last, axis=1)
 
 
-def _on_box_border(table: PcurveTable, bounds) -> bool:
-    """Whether the p-curves run along the face box's border only: a straight p-curve iff
-    both of its ends lie on one border line, others at seven samples each (all p-curves
-    in one evaluation)."""
-    return bool(np.all(_records_on_box_border(table, np.tile(bounds, (len(table.records), 1)))))
-
-
 def _records_on_box_border(table: PcurveTable, bounds: np.ndarray) -> np.ndarray:
     """Per record of ``table``: whether it runs along the border of its face box
-    (``bounds`` ``(R, 4)``, per record), see :func:`_on_box_border`."""
+    (``bounds`` ``(R, 4)``, per record): a straight p-curve iff both of its ends lie on
+    one border line, others at seven samples each (all p-curves in one evaluation)."""
     bounds = np.asarray(bounds, dtype=float)
-    u0, u1, v0, v1 = bounds.T
-    tol = np.stack([RECTANGLE_RTOL * np.maximum(1.0, u1 - u0), RECTANGLE_RTOL * np.maximum(1.0, v1 - v0)], axis=1)
-    tol = tol[:, [0, 0, 1, 1]]
+    tol = _border_tolerance(bounds)
     straight = table.kind == 0
     samples = np.array([0.0, 0.137, 0.291, 0.5, 0.643, 0.871, 1.0])  # ends first, then inside
     ranges = np.array([rec["range"] for rec in table.records])
@@ -247,8 +244,7 @@ def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
 def mass_faces(read: list, pcurves: list) -> list:
     """:func:`mass_face` of every face of a part (``pcurves`` per face, their B-splines'
     Taylor pieces built); the rectangle test of all faces with curved p-curves runs in
-    one evaluation of one :class:`PcurveTable` (:func:`_on_box_border`, face by face
-    there).
+    one evaluation of one :class:`PcurveTable` (:func:`_records_on_box_border`).
 
     >>> import surfmod as sm, build123d as bd
     >>> from surfmod.occ.pcurves import faces_pcurves
@@ -316,7 +312,7 @@ def mass_face(face, pcurves: list | None = None, natural: bool | None = None) ->
         natural = bool(np.all(_lines_on_box_border(pcurves, np.tile(bounds, (len(pcurves), 1)))))
     else:
         table = PcurveTable(pcurves)
-        natural = _on_box_border(table, bounds)
+        natural = bool(np.all(_records_on_box_border(table, np.tile(bounds, (len(pcurves), 1)))))
     evaluate, grid_evaluate = evaluators(face)
     return MassFace(evaluate, bounds, breaks, -1.0 if face.reversed else 1.0,
                     _degrees(surf), None if natural else pcurves,
