@@ -342,11 +342,7 @@ def _scattered(net: LocalNet, u, v, order: int, positions: bool, out) -> np.ndar
     if u.size * (order + 1) ** 2 < COMPILED_SCATTERED or getattr(_TASK, "numpy", False):
         h = scattered(*net[:4], net.ctrl, net.rational, u, v, order)
         _add_origin(net, h[:, 0, 0])
-        h = h[:, 0, 0] if positions else h
-        if out is None:
-            return h
-        out[...] = h
-        return out
+        return _store(h[:, 0, 0] if positions else h, out)
     if out is None:
         out = np.empty((u.size, 3) if positions else (u.size, order + 1, order + 1, 3))
     table = _patch_table(net, u.size) if positions or order in (1, 2) else None
@@ -466,13 +462,6 @@ def _scratch(count: int, per_slot: int) -> np.ndarray:
     return buf[: slots * per_slot].reshape(slots, per_slot)
 
 
-def _u_blocks(n_u: int, threads: int) -> np.ndarray:
-    """Starts of the blocks of (sorted) u-points that the threads share: at least
-    :data:`BLOCKS_PER_THREAD` a thread, of :data:`GRID_MIN_BLOCK` u-points or more."""
-    step = max(GRID_MIN_BLOCK, -(-n_u // (BLOCKS_PER_THREAD * threads)))
-    return np.r_[np.arange(0, n_u, step), n_u].astype(np.int64)
-
-
 def _row_stage_plan(net: LocalNet, sv, bv, rows: int):
     """The vector loops of the grid's row stage (:mod:`surfmod.eval.row_stage`) for
     v-points with spans ``sv`` and basis ``bv`` when ``rows`` net rows are contracted:
@@ -566,5 +555,7 @@ def _grid_sorted(net: LocalNet, us, vs, order: int, out) -> None:
     if count == 1:
         run(*head, scratch[0], *tail)
         return
+    # blocks of u-points the threads share: at least BLOCKS_PER_THREAD a thread, of GRID_MIN_BLOCK or more
+    step = max(GRID_MIN_BLOCK, -(-us.size // (BLOCKS_PER_THREAD * count)))
     with _on(count):
-        run(*head, scratch, *tail, _u_blocks(us.size, count))
+        run(*head, scratch, *tail, np.r_[np.arange(0, us.size, step), us.size].astype(np.int64))
