@@ -170,11 +170,9 @@ class LimitSurface:
         gap, angle = 0.0, 0.0
         for (p0, p1), (n0, n1) in edges:
             gap = max(gap, float(np.linalg.norm(p0 - p1, axis=1).max()))
-            cross = np.linalg.norm(np.cross(n0, n1), axis=1)
-            dot = np.einsum("ij,ij->i", n0, n1)
             ok = np.linalg.norm(n0, axis=1) * np.linalg.norm(n1, axis=1) > 0
             if ok.any():
-                angle = max(angle, float(np.degrees(np.arctan2(cross[ok], dot[ok])).max()))
+                angle = max(angle, float(_angle_deg(n0[ok], n1[ok]).max()))
         return {"max_gap": gap, "max_normal_angle_deg": angle, "shared_edges": len(edges)}
 
     def shape(self):
@@ -273,7 +271,8 @@ def _assemble(v, topo, crease, levels, adaptive, tangent_plane, extra):
         nets.append(nets_j[kept])
         # newly owned faces parametrize their patch directly
         owner[kept] = first + np.arange(len(kept))
-        maps = _reset_maps(maps, kept)
+        for m, identity in zip(maps, _identity_maps(len(kept))):
+            m[kept] = identity
         if j < adaptive:
             active = np.repeat(active & ~reg_j, 4)
             v, topo, crease, owner, maps = _refine(v, topo, crease, owner, maps)
@@ -291,13 +290,6 @@ def _assemble(v, topo, crease, levels, adaptive, tangent_plane, extra):
 def _identity_maps(n):
     """Affine maps (origin, d1, d2) from a face's own (s, t) to its patch's (u, v)."""
     return [np.zeros((n, 2)), np.tile([1.0, 0.0], (n, 1)), np.tile([0.0, 1.0], (n, 1))]
-
-
-def _reset_maps(maps, idx):
-    ident = _identity_maps(len(idx))
-    for m, i in zip(maps, ident):
-        m[idx] = i
-    return maps
 
 
 def _refine(v, topo, crease, owner, maps):
