@@ -32,14 +32,15 @@ def _export_shape(obj):
     raise SurfmodError(f"objects: cannot export {type(obj).__name__} (expected surfaces, curves or build123d shapes)")
 
 
-def _as_list(objects):
-    if isinstance(objects, (list, tuple)):
-        items = list(objects)
-    else:
-        items = [objects]
+def _exported(objects):
+    """The one TopoDS shape to write: the shape of one object, a compound of several."""
+    from ..occ.topo import compound
+
+    items = list(objects) if isinstance(objects, (list, tuple)) else [objects]
     if not items:
         raise SurfmodError("objects: nothing to export")
-    return items
+    shapes = [_export_shape(o) for o in items]
+    return shapes[0] if len(shapes) == 1 else compound(shapes)
 
 
 def export_step(objects, path, *, strict: bool = False) -> None:
@@ -63,11 +64,9 @@ def export_step(objects, path, *, strict: bool = False) -> None:
     >>> sm.export_step(sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0)), os.path.join(d, "p.step"))
     """
     from ..occ.step import write_step
-    from ..occ.topo import compound
 
     target = target_path(path, "path", (".step", ".stp"))
-    shapes = [_export_shape(o) for o in _as_list(objects)]
-    shape = shapes[0] if len(shapes) == 1 else compound(shapes)
+    shape = _exported(objects)
     with atomic_path(target) as tmp:
         write_step(shape, tmp)
         with warnings.catch_warnings():
@@ -122,12 +121,10 @@ def export_iges(objects, path, *, brep: bool = False) -> None:
     >>> len(sm.import_iges(path).faces())
     1
     """
-    from ..occ.topo import compound
     from ..occ.iges import write_iges
 
     target = target_path(path, "path", IGES_SUFFIXES)
-    shapes = [_export_shape(o) for o in _as_list(objects)]
-    shape = shapes[0] if len(shapes) == 1 else compound(shapes)
+    shape = _exported(objects)
     with atomic_path(target) as tmp:
         write_iges(shape, tmp, brep=bool(brep))
 
