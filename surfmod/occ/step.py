@@ -31,13 +31,9 @@ from .guard import kernel
 from .properties import solid_figures
 
 
-def _quiet_messages() -> None:
-    """OCCT's STEP translator prints statistics banners to stdout; keep only failures."""
-    for printer in Message.DefaultMessenger_s().Printers():
-        printer.SetTraceLevel(Message_Gravity.Message_Fail)
-
-
-_quiet_messages()
+# OCCT's STEP translator prints statistics banners to stdout: only failures are kept
+for _printer in Message.DefaultMessenger_s().Printers():
+    _printer.SetTraceLevel(Message_Gravity.Message_Fail)
 
 
 def _solid_shells_forward(solid):

@@ -366,11 +366,6 @@ class _GmshFailure(Exception):
     """gmsh could not mesh the part as given (retried healed, then reported)."""
 
 
-def _part_name(obj) -> str:
-    """``"obj"`` for a shape, ``"obj: part.step"``-style naming for a file."""
-    return f"obj: {Path(obj).name}" if isinstance(obj, (str, Path)) else "obj: this part"
-
-
 def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None,
             max_elements: int = 2_000_000, progress: bool = False) -> FEMesh:
     """Triangle (``kind="surface"``) or tetrahedral (``kind="volume"``) FE mesh of a part
@@ -476,7 +471,8 @@ def fe_mesh(obj, size: float, order: int = 1, kind: str = "volume", *, path=None
         else:
             tried = ", ".join(attempts[:-1]) + " or " + attempts[-1]
             raise SurfmodError(
-                f"{_part_name(obj)}: gmsh cannot {kind}-mesh it at size {size:g}, tried {tried} "
+                f"obj: {Path(obj).name if isinstance(obj, (str, Path)) else 'this part'}: gmsh cannot {kind}-mesh "
+                f"it at size {size:g}, tried {tried} "
                 f"({'; '.join(dict.fromkeys(failures))})"
             )
     quality["inverted"] = 0
