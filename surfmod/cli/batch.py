@@ -73,16 +73,12 @@ def step_files(paths) -> list[Path]:
     return out
 
 
-def _watch_client(client_pid: int) -> None:
-    """In a local worker process: end it as soon as its client (the process that started
-    the run) is gone (:func:`surfmod.child.die_with`); nothing in the client itself (a
-    run of one job stays in the client)."""
+def _watched(job, client_pid, path, options):
+    """``job(path, **options)``; in a local worker process, which then ends as soon as its
+    client (the process that started the run) is gone (:func:`surfmod.child.die_with`),
+    or in the client itself (a run of one job stays there)."""
     if os.getpid() != client_pid:
         child.die_with(client_pid)
-
-
-def _watched(job, client_pid, path, options):
-    _watch_client(client_pid)
     return job(path, **options)
 
 
