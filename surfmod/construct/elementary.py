@@ -46,6 +46,13 @@ class ElementarySurface(Surface):
 
     _linear_u = False  # u is a length (scales under similarity)
     _linear_v = False
+    #: the OCCT kind (``occ.analytic.elementary``), the parameters (in the order of
+    #: ``_trusted``; ``_occt_sizes`` where OCCT takes another) and those of them that are
+    #: lengths (they scale under a similarity)
+    _kind = ""
+    _sizes: tuple = ()
+    _occt_sizes: tuple = ()
+    _lengths: tuple = ()
 
     def _init_frame(self, frame, u_range, v_range):
         self.origin, self.x_dir, self.y_dir, self.z_dir = (checks.frozen(a) for a in frame)
@@ -57,6 +64,13 @@ class ElementarySurface(Surface):
         obj._init_frame(frame, u_range, v_range)
         obj._set_params(*params)
         return obj
+
+    def _set_params(self, *values):
+        for name, value in zip(self._sizes, values):
+            setattr(self, name, float(value))
+
+    def _scaled_params(self, s):
+        return tuple(getattr(self, n) * s if n in self._lengths else getattr(self, n) for n in self._sizes)
 
     @property
     def frame(self):
@@ -103,7 +117,10 @@ class ElementarySurface(Surface):
         raise NotImplementedError
 
     def geom(self):
-        return self._twin(self._build_geom)
+        from ..occ.analytic import elementary
+
+        return self._twin(lambda: elementary(self._kind, self.frame,
+                                                     *(getattr(self, n) for n in self._occt_sizes or self._sizes)))
 
     def transformed(self, matrix):
         """Similarity: same analytic type with a moved frame; otherwise the exact NURBS form
@@ -133,6 +150,7 @@ class PlaneSurface(ElementarySurface):
     """
 
     occt_construct = "Geom_Plane"
+    _kind = "plane"
     _linear_u = _linear_v = True
 
     @property
@@ -145,12 +163,6 @@ class PlaneSurface(ElementarySurface):
         self._init_frame(frame, _range(u_range, "u_range", None), _range(v_range, "v_range", None))
         self._set_params()
 
-    def _set_params(self):
-        pass
-
-    def _scaled_params(self, s):
-        return ()
-
     def _coefficients(self, u, v, order):
         fx, fy, fz = _zeros(np.broadcast_shapes(np.shape(u), np.shape(v)), order)
         fx[..., 0, 0], fy[..., 0, 0] = u, v
@@ -161,11 +173,6 @@ class PlaneSurface(ElementarySurface):
 
     def _closest_local(self, local, box):
         return closest.plane(local, box)
-
-    def _build_geom(self):
-        from ..occ.analytic import elementary
-
-        return elementary("plane", self.frame)
 
     def implicit(self, xyz) -> np.ndarray:
         """Signed distance ``(x - O) . Z``."""
@@ -188,6 +195,7 @@ class CylindricalSurface(ElementarySurface):
     """
 
     occt_construct = "Geom_CylindricalSurface"
+    _kind, _sizes, _lengths = "cylinder", ("radius",), ("radius",)
     _linear_v = True
 
     def __init__(self, radius, origin=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *, u_range=None, v_range=(0.0, 1.0)):
@@ -195,12 +203,6 @@ class CylindricalSurface(ElementarySurface):
         frame = make_frame(origin, axis, x_dir, origin_name="origin")
         self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), _range(v_range, "v_range", None))
         self._set_params(r)
-
-    def _set_params(self, radius):
-        self.radius = float(radius)
-
-    def _scaled_params(self, s):
-        return (self.radius * s,)
 
     def _coefficients(self, u, v, order):
         fx, fy, fz = _zeros(np.broadcast_shapes(np.shape(u), np.shape(v)), order)
@@ -214,11 +216,6 @@ class CylindricalSurface(ElementarySurface):
 
     def _closest_local(self, local, box):
         return closest.cylinder(local, box)
-
-    def _build_geom(self):
-        from ..occ.analytic import elementary
-
-        return elementary("cylinder", self.frame, self.radius)
 
     def implicit(self, xyz) -> np.ndarray:
         """``x^2 + y^2 - R^2`` in the frame."""
@@ -244,6 +241,8 @@ class ConicalSurface(ElementarySurface):
     """
 
     occt_construct = "Geom_ConicalSurface"
+    _kind, _sizes, _lengths = "cone", ("radius", "semi_angle"), ("radius",)
+    _occt_sizes = ("semi_angle", "radius")
     _linear_v = True
 
     def __init__(self, semi_angle, ref_radius=0.0, origin=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *,
@@ -257,12 +256,6 @@ class ConicalSurface(ElementarySurface):
         frame = make_frame(origin, axis, x_dir, origin_name="origin")
         self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), _range(v_range, "v_range", None))
         self._set_params(r, a)
-
-    def _set_params(self, radius, semi_angle):
-        self.radius, self.semi_angle = float(radius), float(semi_angle)
-
-    def _scaled_params(self, s):
-        return (self.radius * s, self.semi_angle)
 
     @property
     def apex(self) -> np.ndarray:
@@ -283,11 +276,6 @@ class ConicalSurface(ElementarySurface):
 
     def _closest_local(self, local, box):
         return closest.cone(local, box, self.radius, self.semi_angle)
-
-    def _build_geom(self):
-        from ..occ.analytic import elementary
-
-        return elementary("cone", self.frame, self.semi_angle, self.radius)
 
     def implicit(self, xyz) -> np.ndarray:
         """``x^2 + y^2 - (R + z tan a)^2`` in the frame."""
@@ -313,6 +301,7 @@ class SphericalSurface(ElementarySurface):
     """
 
     occt_construct = "Geom_SphericalSurface"
+    _kind, _sizes, _lengths = "sphere", ("radius",), ("radius",)
 
     def __init__(self, radius, center=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *, u_range=None, v_range=None):
         r = checks.positive(radius, "radius")
@@ -322,12 +311,6 @@ class SphericalSurface(ElementarySurface):
             raise SurfmodError(f"v_range: latitude must stay within [-pi/2, pi/2], got {vr}")
         self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), vr)
         self._set_params(r)
-
-    def _set_params(self, radius):
-        self.radius = float(radius)
-
-    def _scaled_params(self, s):
-        return (self.radius * s,)
 
     @property
     def center(self) -> np.ndarray:
@@ -348,11 +331,6 @@ class SphericalSurface(ElementarySurface):
 
     def _closest_local(self, local, box):
         return closest.sphere(local, box)
-
-    def _build_geom(self):
-        from ..occ.analytic import elementary
-
-        return elementary("sphere", self.frame, self.radius)
 
     def implicit(self, xyz) -> np.ndarray:
         """``|x - C|^2 - R^2``."""
@@ -376,6 +354,7 @@ class ToroidalSurface(ElementarySurface):
     """
 
     occt_construct = "Geom_ToroidalSurface"
+    _kind, _sizes, _lengths = "torus", ("major", "minor"), ("major", "minor")
 
     def __init__(self, major, minor, center=(0, 0, 0), axis=(0, 0, 1), x_dir=None, *, u_range=None, v_range=None):
         big = checks.positive(major, "major")
@@ -385,12 +364,6 @@ class ToroidalSurface(ElementarySurface):
         frame = make_frame(center, axis, x_dir)
         self._init_frame(frame, _range(u_range, "u_range", (0.0, TWO_PI)), _range(v_range, "v_range", (0.0, TWO_PI)))
         self._set_params(big, small)
-
-    def _set_params(self, major, minor):
-        self.major, self.minor = float(major), float(minor)
-
-    def _scaled_params(self, s):
-        return (self.major * s, self.minor * s)
 
     @property
     def center(self) -> np.ndarray:
@@ -410,11 +383,6 @@ class ToroidalSurface(ElementarySurface):
 
     def _closest_local(self, local, box):
         return closest.torus(local, box, self.major)
-
-    def _build_geom(self):
-        from ..occ.analytic import elementary
-
-        return elementary("torus", self.frame, self.major, self.minor)
 
     def implicit(self, xyz) -> np.ndarray:
         """``(|p|^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + y^2)`` in the frame."""

@@ -107,34 +107,25 @@ class RevolutionSurface(Surface):
         return self.u_range, tuple(float(t) for t in self.profile.domain)
 
     def _derivatives(self, u, v, order):
-        a, o = self.axis_direction, self.axis_origin
-        c = self.profile._derivatives(v, order)  # (N, K, 3)
-        c[:, 0] -= o
-        along = np.einsum("nkd,d->nk", c, a)[..., None] * a  # axial part, (N, K, 3)
-        radial = c - along
-        cross = np.cross(a, radial)
-        out = np.empty((u.size, order + 1, order + 1, 3))
-        for k in range(order + 1):
-            ck, sk = cos_d(u, k)[:, None, None], sin_d(u, k)[:, None, None]
-            out[:, k] = ck * radial + sk * cross
-        out[:, 0] += along
-        out[:, 0, 0] += o
-        return out
+        return self._rotated(self.profile._derivatives(v, order), u[:, None, None], (u.size,), order)
 
     def _grid_derivatives(self, us, vs, order):
         """Tensor grid: the profile is evaluated once per v, the rotation once per u."""
+        return self._rotated(self.profile._derivatives(vs, order), us[:, None, None, None], (us.size, vs.size), order)
+
+    def _rotated(self, c, u, shape, order):
+        """Partials ``shape + (K, K, 3)`` of the profile's partials ``c`` (``(.., K, 3)``)
+        turned by the angles ``u`` (broadcasting against ``c``)."""
         a, o = self.axis_direction, self.axis_origin
-        c = self.profile._derivatives(vs, order)  # (nv, K, 3)
-        c[:, 0] -= o
-        along = np.einsum("nkd,d->nk", c, a)[..., None] * a
+        c[..., 0, :] -= o
+        along = np.einsum("...kd,d->...k", c, a)[..., None] * a  # axial part
         radial = c - along
         cross = np.cross(a, radial)
-        out = np.empty((us.size, vs.size, order + 1, order + 1, 3))
+        out = np.empty((*shape, order + 1, order + 1, 3))
         for k in range(order + 1):
-            ck, sk = cos_d(us, k)[:, None, None, None], sin_d(us, k)[:, None, None, None]
-            out[:, :, k] = ck * radial[None] + sk * cross[None]
-        out[:, :, 0] += along[None]
-        out[:, :, 0, 0] += o
+            out[..., k, :, :] = cos_d(u, k) * radial + sin_d(u, k) * cross
+        out[..., 0, :, :] += along
+        out[..., 0, 0, :] += o
         return out
 
     def geom(self):

@@ -122,6 +122,11 @@ def _side_points(s, side, count):
     return t, s.points(*side_params(s, side, t))
 
 
+def _size(s: Surface) -> float:
+    """The largest extent of a 5 x 5 sample grid of ``s``: the scale of the tests below."""
+    return max(np.ptp(s.grid(*(np.linspace(*d, 5) for d in s.domain)).reshape(-1, 3), axis=0).max(), 1e-300)
+
+
 def _one_sided(p, q):
     """Largest distance from a point of ``p`` to the nearest point of ``q``."""
     return float(np.linalg.norm(p[:, None, :] - q[None, :, :], axis=2).min(axis=1).max())
@@ -132,7 +137,7 @@ def match_sides(a: Surface, b: Surface, probe: int = 41):
     along the side of ``b`` (sampled, then refined by exact closest points; the side of
     ``a`` may be a part of the side of ``b``; degenerate sides such as poles are skipped)
     and that distance."""
-    size = max(np.ptp(a.grid(*(np.linspace(*d, 5) for d in a.domain)).reshape(-1, 3), axis=0).max(), 1e-300)
+    size = _size(a)
     best = (np.inf, None, None)
     for sa in SIDES:
         _, pa = _side_points(a, sa, probe)
@@ -185,21 +190,27 @@ def _pair(a: Surface, b: Surface, side_a: str, side_b: str, samples: int, occt: 
     db = b.derivatives(ub, vb, 2)
     along_a, in_a = side_vectors(a, side_a, da)
     _, in_b = side_vectors(b, side_b, db)
-    gap, angle, jump, k_a, k_b, flip = measure(da, in_a, db, in_b, along_a)
-    uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
+    return _result(label, a, (ua, va), da, in_a, b, (ub, vb), db, in_b, along_a, occt)
+
+
+def _result(label, a, uv_a, da, in_a, b, uv_b, db, in_b, along, occt: bool) -> Continuity:
+    """The measures of derivatives ``da``, ``db`` (order 2) at ``uv_a``, ``uv_b``, with
+    the directions into each surface and along the boundary, and OCCT's when asked for."""
+    gap, angle, jump, k_a, k_b, flip = measure(da, in_a, db, in_b, along)
+    uv_a, uv_b = np.stack(uv_a, axis=1), np.stack(uv_b, axis=1)
     ref = None
     if occt:
         from ..occ.local_analysis import local_analysis
 
         ref = local_analysis(a.geom(), uv_a, b.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
-    return Continuity(label, pa, gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
+    return Continuity(label, da[:, 0, 0], gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
 
 
 def _projected(a: Surface, b: Surface, samples: int, occt: bool):
     """Fallback when no side of ``b`` runs along a side of ``a`` (e.g. ``b`` is a trimmed
     face such as OCCT's filling): the side of ``a`` lying on ``b`` is found by projecting
     its samples onto ``b``; ``b`` is taken to continue ``a`` across that side."""
-    size = max(np.ptp(a.grid(*(np.linspace(*d, 5) for d in a.domain)).reshape(-1, 3), axis=0).max(), 1e-300)
+    size = _size(a)
     best = (np.inf, None)
     for side in SIDES:
         _, pts = _side_points(a, side, 9)
@@ -218,14 +229,7 @@ def _projected(a: Surface, b: Surface, samples: int, occt: bool):
     ub, vb, _, _ = closest_points(b, da[:, 0, 0])
     db = b.derivatives(ub, vb, 2)
     along_a, in_a = side_vectors(a, side_a, da)
-    gap, angle, jump, k_a, k_b, flip = measure(da, in_a, db, -in_a, along_a)
-    uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
-    ref = None
-    if occt:
-        from ..occ.local_analysis import local_analysis
-
-        ref = local_analysis(a.geom(), uv_a, b.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
-    return Continuity(f"a.{side_a} | b (projected)", da[:, 0, 0], gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
+    return _result(f"a.{side_a} | b (projected)", a, (ua, va), da, in_a, b, (ub, vb), db, -in_a, along_a, occt)
 
 
 # -- faces and shells -----------------------------------------------------------------------------
@@ -243,16 +247,8 @@ def _edge_result(rec, surfaces, occt: bool, label: str):
     ua, va = _clip_uv(sa, uva)
     ub, vb = _clip_uv(sb, uvb)
     da, db = sa.derivatives(ua, va, 2), sb.derivatives(ub, vb, 2)
-    tangent = _to_3d(da, rec["tangent"][0])
-    gap, angle, jump, k_a, k_b, flip = measure(
-        da, _to_3d(da, rec["inward"][0]), db, _to_3d(db, rec["inward"][1]), tangent)
-    uv_a, uv_b = np.stack([ua, va], axis=1), np.stack([ub, vb], axis=1)
-    ref = None
-    if occt:
-        from ..occ.local_analysis import local_analysis
-
-        ref = local_analysis(sa.geom(), uv_a, sb.geom(), uv_b, reverse_b=bool(np.median(flip) < 0))
-    return Continuity(label, da[:, 0, 0], gap, angle, jump, k_a, k_b, uv_a, uv_b, ref)
+    return _result(label, sa, (ua, va), da, _to_3d(da, rec["inward"][0]), sb, (ub, vb), db,
+                   _to_3d(db, rec["inward"][1]), _to_3d(da, rec["tangent"][0]), occt)
 
 
 def _combined(label, parts):
