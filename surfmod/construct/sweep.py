@@ -122,11 +122,9 @@ class SweptSurface(Surface):
                     f"path: the curvature vanishes near t = {ts[i]:g}, the Frenet frame is undefined there "
                     "(use mode='corrected_frenet')"
                 )
-            else:
-                self._straight = False
-        if self.guide is None and (self.mode == "corrected_frenet" or getattr(self, "_straight", False)):
-            kappa = frenet_frames(d[:1, 1], d[:1, 2])[1][0]
-            n0 = frenet_frames(d[:1, 1], d[:1, 2])[0][0][:, 1] if kappa * size > 1e-9 else any_normal(tang[0])
+        if self.guide is None and (self.mode == "corrected_frenet" or self._straight):
+            frames, kappa = frenet_frames(d[:1, 1], d[:1, 2])
+            n0 = frames[0][:, 1] if kappa[0] * size > 1e-9 else any_normal(tang[0])
             self._rmf = RotationMinimizingTable(ts, d[:, 0], tang, n0)
         # local coordinates of the sections in their frames
         p = self.path._derivatives(np.array([v0, v1]), 0)[:, 0]
@@ -155,7 +153,7 @@ class SweptSurface(Surface):
         (u0, u1) = self.profile.domain
         us = np.linspace(u0, u1, 9)
         vs = np.linspace(*self._v, 9)
-        pts = self._eval(np.repeat(us, 9), np.tile(vs, 9), 0)[:, 0, 0]
+        pts = self._derivatives(np.repeat(us, 9), np.tile(vs, 9), 0)[:, 0, 0]
         return float(np.ptp(pts, axis=0).max())
 
     def _guide_prepare(self):
@@ -263,7 +261,7 @@ class SweptSurface(Surface):
         b *= scale ** np.arange(order + 1)[None, :, None]  # chain rule for the mapped parameter
         return la, b @ self._r1
 
-    def _eval(self, u, v, order):
+    def _derivatives(self, u, v, order):
         """``(N, order+1, order+1, 3)`` with v-derivatives by 5-point differences."""
         u = np.asarray(u, dtype=float).ravel()
         v = np.asarray(v, dtype=float).ravel()
@@ -318,9 +316,6 @@ class SweptSurface(Surface):
         kind[v - reach < lo] = 1
         return kind
 
-    def _derivatives(self, u, v, order):
-        return self._eval(u, v, order)
-
     # -- OCCT twin -----------------------------------------------------------------------------
     def _pipe(self):
         cached = getattr(self, "_pipe_cache", None)
@@ -328,31 +323,26 @@ class SweptSurface(Surface):
             return cached
         from ..occ.sweep import pipe_shell
 
-        def occ(curve):
-            c = curve.to_bspline()
-            return (c.geom(), *c.domain)
-
-        profiles = [occ(self.profile)] + ([occ(self.end_profile)] if self.end_profile is not None else [])
+        profiles = self._profiles()
         if self.guide is not None:
             law = None
             if self.guide_scale:
                 vs = np.linspace(*self._v, 201)
                 law = (vs, self._guide_scale(vs))
-            shape, faces = pipe_shell(profiles, occ(self.path), mode="auxiliary", auxiliary=occ(self.guide),
+            shape, faces = pipe_shell(profiles, _occ(self.path), mode="auxiliary", auxiliary=_occ(self.guide),
                                       scale_law=law)
         elif self.mode == "frenet" and self.twist == 0.0 and not self._straight:
-            shape, faces = pipe_shell(profiles, occ(self.path), mode="frenet")
+            shape, faces = pipe_shell(profiles, _occ(self.path), mode="frenet")
         else:
             # OCCT's own CorrectedFrenet law is a coarse approximation of the
             # rotation-minimizing frame (about ten angle samples, then smoothed); the
             # auxiliary spine traced from our frame makes OCCT sweep *our* definition.
             # OCCT finds the rail point in the normal plane: a rail close to the path
             # keeps that intersection unique (coiled paths), so shrink it on failure.
-
             for offset in (0.05, 0.01, 0.002):
                 try:
-                    rail = occ(self._frame_rail(offset))
-                    shape, faces = pipe_shell(profiles, occ(self.path), mode="auxiliary", auxiliary=rail)
+                    rail = _occ(self._frame_rail(offset))
+                    shape, faces = pipe_shell(profiles, _occ(self.path), mode="auxiliary", auxiliary=rail)
                     break
                 except KernelError:
                     if offset == 0.002:
@@ -368,12 +358,10 @@ class SweptSurface(Surface):
         CorrectedFrenet is from the exact rotation-minimizing frame."""
         from ..occ.sweep import pipe_shell
 
-        def occ(curve):
-            c = curve.to_bspline()
-            return (c.geom(), *c.domain)
+        return build123d_face(pipe_shell(self._profiles(), _occ(self.path), mode=self.mode)[1][0])
 
-        profiles = [occ(self.profile)] + ([occ(self.end_profile)] if self.end_profile is not None else [])
-        return build123d_face(pipe_shell(profiles, occ(self.path), mode=self.mode)[1][0])
+    def _profiles(self) -> list:
+        return [_occ(c) for c in (self.profile, self.end_profile) if c is not None]
 
     def _frame_rail(self, offset=0.05):
         """An auxiliary spine for OCCT: the path offset along our (twisted) normal,
@@ -414,6 +402,12 @@ class SweptSurface(Surface):
             guide=None if self.guide is None else self.guide.transformed(m),
             guide_scale=self.guide_scale,
         )
+
+
+def _occ(curve) -> tuple:
+    """A curve as the pipe shell takes it: its B-spline's ``Geom_BSplineCurve`` and domain."""
+    c = curve.to_bspline()
+    return (c.geom(), *c.domain)
 
 
 def sweep(profile, path, *, end_profile=None, twist: float = 0.0, mode: str = "frenet", guide=None,
