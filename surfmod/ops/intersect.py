@@ -201,15 +201,15 @@ def _implicit_seeds(problem, s):
     X = np.stack([uu, vv], axis=1)
     F = problem.evaluate(X)[0][:, 0].reshape(len(us), len(vs))
     starts, fixed = [], []
-    # along u (v fixed): edges (i, j) - (i + 1, j)
-    i, j = np.nonzero(F[:-1] * F[1:] < 0)
-    t = F[i, j] / (F[i, j] - F[i + 1, j])
-    starts.append(np.stack([us[i] + t * (us[i + 1] - us[i]), vs[j]], axis=1))
-    fixed.append(np.full(i.size, 1))
-    i, j = np.nonzero(F[:, :-1] * F[:, 1:] < 0)
-    t = F[i, j] / (F[i, j] - F[i, j + 1])
-    starts.append(np.stack([us[i], vs[j] + t * (vs[j + 1] - vs[j])], axis=1))
-    fixed.append(np.full(i.size, 0))
+    # sign changes along u (v held: edges (i, j) - (i + 1, j)), then along v
+    for axis, (lo, hi) in enumerate(((F[:-1], F[1:]), (F[:, :-1], F[:, 1:]))):
+        i, j = np.nonzero(lo * hi < 0)
+        t = lo[i, j] / (lo[i, j] - hi[i, j])
+        uv = [us[i], vs[j]]
+        lines, k = (us, i) if axis == 0 else (vs, j)
+        uv[axis] = lines[k] + t * (lines[k + 1] - lines[k])
+        starts.append(np.stack(uv, axis=1))
+        fixed.append(np.full(i.size, 1 - axis))
     i, j = np.nonzero(F == 0)
     starts.append(np.stack([us[i], vs[j]], axis=1))
     fixed.append(np.full(i.size, 0))

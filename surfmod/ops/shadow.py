@@ -75,16 +75,6 @@ class Shadow:
         return np.stack([p @ x, p @ y], axis=-1)
 
 
-def _projector(origin, normal, light):
-    """``P -> P - ((P - o).n / (L.n)) L`` as a function, and the 2-D map of the frame."""
-    ln = light @ normal
-
-    def project(p):
-        return p - (((p - origin) @ normal) / ln)[..., None] * light
-
-    return project
-
-
 def _boundary_polylines(s: Surface, density: int = 8):
     """The four domain edges, sampled at every knot and ``density`` points per span (at
     least 200 per edge), collapsed edges dropped."""
@@ -198,7 +188,10 @@ def shadow(obj: Surface, light_direction, plane, *, max_angle: float = 2.5) -> S
         raise SurfmodError("light_direction: parallel to the plane, the shadow is undefined")
     angle = checks.positive(max_angle, "max_angle")
     o, xdir, ydir, n = plane_frame(origin, normal)
-    proj = _projector(origin, normal, light)
+
+    def proj(p):
+        """``P - ((P - o).n / (L.n)) L``: along the light onto the plane."""
+        return p - (((p - origin) @ normal) / (light @ normal))[..., None] * light
 
     def to2d(p, vector=False):
         q = (p - (((p @ n) / (light @ n))[..., None]) * light) if vector else proj(p) - o
