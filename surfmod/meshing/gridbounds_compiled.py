@@ -14,22 +14,16 @@ from numba import njit
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _diff(S, A, B, a, I0, K, along_u, d):
+def _diff(S, A, B, a, K, su, sv, d):
     """Derivative of coordinate ``d`` (times twice the lattice step) at lattice point
-    ``(A, B)`` from the points of its own cell (cell-local index ``a`` along the
-    direction, cell start ``I0``): central inside, second-order one-sided on the sides,
-    so the stencil never straddles two cells of different sizes."""
-    if along_u:
-        if a == 0:
-            return -3.0 * S[A, B, d] + 4.0 * S[A + 1, B, d] - S[A + 2, B, d]
-        if a == K:
-            return 3.0 * S[A, B, d] - 4.0 * S[A - 1, B, d] + S[A - 2, B, d]
-        return S[A + 1, B, d] - S[A - 1, B, d]
+    ``(A, B)`` along the lattice step ``(su, sv)`` from the points of its own cell
+    (``a``: the point's index in the cell along it): central inside, second-order
+    one-sided on the sides, so the stencil never straddles two cells of different sizes."""
     if a == 0:
-        return -3.0 * S[A, B, d] + 4.0 * S[A, B + 1, d] - S[A, B + 2, d]
+        return -3.0 * S[A, B, d] + 4.0 * S[A + su, B + sv, d] - S[A + 2 * su, B + 2 * sv, d]
     if a == K:
-        return 3.0 * S[A, B, d] - 4.0 * S[A, B - 1, d] + S[A, B - 2, d]
-    return S[A, B + 1, d] - S[A, B - 1, d]
+        return 3.0 * S[A, B, d] - 4.0 * S[A - su, B - sv, d] + S[A - 2 * su, B - 2 * sv, d]
+    return S[A + su, B + sv, d] - S[A - su, B - sv, d]
 
 
 @njit(cache=True, error_model="numpy")
@@ -80,9 +74,6 @@ def estimates_compiled(S, K, diag, kmax, est, Q):
             J = min(B // K, ncv - 1)
             t = (B - K * J) / K
             a0, a1, b0, b1 = I * K, (I + 1) * K, J * K, (J + 1) * K
-            r0 = 0.0
-            r1 = 0.0
-            r2 = 0.0
             for d in range(3):
                 p00, p10, p01, p11 = S[a0, b0, d], S[a1, b0, d], S[a0, b1, d], S[a1, b1, d]
                 if diag[I, J]:
@@ -96,18 +87,11 @@ def estimates_compiled(S, K, diag, kmax, est, Q):
                     else:
                         q = p11 + (1.0 - s) * (p01 - p11) + (1.0 - t) * (p10 - p11)
                 Q[A, B, d] = q
-                if d == 0:
-                    r0 = S[A, B, 0] - q
-                elif d == 1:
-                    r1 = S[A, B, 1] - q
-                else:
-                    r2 = S[A, B, 2] - q
+            r0, r1, r2 = S[A, B, 0] - Q[A, B, 0], S[A, B, 1] - Q[A, B, 1], S[A, B, 2] - Q[A, B, 2]
             full = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
             ia, jb = A - K * I, B - K * J
-            u0, u1, u2 = _diff(S, A, B, ia, a0, K, True, 0), _diff(S, A, B, ia, a0, K, True, 1), _diff(
-                S, A, B, ia, a0, K, True, 2)
-            v0, v1, v2 = _diff(S, A, B, jb, b0, K, False, 0), _diff(S, A, B, jb, b0, K, False, 1), _diff(
-                S, A, B, jb, b0, K, False, 2)
+            u0, u1, u2 = _diff(S, A, B, ia, K, 1, 0, 0), _diff(S, A, B, ia, K, 1, 0, 1), _diff(S, A, B, ia, K, 1, 0, 2)
+            v0, v1, v2 = _diff(S, A, B, jb, K, 0, 1, 0), _diff(S, A, B, jb, K, 0, 1, 1), _diff(S, A, B, jb, K, 0, 1, 2)
             a = u0 * u0 + u1 * u1 + u2 * u2
             b = u0 * v0 + u1 * v1 + u2 * v2
             c = v0 * v0 + v1 * v1 + v2 * v2
@@ -141,11 +125,9 @@ def cell_maxima_compiled(est, K, err, eu, ev):
     nlu, nlv = est.shape
     ncu, ncv = err.shape
     h = K // 2
-    for i in range(ncu):
-        for j in range(ncv):
-            err[i, j] = 0.0
-            eu[i, j] = 0.0
-            ev[i, j] = 0.0
+    err[:] = 0.0
+    eu[:] = 0.0
+    ev[:] = 0.0
     for A in range(nlu):
         I = min(A // K, ncu - 1)
         a = A - K * I
