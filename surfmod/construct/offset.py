@@ -243,9 +243,7 @@ def thicken(s: Surface, thickness: float, tolerance: float = 1e-5, *, symmetric:
         size = np.ptp(pts, axis=0).max()
         if size < 1e-9 or np.allclose(pts, opposite, atol=1e-9 * max(1.0, size)):
             continue  # a pole, or a closed direction: the faces meet themselves there
-        value = {"u0": near.domain[0][0], "u1": near.domain[0][1], "v0": near.domain[1][0], "v1": near.domain[1][1]}
-        c_near = near.isocurve(**{"uv"[fixed]: value[side]})
-        far_value = far.domain[fixed][end]
-        c_far = far.isocurve(**{"uv"[fixed]: far_value})
+        c_near = near.isocurve(**{"uv"[fixed]: near.domain[fixed][end]})
+        c_far = far.isocurve(**{"uv"[fixed]: far.domain[fixed][end]})
         faces.append(ruled(c_near, c_far))
     return make_solid(faces)

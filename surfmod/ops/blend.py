@@ -29,7 +29,7 @@ from ..nets.bspline import BSplineSurface, cartesian
 from ..nets.convert import as_bspline_surface
 from ..readback import surface_of
 from ..nets.elevate import KNOT_TOL, elevate_degree, merged_knots
-from ..sides import SIDES
+from ..sides import SIDES, side_params
 from ..surface import Surface
 
 ORDERS = {"G0": 0, "G1": 1, "G2": 2}
@@ -97,21 +97,16 @@ def _compatible(curves):
 
 
 def _cartesian_speed(s: Surface, side: str, samples: int = 33) -> float:
-    fixed, end = SIDES[side]
-    lo, hi = s.domain[1 - fixed]
-    t = np.linspace(lo, hi, samples)
-    value = np.full_like(t, s.domain[fixed][end])
-    d = s.derivatives(*((value, t) if fixed == 0 else (t, value)), order=1)
+    fixed = SIDES[side][0]
+    d = s.derivatives(*side_params(s, side, np.linspace(*s.domain[1 - fixed], samples)), order=1)
     cross = d[:, 1, 0] if fixed == 0 else d[:, 0, 1]
     return float(np.linalg.norm(cross, axis=1).mean())
 
 
 def _normals_disagree(a: BSplineSurface, side: str, out: BSplineSurface) -> bool:
     """Does the blend's normal at the middle of its ``v = 0`` row oppose ``a``'s there?"""
-    fixed, end = SIDES[side]
-    lo, hi = a.domain[1 - fixed]
-    t, value = np.array([0.5 * (lo + hi)]), np.array([a.domain[fixed][end]])
-    n_a = a.normals(*((value, t) if fixed == 0 else (t, value)))
+    lo, hi = a.domain[1 - SIDES[side][0]]
+    n_a = a.normals(*side_params(a, side, np.array([0.5 * (lo + hi)])))
     n_out = out.normals(np.array([0.5]), np.array([0.0]))
     return float(np.sum(n_a * n_out)) < 0.0
 
@@ -231,11 +226,8 @@ def occt_blend(a: Surface, side_a: str, b: Surface, side_b: str, lateral: BSplin
         raise SurfmodError(f"order: expected C0, G1 or G2, got {order!r}")
     constraints, faces = [], []
     for s, side in ((a, side_a), (b, side_b)):
-        fixed, end = SIDES[side]
-        lo, hi = s.domain[1 - fixed]
-        mid = np.array([0.5 * (lo + hi)])
-        value = np.array([s.domain[fixed][end]])
-        point = s.points(*((value, mid) if fixed == 0 else (mid, value)))[0]
+        lo, hi = s.domain[1 - SIDES[side][0]]
+        point = s.points(*side_params(s, side, np.array([0.5 * (lo + hi)])))[0]
         face = s.face()
         constraints.append((nearest_edge(face, point), face, order))
         faces.append(face)

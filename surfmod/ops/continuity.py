@@ -112,9 +112,7 @@ class Continuity:
 
 
 def _free_samples(s: Surface, side: str, count: int):
-    fixed, _ = SIDES[side]
-    lo, hi = s.domain[1 - fixed]
-    return np.linspace(lo, hi, count)
+    return np.linspace(*s.domain[1 - SIDES[side][0]], count)
 
 
 def _side_points(s, side, count):
@@ -163,8 +161,8 @@ def _closest_on_side(s: Surface, side: str, points: np.ndarray, iterations: int 
     """Free parameter of the closest point on a side to each point (dense seed + Newton)."""
     seeds_t, seeds_p = _side_points(s, side, 512)
     t = seeds_t[np.argmin(np.linalg.norm(points[:, None] - seeds_p[None], axis=2), axis=1)]
-    lo, hi = s.domain[1 - SIDES[side][0]]
     fixed = SIDES[side][0]
+    lo, hi = s.domain[1 - fixed]
     for _ in range(iterations):
         d = s.derivatives(*side_params(s, side, t), order=2)
         c0 = d[:, 0, 0]
