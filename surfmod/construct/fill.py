@@ -185,7 +185,7 @@ def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: f
     s = np.linspace(0.0, 1.0, 17)
     centre = np.concatenate([rb.curve(s)[0] for rb in ribbons]).mean(axis=0)
     n = len(ribbons)
-    _, _, inradius = polygon(n)
+    verts, _, inradius = polygon(n)
     order = {"G0": 0, "G1": 1, "G2": 2}[continuity]
     for rb in ribbons:
         rb.centre = centre
@@ -196,7 +196,6 @@ def fill(boundary, continuity: str = "G1", *, tension: float = 1.0, tolerance: f
             rb.set_scale(tension * reach / (inradius * max(float(np.linalg.norm(cross, axis=1).mean()), 1e-300)))
     corners = match_corners(ribbons, order, size)
     check_corners(corners, continuity, allow_singular_corners, list(range(n)))
-    verts, _, _ = polygon(n)
     if n == 4:
         quads = [(verts[0], verts[1], verts[3], verts[2])]
     else:

@@ -45,7 +45,7 @@ from ..ops.closest import project_distances
 from . import analytic_distance
 from .closure import faces_against_neighbours
 from .deviation import DENSE, triangle_deviations
-from .facemesh import ANALYTIC, brepmesh
+from .facemesh import ANALYTIC, brepmesh, concatenated
 from .facesurface import FaceSurface
 from .figures import partial_figures, shape_figures
 from .polymesh import Mesh, weld
@@ -150,15 +150,6 @@ def _measure_numpy(fm, tolerance: float, bary, ev: FaceSurface) -> tuple[np.ndar
     return tri_dev, float(node.max(initial=0.0))
 
 
-def _concatenated(fms: list) -> tuple:
-    """``(nodes, triangles, node offsets, triangle offsets)`` of many face meshes end to
-    end, the triangles indexing the joined nodes."""
-    node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
-    tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
-    triangles = np.concatenate([fm.triangles + o for fm, o in zip(fms, node_at)])
-    return np.concatenate([fm.nodes for fm in fms]), triangles, node_at, tri_at
-
-
 def _packed(evs: list):
     """The B-spline nets of :class:`FaceSurface` s (``projector`` not None) with their
     parameter maps, as one :class:`surfmod.eval.packed.NetPack`."""
@@ -175,7 +166,7 @@ def measure_analytic_faces(fms: list, params: list, bary=DENSE) -> list[tuple[np
     kinds = np.array([k for k, _, _ in params])
     frames = np.array([f for _, f, _ in params], float).reshape(-1, 2, 3)
     sizes = np.array([z for _, _, z in params], float).reshape(-1, 2)
-    nodes, triangles, node_at, tri_at = _concatenated(fms)
+    nodes, triangles, node_at, tri_at = concatenated(fms)
     owner = np.repeat(np.arange(len(fms)), np.diff(node_at))
     node = elementary_closest.distances(kinds, frames, sizes, nodes, owner)
     # planes are measured at their nodes (exact: the distance is linear on a triangle),
@@ -200,7 +191,7 @@ def measure_spline_faces(fms: list, evs: list, tolerance: float, bary=DENSE) -> 
             raise SurfmodError(f"shape: BRepMesh gave face {fm.index} no (u, v) nodes to measure against")
     pk = _packed(evs)
     boxes = np.array([_bounds(fm, ev) for fm, ev in zip(fms, evs)])
-    nodes, triangles, node_at, tri_at = _concatenated(fms)
+    nodes, triangles, node_at, tri_at = concatenated(fms)
     uv = np.concatenate([fm.uv for fm in fms])
     faces = np.arange(len(fms))
     half = np.full(len(fms), 0.5 * tolerance)
@@ -525,9 +516,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     in_open_shell = set(opened)
     for solid in sorted({fm.solid for fm in fms}):
         part = [fm for fm in fms if fm.solid == solid]
-        offsets = np.cumsum([0] + [len(fm.nodes) for fm in part])
-        nodes = np.concatenate([fm.nodes for fm in part])
-        joined = np.concatenate([fm.triangles + o for fm, o in zip(part, offsets)])
+        nodes, joined, _, _ = concatenated(part)
         labels = np.concatenate([np.full(len(fm.triangles), fm.index) for fm in part])
         v, t = weld(nodes, joined)
         corner = nodes[joined]  # weld drops the triangles with two equal corners: so do the labels

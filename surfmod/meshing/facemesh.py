@@ -98,3 +98,12 @@ def brepmesh(shape, deflection: float, angular: float = 0.5, *, relative: bool =
     if not out:
         raise SurfmodError("shape: has no faces to triangulate")
     return out
+
+
+def concatenated(fms: list) -> tuple:
+    """``(nodes, triangles, node offsets, triangle offsets)`` of many face meshes end to
+    end, the triangles indexing the joined nodes."""
+    node_at = np.cumsum([0] + [len(fm.nodes) for fm in fms])
+    tri_at = np.cumsum([0] + [len(fm.triangles) for fm in fms])
+    triangles = np.concatenate([fm.triangles + o for fm, o in zip(fms, node_at)])
+    return np.concatenate([fm.nodes for fm in fms]), triangles, node_at, tri_at

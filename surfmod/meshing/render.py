@@ -31,7 +31,7 @@ from ..curve import Curve
 from ..errors import SurfmodError
 from ..readback import TrimmedFace
 from ..surface import Surface, model_size
-from .facemesh import brepmesh
+from .facemesh import brepmesh, concatenated
 from .figures import shape_diagonal
 from .grid import mesh as grid_mesh
 from .isocurves import isocurves as iso
@@ -129,15 +129,8 @@ def display_mesh(m: Mesh, budget: int) -> Mesh:
 
 
 def _shape_mesh(shape, fraction: float = DISPLAY_TOLERANCE) -> Mesh:
-    fms = brepmesh(shape, max(fraction * shape_diagonal(shape), 1e-9), 0.5)
-    verts, tris, offset = [], [], 0
-    for fm in fms:
-        verts.append(fm.nodes)
-        tris.append(fm.triangles + offset)
-        offset += len(fm.nodes)
-    if not verts:
-        raise SurfmodError("objects: the shape has no faces to draw")
-    return Mesh(np.concatenate(verts), np.concatenate(tris))
+    nodes, triangles, _, _ = concatenated(brepmesh(shape, max(fraction * shape_diagonal(shape), 1e-9), 0.5))
+    return Mesh(nodes, triangles)
 
 
 def _shape_edges(shape, samples: int = 48) -> list[np.ndarray]:
