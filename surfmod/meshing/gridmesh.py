@@ -11,22 +11,14 @@ equidistributing a chordal-error bound, then *verified* and refined where it fai
    lines.
 2. **Verification.**  Every cell is sampled on a ``6 x 6`` lattice (the 25 sample points
    per triangle of :mod:`surfmod.meshing.deviation`, for either diagonal), evaluated as
-   one tensor grid of positions (compiled loops in :mod:`surfmod.meshing.gridbounds_compiled`).
-   At each sample ``q = L(u, v)`` (the triangles' linear interpolation) the residual
-   ``r = S(u, v) - q`` is split into its tangential part (a Gauss-Newton step
-   ``J delta``, tangents by finite differences on the cell's lattice) and its normal
-   part; the distance from ``q`` to the surface is at most
-   ``|r_normal| + kappa |J delta|^2 / 2`` to second order (``kappa``: the largest
-   sampled normal curvature, times 1.5), and never more than ``|r|``.  When every cell
-   passes, the samples with the largest bounds are projected onto the surface by
-   Gauss-Newton (:func:`project_distances`), in rounds, until no unprojected bound
-   exceeds the measured maximum: the reported ``max_deviation`` is a measured one.
-3. **Refinement.**  Strips of failing cells get their density raised by
-   ``sqrt(err / tol)`` and all lines are placed again (midlines of the failing strips
-   are inserted after three such corrections, which always terminates); after a
-   passing grid, strips with room are coarsened the same way (twice at most, when it
-   saves at least 10 % of the cells) and the smallest passing grid is kept.  A
-   tolerance that cannot be reached within ``max_triangles`` raises.
+   one tensor grid of positions.  At each sample the distance from the triangles to the
+   surface is bounded to second order (:func:`surfmod.meshing.gridbounds_compiled.estimates_compiled`);
+   when every cell passes, the largest bounds are replaced by projections
+   (:meth:`GridMesh._project`): the reported ``max_deviation`` is a measured one.
+3. **Refinement.**  Strips of failing cells are refined (:meth:`GridMesh.refine`); after
+   a passing grid, strips with room are coarsened (:meth:`GridMesh.coarsen`) and the
+   smallest passing grid is kept.  A tolerance that cannot be reached within
+   ``max_triangles`` raises.
 
 Each cell is split along the diagonal whose midpoint lies closer to the surface.  Seams
 and poles share their vertices, so spheres and tori are watertight.

@@ -380,17 +380,11 @@ def grid_seeds(points, us, vs, g, e, gram, cross, seeds: int, n_basins: int) -> 
 
 
 def seed_starts(points, us, vs, g, seeds: int) -> np.ndarray:
-    """Newton starts ``(N, seeds + seeds // 2, 2)`` in (u, v) for each point.
-
-    The grid ``g`` is split into two triangles per cell.  On each triangle the closest
-    point of its plane with the barycentric coordinates clipped to the triangle (exact
-    inside, a good seed near edges) is the foot.  Starts: the ``seeds`` triangles with
-    the nearest feet, entered at those points; and the bottoms of the deepest valleys of
-    the sampled distance (samples no farther than their eight neighbours), because in a
-    nearly flat valley all nearest triangles sit in one basin.  The search is the
-    compiled branch and bound of :func:`grid_seeds_compiled` (cells whose nearest corner
-    is farther than the current ``seeds``-th foot plus the cell's diameter are skipped).
-    """
+    """Newton starts ``(N, seeds + max(2, seeds // 2), 2)`` in (u, v) for each point: the
+    starts of :func:`grid_seeds`, whose valley bottoms are there because in a nearly flat
+    valley all nearest triangles sit in one basin.  Large work runs in the compiled
+    branch and bound (``grid_seeds_compiled``: cells whose nearest corner is farther
+    than the current ``seeds``-th foot plus the cell's diameter are skipped)."""
     e, gram, cross, diam = triangle_tables(g)
     n_basins = max(2, seeds // 2)
     if len(points) * diam.size < COMPILED_SEED_PAIRS:  # small work: NumPy, no numba to load
