@@ -517,17 +517,14 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     for solid in sorted({fm.solid for fm in fms}):
         part = [fm for fm in fms if fm.solid == solid]
         nodes, joined, _, _ = concatenated(part)
-        labels = np.concatenate([np.full(len(fm.triangles), fm.index) for fm in part])
-        v, t = weld(nodes, joined)
-        corner = nodes[joined]  # weld drops the triangles with two equal corners: so do the labels
-        kept = ~(np.all(corner[:, 0] == corner[:, 1], axis=1) | np.all(corner[:, 1] == corner[:, 2], axis=1)
-                 | np.all(corner[:, 0] == corner[:, 2], axis=1))
+        v, t, kept = weld(nodes, joined)
+        labels = np.concatenate([np.full(len(fm.triangles), fm.index) for fm in part])[kept]
         # a solid of closed shells promises a closed, outward STL (judged when written)
         closes = solid >= 0 and not any(fm.index in in_open_shell for fm in part)
         if closes:
-            turn = faces_against_neighbours(t, labels[kept])
+            turn = faces_against_neighbours(t, labels)
             if turn:  # faces at odds with their neighbours: turned to agree, by the connectivity
-                flip = np.isin(labels[kept], turn)
+                flip = np.isin(labels, turn)
                 t = t.copy()
                 t[flip] = t[flip][:, ::-1]
                 faces_turned.append((solid + 1, turn))
@@ -543,7 +540,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
                               InsideOutWarning, stacklevel=3)
         tris.append(t + sum(len(x) for x in verts))
         verts.append(v)
-        groups.append((f"solid {solid + 1}" if closes else None, len(t), labels[kept]))
+        groups.append((f"solid {solid + 1}" if closes else None, len(t), labels))
     info = {
         "kind": "brepmesh",
         "tolerance": tolerance,

@@ -155,11 +155,9 @@ def faces_against_neighbours(tri: np.ndarray, labels: np.ndarray) -> list[int]:
     """
     tri = np.asarray(tri)
     labels = np.asarray(labels)
+    inverse, counts, _ = edge_uses(tri)
     directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
     owner = np.tile(labels, 3)
-    key = np.sort(directed, axis=1)
-    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    inverse = inverse.ravel()
     if (counts > 2).any():
         return []
     order = np.argsort(inverse, kind="stable")

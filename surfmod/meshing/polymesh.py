@@ -89,16 +89,17 @@ class Mesh:
         return trimesh.Trimesh(self.vertices, self.triangles(), process=False)
 
 
-def weld(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Merge vertices with identical coordinates and drop the triangles that collapse.
+def weld(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Merge vertices with identical coordinates and drop the triangles that collapse:
+    ``(vertices, triangles, kept)``, ``kept`` the mask of the triangles left.
 
     BRepMesh repeats the nodes of a shared edge in every face's triangulation, bit for
     bit, so exact equality is the right test (no distance threshold to choose).
 
-    >>> v, t = weld(np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0]]),
-    ...             np.array([[0, 1, 2], [3, 4, 2]]))
-    >>> len(v), t.tolist()
-    (4, [[0, 2, 1], [2, 3, 1]])
+    >>> v, t, kept = weld(np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0]]),
+    ...                   np.array([[0, 1, 2], [3, 4, 2], [1, 3, 0]]))
+    >>> len(v), t.tolist(), kept.tolist()
+    (4, [[0, 2, 1], [2, 3, 1]], [True, True, False])
     """
     # np.unique(axis=0)'s result (rows in lexicographic order) at half its cost: one
     # lexsort, then a new vertex wherever a sorted row differs from the one before
@@ -111,4 +112,4 @@ def weld(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.nd
     unique = rows[new]
     tri = inverse[triangles]
     keep = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
-    return unique, tri[keep]
+    return unique, tri[keep], keep
