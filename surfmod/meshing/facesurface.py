@@ -15,6 +15,8 @@ are clamped to the parameter range (pcurves may overshoot by a tolerance).
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 from ..construct.extrusion import TabulatedCylinder
@@ -58,6 +60,7 @@ class FaceSurface:
             self._spline = _extrusion_net(surface, bounds[2:])
         if self._spline is not None:
             self.range = tuple(tuple(float(x) for x in r) for r in self._spline.domain)
+        self._evaluator = self._surface if self._spline is None else self._spline
 
     @property
     def spline(self) -> bool:
@@ -71,16 +74,17 @@ class FaceSurface:
         """Whether evaluation runs in NumPy (else OCCT per point)."""
         return self._surface is not None
 
-    def _map(self, x: np.ndarray, direction: int) -> np.ndarray:
-        lo, hi = self.range[direction]
-        if self.periodic[direction]:
-            return lo + np.mod(x - lo, self.period[direction])
-        return np.clip(x, lo, hi)
+    def _mapped(self, u, v) -> tuple:
+        """``(u, v)`` as OCCT takes them: wrapped into periodic directions, else clamped."""
+        out = []
+        for direction, x in enumerate((np.asarray(u, float), np.asarray(v, float))):
+            lo, hi = self.range[direction]
+            out.append(lo + np.mod(x - lo, self.period[direction]) if self.periodic[direction] else np.clip(x, lo, hi))
+        return out
 
     def d1(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        evaluator = self._spline if self._spline is not None else self._surface
-        if evaluator is not None:
-            return evaluator._derivatives(self._map(np.asarray(u, float), 0), self._map(np.asarray(v, float), 1), 1)
+        if self._evaluator is not None:
+            return self._evaluator._derivatives(*self._mapped(u, v), 1)
         from ..occ.sample import surface_d2
 
         return surface_d2(self.surf, np.asarray(u, float), np.asarray(v, float))[:, :2, :2]
@@ -88,7 +92,7 @@ class FaceSurface:
     def d2(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Partials to order 2, ``(N, 3, 3, 3)``, of a surface evaluated as a spline
         (``spline`` is true)."""
-        return self._spline._derivatives(self._map(u, 0), self._map(v, 1), 2)
+        return self._spline._derivatives(*self._mapped(u, v), 2)
 
     @property
     def projector(self):
@@ -100,17 +104,13 @@ class FaceSurface:
             return None
         return self._project
 
-    @property
+    @cached_property
     def parameter_map(self) -> tuple:
         """``(lo, hi, period, periodic)`` per direction as the compiled kernels take them
         (how parameters wrap or clamp)."""
-        cached = self.__dict__.get("_parameter_map")
-        if cached is None:
-            cached = self._parameter_map = (
-                np.array([r[0] for r in self.range], float), np.array([r[1] for r in self.range], float),
+        return (np.array([r[0] for r in self.range], float), np.array([r[1] for r in self.range], float),
                 np.array([float(t) if k else 0.0 for t, k in zip(self.period, self.periodic)]),
                 np.array(self.periodic, bool))
-        return cached
 
     def _project(self, points: np.ndarray, uv: np.ndarray, bounds, threshold: float = 0.0) -> np.ndarray:
         from ..eval import projection_kernel  # numba: compiled on first use, then cached
@@ -125,10 +125,8 @@ class FaceSurface:
         return out
 
     def d0(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        evaluator = self._spline if self._spline is not None else self._surface
-        if evaluator is not None:
-            return evaluator._derivatives(self._map(np.asarray(u, float), 0), self._map(np.asarray(v, float), 1),
-                                          0)[:, 0, 0]
+        if self._evaluator is not None:
+            return self._evaluator._derivatives(*self._mapped(u, v), 0)[:, 0, 0]
         return self.d1(u, v)[:, 0, 0]
 
 
