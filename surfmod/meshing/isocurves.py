@@ -65,12 +65,11 @@ class IsoCurve(Curve):
     def to_bspline(self):
         if hasattr(self.surface, "isocurve"):
             return _spline_iso(self.surface, self.direction, self.value)
-
         return from_edge(self.edge())
 
 
 def _spline_iso(s, direction: int, value: float):
-    return s.isocurve(u=value) if direction == 0 else s.isocurve(v=value)
+    return s.isocurve(**{"uv"[direction]: value})
 
 
 @dataclass(frozen=True)
@@ -107,12 +106,8 @@ class IsoCurves:
         (u0, u1), (v0, v1) = self.surface.domain
         s = self.surface
         ul = s.grid(self.u_values, np.linspace(v0, v1, samples)) if self.u_values.size else np.zeros((0, samples, 3))
-        vl = (
-            s.grid(np.linspace(u0, u1, samples), self.v_values).transpose(1, 0, 2)
-            if self.v_values.size
-            else np.zeros((0, samples, 3))
-        )
-        return ul, vl
+        vl = s.grid(np.linspace(u0, u1, samples), self.v_values) if self.v_values.size else np.zeros((samples, 0, 3))
+        return ul, vl.transpose(1, 0, 2)
 
     def edges(self):
         """All iso-curves as build123d ``Edge`` objects (OCCT's exact counterparts)."""
@@ -144,10 +139,7 @@ def isocurves(s, nu: int, nv: int) -> IsoCurves:
     us = np.linspace(u0, u1, counts[0])
     vs = np.linspace(v0, v1, counts[1])
     exact = hasattr(s, "isocurve")
-    if exact:
-        uc = tuple(_spline_iso(s, 0, float(u)) for u in us)
-        vc = tuple(_spline_iso(s, 1, float(v)) for v in vs)
-    else:
-        uc = tuple(IsoCurve(s, 0, float(u)) for u in us)
-        vc = tuple(IsoCurve(s, 1, float(v)) for v in vs)
+    make = _spline_iso if exact else IsoCurve
+    uc = tuple(make(s, 0, float(u)) for u in us)
+    vc = tuple(make(s, 1, float(v)) for v in vs)
     return IsoCurves(s, checks.frozen(us), checks.frozen(vs), uc, vc, exact)

@@ -95,8 +95,6 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
     >>> m.info["kind"], m.info["closed"], m.info["max_deviation"] <= 0.05
     ('grid', (True, True), True)
     """
-    if method not in ("auto", "grid", "adaptive"):
-        raise SurfmodError(f"method: expected 'auto', 'grid' or 'adaptive', got {method!r}")
     size, estimate = _check_tolerance(s, tolerance, max_triangles)
     with tqdm(desc="tessellate", unit="pass", disable=not progress, leave=False) as bar:
         if method == "grid":
