@@ -51,7 +51,6 @@ class Loop:
         if self.kind == "polyline":
             return Loop("polyline", self.data[::-1].copy())
         c = self.data
-
         k = c.knots
         return Loop("bspline", BSplineCurve._trusted(c.control_points[::-1], c.degree, (k[0] + k[-1]) - k[::-1], None if c.weights is None else c.weights[::-1]))
 
@@ -101,9 +100,7 @@ def _loop(value, name, domain) -> Loop:
 
 def boundary_loops(s: Surface, boundary_curve_uv) -> list[Loop]:
     """Validated loops, oriented: the outer one counter-clockwise, holes clockwise."""
-    if isinstance(boundary_curve_uv, Curve):
-        raw = [boundary_curve_uv]
-    elif isinstance(boundary_curve_uv, np.ndarray) or _is_point_list(boundary_curve_uv):
+    if isinstance(boundary_curve_uv, (Curve, np.ndarray)) or _is_point_list(boundary_curve_uv):
         raw = [boundary_curve_uv]
     else:
         try:
