@@ -123,7 +123,6 @@ class ImplicitSurface:
                 break
         return p
 
-
     def to_explicit(self, x_range, y_range, z0: float = 0.0, tolerance: float | None = None):
         """The explicit form ``z = f(x, y)`` of the sheet of ``F = 0`` through the start
         height ``z0``, where it exists (``∂F/∂z ≠ 0`` over the rectangle): ``f`` solves

@@ -300,7 +300,6 @@ class GridMesh:
             self.vs = np.sort(np.concatenate([self.vs, 0.5 * (self.vs[jv] + self.vs[jv + 1])]))
         return True
 
-
     def coarsen(self) -> bool:
         """After a passing verification: lower the density of the strips whose cells all
         stay well inside the tolerance, by ``sqrt(err / tol)`` per strip (a cell's error
