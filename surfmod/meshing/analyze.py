@@ -154,7 +154,7 @@ def _face_samples(face, target: float, max_triangles: int = 20000):
 
 def _items(obj, name: str):
     """``[(surface, uv, triangles, orientation sign, face or None)]`` for the object."""
-    from ..occ.topo import faces_of, wrapped
+    from ..occ.topo import faces_of, solids_of, wrapped
 
     if isinstance(obj, Surface):
         return [("surface", obj)]
@@ -166,8 +166,6 @@ def _items(obj, name: str):
             continue
         if wrapped(item) is None:
             raise SurfmodError(f"{name}: expected a surfmod surface, a face or a shape, got {type(item).__name__}")
-        from ..occ.topo import solids_of
-
         kind = "solid face" if solids_of(wrapped(item)) else "face"
         out.extend((kind, f) for f in faces_of(item))
     if not out:
@@ -319,6 +317,5 @@ def analyze(obj, kind: str, out=None, *, light=None, stripes: int = 8, resolutio
     combs = _combs(sources, comb_curves, max(24, resolution), comb_scale) if kind == "comb" else ()
     result = Analysis(kind, light_dir, tuple(patches), combs)
     if out is not None:
-        path = write_analysis_png(result, out, eye, title=title, stripes=stripes)
-        result = Analysis(kind, light_dir, tuple(patches), combs, path)
+        result = replace(result, path=write_analysis_png(result, out, eye, title=title, stripes=stripes))
     return result

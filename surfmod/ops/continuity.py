@@ -318,8 +318,7 @@ def continuity(a, b=None, samples: int = 50, *, edge=None, occt: bool = False) -
         parts = _shell(a, samples, occt)
         return _combined(f"shell ({len(parts)} edges)", parts)
     if not isinstance(a, Surface) and not isinstance(b, Surface) and _is_shape(a) and _is_shape(b):
-        from ..occ.topo import compound
-        from ..occ.topo import wrapped
+        from ..occ.topo import compound, wrapped
 
         parts = _shell(compound([wrapped(a), wrapped(b)]), samples, occt, only_faces=(0, 1))
         if len(parts) == 1:
@@ -330,14 +329,13 @@ def continuity(a, b=None, samples: int = 50, *, edge=None, occt: bool = False) -
     b = surface_of(b, "b")
     if edge is None:
         return _matched(a, b, samples, occt)
-    else:
-        try:
-            side_a, side_b = edge
-        except (TypeError, ValueError):
-            raise SurfmodError(f"edge: expected (side_a, side_b), got {edge!r}") from None
-        for name, side in (("edge[0]", side_a), ("edge[1]", side_b)):
-            if side not in SIDES:
-                raise SurfmodError(f"{name}: side must be one of u0, u1, v0, v1, got {side!r}")
+    try:
+        side_a, side_b = edge
+    except (TypeError, ValueError):
+        raise SurfmodError(f"edge: expected (side_a, side_b), got {edge!r}") from None
+    for name, side in (("edge[0]", side_a), ("edge[1]", side_b)):
+        if side not in SIDES:
+            raise SurfmodError(f"{name}: side must be one of u0, u1, v0, v1, got {side!r}")
     return _pair(a, b, side_a, side_b, samples, occt, f"a.{side_a} | b.{side_b}")
 
 
