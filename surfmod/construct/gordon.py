@@ -249,16 +249,11 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
     prof = [prof[i] for i in order_p]
     guid = [guid[j] for j in order_g]
     u, v, un, vn = (a[np.ix_(order_p, order_g)] for a in (u, v, un, vn))
-    for i in range(len(prof)):
-        if np.any(np.diff(un[i]) <= 0):
-            raise SurfmodError(
-                f"profiles[{int(order_p[i])}]: crosses the guides in a different order than the other profiles"
-            )
-    for j in range(len(guid)):
-        if np.any(np.diff(vn[:, j]) <= 0):
-            raise SurfmodError(
-                f"guides[{int(order_g[j])}]: crosses the profiles in a different order than the other guides"
-            )
+    for name, other, order, rows in (("profiles", "guides", order_p, un), ("guides", "profiles", order_g, vn.T)):
+        for i, row in enumerate(rows):
+            if np.any(np.diff(row) <= 0):
+                raise SurfmodError(
+                    f"{name}[{int(order[i])}]: crosses the {other} in a different order than the other {name}")
     _check_ends(prof, u, un, tol, "profiles", order_p, "guides")
     _check_ends(guid, v.T, vn.T, tol, "guides", order_g, "profiles")
     un[:, 0], un[:, -1], vn[0], vn[-1] = 0.0, 1.0, 0.0, 1.0
