@@ -24,20 +24,25 @@ from .axes import cos_d, frame_transformed, make_frame, sin_d
 TWO_PI = 2.0 * math.pi
 
 
-def arc_bspline(center, x_axis, y_axis, t0: float, t1: float) -> BSplineCurve:
-    """Exact rational quadratic B-spline of ``center + cos t x_axis + sin t y_axis`` for
-    ``t`` in ``[t0, t1]`` (axes carry the semi-axis lengths); knots on ``[t0, t1]``."""
+def arc_segments(t0: float, t1: float) -> tuple:
+    """``(theta, scale, weights, knots)`` of the rational quadratic B-spline of the unit
+    circle over ``[t0, t1]`` (radians), in arcs of at most 90 degrees: the poles lie at
+    the angles ``theta``, ``scale`` from the centre; knots on ``[t0, t1]``."""
     span = t1 - t0
     nseg = max(1, int(math.ceil(abs(span) / (math.pi / 2) - 1e-9)))
     delta = span / nseg
     half = math.cos(delta / 2.0)
+    odd = np.arange(2 * nseg + 1) % 2 == 1
     theta = t0 + np.arange(2 * nseg + 1) * (delta / 2.0)
-    scale = np.where(np.arange(2 * nseg + 1) % 2 == 1, 1.0 / half, 1.0)
+    knots = np.concatenate([[t0] * 3, np.repeat(t0 + delta * np.arange(1, nseg), 2), [t1] * 3])
+    return theta, np.where(odd, 1.0 / half, 1.0), np.where(odd, half, 1.0), knots
+
+
+def arc_bspline(center, x_axis, y_axis, t0: float, t1: float) -> BSplineCurve:
+    """Exact rational quadratic B-spline of ``center + cos t x_axis + sin t y_axis`` for
+    ``t`` in ``[t0, t1]`` (axes carry the semi-axis lengths); knots on ``[t0, t1]``."""
+    theta, scale, w, knots = arc_segments(t0, t1)
     pts = center + (np.cos(theta) * scale)[:, None] * x_axis + (np.sin(theta) * scale)[:, None] * y_axis
-    w = np.where(np.arange(2 * nseg + 1) % 2 == 1, half, 1.0)
-    inner = np.repeat(t0 + delta * np.arange(1, nseg), 2)
-    knots = np.concatenate([[t0] * 3, inner, [t1] * 3])
-    knots[-3:] = t1
     return BSplineCurve._trusted(pts, 2, knots, w)
 
 

@@ -19,6 +19,7 @@ from ..errors import SurfmodError
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..surface import Surface
 from .axes import cos_d, sin_d
+from .conics import arc_segments
 from .from_edge import as_curve
 
 
@@ -26,17 +27,9 @@ def revolve_nurbs(profile: BSplineCurve, origin, axis, u_range) -> BSplineSurfac
     """Exact NURBS of the B-spline ``profile`` revolved about ``(origin, axis)`` over
     ``u_range`` (radians): u is degree 2 rational (arcs of at most 90 degrees, knots on
     ``u_range``), v is the profile's own B-spline."""
-    u0, u1 = (float(t) for t in u_range)
+    theta, scale, wu, ku = arc_segments(*(float(t) for t in u_range))
     a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
     o = np.asarray(origin, dtype=float)
-    span = u1 - u0
-    nseg = max(1, int(math.ceil(abs(span) / (math.pi / 2) - 1e-9)))
-    delta = span / nseg
-    half = math.cos(delta / 2.0)
-    idx = np.arange(2 * nseg + 1)
-    theta = u0 + idx * (delta / 2.0)
-    scale = np.where(idx % 2 == 1, 1.0 / half, 1.0)
-    wu = np.where(idx % 2 == 1, half, 1.0)
     p = profile.control_points
     foot = o + ((p - o) @ a)[:, None] * a  # (m, 3)
     xv = p - foot
@@ -48,8 +41,6 @@ def revolve_nurbs(profile: BSplineCurve, origin, axis, u_range) -> BSplineSurfac
     net = foot[None] + c * xv[None] + s * yv[None]  # (2nseg+1, m, 3)
     wv = np.ones(len(p)) if profile.weights is None else profile.weights
     weights = wu[:, None] * wv[None, :]
-    inner = np.repeat(u0 + delta * np.arange(1, nseg), 2)
-    ku = np.concatenate([[u0] * 3, inner, [u1] * 3])
     return BSplineSurface._trusted(net, (2, profile.degree), (ku, profile.knots), weights)
 
 
