@@ -149,7 +149,8 @@ def test_an_extended_operation_keeps_its_written_head(monkeypatch):
              (ring[:31], np.full(31, FEED, np.int8), ring[31:], np.full(30, FEED, np.int8), False)]
     for p0, k0, p1, k1, joins in cases:
         first = Operation("finishing", tool, Motion(p0, k0), 60.0)
-        whole = Operation("finishing", tool, Motion(np.vstack([p0, p1]), np.concatenate([k0, k1])), 60.0)
+        whole = Operation("finishing", tool, Motion(np.vstack([p0, p1]), np.concatenate([k0, k1])), 60.0,
+                          extends=first)
         monkeypatch.setattr(post_module, "_WRITTEN", {})
         programs(Job(None, stock, (first,), 20.0))
         assert post_module._joins(first, whole) is joins

@@ -19,7 +19,7 @@ from ocl_reference import waterline as ocl_waterline
 from surfmod.cam.cutters import cutter
 from surfmod.cam.drop_cutter import TriangleGrid, drop, triangle_rows
 from surfmod.cam.fiber_contact import pair_intervals
-from surfmod.cam.waterline import ContourPoints, _Fibers, _waterline, fiber_pairs, pit_lines, waterline
+from surfmod.cam.waterline import ContourPoints, _Fibers, fiber_pairs, pit_lines, waterline
 from surfmod.errors import SurfmodError
 
 CORPUS_PART = "trimesh_featuretype.STEP"
@@ -234,12 +234,12 @@ def test_the_pair_estimate_counts_the_pairs_met(kind, R, r):
                               np.stack([m[2], m[1], tri[:, 2]], 1), np.stack([m[0], m[1], m[2]], 1)])
     cut = tool(kind, R, r)
     levels = np.linspace(0.1, 7.9, 40)
-    _, fib = _waterline(tri, cut, levels, 0.4, None)
+    _, fib = waterline(tri, cut, levels, sampling=0.4, fibers=True)
     estimate = fiber_pairs(tri, R, 0.4, levels, cut.corner)
     assert fib.pairs <= estimate <= 1.5 * fib.pairs, (fib.pairs, estimate)
     below = np.linspace(-5.0, -1.0 - r, 40)
-    _, one = _waterline(tri, cut, below[:1], 0.4, None)
-    _, many = _waterline(tri, cut, below, 0.4, None)
+    _, one = waterline(tri, cut, below[:1], sampling=0.4, fibers=True)
+    _, many = waterline(tri, cut, below, sampling=0.4, fibers=True)
     assert many.pairs == one.pairs > 0
     assert fiber_pairs(tri, R, 0.4, below, cut.corner) == fiber_pairs(tri, R, 0.4, below[:1], cut.corner)
 
@@ -436,7 +436,7 @@ def test_contour_points_on_the_waterline_fibers_split_as_their_own():
     chords across the loops of a pyramid with a shelf, ball and bull."""
     tri = pyramid_and_shelf()
     for cut in (tool("ball", 1.5), tool("bull", 1.5, 0.5)):
-        (loops,), fibers = _waterline(tri, cut, [2.0], 0.4, None)
+        (loops,), fibers = waterline(tri, cut, [2.0], sampling=0.4, fibers=True)
         shared, own = ContourPoints(tri, cut, 0.6, fibers), ContourPoints(tri, cut, 0.6)
         assert shared.fib is fibers and own.fib is not fibers
         for loop in loops:

@@ -260,10 +260,10 @@ def triangle_rows(tri: np.ndarray) -> np.ndarray:
     [0.0, -0.7071, 0.7071]
     """
     tri = np.asarray(tri, dtype=float)
-    return np.ascontiguousarray(np.hstack([tri.reshape(-1, 9), _upward_normals(tri)]))
+    return np.ascontiguousarray(np.hstack([tri.reshape(-1, 9), upward_normals(tri)]))
 
 
-def _upward_normals(tri: np.ndarray) -> np.ndarray:
+def upward_normals(tri: np.ndarray) -> np.ndarray:
     """Unit normals with n_z ≥ 0 (the tool comes from above: a facet's upper side counts)."""
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n *= np.where(n[:, 2:3] < 0, -1.0, 1.0)

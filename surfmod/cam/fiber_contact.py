@@ -49,7 +49,7 @@ TORUS_STEPS = 200
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _profile_radius(h, R, rc):
+def profile_radius(h, R, rc):
     """Tool radius at height ``h`` ≥ 0 above the tip (R above the corner)."""
     if h >= rc:
         return R
@@ -212,7 +212,7 @@ def _torus_edge(span, px, py, pz, ex, ey, ez, uc, ud, z, R, rc, ox, oy, dx, dy):
         return
     L = math.sqrt(ex * ex + ey * ey + ez * ez)
     if not abs(ez) > 1e-12 * L:
-        _offset_lines(span, px, py, ex, ey, 0.0, 1.0, _profile_radius(pz - z, R, rc), ox, oy, dx, dy)
+        _offset_lines(span, px, py, ex, ey, 0.0, 1.0, profile_radius(pz - z, R, rc), ox, oy, dx, dy)
         return
     ax, ay, az = ex / L, ey / L, ez / L
     # the edge line meets the plane z + rc at the ellipse centre
@@ -283,7 +283,7 @@ def _pair(span, row, ox, oy, dx, dy, z, code, R, rc):
         ex, ey, ez = row[k1] - px, row[k1 + 1] - py, row[k1 + 2] - pz
         h0 = pz - z
         if h0 >= 0.0:
-            _disc(span, px, py, _profile_radius(h0, R, rc), ox, oy, dx, dy)
+            _disc(span, px, py, profile_radius(h0, R, rc), ox, oy, dx, dy)
         # crossings of the heights z and z + rc: points whose disc is the profile's there
         if abs(ez) >= 1e-300:
             u = -h0 / ez

@@ -56,12 +56,12 @@ from scipy.spatial import cKDTree
 
 from ..errors import SurfmodError
 from .cutters import Flat
-from .drop_cutter import TriangleGrid, drop
+from .drop_cutter import TriangleGrid, drop, upward_normals
 from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
 from .tool import Tool
 from .toolpath import REFINE_SHARE, _Part, raster_path
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
-from .waterline import ContourPoints, _waterline, fiber_pairs, sampling_within
+from .waterline import ContourPoints, fiber_pairs, sampling_within, waterline
 
 #: Steep regions: slopes within this many degrees below the threshold count too (the
 #: classification samples the drop-cutter surface, the raster's slope bound its triangles).
@@ -153,11 +153,10 @@ def _add_raster(out: Moves, pts: np.ndarray, top, part: _Part, tool: Tool, safe:
     _leave(out, float(top(pts[-1:, :2])[0]), safe)
 
 
-def _normals(tri: np.ndarray) -> np.ndarray:
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    n *= np.where(n[:, 2:3] < 0, -1.0, 1.0)
-    length = np.linalg.norm(n, axis=1)
-    return n / np.where(length > 0, length, 1.0)[:, None]
+def _slopes(tri: np.ndarray):
+    """The triangles' upward unit normals and their slopes (degrees)."""
+    n = upward_normals(tri)
+    return n, np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
 
 
 def _levels(tri, slope, steep, spacing, top, bottom, reach):
@@ -294,8 +293,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     (closed ones with their first point repeated; the deepest any of its moves cuts,
     judged on the drop-cutter heights), and a report dict."""
     tri = part.grid.triangles if box is None else near_box(part, tool, box)
-    n = _normals(tri)
-    slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
+    _, slope = _slopes(tri)
     steep = slope >= steep_angle - STEEP_MARGIN
     info = {"levels": 0, "z_spacing": (0.0, 0.0), "contours": 0, "length": 0.0, "spacing": spacing, "lifted": 0.0}
     if not steep.any():
@@ -330,7 +328,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
         info["sampling"] = sampling
     bar = part.meter.bar  # the finishing's bar names the waterline's level while it runs
     desc = bar.desc if bar is not None else ""
-    loops, fibers = _waterline(tri, grown, levels - g, sampling, chord, bar)
+    loops, fibers = waterline(tri, grown, levels - g, sampling=sampling, tolerance=chord, bar=bar, fibers=True)
     if bar is not None:
         bar.set_description_str(desc)
     contour = None  # built at the first gouging chord (most parts have none)
@@ -490,8 +488,7 @@ def _raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float |
     the part's triangles below ``steep_angle`` (all of them when None) within the tool's
     radius of the two passes, from ``lo`` to ``hi``.  Returns ``(positions, steepest φ in degrees)``."""
     tri = part.grid.triangles
-    n = _normals(tri)
-    slope = np.degrees(np.arccos(np.clip(n[:, 2], -1, 1)))
+    n, slope = _slopes(tri)
     shallow = slope < (90.0 if steep_angle is None else steep_angle)
     axis = 1 if direction == "x" else 0
     cross = np.minimum(np.degrees(np.arctan2(np.abs(n[shallow, axis]), n[shallow, 2])), 89.0)
@@ -603,7 +600,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
         budget = None
     # the raster runs beyond the part's box until a pass's contact reaches the rim: on ground
     # falling by θ towards it the tool touches its core plus c sin θ uphill of its axis
-    slope = np.degrees(np.arccos(np.clip(_normals(part.grid.triangles)[:, 2], -1, 1)))
+    _, slope = _slopes(part.grid.triangles)
     shallow = slope[slope < (90.0 if steep_angle is None else steep_angle)]
     theta = float(shallow.max()) if len(shallow) else 0.0
     overhang = tool.core + tool.corner * math.sin(math.radians(theta)) if theta > 1e-6 else 0.0

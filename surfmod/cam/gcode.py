@@ -7,7 +7,7 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..atomic import atomic_path, target_path
-from .post import export_job
+from .post import SUFFIXES, export_job, round_up
 
 
 def _is_toolpath(obj) -> bool:
@@ -17,12 +17,6 @@ def _is_toolpath(obj) -> bool:
     tool = getattr(obj, "tool", None)
     return (isinstance(points, np.ndarray) and points.ndim == 2 and points.shape[1] == 3 and len(points) > 0
             and hasattr(tool, "cutter") and hasattr(tool, "radius") and hasattr(obj, "stepover"))
-
-
-def _up(values: np.ndarray, digits: int) -> np.ndarray:
-    """Heights rounded up to the written digits: rounding must never lower the tool."""
-    scale = 10.0**digits
-    return np.ceil(np.round(values * scale, 6)) / scale
 
 
 def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = None,
@@ -44,7 +38,7 @@ def gcode_text(toolpath, *, feed: float = 600.0, plunge_feed: float | None = Non
         raise SurfmodError(f"digits: expected an integer 0..8, got {digits!r}")
     digits = int(digits)
     points = np.array(toolpath.points, dtype=float)
-    points[:, 2] = _up(points[:, 2], digits)
+    points[:, 2] = round_up(points[:, 2], digits)
     top = float(points[:, 2].max())
     if safe_height is None:
         safe = top + max(5.0, toolpath.tool.radius)
@@ -104,7 +98,7 @@ def export_gcode(toolpath, path, *, feed: float = 600.0, safe_height: float | No
         return export_job(toolpath, path, post or "linuxcnc", **kw)
     if post is not None:
         raise SurfmodError("post: a post-processor applies to a machining Job (sm.machine), not to a Toolpath")
-    target = target_path(path, "path", (".nc", ".gcode", ".ngc", ".tap", ".cnc"))
+    target = target_path(path, "path", SUFFIXES)
     text = gcode_text(toolpath, feed=feed, safe_height=safe_height, **kw)
     with atomic_path(target) as tmp:
         tmp.write_text(text, encoding="ascii")

@@ -53,7 +53,6 @@ import numpy as np
 from ..inputs import upright_cylinder
 from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
-from .finishing import height_field
 from .rest import StockModel
 from .roughing import PLUNGE, RAPID, Motion, Moves
 from .verify import BODY_NODES, _probes, body_cell, body_stand
@@ -98,15 +97,6 @@ def body_stock(stock: np.ndarray, smallest_radius: float) -> StockModel:
     return StockModel(stock, body_cell(stock, smallest_radius), MAX_STOCK_NODES)
 
 
-def _floor(stock: StockModel, triangles: np.ndarray) -> np.ndarray:
-    """The part's top (``triangles``) under the stock model's nodes, kept with the model for
-    the mesh it was taken from."""
-    kept = getattr(stock, "floor", None)
-    if kept is None or kept[0] is not triangles:
-        stock.floor = kept = (triangles, height_field(triangles, stock.x, stock.y))
-    return kept[1]
-
-
 def _flush(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, slack: float,
            skin: float) -> np.ndarray:
     """Per move (``points[k] -> points[k + 1]``): whether a disc of the tool no wider than
@@ -135,11 +125,10 @@ def _sweep_body(stock: StockModel, a: np.ndarray, b: np.ndarray, rapid: np.ndarr
     (without ``remove``, the model is left as it is and ``sink`` measures every move).
     The model samples the stock a cell apart, coarser than the verifier's: a disc wider
     than the end is grown by a cell, so that an edge of stock between the nodes its rim
-    passes is met too (on zoo's flange-xy, 0.875 mm cells let a holder pass 4.7 mm into a
-    level's step that the verifier's 0.245 mm cells found).  A move ``flush`` against a
-    wall holds its discs no wider than the end a cell wider too, against the nodes whose
-    stock stands no more than ``thin`` (the roughing's skin, often thinner than a cell,
-    which stands between the nodes) above the part.  Only the stock more than ``rise``
+    passes is met too.  A move ``flush`` against a wall holds its discs no wider than the
+    end a cell wider too, against the nodes whose stock stands no more than ``thin`` (the
+    roughing's skin, often thinner than a cell, which stands between the nodes) above the
+    part.  Only the stock more than ``rise``
     (the cusps) above the part's top at a node (``floor``) counts: a grown disc comes over
     the wall's own column, and the cusps between the model's nodes are the part's rule
     (:func:`part_sink`)."""
@@ -278,20 +267,22 @@ def _without_dips(motion: Motion) -> Motion:
 
 
 def clear_body(motion: Motion, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
-               safe: float, shape=None, cusp: float = 0.0, skin: float = 0.0):
+               safe: float, shape=None, cusp: float = 0.0, skin: float = 0.0, floor: np.ndarray | None = None):
     """``(motion, held)``: ``motion`` swept through ``stock`` with the moves whose shank or
     holder would come within ``cusp`` of the part (``triangles``, and ``shape`` for the
     close calls; the highest cusp the passes so far leave) or meet the stock left on it
     (``skin`` the roughing's allowance on the walls) removed and relinked
-    (:func:`relink`), and what that leaves (:func:`left_out`)."""
+    (:func:`relink`), and what that leaves (:func:`left_out`).  ``floor``: the part's top
+    over the model's nodes (:meth:`~surfmod.cam.rest.StockModel.part_top`), when the caller
+    has it."""
     pts = np.asarray(motion.points, float)
     if len(pts) < 2:
         return motion, None
     rapid = motion.kind[1:] == RAPID
     skip = part_sink(triangles, deflection, tool, pts, slack, shape, cusp) > 0.0
     flush = _flush(triangles, deflection, tool, pts, slack, skin)
-    _, removed = _sweep_body(stock, pts[:-1], pts[1:], rapid, tool, slack, skip, _floor(stock, triangles),
-                             cusp + slack, flush, skin)
+    floor = stock.part_top(triangles) if floor is None else floor
+    _, removed = _sweep_body(stock, pts[:-1], pts[1:], rapid, tool, slack, skip, floor, cusp + slack, flush, skin)
     if not removed.any():
         return motion, None
     cuts = removed & ~rapid  # links replaced by the relinking leave nothing
@@ -321,12 +312,13 @@ def left_out(stock: StockModel, tool, a: np.ndarray, b: np.ndarray, moves: int, 
 
 
 def reach_levels(held: Held, tool, stock: StockModel, triangles: np.ndarray, deflection: float, slack: float,
-                 cusp: float, window: float, skin: float = 0.0) -> list:
+                 cusp: float, window: float, skin: float, floor: np.ndarray) -> list:
     """Where the check left out moves at constant height (a waterline contour's), the
     lowest heights the tool can cut there: each move raised by how far the stock model
     (by ``cusp`` too) or the part stands above its discs' bottoms, the moves grouped by
     that height, a group at most ``window`` deep (else the window doubles until at most
-    :data:`MAX_REACH_LEVELS` groups are left) and cut at its highest.  Returns ``(z,
+    :data:`MAX_REACH_LEVELS` groups are left) and cut at its highest (``floor``: as
+    :func:`clear_body`'s).  Returns ``(z,
     moves)`` pairs, lowest first, ``moves`` the group's ``(K, 2, 3)`` moves as left out."""
     if held is None or held.cuts is None:
         return []
@@ -337,7 +329,7 @@ def reach_levels(held: Held, tool, stock: StockModel, triangles: np.ndarray, def
     # each move alone (the polyline a0 b0 a1 b1 ...: its even moves)
     flush = _flush(triangles, deflection, tool, cuts.reshape(-1, 3), slack, skin)[::2]
     sink, _ = _sweep_body(stock, a, b, np.zeros(len(a), np.bool_), tool, slack, np.zeros(len(a), np.bool_),
-                          _floor(stock, triangles), cusp + slack, flush, skin, remove=False)
+                          floor, cusp + slack, flush, skin, remove=False)
     part = part_sink(triangles, deflection, tool, cuts.reshape(-1, 3), slack, clear=cusp)[::2]
     up = np.maximum(sink, part)
     z = a[:, 2] + up + REACH_MARGIN

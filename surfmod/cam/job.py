@@ -25,8 +25,7 @@ from .cycle_time import cycle_time, feed_time
 from .finishing import Leftover, finish, reach_contours, recut
 from .holder import body_stock, clear_body, left_out, reach_levels, relink
 from .machine_table import MACHINE, Machine
-from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, STEEP_ANGLE, StockModel, _AboveStock, left_over, rest_moves, \
-    rest_part_top
+from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, STEEP_ANGLE, AboveStock, StockModel, left_over, rest_moves
 from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
@@ -113,6 +112,9 @@ class Operation:
     time_estimate: float
     report: dict = field(default_factory=dict, repr=False)
     machine: Machine = field(default=MACHINE, repr=False)
+    #: the operation whose motion this one's begins with (a repair's passes appended),
+    #: whose program lines the posts reuse
+    extends: Operation | None = field(default=None, repr=False, compare=False)
 
     @property
     def feed_time(self) -> float:
@@ -323,7 +325,8 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     report = dict(op.report, recut={"regions": len(found.boxes), "passes": passes, "before": found.worst,
                                     "length": float(seg[extra.kind[1:] != RAPID].sum())})
     ops = list(job.operations)
-    ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine), report=report)
+    ops[k] = replace(op, motion=motion, time_estimate=operation_time(motion, op.tool, op.machine), report=report,
+                     extends=op)
     job = replace(job, operations=tuple(ops))
     return replace(job, verification=verify_job(job, before=job.verification))
 
@@ -342,32 +345,32 @@ def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape,
     (:func:`_at_reach`, given the operation's ``contours``: their ``spacing``,
     ``steep_angle`` and where the stock stands for :func:`~surfmod.cam.finishing.reach_contours`;
     None: it has none) in ``levels`` levels; with ``strict`` a collision refuses the job."""
+    floor = stock_model.part_top(part.grid.triangles)
     motion, held = clear_body(motion, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe,
-                              shape, cusp, skin)
+                              shape, cusp, skin, floor)
     if held is not None and strict:
         raise SurfmodError(f"strict: the {name} with {tool}: {held} (a longer tool: flute_length, shank_length; "
                            f"a narrower holder; or strict=False to leave it)")
     if held is None or contours is None:
         return motion, held, 0
-    return _at_reach(motion, held, tool, stock_model, part, tolerance, safe, shape, cusp, skin, contours)
+    return _at_reach(motion, held, tool, stock_model, part, tolerance, safe, shape, cusp, skin, contours, floor)
 
 
-def _at_reach(motion, held, tool, stock_model, part, tolerance, safe, shape, cusp, skin, contours):
+def _at_reach(motion, held, tool, stock_model, part, tolerance, safe, shape, cusp, skin, contours, floor):
     """Where the holder check left waterline contours out, those contours again at the
-    lowest height the shank and holder let the tool cut there (on cam_part a holder over
-    the mould's top left out the foot of the outer wall's contours, the next level 1.6 mm
-    up: 0.30 mm left on a wall the tool reaches), themselves held and appended; returns
-    the motion, what is left out in all and the levels added (see :func:`_held`)."""
+    lowest height the shank and holder let the tool cut there, themselves held and
+    appended; returns the motion, what is left out in all and the levels added (see
+    :func:`_held`)."""
     spacing = contours["spacing"]
     groups = reach_levels(held, tool, stock_model, part.grid.triangles, part.deflection, tolerance, cusp,
-                          spacing / 2, skin)
+                          spacing / 2, skin, floor)
     if not groups:
         return motion, held, 0
     extra = reach_contours(part, tool, groups, tolerance=tolerance, safe=safe, **contours)
     if not np.any(extra.kind != RAPID):
         return motion, held, 0
     extra, again = clear_body(extra, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe, shape,
-                              cusp, skin)
+                              cusp, skin, floor)
     cuts = held.cuts if again is None else np.concatenate([held.cuts, again.cuts])
     held = left_out(stock_model, tool, cuts[:, 0], cuts[:, 1], held.moves + (again.moves if again else 0), tolerance)
     return (Motion(np.concatenate([motion.points, extra.points]), np.concatenate([motion.kind, extra.kind])), held,
@@ -455,7 +458,7 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
     model = StockModel(stock, cell)
     for i in after:
         model.sweep(done[i].motion, done[i].tool)
-    part_top = rest_part_top(part, model)
+    part_top = model.part_top(part.grid.triangles)
     threshold = scallop + tolerance + model.sag
     pairs = op.max_points * PAIRS_PER_POINT
     mask, before = left_over(model, part_top, part, threshold, pairs)
@@ -464,7 +467,7 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
     motion, info = rest_moves(part, tool, model, mask, scallop=scallop, stepover=stepover, tolerance=tolerance,
                               safe=safe, bottom=float(stock[0, 2]), max_points=op.max_points)
     # its contours again at the holder's reach where it left them out, as the finishing's
-    contours = (dict(spacing=info["spacing"], steep_angle=STEEP_ANGLE, top=_AboveStock(model, tool.radius, safe))
+    contours = (dict(spacing=info["spacing"], steep_angle=STEEP_ANGLE, top=AboveStock(model, tool.radius, safe))
                 if info["levels"] else None)
     motion, kept_out, levels = held(motion, part, tolerance, scallop, contours)
     if levels:

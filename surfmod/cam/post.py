@@ -27,7 +27,8 @@ POSTS = ("linuxcnc", "grbl")
 SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")
 
 
-def _up(values: np.ndarray, digits: int) -> np.ndarray:
+def round_up(values: np.ndarray, digits: int) -> np.ndarray:
+    """Heights rounded up to the written digits: rounding must never lower the tool."""
     scale = 10.0**digits
     return np.ceil(np.round(values * scale, 6)) / scale
 
@@ -44,17 +45,18 @@ def _moves(op, digits: int, arcs: bool = True) -> list[str]:
     change).  Circular runs (:func:`surfmod.cam.arcs.find_arcs`, found on the heights as
     written) become one arc word each, its centre ``I J`` from the written start.
 
-    An operation whose motion extends one written before (a finishing with a repair's
-    cross passes appended) keeps that one's lines and writes only the rest, when the
-    written motion ends with a move and the rest's second move is one that are no
-    longer across than the arcs' ``tolerance`` (a retract, a descent): no arc holds such
-    a move, and every arc has four or more, so no arc of the whole crosses the join and
-    the greedy search finds the same arcs on each side (:func:`_joins`)."""
-    key = (id(op), digits, arcs)
-    entry = _WRITTEN.get(key)
+    An operation that ``extends`` one written before (a finishing with a repair's cross
+    passes appended) keeps that one's lines and writes only the rest, when the written
+    motion ends with a move and the rest's second move is one that are no longer across
+    than the arcs' ``tolerance`` (a retract, a descent): no arc holds such a move, and
+    every arc has four or more, so no arc of the whole crosses the join and the greedy
+    search finds the same arcs on each side (:func:`_joins`)."""
+    entry = _WRITTEN.get((id(op), digits, arcs))
     if entry is not None and entry[0] is op:  # the entry holds its operation: no other can take its id
         return list(entry[1])
-    head = next((e for k, e in _WRITTEN.items() if k[1:] == key[1:] and _joins(e[0], op)), None)
+    head = _WRITTEN.get((id(op.extends), digits, arcs))
+    if head is not None and not (head[0] is op.extends and _joins(head[0], op)):
+        head = None
     if len(_WRITTEN) >= WRITTEN_KEPT:
         _WRITTEN.clear()
     pts, kind = np.array(op.motion.points, float), op.motion.kind
@@ -64,7 +66,7 @@ def _moves(op, digits: int, arcs: bool = True) -> list[str]:
         m = len(head[0].motion.points)
         lines, state = _move_lines(pts[m:], kind[m:], op.tool, digits, arcs, head[2])
         lines = head[1] + lines
-    _WRITTEN[key] = (op, lines, state)
+    _WRITTEN[id(op), digits, arcs] = (op, lines, state)
     return list(lines)
 
 
@@ -86,7 +88,7 @@ def _move_lines(pts: np.ndarray, kind: np.ndarray, tool, digits: int, arcs: bool
     position written and the feed in force), from ``state``."""
     # arcs are found on the path itself: an arc between ends rounded up lies above it
     found = find_arcs(pts, kind) if arcs else []
-    pts[:, 2] = _up(pts[:, 2], digits)
+    pts[:, 2] = round_up(pts[:, 2], digits)
     fmt = f"%.{digits}f"
     # rounded first and + 0.0: no "-0.0000" words
     cols = [np.char.mod(fmt, np.round(pts[:, k], digits) + 0.0) for k in range(3)]
@@ -124,7 +126,7 @@ def _move_lines(pts: np.ndarray, kind: np.ndarray, tool, digits: int, arcs: bool
 
 def _operation(op, job, post: str, digits: int, coolant: bool, arcs: bool) -> list[str]:
     t = op.tool
-    safe = f"{_up(np.array([job.safe_height]), digits)[0]:.{digits}f}"
+    safe = f"{round_up(np.array([job.safe_height]), digits)[0]:.{digits}f}"
     out = [_comment(f"operation: {op.name}, tool {t.number}: {t}, flute length {t.flute_length:g} mm"),
            f"(estimated time {op.time_estimate:.0f} s, cutting length {op.length:.0f} mm)"]
     if post == "linuxcnc":

@@ -83,6 +83,24 @@ class StockModel(NodeGrid):
         more, as the verifier bounds it)."""
         return (self.cell / 4) ** 2 / (2 * self.cell)
 
+    def index(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The indices ``(i, j)`` of the node nearest each ``xy`` (N, 2), beyond the grid too."""
+        return (np.rint((xy[:, 0] - self.lo[0]) / self.cell).astype(int),
+                np.rint((xy[:, 1] - self.lo[1]) / self.cell).astype(int))
+
+    def at(self, a: np.ndarray, xy: np.ndarray, off) -> np.ndarray:
+        """The field ``a`` (on the nodes) at the node nearest each ``xy``, ``off`` beyond the grid."""
+        i, j = self.index(xy)
+        nx, ny = a.shape
+        on = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
+        out = np.full(len(xy), off, a.dtype)
+        out[on] = a[i[on], j[on]]
+        return out
+
+    def part_top(self, triangles: np.ndarray) -> np.ndarray:
+        """The part's top (a vertical ray onto ``triangles``) over the nodes, -inf off the part."""
+        return height_field(triangles, self.x, self.y)
+
     def sweep(self, motion: Motion, tool: Tool) -> None:
         """Cut the stock along ``motion`` with ``tool`` (rapids cut nothing)."""
         p = np.ascontiguousarray(motion.points, float)
@@ -158,9 +176,10 @@ def left_over(stock: StockModel, part_top: np.ndarray, part: _Part, threshold: f
     return mask, stats
 
 
-class _AboveStock:
-    """The height above which the stock model holds no material over the rest tool's
-    footprint at ``xy`` (its highest node within the radius and a cell), plus the clearance."""
+class AboveStock:
+    """The height above which the stock model holds no material over a tool's footprint at
+    ``xy`` (its highest node within the ``radius`` and a cell), plus the clearance, at most
+    ``safe``: where a rest operation's links enter and leave."""
 
     def __init__(self, stock: StockModel, radius: float, safe: float):
         n = int(math.ceil(radius / stock.cell)) + 1
@@ -169,11 +188,9 @@ class _AboveStock:
         self.stock, self.safe = stock, safe
 
     def __call__(self, xy) -> np.ndarray:
-        xy = np.asarray(xy, float).reshape(-1, 2)
+        i, j = self.stock.index(np.asarray(xy, float).reshape(-1, 2))
         nx, ny = self.high.shape
-        i = np.clip(np.rint((xy[:, 0] - self.stock.lo[0]) / self.stock.cell).astype(int), 0, nx - 1)
-        j = np.clip(np.rint((xy[:, 1] - self.stock.lo[1]) / self.stock.cell).astype(int), 0, ny - 1)
-        return np.minimum(self.high[i, j] + REST_CLEARANCE, self.safe)
+        return np.minimum(self.high[np.clip(i, 0, nx - 1), np.clip(j, 0, ny - 1)] + REST_CLEARANCE, self.safe)
 
 
 def _runs(inside: np.ndarray, points: np.ndarray, bridge: float) -> list[tuple[int, int]]:
@@ -217,13 +234,7 @@ class _LeftNear:
         self.stock, self.labels, self.label = stock, labels, 0
 
     def __call__(self, xy: np.ndarray, z: float) -> np.ndarray:
-        nx, ny = self.high.shape
-        i = np.rint((xy[:, 0] - self.stock.lo[0]) / self.stock.cell).astype(int)
-        j = np.rint((xy[:, 1] - self.stock.lo[1]) / self.stock.cell).astype(int)
-        on = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
-        out = np.zeros(len(xy), bool)
-        out[on] = (self.labels[i[on], j[on]] == self.label) & (self.high[i[on], j[on]] > z)
-        return out
+        return (self.stock.at(self.labels, xy, 0) == self.label) & (self.stock.at(self.high, xy, -np.inf) > z)
 
 
 def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, scallop: float, stepover: float,
@@ -246,9 +257,8 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
     # two rasters over every box: estimated before any drop
     estimate = sum(2 * (float(np.ptp(b[:, 0])) / step + 2) * (float(np.ptp(b[:, 1])) / spacing + 2) for b in boxes)
     checks.work(estimate, max_points, "max_points", f"the rest passes over {len(boxes)} region(s)")
-    top = _AboveStock(stock, tool.radius, safe)
+    top = AboveStock(stock, tool.radius, safe)
     allowed = tolerance - part.deflection + part.lift
-    nx, ny = reach.shape
     # the steep part first, by contours as the finishing's (its scallop, levels spaced by
     # the walls' slope): a raster climbing a wall leaves cusps as tall as its steps there
     levels_apart, _ = contour_spacing(part, tool, scallop, tolerance, stepover)
@@ -282,12 +292,7 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
                     continue  # the tool touches no face there
                 raise
             pts = path.points
-            i = np.rint((pts[:, 0] - stock.lo[0]) / stock.cell).astype(int)
-            j = np.rint((pts[:, 1] - stock.lo[1]) / stock.cell).astype(int)
-            on = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
-            inside = np.zeros(len(pts), bool)
-            inside[on] = labels[i[on], j[on]] == label
-            runs = _runs(inside, pts, BRIDGE_RADII * tool.radius)
+            runs = _runs(stock.at(labels, pts, 0) == label, pts, BRIDGE_RADII * tool.radius)
             for a, b in runs:
                 _add_raster(out, pts[a:b], top, part, tool, safe, allowed, "a rest cut's entry")
             info["passes"] += path.n_passes
@@ -318,8 +323,3 @@ def summary_line(report: dict) -> str:
             f"{report['regions']} region(s), {report['passes']} passes"
             + (f", moves lifted by up to {report['lifted']:.3g} mm where refining could not follow the part "
                f"(material left)" if report.get("lifted", 0.0) > 0 else ""))
-
-
-def rest_part_top(part: _Part, stock: StockModel) -> np.ndarray:
-    """The part's top over the stock model's nodes (-inf off the part)."""
-    return height_field(part.grid.triangles, stock.x, stock.y)

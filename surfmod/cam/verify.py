@@ -453,11 +453,8 @@ def _probes(start: np.ndarray, end: np.ndarray, spacing: float, max_probes: int)
     """Points at most ``spacing`` apart along each move (both ends included), each one's
     move, and the spacing used: wider than asked where ``max_probes`` would be passed, so a
     long program is judged more coarsely (and says so), never refused."""
-    length = np.linalg.norm(end - start, axis=1)
-    n = np.ceil(length / spacing).astype(np.int64) + 1
-    if n.sum() > max_probes and 2 * len(start) < max_probes:
-        spacing = max(spacing, float(length.sum()) / (max_probes - 2 * len(start)))
-        n = np.ceil(length / spacing).astype(np.int64) + 1
+    spacing = _spacing(start, end, spacing, max_probes)
+    n = np.ceil(np.linalg.norm(end - start, axis=1) / spacing).astype(np.int64) + 1
     total = int(n.sum())
     checks.work(total, max_probes, "max_probes", f"the verification's {total:,} probes, two per move at the least")
     move = np.repeat(np.arange(len(start)), n)
@@ -482,7 +479,7 @@ class _Measured:
 
 
 def _spacing(start: np.ndarray, end: np.ndarray, spacing: float, max_probes: int) -> float:
-    """The probes' spacing :func:`_probes` takes along the moves."""
+    """The probes' spacing along the moves: ``spacing``, or wider where ``max_probes`` would be passed."""
     length = np.linalg.norm(end - start, axis=1)
     if (np.ceil(length / spacing) + 1).sum() > max_probes and 2 * len(start) < max_probes:
         return max(spacing, float(length.sum()) / (max_probes - 2 * len(start)))
@@ -1057,10 +1054,8 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
     judged, depth_r = q[reach], depth[reach]
     # the deepest measured again against the exact faces, and judged again from the exact
     # foot: the part's points near a stock point may give it a foot on another face than
-    # its nearest (on zoo's flange-xy a plug of stock in a bore under the rim got the back
-    # face's normal, steep and reachable; its nearest point is the bore's top, 7.56 mm
-    # above it, an overhang).  The vector from the nearest point to a point outside is the
-    # part's normal there.
+    # its nearest (a bore's back face under its rim, where the nearest is the overhanging
+    # top).  The vector from the nearest point to a point outside is the part's normal there.
     faces = compound(faces_of(shape))
     exact = np.zeros(len(judged), bool)
     for _ in range(EXACT_ROUNDS):

@@ -42,7 +42,7 @@ from scipy.spatial import cKDTree
 from ..errors import SurfmodError
 from .cutters import Cutter
 from .drop_cutter import TriangleGrid
-from .fiber_contact import _profile_radius, pair_intervals
+from .fiber_contact import profile_radius, pair_intervals
 
 MAX_PAIRS = 200_000_000  # (fiber, triangle) pairs over all levels: beyond this, coarsen sampling
 PAIRS_PER_BLOCK = 400_000
@@ -274,18 +274,15 @@ def _segment_pairs(tris, boxes, z, R, rc, o, d, reach, start, stop):
     """``(fiber, triangle)`` of the cell-list entries ``start:stop`` of each fiber (the
     segment ``o ± reach d``) that the tool at tip height ``z`` can touch: the triangle's top
     reaches ``z``, and its (x, y) box comes within the tool's radius at that top (R above
-    the corner ``rc``, :func:`~surfmod.cam.fiber_contact._profile_radius` below) of the
+    the corner ``rc``, :func:`~surfmod.cam.fiber_contact.profile_radius` below) of the
     segment's box and of the disc of radius ``reach`` round ``o`` (``boxes``: a row per
     triangle, x0 y0 x1 y1 top, so that an entry reads one cache line).  No point of a
     triangle lies farther than that radius from where the tool touches it, so the pairs
     dropped have no interval on the segment; on a wall most triangles within R of a fiber
-    stand low beside it, where the ball's end is narrow (the refinement of the 280 mm
-    mould's contours met 1440 triangles a fiber by the boxes grown by R).  Only the pairs
-    kept are returned: on a metre part under a 26 mm ball the lists hold thousands of
-    triangles per fiber, of which a few dozen are kept (the refinement of nist_ctc_02's
-    contours spent half the job building and filtering the full lists in numpy).  The
-    boxes grown by R lie inside the ones the grid listed the triangles for (``reach`` is at
-    most the grid's), so that is not tested."""
+    stand low beside it, where the ball's end is narrow.  Only the pairs kept are returned
+    (on a metre part the lists hold thousands of triangles per fiber, of which a few dozen
+    are kept).  The boxes grown by R lie inside the ones the grid listed the triangles for
+    (``reach`` is at most the grid's), so that is not tested."""
     n = 0
     for q in range(len(o)):
         n += max(stop[q] - start[q], 0)
@@ -300,7 +297,7 @@ def _segment_pairs(tris, boxes, z, R, rc, o, d, reach, start, stop):
             b = boxes[t]
             if b[4] < z:
                 continue
-            r = _profile_radius(b[4] - z, R, rc) * (1.0 + 1e-9) + 1e-12  # a hair over: rounding never drops a touch
+            r = profile_radius(b[4] - z, R, rc) * (1.0 + 1e-9) + 1e-12  # a hair over: rounding never drops a touch
             gx = max(b[0] - ox, ox - b[2], 0.0)  # the box's distance from o along x and y
             gy = max(b[1] - oy, oy - b[3], 0.0)
             if gx <= ax + r and gy <= ay + r and gx * gx + gy * gy <= (s + r) * (s + r):
@@ -324,8 +321,7 @@ def _merge(qi, lo, hi):
     """The first pair of each component (an index into the pairs) and the component's end,
     in order of fiber then start: the pairs bucketed by fiber, each bucket sorted by start
     and swept with the running end (compiled: a grid line crossing a part meets thousands
-    of triangles, which a lexsort and a segmented maximum vectorised across fibers paid
-    for with 9 of the 280 mm mould's 64 s of contours)."""
+    of triangles)."""
     n = int(qi.max()) + 1
     first = np.zeros(n + 1, np.int64)
     for i in range(len(qi)):
@@ -522,7 +518,7 @@ class ContourPoints:
     """
 
     def __init__(self, part, tool, reach: float, fibers: "_Fibers | None" = None):
-        """``fibers``: those :func:`_waterline` returned for the same triangles and tool at
+        """``fibers``: those :func:`waterline` returned for the same triangles and tool at
         a sampling of ``reach / 1.5`` (its fibers reach that far), reused, not built again."""
         cutter = getattr(tool, "cutter", tool)
         tri = np.asarray(part, dtype=float)
@@ -558,7 +554,8 @@ class ContourPoints:
         return np.insert(pts, which + 1, mid + off[:, None] * normal, axis=0)
 
 
-def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance: float | None = None, bar=None):
+def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance: float | None = None, bar=None,
+              fibers: bool = False):
     """Waterline contours of ``tool`` round ``part`` at each tip height in ``z_levels``:
     a list (one entry per level) of closed loops ``(N, 3)`` in part coordinates (the
     first point not repeated), the material on the left of the direction of travel
@@ -569,7 +566,10 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     ``sampling``: spacing of the fiber grid that finds the loops (default a quarter of the
     radius; features of the tool-offset narrower than it may be missed); ``tolerance``:
     how far a chord's middle may lie from the exact contour (default 1e-6 of the part's
-    size); ``bar``: a tqdm bar whose description counts the levels done.
+    size); ``bar``: a tqdm bar whose description counts the levels done.  With ``fibers``
+    the result is ``(contours, fibers)``, the :class:`_Fibers` that found them (their
+    ``pairs`` counts the fiber-triangle pairs met, against the estimate :func:`fiber_pairs`
+    checked first; :class:`ContourPoints` reuses them).
 
     >>> import numpy as np
     >>> from surfmod.cam.cutters import Flat
@@ -578,12 +578,6 @@ def waterline(part, tool, z_levels, *, sampling: float | None = None, tolerance:
     >>> bool(np.allclose(loop[:, :2].min(axis=0), -1.0, atol=1e-9)), float(loop[0, 2])
     (True, 0.0)
     """
-    return _waterline(part, tool, z_levels, sampling, tolerance, bar)[0]
-
-
-def _waterline(part, tool, z_levels, sampling, tolerance, bar=None):
-    """:func:`waterline`'s contours and its :class:`_Fibers` (whose ``pairs`` counts the
-    fiber-triangle pairs met, against the estimate :func:`fiber_pairs` checked first)."""
     cutter = getattr(tool, "cutter", tool)
     R = cutter.radius
     tri = np.asarray(part, dtype=float)
@@ -624,4 +618,4 @@ def _waterline(part, tool, z_levels, sampling, tolerance, bar=None):
         if loops:
             loops = _refine(fib, z, loops, tol, 1.5 * h)
         out[k] = [np.column_stack([p, np.full(len(p), z)]) for p in loops]
-    return out, fib
+    return (out, fib) if fibers else out

@@ -5,19 +5,16 @@ The same concept as :mod:`surfmod.cam.toolpath`, one level up: the command over 
 
 from __future__ import annotations
 
-
 import sys
 
 from ..atomic import target_path
 from ..errors import SurfmodError
 from ..cam.gcode import export_gcode
+from ..cam.post import SUFFIXES
 from ..inputs import to_shape
 from ..cam.toolpath import Tool, toolpath
 from ..cam.verify import verify_toolpath
 from . import EXIT_PARTIAL
-
-GCODE_SUFFIXES = (".nc", ".gcode", ".ngc", ".tap", ".cnc")
-
 
 def register(sub) -> None:
     p = sub.add_parser("toolpath", help="drop-cutter zig-zag finishing path over a STEP part, every move "
@@ -48,7 +45,7 @@ def run(args) -> int:
     ``SurfmodError``) the common handler prints one line naming the file and exits 1; no
     file is written.  Exit 3: written, but the exact faces come deeper into the tool than
     the tolerance somewhere (the lines before say where)."""
-    target_path(args.out, "out", GCODE_SUFFIXES)
+    target_path(args.out, "out", SUFFIXES)
     if args.radius is None or not args.radius > 0:
         raise SurfmodError(f"radius: tool radius must be > 0, got {args.radius}")
     shape = to_shape(args.path, "path")
