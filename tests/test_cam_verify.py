@@ -25,6 +25,7 @@ from stock_sim import Cutter, Stock, parse_gcode, part_height, reachable, side_g
 from twins.program_lines import read_program_lines
 
 import surfmod as sm
+from surfmod.cam import part_points as P
 from surfmod.cam import verify as V
 from surfmod.cam import wall_dexels as W
 from surfmod.cam.cutters import Bull
@@ -200,11 +201,11 @@ def test_a_verdict_after_a_repair_measures_the_changed_stretch_again(job, monkey
     assert not job.verification.measured  # the job keeps none of it
     # the verdict before holds how the part was sampled, not its points: sampled again
     # (the kept sampling dropped, a verdict samples anew), the part's measures are still its
-    V._SAMPLED.clear()
+    P._SAMPLED.clear()
     V.verify_job(job)
     probed, swept = [], []
-    probes, sweep = V._probes, V.K.sweep_body
-    monkeypatch.setattr(V, "_probes", lambda *a: probed.append(len(a[0])) or probes(*a))
+    probes, sweep = V.probes_along, V.K.sweep_body
+    monkeypatch.setattr(V, "probes_along", lambda *a: probed.append(len(a[0])) or probes(*a))
     monkeypatch.setattr(V.K, "sweep_body", lambda *a: swept.append(len(a[4])) or sweep(*a))
     again = V.verify_job(job, texts=["\n".join(lines)], before=before)
     assert [str(f) for f in again.findings] == [str(f) for f in fresh.findings]
@@ -252,7 +253,7 @@ def test_grbl_programs_are_read_per_tool(job):
 
 def test_work_is_bounded_up_front(job):
     with pytest.raises(SurfmodError, match="max_samples"):
-        V.part_points(job.part, 0.01, max_samples=1000)
+        P.part_points(job.part, 0.01, max_samples=1000)
     moves = sum(len(op.motion.points) for op in job.operations)
     with pytest.raises(SurfmodError, match="max_probes"):  # not even two probes per move
         V.verify_job(job, max_probes=moves)
@@ -329,9 +330,9 @@ def test_the_walls_feet_do_not_depend_on_the_order_of_the_parts_points():
     these 4,000 depths changed (up to 1.6 mm, a far point's coarse nearest) and 5 points
     whether they stand on a wall."""
     part = bd.Box(30, 30, 10) - bd.Pos(0, 0, 2) * bd.Box(16, 16, 6.01)
-    points, _ = V.part_points(part, 0.25)
+    points, _ = P.part_points(part, 0.25)
     rng = np.random.default_rng(5)
-    buckets = [V.PartPoints.bucket(p, 1.0) for p in (points, points[rng.permutation(len(points))])]
+    buckets = [P.PartPoints.bucket(p, 1.0) for p in (points, points[rng.permutation(len(points))])]
     assert np.array_equal(buckets[0].points, buckets[1].points)
     # stock points before the pocket's walls and over its floor, some far from the part
     q = np.column_stack([rng.uniform(-8, 8, 4000), rng.uniform(6.5, 8.0, 4000), rng.uniform(-3.0, 6.0, 4000)])

@@ -141,7 +141,7 @@ def _leave(out: Moves, top: float, safe: float):
     out.add([[p[0], p[1], safe]], RAPID)
 
 
-def _add_raster(out: Moves, pts: np.ndarray, top, part: _Part, tool: Tool, safe: float, allowed: float, what: str):
+def add_raster(out: Moves, pts: np.ndarray, top, part: _Part, tool: Tool, safe: float, allowed: float, what: str):
     """A raster's cutter locations ``pts`` added to ``out``: entered from the clearance
     height (the entry judged on the drop-cutter heights), cut, and left above the stock."""
     before = sum(len(q) for q in out.points)
@@ -620,7 +620,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     allowed = tolerance - part.deflection + part.lift
     # the raster before the contours: the floors are clear when a contour's holder comes
     # down beside them, so the walls are cut down to the holder's limit over a clear floor
-    _add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
+    add_raster(out, path.points, top, part, tool, safe, allowed, "the raster's entry")
     wl_info, depth = None, np.full(1, -np.inf)
     if steep_angle is not None:
         if scallop is not None:
@@ -699,7 +699,7 @@ def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, to
                 if str(exc).startswith("bounds:"):
                     continue  # the tool touches no face there
                 raise
-            _add_raster(out, path.points, top, part, tool, safe, allowed, "a cross pass's entry")
+            add_raster(out, path.points, top, part, tool, safe, allowed, "a cross pass's entry")
             passes += path.n_passes
     return out.motion(), passes
 

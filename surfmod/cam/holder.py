@@ -53,9 +53,10 @@ import numpy as np
 from ..inputs import upright_cylinder
 from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop
+from .part_points import probes_along
 from .rest import StockModel
 from .roughing import PLUNGE, RAPID, Motion, Moves
-from .verify import BODY_NODES, _probes, body_cell, body_stand
+from .verify import BODY_NODES, body_cell, body_stand
 from .verify_kernels import sweep_body, sweep_stock
 
 #: probes along the moves for the part check, and stock nodes of the job's model, at most
@@ -107,7 +108,7 @@ def _flush(triangles: np.ndarray, deflection: float, tool, points: np.ndarray, s
     flush = np.zeros(max(len(points) - 1, 0), bool)
     if not narrow or not len(flush) or skin <= 0.0:
         return flush
-    probes, move, _ = _probes(points[:-1], points[1:], tool.radius / PROBES_PER_RADIUS, MAX_HOLDER_PROBES)
+    probes, move, _ = probes_along(points[:-1], points[1:], tool.radius / PROBES_PER_RADIUS, MAX_HOLDER_PROBES)
     low = np.minimum(points[:-1, 2], points[1:, 2])[move]
     near = np.flatnonzero(low + min(narrow) < float(triangles[:, :, 2].max()) + deflection)
     if near.size:
@@ -168,7 +169,7 @@ def part_sink(triangles: np.ndarray, deflection: float, tool, points: np.ndarray
         return sink
     top = float(triangles[:, :, 2].max()) + deflection
     spacing = min(r for r, _, _ in discs) / PROBES_PER_RADIUS
-    probes, move, spacing = _probes(points[:-1], points[1:], spacing, MAX_HOLDER_PROBES)
+    probes, move, spacing = probes_along(points[:-1], points[1:], spacing, MAX_HOLDER_PROBES)
     seg = points[1:] - points[:-1]
     slope = np.abs(seg[:, 2]) / np.maximum(np.linalg.norm(seg, axis=1), 1e-300)
     # the lowest the move goes within half a spacing

@@ -27,7 +27,7 @@ tool's axis can touch a rest node (the regions grown by the tool's radius and a 
 A run of raster points inside is cut as the raster made it (every move of it was
 judged); runs closer along the raster than ``BRIDGE_RADII`` tool radii are joined by the
 raster's own moves between them, the others are linked as the finishing links
-(:func:`~surfmod.cam.finishing._add_raster`): up at the feed to above the stock left,
+(:func:`~surfmod.cam.finishing.add_raster`): up at the feed to above the stock left,
 rapid at the clearance height, down, plunge.  "Above the stock left" is read from the
 stock model itself: its highest node within the tool's footprint, plus
 ``REST_CLEARANCE``.
@@ -43,7 +43,7 @@ from scipy import ndimage
 from .. import checks
 from ..errors import SurfmodError
 from . import verify_kernels as K
-from .finishing import RECUT_SHARE, REST_CLEARANCE, STEEP_MARGIN, _add_raster, contour_moves, contour_spacing, \
+from .finishing import RECUT_SHARE, REST_CLEARANCE, STEEP_MARGIN, add_raster, contour_moves, contour_spacing, \
     height_field, judge_links, near_box
 from .roughing import RAPID, Motion, Moves
 from .stock_field import NodeGrid
@@ -214,14 +214,6 @@ def _runs(inside: np.ndarray, points: np.ndarray, bridge: float) -> list[tuple[i
     return [(a, b) for a, b in out if b - a >= 2]
 
 
-def _grid_boxes(reach: np.ndarray, stock: StockModel):
-    """The labels of the connected regions of ``reach`` and each one's (x, y) box."""
-    labels, _ = ndimage.label(reach, structure=np.ones((3, 3)))
-    x, y = stock.x, stock.y
-    return labels, [np.array([[x[a.start], y[b.start]], [x[a.stop - 1], y[b.stop - 1]]])
-                    for a, b in ndimage.find_objects(labels)]
-
-
 class _LeftNear:
     """Whether a contour point at ``xy``, tip height ``z``, of the rest region ``label``
     can meet what the stock model shows left: a left node within the tool's radius and a
@@ -251,7 +243,10 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
     di, dj = np.mgrid[-n:n + 1, -n:n + 1]
     disc = np.hypot(di, dj) * stock.cell <= tool.radius + stock.cell
     reach = ndimage.binary_dilation(mask, structure=disc)
-    labels, boxes = _grid_boxes(reach, stock)
+    labels, _ = ndimage.label(reach, structure=np.ones((3, 3)))  # the regions and their (x, y) boxes
+    x, y = stock.x, stock.y
+    boxes = [np.array([[x[a.start], y[b.start]], [x[a.stop - 1], y[b.stop - 1]]])
+             for a, b in ndimage.find_objects(labels)]
     step = tool.radius / 4
     spacing = stepover * RECUT_SHARE
     # two rasters over every box: estimated before any drop
@@ -294,7 +289,7 @@ def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, 
             pts = path.points
             runs = _runs(stock.at(labels, pts, 0) == label, pts, BRIDGE_RADII * tool.radius)
             for a, b in runs:
-                _add_raster(out, pts[a:b], top, part, tool, safe, allowed, "a rest cut's entry")
+                add_raster(out, pts[a:b], top, part, tool, safe, allowed, "a rest cut's entry")
             info["passes"] += path.n_passes
             info["runs"] += len(runs)
             info["lifted"] = max(info["lifted"], path.lifted)

@@ -42,10 +42,10 @@ from ..meshing.render import Drawing, polyline_runs, repr_png
 from .cutters import Cutter
 from .drop_cutter import TriangleGrid, drop, part_triangles
 from .gcode import gcode_text
+from .part_points import lift_gouges
 from .toolpath_exact import exact_heights
 from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
-from .verify import lift_gouges
 
 # Shares of the gouge tolerance: the mesh's chordal deflection, and the depth at which
 # the refinement inserts a location (the rest is the margin between sample points).

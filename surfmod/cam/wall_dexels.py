@@ -24,7 +24,7 @@ move from ``A`` to ``B`` removes from each dexel the chord of those discs:
 Every move is estimated before any is swept (:func:`sweep_work`): the kept dexels of the
 lines its capsule crosses and its stamps' lines, counted in the dexels' plane.
 
-**Judged** (:func:`wall_residual`): every end of a material interval is a point of the
+**Judged** (by :mod:`surfmod.cam.verify`): every end of a material interval is a point of the
 stock's surface.  Its distance to the part is the material left there, measured along the
 normal of the part at its foot: from the plane through the nearest points of the exact
 part (``PLANE_POINTS`` of them; for a point far from the part, those round the nearest of
