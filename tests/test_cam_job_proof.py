@@ -33,7 +33,7 @@ job's stock, one tool after the other:
   (stepcode_HEAD_BACK: 0.160, bound 0.244; 0.276 while the part's height field took every
   node of a slope steeper than 45° as beside a hole's edge, its 72° face 0.481 lower);
 - on walls (faces steeper than 60 degrees, vertical ones included) the dexels along x
-  and y (``SIDE_CELL`` apart in the other horizontal and in z) measure the stock left
+  and y (``Settings.side_cell`` apart in the other horizontal and in z) measure the stock left
   normal to the face at every crossing of a dexel with it, wherever the tool placed
   against the face clears the part (not under an overhang, not in a corner tighter than
   the tool, not below the stock's floor): after roughing at least the allowance (or all
@@ -76,6 +76,7 @@ walls and in concave corners, where the rings stayed a grid cell off the part).
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -91,12 +92,28 @@ from surfmod.cam.drop_cutter import part_triangles
 
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="rs274 (Debian package linuxcnc-uspace) is not installed")
-R1, R2, SCALLOP, ALLOWANCE, MARGIN, CELL = 5.0, 3.0, 0.15, 0.5, 2.0, 0.25
-SIDE_CELL = 0.4  # spacing of the dexels along x and y (in y or x, and in z)
 ROUNDING = 1e-4
-FLUTE, SHANK = 80.0, None  # both tools' flutes and the shank above them (None: the tool's default)
-NECK = 0.0  # how much narrower than the end the shank is
-DEFLECTION = 0.01  # the judge's mesh of the part
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The job :func:`prove` makes and the judge's resolution: by default the coarse
+    settings above, which keep each part to seconds."""
+
+    r1: float = 5.0  # the roughing flat end's radius
+    r2: float = 3.0  # the finishing ball's radius
+    scallop: float = 0.15
+    allowance: float = 0.5
+    margin: float = 2.0  # the stock beyond the part
+    cell: float = 0.25  # the stock simulation's cells
+    side_cell: float = 0.4  # spacing of the dexels along x and y (in y or x, and in z)
+    flute: float = 80.0  # both tools' flutes
+    shank: float | None = None  # the shank above them (None: the tool's default)
+    neck: float = 0.0  # how much narrower than the end the shank is
+    deflection: float = 0.01  # the judge's mesh of the part
+
+
+COARSE = Settings()
 #: corpus parts (20-150 mm, pockets and holes)
 CORPUS_JOBS = ["stepcode_FOOT_BACK_000.stp", "stepcode_TAIL_MIDDLE_PART.stp", "nist_ftc_11_asme1_rb.stp",
                "trimesh_featuretype.STEP", "stepcode_HEAD_BACK.stp"]
@@ -224,14 +241,14 @@ def exact_where_thin(sides, walls, left: np.ndarray, bound: float, tri: np.ndarr
 
 
 def wall_check(walls, floor, stock: Stock, cutter: Cutter, left: np.ndarray, bound: np.ndarray, offset: float,
-               slack: float, tri: np.ndarray, below: float = 0.0):
+               slack: float, tri: np.ndarray, cell: float, below: float = 0.0):
     """Wall points left thicker than ``bound`` that the tool (grown by ``offset``) can touch
     (and ``below`` lower on the face), and the points the quick reach map lets it touch
     less those over the bound that the tool placed at each over the grid's nodes and the
     exact triangles cannot touch (the judged footprint; the quick map is a little generous
     with points within the bound)."""
     kw = dict(offset=offset, below=below, slack=slack)
-    quick = reach_map(floor, CELL, cutter, offset=offset, slack=slack)
+    quick = reach_map(floor, cell, cutter, offset=offset, slack=slack)
     reach = np.concatenate([wall_reach(w, floor, stock.x, stock.y, cutter, quick=quick, **kw) for w in walls])
     # the tip stands on the stock's bottom at lowest (the table), also where the tool is
     # placed beyond the stock's grid, where wall_reach sees no floor (a ball r 9 against
@@ -247,30 +264,30 @@ def wall_check(walls, floor, stock: Stock, cutter: Cutter, left: np.ndarray, bou
     return over, judged
 
 
-def prove(path: Path, tmp_path: Path) -> dict:
+def prove(path: Path, tmp_path: Path, s: Settings = COARSE) -> dict:
     shape = to_shape(path)
-    rough, finish = (sm.Tool(kind, r, flute_length=FLUTE, shank_length=SHANK, shank_radius=r - NECK)
-                     for kind, r in (("flat", R1), ("ball", R2)))
-    job = sm.machine(shape, MARGIN, [sm.Rough(rough, allowance=ALLOWANCE), sm.Finish(finish, scallop=SCALLOP)])
+    rough, finish = (sm.Tool(kind, r, flute_length=s.flute, shank_length=s.shank, shank_radius=r - s.neck)
+                     for kind, r in (("flat", s.r1), ("ball", s.r2)))
+    job = sm.machine(shape, s.margin, [sm.Rough(rough, allowance=s.allowance), sm.Finish(finish, scallop=s.scallop)])
     ngc = tmp_path / "job.ngc"
     sm.export_gcode(job, ngc, post="linuxcnc")
     prog = parse_canon(run_rs274(ngc, tmp_path / "job.txt"), arc_chord=1e-4)
     assert prog.tool_changes == [1, 2] and prog.ended
-    tri, deflection, (_, owner) = part_triangles(shape, DEFLECTION, face_index=True)
-    stock = Stock(job.stock, CELL)
+    tri, deflection, (_, owner) = part_triangles(shape, s.deflection, face_index=True)
+    stock = Stock(job.stock, s.cell)
     top = part_height(tri, stock.x, stock.y, deflection=deflection)  # no face lifted over a hole's chord
     bottom = float(job.stock[0, 2])
     floor = np.where(np.isfinite(top), top, bottom)  # the tool cannot go below the stock
-    sides = side_grids(job.stock, SIDE_CELL)
+    sides = side_grids(job.stock, s.side_cell)
     normals = vertex_normals(tri, owner)
     walls = [wall_points(tri, dex, normals=normals) for dex in sides]
     wall_nz = np.abs(np.concatenate([w.normal[:, 2] for w in walls]))
 
     # roughing
-    rep = simulate(Program([m for m in prog.moves if m.tool == 1]), {1: Cutter("flat", R1)}, stock, top)
-    assert rep.gouge <= -ALLOWANCE + deflection + ROUNDING, str(rep)
+    rep = simulate(Program([m for m in prog.moves if m.tool == 1]), {1: Cutter("flat", s.r1)}, stock, top)
+    assert rep.gouge <= -s.allowance + deflection + ROUNDING, str(rep)
     assert rep.rapid_cut <= 1e-9 and rep.rapid_part < 0 and rep.cut_without_spindle == 0, str(rep)
-    rest = rough_rest(stock, top, job.operations[0], CELL, tri)
+    rest = rough_rest(stock, top, job.operations[0], s.cell, tri)
     share = rest["share"]
     assert share == 0, f"roughing leaves {share:.3%} of the stock above allowance + cusp, unreported"
     assert rest["left_area"] <= rest["declared_area"] + 1e-9, rest
@@ -278,46 +295,46 @@ def prove(path: Path, tmp_path: Path) -> dict:
     # at most allowance + stepdown cos θ + the rings' margin where the tool grown by both
     # touches the wall and a stepdown lower on it
     rough_rep = job.operations[0].report
-    sweep_sides(sides, prog, 1, Cutter("flat", R1))
-    left = exact_where_thin(sides, walls, walls_left(sides, walls), ALLOWANCE - deflection - ROUNDING, tri)
+    sweep_sides(sides, prog, 1, Cutter("flat", s.r1))
+    left = exact_where_thin(sides, walls, walls_left(sides, walls), s.allowance - deflection - ROUNDING, tri)
     # where the part comes back along the line nearer than the allowance (a slit, or a line
     # grazing the part past a step: stepcode_HEAD_BACK's 0.01 mm ring at x 250), the stock
     # there can hold no more than that room
     room = np.concatenate([w.room * np.abs(w.normal[:, dex.axis]) for dex, w in zip(sides, walls)])
-    short = left - np.minimum(ALLOWANCE, room)
+    short = left - np.minimum(s.allowance, room)
     assert short.min() >= -(deflection + ROUNDING), f"roughing cuts {-short.min():.4f} into a wall"
-    ring = 2 * (rough_rep["cell"] ** 2 / (16 * R1) + rough_rep["tolerance"])
-    rough_bound = ALLOWANCE + rough_rep["stepdown"] * wall_nz + ring + deflection + ROUNDING
-    over, rough_reach = wall_check(walls, floor, stock, Cutter("flat", R1), left, rough_bound, ALLOWANCE + ring,
-                                   deflection, tri, rough_rep["stepdown"])
+    ring = 2 * (rough_rep["cell"] ** 2 / (16 * s.r1) + rough_rep["tolerance"])
+    rough_bound = s.allowance + rough_rep["stepdown"] * wall_nz + ring + deflection + ROUNDING
+    over, rough_reach = wall_check(walls, floor, stock, Cutter("flat", s.r1), left, rough_bound, s.allowance + ring,
+                                   deflection, tri, s.cell, rough_rep["stepdown"])
     declared = np.zeros(len(left), bool)
     pts = np.concatenate([w.point for w in walls])
     for g in rough_rep["left"]:
         for x, y in g["ring"]:
-            declared |= np.hypot(pts[:, 0] - x, pts[:, 1] - y) <= R1 + CELL
+            declared |= np.hypot(pts[:, 0] - x, pts[:, 1] - y) <= s.r1 + s.cell
     over &= ~declared
-    over[over] = flat_thickness(pts[over], prog, 1, R1) > rough_bound[over]
+    over[over] = flat_thickness(pts[over], prog, 1, s.r1) > rough_bound[over]
     assert not over.any(), f"roughing leaves {left[over].max():.4f} on {over.sum()} wall points, e.g. {pts[over][0]}"
     rough_wall = float(left[rough_reach].max(initial=0.0))
     roughed = copy.deepcopy(sides)
 
     # finishing on the roughed stock
     fin = job.operations[1]
-    rep = simulate(Program([m for m in prog.moves if m.tool == 2]), {2: Cutter("ball", R2)}, stock, top)
+    rep = simulate(Program([m for m in prog.moves if m.tool == 2]), {2: Cutter("ball", s.r2)}, stock, top)
     tol = fin.report["tolerance"]
     assert rep.gouge <= tol + deflection + ROUNDING, str(rep)
     assert rep.rapid_cut <= 1e-9 and rep.rapid_part < 0 and rep.cut_without_spindle == 0, str(rep)
-    reach = reachable(np.where(np.isfinite(top), top, bottom), Cutter("ball", R2), CELL)
-    theta = np.maximum(_slope(top, CELL), _slope(reach, CELL))
+    reach = reachable(np.where(np.isfinite(top), top, bottom), Cutter("ball", s.r2), s.cell)
+    theta = np.maximum(_slope(top, s.cell), _slope(reach, s.cell))
     wall = ~np.isfinite(top) | ~(np.nan_to_num(theta, nan=90.0) <= 60)
-    pad = int(np.ceil(2 * R2 / CELL))
+    pad = int(np.ceil(2 * s.r2 / s.cell))
     near = ndimage.binary_dilation(wall, iterations=pad)
     near[:pad] = near[-pad:] = True
     near[:, :pad] = near[:, -pad:] = True
     shallow = ~near & (np.nan_to_num(theta, nan=90.0) < 30)
     residual = (stock.top - reach)[shallow]
     lift = fin.report["toolpath"].deflection
-    bound = SCALLOP / np.cos(np.radians(theta[shallow])) ** 3 + tol + lift
+    bound = s.scallop / np.cos(np.radians(theta[shallow])) ** 3 + tol + lift
     assert shallow.sum() > 1000
     worst = float((residual - bound).max())
     assert worst <= 0, f"residual {residual.max():.4f} above S/cos³θ + tol + lift by {worst:.4f}"
@@ -325,22 +342,22 @@ def prove(path: Path, tmp_path: Path) -> dict:
     # holes, near-vertical walls or the rest the ball cannot reach): normal to the reachable
     # surface the material left is at most S + tolerance + lift
     th = np.nan_to_num(theta, nan=90.0)
-    rest = np.isfinite(top) & (reach - top > SCALLOP)
+    rest = np.isfinite(top) & (reach - top > s.scallop)
     off = ndimage.binary_dilation(~np.isfinite(top) | (th >= 85) | rest, iterations=2)
     off[:2] = off[-2:] = True
     off[:, :2] = off[:, -2:] = True
     steep = ~off & (th >= 30) & (th < 85)
-    normal = normal_residual(stock.top, reach, CELL)[steep]
+    normal = normal_residual(stock.top, reach, s.cell)[steep]
     steep_worst = float(np.nanmax(normal, initial=0.0))
-    if steep_worst > SCALLOP + tol + lift:
+    if steep_worst > s.scallop + tol + lift:
         i, j = np.argwhere(steep)[np.nanargmax(normal)]
         raise AssertionError(f"normal residual {steep_worst:.4f} on steep ground > S + tol + lift "
-                             f"{SCALLOP + tol + lift:.4f}, at ({stock.x[i]:.3f}, {stock.y[j]:.3f}, {top[i, j]:.3f}), "
+                             f"{s.scallop + tol + lift:.4f}, at ({stock.x[i]:.3f}, {stock.y[j]:.3f}, {top[i, j]:.3f}), "
                              f"slope {th[i, j]:.1f} deg")
     # walls (steeper than 60 degrees) through the dexels along x and y: where the ball can
     # touch the wall, at most S + tolerance + lift is left normal to it, and no cut into it
-    left, over, reach = judge_finish(sides, walls, prog, Cutter("ball", R2), floor, stock, deflection, tri,
-                                     SCALLOP + tol + lift)
+    left, over, reach = judge_finish(sides, walls, prog, Cutter("ball", s.r2), floor, stock, deflection, tri,
+                                     s.scallop + tol + lift, s)
     assert left.min() >= -(tol + deflection + ROUNDING), f"finishing cuts {-left.min():.4f} into a wall"
     assert not over.any(), f"finishing leaves {left[over].max():.4f} > S + tol + lift on {over.sum()} wall points, " \
                            f"e.g. {pts[over][0]}"
@@ -350,15 +367,15 @@ def prove(path: Path, tmp_path: Path) -> dict:
             "rough_wall": rough_wall, "rough_wall_nodes": int(rough_reach.sum()),
             # to judge the finishing again: the walls, the roughed dexels and what bounds them
             "finish": lambda cutter: judge_finish(roughed, walls, prog, cutter, floor, stock, deflection, tri,
-                                                  SCALLOP + tol + lift)}
+                                                  s.scallop + tol + lift, s)}
 
 
-def judge_finish(sides, walls, prog, cutter, floor, stock, deflection, tri, bound):
+def judge_finish(sides, walls, prog, cutter, floor, stock, deflection, tri, bound, s: Settings):
     """Stock left on the walls after the finishing moves swept with ``cutter``, the points
-    over ``bound`` the finishing ball (radius R2) can touch, and the points judged."""
+    over ``bound`` the finishing ball (radius ``s.r2``) can touch, and the points judged."""
     sweep_sides(sides, prog, 2, cutter)
     left = walls_left(sides, walls)
-    return (left,) + wall_check(walls, floor, stock, Cutter("ball", R2), left, bound, 0.0, deflection, tri)
+    return (left,) + wall_check(walls, floor, stock, Cutter("ball", s.r2), left, bound, 0.0, deflection, tri, s.cell)
 
 
 @needs_rs274
@@ -368,9 +385,9 @@ def test_cam_part_job_in_stock(tmp_path):
     # the top of the mould is shallow: most of it is judged; so are its walls
     assert got["wall_nodes"] > 25_000 and got["rough_wall_nodes"] > 20_000
     # the same program run with a ball 0.2 smaller than it was made for: the walls show it
-    left, over, _ = got["finish"](Cutter("ball", R2 - 0.2))
+    left, over, _ = got["finish"](Cutter("ball", COARSE.r2 - 0.2))
     assert over.sum() > 1000 and left[over].max() > 0.2
-    assert got["nodes"] > 40_000 and got["residual"] > SCALLOP / 2
+    assert got["nodes"] > 40_000 and got["residual"] > COARSE.scallop / 2
 
 
 @needs_rs274
@@ -385,18 +402,15 @@ def test_corpus_job_in_stock(tmp_path, corpus_dir, name):
 #: 5 mm thick, its tooth roots rounded 1.59 mm and a 2 mm deep recess with 2 mm corners;
 #: a flat r = 1 roughs and a ball r = 0.8 finishes (the issue's tools), the scallop 2.5 %
 #: of the ball's radius, the judge's stock cells 0.1 mm (about a quarter of the stepover)
-SMALL_TOOL_JOB = {"name": "f360grbl_gear.step", "R1": 1.0, "R2": 0.8, "SCALLOP": 0.02, "CELL": 0.1}
+SMALL_TOOL_JOB = "f360grbl_gear.step", Settings(r1=1.0, r2=0.8, scallop=0.02, cell=0.1)
 
 
-def prove_with(settings: dict, corpus_dir: Path, tmp_path: Path, monkeypatch, least: dict | None = None) -> dict:
-    """:func:`prove` on the corpus part ``settings["name"]`` with the module's tools, scallop
-    and cells set to the rest of ``settings``; with ``least``, each named count of the
-    proof (nodes judged shallow or steep, wall points) at least that."""
-    settings = dict(settings)
-    name = settings.pop("name")
-    for key, value in settings.items():  # prove() reads the tools and the cells from here
-        monkeypatch.setitem(globals(), key, value)
-    got = prove(corpus_dir / name, tmp_path)
+def prove_with(job: tuple[str, Settings], corpus_dir: Path, tmp_path: Path, least: dict | None = None) -> dict:
+    """:func:`prove` on the corpus part ``job[0]`` with the settings ``job[1]``; with
+    ``least``, each named count of the proof (nodes judged shallow or steep, wall points)
+    above that."""
+    name, settings = job
+    got = prove(corpus_dir / name, tmp_path, settings)
     shown = {k: v for k, v in got.items() if k not in ("job", "finish")}
     print(name, shown)
     assert all(got[key] > count for key, count in (least or {}).items()), shown
@@ -405,8 +419,8 @@ def prove_with(settings: dict, corpus_dir: Path, tmp_path: Path, monkeypatch, le
 
 @needs_rs274
 @pytest.mark.corpus
-def test_corpus_job_with_a_small_tool(tmp_path, corpus_dir, monkeypatch):
-    got = prove_with(SMALL_TOOL_JOB, corpus_dir, tmp_path, monkeypatch)
+def test_corpus_job_with_a_small_tool(tmp_path, corpus_dir):
+    got = prove_with(SMALL_TOOL_JOB, corpus_dir, tmp_path)
     fin = got["job"].operations[1].report
     # the ball reaches the tooth roots (their fillets are larger than it) and the floor
     # of the recess: most of the gear's top is judged shallow ground
@@ -419,17 +433,16 @@ def test_corpus_job_with_a_small_tool(tmp_path, corpus_dir, monkeypatch):
 #: its width) on 40 mm flutes, the scallop 2 % of the ball's radius, the judge's stock
 #: cells 0.1 mm (a quarter of the 0.4 mm stepover) and its wall dexels 0.2 mm apart.  The
 #: slots' hidden walls are material the dexels keep and no tool from above can reach.
-OVERHANG_JOB = {"name": "tcv_profile4040.step", "R1": 1.5, "R2": 1.0, "SCALLOP": 0.02, "CELL": 0.1,
-                "SIDE_CELL": 0.2, "FLUTE": 40.0}
+OVERHANG_JOB = "tcv_profile4040.step", Settings(r1=1.5, r2=1.0, scallop=0.02, cell=0.1, side_cell=0.2, flute=40.0)
 
 
 @needs_rs274
 @pytest.mark.corpus
-def test_corpus_job_under_overhangs(tmp_path, corpus_dir, monkeypatch):
+def test_corpus_job_under_overhangs(tmp_path, corpus_dir):
     # the profile's top and slot floors are judged shallow ground (60,333 nodes: residual
     # 0.0192), the rounded edges steep ground (5,502) and the walls through the
     # dexels (54,324 of 142,540 points reached: 0.0087); the undercuts stay unreached
-    prove_with(OVERHANG_JOB, corpus_dir, tmp_path, monkeypatch,
+    prove_with(OVERHANG_JOB, corpus_dir, tmp_path,
                least={"nodes": 40_000, "steep_nodes": 3_000, "wall_nodes": 40_000})
 
 
@@ -439,16 +452,16 @@ def test_corpus_job_under_overhangs(tmp_path, corpus_dir, monkeypatch):
 #: the issue's tools), the scallop 1 % of the ball's radius, the judge's stock cells 0.5 mm
 #: (a fifth of the 2.5 mm stepover) and its wall dexels 0.8 mm apart (at 0.4 the dexels
 #: would meet the moves 7.6e7 times, above the judge's 6e7)
-MOULD_JOB = {"name": "occt_cornetta.stp", "R1": 12.0, "R2": 9.0, "SCALLOP": 0.09, "CELL": 0.5, "SIDE_CELL": 0.8}
+MOULD_JOB = "occt_cornetta.stp", Settings(r1=12.0, r2=9.0, scallop=0.09, cell=0.5, side_cell=0.8)
 
 
 @needs_rs274
 @pytest.mark.corpus
-def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
+def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir):
     # the plate and the block's top are judged shallow ground (26,247 nodes; the rest is
     # within two ball radii of a wall), the block's rounded walls steep ground (5,323) and
     # the walls through the dexels (39,457 points)
-    prove_with(MOULD_JOB, corpus_dir, tmp_path, monkeypatch,
+    prove_with(MOULD_JOB, corpus_dir, tmp_path,
                least={"nodes": 20_000, "steep_nodes": 4_000, "wall_nodes": 30_000})
 
 
@@ -463,15 +476,15 @@ def test_corpus_job_on_a_freeform_mould(tmp_path, corpus_dir, monkeypatch):
 #: 0.097 off its faces).  The proof takes about 8 CPU minutes, most of them the job itself
 #: (its waterline, drop-cutter and meshing, the verification's gouge measure): marked
 #: ``heavy``, run with ``python -m pytest -q -m heavy``, outside CI
-PLATE_JOB = {"name": "nist_ctc_02_asme1_rc.stp", "R1": 30.0, "R2": 25.0, "SCALLOP": 0.5, "CELL": 2.0,
-             "SIDE_CELL": 4.0, "FLUTE": 100.0, "SHANK": 320.0, "DEFLECTION": 0.05}
+PLATE_JOB = "nist_ctc_02_asme1_rc.stp", Settings(r1=30.0, r2=25.0, scallop=0.5, cell=2.0, side_cell=4.0, flute=100.0,
+                                               shank=320.0, deflection=0.05)
 
 
 @needs_rs274
 @pytest.mark.heavy
-def test_corpus_job_on_a_pocketed_plate(tmp_path, corpus_dir, monkeypatch):
+def test_corpus_job_on_a_pocketed_plate(tmp_path, corpus_dir):
     # the floors and the top are judged shallow ground (22,182 nodes: residual 0.307), the
     # rounded edges steep ground (737: 0.346), the pockets' walls through the dexels
     # (36,363 of 97,397 points: 0.516 after finishing, 29,084 after roughing)
-    prove_with(PLATE_JOB, corpus_dir, tmp_path, monkeypatch,
+    prove_with(PLATE_JOB, corpus_dir, tmp_path,
                least={"nodes": 20_000, "steep_nodes": 500, "wall_nodes": 30_000})
