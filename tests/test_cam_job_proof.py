@@ -388,6 +388,15 @@ def test_cam_part_job_in_stock(tmp_path):
     left, over, _ = got["finish"](Cutter("ball", COARSE.r2 - 0.2))
     assert over.sum() > 1000 and left[over].max() > 0.2
     assert got["nodes"] > 40_000 and got["residual"] > COARSE.scallop / 2
+    # the job's own verdict measures what this judge does: its residual after finishing
+    # more than two thirds of the scallop (0.125 of 0.15) and within its limit, its walls'
+    # the dexels' (0.0079)
+    v = got["job"].verification
+    assert v.ok, str(v)
+    residual = next(f for f in v.findings if f.what.startswith("residual after finishing"))
+    assert 2 / 3 * COARSE.scallop < residual.worst <= residual.limit < 7 / 6 * COARSE.scallop, residual
+    walls = next(f for f in v.findings if f.what.startswith("residual on walls"))
+    assert abs(walls.worst - got["wall_residual"]) < 1e-3, (walls, got["wall_residual"])
 
 
 @needs_rs274
