@@ -98,15 +98,16 @@ def compiled_kernels():
     local.COMPILED_SCATTERED, local.COMPILED_GRID = saved
 
 
-#: Tests of a minute or more on the 2-core CI machine (the corpus judges), the longest
-#: first: each of pytest-xdist's workers starts on its share of them and the short tests fill
-#: in behind, instead of one long test arriving last and leaving the other worker idle for
-#: its whole run.  xdist's ``load`` scheduling sends each worker a first chunk of
-#: consecutive tests (an eighth of the run on two workers: 133 of the corpus run's 1068),
-#: then the rest one short batch at a time; with the slow tests simply collected first,
-#: the first worker's chunk held them all and the other ran out of work (the corpus run's
-#: last 3.5 minutes on one worker).  So :func:`pytest_collection_modifyitems` deals them
-#: into the workers' first chunks, the longest first, in turn.
+#: Tests of a minute or more on the 2-core CI machine (the corpus judges), then the default
+#: run's of 8-20 s, the longest first: each of pytest-xdist's workers starts on its share of
+#: them and the short tests fill in behind, instead of one long test arriving last and
+#: leaving the other worker idle for its whole run.  xdist's ``load`` scheduling sends each
+#: worker a first chunk of consecutive tests (an eighth of the run on two workers: 133 of
+#: the corpus run's 1068), then the rest one short batch at a time; with the slow tests
+#: simply collected first, the first worker's chunk held them all and the other ran out of
+#: work (the corpus run's last 3.5 minutes on one worker).  So
+#: :func:`pytest_collection_modifyitems` deals them into the workers' first chunks, the
+#: longest first, in turn.
 SLOW_FIRST = (
     "test_corpus_toolpath.py::test_corpus_toolpath_never_gouges[pythonocc_Ventilator.stp]",
     "test_corpus_toolpath.py::test_ventilator",
@@ -125,6 +126,15 @@ SLOW_FIRST = (
     "test_mass_green.py::test_green_grid_equals_node_by_node_on_the_corpus",
     "test_femesh.py::test_no_inverted_tet_on_any_corpus_solid",
     "test_femesh_fallback.py::test_11752",
+    "test_examples.py::test_example_runs_and_writes_samples[cam_machining.py]",
+    "test_examples.py::test_example_runs_and_writes_samples[fill_hole.py]",
+    "test_projection_kernel.py::test_the_meshers_projections_compile_one_signature",
+    "test_toolpath.py::test_the_judges_culling_finds_what_the_whole_part_finds",
+    "test_cli_batch.py::test_killed_client_of_its_own_local_cluster_leaves_no_process",
+    "test_cli_batch.py::test_a_worker_killed_mid_run_loses_no_other_file",
+    "test_cli_batch.py::test_killed_client_leaves_no_worker_and_keeps_its_rows",
+    "test_fill.py::test_five_sided_hole_in_a_paraboloid",
+    "test_cli.py::test_console_script_runs_the_gallery",
 )
 
 
