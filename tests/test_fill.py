@@ -96,12 +96,12 @@ def test_five_sided_hole_in_a_paraboloid():
     f = sm.fill(boundary)
     assert len(f) == 5
     angles = []
-    for nb, side in boundary:
-        for patch in f:
-            try:
-                c = sm.continuity(patch, nb, samples=21)
-            except sm.SurfmodError:
-                continue
+    # patch k has its corner at vertex k, between sides k - 1 and k: each side is shared by
+    # two patches (sm.continuity refuses a pair that shares no side; asking every pair
+    # spent 15 of its 25 calls on those refusals)
+    for k, patch in enumerate(f):
+        for j in (k, k - 1):
+            c = sm.continuity(patch, boundary[j][0], samples=21)
             assert c.g0 < 1e-12
             angles.append(c.g1)
     assert len(angles) == 10 and max(angles) < 1e-6
