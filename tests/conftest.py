@@ -18,6 +18,13 @@ from hypothesis import settings
 
 from surfmod.eval import local
 
+# The run keeps Python's bytecode cache where the environment turns it off
+# (PYTHONDONTWRITEBYTECODE): without it each xdist worker rewrote and compiled every test
+# module again (6 of its 13 CPU seconds of collection) and each interpreter a test starts
+# compiled surfmod again.  The workers and those interpreters inherit the environment.
+if os.environ.pop("PYTHONDONTWRITEBYTECODE", None) is not None:
+    sys.dont_write_bytecode = False
+
 settings.register_profile("reproducible", derandomize=True, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "reproducible"))
