@@ -17,16 +17,16 @@ SAMPLES = 50
 
 
 def worst(fill, boundary):
-    """Largest gap, normal angle, curvature jump and relative jump over every side."""
+    """Largest gap, normal angle, curvature jump and relative jump over every side: one
+    patch meets every side, patch k of n meets sides k - 1 and k (``sm.Fill``)."""
+    n = len(boundary)
+    pairs = [(p, nb) for p in fill for nb, _ in boundary] if len(fill) == 1 else \
+        [(fill[k], boundary[j][0]) for k in range(n) for j in (k - 1, k)]
     rows = []
-    for nb, _ in boundary:
-        for patch in fill:
-            try:   # a patch side lies on (part of) the neighbour's side; OCCT's face is projected
-                c = sm.continuity(patch, nb, samples=SAMPLES) if isinstance(patch, sm.Surface) \
-                    else sm.continuity(nb, patch, samples=SAMPLES)
-            except sm.SurfmodError:     # this patch does not border this neighbour
-                continue
-            rows.append((c.g0, c.g1, c.g2, c.g2_relative))
+    for patch, nb in pairs:   # OCCT's face is projected onto the neighbour's side
+        c = sm.continuity(patch, nb, samples=SAMPLES) if isinstance(patch, sm.Surface) \
+            else sm.continuity(nb, patch, samples=SAMPLES)
+        rows.append((c.g0, c.g1, c.g2, c.g2_relative))
     return np.max(rows, axis=0)
 
 

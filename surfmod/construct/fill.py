@@ -97,9 +97,10 @@ class FillPatch(Surface):
 
 
 class Fill(tuple):
-    """The patches of a fill (one for a 4-sided hole, n for 3 and 5 sides), with
-    ``n_sides``, ``continuity`` and ``corners`` (a ``Corner`` per corner, where side
-    ``index`` ends); ``faces()`` gives build123d faces.
+    """The patches of a fill (one for a 4-sided hole, n for 3 and 5 sides: patch k has
+    its corner where side k - 1 ends and meets sides k - 1 and k), with ``n_sides``,
+    ``continuity`` and ``corners`` (a ``Corner`` per corner, where side ``index`` ends);
+    ``faces()`` gives build123d faces.
 
     >>> import surfmod as sm
     >>> flat = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
