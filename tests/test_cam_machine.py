@@ -320,8 +320,8 @@ def test_each_mesh_estimate_is_surveyed_once_before_its_meshing(monkeypatch):
     import surfmod.cam.toolpath as toolpath_module
 
     calls = []
-    survey = toolpath_module._estimate
-    monkeypatch.setattr(toolpath_module, "_estimate", lambda *a, **k: calls.append(a[1]) or survey(*a, **k))
+    survey = toolpath_module.triangle_estimate
+    monkeypatch.setattr(toolpath_module, "triangle_estimate", lambda *a, **k: calls.append(a[1]) or survey(*a, **k))
     sm.machine(pocket_part(), 2.0, [sm.Rough(sm.Tool("flat", 2.0), stepdown=1.5, allowance=0.3),
                                     sm.Finish(sm.Tool("ball", 1.0), scallop=0.05)], verify=False)
     assert len(calls) == 2 and calls[0] != calls[1], calls

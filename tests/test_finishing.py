@@ -19,7 +19,7 @@ from surfmod.cam import waterline as waterline_module
 from surfmod.cam.drop_cutter import TriangleGrid, drop
 from surfmod.cam.finishing import judge_links, recut, summary_lines
 from surfmod.cam.roughing import FEED, PLUNGE, RAPID, Moves
-from surfmod.cam.toolpath import _part
+from surfmod.cam.toolpath import meshed_part
 from surfmod.errors import SurfmodError
 
 SAMPLES = Path(__file__).resolve().parent.parent / "step_samples"
@@ -286,13 +286,13 @@ def test_a_big_part_spreads_the_waterline_fibers_to_fit_the_cap(monkeypatch):
 
 
 def test_a_clear_part_drops_the_tool_grown_by_the_deflection():
-    """``_part(..., clear=True)`` (the finishing's mesh) drops the cutter grown by the
+    """``meshed_part(..., clear=True)`` (the finishing's mesh) drops the cutter grown by the
     mesh's deflection and lifts every height by it, on a grid built once for the grown
     radius: its heights are those of a grid built for the grown tool from the plain
     part's triangles, bit for bit."""
     part = bd.Box(20, 20, 5) + bd.Pos(0, 0, 2.5) * bd.Sphere(6)
     cutter = sm.Tool("ball", 2.0).cutter
-    plain, clear = _part(part, cutter, 0.01), _part(part, cutter, 0.01, clear=True)
+    plain, clear = meshed_part(part, cutter, 0.01), meshed_part(part, cutter, 0.01, clear=True)
     d = clear.deflection
     assert d == plain.deflection and clear.lift == d and clear.cutter == cutter.grown(d)
     assert clear.grid.radius == cutter.radius + d
@@ -308,7 +308,7 @@ def test_cross_passes_stand_closer_the_further_the_residual_was_over():
     give passes a 0.71, 0.35 and 0.18 stepover apart."""
     part = bd.Box(40, 40, 5) - bd.Cylinder(1.5, 6)
     tool = sm.Tool("ball", 5.2).with_defaults(2)
-    mesh = _part(part, tool.cutter, 0.005, clear=True)
+    mesh = meshed_part(part, tool.cutter, 0.005, clear=True)
     stock = np.array([[-22.0, -22.0, -2.5], [22.0, 22.0, 4.5]])
     xs = []
     for over in (1.0, 4.0, 100.0):

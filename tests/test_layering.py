@@ -671,3 +671,25 @@ def repeated_names(modules) -> dict[str, list[str]]:
 def test_few_public_names_are_defined_twice():
     repeated = repeated_names(MODULES)
     assert len(repeated) <= MAX_REPEATED_NAMES, "\n".join(f"{k}: {v}" for k, v in sorted(repeated.items()))
+
+
+def private_imports(root: Path) -> list[str]:
+    """``module: name`` of every import of another module's private (``_``-prefixed) name
+    under ``root``: a name two modules need has a public home in one of them."""
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                found += [f"{path.relative_to(root).with_suffix('')}: {a.name}" for a in node.names
+                          if a.name.startswith("_") and not a.name.startswith("__")]
+    return found
+
+
+def test_no_module_imports_another_modules_private_name():
+    assert not private_imports(PACKAGE)
+
+
+def test_a_private_import_is_found(tmp_path):
+    (tmp_path / "a.py").write_text("def _f():\n    return 1\n")
+    (tmp_path / "b.py").write_text("def g():\n    from .a import _f, __version__\n    return _f()\n")
+    assert private_imports(tmp_path) == ["b: _f"]

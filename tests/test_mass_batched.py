@@ -18,7 +18,7 @@ from surfmod.occ.pcurves import face_pcurves, faces_pcurves
 from surfmod.occ.topo import faces_of
 from surfmod.readback import from_face
 from surfmod.inputs import to_shape
-from surfmod.mass.moments import _moments
+from surfmod.mass.moments import node_moments
 from surfmod.readback import from_faces as _read_faces
 from surfmod.mass.boundary import PcurveTable, pcurve_d1, taylor_pieces
 import surfmod.mass.nodes as mg
@@ -111,7 +111,7 @@ def _planes_equal_node_by_node(path):
     closed, exact = plane_moments(planes, 12, ref)
     for mf, mine, is_exact in zip(planes, closed, exact):
         ders, w, node_exact = face_nodes(mf, 12)
-        nodes = _moments(ders, w, ref)
+        nodes = node_moments(ders, w, ref)
         assert np.abs(mine - nodes).max() <= 1e-13 * np.abs(nodes).max(), path.name
         assert is_exact == node_exact
     return len(planes)
@@ -294,7 +294,7 @@ def test_moments_of_groups_equal_one_call_per_group(corpus_dir):
     cuts = [0, len(nodes[0][1]), len(nodes[0][1]) + len(nodes[1][1]), len(w)]
     groups = _moments_of_groups(ders, w, ref, cuts)
     for g in range(3):
-        assert np.array_equal(groups[g], _moments(ders[cuts[g]:cuts[g + 1]], w[cuts[g]:cuts[g + 1]], ref))
+        assert np.array_equal(groups[g], node_moments(ders[cuts[g]:cuts[g + 1]], w[cuts[g]:cuts[g + 1]], ref))
 
 
 @pytest.mark.parametrize("cut", ["disc", "holed plate", "slot"])

@@ -15,7 +15,7 @@ import surfmod.mass.nodes as mg
 import surfmod.mass.rules as mgrid
 from surfmod.occ.pcurves import adaptor_d1, face_pcurves
 from surfmod.occ.topo import faces_of
-from surfmod.mass.moments import _moments, face_moments
+from surfmod.mass.moments import face_moments, node_moments
 
 CORPUS_FILE = "pythonocc_face_recognition_sample_part.stp"
 
@@ -99,9 +99,9 @@ def test_green_along_u_and_v_agree_on_a_closed_trimmed_cylinder(monkeypatch):
     wall = next(f for f in part.faces() if f.geom_type == bd.GeomType.CYLINDER)
     mf = mg.mass_face(sm.from_face(wall))
     assert not mf.natural and mf.degrees == (None, 1) and mg._largest_gap(mf) < 1e-14
-    along_v = _moments(*mg.face_nodes(mf, 12)[:2], np.zeros(3))
+    along_v = node_moments(*mg.face_nodes(mf, 12)[:2], np.zeros(3))
     monkeypatch.setattr(mg, "CLOSURE_RTOL", -1.0)  # "not closed": BRepGProp's direction u
-    along_u = _moments(*mg.face_nodes(mf, 12)[:2], np.zeros(3))
+    along_u = node_moments(*mg.face_nodes(mf, 12)[:2], np.zeros(3))
     assert np.abs(along_v - along_u).max() < 1e-13 * np.abs(along_u).max()
     ref = sm.mass_properties(part, method="occt", eps=1e-9)
     assert _rel(sm.mass_properties(part).volume, ref.volume) < 1e-10
@@ -175,9 +175,9 @@ def test_chebyshev_interpolation_and_antiderivatives_are_exact_for_polynomials()
 def _grid_vs_node_by_node(monkeypatch, face, order=12):
     mf = mg.mass_face(sm.from_face(face))
     monkeypatch.setattr(mg, "GRID_OVERHEAD", -1e18)  # always the grid
-    grid = _moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
+    grid = node_moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
     monkeypatch.setattr(mg, "GRID_OVERHEAD", 1e18)  # never
-    nodes = _moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
+    nodes = node_moments(*mg.face_nodes(mf, order)[:2], np.zeros(3))
     return grid, nodes
 
 
@@ -253,8 +253,8 @@ def test_circle_crossings_in_closed_form_equal_newton_on_occt():
     c = rec["centre"]  # lines through the circle (4 x 2 crossings) and one beside it
     lines_u, lines_v = c[0] + np.array([-0.5, 0.1, 0.99, 2.0]), c[1] + np.array([-0.999, 0.3])
     cuts = np.linspace(*rec["range"], 5)
-    mine = np.sort(mg._crossings(rec, cuts, lines_u, lines_v))
-    ref = np.sort(mg._crossings(dict(rec, kind="other"), cuts, lines_u, lines_v))
+    mine = np.sort(mg.pcurve_crossings(rec, cuts, lines_u, lines_v))
+    ref = np.sort(mg.pcurve_crossings(dict(rec, kind="other"), cuts, lines_u, lines_v))
     assert len(mine) == len(ref) == 10 and np.abs(mine - ref).max() < 1e-12
 
 

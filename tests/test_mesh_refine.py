@@ -123,13 +123,13 @@ def test_isometric_repeats_have_the_deviation_of_their_first_instance(corpus_dir
 def test_spline_figures_in_one_pass_equal_geomlprop(ventilator):
     """The triangle estimate samples B-spline faces with surfmod's evaluator (all faces'
     curvatures at once) and gets what GeomLProp, face by face, gives."""
-    from surfmod.meshing.brep import _estimate
+    from surfmod.meshing.brep import triangle_estimate
 
     part = ventilator
     evaluators: dict = {}
     for tolerance in (0.05, 0.5):
-        by_occt, diag = _estimate(part, tolerance)
-        ours, same_diag = _estimate(part, tolerance, evaluators)
+        by_occt, diag = triangle_estimate(part, tolerance)
+        ours, same_diag = triangle_estimate(part, tolerance, evaluators)
         assert same_diag == diag
         assert ours == pytest.approx(by_occt, rel=1e-6)
     assert len(evaluators) == 189 + 26  # every B-spline face and extrusion, kept for measuring

@@ -223,7 +223,7 @@ def test_solid_whose_model_is_off_by_more_than_the_tolerance_is_reported_or_refu
 def test_ear_clipping_never_collapses_onto_a_side():
     """Regression: a cell with two hanging nodes on one side, whose greedy clipping used to
     leave four collinear points; every triangle must keep an area and they tile the cell."""
-    from surfmod.meshing.tessellate import _ear_clip
+    from surfmod.meshing.adaptive import ear_clip
 
     poly = np.array([[16, 4], [20, 4], [20, 5], [20, 6], [20, 8], [16, 8]], dtype=np.int64)
     pos = np.array(
@@ -236,7 +236,7 @@ def test_ear_clipping_never_collapses_onto_a_side():
             [1.8424589576, 2.0931728884, -0.1520255821],
         ]
     )
-    tris = _ear_clip(poly, pos)
+    tris = ear_clip(poly, pos)
     assert tris.shape == (4, 3, 2)
     e1, e2 = tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]
     cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
@@ -377,7 +377,7 @@ def test_tiny_tolerance_refused_before_meshing(monkeypatch):
     def never(*args, **kwargs):
         raise AssertionError("meshing started before the refusal")
 
-    monkeypatch.setattr(adaptive._Refiner, "run", never)
+    monkeypatch.setattr(adaptive.Refiner, "run", never)
     monkeypatch.setattr(tessellate_module, "grid_tessellate", never)
     s = sm.superellipsoid(1, 1, 1, 1.8, 1.8)
     with pytest.raises(sm.SurfmodError, match=r"^tolerance: 3e-06 would need about [\d,]+ triangles.*max_triangles=250,000"):
@@ -391,13 +391,13 @@ def test_refinement_refuses_as_soon_as_its_fewest_cells_pass_the_cap(monkeypatch
     from surfmod.meshing import adaptive
 
     sizes = []
-    original = adaptive._Refiner.split
+    original = adaptive.Refiner.split
 
     def split(self, cells):
         sizes.append(self.x0.size)
         return original(self, cells)
 
-    monkeypatch.setattr(adaptive._Refiner, "split", split)
+    monkeypatch.setattr(adaptive.Refiner, "split", split)
     with pytest.raises(sm.SurfmodError, match=r"^tolerance: 0.0001 needs more than [\d,]+ triangles.*found after"):
         sm.tessellate(sm.superellipsoid(1, 1, 1, 1.8, 1.8), 1e-4, method="adaptive", max_triangles=20_000)
     assert all(2 * n <= 20_000 for n in sizes)  # never built more cells than the cap allows

@@ -389,13 +389,13 @@ def test_tiny_tolerance_and_huge_work_are_refused_before_the_work(tmp_path, monk
     assert drops == []  # refused from the estimate: nothing dropped
     # a cap above the estimate but below what the refinement needs: refused between rounds
     calls = []
-    original = toolpath_module._Meter.charge
+    original = toolpath_module.WorkMeter.charge
 
     def charge(self, work, what):
         calls.append(self.used + work)
         return original(self, work, what)
 
-    monkeypatch.setattr(toolpath_module._Meter, "charge", charge)
+    monkeypatch.setattr(toolpath_module.WorkMeter, "charge", charge)
     tp = sm.toolpath(sphere, tool, stepover=1.0)
     cap = (calls[0] * toolpath_module.NOMINAL_DROPS + calls[-1]) // 2
     assert calls[0] * toolpath_module.NOMINAL_DROPS < cap < calls[-1] and tp.gouge + tp.deflection <= tp.tolerance
@@ -416,13 +416,13 @@ def test_progress_bar_counts_the_drop_cutter_work(monkeypatch):
     """The bar's total is the estimate from the raster, its count every triangle test
     charged (so it moves in every round), and it ends full."""
     seen = []
-    original = toolpath_module._Meter.charge
+    original = toolpath_module.WorkMeter.charge
 
     def charge(self, work, what):
         original(self, work, what)
         seen.append((self.bar.n, self.bar.total, self.used))
 
-    monkeypatch.setattr(toolpath_module._Meter, "charge", charge)
+    monkeypatch.setattr(toolpath_module.WorkMeter, "charge", charge)
     sm.toolpath(bumpy(), sm.Tool("ball", 2.0), stepover=2.5, step=1.0, progress=True)
     counts = [n for n, _, _ in seen]
     assert len(seen) > 5 and counts == sorted(counts) and len(set(counts)) == len(counts)

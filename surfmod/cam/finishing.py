@@ -18,7 +18,7 @@ for less what exactness costs: the tool keeps the mesh's deflection ``δ`` from 
 which lies within ``δ`` of the faces (``2 δ``), the contours also their chord tolerance.
 
 **Exact and gouge-free.**  All heights are drop-cutter heights of the tool grown by ``δ``
-(``_part(..., clear=True)``, :func:`surfmod.cam.toolpath._part`): the tool never touches the faces the mesh stands for, in any
+(``_part(..., clear=True)``, :func:`surfmod.cam.toolpath.meshed_part`): the tool never touches the faces the mesh stands for, in any
 direction (a vertical lift would not do: on a wall of slope θ the mesh's ``δ`` is
 ``δ / cos θ`` deep measured vertically).  The waterline
 (:func:`surfmod.cam.waterline.waterline`) is computed for the tool grown by ``g`` = ``δ``
@@ -59,7 +59,7 @@ from .cutters import Flat
 from .drop_cutter import TriangleGrid, drop, upward_normals
 from .roughing import FEED, PLUNGE, RAMP_ANGLE, RAPID, Moves
 from .tool import Tool
-from .toolpath import REFINE_SHARE, _Part, raster_path
+from .toolpath import REFINE_SHARE, MeshedPart, raster_path
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge
 from .waterline import ContourPoints, fiber_pairs, sampling_within, waterline
 
@@ -96,7 +96,7 @@ class Leftover:
 class _StockTop:
     """The height above which no stock is left over the finishing tool's footprint."""
 
-    def __init__(self, part: _Part, tool: Tool, rest: Leftover | None, stock: np.ndarray, safe: float):
+    def __init__(self, part: MeshedPart, tool: Tool, rest: Leftover | None, stock: np.ndarray, safe: float):
         self.part, self.rest, self.stock, self.safe = part, rest, stock, safe
         self.grid = None if rest is None else TriangleGrid(part.grid.triangles, tool.radius + rest.reach)
 
@@ -109,7 +109,7 @@ class _StockTop:
         return np.minimum(h, self.safe)
 
 
-def _enter(out: Moves, p, top: float, part: _Part, tool: Tool, safe: float, allowed: float):
+def _enter(out: Moves, p, top: float, part: MeshedPart, tool: Tool, safe: float, allowed: float):
     """From the clearance height over ``p``: rapid down to ``top`` (above any stock left),
     then a ball plunges, a flat or bull end descends by a helix onto ``p`` (half its radius
     wide, narrower where the part stands within it: the helix may not rise above the part's
@@ -141,7 +141,7 @@ def _leave(out: Moves, top: float, safe: float):
     out.add([[p[0], p[1], safe]], RAPID)
 
 
-def add_raster(out: Moves, pts: np.ndarray, top, part: _Part, tool: Tool, safe: float, allowed: float, what: str):
+def add_raster(out: Moves, pts: np.ndarray, top, part: MeshedPart, tool: Tool, safe: float, allowed: float, what: str):
     """A raster's cutter locations ``pts`` added to ``out``: entered from the clearance
     height (the entry judged on the drop-cutter heights), cut, and left above the stock."""
     before = sum(len(q) for q in out.points)
@@ -224,12 +224,12 @@ def _pieces(loop: np.ndarray, keep: np.ndarray):
     return out
 
 
-def _chord(part: _Part, tool: Tool, tolerance: float) -> float:
+def _chord(part: MeshedPart, tool: Tool, tolerance: float) -> float:
     """Chord tolerance of the contours (their margin from the mesh is it plus the mesh's deflection)."""
     return max(min(tolerance / 8, 1e-3 * tool.radius), 1e-7 * float(np.max(part.box[1] - part.box[0])))
 
 
-def _judge(part: _Part, pts: np.ndarray, allowed: float, depth: np.ndarray | None = None):
+def _judge(part: MeshedPart, pts: np.ndarray, allowed: float, depth: np.ndarray | None = None):
     """Gouge-check one polyline (``depth`` its per-move depth when known); lift what would
     cut (returns points, lift, the deepest a move then cuts)."""
     if len(pts) < 2:
@@ -244,7 +244,7 @@ def _judge(part: _Part, pts: np.ndarray, allowed: float, depth: np.ndarray | Non
     return pts, float(lift.max()), float(depth.max())
 
 
-def _follow(part: _Part, contour: ContourPoints, z: float, piece: np.ndarray, depth: np.ndarray, allowed: float,
+def _follow(part: MeshedPart, contour: ContourPoints, z: float, piece: np.ndarray, depth: np.ndarray, allowed: float,
             shortest: float):
     """``piece`` (tip height ``z`` + the contours' margin above the waterline's own ``z``)
     with every chord cutting deeper than ``allowed`` split at the exact contour point
@@ -266,7 +266,7 @@ def _follow(part: _Part, contour: ContourPoints, z: float, piece: np.ndarray, de
     return piece, depth
 
 
-def near_box(part: _Part, tool: Tool, box) -> np.ndarray:
+def near_box(part: MeshedPart, tool: Tool, box) -> np.ndarray:
     """The triangles of ``part`` within two radii of ``tool`` (grown by the mesh's
     deflection) of the (x, y) ``box`` ``[[x0, y0], [x1, y1]]``: every triangle the tool
     standing over the box can touch."""
@@ -277,7 +277,7 @@ def near_box(part: _Part, tool: Tool, box) -> np.ndarray:
     return tri[near]
 
 
-def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float,
+def _waterline_pieces(part: MeshedPart, tool: Tool, steep_angle: float, spacing: float, tolerance: float, bottom: float,
                       box: np.ndarray | None = None, keep=None, highest: float = math.inf, left: float = 0.0,
                       clear: float = 0.0):
     """The steep pieces of the waterline contours of ``tool`` round ``part``, levels from
@@ -374,7 +374,7 @@ def _waterline_pieces(part: _Part, tool: Tool, steep_angle: float, spacing: floa
     return out, info
 
 
-def contour_spacing(part: _Part, tool: Tool, scallop: float, tolerance: float, stepover: float | None):
+def contour_spacing(part: MeshedPart, tool: Tool, scallop: float, tolerance: float, stepover: float | None):
     """The distance of neighbouring contours along a wall for cusps within ``scallop``
     (``stepover`` for a tool without a corner), and whether that holds the scallop
     (:func:`_budget`): the contours keep a chord + the deflection from the mesh, give or
@@ -383,7 +383,7 @@ def contour_spacing(part: _Part, tool: Tool, scallop: float, tolerance: float, s
     return (tool.cutter.cusp_spacing(budget) if tool.corner > 0 else stepover), held
 
 
-def contour_moves(out: Moves, part: _Part, tool: Tool, top, safe: float, steep_angle: float, spacing: float,
+def contour_moves(out: Moves, part: MeshedPart, tool: Tool, top, safe: float, steep_angle: float, spacing: float,
                   tolerance: float, bottom: float, **where) -> dict:
     """The steep pieces of the waterline contours (:func:`_waterline_pieces`, ``where``
     its ``box``, ``keep`` and ``highest``) appended to ``out`` level by level, linked
@@ -395,7 +395,7 @@ def contour_moves(out: Moves, part: _Part, tool: Tool, top, safe: float, steep_a
     return info
 
 
-def judge_links(part: _Part, out: Moves, allowed: float, what: str, first: int = 0) -> np.ndarray:
+def judge_links(part: MeshedPart, out: Moves, allowed: float, what: str, first: int = 0) -> np.ndarray:
     """Every move in ``out`` from its run ``first`` on (the contours' links, entries and
     retracts among them) judged on the drop-cutter heights, but the moves inside runs
     judged as they were made (``out.judged``: the contours' pieces; the rasters before
@@ -421,7 +421,7 @@ def judge_links(part: _Part, out: Moves, allowed: float, what: str, first: int =
     return np.r_[depth, known, -np.inf]
 
 
-def _link_clear(part: _Part, a, b, allowed: float, step: float) -> np.ndarray | None:
+def _link_clear(part: MeshedPart, a, b, allowed: float, step: float) -> np.ndarray | None:
     """The straight move a -> b sampled ``step`` apart, if it stays clear of the part."""
     n = int(np.ceil(np.linalg.norm(b[:2] - a[:2]) / step)) + 1
     pts = a + np.linspace(0, 1, n + 1)[:, None] * (b - a)
@@ -443,7 +443,7 @@ def _budget(scallop: float, margin: float):
     return scallop / 2, False  # no promise either way: not a raster ten times denser for nothing
 
 
-def _order_pieces(out: Moves, levels, part: _Part, tool: Tool, top: _StockTop, safe: float, tolerance: float,
+def _order_pieces(out: Moves, levels, part: MeshedPart, tool: Tool, top: _StockTop, safe: float, tolerance: float,
                  max_down: float):
     """Append the pieces level by level (top first), each level's nearest first, linked
     along the part where short and clear, else up and over."""
@@ -481,7 +481,7 @@ def _order_pieces(out: Moves, levels, part: _Part, tool: Tool, top: _StockTop, s
     return links
 
 
-def _raster_passes(part: _Part, tool: Tool, scallop: float, steep_angle: float | None, direction: str,
+def _raster_passes(part: MeshedPart, tool: Tool, scallop: float, steep_angle: float | None, direction: str,
                    lo: float, hi: float):
     """Cross positions of the raster's passes for cusps of ``scallop`` across the ground
     between them: each next pass ``s · cos φ`` further, ``φ`` the steepest cross slope of
@@ -547,7 +547,7 @@ def height_field(tri: np.ndarray, x: np.ndarray, y: np.ndarray, block: int = 2_0
     return top
 
 
-def rest_left(part: _Part, tool: Tool, floor: float, threshold: float, spacing: float | None = None) -> dict:
+def rest_left(part: MeshedPart, tool: Tool, floor: float, threshold: float, spacing: float | None = None) -> dict:
     """Where ``tool`` cannot reach the part's top-visible surface by more than
     ``threshold``: ``area`` (mm²), ``max_depth`` (vertical, mm), ``box``
     ``[[x0, y0], [x1, y1]]`` (None when nowhere), ``regions``, the grid ``spacing`` and
@@ -585,7 +585,7 @@ def rest_left(part: _Part, tool: Tool, floor: float, threshold: float, spacing: 
 
 # ----------------------------------------------------------------------------------------------
 
-def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | None, direction: str,
+def finish(part: MeshedPart, tool: Tool, *, scallop: float | None, stepover: float | None, direction: str,
            steep_angle: float | None, tolerance: float, stock: np.ndarray, safe: float, rest: Leftover | None):
     """The finishing :class:`~surfmod.cam.roughing.Motion` (the raster, then waterline
     pieces on the steep regions, cut once the floors beside them are clear) and its
@@ -648,7 +648,7 @@ def finish(part: _Part, tool: Tool, *, scallop: float | None, stepover: float | 
     return motion, report
 
 
-def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, tolerance: float,
+def recut(part: MeshedPart, tool: Tool, boxes, *, stepover: float, direction: str, tolerance: float,
           stock: np.ndarray, safe: float, rest: Leftover | None, over: float = 1.0, raster=None):
     """Cross passes over the regions a finishing left too much on: a drop-cutter raster
     across ``direction`` over each box ``(x0, y0, x1, y1)`` grown by the tool radius, each
@@ -704,7 +704,7 @@ def recut(part: _Part, tool: Tool, boxes, *, stepover: float, direction: str, to
     return out.motion(), passes
 
 
-def reach_contours(part: _Part, tool: Tool, groups, *, spacing: float, steep_angle: float, tolerance: float,
+def reach_contours(part: MeshedPart, tool: Tool, groups, *, spacing: float, steep_angle: float, tolerance: float,
                    safe: float, stock: np.ndarray | None = None, rest: Leftover | None = None, top=None):
     """One waterline level per group ``(z, moves)`` of :func:`surfmod.cam.holder.reach_levels`
     (where the job's holder check left contours out, the lowest height the shank and holder

@@ -29,7 +29,7 @@ from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, STEEP_ANGLE, AboveStock, Stock
 from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
-from .toolpath import MAX_WORK, _Meter, _mesh_estimate, _part
+from .toolpath import MAX_WORK, WorkMeter, mesh_estimate, meshed_part
 from .verify import cusp_clearance, verify_job
 
 #: Clearance of links and retracts above the stock (mm).
@@ -287,10 +287,10 @@ def _finish(shape, op: Finish, tool: Tool, stock: np.ndarray, safe: float, rest:
     # starts; a small tool on a fine scallop is refused there, naming the scallop, and
     # the bar counts the triangle tests (the finishing is most of a small tool's job)
     with tqdm(total=1, desc="finishing", unit=" tests", unit_scale=True, leave=False, disable=not progress) as bar:
-        meter = _Meter(MAX_WORK, bar if progress else None, "scallop",
+        meter = WorkMeter(MAX_WORK, bar if progress else None, "scallop",
                        f"choose a larger scallop than {op.scallop:g} or a larger finishing tool"
                        if op.scallop is not None else "choose a larger stepover or a larger finishing tool")
-        part = _part(shape, tool.cutter, tolerance, meter, estimate, clear=True)
+        part = meshed_part(shape, tool.cutter, tolerance, meter, estimate, clear=True)
         motion, report = finish(part, tool, scallop=op.scallop, stepover=stepover, direction=op.direction,
                                 steep_angle=steep, tolerance=tolerance, stock=stock, safe=safe, rest=rest)
         bar.total = max(bar.n, 1)  # the contours' drops came after the raster's estimate: the bar ends full
@@ -453,7 +453,7 @@ def _rest(shape, op: Rest, tool: Tool, k: int, specs: list, done: list, stock: n
         warnings.warn(f"rest: {tool} is no smaller than the tools before it (r={smallest:g}): it cuts only what "
                       f"the stock model shows left where it reaches", UserWarning, stacklevel=3)
     tolerance = scallop / 10
-    part = _part(shape, tool.cutter, tolerance, clear=True)
+    part = meshed_part(shape, tool.cutter, tolerance, clear=True)
     cell = max(min([stepover] + [float(o.report["stepover"]) for o in cutting]) / 4, 1e-3)
     model = StockModel(stock, cell)
     for i in after:
@@ -536,10 +536,10 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
         tool = op.tool.with_defaults(k + 1)
         if isinstance(op, Rough):
             with _options("roughing's mesh", "allowance", "a larger allowance meshes coarser"):
-                estimates[k] = _mesh_estimate(shape, _rough_settings(op, tool, box)[3])
+                estimates[k] = mesh_estimate(shape, _rough_settings(op, tool, box)[3])
         elif isinstance(op, Finish):
             with _options("finishing's mesh", "scallop", "choose a larger scallop or finishing tool"):
-                estimates[k] = _mesh_estimate(shape, _finish_settings(op, tool)[2])
+                estimates[k] = mesh_estimate(shape, _finish_settings(op, tool)[2])
     # the stock model the shanks and holders are held against, shared by the operations
     stock_model = body_stock(stock, min(o.tool.radius for o in ops))
     done, rest, finishing = [], None, {}
@@ -555,7 +555,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                 stepdown, stepover, allowance, tolerance = _rough_settings(op, tool, box)
                 grown = tool.cutter.roughing_offset(allowance) if allowance > 0 else tool.cutter
                 with _stage(bar, "roughing's mesh", "allowance", "a larger allowance meshes coarser"):
-                    p = _part(shape, grown, tolerance, estimate=estimates[k])
+                    p = meshed_part(shape, grown, tolerance, estimate=estimates[k])
                 with _stage(bar, "roughing", "stepdown", "a larger stepdown or roughing tool"):
                     motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover,
                                            CLEARANCE, deflection=p.deflection)

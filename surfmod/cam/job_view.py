@@ -36,7 +36,7 @@ import math
 import numpy as np
 
 from ..atomic import atomic_path, target_path
-from ..meshing.brep import _estimate
+from ..meshing.brep import triangle_estimate
 from ..meshing.polymesh import Mesh
 from ..meshing.render import display_mesh, polyline_runs
 from .roughing import RAPID
@@ -73,7 +73,7 @@ def _part_trace(job) -> dict:
     from .drop_cutter import part_triangles
 
     deflection = VIEW_DEFLECTION * float(np.ptp(job.stock, axis=0).max())
-    estimate, _ = _estimate(job.part, deflection)
+    estimate, _ = triangle_estimate(job.part, deflection)
     if estimate > MESH_TRIANGLES:  # a triangle's sag grows with its area: the count falls as 1 / deflection
         deflection *= 1.1 * estimate / MESH_TRIANGLES
     tri, _ = part_triangles(job.part, deflection)

@@ -48,7 +48,7 @@ from .finishing import RECUT_SHARE, REST_CLEARANCE, STEEP_MARGIN, add_raster, co
 from .roughing import RAPID, Motion, Moves
 from .stock_field import NodeGrid
 from .tool import Tool
-from .toolpath import _Part, raster_path
+from .toolpath import MeshedPart, raster_path
 from .verify import MAX_NODES, stock_cells
 from .waterline import MAX_PAIRS, fiber_pairs
 
@@ -141,7 +141,7 @@ def point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     return np.where(inside, plane, edge)
 
 
-def left_over(stock: StockModel, part_top: np.ndarray, part: _Part, threshold: float, max_pairs: int):
+def left_over(stock: StockModel, part_top: np.ndarray, part: MeshedPart, threshold: float, max_pairs: int):
     """Where the stock model holds material thicker than ``threshold`` on the part: a
     node over the part is left when the stock's top there lies farther than it from
     every triangle (measured in 3D, so the flank of a wall the stock hugs is thin however
@@ -229,7 +229,7 @@ class _LeftNear:
         return (self.stock.at(self.labels, xy, 0) == self.label) & (self.stock.at(self.high, xy, -np.inf) > z)
 
 
-def rest_moves(part: _Part, tool: Tool, stock: StockModel, mask: np.ndarray, *, scallop: float, stepover: float,
+def rest_moves(part: MeshedPart, tool: Tool, stock: StockModel, mask: np.ndarray, *, scallop: float, stepover: float,
                tolerance: float, safe: float, bottom: float, max_points: int = MAX_LOCATIONS):
     """The rest tool's moves over the nodes of ``mask`` (see the module): a
     :class:`~surfmod.cam.roughing.Motion` from and back to the clearance height, and a

@@ -37,7 +37,7 @@ from tqdm import tqdm
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
-from ..meshing.brep import _estimate
+from ..meshing.brep import triangle_estimate
 from ..meshing.render import Drawing, polyline_runs, repr_png
 from .cutters import Cutter
 from .drop_cutter import TriangleGrid, drop, part_triangles
@@ -142,7 +142,7 @@ class Toolpath:
         )
 
 
-class _Meter:
+class WorkMeter:
     """The drop-cutter work of one path against its cap, charged before each drop (so a
     refusal comes before the work), shown on the progress bar.  ``flag`` and ``hint``
     name what the caller can change (``surfmod machine`` has no ``max_work``: its
@@ -172,7 +172,7 @@ class _Meter:
 
 
 @dataclass(frozen=True)
-class _Part:
+class MeshedPart:
     """The machined part for one tool: its mesh on a query grid, and the lift that covers
     a mesh deflection larger than requested."""
 
@@ -183,7 +183,7 @@ class _Part:
     box: np.ndarray
     faces: list = field(default_factory=list, repr=False)  # OCCT faces, and the face of each triangle
     owner: np.ndarray = field(default=None, repr=False)
-    meter: _Meter = field(default_factory=_Meter, repr=False)
+    meter: WorkMeter = field(default_factory=WorkMeter, repr=False)
 
     def height(self, xy: np.ndarray) -> np.ndarray:
         """Tip heights at ``xy`` (N, 2), NaN where the tool touches nothing."""
@@ -191,7 +191,7 @@ class _Part:
         return drop(self.grid, self.cutter, xy) + self.lift
 
 
-def _mesh_estimate(shape, tolerance: float) -> float:
+def mesh_estimate(shape, tolerance: float) -> float:
     """The curvature estimate of the part's mesh at ``tolerance`` (triangles); refuses,
     before BRepMesh runs, a tolerance whose estimate exceeds :data:`MAX_TRIANGLES` or
     which lies below :data:`TOLERANCE_FLOOR` of the part's size."""
@@ -204,7 +204,7 @@ def _mesh_estimate(shape, tolerance: float) -> float:
         raise SurfmodError(f"tolerance: {tolerance:g} is below {TOLERANCE_FLOOR:g} x the part size {diag:.3g} "
                            f"(BRepMesh's time grows without bound below it)")
     deflection = MESH_SHARE * tolerance
-    estimate, _ = _estimate(shape, deflection)
+    estimate, _ = triangle_estimate(shape, deflection)
     if estimate > MAX_TRIANGLES:
         raise SurfmodError(
             f"tolerance: {tolerance:.3g} meshes the part at deflection {deflection:.3g}, about "
@@ -212,9 +212,9 @@ def _mesh_estimate(shape, tolerance: float) -> float:
     return float(estimate)
 
 
-def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None, estimate: float | None = None, *,
-          clear: bool = False) -> _Part:
-    """The part meshed for ``tolerance``; ``estimate`` is :func:`_mesh_estimate`'s value
+def meshed_part(obj, cutter: Cutter, tolerance: float, meter: WorkMeter | None = None, estimate: float | None = None, *,
+          clear: bool = False) -> MeshedPart:
+    """The part meshed for ``tolerance``; ``estimate`` is :func:`mesh_estimate`'s value
     when the caller has already checked this tolerance (the survey costs 0.4 s on a
     280 mm mould), else the check runs here.  With ``clear`` the cutter is grown by the
     mesh's deflection ``δ`` (:meth:`~surfmod.cam.cutters.Cutter.grown`) and every height
@@ -225,7 +225,7 @@ def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None, es
     shape = to_shape(obj, "obj")
     requested = MESH_SHARE * tolerance
     if estimate is None:
-        _mesh_estimate(shape, tolerance)
+        mesh_estimate(shape, tolerance)
     try:
         triangles, measured, (faces, owner) = part_triangles(shape, requested, face_index=True)
     except SurfmodError as exc:
@@ -236,8 +236,8 @@ def _part(obj, cutter: Cutter, tolerance: float, meter: _Meter | None = None, es
     lift = max(measured - requested, 0.0)
     if clear:
         cutter, lift = cutter.grown(deflection), deflection
-    return _Part(TriangleGrid(triangles, cutter.radius), cutter, deflection, lift, box, faces, owner,
-                 meter or _Meter())
+    return MeshedPart(TriangleGrid(triangles, cutter.radius), cutter, deflection, lift, box, faces, owner,
+                 meter or WorkMeter())
 
 
 def _check_tool(tool) -> Tool:
@@ -268,7 +268,7 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     tool = _check_tool(tool)
     cl = checks.finite_array(xy, "xy", ndim=2, last=2)
     tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
-    part = _part(obj, tool.cutter, tolerance)
+    part = meshed_part(obj, tool.cutter, tolerance)
     z, contacts, touched = drop(part.grid, part.cutter, cl, contacts=True, triangles=True)
     z = z + part.lift
     if exact:
@@ -359,8 +359,8 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     # every round of the refinement, the stage it is in beside it
     with tqdm(total=1, desc="toolpath", unit=" tests", unit_scale=True, disable=not progress) as bar:
         bar.set_postfix_str("meshing")
-        meter = _Meter(max_work, bar)
-        part = _part(shape, tool.cutter, tolerance, meter)
+        meter = WorkMeter(max_work, bar)
+        part = meshed_part(shape, tool.cutter, tolerance, meter)
         path = raster_path(part, tool, stepover, step, direction, None if bounds is None else box, tolerance,
                            bar, meter=meter)
         # the mesh's triangles can miss where a face leaves them between the measured
@@ -372,8 +372,8 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     return replace(path, points=checks.frozen(points), lifted=max(path.lifted, float(lift.max())))
 
 
-def raster_path(part: _Part, tool: Tool, stepover: float, step: float, direction: str, bounds, tolerance: float,
-                bar=None, across=None, meter: _Meter | None = None) -> Toolpath:
+def raster_path(part: MeshedPart, tool: Tool, stepover: float, step: float, direction: str, bounds, tolerance: float,
+                bar=None, across=None, meter: WorkMeter | None = None) -> Toolpath:
     """The verified zig-zag :class:`Toolpath` of ``tool`` over an already meshed ``part``
     (:func:`toolpath` after its checks; ``bounds`` ``((xmin, ymin), (xmax, ymax))`` or None
     for the part's box; ``bar`` a tqdm bar counting triangle tests; ``across``: the passes'

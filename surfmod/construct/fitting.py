@@ -137,7 +137,7 @@ def approximation_knots(params: np.ndarray, degree: int, n_ctrl: int) -> np.ndar
     return np.concatenate([np.full(p + 1, params[0]), inner, np.full(p + 1, params[-1])])
 
 
-def _interp_along(params, knots, p, data):
+def interp_along(params, knots, p, data):
     """Solve ``B c = data`` along axis 0 for every trailing column at once.
 
     With knots by averaging, ``B`` is banded (at most ``p`` sub- and super-diagonals,
@@ -231,8 +231,8 @@ def interpolate(points, degree=(3, 3), method: str = "chord", parameters=None) -
     _check_method(method)
     us, vs = _parameters_for(q, method, parameters)
     ku, kv = averaging_knots(us, p), averaging_knots(vs, r)
-    tmp = _interp_along(us, ku, p, q)  # (n, m, 3): control rows in u
-    net = _interp_along(vs, kv, r, tmp.transpose(1, 0, 2)).transpose(1, 0, 2)
+    tmp = interp_along(us, ku, p, q)  # (n, m, 3): control rows in u
+    net = interp_along(vs, kv, r, tmp.transpose(1, 0, 2)).transpose(1, 0, 2)
     return FittedSurface._make(net, (p, r), (ku, kv), q, (us, vs), "interpolation")
 
 

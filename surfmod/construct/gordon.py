@@ -32,7 +32,7 @@ from ..errors import SurfmodError
 from ..nets import knots as kn
 from ..nets.bspline import BSplineCurve, BSplineSurface
 from ..nets.elevate import elevate_degree, make_compatible, merged_knots, reparametrized
-from .fitting import _interp_along, averaging_knots
+from .fitting import averaging_knots, interp_along
 from .from_edge import as_curves
 
 #: crossings closer than this (relative to the curve's parameter span) count as equal
@@ -141,7 +141,7 @@ def _reparametrized_curve(curve, crossings, targets, tolerance):
         pts = curve.points(np.clip(phi(t), a, b))
         deg = min(3, len(t) - 1)
         knots = averaging_knots(t, deg)
-        ctrl = _interp_along(t, knots, deg, pts)
+        ctrl = interp_along(t, knots, deg, pts)
         fitted = BSplineCurve._trusted(ctrl, deg, knots)
         mid = np.concatenate([np.linspace(x0, x1, 4 * per + 1) for x0, x1 in zip(x[:-1], x[1:])])
         err = float(np.linalg.norm(fitted.points(mid) - curve.points(np.clip(phi(mid), a, b)), axis=-1).max())
@@ -275,11 +275,11 @@ def gordon(profiles, guides, tolerance: float = 1e-4) -> GordonSurface:
     kv, ku = averaging_knots(big_v, qv), averaging_knots(big_u, pu)
     cp = np.stack([c.control_points for c in p_curves])  # (K, n, 3)
     cg = np.stack([c.control_points for c in g_curves])  # (L, m, 3)
-    skin_p = _interp_along(big_v, kv, qv, cp).transpose(1, 0, 2)  # (n, K, 3): u first
-    skin_g = _interp_along(big_u, ku, pu, cg)  # (L, m, 3): u first
+    skin_p = interp_along(big_v, kv, qv, cp).transpose(1, 0, 2)  # (n, K, 3): u first
+    skin_g = interp_along(big_u, ku, pu, cg)  # (L, m, 3): u first
     # crossing points on the (reparametrized) curves, averaged over profile and guide
     q = 0.5 * (np.stack([c.points(big_u) for c in p_curves]) + np.stack([c.points(big_v) for c in g_curves], axis=1))
-    tensor = _interp_along(big_v, kv, qv, _interp_along(big_u, ku, pu, q.transpose(1, 0, 2)).transpose(1, 0, 2))
+    tensor = interp_along(big_v, kv, qv, interp_along(big_u, ku, pu, q.transpose(1, 0, 2)).transpose(1, 0, 2))
     tensor = tensor.transpose(1, 0, 2)  # (L, K, 3): u first
     net, deg, knots = _compatible_sum([
         (1.0, skin_p, (p_curves[0].degree, qv), (p_curves[0].knots, kv)),

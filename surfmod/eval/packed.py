@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 
 from .kernels import binomials
-from .projection_kernel import _wrap, project_distances_compiled
+from .projection_kernel import project_distances_compiled, wrap_parameter
 from .scattered_compiled import scattered_compiled
 
 
@@ -233,6 +233,6 @@ def _derivatives_segments(pk, u, v, segments, order, binom, out):
         ku, pf, kv, qf, net, rat, iu, iv, bu, bv = _net(pk, f)
         uu, vv = np.empty(b - a), np.empty(b - a)
         for i in range(b - a):
-            uu[i] = _wrap(u[a + i], pk.lo[f, 0], pk.hi[f, 0], pk.period[f, 0], pk.periodic[f, 0])
-            vv[i] = _wrap(v[a + i], pk.lo[f, 1], pk.hi[f, 1], pk.period[f, 1], pk.periodic[f, 1])
+            uu[i] = wrap_parameter(u[a + i], pk.lo[f, 0], pk.hi[f, 0], pk.period[f, 0], pk.periodic[f, 0])
+            vv[i] = wrap_parameter(v[a + i], pk.lo[f, 1], pk.hi[f, 1], pk.period[f, 1], pk.periodic[f, 1])
         scattered_compiled(ku, pf, kv, qf, net, uu, vv, order, rat, binom, iu, iv, bu, bv, out[a:b])

@@ -38,7 +38,7 @@ ITERATIONS = 6
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _wrap(x, lo, hi, period, periodic):
+def wrap_parameter(x, lo, hi, period, periodic):
     """OCCT's parameter: periodic directions wrap into the period, others clamp."""
     if periodic:
         return lo + np.mod(x - lo, period)
@@ -68,14 +68,14 @@ def project_distances_compiled(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucke
         px, py, pz = points[a, 0], points[a, 1], points[a, 2]
         ua, va = min(max(uv[a, 0], u0), u1), min(max(uv[a, 1], v0), v1)
         x, y, z = position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
-                            _wrap(ua, lo[0], hi[0], period[0], periodic[0]),
-                            _wrap(va, lo[1], hi[1], period[1], periodic[1]), lu, ru, tu, lv, rv, tv)
+                            wrap_parameter(ua, lo[0], hi[0], period[0], periodic[0]),
+                            wrap_parameter(va, lo[1], hi[1], period[1], periodic[1]), lu, ru, tu, lv, rv, tv)
         best = np.sqrt((px - x) ** 2 + (py - y) ** 2 + (pz - z) ** 2)
         active = best > first_stop
         if active:
             for _ in range(ITERATIONS):
                 _eval(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
-                      _wrap(ua, lo[0], hi[0], period[0], periodic[0]), _wrap(va, lo[1], hi[1], period[1], periodic[1]),
+                      wrap_parameter(ua, lo[0], hi[0], period[0], periodic[0]), wrap_parameter(va, lo[1], hi[1], period[1], periodic[1]),
                       1, binom, sc, s)
                 rx, ry, rz = px - s[0, 0, 0], py - s[0, 0, 1], pz - s[0, 0, 2]
                 best = min(best, np.sqrt(rx * rx + ry * ry + rz * rz))
@@ -98,8 +98,8 @@ def project_distances_compiled(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucke
                     break
         if active:  # still moving after the last iteration: its last iterate counts too
             x, y, z = position_at(ku, p, kv, q, ctrl, rational, inv_u, inv_v, bucket_u, bucket_v,
-                                _wrap(ua, lo[0], hi[0], period[0], periodic[0]),
-                                _wrap(va, lo[1], hi[1], period[1], periodic[1]), lu, ru, tu, lv, rv, tv)
+                                wrap_parameter(ua, lo[0], hi[0], period[0], periodic[0]),
+                                wrap_parameter(va, lo[1], hi[1], period[1], periodic[1]), lu, ru, tu, lv, rv, tv)
             best = min(best, np.sqrt((px - x) ** 2 + (py - y) ** 2 + (pz - z) ** 2))
         out[a] = best
 

@@ -28,7 +28,7 @@ PIECES = 4
 _KINDS = {"line": 0, "circle": 1, "bspline": 2}
 
 #: np.linspace(0, 1, PIECES + 1), made once
-_FRACTIONS = np.linspace(0.0, 1.0, PIECES + 1)
+PIECE_FRACTIONS = np.linspace(0.0, 1.0, PIECES + 1)
 _FRACTION_CACHE: dict = {}
 
 
@@ -39,7 +39,7 @@ def _fractions(pieces: int) -> np.ndarray:
     return _FRACTION_CACHE[pieces]
 
 
-def _spans(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
+def piece_spans(breaks: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
     x, w = gauss(order)
     a, b = breaks[:-1, None], breaks[1:, None]
     return ((a + b) / 2 + (b - a) / 2 * x).ravel(), ((b - a) / 2 * w).ravel()
@@ -125,7 +125,7 @@ def _span_derivatives(knots, p: int, span, mid, poles) -> np.ndarray:
     return out
 
 
-def _crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
+def pcurve_crossings(rec: dict, cuts: np.ndarray, lines_u: np.ndarray, lines_v: np.ndarray, per_piece: int = 8) -> np.ndarray:
     """Parameters where a p-curve crosses the lines ``u = c`` and ``v = c``: exact on
     straight and circular p-curves, else :func:`_table_crossings` on its pieces ``cuts``."""
     if not len(lines_u) and not len(lines_v):
@@ -313,7 +313,7 @@ class PcurveTable:
 
 
 def _table_crossings(table: PcurveTable, owner, a, b, scale, lines, coord, per_piece: int = 8):
-    """:func:`_crossings` of curved p-curves at once: pieces ``[a, b]`` of records ``owner``
+    """:func:`pcurve_crossings` of curved p-curves at once: pieces ``[a, b]`` of records ``owner``
     (indices into ``table``; ``scale`` per piece: its record's parameter length, for the
     Newton tolerance) against per piece the lines ``lines[piece]`` of coordinate
     ``coord[piece]`` (``(pieces, L)``, NaN-padded: each face has its own), one sampling and
@@ -414,7 +414,7 @@ def boundaries(faces: list, table: PcurveTable | None = None) -> list:
     # pieces, the curved ones also cut at their own breaks (knots) inside the range
     idx = np.flatnonzero(live)
     straight = table.kind[idx] == 0
-    frac = _FRACTIONS
+    frac = PIECE_FRACTIONS
     f, l = f_all[idx, None], l_all[idx, None]
     even = f + (l - f) * frac
     even[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it
@@ -490,7 +490,7 @@ def _cut_at_lines(table, cuts, face_of, lines_u, lines_v, angular, ranges):
     for i in np.unique(rec_of[table.kind[rec_of] < 2]):  # straight and circular: closed form
         k = face_of[i]
         if len(lines_u[k]) or len(lines_v[k]):
-            x = _crossings(records[i], val[rec_of == i], lines_u[k], lines_v[k])
+            x = pcurve_crossings(records[i], val[rec_of == i], lines_u[k], lines_v[k])
             extra_keys.append(i + 1j * x)
     inner = (rec_of[:-1] == rec_of[1:]) & (table.kind[rec_of[:-1]] >= 2)
     owner, a, b = rec_of[:-1][inner], val[:-1][inner], val[1:][inner]

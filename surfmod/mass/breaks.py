@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..construct.elementary import PlaneSurface, ConicalSurface, CylindricalSurface, SphericalSurface, ToroidalSurface
+from ..construct.elementary import ConicalSurface, CylindricalSurface, PlaneSurface, SphericalSurface, ToroidalSurface
 from ..construct.conics import Conic
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.offset_surface import OffsetSurface
@@ -38,7 +38,7 @@ def is_face(obj) -> bool:
     return isinstance(getattr(obj, "surface", None), Surface) and "face_shape" in vars(obj)
 
 
-def _breaks(lo: float, hi: float, knots, periodic_piece: float | None, period: float | None = None) -> np.ndarray:
+def interval_breaks(lo: float, hi: float, knots, periodic_piece: float | None, period: float | None = None) -> np.ndarray:
     """Sorted break points in ``[lo, hi]``: the ends, the knots (repeated every
     ``period`` when the direction wraps) and pieces of at most ``periodic_piece``."""
     pts = [lo, hi]
@@ -126,19 +126,19 @@ def rational_pieces(surface, direction: int) -> int:
 
 
 def knot_breaks(surface, lo: float, hi: float, knots, direction: int, period: float | None = None) -> np.ndarray:
-    """:func:`_breaks` at the ``knots`` of a spline direction of ``surface`` (a face read
+    """:func:`interval_breaks` at the ``knots`` of a spline direction of ``surface`` (a face read
     back or a surface), each span then split in :func:`rational_pieces` equal pieces."""
-    out = _breaks(lo, hi, knots, None, period)
+    out = interval_breaks(lo, hi, knots, None, period)
     pieces = rational_pieces(surface, direction)
     if pieces > 1:
         out = np.concatenate([out[:1]] + [np.linspace(a, c, pieces + 1)[1:] for a, c in zip(out[:-1], out[1:])])
     return out
 
 
-def _patch_breaks(surface, lo, hi, direction, period):
+def patch_breaks(surface, lo, hi, direction, period):
     b = direction_breaks(surface, direction)
     if isinstance(b, str):
-        return _breaks(lo, hi, None, ANGULAR_PIECE)
+        return interval_breaks(lo, hi, None, ANGULAR_PIECE)
     return knot_breaks(surface, lo, hi, b, direction, period)
 
 

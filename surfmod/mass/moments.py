@@ -4,7 +4,7 @@ in one pass.
 
 >>> import numpy as np
 >>> ders = np.zeros((1, 2, 2, 3)); ders[0, 1, 0], ders[0, 0, 1] = (1, 0, 0), (0, 1, 0)
->>> float(_moments(ders, np.array([2.0]), np.zeros(3))[0])  # area: weight times |Su x Sv|
+>>> float(node_moments(ders, np.array([2.0]), np.zeros(3))[0])  # area: weight times |Su x Sv|
 2.0
 """
 
@@ -15,14 +15,14 @@ import numpy as np
 from .nodes import face_nodes, mass_face
 
 
-def _moments(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray) -> np.ndarray:
+def node_moments(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray) -> np.ndarray:
     """[area, V, M(3), S(3,3)] contributions from partials at quadrature nodes (``Su``
     already signed so that ``Su × Sv`` is the outward ``n dA``)."""
     return _moments_of_groups(ders, weights, ref, [0, len(weights)])[0]
 
 
 def _moments_of_groups(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray, bounds) -> np.ndarray:
-    """``(G, 14)``: :func:`_moments` of the node groups ``[bounds[g], bounds[g + 1])``,
+    """``(G, 14)``: :func:`node_moments` of the node groups ``[bounds[g], bounds[g + 1])``,
     the integrands computed once for all of them and summed group by group (each sum the
     one the group's own call makes, bit for bit: contiguous rows, pairwise)."""
     # (3, N) rows, contiguous: np.sum then reduces each row pairwise, which keeps the 1e-14
@@ -46,8 +46,8 @@ def _moments_of_groups(ders: np.ndarray, weights: np.ndarray, ref: np.ndarray, b
     return out
 
 
-class _Accumulator:
-    """Sums :func:`_moments` over many faces in ``groups`` separate totals (e.g. rules
+class MomentAccumulator:
+    """Sums :func:`node_moments` over many faces in ``groups`` separate totals (e.g. rules
     exact by degree and the others), evaluating them in batches of about ``BATCH`` nodes
     (one NumPy pass for many small faces and both groups, bounded memory for big ones)."""
 
@@ -88,4 +88,4 @@ def face_moments(face, ref=(0.0, 0.0, 0.0), order: int = 12) -> np.ndarray:
     12.0
     """
     ders, w, _ = face_nodes(mass_face(face), order)
-    return _moments(ders, w, np.asarray(ref, dtype=float))
+    return node_moments(ders, w, np.asarray(ref, dtype=float))

@@ -44,8 +44,8 @@ from ..construct.elementary import (ConicalSurface, CylindricalSurface, Elementa
 from ..construct.extrusion import TabulatedCylinder
 from ..construct.revolution import RevolutionSurface
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from .breaks import ANGULAR_PIECE, _breaks, _patch_breaks, direction_breaks, is_face, knot_breaks
-from .boundary import PIECES, PcurveTable, _crossings, _spans, boundaries, pcurve_d1, taylor_pieces  # noqa: F401 (re-exported)
+from .breaks import ANGULAR_PIECE, direction_breaks, interval_breaks, is_face, knot_breaks, patch_breaks
+from .boundary import PIECES, PcurveTable, boundaries, pcurve_crossings, pcurve_d1, piece_spans, taylor_pieces  # noqa: F401 (re-exported)
 from .rules import (GridJob, exact_order, gauss, green_layout, grids_nodes, inner_nodes,  # noqa: F401
                         interpolation_points)
 
@@ -230,7 +230,7 @@ def _linspace(lo: float, hi: float, num: int) -> np.ndarray:
 
 
 def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
-    """:func:`surfmod.mass.breaks._patch_breaks` (angular directions without its general
+    """:func:`surfmod.mass.breaks.patch_breaks` (angular directions without its general
     merging: equal pieces of at most an eighth turn, the same points) and whether the
     direction is an analytic angle (its breaks are no knots)."""
     b = direction_breaks(face, direction)
@@ -238,7 +238,7 @@ def _mass_breaks(face, lo: float, hi: float, direction: int) -> np.ndarray:
         return np.array([lo, hi]), False
     if isinstance(b, str) and hi - lo > 1e-9:
         return _linspace(lo, hi, max(int(np.ceil((hi - lo) / ANGULAR_PIECE - 1e-9)), 1) + 1), True
-    return _patch_breaks(face, lo, hi, direction, face.periods[direction]), isinstance(b, str)
+    return patch_breaks(face, lo, hi, direction, face.periods[direction]), isinstance(b, str)
 
 
 def mass_faces(read: list, pcurves: list) -> list:
@@ -326,7 +326,7 @@ def surface_mass_face(surf) -> MassFace:
     for direction, (lo, hi) in enumerate(surf.domain):
         b = direction_breaks(surf, direction)
         # analytic directions without knots: eight pieces keep Gauss converged
-        breaks.append(_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None
+        breaks.append(interval_breaks(lo, hi, None, (hi - lo) / 8) if isinstance(b, str) or b is None
                       else knot_breaks(surf, lo, hi, b, direction))
     (u0, u1), (v0, v1) = surf.domain
     evaluate, grid_evaluate = evaluators(surf)
@@ -351,8 +351,8 @@ def face_nodes(mf: MassFace, order: int):
         return faces_nodes([mf], order)[0]
     mu, eu = _direction_order(mf, 0, order)
     mv, ev = _direction_order(mf, 1, order)
-    un, uw = _spans(mf.breaks[0], mu)
-    vn, vw = _spans(mf.breaks[1], mv)
+    un, uw = piece_spans(mf.breaks[0], mu)
+    vn, vw = piece_spans(mf.breaks[1], mv)
     if mf.grid_evaluate is not None:  # u-major, as the repeat/tile below
         ders = mf.grid_evaluate(un, vn, 1).reshape(-1, 2, 2, 3)
     else:

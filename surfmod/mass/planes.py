@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from .nodes import face_boundary, is_conic  # noqa: F401 (is_conic re-exported)
-from .boundary import _FRACTIONS, PIECES  # noqa: F401
+from .boundary import PIECE_FRACTIONS, PIECES  # noqa: F401
 from .rules import gauss
 
 # the six monomials a^p b^q (p + q <= 2) and, for the basis e = (1, a, b), the moment each
@@ -121,7 +121,7 @@ def _arc_nodes(arcs: list, order: int):
     f, l, sign, r = data[:, :1], data[:, 1:2], data[:, 2:3], data[:, 3:4]
     centre, ax, ay = data[:, 4:6], data[:, 6:8], data[:, 8:10]
     live = (l > f)[:, 0]
-    cuts = f + (l - f) * _FRACTIONS
+    cuts = f + (l - f) * PIECE_FRACTIONS
     cuts[:, -1] = l[:, 0]  # the end itself, as np.linspace gives it
     a, b = cuts[:, :-1, None], cuts[:, 1:, None]  # (A, PIECES, 1)
     x, gw = gauss(order)
@@ -139,7 +139,7 @@ def _arc_nodes(arcs: list, order: int):
 def plane_moments(faces: list, order: int, ref) -> tuple[np.ndarray, np.ndarray]:
     """``(F, 14)`` ``[area, V, M(3), S(3, 3)]`` of trimmed planar faces (each a
     :class:`~surfmod.mass.nodes.MassFace` with its frame), the sums
-    :func:`surfmod.mass.moments._moments` makes of their quadrature nodes, in closed form
+    :func:`surfmod.mass.moments.node_moments` makes of their quadrature nodes, in closed form
     from the moments of their parameter regions (module notes); and per face whether no
     rule depended on ``order`` (straight p-curves only).
 

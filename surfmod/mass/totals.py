@@ -16,8 +16,8 @@ import numpy as np
 
 from ..errors import SurfmodError
 from ..surface import Surface
-from .moments import _Accumulator, _moments
-from .nodes import faces_nodes, face_nodes, mass_faces, plane_nodes, prepare_boundaries, surface_mass_face, taylor_pieces
+from .moments import MomentAccumulator, node_moments
+from .nodes import face_nodes, faces_nodes, mass_faces, plane_nodes, prepare_boundaries, surface_mass_face, taylor_pieces
 from .planes import plane_moments
 
 
@@ -110,7 +110,7 @@ def integrate(obj, ref: np.ndarray, density: float = 1.0, order: int = 12, estim
         # one closed surface (sphere, torus, ...): integrate its own NumPy evaluator over
         # its domain; the orientation is fixed by the sign of the enclosed volume
         faces = [surface_mass_face(obj)]
-        if _moments(*face_nodes(faces[0], order)[:2], ref)[1] < 0:
+        if node_moments(*face_nodes(faces[0], order)[:2], ref)[1] < 0:
             faces[0].sign = -1.0
     else:
         read = obj
@@ -126,7 +126,7 @@ def integrate(obj, ref: np.ndarray, density: float = 1.0, order: int = 12, estim
     # faces whose every rule is exact by degree give the same sums at any order: the
     # lower-order pass behind the error estimate only re-integrates the others.  Two
     # totals per solid: faces whose every rule is exact by degree (2 s) and the others (2 s + 1)
-    sums = _Accumulator(ref, groups=2 * count)
+    sums = MomentAccumulator(ref, groups=2 * count)
     inexact = []
     planes = [f for f in faces if f.plane and f.natural and f.frame is not None]
     for s in range(count):  # whole planar rectangles (most faces of prismatic parts): all at once
@@ -160,7 +160,7 @@ def integrate(obj, ref: np.ndarray, density: float = 1.0, order: int = 12, estim
     nat = sum(f.natural for f in faces)
 
     def estimate() -> float:
-        low = _Accumulator(ref, groups=count)
+        low = MomentAccumulator(ref, groups=count)
         for f in inexact:
             low.add(*face_nodes(f, max(2, order - 4))[:2], solid_of[id(f)])
         if inexact_planes:

@@ -27,7 +27,7 @@ from ..errors import SurfmodError
 from ..eval.basis import knots_inside
 from ..surface import model_size
 from .deviation import COARSE, DENSE, triangle_deviations
-from .domain import _sides
+from .domain import domain_sides
 
 #: Lattice steps per start cell, as a power of two (depth limit of the refinement).
 LEVELS = 22
@@ -90,7 +90,7 @@ def _start_counts(s, tolerance: float, scale: float = 1.0, samples: int = 33) ->
     return int(min(cap, max(2, np.floor(0.999 * nu) + 1))), int(min(cap, max(2, np.floor(0.999 * nv) + 1)))
 
 
-class _Refiner:
+class Refiner:
     def __init__(self, s, tolerance: float, max_triangles: int, start_scale: float = 1.0, bar=None):
         self.bar = bar  # a tqdm bar ticked once per refinement pass, or None
         self.s, self.tol, self.max_triangles = s, tolerance, max_triangles
@@ -103,7 +103,7 @@ class _Refiner:
             ub = np.linspace(ub[0], ub[-1], nu + 1)
             vb = np.linspace(vb[0], vb[-1], nv + 1)
         self.lat = _Lattice(ub, vb)
-        self.degenerate, self.closed_u, self.closed_v = _sides(s, self.size)
+        self.degenerate, self.closed_u, self.closed_v = domain_sides(s, self.size)
         st = self.lat.step
         i, j = np.meshgrid(np.arange(len(self.lat.ub) - 1), np.arange(len(self.lat.vb) - 1), indexing="ij")
         self.x0, self.y0 = (i.ravel() * st).astype(np.int64), (j.ravel() * st).astype(np.int64)
@@ -203,7 +203,7 @@ class _Refiner:
             poly.append((x0[k], y1[k]))
             poly += [(x0[k], yy) for yy in vy[ll[k] : ll[k] + ln[k]][::-1]]
             poly = np.array(poly, dtype=np.int64)
-            out = _ear_clip(poly, lookup(poly))
+            out = ear_clip(poly, lookup(poly))
             tris.append(out)
             owner.append(np.full(len(out), k))
         return np.concatenate(tris).astype(np.int64), np.concatenate(owner), sig
@@ -319,7 +319,7 @@ class _Refiner:
                 return tris, self.measure(tris, DENSE), stuck_total
 
 
-def _ear_clip(poly: np.ndarray, pos: np.ndarray) -> np.ndarray:
+def ear_clip(poly: np.ndarray, pos: np.ndarray) -> np.ndarray:
     """Triangulate a convex cell polygon (CCW lattice points, collinear points on its
     sides) into ``n - 2`` non-degenerate triangles, clipping the ear with the shortest
     3-D diagonal first."""

@@ -219,7 +219,7 @@ def measure_face_meshes(face_meshes, bary=DENSE) -> np.ndarray:
 
 
 # -- the mesh of a shape ------------------------------------------------------------------
-def _estimate(shape, tolerance: float, evaluators: dict | None = None,
+def triangle_estimate(shape, tolerance: float, evaluators: dict | None = None,
               uv_bounds: dict | None = None) -> tuple[float, float]:
     """``(triangles, bbox diagonal)``: a chord of length ``h`` on curvature ``k`` sags
     ``k h^2 / 8``; per face the median curvature (robust to the singular points of real
@@ -452,7 +452,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
 
     evaluators: dict = {}  # face hash -> FaceSurface (splines from the estimate, others when measured)
     uv_bounds: dict = {}  # face hash -> UV box, read once
-    estimate, diag = _estimate(shape, tolerance, evaluators, uv_bounds)
+    estimate, diag = triangle_estimate(shape, tolerance, evaluators, uv_bounds)
     if tolerance < MIN_RELATIVE_TOLERANCE * diag:
         raise SurfmodError(
             f"tolerance: {tolerance:g} is below {MIN_RELATIVE_TOLERANCE:g} x the shape size {diag:.3g}"

@@ -7,12 +7,12 @@ from __future__ import annotations
 import numpy as np
 
 
-def _sides(s, size: float):
+def domain_sides(s, size: float):
     """``(degenerate, closed_u, closed_v)``: which domain sides (``"u0"``, ``"u1"``,
     ``"v0"``, ``"v1"``) collapse to a point and which directions close on themselves.
 
     >>> import surfmod as sm
-    >>> deg, cu, cv = _sides(sm.sphere(1.0), 2.0)
+    >>> deg, cu, cv = domain_sides(sm.sphere(1.0), 2.0)
     >>> sorted(k for k, d in deg.items() if d), cu, cv
     (['v0', 'v1'], True, False)
     """

@@ -340,13 +340,13 @@ class GridMesh:
 
 def grid_tessellate(s, tol: float, max_triangles: int, sides, bar=None):
     """Tessellate ``s`` as a verified structured grid.  ``sides = (degenerate, closed_u,
-    closed_v)`` from :func:`surfmod.meshing.domain._sides`.  Returns
+    closed_v)`` from :func:`surfmod.meshing.domain.domain_sides`.  Returns
     ``(vertices, triangles, uv, max_deviation, passes)``.
 
     >>> import surfmod as sm
-    >>> from surfmod.meshing.domain import _sides
+    >>> from surfmod.meshing.domain import domain_sides
     >>> s = sm.sphere(1.0)
-    >>> v, f, uv, dev, passes = grid_tessellate(s, 0.01, 10_000, _sides(s, 2.0))
+    >>> v, f, uv, dev, passes = grid_tessellate(s, 0.01, 10_000, domain_sides(s, 2.0))
     >>> bool(dev <= 0.01), v.shape == (len(uv), 3)
     (True, True)
     """

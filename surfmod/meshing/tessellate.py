@@ -21,9 +21,9 @@ from .. import checks
 from ..errors import SurfmodError
 from ..surface import Surface, model_size
 from .brep import MAX_TRIANGLES, tessellate_shape
-from .adaptive import _ear_clip, _Refiner  # noqa: F401  (_ear_clip: tested here)
+from .adaptive import Refiner
 from .deviation import DENSE
-from .domain import _sides
+from .domain import domain_sides
 from .gridmesh import grid_tessellate
 from .polymesh import Mesh
 from tqdm import tqdm
@@ -117,7 +117,7 @@ def tessellate_surface(s, tolerance: float, max_triangles: int = MAX_TRIANGLES, 
 
 
 def _grid_mesh(s, tolerance: float, max_triangles: int, size: float, bar) -> Mesh:
-    sides = _sides(s, size)
+    sides = domain_sides(s, size)
     verts, faces, uv, dev, passes = grid_tessellate(s, tolerance, max_triangles, sides, bar)
     info = {
         "kind": "grid",
@@ -138,7 +138,7 @@ def _adaptive_mesh(s, tolerance: float, max_triangles: int, bar) -> Mesh:
     # the need depends on the surface, so both are tried and the smaller mesh is kept
     best = None
     for scale in (1.0,) if getattr(s, "knots", None) is not None else (1.0, 2.0):
-        ref = _Refiner(s, tolerance, max_triangles, scale, bar)
+        ref = Refiner(s, tolerance, max_triangles, scale, bar)
         tris, dev, stuck = ref.run()
         if best is None or len(tris) < len(best[1]):
             best = (ref, tris, dev, stuck)

@@ -29,12 +29,12 @@ from tqdm import tqdm
 # -- problems -------------------------------------------------------------------------------
 
 
-def _size(*surfaces) -> float:
+def seeded_size(*surfaces) -> float:
     pts = np.concatenate([s.grid(seed_parameters(s, 0, 2, 8, 16), seed_parameters(s, 1, 2, 8, 16)).reshape(-1, 3) for s in surfaces])
     return max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), 1e-300)
 
 
-class _Base:
+class IntersectionProblem:
     def __init__(self, domains, scale, tolerance):
         self.lo = np.array([d[0] for d in domains], dtype=float)
         self.hi = np.array([d[1] for d in domains], dtype=float)
@@ -44,11 +44,11 @@ class _Base:
         self.tolerance = tolerance
 
 
-class SurfaceSurface(_Base):
+class SurfaceSurface(IntersectionProblem):
     """Unknowns ``(u, v, s, t)``; ``F = A(u, v) - B(s, t)``."""
 
     def __init__(self, a, b, tolerance):
-        super().__init__([*a.domain, *b.domain], _size(a, b), tolerance)
+        super().__init__([*a.domain, *b.domain], seeded_size(a, b), tolerance)
         self.a, self.b = a, b
 
     def evaluate(self, X):
@@ -61,11 +61,11 @@ class SurfaceSurface(_Base):
         return F, J, da[:, 0, 0], dP
 
 
-class SurfacePlane(_Base):
+class SurfacePlane(IntersectionProblem):
     """Unknowns ``(u, v)``; ``F = n . (A(u, v) - o)`` (signed distance to the plane)."""
 
     def __init__(self, a, origin, normal, tolerance):
-        super().__init__(list(a.domain), _size(a), tolerance)
+        super().__init__(list(a.domain), seeded_size(a), tolerance)
         self.a, self.origin, self.normal = a, origin, normal
 
     def evaluate(self, X):
@@ -76,11 +76,11 @@ class SurfacePlane(_Base):
         return F, J, d[:, 0, 0], dP
 
 
-class SurfaceLine(_Base):
+class SurfaceLine(IntersectionProblem):
     """Unknowns ``(u, v, w)``; ``F = A(u, v) - (o + w d)``, ``d`` a unit vector."""
 
     def __init__(self, a, origin, direction, tolerance):
-        super().__init__([*a.domain, (-np.inf, np.inf)], _size(a), tolerance)
+        super().__init__([*a.domain, (-np.inf, np.inf)], seeded_size(a), tolerance)
         self.a, self.origin, self.direction = a, origin, direction
 
     def evaluate(self, X):
@@ -195,7 +195,7 @@ def _surface_surface_seeds(problem):
     return np.concatenate(seeds)
 
 
-def _implicit_seeds(problem, s):
+def implicit_seeds(problem, s):
     """Zeros of the scalar ``F`` of a 2-unknown problem along the grid lines of ``s``."""
     us, vs, uu, vv, _, _ = _grid(s)
     X = np.stack([uu, vv], axis=1)
@@ -348,7 +348,7 @@ def intersect(a, b, tolerance: float = 1e-6, *, step: float | None = None, max_a
         uv_b_of = lambda X, P: X[:, 2:]  # noqa: E731
     else:
         origin, normal = plane
-        seeds = _implicit_seeds(problem, a)
+        seeds = implicit_seeds(problem, a)
         o, x, y, _ = plane_frame(origin, normal)
         uv_b_of = lambda X, P: np.stack([(P - o) @ x, (P - o) @ y], axis=1)  # noqa: E731
 
@@ -375,7 +375,7 @@ def intersect_line(s: Surface, origin, direction, *, tolerance: float = 1e-9) ->
     s = require_surface(s, "s")
     o = checks.point(origin, "origin")
     d = checks.direction(direction, "direction")
-    tol = checks.tolerance(tolerance, "tolerance", _size(s))
+    tol = checks.tolerance(tolerance, "tolerance", seeded_size(s))
     problem = SurfaceLine(s, o, d, tol)
     _, _, uu, vv, pts, cell = _grid(s)
     rel = pts - o

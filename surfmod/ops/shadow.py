@@ -22,15 +22,15 @@ from .. import checks
 from ..errors import SurfmodError
 from ..surface import Surface, require_surface
 from . import marching
-from .intersect import _Base, _implicit_seeds, _size, as_plane, plane_frame
+from .intersect import IntersectionProblem, as_plane, implicit_seeds, plane_frame, seeded_size
 from .closest import nearest_samples, seed_parameters
 
 
-class Silhouette(_Base):
+class Silhouette(IntersectionProblem):
     """Unknowns ``(u, v)``; ``F = (Su x Sv) . L``."""
 
     def __init__(self, s, light, tolerance):
-        super().__init__(list(s.domain), _size(s), tolerance)
+        super().__init__(list(s.domain), seeded_size(s), tolerance)
         self.s, self.light = s, light
 
     def evaluate(self, X):
@@ -82,7 +82,7 @@ def _boundary_polylines(s: Surface, density: int = 8):
     us = seed_parameters(s, 0, per_span=density, minimum=200, maximum=400)
     vs = seed_parameters(s, 1, per_span=density, minimum=200, maximum=400)
     edges = [s.points(us, v0), s.points(u1, vs), s.points(us[::-1], v1), s.points(u0, vs[::-1])]
-    size = _size(s)
+    size = seeded_size(s)
     return [e for e in edges if np.linalg.norm(np.ptp(e, axis=0)) > 1e-9 * size]
 
 
@@ -197,10 +197,10 @@ def shadow(obj: Surface, light_direction, plane, *, max_angle: float = 2.5) -> S
         q = (p - (((p @ n) / (light @ n))[..., None]) * light) if vector else proj(p) - o
         return np.stack([q @ xdir, q @ ydir], axis=-1)
 
-    size = _size(obj)
+    size = seeded_size(obj)
     boundary3 = _boundary_polylines(obj)
     problem = Silhouette(obj, light, 1e-12 * size)
-    seeds = _implicit_seeds(problem, obj)
+    seeds = implicit_seeds(problem, obj)
     traced = marching.trace_all(problem, seeds, size / 40, angle)
     sil3 = [problem.evaluate(X)[2] for X, _ in traced]
     boundary = [checks.frozen(proj(b)) for b in boundary3]

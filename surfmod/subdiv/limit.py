@@ -44,7 +44,7 @@ from ..nets.bezier import BezierSurface
 from ..nets.bspline import BSplineSurface
 from . import topology as tp
 from .catmull_clark import step as cc_step
-from .masks import _cc_limit
+from .masks import cc_limit
 
 #: Most patches a limit surface may have (each becomes an OCCT face).
 MAX_PATCHES = 200_000
@@ -345,7 +345,7 @@ def _level_patches(v, topo, crease, tangent_plane):
     nsharp[topo.faces_at() == 1] = 3  # a boundary vertex of a single face is a corner
     on_curve = nsharp >= 2  # boundary/crease curve vertices and corners
     regular = np.all(_regular_corners(topo, twin, nsharp).reshape(-1, 4), axis=1)
-    limit_pos, normals, _ = _cc_limit(v, topo, crease)
+    limit_pos, normals, _ = cc_limit(v, topo, crease)
 
     # ACC rules (curve vertices weighted as regular ones continued by ghost points)
     nval = np.where(on_curve, 4, valence)[corners].astype(float)[:, None]
@@ -450,7 +450,7 @@ def _measure(v, topo, crease, owner, maps, nets, regular, extra, samples: int = 
     fine_v, fine_topo, fine_crease, fine_owner, fine_maps = v, topo, crease, owner, maps
     for _ in range(extra):
         fine_v, fine_topo, fine_crease, fine_owner, fine_maps = _refine(fine_v, fine_topo, fine_crease, fine_owner, fine_maps)
-    pos, nrm, _ = _cc_limit(fine_v, fine_topo, fine_crease)
+    pos, nrm, _ = cc_limit(fine_v, fine_topo, fine_crease)
     faces = np.repeat(np.arange(fine_topo.n_faces), 4)
     corner = np.tile(np.arange(4), fine_topo.n_faces)
     vert = fine_topo.corners

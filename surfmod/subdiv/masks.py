@@ -128,11 +128,11 @@ def catmull_clark_limit(vertices, faces, *, creases=None) -> LimitPoints:
     n_orig = len(v)
     if np.any(topo.sizes != 4):
         v, topo, sharp = step(v, topo, sharp)
-    out = _cc_limit(v, topo, sharp)
+    out = cc_limit(v, topo, sharp)
     return LimitPoints(*(a[:n_orig] for a in out))
 
 
-def _cc_limit(v, topo, crease):
+def cc_limit(v, topo, crease):
     sharp = crease | topo.boundary
     nsharp, interior = _interior_vertices(topo, sharp)
     corners, nxt = topo.corners, topo.nxt
