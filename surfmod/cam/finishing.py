@@ -18,9 +18,9 @@ for less what exactness costs: the tool keeps the mesh's deflection ``δ`` from 
 which lies within ``δ`` of the faces (``2 δ``), the contours also their chord tolerance.
 
 **Exact and gouge-free.**  All heights are drop-cutter heights of the tool grown by ``δ``
-(``_part(..., clear=True)``, :func:`surfmod.cam.toolpath.meshed_part`): the tool never touches the faces the mesh stands for, in any
-direction (a vertical lift would not do: on a wall of slope θ the mesh's ``δ`` is
-``δ / cos θ`` deep measured vertically).  The waterline
+(:func:`surfmod.cam.toolpath.meshed_part` with ``clear=True``): the tool never touches
+the faces the mesh stands for, in any direction (a vertical lift would not do: on a wall
+of slope θ the mesh's ``δ`` is ``δ / cos θ`` deep measured vertically).  The waterline
 (:func:`surfmod.cam.waterline.waterline`) is computed for the tool grown by ``g`` = ``δ``
 plus the contours' chord tolerance (:meth:`~surfmod.cam.cutters.Cutter.grown`), so along
 every chord the real tool keeps at least ``δ`` from every triangle.  Every move is then

@@ -129,10 +129,9 @@ def _sweep_body(stock: StockModel, a: np.ndarray, b: np.ndarray, rapid: np.ndarr
     passes is met too.  A move ``flush`` against a wall holds its discs no wider than the
     end a cell wider too, against the nodes whose stock stands no more than ``thin`` (the
     roughing's skin, often thinner than a cell, which stands between the nodes) above the
-    part.  Only the stock more than ``rise``
-    (the cusps) above the part's top at a node (``floor``) counts: a grown disc comes over
-    the wall's own column, and the cusps between the model's nodes are the part's rule
-    (:func:`part_sink`)."""
+    part.  Only the stock more than ``rise`` (the cusps) above the part's top at a node
+    (``floor``) counts: a grown disc comes over the wall's own column, and the cusps
+    between the model's nodes are the part's rule (:func:`part_sink`)."""
     m = len(a)
     discs = np.column_stack([tool.body[:, :2], np.full(len(tool.body), np.inf)])
     wider = discs[:, 0] > tool.radius + slack
@@ -319,8 +318,8 @@ def reach_levels(held: Held, tool, stock: StockModel, triangles: np.ndarray, def
     (by ``cusp`` too) or the part stands above its discs' bottoms, the moves grouped by
     that height, a group at most ``window`` deep (else the window doubles until at most
     :data:`MAX_REACH_LEVELS` groups are left) and cut at its highest (``floor``: as
-    :func:`clear_body`'s).  Returns ``(z,
-    moves)`` pairs, lowest first, ``moves`` the group's ``(K, 2, 3)`` moves as left out."""
+    :func:`clear_body`'s).  Returns ``(z, moves)`` pairs, lowest first, ``moves`` the
+    group's ``(K, 2, 3)`` moves as left out."""
     if held is None or held.cuts is None:
         return []
     cuts = held.cuts[np.abs(held.cuts[:, 0, 2] - held.cuts[:, 1, 2]) <= 1e-9]

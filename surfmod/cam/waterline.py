@@ -42,7 +42,7 @@ from scipy.spatial import cKDTree
 from ..errors import SurfmodError
 from .cutters import Cutter
 from .drop_cutter import TriangleGrid
-from .fiber_contact import profile_radius, pair_intervals
+from .fiber_contact import pair_intervals, profile_radius
 
 MAX_PAIRS = 200_000_000  # (fiber, triangle) pairs over all levels: beyond this, coarsen sampling
 PAIRS_PER_BLOCK = 400_000
