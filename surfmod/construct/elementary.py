@@ -119,8 +119,8 @@ class ElementarySurface(Surface):
     def geom(self):
         from ..occ.analytic import elementary
 
-        return self._twin(lambda: elementary(self._kind, self.frame,
-                                                     *(getattr(self, n) for n in self._occt_sizes or self._sizes)))
+        sizes = [getattr(self, n) for n in self._occt_sizes or self._sizes]
+        return self._twin(lambda: elementary(self._kind, self.frame, *sizes))
 
     def transformed(self, matrix):
         """Similarity: same analytic type with a moved frame; otherwise the exact NURBS form
