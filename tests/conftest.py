@@ -140,7 +140,6 @@ SLOW_FIRST = (
     "test_cli_batch.py::test_killed_client_of_its_own_local_cluster_leaves_no_process",
     "test_cli_batch.py::test_a_worker_killed_mid_run_loses_no_other_file",
     "test_cli_batch.py::test_killed_client_leaves_no_worker_and_keeps_its_rows",
-    "test_fill.py::test_five_sided_hole_in_a_paraboloid",
     "test_cli.py::test_console_script_runs_the_gallery",
 )
 
