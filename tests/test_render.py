@@ -4,11 +4,13 @@ speed for the gallery, atomic writes and bad input."""
 from __future__ import annotations
 
 
+import build123d as bd
 import numpy as np
 import pytest
 
 import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
+from surfmod.meshing import render
 
 
 def _read(path):
@@ -233,3 +235,11 @@ def test_objects_of_higher_layers_draw_through_the_drawing_protocol(empty_cwd):
 
     with pytest.raises(sm.SurfmodError, match="drawing"):
         png_bytes(Broken())
+
+
+def test_a_shape_whose_faces_all_fail_to_mesh_is_refused(monkeypatch):
+    """BRepMesh may leave every face without triangles (brepmesh skips such faces): one
+    SurfmodError naming the argument, not NumPy's error on nothing to join."""
+    monkeypatch.setattr(render, "brepmesh", lambda *a, **k: [])
+    with pytest.raises(sm.SurfmodError, match="objects: the shape has no faces to draw"):
+        render._shape_mesh(bd.Box(1, 1, 1))

@@ -129,7 +129,10 @@ def display_mesh(m: Mesh, budget: int) -> Mesh:
 
 
 def _shape_mesh(shape, fraction: float = DISPLAY_TOLERANCE) -> Mesh:
-    nodes, triangles, _, _ = concatenated(brepmesh(shape, max(fraction * shape_diagonal(shape), 1e-9), 0.5))
+    fms = brepmesh(shape, max(fraction * shape_diagonal(shape), 1e-9), 0.5)
+    if not fms:  # faces all left untriangulated by BRepMesh (brepmesh skips them)
+        raise SurfmodError("objects: the shape has no faces to draw")
+    nodes, triangles, _, _ = concatenated(fms)
     return Mesh(nodes, triangles)
 
 
