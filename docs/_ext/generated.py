@@ -22,6 +22,10 @@
 * ``cli.md``: the marker ``<!-- surfmod-cli-reference -->`` becomes one section per
   subcommand of the ``surfmod`` parser: its usage line and a table of its arguments,
   taken from argparse (what ``surfmod CMD --help`` prints).
+
+Module docstrings point to the page that explains their algorithm (``See :doc:`/guide/cam`
+(section "Drop-cutter").``); Sphinx never renders them, so :func:`doc_references` checks
+each such page and section exists and the build warns (an error under ``-W``) where not.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from __future__ import annotations
 import argparse
 import ast
 import inspect
+import re
 from pathlib import Path
 
 import surfmod
@@ -233,6 +238,30 @@ def quirk_table_md(path: Path = QUIRKS_TEST) -> str:
     return "\n".join(rows)
 
 
+DOC_REFERENCE = re.compile(r':doc:`(/[\w/]+)`(?:\s+\(section\s+"([^"]+)"\))?')
+
+
+def doc_references(package: Path = PACKAGE) -> list[str]:
+    """Each ``:doc:`` reference in surfmod's sources whose page or section heading is missing."""
+    docs, missing = GALLERY.parent, []
+    for path in sorted(package.rglob("*.py")):
+        for page, wrapped in DOC_REFERENCE.findall(path.read_text(encoding="utf-8")):
+            section = " ".join(wrapped.split())
+            target = docs / (page.lstrip("/") + ".md")
+            headings = [line.lstrip("#").strip() for line in target.read_text(encoding="utf-8").splitlines()
+                        if line.startswith("#")] if target.exists() else []
+            if not target.exists() or (section and section not in headings):
+                missing.append(f"{path.relative_to(package.parent)}: {page}" + (f' (section "{section}")' if section else ""))
+    return missing
+
+
+def _check_references(app):
+    from sphinx.util import logging
+
+    for reference in doc_references():
+        logging.getLogger(__name__).warning(f"docstring points to no such page or section: {reference}")
+
+
 def _source_read(app, docname, source):
     text = source[0]
     if API_MARKER in text:
@@ -254,4 +283,5 @@ def _source_read(app, docname, source):
 
 def setup(app):
     app.connect("source-read", _source_read)
+    app.connect("builder-inited", _check_references)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -1,23 +1,11 @@
 """Circular (and helical) runs of a polyline tool path, for ``G2``/``G3`` in the posts.
 
-A run of consecutive cutter locations becomes one arc in the XY plane (``G17``) when the
-points are samples of a circle, not merely a polygon whose corners lie on one:
-
-- every point lies within ``tolerance`` (default :data:`TOLERANCE` = 1e-4 mm) of the
-  circle through the run's first, middle and last points, radially in XY;
-- Z is linear in the swept angle (a helix; a level arc when constant): no point lies
-  above that line by more than ``tolerance``, nor below it at all (an arc never runs
-  lower than the points it replaces);
-- the angle turns one way, each step at most :data:`MAX_STEP_ANGLE`, the run at most
-  :data:`MAX_SWEEP` (half a turn: no arc word is ever ambiguous with a full circle);
-- between two points the arc stands off the chord the path was verified along by the
-  sagitta ``r (1 - cos(step / 2))``; it must be at most ``sagitta`` (default
-  :data:`MAX_SAGITTA` = 0.01 mm, a common arc-fitting tolerance of CAM posts), so the arc and the polyline lie within that of each
-  other everywhere and within ``tolerance`` at every point;
-- at least :data:`MIN_POINTS` points, all reached by the same kind of move (one feed).
-
-Straight lines (collinear points) are not arcs: a radius beyond :data:`MAX_RADIUS` is
-refused.
+:func:`find_arcs` makes one arc in the XY plane of a run of at least :data:`MIN_POINTS`
+locations of one feed when they are samples of the circle through the run's first, middle
+and last points (within :data:`TOLERANCE`, each step at most :data:`MAX_STEP_ANGLE`, the
+run at most :data:`MAX_SWEEP`, the sagitta over each chord at most :data:`MAX_SAGITTA`),
+never above it as a helix and never lower than the points it replaces; a radius beyond
+:data:`MAX_RADIUS` is a straight line.  See :doc:`/guide/cam` (section "A job from stock").
 
 >>> import numpy as np
 >>> t = np.linspace(0, np.pi / 2, 25)

@@ -1,13 +1,9 @@
-"""End mills as objects: one class per cutter, holding its shape and what follows from it.
+"""End mills as objects: one class per cutter (:class:`Ball`, :class:`Flat`, :class:`Bull`),
+holding its shape and what follows from it.
 
-A cutter is a cutting end of radius ``R`` on a shank as wide as it, its edge rounded with
-the corner radius ``c``: ``R`` for a ball, 0 for a flat end, ``0 < c < R`` for a bull nose
-(a flat core of radius ``R - c`` rounded by a torus).  Its class holds its profile, cusps,
-envelopes, entry, raster gap and texts.  Its drop onto a triangle
-(:mod:`~surfmod.cam.drop_cutter`) and its push along a fiber
-(:mod:`~surfmod.cam.fiber_contact`) are compiled, which holds no Python object: its
-``code`` chooses them there, in one place each.  A new cutter is a class here and its two
-routines there.  :func:`cutter` is the one place a kind's name is looked up.
+A cutter's drop (:mod:`~surfmod.cam.drop_cutter`) and push (:mod:`~surfmod.cam.fiber_contact`)
+are compiled and hold no Python object: its ``code`` chooses them there, in one place each.
+:func:`cutter` is the one place a kind's name is looked up.  See :doc:`/design` (section "Cutters").
 """
 
 from __future__ import annotations

@@ -1,31 +1,10 @@
-"""The time a machine takes for a job's moves: a trapezoidal velocity profile per move.
+"""The time a machine takes for a job's moves (:func:`plan`), beside the plain feed-rate sum
+(:func:`feed_time`).
 
-A feed-rate sum (length over feed, :func:`feed_time`) assumes every move runs at its feed
-from end to end.  A machine (:class:`~surfmod.cam.machine_table.Machine`) cannot:
-
-- a move's speed is the commanded feed (the rapid rate for ``G0``) capped by the axis
-  velocities projected on its direction, ``min_a vmax_a / |u_a|`` (the axis that saturates
-  first limits it), and it accelerates at ``min_a amax_a / |u_a|``;
-- at a corner the controller blends within the tolerance ``P`` (LinuxCNC ``G64 P``): a
-  circular arc tangent to both moves that leaves the corner by at most ``P``, driven at
-  the speed whose centripetal acceleration the axes allow, ``v² = a_n R``.  For a turn
-  of ``φ`` the deviation of the arc of radius ``R`` is ``R (1/cos(φ/2) - 1)``, so
-  ``R = P cos(φ/2) / (1 - cos(φ/2))``: grbl's junction deviation (``planner.c``,
-  ``v² = a δ sin(θ/2) / (1 - sin(θ/2))``, θ = π - φ the angle between the moves, ``a``
-  the axis limits projected on the junction vector ``u2 - u1`` as here) and the blend arc
-  of LinuxCNC's trajectory planner (``src/emc/tp/blendmath.c``; LinuxCNC keeps a share
-  of the acceleration for the tangent, ``BLEND_ACC_RATIO_NORMAL``, so it is a little
-  slower there).  The arc must fit on the moves: its tangent length ``R tan(φ/2)`` at
-  most half the shorter one (LinuxCNC's blend takes at most half of a segment's nominal
-  length), which on a circle of many chords gives ``R → r cos(π/n)`` and the centripetal
-  limit ``v = sqrt(a r)``.  ``P = 0`` stops at every corner; a straight-through point
-  (turn below ``STRAIGHT``) keeps the speed;
-- each move accelerates from its entry speed and brakes to its exit speed: where it is
-  too short to reach its feed the profile is a triangle.
-
-The entry and exit speeds come from one backward and one forward pass over the segments
-(``w_{k+1} = min(cap_{k+1}, w_k + 2 a_k L_k)`` on squared speeds), each a running minimum
-of prefix sums (``np.minimum.accumulate``): O(n), vectorized, no loop in Python.
+Each move runs a trapezoidal (or triangular) velocity profile under the axis limits of a
+:class:`~surfmod.cam.machine_table.Machine` projected on its direction, entering and leaving
+at the speed of the blend arc each corner allows; one backward and one forward pass give
+those speeds, vectorized.  See :doc:`/guide/cam` (section "Cycle time").
 
 >>> import numpy as np
 >>> from surfmod.cam.machine_table import Machine

@@ -1,45 +1,11 @@
-"""Drop-cutter against a triangle soup, compiled: one scalar loop per cutter location over its candidate triangles.
+"""Drop-cutter against a triangle soup, compiled: one scalar loop per cutter location over its
+candidate triangles (:func:`drop`).
 
 The soup is the part's faces meshed by BRepMesh and measured against them
-(:func:`part_triangles`): their triangles lie inside each face's trim, within a measured
-deviation of the exact surface.
-
-The tool is an end mill with an endless shank of its own radius above the tip: a ball
-end (sphere of radius ``r`` centred ``r`` above the tip), a flat end (a disc at the
-tip) or a bull nose (a flat core of radius ``a = r - c`` rounded by a torus of corner
-radius ``c``).  Dropped along -Z at the cutter location ``(x, y)``, it stops at the lowest tip
-height where no triangle point lies inside it.  Since the shank is as wide as the end,
-every triangle point within horizontal distance ``r`` of the axis bounds the tip from
-below, so the shank is included without extra work (the "full cutter").
-
-Per pair the exact contact with the triangle's three vertices, three edges and its
-facet is solved in closed form (as OpenCAMLib does), then the highest contact wins:
-
-* ball: vertex ``z + sqrt(r² - d²)``; edge: the higher root of the quadratic for the
-  centre on the cylinder of radius ``r`` round the edge's line, kept when the contact
-  falls inside the edge; facet: the centre at ``r`` along the upward unit normal, kept
-  when the contact point ``(x, y) - r·n_xy`` lies inside the triangle;
-* flat: vertex ``z`` within the disc; edge: the higher end of the edge's piece inside
-  the disc; facet: the disc's rim point uphill along the plane's gradient, when inside;
-* bull: vertex ``z - f(d)`` with the profile ``f(d) = 0`` on the core (``d ≤ a``) and
-  ``c - sqrt(c² - (d - a)²)`` on the torus; facet: the torus's ring point ``a`` uphill of
-  the axis, pushed out by ``c`` along the normal (the ball's rule for ``a = 0``, the flat
-  end's for ``c = 0``); edge: along the edge ``z(u) - f(d(u))`` is concave (``f`` convex
-  and increasing, ``d`` convex), so its maximum is the one root of the decreasing
-  derivative, found by bisection to rounding (the torus-line contact is a quartic;
-  OpenCAMLib also solves it numerically).
-
-Candidate pairs come from a uniform (x, y) grid of cell size ~``r/2`` holding, for each
-cell, every triangle whose (x, y) box grown by ``r`` meets it.  On a fine mesh under a
-large tool a location's list holds thousands of triangles of which a few dozen can win:
-a bound per triangle (its highest vertex, lifted by the ball over its box) against the
-best height found so far skips the rest before any contact is solved, which is why the
-loop is compiled rather than vectorized over pairs (the pairs' arrays alone cost a
-millisecond per location there).  A drop walks its cell's list from the highest bound
-any location of the cell can get from a triangle down (the top lowered by the cutter's
-profile at the cell's distance from the triangle's box), so it stops at the first
-bound below the height found: under a large ball most triangles whose tops stand above
-the contact lie too far to lift it there, and are never read.
+(:func:`part_triangles`).  A location's height is the lowest tip height where no triangle
+point lies inside the tool and its shank, the highest of the closed-form contacts with the
+vertices, edges and facets of the triangles a :class:`TriangleGrid` cell lists, walked from
+the highest bound down.  See :doc:`/guide/cam` (section "Drop-cutter").
 """
 
 from __future__ import annotations

@@ -1,26 +1,9 @@
 """Where along a horizontal line ("fiber") an end mill at tip height ``z`` meets a triangle:
-one compiled scalar routine per (fiber, triangle) pair.
+one compiled scalar routine per (fiber, triangle) pair (:func:`pair_intervals`).
 
-The tool is an end mill with a shank of its own radius up to infinity: flat, ball, or
-bull (a flat core of radius ``R - r`` rounded by a torus of corner radius ``r``).  It and
-the triangle are convex, so the positions ``o + t d`` where they meet form one interval
-of ``t``, whose ends are contacts solved in closed form from the triangle's features (as
-OpenCAMLib's push-cutter does):
-
-* a vertex (or a point where an edge crosses height ``z`` or ``z + r``) forbids a disc
-  of the tool's radius at that height;
-* an edge's part above ``z + r`` (the whole edge above ``z`` for a flat end) forbids the
-  band within ``R`` of its (x, y) projection: the fiber meets the two offset lines;
-* an edge's part between ``z`` and ``z + r`` is touched by the ball (the centre line
-  meets the cylinder of radius ``R`` round the edge: a quadratic) or by the torus (see
-  :func:`_torus_edge`);
-* the facet is touched by the tool's support point along its normal (linear in ``t``),
-  kept when that point falls inside the triangle.
-
-Every candidate is a position where the tool touches the triangle, so the interval is
-the smallest and largest of them.  The loop is compiled rather than vectorized over
-pairs because the torus contact is a root search: vectorized, every pair paid for the
-worst pair's bracketing and bisection (9/10 of a bull waterline's time went there).
+Tool and triangle are convex, so the positions where they meet are one interval, whose ends
+are closed-form contacts with the triangle's vertices, edges and facet.
+See :doc:`/guide/cam` (section "Waterline").
 
 A ball of radius 1 along the x axis under a level triangle 1 above its tip: the
 triangle's x range [0, 1] grown by the radius.

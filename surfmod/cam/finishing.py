@@ -1,48 +1,11 @@
 """Finishing in a job: the drop-cutter raster over the whole part, waterline (constant-Z)
 contours on its steep regions, and a report of the rest the tool cannot reach.
 
-**The scallop rule.**  Passes of a ball (or a bull's corner, radius ``c``) a distance
-``s`` apart along the surface leave cusps ``c - sqrt(c² - (s/2)²)`` on flat and convex
-ground (concave ground of curvature radius ``ρ`` adds about ``s²/(8(ρ - c))``, not
-budgeted).  The raster's passes ``d`` apart in (x, y) stand ``d / cos φ`` apart along
-ground sloping by ``φ`` across them, so each next pass is placed ``s · cos φ`` further,
-``φ`` the steepest cross slope of the triangles below the threshold ``steep_angle``
-within the tool's radius of the two passes (``s`` apart over level ground, closer beside
-slopes).  Waterline levels ``Δz`` apart lie ``Δz / sin θ`` apart along a wall of slope
-``θ``, so ``Δz = s · sin θ_min``, ``θ_min`` the least slope (at least the threshold) of
-the steep triangles near each level: on a vertical wall the levels stand ``s`` apart.
-The raster runs everywhere (its cusps on the steep regions are cut again by the contours;
-its length there is the steep regions' small (x, y) footprint), the contours only on the
-steep pieces of each level's loops.  The budget ``s`` is computed for is the scallop asked
-for less what exactness costs: the tool keeps the mesh's deflection ``δ`` from the mesh,
-which lies within ``δ`` of the faces (``2 δ``), the contours also their chord tolerance.
-
-**Exact and gouge-free.**  All heights are drop-cutter heights of the tool grown by ``δ``
-(:func:`surfmod.cam.toolpath.meshed_part` with ``clear=True``): the tool never touches
-the faces the mesh stands for, in any direction (a vertical lift would not do: on a wall
-of slope θ the mesh's ``δ`` is ``δ / cos θ`` deep measured vertically).  The waterline
-(:func:`surfmod.cam.waterline.waterline`) is computed for the tool grown by ``g`` = ``δ``
-plus the contours' chord tolerance (:meth:`~surfmod.cam.cutters.Cutter.grown`), so along
-every chord the real tool keeps at least ``δ`` from every triangle.  Every move is then
-judged like the raster's (:func:`~surfmod.cam.toolpath_moves.move_gouge` against the
-drop-cutter heights).  The waterline checks a chord at its middle only, so a chord can
-cross a notch of the contour whose middle lies on it: such a chord is split at the exact
-contour point near its middle (:class:`~surfmod.cam.waterline.ContourPoints`), again and
-again (:func:`_follow`; ``split`` counts the pieces), and only a move that still cuts
-after that is lifted (reported as ``lifted``).
-
-**Links** between contours run along the part when the straight move stays clear of it
-and is short (at most a tool radius across, no more than 1.5 levels down); otherwise the
-tool goes up at the feed to above the stock the roughing can have left (:class:`Leftover`),
-then rapidly to the clearance height, across, down to that height, and enters as the raster
-does (a ball plunges, a flat or bull end helixes).
-
-**Rest.**  On an (x, y) grid, the part's top (a vertical ray onto the triangles) and the
-opening of it by the tool's lower surface (the lowest the tool's surface comes over each
-node among all drop-cutter positions on the grid): where the opening stands more than the
-scallop above the part, the finishing tool cannot reach (corners and slots narrower than
-the tool, the fillet a ball leaves where a wall meets a floor).  Its area, deepest point
-and box are reported, not cut.
+Passes and levels are spaced by the scallop rule; every height is a drop-cutter height of
+the tool grown by the mesh's deflection (:func:`surfmod.cam.toolpath.meshed_part` with
+``clear=True``), never a vertical lift, and every move is judged as the raster's are; a
+contour's chord that still cuts is split at exact contour points (:func:`_follow`) before
+any move is lifted.  See :doc:`/guide/cam` (section "A job from stock").
 """
 
 from __future__ import annotations

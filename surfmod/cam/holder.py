@@ -1,47 +1,11 @@
 """Shank and holder collisions: what does not cut must clear the part and the stock.
 
-Above its flutes a tool does not cut (:attr:`surfmod.cam.tool.Tool.body`: the shank from
-the flutes' end, the holder from the shank's).  Every move of an operation, cutting or
-linking, is checked twice:
-
-- **against the part**, by the reach rule the verifier judges with too
-  (:func:`surfmod.cam.verify.body_stand`): the discs wider than the cutting end (a wider
-  shank, the holder) dropped as flat cylinders onto the part's mesh
-  (:func:`surfmod.cam.drop_cutter.drop`) at probes along the move, each disc grown by half
-  the probes' spacing (so it holds the disc at every point between) and its bottom at the
-  lowest height within half a spacing, must stand the highest cusp the finishing passes
-  so far leave above the part (the model's cells, a quarter of the smallest tool, are
-  wider than those passes: it does not see their cusps; counted here alone); the mesh's
-  deflection is added to the heights found (the exact faces lie at most that far above
-  the mesh), and where only that margin flags a move, OCCT's exact distance from the disc
-  as a solid cylinder to the part settles it (a bounded number of them).  A narrower
-  shank stands in the column the end's drop-cutter already keeps clear of the part;
-- **against the stock**: the operation's moves swept in order through a height-field
-  stock model shared by the job's operations (:class:`surfmod.cam.rest.StockModel`,
-  swept by :func:`surfmod.cam.verify_kernels.sweep_body`): before each stamp of the
-  cutting end, the stock more than the cusps above the part may stand no higher than a
-  disc's bottom within the disc (the shank, even as narrow as the end, meets stock above
-  the flutes in front of the tool).  Beside a wall taller than the flutes, within the
-  allowance a roughing left on it, a shank as wide as the end meets that skin, thinner
-  than a cell: there the narrow discs are held a cell wider against the stock no
-  thicker than the skin (on a boss 30 mm tall the raster beside it, before the contours
-  cut the skin, rubbed it 24.5 mm deep).
-
-A disc may rub sideways within the operation's tolerance (its radius is taken that much
-smaller: the end's own side comes that near a wall), but never stand lower than the part
-or the stock under it.  A move that fails either check is removed: the tool retracts to the clearance height,
-crosses, and comes straight down at the plunge feed onto the start of the next move kept
-(a flat or bull end must cut at its centre there: the stock the removed moves leave is
-not what the operation's own ramps and helices were laid out for).  What the removed moves
-would have cut is left, and reported (:class:`Held`): the (x, y) area where more than the
-tolerance is left, the deepest point they would have reached and the thickness left.
-Where the moves left out are a waterline contour's (at one height), :func:`reach_levels`
-says how high the tool must stand there for its body to clear, and the job contours
-those places again at that height (:func:`surfmod.cam.finishing.reach_contours`).
-
-The work is counted before it starts: probes along the moves (at most
-:data:`MAX_HOLDER_PROBES`, else they stand farther apart and the discs grow with them, a
-more cautious check) and stock nodes (at most :data:`MAX_STOCK_NODES`, else coarser cells).
+Every move, cutting or linking, is held against the part by the verifier's own reach rule
+(:func:`surfmod.cam.verify.body_stand`) and against the job's height-field stock
+(:class:`surfmod.cam.rest.StockModel`).  A move that fails is left out and reported
+(:class:`Held`); :func:`reach_levels` says how high a contour left out may run instead.
+Probes and stock nodes are counted first (:data:`MAX_HOLDER_PROBES`,
+:data:`MAX_STOCK_NODES`).  See :doc:`/guide/cam` (section "Holder and shank").
 """
 
 from __future__ import annotations

@@ -1,30 +1,10 @@
-"""A job in the browser: one self-contained HTML file (plotly's offline HTML, plotly.js
-written inside it, so it opens without a network), which ``surfmod machine --html`` writes
-and a notebook shows (``Job._repr_html_``).
+"""A job in the browser: one self-contained HTML file (plotly's offline HTML), which
+``surfmod machine --html`` writes and a notebook shows (``Job._repr_html_``).
 
-It holds, each a trace the legend switches on and off:
-
-- **the part**, shaded: BRepMesh's triangles at ``VIEW_DEFLECTION`` of the stock's size
-  (coarser where the curvature estimate passes ``MESH_TRIANGLES``), simplified to at
-  most ``VIEW_TRIANGLES`` (:func:`surfmod.meshing.render.display_mesh`);
-- **each operation's moves**, cuts in the operation's colour, rapids apart (grey,
-  dashed); the last operation's cuts are shown, the others' and the rapids are listed
-  in the legend, one click away (drawn at once they hide the part): at most ``VIEW_POINTS`` tool locations over the whole job, shared by the
-  operations as their moves are; where an operation has more, every ``s``-th location is
-  kept, a chord drawn where the moves it stands for all cut or are all rapids, left out
-  where they mix;
-- **the stock after the job**, as the verifier swept it (``job.verification.stock``, see
-  :mod:`surfmod.cam.stock_field`): a surface over the nodes where more than the last
-  finishing's residual limit is left on the part (any material, without a finishing),
-  coloured by how much, measured along the part's normal; at most ``VIEW_NODES`` nodes
-  (maxima over blocks).  A job not verified has no stock model: the title says so;
-- **a title**: the stock, the operations with their tools, the time estimate and the
-  verification's verdict.
-
-The numbers go into the page as typed arrays (4-byte floats and integers, base64), so the
-data is at most 64 bytes a triangle (three corners of its own, three indices), 48 a tool
-location (drawn in two traces at most, and a gap) and 11 a stock node: 4.1 MB at the
-bounds, beside plotly.js's 4.8 MB (the tests' small job: 0.5 MB).
+Its traces are the part, each operation's cuts and rapids, and the stock the verifier swept
+(``job.verification.stock``) where more than the residual limit is left; the page is bounded
+before it is written (``VIEW_TRIANGLES``, ``VIEW_POINTS``, ``VIEW_NODES``).
+See :doc:`/guide/cam` (section "Job view").
 """
 
 from __future__ import annotations

@@ -1,9 +1,6 @@
-"""The machine a job runs on: axis limits, rapid rate, corner blending, tool change time.
-
-The machine table sits beside the tool table (:func:`surfmod.cam.tool.load_tool_table`):
-a TOML file with a ``[machine]`` table, or JSON ``{"machine": {...}}``, holding any of the
-fields of :class:`Machine`; what it leaves out keeps the default.  The cycle time of a job
-(:mod:`surfmod.cam.cycle_time`) is planned with these limits.
+"""The machine a job runs on (:class:`Machine`: axis limits, rapid rate, corner blending, tool
+change time), read from a TOML or JSON table beside the tool table; what it leaves out keeps
+the default.  See :doc:`/guide/cam` (section "Cycle time").
 
 >>> import tempfile, os
 >>> p = os.path.join(tempfile.mkdtemp(), "mill.toml")

@@ -1,15 +1,8 @@
-"""Post-processors: a :class:`~surfmod.cam.job.Job` as G-code a controller runs.
+"""Post-processors (:func:`programs`): a :class:`~surfmod.cam.job.Job` as G-code for
+``"linuxcnc"`` (one RS274NGC program with tool changes) or ``"grbl"`` (one program per tool).
 
-Both posts write millimetres, absolute, in part coordinates; retracts are plain ``G0 Z``
-moves to the job's clearance height (no ``G28``/``G30``/``G53`` machine-coordinate moves,
-no ``G5`` splines).  Heights are rounded up to the written digits (the tool never sits
-lower than the verified path).
-
-- ``"linuxcnc"``: one RS274NGC program; per operation a comment naming it and its tool,
-  ``T n M6`` and ``G43 H n`` (tool length offset), ``S… M3`` before the first cut, ``M5``
-  after it; ``M30`` at the end.
-- ``"grbl"``: no tool changer, so one program per tool (``NAME_T1.nc``, ``NAME_T2.nc``…),
-  each with its spindle start and stop and no ``M6``/``G43``.
+Heights are rounded up to the written digits: the tool never sits lower than the verified
+path.  See :doc:`/guide/cam` (section "A job from stock").
 """
 
 from __future__ import annotations

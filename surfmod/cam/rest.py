@@ -1,36 +1,11 @@
 """Rest machining: a smaller tool cuts only where the operations before it left more than
 the scallop above the part.
 
-**Where** comes from the job's own stock model, not from a guess about the part: a height
-field over the stock box (:func:`~surfmod.cam.verify.stock_cells`), swept by each tool's
-lower surface along the moves already made (the verifier's compiled sweep,
-:func:`surfmod.cam.verify_kernels.sweep_stock`), is held against the part's top (a vertical
-ray onto the rest tool's triangles, :func:`~surfmod.cam.finishing.height_field`).  The
-stock over a node is *left* where it is thicker than the scallop plus the tolerance plus
-the sweep's sampling: the stock's top there lies farther than that from every triangle
-of the part, in 3D (so the material on a wall's flank, a sliver thin across however
-tall, is not counted, as a vertical measure would count it; a fillet a ball left in a
-corner is).  Those nodes are the rest regions; their area
-before and after the rest operation is its report.
-
-**The moves** first finish each region's steep part (slopes from ``STEEP_ANGLE``) by
-the finishing's waterline contours (:func:`~surfmod.cam.finishing.contour_moves`, levels
-:func:`~surfmod.cam.finishing.contour_spacing` apart: the scallop and the walls' slope
-set them), made of the triangles within two tool radii of the region and kept where a
-left node within the tool's reach holds stock above the level (:class:`_LeftNear`): a
-raster climbing a wall leaves cusps as tall as its steps there.  Then the rest tool's
-own gouge-checked drop-cutter rasters
-(:func:`~surfmod.cam.toolpath.raster_path`), one along x and one along y over each
-region's box (passes a ``cos 45°`` share of the scallop's stepover apart, as the repair's
-cross passes: fillets along walls in either direction are crossed), clipped to where the
-tool's axis can touch a rest node (the regions grown by the tool's radius and a cell).
-A run of raster points inside is cut as the raster made it (every move of it was
-judged); runs closer along the raster than ``BRIDGE_RADII`` tool radii are joined by the
-raster's own moves between them, the others are linked as the finishing links
-(:func:`~surfmod.cam.finishing.add_raster`): up at the feed to above the stock left,
-rapid at the clearance height, down, plunge.  "Above the stock left" is read from the
-stock model itself: its highest node within the tool's footprint, plus
-``REST_CLEARANCE``.
+Where is read from the job's own stock model (:class:`StockModel`, swept as the verifier
+sweeps): a node is left where the stock's top lies farther than the scallop plus the
+tolerance from every triangle, in 3D (:func:`left_over`).  :func:`rest_moves` runs the
+finishing's contours on each region's steep part, then drop-cutter rasters along x and y
+clipped to it, linked as the finishing links.  See :doc:`/guide/cam` (section "Rest machining").
 """
 
 from __future__ import annotations

@@ -1,37 +1,10 @@
-"""Z-level roughing: clearing a block of stock down to the part plus an allowance.
+"""Z-level roughing (:func:`rough`): clearing a block of stock down to the part plus an allowance.
 
-The part grown by the allowance is bounded by the drop-cutter surface of the tool grown by
-it (:meth:`~surfmod.cam.cutters.Cutter.roughing_offset`; its tip is ``A`` below the real
-one), sampled on an (x, y) grid over the stock: ``h(x, y)`` is the lowest tip height that
-keeps the tool ``A`` clear of the part.  At a level ``z`` the tool may stand wherever
-``h ≤ z``.  Every region of that set is cleared by contour-parallel rings: its boundary
-itself (the grid's isolines of ``h`` moved onto the exact boundary by bisection with the
-exact drop height, then a hair inside: material within ``R`` of the boundary is cut
-however near the part it lies), and inside it the isolines of the grid's distance to the
-boundary, ``stepover`` apart (each point of the region lies within ``stepover`` of a
-ring, so the tool, wider than that, sweeps it all; each ring engages about ``stepover``
-of material radially beside the one before, up to a grid cell more).  Rings are clipped
-to the stock grown by ``radius + stepover / 2`` and cut from the far side inwards towards the part; open
-stock is entered from the air, sideways; a closed ring from the end of the ring before
-at the level when that is near, else by a ramp along itself, or
-(a ring too short to ramp along) by a helix round its centre as wide as the region
-allows — never a straight plunge.  The ramp comes down rapidly only to half a unit above
-the lowest level that cleared the tool's disc round its start with ``ENTRY_CELLS`` grid
-cells to spare (the rings cleared, exactly, the region where the tool stood grown by its
-radius; the boundary ring stands up to two cells inside that region and the grid's
-distance errs by about a cell): it starts at the ring's point where that level is
-lowest, the level above wherever the ring lies well inside what it cleared.  Beside a
-wall the levels above left their stair of allowance: an entry there starts higher and
-ramps down through it, never rapids into it.  A region too small even for a helix of
-``MIN_HELIX`` tool radii is left, with every level below it, and reported (``left``:
-level, centre, at most how much (x, y) area of stock): the job's summary names it.
-Links go up to the clearance height above the stock, except a short link (at most
-``1.5 stepover``) at the level when it stays where the tool may stand.
-
-Every cutter location is lifted onto the exact drop-cutter height where the grid put it
-too low, and every move is checked between its ends (:func:`move_gouge`), split and
-lifted until none cuts into the allowance: roughing never cuts into the part plus the
-allowance, beyond the mesh's deflection.
+Each level's regions are cleared by contour-parallel rings, entered by ramps or helices
+(never a straight plunge) and linked above the stock.  Every cutter location stands on the
+exact drop-cutter height of the tool grown by the allowance and every move is checked
+between its ends: roughing never cuts into the part plus the allowance, beyond the mesh's
+deflection.  See :doc:`/guide/cam` (section "Roughing").
 """
 
 from __future__ import annotations

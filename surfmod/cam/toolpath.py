@@ -1,30 +1,11 @@
 """NC tool paths for continuous-path machining: drop-cutter zig-zag rasters that never gouge.
 
 The same concept as :mod:`surfmod.cli.toolpath` (the ``surfmod toolpath`` command over it),
-one level down.
-
-The part is every face of the input (walls, undersides and trimmed faces included), meshed
-by OCCT's BRepMesh inside each face's trim at a chordal deflection of 40 % of the
-gouge ``tolerance``, measured against the exact faces and refined where it strays
-(:func:`~surfmod.cam.drop_cutter.part_triangles`).  The end mill (ball, flat or bull nose,
-with a shank of its own radius up to infinity) is dropped onto that mesh in closed form
-(:mod:`surfmod.cam.drop_cutter`), so a cutter location touches but never enters the
-triangles; where the measured deviation is larger than asked for (faces of real parts
-whose edges lie off them by their own tolerance) every height is lifted by the difference.
-
-Every straight G1 move between cutter locations is then checked along its length, not only
-at its ends (:mod:`surfmod.cam.toolpath_moves`): locations are inserted where a move would
-cut deeper than half the tolerance, steps at walls become vertical-level-vertical
-staircases, and a final check on other sample points must find every move within
-``tolerance - deflection``.  Moves the refinement cannot bring within it are lifted
-(:func:`~surfmod.cam.toolpath_moves.lift_moves`: material is left there, reported as
-``Toolpath.lifted``); a path that still cuts deeper raises ``SurfmodError``: gouging
-G-code is never returned.  The default tolerance is a tenth of the scallop height.
-
-The triangles can miss where a face leaves its mesh between the measured samples, so
-the moves are then held against points of the exact faces (:mod:`surfmod.cam.verify`)
-and lifted where those come deeper than half the tolerance into the tool (also counted
-in ``Toolpath.lifted``); ``surfmod toolpath`` judges the written G-code once more.
+one level down.  The tool is dropped onto the part's faces meshed inside their trims and
+measured against them; every move is checked along its length
+(:mod:`surfmod.cam.toolpath_moves`) and against the exact faces' points, what still cuts is
+lifted (``Toolpath.lifted``), and a path that cuts deeper than the tolerance raises: gouging
+G-code is never returned.  See :doc:`/guide/cam` (section "From a NURBS surface to G-code").
 """
 
 from __future__ import annotations

@@ -1,23 +1,10 @@
-"""Drop-cutter heights on the exact faces, polished from the mesh's (ball, flat and bull
-nose end mills: one set of equations, the ball and the flat end its limits).
+"""Drop-cutter heights on the exact faces, polished from the mesh's by Newton's method over
+each face's own evaluator (ball, flat and bull nose: one set of equations, the ball and the
+flat end its limits).
 
-The mesh drop (:mod:`surfmod.cam.drop_cutter`) is exact for BRepMesh's triangles, which
-are chords of the faces.  Where the tool touches a face inside its trim, the exact cutter
-location solves two equations in the face's ``(u, v)``, with ``S`` the face point, ``N``
-its upward unit normal and ``(x, y)`` the tool axis.  An end mill of radius ``R`` and
-corner radius ``c`` touching with its rounded end: the corner's centre ``S + c N`` lies on
-the ring of radius ``a = R - c``, ``a`` uphill of the axis, so
-``(S + c N)_xy + a N_xy / |N_xy| = (x, y)``, and the tip height is ``(S + c N)_z - c``
-(a ball, ``c = R``: its centre ``S + R N`` on the axis; a flat end, ``c = 0``: its rim
-tangent to the face, which rises towards the axis).  Touching with its flat core (a
-summit of the face within ``a`` of the axis): ``N_xy = 0``, and the tip height is ``S_z``.
-
-Newton's method solves them for every location at once (per face, vectorized), started
-from the projection of the mesh contact onto the face; the Jacobian comes from central
-differences of the exact evaluator (the residual is exact, so Newton still converges to
-rounding).  A solution outside the face's trim (the tool rests on an edge or a vertex,
-not the face's interior), on a face seen from below or level where it should slope, or
-that does not converge keeps the mesh height and is reported so.
+A solution outside the face's trim, on a face seen from below, or one that does not
+converge keeps the mesh height and is reported so.  See :doc:`/guide/cam` (section "From a
+NURBS surface to G-code").
 """
 
 from __future__ import annotations

@@ -1,13 +1,9 @@
 """Zig-zag rasters and the straight G1 moves between cutter locations.
 
-A tool path is safe only if every straight move is: at each point of the move the tip
-must stay above the drop-cutter height there.  ``refine_moves`` samples the interior of
-every move, inserts the worst sampled location where the straight move would cut (the
-drop-cutter height is piecewise smooth, so a few rounds of insertion follow it), and
-where a move has shrunk to a step at a wall (drop heights jump), replaces it by a
-staircase: vertical up, level across, vertical down.  ``move_gouge`` measures every move
-again on a different set of sample parameters, so the refinement and the verdict do not
-share sample points.
+``refine_moves`` inserts locations where a straight move would cut and turns steps at walls
+into staircases; ``move_gouge`` measures every move again on other sample points, so the
+refinement and the verdict share none.  See :doc:`/guide/cam` (section "From a NURBS surface
+to G-code").
 """
 
 from __future__ import annotations

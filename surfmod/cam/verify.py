@@ -1,69 +1,13 @@
-"""Every program judged before it leaves: the G-code read back, swept through a stock
-model and held against the exact part.
+"""Every program judged before it leaves (:func:`verify_job`, :func:`verify_toolpath`): the
+G-code read back, swept through a stock model and held against the exact part.
 
-The judge shares nothing with how the moves were made (the drop-cutter on BRepMesh
-triangles, :mod:`surfmod.cam.drop_cutter`):
-
-- **the program** is read back from its text (:mod:`surfmod.cam.program`): the rounded
-  coordinates, the arcs and the tool in the spindle are the machine's;
-- **the part** is points on its exact faces and edges (:mod:`surfmod.cam.part_points`).
-  Between points a surface can come nearer a tool by about ``spacing² (1/c + κ)/8``
-  (``c`` the tool's corner radius, ``κ`` the surface's curvature): the spacing keeps the
-  tool's share within a quarter of the limit judged, and a face curved more is sampled
-  closer.  Where a ball cuts deepest, the depth is measured once more by OCCT's exact
-  distance to the faces (``BRepExtrema``);
-- **gouge**: every move of an operation, probed at points ``spacing`` apart along it, may
-  bring no point of the part deeper into the tool than the operation's limit: its
-  tolerance for finishing; for roughing the tool grown by its allowance, so that it
-  stays the allowance away less its tolerance.  Rapids may touch nothing;
-- **stock**: a height field over the stock box, a cell a quarter of the finishing
-  stepover wide, from which each feed removes what the tool's lower surface sweeps, in
-  the program's order.  A rapid whose tool goes below the stock's top there runs through
-  material; the tool is grown sideways by a cell for it (not going straight up, out of
-  the column it cut), since a node stands for the stock up to a cell round it: a sliver
-  the moves left between two nodes is met.  The stock left is kept with the verdict (``Verification.stock``, a
-  :class:`~surfmod.cam.stock_field.StockField`), which the job view draws;
-- **holder and shank**: above its flutes a tool does not cut (:attr:`Tool.body
-  <surfmod.cam.tool.Tool.body>`): along every move, its discs wider than the end dropped
-  onto the part's points (grown by half the probes' spacing) and, in the stock sweep
-  below, every disc measured against the stock the moves before left
-  (:func:`~surfmod.cam.verify_kernels.sweep_body`), each disc narrower by the operation's
-  limit (a rub beside a wall), may stand no lower than the part or the stock beyond the 4
-  decimals written and the stamped sweep's sag;
-- **residual**: after the last finishing, the stock left above the lowest the finishing
-  tool can reach (the part's closing by the tool, from its drop onto the part's points),
-  measured normal to that surface, is at most the scallop plus the tolerance wherever the
-  tool reaches.  A height field cannot see a wall: nodes steeper than ``WALL_SLOPE`` and a
-  band one cell wide at the part's outline are left to the walls' judge below; the nodes
-  the shank or holder keeps the tool from (the whole tool's reach by the job's reach rule,
-  :func:`body_stand`, above the end's), and a tool radius round them, are counted, not
-  judged;
-- **walls**: the stock is also dexels along x and along y, a cell apart, kept in a band
-  round every place the height field sees rise steeper than ``DEXEL_SLOPE`` less 10° (a
-  wall, the part's outline), each holding its material as intervals, swept by each tool's
-  exact envelope (its end, and a cylinder of its radius going up) along every feed move in
-  program order (:mod:`~surfmod.cam.wall_dexels`).  Every end of an interval is a point of
-  the stock's surface; where the part at its foot is steeper than ``DEXEL_SLOPE`` its
-  distance to the part is the material left there, measured along the part's normal (a
-  plane through the nearest points of the exact part; the deepest once more by OCCT's exact
-  distance), judged against the same limit (or the cusp the finishing's contours leave on
-  a wall of ``DEXEL_SLOPE`` where more: a stepover asked of a bull nose,
-  :meth:`~surfmod.cam.cutters.Cutter.wall_cusp`)
-  where the finishing tool reaches: tangent to
-  the part at the foot it takes in no point of the part beyond the limit, stands no lower
-  than the table, the normal does not face down (an overhang) and no disc of its shank or
-  holder wider than its end (grown by the job's body cell, :func:`body_cell`) stands below
-  the part and its cusps (:func:`body_stand`; the flutes set no depth of their own: a
-  shank no wider than the end follows them down a hole).  A cusp between the
-  dexels' levels is seen lower, by at most its slope over half a cell.
-
-Each finding keeps its maximum and where it is.  The work is estimated before it starts
-(points on the part, probes along the moves, stock nodes, the dexels' cuts); where it would pass its cap the
-points, probes or cells stand farther apart and the verdict carries a note saying so, so a
-large job is judged more coarsely, never refused (only a program of more moves than half
-``max_probes`` is).  A verdict after a repair measures against the part only the stretch of
-the program the repair changed (:func:`verify_job`'s ``before``).  The part's points are
-:mod:`surfmod.cam.part_points`', which a tool path's last repair is held against too.
+The judge shares nothing with how the moves were made: the program is read from its text
+(:mod:`surfmod.cam.program`), the part is points on its exact faces and edges
+(:mod:`surfmod.cam.part_points`), the walls are dexels (:mod:`surfmod.cam.wall_dexels`).
+The reach rule of shank and holder (:func:`body_stand`) is the one the job keeps, so the
+judge asks nothing of a tool the job did not.  Work is estimated first; past a cap the
+judge samples more coarsely and says so, never refuses.
+See :doc:`/guide/cam` (section "Every program verified before it leaves").
 """
 
 from __future__ import annotations

@@ -1,19 +1,10 @@
 """The verification's compiled loops: points of the exact part inside the tool, and the
-height-field stock swept by the tool (see :mod:`surfmod.cam.verify`).
+height-field stock swept by the tool and by its shank and holder (see :mod:`surfmod.cam.verify`).
 
-A tool is an end mill of radius ``R`` with corner radius ``c`` (ball: ``c = R``, flat:
-``c = 0``) on an endless shank of its own radius.  In the meridian half-plane of a point
-(``d`` from the axis, ``h`` above the tip) its lower surface is the flat core ``d <= R - c``
-at ``h = 0`` and the corner's quarter circle round ``(R - c, c)``, its side the line
-``d = R``.  A point is inside when ``d < R`` and ``h`` lies above the profile; how deep is
-its distance to that boundary, the least of the three pieces' distances (the nearest
-point of a surface of revolution lies in the point's own meridian plane).
-
-Points are bucketed on an (x, y) grid, each cell's list from its highest point down, so a
-probe stops reading a cell at the first point below its tip: nothing lower can be inside.
-
-Above its flutes a tool does not cut: :func:`sweep_body` measures its shank and holder
-against the stock the moves before left (:mod:`surfmod.cam.holder`).
+A point's depth inside the tool is measured in its own meridian half-plane (the nearest
+point of a surface of revolution lies there); points are bucketed on an (x, y) grid, each
+cell's list from its highest point down, so a probe stops at the first point below its tip.
+See :doc:`/guide/cam` (section "The verifier's probes").
 """
 
 from __future__ import annotations

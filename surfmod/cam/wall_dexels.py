@@ -2,39 +2,9 @@
 every feed move, and the material they keep on the part's steep faces (see
 :mod:`surfmod.cam.verify`).
 
-A height field (the verifier's z dexels) holds one height per node, so a vertical wall is
-a step between two nodes and a cusp on it, thinner than a cell, is not there at all.  A
-dexel along x at ``(y_j, z_k)`` is a line through the stock holding the material on it as
-intervals ``[x0, x1]`` (at most ``SEGMENTS`` of them); the dexels along y likewise, one
-kernel serving both with the coordinates swapped.  The lines stand a ``cell`` apart,
-their levels at ``z0 + (k + 1/2) cell``.  Only walls need them: they are kept in a band
-round the places the height field sees steep (:func:`steep_band`, :func:`band`), the
-others stand empty and cost a test each.
-
-The tool is an end of radius ``R`` and corner ``c`` (:class:`~surfmod.cam.cutters.Cutter`)
-on a cylinder of its radius going up: at a height ``h`` above the tip its section is a disc
-of radius ``R - c + sqrt(c² - (c - h)²)`` below the corner's top and ``R`` above it.  A feed
-move from ``A`` to ``B`` removes from each dexel the chord of those discs:
-
-- at the levels above ``max(A_z, B_z) + c`` the tool's column sweeps the capsule of radius
-  ``R`` round the segment ``AB`` in the dexels' plane, exactly (its chord is one interval);
-- at the levels below it (the corner's band, and a descending move's column), the move is
-  stamped at points at most ``step`` apart, each stamp's disc at that level cut.
-
-Every move is estimated before any is swept (:func:`sweep_work`): the kept dexels of the
-lines its capsule crosses and its stamps' lines, counted in the dexels' plane.
-
-**Judged** (by :mod:`surfmod.cam.verify`): every end of a material interval is a point of the
-stock's surface.  Its distance to the part is the material left there, measured along the
-normal of the part at its foot: from the plane through the nearest points of the exact
-part (``PLANE_POINTS`` of them; for a point far from the part, those round the nearest of
-the points kept one per voxel, :func:`feet`), never more than the nearest point's own
-distance; the worst are measured again by OCCT's exact distance.  A point is judged where
-the part under it is steep (slope at least ``DEXEL_SLOPE``; the height field judges the rest) and the
-finishing tool reaches: the tool tangent to the part at the foot, its corner's centre on
-the normal, takes in no point of the part deeper than the operation's limit, the normal
-does not face down (under an overhang nothing from above touches), and no disc of the
-shank or holder stands below the part there.
+Dexels are kept only in a band round what the height field sees steep (:func:`steep_band`,
+:func:`band`); the sweep's work is counted before any move is swept (:func:`sweep_work`).
+See :doc:`/guide/cam` (section "Every program verified before it leaves").
 """
 
 from __future__ import annotations

@@ -1,36 +1,10 @@
-"""Waterline (constant-Z) contours of an end mill round a triangle soup.
+"""Waterline (constant-Z) contours of an end mill round a triangle soup (:func:`waterline`).
 
-At tip height ``z`` the tool (an end mill with a shank of its own radius up to infinity:
-flat, ball, or bull = flat core of radius ``R - r`` rounded by a torus of corner radius
-``r``) may stand at the (x, y) positions where it meets no triangle; the waterline is
-the boundary of the positions where it does.  That set is, per triangle, convex (the
-tool and the triangle are convex), so along any horizontal line ("fiber") each triangle
-forbids one interval of positions, whose ends :mod:`surfmod.cam.fiber_contact` solves in
-closed form from the triangle's features, as OpenCAMLib's push-cutter does.
-
-The contours come from a grid of fibers of spacing
-``sampling``: node states (inside or outside) and the exact crossing on every grid edge
-whose nodes differ, joined cell by cell (marching squares, the material kept on the
-left) into closed loops; where a fiber runs along the contour (a straight wall's offset)
-and the line across sees no boundary within an edge, the crossing is the node it
-disagrees on (:func:`_line_crossings`).  A loop is found only where a node of the grid
-lies inside it: a hole a little wider than the tool leaves it a pit narrower than the
-spacing, which uniform fibers miss at every level, so one more fiber in x and one in y pass
-through the middle of every pit (:func:`pit_lines`); then every chord whose midpoint lies farther than
-``tolerance`` from the true contour (measured along a fiber normal to the chord) gets
-that exact point inserted, until none does.  A chord can still cross a notch of the
-contour whose middle it misses; :class:`ContourPoints` splits given chords at exact
-contour points (finishing does it where the drop-cutter check finds a chord cutting).
-
-The triangles are indexed by height and by grid line: at a level only those the tool's
-end can touch there (reaching into [z, z + corner radius)) are met, each with the grid
-lines within the radius of its box; those wholly above are met once and carried down
-as shank intervals, those wholly below not at all (:func:`fiber_pairs`).  The
-refinement's fibers meet the triangles of a bucket grid near them (:class:`~surfmod.cam.drop_cutter.TriangleGrid`).
-
-Work is bounded before it starts: the number of (fiber, triangle) pairs on the grid
-lines is counted from that index and refused above ``MAX_PAIRS``; refinement stops
-after ``MAX_REFINE`` rounds (each halves the chord error's scale).
+Fibers on a grid meet the triangles (:mod:`surfmod.cam.fiber_contact`), marching squares
+joins their crossings into loops, extra fibers cross every pit (:func:`pit_lines`), and
+chords are refined onto the exact contour.  The (fiber, triangle) pairs are counted from
+the index before any is met (:func:`fiber_pairs`, at most :data:`MAX_PAIRS`).
+See :doc:`/guide/cam` (section "Waterline").
 """
 
 from __future__ import annotations
