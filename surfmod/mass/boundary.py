@@ -1,17 +1,9 @@
-"""Stage three of the mass pipeline (:mod:`surfmod.mass`): the boundary pieces, Gauss nodes on a face's p-curves, the outer integral of Green's theorem in
-:mod:`surfmod.mass.nodes`.
+"""Stage three of the mass pipeline (:mod:`surfmod.mass`): the boundary pieces, Gauss nodes on
+a face's p-curves (:func:`boundaries`), the outer integral of Green's theorem.
 
-Every p-curve is evaluated from data (:func:`surfmod.occ.pcurves.face_pcurves`): lines,
-circles and B-splines for all nodes at once (B-splines as one polynomial per span, built
-for all p-curves of a part in one pass per degree, :func:`taylor_pieces`); other types
-through OCCT per node.  Lines and circles cross the surface's break lines in closed form,
-other p-curves by sign changes refined by Newton steps.
-
-A face's p-curves are laid out once as arrays (:class:`PcurveTable`) and evaluated at
-``(record, parameter)`` pairs in one pass per kind, so the crossings of all its curved
-p-curves, their Newton steps and the Gauss nodes of the whole boundary each take one
-evaluation, not one per p-curve: on small parts that per-p-curve overhead was most of
-the time.
+A face's p-curves are one table (:class:`PcurveTable`) evaluated from their data at
+``(record, parameter)`` pairs in one pass per kind, not one per p-curve.
+See :doc:`/guide/uses` (section "How a face is integrated").
 """
 
 from __future__ import annotations

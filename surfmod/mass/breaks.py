@@ -1,15 +1,10 @@
 """Stage two of the mass pipeline (:mod:`surfmod.mass`): where a face's parametrization
-breaks into pieces that Gauss–Legendre integrates to round-off.
+breaks into pieces that Gauss–Legendre integrates to round-off (:func:`direction_breaks`,
+:func:`rational_pieces`, :func:`spline_breaks`).
 
-Knots of splines and of the basis curves of swept surfaces, eighth turns on angular
-(trigonometric) directions, one piece on polynomial directions.  A rational direction's
-spans are split further by its weights (:func:`rational_pieces`): the integrands carry
-powers of the weight function in their denominators, whose complex zeros come nearer the
-span as the weights part, and Gauss–Legendre slows with them (a semicircle as one cubic
-span, weights 1, 1/3, 1/3, 1: 3e-10 of the volume at 12 nodes, round-off at two pieces).  Faces are those read
-back by :func:`surfmod.from_face`: a ``TrimmedFace`` (which ranks above this package and
-calls it for its ``area()``) is recognized by the OCCT face it carries (:func:`is_face`).
-The breaks of a face's B-spline p-curves are their knots too (:func:`spline_breaks`).
+A ``TrimmedFace`` (which ranks above this package and calls it for its ``area()``) is
+recognized by the OCCT face it carries (:func:`is_face`).
+See :doc:`/guide/uses` (section "How a face is integrated").
 
 >>> import surfmod as sm
 >>> direction_breaks(sm.sphere(1.0), 0)

@@ -1,35 +1,8 @@
-"""Stage four of the mass pipeline (:mod:`surfmod.mass`): faces prepared for quadrature and their nodes, face by face.
-
-A face contributes ``∫∫_D g(u, v) du dv`` over its parameter region ``D`` for the
-integrands ``g`` of the divergence theorem (``x·n``, ``x_i (x·n)``, ``x_i x_j (x·n)``).
-:func:`face_nodes` returns the surface partials at the nodes and their weights:
-
-* a face whose boundary is its parameter rectangle: tensor Gauss–Legendre on every span;
-* a trimmed face: Green's theorem, ``∫∫_D g = ∮ G dv`` with ``G = ∫_{u0}^{u} g du``
-  (inner direction ``u``) or ``∫∫_D g = -∮ H du`` with ``H = ∫_{v0}^{v} g dv`` (inner
-  direction ``v``): Gauss on the exact p-curves of the boundary (outer integral),
-  and the inner integral from the face box's edge to each boundary node, either by
-  Gauss node by node or, where that evaluates fewer points, on one fixed grid per cell
-  (inner span × outer span, :func:`surfmod.mass.rules.grids_nodes`): the integrands' tensor interpolant at
-  Chebyshev points, whose inner antiderivative is exact, so every boundary node only adds
-  weights to the grid points and the surface is evaluated on the grids alone (exact
-  where the surface is a polynomial in both directions; ``2 order`` points per span
-  elsewhere, Gauss ``order``'s polynomial degree).  Whole-rectangle planar faces of a
-  part are integrated all at once (:func:`plane_nodes`).
-
-The Gauss order is chosen per direction and per piece from what the integrand is.  On a
-direction in which the surface is a polynomial of degree ``p`` (planes: 1; the axial
-direction of cylinders, cones and extrusions: 1; a non-rational spline: its degree), the
-integrands are polynomials of degree at most ``5p`` there (``x³`` times ``Su × Sv``),
-which ``⌈(5p + 1)/2⌉`` Gauss nodes per span integrate exactly.  Green's inner integral
-runs along the cheaper direction (fewer spans times nodes: the axis of a cylinder, not
-its angle).  On a plane the inner integrals are polynomials of degree 4 in ``(u, v)``, so
-a straight p-curve needs 3 nodes.  Everything else (angular directions, rational
-splines, curved p-curves on curved faces) takes the caller's ``order`` per piece: eighth
-turns on angular directions, knot spans, and at least ``PIECES`` pieces per curved edge.
-
-The p-curves are evaluated from data, all of a face's at once
-(:mod:`surfmod.mass.boundary`).
+"""Stage four of the mass pipeline (:mod:`surfmod.mass`): faces prepared for quadrature
+(:class:`MassFace`) and their nodes and weights (:func:`face_nodes`, :func:`faces_nodes`,
+:func:`plane_nodes`): tensor Gauss–Legendre on a face bounded by its parameter rectangle,
+Green's theorem on a trimmed one, with the fewest nodes that keep round-off.
+See :doc:`/guide/uses` (section "How a face is integrated").
 """
 
 from __future__ import annotations

@@ -1,26 +1,10 @@
-"""Stage five of the mass pipeline (:mod:`surfmod.mass`): trimmed planar faces in closed form, their mass integrals from boundary integrals alone.
+"""Stage five of the mass pipeline (:mod:`surfmod.mass`): trimmed planar faces in closed form
+from the moments of their parameter regions (:func:`plane_moments`), one pass for all
+planar faces of a part, no surface evaluated.
 
-On a plane ``S = O + u X + v Y`` the normal ``n`` and the height ``x·n`` of the reference
-point are constant, so every integrand of :mod:`surfmod.mass` (``x_i x_j (x·n)``, ``x``
-affine) is that height times a polynomial of degree at most 2 in ``(u, v)``, and a face's
-share is fixed by the six moments ``M_pq = ∫∫_D a^p b^q`` of its parameter region ``D``
-(``p + q ≤ 2``, ``a, b`` the parameters shifted to the foot of the
-reference point: no cancellation).  Green's theorem turns each into a boundary integral
-with the inner antiderivative written out,
-
-    M_pq = ∮ [∫_{u0}^{u} (s - uc)^p ds] b^q dv,
-
-the inner integral from the face box's edge ``u0`` exactly as the node-by-node rule of
-:mod:`surfmod.mass.nodes` takes it (so a boundary whose p-curves leave gaps gives the
-same result as there), evaluated as ``(u - u0) Σ A^k B^(p-k) / (p + 1)`` without
-cancellation.  The outer integral runs on the same Gauss nodes of the p-curves
-(:func:`surfmod.mass.boundary.boundaries`: 3 per straight piece, exact); on faces
-bounded by lines and circles only (plates with holes, slots) the same nodes are laid
-directly, all such faces at once (:func:`_line_nodes`, :func:`_arc_nodes`), without the
-boundary pass (its cuts, crossings and p-curve table serve curved p-curves).  Then with
-``x = c + a X + b Y`` the sums are tensor contractions of the moments with ``[c, X, Y]``:
-no surface is evaluated and no inner node is made, one pass for all planar faces of a
-part.
+The inner integral starts at the face box's edge as in :mod:`surfmod.mass.nodes`, so a
+boundary whose p-curves leave gaps gives the same result there and here.
+See :doc:`/guide/uses` (section "How a face is integrated").
 """
 
 from __future__ import annotations

@@ -1,14 +1,7 @@
-"""Stage one of the mass pipeline (:mod:`surfmod.mass`): quadrature rules and Green's theorem grids for :mod:`surfmod.mass.nodes`.
-
-Gauss–Legendre rules (cached), the orders exact for polynomial directions, and the
-inner integrals of Green's theorem: node by node (:func:`inner_nodes`) or on one fixed
-interpolation grid per cell (:func:`grids_nodes`).  On a cell (inner span × outer span)
-the integrands are replaced by their tensor interpolant at Chebyshev points of the
-first kind (inside the span: a degree-1 spline's derivatives jump at its ends), exact
-where the surface is a polynomial of degree ``p`` there (``5p + 1`` points: the
-integrands' degree); the interpolant's antiderivative along the inner direction is
-integrated exactly through the Chebyshev polynomials, so each boundary node adds weights
-to the grid points and the surface is evaluated on the grids only.
+"""Stage one of the mass pipeline (:mod:`surfmod.mass`): Gauss–Legendre rules (cached), the
+orders exact for polynomial directions, and the inner integrals of Green's theorem, node
+by node (:func:`inner_nodes`) or on one Chebyshev interpolation grid per cell
+(:func:`grids_nodes`).  See :doc:`/guide/uses` (section "How a face is integrated").
 """
 
 from __future__ import annotations
