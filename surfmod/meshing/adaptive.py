@@ -1,22 +1,8 @@
-"""Adaptive cell refinement of a surfmod surface (``sm.tessellate(..., method="adaptive")``):
+"""Adaptive cell refinement of a surfmod surface (``sm.tessellate(..., method="adaptive")``).
 
-1. the parameter domain starts as its knot grid (B-splines) or a uniform grid sized by
-   curvature; cells live on an integer lattice (2**22 steps per start cell) so that
-   splitting is exact;
-2. every cell is triangulated together with the corners of its finer neighbours that lie
-   on its sides (no T-junctions, hence no cracks), with the minimum number of triangles
-   (ear clipping of the cell polygon, shortest 3-D diagonal first);
-3. each triangle is sampled (edge points and interior points) and every sample is
-   projected onto the exact surface by Gauss-Newton from its parameter-space
-   correspondent; cells whose triangles deviate more than the tolerance are split, in u
-   only, v only or both, following the chord sagitta in each direction (a cylinder is
-   refined around, not along);
-4. when the coarse samples pass, a denser sampling (25 points per triangle) is measured
-   and refinement continues until it passes too.
-
-Refinement is local (triangles crowd around an isolated feature) at the price of
-per-cell work; the default structured grid (:mod:`surfmod.meshing.gridmesh`) is several
-times faster on smooth surfaces.
+Cells live on an integer lattice, so splitting is exact, and each is triangulated with the
+corners of its finer neighbours on its sides: no T-junctions, hence no cracks.
+See :doc:`/guide/meshing` (section "Tessellation of a surface").
 """
 
 from __future__ import annotations

@@ -1,27 +1,9 @@
 """Surface analysis without a GUI: zebra stripes, isophotes, curvature maps, curvature
 combs and a fairness figure, as arrays and (optionally) a PNG.
 
-Every object is sampled as patches of parameter-space triangles: a surfmod surface on a
-regular ``resolution x resolution`` grid, a face (or each face of a shape) on OCCT's
-triangulation of its trimmed parameter region.  Normals and curvatures at the nodes come
-from surfmod's exact evaluator (never from the triangles); normals of reversed faces
-are flipped so a solid shows its outside.
-
-* ``isophote``: ``n . L`` per node (``L`` the unit light direction); isophotes are its
-  level lines.
-* ``zebra``: stripes of equal width in the angle ``arccos(n . L)`` (``stripes`` black
-  and as many white bands between the normal pointing at and away from the light):
-  alternating isophote bands.  A G1 break cuts a stripe, a G2 break kinks it.
-* ``gaussian``, ``mean``, ``max_abs`` (``max(|k1|, |k2|)``): curvature per node.
-* ``comb``: curvature combs, the normal curvature along iso-curves and along the
-  boundary (sides of a surface, edges of a face), drawn as spikes ``-scale k_n n``.
-
-Fairness, per patch: ``bending = integral of (k1^2 + k2^2) dA`` (thin-plate energy) and
-``variation = integral of |grad H|^2 dA`` (the squared surface gradient of the mean
-curvature: zero on spheres, cylinders and planes), both by the trapezoid rule on the
-triangles, so two designs can be compared by a number.
-
-The same concept as :mod:`surfmod.cli.analyze` (the ``surfmod analyze`` command over this).
+Normals and curvatures come from surfmod's exact evaluator at the nodes of parameter-space
+triangles, never from the triangles.  The same concept as :mod:`surfmod.cli.analyze` (the
+``surfmod analyze`` command over this).  See :doc:`/guide/analysis`.
 """
 
 from __future__ import annotations

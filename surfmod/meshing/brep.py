@@ -2,32 +2,11 @@
 against the exact faces, tightened where meshing is the cause and reported where the
 model itself is the cause.
 
-Measurement (per face, every triangle, 25 sample points each; all faces of a kind at
-once):
-
-* planes, cylinders, cones, spheres and tori, and surfaces of revolution that are one of
-  those (a circle or line in a plane through the axis): the exact distance in closed
-  form (:mod:`surfmod.construct.elementary_closest`);
-* B-spline faces, and extrusions of spline curves (exact B-spline nets over their
-  box): the *UV-parametric error* ``|q - S(uv)|`` of each sample ``q`` of a triangle and
-  its UV-interpolated parameter (an upper bound of the distance, ``S(uv)`` being a point
-  of the face), then Gauss-Newton projection of the samples whose bound exceeds half the
-  tolerance, compiled (:mod:`surfmod.eval.packed`), or in NumPy while they are few
-  (:data:`COMPILED_MEASURE`); periodic directions wrap, as OCCT evaluates them;
-* any other surface (Bezier, other surfaces of revolution and extrusions, offset): the
-  same in NumPy, with :class:`FaceSurface` (the surface :mod:`surfmod.readback` reads, or
-  OCCT per point for a type the reader does not know).
-
-A real part is not exact: BRepMesh puts the nodes of a face's boundary on the *edges'*
-3-D curves, which the model only keeps within the edges' declared tolerance of the
-face.  So each face gets two figures: the deviation of its triangles and the deviation of
-its nodes (the model's own error, which no mesh can go below).  A face whose triangles
-deviate more than the tolerance (or, where its nodes are nearly that far off already,
-more than a quarter of it beyond them: ``allowed_deviation``) is first refined inside its
-boundary (:mod:`surfmod.meshing.refine`: BRepMesh overshoots its deflection by a few
-percent inside some faces); only where that does not help is the deflection tightened
-for a new BRepMesh pass; faces whose excess is the model's are reported with their declared
-tolerance, and refused only with ``strict=True``.
+Each face gets two figures, the deviation of its triangles and that of its nodes (on the
+edges' 3-D curves: the model's own error, which no mesh goes below), and is held to
+:func:`allowed_deviation`; a face over it is refined inside its boundary
+(:mod:`surfmod.meshing.refine`) before the deflection is tightened.  Faces are measured by
+kind, all of a kind at once.  See :doc:`/guide/meshing` (section "Meshing B-rep parts").
 """
 
 from __future__ import annotations

@@ -1,17 +1,7 @@
-"""The judge of a written STL, independent of how it was meshed: the file read back, and
-every solid's triangles closed, 2-manifold, consistently and outward oriented, without a
-degenerate facet (what admesh would otherwise repair, and what a slicer needs).
-
-The triangles are read from the file (float32, as any reader sees them); vertices are
-the same where their float32 coordinates are equal, which is how admesh and slicers join
-facets.  Per group of triangles (one solid):
-
-* an edge met once is *open*, an edge met three or more times is *non-manifold*;
-* an edge met twice in the same direction joins two facets of opposite orientation
-  (*inconsistent* winding);
-* a facet with two equal corners is *degenerate*;
-* the enclosed volume (the divergence theorem over the facets) must be positive: a
-  negative one is a solid meshed inside out.
+"""The judge of a written STL, independent of how it was meshed: the file read back (float32,
+vertices joined where equal, as admesh and slicers join them), and every solid's triangles
+closed, 2-manifold, consistently and outward oriented, without a degenerate facet.
+See :doc:`/guide/meshing` (section "The STL read back before exit 0").
 """
 
 from __future__ import annotations

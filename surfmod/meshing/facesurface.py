@@ -1,16 +1,11 @@
-"""A face's surface evaluated as OCCT evaluates it, vectorized, for measuring meshes of
-real parts: the surfmod surface :func:`surfmod.readback.read_surface` reads (B-spline
-and Bezier nets, swept curves, elementary and offset surfaces, each with its own
-evaluator), and OCCT per point only for a surface type the reader does not know.
+"""A face's surface evaluated as OCCT evaluates it, vectorized, for measuring meshes of real
+parts: the surfmod surface :func:`surfmod.readback.read_surface` reads, and OCCT per point
+only for a type the reader does not know; an extrusion of a spline curve as the B-spline
+it is over its box.
 
-An extrusion of a B-spline or Bezier curve over a known UV box *is* a B-spline surface
-(``TabulatedCylinder.to_nurbs``: the curve's net and its copy moved along the direction,
-degree 1 across), so it goes through the same compiled kernels as B-spline faces:
-projection, partials to order 2.
-
-Parameters are OCCT's: periodic directions wrap into their period (a face trimmed
-across the seam of a periodic B-spline lives on both sides of it), other directions
-are clamped to the parameter range (pcurves may overshoot by a tolerance).
+Parameters are OCCT's: periodic directions wrap into their period (a face trimmed across
+the seam of a periodic B-spline lives on both sides of it), other directions are clamped to
+the parameter range (p-curves may overshoot by a tolerance).
 """
 
 from __future__ import annotations

@@ -1,12 +1,7 @@
-"""The loops of :mod:`surfmod.meshing.gridbounds_compiled` in NumPy, for lattices too small to wait
-for numba: the first mesh of a process would otherwise spend a second importing numba
-and loading the kernels (minutes compiling them into an empty cache) on work NumPy does
-in milliseconds.  Same arithmetic in the same order, so the same values bit for bit
-(numba does not contract or reorder floating-point operations without ``fastmath``);
-:mod:`surfmod.meshing.gridmesh` chooses by the lattice size.
-
-The lattice ``S`` is ``(ncu K + 1, ncv K + 1, 3)``: ``K`` points per cell and direction
-plus the closing line, cells sharing their sides.
+"""The loops of :mod:`surfmod.meshing.gridbounds_compiled` in NumPy, for lattices too small to
+wait for numba: same arithmetic in the same order, so the same values bit for bit (no
+``fastmath``).  The lattice ``S`` is ``(ncu K + 1, ncv K + 1, 3)``, ``K`` points per cell and
+direction, cells sharing their sides.  See :doc:`/design` (section "The evaluation core").
 
 >>> import numpy as np
 >>> S = np.zeros((5, 3, 3)); S[..., 0], S[..., 1] = np.mgrid[0:5, 0:3]  # K = 2: 2 x 1 flat cells

@@ -1,27 +1,10 @@
 """Structured anisotropic tessellation: a tensor grid of u- and v-lines placed by
 equidistributing a chordal-error bound, then *verified* and refined where it fails.
 
-1. **Placement.**  On a sample grid the second fundamental form ``L, M, N`` (normal
-   components of ``S_uu, S_uv, S_vv``) gives the chordal error of a grid cell,
-   about ``(|L| h_u^2 + 2|M| h_u h_v + |N| h_v^2) / 8``.  Per u-sample the worst density
-   over v, ``sqrt(L_eff / (c tol))`` (``c`` between 4 where both directions bend as
-   much, a triangle's interior sagging by both chords, and 8 on a cylinder), is
-   integrated along u; lines are put at equal steps of that integral (equidistribution),
-   the fewest that satisfy the bound.  The same for v.  C0 knots (creases) are always
-   lines.
-2. **Verification.**  Every cell is sampled on a ``6 x 6`` lattice (the 25 sample points
-   per triangle of :mod:`surfmod.meshing.deviation`, for either diagonal), evaluated as
-   one tensor grid of positions.  At each sample the distance from the triangles to the
-   surface is bounded to second order (:func:`surfmod.meshing.gridbounds_compiled.estimates_compiled`);
-   when every cell passes, the largest bounds are replaced by projections
-   (:meth:`GridMesh._project`): the reported ``max_deviation`` is a measured one.
-3. **Refinement.**  Strips of failing cells are refined (:meth:`GridMesh.refine`); after
-   a passing grid, strips with room are coarsened (:meth:`GridMesh.coarsen`) and the
-   smallest passing grid is kept.  A tolerance that cannot be reached within
-   ``max_triangles`` raises.
-
-Each cell is split along the diagonal whose midpoint lies closer to the surface.  Seams
-and poles share their vertices, so spheres and tori are watertight.
+The reported ``max_deviation`` is a measured one (the largest bounds projected); seams and
+poles share their vertices, so spheres and tori are watertight.  A tolerance that cannot be
+reached within ``max_triangles`` raises.  See :doc:`/guide/meshing` (section "Tessellation of
+a surface").
 """
 
 from __future__ import annotations

@@ -1,14 +1,6 @@
-"""Refining one face of a BRepMesh triangulation inside the face, its boundary kept.
-
-BRepMesh's measured deviation overshoots its deflection by a few percent on some faces
-(up to ~15 % on a cone of the corpus).  Asking BRepMesh again for the whole shape at a
-finer deflection doubles the meshing time; refining only the triangles that deviate
-does not.  The refinement is conforming and leaves every edge on the face's boundary
-(shared with the neighbouring faces, or a seam) untouched, so the mesh of the whole
-shape stays watertight: a triangle that deviates has its longest *interior* edge split
-at the surface point of the edge's (u, v) midpoint (the triangle across the edge is
-split too), a triangle without interior edge gets its (u, v) centroid on the surface.
-Every new triangle is measured against the exact face like the others.
+"""Refining one face of a BRepMesh triangulation inside the face, its boundary kept, so the
+shape's mesh stays watertight: cheaper than asking BRepMesh again for the whole shape.
+See :doc:`/guide/meshing` (section "Meshing B-rep parts").
 """
 
 from __future__ import annotations

@@ -1,13 +1,8 @@
-"""Headless shaded pictures (PNG) of surfaces, curves, faces, meshes, shapes and tool paths.
+"""Headless shaded pictures (PNG) of surfaces, curves, faces, meshes, shapes and tool paths
+(matplotlib's Agg backend, no display server).
 
-Matplotlib's Agg backend draws a ``Poly3DCollection`` of the tessellation, shaded with a
-directional light (Lambert, two-sided, plus ambient), with the surface's iso-curves
-(the lecture's "mesh of curves") and optionally its control net on top.  No display
-server is needed.
-
-:func:`render` writes a PNG file; :func:`png_bytes` returns a small one in memory, which
-is what the ``_repr_png_`` of surfmod's objects calls, so a Jupyter notebook shows a
-surface, a face read back, a mesh or a tool path as a picture:
+:func:`render` writes a PNG file; :func:`png_bytes` returns a small one in memory, which is
+what the ``_repr_png_`` of surfmod's objects calls:
 
 >>> import surfmod as sm
 >>> sm.sphere(1.0)._repr_png_().startswith(PNG_SIGNATURE)

@@ -1,16 +1,7 @@
-"""Tessellation to a chordal tolerance, with the deviation *measured*, not estimated.
-
-Surfmod surfaces are meshed on the NumPy evaluator, by default as a structured grid
-whose lines are placed by equidistributing a chordal-error bound and then verified on
-every triangle (:mod:`surfmod.meshing.gridmesh`); surfaces with an isolated feature are
-also refined locally, cell by cell (:mod:`surfmod.meshing.adaptive`), and the smaller
-mesh is kept.  Either way every triangle is sampled at 25 points (edges and interior)
-and ``Mesh.info["max_deviation"]`` is the measured maximum.
-
-Closed directions (seams) and collapsed sides (poles) are detected by sampling the
-domain boundary and their vertices are shared, so a sphere or torus gives a watertight
-mesh.  Build123d shapes (several faces, solids, STEP parts) go through OCCT's BRepMesh,
-measured face by face (:mod:`surfmod.meshing.brep`).
+"""Tessellation to a chordal tolerance, with the deviation *measured*, not estimated: surfmod
+surfaces on the NumPy evaluator (:mod:`surfmod.meshing.gridmesh`, :mod:`surfmod.meshing.adaptive`),
+build123d shapes through BRepMesh measured face by face (:mod:`surfmod.meshing.brep`).
+See :doc:`/guide/meshing` (section "Tessellation of a surface").
 """
 
 from __future__ import annotations
