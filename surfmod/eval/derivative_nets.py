@@ -1,23 +1,10 @@
-"""Derivative control nets (The NURBS Book, eq. 3.8 and A3.3 applied in u and in v):
-the partial d^(k+l) S / du^k dv^l of a B-spline net is itself a B-spline net, of degrees
-``(p - k, q - l)`` on the knots less ``k`` (``l``) at each end, whose poles are scaled
-differences of neighbouring poles.
+"""Derivative control nets (The NURBS Book, eq. 3.8 and A3.3 applied in u and in v): the
+partial d^(k+l) S / du^k dv^l of a B-spline net is a B-spline net of degrees
+``(p - k, q - l)`` whose poles are scaled differences of neighbouring poles.
 
-This is the form that keeps the digits on crowded knots.  Where a face's knots crowd
-into spans ten thousand times shorter than the others (graded fillets and slivers of
-real parts: ansys_race_car_nose.stp's face 121 has spans of 8.8e-10 next to 1.4e-5,
-poles 900 mm from the origin and 1e-6 mm apart), the basis derivatives of a short span
-are as large as one over it and alternate in sign, so the usual sum of basis derivatives
-times poles cancels: the partials lose the ratio of the net's size to the poles'
-spacing, 1e-8 of the second partials there.  A difference of two neighbouring poles is
-exact (Sterbenz), and a derivative net is evaluated with basis functions that are
-positive and sum to one, so nothing cancels; OCCT differences each span's poles the
-same way (``BSplCLib::Bohm``).  It costs ``(order + 1)^2`` position evaluations where
-the usual sum costs one derivative evaluation, so :mod:`surfmod.eval.local` takes it
-only for nets whose spans differ by more than :data:`CROWDED`.
-
-The nets are NumPy arrays; :mod:`surfmod.eval.local` evaluates them with its position
-kernels.
+The form that keeps the digits on crowded knots, where the usual sum of basis derivatives
+cancels; :mod:`surfmod.eval.local` takes it for nets whose spans differ by more than
+:data:`CROWDED`.  See :doc:`/design_eval` (section "Where the precision is kept").
 
 >>> import numpy as np
 >>> knots = np.array([0, 0, 0, 1, 1, 1.0])

@@ -1,20 +1,11 @@
-"""Compiled (numba) kernels for tensor-product evaluation with local support.
+"""Compiled (numba) kernels for tensor-product evaluation with local support: what the
+``_compiled`` twins share (span search, basis functions, quotient rule).
 
-Every point touches only its ``(p+1) x (q+1)`` poles, so the cost depends on the number
-of points and the degrees, never on the size of the control net.  The kernels are
-imported lazily (``import surfmod`` never imports numba) and compiled once into numba's
-on-disk cache (``cache=True``).  Every sizeable array they write (outputs, the grid's
-ring of rows) is allocated by the NumPy caller, so ``tracemalloc`` sees the memory and the
-caller decides the blocking; inside there are only per-chunk scratch planes of a few
-hundred KiB at most.  This module holds what the kernels share (span search, basis
-functions, quotient rule); the kernels themselves are the ``_compiled`` twins
-(:mod:`surfmod.eval.scattered_compiled`, :mod:`surfmod.eval.tensor_grid_compiled`,
-:mod:`surfmod.eval.patches`) and their ``_parallel`` variants (:mod:`surfmod.eval.parallel`).
-
-Conventions: ``ctrl`` is the homogeneous net ``(n, m, dim)`` (``dim`` = 3 polynomial,
-4 rational ``(w x, w y, w z, w)``), C-contiguous float64.  Spans follow
-:func:`surfmod.eval.basis.find_spans`: ``knots[i] <= t < knots[i+1]`` clipped to
-``[degree, n_ctrl - 1]`` (the right end of the domain belongs to the last span).
+Every sizeable array they write is allocated by the NumPy caller, so ``tracemalloc`` sees
+the memory and the caller decides the blocking.  Conventions: ``ctrl`` is the homogeneous
+net ``(n, m, dim)`` (``dim`` = 3 polynomial, 4 rational ``(w x, w y, w z, w)``),
+C-contiguous float64; spans follow :func:`surfmod.eval.basis.find_spans` (the right end of
+the domain belongs to the last span).  See :doc:`/design_eval`.
 """
 
 from __future__ import annotations

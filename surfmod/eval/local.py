@@ -1,26 +1,10 @@
-"""Tensor-product surface evaluation with local support: each point touches only its
-``(p+1) x (q+1)`` poles, so the cost depends on the points and the degrees, not on the
-size of the control net (a 1000 x 1000 net costs what a 4 x 4 one does).
+"""Tensor-product surface evaluation with local support, the one entry of the eval core
+(:func:`prepare`, :func:`surface_points`, :func:`surface_derivatives`, :func:`surface_grid`).
 
-Scattered pairs run one compiled loop over the points (span search, basis derivatives,
-local contraction, quotient rule); many positions on a small net of degree <= 3 use
-per-span Taylor patches instead (:mod:`surfmod.eval.patches`: a span search and a Horner
-scheme per point).  Grids run in two interleaved stages: each net row that the sorted
-u-points need is contracted with the v-basis once a chunk of v-points, into a ring of
-rows that stays in L2 whatever the grid or the net, and each u-point combines its p+1
-rows with the v-points on the contiguous axis.  Results are written point-major,
-into a caller's array when given.  :func:`partials_finite` bounds the partials once per
-net, so callers need not rescan large outputs for NaN or infinity.
-
-Every path is a twin: ``name`` in NumPy (:mod:`surfmod.eval.scattered`,
-:mod:`surfmod.eval.tensor_grid`) for small work, ``name_compiled`` (numba, one thread:
-:mod:`surfmod.eval.scattered_compiled`, :mod:`surfmod.eval.tensor_grid_compiled`,
-:mod:`surfmod.eval.patches`) for large, ``name_parallel`` (:mod:`surfmod.eval.parallel`)
-when several threads may run.  The amount of work picks NumPy or compiled (scattered
-pairs in :func:`_scattered`, grids in :func:`surface_grid`; a caller that counted a whole
-task up front and found it small keeps its scattered pairs in NumPy with
-:func:`numpy_only`), :func:`_kernel` the compiled twin and its threads; the compiled
-modules are imported on first use (so ``import surfmod`` does not load numba).
+The amount of work picks the NumPy twin or the compiled one (:func:`_scattered`,
+:func:`surface_grid`; :func:`numpy_only` for a caller that counted a small task up front),
+:func:`_kernel` the compiled twin and its threads; the compiled modules are imported on
+first use, so ``import surfmod`` does not load numba.  See :doc:`/design_eval`.
 
 >>> import numpy as np
 >>> net = np.zeros((4, 4, 3)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]

@@ -1,14 +1,7 @@
-"""Multi-threaded variants of the evaluation kernels (numba ``parallel=True``, ``prange``):
-``name_parallel`` beside each single-threaded ``name_compiled``.
-
-Each variant has the signature of its single-threaded kernel (in
-:mod:`surfmod.eval.scattered_compiled`, :mod:`surfmod.eval.tensor_grid_compiled`,
-:mod:`surfmod.eval.patches`) and runs the same compiled chunk functions, only with
-the chunks (blocks of rows, of u-points, of scattered points) shared among threads.  A
-chunk writes only its own part of the output and has its own scratch, and no value
-depends on which chunk computes it, so the results equal the single-threaded ones bit
-for bit.  :mod:`surfmod.eval.threads` decides when they run; this module (and numba's
-thread pool) is loaded only then.
+"""Multi-threaded variants of the evaluation kernels (numba ``parallel=True``): ``name_parallel``
+beside each ``name_compiled``, with its signature and its chunk functions, only the chunks
+shared among threads.  A chunk writes only its own part of the output, so the results equal
+the single-threaded ones bit for bit.  :mod:`surfmod.eval.threads` decides when they run.
 """
 
 from __future__ import annotations

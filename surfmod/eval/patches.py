@@ -1,25 +1,11 @@
 """Per-span polynomial patches for many scattered positions and partials to order 2
-(compiled, numba).
+(compiled, numba): a span search and a Horner scheme a point, what OCCT's
+``BSplSLib_Cache`` does.
 
-Within one knot span in u and one in v a (rational) B-spline surface is a polynomial
-patch.  Written in Taylor form about the span's midpoint with the normalized parameters
-``x = (u - mid_u) / half_u`` and ``y = (v - mid_v) / half_v`` (both in ``[-1, 1]``),
-
-    H(u, v) = sum_k sum_l C[k, l] x^k y^l,    C[k, l] = sum_i sum_j T_u[k, i] T_v[l, j] P_ij,
-
-where ``T[k, i] = N_i^(k)(mid) half^k / k!`` are the Taylor rows of the basis functions
-(computed by the same division-free Cox-de Boor triangle as every other kernel).  A
-point then costs a span search and a Horner scheme: no basis triangle, no knot look-ups;
-its partials, Horner schemes that carry their first two derivatives, the chain rule's
-factors ``(1 / half)^k`` and the quotient rule (:func:`patch_derivatives_compiled`: about a third of
-the basis-function kernel's time on a 20x20 bicubic NURBS).  OCCT's ``BSplSLib_Cache``
-evaluates the same kind of per-span polynomial.  ``eval/local.py`` runs these kernels, or
-their parallel variants (:mod:`surfmod.eval.parallel`), with :func:`arguments`.
-
-The table holds ``(p+1)(q+1)`` homogeneous 4-vectors per span pair, so it is built only
-for small nets and degrees up to 3 (:func:`suits`), where the Taylor coefficients of a
-basis function on ``[-1, 1]`` are at most a few units and Horner's rounding stays at the
-level of the basis-function sums (agreement 1e-13 relative, tests/test_eval_local.py).
+The table holds ``(p+1)(q+1)`` homogeneous 4-vectors per span pair, so it is built only for
+small nets of degree up to 3 (:func:`suits`), where Horner's rounding stays at the level of
+the basis-function sums.  :mod:`surfmod.eval.local` runs these kernels with :func:`arguments`.
+See :doc:`/design_eval` (section "The compiled paths").
 
 >>> import numpy as np
 >>> from surfmod.eval import local

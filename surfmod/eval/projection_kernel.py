@@ -1,29 +1,12 @@
-"""The compiled (numba) twins of the closest-point family of :mod:`surfmod.ops.closest`.
+"""The compiled (numba) twins of the closest-point family of :mod:`surfmod.ops.closest`:
+:func:`grid_seeds_compiled` (Newton starts by branch and bound over the sampled grid's
+cells: the exact ``k`` nearest triangles), :func:`newton_in_boxes_compiled` and
+:func:`project_distances_compiled` (the meshers' deviation bounds, batched by
+:mod:`surfmod.eval.packed`).
 
-Each kernel here is the ``_compiled`` twin of the NumPy function of the same name there,
-the same operations point by point in one call (``tests/test_ops_nearest.py`` and
-``tests/test_projection_kernel.py`` hold each pair to the same answers):
-
-* :func:`grid_seeds_compiled`: the Newton starts of every point from a sampled grid --
-  the nearest triangles and the bottoms of the sampled distance -- by branch and bound.
-  Per point the squared distances to all samples are computed once, then the grid cells
-  are visited with a cheap lower bound (the nearest corner's distance minus the cell's
-  diameter) and a cell's two triangles are evaluated only when that bound beats the
-  current ``k``-th best foot; the cells around the nearest sample go first, so the bound
-  prunes almost everything else.  The result is the exact ``k`` nearest triangles (by
-  clipped-foot distance), not a ranking of bounding spheres.
-* :func:`newton_in_boxes_compiled`: the projected Newton iteration on a B-spline /
-  NURBS net, one start at a time: per step one evaluation of the partials to order 2 at
-  one point (local support, :mod:`surfmod.eval.kernels`), the safeguarded step in the
-  start's box, and backtracking with positions only.
-* :func:`project_distances_compiled`: the damped Gauss-Newton distance bounds of the
-  meshers' deviation judge, for a net (batched over many faces by
-  :mod:`surfmod.eval.packed`).  Measuring a real part's B-spline faces projects a few
-  hundred samples per face; in NumPy each of the six iterations is a dozen array calls
-  on those few points, which cost more than the arithmetic.
-
-Imported lazily (``import surfmod`` does not load numba): the NumPy twins serve work too
-small to wait for the kernels to load.
+Each is the ``_compiled`` twin of the NumPy function of the same name, held to the same
+answers by ``tests/test_ops_nearest.py`` and ``tests/test_projection_kernel.py``.
+See :doc:`/design_eval` (section "The compiled paths").
 """
 
 from __future__ import annotations

@@ -1,21 +1,9 @@
-"""The row stage of the grid (:mod:`surfmod.eval.tensor_grid_compiled`): a net row the u-points
-need, contracted with the v-basis, in vector loops where the v-points allow.
-
-Each v-point's window of q+1 poles starts at its own column, so a loop over the v-points
-reads the net at data-dependent places, which LLVM compiles to scalar loads and
-arithmetic (16 multiply-adds a pole row and v-point, one at a time).  Sorted v-points
-on a net with about as many spans as points fall into *runs* of consecutive spans:
-point ``b`` of a run reads columns ``c + b .. c + b + q``, contiguous streams shifted by
-one a point.  With the net as one contiguous plane per coordinate and row
-(:func:`net_planes`, built once per surface), a run is a loop over its points with
-contiguous loads, and LLVM vectorizes it without ``fastmath``: the lanes are independent
-points, and each one's sum is formed term by term in the order of the scalar loop, so the
-values are the same whatever the runs (no reduction is reordered).  The other points go
-one at a time with the same arithmetic (on a small net many points share a span, and
-the stage costs little anyway).
-
-:func:`runs` splits the v-points; :func:`contract_row` (and :func:`contract_row_pair`, two
-rows at once) is the stage itself, for one net row.
+"""The row stage of the grid (:mod:`surfmod.eval.tensor_grid_compiled`): a net row the
+u-points need, contracted with the v-basis (:func:`contract_row`,
+:func:`contract_row_pair`), in vector loops over the runs of v-points in consecutive spans
+(:func:`runs`, on the planes of :func:`net_planes`).  Each lane's sum keeps the scalar
+loop's order, so the values do not depend on the runs.
+See :doc:`/design_eval` (section "The compiled grid").
 
 >>> import numpy as np
 >>> runs(np.array([3, 3, 3, 4, 5, 6, 7, 8, 10]), min_run=4)

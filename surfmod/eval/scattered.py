@@ -1,20 +1,9 @@
 """Scattered local-support evaluation in NumPy, for work too small to wait for a compiled
-kernel; the compiled twins are in :mod:`surfmod.eval.scattered_compiled` (and
-:mod:`surfmod.eval.tensor_grid` is this module's grid).
-
-The compiled kernels (``scattered_compiled``, ``tensor_grid_compiled``) are the fast path
-for large work, but a process pays for them once: importing numba and loading the
-kernels from its disk cache costs about a second, compiling them into an empty cache
-minutes.  A new user's first grid of a few thousand points, or a mesher's few hundred
-samples per face, is done here instead in milliseconds, with the same algorithm as the
-kernels (each point touches only its ``(p+1) x (q+1)`` poles; a grid contracts the net
-rows it needs with the v-basis once, then each u-point combines ``p + 1`` of them) and
-the basis of :mod:`surfmod.eval.basis` (The NURBS Book A2.3).  The values agree with the
-kernels' to round-off (a few ulps: the kernels multiply by reciprocal knot differences
-where A2.3 divides); :mod:`surfmod.eval.local` chooses the path by the amount of work.
+kernel: the twin of :mod:`surfmod.eval.scattered_compiled`, with the same algorithm and
+values equal to round-off (:mod:`surfmod.eval.tensor_grid` is its grid).
 
 ``ctrl`` is the ``(n, m, 4)`` homogeneous net of :class:`surfmod.eval.local.LocalNet`
-(the weight column is 1 for a polynomial net and not used).
+(the weight column is 1 for a polynomial net and not used).  See :doc:`/design_eval`.
 
 >>> import numpy as np
 >>> net = np.ones((4, 4, 4)); net[..., 0], net[..., 1] = np.mgrid[0:4, 0:4]; net[..., 2] = 0

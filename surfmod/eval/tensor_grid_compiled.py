@@ -1,24 +1,8 @@
 """The compiled (numba) twin of :mod:`surfmod.eval.tensor_grid`: the grid ``us x vs``,
-positions and partials to any order, one path.
-
-Two stages, interleaved.  The *row stage* (:func:`surfmod.eval.row_stage.contract_row`)
-contracts a net row with the v-basis; the *combine* stage forms a u-point's values from
-its p+1 contracted rows with the v-points on the contiguous axis.  The u-points are taken
-in ascending order (the caller sorts them), so each u-point needs at most one or two rows
-more than the one before: a row is contracted just before the first u-point that reads
-it, into a ring of ``ring_rows`` rows (row ``r`` in slot ``r % ring_rows``), a chunk of
-v-points at a time, and the ring stays in L2 whatever the net (a 1000 x 1000 net is
-32 MB; one u-point a span brings a new row per u-point).  Rows no u-point reads are
-skipped.
-
-The combine stage is :func:`surfmod.eval.position_stage.positions_pass` for positions
-at degree <= 3 in u (the common case, everything in registers); otherwise
-:func:`_combine` forms a u-point's partials on planes of :data:`PLANE_POINTS` v-points
-that stay in L1 (to order 2, each row window loaded once for the three u-orders), the
-quotient rule runs there (:func:`surfmod.eval.kernels.quotient_planes`), and
-:func:`_store` writes each point's ``3 K^2`` values together.  Conventions as in
-:mod:`surfmod.eval.kernels`; the multi-threaded variant (blocks of u-points, a ring
-each) is :func:`surfmod.eval.parallel.tensor_grid_parallel`.
+positions and partials to any order, one path: a ring of contracted net rows
+(:mod:`surfmod.eval.row_stage`) combined per sorted u-point (:func:`_combine`, or
+:func:`surfmod.eval.position_stage.positions_pass` for positions).  Conventions as in
+:mod:`surfmod.eval.kernels`.  See :doc:`/design_eval` (section "The compiled grid").
 """
 
 from __future__ import annotations

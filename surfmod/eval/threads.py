@@ -1,15 +1,8 @@
-"""How many threads the compiled evaluation kernels may use.
-
-Large grids and many scattered points run in parallel variants of the kernels
-(:mod:`surfmod.eval.parallel`, numba ``prange`` over blocks of u-points or of points)
-whose every value is computed by the same code as in the single-threaded kernels, so
-the results are identical bit for bit whatever the thread count.  Small work stays on
-one thread: starting the workers costs more than it saves.
-
-The default uses every thread numba may start (``NUMBA_NUM_THREADS``, all cores unless
-the environment says otherwise) for work of at least :data:`PARALLEL_MIN_POINTS`
-points; :func:`set_threads` caps it (``1``: always single-threaded), :func:`limit` does
-so for a ``with`` block.
+"""How many threads the compiled evaluation kernels may use: every thread numba may start
+for work of at least :data:`PARALLEL_MIN_POINTS` points, capped by :func:`set_threads`
+(``1``: always single-threaded) or for a ``with`` block by :func:`limit`.  Results are the
+same bit for bit whatever the count.  See :doc:`/guide/surfaces` (section "Large evaluations
+and threads").
 
 >>> from surfmod.eval import threads
 >>> previous = threads.set_threads(1)
