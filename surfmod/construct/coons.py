@@ -1,30 +1,7 @@
-"""Coons patches: the surface spanned by four boundary curves, as an exact B-spline.
-
-With ``c0``/``c1`` the boundaries at ``v = v0``/``v1`` and ``d0``/``d1`` those at
-``u = u0``/``u1``, the bilinearly blended Coons patch is
-
-    S(u, v) = (1-t) c0(u) + t c1(u) + (1-s) d0(v) + s d1(v) - B(s, t)
-
-with ``s``, ``t`` the normalized parameters and ``B`` the bilinear interpolant of the
-four corners.  Once opposite curves are *compatible* (same degree, interval and knots:
-:func:`surfmod.nets.elevate.make_compatible`, OCCT's ``SetSameDistribution`` steps), each
-of the three terms is a B-spline surface of degree ``(p, q)`` on the knots ``(U, V)``:
-a linear function of ``s`` has the normalized Greville abscissae of ``U`` as its
-coefficients (linear precision), so the patch's control net is the same formula
-applied to control points and Greville abscissae - exact, no approximation.
-
-``blend="hermite"`` uses OCCT's ``GeomFill_Coons`` blending instead: the cubic Hermite
-functions ``F = 1 - 3t^2 + 2t^3``, ``G = 1 - F`` written as Bernstein coefficients,
-degree-elevated to the number of poles and applied to pole *indices*
-(``GeomFill_BSplineCurves(..., GeomFill_CoonsStyle)``); for polynomial curves the net
-equals OCCT's pole for pole.  For Bézier boundaries of degree >= 3 that is the
-cubically blended Coons patch; for multi-span B-splines it is OCCT's construct, which
-still interpolates the four curves.  On a translational network (``c1 - c0`` and
-``d1 - d0`` constant) both blends give ``c0(u) + d0(v) - c0(u0)``.
-
-Rational boundaries are blended in homogeneous coordinates, after scaling each curve's
-weights (which leaves the curve unchanged) so that the two curves meeting at a corner
-carry the same corner weight there.
+"""Coons patches (:func:`coons`): the surface spanned by four boundary curves, as an exact
+B-spline, bilinearly blended or with OCCT's Hermite blend (``GeomFill_Coons``), equal to
+OCCT's net pole for pole for polynomial curves.
+See :doc:`/guide/surfaces` (section "Coons, ruled and lofted surfaces").
 """
 
 from __future__ import annotations

@@ -1,35 +1,12 @@
 """Closest points on the elementary surfaces in closed form: planes, cylinders, cones,
 spheres and tori (OCCT's, and the 3-point parallelogram), the one home of these formulas.
 
-Two questions are answered here.  :func:`plane` ... :func:`cone` (and
-:func:`parallelogram`) give the *parameters* of the closest point of a bounded patch --
-the box ``[u0, u1] x [v0, v1]`` of the surface's own parametrization, rather than the
-infinite surface (the counterpart of OCCT's ``Extrema_ExtPElS``): the orthogonal foot when
-that lies inside, a boundary or corner point otherwise.  :func:`distances` and
-:func:`triangle_distances` give the *distance* to the untrimmed surfaces (as OCCT
-defines them), for many surfaces at once: each point names its surface, so the faces
-of a whole part are measured in a few array passes (the meshers' deviation judge).
-
-All five distances separate.  In the frame of the surface write the point as
-``(rho cos t, rho sin t, z)``.  On a cylinder, sphere or ring torus the squared distance
-is ``g(v) - 2 rho w(v) cos(u - t)`` with a weight ``w(v) >= 0`` (the radius, ``R cos v``,
-``R + r cos v``), so for every ``v`` the best ``u`` is the angle of the box closest to
-``t``, the same for all ``v``; what is left is one-dimensional: a clipped line parameter
-(plane, cylinder), or the angle of the box closest to the direction of the point in the
-meridian half-plane (sphere, torus).  On a cone the weight ``R + v sin a`` changes sign
-at the apex, so each nappe gets its own best ``u`` (towards ``t`` or away from it) and the
-squared distance is a convex quadratic in ``v`` there: two candidates, the nearer wins
-(a box always holds one of them: at least one side of the apex is not empty).  For the
-untrimmed distance the same holds in the point's meridian plane, where the cone and the
-torus show *two* profiles (the generatrix line and the one mirrored through the axis:
-a cone goes on past its apex, a spindle torus' tube crosses the axis): the smaller
-distance wins.
-
-Points on the axis (or at the centre, or on a torus' core circle) are equally far from a
-whole circle of points: the angle chosen is the one closest to 0 in the box, a valid
-closest point like any other.
-
-NumPy only: a projection or a measurement never waits for numba to load.
+:func:`plane` ... :func:`cone` (and :func:`parallelogram`) give the parameters of the
+closest point of a bounded patch of the surface's own parametrization (OCCT's
+``Extrema_ExtPElS``); :func:`distances` and :func:`triangle_distances` the distance to the
+untrimmed surfaces, for many surfaces at once.  On the axis the angle nearest 0 in the box
+is chosen.  NumPy only: a projection never waits for numba.
+See :doc:`/guide/surfaces` (section "Closest points").
 """
 
 from __future__ import annotations

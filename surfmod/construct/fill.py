@@ -1,31 +1,9 @@
-"""Filling 3-, 4- and 5-sided holes between surfaces with G1 or G2 (or G0) continuity.
+"""Filling 3-, 4- and 5-sided holes between surfaces with G1 or G2 (or G0) continuity
+(:func:`fill`): a transfinite side-blending surface over a regular n-gon (Kato's scheme).
 
-The fill is a transfinite side-blending surface over a regular n-gon domain (Kato's
-scheme, ``fill_domain``): every side ``i`` carries a ribbon ``R_i(s, d)``, the
-neighbour's second-order Taylor expansion across the side (``fill_ribbons``), and the
-surface is ``sum_i B_i R_i(s_i, d_i)`` with ``d_i`` the distance to side ``i`` in the
-domain, ``s_i = d_(i-1) / (d_(i-1) + d_(i+1))`` and weights
-``B_i = prod_(j != i) d_j^p / sum_k prod_(j != k) d_j^p``.  On side ``i`` the weight
-``B_i`` is 1 and every weight is flat to order ``p - 1`` (p = 2 for G1, 3 for G2), so the
-fill has the ribbon's, i.e. the neighbour's, 1-jet (G1) or 2-jet (G2) along the side.
-
-Corners: the blend is 0/0 at the polygon's vertices, and it is C1/C2 through a vertex
-only if the two ribbons meeting there have the same 1-/2-jet as functions of the
-domain.  The ribbons' free parameter paths are solved for that (``match_corners``);
-it is possible exactly when the two neighbours agree at the corner point (same normal;
-for G2 the same curvature too, as when the hole is cut out of one smooth surface).
-The measured mismatches are in ``Fill.corners``; a G1/G2 fill with an incompatible
-corner raises ``SurfmodError`` naming it, unless ``allow_singular_corners=True``, which
-keeps the asked continuity along the open sides and leaves that corner point singular
-(the curvature near it depends on the direction of approach), the behaviour of the
-classic n-sided patches (Gregory, Charrot-Gregory, Kato) with incompatible twists.
-
-A four-sided hole is one patch over the square; a 3- or 5-sided hole is split from the
-centre into n quadrilateral patches (vertex, side midpoints, centre) of the same smooth
-surface, so they join each other smoothly.  Positions, first and second derivatives are
-exact (second-order forward differentiation through the construction, vectorized); the
-OCCT twin of each patch is a bicubic B-spline within ``tolerance`` (``exact_in_occt`` is
-False; the cross-check is geometric).
+An incompatible corner raises naming it unless ``allow_singular_corners=True``; positions
+and partials to order 2 are exact, the OCCT twin of each patch a bicubic approximation
+within ``tolerance``.  See :doc:`/guide/analysis` (section "How a blend and a fill are built").
 """
 
 from __future__ import annotations

@@ -1,31 +1,8 @@
-"""Ribbons of a fill and their corner compatibility.
-
-Side ``i`` of a hole bordered by a surface ``S`` carries a ribbon, a second-order
-Taylor expansion of ``S`` across the side along a chosen parameter path::
-
-    R(s, d) = F(s + d beta(s) + d^2/2 gamma(s),  d alpha(s) + d^2/2 delta(s))
-
-where ``F(s, e)`` is ``S`` with ``s`` running along the side (0 to 1) and ``e`` across it
-into the hole.  Whatever the scalar profiles ``alpha > 0``, ``beta``, ``gamma``, ``delta``
-are, the ribbon has ``S``'s tangent plane (G1) and ``S``'s normal curvature in every
-direction (G2) along the side, because it *is* ``S`` to second order.  The profiles
-are free, and that freedom is what makes two ribbons agree at the corner where they
-meet: in the side-blending surface both ribbons are functions of the domain, and the
-blend is C1 (C2) through the vertex exactly when the two ribbons have the same 1-jet
-(2-jet) there.  ``match_corners`` solves for the end values of the profiles:
-
-* first order, ``alpha, beta`` at the end: the cross derivative of one ribbon equals the
-  (domain-scaled) tangent of the next side, which lies in the same tangent plane only if
-  the two neighbours share the normal at the corner;
-* second order, ``alpha', beta'`` (the twist) and ``gamma, delta``: the tangential parts
-  can always be matched; the normal parts are the neighbours' second fundamental forms
-  at the corner, so they agree only if the neighbours have the same curvature there
-  (e.g. a hole cut out of one smooth surface).  That mismatch is the corner's measured
-  G2 incompatibility; no surface that is C2 at the corner can be G2 to both neighbours
-  when it is not zero.
-
-Each profile is the quartic through the corner data at both ends (value and slope) and
-the default in the middle (``alpha`` = the tangent scale set by ``tension``, the rest 0).
+"""Ribbons of a fill and their corner compatibility: a neighbour's second-order Taylor
+expansion across a side (:class:`Ribbon`), and :func:`match_corners`, which solves the
+ribbons' free profiles so that two ribbons share their 1-jet (2-jet) at a corner, and
+measures what cannot be matched (:class:`Corner`).
+See :doc:`/guide/analysis` (section "How a blend and a fill are built").
 """
 
 from __future__ import annotations

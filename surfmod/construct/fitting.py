@@ -1,23 +1,8 @@
-"""Interpolation and approximation surfaces through an (n, m, 3) grid of points.
-
-The lecture contrasts two ways of making a surface from measured points:
-
-* **interpolation** (:func:`interpolate`) passes through every point: global B-spline
-  interpolation of Piegl & Tiller (*The NURBS Book*, section 9.2.5): parameters by
-  chord length or centripetal spacing averaged across rows/columns, knots by averaging,
-  then one linear solve per direction (all rows/columns at once, multiple right-hand
-  sides), so ``n x m`` points give ``n x m`` control points;
-* **approximation** (:func:`approximate`) uses fewer control points and minimizes the
-  squared residual (section 9.4): the tensor-product least-squares problem separates
-  into two one-directional ones, and the number of control points per direction is the
-  smallest that keeps the max error within ``tolerance``.
-
-Both return a :class:`FittedSurface` (a B-spline surface that *is* its OCCT twin
-``Geom_BSplineSurface``) with the data parameters and the measured ``max_deviation``;
-:meth:`FittedSurface.occt_fit` builds OCCT's own fit (``GeomAPI_PointsToBSplineSurface``)
-of the same data for comparison.
-
-Its OCCT twin (``GeomAPI_PointsToBSplineSurface``) is :mod:`surfmod.occ.points_to_bspline`, behind the kernel door.
+"""Interpolation (:func:`interpolate`) and approximation (:func:`approximate`) surfaces through
+an (n, m, 3) grid of points, both a :class:`FittedSurface` with its data parameters and
+measured ``max_deviation``.  Its OCCT twin (``GeomAPI_PointsToBSplineSurface``) is
+:mod:`surfmod.occ.points_to_bspline`, behind the kernel door.
+See :doc:`/guide/surfaces` (section "Fitting a grid of points").
 """
 
 from __future__ import annotations

@@ -1,15 +1,7 @@
-"""The three forms of a surface: explicit ``z = f(x, y)``, implicit ``F(x, y, z) = 0`` and
-parametric ``S(u, v)``, and the conversions between them where they exist.
-
-* explicit -> parametric: ``S(x, y) = (x, y, f(x, y))``; :func:`explicit` fits it with a
-  bicubic B-spline (OCCT's form) to a stated tolerance, interpolating ``f`` on a grid
-  whose parameters *are* ``x`` and ``y``, so the spline's x and y are exactly linear;
-* explicit -> implicit: ``F = z - f(x, y)`` (:meth:`ExplicitSurface.to_implicit`);
-* parametric -> implicit where the implicit equation is known (planes, quadrics,
-  superellipsoids: :func:`to_implicit`);
-* implicit -> explicit: where ``∂F/∂z ≠ 0``, by solving ``F(x, y, z) = 0`` for ``z``
-  (:meth:`ImplicitSurface.to_explicit`); in general only locally, and
-  :meth:`ImplicitSurface.project` moves points onto ``F = 0``.
+"""The three forms of a surface, explicit ``z = f(x, y)`` (:func:`explicit`), implicit
+``F(x, y, z) = 0`` (:func:`implicit`, :func:`to_implicit`) and parametric, and the
+conversions between them where they exist.
+See :doc:`/guide/surfaces` (section "The superellipsoid and the three forms").
 """
 
 from __future__ import annotations

@@ -1,26 +1,9 @@
-"""Gordon surfaces: one B-spline surface through a network of profile and guide curves.
+"""Gordon surfaces (:func:`gordon`): one B-spline surface through a network of profile and
+guide curves, the Boolean sum of two skins less the interpolant of their crossings.
 
-Profiles ``P_i`` run in ``u``, guides ``G_j`` in ``v``; every profile crosses every guide.
-The Gordon surface is the Boolean sum
-
-    S = skin(profiles, v) + skin(guides, u) - interpolant(intersection points)
-
-where each term interpolates with the *same* spline spaces: profiles are skinned
-across ``v`` at the parameters ``V_i``, guides across ``u`` at ``U_j`` (degree up to 3,
-knots by averaging), and the tensor-product interpolant of the intersection points
-``Q_ij`` uses exactly those two spaces.  Then ``S(u, V_i) = P_i(u)`` and
-``S(U_j, v) = G_j(v)`` (Gordon 1969; the construction of TiGL's
-``CTiglInterpolateCurveNetwork``, which build123d's ``Face.make_gordon_surface`` uses).
-
-This needs each profile to cross the guides at the same parameters ``U_j`` and each
-guide to cross the profiles at ``V_i``.  A network that already does (e.g. iso-curves of
-one B-spline surface) is used as is and the surface is exact.  Otherwise every curve is
-reparametrized by a smooth monotone map sending its crossings to the common parameters (the
-means over the network), and re-interpolated as a cubic B-spline whose distance from
-the original curve is measured and kept below half of ``tolerance``; the crossing
-points themselves are hit exactly.  The three terms are then made compatible (degree
-elevation and knot merging, :mod:`surfmod.nets.elevate`) and summed control point by
-control point.
+A network whose curves do not cross at common parameters is reparametrized within half the
+tolerance; the crossings themselves are hit exactly.
+See :doc:`/guide/surfaces` (section "Gordon surfaces").
 """
 
 from __future__ import annotations

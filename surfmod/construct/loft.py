@@ -1,21 +1,7 @@
-"""Lofted (skinned) surfaces through a list of section curves.
-
-The sections are made compatible (same degree, parameter interval and knot vector:
-:func:`surfmod.nets.elevate.make_compatible`, OCCT's ``GeomFill_Profiler`` steps), then
-corresponding control points are interpolated across the sections (P&T 10.3,
-skinning): in homogeneous coordinates for rational sections, with section parameters
-``v_k`` by chord length between the sections' whole (homogeneous) control polygons (as
-OCCT), knots by
-averaging, degree ``K - 1`` for up to 9 sections (one polynomial piece, as OCCT) and 3
-beyond - or degree 1 (``ruled=True``: straight rulings between consecutive sections).
-The result is a B-spline surface through every section exactly (``S(u, v_k) = C_k(u)``).
-
-OCCT's counterpart is ``BRepOffsetAPI_ThruSections`` (smooth: ``GeomFill_AppSurf``
-through the sections; ruled: one ruled face per pair of sections); the check is
-geometric (distance from our points to OCCT's shell).  Measured: smooth lofts through
-up to 9 sections and all ruled lofts agree with OCCT to round-off (1e-15 .. 1e-10);
-with 10 or more sections OCCT switches to a smoothing approximation and the two
-surfaces differ (both still pass through every section).
+"""Lofted (skinned) surfaces through a list of section curves (:func:`loft`): the sections
+made compatible, their control points interpolated across them; the surface passes
+through every section exactly.  See :doc:`/guide/surfaces` (section "Coons, ruled and
+lofted surfaces").
 """
 
 from __future__ import annotations

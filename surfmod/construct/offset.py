@@ -1,17 +1,6 @@
-"""Offsets as B-splines, with a pre-check that says where they would fail, and thickening.
-
-``offset(s, d, tolerance)`` approximates the exact offset ``S + d N`` (surfmod's
-:class:`~surfmod.construct.offset_surface.OffsetSurface`, OCCT's
-``Geom_OffsetSurface``) by a bicubic B-spline in the base surface's own parameters:
-least squares on a tensor grid (separable, one solve per direction), then knots are
-inserted in the middle of every span whose error at the span midpoints exceeds the
-tolerance, until the fit holds everywhere sampled.
-
-The pre-check: the offset's partials are ``S_x (1 - d k)`` along principal directions
-(``k`` signed against the normal, as ``curvatures``), so the offset folds wherever
-``d k >= 1``, i.e. where ``|d|`` reaches the smallest radius of curvature on the concave
-side.  A B-spline base with a C0 knot line across which the normal jumps (a crease)
-has no offset either.  Both raise :class:`SurfmodError` naming the ``(u, v)`` region.
+"""Offsets as B-splines (:func:`offset`), with a pre-check that says where they would fail
+(:func:`precheck`: folds and creases, raised naming the ``(u, v)`` region), and thickening
+(:func:`thicken`).  See :doc:`/guide/analysis` (section "Offsets").
 """
 
 from __future__ import annotations

@@ -1,18 +1,6 @@
-"""Ruled surface between two curves, ``S(u, v) = (1 - v) G(u) + v Q(u)``.
-
-Both curves are converted to B-splines and made compatible exactly as OCCT's
-``GeomFill_Profiler`` does (degree elevation to the higher degree, linear
-reparametrization onto the parameter interval of the curve with the longer one,
-knot merging with maximal multiplicities); the surface is the B-spline of degree
-``(p, 1)`` with the two control polygons as its two rows, v in ``[0, 1]`` — the surface
-``GeomFill::Surface``/``GeomFill_Generator`` builds from the same B-spline curves,
-pole for pole.
-
-For polynomial curves (and rational ones with the same weights) this is exactly
-``(1 - v) G(u) + v Q(u)``.  For rational curves with different weights OCCT (and
-therefore surfmod, to stay point-for-point equal) scales each curve's weights to mean 1
-and blends homogeneous points: the rulings are still the segments ``G(u) Q(u)``, but v
-moves along them at a rational, not linear, rate.
+"""Ruled surface between two curves (:func:`ruled`), ``S(u, v) = (1 - v) G(u) + v Q(u)``,
+built pole for pole as OCCT's ``GeomFill`` builds it (rational curves with different
+weights included).  See :doc:`/guide/surfaces` (section "Coons, ruled and lofted surfaces").
 """
 
 from __future__ import annotations

@@ -1,26 +1,6 @@
-"""The superellipsoid (Barr's superquadric) and its B-spline fit with a stated tolerance.
-
-Parametric form, with the signed power ``c(θ, s) = sgn(cos θ)|cos θ|^s`` and
-``d(θ, s) = sgn(sin θ)|sin θ|^s``::
-
-    x = rx c(η, s1) c(ω, s2),   y = ry c(η, s1) d(ω, s2),   z = rz d(η, s1)
-    η in [-π/2, π/2] (latitude),   ω in [-π, π] (longitude)
-
-Implicit form::
-
-    F(x, y, z) = (|x/rx|^(2/s2) + |y/ry|^(2/s2))^(s2/s1) + |z/rz|^(2/s1) - 1
-
-``s1 = s2 = 1`` is the ellipsoid; ``s -> 0`` squares the shape off towards a box (sharp
-edges, where the signed powers are steep) and ``s > 2`` pinches it (concave cusps; for
-``s = 3`` the sections are astroids).
-
-OCCT has no superquadric, so the surface is a bicubic B-spline interpolating the
-analytic surface on a grid.  The superellipsoid is the *spherical product* of two
-superellipses, so each direction is handled as a plane curve: for ``s < 1`` the angle
-is redistributed by a curvature-weighted arc length (samples crowd into the sharp
-edges, where the signed power would otherwise leave gaps), for ``s >= 1`` the angle is
-used as is (the pinched cusps are parametrically smooth).  The grid is refined until
-the measured deviation from the analytic surface is below ``tolerance``.
+"""The superellipsoid (Barr's superquadric) and its bicubic B-spline fit with a stated
+tolerance (:func:`superellipsoid`), its signed-power parametric and implicit forms.
+See :doc:`/guide/surfaces` (section "The superellipsoid and the three forms").
 """
 
 from __future__ import annotations

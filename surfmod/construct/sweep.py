@@ -1,34 +1,10 @@
-"""Swept surfaces: a profile curve moved along a path curve by a moving frame.
+"""Swept surfaces (:func:`sweep`): a profile curve moved along a path curve by a moving frame,
+the lecture's four swept surfaces as one formula.
 
-The lecture's four swept surfaces are one formula::
-
-    S(u, v) = P(v) + R(v) L(u, v),
-    L(u, v) = (1 - w(v)) R(v0)^T (A(u) - P(v0)) + w(v) R(v1)^T (B(u) - P(v1))
-
-``P`` is the path, ``A`` the profile (placed where it should sit at the path start),
-``B`` an optional end profile (placed at the path end; ``B = A`` moved along when not
-given), ``w(v) = (v - v0) / (v1 - v0)`` the blending law, and ``R(v)`` the moving frame
-(columns tangent, normal, binormal):
-
-* **tangent-following** (``mode="frenet"``): the Frenet frame; ``"corrected_frenet"``:
-  the rotation-minimizing frame (no spin about the tangent, also defined on straight
-  pieces) - see :mod:`surfmod.eval.frames`;
-* **changing profile** (``end_profile=B``): start and end sections blended along the path;
-* **guide rail** (``guide=G``): the normal points from ``P(v)`` to the point of the guide
-  in the normal plane of the path at ``P(v)``; with ``guide_scale=True`` the section is
-  also scaled about ``P(v)`` by the rail's distance relative to the start (OCCT: the
-  auxiliary spine plus a homothetic ``Law_Interpol`` through ``SetLaw``);
-* **twisted** (``twist=degrees``): the frame additionally turns about the tangent by
-  ``twist * w(v)`` (linear law).
-
-OCCT builds the same surfaces with ``BRepOffsetAPI_MakePipeShell`` (Frenet /
-CorrectedFrenet trihedron, two sections, or an auxiliary spine - for the twist the
-auxiliary spine is traced from our own twisted frame), but approximates them, so
-``exact_in_occt`` is False and the cross-check is geometric (distance from the NumPy
-points to the pipe-shell face).  Derivatives in ``u`` are exact; derivatives in ``v``
-are 5-point central differences (relative accuracy ~1e-9), up to second order.
-
-The same concept as :mod:`surfmod.occ.sweep`, its OCCT twin (the pipe shell) behind the kernel door.
+Derivatives in ``u`` are exact, in ``v`` 5-point central differences (about 1e-9 relative).
+The same concept as :mod:`surfmod.occ.sweep`, its OCCT twin (the pipe shell, which only
+approximates the surface) behind the kernel door.  See :doc:`/guide/surfaces` (section
+"Swept surfaces").
 """
 
 from __future__ import annotations

@@ -1,16 +1,9 @@
 """Moving frames along a space curve, vectorized: Frenet and rotation-minimizing.
 
-Frames are returned as rotation matrices ``R`` of shape ``(N, 3, 3)`` whose columns are
-``(T, N, B)``: tangent, normal, binormal.
-
-* **Frenet**: ``T = C'/|C'|``, ``B = C' x C'' / |C' x C''|``, ``N = B x T``; undefined
-  where the curvature vanishes.
-* **Rotation-minimizing** ("corrected Frenet"): the normal is parallel-transported along
-  the curve (no rotation about the tangent).  It is computed by the *double reflection*
-  method (Wang, Jüttler, Zheng & Liu, ACM TOG 2008), fourth-order accurate: once on a
-  dense table along the curve (the only sequential step, done at construction), then
-  from the nearest table entry to any parameter by one more double reflection,
-  vectorized over the parameters.
+Frames are rotation matrices ``R`` of shape ``(N, 3, 3)`` whose columns are ``(T, N, B)``:
+tangent, normal, binormal.  The rotation-minimizing frame is tabulated once at construction
+(double reflection), then reached from the nearest entry.  See :doc:`/guide/surfaces`
+(section "Swept surfaces").
 """
 
 from __future__ import annotations
