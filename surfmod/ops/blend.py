@@ -1,21 +1,6 @@
-"""G0 / G1 / G2 blend surfaces between a boundary of one surface and a boundary of another.
-
-The blend is an exact B-spline surface: along the boundary (its ``u``) it carries the
-union of the neighbours' knots at the higher of their degrees; across (its ``v``) it is
-one Bézier span of degree 1 (G0), 3 (G1) or 5 (G2).  Its first and last rows of control
-points are the neighbours' boundary curves; the next one or two rows come from the
-neighbours' first and second cross-boundary derivatives, which along a side of a
-B-spline surface are themselves B-spline curves with the side's knots (the derivative of
-the basis in the other direction, contracted with the net).  Rational neighbours are
-handled in homogeneous coordinates, where the same rows hold: contact of order two
-between the homogeneous surfaces survives the division by the weight, so the blend is
-G2 to a NURBS neighbour too.
-
-Why this is G2: near ``v = 0`` the blend agrees to second order with
-``S_a(s, x0 + lambda v)`` (the neighbour continued past its side with the parameter
-scaled by ``lambda``), i.e. it is C2 to a reparametrization of ``a``.  ``tension`` scales
-``lambda`` (and ``lambda^2`` for the second row): larger values make the blend leave the
-neighbours more steeply.
+"""G0 / G1 / G2 blend surfaces between a boundary of one surface and a boundary of another
+(:func:`blend`): an exact B-spline, one Bézier span of degree 1, 3 or 5 across, G2 to NURBS
+neighbours too.  See :doc:`/guide/analysis` (section "How a blend and a fill are built").
 """
 
 from __future__ import annotations

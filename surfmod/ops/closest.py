@@ -1,24 +1,13 @@
 """Closest points on a surface for many points at once: the closest-point family.
 
 :func:`closest_points` answers in closed form on the elementary surfaces
-(:mod:`surfmod.construct.elementary_closest`, through ``Surface._closest_parameters``)
-and searches every other surface here.  Every point starts from the nearest triangles of
-a sampled grid (resolving every knot span, evenly spaced in chord length) and from the
-valley bottoms of its sampled distance (:func:`grid_seeds`); then a projected Newton
-iteration on ``f(u, v) = |S(u, v) - P|^2 / 2`` runs on all starts together
-(:func:`newton_closest`).  The domain is a box constraint: a parameter at its bound
-whose gradient points outward is held there and the other one is solved alone (the
-constrained step), so points whose closest point lies on an edge or at a corner converge
-too; a start stopped on a C0 crease with the distance still falling across it carries
-on in the next piece.  The best start wins.  The seeding is a dense sampling, not a
-proof of global optimality.  :func:`project_distances` is the family's distance bound
-from parameter guesses (Gauss-Newton, the meshers' deviation judge).
-
-Twins: each of :func:`grid_seeds`, :func:`newton_in_boxes` and :func:`project_distances`
-(NumPy) has a compiled twin ``<name>_compiled`` in :mod:`surfmod.eval.projection_kernel`
-with the same answers; the NumPy one serves work too small to wait for numba (a first
-``sm.project`` of a few hundred points would otherwise spend seconds importing numba and
-loading the kernels, minutes compiling them into an empty cache).
+(:mod:`surfmod.construct.elementary_closest`) and searches every other surface here: seeds
+from a sampled grid (:func:`grid_seeds`), then projected Newton in the parameter box on all
+starts together (:func:`newton_closest`).  :func:`project_distances` is the family's
+distance bound from parameter guesses (the meshers' deviation judge).  Each of
+:func:`grid_seeds`, :func:`newton_in_boxes` and :func:`project_distances` has its compiled
+twin in :mod:`surfmod.eval.projection_kernel`.  See :doc:`/guide/surfaces` (section
+"Closest points").
 """
 
 from __future__ import annotations

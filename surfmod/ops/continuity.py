@@ -1,22 +1,6 @@
-"""How well two surfaces meet along a shared boundary: G0 gap, G1 normal angle and the G2
-jump of the normal curvature across the boundary.
-
-What is compared, at each sample of the boundary:
-
-* **G0**: the distance between the two surfaces' points.
-* **G1**: the angle between the unit normals, after orienting the second surface like
-  the first (the frame *edge tangent, direction into the surface, normal* must have the
-  same handedness on both sides, so a fold reads as an angle near pi, not as 0).
-* **G2**: ``|k_a - k_b|``, the normal curvatures of both surfaces in the direction that
-  crosses the boundary at right angles (in the tangent plane).  Once the normals agree
-  along the boundary, the curvature along the edge and the geodesic torsion agree by
-  themselves (both surfaces contain the edge with the same normal), so this one number
-  is the whole difference of the shape operators: zero exactly when the join is G2.
-
-The boundary is found by matching sides (``"u0"``, ``"u1"``, ``"v0"``, ``"v1"``) of the
-two parameter rectangles by sampled distance in either orientation, or given with
-``edge=(side_a, side_b)``; faces sharing a topological edge and whole shells are sampled
-through the edges' p-curves.
+"""How well two surfaces meet along a shared boundary (:func:`continuity`): G0 gap, G1 normal
+angle and the G2 jump of the normal curvature across the boundary, the second surface
+oriented like the first.  See :doc:`/guide/analysis`.
 """
 
 from __future__ import annotations

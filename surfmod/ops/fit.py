@@ -1,29 +1,8 @@
-"""A B-spline surface through unordered points (a scan) with a guaranteed deviation.
-
-1. **Parameters by projection** onto a base surface.  By default the base is the plane
-   through the centroid normal to the points' mean local normal, and the fit is a
-   *height field* over it: the in-plane coordinates of the poles are the exact linear
-   map of the Greville abscissae and only the heights are unknown, so every point keeps
-   its exact parameters.  With ``base=`` a surfmod surface, the parameters come from
-   :func:`surfmod.project` and all three coordinates of the poles are unknown.  The
-   parameters are scaled onto ``[0, 1]^2``.
-2. **Penalized least squares**: the control net minimizes
-   ``sum_k |S(u_k, v_k) - Q_k|^2 + lambda * E(S)`` with the thin-plate energy
-   ``E = integral |S_uu|^2 + 2 |S_uv|^2 + |S_vv|^2 du dv`` (membrane energy for degree 1).
-   The normal matrix is sparse (each point touches ``(p+1)(q+1)`` poles) and assembled
-   in chunks of points, so 10^6 points stay within memory; ``lambda`` is ``smoothing``
-   times the ratio of the traces of the data and energy matrices, so ``smoothing`` is
-   dimensionless.  Where there are no data (holes) the energy alone fixes the poles,
-   which is what keeps the surface from going wild there.
-3. **Foot points**: each point's closest point on the new surface (projected Newton from
-   its parameters, all points at once) gives its distance; with a base surface these
-   foot points are also the next parameters (parameter correction).
-4. **Knot refinement**: every knot span (in u and in v) holding a point farther than
-   ``tolerance`` is halved; repeat until every distance is within ``tolerance`` or the
-   next refinement would pass ``max_poles`` (then ``converged`` is False).
-5. **Measured with OCCT**: the final distances come from projecting *every* point onto
-   the OCCT twin (:func:`surfmod.occ.points_to_bspline.project_points`); if OCCT measures a
-   point beyond the tolerance, refinement resumes from those distances.
+"""A B-spline surface through unordered points (a scan) with a guaranteed deviation
+(:func:`fit`): parameters by projection onto a base surface, penalized least squares with
+the thin-plate energy, knot spans halved until every point is within the tolerance, the
+final distances measured by OCCT.  See :doc:`/guide/surfaces` (section "Fitting scattered
+points").
 """
 
 from __future__ import annotations

@@ -1,18 +1,9 @@
-"""Curve tracing on the NumPy evaluator: the shared engine of surface–surface and
-surface–plane intersection and of silhouette curves.
+"""Curve tracing on the NumPy evaluator (:func:`newton`, :func:`trace`): the shared engine of
+surface–surface and surface–plane intersection and of silhouette curves.
 
-A *problem* has ``n`` unknowns ``x`` in a box (the parameter domains) and ``n - 1``
-equations ``F(x) = 0``; its solution set is a curve.  ``evaluate(X)`` returns, for flat
-``(N, n)`` parameters, ``F (N, n-1)``, the Jacobian ``J (N, n-1, n)``, the 3-D point
-``P (N, 3)`` and ``dP/dx (N, 3, n)`` (for steps of a given length in space).
-
-* :func:`newton` solves ``F = 0`` plus one linear condition ``c . x = d`` per point,
-  vectorized over all points, clipped to the box.
-* :func:`trace` marches from a seed along the tangent (the null vector of ``J``):
-  predictor step of 3-D length ``h``, Newton corrector on the hyperplane through the
-  predicted point orthogonal to the tangent, step halving when the corrector fails or the
-  tangent turns by more than ``max_angle``; it stops on the box boundary (solved exactly
-  with the leaving parameter held at its bound) or when the curve closes.
+A problem's ``evaluate(X)`` returns, for flat ``(N, n)`` parameters, ``F (N, n-1)``, the
+Jacobian ``J (N, n-1, n)``, the 3-D point ``P (N, 3)`` and ``dP/dx (N, 3, n)``.
+See :doc:`/guide/surfaces` (section "Intersections and shadows").
 """
 
 from __future__ import annotations

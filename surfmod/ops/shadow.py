@@ -1,15 +1,7 @@
-"""Shadows under parallel light: the outline of a surface projected along a direction onto
-a plane.
-
-The outline of the projected region is made of pieces of two kinds of curves: the
-projected **boundary** of the patch and the projected **silhouette** curves, where the
-light grazes the surface (``(Su x Sv) . L = 0``, traced by the marching engine of
-:mod:`surfmod.ops.marching`).  All of them are projected obliquely along ``L`` onto the
-plane; the **outline** proper is extracted from their planar arrangement: every piece
-between crossings is kept when the region is covered on exactly one side of it (tested
-by solving ``proj(S(u, v)) = q`` with vectorized Newton), and the kept pieces are
-chained into loops oriented with the shadow on their left (outer loops counter-clockwise,
-holes clockwise, in the plane frame).
+"""Shadows under parallel light (:func:`shadow`): the outline of a surface projected along a
+direction onto a plane, from its projected boundary and silhouettes, outer loops
+counter-clockwise and holes clockwise in the plane's frame.
+See :doc:`/guide/surfaces` (section "Intersections and shadows").
 """
 
 from __future__ import annotations

@@ -1,33 +1,11 @@
 """The independent reference for mass properties, and the verdict of ``surfmod mass``.
 
-When surfmod's quadrature (the :mod:`surfmod.mass` pipeline) and plain ``BRepGProp``
-(:func:`surfmod.occ.properties.gprops`) differ, a third integrator decides which is right.
-Two are tried in turn, each about the solid's vertex mean (BRepGProp's and surfmod's
-reference point: on a real file whose edges leave gaps the integrals depend on that point,
-and with the same point and the same radial fields surfmod and the reference compute one
-and the same quantity):
-
-* :func:`refined_props`: ``BRepGProp`` on the same solid with every face split into
-  ``k × k`` iso-parametric pieces, ``k`` in :data:`SPLITS`, until two refinements agree.
-  BRepGProp's adaptive rule stops when the *volume* of each face has converged; the first
-  and second moments converge more slowly (on a torus of nist_ftc_11 its inertia stays
-  5e-7 off the closed form at ``eps = 1e-13``, where surfmod's is within 3e-16), and do
-  converge on smaller faces (split ``2 × 2``: 2e-14).  The split changes nothing but the
-  quadrature: the pieces keep the face's surface and the pieces of its p-curves, and the new
-  edges between two pieces carry the same p-curve on both sides with opposite orientations,
-  so their contributions cancel.  Its error estimate is the change of the last refinement.
-  Where edges stray off their faces ``ShapeUpgrade`` fits their p-curves again, the split is
-  not exact and the refinements do not settle (changes of 1e-9 to 1e-2 on those corpus
-  files, build123d's screw thread and axom's B-spline sphere; below 1e-10 elsewhere).
-* :func:`kronrod_props`: ``BRepGProp::VolumePropertiesGK`` with the moments converged as
-  well as the volume, on the solid as it is, with its own error estimate (on stepcode_dm1's
-  B-spline solids it agrees with surfmod to 1e-12 where plain BRepGProp is 1e-8 off in
-  inertia).  Its time is one C++ call no bound estimated beforehand can stop (0.2 s to 60 s
-  on the corpus at ``eps = 1e-10``), so :func:`kronrod_props_within` runs it in a child
-  process with a deadline (:mod:`surfmod.child`), the shape passed as binary BREP bytes.
-
-:func:`judge` is the command's verdict on one solid, from the two sides' figures, the
-model's straying edges and its boundary ambiguity.
+When the :mod:`surfmod.mass` pipeline and plain ``BRepGProp`` differ, :func:`refined_props`
+(BRepGProp on faces split ``k × k``, ``k`` in :data:`SPLITS`) and then :func:`kronrod_props`
+(its Gauss–Kronrod rule with the moments converged, in a child process:
+:func:`kronrod_props_within`) decide which is right, both about the solid's vertex mean, the
+point and fields surfmod uses.  :func:`judge` is the command's verdict on one solid.
+See :doc:`/guide/uses` (section "Checked against BRepGProp and the references").
 """
 
 from __future__ import annotations
