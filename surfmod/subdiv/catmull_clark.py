@@ -1,21 +1,7 @@
-"""Catmull–Clark subdivision of polygon meshes (vectorized, boundaries and sharp creases).
-
-One step of the lecture's "coarse mesh & subdivision rule":
-
-* face point  ``F = average of the face's vertices``;
-* edge point  ``E = (a + b + F1 + F2) / 4`` on an interior edge, ``(a + b) / 2`` on a
-  boundary or crease edge (the cubic B-spline curve rule);
-* vertex point ``V = (Q + 2R + (n - 3) v) / n`` for a smooth vertex of valence ``n``
-  (``Q`` the average of the adjacent face points, ``R`` of the adjacent edge midpoints);
-  ``(a + 6 v + b) / 8`` on a boundary/crease curve (``a``, ``b`` its two sharp
-  neighbours); a vertex with three or more sharp edges is a corner and stays put, and so
-  does a boundary vertex used by a single face (OpenSubdiv's "edge and corner" boundary
-  interpolation: the corners of an open quad grid are interpolated).
-
-Every polygon with ``k`` corners becomes ``k`` quads ``[v_j, e_j, f, e_(j-1)]``, so after
-one step the mesh is all quads: ``V' = V + E + F``, ``F' = sum(k)``, ``E' = 2E + sum(k)``.
-New vertices are numbered vertex points first, then edge points (in the order of
-:attr:`Topology.edges`), then face points.
+"""Catmull–Clark subdivision of polygon meshes (:func:`catmull_clark`; vectorized, boundaries
+and sharp creases).  After one step the mesh is all quads; new vertices are numbered vertex
+points first, then edge points (in the order of :attr:`Topology.edges`), then face points.
+See :doc:`/guide/surfaces` (section "Subdivision and its limit surface").
 """
 
 from __future__ import annotations

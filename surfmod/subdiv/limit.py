@@ -1,36 +1,10 @@
-"""Catmull–Clark limit surfaces as CAD patches (``sm.limit_surface``).
+"""Catmull–Clark limit surfaces as CAD patches (``sm.limit_surface``): exact bicubic
+B-spline patches on regular faces, Loop & Schaefer's approximate Bézier patches at
+extraordinary vertices with the exact limit normal there, refined ``adaptive`` times.
 
-The cage (closed or with boundaries) is first subdivided ``levels`` times (default 2),
-which makes it all quads and isolates the extraordinary vertices (valence != 4): after two
-steps each face touches at most one of them.  Then one patch per quad face, parametrized ``u`` along corner 0 -> 1
-and ``v`` along corner 0 -> 3 on ``[0, 1]^2`` (so ``Su x Sv`` follows the face winding):
-
-* **regular faces** (all four vertices of valence 4): the limit surface is *exactly* the
-  bicubic uniform B-spline of the face's 4 x 4 neighbourhood; the patch is
-  ``BSplineSurface.uniform_cubic(net4x4)``.  On a boundary a vertex with two faces (the
-  cubic B-spline curve rule) or one face (a corner) is regular too: the neighbourhood is
-  continued by ghost points ``2 b - i`` (b on the boundary, i its inner neighbour), which
-  is exactly what the boundary rules compute;
-* **faces at an extraordinary vertex**: a bicubic Bézier patch built with the rules of
-  Loop & Schaefer's approximation (ACC, 2008): interior points
-  ``(n v + 2 (e_prev + e_next) + d) / (n + 5)``, edge points the average of the two interior
-  points beside them, corner points the average of the interior points around the vertex
-  (= the exact limit position).  Edge points next to an extraordinary vertex are then
-  projected into the exact limit tangent plane (limit masks), so every patch meeting there
-  has the exact limit normal.  On regular faces these rules reproduce the B-spline's
-  Bézier points, so the patches are watertight (C0) everywhere; across edges near an
-  extraordinary vertex the normal is only approximately continuous.  Boundary edges take
-  the Bézier points of the cubic B-spline boundary curve, which is the exact limit there.
-
-With ``adaptive = a`` the faces at extraordinary vertices are refined ``a`` more times
-(and only those): three of the four children of each are regular, so they become exact
-patches, and the approximate patches shrink towards the extraordinary vertices.  Patches
-of different levels meet in T-junctions (exact there, since both sides are exact).
-
-Both the approximation and the continuity are *measured* on construction (``errors``):
-the gap and the normal angle across every shared patch edge, and the distance and
-normal angle from the patches to the exact limit surface at the vertices of two further
-subdivision levels (placed with the closed-form limit masks).
+The patches are watertight everywhere; the gaps, normal angles and distances to the exact
+limit are measured on construction (:attr:`LimitSurface.errors`).
+See :doc:`/guide/surfaces` (section "Subdivision and its limit surface").
 """
 
 from __future__ import annotations

@@ -1,14 +1,7 @@
-"""Loop subdivision of triangle meshes (vectorized, with boundary rules).
-
-* edge point ``3/8 (a + b) + 1/8 (c + d)`` on an interior edge (``c``, ``d`` the opposite
-  vertices), the midpoint on a boundary edge;
-* vertex point ``(1 - n beta) v + beta * sum(neighbours)`` for an interior vertex of
-  valence ``n``; ``3/4 v + 1/8 (a + b)`` on the boundary (cubic B-spline rule);
-* ``beta`` is Loop's ``(5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n`` (default) or Warren's
-  ``3 / (8 n)`` (``3/16`` for ``n = 3``).
-
-Each triangle becomes four: ``V' = V + E``, ``F' = 4F``, ``E' = 2E + 3F``.  New vertices:
-vertex points first, then edge points in the order of :attr:`Topology.edges`.
+"""Loop subdivision of triangle meshes (:func:`loop_subdivide`; vectorized, with boundary
+rules, Loop's or Warren's ``beta``).  New vertices: vertex points first, then edge points
+in the order of :attr:`Topology.edges`.
+See :doc:`/guide/surfaces` (section "Subdivision and its limit surface").
 """
 
 from __future__ import annotations

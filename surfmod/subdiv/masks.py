@@ -1,21 +1,7 @@
-"""Closed-form limit masks: where a subdivision vertex ends up after infinitely many steps.
-
-Catmull–Clark (quad mesh, interior vertex of valence ``n`` with edge neighbours ``e_i``
-and diagonal neighbours ``d_i``, in order around the vertex)::
-
-    position  = (n^2 v + 4 sum e_i + sum d_i) / (n (n + 5))
-    tangent 1 = sum A_n cos(2 pi i/n) e_i + (cos(2 pi i/n) + cos(2 pi (i+1)/n)) d_i
-    tangent 2 = the same with sin,    A_n = 1 + cos(2 pi/n) + cos(pi/n) sqrt(2 (9 + cos(2 pi/n)))
-
-Loop (interior vertex, ``beta`` of the scheme)::
-
-    position  = (1 - n chi) v + chi sum e_i,   chi = 1 / (3 / (8 beta) + n)
-    tangent 1 = sum cos(2 pi i/n) e_i,   tangent 2 = sum sin(2 pi i/n) e_i
-
-On a boundary or crease curve both schemes follow the cubic B-spline curve, whose limit
-point is ``(a + 4 v + b) / 6`` with tangent ``b - a``; corners (three or more sharp edges,
-or a boundary vertex of a single face) stay where they are.  The normal is ``tangent 1 x tangent 2`` normalised; it is only
-given (not NaN) at smooth interior vertices.
+"""Closed-form limit masks (:func:`catmull_clark_limit`, :func:`loop_limit`): where a
+subdivision vertex ends up after infinitely many steps, and its tangents; the normal is
+given (not NaN) only at smooth interior vertices.
+See :doc:`/guide/surfaces` (section "Subdivision and its limit surface").
 """
 
 from __future__ import annotations
