@@ -1,19 +1,9 @@
-"""Atomic file writes: write a temporary file beside the target, then rename it over
-the target.
-
-A failure at any point removes the temporary file and leaves an existing target as it
-was, so no reader ever sees a half-written file.  A writer killed outright (SIGKILL)
-cannot clean up, so its temporary file is named for what it is,
-``.<target name>.surfmod-tmp-<pid>-<random>``, and the next write to the same target
-removes every such file whose writer process is gone.
-
-The file is not ``fsync``-ed before the rename: on this project's machines that alone
-took 3-4 ms a file, more than meshing a small part, and durability across a power loss
-is left to the file system (ext4, by default, writes a file's data out before a rename
-that replaces another file; OCCT's own writers do not sync either).
-
-This module sits low (beside ``checks.py``) so that ``io/``, ``meshing/`` and ``uses/``
-all write files the same way.
+"""Atomic file writes: a temporary file beside the target, renamed over it; a failure
+removes it and leaves an existing target as it was.  A writer killed outright leaves
+``.<target name>.surfmod-tmp-<pid>-<random>``, which the next write to the target removes
+once its process is gone.  No ``fsync`` before the rename: it cost more than meshing a
+small part, and durability across a power loss is left to the file system, as OCCT's own
+writers leave it.  See :doc:`/errors` (section "Atomic writes").
 """
 
 from __future__ import annotations

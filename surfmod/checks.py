@@ -1,29 +1,14 @@
 """Input checks done once, at the door of every public entry.
 
-One validator per kind of argument, reused everywhere: arrays of numbers
-(:func:`finite_array`), single numbers (:func:`real`, :func:`positive`, :func:`angle`),
-integers (:func:`count`, :func:`derivative_order`), points and directions, parameter
-arrays that must broadcast (:func:`parameter_pair`), file paths (:func:`file_path`) and
-STEP files (:func:`step_file`),
-surfaces and curves (:func:`surface`, :func:`curve`), and the cost of a piece of work
-against its cap (:func:`work`).  Each raises :class:`~surfmod.errors.SurfmodError` whose
-message starts with the argument's name; arrays come back as float64.  Inside the package
-the values are trusted.
+One validator per kind of argument (numbers, counts, points, parameter arrays, paths,
+STEP files, surfaces and curves, the cost of a piece of work against its cap), each
+raising :class:`~surfmod.errors.SurfmodError` whose message starts with the argument's
+name; arrays come back as float64.  Inside the package the values are trusted.
 
-The limits, documented once (README "Errors and limits"):
-
-``LARGEST``
-    Largest magnitude accepted for any number (coordinates, lengths, angles, parameters):
-    ``1e70``.  Curvature multiplies four first derivatives (``EG - F^2``), so fourth powers
-    of such numbers, with room for sums and degree factors, stay finite in float64: no
-    evaluation overflows to inf, and larger inputs are refused instead of giving NaN later.
-``MAX_DERIVATIVE_ORDER``
-    Highest derivative order of ``derivatives``/``grid_derivatives`` (20): the result holds
-    ``(order + 1)**2`` vectors per point.
-``MAX_POINTS``
-    Default cap on the number of points an evaluation may produce (``max_points=`` raises it).
-``MAX_PATH_COMPONENT``, ``MAX_PATH``
-    Longest file name (255 bytes) and path (4096 bytes) that POSIX file systems take.
+The limits are documented once, in :doc:`/errors` (section "Limits, and the keyword that
+raises each"): :data:`LARGEST` (``1e70``: curvature multiplies four first derivatives, so
+fourth powers of such numbers stay finite in float64), :data:`MAX_DERIVATIVE_ORDER`,
+:data:`MAX_POINTS`, :data:`MAX_PATH_COMPONENT` and :data:`MAX_PATH`.
 """
 
 from __future__ import annotations

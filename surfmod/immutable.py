@@ -1,18 +1,11 @@
 """Immutable values: the one way surfmod surfaces and curves are built and cached.
 
-A surface or curve is a value.  Its public attributes (control net, knots, weights, frame,
-profile...) are bound once, while it is built; rebinding one afterwards would leave the
-caches derived from it (homogeneous net, OCCT twin) silently stale, so it is refused.
-Arrays are frozen separately (``checks.frozen``).  Two doors build an object:
-
-* the class's own ``__init__``, which validates user input (DESIGN.md rule 3);
-* ``cls._construct_fast(**fields)`` for data produced inside surfmod, already valid
-  (scipy's ``construct_fast`` idea): fields are bound as given, nothing is re-checked.
-
-Analytic constructs whose OCCT twin is costly to rebuild (elementary, revolution,
-extrusion, offset) cache it with :meth:`_twin`; the cached ``Geom_Surface`` is shared, so
-a caller who wants to modify it in place (``Segment``, ``Transform``) copies it first.
-Net-based surfaces build a fresh twin on every ``geom()`` call.
+A public attribute binds once, while the object is built: rebinding it would leave the
+caches derived from it (homogeneous net, OCCT twin) stale, so it is refused.  The class's
+``__init__`` validates user input; ``cls._construct_fast(**fields)`` binds data made inside
+surfmod as given.  A twin cached with :meth:`_twin` is shared: copy it before modifying it
+in place (``Segment``, ``Transform``).  See :doc:`/design` (section "Values, not objects
+that change").
 """
 
 from __future__ import annotations

@@ -1,9 +1,7 @@
-"""The four sides of a parameter rectangle and the G0/G1/G2 measure across a boundary.
-
-The measure is one level below the constructs that build to a continuity (blends,
-fills, offsets: :mod:`surfmod.ops.blend`, :mod:`surfmod.construct.fill`) and the
-operation that reports it for surfaces, faces and shells (:mod:`surfmod.ops.continuity`,
-whose module notes say what is compared).
+"""The four sides of a parameter rectangle and the G0/G1/G2 measure across a boundary, one
+level below the constructs that build to a continuity (:mod:`surfmod.ops.blend`,
+:mod:`surfmod.construct.fill`) and the operation that reports it
+(:mod:`surfmod.ops.continuity`).  See :doc:`/guide/analysis`.
 
 >>> import surfmod as sm, numpy as np
 >>> s = sm.plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
