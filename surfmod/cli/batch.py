@@ -1,23 +1,10 @@
 """Running one per-file job over folders of STEP files: locally with joblib, or on a Dask
 distributed cluster (``--scheduler ADDRESS``), results streamed as a table or a CSV file.
 
-A job is a plain module-level function ``job(path, **options) -> list of row tuples``;
-it must catch its own per-file errors and report them as rows, so one bad file never
-stops a run of thousands.  Memory per worker stays bounded because a worker holds one
-file at a time and only rows travel back.
-
-What a run of ten thousand files needs besides:
-
-* each file's rows go to the CSV when the file completes, in one write, flushed: a crash
-  or Ctrl-C loses nothing finished, and ``--resume`` skips the files already there;
-* local workers (loky) watch the client and exit when it is gone, so a killed client
-  leaves no orphan process behind;
-* on a cluster each task runs in a child process of its worker thread (one child serves
-  the thread's tasks in turn, :class:`surfmod.child.Server`) within a time and a memory
-  budget (``--task-seconds``, ``--task-memory``): a file over budget is named and
-  skipped, the worker lives on, and the child goes with the file's shapes; a task that
-  kills its worker (Dask gives up after its ``allowed-failures``) is named and skipped
-  too, never retried for ever.
+A job is a plain module-level function ``job(path, **options) -> list of row tuples``; it
+catches its own per-file errors and reports them as rows, so one bad file never stops a
+run, and only rows travel back, so a worker's memory stays bounded.
+See :doc:`/cli` (section "Folders of many files").
 """
 
 from __future__ import annotations

@@ -1,20 +1,10 @@
 """``surfmod mass FILE.step``: volume, area, centroid and inertia of a STEP solid, checked
-against ``BRepGProp``.  Exit 0 when all four agree within ``MASS_AGREEMENT_RTOL`` (one line
-says so), or when they differ and an independent reference (:mod:`surfmod.uses.mass_reference`:
-BRepGProp on the faces split into ever smaller iso-parametric pieces until it converges,
-then, where that split is not exact, BRepGProp's Gauss-Kronrod rule with the moments
-converged; both about the same point, within ``REFERENCE_BUDGET`` seconds) confirms
-surfmod's values (one line says which side it confirms); 4 when it confirms BRepGProp's, or cannot tell on a
-model whose edges close; 3 when it cannot tell and the model itself is ambiguous (its edges
-leave the volume open by more than the disagreement, or p-curves stray beyond their
-edges' tolerance: they are named).  Edges that stray are named in a note whatever the
-verdict, and so are the faces left out (open shells or loose faces beside the solids
-enclose no volume).
-
-Given folders or several files, one row per file (volume, area, centroid, exit status and
-verdict), to the table or ``--csv`` as each file completes (:mod:`surfmod.cli.batch`).
+against ``BRepGProp``, with the verdict of an independent reference where they differ
+(:mod:`surfmod.uses.mass_reference`, within ``REFERENCE_BUDGET`` seconds) and exit 0, 3 or
+4; folders and several files give one row per file (:mod:`surfmod.cli.batch`).
 
 The same concept as :mod:`surfmod.uses.mass`, one level up: the command over it.
+See :doc:`/guide/uses` (section "Checked against BRepGProp and the references").
 """
 
 from __future__ import annotations

@@ -41,7 +41,7 @@ def run(args) -> int:
         return run_mesh(args)
     args.step = args.step[0]
     # the kernel's shape, not a build123d one: the STL needs nothing of build123d, whose
-    # import is most of a fresh process's start-up (issue 34's start-up row)
+    # import is most of a fresh process's start-up
     shape = read_step_file(args.step, "step")
     out = Path(args.out) if args.out else Path(args.step).with_suffix(".stl")
     with warnings.catch_warnings():

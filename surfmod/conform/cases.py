@@ -1,21 +1,9 @@
-"""The cases an evaluator is held against: control-net surfaces and curves, each with the
-parameters it is sampled at.
+"""The cases an evaluator is held against (``"stress"``, ``"lecture"``, ``"corpus"`` or a STEP
+path): control-net surfaces and curves, each with the parameters it is sampled at.
 
-* ``"stress"``: a family built here from seeded nets, where floating point loses digits —
-  crowded knots (spans of 1e-6 to 1e-3 of the domain beside long ones), parameter ranges
-  from 1e-3 to 1e4 wide and offset from zero, degrees 1 to 9 (Bézier up to 25), interior
-  knots of multiplicity up to the degree, weight ratios up to 1e4, coordinates 1e6 from
-  the origin, periodic (closed, unclamped) nets and collapsed rows of poles;
-* ``"lecture"``: the gallery's control-net entities (Bézier, B-spline, NURBS, uniform
-  cubic, Hermite, plane, quadrics and constructions with an exact NURBS form);
-* ``"corpus"`` or a STEP path: every Bézier and B-spline face of the files, read with
-  :func:`surfmod.from_face` and sampled over its own UV bounds.
-
-Samples avoid the interior knots themselves, where a partial of the order the surface
-lacks there jumps and an evaluator that takes the span on the other side is not wrong;
-they sit just beside them (a thousandth of the shorter neighbouring span away), at the
-ends of the domain, and in the middle and quarter points of the shortest spans, where the
-knot differences are smallest.
+Samples sit beside interior knots, not on them (where a partial the surface lacks jumps
+and either side's value is right), at the domain ends and in the shortest spans.
+See :doc:`/guide/real_parts` (section "Holding your own evaluator against OCCT").
 """
 
 from __future__ import annotations

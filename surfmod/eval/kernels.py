@@ -14,10 +14,9 @@ import numpy as np
 from numba import njit
 
 # The per-point helpers below are plain compiled functions, not ``inline="always"``:
-# numba's own inlining copies a helper into every caller and types it again there (a
-# first `surfmod mesh` of a B-spline part compiled 24 s of kernels with it, 19 s
-# without), while LLVM still inlines them where it pays (the run times are the same,
-# benchmarks/bench_eval.py).  quotient_order2 stays inlined: it must take its caller's
+# numba's own inlining copies a helper into every caller and types it again there, which
+# lengthens every first compile (design_eval.md, "Start-up, measured"), while LLVM still
+# inlines them where it pays (the run times are the same, benchmarks/bench_eval.py).  quotient_order2 stays inlined: it must take its caller's
 # floating-point flags.
 
 # unsigned index steps: unsigned offsets spare numba's negative-index wraparound (a
