@@ -2,23 +2,13 @@
 the build123d objects users get: with :mod:`surfmod.occ`, the only module that imports
 build123d.
 
-Accepted: a surfmod ``Surface`` (its face), a list/tuple of surfaces or faces (sewn into
-a closed solid when ``solid=True``), any build123d shape, an OCP ``TopoDS_Shape``, or the
-path of a STEP file.  Volume work gets a closed solid whose faces agree and point out
-(:func:`closed_solid`: the faces to turn are chosen here, from the edges they share that
-the door reports).
-
-A STEP file is read in one long-lived :class:`surfmod.child.Server` (started on first
-use, reused afterwards, so the normal case pays the interpreter start once; its start,
-OCCT's import included, overlaps the caller's own and is not charged to a file's time
-limit), so a damaged file cannot take the caller down: the child runs
-:func:`surfmod.occ.isolated.read_and_check` and returns the shape as OCCT binary BRep
-bytes, or the reason it refused; if the child dies (a crash in OCCT) or does not answer
-within the time limit (it is then killed), :func:`read_step_file` raises
-:class:`~surfmod.errors.DamagedFileError` naming the file, and the next read starts a
-fresh child.  The child is the plain ``python -m surfmod.child`` process, so it works from
-threads, from joblib/loky workers and from daemon processes alike, and it dies with its
-parent.
+Accepted: a surfmod ``Surface``, a list of surfaces or faces (sewn into a closed solid when
+``solid=True``), any build123d shape, an OCP ``TopoDS_Shape``, or a STEP file's path.
+Volume work gets a closed solid whose faces agree and point out (:func:`closed_solid`).  A
+STEP file is read in one reused :class:`surfmod.child.Server`, so a file that crashes or
+hangs OCCT's reader raises :class:`~surfmod.errors.DamagedFileError` naming it
+(:func:`read_step_file`) and the next read starts a fresh child.
+See :doc:`/design` (section "The kernel door").
 """
 
 from __future__ import annotations

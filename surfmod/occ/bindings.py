@@ -1,16 +1,9 @@
 """OCCT's collection classes and the few renamed tools, under one set of names on OCCT 7.9 and 8.0.
 
-This is the door's one version switch.  OCP 7.9 binds every NCollection instantiation
-under its package typedef (``OCP.TColgp.TColgp_Array1OfPnt``); OCP 8.0 binds each
-template instantiation once, in ``OCP.collections`` (``Array1_gp_Pnt``), and its per-package
-modules (``OCP.TColgp``, ``OCP.TopTools``...) export no names at all.  OCCT 8.0 also
-removed two duplicated tools: ``GCE2d_MakeSegment`` (now ``GC_MakeSegment2d``) and
-``BRepTopAdaptor_FClass2d`` (``IntTools_FClass2d`` is the same classifier on both); and
-``Bnd_Box.Get()`` returns a ``Limits`` struct OCP 8.0 cannot convert (:func:`box_limits`
-reads the corners, which both bind).
-
-The rest of surfmod imports these names from here, spelled as OCCT 7.9 and its
-documentation spell them, so no other module knows which OCCT it runs on.
+This is the door's one version switch: the rest of surfmod imports these names from here,
+spelled as OCCT 7.9 spells them, so no other module knows which OCCT it runs on
+(:func:`box_limits` reads a ``Bnd_Box`` both bind).  See :doc:`/guide/stacks` (section
+"What differs, and where surfmod keeps it").
 
 >>> arr = TColgp_Array1OfPnt(1, 2)
 >>> (arr.Lower(), arr.Upper())

@@ -1,22 +1,8 @@
-"""OCCT's Boolean operations (``BRepAlgoAPI``, ``BOPAlgo``): plane sections of shapes, the
-common volume of two parts (with their ``BRepExtrema`` distance), and the material regions
-of a solid whose boundary touches itself.
-
-Sections: ``BRepAlgoAPI_Section`` edges chained into wires, and the planar faces lying in a
-plane (:mod:`surfmod.uses.section` turns these wires into section curves and areas, and
-sections face by face what OCCT cannot section whole).
-Interference: the ``BRepAlgoAPI_Common`` volume of two parts and their
-``BRepExtrema_DistShapeShape`` distance (:mod:`surfmod.uses.interference` reports them).
-
-Material regions: real parts carry solids whose shells meet along a curve without sharing
-an edge there: pythonocc_11752.stp has an inner void shell (a blind bore) whose rim circle
-lies on the outer shell, where a boss is attached by that same circle only.  The two shells
-hold two distinct, coincident circle edges, which any triangulation discretizes
-independently, so the triangles on either side cross each other.  ``BOPAlgo_MakerVolume``
-(OCCT's general fuse of faces into the volumes they bound) intersects the faces, merges
-coincident edges and splits space into closed regions; the regions on the material side of
-the original faces are the solid, each with a manifold boundary that shares its contact
-edges with its neighbours.
+"""OCCT's Boolean operations (``BRepAlgoAPI``, ``BOPAlgo``): plane sections of shapes (for
+:mod:`surfmod.uses.section`), the common volume of two parts with their ``BRepExtrema``
+distance (for :mod:`surfmod.uses.interference`), and the material regions of a solid whose
+boundary touches itself (``BOPAlgo_MakerVolume``, the regions on the material side of the
+original faces).  See :doc:`/guide/uses` (section "Finite element meshes").
 """
 
 from __future__ import annotations

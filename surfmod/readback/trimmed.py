@@ -1,20 +1,11 @@
 """A face read back: its surface, the face's own parameter bounds and its boundary.
 
-:func:`from_face` is the one reader of OCCT faces in surfmod.  It returns a
-:class:`TrimmedFace`, a :class:`~surfmod.surface.Surface` whose domain is the face's UV
-bounds and which evaluates there exactly as OCCT evaluates the face's surface:
-
-* periodic directions wrap (a periodic B-spline surface trimmed across its seam, an
-  extrusion of a periodic curve);
-* parameters a tolerance beyond the knot range (real p-curves reach 1e-6 to 1e-4 past
-  it) continue the end span's polynomial, as OCCT's ``BSplSLib`` does: the surfmod span
-  search clamps to the first/last span and Cox–de Boor evaluates that span's polynomial
-  anywhere.
-
-The trim stays available: :meth:`TrimmedFace.face` is the original face (holes and all),
-:meth:`TrimmedFace.contains` classifies parameters against the boundary,
-:meth:`TrimmedFace.boundary_loops` samples it.  Operations that take a face (area, mass,
-intersect, project) use these; the untrimmed surface is :attr:`TrimmedFace.surface`.
+:func:`from_face` is the one reader of OCCT faces in surfmod.  Its :class:`TrimmedFace`
+evaluates over the face's UV bounds exactly as OCCT evaluates the face's surface: periodic
+directions wrap, and parameters a tolerance beyond the knot range continue the end span's
+polynomial, as ``BSplSLib`` does.  The trim stays available (:meth:`TrimmedFace.face`,
+:meth:`TrimmedFace.contains`, :meth:`TrimmedFace.boundary_loops`); the untrimmed surface is
+:attr:`TrimmedFace.surface`.  See :doc:`/guide/real_parts`.
 """
 
 from __future__ import annotations
