@@ -50,10 +50,9 @@ BLOCKS_PER_THREAD = 8
 #: and its kernels (about a second; minutes into an empty cache)
 COMPILED_SCATTERED = 1 << 15
 #: the same for grids, whose NumPy path costs less per point (one row stage for all u):
-#: below 3 * 2^18 partials it takes at most about 70 ms (50 ms for a bicubic 103 x 633
-#: grid to order 2), less than loading the grid kernels from a warm cache and a small
-#: fraction of compiling them (12-25 s each); the meshers' and the gallery's grids (up
-#: to 640k partials) stay below it, so a first `surfmod gallery` compiles no grid stage
+#: below it, less than loading the grid kernels; the meshers' and the gallery's grids stay
+#: below it, so a first `surfmod gallery` compiles no grid stage (design_eval.md,
+#: "Start-up, measured")
 COMPILED_GRID = 3 << 18
 
 

@@ -18,16 +18,13 @@ from ..eval.local import COMPILED_SCATTERED
 from ..surface import Surface
 
 #: point-cell pairs from which the seeds are searched by the compiled branch and bound
-#: (:func:`~surfmod.eval.projection_kernel.grid_seeds_compiled`); fewer by every triangle
-#: in NumPy (:func:`grid_seeds`, about 0.12 us a pair): below 2^21 pairs (500 points on
-#: a 40 x 40 seed grid) NumPy's 0.25 s is less than loading the compiled kernel from
-#: numba's cache (0.2-0.4 s) and far less than compiling it into an empty one (4-10 s)
+#: (:func:`~surfmod.eval.projection_kernel.grid_seeds_compiled`); fewer, by every triangle
+#: in NumPy (:func:`grid_seeds`), cost less than loading the kernel (design_eval.md,
+#: "The compiled grid")
 COMPILED_SEED_PAIRS = 1 << 21
-#: Newton starts from which B-spline projections iterate in the compiled loop
-#: (:func:`~surfmod.eval.projection_kernel.newton_in_boxes_compiled`, about 7 s to
-#: compile into an empty cache); below it NumPy's iteration (about 15 us a start), whose
-#: partials to order 2 (9 a start) then stay below eval.local.COMPILED_SCATTERED and so
-#: in NumPy too
+#: Newton starts from which B-spline projections iterate in the compiled loop; below it
+#: NumPy's iteration, whose partials to order 2 (9 a start) then stay below
+#: eval.local.COMPILED_SCATTERED and so in NumPy too
 COMPILED_NEWTON_STARTS = COMPILED_SCATTERED // 9
 
 
