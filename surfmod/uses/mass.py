@@ -1,9 +1,8 @@
 """Mass properties of solids: :func:`mass_properties` reads its input (a surfmod surface,
 faces, a build123d shape, a STEP path) and hands the faces read back to the quadrature
-pipeline of :mod:`surfmod.mass` (its module notes hold the method); ``method="occt"``
-returns OCCT's ``BRepGProp`` instead (the cross-check).
-
-The same concept as :mod:`surfmod.cli.mass` (the ``surfmod mass`` command over this).
+pipeline of :mod:`surfmod.mass`; ``method="occt"`` returns OCCT's ``BRepGProp`` instead (the
+cross-check).  The same concept as :mod:`surfmod.cli.mass` (the ``surfmod mass`` command over
+this).  See :doc:`/guide/uses` (section "How a face is integrated").
 """
 
 from __future__ import annotations
