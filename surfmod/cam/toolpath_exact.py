@@ -3,8 +3,8 @@ each face's own evaluator (ball, flat and bull nose: one set of equations, the b
 flat end its limits).
 
 A solution outside the face's trim, on a face seen from below, or one that does not
-converge keeps the mesh height and is reported so.  See :doc:`/guide/cam` (section "From a
-NURBS surface to G-code").
+converge keeps the mesh height and is reported so.  See :doc:`/guide/cam` (section "Exact
+heights").
 """
 
 from __future__ import annotations
