@@ -186,7 +186,19 @@ def test_an_stl_that_stays_open_is_said_and_the_first_mesh_kept(tmp_path, monkey
     asked = _fake_mesher(monkeypatch, open_until=0.0)
     with pytest.warns(sm.RoundTripWarning, match=r"^box.stl read back breaks its promise: solid 1: 3 open edge"):
         mesh = sm.export_stl("part", tmp_path / "box.stl", 0.01)
-    assert asked == [0.01, 0.005, 0.0025] and len(read_stl(tmp_path / "box.stl")) == len(mesh.faces) == 11
+    assert asked == [0.01, 0.005, 0.0025, 0.00125] and len(read_stl(tmp_path / "box.stl")) == len(mesh.faces) == 11
+
+
+def test_an_stl_is_meshed_again_down_to_an_eighth_of_the_tolerance(tmp_path, monkeypatch):
+    # a propeller's blade tip (bitcraze-mechanics' FreeCAD mockup): two B-spline faces meet
+    # at a knife edge and share triangles along it (5, 3 and 4 non-manifold edges at 0.01,
+    # 0.005 and 0.0025); at 0.00125 the mesh parts them and the STL closes
+    asked = _fake_mesher(monkeypatch, open_until=0.00125)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", sm.RoundTripWarning)
+        mesh = sm.export_stl("part", tmp_path / "box.stl", 0.01)
+    assert asked == [0.01, 0.005, 0.0025, 0.00125] and mesh.info["stl_problems"] == []
+    assert mesh.info["remeshed"].endswith("at tolerance 0.01: closed meshed again at 0.00125")
 
 
 def test_orientation_is_not_meshed_again(tmp_path, monkeypatch):
