@@ -313,6 +313,30 @@ def test_a_finishing_mesh_refused_before_any_operation_runs(monkeypatch):
     assert text.startswith("scallop: the finishing's mesh (tolerance): 0.001 is below") and "\n" not in text, text
 
 
+@pytest.mark.parametrize("finish, message", [
+    (sm.Finish(sm.Tool("flat", 1.0), scallop=0.05), "scallop: a flat end mill leaves no scallop"),
+    (sm.Finish(sm.Tool("ball", 1.0), scallop=-0.1), "scallop: must be a finite number > 0, got -0.1"),
+    (sm.Finish(sm.Tool("ball", 1.0), scallop=1.5), "scallop: must be smaller than the tool radius 1"),
+    (sm.Finish(sm.Tool("ball", 1.0), stepover=2.5), "stepover: 2.5 is larger than the tool diameter 2"),
+    (sm.Finish(sm.Tool("ball", 1.0), scallop=0.1, direction="z"), "direction: expected 'x' or 'y'"),
+])
+def test_a_scallop_the_tool_cannot_leave_is_refused_before_the_roughing(monkeypatch, finish, message):
+    """The finishing's stepover or scallop is checked against its tool as ``sm.toolpath``
+    checks it (one function), before any operation runs, naming the option to change."""
+    import surfmod.cam.job as job_module
+
+    def no_roughing(*args, **kwargs):
+        raise AssertionError("the roughing ran before the finishing's refusal")
+
+    monkeypatch.setattr(job_module, "rough", no_roughing)
+    with pytest.raises(sm.SurfmodError) as err:
+        sm.machine(bd.Box(10, 10, 4), 2.0, [sm.Rough(sm.Tool("flat", 2.0)), finish])
+    assert str(err.value).startswith(message), str(err.value)
+    if finish.scallop is not None and finish.direction == "x":
+        with pytest.raises(sm.SurfmodError, match="^" + re.escape(message)):
+            sm.toolpath(bd.Box(10, 10, 4), finish.tool, scallop=finish.scallop)
+
+
 def test_each_mesh_estimate_is_surveyed_once_before_its_meshing(monkeypatch):
     """The up-front check's curvature estimate is passed to the operation's meshing, not
     surveyed again (0.4 s each on the 280 mm mould): one survey per roughing and finishing

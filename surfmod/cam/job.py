@@ -29,7 +29,7 @@ from .rest import MAX_LOCATIONS, PAIRS_PER_POINT, STEEP_ANGLE, AboveStock, Stock
 from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
-from .toolpath import MAX_WORK, WorkMeter, mesh_estimate, meshed_part
+from .toolpath import MAX_WORK, WorkMeter, finish_settings, mesh_estimate, meshed_part
 from .verify import cusp_clearance, verify_job
 
 #: Clearance of links and retracts above the stock (mm).
@@ -257,26 +257,17 @@ def _rough_settings(op: Rough, tool: Tool, box: np.ndarray) -> tuple:
 
 
 def _finish_settings(op: Finish, tool: Tool) -> tuple:
-    """``(stepover or None, steep angle or None, tolerance)`` of a finishing, checked."""
-    if op.stepover is not None and op.scallop is not None:
-        raise SurfmodError("stepover: give either stepover or scallop, not both")
-    if op.scallop is None and op.stepover is None:
-        raise SurfmodError("stepover: give stepover or scallop")
-    stepover = None if op.stepover is None else checks.positive(op.stepover, "stepover")
-    if stepover is not None and stepover > tool.diameter:
-        raise SurfmodError(f"stepover: {stepover:g} is larger than the tool diameter {tool.diameter:g}")
-    if op.direction not in ("x", "y"):
-        raise SurfmodError(f"direction: expected 'x' or 'y', got {op.direction!r}")
+    """``(stepover or None, steep angle or None, tolerance)`` of a finishing, checked
+    (:func:`~surfmod.cam.toolpath.finish_settings`: a scallop the tool cannot leave is
+    refused here, before the roughing runs)."""
+    stepover, tolerance = finish_settings(tool, op.stepover, op.scallop, op.direction)
     steep = op.steep_angle
     if steep is not None:
         steep = float(steep)
         if not 0.0 < steep <= 90.0:
             raise SurfmodError(f"steep_angle: must be in (0, 90] degrees, got {op.steep_angle!r}")
     if op.scallop is not None:
-        tolerance = op.scallop / 10
-    else:
-        cusp = tool.scallop_for_stepover(stepover)
-        tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
+        return None, steep, op.scallop / 10
     return stepover, steep, tolerance
 
 
@@ -574,8 +565,6 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                                                max(cusp_clearance(done), scallop + tol), wall_skin(done), contours))
                 name = "rest"
             else:
-                if op.scallop is not None:
-                    tool.stepover_for_scallop(op.scallop)  # scallop >= radius etc. raise here
                 bar.update()
                 # the contours go down to the stock's bottom: how deep the tool goes is its
                 # body's to say (a shank no wider than the end follows the flutes down a

@@ -257,7 +257,12 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     return z, contacts
 
 
-def _stepover(tool: Tool, stepover, scallop) -> float:
+def finish_settings(tool: Tool, stepover, scallop, direction: str) -> tuple[float, float]:
+    """``(stepover, tolerance)`` of a finishing by ``tool`` given ``stepover`` or
+    ``scallop`` (the stepover that leaves it on flat ground), checked against the tool;
+    ``tolerance`` is the default depth no move may cut: a tenth of the cusp the stepover
+    leaves, or ``radius / 100`` where it leaves none.  :func:`toolpath` and the job's
+    finishing both call it, so a bad scallop is refused before any work."""
     if stepover is not None and scallop is not None:
         raise SurfmodError("stepover: give either stepover or scallop, not both")
     if scallop is not None:
@@ -268,7 +273,10 @@ def _stepover(tool: Tool, stepover, scallop) -> float:
         stepover = checks.positive(stepover, "stepover")
     if stepover > tool.diameter:
         raise SurfmodError(f"stepover: {stepover:g} is larger than the tool diameter {tool.diameter:g}")
-    return stepover
+    if direction not in ("x", "y"):
+        raise SurfmodError(f"direction: expected 'x' or 'y', got {direction!r}")
+    cusp = tool.scallop_for_stepover(stepover)
+    return stepover, cusp / 10 if cusp > 0 else tool.radius / 100
 
 
 def _drop_repeats(points: np.ndarray, index: np.ndarray):
@@ -307,15 +315,9 @@ def toolpath(obj, tool: Tool, stepover: float | None = None, *, scallop: float |
     (True, True)
     """
     tool = _check_tool(tool)
-    stepover = _stepover(tool, stepover, scallop)
+    stepover, default = finish_settings(tool, stepover, scallop, direction)
     step = tool.radius / 4 if step is None else checks.positive(step, "step")
-    if direction not in ("x", "y"):
-        raise SurfmodError(f"direction: expected 'x' or 'y', got {direction!r}")
-    if tolerance is None:
-        cusp = tool.scallop_for_stepover(stepover)
-        tolerance = cusp / 10 if cusp > 0 else tool.radius / 100
-    else:
-        tolerance = checks.positive(tolerance, "tolerance")
+    tolerance = default if tolerance is None else checks.positive(tolerance, "tolerance")
     if bounds is not None:
         box = checks.finite_array(bounds, "bounds")
         if box.shape != (2, 2) or np.any(box[1] < box[0]):
