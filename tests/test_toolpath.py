@@ -316,6 +316,21 @@ def test_gcode_export(tmp_path):
     assert "drop-cutter" in tp.to_gcode() and str(tp).startswith("toolpath: flat")
 
 
+def test_export_gcode_takes_a_toolpath_not_its_look_alike(tmp_path):
+    """The writer checks the type (the import cycle that made it guess from attributes is
+    gone): an object with a Toolpath's fields is refused naming ``toolpath``, no file made."""
+    from types import SimpleNamespace
+
+    tp = sm.toolpath(sm.plane((0, 0, 0), (4, 0, 0), (0, 4, 0)), sm.Tool("flat", 1.0), stepover=1.5)
+    look_alike = SimpleNamespace(**{k: getattr(tp, k) for k in ("points", "tool", "stepover", "scallop", "tolerance")})
+    path = tmp_path / "p.nc"
+    with pytest.raises(sm.SurfmodError, match="^toolpath: expected a surfmod Toolpath, got SimpleNamespace"):
+        sm.export_gcode(look_alike, path)
+    assert not path.exists()
+    sm.export_gcode(tp, path)
+    assert path.read_text() == tp.to_gcode()
+
+
 @pytest.mark.parametrize("make, arg", [
     (lambda: sm.Tool("ball", 0), "radius"),
     (lambda: sm.Tool("ball", -1), "radius"),

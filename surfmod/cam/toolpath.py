@@ -22,8 +22,8 @@ from ..meshing.brep import triangle_estimate
 from ..meshing.render import Drawing, polyline_runs, repr_png
 from .cutters import Cutter
 from .drop_cutter import TriangleGrid, drop, part_triangles
-from .gcode import gcode_text
 from .part_points import lift_gouges
+from .post import round_up
 from .toolpath_exact import exact_heights
 from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
@@ -94,9 +94,58 @@ class Toolpath:
     def length(self) -> float:
         return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
 
-    def to_gcode(self, **kw) -> str:
-        """The G-code text (see :func:`surfmod.export_gcode`)."""
-        return gcode_text(self, **kw)
+    def to_gcode(self, *, feed: float = 600.0, plunge_feed: float | None = None, safe_height: float | None = None,
+                 spindle: float | None = None, digits: int = 4) -> str:
+        """The G-code text (millimetres, absolute; written by :func:`surfmod.export_gcode`).
+        Heights are rounded up to ``digits`` decimals, so the written path never sits lower
+        than the verified one; x and y are rounded to nearest.
+
+        >>> import surfmod as sm
+        >>> tp = sm.toolpath(sm.plane((0, 0, 0), (2, 0, 0), (0, 2, 0)), sm.Tool("flat", 1.0), stepover=1.5)
+        >>> [ln for ln in tp.to_gcode().splitlines() if ln.startswith("G1 ")][:2]
+        ['G1 Z0.0000 F200', 'G1 X0.2500 Y0.0000 Z0.0000 F600']
+        """
+        feed = checks.positive(feed, "feed")
+        plunge = feed / 3 if plunge_feed is None else checks.positive(plunge_feed, "plunge_feed")
+        if int(digits) != digits or not 0 <= digits <= 8:
+            raise SurfmodError(f"digits: expected an integer 0..8, got {digits!r}")
+        digits = int(digits)
+        points = np.array(self.points, dtype=float)
+        points[:, 2] = round_up(points[:, 2], digits)
+        top = float(points[:, 2].max())
+        if safe_height is None:
+            safe = top + max(5.0, self.tool.radius)
+        else:
+            safe = float(checks.finite_array(safe_height, "safe_height"))
+            if safe <= top:
+                raise SurfmodError(f"safe_height: {safe:g} must be above the highest path point {top:.6g}")
+        number = f"{{:.{digits}f}}"
+        lines = [
+            "%",
+            f"(surfmod drop-cutter zig-zag: {self.tool.cutter.comment})",
+            f"(stepover {self.stepover:.6g} mm, scallop {self.scallop:.4g} mm, {len(points)} points)",
+            f"(every move checked: no cut deeper than {self.tolerance:.4g} mm)",
+            "G21 (millimetres)", "G90 (absolute)", "G17 (XY plane)",
+        ]
+        if spindle is not None:
+            lines.append(f"S{checks.positive(spindle, 'spindle'):.0f} M3")
+        x0, y0, z0 = points[0]
+        lines += [
+            f"G0 Z{number.format(safe)}",
+            f"G0 X{number.format(x0)} Y{number.format(y0)}",
+            f"G1 Z{number.format(z0)} F{plunge:g}",
+        ]
+        columns = [np.char.mod(f"%.{digits}f", points[1:, k]) for k in range(3)]
+        body = list(np.char.add(np.char.add(np.char.add("G1 X", columns[0]), np.char.add(" Y", columns[1])),
+                                np.char.add(" Z", columns[2])))
+        if body:
+            body[0] = f"{body[0]} F{feed:g}"
+        lines += body
+        lines += [f"G0 Z{number.format(safe)}"]
+        if spindle is not None:
+            lines.append("M5")
+        lines += ["M2", "%", ""]
+        return "\n".join(lines)
 
     def drawing(self) -> list[Drawing]:
         """The path as lines for :func:`surfmod.render`: raster passes in blue, links and
