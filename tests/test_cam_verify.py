@@ -611,11 +611,17 @@ def test_cli_machine_exit_3_and_header_on_a_broken_promise(tmp_path, capsys, mon
 
 
 # -- the repair ----------------------------------------------------------------------------------
-def test_a_low_rib_along_the_raster_is_recut_and_both_judges_agree():
+def test_a_low_rib_along_the_raster_is_recut_and_both_judges_agree(monkeypatch):
     """A rib 1 mm high running along the raster: the ball rolls over its edges, and the
     passes along x stand too far apart on the slopes it leaves there (0.16 mm of cusps for
     a 0.05 scallop).  The verifier finds the strips, cross passes re-cut them, the job is
-    judged again, and the tests' own simulation measures the same."""
+    judged again, and the tests' own simulation measures the same.  The part's top under
+    the stock model is computed once per operation, the repair reusing the finishing's."""
+    from surfmod.cam.rest import StockModel
+
+    tops = []
+    part_top = StockModel.part_top
+    monkeypatch.setattr(StockModel, "part_top", lambda self, tri: tops.append(len(tri)) or part_top(self, tri))
     part = bd.Box(40, 30, 5) + bd.Pos(0, 4, 3.0) * bd.Box(40, 6, 1.0)
     job = sm.machine(part, 1.0, [sm.Rough(sm.Tool("flat", 4.0), allowance=0.3),
                                  sm.Finish(sm.Tool("ball", 3.0), scallop=0.05)])
@@ -623,6 +629,7 @@ def test_a_low_rib_along_the_raster_is_recut_and_both_judges_agree():
     residual = _finding(job.verification, "residual")
     assert fin.report["recut"]["before"] > 2 * residual.limit and fin.report["recut"]["passes"] > 10
     assert job.verification.ok, str(job.verification)
+    assert len(tops) == 2, tops
 
     simulated = _simulated_residual(job, {1: Cutter("flat", 4.0), 2: Cutter("ball", 3.0)}, 80)
     assert simulated <= residual.limit + 0.005, simulated

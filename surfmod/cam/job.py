@@ -301,14 +301,14 @@ def _recut(job: Job, finishing: dict, stock: StockModel) -> Job:
     k = max(finishing)
     if any(o.name == "rest" for o in job.operations[k + 1:]):
         return job  # the residual judged is the rest tool's, which cross passes of the finishing do not serve
-    op, (spec, part, rest) = job.operations[k], finishing[k]
+    op, (spec, part, rest, floor) = job.operations[k], finishing[k]
     extra, passes = recut(part, op.tool, found.boxes, stepover=float(op.report["stepover"]), direction=spec.direction,
                           tolerance=float(op.report["tolerance"]), stock=job.stock, safe=job.safe_height, rest=rest,
                           over=found.worst / found.limit, raster=op.report.get("toolpath"))
     if passes == 0:
         return job
     extra, _ = clear_body(extra, op.tool, stock, part.grid.triangles, part.deflection, float(op.report["tolerance"]),
-                          job.safe_height, job.part, cusp_clearance(job.operations), wall_skin(job.operations))
+                          job.safe_height, job.part, cusp_clearance(job.operations), wall_skin(job.operations), floor)
     if not np.any(extra.kind != RAPID):
         return job
     motion = Motion(np.concatenate([op.motion.points, extra.points]), np.concatenate([op.motion.kind, extra.kind]))
@@ -329,14 +329,14 @@ def wall_skin(operations) -> float:
     return max((float(o.report["allowance"]) for o in operations[last + 1:] if o.name == "roughing"), default=0.0)
 
 
-def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape, cusp, skin, contours=None):
+def _held(motion, tool, stock_model, part, tolerance, safe, strict, name, shape, cusp, skin, floor, contours=None):
     """``(motion, held, levels)``: the operation's moves cleared of shank and holder
     collisions, a disc clearing the part by ``cusp`` (``skin``: :func:`wall_skin`), and
     where that left waterline contours out, those again at the holder's reach
     (:func:`_at_reach`, given the operation's ``contours``: their ``spacing``,
     ``steep_angle`` and where the stock stands for :func:`~surfmod.cam.finishing.reach_contours`;
-    None: it has none) in ``levels`` levels; with ``strict`` a collision refuses the job."""
-    floor = stock_model.part_top(part.grid.triangles)
+    None: it has none) in ``levels`` levels; with ``strict`` a collision refuses the job.
+    ``floor``: the part's top over the model's nodes, computed once per operation."""
     motion, held = clear_body(motion, tool, stock_model, part.grid.triangles, part.deflection, tolerance, safe,
                               shape, cusp, skin, floor)
     if held is not None and strict:
@@ -551,7 +551,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     motion, report = rough(p.grid, p.lift, grown, tool, allowance, stock, stepdown, stepover,
                                            CLEARANCE, deflection=p.deflection)
                     motion, held, _ = _held(motion, tool, stock_model, p, tolerance, safe, strict, "roughing", shape,
-                                            cusp_clearance(done), wall_skin(done))
+                                            cusp_clearance(done), wall_skin(done),
+                                            stock_model.part_top(p.grid.triangles))
                 report.update(allowance=allowance, stepdown=stepdown, stepover=stepover, tolerance=tolerance,
                               holder=held)
                 rest = Leftover(tool.radius + allowance, allowance + stepdown + p.lift, allowance + p.lift)
@@ -562,7 +563,8 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     motion, report = _rest(shape, op, tool, k, ops, done, stock, safe,
                                            lambda m, part, tol, scallop, contours: _held(
                                                m, tool, stock_model, part, tol, safe, strict, "rest machining", shape,
-                                               max(cusp_clearance(done), scallop + tol), wall_skin(done), contours))
+                                               max(cusp_clearance(done), scallop + tol), wall_skin(done),
+                                               stock_model.part_top(part.grid.triangles), contours))
                 name = "rest"
             else:
                 bar.update()
@@ -577,11 +579,12 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     w = report.get("waterline")
                     contours = (dict(spacing=w["spacing"], steep_angle=report["steep_angle"], stock=stock, rest=rest)
                                 if w and w["levels"] else None)
+                    floor = stock_model.part_top(finish_part.grid.triangles)  # the repair reuses it
                     motion, held, levels = _held(motion, tool, stock_model, finish_part, tolerance, safe, strict,
-                                                 "finishing", shape, cusp, wall_skin(done), contours)
+                                                 "finishing", shape, cusp, wall_skin(done), floor, contours)
                     if levels:
                         w["at_reach"] = levels
-                finishing[k] = (op, finish_part, rest)
+                finishing[k] = (op, finish_part, rest, floor)
                 report["holder"] = held
                 name = "finishing"
             done.append(Operation(name, tool, motion, operation_time(motion, tool, machine), report, machine))
