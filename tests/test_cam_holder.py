@@ -10,6 +10,7 @@ tests' own G-code reader, :mod:`stock_sim`), not the package's checks.
 import json
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import build123d as bd
 import numpy as np
@@ -23,7 +24,8 @@ from surfmod.cam.holder import clear_body, part_sink
 from surfmod.cam.rest import StockModel
 from surfmod.cam.roughing import FEED, RAPID, Motion
 from surfmod.cam.tool import load_tool_table
-from surfmod.cam.verify import verify_job
+from surfmod.cam import wall_dexels
+from surfmod.cam.verify import cusp_clearance, verify_job
 
 TOP, FLOOR, HALF, BLOCK = 5.0, -3.0, 6.0, 12.0
 HOLDER = 7.0
@@ -306,6 +308,35 @@ def test_a_holder_over_cusps_the_model_cannot_see_is_held():
                     np.array([RAPID, FEED, FEED], np.int8))
     kept, _ = clear_body(plunge, tool, stock, plane, 0.0, 0.001, 30.0)
     assert kept.points[:, 2].min() == tip  # blind: kept
+    kept, _ = clear_body(plunge, tool, stock, plane, 0.0, 0.001, 30.0, cusp=cusp)
+    assert kept.points[:, 2].min() > tip + 1.0, kept.points.tolist()
+
+
+def test_the_holder_clears_the_cusps_a_stepover_leaves_on_walls():
+    """A bull nose 3/1 finishing at a stepover of 2.5 leaves no scallop on flat ground, but
+    its contours 2.5 apart along a wall leave cusps up to 0.525 high (the wall check's
+    ``Cutter.wall_cusp`` on a wall of ``DEXEL_SLOPE``).  The holder is held above the part
+    by that same cusp: a plunge whose holder's bottom comes 0.3 over the part is left out
+    (the old rule, scallop + tolerance = 0.03, kept it: the holder in the cusps)."""
+    bull = sm.Tool("bull", 3.0, 1.0)
+    finishing = SimpleNamespace(name="finishing", tool=bull,
+                                report={"scallop": 0.0, "tolerance": 0.03, "waterline": {"spacing": 2.5}})
+    wall_cusp = bull.cutter.wall_cusp(2.5, wall_dexels.DEXEL_SLOPE)
+    assert 0.52 < wall_cusp < 0.53
+    cusp = cusp_clearance([finishing])
+    assert cusp == pytest.approx(wall_cusp + 0.03, rel=1e-15)
+    z = 18.0
+    stock = StockModel(np.array([[0.0, 0.0, 0.0], [40.0, 40.0, 20.0]]), 1.0)
+    tool = sm.Tool("bull", 3.0, 1.0, flute_length=5.0, shank_length=0.0, holder_radius=8.0, holder_length=20.0)
+    plane = np.array([[[-10.0, -10.0, z], [60.0, -10.0, z], [-10.0, 60.0, z]],
+                      [[60.0, -10.0, z], [60.0, 60.0, z], [-10.0, 60.0, z]]])
+    tip = z + 0.3 - 5.0  # the holder's bottom 0.3 over the part: below the wall cusps' 0.525
+    stock.sweep(Motion(np.array([[20.0, -5.0, tip], [20.0, 45.0, tip]]), np.array([RAPID, FEED], np.int8)),
+                sm.Tool("flat", 10.0, flute_length=40.0))  # the stock round it already cut
+    plunge = Motion(np.array([[20.0, 20.0, 30.0], [20.0, 20.0, tip], [20.0, 20.0, 30.0]]),
+                    np.array([RAPID, FEED, FEED], np.int8))
+    kept, _ = clear_body(plunge, tool, stock, plane, 0.0, 0.001, 30.0, cusp=0.03)
+    assert kept.points[:, 2].min() == tip  # the old clearance: kept
     kept, _ = clear_body(plunge, tool, stock, plane, 0.0, 0.001, 30.0, cusp=cusp)
     assert kept.points[:, 2].min() > tip + 1.0, kept.points.tolist()
 

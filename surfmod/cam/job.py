@@ -30,7 +30,7 @@ from .rest import summary_line as rest_summary
 from .roughing import RAPID, Motion, left_summary, rough
 from .tool import Tool
 from .toolpath import MAX_WORK, WorkMeter, finish_settings, mesh_estimate, meshed_part
-from .verify import cusp_clearance, verify_job
+from .verify import cusp_clearance, cusp_left, verify_job
 
 #: Clearance of links and retracts above the stock (mm).
 CLEARANCE = 5.0
@@ -575,7 +575,7 @@ def machine(part, stock, operations, *, progress: bool = False, verify: bool = T
                     motion, report, finish_part = _finish(shape, op, tool, stock, safe, rest, progress, estimates[k])
                     tolerance = float(report["tolerance"])
                     # its own cusps too: a holder coming down beside the part passes over them
-                    cusp = max(cusp_clearance(done), float(report["scallop"]) + tolerance)
+                    cusp = max(cusp_clearance(done), cusp_left(report, tool.cutter) + tolerance)
                     w = report.get("waterline")
                     contours = (dict(spacing=w["spacing"], steep_angle=report["steep_angle"], stock=stock, rest=rest)
                                 if w and w["levels"] else None)

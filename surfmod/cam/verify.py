@@ -587,11 +587,21 @@ def body_stand(drop, xy: np.ndarray, tool, slack: float, grow: float = 0.0, clea
     return np.array(rows).reshape(len(rows), len(xy))
 
 
+def cusp_left(report: dict, cutter) -> float:
+    """The highest cusp a finishing or rest operation (its ``report``, its tool's
+    ``cutter``) leaves: its scallop, or the cusp its contours leave a wall of
+    ``DEXEL_SLOPE`` where they stand the report's ``spacing`` apart along it, when more (a
+    stepover asked of a bull nose, :meth:`~surfmod.cam.cutters.Cutter.wall_cusp`).  The
+    walls are judged against it and the holder kept above it (:func:`cusp_clearance`)."""
+    spacing = (report.get("waterline") or {}).get("spacing")
+    return max(float(report.get("scallop") or 0.0), cutter.wall_cusp(float(spacing), W.DEXEL_SLOPE) if spacing else 0.0)
+
+
 def cusp_clearance(operations) -> float:
-    """The highest cusp the finishing and rest ``operations`` leave: their scallop with its
-    tolerance.  :func:`body_stand` holds every disc of a shank or holder that far above the
-    part, in the job and in the verifier's reach alike."""
-    return max((float(o.report["scallop"]) + float(o.report["tolerance"]) for o in operations
+    """The highest cusp the finishing and rest ``operations`` leave (:func:`cusp_left`)
+    with its tolerance.  :func:`body_stand` holds every disc of a shank or holder that far
+    above the part, in the job and in the verifier's reach alike."""
+    return max((cusp_left(o.report, o.tool.cutter) + float(o.report["tolerance"]) for o in operations
                 if o.name != "roughing"), default=0.0)
 
 
@@ -659,11 +669,9 @@ def _wall_residual(part: PartPoints, moves: ProgramMoves, radii: np.ndarray, cor
         every = math.ceil(len(q) / MAX_WALL_POINTS)
         notes.append(f"note: walls: every {every}th of {len(q):,} stock points judged ({MAX_WALL_POINTS:,} at most)")
         q = q[::every]
-    # the cusps the contours leave on the least steep wall judged, their levels the report's
-    # ``spacing`` apart along it: more than the scallop where a stepover was asked
-    spacing = (op.report.get("waterline") or {}).get("spacing")
-    scallop = max(float(op.report.get("scallop") or 0.0),
-                  cutter.wall_cusp(float(spacing), W.DEXEL_SLOPE) if spacing else 0.0)
+    # the cusps the contours leave on the least steep wall judged: more than the scallop
+    # where a stepover was asked
+    scallop = cusp_left(op.report, cutter)
     # the stamps' sag between stamps half a cell apart, as in the height field
     bound = scallop + limit + (cell / 4) ** 2 / (2 * max(cutter.corner, cell))
     if not len(q):
