@@ -84,11 +84,7 @@ def run(args) -> int:
     rest_tool = _tool(args.rest, 3, table, "rest") if args.rest else None
     if args.stepdown is not None and not args.stepdown > 0:
         raise SurfmodError(f"stepdown: must be > 0, got {args.stepdown:g}")
-    if not args.scallop > 0:
-        raise SurfmodError(f"scallop: must be > 0, got {args.scallop:g}")
-    if args.scallop >= finish_tool.radius:
-        raise SurfmodError(f"scallop: {args.scallop:g} must be smaller than the finishing tool radius "
-                           f"{finish_tool.radius:g}")
+    # the finishing's scallop is checked against its tool by sm.machine before any work
     if rest_tool is not None and args.scallop >= rest_tool.radius:
         raise SurfmodError(f"scallop: {args.scallop:g} must be smaller than the rest tool radius {rest_tool.radius:g}")
     if not args.allowance >= 0:
