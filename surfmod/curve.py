@@ -14,7 +14,7 @@ import numpy as np
 from . import checks, pictures
 from .errors import SurfmodError
 from .immutable import Immutable
-from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
+from .transforms import Transformable
 
 
 def _finite(out: np.ndarray, t: np.ndarray, what: str) -> np.ndarray:
@@ -25,7 +25,7 @@ def _finite(out: np.ndarray, t: np.ndarray, what: str) -> np.ndarray:
     raise SurfmodError(f"t: the {what} at t = {t[i]:.17g} are not finite (the curve is singular or overflows there)")
 
 
-class Curve(Immutable, abc.ABC):
+class Curve(Transformable, Immutable, abc.ABC):
     """Base of every parametric curve in surfmod.
 
     Curves evaluate like surfaces, vectorized over the parameter:
@@ -137,15 +137,3 @@ class Curve(Immutable, abc.ABC):
         t = ((b[1:, None] + b[:-1, None]) / 2 + half * nodes).ravel()
         speed = np.linalg.norm(self._derivatives(t, 1)[:, 1, :], axis=-1)
         return float(np.sum((half * wts).ravel() * speed))
-
-    def translated(self, vector) -> "Curve":
-        return self.transformed(translation_matrix(vector))
-
-    def rotated(self, axis_origin, axis_direction, degrees: float) -> "Curve":
-        return self.transformed(rotation_matrix(axis_origin, axis_direction, degrees))
-
-    def mirrored(self, point, normal) -> "Curve":
-        return self.transformed(mirror_matrix(point, normal))
-
-    def scaled(self, factor, center=(0.0, 0.0, 0.0)) -> "Curve":
-        return self.transformed(scale_matrix(factor, center))

@@ -2,8 +2,8 @@
 
 A subclass supplies its parameter ``domain``, ``_derivatives(u, v, order)`` on flat,
 validated parameter arrays, ``geom()`` (its OCCT twin) and ``transformed(matrix)``.
-Everything else (broadcasting, grids, normals, curvature, faces, the named transforms)
-is derived here once.
+Everything else (broadcasting, grids, normals, curvature, faces) is derived here once;
+the named transforms come from ``transforms.Transformable``.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from . import checks, pictures, tolerances
 from .errors import SurfmodError
 from .eval.differential import Curvatures, curvatures, degenerate_mask, unit_normals
 from .immutable import Immutable
-from .transforms import mirror_matrix, rotation_matrix, scale_matrix, translation_matrix
+from .transforms import Transformable
 
 
 def all_finite(out: np.ndarray) -> bool:
@@ -77,7 +77,7 @@ def model_size(*surfaces, samples: int = 9) -> float:
     return size if np.isfinite(size) else 0.0
 
 
-class Surface(Immutable, abc.ABC):
+class Surface(Transformable, Immutable, abc.ABC):
     """Base of every parametric surface in surfmod.
 
     Parameters broadcast like NumPy ufunc arguments; results carry the broadcast shape
@@ -279,20 +279,3 @@ class Surface(Immutable, abc.ABC):
     def _repr_png_(self) -> bytes | None:
         """A shaded picture for Jupyter (see :func:`surfmod.meshing.render.png_bytes`)."""
         return pictures.repr_png(self)
-
-    # -- named transforms (all through ``transformed``) ----------------------------------
-    def translated(self, vector) -> "Surface":
-        """A copy moved by ``vector``."""
-        return self.transformed(translation_matrix(vector))
-
-    def rotated(self, axis_origin, axis_direction, degrees: float) -> "Surface":
-        """A copy rotated by ``degrees`` about the axis (right-hand rule)."""
-        return self.transformed(rotation_matrix(axis_origin, axis_direction, degrees))
-
-    def mirrored(self, point, normal) -> "Surface":
-        """A copy mirrored in the plane through ``point`` with ``normal``."""
-        return self.transformed(mirror_matrix(point, normal))
-
-    def scaled(self, factor, center=(0.0, 0.0, 0.0)) -> "Surface":
-        """A copy scaled about ``center``; ``factor`` is a number or three (non-uniform)."""
-        return self.transformed(scale_matrix(factor, center))

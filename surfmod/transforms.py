@@ -80,3 +80,26 @@ def scale_matrix(factor, center=(0.0, 0.0, 0.0)) -> np.ndarray:
     m[:3, :3] = np.diag(f)
     m[:3, 3] = c - f * c
     return m
+
+
+class Transformable:
+    """The named transforms of a surface or curve, each a matrix given to the object's
+    own ``transformed(matrix)``."""
+
+    __slots__ = ()
+
+    def translated(self, vector):
+        """A copy moved by ``vector``."""
+        return self.transformed(translation_matrix(vector))
+
+    def rotated(self, axis_origin, axis_direction, degrees: float):
+        """A copy rotated by ``degrees`` about the axis (right-hand rule)."""
+        return self.transformed(rotation_matrix(axis_origin, axis_direction, degrees))
+
+    def mirrored(self, point, normal):
+        """A copy mirrored in the plane through ``point`` with ``normal``."""
+        return self.transformed(mirror_matrix(point, normal))
+
+    def scaled(self, factor, center=(0.0, 0.0, 0.0)):
+        """A copy scaled about ``center``; ``factor`` is a number or three (non-uniform)."""
+        return self.transformed(scale_matrix(factor, center))

@@ -12,7 +12,7 @@ from strategies import bspline_surfaces
 from surfmod import transforms
 from twins.transformed import geom_gtransformed, geom_transformed, named_trsf, trsf_matrix
 from surfmod.occ.geom import surface_type
-from surfmod.occ.sample import surface_d0
+from surfmod.occ.sample import curve_d2, surface_d0
 
 
 def _net(n, m, seed=0):
@@ -195,3 +195,20 @@ def test_transforms_are_new_objects_and_frozen():
 def test_bad_transform_input(call, match):
     with pytest.raises(sm.SurfmodError, match=match):
         call(SUBJECTS["bspline"]())
+
+
+CURVES = {
+    "nurbs": lambda: sm.BSplineCurve([(0, 0, 0), (1, 2, 0.5), (3, 1, -1), (4, 3, 2)], 2, weights=[1, 2, 0.5, 1]),
+    "circle": lambda: sm.Circle((1, -1, 0.5), (1, 2, 2), 1.5),
+    "line": lambda: sm.Line((0, 1, 2), (3, -1, 4)),
+}
+
+
+@pytest.mark.parametrize("subject", sorted(CURVES))
+def test_curves_share_the_named_transforms_and_match_gp_trsf(subject):
+    c = CURVES[subject]()
+    for apply, trsf_args in NAMED.values():
+        mine = apply(c)
+        t = np.linspace(*mine.domain, 11)
+        theirs = curve_d2(c.geom().Transformed(named_trsf(*trsf_args)), t)[:, 0]
+        np.testing.assert_allclose(mine.points(t), theirs, rtol=0, atol=1e-11)

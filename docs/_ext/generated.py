@@ -37,6 +37,7 @@ import re
 from pathlib import Path
 
 import surfmod
+from surfmod.transforms import Transformable
 
 from . import api_groups
 
@@ -76,7 +77,10 @@ def api_rst() -> str:
         for n in names:
             obj = getattr(surfmod, n)
             if inspect.isclass(obj):
-                lines += [f".. autoclass:: {n}", "   :members:", ""]
+                lines += [f".. autoclass:: {n}", "   :members:"]
+                if Transformable in obj.__bases__:  # its named transforms, written once in the mixin
+                    lines.append("   :inherited-members: Immutable, ABC")
+                lines.append("")
             else:
                 lines += [f".. autofunction:: {n}", ""]
     return "\n".join(lines)
