@@ -12,6 +12,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface, cartesian, homogeneous
 from ..nets.elevate import elevated, make_compatible
+from ..nets.knots import greville
 from .from_edge import as_curve
 
 BLENDS = ("linear", "hermite")
@@ -63,12 +64,6 @@ def _corner_check(curves, tolerance):
                 f"{b}: its {which[ib]} is {gap:.3g} away from the {which[ia]} of {a}; the boundary "
                 f"curves must meet at the corner {label} (c0/c1 run along u at v0/v1, d0/d1 along v at u0/u1)"
             )
-
-
-def _greville01(knots, degree, n):
-    """Normalized Greville abscissae: the coefficients of ``s`` in the spline space."""
-    g = np.array([knots[i + 1 : i + degree + 1].mean() for i in range(n)])
-    return (g - knots[degree]) / (knots[n] - knots[degree])
 
 
 def _bezier_elevated(coefs, degree):
@@ -145,8 +140,9 @@ def coons(c0, c1, d0, d1, *, blend: str = "linear", tolerance: float = 1e-7) -> 
         h0, h1, hd0, hd1 = (c.control_points for c in curves)
     n, m = len(h0), len(hd0)
     if blend == "linear":
-        fu = 1.0 - _greville01(cu[0].knots, cu[0].degree, n)
-        fv = 1.0 - _greville01(cv[0].knots, cv[0].degree, m)
+        # 1 - s at the Greville abscissae, s running over [0, 1] on the domain
+        fu, fv = (1.0 - (greville(c.knots, c.degree) - c.domain[0]) / (c.domain[1] - c.domain[0])
+                  for c in (cu[0], cv[0]))
         gu, gv = 1.0 - fu, 1.0 - fv
     else:
         fu, gu = _hermite_coefficients(n)

@@ -20,6 +20,20 @@ def span_samples(breaks: np.ndarray, per_span: int) -> np.ndarray:
     return np.concatenate([(breaks[:-1, None] + np.diff(breaks)[:, None] * t).ravel(), breaks[-1:]])
 
 
+def greville(knots: np.ndarray, degree: int) -> np.ndarray:
+    """Greville abscissae: the means of ``degree`` consecutive knots, one per control
+    point.  A spline whose control values are a linear function of them is that linear
+    function, and they are the collocation sites of degree elevation.  A window of equal
+    knots gives that knot exactly (a clamped vector's first and last lie on its ends).
+
+    >>> greville(np.array([0.0, 0, 0, 0.5, 1, 1, 1]), 2).tolist()
+    [0.0, 0.25, 0.75, 1.0]
+    """
+    n = len(knots) - degree - 1
+    windows = np.lib.stride_tricks.sliding_window_view(knots[1:-1], degree)[:n]
+    return np.clip(windows.mean(axis=1), windows[:, 0], windows[:, -1])
+
+
 def multiplicity(knots: np.ndarray, t: float) -> int:
     """How many times ``t`` occurs in ``knots`` (exact comparison)."""
     return int(np.count_nonzero(knots == t))

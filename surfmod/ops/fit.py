@@ -15,6 +15,7 @@ from .. import checks
 from ..errors import SurfmodError
 from ..eval.basis import basis_derivatives, find_spans
 from ..nets.bspline import BSplineSurface
+from ..nets.knots import greville
 from .closest import newton_closest
 from .project import project
 from ..surface import require_surface
@@ -124,17 +125,11 @@ class HeightFrame(NamedTuple):
         """Control net whose in-plane coordinates are the linear map of the Greville
         abscissae (a B-spline reproduces linear functions exactly) and whose heights
         are ``heights`` ``(n, m)``."""
-        gu, gv = (_greville(k, p) for k, p in zip(knots, degree))
+        gu, gv = (greville(k, p) for k, p in zip(knots, degree))
         x = self.x0 + gu * self.lx
         y = self.y0 + gv * self.ly
         e1, e2, nrm = self.axes
         return (self.origin + x[:, None, None] * e1 + y[None, :, None] * e2 + heights[..., None] * nrm)
-
-
-def _greville(knots, degree):
-    n = len(knots) - degree - 1
-    windows = np.lib.stride_tricks.sliding_window_view(knots[1:-1], degree)[:n]
-    return windows.mean(axis=1)
 
 
 def height_frame(points: np.ndarray):
