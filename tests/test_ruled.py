@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.nets.elevate import elevated, make_compatible
+from surfmod.nets.elevate import compatible, elevated, make_compatible
 from surfmod.occ.sample import curve_d2, surface_d0
 
 
@@ -137,6 +137,36 @@ def test_make_compatible_shares_degree_domain_and_knots():
     assert ca.domain == cb.domain == (0.0, 3.0)
     np.testing.assert_array_equal(ca.knots, cb.knots)
     np.testing.assert_allclose(ca.points(np.linspace(0, 3, 7)), a.points(np.linspace(0, 1, 7)), atol=1e-14)
+
+
+def _rational_pair():
+    rng = np.random.default_rng(11)
+    a = sm.BSplineSurface(rng.normal(size=(5, 6, 3)), (2, 3), ([0, 0, 0, 0.5, 0.8, 1, 1, 1], [0, 0, 0, 0, 0.3, 0.6, 1, 1, 1, 1]),
+                          1 + rng.random((5, 6)))
+    b = sm.BSplineSurface(rng.normal(size=(5, 4, 3)), (3, 2), ([0, 0, 0, 0, 0.5 + 1e-12, 1, 1, 1, 1], [0, 0, 0, 0.3, 1, 1, 1]),
+                          1 + rng.random((5, 4)))
+    return a, b
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_compatible_nets_along_either_axis_share_snapped_knots(axis):
+    """Gordon's terms and the blend's rows go through the one home with a net axis: the
+    surfaces do not change, and knots within the tolerance become the first's knot in
+    every output (``tol=0`` keeps both)."""
+    a, b = _rational_pair()
+    nets = [(s.knots[axis], s.degree[axis], s._homogeneous) for s in (a, b)]
+    degree, knots, out = compatible(nets, axis=axis)
+    assert degree == 3
+    u, v = np.meshgrid(np.linspace(0, 1, 13), np.linspace(0, 1, 11), indexing="ij")
+    for s, h in zip((a, b), out):
+        deg, kv = list(s.degree), list(s.knots)
+        deg[axis], kv[axis] = degree, knots
+        same = sm.BSplineSurface(h[..., :3] / h[..., 3:], tuple(deg), tuple(kv), h[..., 3])
+        np.testing.assert_allclose(same.points(u, v), s.points(u, v), rtol=0, atol=1e-10)
+    if axis == 0:
+        assert np.unique(knots[(knots > 0.4) & (knots < 0.6)]).tolist() == [0.5]
+        _, exact, _ = compatible(nets, tol=0.0)
+        assert np.unique(exact[(exact > 0.4) & (exact < 0.6)]).tolist() == [0.5, 0.5 + 1e-12]
 
 
 @pytest.mark.parametrize(

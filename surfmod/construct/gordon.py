@@ -12,9 +12,8 @@ import numpy as np
 
 from .. import checks
 from ..errors import SurfmodError
-from ..nets import knots as kn
 from ..nets.bspline import BSplineCurve, BSplineSurface
-from ..nets.elevate import elevate_degree, make_compatible, merged_knots, reparametrized
+from ..nets.elevate import compatible, make_compatible, reparametrized
 from .fitting import averaging_knots, interp_along
 from .from_edge import as_curves
 
@@ -138,43 +137,16 @@ def _reparametrized_curve(curve, crossings, targets, tolerance):
 
 
 # -- surface algebra ------------------------------------------------------------------------
-def _elevate_along(h, knots, degree, target, axis):
-    if target == degree:
-        return h, knots
-    a = np.moveaxis(h, axis, 0)
-    k, c = elevate_degree(knots, degree, a.reshape(a.shape[0], -1), target - degree)
-    return np.moveaxis(c.reshape((c.shape[0],) + a.shape[1:]), 0, axis), k
-
-
-def _insert_along(h, knots, degree, values, mults, axis):
-    a = np.moveaxis(h, axis, 0)
-    for value, mult in zip(values, mults):
-        cap = degree + 1 if value in (knots[0], knots[-1]) else degree
-        need = min(int(mult), cap) - kn.multiplicity(knots, value)
-        if need > 0:
-            knots, a = kn.insert_knot(knots, degree, a, float(value), need)
-    return np.moveaxis(a, 0, axis), knots
-
-
 def _compatible_sum(terms):
     """``sum(sign * surface)`` over ``(sign, net, (p, q), (U, V))`` after elevating every
     term to the common degrees and merging the knot vectors (exact)."""
-    out_deg = [max(t[2][d] for t in terms) for d in (0, 1)]
-    elevated = []
-    for sign, net, deg, knots in terms:
-        ks = list(knots)
-        for d in (0, 1):
-            net, ks[d] = _elevate_along(net, ks[d], deg[d], out_deg[d], d)
-        elevated.append((sign, net, ks))
-    common = [merged_knots([ks[d] for _, _, ks in elevated], tol=0.0) for d in (0, 1)]
-    total = None
-    knots_out = None
-    for sign, net, ks in elevated:
-        for d in (0, 1):
-            net, ks[d] = _insert_along(net, ks[d], out_deg[d], *common[d], d)
-        total = sign * net if total is None else total + sign * net
-        knots_out = ks
-    return total, tuple(out_deg), tuple(knots_out)
+    signs, nets = [t[0] for t in terms], [t[1] for t in terms]
+    degree, knots = [], []
+    for d in (0, 1):  # tol=0: snapping a knot would move its term, and the sum must be exact
+        p, k, nets = compatible([(t[3][d], t[2][d], net) for t, net in zip(terms, nets)], tol=0.0, axis=d)
+        degree.append(p)
+        knots.append(k)
+    return sum(sign * net for sign, net in zip(signs, nets)), tuple(degree), tuple(knots)
 
 
 def _check_ends(curves, t, tn, tol, name, order, other):

@@ -30,10 +30,11 @@ def clamped(curve: BSplineCurve) -> BSplineCurve:
     return curve.segment(*curve.domain)
 
 
-def elevate_degree(knots: np.ndarray, degree: int, ctrl: np.ndarray, times: int):
+def elevate_degree(knots: np.ndarray, degree: int, ctrl: np.ndarray, times: int, axis: int = 0):
     """Raise the degree of a clamped spline by ``times``: ``(new_knots, new_ctrl)``.
 
-    ``ctrl`` is ``(n, dim)`` (homogeneous for rational splines).
+    ``ctrl`` holds the control index along ``axis`` (homogeneous for rational splines);
+    the other axes ride along (coordinates, the other direction of a surface's net).
 
     >>> import numpy as np
     >>> k, c = elevate_degree(np.array([0., 0, 1, 1]), 1, np.array([[0., 0], [2, 0]]), 1)
@@ -42,16 +43,15 @@ def elevate_degree(knots: np.ndarray, degree: int, ctrl: np.ndarray, times: int)
     """
     if times <= 0:
         return knots, ctrl
+    a = np.moveaxis(ctrl, axis, 0)
     values, counts = np.unique(knots, return_counts=True)
     new_knots = np.repeat(values, counts + times)
     q = degree + times
-    n_new = new_knots.size - q - 1
-    windows = np.lib.stride_tricks.sliding_window_view(new_knots[1:-1], q)[:n_new]
-    greville = windows.mean(axis=1)
-    greville[0], greville[-1] = new_knots[q], new_knots[n_new]
-    mat = basis_matrix(new_knots, q, n_new, greville)[0]
-    rhs = curve_derivatives(knots, degree, ctrl, greville, 0)[:, 0]
-    return new_knots, np.linalg.solve(mat, rhs)
+    sites = kn.greville(new_knots, q)
+    mat = basis_matrix(new_knots, q, sites.size, sites)[0]
+    rhs = curve_derivatives(knots, degree, a.reshape(a.shape[0], -1), sites, 0)[:, 0]
+    new = np.linalg.solve(mat, rhs).reshape((sites.size,) + a.shape[1:])
+    return new_knots, np.moveaxis(new, 0, axis)
 
 
 def elevated(curve: BSplineCurve, degree: int) -> BSplineCurve:
@@ -62,32 +62,34 @@ def elevated(curve: BSplineCurve, degree: int) -> BSplineCurve:
     return BSplineCurve._trusted(pts, degree, k, w)
 
 
+def rescaled_knots(knots: np.ndarray, t0: float, t1: float) -> np.ndarray:
+    """The knot vector mapped affinely onto ``[t0, t1]``, its ends exactly there."""
+    new = t0 + (knots - knots[0]) * ((t1 - t0) / (knots[-1] - knots[0]))
+    new[0], new[-1] = t0, t1
+    return np.clip(new, t0, t1)
+
+
 def reparametrized(curve: BSplineCurve, t0: float, t1: float) -> BSplineCurve:
     """Affine change of parameter mapping the (clamped) knot range onto ``[t0, t1]``."""
-    k = curve.knots
-    new = t0 + (k - k[0]) * ((t1 - t0) / (k[-1] - k[0]))
-    new[0], new[-1] = t0, t1
-    new[new < t0] = t0
-    new[new > t1] = t1
-    return BSplineCurve._trusted(curve.control_points, curve.degree, new, curve.weights)
+    return BSplineCurve._trusted(curve.control_points, curve.degree, rescaled_knots(curve.knots, t0, t1),
+                                 curve.weights)
 
 
-def with_knots(curve: BSplineCurve, values, mults, tol: float = KNOT_TOL) -> BSplineCurve:
-    """Insert knots so that each ``values[i]`` has multiplicity at least ``mults[i]``; a
-    knot within ``tol`` of an existing one raises that knot's multiplicity instead (as
-    OCCT's ``InsertKnots`` with a parametric tolerance)."""
-    k, h = curve.knots, homogeneous(curve.control_points, curve.weights)
+def inserted(knots, degree: int, ctrl: np.ndarray, values, mults, tol: float = KNOT_TOL, axis: int = 0):
+    """Insert knots so that each ``values[i]`` has multiplicity at least ``mults[i]``
+    (at most the degree, or degree + 1 at the ends); a knot within ``tol`` of an
+    existing one raises that knot's multiplicity instead (as OCCT's ``InsertKnots`` with a
+    parametric tolerance).  ``ctrl`` as in :func:`elevate_degree`; returns ``(knots, ctrl)``."""
+    a = np.moveaxis(ctrl, axis, 0)
     for value, mult in zip(values, mults):
-        existing = np.unique(k)
+        existing = np.unique(knots)
         near = existing[np.abs(existing - value) <= tol]
         at = float(near[0]) if near.size else float(value)
-        have = kn.multiplicity(k, at)
-        cap = curve.degree + 1 if (at == k[0] or at == k[-1]) else curve.degree
-        need = min(int(mult), cap) - have
+        cap = degree + 1 if at in (knots[0], knots[-1]) else degree
+        need = min(int(mult), cap) - kn.multiplicity(knots, at)
         if need > 0:
-            k, h = kn.insert_knot(k, curve.degree, h, at, need)
-    pts, w = cartesian(h, curve.weights is not None)
-    return BSplineCurve._trusted(pts, curve.degree, k, w)
+            knots, a = kn.insert_knot(knots, degree, a, at, need)
+    return knots, np.moveaxis(a, 0, axis)
 
 
 def merged_knots(knot_vectors, tol: float = KNOT_TOL):
@@ -108,11 +110,36 @@ def merged_knots(knot_vectors, tol: float = KNOT_TOL):
     return np.asarray(values)[order], np.asarray(mults)[order]
 
 
+def compatible(splines, tol: float = KNOT_TOL, axis: int = 0):
+    """One degree and one knot vector for clamped splines ``[(knots, degree, ctrl)]`` over
+    one parameter interval: each is elevated to the highest degree and given the union of
+    all knots at their highest multiplicities (exact: the splines do not change).  Knots
+    within ``tol`` count as one, and the first spline's value is the one kept; ``tol=0``
+    merges equal knots only.  ``ctrl`` as in :func:`elevate_degree`.  Returns
+    ``(degree, knots, [ctrl, ...])``.
+
+    >>> import numpy as np
+    >>> line = (np.array([0., 0, 1, 1]), 1, np.array([[0.], [2.]]))
+    >>> bump = (np.array([0., 0, 0, 0.5, 1, 1, 1]), 2, np.array([[0.], [1.], [1.], [0.]]))
+    >>> p, k, (a, b) = compatible([line, bump])
+    >>> p, k.tolist(), a.ravel().tolist()
+    (2, [0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0], [0.0, 0.5, 1.5, 2.0])
+    """
+    degree = max(p for _, p, _ in splines)
+    up = [elevate_degree(k, p, c, degree - p, axis) for k, p, c in splines]
+    values, mults = merged_knots([k for k, _ in up], tol)
+    knots, first = inserted(up[0][0], degree, up[0][1], values, mults, tol, axis)
+    # the others take the first's knots, so a knot snapped in one is snapped in all
+    values, mults = np.unique(knots, return_counts=True)
+    return degree, knots, [first] + [inserted(k, degree, c, values, mults, tol, axis)[1] for k, c in up[1:]]
+
+
 def make_compatible(curves, tol: float = KNOT_TOL):
     """Same degree, same parameter interval, same knot vector (``GeomFill_Profiler``):
-    every curve is elevated to the highest degree, reparametrized onto the interval of
-    the curve with the longest one (the first such curve wins) and given the union of
-    all knots (maximal multiplicities).  Returns the list of compatible curves.
+    every curve is reparametrized onto the interval of the curve with the longest one
+    (the first such curve wins), elevated to the highest degree and given the union of
+    all knots (maximal multiplicities, :func:`compatible`).  Returns the list of
+    compatible curves.
 
     >>> import surfmod as sm
     >>> a = sm.BSplineCurve([(0, 0, 0), (1, 1, 0), (2, 0, 0)], 2)
@@ -121,11 +148,9 @@ def make_compatible(curves, tol: float = KNOT_TOL):
     ([2, 2], (0.0, 2.0))
     """
     curves = [clamped(c.to_bspline()) for c in curves]
-    degree = max(c.degree for c in curves)
     spans = [c.domain[1] - c.domain[0] for c in curves]
     widest = curves[int(np.argmax(spans))].domain
-    curves = [reparametrized(elevated(c, degree), *widest) for c in curves]
-    values, mults = merged_knots([c.knots for c in curves], tol)
-    first = with_knots(curves[0], values, mults, tol)
-    vals1, mults1 = np.unique(first.knots, return_counts=True)
-    return [first] + [with_knots(c, vals1, mults1, tol) for c in curves[1:]]
+    degree, knots, nets = compatible(
+        [(rescaled_knots(c.knots, *widest), c.degree, homogeneous(c.control_points, c.weights)) for c in curves], tol)
+    out = [cartesian(h, c.weights is not None) for h, c in zip(nets, curves)]
+    return [BSplineCurve._trusted(pts, degree, knots, w) for pts, w in out]

@@ -9,11 +9,10 @@ import numpy as np
 
 from ..errors import SurfmodError
 from ..eval.basis import basis_matrix
-from ..nets import knots as kn
 from ..nets.bspline import BSplineSurface, cartesian
 from ..nets.convert import as_bspline_surface
 from ..readback import surface_of
-from ..nets.elevate import KNOT_TOL, elevate_degree, merged_knots
+from ..nets.elevate import compatible, rescaled_knots
 from ..sides import SIDES, side_params
 from ..surface import Surface
 
@@ -47,38 +46,6 @@ def side_curves(s: BSplineSurface, side: str, order: int):
     sign = -1.0 if end == 0 else 1.0                                    # leaving through the low end
     rows *= (sign ** np.arange(order + 1))[:, None, None]
     return rows, s.knots[1 - fixed], s.degree[1 - fixed]
-
-
-def _normalized(knots):
-    k = (knots - knots[0]) / (knots[-1] - knots[0])
-    k[0], k[-1] = 0.0, 1.0
-    return k
-
-
-def _compatible(curves):
-    """``[(knots, degree, ctrl (k, m, 4))]`` -> same degree and knots for all."""
-    degree = max(p for _, p, _ in curves)
-    up = []
-    for knots, p, ctrl in curves:
-        k, c = knots, ctrl
-        if p < degree:
-            flat = np.moveaxis(ctrl, 1, 0).reshape(ctrl.shape[1], -1)
-            k, flat = elevate_degree(knots, p, flat, degree - p)
-            c = np.moveaxis(flat.reshape(flat.shape[0], ctrl.shape[0], ctrl.shape[2]), 0, 1)
-        up.append((k, c))
-    values, mults = merged_knots([k for k, _ in up])
-    out = []
-    for k, c in up:
-        h = np.moveaxis(c, 1, 0)
-        for value, mult in zip(values, mults):
-            existing = np.unique(k)
-            near = existing[np.abs(existing - value) <= KNOT_TOL]
-            at = float(near[0]) if near.size else value
-            need = min(mult, degree + 1 if at in (0.0, 1.0) else degree) - kn.multiplicity(k, at)
-            if need > 0:
-                k, h = kn.insert_knot(k, degree, h, at, need)
-        out.append((k, np.moveaxis(h, 0, 1)))
-    return degree, out
 
 
 def _cartesian_speed(s: Surface, side: str, samples: int = 33) -> float:
@@ -152,7 +119,7 @@ def blend(a: Surface, side_a: str, b: Surface, side_b: str, continuity: str = "G
     sa, sb = as_bspline_surface(a, "a"), as_bspline_surface(b, "b")
     rows_a, ka, pa = side_curves(sa, side_a, order)
     rows_b, kb, pb = side_curves(sb, side_b, order)
-    ka, kb = _normalized(ka), _normalized(kb)
+    ka, kb = rescaled_knots(ka, 0.0, 1.0), rescaled_knots(kb, 0.0, 1.0)
     # orient b's boundary like a's
     ends_a = cartesian(rows_a[0][[0, -1]], True)[0]
     ends_b = cartesian(rows_b[0][[0, -1]], True)[0]
@@ -160,7 +127,7 @@ def blend(a: Surface, side_a: str, b: Surface, side_b: str, continuity: str = "G
     crossed = np.linalg.norm(ends_a - ends_b[::-1], axis=1).sum()
     if crossed < straight:
         kb, rows_b = 1.0 - kb[::-1], rows_b[:, ::-1]
-    degree, ((knots, ca), (_, cb)) = _compatible([(ka, pa, rows_a), (kb, pb, rows_b)])
+    degree, knots, (ca, cb) = compatible([(ka, pa, rows_a), (kb, pb, rows_b)], axis=1)
     # cross-boundary scales: tension times the distance to bridge over the tangent speed
     pts_a = cartesian(ca[0], True)[0]
     pts_b = cartesian(cb[0], True)[0]
