@@ -12,7 +12,9 @@ import surfmod as sm
 from surfmod.gallery.synthetic import wavy_net
 from surfmod.meshing import tessellate as tessellate_module
 from surfmod.meshing.deviation import _barycentric
+from surfmod.meshing.domain import domain_sides
 from surfmod.occ.bindings import OCCT_VERSION
+from surfmod.surface import model_size
 
 
 def _independent_max_distance(s, mesh, per_triangle=3, limit=1500, seed=0):
@@ -120,6 +122,29 @@ def test_torus_closed_both_ways_is_watertight():
     assert tm.is_watertight and tm.is_winding_consistent
     assert abs(tm.volume) <= 2 * np.pi**2 * 3.0 * 1.0**2
     assert abs(tm.volume) >= 2 * np.pi**2 * 3.0 * (1.0 - 0.02) ** 2 * 0.99
+
+
+def _teardrop(offset):
+    """A profile leaving the axis ``offset`` from it and coming back onto it, revolved."""
+    profile = sm.BSplineCurve([(offset, 0, 0), (1.2, 0, 0.3), (0.8, 0, 1.6), (0, 0, 1), (0, 0, 0)], 3)
+    return sm.revolution(profile, (0, 0, 0), (0, 0, 1), 360.0)
+
+
+@pytest.mark.parametrize("method", ["grid", "adaptive"])
+@pytest.mark.parametrize("offset, sides", [(0.0, ({"v0", "v1"}, True, False)),  # two poles, one point
+                                           (1.5e-9, ({"v1"}, True, True))])     # v1 collapsed and closed
+def test_both_meshers_share_seams_and_poles_where_a_side_is_closed_and_collapsed(method, offset, sides):
+    """The pole and seam vertices of both meshers come from one rule
+    (``domain.shared_points``): a start 1.5e-9 off the axis makes ``v`` closed while only
+    ``v1`` collapses, and closing before collapsing keeps the mesh watertight there (the
+    grid's own rule, collapsing first, left the seam open)."""
+    s = _teardrop(offset)
+    deg, cu, cv = domain_sides(s, model_size(s, samples=17))
+    assert ({k for k, d in deg.items() if d}, cu, cv) == sides
+    m = sm.tessellate(s, 0.01, method=method)
+    assert m.edge_use() == (True, True)
+    if offset == 0.0:  # one vertex per pole, not a ring
+        assert np.count_nonzero(np.linalg.norm(m.vertices, axis=1) <= 1e-12) == 2
 
 
 def test_closed_solid_is_watertight_outward_and_within_tolerance():

@@ -60,9 +60,9 @@ def _start_counts(s, tolerance: float, scale: float = 1.0, samples: int = 33) ->
     su, sv, suu, svv = d[:, :, 1, 0], d[:, :, 0, 1], d[:, :, 2, 0], d[:, :, 0, 2]
     lu, lv = np.linalg.norm(su, axis=-1), np.linalg.norm(sv, axis=-1)
     tiny = np.finfo(float).tiny
-    ku = np.linalg.norm(np.cross(su, suu), axis=-1) / np.maximum(lu, tiny) ** 3
-    kv = np.linalg.norm(np.cross(sv, svv), axis=-1) / np.maximum(lv, tiny) ** 3
-    ku, kv = np.where(lu > 0, ku, 0.0), np.where(lv > 0, kv, 0.0)
+    # no curvature counted where a speed vanishes (a pole), and no 0/0 computed there
+    ku = np.divide(np.linalg.norm(np.cross(su, suu), axis=-1), lu**3, out=np.zeros_like(lu), where=lu > 0)
+    kv = np.divide(np.linalg.norm(np.cross(sv, svv), axis=-1), lv**3, out=np.zeros_like(lv), where=lv > 0)
     n = np.cross(su, sv)
     same = np.einsum("...i,...i->...", n, suu) * np.einsum("...i,...i->...", n, svv) > 0  # elliptic point
     cu = scale * np.where(same, 4.0 + 4.0 * (1.0 - np.minimum(1.0, kv / np.maximum(ku, tiny))), 8.0)
@@ -89,7 +89,8 @@ class Refiner:
             ub = np.linspace(ub[0], ub[-1], nu + 1)
             vb = np.linspace(vb[0], vb[-1], nv + 1)
         self.lat = _Lattice(ub, vb)
-        self.degenerate, self.closed_u, self.closed_v = domain_sides(s, self.size)
+        self.sides = domain_sides(s, self.size)
+        _, self.closed_u, self.closed_v = self.sides
         st = self.lat.step
         i, j = np.meshgrid(np.arange(len(self.lat.ub) - 1), np.arange(len(self.lat.vb) - 1), indexing="ij")
         self.x0, self.y0 = (i.ravel() * st).astype(np.int64), (j.ravel() * st).astype(np.int64)
@@ -107,23 +108,6 @@ class Refiner:
     # lattice points -> positions
     def _key(self, x, y):
         return x * (self.lat.Y + 1) + y
-
-    def _canonical(self, x, y):
-        x, y = x.copy(), y.copy()
-        X, Y = self.lat.X, self.lat.Y
-        if self.closed_u:
-            x[x == X] = 0
-        if self.closed_v:
-            y[y == Y] = 0
-        for name, mask, fix in (
-            ("u0", x == 0, (0, 0)),
-            ("u1", x == X, (X, 0)),
-            ("v0", y == 0, (0, 0)),
-            ("v1", y == Y, (0, Y)),
-        ):
-            if self.degenerate[name]:
-                x[mask], y[mask] = fix
-        return x, y
 
     def triangulate(self):
         """Triangles of all cells as lattice corner coordinates ``(T, 3, 2)`` and their

@@ -30,3 +30,29 @@ def domain_sides(s, size: float):
     closed_u = not degenerate["u0"] and bool(np.abs(side["u0"] - side["u1"]).max() <= eps)
     closed_v = not degenerate["v0"] and bool(np.abs(side["v0"] - side["v1"]).max() <= eps)
     return degenerate, closed_u, closed_v
+
+
+def shared_points(i: np.ndarray, j: np.ndarray, last_i: int, last_j: int, sides):
+    """The grid point that stands for each integer point ``(i, j)`` of ``[0, last_i] x
+    [0, last_j]`` (``sides`` from :func:`domain_sides`), so that meshes keyed by it share
+    their vertices across seams and poles: a closed direction's last line is its first,
+    then every point of a collapsed side is that side's first corner.  Closing comes first:
+    where a side is both closed and collapsed, its points already stand on the other
+    side, and collapsing them apart from it would open the seam.
+
+    >>> deg = {"u0": False, "u1": False, "v0": False, "v1": True}
+    >>> i, j = shared_points(np.array([2, 2]), np.array([0, 3]), 4, 3, (deg, False, True))
+    >>> i.tolist(), j.tolist()
+    ([2, 2], [0, 0])
+    """
+    degenerate, closed_u, closed_v = sides
+    i, j = i.copy(), j.copy()
+    if closed_u:
+        i[i == last_i] = 0
+    if closed_v:
+        j[j == last_j] = 0
+    for name, mask, fix in (("u0", i == 0, (0, 0)), ("u1", i == last_i, (last_i, 0)),
+                            ("v0", j == 0, (0, 0)), ("v1", j == last_j, (0, last_j))):
+        if degenerate[name]:
+            i[mask], j[mask] = fix
+    return i, j

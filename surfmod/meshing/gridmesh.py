@@ -15,6 +15,7 @@ from ..errors import SurfmodError
 from ..nets.knots import span_samples
 from ..ops.closest import crease_breaks, project_distances
 from . import gridbounds
+from .domain import shared_points
 
 #: lattice divisions per cell side for verification (6: DENSE's 25 samples per triangle)
 K = 6
@@ -370,18 +371,8 @@ def grid_tessellate(s, tol: float, max_triangles: int, sides, bar=None):
 
 def _assemble(g: GridMesh, sides):
     """Vertices shared across seams and poles, two triangles per cell on its diagonal."""
-    degenerate, closed_u, closed_v = sides
     nu, nv = len(g.us) - 1, len(g.vs) - 1
-    I, J = np.meshgrid(np.arange(nu + 1), np.arange(nv + 1), indexing="ij")
-    ci, cj = I.copy(), J.copy()
-    if closed_u:
-        ci[ci == nu] = 0
-    if closed_v:
-        cj[cj == nv] = 0
-    for name, mask, fix in (("u0", I == 0, (0, 0)), ("u1", I == nu, (nu, 0)), ("v0", J == 0, (0, 0)),
-                            ("v1", J == nv, (0, nv))):
-        if degenerate[name]:
-            ci[mask], cj[mask] = fix
+    ci, cj = shared_points(*np.meshgrid(np.arange(nu + 1), np.arange(nv + 1), indexing="ij"), nu, nv, sides)
     key = ci * (nv + 1) + cj
     unique, first, inverse = np.unique(key.ravel(), return_index=True, return_inverse=True)
     vid = inverse.reshape(nu + 1, nv + 1)

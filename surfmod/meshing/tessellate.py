@@ -14,7 +14,7 @@ from ..surface import Surface, model_size
 from .brep import MAX_TRIANGLES, tessellate_shape
 from .adaptive import Refiner
 from .deviation import DENSE
-from .domain import domain_sides
+from .domain import domain_sides, shared_points
 from .gridmesh import grid_tessellate
 from .polymesh import Mesh
 from tqdm import tqdm
@@ -140,7 +140,7 @@ def _adaptive_mesh(s, tolerance: float, max_triangles: int, bar) -> Mesh:
             f"passes ({stuck} cells could not be split further)"
         )
     flat = tris.reshape(-1, 2)
-    cx, cy = ref._canonical(flat[:, 0], flat[:, 1])
+    cx, cy = shared_points(flat[:, 0], flat[:, 1], ref.lat.X, ref.lat.Y, ref.sides)
     keys = ref._key(cx, cy)
     unique, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
     faces = inverse.reshape(-1, 3)
