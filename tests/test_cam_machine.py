@@ -349,3 +349,20 @@ def test_each_mesh_estimate_is_surveyed_once_before_its_meshing(monkeypatch):
     sm.machine(pocket_part(), 2.0, [sm.Rough(sm.Tool("flat", 2.0), stepdown=1.5, allowance=0.3),
                                     sm.Finish(sm.Tool("ball", 1.0), scallop=0.05)], verify=False)
     assert len(calls) == 2 and calls[0] != calls[1], calls
+
+
+def test_cli_a_flat_finishing_takes_a_stepover(tmp_path, capsys):
+    """A flat end mill leaves no scallop: the command finishes with it by ``--stepover``, the
+    flag its refusal of ``--scallop`` names, and takes one of the two, not both."""
+    part, out = tmp_path / "step.step", tmp_path / "flat.ngc"
+    bd.export_step(bd.Box(8, 6, 3) - bd.Pos(1.5, 0, 1) * bd.Box(3, 6, 1), str(part))
+    argv = ["machine", str(part), "--out", str(out), "--stock-margin", "1", "--rough", "flat:1.5",
+            "--finish", "flat:1", "--no-progress"]
+    assert main(argv + ["--scallop", "0.05"]) == 1
+    assert "give stepover instead" in capsys.readouterr().err and not out.exists()
+    with pytest.raises(SystemExit) as usage:  # argparse: one of the two
+        main(argv + ["--scallop", "0.05", "--stepover", "0.8"])
+    assert usage.value.code == 2 and "not allowed with argument --scallop" in capsys.readouterr().err
+    assert main(argv + ["--stepover", "1.5"]) == 0
+    text = capsys.readouterr().out
+    assert "verified" in out.read_text() and "T2 M6" in out.read_text() and "finishing" in text

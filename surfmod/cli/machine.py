@@ -29,7 +29,10 @@ def register(sub) -> None:
                    help="stock box in part coordinates")
     p.add_argument("--rough", required=True, help="roughing tool flat:R, ball:R or bull:R:r (tool 1)")
     p.add_argument("--finish", required=True, help="finishing tool flat:R, ball:R or bull:R:r (tool 2)")
-    p.add_argument("--scallop", type=float, required=True, help="finishing scallop height (mm)")
+    finishing = p.add_mutually_exclusive_group(required=True)
+    finishing.add_argument("--scallop", type=float, help="finishing scallop height (mm)")
+    finishing.add_argument("--stepover", type=float,
+                           help="finishing passes and contours this far apart instead (mm; a flat end mill)")
     p.add_argument("--rest", help="rest machining tool flat:R, ball:R or bull:R:r (tool 3): cuts only where the "
                                   "finishing left more than the scallop (a tool no smaller than the finishing's: "
                                   "a warning)")
@@ -85,7 +88,7 @@ def run(args) -> int:
     if args.stepdown is not None and not args.stepdown > 0:
         raise SurfmodError(f"stepdown: must be > 0, got {args.stepdown:g}")
     # the finishing's scallop is checked against its tool by sm.machine before any work
-    if rest_tool is not None and args.scallop >= rest_tool.radius:
+    if rest_tool is not None and args.scallop is not None and args.scallop >= rest_tool.radius:
         raise SurfmodError(f"scallop: {args.scallop:g} must be smaller than the rest tool radius {rest_tool.radius:g}")
     if not args.allowance >= 0:
         raise SurfmodError(f"allowance: must be >= 0, got {args.allowance:g}")
@@ -94,7 +97,7 @@ def run(args) -> int:
     shape = to_shape(args.path, "path", solid=True)
     stock = args.stock_margin if args.stock is None else [args.stock[:3], args.stock[3:]]
     ops = [Rough(rough_tool, stepdown=args.stepdown, allowance=args.allowance),
-           Finish(finish_tool, scallop=args.scallop)] + ([Rest(rest_tool)] if rest_tool is not None else [])
+           Finish(finish_tool, scallop=args.scallop, stepover=args.stepover)] + ([Rest(rest_tool)] if rest_tool is not None else [])
     job = machine(shape, stock, ops, progress=not args.no_progress, verify=not args.no_verify,
                   machine=mill, strict=args.strict)
     texts = programs(job, args.post)  # any refusal before a file is written
