@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import surfmod as sm
-from surfmod.occ.step import write_step_full
+from surfmod.occ.step import write_step
 
 
 def _nurbs(seed, rational=True):
@@ -39,7 +39,7 @@ def test_iges_round_trip_is_bit_exact(tmp_path, seed, rational):
 def test_full_precision_step_round_trip_is_bit_exact(tmp_path):
     s = _nurbs(7)
     path = tmp_path / "s.step"
-    write_step_full(s.face().wrapped, path)
+    write_step(s.face().wrapped, path)
     _same(s, sm.from_face(sm.import_step(path).faces()[0]))
 
 

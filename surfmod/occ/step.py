@@ -1,9 +1,8 @@
 """STEP read/write of TopoDS shapes (``STEPControl``), with full-precision reals, and OCCT's
 native BREP format (``BRepTools`` files for gmsh, ``BinTools`` bytes between processes).
 
-In process; files from users go through :func:`surfmod.inputs.read_step_file`, which runs
-:func:`read_step` in a child process.  The same concept as :mod:`surfmod.io.step_iges`, one
-level down: that module is the public ``import_step``/``export_step`` over this one.
+In process; users' files go through :func:`surfmod.inputs.read_step_file` (a child process).
+The public ``import_step``/``export_step`` over this module are :mod:`surfmod.io.step_iges`'s.
 
 OCCT's writers print reals with 12 (STEP) or 10 (IGES) significant digits by default,
 which moves a NURBS pole by up to ~5e-13 (STEP) or ~5e-10 (IGES) relative.  Writing
@@ -15,20 +14,27 @@ from __future__ import annotations
 
 import io
 
-from OCP.BRep import BRep_Builder
+from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.BRepTools import BRepTools
 from OCP.BinTools import BinTools
 from OCP.IFSelect import IFSelect_RetDone
 from OCP.Interface import Interface_Static
 from OCP.Message import Message, Message_Gravity
+from OCP.Geom import Geom_Circle, Geom_SurfaceOfRevolution, Geom_ToroidalSurface
 from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Writer
 from OCP.StepData import StepData_StepWriter
-from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
-from OCP.TopoDS import TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shape, TopoDS_Shell, TopoDS_Solid
+from OCP.TopAbs import (TopAbs_COMPOUND, TopAbs_COMPSOLID, TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED,
+                        TopAbs_SHELL, TopAbs_SOLID)
+from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import (TopoDS, TopoDS_Compound, TopoDS_CompSolid, TopoDS_Iterator, TopoDS_Shape, TopoDS_Shell,
+                        TopoDS_Solid)
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Pnt
 
 from ..errors import KernelError, SurfmodError
 from .guard import kernel
 from .properties import solid_figures
+from .topo import explore
 
 
 # OCCT's STEP translator prints statistics banners to stdout: only failures are kept
@@ -103,15 +109,48 @@ def map_solids(shape, fn):
 
 
 def write_step(shape, path: str) -> None:
-    """Write a TopoDS shape as AP214 STEP to ``path`` (the caller makes this atomic), reals
-    with 17 significant digits so every pole and weight survives the text bit for bit
-    (OCCT's default 12 digits move poles by up to ~5e-13 relative).
+    """Write a TopoDS shape as AP214 STEP (:func:`step_text`) to ``path`` (the caller makes
+    this atomic).
 
     A solid whose shell is used REVERSED (OCCT's reader makes one of a file's inside-out
     closed shell) is written as a FORWARD shell of its faces reversed: the same solid, and
     the file holds every face the way it faces, for any reader (a STEP CLOSED_SHELL has
-    no orientation of its own)."""
-    write_step_full(map_solids(shape, _solid_shells_forward), path)
+    no orientation of its own).  Faces on a spindle torus are written on its exact
+    revolution (:func:`exact_spindle_tori`)."""
+    write_bytes(path, step_text(map_solids(exact_spindle_tori(shape), _solid_shells_forward)))
+
+
+def _spindle(face):
+    """``(torus, location)`` of a face on a torus whose major radius is below its minor, or None."""
+    location = TopLoc_Location()
+    surface = BRep_Tool.Surface_s(face, location)
+    spindle = isinstance(surface, Geom_ToroidalSurface) and surface.MajorRadius() < surface.MinorRadius()
+    return (surface, location) if spindle else None
+
+
+def exact_spindle_tori(shape):
+    """A copy of ``shape`` whose faces on a spindle torus (as some writers' fillets) lie on
+    the same surface, same (u, v), as a revolution of its exact meridian circle: OCCT's STEP
+    writer makes it a revolution of a B-spline 5e-7 off.  ``shape`` itself when it has none."""
+    if not any(_spindle(TopoDS.Face(f)) for f in explore(shape, TopAbs_FACE)):
+        return shape
+    shape, builder = BRepBuilderAPI_Copy(shape, True, False).Shape(), BRep_Builder()
+    for face in (TopoDS.Face(f.Oriented(TopAbs_FORWARD)) for f in explore(shape, TopAbs_FACE)):
+        if (found := _spindle(face)) is None:
+            continue
+        (torus, location), frame = found, found[0].Position()
+        x, z, origin = frame.XDirection(), frame.Direction(), frame.Location()
+        centre = gp_Pnt(origin.XYZ().Added(x.XYZ().Multiplied(torus.MajorRadius())))
+        meridian = Geom_Circle(gp_Ax2(centre, x.Crossed(z), x), torus.MinorRadius())  # at v: cos v x + sin v z
+        exact = Geom_SurfaceOfRevolution(meridian, gp_Ax1(origin, z if frame.Direct() else z.Reversed()))
+        edges = [TopoDS.Edge(e) for e in explore(face, TopAbs_EDGE)]
+        sides = [(TopAbs_FORWARD, TopAbs_REVERSED) if BRep_Tool.IsClosed_s(e, face) else (TopAbs_FORWARD,) for e in edges]
+        pcurves = [[BRep_Tool.CurveOnSurface_s(TopoDS.Edge(e.Oriented(o)), face, 0.0, 0.0) for o in s]
+                   for e, s in zip(edges, sides)]  # keyed by the face's surface: read before it changes
+        builder.UpdateFace(face, exact, location, BRep_Tool.Tolerance_s(face))
+        for edge, curves in zip(edges, pcurves):
+            builder.UpdateEdge(edge, *curves, exact, location, BRep_Tool.Tolerance_s(edge))
+    return shape
 
 
 def read_with(reader, kind: str, path: str):
@@ -132,11 +171,8 @@ def outward_solids(shape, inside_out: list | None = None):
     inwards) reversed, so each solid's faces point out of its material.
 
     OCCT's reader orients a closed shell by classifying a point at infinity
-    (``ShapeFix_Solid``), which on some valid parts answers IN whatever the faces say:
-    stepcode_HEAD_BACK.stp (edges 6.9e-2 off its spheres) reads outward from its
-    inside-out file, and that correct solid, written and read again, comes back inside
-    out.  The sign of the volume (the divergence theorem over the faces as oriented)
-    decides instead.
+    (``ShapeFix_Solid``), which on some valid parts (stepcode_HEAD_BACK.stp) answers IN
+    whatever the faces say; the sign of the volume over the faces as oriented decides instead.
 
     ``inside_out``, a list, receives ``(number, volume)`` of each solid of a freshly
     read ``shape`` that is inside out *in the file* (numbered from 1 in explorer order),
@@ -218,11 +254,9 @@ def step_text(shape) -> bytes:
         writer = STEPControl_Writer()
         Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
         Interface_Static.SetCVal_s("write.step.unit", "MM")
-        # The file's UNCERTAINTY is the precision OCCT's reader heals with.  The default,
-        # the average tolerance of the shape, made the reader re-project p-curves and move
-        # the re-read solids of 15 of the 41 corpus files by 4e-10 .. 6e-3 (volume or
-        # centroid, relative); the greatest tolerance (mode 1) leaves 11 of them bit-exact
-        # (tests/test_step_roundtrip.py holds the four it does not).
+        # The file's UNCERTAINTY is the precision OCCT's reader heals with: the default (the
+        # shape's average tolerance) made it re-project p-curves and move re-read solids by up
+        # to 6e-3 relative; the greatest (mode 1) does not (tests/test_step_roundtrip.py).
         Interface_Static.SetIVal_s("write.precision.mode", 1)
         if writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone:
             raise KernelError("STEPControl_Writer: transfer failed")
@@ -233,8 +267,3 @@ def step_text(shape) -> bytes:
         if not text.Print(out):
             raise KernelError("StepData_StepWriter: could not print the model")
     return out.getvalue()
-
-
-def write_step_full(shape, path: str) -> None:
-    """:func:`step_text` written to ``path`` (the caller makes this atomic)."""
-    write_bytes(path, step_text(shape))
