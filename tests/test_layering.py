@@ -554,6 +554,9 @@ def test_a_kind_switch_is_found(tmp_path):
 #: the kernel door stays thin: modules (its __init__ aside), lines (with it), the largest
 #: module, at issue 34's figures
 OCC_MODULES, OCC_LINES, OCC_LARGEST = 24, 3200, 300
+#: lines of the whole package: a ratchet, lowered as the package shrinks (issue 34 asks for
+#: 31,000; a change that must grow it raises this in its own commit, saying why)
+PACKAGE_LINES = 38_241
 #: module names that two packages share: each a command over the function it names or a
 #: function over its OCCT twin, and the higher imports the lower
 MAX_SAME_NAMED = 6
@@ -582,6 +585,11 @@ def door_figures(modules) -> tuple[int, int, int]:
 def test_occ_is_a_thin_door():
     count, lines, largest = door_figures(MODULES)
     assert count <= OCC_MODULES and lines <= OCC_LINES and largest <= OCC_LARGEST, (count, lines, largest)
+
+
+def test_the_package_does_not_grow():
+    lines = sum(_lines(p) for p in MODULES.values())
+    assert lines <= PACKAGE_LINES, f"surfmod/ has {lines} lines, the ratchet {PACKAGE_LINES}"
 
 
 def entry_points(root: Path) -> set[str]:
