@@ -45,7 +45,7 @@ def normal_curvature(ders, normal, direction):
 def measure(ders_a, inward_a, ders_b, inward_b, edge_tangent):
     """Per-sample ``(gap, angle, jump, k_a, k_b, flip)`` from order-2 derivative arrays
     ``(N, 3, 3, 3)`` of both surfaces, 3-D vectors pointing into each surface and the
-    edge tangent (see the module docstring for what is compared).  ``flip`` is -1 where
+    edge tangent (what is compared: :doc:`/guide/analysis`).  ``flip`` is -1 where
     ``b``'s normal had to be reversed to be oriented like ``a``'s."""
     gap = np.linalg.norm(ders_a[:, 0, 0] - ders_b[:, 0, 0], axis=1)
     n_a = _unit(np.cross(ders_a[:, 1, 0], ders_a[:, 0, 1]))

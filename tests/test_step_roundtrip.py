@@ -34,16 +34,18 @@ from test_occt_quirks import quirk_holds
 
 import surfmod as sm
 from surfmod.occ.step import map_solids, outward_solids
-from surfmod.occ.topo import faces_of, solids_of
+from surfmod.occ.properties import solid_figures
+from surfmod.occ.topo import faces_of, loose_faces, solids_of
 
-#: file -> (largest relative change of a solid's volume or centroid, measured; the reason)
+#: file -> (largest relative change of a solid's volume or centroid, or of a loose face's area or
+#: centroid, measured; the reason)
 OCCT_REBUILDS = {
+    "ansys_race_car_nose.stp": (1.6e-05, "measured 1.21e-05 (area of loose face 108 of 141; three more "
+                                         "2.6e-7 .. 3.6e-10): Parasolid B-spline faces with crowded knots"),
     "axom_boxed_sphere.step": (1.6e-05, "measured 1.22e-05: Rhino B-spline faces, 2 solids (was 5.75e-3 at the "
                                         "average uncertainty)"),
     "nist_ftc_07_asme1_rd.stp": (1.6e-09, "measured 1.23e-09: B-spline faces (was 3.34e-7)"),
     "nist_ftc_10_asme1_rb.stp": (2.2e-09, "measured 1.68e-09: tori, one B-spline (was 6.3e-8)"),
-    "occt_screw.step": (2.6e-09, "measured 2.0e-09: torus faces whose edges the reader makes SameParameter "
-                                 "again, edge tolerance 3.00270e-4 -> 3.00288e-4 (was 8.7e-10)"),
     "occt_cornetta.stp": (1.6e-07, "measured 1.27e-07 (volume; centroid 6.6e-8): ST-Developer B-spline faces, "
                                    "60 of 254 edges 1e-4 to 9.2e-3 off their p-curves' images"),
     "pythonocc_Ventilator.stp": (1.0e-06, "measured 7.87e-07: edges up to 1.4e-2 off their extrusion faces "
@@ -76,7 +78,7 @@ def roundtrip_change(path, tmp_path, *, warns: bool = False) -> float:
         sm.export_step(first, out)
     said = [str(w.message) for w in caught if issubclass(w.category, sm.RoundTripWarning)]
     assert bool(said) == warns, (path.name, said)
-    assert all("solid " in m and "relative change" in m for m in said), said
+    assert all("relative change" in m for m in said), said
     again = sm.import_step(out)
     a, b = solids_of(first.wrapped), solids_of(again.wrapped)
     assert len(a) == len(b), (path.name, "solids", len(a), len(b))
@@ -87,6 +89,9 @@ def roundtrip_change(path, tmp_path, *, warns: bool = False) -> float:
         (va, ca), (vb, cb) = _props(x), _props(y)
         assert va > 0 and vb > 0, (path.name, i, "inside out", va, vb)
         worst = max(worst, abs(va - vb) / va, float(np.abs(ca - cb).max()) / va ** (1 / 3))
+    for x, y in zip(loose_faces(first.wrapped), loose_faces(again.wrapped), strict=True):
+        (sa, ca), (sb, cb) = solid_figures(x), solid_figures(y)
+        worst = max(worst, abs(sa - sb) / sa, float(np.abs(ca - cb).max()) / sa ** 0.5)
     return worst
 
 
@@ -225,3 +230,20 @@ def test_a_spindle_torus_is_written_on_its_exact_revolution(tmp_path, direct):
     far = max(GeomAPI_ProjectPointOnSurf(surface.Value(u, v), torus).LowerDistance()
               for u in np.linspace(u0, u1, 9) for v in np.linspace(v0, v1, 9))
     assert far < 1e-12  # 5.5e-7 as OCCT writes it
+
+
+def test_shape_changes_measures_every_face_in_no_solid(tmp_path):
+    """A loose face whose surface the writer moves (OCCT's own writer, a spindle torus: 5.5e-7
+    off) is named with its area and centroid; solids alone were measured before."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.Geom import Geom_ToroidalSurface
+    from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
+    from surfmod.io.step_iges import shape_changes
+    from surfmod.occ.step import step_text, write_bytes
+
+    torus = Geom_ToroidalSurface(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 0.3, 1.2)
+    face = BRepBuilderAPI_MakeFace(torus, np.pi, 1.5 * np.pi, 0.0, 0.5 * np.pi, 1e-7).Face()
+    write_bytes(tmp_path / "raw.step", step_text(face))  # the writer alone, no exact revolution
+    said = shape_changes(face, sm.import_step(tmp_path / "raw.step").wrapped)
+    assert len(said) == 1 and said[0].startswith("face 1 in no solid: area 3.15021 -> 3.15021 (relative change 2.1e-07)")
+    assert shape_changes(face, face) == []

@@ -20,8 +20,9 @@ NAMES = ("c0", "c1", "d0", "d1")
 
 
 class CoonsSurface(BSplineSurface):
-    """A Coons patch (see the module docstring); a B-spline surface that *is* its
-    OCCT twin.  Attributes: ``boundaries`` (``c0, c1, d0, d1`` as given), ``blend``.
+    """A Coons patch (:doc:`/guide/surfaces` (section "Coons, ruled and lofted surfaces"));
+    a B-spline surface that *is* its OCCT twin.  Attributes: ``boundaries`` (``c0, c1, d0,
+    d1`` as given), ``blend``.
 
     :meth:`occt_fill` builds OCCT's ``GeomFill_BSplineCurves`` Coons-style surface on
     the same curves (equal to this one for ``blend="hermite"`` and for translational

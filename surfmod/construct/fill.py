@@ -25,7 +25,8 @@ __all__ = ["Corner", "Fill", "FillPatch", "fill", "occt_fill"]
 
 class FillPatch(Surface):
     """One quadrilateral piece of a fill: the unit square mapped bilinearly onto a quad
-    of the n-gon domain, then through the side-blending surface (see the module doc)."""
+    of the n-gon domain, then through the side-blending surface (:doc:`/guide/analysis`
+    (section "How a blend and a fill are built"))."""
 
     exact_in_occt = False
     occt_construct = "Geom_BSplineSurface (bicubic approximation)"

@@ -22,7 +22,7 @@ SAME_PARAMETER = 1e-10
 
 
 class GordonSurface(BSplineSurface):
-    """A Gordon surface (see the module docstring); a B-spline surface that *is* its OCCT
+    """A Gordon surface (:doc:`/guide/surfaces` (section "Gordon surfaces")); a B-spline surface that *is* its OCCT
     twin.  Attributes: ``profiles``, ``guides`` (the input curves, in network order),
     ``parameters`` (``(U, V)``: the guides' ``u`` and the profiles' ``v``),
     ``tolerance``, ``reparametrized`` (False when the network was used exactly).

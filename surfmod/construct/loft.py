@@ -22,7 +22,8 @@ _MAX_DEGREE = 8  # BRepOffsetAPI_ThruSections default max degree
 
 
 class LoftSurface(BSplineSurface):
-    """A lofted surface: a B-spline through the sections (see the module docstring).
+    """A lofted surface: a B-spline through the sections (see :doc:`/guide/surfaces`
+    (section "Coons, ruled and lofted surfaces")).
 
     Attributes: ``sections`` (the input curves), ``ruled``, ``section_parameters``
     (``v_k``), ``tolerance`` (pass threshold of the geometric cross-check, ``1e-4`` x

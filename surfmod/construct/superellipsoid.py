@@ -114,7 +114,8 @@ def _starts_on_x_axis(start: np.ndarray) -> np.ndarray:
 
 
 class Superellipsoid(FittedSurface):
-    """A superellipsoid fitted by a bicubic B-spline (see the module docstring).
+    """A superellipsoid fitted by a bicubic B-spline (see :doc:`/guide/surfaces` (section
+    "The superellipsoid and the three forms")).
 
     Attributes: ``rx, ry, rz, s1, s2``, ``tolerance`` (requested), ``max_deviation``
     (measured largest distance between the spline and the analytic surface at the same

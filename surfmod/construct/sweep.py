@@ -32,7 +32,7 @@ _TABLE = 1025  # samples of the frame table along the path
 
 
 class SweptSurface(Surface):
-    """A swept surface (see the module docstring for the formula).
+    """A swept surface (the formula: :doc:`/guide/surfaces` (section "Swept surfaces")).
 
     Attributes: ``profile``, ``path``, ``end_profile``, ``guide`` (surfmod curves),
     ``twist`` (degrees), ``mode``; ``tolerance`` is the pass threshold of the geometric

@@ -50,7 +50,6 @@ def surface_quotient(hders: np.ndarray) -> np.ndarray:
     return np.moveaxis(out, (0, 1, 2), (-3, -2, -1))
 
 
-
 def _quotient_planes(planes, out, order: int) -> None:
     """The quotient rule on planes ``(K, K, 4, ...)`` written into ``out (K, K, 3, ...)``."""
     a, w = planes[:, :, :3], planes[:, :, 3:4]

@@ -155,8 +155,8 @@ def shape_changes(given, again, rtol: float = 1e-12) -> list[str]:
     """What a write and read (``again``) changed of ``given``, one line per change: the
     number of solids, of faces and of faces in no solid (loose faces, open shells); each
     solid's face count, the sign of its enclosed volume, its volume (relative) and its
-    centroid (relative to the volume's cube root) beyond ``rtol``.  Solids pair in the
-    order the explorer meets them (numbered from 1); an empty list when nothing changed.
+    centroid (relative to the volume's cube root) beyond ``rtol``, each loose face's area
+    and centroid alike.  Solids and faces pair in the explorer's order (numbered from 1).
 
     >>> import build123d as bd
     >>> box = bd.Solid.make_box(1, 2, 3).wrapped
@@ -168,19 +168,25 @@ def shape_changes(given, again, rtol: float = 1e-12) -> list[str]:
     ['solid 1: enclosed volume 6 -> -6 (turned inside out)']
     """
     from ..occ.properties import solid_figures
-    from ..occ.topo import faces_of, solids_of
+    from ..occ.topo import faces_of, loose_faces, solids_of
 
     changes = []
     a, b = solids_of(given), solids_of(again)
     fa, fb = len(faces_of(given)), len(faces_of(again))
-    loose_a = fa - sum(len(faces_of(x)) for x in a)
-    loose_b = fb - sum(len(faces_of(x)) for x in b)
+    loose_a, loose_b = loose_faces(given), loose_faces(again)
     if len(a) != len(b):
         changes.append(f"solids: {len(a)} -> {len(b)}")
     if fa != fb:
         changes.append(f"faces: {fa} -> {fb}")
-    if loose_a != loose_b:
-        changes.append(f"faces in no solid: {loose_a} -> {loose_b}")
+    if len(loose_a) != len(loose_b):
+        changes.append(f"faces in no solid: {len(loose_a)} -> {len(loose_b)}")
+    for i, (x, y) in enumerate(zip(loose_a, loose_b) if len(loose_a) == len(loose_b) else (), 1):
+        (sa, ca), (sb, cb) = solid_figures(x), solid_figures(y)
+        size = max(abs(sa), 1e-300)
+        da, dc = abs(sb - sa) / size, float(np.abs(cb - ca).max())
+        if da > rtol or dc > rtol * size ** 0.5:
+            changes.append(f"face {i} in no solid: area {sa:.6g} -> {sb:.6g} (relative change {da:.3g}); "
+                           f"centroid moved {dc:.3g} ({dc / size ** 0.5:.3g} of the area^(1/2))")
     for i, (x, y) in enumerate(zip(a, b), 1):
         nx, ny = len(faces_of(x)), len(faces_of(y))
         if nx != ny:

@@ -156,7 +156,7 @@ def _items(obj, name: str):
 
 
 def fairness(points, triangles, k1, k2, mean) -> Fairness:
-    """Trapezoid-rule fairness integrals over a triangulated patch (see the module doc)."""
+    """Trapezoid-rule fairness integrals over a triangulated patch (see :doc:`/guide/analysis`)."""
     p = points[triangles]
     e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
     area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
@@ -248,7 +248,7 @@ def analyze(obj, kind: str, out=None, *, light=None, stripes: int = 8, resolutio
     """Analyse a surface, a face, a list of them or a whole shape (every face).
 
     ``kind``: ``"zebra"``, ``"isophote"``, ``"gaussian"``, ``"mean"``, ``"max_abs"`` or
-    ``"comb"`` (see the module docstring).  ``light``: light direction for zebra and
+    ``"comb"`` (see :doc:`/guide/analysis`).  ``light``: light direction for zebra and
     isophotes (default: the viewing direction of ``view = (elevation, azimuth)`` in
     degrees); ``stripes``: black stripes of the zebra over the half turn of the normal;
     ``resolution``: grid nodes per direction for surfaces (faces are triangulated to a

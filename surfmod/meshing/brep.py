@@ -415,7 +415,7 @@ def tessellate_shape(shape, tolerance: float, max_triangles: int = MAX_TRIANGLES
     The deflection is tightened while some face's triangles deviate more than
     :func:`allowed_deviation` (``tolerance``, unless the face's own model error nearly
     fills it) and more than its declared
-    tolerance (see the module docstring).
+    tolerance (see :doc:`/guide/meshing` (section "Meshing B-rep parts")).
     ``info["max_deviation"]`` is the measured maximum, ``info["faces_over_tolerance"]``
     lists the faces whose deviation exceeds ``tolerance`` because of the model; with
     ``strict=True`` any such face raises ``SurfmodError`` instead.  A face BRepMesh

@@ -50,7 +50,6 @@ except ImportError:  # OCCT 7.9: the package typedefs
     )
 
 
-
 def box_limits(box) -> tuple:
     """``(xmin, ymin, zmin, xmax, ymax, zmax)`` of a non-void ``Bnd_Box``, its gap included
     (what ``Bnd_Box.Get()`` returns on OCCT 7.9)."""

@@ -14,7 +14,7 @@ from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepGProp import BRepGProp, BRepGProp_Domain, BRepGProp_Face, BRepGProp_Vinert
 from OCP.GProp import GProp_GProps
 from OCP.ShapeUpgrade import ShapeUpgrade_ShapeDivideArea
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
 from OCP.gp import gp_Pnt
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
@@ -76,13 +76,12 @@ def inertia_matrix(props: GProp_GProps) -> np.ndarray:
 
 
 def solid_figures(solid):
-    """Volume and centroid of one solid by BRepGProp's fixed Gauss rule (the same digits
-    for the same geometry, so a change is the geometry's)."""
+    """Volume and centroid of one solid (area and centroid of a face) by BRepGProp's fixed
+    Gauss rule (the same digits for the same geometry, so a change is the geometry's)."""
     with kernel("BRepGProp.VolumeProperties_s"):
         vp = GProp_GProps()
-        BRepGProp.VolumeProperties_s(solid, vp)
+        (BRepGProp.SurfaceProperties_s if solid.ShapeType() == TopAbs_FACE else BRepGProp.VolumeProperties_s)(solid, vp)
     return vp.Mass(), xyz(vp.CentreOfMass())
-
 
 
 def vertex_mean(shape) -> np.ndarray:

@@ -144,7 +144,6 @@ def edge_length(edge) -> float:
         return float(GCPnts_AbscissaPoint.Length_s(BRepAdaptor_Curve(edge), 1e-12))
 
 
-
 def sample_curve(curve, t0: float, t1: float, count: int) -> np.ndarray:
     """``count`` points equally spaced in parameter."""
     with kernel("Geom_Curve.Value"):

@@ -6,14 +6,8 @@ import numpy as np
 from OCP import TopAbs
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
-from OCP.BRepBuilderAPI import (
-    BRepBuilderAPI_Copy,
-    BRepBuilderAPI_GTransform,
-    BRepBuilderAPI_MakeEdge,
-    BRepBuilderAPI_MakeFace,
-    BRepBuilderAPI_MakeVertex,
-    BRepBuilderAPI_Transform,
-)
+from OCP.BRepBuilderAPI import (BRepBuilderAPI_Copy, BRepBuilderAPI_GTransform, BRepBuilderAPI_MakeEdge,
+                                BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeVertex, BRepBuilderAPI_Transform)
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.Geom import Geom_TrimmedCurve
@@ -95,10 +89,10 @@ def curve_of_edge(edge):
         return curve, t0, t1
 
 
-def explore(shape, kind):
-    """Sub-shapes of one ``TopAbs`` kind, in exploration order (with repeats, as OCCT)."""
+def explore(shape, kind, avoid=TopAbs.TopAbs_SHAPE):
+    """Sub-shapes of one ``TopAbs`` kind, none inside an ``avoid``, in exploration order (repeats as OCCT)."""
     out = []
-    explorer = TopExp_Explorer(shape, kind)
+    explorer = TopExp_Explorer(shape, kind, avoid)
     while explorer.More():
         out.append(explorer.Current())
         explorer.Next()
@@ -111,6 +105,11 @@ def faces_of(shape):
     if shp is None:
         raise SurfmodError(f"shape: expected a build123d shape or TopoDS_Shape, got {type(shape).__name__}")
     return [TopoDS.Face(f) for f in explore(shp, TopAbs_FACE)]
+
+
+def loose_faces(shape):
+    """The faces of ``shape`` in no solid (loose faces, open shells), in exploration order."""
+    return [TopoDS.Face(f) for f in explore(shape, TopAbs_FACE, TopAbs_SOLID)]
 
 
 def solids_of(shape):

@@ -283,7 +283,7 @@ def fit(points, tolerance: float, degree=(3, 3), *, smoothing: float = 1e-6, bas
     """A B-spline surface within ``tolerance`` of unordered ``points`` ``(N, 3)``.
 
     ``degree`` ``(p, q)``; ``smoothing`` weights the thin-plate fairing (dimensionless,
-    see the module docstring; 0 disables it); ``base`` a surfmod surface whose
+    see :doc:`/guide/surfaces` (section "Fitting scattered points"); 0 disables it); ``base`` a surfmod surface whose
     parametrization seeds the parameters (default: the plane normal to the points' mean
     local normal, so the points should be a height field over some plane or be given a
     base); ``max_poles`` caps the

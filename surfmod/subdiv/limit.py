@@ -170,7 +170,8 @@ def limit_surface(
     ``creases`` are sharp cage edges as in :func:`catmull_clark` (patches meet there with
     a crease, C0, and a straight crease through regular vertices keeps exact patches).
     Regular faces give exact bicubic uniform B-spline patches; faces at extraordinary
-    vertices give approximating bicubic Bézier patches (module docstring).
+    vertices give approximating bicubic Bézier patches (:doc:`/guide/surfaces` (section
+    "Subdivision and its limit surface")).
     ``adaptive`` more levels refine only the faces at extraordinary vertices (feature
     adaptive, like OpenSubdiv): each one splits into three exact patches and one smaller
     approximate patch, so the approximation error shrinks about twofold per level while

@@ -221,7 +221,6 @@ def _edge_entity(sec: Section, edge) -> tuple:
     return ("spline", c.degree, sec.to_plane(c.control_points), np.asarray(c.knots), None if c.weights is None else np.asarray(c.weights))
 
 
-
 def section(obj, plane_origin, plane_normal, *, samples: int = 64, x_axis=None, partial: bool = False) -> Section:
     """Planar section of a part (or of surfaces): curves where the plane cuts it.
 
