@@ -100,8 +100,7 @@ def test_bull_exact_on_sphere():
     """A bull nose on a sphere of radius 5: the tube centre rides the sphere of radius
     5 + c, on the ring a from the axis: tip = sqrt((5 + c)² - (|q| - a)²) - c.  On a
     coarse mesh (tolerance 0.05, its heights 0.0098 low): the polish must make up all of
-    it (at radius / 1000, the mesh the default once asked, the sphere's 126,000 triangles
-    took 6 CPU seconds)."""
+    it (at the default radius / 1000 the sphere's 125,000 triangles took 6 CPU seconds)."""
     R, c = 1.0, 0.4
     a = R - c
     q = np.array([[1.5, 0.5], [2.0, -1.0], [0.3, 2.2]])

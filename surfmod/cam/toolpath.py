@@ -50,9 +50,6 @@ MAX_WORK = 25_000_000_000
 #: drops per raster location a path costs at the least: two refinement passes of two
 #: samples per move, the verdict's four, a repair's two and its verdict's four, the contacts
 NOMINAL_DROPS = 17
-#: the coarsest mesh (a share of the tool's radius) that seeds ``drop_cutter``'s polish on
-#: the exact faces; its heights there do not depend on it (tests/test_toolpath_exact.py)
-SEED_SHARE = 0.05
 
 
 @dataclass(frozen=True)
@@ -282,18 +279,17 @@ def _check_tool(tool) -> Tool:
 def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: bool = False):
     """Tool-tip heights ``(N,)`` and contact points ``(N, 3)`` of ``tool`` dropped onto
     every face of ``obj`` at the (x, y) locations ``xy`` ``(N, 2)`` (NaN where the tool
-    touches nothing).  ``tolerance`` is the accuracy asked of the heights (default
-    ``radius / 1000``): the faces are meshed to 40 % of it, and the heights are exact for
-    that mesh.
+    touches nothing).  The faces are meshed to 40 % of ``tolerance`` (default
+    ``radius / 1000``); heights are exact for that mesh.
 
     ``exact=True`` polishes each height on the exact face the tool rests on
     (:mod:`surfmod.cam.toolpath_exact`: Newton on the face's own evaluator, inside its
     trim: the ball's centre, a flat end's rim on a sloped face or its bottom on a
-    summit), so it is exact to rounding on the B-rep, contact points included, whatever
-    the mesh: the faces are then meshed no finer than :data:`SEED_SHARE` of the radius
-    (a sphere 5 times the tool's radius: 2,600 triangles, not 126,000).  Where the tool
-    rests on an edge or a vertex instead, the height is the mesh's at ``tolerance``
-    (those locations alone are dropped again on that mesh).
+    summit), so it is exact to rounding on the B-rep, contact points included; where the
+    tool rests on an edge or a vertex of the mesh the mesh height is kept, lifted as
+    above.  The face is the one the mesh says the tool rests on: where another face
+    stands within the mesh's deviation of it (a ball at the foot of a bump beside the
+    floor) the height is that face's, up to about ``tolerance`` low.
 
     >>> import surfmod as sm
     >>> from surfmod.cam.toolpath import drop_cutter
@@ -302,25 +298,14 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     ([2.0], [[1.0, 1.0, 2.0]])
     """
     tool = _check_tool(tool)
-    shape = to_shape(obj, "obj")
     cl = checks.finite_array(xy, "xy", ndim=2, last=2)
     tolerance = tool.radius / 1000 if tolerance is None else checks.positive(tolerance, "tolerance")
-    seed = max(tolerance, SEED_SHARE * tool.radius) if exact else tolerance
-    z, contacts, polished = _mesh_drop(shape, tool, cl, seed, exact)
-    again = ~polished & ~np.isnan(z)
-    if exact and seed > tolerance and again.any():
-        z[again], contacts[again], _ = _mesh_drop(shape, tool, cl[again], tolerance, exact)
-    return z, contacts
-
-
-def _mesh_drop(shape, tool: Tool, cl: np.ndarray, tolerance: float, exact: bool):
-    """``(heights, contacts, polished)`` of :func:`drop_cutter` on the mesh of ``tolerance``."""
-    part = meshed_part(shape, tool.cutter, tolerance)
+    part = meshed_part(obj, tool.cutter, tolerance)
     z, contacts, touched = drop(part.grid, part.cutter, cl, contacts=True, triangles=True)
     z = z + part.lift
-    if not exact:
-        return z, contacts, np.zeros(len(z), bool)
-    return exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.radius, tool.corner)
+    if exact:
+        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.radius, tool.corner)
+    return z, contacts
 
 
 def finish_settings(tool: Tool, stepover, scallop, direction: str) -> tuple[float, float]:
