@@ -18,13 +18,14 @@ from tqdm import tqdm
 from .. import checks
 from ..errors import SurfmodError
 from ..inputs import to_shape
+from ..readback import from_face
 from ..meshing.brep import triangle_estimate
 from ..meshing.render import Drawing, polyline_runs, repr_png
 from .cutters import Cutter
 from .drop_cutter import TriangleGrid, drop, part_triangles
 from .part_points import lift_gouges
 from .post import round_up
-from .toolpath_exact import exact_heights
+from .toolpath_exact import exact_heights, polish
 from .tool import Tool
 from .toolpath_moves import NoSafePathError, lift_moves, move_gouge, raster, refine_moves, staircase_steep
 
@@ -287,9 +288,9 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     trim: the ball's centre, a flat end's rim on a sloped face or its bottom on a
     summit), so it is exact to rounding on the B-rep, contact points included; where the
     tool rests on an edge or a vertex of the mesh the mesh height is kept, lifted as
-    above.  The face is the one the mesh says the tool rests on: where another face
-    stands within the mesh's deviation of it (a ball at the foot of a bump beside the
-    floor) the height is that face's, up to about ``tolerance`` low.
+    above.  Every other face under the tool is polished too and the highest height kept:
+    the mesh can pick the wrong face where another stands within its deviation (a ball
+    at the foot of a bump beside the floor).
 
     >>> import surfmod as sm
     >>> from surfmod.cam.toolpath import drop_cutter
@@ -304,8 +305,37 @@ def drop_cutter(obj, tool: Tool, xy, *, tolerance: float | None = None, exact: b
     z, contacts, touched = drop(part.grid, part.cutter, cl, contacts=True, triangles=True)
     z = z + part.lift
     if exact:
-        z, contacts, _ = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.radius, tool.corner)
+        z, contacts, polished = exact_heights(part.faces, part.owner, cl, z, contacts, touched, tool.radius,
+                                              tool.corner)
+        _rival_faces(part, tool, cl, z, contacts, np.flatnonzero(polished), part.owner[touched[polished]])
     return z, contacts
+
+
+def _rival_faces(part: MeshedPart, tool: Tool, xy: np.ndarray, z, contacts, rows: np.ndarray, chosen: np.ndarray):
+    """Raise, in place, the heights ``z`` polished at ``xy[rows]`` on the faces ``chosen``
+    where another face under the tool is higher on the exact B-rep (a ball at the foot of a
+    bump beside the floor, where the mesh saw the floor higher: a steep face's mesh can
+    stand lower by its deviation over the normal's vertical part): each such face's exact
+    height, its lifted mesh height where it cannot be polished."""
+    tri = part.grid.triangles
+    lo, hi = tri[:, :, :2].min(axis=1) - tool.radius, tri[:, :, :2].max(axis=1) + tool.radius
+    for face in np.unique(part.owner):
+        mine = part.owner == face
+        near = (np.all(xy[rows, None] >= lo[mine].min(axis=0), axis=2) & np.all(xy[rows, None] <= hi[mine].max(axis=0),
+                                                                                   axis=2))[:, 0]
+        at = rows[near & (chosen != face)]
+        if not at.size:
+            continue
+        h, touch = drop(TriangleGrid(tri[mine], tool.radius), part.cutter, xy[at], contacts=True)
+        rival = np.isfinite(h)
+        if not rival.any():
+            continue
+        at, h, touch = at[rival], h[rival], touch[rival]
+        exact, contact, on = polish(from_face(part.faces[face]), xy[at], touch, tool.radius, tool.corner)
+        height = np.where(on, exact, h + part.lift)
+        higher = height > z[at]
+        z[at[higher]] = height[higher]
+        contacts[at[higher]] = np.where(on[higher, None], contact[higher], touch[higher])
 
 
 def finish_settings(tool: Tool, stepover, scallop, direction: str) -> tuple[float, float]:
