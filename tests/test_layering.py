@@ -556,7 +556,7 @@ def test_a_kind_switch_is_found(tmp_path):
 OCC_MODULES, OCC_LINES, OCC_LARGEST = 24, 3200, 300
 #: lines of the whole package: a ratchet, lowered as the package shrinks (issue 34 asks for
 #: 31,000; a change that must grow it raises this in its own commit, saying why)
-PACKAGE_LINES = 38_261
+PACKAGE_LINES = 38_307
 #: module names that two packages share: each a command over the function it names or a
 #: function over its OCCT twin, and the higher imports the lower
 MAX_SAME_NAMED = 6

@@ -11,7 +11,7 @@ import numpy as np
 from .. import checks
 from ..errors import SurfmodError
 from ..nets.bspline import BSplineSurface, cartesian, homogeneous
-from ..nets.elevate import elevated, make_compatible
+from ..nets.elevate import elevate_degree, elevated, make_compatible
 from ..nets.knots import greville
 from .from_edge import as_curve
 
@@ -67,19 +67,10 @@ def _corner_check(curves, tolerance):
             )
 
 
-def _bezier_elevated(coefs, degree):
-    """Bernstein coefficients of a polynomial raised to ``degree`` (repeated elevation)."""
-    c = np.asarray(coefs, dtype=float)
-    while c.size - 1 < degree:
-        n = c.size  # current degree + 1
-        a = np.arange(1, n) / n
-        c = np.concatenate([[c[0]], a * c[:-1] + (1 - a) * c[1:], [c[-1]]])
-    return c
-
-
 def _hermite_coefficients(n):
     """OCCT's ``GeomFill_Coons`` blend coefficients ``(F, G)`` for ``n`` poles."""
-    f = _bezier_elevated([1.0, 1.0, 0.0, 0.0], n - 1)
+    # the cubic Hermite blend 1 - 3s^2 + 2s^3 in Bernstein form, raised to degree n - 1
+    f = elevate_degree(np.repeat([0.0, 1.0], 4), 3, np.array([1.0, 1.0, 0.0, 0.0]), n - 4)[1]
     return f, 1.0 - f
 
 

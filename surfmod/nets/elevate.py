@@ -1,19 +1,20 @@
 """Making B-spline curves compatible: degree elevation, reparametrization to a common
 interval and knot merging (the steps of OCCT's ``GeomFill_Profiler``).
 
-Degree elevation is exact: the elevated spline lives in the space of degree ``p + t``
-with every knot's multiplicity raised by ``t``, so the new control points are found by
-collocation at that space's Greville abscissae (a square, well-conditioned,
-Schoenberg-Whitney system).  The result equals OCCT's ``Geom_BSplineCurve::IncreaseDegree``
-up to round-off.  Rational curves are elevated in homogeneous coordinates.
+Degree elevation is in closed form (Piegl & Tiller, *The NURBS Book*, algorithm A5.9):
+the spline is cut into Bezier segments by knot insertion, each segment is elevated by the
+binomial formula, and the knots are removed again down to their old multiplicity plus
+``t``.  No linear system is solved, so the result stays exact to round-off at any degree
+and equals OCCT's ``Geom_BSplineCurve::IncreaseDegree``.  Rational curves are elevated in
+homogeneous coordinates.
 """
 
 from __future__ import annotations
 
+from math import comb
+
 import numpy as np
 
-from ..eval.basis import basis_matrix
-from ..eval.tensor import curve_derivatives
 from . import knots as kn
 from .bspline import BSplineCurve, cartesian, homogeneous
 
@@ -43,15 +44,69 @@ def elevate_degree(knots: np.ndarray, degree: int, ctrl: np.ndarray, times: int,
     """
     if times <= 0:
         return knots, ctrl
-    a = np.moveaxis(ctrl, axis, 0)
-    values, counts = np.unique(knots, return_counts=True)
-    new_knots = np.repeat(values, counts + times)
-    q = degree + times
-    sites = kn.greville(new_knots, q)
-    mat = basis_matrix(new_knots, q, sites.size, sites)[0]
-    rhs = curve_derivatives(knots, degree, a.reshape(a.shape[0], -1), sites, 0)[:, 0]
-    new = np.linalg.solve(mat, rhs).reshape((sites.size,) + a.shape[1:])
-    return new_knots, np.moveaxis(new, 0, axis)
+    U = np.asarray(knots, dtype=float)
+    moved = np.moveaxis(np.asarray(ctrl, dtype=float), axis, 0)
+    pw = moved.reshape(moved.shape[0], -1)  # the trailing axes ride along as columns
+    p, t, m = degree, times, U.size - 1
+    ph = p + t
+    values, counts = np.unique(U, return_counts=True)
+    new_knots = np.repeat(values, counts + t)
+    alf_bez = _elevation_matrix(p, t)
+    qw = np.zeros((new_knots.size - ph - 1,) + pw.shape[1:])
+    uh = np.empty(new_knots.size)
+    uh[: ph + 1], qw[0] = U[0], pw[0]
+    bpts, next_bpts = pw[: p + 1].copy(), np.empty_like(pw[: p + 1])
+    kind, cind, r, a, b, ua = ph + 1, 1, -1, p, p + 1, U[0]
+    while b < m:  # one pass per distinct interior knot and the end (at most len(knots))
+        i = b
+        while b < m and U[b] == U[b + 1]:
+            b += 1
+        mul, ub = b - i + 1, U[b]
+        oldr, r = r, p - mul
+        lbz = (oldr + 2) // 2 if oldr > 0 else 1
+        rbz = ph - (r + 1) // 2 if r > 0 else ph
+        if r > 0:  # insert ub r times: the Bezier segment [ua, ub] is in bpts
+            alfs = (ub - ua) / (U[a + mul + 1: a + p + 1] - ua)
+            for j in range(1, r + 1):
+                al = alfs[: p - (s := mul + j) + 1, None]
+                bpts[s:] = al * bpts[s:] + (1 - al) * bpts[s - 1: p]
+                next_bpts[r - j] = bpts[p]
+        ebpts = alf_bez @ bpts  # the segment elevated (binomial form)
+        if oldr > 1:  # remove the knot ua oldr - 1 times
+            first, last, den = kind - 2, kind, ub - ua
+            bet = (ub - uh[kind - 1]) / den
+            for tr in range(1, oldr):
+                i, j, kj = first, last, last - kind + 1
+                while j - i > tr:
+                    if i < cind:
+                        alf = (ub - uh[i]) / (ua - uh[i])
+                        qw[i] = alf * qw[i] + (1 - alf) * qw[i - 1]
+                    if j >= lbz:
+                        if j - tr <= kind - ph + oldr:
+                            gam = (ub - uh[j - tr]) / den
+                            ebpts[kj] = gam * ebpts[kj] + (1 - gam) * ebpts[kj + 1]
+                        else:
+                            ebpts[kj] = bet * ebpts[kj] + (1 - bet) * ebpts[kj + 1]
+                    i, j, kj = i + 1, j - 1, kj - 1
+                first, last = first - 1, last + 1
+        if a != p:
+            uh[kind: kind + ph - oldr] = ua
+            kind += ph - oldr
+        qw[cind: cind + rbz - lbz + 1] = ebpts[lbz: rbz + 1]
+        cind += rbz - lbz + 1
+        if b < m:
+            bpts[:r] = next_bpts[:r]
+            bpts[r:] = pw[b - p + r: b + 1]
+            a, b, ua = b, b + 1, ub
+    return new_knots, np.moveaxis(qw.reshape((-1,) + moved.shape[1:]), 0, axis)
+
+
+def _elevation_matrix(p: int, t: int) -> np.ndarray:
+    """Bernstein coefficients of degree ``p + t`` from those of degree ``p``: entry ``(i, j)``
+    is ``C(p, j) C(t, i - j) / C(p + t, i)`` (exact binomials, each row sums to one)."""
+    i, j = np.meshgrid(np.arange(p + t + 1), np.arange(p + 1), indexing="ij")
+    num = np.vectorize(lambda a, b: comb(p, b) * comb(t, a - b) if 0 <= a - b <= t else 0, otypes=[float])(i, j)
+    return num / np.array([comb(p + t, k) for k in range(p + t + 1)], dtype=float)[:, None]
 
 
 def elevated(curve: BSplineCurve, degree: int) -> BSplineCurve:
