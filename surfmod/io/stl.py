@@ -7,17 +7,17 @@ import warnings
 import numpy as np
 
 from .. import checks
+from ..atomic import atomic_path, target_path
 from ..errors import RoundTripWarning, SurfmodError
 from ..meshing.closure import STL_RECORD, judge_stl
+from ..meshing.polymesh import Mesh
+from ..meshing.tessellate import tessellate
 
 #: fractions of the tolerance at which a part whose STL does not close is meshed again
 #: (each within the tolerance asked for; about 4x, 16x and 64x the triangles at most).
 #: An eighth: where two faces meet at a knife edge (a zero dihedral angle, a propeller's
 #: tip), both meshes share the triangles along it until the mesh is fine enough to part them
 REMESH = (0.5, 0.25, 0.125)
-from ..meshing.polymesh import Mesh
-from ..meshing.tessellate import tessellate
-from ..atomic import atomic_path, target_path
 
 
 def _mesh_of(obj, tolerance: float, strict: bool, progress: bool) -> Mesh:
