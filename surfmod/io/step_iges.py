@@ -181,12 +181,7 @@ def shape_changes(given, again, rtol: float = 1e-12) -> list[str]:
     if len(loose_a) != len(loose_b):
         changes.append(f"faces in no solid: {len(loose_a)} -> {len(loose_b)}")
     for i, (x, y) in enumerate(zip(loose_a, loose_b) if len(loose_a) == len(loose_b) else (), 1):
-        (sa, ca), (sb, cb) = solid_figures(x), solid_figures(y)
-        size = max(abs(sa), 1e-300)
-        da, dc = abs(sb - sa) / size, float(np.abs(cb - ca).max())
-        if da > rtol or dc > rtol * size ** 0.5:
-            changes.append(f"face {i} in no solid: area {sa:.6g} -> {sb:.6g} (relative change {da:.3g}); "
-                           f"centroid moved {dc:.3g} ({dc / size ** 0.5:.3g} of the area^(1/2))")
+        changes += _moved(f"face {i} in no solid", "area", 2, solid_figures(x), solid_figures(y), rtol)
     for i, (x, y) in enumerate(zip(a, b), 1):
         nx, ny = len(faces_of(x)), len(faces_of(y))
         if nx != ny:
@@ -197,9 +192,16 @@ def shape_changes(given, again, rtol: float = 1e-12) -> list[str]:
             changes.append(f"solid {i}: enclosed volume {va:.6g} -> {vb:.6g} (turned "
                            f"{'inside out' if vb < 0 else 'outward'})")
             continue
-        size = max(abs(va), 1e-300)
-        dv, dc = abs(vb - va) / size, float(np.abs(cb - ca).max())
-        if dv > rtol or dc > rtol * size ** (1 / 3):
-            changes.append(f"solid {i}: volume {va:.6g} -> {vb:.6g} (relative change {dv:.3g}); "
-                           f"centroid moved {dc:.3g} ({dc / size ** (1 / 3):.3g} of the volume^(1/3))")
+        changes += _moved(f"solid {i}", "volume", 3, (va, ca), (vb, cb), rtol)
     return changes
+
+
+def _moved(name: str, measure: str, root: int, before, after, rtol: float) -> list[str]:
+    """``[line]`` if ``(measure, centroid)`` moved beyond ``rtol`` (centroid over the measure's ``root``-th root)."""
+    (ma, ca), (mb, cb) = before, after
+    size = max(abs(ma), 1e-300)
+    dm, dc, scale = abs(mb - ma) / size, float(np.abs(cb - ca).max()), size ** (1 / root)
+    if dm > rtol or dc > rtol * scale:
+        return [f"{name}: {measure} {ma:.6g} -> {mb:.6g} (relative change {dm:.3g}); "
+                f"centroid moved {dc:.3g} ({dc / scale:.3g} of the {measure}^(1/{root}))"]
+    return []
