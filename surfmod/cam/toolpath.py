@@ -318,12 +318,10 @@ def _rival_faces(part: MeshedPart, tool: Tool, xy: np.ndarray, z, contacts, rows
     stand lower by its deviation over the normal's vertical part): each such face's exact
     height, its lifted mesh height where it cannot be polished."""
     tri = part.grid.triangles
-    lo, hi = tri[:, :, :2].min(axis=1) - tool.radius, tri[:, :, :2].max(axis=1) + tool.radius
     for face in np.unique(part.owner):
         mine = part.owner == face
-        near = (np.all(xy[rows, None] >= lo[mine].min(axis=0), axis=2) & np.all(xy[rows, None] <= hi[mine].max(axis=0),
-                                                                                   axis=2))[:, 0]
-        at = rows[near & (chosen != face)]
+        lo, hi = tri[mine, :, :2].min(axis=(0, 1)) - tool.radius, tri[mine, :, :2].max(axis=(0, 1)) + tool.radius
+        at = rows[np.all((xy[rows] >= lo) & (xy[rows] <= hi), axis=1) & (chosen != face)]
         if not at.size:
             continue
         h, touch = drop(TriangleGrid(tri[mine], tool.radius), part.cutter, xy[at], contacts=True)
