@@ -55,16 +55,6 @@ OCCT_REBUILDS = {
 REBUILT_BY_OCCT_79_ONLY = {"axom_boxed_sphere.step"}
 
 
-def _props(solid):
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
-    vp = GProp_GProps()
-    BRepGProp.VolumeProperties_s(solid, vp)
-    c = vp.CentreOfMass()
-    return vp.Mass(), np.array([c.X(), c.Y(), c.Z()])
-
-
 def roundtrip_change(path, tmp_path, *, warns: bool = False) -> float:
     """Largest relative change of a solid's volume or centroid (to volume^(1/3)) through
     ``export_step``; solid and face counts must not change.  ``export_step`` must warn
@@ -86,7 +76,7 @@ def roundtrip_change(path, tmp_path, *, warns: bool = False) -> float:
     worst = 0.0
     for i, (x, y) in enumerate(zip(a, b)):
         assert len(faces_of(x)) == len(faces_of(y)), (path.name, i, "faces")
-        (va, ca), (vb, cb) = _props(x), _props(y)
+        (va, ca), (vb, cb) = solid_figures(x), solid_figures(y)
         assert va > 0 and vb > 0, (path.name, i, "inside out", va, vb)
         worst = max(worst, abs(va - vb) / va, float(np.abs(ca - cb).max()) / va ** (1 / 3))
     for x, y in zip(loose_faces(first.wrapped), loose_faces(again.wrapped), strict=True):
@@ -108,12 +98,12 @@ def test_outward_solids_reverses_inside_out_solids_only():
     moved = bd.Solid.make_box(1, 1, 1).moved(bd.Location((5, 0, 0))).wrapped
     comp = bd.Compound([bd.Solid(box.Reversed()), bd.Solid(moved)]).wrapped
     fixed = outward_solids(comp)
-    vols = sorted(_props(s)[0] for s in solids_of(fixed))
+    vols = sorted(solid_figures(s)[0] for s in solids_of(fixed))
     assert vols == pytest.approx([1.0, 6.0], rel=1e-14)
-    centres = np.array(sorted(tuple(_props(s)[1]) for s in solids_of(fixed)))
+    centres = np.array(sorted(tuple(solid_figures(s)[1]) for s in solids_of(fixed)))
     np.testing.assert_allclose(centres, [(0.5, 1.0, 1.5), (5.5, 0.5, 0.5)], atol=1e-14)  # locations kept
     assert outward_solids(box) is box  # nothing to change: the same shape
-    assert _props(outward_solids(box.Reversed()))[0] == pytest.approx(6.0, rel=1e-14)
+    assert solid_figures(outward_solids(box.Reversed()))[0] == pytest.approx(6.0, rel=1e-14)
 
 
 def test_map_solids_keeps_what_it_does_not_replace():
@@ -123,7 +113,7 @@ def test_map_solids_keeps_what_it_does_not_replace():
     assert map_solids(face, lambda s: s.Reversed()) is face
     comp = bd.Compound([bd.Solid.make_box(1, 1, 1), bd.Face.make_rect(2, 2)]).wrapped
     out = map_solids(comp, lambda s: s.Reversed())
-    assert len(faces_of(out)) == 7 and _props(solids_of(out)[0])[0] == pytest.approx(-1.0)
+    assert len(faces_of(out)) == 7 and solid_figures(solids_of(out)[0])[0] == pytest.approx(-1.0)
 
 
 @pytest.mark.corpus

@@ -22,9 +22,9 @@ SAME_PARAMETER = 1e-10
 
 
 class GordonSurface(BSplineSurface):
-    """A Gordon surface (:doc:`/guide/surfaces` (section "Gordon surfaces")); a B-spline surface that *is* its OCCT
-    twin.  Attributes: ``profiles``, ``guides`` (the input curves, in network order),
-    ``parameters`` (``(U, V)``: the guides' ``u`` and the profiles' ``v``),
+    """A Gordon surface (:doc:`/guide/surfaces` (section "Gordon surfaces")); a B-spline
+    surface that *is* its OCCT twin.  Attributes: ``profiles``, ``guides`` (the input curves,
+    in network order), ``parameters`` (``(U, V)``: the guides' ``u`` and the profiles' ``v``),
     ``tolerance``, ``reparametrized`` (False when the network was used exactly).
 
     >>> import numpy as np, surfmod as sm
